@@ -1,0 +1,82 @@
+// A one-parameter nonlinear system F(u, λ) = 0 as the continuation core sees it.
+//
+// The core knows nothing about what the unknowns mean. A problem is a tiny
+// interface (in the spirit of Ceres' CostFunction / tiny_solver): a residual,
+// its exact Jacobian F_u and parameter derivative F_λ, and optionally
+//   - a symmetric stability operator H with constraint rows C: the state is
+//     stable when H is positive definite on ker C (mechanics: the Hessian of the
+//     total potential, C = rows of the held end coordinates);
+//   - directional second derivatives (used to locate folds and branch points;
+//     the default takes central differences of the analytic Jacobian);
+//   - boundaries g_k(u, λ) > 0 (joint limits, a box): the tracer stops exactly on
+//     g_k = 0.
+// A problem refuses a point outside its domain by returning false, never by
+// throwing; the corrector then treats the step as failed and halves it.
+//
+// Evaluations write into caller-owned storage (Eigen::Ref), so the hot loop of
+// the tracer maps SUNDIALS buffers directly and allocates nothing.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+namespace buckle::continuation {
+
+using Vector = Eigen::VectorXd;
+using Matrix = Eigen::MatrixXd;
+using ConstVectorRef = Eigen::Ref<const Eigen::VectorXd>;
+using VectorRef = Eigen::Ref<Eigen::VectorXd>;
+using ConstMatrixRef = Eigen::Ref<const Eigen::MatrixXd>;
+using MatrixRef = Eigen::Ref<Eigen::MatrixXd>;
+
+/// Inertia and lowest spectrum of the stability operator on ker C.
+struct StabilityInfo {
+  int negative = -1;          ///< number of negative eigenvalues (-1: not computed)
+  int zero = 0;               ///< eigenvalues with |μ| <= tolerance·‖H‖ (reported, not counted as negative)
+  double smallest = 0.0;      ///< smallest eigenvalue
+  Vector lowest;              ///< the few lowest eigenvalues, ascending
+  bool valid() const { return negative >= 0; }
+  bool stable() const { return negative == 0 && zero == 0; }
+};
+
+class Problem {
+ public:
+  virtual ~Problem() = default;
+
+  /// Number of unknowns N.
+  virtual int dimension() const = 0;
+
+  /// F(u, λ) → F (size N). False: (u, λ) is outside the domain.
+  virtual bool residual(ConstVectorRef u, double lambda, VectorRef F) = 0;
+
+  /// Exact F_u (N×N, Fu may be a block of a larger matrix) and F_λ (size N).
+  virtual bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) = 0;
+
+  /// d/dε [F_u, F_λ](u + ε·du, λ + ε·dlambda) at ε = 0. Default: central
+  /// differences of jacobian(); override with the exact second derivative.
+  virtual bool jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
+                                             double dlambda, MatrixRef dFu, VectorRef dFlambda);
+
+  // ---- optional: mechanical stability ---------------------------------------------------
+  virtual bool hasStabilityOperator() const { return false; }
+  /// Symmetric H (n_s×n_s) and constraint rows C (m×n_s, m may be 0); resized by the problem.
+  virtual bool stabilityOperator(ConstVectorRef u, double lambda, Matrix& H, Matrix& C);
+  /// Inertia of H on ker C. Default: dense eigen-decomposition of Zᵀ H Z (Z a basis of
+  /// ker C). Problems with structure override this (e.g. an O(n) Sturm count).
+  virtual bool stability(ConstVectorRef u, double lambda, StabilityInfo& info);
+
+  // ---- optional: domain boundaries ------------------------------------------------------
+  virtual int boundaryCount() const { return 0; }
+  /// g_k(u, λ): positive inside the admissible set, zero on its boundary.
+  virtual double boundary(int /*k*/, ConstVectorRef /*u*/, double /*lambda*/) { return 1.0; }
+  virtual std::string boundaryName(int k) const { return "boundary " + std::to_string(k); }
+
+ private:
+  Matrix stabilityH_, stabilityC_;  // workspace of the default stability()
+};
+
+/// Inertia of the symmetric H restricted to ker C (C may have zero rows), by a dense
+/// eigen-decomposition. `zeroTolerance` is relative to max(1, ‖H‖).
+StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance = 1e-13);
+
+}  // namespace buckle::continuation

@@ -1,0 +1,77 @@
+#include "buckle/continuation/problem.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+
+namespace buckle::continuation {
+
+bool Problem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
+                                            double dlambda, MatrixRef dFu, VectorRef dFlambda) {
+  const int n = dimension();
+  // Step scaled to the point so that the O(h²) truncation and O(ε/h) rounding errors balance
+  // (h ~ ε^{1/3}); Newton on the augmented systems only needs an approximate Jacobian, the
+  // located point's accuracy is set by the exact residuals.
+  const double scale = std::max({1.0, u.norm(), std::abs(lambda)});
+  const double dirNorm = std::sqrt(du.squaredNorm() + dlambda * dlambda);
+  if (dirNorm == 0.0) {
+    dFu.setZero();
+    dFlambda.setZero();
+    return true;
+  }
+  const double h = 6e-6 * scale / dirNorm;
+  Vector up = u + h * du, um = u - h * du;
+  Matrix Jp(n, n), Jm(n, n);
+  Vector lp(n), lm(n);
+  if (!jacobian(up, lambda + h * dlambda, Jp, lp)) return false;
+  if (!jacobian(um, lambda - h * dlambda, Jm, lm)) return false;
+  dFu = (Jp - Jm) / (2.0 * h);
+  dFlambda = (lp - lm) / (2.0 * h);
+  return true;
+}
+
+bool Problem::stabilityOperator(ConstVectorRef, double, Matrix&, Matrix&) { return false; }
+
+bool Problem::stability(ConstVectorRef u, double lambda, StabilityInfo& info) {
+  if (!hasStabilityOperator()) return false;
+  if (!stabilityOperator(u, lambda, stabilityH_, stabilityC_)) return false;
+  info = projectedInertia(stabilityH_, stabilityC_);
+  return true;
+}
+
+StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance) {
+  StabilityInfo info;
+  Matrix reduced;
+  if (C.rows() == 0) {
+    reduced = H;
+  } else {
+    // Z = last (n − rank C) columns of Q in Cᵀ = Q R: an orthonormal basis of ker C.
+    Eigen::ColPivHouseholderQR<Matrix> qr(C.transpose());
+    const Eigen::Index rank = qr.rank();
+    const Eigen::Index n = H.rows();
+    Matrix Q = qr.householderQ() * Matrix::Identity(n, n);
+    Matrix Z = Q.rightCols(n - rank);
+    reduced = Z.transpose() * H * Z;
+  }
+  if (reduced.rows() == 0) {
+    info.negative = 0;
+    info.smallest = 0.0;
+    info.lowest.resize(0);
+    return info;
+  }
+  Eigen::SelfAdjointEigenSolver<Matrix> es(0.5 * (reduced + reduced.transpose()), Eigen::EigenvaluesOnly);
+  const Vector& mu = es.eigenvalues();
+  const double tol = zeroTolerance * std::max(1.0, mu.cwiseAbs().maxCoeff());
+  info.negative = 0;
+  info.zero = 0;
+  for (Eigen::Index i = 0; i < mu.size(); ++i) {
+    if (std::abs(mu[i]) <= tol) ++info.zero;
+    else if (mu[i] < 0.0) ++info.negative;
+  }
+  info.smallest = mu[0];
+  info.lowest = mu.head(std::min<Eigen::Index>(3, mu.size()));
+  return info;
+}
+
+}  // namespace buckle::continuation
