@@ -1,0 +1,75 @@
+// The chain's equilibrium as a continuation problem (the mechanics layer on the generic core).
+//
+// Unknowns u = (q_1 … q_n, r_1 … r_m): joint angles and the reactions (Lagrange multipliers)
+// of the m held end coordinates, in (x, y, φ) order. Parameter λ moves the prescribed loads
+// and coordinates along a straight line: value(λ) = end.value + λ·direction.
+// Equations (eq 9 / 13 with multipliers):
+//   ∂E/∂q − Jᵀ F(u, λ) = 0,           F = given loads on loaded coordinates, r on held ones
+//   −(p_c(q) − value_c(λ)) = 0         for every held coordinate c
+// so that F_u = [[K_q − K_g(F), −J_hᵀ], [−J_h, 0]] is symmetric (a KKT matrix).
+// Stability operator: K_q − K_g(F) on ker J_h.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "buckle/continuation/problem.h"
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/end_condition.h"
+
+namespace buckle::mechanics {
+
+struct EquilibriumOptions {
+  /// Report the joint limits as boundaries g = q_max − q, q − q_min (the tracer stops on them).
+  bool jointLimitsAsBoundaries = true;
+};
+
+class EquilibriumProblem final : public continuation::Problem {
+ public:
+  EquilibriumProblem(const Chain& chain, const EndCondition& end, const Eigen::Vector3d& direction,
+                     EquilibriumOptions options = {});
+
+  const Chain& chain() const { return chain_; }
+  const EndCondition& endCondition() const { return end_; }
+  const Eigen::Vector3d& direction() const { return direction_; }
+  int segments() const { return chain_.size(); }
+  int heldCount() const { return static_cast<int>(held_.size()); }
+
+  /// Prescribed values (loads or coordinates) at λ.
+  Eigen::Vector3d prescribed(double lambda) const { return end_.value + lambda * direction_; }
+  /// Total end wrench at (u, λ): given loads and the multipliers.
+  Wrench wrench(continuation::ConstVectorRef u, double lambda) const;
+  /// Unknown vector for given joint angles, with the multipliers that best satisfy the
+  /// equilibrium in the least-squares sense (a starting guess).
+  Vector initialGuess(continuation::ConstVectorRef q, double lambda) const;
+
+  int dimension() const override { return chain_.size() + heldCount(); }
+  bool residual(continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) override;
+  bool jacobian(continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
+                continuation::VectorRef Flambda) override;
+  bool jacobianDirectionalDerivative(continuation::ConstVectorRef u, double lambda,
+                                     continuation::ConstVectorRef du, double dlambda,
+                                     continuation::MatrixRef dFu, continuation::VectorRef dFlambda) override;
+
+  bool hasStabilityOperator() const override { return true; }
+  bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
+
+  int boundaryCount() const override;
+  double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
+  std::string boundaryName(int k) const override;
+
+ private:
+  bool inDomain(continuation::ConstVectorRef u) const;
+  void evaluateKinematics(continuation::ConstVectorRef u);
+
+  Chain chain_;
+  EndCondition end_;
+  Eigen::Vector3d direction_;
+  EquilibriumOptions options_;
+  std::vector<int> held_, loaded_;
+  ChainData data_;
+  Matrix J_;             // 3×n
+  Vector work_, work2_;  // size n
+};
+
+}  // namespace buckle::mechanics

@@ -1,0 +1,65 @@
+// One dual-triangle segment: two rigid triangles on a passive joint, two preloaded springs.
+// Conventions: conventions.h.
+#pragma once
+
+#include <limits>
+
+namespace buckle::mechanics {
+
+struct SegmentParameters {
+  double a1 = 0.5, b1 = 1.0;   ///< proximal triangle: half-height a, half-length b
+  double a2 = 0.5, b2 = 1.0;   ///< distal triangle
+  double k1 = 1.0, k2 = 1.0;   ///< spring stiffnesses (spring 1 closes for q > 0)
+  double L1_0 = 2.25, L2_0 = 2.25;  ///< spring free lengths (the control inputs)
+  /// Optional user joint limits, intersected with the geometric ones.
+  double qMinUser = -std::numeric_limits<double>::infinity();
+  double qMaxUser = std::numeric_limits<double>::infinity();
+
+  /// Identical triangles (a, b), equal springs k and equal free lengths L0.
+  static SegmentParameters symmetric(double a, double b, double k, double L0);
+};
+
+/// Value and first three q-derivatives of a quantity of the joint angle.
+struct Jet3 {
+  double value = 0, d1 = 0, d2 = 0, d3 = 0;
+};
+
+class Segment {
+ public:
+  /// Validates the parameters; throws std::invalid_argument naming the bad one.
+  explicit Segment(const SegmentParameters& p);
+
+  const SegmentParameters& parameters() const { return p_; }
+
+  /// Spring lengths and their q-derivatives (eq 1).
+  Jet3 spring1(double q) const;
+  Jet3 spring2(double q) const;
+
+  double energy(double q) const;             ///< E(q) = ½ Σ k (L − L⁰)²
+  double torque(double q) const;             ///< M = −dE/dq
+  double torqueDerivative(double q) const;   ///< dM/dq = −K_q
+  double torqueSecondDerivative(double q) const;  ///< d²M/dq²
+  double stiffness(double q) const;          ///< K_q = d²E/dq²
+  /// E and its first three derivatives in one pass (hot loop).
+  Jet3 energyJet(double q) const;
+
+  /// Straight-state joint stiffness K_q(0) (κ in the symmetric case).
+  double straightStiffness() const { return stiffness(0.0); }
+
+  /// Geometric limits: spring 1 (closing for q > 0) reaches zero length — the triangles' spring
+  /// attachment points meet — at β12 + q = π, so q_max = π − β12; symmetrically q_min = β12 − π.
+  double geometricUpperLimit() const;
+  double geometricLowerLimit() const;
+  /// Geometric limits intersected with the user's.
+  double upperLimit() const;
+  double lowerLimit() const;
+
+  double beta12() const { return beta12_; }
+
+ private:
+  Jet3 spring(double q, double sign) const;
+  SegmentParameters p_;
+  double c1_, c2_, beta12_, c1c2_, csq_;
+};
+
+}  // namespace buckle::mechanics

@@ -1,0 +1,127 @@
+#include "buckle/mechanics/chain.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace buckle::mechanics {
+
+Chain::Chain(const std::vector<SegmentParameters>& segments) {
+  if (segments.empty()) throw std::invalid_argument("n (segment count) must be >= 1 (got 0)");
+  segments_.reserve(segments.size());
+  for (size_t i = 0; i < segments.size(); ++i) {
+    try {
+      segments_.emplace_back(segments[i]);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("segment " + std::to_string(i + 1) + ": " + e.what());
+    }
+  }
+  const int n = size();
+  links_.resize(n + 1);
+  qMin_.resize(n);
+  qMax_.resize(n);
+  // Each segment's distal triangle is rigidly joined to the next one's proximal triangle.
+  links_[0] = segments[0].b1;
+  for (int i = 0; i + 1 < n; ++i) links_[i + 1] = segments[size_t(i)].b2 + segments[size_t(i) + 1].b1;
+  links_[n] = segments[size_t(n) - 1].b2;
+  for (int i = 0; i < n; ++i) {
+    qMin_[i] = segments_[size_t(i)].lowerLimit();
+    qMax_[i] = segments_[size_t(i)].upperLimit();
+  }
+}
+
+Chain Chain::uniform(int n, const SegmentParameters& p) {
+  if (n < 1) throw std::invalid_argument("n (segment count) must be >= 1 (got " + std::to_string(n) + ")");
+  return Chain(std::vector<SegmentParameters>(size_t(n), p));
+}
+
+ChainData::ChainData(const Chain& chain)
+    : theta(Vector::Zero(chain.size())), S(Vector::Zero(chain.size())), C(Vector::Zero(chain.size())) {}
+
+void forwardKinematics(const Chain& chain, ConstVectorRef q, ChainData& data) {
+  const int n = chain.size();
+  const Vector& l = chain.linkLengths();
+  double t = 0.0;
+  for (int m = 0; m < n; ++m) {
+    t += q[m];
+    data.theta[m] = t;
+  }
+  double s = 0.0, c = 0.0;
+  for (int m = n - 1; m >= 0; --m) {
+    s += l[m + 1] * std::sin(data.theta[m]);
+    c += l[m + 1] * std::cos(data.theta[m]);
+    data.S[m] = s;
+    data.C[m] = c;
+  }
+  data.pose = Pose(l[0] + c, s, data.theta[n - 1]);
+}
+
+Pose endPose(const Chain& chain, ConstVectorRef q) {
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  return data.pose;
+}
+
+void endJacobian(const ChainData& data, MatrixRef J) {
+  J.row(0) = -data.S.transpose();
+  J.row(1) = data.C.transpose();
+  J.row(2).setOnes();
+}
+
+void loadHessianGenerator(const ChainData& data, const Wrench& F, VectorRef h) {
+  // ∂²x/∂q_i∂q_j = −C_max(i,j), ∂²y/∂q_i∂q_j = −S_max(i,j)  (eq 27)
+  h = -F[0] * data.C - F[1] * data.S;
+}
+
+void loadMatrix(const ChainData& data, const Wrench& F, MatrixRef Kg) {
+  const Eigen::Index n = data.S.size();
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index m = std::max(i, j);
+      Kg(i, j) = -F[0] * data.C[m] - F[1] * data.S[m];
+    }
+}
+
+double energy(const Chain& chain, ConstVectorRef q) {
+  double e = 0.0;
+  for (int i = 0; i < chain.size(); ++i) e += chain.segment(i).energy(q[i]);
+  return e;
+}
+
+void energyGradient(const Chain& chain, ConstVectorRef q, VectorRef g) {
+  for (int i = 0; i < chain.size(); ++i) g[i] = chain.segment(i).energyJet(q[i]).d1;
+}
+
+void jointTorques(const Chain& chain, ConstVectorRef q, VectorRef M) {
+  for (int i = 0; i < chain.size(); ++i) M[i] = chain.segment(i).torque(q[i]);
+}
+
+void jointStiffness(const Chain& chain, ConstVectorRef q, VectorRef kq) {
+  for (int i = 0; i < chain.size(); ++i) kq[i] = chain.segment(i).energyJet(q[i]).d2;
+}
+
+void jointStiffnessDerivative(const Chain& chain, ConstVectorRef q, VectorRef dkq) {
+  for (int i = 0; i < chain.size(); ++i) dkq[i] = chain.segment(i).energyJet(q[i]).d3;
+}
+
+double totalPotential(const Chain& chain, ConstVectorRef q, const Wrench& F) {
+  return energy(chain, q) - F.dot(endPose(chain, q));
+}
+
+void totalPotentialGradient(const Chain& chain, ConstVectorRef q, const Wrench& F, VectorRef grad) {
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  energyGradient(chain, q, grad);
+  // Jᵀ F with J rows (−S, C, 1)
+  grad.array() -= -F[0] * data.S.array() + F[1] * data.C.array() + F[2];
+}
+
+void totalPotentialHessian(const Chain& chain, ConstVectorRef q, const Wrench& F, MatrixRef H) {
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  loadMatrix(data, F, H);
+  H = -H;
+  for (int i = 0; i < chain.size(); ++i) H(i, i) += chain.segment(i).energyJet(q[i]).d2;
+}
+
+}  // namespace buckle::mechanics

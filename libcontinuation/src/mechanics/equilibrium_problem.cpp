@@ -1,0 +1,188 @@
+#include "buckle/mechanics/equilibrium_problem.h"
+
+#include <Eigen/QR>
+#include <cmath>
+#include <stdexcept>
+
+#include "buckle/mechanics/validation.h"
+
+namespace buckle::mechanics {
+
+using continuation::ConstVectorRef;
+using continuation::MatrixRef;
+using continuation::VectorRef;
+
+EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
+                                       const Eigen::Vector3d& direction, EquilibriumOptions options)
+    : chain_(chain),
+      end_(end),
+      direction_(direction),
+      options_(options),
+      held_(end.heldIndices()),
+      loaded_(end.loadedIndices()),
+      data_(chain),
+      J_(3, chain.size()),
+      work_(chain.size()),
+      work2_(chain.size()) {
+  static const char* names[3] = {"x", "y", "phi"};
+  for (int c = 0; c < 3; ++c) {
+    requireFinite(std::string("end value ") + names[c], end.value[c]);
+    requireFinite(std::string("load path direction ") + names[c], direction[c]);
+  }
+}
+
+void EquilibriumProblem::evaluateKinematics(ConstVectorRef u) {
+  forwardKinematics(chain_, u.head(chain_.size()), data_);
+  endJacobian(data_, J_);
+}
+
+Wrench EquilibriumProblem::wrench(ConstVectorRef u, double lambda) const {
+  Wrench F = prescribed(lambda);
+  const int n = chain_.size();
+  for (size_t k = 0; k < held_.size(); ++k) F[held_[k]] = u[n + int(k)];
+  return F;
+}
+
+Vector EquilibriumProblem::initialGuess(ConstVectorRef q, double lambda) const {
+  const int n = chain_.size();
+  const int m = heldCount();
+  Vector u(n + m);
+  u.head(n) = q;
+  if (m == 0) return u;
+  ChainData data(chain_);
+  forwardKinematics(chain_, q, data);
+  Matrix J(3, n);
+  endJacobian(data, J);
+  // ∂E/∂q − J_lᵀ F_l = J_hᵀ r in the least-squares sense
+  Vector rhs(n);
+  energyGradient(chain_, q, rhs);
+  const Eigen::Vector3d value = prescribed(lambda);
+  for (int c : loaded_) rhs -= J.row(c).transpose() * value[c];
+  Matrix Jh(n, m);
+  for (int k = 0; k < m; ++k) Jh.col(k) = J.row(held_[size_t(k)]).transpose();
+  u.tail(m) = Jh.colPivHouseholderQr().solve(rhs);
+  return u;
+}
+
+bool EquilibriumProblem::inDomain(ConstVectorRef u) const {
+  // Beyond the geometric limit a spring would pass through zero length: the smooth model no
+  // longer describes the mechanism, so such points are refused (not extrapolated).
+  const int n = chain_.size();
+  for (int i = 0; i < n; ++i) {
+    const Segment& s = chain_.segment(i);
+    if (!std::isfinite(u[i]) || u[i] >= s.geometricUpperLimit() || u[i] <= s.geometricLowerLimit()) return false;
+  }
+  for (int k = n; k < u.size(); ++k)
+    if (!std::isfinite(u[k])) return false;
+  return true;
+}
+
+bool EquilibriumProblem::residual(ConstVectorRef u, double lambda, VectorRef F) {
+  if (!inDomain(u) || !std::isfinite(lambda)) return false;
+  const int n = chain_.size();
+  evaluateKinematics(u);
+  const Wrench W = wrench(u, lambda);
+  auto top = F.head(n);
+  energyGradient(chain_, u.head(n), top);
+  top.noalias() -= J_.transpose() * W;
+  const Eigen::Vector3d value = prescribed(lambda);
+  for (size_t k = 0; k < held_.size(); ++k) F[n + int(k)] = value[held_[k]] - data_.pose[held_[k]];
+  return true;
+}
+
+bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) {
+  if (!inDomain(u) || !std::isfinite(lambda)) return false;
+  const int n = chain_.size();
+  evaluateKinematics(u);
+  const Wrench W = wrench(u, lambda);
+  loadHessianGenerator(data_, W, work_);
+  jointStiffness(chain_, u.head(n), work2_);
+  // K_q − K_g with K_g(i, j) = h_max(i,j)  (eq 27)
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) Fu(i, j) = -work_[std::max(i, j)];
+  for (int i = 0; i < n; ++i) Fu(i, i) += work2_[i];
+  const int m = heldCount();
+  for (int k = 0; k < m; ++k) {
+    Fu.block(0, n + k, n, 1) = -J_.row(held_[size_t(k)]).transpose();
+    Fu.block(n + k, 0, 1, n) = -J_.row(held_[size_t(k)]);
+  }
+  if (m > 0) Fu.bottomRightCorner(m, m).setZero();
+  Flambda.head(n).setZero();
+  for (int c : loaded_) Flambda.head(n) -= J_.row(c).transpose() * direction_[c];
+  for (int k = 0; k < m; ++k) Flambda[n + k] = direction_[held_[size_t(k)]];
+  return true;
+}
+
+bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
+                                                       double dlambda, MatrixRef dFu, VectorRef dFlambda) {
+  if (!inDomain(u) || !std::isfinite(lambda)) return false;
+  const int n = chain_.size();
+  const int m = heldCount();
+  evaluateKinematics(u);
+  const Wrench W = wrench(u, lambda);
+  Wrench dW = dlambda * direction_;
+  for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = du[n + k];
+  // Tail-sum derivatives: dS_m = Σ_{p≥m} ℓ cos θ_p dθ_p, dC_m = −Σ_{p≥m} ℓ sin θ_p dθ_p.
+  const Vector& l = chain_.linkLengths();
+  Vector dS(n), dC(n);
+  double dtheta = 0.0;
+  Vector dth(n);
+  for (int p = 0; p < n; ++p) {
+    dtheta += du[p];
+    dth[p] = dtheta;
+  }
+  double s = 0.0, c = 0.0;
+  for (int p = n - 1; p >= 0; --p) {
+    s += l[p + 1] * std::cos(data_.theta[p]) * dth[p];
+    c -= l[p + 1] * std::sin(data_.theta[p]) * dth[p];
+    dS[p] = s;
+    dC[p] = c;
+  }
+  // dh_m for h_m = −Fx C_m − Fy S_m
+  Vector dh = -dW[0] * data_.C - W[0] * dC - dW[1] * data_.S - W[1] * dS;
+  jointStiffnessDerivative(chain_, u.head(n), work2_);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) dFu(i, j) = -dh[std::max(i, j)];
+  for (int i = 0; i < n; ++i) dFu(i, i) += work2_[i] * du[i];
+  // dJ rows: (−dS, dC, 0)
+  Matrix dJ(3, n);
+  dJ.row(0) = -dS.transpose();
+  dJ.row(1) = dC.transpose();
+  dJ.row(2).setZero();
+  for (int k = 0; k < m; ++k) {
+    dFu.block(0, n + k, n, 1) = -dJ.row(held_[size_t(k)]).transpose();
+    dFu.block(n + k, 0, 1, n) = -dJ.row(held_[size_t(k)]);
+  }
+  if (m > 0) dFu.bottomRightCorner(m, m).setZero();
+  dFlambda.setZero();
+  for (int cc : loaded_) dFlambda.head(n) -= dJ.row(cc).transpose() * direction_[cc];
+  return true;
+}
+
+bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix& H, Matrix& C) {
+  if (!inDomain(u)) return false;
+  const int n = chain_.size();
+  H.resize(n, n);
+  C.resize(heldCount(), n);
+  totalPotentialHessian(chain_, u.head(n), wrench(u, lambda), H);
+  forwardKinematics(chain_, u.head(n), data_);
+  endJacobian(data_, J_);
+  for (int k = 0; k < heldCount(); ++k) C.row(k) = J_.row(held_[size_t(k)]);
+  return true;
+}
+
+int EquilibriumProblem::boundaryCount() const { return options_.jointLimitsAsBoundaries ? 2 * chain_.size() : 0; }
+
+double EquilibriumProblem::boundary(int k, ConstVectorRef u, double) {
+  const int n = chain_.size();
+  if (k < n) return chain_.upperLimits()[k] - u[k];
+  return u[k - n] - chain_.lowerLimits()[k - n];
+}
+
+std::string EquilibriumProblem::boundaryName(int k) const {
+  const int n = chain_.size();
+  if (k < n) return "joint " + std::to_string(k + 1) + " upper limit";
+  return "joint " + std::to_string(k - n + 1) + " lower limit";
+}
+
+}  // namespace buckle::mechanics

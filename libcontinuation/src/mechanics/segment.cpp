@@ -1,0 +1,90 @@
+#include "buckle/mechanics/segment.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "buckle/mechanics/validation.h"
+
+namespace buckle::mechanics {
+
+SegmentParameters SegmentParameters::symmetric(double a, double b, double k, double L0) {
+  SegmentParameters p;
+  p.a1 = p.a2 = a;
+  p.b1 = p.b2 = b;
+  p.k1 = p.k2 = k;
+  p.L1_0 = p.L2_0 = L0;
+  return p;
+}
+
+Segment::Segment(const SegmentParameters& p) : p_(p) {
+  requireNonNegative("a1", p.a1);
+  requireNonNegative("a2", p.a2);
+  requirePositive("b1", p.b1);
+  requirePositive("b2", p.b2);
+  requirePositive("k1", p.k1);
+  requirePositive("k2", p.k2);
+  // A free length <= 0 is a spring that would have to pass through zero length: no preload
+  // can produce it on the real mechanism.
+  requirePositive("L1_0", p.L1_0);
+  requirePositive("L2_0", p.L2_0);
+  if (std::isnan(p.qMinUser)) throw std::invalid_argument("qMinUser must not be NaN");
+  if (std::isnan(p.qMaxUser)) throw std::invalid_argument("qMaxUser must not be NaN");
+  c1_ = std::hypot(p.a1, p.b1);
+  c2_ = std::hypot(p.a2, p.b2);
+  c1c2_ = c1_ * c2_;
+  csq_ = c1_ * c1_ + c2_ * c2_;
+  beta12_ = std::atan(p.a1 / p.b1) + std::atan(p.a2 / p.b2);
+  if (!(lowerLimit() < upperLimit())) {
+    std::ostringstream os;
+    os << "joint limits are empty: qMinUser=" << p.qMinUser << ", qMaxUser=" << p.qMaxUser
+       << ", geometric range (" << geometricLowerLimit() << ", " << geometricUpperLimit() << ")";
+    throw std::invalid_argument(os.str());
+  }
+}
+
+// θ = β12 + s·q (s = +1: spring 1, s = −1: spring 2), L² = c1² + c2² + 2c1c2 cos θ (eq 1).
+// Differentiating L² and eliminating sin θ through L L' = −s c1c2 sin θ:
+//   L'' = −c1c2 cos θ / L − L'²/L,   L''' = −L' − 3 L' L''/L.
+Jet3 Segment::spring(double q, double s) const {
+  const double theta = beta12_ + s * q;
+  const double ct = std::cos(theta), st = std::sin(theta);
+  Jet3 L;
+  L.value = std::sqrt(std::max(0.0, csq_ + 2.0 * c1c2_ * ct));
+  L.d1 = -s * c1c2_ * st / L.value;
+  L.d2 = -c1c2_ * ct / L.value - L.d1 * L.d1 / L.value;
+  L.d3 = -L.d1 - 3.0 * L.d1 * L.d2 / L.value;
+  return L;
+}
+
+Jet3 Segment::spring1(double q) const { return spring(q, +1.0); }
+Jet3 Segment::spring2(double q) const { return spring(q, -1.0); }
+
+Jet3 Segment::energyJet(double q) const {
+  Jet3 E;
+  const Jet3 Ls[2] = {spring1(q), spring2(q)};
+  const double k[2] = {p_.k1, p_.k2};
+  const double L0[2] = {p_.L1_0, p_.L2_0};
+  for (int i = 0; i < 2; ++i) {
+    const Jet3& L = Ls[i];
+    const double stretch = L.value - L0[i];
+    E.value += 0.5 * k[i] * stretch * stretch;
+    E.d1 += k[i] * stretch * L.d1;
+    E.d2 += k[i] * (L.d1 * L.d1 + stretch * L.d2);
+    E.d3 += k[i] * (3.0 * L.d1 * L.d2 + stretch * L.d3);
+  }
+  return E;
+}
+
+double Segment::energy(double q) const { return energyJet(q).value; }
+double Segment::torque(double q) const { return -energyJet(q).d1; }
+double Segment::torqueDerivative(double q) const { return -energyJet(q).d2; }
+double Segment::torqueSecondDerivative(double q) const { return -energyJet(q).d3; }
+double Segment::stiffness(double q) const { return energyJet(q).d2; }
+
+double Segment::geometricUpperLimit() const { return M_PI - beta12_; }
+double Segment::geometricLowerLimit() const { return beta12_ - M_PI; }
+double Segment::upperLimit() const { return std::min(geometricUpperLimit(), p_.qMaxUser); }
+double Segment::lowerLimit() const { return std::max(geometricLowerLimit(), p_.qMinUser); }
+
+}  // namespace buckle::mechanics

@@ -1,0 +1,140 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+#include "buckle/mechanics/segment.h"
+
+using namespace buckle::mechanics;
+
+namespace {
+
+SegmentParameters randomAsymmetric(std::mt19937& rng) {
+  std::uniform_real_distribution<double> A(0.1, 0.9), B(0.8, 1.4), K(0.5, 3.0), L(1.5, 2.8);
+  SegmentParameters p;
+  p.a1 = A(rng); p.a2 = A(rng);
+  p.b1 = B(rng); p.b2 = B(rng);
+  p.k1 = K(rng); p.k2 = K(rng);
+  p.L1_0 = L(rng); p.L2_0 = L(rng);
+  return p;
+}
+
+double central(const std::function<double(double)>& f, double x, double h = 1e-5) {
+  return (f(x + h) - f(x - h)) / (2 * h);
+}
+
+}  // namespace
+
+TEST_CASE("segment torque derivatives match finite differences", "[segment]") {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 20; ++trial) {
+    Segment s(randomAsymmetric(rng));
+    std::uniform_real_distribution<double> Q(0.8 * s.geometricLowerLimit(), 0.8 * s.geometricUpperLimit());
+    const double q = Q(rng);
+    CHECK(s.torque(q) == Approx(-central([&](double x) { return s.energy(x); }, q)).margin(1e-8));
+    CHECK(s.torqueDerivative(q) == Approx(central([&](double x) { return s.torque(x); }, q)).margin(1e-7));
+    CHECK(s.torqueSecondDerivative(q) ==
+          Approx(central([&](double x) { return s.torqueDerivative(x); }, q)).margin(1e-7));
+    CHECK(s.stiffness(q) == Approx(-s.torqueDerivative(q)).margin(1e-14));
+  }
+}
+
+TEST_CASE("general torque (eq 1) equals the symmetric closed forms (eq 3, 10, 19)", "[segment]") {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> A(0.1, 1.2), B(0.8, 1.4), K(0.5, 3.0), L(1.0, 3.0), Q(-1.0, 1.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const double a = A(rng), b = B(rng), k = K(rng), L0 = L(rng), q = Q(rng);
+    const Segment s(SegmentParameters::symmetric(a, b, k, L0));
+    // eq 1 literally: M = k1(1 − L1⁰/L1) c² sin θ1 − k2(1 − L2⁰/L2) c² sin θ2
+    const double c = std::hypot(a, b), beta = 2 * std::atan(a / b);
+    const double L1 = std::sqrt(2 * c * c + 2 * c * c * std::cos(beta + q));
+    const double L2 = std::sqrt(2 * c * c + 2 * c * c * std::cos(beta - q));
+    const double eq1 = k * (1 - L0 / L1) * c * c * std::sin(beta + q) - k * (1 - L0 / L2) * c * c * std::sin(beta - q);
+    // eq 3
+    const double eq3 = 2 * c * k * (c * std::cos(beta) * std::sin(q) - L0 * std::cos(beta / 2) * std::sin(q / 2));
+    const double eq3d = c * k * (2 * c * std::cos(beta) * std::cos(q) - L0 * std::cos(beta / 2) * std::cos(q / 2));
+    // eq 10
+    const double eq10 = 2 * k * ((b * b - a * a) * std::sin(q) - b * L0 * std::sin(q / 2));
+    CHECK(s.torque(q) == Approx(eq1).margin(1e-12));
+    CHECK(s.torque(q) == Approx(eq3).margin(1e-12));
+    CHECK(s.torque(q) == Approx(eq10).margin(1e-12));
+    CHECK(s.torqueDerivative(q) == Approx(eq3d).margin(1e-12));
+    // spring lengths, ERRATA: 2(b cos(q/2) ∓ a sin(q/2))
+    CHECK(s.spring1(q).value == Approx(2 * (b * std::cos(q / 2) - a * std::sin(q / 2))).margin(1e-13));
+    CHECK(s.spring2(q).value == Approx(2 * (b * std::cos(q / 2) + a * std::sin(q / 2))).margin(1e-13));
+  }
+  // eq 19: unequal preloads, symmetric geometry
+  for (int trial = 0; trial < 50; ++trial) {
+    SegmentParameters p = SegmentParameters::symmetric(A(rng), B(rng), K(rng), 2.0);
+    p.L1_0 = L(rng);
+    p.L2_0 = L(rng);
+    const Segment s(p);
+    const double a = p.a1, b = p.b1, k = p.k1, q = Q(rng);
+    const double eq19 = 2 * k * (b * b - a * a) * std::sin(q) - k * p.L1_0 * (a * std::cos(q / 2) + b * std::sin(q / 2)) +
+                        k * p.L2_0 * (a * std::cos(q / 2) - b * std::sin(q / 2));
+    CHECK(s.torque(q) == Approx(eq19).margin(1e-12));
+  }
+}
+
+TEST_CASE("stability condition (eq 4) is the sign of K_q at q = 0", "[segment]") {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> A(0.05, 1.3), B(0.5, 2.0), L(0.3, 4.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const double a = A(rng), b = B(rng), L0 = L(rng);
+    const Segment s(SegmentParameters::symmetric(a, b, 1.0, L0));
+    const bool eq4 = L0 > 2 * b * (1 - (a / b) * (a / b));
+    const double kappa = b * L0 - 2 * (b * b - a * a);
+    CHECK(s.straightStiffness() == Approx(kappa).margin(1e-12));
+    if (std::abs(kappa) > 1e-9) CHECK((s.straightStiffness() > 0) == eq4);
+  }
+}
+
+TEST_CASE("geometric joint limit: closing spring reaches zero length at pi - beta12", "[segment]") {
+  const Segment s(SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const double qmax = s.geometricUpperLimit();
+  CHECK(qmax == Approx(2 * std::atan(1.0 / 0.5)).epsilon(1e-14));
+  CHECK(s.spring1(qmax).value == Approx(0.0).margin(1e-7));
+  CHECK(s.spring2(-qmax).value == Approx(0.0).margin(1e-7));
+  CHECK(s.spring1(0.99 * qmax).value > 0.0);
+  SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
+  p.qMaxUser = 1.0;
+  CHECK(Segment(p).upperLimit() == 1.0);
+  CHECK(Segment(p).lowerLimit() == Approx(-qmax));
+}
+
+TEST_CASE("bad segment parameters are rejected naming the parameter", "[segment]") {
+  auto message = [](SegmentParameters p) {
+    try {
+      Segment s(p);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  SegmentParameters p;
+  p.b1 = 0;
+  CHECK_THAT(message(p), Catch::Contains("b1"));
+  p = {};
+  p.k2 = -1;
+  CHECK_THAT(message(p), Catch::Contains("k2"));
+  p = {};
+  p.a1 = -0.1;
+  CHECK_THAT(message(p), Catch::Contains("a1"));
+  p = {};
+  p.L1_0 = -2;
+  CHECK_THAT(message(p), Catch::Contains("L1_0"));
+  p = {};
+  p.a2 = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THAT(message(p), Catch::Contains("a2"));
+  p = {};
+  p.k1 = std::numeric_limits<double>::infinity();
+  CHECK_THAT(message(p), Catch::Contains("k1"));
+  p = {};
+  p.qMinUser = 1.0;
+  p.qMaxUser = 0.5;
+  CHECK_THAT(message(p), Catch::Contains("joint limits"));
+  CHECK(message(SegmentParameters{}) == "accepted");
+}
