@@ -1,0 +1,722 @@
+#include "scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <nlohmann/json.hpp>
+
+#include "buckle/mechanics/chain.h"
+
+namespace buckle::scene {
+
+using nlohmann::json;
+using Pointer = json::json_pointer;
+
+SceneError::SceneError(std::string file, std::string path, std::string message)
+    : std::runtime_error(file + ": " + (path.empty() ? std::string("(document)") : path) + ": " + message),
+      file_(std::move(file)),
+      path_(std::move(path)),
+      message_(std::move(message)) {}
+
+const char* plotTypeName(PlotType t) {
+  switch (t) {
+    case PlotType::Bifurcation: return "bifurcation";
+    case PlotType::Stiffness: return "stiffness";
+    case PlotType::EnergyCurves: return "energy_curves";
+    case PlotType::TorqueAngle: return "torque_angle";
+    case PlotType::Shapes: return "shapes";
+  }
+  return "?";
+}
+
+int Scene::maxSegments() const {
+  int n = 0;
+  for (const CaseSpec& c : cases) n = std::max(n, static_cast<int>(c.chain.segments.size()));
+  return n;
+}
+
+mechanics::SegmentParameters preloadForAngle(const mechanics::SegmentParameters& p, double q0) {
+  // M(q0) = 0 with L1⁰ = S/2 + d, L2⁰ = S/2 − d (S = L1⁰ + L2⁰ kept):
+  //   k1 (L1 − L1⁰) L1' + k2 (L2 − L2⁰) L2' = 0 is linear in d.
+  mechanics::Segment seg(p);
+  const mechanics::Jet3 L1 = seg.spring1(q0), L2 = seg.spring2(q0);
+  const double S = p.L1_0 + p.L2_0;
+  const double denom = p.k1 * L1.d1 - p.k2 * L2.d1;
+  if (!(std::abs(denom) > 1e-14))
+    throw std::invalid_argument("no preloads make this angle an unloaded equilibrium");
+  const double d = (p.k1 * (L1.value - 0.5 * S) * L1.d1 + p.k2 * (L2.value - 0.5 * S) * L2.d1) / denom;
+  mechanics::SegmentParameters out = p;
+  out.L1_0 = 0.5 * S + d;
+  out.L2_0 = 0.5 * S - d;
+  if (!(out.L1_0 > 0.0) || !(out.L2_0 > 0.0)) {
+    std::ostringstream os;
+    os << "the preloads for this angle would be L1_0=" << out.L1_0 << ", L2_0=" << out.L2_0
+       << " (a free length must be > 0)";
+    throw std::invalid_argument(os.str());
+  }
+  return out;
+}
+
+namespace {
+
+std::string describe(const json& v) {
+  if (v.is_null()) return "null";
+  if (v.is_boolean()) return std::string("the boolean ") + (v.get<bool>() ? "true" : "false");
+  if (v.is_number()) {
+    std::ostringstream os;
+    os << "the number " << v.dump();
+    return os.str();
+  }
+  if (v.is_string()) return "the string " + v.dump();
+  if (v.is_array()) return "an array";
+  return "an object";
+}
+
+/// Validating accessors over one JSON document; every failure names file and JSON path.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+  const std::string& file() const { return file_; }
+
+  [[noreturn]] void fail(const Pointer& p, const std::string& message) const {
+    throw SceneError(file_, p.to_string(), message);
+  }
+  [[noreturn]] void expected(const Pointer& p, const json& got, const std::string& what) const {
+    fail(p, "expected " + what + ", got " + describe(got));
+  }
+
+  void requireObject(const json& v, const Pointer& p) const {
+    if (!v.is_object()) expected(p, v, "an object");
+  }
+  /// Rejects keys outside `allowed`.
+  void onlyKeys(const json& v, const Pointer& p, const std::set<std::string>& allowed) const {
+    requireObject(v, p);
+    for (auto it = v.begin(); it != v.end(); ++it) {
+      if (allowed.count(it.key())) continue;
+      std::string list;
+      for (const std::string& k : allowed) list += (list.empty() ? "" : ", ") + k;
+      fail(p / it.key(), "unknown key \"" + it.key() + "\" (allowed here: " + list + ")");
+    }
+  }
+
+  double number(const json& v, const Pointer& p) const {
+    if (!v.is_number()) expected(p, v, "a number");
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) expected(p, v, "a finite number");
+    return x;
+  }
+  double positive(const json& v, const Pointer& p) const {
+    const double x = number(v, p);
+    if (!(x > 0.0)) expected(p, v, "a number > 0");
+    return x;
+  }
+  double nonNegative(const json& v, const Pointer& p) const {
+    const double x = number(v, p);
+    if (x < 0.0) expected(p, v, "a number >= 0");
+    return x;
+  }
+  int integer(const json& v, const Pointer& p, int lo, int hi) const {
+    const std::string what = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    if (!v.is_number_integer()) expected(p, v, what);
+    const long long x = v.get<long long>();
+    if (x < lo || x > hi) expected(p, v, what);
+    return static_cast<int>(x);
+  }
+  bool boolean(const json& v, const Pointer& p) const {
+    if (!v.is_boolean()) expected(p, v, "true or false");
+    return v.get<bool>();
+  }
+  std::string string(const json& v, const Pointer& p) const {
+    if (!v.is_string()) expected(p, v, "a string");
+    return v.get<std::string>();
+  }
+
+ private:
+  std::string file_;
+};
+
+const char* const kCoordinateNames[3] = {"x", "y", "phi"};
+const char* const kLoadNames[3] = {"Fx", "Fy", "Me"};
+
+int coordinateOfParameter(const std::string& s, bool& isLoad) {
+  for (int c = 0; c < 3; ++c) {
+    if (s == kLoadNames[c]) {
+      isLoad = true;
+      return c;
+    }
+    if (s == kCoordinateNames[c]) {
+      isLoad = false;
+      return c;
+    }
+  }
+  return -1;
+}
+
+// ---- chain ------------------------------------------------------------------------------------
+
+const std::set<std::string> kSegmentKeys = {"a", "b", "k", "L0", "a1", "b1", "a2", "b2", "k1", "k2",
+                                            "L1_0", "L2_0", "q_min", "q_max", "q0"};
+
+struct SegmentDefaults {
+  std::map<std::string, double> values;  // resolved names a1..L2_0, q_min, q_max, q0
+};
+
+// Applies the keys of one object (chain level or segment level) on top of `d`.
+void applySegmentKeys(const Reader& r, const json& obj, const Pointer& p, SegmentDefaults& d) {
+  static const std::map<std::string, std::vector<std::string>> generic = {
+      {"a", {"a1", "a2"}}, {"b", {"b1", "b2"}}, {"k", {"k1", "k2"}}, {"L0", {"L1_0", "L2_0"}}};
+  // generic keys first, specific ones override
+  for (const auto& [key, targets] : generic) {
+    if (!obj.contains(key)) continue;
+    const Pointer q = p / key;
+    double v = 0;
+    if (key == "a")
+      v = r.nonNegative(obj[key], q);
+    else
+      v = r.positive(obj[key], q);
+    for (const std::string& t : targets) d.values[t] = v;
+  }
+  for (const char* key : {"a1", "a2"})
+    if (obj.contains(key)) d.values[key] = r.nonNegative(obj[key], p / key);
+  for (const char* key : {"b1", "b2", "k1", "k2", "L1_0", "L2_0"})
+    if (obj.contains(key)) d.values[key] = r.positive(obj[key], p / key);
+  for (const char* key : {"q_min", "q_max", "q0"})
+    if (obj.contains(key)) d.values[key] = r.number(obj[key], p / key);
+}
+
+mechanics::SegmentParameters toParameters(const SegmentDefaults& d) {
+  mechanics::SegmentParameters s;
+  s.a1 = d.values.at("a1");
+  s.a2 = d.values.at("a2");
+  s.b1 = d.values.at("b1");
+  s.b2 = d.values.at("b2");
+  s.k1 = d.values.at("k1");
+  s.k2 = d.values.at("k2");
+  s.L1_0 = d.values.at("L1_0");
+  s.L2_0 = d.values.at("L2_0");
+  if (d.values.count("q_min")) s.qMinUser = d.values.at("q_min");
+  if (d.values.count("q_max")) s.qMaxUser = d.values.at("q_max");
+  return s;
+}
+
+ChainSpec parseChain(const Reader& r, const json& chain, const Pointer& p) {
+  std::set<std::string> keys = kSegmentKeys;
+  keys.insert("segments");
+  r.onlyKeys(chain, p, keys);
+  if (!chain.contains("segments")) r.fail(p / "segments", "missing: expected the segment count (an integer >= 1) or a list of segments");
+
+  SegmentDefaults base;
+  base.values = {{"a1", 0.5}, {"a2", 0.5}, {"b1", 1.0}, {"b2", 1.0}, {"k1", 1.0},
+                 {"k2", 1.0}, {"L1_0", 2.25}, {"L2_0", 2.25}};
+  json chainLevel = chain;
+  chainLevel.erase("segments");
+  chainLevel.erase("q0");
+  applySegmentKeys(r, chainLevel, p, base);
+
+  const json& segs = chain["segments"];
+  const Pointer ps = p / "segments";
+  std::vector<SegmentDefaults> resolved;
+  std::vector<Pointer> segPointers;
+  if (segs.is_number()) {
+    const int n = r.integer(segs, ps, 1, 100000);
+    resolved.assign(size_t(n), base);
+    segPointers.assign(size_t(n), p);
+  } else if (segs.is_array()) {
+    if (segs.empty()) r.expected(ps, segs, "a segment count >= 1 or a non-empty list of segments");
+    for (size_t i = 0; i < segs.size(); ++i) {
+      const Pointer pi = ps / i;
+      r.onlyKeys(segs[i], pi, kSegmentKeys);
+      SegmentDefaults d = base;
+      applySegmentKeys(r, segs[i], pi, d);
+      resolved.push_back(d);
+      segPointers.push_back(pi);
+    }
+  } else {
+    r.expected(ps, segs, "a segment count (integer >= 1) or a list of segment objects");
+  }
+  const size_t n = resolved.size();
+
+  // desired unloaded angles: chain-level list, or per-segment "q0"
+  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(Eigen::Index(n));
+  std::vector<Pointer> q0Pointers(n);
+  bool haveQ0 = false;
+  if (chain.contains("q0")) {
+    const json& v = chain["q0"];
+    const Pointer pq = p / "q0";
+    if (!v.is_array() || v.size() != n)
+      r.expected(pq, v, "an array of " + std::to_string(n) + " angles (radians), one per segment");
+    for (size_t i = 0; i < n; ++i) {
+      q0[Eigen::Index(i)] = r.number(v[i], pq / i);
+      q0Pointers[i] = pq / i;
+    }
+    haveQ0 = true;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    if (resolved[i].values.count("q0") && segs.is_array() && segs[i].contains("q0")) {
+      if (chain.contains("q0")) r.fail(segPointers[i] / "q0", "q0 given both per segment and as /chain/q0");
+      q0[Eigen::Index(i)] = resolved[i].values.at("q0");
+      q0Pointers[i] = segPointers[i] / "q0";
+      haveQ0 = true;
+    }
+  }
+
+  ChainSpec spec;
+  spec.q0 = q0;
+  for (size_t i = 0; i < n; ++i) {
+    mechanics::SegmentParameters sp = toParameters(resolved[i]);
+    try {
+      mechanics::Segment check(sp);
+    } catch (const std::invalid_argument& e) {
+      r.fail(segPointers[i], std::string("invalid segment") + (segs.is_array() ? "" : "s") + ": " + e.what());
+    }
+    if (haveQ0 && q0[Eigen::Index(i)] != 0.0) {
+      mechanics::Segment seg(sp);
+      const double qi = q0[Eigen::Index(i)];
+      if (!(qi > seg.lowerLimit() && qi < seg.upperLimit())) {
+        std::ostringstream os;
+        os << "expected an angle inside the joint limits (" << seg.lowerLimit() << ", " << seg.upperLimit()
+           << ") rad, got " << qi;
+        r.fail(q0Pointers[i], os.str());
+      }
+      try {
+        sp = preloadForAngle(sp, qi);
+      } catch (const std::invalid_argument& e) {
+        r.fail(q0Pointers[i], e.what());
+      }
+      spec.preloadsFromQ0 = true;
+    }
+    spec.segments.push_back(sp);
+  }
+  return spec;
+}
+
+// ---- end and path -----------------------------------------------------------------------------
+
+EndSpec parseEnd(const Reader& r, const json& end, const Pointer& p) {
+  r.onlyKeys(end, p, {"x", "y", "phi"});
+  EndSpec spec;
+  for (int c = 0; c < 3; ++c) {
+    spec.condition.control[size_t(c)] = mechanics::Control::Load;
+    spec.condition.value[c] = 0.0;
+    if (!end.contains(kCoordinateNames[c])) continue;
+    const json& v = end[kCoordinateNames[c]];
+    const Pointer pc = p / kCoordinateNames[c];
+    const std::string what = "\"free\", {\"load\": number} or {\"held\": number | \"start\"}";
+    if (v.is_string()) {
+      if (v.get<std::string>() != "free") r.expected(pc, v, what);
+      continue;
+    }
+    if (!v.is_object() || v.size() != 1) r.expected(pc, v, what);
+    if (v.contains("load")) {
+      spec.condition.value[c] = r.number(v["load"], pc / "load");
+    } else if (v.contains("held")) {
+      spec.condition.control[size_t(c)] = mechanics::Control::Held;
+      const json& h = v["held"];
+      if (h.is_string()) {
+        if (h.get<std::string>() != "start") r.expected(pc / "held", h, "a number or \"start\"");
+        spec.heldAtStart[size_t(c)] = true;
+      } else {
+        spec.condition.value[c] = r.number(h, pc / "held");
+      }
+    } else {
+      r.fail(pc / v.begin().key(), "unknown key \"" + v.begin().key() + "\" (allowed here: load, held)");
+    }
+  }
+  return spec;
+}
+
+PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const EndSpec& end, double startValue) {
+  r.onlyKeys(path, p, {"parameter", "from", "to", "direction"});
+  for (const char* key : {"parameter", "from", "to"})
+    if (!path.contains(key)) r.fail(p / key, "missing (required)");
+  PathSpec spec;
+  spec.parameter = r.string(path["parameter"], p / "parameter");
+  bool isLoad = false;
+  spec.coordinate = coordinateOfParameter(spec.parameter, isLoad);
+  if (spec.coordinate < 0) r.expected(p / "parameter", path["parameter"], "one of Fx, Fy, Me, x, y, phi");
+  const bool held = end.condition.isHeld(static_cast<mechanics::EndCoordinate>(spec.coordinate));
+  if (isLoad && held)
+    r.fail(p / "parameter", std::string("the load ") + spec.parameter + " cannot be the parameter: /end/" +
+                                kCoordinateNames[spec.coordinate] + " is held (use \"" +
+                                kCoordinateNames[spec.coordinate] + "\" or make it loaded)");
+  if (!isLoad && !held)
+    r.fail(p / "parameter", std::string("the coordinate ") + spec.parameter + " cannot be the parameter: /end/" +
+                                spec.parameter + " is not held (use {\"held\": value} there, or the load " +
+                                kLoadNames[spec.coordinate] + ")");
+  spec.from = r.number(path["from"], p / "from");
+  spec.to = r.number(path["to"], p / "to");
+  if (spec.from == spec.to) r.fail(p / "to", "expected a value different from /path/from (an empty range)");
+  const double lo = std::min(spec.from, spec.to), hi = std::max(spec.from, spec.to);
+  if (!(startValue >= lo - 1e-12 && startValue <= hi + 1e-12)) {
+    std::ostringstream os;
+    os << "expected a range [from, to] that contains the start value " << spec.parameter << " = " << startValue
+       << " (set by /end/" << kCoordinateNames[spec.coordinate] << "), got [" << spec.from << ", " << spec.to << "]";
+    r.fail(p / (std::abs(spec.from - startValue) <= std::abs(spec.to - startValue) ? "from" : "to"), os.str());
+  }
+  spec.direction.setZero();
+  spec.direction[spec.coordinate] = 1.0;
+  if (path.contains("direction")) {
+    const json& d = path["direction"];
+    const Pointer pd = p / "direction";
+    r.requireObject(d, pd);
+    for (auto it = d.begin(); it != d.end(); ++it) {
+      bool keyIsLoad = false;
+      const int c = coordinateOfParameter(it.key(), keyIsLoad);
+      if (c < 0) r.fail(pd / it.key(), "unknown key \"" + it.key() + "\" (allowed here: Fx, Fy, Me, x, y, phi)");
+      if (c == spec.coordinate)
+        r.fail(pd / it.key(), "the path parameter's own rate is 1 by definition; remove this key");
+      const bool cHeld = end.condition.isHeld(static_cast<mechanics::EndCoordinate>(c));
+      if (keyIsLoad == cHeld)
+        r.fail(pd / it.key(), std::string("expected ") + (cHeld ? kCoordinateNames[c] : kLoadNames[c]) +
+                                  ": /end/" + kCoordinateNames[c] + " is " + (cHeld ? "held" : "loaded"));
+      spec.direction[c] = r.number(it.value(), pd / it.key());
+    }
+  }
+  return spec;
+}
+
+CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label) {
+  CaseSpec cs;
+  cs.label = label;
+  if (!doc.contains("chain")) r.fail(Pointer("/chain"), "missing (required): the chain to model");
+  cs.chain = parseChain(r, doc["chain"], Pointer("/chain"));
+  cs.end = parseEnd(r, doc.contains("end") ? doc["end"] : json::object(), Pointer("/end"));
+  // "held": "start" takes the unloaded shape's end pose
+  mechanics::Chain chain(cs.chain.segments);
+  const mechanics::Pose pose0 = mechanics::endPose(chain, cs.chain.q0);
+  for (int c = 0; c < 3; ++c)
+    if (cs.end.heldAtStart[size_t(c)]) cs.end.condition.value[c] = pose0[c];
+  if (!doc.contains("path")) r.fail(Pointer("/path"), "missing (required): the load path");
+  const json& path = doc["path"];
+  r.requireObject(path, Pointer("/path"));
+  double start = 0.0;
+  if (path.contains("parameter") && path["parameter"].is_string()) {
+    bool isLoad = false;
+    const int c = coordinateOfParameter(path["parameter"].get<std::string>(), isLoad);
+    if (c >= 0) start = cs.end.condition.value[c];
+  }
+  cs.path = parsePath(r, path, Pointer("/path"), cs.end, start);
+  return cs;
+}
+
+// ---- analyses, solver, plots ------------------------------------------------------------------
+
+AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
+  r.onlyKeys(a, p, {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump"});
+  AnalysesSpec s;
+  if (a.contains("continuation")) {
+    const json& c = a["continuation"];
+    const Pointer pc = p / "continuation";
+    if (c.is_boolean()) {
+      s.continuation.enabled = c.get<bool>();
+    } else {
+      r.onlyKeys(c, pc, {"branch_switching"});
+      s.continuation.enabled = true;
+      if (c.contains("branch_switching"))
+        s.continuation.branchSwitching = r.integer(c["branch_switching"], pc / "branch_switching", 0, 4);
+    }
+  }
+  if (a.contains("stiffness")) {
+    s.stiffness = r.boolean(a["stiffness"], p / "stiffness");
+    if (s.stiffness && !s.continuation.enabled)
+      r.fail(p / "stiffness", "stiffness is computed along the traced branches: it needs /analyses/continuation");
+  }
+  if (a.contains("energy_curves")) {
+    const json& e = a["energy_curves"];
+    const Pointer pe = p / "energy_curves";
+    r.onlyKeys(e, pe, {"x", "y", "q1_from", "q1_to", "points", "torque"});
+    s.energyCurves.enabled = true;
+    if (!e.contains("x") || !e.contains("y")) r.fail(pe / (e.contains("x") ? "y" : "x"), "missing (required): the held end position");
+    s.energyCurves.x = r.number(e["x"], pe / "x");
+    s.energyCurves.y = r.number(e["y"], pe / "y");
+    if (e.contains("q1_from")) s.energyCurves.q1From = r.number(e["q1_from"], pe / "q1_from");
+    if (e.contains("q1_to")) s.energyCurves.q1To = r.number(e["q1_to"], pe / "q1_to");
+    if (!(s.energyCurves.q1From < s.energyCurves.q1To)) r.fail(pe / "q1_to", "expected q1_to > q1_from");
+    if (e.contains("points")) s.energyCurves.points = r.integer(e["points"], pe / "points", 3, 1000000);
+    if (e.contains("torque")) s.energyCurves.torque = r.boolean(e["torque"], pe / "torque");
+  }
+  if (a.contains("torque_angle")) {
+    const json& t = a["torque_angle"];
+    const Pointer pt = p / "torque_angle";
+    if (t.is_boolean()) {
+      s.torqueAngle.enabled = t.get<bool>();
+    } else {
+      r.onlyKeys(t, pt, {"q_from", "q_to", "points"});
+      s.torqueAngle.enabled = true;
+      if (t.contains("q_from")) s.torqueAngle.qFrom = r.number(t["q_from"], pt / "q_from");
+      if (t.contains("q_to")) s.torqueAngle.qTo = r.number(t["q_to"], pt / "q_to");
+      if (!(s.torqueAngle.qFrom < s.torqueAngle.qTo)) r.fail(pt / "q_to", "expected q_to > q_from");
+      if (t.contains("points")) s.torqueAngle.points = r.integer(t["points"], pt / "points", 3, 1000000);
+    }
+  }
+  if (a.contains("critical_forces")) {
+    const json& c = a["critical_forces"];
+    const Pointer pc = p / "critical_forces";
+    if (c.is_boolean()) {
+      s.criticalForces.enabled = c.get<bool>();
+    } else {
+      r.onlyKeys(c, pc, {"modes"});
+      s.criticalForces.enabled = true;
+      if (c.contains("modes")) s.criticalForces.modes = r.integer(c["modes"], pc / "modes", 1, 100000);
+    }
+  }
+  if (a.contains("jump"))
+    r.fail(p / "jump", "not supported in this build: jump dynamics (time integration of a snap-through) is not "
+                       "available yet; remove this analysis");
+  if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled)
+    r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces)");
+  return s;
+}
+
+SolverSpec parseSolver(const Reader& r, const json& s, const Pointer& p) {
+  r.onlyKeys(s, p, {"initial_step", "min_step", "max_step", "tolerance", "max_points", "time_limit"});
+  SolverSpec o;
+  if (s.contains("initial_step")) o.initialStep = r.positive(s["initial_step"], p / "initial_step");
+  if (s.contains("min_step")) o.minStep = r.positive(s["min_step"], p / "min_step");
+  if (s.contains("max_step")) o.maxStep = r.positive(s["max_step"], p / "max_step");
+  if (s.contains("tolerance")) o.tolerance = r.positive(s["tolerance"], p / "tolerance");
+  if (s.contains("max_points")) o.maxPoints = r.integer(s["max_points"], p / "max_points", 2, 10000000);
+  if (s.contains("time_limit")) o.timeLimit = r.positive(s["time_limit"], p / "time_limit");
+  if (!(o.minStep <= o.initialStep)) r.fail(p / "min_step", "expected min_step <= initial_step");
+  if (!(o.initialStep <= o.maxStep)) r.fail(p / "max_step", "expected max_step >= initial_step");
+  return o;
+}
+
+std::set<std::string> branchColumns(int maxN, bool stiffness) {
+  std::set<std::string> c = {"parameter", "Fx", "Fy", "Me", "x", "y", "phi", "dx", "dy", "min_eig"};
+  for (int i = 1; i <= maxN; ++i) c.insert("q" + std::to_string(i));
+  if (stiffness) c.insert({"Kxx", "Kyy", "Kxy"});
+  return c;
+}
+
+PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN) {
+  PlotSpec s;
+  json obj = v;
+  if (v.is_string()) obj = json{{"type", v}};
+  r.onlyKeys(obj, p, {"type", "name", "x", "y", "at", "title"});
+  if (!obj.contains("type")) r.fail(p / "type", "missing (required)");
+  const Pointer pt = v.is_string() ? p : p / "type";
+  const std::string type = r.string(obj["type"], pt);
+  const std::map<std::string, PlotType> types = {{"bifurcation", PlotType::Bifurcation},
+                                                 {"stiffness", PlotType::Stiffness},
+                                                 {"energy_curves", PlotType::EnergyCurves},
+                                                 {"torque_angle", PlotType::TorqueAngle},
+                                                 {"shapes", PlotType::Shapes}};
+  auto it = types.find(type);
+  if (it == types.end())
+    r.expected(pt, obj["type"], "one of bifurcation, stiffness, energy_curves, torque_angle, shapes");
+  s.type = it->second;
+  auto needs = [&](bool have, const char* analysis) {
+    if (!have) r.fail(pt, std::string("a ") + type + " plot needs /analyses/" + analysis);
+  };
+  switch (s.type) {
+    case PlotType::Bifurcation:
+    case PlotType::Shapes: needs(a.continuation.enabled, "continuation"); break;
+    case PlotType::Stiffness: needs(a.stiffness, "stiffness"); break;
+    case PlotType::EnergyCurves: needs(a.energyCurves.enabled, "energy_curves"); break;
+    case PlotType::TorqueAngle: needs(a.torqueAngle.enabled, "torque_angle"); break;
+  }
+  s.name = type;
+  if (obj.contains("name")) {
+    s.name = r.string(obj["name"], p / "name");
+    const bool ok = !s.name.empty() && std::all_of(s.name.begin(), s.name.end(), [](char ch) {
+      return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-';
+    });
+    if (!ok) r.expected(p / "name", obj["name"], "a file stem of letters, digits, '_' and '-'");
+  }
+  if (obj.contains("title")) s.title = r.string(obj["title"], p / "title");
+  const bool columns = s.type == PlotType::Bifurcation || s.type == PlotType::Stiffness;
+  if (!columns) {
+    for (const char* key : {"x", "y"})
+      if (obj.contains(key)) r.fail(p / key, std::string("a ") + type + " plot has fixed axes; remove this key");
+  } else {
+    const std::set<std::string> allowed = branchColumns(maxN, a.stiffness);
+    std::string list;
+    for (const std::string& c : allowed) list += (list.empty() ? "" : ", ") + c;
+    auto column = [&](const json& c, const Pointer& pc) {
+      const std::string name = r.string(c, pc);
+      if (!allowed.count(name)) r.expected(pc, c, "a column of branches.csv (" + list + ")");
+      return name;
+    };
+    s.x = obj.contains("x") ? column(obj["x"], p / "x") : "parameter";
+    if (obj.contains("y")) {
+      const json& y = obj["y"];
+      if (y.is_array()) {
+        if (y.empty()) r.expected(p / "y", y, "a column name or a non-empty list of them");
+        for (size_t i = 0; i < y.size(); ++i) s.y.push_back(column(y[i], p / "y" / i));
+      } else {
+        s.y.push_back(column(y, p / "y"));
+      }
+    } else if (s.type == PlotType::Stiffness) {
+      s.y = {"Kxx", "Kyy"};
+    } else {
+      s.y = {"q1"};
+    }
+  }
+  if (s.type == PlotType::Shapes) {
+    if (!obj.contains("at")) r.fail(p / "at", "missing (required): parameter values at which to draw the chain");
+    const json& at = obj["at"];
+    if (!at.is_array() || at.empty()) r.expected(p / "at", at, "a non-empty array of parameter values");
+    for (size_t i = 0; i < at.size(); ++i) s.at.push_back(r.number(at[i], p / "at" / i));
+  } else if (obj.contains("at")) {
+    r.fail(p / "at", "only a shapes plot takes \"at\"");
+  }
+  return s;
+}
+
+std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a) {
+  std::vector<PlotSpec> out;
+  if (a.continuation.enabled) out.push_back({PlotType::Bifurcation, "bifurcation", "parameter", {"q1"}, {}, ""});
+  if (a.stiffness) out.push_back({PlotType::Stiffness, "stiffness", "parameter", {"Kxx", "Kyy"}, {}, ""});
+  if (a.energyCurves.enabled) out.push_back({PlotType::EnergyCurves, "energy_curves", "", {}, {}, ""});
+  if (a.torqueAngle.enabled) out.push_back({PlotType::TorqueAngle, "torque_angle", "", {}, {}, ""});
+  return out;
+}
+
+// Parses the document, keeping the JSON path of the value being read so that a syntax error
+// (NaN, a missing comma) is reported where it happened.
+json parseDocument(const std::string& text, const std::string& file) {
+  struct Frame {
+    bool array = false;
+    std::string key;
+    long index = -1;
+  };
+  std::vector<Frame> stack;
+  auto enterValue = [&]() {
+    if (!stack.empty() && stack.back().array) ++stack.back().index;
+  };
+  json::parser_callback_t cb = [&](int /*depth*/, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+        enterValue();
+        stack.push_back({false, "", -1});
+        break;
+      case json::parse_event_t::array_start:
+        enterValue();
+        stack.push_back({true, "", -1});
+        break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        if (!stack.empty()) stack.pop_back();
+        break;
+      case json::parse_event_t::key:
+        if (!stack.empty()) stack.back().key = parsed.get<std::string>();
+        break;
+      case json::parse_event_t::value: enterValue(); break;
+    }
+    return true;
+  };
+  try {
+    return json::parse(text, cb);
+  } catch (const json::parse_error& e) {
+    Pointer where;
+    for (const Frame& f : stack) {
+      if (f.array)
+        where /= std::to_string(f.index + 1);
+      else if (!f.key.empty())
+        where /= f.key;
+    }
+    std::string what = e.what();
+    const auto pos = what.find("syntax error");
+    if (pos != std::string::npos) what = what.substr(pos);
+    // NaN / Infinity are not JSON: say so plainly.
+    const size_t byte = e.byte > 0 ? e.byte - 1 : 0;
+    for (const char* bad : {"NaN", "nan", "Infinity", "-Infinity", "inf"}) {
+      const size_t b = text.rfind(bad, byte);
+      if (b != std::string::npos && byte - b < 10)
+        throw SceneError(file, where.to_string(),
+                         std::string("expected a finite number, got ") + bad + " (not valid JSON)");
+    }
+    size_t line = 1, column = 1;
+    for (size_t i = 0; i < byte && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+    }
+    throw SceneError(file, where.to_string(),
+                     "invalid JSON at line " + std::to_string(line) + ", column " + std::to_string(column) + ": " + what);
+  }
+}
+
+}  // namespace
+
+Scene parseScene(const std::string& text, const std::string& file) {
+  const Reader r(file);
+  const json doc = parseDocument(text, file);
+  r.onlyKeys(doc, Pointer(""), {"description", "chain", "end", "path", "cases", "analyses", "solver", "plots"});
+  Scene scene;
+  scene.file = file;
+  if (doc.contains("description")) scene.description = r.string(doc["description"], Pointer("/description"));
+
+  json base = doc;
+  base.erase("cases");
+  base.erase("analyses");
+  base.erase("solver");
+  base.erase("plots");
+  base.erase("description");
+  if (doc.contains("cases")) {
+    const json& cases = doc["cases"];
+    if (!cases.is_array() || cases.empty()) r.expected(Pointer("/cases"), cases, "a non-empty array of case objects");
+    for (size_t i = 0; i < cases.size(); ++i) {
+      const Pointer pi = Pointer("/cases") / i;
+      r.onlyKeys(cases[i], pi, {"label", "chain", "end", "path"});
+      std::string label = "case " + std::to_string(i + 1);
+      if (cases[i].contains("label")) label = r.string(cases[i]["label"], pi / "label");
+      json patch = cases[i];
+      patch.erase("label");
+      json merged = base;
+      merged.merge_patch(patch);
+      try {
+        scene.cases.push_back(parseCase(r, merged, label));
+      } catch (const SceneError& e) {
+        // point into the case when the bad value came from it
+        const Pointer bad(e.path().empty() ? "" : e.path());
+        if (!e.path().empty() && patch.contains(bad)) throw SceneError(file, (pi / bad).to_string(), e.message());
+        throw SceneError(file, e.path(), e.message() + " (in " + pi.to_string() + ", \"" + label + "\")");
+      }
+    }
+  } else {
+    scene.cases.push_back(parseCase(r, base, "main"));
+  }
+
+  if (!doc.contains("analyses")) r.fail(Pointer("/analyses"), "missing (required): what to compute");
+  scene.analyses = parseAnalyses(r, doc["analyses"], Pointer("/analyses"));
+  if (scene.analyses.energyCurves.enabled)
+    for (size_t i = 0; i < scene.cases.size(); ++i)
+      if (scene.cases[i].chain.segments.size() != 3)
+        r.fail(Pointer("/analyses/energy_curves"),
+               "energy curves E(q1) with the end held use the 3-segment inverse kinematics (eq 6): case \"" +
+                   scene.cases[i].label + "\" has " + std::to_string(scene.cases[i].chain.segments.size()) +
+                   " segments");
+  if (doc.contains("solver")) scene.solver = parseSolver(r, doc["solver"], Pointer("/solver"));
+  if (doc.contains("plots")) {
+    const json& plots = doc["plots"];
+    if (!plots.is_array()) r.expected(Pointer("/plots"), plots, "an array of plot names or plot objects");
+    std::set<std::string> names;
+    for (size_t i = 0; i < plots.size(); ++i) {
+      PlotSpec ps = parsePlot(r, plots[i], Pointer("/plots") / i, scene.analyses, scene.maxSegments());
+      if (!names.insert(ps.name).second)
+        r.fail(Pointer("/plots") / i, "two plots named \"" + ps.name + "\": give one a distinct \"name\"");
+      scene.plots.push_back(ps);
+    }
+  } else {
+    scene.plots = defaultPlots(scene.analyses);
+  }
+  return scene;
+}
+
+Scene loadScene(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw SceneError(file, "", "cannot open the file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parseScene(ss.str(), file);
+}
+
+}  // namespace buckle::scene

@@ -1,0 +1,133 @@
+// A scene: what the user wants to know about one manipulator (or a few variants of it), read
+// from a JSON file. The schema is documented in docs/scenes.md. Parsing validates everything
+// up front, so the runner never meets a bad value: a SceneError names the file, the JSON path
+// of the offending value (RFC 6901, e.g. /chain/k) and what was expected.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "buckle/mechanics/end_condition.h"
+#include "buckle/mechanics/segment.h"
+
+namespace buckle::scene {
+
+/// Bad input: the file, the JSON path of the bad value and what was expected.
+class SceneError : public std::runtime_error {
+ public:
+  SceneError(std::string file, std::string path, std::string message);
+  const std::string& file() const { return file_; }
+  const std::string& path() const { return path_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  std::string file_, path_, message_;
+};
+
+/// One chain variant: segment parameters (after preloads for q0 were computed) and its
+/// unloaded shape.
+struct ChainSpec {
+  std::vector<mechanics::SegmentParameters> segments;
+  Eigen::VectorXd q0;           ///< unloaded joint angles (zero for a straight start)
+  bool preloadsFromQ0 = false;  ///< L1⁰/L2⁰ were computed from a desired q0
+};
+
+/// How each end coordinate (x, y, φ) is prescribed at the start of the path.
+struct EndSpec {
+  mechanics::EndCondition condition;  ///< control and start values
+  std::array<bool, 3> heldAtStart{false, false, false};  ///< "held": "start" (use q0's pose)
+};
+
+/// Names of the path parameters: Fx Fy Me (loads) and x y phi (held coordinates).
+struct PathSpec {
+  std::string parameter;       ///< "Fx", "Fy", "Me", "x", "y" or "phi"
+  int coordinate = 0;          ///< 0 = x, 1 = y, 2 = φ
+  double from = 0.0, to = 0.0; ///< parameter range; contains the start value
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  ///< d(prescribed)/d(parameter)
+};
+
+struct ContinuationSpec {
+  bool enabled = false;
+  int branchSwitching = 0;  ///< depth of the branch tree (0: primary branch only)
+};
+
+struct EnergyCurvesSpec {
+  bool enabled = false;
+  double x = 0.0, y = 0.0;     ///< end position held while q1 sweeps
+  double q1From = -1.0, q1To = 1.0;
+  int points = 801;
+  bool torque = false;         ///< also the end torque Me(q1) (paper Fig 5)
+};
+
+struct TorqueAngleSpec {
+  bool enabled = false;
+  double qFrom = -2.0, qTo = 2.0;
+  int points = 401;
+};
+
+struct CriticalForcesSpec {
+  bool enabled = false;
+  int modes = 3;  ///< how many critical loads of the start configuration to report
+};
+
+struct AnalysesSpec {
+  ContinuationSpec continuation;
+  bool stiffness = false;
+  EnergyCurvesSpec energyCurves;
+  TorqueAngleSpec torqueAngle;
+  CriticalForcesSpec criticalForces;
+};
+
+struct SolverSpec {
+  double initialStep = 0.02;
+  double minStep = 1e-7;
+  double maxStep = 0.05;
+  double tolerance = 1e-10;    ///< corrector residual tolerance
+  int maxPoints = 4000;        ///< per branch
+  double timeLimit = 120.0;    ///< seconds for the whole scene; past it the run stops (exit 1)
+};
+
+enum class PlotType { Bifurcation, Stiffness, EnergyCurves, TorqueAngle, Shapes };
+const char* plotTypeName(PlotType t);
+
+struct PlotSpec {
+  PlotType type = PlotType::Bifurcation;
+  std::string name;                  ///< output file stem
+  std::string x;                     ///< column on the horizontal axis
+  std::vector<std::string> y;        ///< columns on the vertical axis
+  std::vector<double> at;            ///< shapes: parameter values to draw the chain at
+  std::string title;
+};
+
+/// One complete run: a chain, an end condition and a path.
+struct CaseSpec {
+  std::string label;
+  ChainSpec chain;
+  EndSpec end;
+  PathSpec path;
+};
+
+struct Scene {
+  std::string file;
+  std::string description;
+  std::vector<CaseSpec> cases;  ///< at least one
+  AnalysesSpec analyses;
+  SolverSpec solver;
+  std::vector<PlotSpec> plots;
+  int maxSegments() const;
+};
+
+/// Parses and validates a scene file. Throws SceneError on any bad input.
+Scene loadScene(const std::string& file);
+/// Same, from text (file is only used in messages).
+Scene parseScene(const std::string& text, const std::string& file);
+
+/// Preloads (L1⁰, L2⁰) making q0 an unloaded equilibrium of a segment, keeping L1⁰ + L2⁰.
+/// Throws std::invalid_argument if no such preloads exist (both springs must stay positive).
+mechanics::SegmentParameters preloadForAngle(const mechanics::SegmentParameters& p, double q0);
+
+}  // namespace buckle::scene
