@@ -1,0 +1,65 @@
+// Cartesian stiffness of the end position by the virtual joint method (eq 21–29).
+//
+// At an equilibrium q under the total end wrench F = (Fx, Fy, Me) (given loads and the
+// reactions of held coordinates), a small change δF of the position force moves the end by
+// δp = C_F δF; K_F = C_F⁻¹. Joint increments obey (K_q − K_g(F)) δq = Jᵀ δF (eq 28), with the
+// end rotation either free (δMe = 0) or held (δφ = 0, Me a Lagrange multiplier). Hence
+//   rotation free:  C_F = J_p (K_q − K_g)⁻¹ J_pᵀ                             (eq 29; F = 0: eq 21)
+//   rotation held:  C_F = J_p P J_pᵀ, P the inverse of K_q − K_g on ker J_φ.
+// Both are evaluated through bordered (KKT) solves, never by inverting K_q − K_g itself:
+//   C_F from [[K_q − K_g, J_φᵀ], [J_φ, 0]] X = [J_pᵀ; 0] (no border when the rotation is free),
+//   which is regular whenever K_q − K_g is regular on ker J_φ — in particular where K_q − K_g
+//   alone is singular but the held rotation removes the singular direction;
+//   where that fails (a force-control limit / bifurcation point: infinite compliance), K_F from
+//   the position-held system [[K_q − K_g, J_hᵀ], [J_h, 0]] (J_h = J_p, or (J_p; J_φ)), whose
+//   inverse has −K_F as the position block of its multiplier corner and stays finite there.
+// A singular C_F (a direction the joints cannot move the end in, e.g. x at the straight
+// configuration) is reported as `rigid` with K_F NaN; a singular K_F as `singular` with C_F NaN.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/end_condition.h"
+
+namespace buckle::mechanics {
+
+struct CartesianStiffness {
+  Eigen::Matrix2d stiffness = Eigen::Matrix2d::Zero();   ///< K_F: δF = K_F δp (rows/cols x, y)
+  Eigen::Matrix2d compliance = Eigen::Matrix2d::Zero();  ///< C_F = K_F⁻¹ (NaN when K_F is singular)
+  bool rotationHeld = false;
+  /// K_F is singular: infinite compliance in some direction (C_F NaN). Set where K_q − K_g is
+  /// singular on ker J_φ (force-control limit / bifurcation point); K_F is then still given.
+  bool singular = false;
+  /// C_F is singular: infinite stiffness in some direction (K_F NaN), e.g. the axial direction
+  /// of the straight chain, whose end cannot move along x to first order.
+  bool rigid = false;
+  /// Both C_F and K_F defined, K_F symmetric positive definite.
+  bool positiveDefinite = false;
+  /// Number of negative eigenvalues of K_q − K_g on ker J_φ (rotation held) or on the whole
+  /// space (rotation free): the equilibrium is stable under force control iff this is 0 and
+  /// `singular` is false.
+  int negativeDirections = 0;
+  /// Smallest eigenvalue of K_q − K_g on that space.
+  double smallestEigenvalue = 0.0;
+};
+
+struct StiffnessOptions {
+  /// Reciprocal condition number below which a matrix is treated as singular.
+  double singularTolerance = 1e-12;
+  /// Also compute negativeDirections / smallestEigenvalue (a dense eigen-decomposition).
+  bool computeInertia = true;
+};
+
+/// Loaded stiffness K_F at (q, F) (eq 24–29); rotation free or held.
+CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, bool rotationHeld = false,
+                                   const StiffnessOptions& options = {});
+/// Same, with the end rotation held iff `end` holds φ (the held x / y only decide which forces
+/// are reactions in F, not the definition of K_F).
+CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, const EndCondition& end,
+                                   const StiffnessOptions& options = {});
+/// Unloaded stiffness K_F⁰ = (J K_q⁻¹ Jᵀ)⁻¹ (eq 21–23): loadedStiffness with F = 0.
+CartesianStiffness unloadedStiffness(const Chain& chain, ConstVectorRef q, bool rotationHeld = false,
+                                     const StiffnessOptions& options = {});
+
+}  // namespace buckle::mechanics
