@@ -1,0 +1,295 @@
+// Dynamics of the chain under fixed end loads / held end coordinates: what happens between two
+// equilibria (a jump at a fold, the response to a sudden load). Conventions: conventions.h.
+//
+// Two models, "model only what the scene needs":
+//
+//  * GradientFlowModel — overdamped, massless joints (always available):
+//        c · dq/dt = −P ∇Π(q) − κ_h J_h⁺ h(q)                                           (D1)
+//    ∇Π = ∂E/∂q − J_lᵀ F_l (eq 9 with the given loads only), J_h the rows of the end Jacobian
+//    (eq 11) of the held coordinates, h(q) = p_h(q) − target, J_h⁺ = J_hᵀ(J_h J_hᵀ)⁻¹ and
+//    P = I − J_h⁺ J_h the projection onto the tangent space of the held coordinates. With h = 0
+//    the held reactions are the least-squares multipliers r = (J_h J_hᵀ)⁻¹ J_h ∇Π, and
+//    dΠ/dt = −c |dq/dt|² ≤ 0: Π is a Lyapunov function, the flow can only come to rest at an
+//    equilibrium, and generically at a stable one. The κ_h term pulls any drift of h back at
+//    the rate κ_h / c (dh/dt = −(κ_h/c) h exactly): no projection step is needed, so the
+//    adaptive explicit integrators see one smooth ODE.
+//
+//  * InertialModel — links with mass and rotary inertia, viscous joint damping (only when
+//    InertiaData is given; it has no other constructor):
+//        M(q) q̈ + c(q, q̇) + D q̇ + ∇Π(q) = J_hᵀ r                                        (D2)
+//        J_h q̈ + J̇_h q̇ = −2ω J_h q̇ − ω² h(q)                      (Baumgarte, critically damped)
+//    Link m (m = 1 … n: between joint m and m+1, the last one being the end link; the base link
+//    ℓ_0 is clamped) has mass m_m, centroidal inertia I_m and its centre of mass at distance d_m
+//    from joint m along the link. In absolute angles θ = T q (T lower-triangular ones) the
+//    kinetic energy is ½ θ̇ᵀ M_θ θ̇ with M_θ(i, j) = μ_ij cos(θ_i − θ_j),
+//        μ_ii = I_i + m_i d_i² + ℓ_i² Σ_{k>i} m_k,   μ_ij = ℓ_i (m_j d_j + ℓ_j Σ_{k>j} m_k)  (i < j),
+//    and Lagrange's equations give the velocity terms c_θ,i = Σ_j μ_ij sin(θ_i − θ_j) θ̇_j².
+//    In joint angles M = Tᵀ M_θ T and c = Tᵀ c_θ. The dissipated energy ∫ q̇ᵀ D q̇ dt is an extra
+//    state, so K + Π + W_d = const is checkable to the integrator tolerance.
+//
+// Both models append the dissipated energy to the state; the integrator (simulate) stops at
+// rest (velocity and equilibrium residual below tolerance) or at a guard (time, steps, a joint
+// limit, step-size underflow, a non-finite state) and says which. Models own their workspace:
+// the right-hand side allocates nothing. A model is not thread-safe (one per thread).
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/end_condition.h"
+
+namespace buckle::mechanics {
+
+// ---- scene data ------------------------------------------------------------------------------
+
+/// One moving link as a rigid body.
+struct LinkInertia {
+  double mass = 0.0;     ///< m_m > 0
+  double inertia = 0.0;  ///< centroidal rotary inertia I_m >= 0
+  /// Distance d_m of the centre of mass from the link's proximal joint along the link, in
+  /// [0, ℓ_m]; NaN (default) means mid-link, ℓ_m / 2.
+  double comOffset = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// Masses of the n moving links (link m between joint m and m+1, the last one the end link).
+struct InertiaData {
+  std::vector<LinkInertia> links;
+
+  /// Slender uniform rods: m = ρ ℓ_m, I = m ℓ_m² / 12, centre of mass mid-link.
+  static InertiaData uniformRods(const Chain& chain, double massPerLength);
+  /// The same mass, centroidal inertia and mid-link centre of mass for every link.
+  static InertiaData uniform(const Chain& chain, double mass, double inertia);
+
+  /// Sizes and values against the chain: n links, m > 0, I >= 0, d in [0, ℓ], all finite.
+  bool IsValid(const Chain& chain, std::string* why) const;
+};
+
+/// What the scene provides. Without `inertia` the overdamped gradient flow is used and the
+/// inertial model is never built.
+struct DynamicsScene {
+  std::optional<InertiaData> inertia;
+  /// Viscous joint damping d_i (D = diag(d), size n) of the inertial model; empty = undamped.
+  std::vector<double> jointDamping;
+  /// Damping scale c > 0 of the gradient flow (D1): time is measured in units of c / stiffness.
+  double flowDamping = 1.0;
+  /// Gradient flow: constraint restoring stiffness κ_h in (D1) (same units as a joint
+  /// stiffness). <= 0: automatic, 10·max(1, max_i |K_q,ii(q0)|).
+  double constraintStiffness = 0.0;
+  /// Inertial model: Baumgarte rate ω (1/time) of the held coordinates. <= 0: automatic,
+  /// 10·max_i √(|∂²Π/∂q_i²| / M_ii) at the start (ten times the fastest joint frequency).
+  double baumgarteRate = 0.0;
+
+  bool IsValid(const Chain& chain, std::string* why) const;
+};
+
+// ---- models ----------------------------------------------------------------------------------
+
+enum class DynamicsKind { GradientFlow, Inertial };
+
+/// Common part: the chain, the fixed loads / held targets, Π, its gradient and the constraints.
+/// State x = (q, [q̇,] W_d): joint angles, velocities (inertial only), dissipated energy.
+class DynamicsModel {
+ public:
+  virtual ~DynamicsModel() = default;
+  DynamicsModel(const DynamicsModel&) = delete;
+  DynamicsModel& operator=(const DynamicsModel&) = delete;
+
+  virtual DynamicsKind kind() const = 0;
+  virtual int stateSize() const = 0;
+  int segments() const { return chain_.size(); }
+  const Chain& chain() const { return chain_; }
+  const EndCondition& endCondition() const { return end_; }
+  int heldCount() const { return static_cast<int>(held_.size()); }
+
+  /// x0 from q and q̇ (q̇ ignored by the gradient flow), dissipated energy 0.
+  virtual void packState(ConstVectorRef q, ConstVectorRef qdot, VectorRef x) const = 0;
+  /// dx/dt at x. Allocation-free.
+  virtual void rhs(const double* x, double* dxdt) = 0;
+  /// ∂(dx/dt)/∂x, row-major stateSize² (for the stiff stepper). Exact for the unconstrained
+  /// gradient flow, central differences of rhs() otherwise.
+  virtual void jacobian(const double* x, double* jacobianRowMajor);
+
+  /// Joint angles / velocities / dissipated energy stored in x.
+  Eigen::Map<const Vector> angles(const double* x) const { return Eigen::Map<const Vector>(x, segments()); }
+  /// Joint velocity q̇ at x (the flow evaluates (D1); needs rhs(), hence non-const).
+  virtual void velocity(const double* x, VectorRef qdot) = 0;
+  virtual double dissipated(const double* x) const = 0;
+  virtual double kineticEnergy(const double* x) = 0;
+
+  /// Π(q) = E(q) − F_l · p_l(q) (held coordinates do no work while held).
+  double potential(ConstVectorRef q);
+  /// ∂Π/∂q = ∂E/∂q − J_lᵀ F_l.
+  void potentialGradient(ConstVectorRef q, VectorRef g);
+  /// Equilibrium residual max(‖P ∇Π‖∞, ‖h‖∞): zero exactly at an equilibrium of the scene.
+  double equilibriumResidual(ConstVectorRef q);
+  /// ‖h(q)‖∞ = max over held coordinates |p_c(q) − target_c| (0 without held coordinates).
+  double constraintViolation(ConstVectorRef q);
+  /// Gauss–Newton onto h(q) = 0 (minimum-norm corrections J_h⁺ h); true when ‖h‖∞ <= tol.
+  bool projectOntoConstraints(VectorRef q, double tolerance = 1e-13, int maxIterations = 20);
+  /// Inside the joint limits (geometric ∩ user, open interval)?
+  bool withinLimits(ConstVectorRef q) const;
+
+ protected:
+  DynamicsModel(const Chain& chain, const EndCondition& end);
+  /// Kinematics, J, ∇Π and (with held coordinates) J_h, h, the Cholesky of J_h J_hᵀ at q.
+  void evaluateStatics(ConstVectorRef q);
+
+  Chain chain_;
+  EndCondition end_;
+  std::vector<int> held_, loaded_;
+  Wrench loads_;  ///< F_l on loaded coordinates, 0 on held ones
+  ChainData data_;
+  Matrix J_;      ///< 3×n end Jacobian
+  Vector grad_;   ///< ∇Π
+  Matrix Jh_;     ///< m×n held rows
+  Vector h_;      ///< p_h − target
+  Matrix A_;      ///< J_h J_hᵀ
+  Eigen::LLT<Matrix> llt_;
+  Vector r_, tmpM_;  // size m
+  Vector tmpN_;      // size n
+  std::vector<double> fdPlus_, fdMinus_, fdState_;  // for the finite-difference jacobian()
+};
+
+/// (D1). dx/dt = (q̇, c|q̇|²).
+class GradientFlowModel final : public DynamicsModel {
+ public:
+  /// `q0` sets the automatic constraint stiffness (scene.constraintStiffness <= 0).
+  GradientFlowModel(const Chain& chain, const EndCondition& end, const DynamicsScene& scene, ConstVectorRef q0);
+
+  DynamicsKind kind() const override { return DynamicsKind::GradientFlow; }
+  int stateSize() const override { return segments() + 1; }
+  void packState(ConstVectorRef q, ConstVectorRef qdot, VectorRef x) const override;
+  void rhs(const double* x, double* dxdt) override;
+  void jacobian(const double* x, double* jacobianRowMajor) override;
+  void velocity(const double* x, VectorRef qdot) override;
+  double dissipated(const double* x) const override { return x[segments()]; }
+  double kineticEnergy(const double*) override { return 0.0; }
+
+  double damping() const { return c_; }
+  double constraintStiffness() const { return kappaH_; }
+
+ private:
+  double c_, kappaH_;
+  Matrix H_;  // Hessian workspace for the exact Jacobian
+  Vector qdot_;
+};
+
+/// (D2). x = (q, q̇, W_d), dx/dt = (q̇, q̈, q̇ᵀ D q̇). Only constructible from explicit mass data.
+class InertialModel final : public DynamicsModel {
+ public:
+  /// Throws std::invalid_argument when the inertia data or the damping do not fit the chain.
+  InertialModel(const Chain& chain, const EndCondition& end, const InertiaData& inertia,
+                const std::vector<double>& jointDamping, double baumgarteRate, ConstVectorRef q0);
+  ~InertialModel() override;
+
+  /// How many InertialModel objects were ever constructed in this process (tests check that a
+  /// scene without masses never builds one).
+  static long constructedCount();
+
+  DynamicsKind kind() const override { return DynamicsKind::Inertial; }
+  int stateSize() const override { return 2 * segments() + 1; }
+  void packState(ConstVectorRef q, ConstVectorRef qdot, VectorRef x) const override;
+  void rhs(const double* x, double* dxdt) override;
+  void velocity(const double* x, VectorRef qdot) override;
+  double dissipated(const double* x) const override { return x[2 * segments()]; }
+  double kineticEnergy(const double* x) override;
+
+  /// Joint-space mass matrix M(q) = Tᵀ M_θ(q) T (n×n, symmetric positive definite).
+  void massMatrix(ConstVectorRef q, MatrixRef M);
+  /// Velocity-dependent generalized force c(q, q̇) = Tᵀ c_θ of (D2).
+  void velocityTerms(ConstVectorRef q, ConstVectorRef qdot, VectorRef c);
+  /// Positions of the link centres of mass (2×n) — an independent kinematic check.
+  void centresOfMass(ConstVectorRef q, Eigen::Ref<Eigen::Matrix2Xd> G) const;
+  const Vector& jointDamping() const { return d_; }
+  double baumgarteRate() const { return omega_; }
+
+ private:
+  void computeMassMatrix(ConstVectorRef q);  // fills Mtheta_, M_ (uses theta from data_)
+
+  Vector mass_, inertia_, com_, d_;
+  Vector tailMass_;  // Σ_{k>i} m_k
+  Matrix mu_;                  // μ_ij (constant)
+  Matrix Mtheta_, M_;
+  Vector cos_, sin_;  // cos θ_i, sin θ_i
+  Eigen::LLT<Matrix> mllt_;
+  Vector thetaDot_, cTheta_, f_, acc_;
+  Matrix B_, S_;  // M⁻¹ J_hᵀ (n×m), J_h M⁻¹ J_hᵀ (m×m)
+  Eigen::LLT<Matrix> sllt_;
+  double omega_;
+};
+
+/// The only way scenes build a model: the inertial one if and only if scene.inertia is set.
+/// Throws std::invalid_argument (with the reason) if the scene does not fit the chain.
+std::unique_ptr<DynamicsModel> makeDynamicsModel(const Chain& chain, const EndCondition& end,
+                                                 const DynamicsScene& scene, ConstVectorRef q0);
+
+// ---- integration -----------------------------------------------------------------------------
+
+enum class StepperKind {
+  DormandPrince5,  ///< runge_kutta_dopri5, FSAL, error-controlled (default)
+  CashKarp54,      ///< runge_kutta_cash_karp54, error-controlled
+  Rosenbrock4,     ///< rosenbrock4 (L-stable, uses the model's Jacobian) for stiff scenes
+};
+
+struct IntegrationOptions {
+  StepperKind stepper = StepperKind::DormandPrince5;
+  double absoluteTolerance = 1e-10;  ///< per-step local error control (odeint eps_abs)
+  double relativeTolerance = 1e-10;  ///< (odeint eps_rel)
+  double initialStep = 1e-3;
+  double maxStep = 0.0;              ///< 0: unlimited
+  double minStep = 1e-13;            ///< below this the step size has underflowed: stop
+  double maxTime = 1e5;              ///< guard
+  long maxSteps = 1000000;           ///< guard (accepted steps)
+  /// Rest: ‖q̇‖∞ <= velocityTolerance and equilibrium residual <= residualTolerance.
+  double velocityTolerance = 1e-9;
+  double residualTolerance = 1e-9;
+  /// Record a sample when at least this much time passed since the last one (0: every
+  /// accepted step); the first and the last states are always recorded.
+  double recordInterval = 0.0;
+  bool recordTrajectory = true;
+  std::size_t maxSamples = 200000;   ///< recording stops (trajectoryTruncated) beyond this
+
+  bool IsValid(std::string* why) const;
+};
+
+enum class StopReason { Rest, MaxTime, MaxSteps, JointLimit, StepSizeUnderflow, NonFinite };
+const char* toString(StopReason reason);
+
+struct TrajectorySample {
+  double t = 0.0;
+  Vector q, qdot;
+  double potential = 0.0;    ///< Π
+  double kinetic = 0.0;      ///< ½ q̇ᵀ M q̇ (0 for the gradient flow)
+  double dissipated = 0.0;   ///< ∫ q̇ᵀ D q̇ dt  (gradient flow: ∫ c |q̇|² dt)
+  double residual = 0.0;     ///< equilibrium residual
+  double constraintViolation = 0.0;
+};
+
+struct DynamicsResult {
+  StopReason reason = StopReason::MaxSteps;
+  std::string message;              ///< human-readable reason
+  DynamicsKind kind = DynamicsKind::GradientFlow;
+  double time = 0.0;                ///< duration (model time)
+  long steps = 0, rejectedSteps = 0;
+  Vector q, qdot;                   ///< final state
+  double initialEnergy = 0.0;       ///< Π + K at t = 0
+  double potential = 0.0, kinetic = 0.0, dissipated = 0.0;
+  double residual = 0.0, speed = 0.0;  ///< final equilibrium residual and ‖q̇‖∞
+  double maxConstraintViolation = 0.0;  ///< over every accepted step
+  double maxEnergyBalanceError = 0.0;   ///< max |Π + K + W_d − initialEnergy| over accepted steps
+  double wallSeconds = 0.0;
+  std::vector<TrajectorySample> trajectory;
+  bool trajectoryTruncated = false;
+};
+
+/// Integrates the model from (q0, q̇0) until rest or a guard. Throws std::invalid_argument for
+/// invalid options or sizes; every other ending is reported in DynamicsResult::reason.
+DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef qdot0, const IntegrationOptions& options);
+
+}  // namespace buckle::mechanics
