@@ -1,0 +1,47 @@
+// Branch switching at simple branch points, and automatic tracing of the bifurcation tree.
+//
+// At a located simple BP, ker F_x (F_x = [F_u, F_λ], N×(N+1)) is 2-dimensional and spanned by
+// the parent tangent t and an orthogonal φ. The tangents of the two crossing branches are the
+// roots (α, β) of the algebraic bifurcation equation
+//     ψᵀF_xx[αt + βφ, αt + βφ] = 0      (ψ: left null vector of F_x),
+// one of which is the parent's. The child's direction is the other root (for a symmetric
+// pitchfork it is φ; for a transcritical bifurcation it is not orthogonal to t). When the second
+// derivatives are degenerate the direction falls back to φ, which still works: the first Keller
+// step on the hyperplane φᵀ(x − x_BP) = h crosses the child branch transversally.
+#pragma once
+
+#include "buckle/continuation/branch.h"
+#include "buckle/continuation/problem.h"
+#include "buckle/continuation/tracer.h"
+
+#include <string>
+
+namespace buckle::continuation {
+
+struct BranchSwitchingOptions {
+  /// Length h of the first step off the branch point; 0: the tracer's initialStep.
+  double amplitude = 0.0;
+  /// The first corrected point counts as off the parent branch when its distance from the
+  /// parent's tangent line is at least this fraction of its distance from the BP.
+  double minOffBranchFraction = 0.05;
+  bool IsValid(std::string *why) const;
+};
+
+/// Unit tangent (N+1) of the branch that crosses the traced one at the simple branch point bp
+/// (bp.nullVectors has the parent tangent and φ as columns). `note` says how it was obtained.
+bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note = nullptr);
+
+/// A new branch leaving bp along sign·direction: point 0 is the branch point itself, point 1
+/// the first corrected point (confirmed off the parent branch), then traced with `tracer`.
+/// Branch::stopReason == SwitchFailed when the first point could not be found.
+Branch switchBranch(Tracer &tracer, const SpecialPoint &bp, const Vector &direction, int sign,
+                    const BranchSwitchingOptions &options = BranchSwitchingOptions());
+
+/// Traces the branch from (u0, λ0), then switches at every simple branch point in both
+/// directions, recursively, down to maxDepth generations (0: only the first branch).
+/// Multiplicity-2 points are reported but not switched.
+BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
+                     const TracerOptions &options, int maxDepth,
+                     const BranchSwitchingOptions &switching = BranchSwitchingOptions());
+
+}  // namespace buckle::continuation

@@ -1,0 +1,104 @@
+// Newton corrector for the Keller pseudo-arclength system, on KINSOL.
+//
+// With x = (u, λ) ∈ R^{N+1}, a predictor x̂ and a unit tangent t, the corrector solves
+//     G(x) = [ F(u, λ) ; tᵀ(x − x̂) ] = 0,
+// whose Jacobian [[F_u, F_λ], [tᵀ]] is regular at regular points and at simple folds (Keller
+// 1977), so the same code walks around turning points. Exact Newton (Jacobian refreshed at
+// every iterate, dense LU): continuation steps are short, so the quadratic convergence
+// region is where we live and the iteration count is a reliable step-size signal.
+//
+// One KINSOL instance, N_Vector, SUNMatrix and linear solver are created per Corrector and
+// reused for every solve; a solve only copies the new predictor/tangent into storage the
+// callbacks read, so the hot loop allocates nothing. A point refused by the problem
+// (residual() == false) is a recoverable failure: KINSOL halves its Newton step, and if the
+// predictor itself is refused the solve fails with KIN_FIRST_SYSFUNC_ERR.
+#pragma once
+
+#include "buckle/continuation/problem.h"
+#include "buckle/continuation/sundials_raii.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace buckle::continuation {
+
+struct CorrectorOptions {
+  /// Converged when ‖G‖∞ ≤ residualTolerance (KINSOL fnormtol).
+  double residualTolerance = 1e-10;
+  /// KINSOL scaled step tolerance: stop when the Newton step is this small relative to x.
+  double stepTolerance = 1e-14;
+  int maxIterations = 10;
+  /// KIN_LINESEARCH instead of full Newton steps (KIN_NONE).
+  bool lineSearch = false;
+  /// A solve that stalls on the step tolerance (KIN_STEP_LT_STPTOL: rounding floor reached)
+  /// still counts as converged if ‖G‖₂ ≤ stagnationFactor · residualTolerance.
+  double stagnationFactor = 100.0;
+
+  bool IsValid(std::string *why) const;
+};
+
+/// Why and how a corrector solve ended.
+struct CorrectorSummary {
+  bool converged = false;
+  int flag = 0;                   ///< KINSOL return flag
+  const char *flagName = "";      ///< kinsolFlagName(flag)
+  int iterations = 0;             ///< Newton iterations (KINGetNumNonlinSolvIters)
+  int residualEvaluations = 0;
+  double residualNorm = 0.0;      ///< ‖G‖₂ at the returned point (KINGetFuncNorm)
+  double lastStepNorm = 0.0;      ///< ‖Δx‖₂ of the last Newton step
+  double contraction = 0.0;       ///< largest ‖Δx_{k+1}‖/‖Δx_k‖ seen (0: fewer than two steps)
+  bool refusedPoint = false;      ///< the problem refused at least one iterate
+  std::string message;            ///< KINSOL's own message when it reported an error
+};
+
+class Corrector {
+ public:
+  explicit Corrector(Problem &problem, const CorrectorOptions &options = CorrectorOptions());
+  Corrector(const Corrector &) = delete;
+  Corrector &operator=(const Corrector &) = delete;
+
+  int dimension() const { return n_; }
+  const CorrectorOptions &options() const { return options_; }
+  /// Tolerances may change between solves (the locator tightens them); no reallocation.
+  void setOptions(const CorrectorOptions &options);
+
+  /// Keller system: F(x) = 0, tangentᵀ(x − predictor) = 0, starting at the predictor.
+  /// predictor, tangent and x have size N+1; x receives the last iterate even on failure.
+  CorrectorSummary correct(ConstVectorRef predictor, ConstVectorRef tangent, VectorRef x);
+
+  /// F(u, λ) = 0 at fixed λ (start-point polishing, landing on a λ value): the bordered
+  /// system with tangent e_λ, so the same KINSOL instance serves. u has size N.
+  CorrectorSummary solveAtFixedParameter(ConstVectorRef u0, double lambda, VectorRef u);
+
+  /// Keeps coordinate `index` of x at predictor[index] (a face of a box, or λ).
+  CorrectorSummary solveWithFixedCoordinate(ConstVectorRef predictor, int index, VectorRef x);
+
+ private:
+  static int systemFunction(N_Vector x, N_Vector g, void *self);
+  static int jacobianFunction(N_Vector x, N_Vector g, SUNMatrix J, void *self, N_Vector, N_Vector);
+  static void errorHandler(int code, const char *module, const char *function, char *message, void *self);
+  int evaluate(const double *x, double *g);
+  int evaluateJacobian(const double *x, double *J);
+  void applyOptions();
+
+  Problem &problem_;
+  CorrectorOptions options_;
+  int n_;
+  Vector predictor_, tangent_, lastIterate_;
+  Vector unit_;  // e_k for the fixed-coordinate solves
+  std::vector<double> stepNorms_;  // capacity fixed at construction
+  bool haveLastIterate_ = false;
+  bool refused_ = false;
+  int evaluations_ = 0;
+  std::array<char, 256> lastError_{};
+
+  // Declaration order is release order reversed: KINSOL memory goes first, context last.
+  SunContextPtr context_;
+  NVectorPtr x_, scale_;
+  SunMatrixPtr jacobian_;
+  SunLinearSolverPtr linearSolver_;
+  KinsolMemoryPtr kinsol_;
+};
+
+}  // namespace buckle::continuation

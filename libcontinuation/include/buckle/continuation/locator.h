@@ -1,0 +1,110 @@
+// Location of special points and stop events inside one continuation step.
+//
+// Two stages, as in MATCONT/BifurcationKit:
+//  1. along the branch: a safeguarded secant (Illinois) iteration on a test function of the
+//     pseudo-arclength s ∈ (0, ds) measured along the step's tangent; every evaluation is a
+//     Keller corrector solve on the hyperplane t_aᵀ(x − x_a) = s, so every iterate is on the
+//     branch;
+//  2. refinement: Newton on an augmented system whose regular solution IS the special point
+//       fold          (F = 0, F_u v = 0, cᵀv = 1)                 unknowns (u, λ, v)
+//       simple BP     (F(x) + βp = 0, F_xᵀp = 0, pᵀp = 1)  (Moore)  unknowns (x, β, p)
+//     with second derivatives from Problem::jacobianDirectionalDerivative. The residuals are
+//     exact, so even finite-difference second derivatives converge to the exact point.
+// Even numbers of eigenvalue crossings in one step (seen by the stability inertia only) are
+// separated by bisection on the inertia count; crossings that stay together down to a tiny
+// fraction of the step are reported as one point of higher multiplicity, unrefined.
+#pragma once
+
+#include "buckle/continuation/branch.h"
+#include "buckle/continuation/corrector.h"
+#include "buckle/continuation/problem.h"
+#include "buckle/continuation/test_functions.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace buckle::continuation {
+
+struct LocatorOptions {
+  double tolerance = 1e-12;          ///< target |Δλ| ≤ tolerance·max(1, |λ|)
+  double newtonTolerance = 1e-13;    ///< corrector ‖G‖∞ while locating
+  int maxIterations = 60;            ///< secant/bisection evaluations
+  int maxRefinementIterations = 15;
+  double separationFraction = 1e-9;  ///< of the step length
+  bool detectFolds = true;
+  bool detectBranchPoints = true;
+};
+
+/// A point on the current step at offset s (s = 0: its start point a).
+struct StepSample {
+  double s = 0.0;
+  ContinuationPoint point;
+};
+
+class Locator {
+ public:
+  Locator(Problem &problem, Corrector &corrector, PointEvaluator &evaluator, const LocatorOptions &options);
+
+  /// The step from a to b (b was corrected on t_aᵀ(x − x_a) = ds).
+  void setStep(const ContinuationPoint &a, const ContinuationPoint &b);
+  /// Branch point at offset s, predicted by interpolating a→b. False if the corrector fails.
+  bool sample(double s, StepSample &out, CorrectorSummary *summary = nullptr);
+
+  using TestFunction = std::function<bool(const ContinuationPoint &, double &)>;
+  struct Root {
+    StepSample at;
+    double value = 0.0;
+    double lastDs = 0.0;       ///< |Δs| of the last update
+    double lastDLambda = 0.0;  ///< |Δλ| of the last update
+    int evaluations = 0;
+    bool converged = false;
+    std::string failure;
+  };
+  /// Zero of test along the step inside [lo.s, hi.s], where fLo·fHi ≤ 0.
+  bool findRoot(const StepSample &lo, double fLo, const StepSample &hi, double fHi, const TestFunction &test,
+                Root &root);
+
+  /// Folds and branch points inside the current step, in arclength order (index not set).
+  std::vector<SpecialPoint> locateSpecialPoints(const IntervalCrossings &crossings);
+
+  const StepSample &start() const { return a_; }
+  const StepSample &end() const { return b_; }
+  double tolerance(double lambda) const { return options_.tolerance * std::max(1.0, std::abs(lambda)); }
+
+ private:
+  SpecialPoint locateFold(const StepSample &lo, const StepSample &hi);
+  SpecialPoint locateSimpleBranchPoint(const StepSample &lo, const StepSample &hi);
+  SpecialPoint multipleBranchPoint(const StepSample &lo, const StepSample &hi, int multiplicity);
+  void separateCrossings(const StepSample &lo, const StepSample &hi, std::vector<std::pair<StepSample, StepSample>> &simple,
+                         std::vector<std::pair<StepSample, StepSample>> &multiple, int depth);
+  bool refineFold(SpecialPoint &point, const Vector &tangentRef);
+  bool refineBranchPoint(SpecialPoint &point, const Vector &tangentRef);
+  void fillBranchPointGeometry(SpecialPoint &point, const Vector &tangentRef);
+  double residualNorm(ConstVectorRef u, double lambda);
+
+  Problem &problem_;
+  Corrector &corrector_;
+  PointEvaluator &evaluator_;
+  LocatorOptions options_;
+  int n_;
+  StepSample a_, b_;
+  Vector xa_, dx_, predictor_, x_;
+  double stepLength_ = 0.0;
+};
+
+/// Newton on a square augmented system z ↦ R(z) with Jacobian J(z); the λ unknown sits at
+/// lambdaIndex. Stops when the whole update is below tolerance·max(1,|λ|) or after maxIterations;
+/// converged iff the last |Δλ| met the tolerance. Reports the last |Δλ| and ‖R‖₂ at the end.
+struct AugmentedNewtonResult {
+  bool converged = false;
+  int iterations = 0;
+  double lastDLambda = 0.0;
+  double residualNorm = 0.0;
+  std::string failure;
+};
+using AugmentedSystem = std::function<bool(const Vector &z, Vector &R, Matrix *J)>;
+AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, int lambdaIndex, double tolerance,
+                                      int maxIterations, double maxDistance);
+
+}  // namespace buckle::continuation

@@ -1,0 +1,83 @@
+// Test functions: scalar quantities along a branch whose sign changes bracket special points.
+//
+//   fold          λ-component of the tangent (t_λ = 0 exactly at a simple fold);
+//   branch point  det [[F_u, F_λ], [tᵀ]] (regular at folds, simple zero at simple BPs), and the
+//                 inertia of the stability operator, which also sees even crossings (a double
+//                 zero, two BPs inside one step) that leave the determinant sign unchanged;
+//   location      the minimally augmented ψ (Govaerts 2000), a well-scaled smooth stand-in for
+//                 the determinant, whose magnitude is ~ the smallest singular value.
+#pragma once
+
+#include "buckle/continuation/branch.h"
+#include "buckle/continuation/problem.h"
+
+#include <Eigen/LU>
+
+namespace buckle::continuation {
+
+/// Completes a point whose u and λ are set: tangent (oriented by a reference direction), the
+/// fold and determinant tests, and the stability inertia. Workspaces are sized once.
+class PointEvaluator {
+ public:
+  PointEvaluator(Problem &problem, bool computeStability);
+
+  /// Tangent from [[F_u, F_λ], [referenceᵀ]] t = e_{N+1}, normalised, so tᵀreference > 0.
+  /// False when the problem refuses the point or the bordered matrix is exactly singular; in
+  /// the singular case (lastWasSingular()) the point still gets determinantSign = 0, the
+  /// normalised reference as tangent and its stability, so test functions stay evaluable.
+  bool complete(ContinuationPoint &point, ConstVectorRef reference);
+  bool lastWasSingular() const { return singular_; }
+
+  /// Writes [[F_u, F_λ], [tᵀ]] into A ((N+1)×(N+1)).
+  bool borderedJacobian(ConstVectorRef u, double lambda, ConstVectorRef t, MatrixRef A);
+
+  bool stabilityEnabled() const { return stability_; }
+  Problem &problem() { return problem_; }
+
+ private:
+  Problem &problem_;
+  int n_;
+  bool stability_;
+  bool singular_ = false;
+  Matrix bordered_;
+  Eigen::PartialPivLU<Matrix> lu_;
+  Vector rhs_, solution_;
+};
+
+/// ψ from [[A, b], [cᵀ, 0]] [v; ψ] = [0; 1]. b and c are frozen at a reference matrix (its
+/// left/right singular vectors of the smallest singular value), so ψ is a smooth function
+/// along the step with a simple zero where A is singular.
+class MinimallyAugmentedTest {
+ public:
+  void initialize(const Matrix &referenceA);
+  /// ψ for A; v (size of A) receives the approximate null vector when non-null.
+  bool evaluate(const Matrix &A, double &psi, Vector *v = nullptr);
+
+ private:
+  Vector b_, c_;
+  Matrix augmented_;
+  Vector rhs_, solution_;
+};
+
+/// What changed between two consecutive points.
+struct IntervalCrossings {
+  bool fold = false;               ///< t_λ changed sign
+  bool determinantChange = false;  ///< bordered determinant changed sign
+  int inertiaChange = -1;          ///< |Δ negative eigenvalues|; -1 when not known at both ends
+  int branchPointCrossings = 0;    ///< eigenvalue crossings not explained by the fold
+};
+
+IntervalCrossings classifyInterval(const ContinuationPoint &a, const ContinuationPoint &b, bool detectFolds,
+                                   bool detectBranchPoints);
+
+/// Smallest singular value of F_x = [F_u, F_λ] and its right/left singular vectors: an
+/// orthonormal basis of the (approximate) kernel from a dense SVD. Allocates; used at special
+/// points only.
+struct KernelInfo {
+  Vector singularValues;  ///< ascending, size N+1; [0] = 0 is the structural extra kernel direction
+  Matrix right;           ///< columns: right singular vectors, same order ((N+1)×(N+1))
+  Matrix left;            ///< columns: left singular vectors; left.col(k) pairs with singularValues[k + 1]
+};
+bool jacobianKernel(Problem &problem, ConstVectorRef u, double lambda, KernelInfo &info);
+
+}  // namespace buckle::continuation

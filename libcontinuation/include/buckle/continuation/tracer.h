@@ -1,0 +1,122 @@
+// Pseudo-arclength continuation of one branch (Keller; AUTO-07p / MATCONT style).
+//
+// Each step: tangent predictor x̂ = x + ds·t, Keller corrector on the bordered system, new
+// tangent from [[F_u, F_λ], [t_prevᵀ]] t = e_{N+1} (which keeps the orientation, t_newᵀt_prev > 0),
+// a branch-jump guard on the tangent turning angle, then detection and location of special
+// points and of the stop conditions (parameter range, box, boundaries g_k = 0) between the last
+// two points. The step adapts to the Newton iteration count and contraction.
+#pragma once
+
+#include "buckle/continuation/branch.h"
+#include "buckle/continuation/corrector.h"
+#include "buckle/continuation/problem.h"
+#include "buckle/continuation/test_functions.h"
+
+#include <limits>
+#include <memory>
+#include <string>
+
+namespace buckle::continuation {
+
+struct TracerOptions {
+  // ---- step control -----------------------------------------------------------------------
+  double initialStep = 0.01;
+  double minStep = 1e-8;
+  double maxStep = 0.1;
+  int targetNewtonIterations = 3;   ///< ds·target/iterations, clamped to [stepShrink, stepGrowth]
+  double stepGrowth = 1.5;
+  double stepShrink = 0.5;
+  double slowContraction = 0.3;     ///< contraction above this shrinks the next step
+  double minTangentCosine = 0.9;    ///< branch-jump guard: t_newᵀt_old must stay ≥ this (MATCONT)
+
+  // ---- stop conditions -------------------------------------------------------------------
+  int maxPoints = 500;              ///< including the start point
+  double lambdaMin = -std::numeric_limits<double>::infinity();
+  double lambdaMax = std::numeric_limits<double>::infinity();
+  double maxArclength = std::numeric_limits<double>::infinity();
+  /// Optional box on x = (u, λ): empty, or both of size N+1 (±inf entries allowed).
+  Vector boxLower, boxUpper;
+
+  // ---- corrector -------------------------------------------------------------------------
+  double newtonTolerance = 1e-10;   ///< ‖G‖∞ of the Keller system
+  double newtonStepTolerance = 1e-14;
+  int maxNewtonIterations = 10;
+  bool lineSearch = false;
+
+  // ---- detection and location ------------------------------------------------------------
+  bool detectFolds = true;
+  bool detectBranchPoints = true;
+  bool detectBoundaries = true;     ///< Problem::boundary(k) and the box
+  bool computeStability = true;     ///< record Problem::stability() at every point
+  /// Target |Δλ| ≤ locationTolerance·max(1, |λ|) for located points and stop events.
+  double locationTolerance = 1e-12;
+  /// ‖G‖∞ target of the corrector solves made while locating.
+  double locationNewtonTolerance = 1e-13;
+  int maxLocationIterations = 60;   ///< secant/bisection evaluations per located point
+  int maxRefinementIterations = 15; ///< Newton steps on the augmented (fold / Moore) systems
+  /// Two crossings inside one step that cannot be separated down to this fraction of the step
+  /// are one point of higher multiplicity.
+  double separationFraction = 1e-9;
+
+  bool IsValid(std::string *why) const;
+};
+
+/// Which way to leave the start point.
+struct InitialDirection {
+  int lambdaSign = 1;  ///< used when `tangent` is empty: sign of dλ/ds at the start
+  Vector tangent;      ///< optional (N+1) direction; the start tangent is oriented along it
+
+  static InitialDirection increasingLambda() { return InitialDirection{1, Vector()}; }
+  static InitialDirection decreasingLambda() { return InitialDirection{-1, Vector()}; }
+  static InitialDirection along(const Vector &t) { return InitialDirection{1, t}; }
+};
+
+class Locator;
+
+/// Holds the corrector (one KINSOL instance) and the workspaces for a problem; trace() may be
+/// called repeatedly.
+class Tracer {
+ public:
+  Tracer(Problem &problem, const TracerOptions &options);
+  ~Tracer();
+  Tracer(const Tracer &) = delete;
+  Tracer &operator=(const Tracer &) = delete;
+
+  /// Polishes (u0, λ0) at fixed λ, takes the start tangent from the kernel of [F_u, F_λ] and
+  /// traces until a stop condition. Invalid options give an empty branch with
+  /// StopReason::InvalidOptions.
+  Branch trace(ConstVectorRef u0, double lambda0, const InitialDirection &direction);
+
+  /// Continues `branch`, whose points are complete (tangent set); the last point is the
+  /// current one. Special points are not searched in the first `skipIntervals` intervals
+  /// (a branch that starts at a branch point).
+  void continueBranch(Branch &branch, int skipIntervals = 0);
+
+  /// Fills tangent, test functions and stability of a point from its u, λ.
+  bool completePoint(ContinuationPoint &point, ConstVectorRef referenceDirection);
+
+  Corrector &corrector() { return *corrector_; }
+  Problem &problem() { return problem_; }
+  const TracerOptions &options() const { return options_; }
+
+ private:
+  double eventValue(int event, const ContinuationPoint &point);
+  std::string eventName(int event) const;
+  int eventCount() const;
+  CorrectorOptions stepCorrectorOptions() const;
+
+  Problem &problem_;
+  TracerOptions options_;
+  std::string invalidReason_;
+  int n_;
+  std::unique_ptr<Corrector> corrector_;
+  std::unique_ptr<PointEvaluator> evaluator_;
+  std::unique_ptr<Locator> locator_;
+  Vector predictor_, x_;
+};
+
+/// One-shot convenience: Tracer(problem, options).trace(u0, λ0, direction).
+Branch trace(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
+             const TracerOptions &options = TracerOptions());
+
+}  // namespace buckle::continuation

@@ -1,0 +1,45 @@
+#include "buckle/continuation/branch.h"
+
+namespace buckle::continuation {
+
+Vector ContinuationPoint::state() const {
+  Vector x(u.size() + 1);
+  x << u, lambda;
+  return x;
+}
+
+const char *specialPointLabel(SpecialPointType type) {
+  switch (type) {
+    case SpecialPointType::Fold: return "LP";
+    case SpecialPointType::BranchPoint: return "BP";
+    case SpecialPointType::Boundary: return "BD";
+    case SpecialPointType::Endpoint: return "EP";
+  }
+  return "??";
+}
+
+const char *stopReasonName(StopReason reason) {
+  switch (reason) {
+    case StopReason::NotStarted: return "not started";
+    case StopReason::InvalidOptions: return "invalid options";
+    case StopReason::StartFailed: return "start failed";
+    case StopReason::MaxPoints: return "maximum number of points";
+    case StopReason::LambdaRange: return "parameter range end";
+    case StopReason::MaxArclength: return "maximum arclength";
+    case StopReason::Box: return "box";
+    case StopReason::Boundary: return "boundary";
+    case StopReason::StepSizeTooSmall: return "step size below minimum";
+    case StopReason::TangentFailed: return "tangent failed";
+    case StopReason::SwitchFailed: return "branch switching failed";
+  }
+  return "unknown";
+}
+
+std::vector<const SpecialPoint *> Branch::specialPointsOfType(SpecialPointType type) const {
+  std::vector<const SpecialPoint *> result;
+  for (const SpecialPoint &point : specialPoints)
+    if (point.type == type) result.push_back(&point);
+  return result;
+}
+
+}  // namespace buckle::continuation

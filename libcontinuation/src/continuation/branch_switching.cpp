@@ -1,0 +1,211 @@
+#include "buckle/continuation/branch_switching.h"
+
+#include "buckle/continuation/test_functions.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace buckle::continuation {
+
+bool BranchSwitchingOptions::IsValid(std::string *why) const {
+  if (!(amplitude >= 0.0) || !std::isfinite(amplitude)) {
+    if (why) *why = "amplitude must be finite and >= 0";
+    return false;
+  }
+  if (!(minOffBranchFraction > 0.0 && minOffBranchFraction < 1.0)) {
+    if (why) *why = "minOffBranchFraction must lie in (0, 1)";
+    return false;
+  }
+  return true;
+}
+
+bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note) {
+  const int n = problem.dimension();
+  if (bp.type != SpecialPointType::BranchPoint || bp.nullVectors.cols() < 2 || bp.nullVectors.rows() != n + 1) {
+    if (note) *note = "not a branch point with a 2-dimensional kernel";
+    return false;
+  }
+  const Vector t = bp.nullVectors.col(0);
+  const Vector phi = bp.nullVectors.col(1);
+  Vector psi = bp.leftNullVector;
+  if (psi.size() != n) {
+    KernelInfo kernel;
+    if (!jacobianKernel(problem, bp.u, bp.lambda, kernel)) return false;
+    psi = kernel.left.col(0);
+  }
+  Matrix Dt(n, n + 1), Dphi(n, n + 1);
+  const bool haveSecond =
+      problem.jacobianDirectionalDerivative(bp.u, bp.lambda, t.head(n), t[n], Dt.leftCols(n), Dt.col(n)) &&
+      problem.jacobianDirectionalDerivative(bp.u, bp.lambda, phi.head(n), phi[n], Dphi.leftCols(n), Dphi.col(n));
+  direction = phi;
+  if (!haveSecond) {
+    if (note) *note = "second derivatives unavailable: kernel direction orthogonal to the parent tangent";
+    return true;
+  }
+  // Coefficients of ψᵀF_xx[αt + βφ, αt + βφ] = aα² + 2bαβ + cβ².
+  const double a = psi.dot(Dt * t);
+  const double b = 0.5 * (psi.dot(Dt * phi) + psi.dot(Dphi * t));
+  const double c = psi.dot(Dphi * phi);
+  const double scale = std::max({std::abs(a), std::abs(b), std::abs(c)});
+  if (!(scale > 1e-12)) {
+    if (note) *note = "degenerate bifurcation equation: kernel direction orthogonal to the parent tangent";
+    return true;
+  }
+  const double discriminant = b * b - a * c;
+  if (discriminant < -1e-8 * scale * scale) {
+    if (note) *note = "bifurcation equation has no real roots (isolated point): kernel direction used";
+    return true;
+  }
+  const double root = std::sqrt(std::max(0.0, discriminant));
+  Vector candidates[2];
+  if (std::abs(a) <= 1e-10 * scale && std::abs(c) <= 1e-10 * scale) {
+    candidates[0] = t;
+    candidates[1] = phi;
+  } else if (std::abs(c) >= std::abs(a)) {
+    // β/α = r solves c r² + 2b r + a = 0.
+    for (int k = 0; k < 2; ++k) candidates[k] = t + ((-b + (k ? -root : root)) / c) * phi;
+  } else {
+    // α/β = r solves a r² + 2b r + c = 0.
+    for (int k = 0; k < 2; ++k) candidates[k] = ((-b + (k ? -root : root)) / a) * t + phi;
+  }
+  for (Vector &v : candidates) v.normalize();
+  // The parent's own tangent is one root; the child is the one farther from it.
+  direction = std::abs(candidates[0].dot(t)) <= std::abs(candidates[1].dot(t)) ? candidates[0] : candidates[1];
+  if (note) *note = "algebraic bifurcation equation";
+  return true;
+}
+
+Branch switchBranch(Tracer &tracer, const SpecialPoint &bp, const Vector &direction, int sign,
+                    const BranchSwitchingOptions &options) {
+  Branch child;
+  child.direction = sign >= 0 ? 1 : -1;
+  std::string why;
+  if (!options.IsValid(&why)) {
+    child.stopReason = StopReason::InvalidOptions;
+    child.stopMessage = "BranchSwitchingOptions: " + why;
+    return child;
+  }
+  Problem &problem = tracer.problem();
+  const int n = problem.dimension();
+  if (direction.size() != n + 1 || bp.u.size() != n) {
+    child.stopReason = StopReason::InvalidOptions;
+    child.stopMessage = "branch point or direction has the wrong size";
+    return child;
+  }
+  const double h = options.amplitude > 0.0 ? options.amplitude : tracer.options().initialStep;
+  const Vector d = child.direction * direction.normalized();
+  Vector xBP(n + 1);
+  xBP << bp.u, bp.lambda;
+  const Vector predictor = xBP + h * d;
+  Vector x(n + 1);
+  const CorrectorSummary summary = tracer.corrector().correct(predictor, d, x);
+  if (!summary.converged) {
+    child.stopReason = StopReason::SwitchFailed;
+    child.stopMessage = std::string("first point off the branch point did not converge (") + summary.flagName + ")";
+    return child;
+  }
+  const Vector w = x - xBP;
+  const Vector parentTangent = bp.nullVectors.cols() ? Vector(bp.nullVectors.col(0)) : bp.tangent;
+  const double offLine = (w - w.dot(parentTangent) * parentTangent).norm();
+  if (!(offLine >= options.minOffBranchFraction * w.norm()) || w.norm() == 0.0) {
+    child.stopReason = StopReason::SwitchFailed;
+    child.stopMessage = "first point converged back onto the parent branch";
+    return child;
+  }
+
+  ContinuationPoint start;
+  start.u = bp.u;
+  start.lambda = bp.lambda;
+  // The bordered Jacobian is singular exactly at the BP; completePoint still records stability.
+  tracer.completePoint(start, d);
+  start.tangent = d;
+  start.foldTest = d[n];
+  start.determinantSign = 0;
+  start.residualNorm = bp.residualNorm;
+
+  ContinuationPoint first;
+  first.u = x.head(n);
+  first.lambda = x[n];
+  if (!tracer.completePoint(first, d)) {
+    child.stopReason = StopReason::SwitchFailed;
+    child.stopMessage = "singular bordered Jacobian at the first point off the branch point";
+    return child;
+  }
+  first.arclength = d.dot(w);
+  first.stepSize = first.arclength;
+  first.newtonIterations = summary.iterations;
+  first.residualNorm = summary.residualNorm;
+
+  child.points.push_back(start);
+  child.points.push_back(first);
+  SpecialPoint ep;
+  ep.type = SpecialPointType::Endpoint;
+  ep.index = 0;
+  ep.u = start.u;
+  ep.lambda = start.lambda;
+  ep.tangent = d;
+  ep.residualNorm = bp.residualNorm;
+  ep.inertiaBefore = ep.inertiaAfter = start.stability.negative;
+  ep.note = "start: branch point of the parent branch";
+  child.specialPoints.push_back(ep);
+  // The branch point sits at point 0, where the test functions are degenerate: skip interval 0.
+  tracer.continueBranch(child, 1);
+  return child;
+}
+
+BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
+                     const TracerOptions &options, int maxDepth, const BranchSwitchingOptions &switching) {
+  BranchTree tree;
+  Tracer tracer(problem, options);
+  tree.branches.push_back(tracer.trace(u0, lambda0, direction));
+  tree.branches[0].id = 0;
+  std::vector<int> depth{0};
+  std::vector<Vector> switchedAt;
+  const int n = problem.dimension();
+  const double h = switching.amplitude > 0.0 ? switching.amplitude : options.initialStep;
+
+  for (std::size_t i = 0; i < tree.branches.size(); ++i) {
+    if (depth[i] >= maxDepth) continue;
+    for (std::size_t k = 0; k < tree.branches[i].specialPoints.size(); ++k) {
+      SpecialPoint bp = tree.branches[i].specialPoints[k];
+      if (bp.type != SpecialPointType::BranchPoint) continue;
+      if (bp.multiplicity > 1) continue;  // its note already says it is not switched
+      // The BP a child starts from is the parent's; never switch back at it.
+      if (!tree.branches[i].points.empty() && bp.arclength - tree.branches[i].points.front().arclength <= 1e-6 * h)
+        continue;
+      Vector xBP(n + 1);
+      xBP << bp.u, bp.lambda;
+      bool seen = false;
+      for (const Vector &y : switchedAt)
+        if ((y - xBP).norm() <= 1e-7 * std::max(1.0, xBP.norm())) seen = true;
+      std::string &note = tree.branches[i].specialPoints[k].note;
+      if (seen) {
+        note += (note.empty() ? "" : "; ") + std::string("already switched from another branch");
+        continue;
+      }
+      switchedAt.push_back(xBP);
+      Vector dir;
+      std::string how;
+      if (!bifurcatingDirection(problem, bp, dir, &how)) {
+        note += (note.empty() ? "" : "; ") + std::string("not switched: ") + how;
+        continue;
+      }
+      std::string children;
+      for (int sign : {1, -1}) {
+        Branch child = switchBranch(tracer, bp, dir, sign, switching);
+        child.id = static_cast<int>(tree.branches.size());
+        child.parentId = static_cast<int>(i);
+        child.parentSpecialPoint = static_cast<int>(k);
+        children += (children.empty() ? "" : ", ") + std::to_string(child.id);
+        tree.branches.push_back(std::move(child));
+        depth.push_back(depth[i] + 1);
+      }
+      std::string &noteAfter = tree.branches[i].specialPoints[k].note;
+      noteAfter += (noteAfter.empty() ? "" : "; ") + ("switched (" + how + "): branches " + children);
+    }
+  }
+  return tree;
+}
+
+}  // namespace buckle::continuation

@@ -1,0 +1,170 @@
+#include "buckle/continuation/corrector.h"
+
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace buckle::continuation {
+
+bool CorrectorOptions::IsValid(std::string *why) const {
+  auto fail = [why](const char *message) {
+    if (why) *why = message;
+    return false;
+  };
+  if (!(residualTolerance > 0.0) || !std::isfinite(residualTolerance))
+    return fail("residualTolerance must be positive and finite");
+  if (!(stepTolerance > 0.0) || !std::isfinite(stepTolerance))
+    return fail("stepTolerance must be positive and finite");
+  if (maxIterations < 1) return fail("maxIterations must be at least 1");
+  if (!(stagnationFactor >= 1.0) || !std::isfinite(stagnationFactor))
+    return fail("stagnationFactor must be finite and >= 1");
+  return true;
+}
+
+Corrector::Corrector(Problem &problem, const CorrectorOptions &options)
+    : problem_(problem), options_(options), n_(problem.dimension()) {
+  std::string why;
+  if (!options_.IsValid(&why)) throw std::invalid_argument("CorrectorOptions: " + why);
+  if (n_ < 1) throw std::invalid_argument("Problem::dimension() must be positive");
+  const sunindextype m = n_ + 1;
+  predictor_ = Vector::Zero(m);
+  tangent_ = Vector::Zero(m);
+  lastIterate_ = Vector::Zero(m);
+  unit_ = Vector::Zero(m);
+  // Full Newton evaluates once per iterate plus once per recoverable halving (at most 5 each).
+  stepNorms_.reserve(static_cast<std::size_t>(8 * options_.maxIterations + 16));
+
+  context_ = makeSunContext();
+  x_ = makeSerialVector(m, context_.get());
+  scale_ = makeSerialVector(m, context_.get());
+  N_VConst(1.0, scale_.get());
+  jacobian_ = makeDenseMatrix(m, m, context_.get());
+  linearSolver_ = makeDenseLinearSolver(x_.get(), jacobian_.get(), context_.get());
+  kinsol_ = makeKinsolMemory(context_.get());
+  void *mem = kinsol_.get();
+  if (KINInit(mem, &Corrector::systemFunction, x_.get()) != KIN_SUCCESS ||
+      KINSetUserData(mem, this) != KIN_SUCCESS ||
+      KINSetLinearSolver(mem, linearSolver_.get(), jacobian_.get()) != KINLS_SUCCESS ||
+      KINSetJacFn(mem, &Corrector::jacobianFunction) != KINLS_SUCCESS ||
+      KINSetErrHandlerFn(mem, &Corrector::errorHandler, this) != KIN_SUCCESS ||
+      KINSetMaxSetupCalls(mem, 1) != KIN_SUCCESS)
+    throw std::runtime_error("KINSOL set-up failed");
+  applyOptions();
+}
+
+void Corrector::setOptions(const CorrectorOptions &options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("CorrectorOptions: " + why);
+  options_ = options;
+  const auto needed = static_cast<std::size_t>(8 * options_.maxIterations + 16);
+  if (stepNorms_.capacity() < needed) stepNorms_.reserve(needed);
+  applyOptions();
+}
+
+void Corrector::applyOptions() {
+  void *mem = kinsol_.get();
+  KINSetFuncNormTol(mem, options_.residualTolerance);
+  KINSetScaledStepTol(mem, options_.stepTolerance);
+  KINSetNumMaxIters(mem, options_.maxIterations);
+}
+
+int Corrector::systemFunction(N_Vector x, N_Vector g, void *self) {
+  return static_cast<Corrector *>(self)->evaluate(N_VGetArrayPointer(x), N_VGetArrayPointer(g));
+}
+
+int Corrector::jacobianFunction(N_Vector x, N_Vector, SUNMatrix J, void *self, N_Vector, N_Vector) {
+  return static_cast<Corrector *>(self)->evaluateJacobian(N_VGetArrayPointer(x), SUNDenseMatrix_Data(J));
+}
+
+void Corrector::errorHandler(int, const char *, const char *function, char *message, void *self) {
+  auto &buffer = static_cast<Corrector *>(self)->lastError_;
+  std::snprintf(buffer.data(), buffer.size(), "%s: %s", function ? function : "KINSOL", message ? message : "");
+}
+
+int Corrector::evaluate(const double *xData, double *gData) {
+  const int m = n_ + 1;
+  Eigen::Map<const Vector> x(xData, m);
+  Eigen::Map<Vector> g(gData, m);
+  ++evaluations_;
+  if (haveLastIterate_ && stepNorms_.size() < stepNorms_.capacity())
+    stepNorms_.push_back((x - lastIterate_).norm());
+  lastIterate_ = x;
+  haveLastIterate_ = true;
+  if (!x.allFinite() || !problem_.residual(x.head(n_), x[n_], g.head(n_))) {
+    refused_ = true;
+    return 1;  // recoverable: KINSOL halves the step
+  }
+  g[n_] = tangent_.dot(x - predictor_);
+  return g.allFinite() ? 0 : 1;
+}
+
+int Corrector::evaluateJacobian(const double *xData, double *jData) {
+  const int m = n_ + 1;
+  Eigen::Map<const Vector> x(xData, m);
+  Eigen::Map<Matrix> J(jData, m, m);  // SUNDIALS dense storage is column-major, like Eigen
+  J.setZero();
+  if (!problem_.jacobian(x.head(n_), x[n_], J.topLeftCorner(n_, n_), J.col(n_).head(n_))) return -1;
+  J.row(n_) = tangent_.transpose();
+  return J.allFinite() ? 0 : -1;
+}
+
+CorrectorSummary Corrector::correct(ConstVectorRef predictor, ConstVectorRef tangent, VectorRef x) {
+  predictor_ = predictor;
+  tangent_ = tangent;
+  Eigen::Map<Vector>(N_VGetArrayPointer(x_.get()), n_ + 1) = predictor_;
+  stepNorms_.clear();
+  haveLastIterate_ = false;
+  refused_ = false;
+  evaluations_ = 0;
+  lastError_[0] = '\0';
+
+  void *mem = kinsol_.get();
+  const int flag = KINSol(mem, x_.get(), options_.lineSearch ? KIN_LINESEARCH : KIN_NONE, scale_.get(),
+                          scale_.get());
+  CorrectorSummary summary;
+  summary.flag = flag;
+  summary.flagName = kinsolFlagName(flag);
+  long iterations = 0;
+  KINGetNumNonlinSolvIters(mem, &iterations);
+  summary.iterations = static_cast<int>(iterations);
+  summary.residualEvaluations = evaluations_;
+  double fnorm = 0.0;
+  KINGetFuncNorm(mem, &fnorm);
+  summary.residualNorm = fnorm;
+  summary.refusedPoint = refused_;
+  if (!stepNorms_.empty()) summary.lastStepNorm = stepNorms_.back();
+  for (std::size_t k = 1; k < stepNorms_.size(); ++k)
+    if (stepNorms_[k - 1] > 0.0) summary.contraction = std::max(summary.contraction, stepNorms_[k] / stepNorms_[k - 1]);
+  summary.converged = flag == KIN_SUCCESS || flag == KIN_INITIAL_GUESS_OK ||
+                      (flag == KIN_STEP_LT_STPTOL && fnorm <= options_.stagnationFactor * options_.residualTolerance);
+  if (flag < 0 && lastError_[0] != '\0') summary.message = lastError_.data();
+  x = Eigen::Map<const Vector>(N_VGetArrayPointer(x_.get()), n_ + 1);
+  return summary;
+}
+
+CorrectorSummary Corrector::solveWithFixedCoordinate(ConstVectorRef predictor, int index, VectorRef x) {
+  unit_.setZero();
+  unit_[index] = 1.0;
+  CorrectorSummary summary = correct(predictor, unit_, x);
+  if (summary.converged) x[index] = predictor_[index];  // linear constraint: exact up to rounding
+  return summary;
+}
+
+CorrectorSummary Corrector::solveAtFixedParameter(ConstVectorRef u0, double lambda, VectorRef u) {
+  // Build the predictor in the KINSOL vector itself: correct() copies it into predictor_ and
+  // starts from it, so nothing is allocated.
+  Eigen::Map<Vector> x(N_VGetArrayPointer(x_.get()), n_ + 1);
+  x.head(n_) = u0;
+  x[n_] = lambda;
+  unit_.setZero();
+  unit_[n_] = 1.0;
+  CorrectorSummary summary = correct(x, unit_, x);
+  if (summary.converged) x[n_] = lambda;
+  u = x.head(n_);
+  return summary;
+}
+
+}  // namespace buckle::continuation

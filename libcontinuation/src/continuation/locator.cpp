@@ -1,0 +1,506 @@
+#include "buckle/continuation/locator.h"
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace buckle::continuation {
+
+namespace {
+
+bool sameSign(double a, double b) { return (a > 0.0) == (b > 0.0); }
+
+int crossingIndex(const ContinuationPoint &lo, const ContinuationPoint &hi) {
+  return std::min(lo.stability.negative, hi.stability.negative);
+}
+
+// The eigenvalue with this ascending index is the one that passes through zero inside the
+// bracket: with k negative eigenvalues on one side and k+m on the other, μ_k changes sign.
+bool crossingEigenvalue(const ContinuationPoint &p, int index, double &value) {
+  if (!p.stability.valid() || index < 0 || index >= p.stability.lowest.size()) return false;
+  value = p.stability.lowest[index];
+  return true;
+}
+
+std::string format(const char *pattern, double value) {
+  char buffer[160];
+  std::snprintf(buffer, sizeof buffer, pattern, value);
+  return buffer;
+}
+
+}  // namespace
+
+AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, int lambdaIndex, double tolerance,
+                                      int maxIterations, double maxDistance) {
+  AugmentedNewtonResult result;
+  const Eigen::Index m = z.size();
+  const Vector z0 = z;
+  Vector R(m), delta(m);
+  Matrix J(m, m);
+  double lastUpdate = std::numeric_limits<double>::infinity();
+  for (int it = 0; it < maxIterations; ++it) {
+    if (!system(z, R, &J)) {
+      result.failure = "the problem refused an iterate";
+      break;
+    }
+    Eigen::FullPivLU<Matrix> lu(J);
+    if (!lu.isInvertible()) {
+      result.failure = "singular augmented Jacobian";
+      break;
+    }
+    delta = -lu.solve(R);
+    if (!delta.allFinite()) {
+      result.failure = "non-finite Newton update";
+      break;
+    }
+    z += delta;
+    ++result.iterations;
+    result.lastDLambda = std::abs(delta[lambdaIndex]);
+    lastUpdate = delta.cwiseAbs().maxCoeff();
+    if ((z - z0).norm() > maxDistance) {
+      result.failure = "Newton iterate left the step";
+      break;
+    }
+    if (lastUpdate <= tolerance * std::max(1.0, std::abs(z[lambdaIndex]))) break;
+  }
+  if (!result.failure.empty()) {
+    z = z0;
+    return result;
+  }
+  if (system(z, R, nullptr)) result.residualNorm = R.norm();
+  const double tol = tolerance * std::max(1.0, std::abs(z[lambdaIndex]));
+  // λ must meet the target; the other unknowns (null vectors) only need to have settled.
+  result.converged = result.lastDLambda <= tol && lastUpdate <= 1e-6;
+  if (!result.converged) result.failure = format("no convergence: last |dlambda| = %.3g", result.lastDLambda);
+  return result;
+}
+
+Locator::Locator(Problem &problem, Corrector &corrector, PointEvaluator &evaluator, const LocatorOptions &options)
+    : problem_(problem), corrector_(corrector), evaluator_(evaluator), options_(options), n_(problem.dimension()) {
+  predictor_ = Vector::Zero(n_ + 1);
+  x_ = Vector::Zero(n_ + 1);
+}
+
+void Locator::setStep(const ContinuationPoint &a, const ContinuationPoint &b) {
+  a_.s = 0.0;
+  a_.point = a;
+  xa_ = a.state();
+  dx_ = b.state() - xa_;
+  stepLength_ = a.tangent.dot(dx_);
+  b_.s = stepLength_;
+  b_.point = b;
+}
+
+bool Locator::sample(double s, StepSample &out, CorrectorSummary *summary) {
+  // Interpolating a→b (instead of extrapolating along t_a) starts Newton closer to the branch;
+  // the hyperplane t_aᵀ(x − x_a) = s is the same.
+  predictor_ = xa_ + (stepLength_ != 0.0 ? s / stepLength_ : 0.0) * dx_;
+  const CorrectorOptions saved = corrector_.options();
+  CorrectorOptions tight = saved;
+  tight.residualTolerance = std::min(saved.residualTolerance, options_.newtonTolerance);
+  tight.maxIterations = std::max(saved.maxIterations, 15);
+  corrector_.setOptions(tight);
+  const CorrectorSummary result = corrector_.correct(predictor_, a_.point.tangent, x_);
+  corrector_.setOptions(saved);
+  if (summary) *summary = result;
+  if (!result.converged) return false;
+  out.s = s;
+  out.point.u = x_.head(n_);
+  out.point.lambda = x_[n_];
+  out.point.arclength = a_.point.arclength + s;
+  out.point.stepSize = s;
+  out.point.newtonIterations = result.iterations;
+  out.point.residualNorm = result.residualNorm;
+  return evaluator_.complete(out.point, a_.point.tangent) || evaluator_.lastWasSingular();
+}
+
+bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, double fHi, const TestFunction &test,
+                       Root &root) {
+  root = Root();
+  if (fLo == 0.0 || fHi == 0.0) {
+    root.at = fLo == 0.0 ? lo : hi;
+    root.converged = true;
+    return true;
+  }
+  if (sameSign(fLo, fHi)) {
+    root.failure = "test function does not change sign";
+    return false;
+  }
+  StepSample left = lo, right = hi;
+  double fl = fLo, fr = fHi;
+  int lastSide = 0;
+  double previousS = 0.0, previousLambda = 0.0;
+  const double tolS = tolerance(0.5 * (lo.point.lambda + hi.point.lambda));
+  StepSample trial;
+  for (int it = 0; it < options_.maxIterations; ++it) {
+    // Illinois: regula falsi with the stale end's value halved, so both ends keep moving.
+    double s = (left.s * fr - right.s * fl) / (fr - fl);
+    if (!(s > left.s && s < right.s)) s = 0.5 * (left.s + right.s);
+    CorrectorSummary summary;
+    if (!sample(s, trial, &summary)) {
+      root.failure = std::string("corrector failed while locating (") + summary.flagName + ")";
+      return root.evaluations > 0;
+    }
+    double f = 0.0;
+    if (!test(trial.point, f)) {
+      root.failure = "test function could not be evaluated";
+      return root.evaluations > 0;
+    }
+    if (root.evaluations == 0) {
+      root.lastDs = right.s - left.s;
+      root.lastDLambda = std::abs(right.point.lambda - left.point.lambda);
+    } else {
+      root.lastDs = std::abs(s - previousS);
+      root.lastDLambda = std::abs(trial.point.lambda - previousLambda);
+    }
+    ++root.evaluations;
+    previousS = s;
+    previousLambda = trial.point.lambda;
+    root.at = trial;
+    root.value = f;
+    if (f == 0.0) {
+      root.converged = true;
+      break;
+    }
+    if (sameSign(f, fl)) {
+      left = trial;
+      fl = f;
+      if (lastSide == -1) fr *= 0.5;
+      lastSide = -1;
+    } else {
+      right = trial;
+      fr = f;
+      if (lastSide == 1) fl *= 0.5;
+      lastSide = 1;
+    }
+    if (right.s - left.s <= tolS || (root.evaluations > 1 && root.lastDs <= tolS)) {
+      root.converged = true;
+      break;
+    }
+  }
+  if (!root.converged) root.failure = "secant iteration limit reached";
+  return true;
+}
+
+double Locator::residualNorm(ConstVectorRef u, double lambda) {
+  Vector F(n_);
+  if (!problem_.residual(u, lambda, F)) return std::numeric_limits<double>::infinity();
+  return F.norm();
+}
+
+std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &crossings) {
+  std::vector<SpecialPoint> found;
+  if (crossings.fold && options_.detectFolds) found.push_back(locateFold(a_, b_));
+  if (crossings.branchPointCrossings > 0 && options_.detectBranchPoints) {
+    std::vector<std::pair<StepSample, StepSample>> simple, multiple;
+    if (crossings.branchPointCrossings == 1 && crossings.determinantChange) simple.emplace_back(a_, b_);
+    else separateCrossings(a_, b_, simple, multiple, 0);
+    for (const auto &bracket : simple) found.push_back(locateSimpleBranchPoint(bracket.first, bracket.second));
+    for (const auto &bracket : multiple) {
+      const int m = std::abs(bracket.second.point.stability.negative - bracket.first.point.stability.negative);
+      found.push_back(multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
+    }
+  }
+  std::sort(found.begin(), found.end(),
+            [](const SpecialPoint &p, const SpecialPoint &q) { return p.arclength < q.arclength; });
+  return found;
+}
+
+void Locator::separateCrossings(const StepSample &lo, const StepSample &hi,
+                                std::vector<std::pair<StepSample, StepSample>> &simple,
+                                std::vector<std::pair<StepSample, StepSample>> &multiple, int depth) {
+  const ContinuationPoint &p = lo.point, &q = hi.point;
+  const bool det = p.determinantSign * q.determinantSign < 0;
+  if (!p.stability.valid() || !q.stability.valid()) {
+    if (det) simple.emplace_back(lo, hi);
+    return;
+  }
+  const bool fold = options_.detectFolds && ((p.foldTest >= 0.0) != (q.foldTest >= 0.0));
+  const int inertia = std::abs(q.stability.negative - p.stability.negative);
+  const int crossings = std::max(det ? 1 : 0, inertia - (fold ? 1 : 0));
+  if (crossings == 0) return;
+  if (crossings == 1) {
+    simple.emplace_back(lo, hi);
+    return;
+  }
+  // Bisection on the inertia count: each half keeps the crossings it contains.
+  if (hi.s - lo.s <= options_.separationFraction * std::abs(stepLength_) || depth > 200) {
+    multiple.emplace_back(lo, hi);
+    return;
+  }
+  StepSample mid;
+  if (!sample(0.5 * (lo.s + hi.s), mid)) {
+    multiple.emplace_back(lo, hi);
+    return;
+  }
+  separateCrossings(lo, mid, simple, multiple, depth + 1);
+  separateCrossings(mid, hi, simple, multiple, depth + 1);
+}
+
+SpecialPoint Locator::locateFold(const StepSample &lo, const StepSample &hi) {
+  SpecialPoint sp;
+  sp.type = SpecialPointType::Fold;
+  sp.inertiaBefore = lo.point.stability.negative;
+  sp.inertiaAfter = hi.point.stability.negative;
+  Root root;
+  const TestFunction test = [](const ContinuationPoint &p, double &f) {
+    f = p.foldTest;
+    return true;
+  };
+  const bool ok = findRoot(lo, lo.point.foldTest, hi, hi.point.foldTest, test, root);
+  const StepSample &at = ok ? root.at : (std::abs(lo.point.foldTest) < std::abs(hi.point.foldTest) ? lo : hi);
+  sp.arclength = at.point.arclength;
+  sp.u = at.point.u;
+  sp.lambda = at.point.lambda;
+  sp.tangent = at.point.tangent;
+  sp.testFunctionValue = at.point.foldTest;
+  sp.lambdaAccuracy = ok ? root.lastDLambda : std::abs(hi.point.lambda - lo.point.lambda);
+  sp.locationIterations = root.evaluations;
+  if (!root.failure.empty()) sp.note = "fold secant: " + root.failure;
+  refineFold(sp, a_.point.tangent);
+  sp.residualNorm = residualNorm(sp.u, sp.lambda);
+  return sp;
+}
+
+bool Locator::refineFold(SpecialPoint &sp, const Vector &tangentRef) {
+  const int n = n_;
+  Matrix Fu(n, n);
+  Vector Fl(n);
+  if (!problem_.jacobian(sp.u, sp.lambda, Fu, Fl)) return false;
+  Eigen::JacobiSVD<Matrix> svd(Fu, Eigen::ComputeFullV);
+  const Vector c = svd.matrixV().col(n - 1);
+  Vector z(2 * n + 1);
+  z << sp.u, sp.lambda, c;
+  Matrix dFu(n, n);
+  Vector dFl(n), F(n);
+  const AugmentedSystem system = [&](const Vector &w, Vector &R, Matrix *J) {
+    const auto u = w.head(n);
+    const double lambda = w[n];
+    const auto v = w.tail(n);
+    if (!problem_.residual(u, lambda, F)) return false;
+    if (!problem_.jacobian(u, lambda, Fu, Fl)) return false;
+    R.head(n) = F;
+    R.segment(n, n) = Fu * v;
+    R[2 * n] = c.dot(v) - 1.0;
+    if (!J) return R.allFinite();
+    // d(F_u v)/du · du = F_uu[v, du]: one directional derivative along (v, 0) gives both the
+    // u-block and the λ-column (F_uλ v = F_λu v).
+    if (!problem_.jacobianDirectionalDerivative(u, lambda, v, 0.0, dFu, dFl)) return false;
+    J->setZero();
+    J->block(0, 0, n, n) = Fu;
+    J->block(0, n, n, 1) = Fl;
+    J->block(n, 0, n, n) = dFu;
+    J->block(n, n, n, 1) = dFl;
+    J->block(n, n + 1, n, n) = Fu;
+    J->block(2 * n, n + 1, 1, n) = c.transpose();
+    return J->allFinite();
+  };
+  const double maxDistance = 4.0 * dx_.norm() + 1e-8 + 4.0 * c.norm();
+  const AugmentedNewtonResult result =
+      augmentedNewton(system, z, n, options_.tolerance, options_.maxRefinementIterations, maxDistance);
+  sp.locationIterations += result.iterations;
+  if (!result.converged) {
+    sp.note += (sp.note.empty() ? "" : "; ") + std::string("fold refinement: ") + result.failure;
+    sp.nullVectors = c;
+    return false;
+  }
+  sp.refined = true;
+  sp.u = z.head(n);
+  sp.lambda = z[n];
+  sp.lambdaAccuracy = result.lastDLambda;
+  sp.augmentedResidualNorm = result.residualNorm;
+  const Vector v = z.tail(n);
+  sp.nullVectors = v.normalized();
+  ContinuationPoint p;
+  p.u = sp.u;
+  p.lambda = sp.lambda;
+  if (evaluator_.complete(p, tangentRef)) {
+    sp.tangent = p.tangent;
+    sp.testFunctionValue = p.foldTest;
+  } else {
+    sp.tangent = Vector::Zero(n + 1);
+    sp.tangent.head(n) = v.normalized();
+    if (sp.tangent.dot(tangentRef) < 0.0) sp.tangent = -sp.tangent;
+    sp.testFunctionValue = 0.0;
+  }
+  // Along the located fold the arclength is interpolated in the step coordinate.
+  sp.arclength = a_.point.arclength + tangentRef.dot(
+                     (Vector(n + 1) << sp.u, sp.lambda).finished() - xa_);
+  return true;
+}
+
+SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSample &hi) {
+  SpecialPoint sp;
+  sp.type = SpecialPointType::BranchPoint;
+  sp.multiplicity = 1;
+  sp.inertiaBefore = lo.point.stability.negative;
+  sp.inertiaAfter = hi.point.stability.negative;
+
+  Matrix A(n_ + 1, n_ + 1);
+  MinimallyAugmentedTest psi;
+  TestFunction test;
+  double fLo = 0.0, fHi = 0.0;
+  bool haveTest = false;
+  if (lo.point.determinantSign * hi.point.determinantSign < 0) {
+    if (evaluator_.borderedJacobian(lo.point.u, lo.point.lambda, lo.point.tangent, A)) {
+      psi.initialize(A);
+      test = [&](const ContinuationPoint &p, double &f) {
+        return evaluator_.borderedJacobian(p.u, p.lambda, p.tangent, A) && psi.evaluate(A, f);
+      };
+      haveTest = test(lo.point, fLo) && test(hi.point, fHi) && !sameSign(fLo, fHi);
+    }
+    if (!haveTest) {
+      // ψ's frozen border lost transversality: fall back to the determinant, scaled to O(1).
+      const double reference = std::max(lo.point.logAbsDeterminant, hi.point.logAbsDeterminant);
+      test = [reference](const ContinuationPoint &p, double &f) {
+        f = p.determinantSign * std::exp(p.logAbsDeterminant - reference);
+        return true;
+      };
+      test(lo.point, fLo);
+      test(hi.point, fHi);
+      haveTest = !sameSign(fLo, fHi);
+    }
+  } else {
+    const int index = crossingIndex(lo.point, hi.point);
+    test = [index](const ContinuationPoint &p, double &f) { return crossingEigenvalue(p, index, f); };
+    haveTest = test(lo.point, fLo) && test(hi.point, fHi) && !sameSign(fLo, fHi);
+    sp.note = "inertia change without determinant sign change; located on the crossing eigenvalue";
+  }
+
+  Root root;
+  bool ok = false;
+  if (haveTest) ok = findRoot(lo, fLo, hi, fHi, test, root);
+  const StepSample &at = ok ? root.at : lo;
+  sp.arclength = at.point.arclength;
+  sp.u = at.point.u;
+  sp.lambda = at.point.lambda;
+  sp.tangent = at.point.tangent;
+  sp.testFunctionValue = ok ? root.value : fLo;
+  sp.lambdaAccuracy = ok ? root.lastDLambda : std::abs(hi.point.lambda - lo.point.lambda);
+  sp.locationIterations = root.evaluations;
+  if (!haveTest) sp.note += (sp.note.empty() ? "" : "; ") + std::string("no usable test function");
+  else if (!root.failure.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("branch point secant: " + root.failure);
+  refineBranchPoint(sp, a_.point.tangent);
+  sp.residualNorm = residualNorm(sp.u, sp.lambda);
+  return sp;
+}
+
+bool Locator::refineBranchPoint(SpecialPoint &sp, const Vector &tangentRef) {
+  const int n = n_;
+  KernelInfo kernel;
+  if (!jacobianKernel(problem_, sp.u, sp.lambda, kernel)) return false;
+  Vector z(2 * n + 2);
+  z << sp.u, sp.lambda, 0.0, kernel.left.col(0);
+  Matrix Fx(n, n + 1), dFx(n, n + 1), Hp(n + 1, n + 1);
+  Vector F(n);
+  const AugmentedSystem system = [&](const Vector &w, Vector &R, Matrix *J) {
+    const auto u = w.head(n);
+    const double lambda = w[n];
+    const double beta = w[n + 1];
+    const auto p = w.tail(n);
+    if (!problem_.residual(u, lambda, F)) return false;
+    if (!problem_.jacobian(u, lambda, Fx.leftCols(n), Fx.col(n))) return false;
+    R.head(n) = F + beta * p;
+    R.segment(n, n + 1) = Fx.transpose() * p;
+    R[2 * n + 1] = p.squaredNorm() - 1.0;
+    if (!J) return R.allFinite();
+    // Hessian of pᵀF in x, one column per coordinate direction; symmetrised because the
+    // default second derivatives are finite differences.
+    Vector e = Vector::Zero(n + 1);
+    for (int j = 0; j <= n; ++j) {
+      e.setZero();
+      e[j] = 1.0;
+      if (!problem_.jacobianDirectionalDerivative(u, lambda, e.head(n), e[n], dFx.leftCols(n), dFx.col(n)))
+        return false;
+      Hp.col(j) = dFx.transpose() * p;
+    }
+    Hp = (0.5 * (Hp + Hp.transpose())).eval();
+    J->setZero();
+    J->block(0, 0, n, n + 1) = Fx;
+    J->block(0, n + 1, n, 1) = p;
+    J->block(0, n + 2, n, n) = beta * Matrix::Identity(n, n);
+    J->block(n, 0, n + 1, n + 1) = Hp;
+    J->block(n, n + 2, n + 1, n) = Fx.transpose();
+    J->block(2 * n + 1, n + 2, 1, n) = 2.0 * p.transpose();
+    return J->allFinite();
+  };
+  const double maxDistance = 4.0 * dx_.norm() + 1e-8 + 4.0;
+  const AugmentedNewtonResult result =
+      augmentedNewton(system, z, n, options_.tolerance, options_.maxRefinementIterations, maxDistance);
+  sp.locationIterations += result.iterations;
+  if (result.converged) {
+    sp.refined = true;
+    sp.u = z.head(n);
+    sp.lambda = z[n];
+    sp.lambdaAccuracy = result.lastDLambda;
+    sp.augmentedResidualNorm = result.residualNorm;
+    sp.arclength = a_.point.arclength + tangentRef.dot((Vector(n + 1) << sp.u, sp.lambda).finished() - xa_);
+  } else {
+    sp.note += (sp.note.empty() ? "" : "; ") + std::string("Moore refinement: ") + result.failure;
+  }
+  fillBranchPointGeometry(sp, tangentRef);
+  return result.converged;
+}
+
+void Locator::fillBranchPointGeometry(SpecialPoint &sp, const Vector &tangentRef) {
+  KernelInfo kernel;
+  if (!jacobianKernel(problem_, sp.u, sp.lambda, kernel)) return;
+  const double scale = std::max(1.0, kernel.singularValues.maxCoeff());
+  int dimension = 2;
+  for (int k = 2; k < kernel.singularValues.size(); ++k)
+    if (kernel.singularValues[k] <= 1e-8 * scale) dimension = k + 1;
+  if (sp.multiplicity == 1) dimension = 2;
+  const Matrix K = kernel.right.leftCols(dimension);
+  // First basis vector: the traced branch's direction projected onto the kernel.
+  Vector t = K * (K.transpose() * tangentRef);
+  if (t.norm() < 1e-12) t = K.col(0);
+  t.normalize();
+  if (t.dot(tangentRef) < 0.0) t = -t;
+  Matrix basis(n_ + 1, dimension);
+  basis.col(0) = t;
+  int filled = 1;
+  for (int k = 0; k < dimension && filled < dimension; ++k) {
+    Vector w = K.col(k);
+    for (int j = 0; j < filled; ++j) w -= basis.col(j).dot(w) * basis.col(j);
+    if (w.norm() > 1e-6) basis.col(filled++) = w.normalized();
+  }
+  sp.nullVectors = basis.leftCols(filled);
+  sp.tangent = t;
+  sp.leftNullVector = kernel.left.col(0);
+  sp.testFunctionValue = kernel.singularValues[1];
+}
+
+SpecialPoint Locator::multipleBranchPoint(const StepSample &lo, const StepSample &hi, int multiplicity) {
+  SpecialPoint sp;
+  sp.type = SpecialPointType::BranchPoint;
+  sp.multiplicity = multiplicity;
+  sp.inertiaBefore = lo.point.stability.negative;
+  sp.inertiaAfter = hi.point.stability.negative;
+  const int index = crossingIndex(lo.point, hi.point);
+  const TestFunction test = [index](const ContinuationPoint &p, double &f) { return crossingEigenvalue(p, index, f); };
+  double fLo = 0.0, fHi = 0.0;
+  Root root;
+  bool ok = false;
+  // The bisection bracket is already below separationFraction of the step; a last secant on
+  // the crossing eigenvalue only sharpens where inside it the point sits.
+  if (test(lo.point, fLo) && test(hi.point, fHi) && !sameSign(fLo, fHi)) ok = findRoot(lo, fLo, hi, fHi, test, root);
+  const StepSample &at = ok ? root.at : lo;
+  sp.arclength = at.point.arclength;
+  sp.u = at.point.u;
+  sp.lambda = at.point.lambda;
+  sp.tangent = at.point.tangent;
+  sp.testFunctionValue = ok ? root.value : fLo;
+  sp.lambdaAccuracy = std::abs(hi.point.lambda - lo.point.lambda);
+  if (ok && root.evaluations > 0) sp.lambdaAccuracy = std::min(sp.lambdaAccuracy, root.lastDLambda);
+  sp.locationIterations = root.evaluations;
+  sp.note = format("multiplicity %.0f: crossings not separable by inertia bisection (bracket |ds| = ", multiplicity) +
+            format("%.3g); Moore refinement skipped; not switched", hi.s - lo.s);
+  sp.residualNorm = residualNorm(sp.u, sp.lambda);
+  fillBranchPointGeometry(sp, a_.point.tangent);
+  return sp;
+}
+
+}  // namespace buckle::continuation

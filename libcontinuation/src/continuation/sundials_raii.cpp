@@ -1,0 +1,92 @@
+#include "buckle/continuation/sundials_raii.h"
+
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include <stdexcept>
+
+namespace buckle::continuation {
+
+namespace {
+// KINSOL's default handler prints to stderr; a library must stay silent unless asked.
+void silentErrorHandler(int, const char *, const char *, char *, void *) {}
+}  // namespace
+
+void SunContextDeleter::operator()(std::remove_pointer_t<SUNContext> *context) const noexcept {
+  SUNContext handle = context;
+  SUNContext_Free(&handle);
+}
+void NVectorDeleter::operator()(std::remove_pointer_t<N_Vector> *vector) const noexcept { N_VDestroy(vector); }
+void SunMatrixDeleter::operator()(std::remove_pointer_t<SUNMatrix> *matrix) const noexcept {
+  SUNMatDestroy(matrix);
+}
+void SunLinearSolverDeleter::operator()(std::remove_pointer_t<SUNLinearSolver> *solver) const noexcept {
+  SUNLinSolFree(solver);
+}
+void KinsolMemoryDeleter::operator()(void *memory) const noexcept { KINFree(&memory); }
+
+SunContextPtr makeSunContext() {
+  SUNContext context = nullptr;
+  if (SUNContext_Create(nullptr, &context) != 0 || context == nullptr)
+    throw std::runtime_error("SUNContext_Create failed");
+  return SunContextPtr(context);
+}
+
+NVectorPtr makeSerialVector(sunindextype n, SUNContext context) {
+  NVectorPtr vector(N_VNew_Serial(n, context));
+  if (!vector) throw std::runtime_error("N_VNew_Serial failed");
+  N_VConst(0.0, vector.get());
+  return vector;
+}
+
+SunMatrixPtr makeDenseMatrix(sunindextype rows, sunindextype cols, SUNContext context) {
+  SunMatrixPtr matrix(SUNDenseMatrix(rows, cols, context));
+  if (!matrix) throw std::runtime_error("SUNDenseMatrix failed");
+  SUNMatZero(matrix.get());
+  return matrix;
+}
+
+SunLinearSolverPtr makeDenseLinearSolver(N_Vector vector, SUNMatrix matrix, SUNContext context) {
+  SunLinearSolverPtr solver(SUNLinSol_Dense(vector, matrix, context));
+  if (!solver) throw std::runtime_error("SUNLinSol_Dense failed");
+  return solver;
+}
+
+KinsolMemoryPtr makeKinsolMemory(SUNContext context) {
+  KinsolMemoryPtr memory(KINCreate(context));
+  if (!memory) throw std::runtime_error("KINCreate failed");
+  KINSetErrHandlerFn(memory.get(), silentErrorHandler, nullptr);
+  KINSetPrintLevel(memory.get(), 0);
+  return memory;
+}
+
+const char *kinsolFlagName(int flag) {
+  // A static table rather than KINGetReturnFlagName, whose result is malloc'd and would have to
+  // be freed by every caller.
+  switch (flag) {
+    case KIN_SUCCESS: return "KIN_SUCCESS";
+    case KIN_INITIAL_GUESS_OK: return "KIN_INITIAL_GUESS_OK";
+    case KIN_STEP_LT_STPTOL: return "KIN_STEP_LT_STPTOL";
+    case KIN_WARNING: return "KIN_WARNING";
+    case KIN_MEM_NULL: return "KIN_MEM_NULL";
+    case KIN_ILL_INPUT: return "KIN_ILL_INPUT";
+    case KIN_NO_MALLOC: return "KIN_NO_MALLOC";
+    case KIN_MEM_FAIL: return "KIN_MEM_FAIL";
+    case KIN_LINESEARCH_NONCONV: return "KIN_LINESEARCH_NONCONV";
+    case KIN_MAXITER_REACHED: return "KIN_MAXITER_REACHED";
+    case KIN_MXNEWT_5X_EXCEEDED: return "KIN_MXNEWT_5X_EXCEEDED";
+    case KIN_LINESEARCH_BCFAIL: return "KIN_LINESEARCH_BCFAIL";
+    case KIN_LINSOLV_NO_RECOVERY: return "KIN_LINSOLV_NO_RECOVERY";
+    case KIN_LINIT_FAIL: return "KIN_LINIT_FAIL";
+    case KIN_LSETUP_FAIL: return "KIN_LSETUP_FAIL";
+    case KIN_LSOLVE_FAIL: return "KIN_LSOLVE_FAIL";
+    case KIN_SYSFUNC_FAIL: return "KIN_SYSFUNC_FAIL";
+    case KIN_FIRST_SYSFUNC_ERR: return "KIN_FIRST_SYSFUNC_ERR";
+    case KIN_REPTD_SYSFUNC_ERR: return "KIN_REPTD_SYSFUNC_ERR";
+    case KIN_VECTOROP_ERR: return "KIN_VECTOROP_ERR";
+    case KIN_CONTEXT_ERR: return "KIN_CONTEXT_ERR";
+    default: return "KIN_UNKNOWN_FLAG";
+  }
+}
+
+}  // namespace buckle::continuation

@@ -1,0 +1,135 @@
+#include "buckle/continuation/test_functions.h"
+
+#include <Eigen/SVD>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+namespace buckle::continuation {
+
+PointEvaluator::PointEvaluator(Problem &problem, bool computeStability)
+    : problem_(problem),
+      n_(problem.dimension()),
+      stability_(computeStability && problem.hasStabilityOperator()),
+      bordered_(Matrix::Zero(n_ + 1, n_ + 1)),
+      lu_(n_ + 1),
+      rhs_(Vector::Zero(n_ + 1)),
+      solution_(Vector::Zero(n_ + 1)) {
+  rhs_[n_] = 1.0;
+}
+
+bool PointEvaluator::borderedJacobian(ConstVectorRef u, double lambda, ConstVectorRef t, MatrixRef A) {
+  A.setZero();
+  if (!problem_.jacobian(u, lambda, A.topLeftCorner(n_, n_), A.col(n_).head(n_))) return false;
+  A.row(n_) = t.transpose();
+  return A.allFinite();
+}
+
+bool PointEvaluator::complete(ContinuationPoint &point, ConstVectorRef reference) {
+  singular_ = false;
+  if (!borderedJacobian(point.u, point.lambda, reference, bordered_)) return false;
+  if (stability_) {
+    if (!problem_.stability(point.u, point.lambda, point.stability)) point.stability = StabilityInfo();
+  } else {
+    point.stability = StabilityInfo();
+  }
+  lu_.compute(bordered_);
+  const auto &LU = lu_.matrixLU();
+  int sign = lu_.permutationP().determinant() > 0 ? 1 : -1;
+  double logAbs = 0.0;
+  for (int i = 0; i <= n_; ++i) {
+    const double pivot = LU(i, i);
+    if (pivot == 0.0 || !std::isfinite(pivot)) {
+      singular_ = true;
+      break;
+    }
+    if (pivot < 0.0) sign = -sign;
+    logAbs += std::log(std::abs(pivot));
+  }
+  if (!singular_) {
+    solution_ = lu_.solve(rhs_);
+    const double norm = solution_.norm();
+    if (!(norm > 0.0) || !std::isfinite(norm)) {
+      singular_ = true;
+    } else {
+      point.tangent = solution_ / norm;
+      // det with the point's own tangent as last row: det_ref = (refᵀt)·det_t, refᵀt = 1/‖y‖ > 0.
+      point.determinantSign = sign;
+      point.logAbsDeterminant = logAbs + std::log(norm);
+    }
+  }
+  if (singular_) {
+    point.tangent = reference.normalized();
+    point.determinantSign = 0;
+    point.logAbsDeterminant = -std::numeric_limits<double>::infinity();
+  }
+  point.foldTest = point.tangent[n_];
+  return !singular_;
+}
+
+void MinimallyAugmentedTest::initialize(const Matrix &referenceA) {
+  const Eigen::Index m = referenceA.rows();
+  Eigen::JacobiSVD<Matrix> svd(referenceA, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  b_ = svd.matrixU().col(m - 1);
+  c_ = svd.matrixV().col(m - 1);
+  augmented_ = Matrix::Zero(m + 1, m + 1);
+  rhs_ = Vector::Zero(m + 1);
+  rhs_[m] = 1.0;
+  solution_ = Vector::Zero(m + 1);
+}
+
+bool MinimallyAugmentedTest::evaluate(const Matrix &A, double &psi, Vector *v) {
+  const Eigen::Index m = A.rows();
+  if (b_.size() != m) return false;
+  augmented_.topLeftCorner(m, m) = A;
+  augmented_.col(m).head(m) = b_;
+  augmented_.row(m).head(m) = c_.transpose();
+  augmented_(m, m) = 0.0;
+  Eigen::FullPivLU<Matrix> lu(augmented_);
+  if (!lu.isInvertible()) return false;
+  solution_ = lu.solve(rhs_);
+  if (!solution_.allFinite()) return false;
+  psi = solution_[m];
+  if (v) *v = solution_.head(m);
+  return true;
+}
+
+IntervalCrossings classifyInterval(const ContinuationPoint &a, const ContinuationPoint &b, bool detectFolds,
+                                   bool detectBranchPoints) {
+  IntervalCrossings crossings;
+  crossings.fold = detectFolds && ((a.foldTest >= 0.0) != (b.foldTest >= 0.0));
+  if (!detectBranchPoints) return crossings;
+  crossings.determinantChange = a.determinantSign * b.determinantSign < 0;
+  if (a.stability.valid() && b.stability.valid())
+    crossings.inertiaChange = std::abs(b.stability.negative - a.stability.negative);
+  int count = crossings.determinantChange ? 1 : 0;
+  // A fold moves one eigenvalue through zero too; only the rest are branch points.
+  if (crossings.inertiaChange >= 0) count = std::max(count, crossings.inertiaChange - (crossings.fold ? 1 : 0));
+  crossings.branchPointCrossings = count;
+  return crossings;
+}
+
+bool jacobianKernel(Problem &problem, ConstVectorRef u, double lambda, KernelInfo &info) {
+  const int n = problem.dimension();
+  Matrix Fx = Matrix::Zero(n, n + 1);
+  if (!problem.jacobian(u, lambda, Fx.leftCols(n), Fx.col(n))) return false;
+  // Full SVD of the N×(N+1) matrix: V has N+1 columns, the last one spans the always-present
+  // extra kernel dimension; Eigen orders singular values descending.
+  Eigen::JacobiSVD<Matrix> svd(Fx, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Vector &sigma = svd.singularValues();
+  info.singularValues = Vector::Zero(n + 1);
+  info.right.resize(n + 1, n + 1);
+  info.left.resize(n, n);
+  // Ascending: column k of `right` pairs with singularValues[k]; the (N+1)-th right vector has
+  // no singular value (σ = 0 by dimension).
+  info.right.col(0) = svd.matrixV().col(n);
+  info.singularValues[0] = 0.0;
+  for (int k = 0; k < n; ++k) {
+    info.singularValues[k + 1] = sigma[n - 1 - k];
+    info.right.col(k + 1) = svd.matrixV().col(n - 1 - k);
+    info.left.col(k) = svd.matrixU().col(n - 1 - k);
+  }
+  return true;
+}
+
+}  // namespace buckle::continuation
