@@ -161,7 +161,9 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
     previousLambda = trial.point.lambda;
     root.at = trial;
     root.value = f;
-    if (f == 0.0) {
+    if (f == 0.0) {  // an exact zero of the test function: nothing left to refine
+      root.lastDs = 0.0;
+      root.lastDLambda = 0.0;
       root.converged = true;
       break;
     }

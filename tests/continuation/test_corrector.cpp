@@ -1,0 +1,131 @@
+#include "buckle/continuation/corrector.h"
+
+#include "toy_problems.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+using namespace buckle::continuation;
+using Catch::Matchers::Contains;
+
+TEST_CASE("Keller corrector lands on the closed-form intersection", "[corrector]") {
+  toys::Circle circle;
+  Corrector corrector(circle);
+  // Hyperplane u + λ = 1.4 meets the unit circle at (0.8, 0.6) and (0.6, 0.8).
+  Vector predictor(2), tangent(2), x(2);
+  predictor << 0.75, 0.65;
+  tangent << 1.0 / std::sqrt(2.0), 1.0 / std::sqrt(2.0);
+  const CorrectorSummary summary = corrector.correct(predictor, tangent, x);
+  REQUIRE(summary.converged);
+  CHECK(std::string(summary.flagName) == "KIN_SUCCESS");
+  CHECK(std::abs(x[0] - 0.8) < 1e-12);
+  CHECK(std::abs(x[1] - 0.6) < 1e-12);
+  CHECK(summary.iterations >= 2);
+  CHECK(summary.iterations <= 6);
+  CHECK(summary.residualNorm <= 1e-10);
+  CHECK(summary.lastStepNorm > 0.0);
+  CHECK(summary.lastStepNorm < 1e-4);
+  CHECK(summary.contraction > 0.0);
+  CHECK(summary.contraction < 0.5);  // quadratic convergence
+}
+
+TEST_CASE("Corrector at fixed lambda polishes a root", "[corrector]") {
+  toys::Circle circle;
+  Corrector corrector(circle);
+  Vector u0(1), u(1);
+  u0 << 0.95;
+  const CorrectorSummary summary = corrector.solveAtFixedParameter(u0, 0.6, u);
+  REQUIRE(summary.converged);
+  CHECK(std::abs(u[0] - 0.8) < 1e-12);
+  // Reuse of the same KINSOL instance: many solves, each independent of the previous one.
+  CorrectorOptions tight;
+  tight.residualTolerance = 1e-13;
+  corrector.setOptions(tight);
+  for (int k = 1; k <= 50; ++k) {
+    const double lambda = 0.9 * std::sin(0.1 * k);
+    u0 << 0.9;
+    const CorrectorSummary again = corrector.solveAtFixedParameter(u0, lambda, u);
+    REQUIRE(again.converged);
+    CHECK(std::abs(u[0] - std::sqrt(1.0 - lambda * lambda)) < 1e-12);
+  }
+}
+
+TEST_CASE("Corrector with fixed coordinate keeps it exactly", "[corrector]") {
+  toys::Circle circle;
+  Corrector corrector(circle);
+  Vector predictor(2), x(2);
+  predictor << 0.3, 0.7;  // hold u = 0.3
+  const CorrectorSummary summary = corrector.solveWithFixedCoordinate(predictor, 0, x);
+  REQUIRE(summary.converged);
+  CHECK(x[0] == 0.3);
+  CHECK(std::abs(x[1] - std::sqrt(1.0 - 0.09)) < 1e-12);
+}
+
+TEST_CASE("Corrector reports KINSOL failures by name", "[corrector]") {
+  SECTION("predictor refused by the problem") {
+    toys::LineWithDomain line(0.3);
+    Corrector corrector(line);
+    Vector predictor(2), tangent(2), x(2);
+    predictor << 0.5, 0.5;
+    tangent << 1.0, 0.0;
+    const CorrectorSummary summary = corrector.correct(predictor, tangent, x);
+    CHECK_FALSE(summary.converged);
+    CHECK(std::string(summary.flagName) == "KIN_FIRST_SYSFUNC_ERR");
+    CHECK(summary.refusedPoint);
+  }
+  SECTION("iteration limit") {
+    toys::Circle circle;
+    CorrectorOptions options;
+    options.maxIterations = 1;
+    Corrector corrector(circle, options);
+    Vector u0(1), u(1);
+    u0 << 5.0;
+    const CorrectorSummary summary = corrector.solveAtFixedParameter(u0, 0.6, u);
+    CHECK_FALSE(summary.converged);
+    CHECK(std::string(summary.flagName) == "KIN_MAXITER_REACHED");
+    CHECK(summary.iterations == 1);
+  }
+  SECTION("no real root: singular or non-converging") {
+    toys::Circle circle;
+    Corrector corrector(circle);
+    Vector u0(1), u(1);
+    u0 << 0.5;
+    const CorrectorSummary summary = corrector.solveAtFixedParameter(u0, 1.5, u);  // u² = −1.25
+    CHECK_FALSE(summary.converged);
+    CHECK(summary.flag < 0);
+  }
+}
+
+TEST_CASE("Corrector line search reaches a root from farther away", "[corrector]") {
+  toys::CubicFold cubic;
+  CorrectorOptions options;
+  options.lineSearch = true;
+  options.maxIterations = 50;
+  Corrector corrector(cubic, options);
+  Vector u0(1), u(1);
+  u0 << 3.0;
+  const CorrectorSummary summary = corrector.solveAtFixedParameter(u0, 0.0, u);  // roots 0, ±√3
+  REQUIRE(summary.converged);
+  Vector F(1);
+  cubic.residual(u, 0.0, F);
+  CHECK(std::abs(F[0]) < 1e-10);
+}
+
+TEST_CASE("CorrectorOptions::IsValid names the bad option", "[corrector]") {
+  std::string why;
+  CorrectorOptions options;
+  CHECK(options.IsValid(&why));
+  options.residualTolerance = -1.0;
+  CHECK_FALSE(options.IsValid(&why));
+  CHECK_THAT(why, Contains("residualTolerance"));
+  options = CorrectorOptions();
+  options.maxIterations = 0;
+  CHECK_FALSE(options.IsValid(&why));
+  CHECK_THAT(why, Contains("maxIterations"));
+  options = CorrectorOptions();
+  options.stepTolerance = std::nan("");
+  CHECK_FALSE(options.IsValid(&why));
+  CHECK_THAT(why, Contains("stepTolerance"));
+}

@@ -1,0 +1,274 @@
+#include "buckle/continuation/tracer.h"
+
+#include "toy_problems.h"
+
+#include <catch2/catch.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <string>
+
+using namespace buckle::continuation;
+using Catch::Matchers::Contains;
+
+namespace {
+Vector vec1(double a) { return (Vector(1) << a).finished(); }
+}  // namespace
+
+TEST_CASE("TracerOptions::IsValid rejects bad options and names them", "[tracer]") {
+  std::string why;
+  TracerOptions ok;
+  CHECK(ok.IsValid(&why));
+
+  TracerOptions o;
+  o.initialStep = -0.1;
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK_THAT(why, Contains("initialStep"));
+
+  o = TracerOptions();
+  o.minStep = -1e-3;
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK_THAT(why, Contains("minStep"));
+
+  o = TracerOptions();
+  o.minStep = 0.5;
+  o.maxStep = 0.1;
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK_THAT(why, Contains("minStep"));
+  CHECK_THAT(why, Contains("maxStep"));
+
+  o = TracerOptions();
+  o.maxStep = std::nan("");
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK_THAT(why, Contains("maxStep"));
+
+  o = TracerOptions();
+  o.lambdaMin = std::nan("");
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK_THAT(why, Contains("lambdaMin"));
+
+  o = TracerOptions();
+  o.lambdaMin = 2.0;
+  o.lambdaMax = 1.0;
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK_THAT(why, Contains("lambdaMin"));
+
+  o = TracerOptions();
+  o.locationTolerance = 0.0;
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK_THAT(why, Contains("locationTolerance"));
+
+  o = TracerOptions();
+  o.maxPoints = 1;
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK_THAT(why, Contains("maxPoints"));
+
+  o = TracerOptions();
+  o.boxLower = Vector::Zero(2);
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK_THAT(why, Contains("boxLower"));
+
+  // A tracer built with invalid options says so instead of running.
+  toys::Circle circle;
+  o = TracerOptions();
+  o.initialStep = std::nan("");
+  const Branch branch = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), o);
+  CHECK(branch.stopReason == StopReason::InvalidOptions);
+  CHECK_THAT(branch.stopMessage, Contains("initialStep"));
+  CHECK(branch.points.empty());
+}
+
+TEST_CASE("Circle: both folds located exactly, points on the circle", "[tracer]") {
+  toys::Circle circle;
+  TracerOptions options;
+  options.initialStep = 0.05;
+  options.maxStep = 0.1;
+  options.maxArclength = 2.0 * M_PI - 0.3;
+  const Branch branch = trace(circle, vec1(1.02), 0.0, InitialDirection::increasingLambda(), options);
+  REQUIRE(branch.points.size() > 10);
+  CHECK(branch.stopReason == StopReason::MaxArclength);
+  CHECK(std::abs(branch.points.back().arclength - options.maxArclength) < 1e-12);
+  // Start polished at fixed λ: u = 1 exactly.
+  CHECK(std::abs(branch.points.front().u[0] - 1.0) < 1e-12);
+  CHECK(branch.points[1].lambda > 0.0);
+  for (const ContinuationPoint &p : branch.points) {
+    CHECK(std::abs(p.u[0] * p.u[0] + p.lambda * p.lambda - 1.0) < 1e-9);
+    CHECK(std::abs(p.tangent.norm() - 1.0) < 1e-12);
+  }
+  const auto folds = branch.specialPointsOfType(SpecialPointType::Fold);
+  REQUIRE(folds.size() == 2);
+  CHECK(branch.specialPointsOfType(SpecialPointType::BranchPoint).empty());
+  CHECK(std::abs(folds[0]->lambda - 1.0) < 1e-12);
+  CHECK(std::abs(folds[1]->lambda + 1.0) < 1e-12);
+  for (const SpecialPoint *fold : folds) {
+    CHECK(fold->refined);
+    CHECK(std::abs(fold->u[0]) < 1e-12);
+    CHECK(fold->lambdaAccuracy <= 1e-12);
+    CHECK(fold->residualNorm < 1e-13);
+    CHECK(std::abs(fold->testFunctionValue) < 1e-10);  // t_λ at the fold
+    CHECK(std::abs(std::abs(fold->nullVectors(0, 0)) - 1.0) < 1e-12);
+    // It lies between the two points it is filed under.
+    const ContinuationPoint &p = branch.points[fold->index], &q = branch.points[fold->index + 1];
+    CHECK(fold->arclength >= p.arclength);
+    CHECK(fold->arclength <= q.arclength);
+    CHECK(p.foldTest * q.foldTest < 0.0);
+  }
+}
+
+TEST_CASE("Consecutive tangents respect the branch-jump guard", "[tracer]") {
+  toys::Circle circle;
+  TracerOptions options;
+  options.initialStep = 0.4;
+  options.maxStep = 0.8;  // 0.8 rad turns per step would violate cos ≥ 0.9
+  options.maxPoints = 40;
+  const Branch branch = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), options);
+  REQUIRE(branch.points.size() == 40);
+  CHECK(branch.stopReason == StopReason::MaxPoints);
+  for (std::size_t i = 1; i < branch.points.size(); ++i)
+    CHECK(branch.points[i].tangent.dot(branch.points[i - 1].tangent) >= options.minTangentCosine);
+}
+
+TEST_CASE("Parameter range end is landed on exactly", "[tracer]") {
+  toys::Circle circle;
+  TracerOptions options;
+  options.initialStep = 0.03;
+  options.lambdaMax = 0.5;
+  const Branch branch = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), options);
+  CHECK(branch.stopReason == StopReason::LambdaRange);
+  const ContinuationPoint &last = branch.points.back();
+  CHECK(std::abs(last.lambda - 0.5) <= 1e-15);
+  CHECK(std::abs(last.u[0] - std::sqrt(0.75)) < 1e-12);
+  const SpecialPoint &ep = branch.specialPoints.back();
+  CHECK(ep.type == SpecialPointType::Endpoint);
+  CHECK(std::string(specialPointLabel(ep.type)) == "EP");
+  CHECK(ep.boundaryName == "lambda max");
+  CHECK(ep.index == static_cast<int>(branch.points.size()) - 1);
+  for (const ContinuationPoint &p : branch.points) CHECK(p.lambda <= 0.5);
+
+  SECTION("decreasing direction stops on lambdaMin") {
+    TracerOptions down = options;
+    down.lambdaMin = -0.25;
+    const Branch other = trace(circle, vec1(1.0), 0.0, InitialDirection::decreasingLambda(), down);
+    CHECK(other.direction == -1);
+    CHECK(other.points[1].lambda < 0.0);
+    CHECK(other.stopReason == StopReason::LambdaRange);
+    CHECK(std::abs(other.points.back().lambda + 0.25) <= 1e-15);
+  }
+}
+
+TEST_CASE("Boundary g = 0.5 - u is located exactly", "[tracer]") {
+  toys::LineWithDomain line(std::numeric_limits<double>::infinity(), true);
+  TracerOptions options;
+  options.initialStep = 0.07;
+  options.maxStep = 0.07;
+  const Branch branch = trace(line, vec1(0.0), 0.0, InitialDirection::increasingLambda(), options);
+  CHECK(branch.stopReason == StopReason::Boundary);
+  const SpecialPoint &bd = branch.specialPoints.back();
+  CHECK(bd.type == SpecialPointType::Boundary);
+  CHECK(std::string(specialPointLabel(bd.type)) == "BD");
+  CHECK(bd.boundaryName == "u limit");
+  CHECK(std::abs(bd.lambda - 0.5) < 1e-12);
+  CHECK(std::abs(branch.points.back().u[0] - 0.5) < 1e-12);
+  CHECK(std::abs(bd.testFunctionValue) < 1e-12);
+  CHECK(bd.lambdaAccuracy < 1e-12);
+}
+
+TEST_CASE("Box on (u, lambda) stops on its face", "[tracer]") {
+  toys::Circle circle;
+  TracerOptions options;
+  const double inf = std::numeric_limits<double>::infinity();
+  options.boxLower = (Vector(2) << 0.5, -inf).finished();
+  options.boxUpper = (Vector(2) << inf, inf).finished();
+  const Branch branch = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), options);
+  CHECK(branch.stopReason == StopReason::Box);
+  CHECK(branch.points.back().u[0] == 0.5);
+  CHECK(std::abs(branch.points.back().lambda - std::sqrt(0.75)) < 1e-12);
+  CHECK(branch.specialPoints.back().boundaryName == "box lower u[0]");
+
+  TracerOptions wrongSize;
+  wrongSize.boxLower = Vector::Constant(5, -1.0);
+  wrongSize.boxUpper = Vector::Constant(5, 1.0);
+  const Branch rejected = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), wrongSize);
+  CHECK(rejected.stopReason == StopReason::InvalidOptions);
+  CHECK_THAT(rejected.stopMessage, Contains("boxLower"));
+}
+
+TEST_CASE("A refused domain stops with the KINSOL flag and keeps the points", "[tracer]") {
+  toys::LineWithDomain line(0.3);
+  TracerOptions options;
+  options.initialStep = 0.05;
+  options.maxStep = 0.05;
+  options.minStep = 1e-6;
+  const Branch branch = trace(line, vec1(0.0), 0.0, InitialDirection::increasingLambda(), options);
+  CHECK(branch.stopReason == StopReason::StepSizeTooSmall);
+  CHECK_THAT(branch.stopMessage, Contains("step size below minimum after KIN_FIRST_SYSFUNC_ERR"));
+  REQUIRE(branch.points.size() >= 6);
+  for (const ContinuationPoint &p : branch.points) CHECK(p.u[0] <= 0.3);
+  CHECK(branch.points.back().u[0] > 0.3 - 1e-5);
+}
+
+TEST_CASE("Start point that cannot be polished is reported", "[tracer]") {
+  toys::Circle circle;
+  const Branch branch = trace(circle, vec1(0.5), 1.5, InitialDirection::increasingLambda());
+  CHECK(branch.stopReason == StopReason::StartFailed);
+  CHECK_THAT(branch.stopMessage, Contains("KIN_"));
+  CHECK(branch.points.empty());
+}
+
+TEST_CASE("Stability is recorded at every point when asked", "[tracer]") {
+  toys::CubicFold cubic;
+  TracerOptions options;
+  options.lambdaMin = -3.0;
+  options.lambdaMax = 3.0;
+  // u = 2.5: λ = −u + u³/3 > 0; decreasing λ goes down the stable outer branch (H = u² − 1 > 0).
+  const double u0 = 2.5, lambda0 = -u0 + u0 * u0 * u0 / 3.0;
+  const Branch branch = trace(cubic, vec1(u0), lambda0, InitialDirection::decreasingLambda(), options);
+  REQUIRE(branch.points.size() > 10);
+  for (const ContinuationPoint &p : branch.points) {
+    REQUIRE(p.stability.valid());
+    CHECK(p.stability.negative == (p.u[0] * p.u[0] < 1.0 ? 1 : 0));
+  }
+  options.computeStability = false;
+  const Branch without = trace(cubic, vec1(u0), lambda0, InitialDirection::decreasingLambda(), options);
+  REQUIRE(without.points.size() > 2);
+  for (const ContinuationPoint &p : without.points) CHECK_FALSE(p.stability.valid());
+}
+
+TEST_CASE("Step size grows on an easy branch and is clamped to maxStep", "[tracer]") {
+  toys::LineWithDomain line;
+  TracerOptions options;
+  options.initialStep = 0.001;
+  options.maxStep = 0.2;
+  options.maxPoints = 40;
+  const Branch branch = trace(line, vec1(0.0), 0.0, InitialDirection::increasingLambda(), options);
+  REQUIRE(branch.points.size() == 40);
+  CHECK(branch.points[1].stepSize == Approx(0.001));
+  CHECK(branch.points.back().stepSize == Approx(0.2));
+  for (const ContinuationPoint &p : branch.points) CHECK(p.stepSize <= 0.2 + 1e-15);
+}
+
+TEST_CASE("Per-point cost on a 50-unknown Bratu problem", "[.][timing]") {
+  toys::Bratu bratu(50);
+  TracerOptions options;
+  options.maxPoints = 200;
+  options.maxStep = 0.5;
+  options.initialStep = 0.05;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Branch branch = trace(bratu, Vector::Zero(50), 0.0, InitialDirection::increasingLambda(), options);
+  const auto t1 = std::chrono::steady_clock::now();
+  const double us = std::chrono::duration<double, std::micro>(t1 - t0).count();
+  std::cout << "Bratu N=50: " << branch.points.size() << " points, " << us / branch.points.size()
+            << " us/point (stability on), stop: " << branch.stopMessage << "\n";
+  options.computeStability = false;
+  options.detectBranchPoints = false;
+  options.detectFolds = false;
+  const auto t2 = std::chrono::steady_clock::now();
+  const Branch plain = trace(bratu, Vector::Zero(50), 0.0, InitialDirection::increasingLambda(), options);
+  const auto t3 = std::chrono::steady_clock::now();
+  const double us2 = std::chrono::duration<double, std::micro>(t3 - t2).count();
+  std::cout << "Bratu N=50: " << plain.points.size() << " points, " << us2 / plain.points.size()
+            << " us/point (no stability, no detection)\n";
+  CHECK(branch.points.size() > 10);
+}

@@ -1,0 +1,174 @@
+// Small analytic problems with closed-form branches and special points, for the core tests.
+#pragma once
+
+#include "buckle/continuation/problem.h"
+
+#include <cmath>
+#include <limits>
+
+namespace buckle::continuation::toys {
+
+/// u² + λ² = 1: folds at λ = ±1 (u = 0).
+class Circle : public Problem {
+ public:
+  int dimension() const override { return 1; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    F[0] = u[0] * u[0] + lambda * lambda - 1.0;
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+    Fu(0, 0) = 2.0 * u[0];
+    Fl[0] = 2.0 * lambda;
+    return true;
+  }
+};
+
+/// λ + u − u³/3 = 0, a gradient system (H = −F_u = u² − 1): folds at u = ±1, λ = ∓2/3.
+class CubicFold : public Problem {
+ public:
+  int dimension() const override { return 1; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    F[0] = lambda + u[0] - u[0] * u[0] * u[0] / 3.0;
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+    Fu(0, 0) = 1.0 - u[0] * u[0];
+    Fl[0] = 1.0;
+    return true;
+  }
+  bool hasStabilityOperator() const override { return true; }
+  bool stabilityOperator(ConstVectorRef u, double, Matrix &H, Matrix &C) override {
+    H.resize(1, 1);
+    H(0, 0) = u[0] * u[0] - 1.0;
+    C.resize(0, 1);
+    return true;
+  }
+};
+
+/// Symmetric pitchforks [λu₁ − u₁³, (λ − c)u₂ − u₂³], H = −F_u: branch points at λ = 0 and
+/// λ = c on u = 0, bifurcating branch u₁² = λ (u₂ = 0) stable for 0 < λ < c.
+class TwoPitchforks : public Problem {
+ public:
+  explicit TwoPitchforks(double c) : c_(c) {}
+  int dimension() const override { return 2; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    F[0] = lambda * u[0] - u[0] * u[0] * u[0];
+    F[1] = (lambda - c_) * u[1] - u[1] * u[1] * u[1];
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+    Fu.setZero();
+    Fu(0, 0) = lambda - 3.0 * u[0] * u[0];
+    Fu(1, 1) = lambda - c_ - 3.0 * u[1] * u[1];
+    Fl << u[0], u[1];
+    return true;
+  }
+  bool hasStabilityOperator() const override { return true; }
+  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
+    H = Matrix::Zero(2, 2);
+    H(0, 0) = -(lambda - 3.0 * u[0] * u[0]);
+    H(1, 1) = -(lambda - c_ - 3.0 * u[1] * u[1]);
+    C.resize(0, 2);
+    return true;
+  }
+  double c() const { return c_; }
+
+ private:
+  double c_;
+};
+
+/// [λu₁ − u₁³, λu₂ − u₂³]: both eigenvalues of H = −F_u cross zero at λ = 0 on u = 0 (a double
+/// zero; the bordered determinant λ² does not change sign).
+class DoubleZero : public TwoPitchforks {
+ public:
+  DoubleZero() : TwoPitchforks(0.0) {}
+};
+
+/// λu − u² (H = −F_u = 2u − λ): transcritical branch point at 0, branches u = 0 and u = λ.
+class Transcritical : public Problem {
+ public:
+  int dimension() const override { return 1; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    F[0] = lambda * u[0] - u[0] * u[0];
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+    Fu(0, 0) = lambda - 2.0 * u[0];
+    Fl[0] = u[0];
+    return true;
+  }
+  bool hasStabilityOperator() const override { return true; }
+  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
+    H.resize(1, 1);
+    H(0, 0) = 2.0 * u[0] - lambda;
+    C.resize(0, 1);
+    return true;
+  }
+};
+
+/// u = λ, refusing points with u > limit (a domain the corrector must not leave), with one
+/// boundary g = 0.5 − u.
+class LineWithDomain : public Problem {
+ public:
+  explicit LineWithDomain(double limit = std::numeric_limits<double>::infinity(), bool boundary = false)
+      : limit_(limit), boundary_(boundary) {}
+  int dimension() const override { return 1; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    if (u[0] > limit_) return false;
+    F[0] = u[0] - lambda;
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+    if (u[0] > limit_) return false;
+    Fu(0, 0) = 1.0;
+    Fl[0] = -1.0;
+    return true;
+  }
+  int boundaryCount() const override { return boundary_ ? 1 : 0; }
+  double boundary(int, ConstVectorRef u, double) override { return 0.5 - u[0]; }
+  std::string boundaryName(int) const override { return "u limit"; }
+
+ private:
+  double limit_;
+  bool boundary_;
+};
+
+/// Bratu problem u'' + λ eᵘ = 0 on (0, 1), u(0) = u(1) = 0, central differences on n interior
+/// nodes; symmetric F_u, gradient system (H = −F_u). One fold near λ ≈ 3.51.
+class Bratu : public Problem {
+ public:
+  explicit Bratu(int n) : n_(n), h_(1.0 / (n + 1)) {}
+  int dimension() const override { return n_; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    for (int i = 0; i < n_; ++i) {
+      const double left = i > 0 ? u[i - 1] : 0.0, right = i + 1 < n_ ? u[i + 1] : 0.0;
+      F[i] = (left - 2.0 * u[i] + right) / (h_ * h_) + lambda * std::exp(u[i]);
+    }
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+    Fu.setZero();
+    for (int i = 0; i < n_; ++i) {
+      Fu(i, i) = -2.0 / (h_ * h_) + lambda * std::exp(u[i]);
+      if (i > 0) Fu(i, i - 1) = 1.0 / (h_ * h_);
+      if (i + 1 < n_) Fu(i, i + 1) = 1.0 / (h_ * h_);
+      Fl[i] = std::exp(u[i]);
+    }
+    return true;
+  }
+  bool hasStabilityOperator() const override { return true; }
+  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
+    H.resize(n_, n_);
+    Vector Fl(n_);
+    jacobian(u, lambda, H, Fl);
+    H = -H;
+    C.resize(0, n_);
+    return true;
+  }
+
+ private:
+  int n_;
+  double h_;
+};
+
+}  // namespace buckle::continuation::toys
