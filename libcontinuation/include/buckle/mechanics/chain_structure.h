@@ -1,0 +1,147 @@
+// Linear-time linear algebra for the chain's Hessian (notes: shared/notes/chain-structure.md).
+//
+// With K_q = diag(κ) and K_g(i, j) = h_max(i,j) (eq 27), the Hessian of the total potential is
+//     H = K_q − K_g = U · T · Uᵀ,
+// U the upper-triangular matrix of ones and T tridiagonal:
+//     T_mm = κ_m + κ_{m+1} − d_m,  T_m,m+1 = −κ_{m+1},  d_m = h_m − h_{m+1}  (κ_{n+1} = h_{n+1} = 0).
+// T is the Hessian in absolute link angles θ = Uᵀ q. The identity metric of q-space becomes
+// M = U⁻¹U⁻ᵀ in θ-space, again tridiagonal (diagonal 2, …, 2, 1; off-diagonal −1), so for any
+// shift σ, H − σI = U (T − σM) Uᵀ: every eigenvalue count of H, and of H restricted to the
+// kernel of held end-coordinate rows C, is a count on a tridiagonal matrix, O(n).
+//
+// Algorithms (all O(n); m = number of border columns, at most kMaxBorder):
+//  - factorize(): LDLᵀ of T − σM with Bunch's (1974) tridiagonal pivoting (1×1 or 2×2 pivots,
+//    α = (√5 − 1)/2), which bounds element growth without destroying the band. Its pivot
+//    blocks give the inertia of T − σM (Sylvester), i.e. the number of eigenvalues of H below σ.
+//  - countBelow(): the same count by the plain Sturm recurrence (no storage; Kahan's backward-
+//    stable count, zero pivots replaced by −pivmin as in LAPACK dstebz).
+//  - hessianInertia(): negative = #{μ < −τ}, zero = #{|μ| ≤ τ} from two counts at σ = ∓τ,
+//    τ = zeroTolerance · max(1, ‖H‖_F) (‖H‖_F computed exactly in O(n)).
+//  - constrainedInertia(): inertia of H on ker C. The rows of C are orthonormalised (modified
+//    Gram–Schmidt, twice, rank-revealing with rankTolerance): Q (n×r). With B = U⁻¹Q the bordered
+//    matrix K_σ = [[T − σM, B], [Bᵀ, 0]] is congruent to [[H − σI, Q], [Qᵀ, 0]], whose inertia is
+//    In(Zᵀ H Z − σI) + (r, r, 0) for Z an orthonormal basis of ker C. Block elimination (Haynsworth):
+//    In(K_σ) = In(T − σM) + In(S), S = −Bᵀ(T − σM)⁻¹B (r×r), so
+//        #{eigenvalues of ZᵀHZ below σ} = neg(T − σM) + neg(S) − r,
+//    O(n r) for the r solves. Singular T (e.g. κ = 0 at F = 0, or σ an eigenvalue of H) is
+//    handled by the shift test: counts are taken at σ = ±τ, and if the factorization of T − σM
+//    shows a pivot below 1e-10 of its scale (σ too close to an eigenvalue of the *unconstrained*
+//    H, where S would be dominated by rounding), σ is moved within [τ/2, 2τ] (an eigenvalue that
+//    close to the threshold is ambiguous anyway) and the best-conditioned shift is used.
+//  - solve(): H x = r as T z = U⁻¹ r, x = U⁻ᵀ z.
+//  - solveBordered(): [[H, V], [Wᵀ, D]] [x; y] = [f; g] (V, W n×p, D p×p, p ≤ kMaxBorder) by block
+//    elimination through T, plus one step of iterative refinement with the O(n) product H·x
+//    (block elimination with refinement is accurate near folds where H itself is singular,
+//    Govaerts 2000, ch. 3). This covers the KKT system (V = W = Cᵀ, D = 0) and the Keller
+//    pseudo-arclength system of the corrector. Requires T − 0·M to be nonsingular.
+//  - smallestEigenvalue(): bisection on the counts (optional, ~40 counts).
+//
+// The workspace is sized once; no function allocates on the heap after construction.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "buckle/mechanics/chain.h"
+
+namespace buckle::mechanics {
+
+/// Eigenvalue counts of a symmetric operator.
+struct Inertia {
+  int negative = 0;
+  int zero = 0;
+  int positive = 0;
+  int size() const { return negative + zero + positive; }
+};
+
+/// Workspace for one chain length; T, its factorization and the border storage.
+struct ChainStructure {
+  static constexpr int kMaxBorder = 4;
+  using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxBorder, kMaxBorder>;
+  using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxBorder, 1>;
+
+  explicit ChainStructure(int n);
+  int size() const { return n; }
+
+  int n;
+  Vector kappa, h;     ///< inputs of the last assemble(): K_q diagonal and h_m
+  Vector diag, off;    ///< T: diagonal (n) and off-diagonal (n − 1 used)
+  double frobeniusH = 0.0;  ///< ‖H‖_F
+
+  // Factorization of T − σM (Bunch pivoting); valid after factorize().
+  double shift = 0.0;
+  std::vector<unsigned char> blockStart;  ///< 1: 1×1 pivot at k; 2: 2×2 pivot at (k, k+1); 0: second row of a 2×2
+  Vector pivA, pivE;   ///< pivot entries: 1×1: pivA[k]; 2×2: [[pivA[k], pivE[k]], [pivE[k], pivA[k+1]]]
+  Vector l1, l2;       ///< multipliers: row below a 1×1 at k: l1[k]; row k+2 below a 2×2 at k: (l1[k], l2[k])
+  Inertia factorInertia;     ///< inertia of T − σM from the pivots
+  double minPivotRatio = 0;  ///< smallest |1×1 pivot| / scale: near 0 means T − σM nearly singular
+  bool singular = false;     ///< an exactly zero pivot was replaced
+
+  // Border storage (n × kMaxBorder) and scratch.
+  Matrix Q, B, X, V2, W2;
+  Vector t1, t2, t3;
+  Matrix zeroBorder;  ///< kMaxBorder² zeros (the D block of solveKKT)
+  SmallMatrix S;
+  int rank = 0;  ///< rank of the last C (rows kept after orthonormalisation)
+};
+
+// ---- assembly ----------------------------------------------------------------------------
+/// T from the joint stiffnesses κ (K_q diagonal) and the load generator h (K_g(i,j) = h_max(i,j)).
+void assemble(ConstVectorRef kappa, ConstVectorRef h, ChainStructure& ws);
+/// T at joint angles q under the end wrench F (data must hold forwardKinematics(q)).
+void assemble(const Chain& chain, const ChainData& data, ConstVectorRef q, const Wrench& F, ChainStructure& ws);
+
+// ---- O(n) products with U (tail sums) ---------------------------------------------------
+/// y = U x (y_i = Σ_{k≥i} x_k); y = U⁻¹ x (y_i = x_i − x_{i+1}); y = Uᵀ x (prefix sums);
+/// y = U⁻ᵀ x (y_i = x_i − x_{i−1}). In place allowed.
+void applyU(ConstVectorRef x, VectorRef y);
+void applyUInverse(ConstVectorRef x, VectorRef y);
+void applyUTranspose(ConstVectorRef x, VectorRef y);
+void applyUInverseTranspose(ConstVectorRef x, VectorRef y);
+
+/// y = H x = U T Uᵀ x, O(n) (y must not alias x).
+void applyHessian(const ChainStructure& ws, ConstVectorRef x, VectorRef y);
+/// Dense T (tests and cross-checks).
+Matrix tridiagonalMatrix(const ChainStructure& ws);
+
+// ---- factorization and counts ------------------------------------------------------------
+/// LDLᵀ of T − σM with Bunch pivoting; fills the factor fields and factorInertia.
+void factorize(ChainStructure& ws, double sigma = 0.0);
+/// Number of eigenvalues of H below σ (Sturm count of T − σM; no factor stored).
+int countBelow(const ChainStructure& ws, double sigma);
+/// Solve (T − σM) Z = Y in place for the first `cols` columns of Y (after factorize(σ)).
+void solveFactored(const ChainStructure& ws, MatrixRef Y, int cols);
+void solveFactored(const ChainStructure& ws, VectorRef y);
+
+/// Zero threshold τ = zeroTolerance · max(1, ‖H‖_F).
+double zeroThreshold(const ChainStructure& ws, double zeroTolerance);
+
+/// Inertia of H (n eigenvalues). Two O(n) Sturm counts.
+Inertia hessianInertia(const ChainStructure& ws, double zeroTolerance = 1e-13);
+
+/// Orthonormalise the rows of C (m×n, m ≤ 3) into ws.Q (first ws.rank columns) and form
+/// B = U⁻¹Q. Rows whose remainder falls below rankTolerance (relative to the largest row norm)
+/// are dropped, so rank-deficient C (e.g. x held on a straight chain, J_x = 0) is handled.
+int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double rankTolerance = 1e-10);
+/// Number of eigenvalues of Zᵀ H Z below σ (after setConstraints()); refactorizes at σ.
+int constrainedCountBelow(ChainStructure& ws, double sigma);
+/// Inertia of H on ker C (n − rank(C) eigenvalues). C may have zero rows.
+Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double zeroTolerance = 1e-13,
+                           double rankTolerance = 1e-10);
+
+/// Smallest eigenvalue of H (constrained: of Zᵀ H Z after setConstraints(), when useConstraints)
+/// by bisection on the counts, to absolute accuracy tolerance · max(1, ‖H‖_F).
+double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance = 1e-12);
+
+// ---- solves --------------------------------------------------------------------------------
+/// H x = r (x may alias r). Factorizes T at σ = 0; false if T is singular to working precision.
+bool solve(ChainStructure& ws, ConstVectorRef r, VectorRef x);
+/// [[H, V], [Wᵀ, D]] [x; y] = [f; g] with V, W n×p, D p×p, p ≤ kMaxBorder (x, y may not alias inputs).
+/// Factorizes T at σ = 0; false if T or the p×p Schur complement is singular.
+bool solveBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const Eigen::Ref<const Matrix>& W,
+                   const Eigen::Ref<const Matrix>& D, ConstVectorRef f, ConstVectorRef g, VectorRef x, VectorRef y);
+/// KKT system [[H, Cᵀ], [C, 0]] [x; y] = [f; g] (C m×n, full row rank).
+bool solveKKT(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, ConstVectorRef f, ConstVectorRef g, VectorRef x,
+              VectorRef y);
+
+}  // namespace buckle::mechanics

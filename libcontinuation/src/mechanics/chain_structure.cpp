@@ -1,0 +1,445 @@
+#include "buckle/mechanics/chain_structure.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace buckle::mechanics {
+
+namespace {
+
+constexpr double kBunchAlpha = 0.6180339887498949;  // (√5 − 1)/2
+constexpr double kTinyPivot = 1e-290;
+
+/// Diagonal of the q-space identity in θ-coordinates, M = U⁻¹U⁻ᵀ (off-diagonal −1).
+inline double metricDiagonal(int k, int n) { return k + 1 < n ? 2.0 : 1.0; }
+
+/// Number of negative eigenvalues of a small symmetric matrix (r ≤ kMaxBorder).
+int smallNegativeCount(const ChainStructure::SmallMatrix& S) {
+  const Eigen::Index r = S.rows();
+  if (r == 0) return 0;
+  if (r == 1) return S(0, 0) < 0.0 ? 1 : 0;
+  if (r == 2) {
+    const double mean = 0.5 * (S(0, 0) + S(1, 1));
+    const double rad = std::hypot(0.5 * (S(0, 0) - S(1, 1)), 0.5 * (S(0, 1) + S(1, 0)));
+    return (mean - rad < 0.0 ? 1 : 0) + (mean + rad < 0.0 ? 1 : 0);
+  }
+  Eigen::SelfAdjointEigenSolver<ChainStructure::SmallMatrix> es(0.5 * (S + S.transpose()), Eigen::EigenvaluesOnly);
+  int neg = 0;
+  for (Eigen::Index i = 0; i < r; ++i)
+    if (es.eigenvalues()[i] < 0.0) ++neg;
+  return neg;
+}
+
+/// Solve (T − σM)ξ and the bordered elimination for one right-hand side, with the Schur LU.
+template <class LU>
+void borderedElimination(ChainStructure& ws, int p, const LU& lu, ConstVectorRef f, ConstVectorRef g, VectorRef x,
+                         VectorRef y) {
+  const int n = ws.n;
+  Vector& t = ws.t1;
+  applyUInverse(f, t);
+  solveFactored(ws, t);
+  ChainStructure::SmallVector rhs(p);
+  for (int j = 0; j < p; ++j) rhs[j] = g[j] - ws.W2.col(j).dot(t);
+  const ChainStructure::SmallVector yy = lu.solve(rhs);
+  for (int j = 0; j < p; ++j) {
+    y[j] = yy[j];
+    t.noalias() -= yy[j] * ws.V2.col(j);
+  }
+  applyUInverseTranspose(t, x.head(n));
+}
+
+}  // namespace
+
+ChainStructure::ChainStructure(int size)
+    : n(size),
+      kappa(Vector::Zero(size)),
+      h(Vector::Zero(size)),
+      diag(Vector::Zero(size)),
+      off(Vector::Zero(std::max(size, 1))),
+      blockStart(size_t(std::max(size, 1)), 1),
+      pivA(Vector::Zero(size)),
+      pivE(Vector::Zero(size)),
+      l1(Vector::Zero(size)),
+      l2(Vector::Zero(size)),
+      Q(Matrix::Zero(size, kMaxBorder)),
+      B(Matrix::Zero(size, kMaxBorder)),
+      X(Matrix::Zero(size, kMaxBorder)),
+      V2(Matrix::Zero(size, kMaxBorder)),
+      W2(Matrix::Zero(size, kMaxBorder)),
+      t1(Vector::Zero(size)),
+      t2(Vector::Zero(size)),
+      t3(Vector::Zero(size)),
+      zeroBorder(Matrix::Zero(kMaxBorder, kMaxBorder)) {
+  if (size < 1) throw std::invalid_argument("ChainStructure: n must be >= 1");
+}
+
+void assemble(ConstVectorRef kappa, ConstVectorRef h, ChainStructure& ws) {
+  const int n = ws.n;
+  assert(kappa.size() == n && h.size() == n);
+  double fro2 = 0.0;
+  for (int m = 0; m < n; ++m) {
+    const double km = kappa[m], hm = h[m];
+    const double kn = m + 1 < n ? kappa[m + 1] : 0.0;
+    const double hn = m + 1 < n ? h[m + 1] : 0.0;
+    ws.diag[m] = km + kn - (hm - hn);
+    if (m + 1 < n) ws.off[m] = -kn;
+    fro2 += (km - hm) * (km - hm) + 2.0 * m * hm * hm;
+  }
+  if (ws.kappa.data() != kappa.data()) ws.kappa = kappa;
+  if (ws.h.data() != h.data()) ws.h = h;
+  ws.frobeniusH = std::sqrt(fro2);
+}
+
+void assemble(const Chain& chain, const ChainData& data, ConstVectorRef q, const Wrench& F, ChainStructure& ws) {
+  jointStiffness(chain, q, ws.kappa);
+  loadHessianGenerator(data, F, ws.h);
+  assemble(ws.kappa, ws.h, ws);
+}
+
+void applyU(ConstVectorRef x, VectorRef y) {
+  double s = 0.0;
+  for (Eigen::Index i = x.size() - 1; i >= 0; --i) {
+    s += x[i];
+    y[i] = s;
+  }
+}
+
+void applyUInverse(ConstVectorRef x, VectorRef y) {
+  const Eigen::Index n = x.size();
+  for (Eigen::Index i = 0; i + 1 < n; ++i) y[i] = x[i] - x[i + 1];
+  y[n - 1] = x[n - 1];
+}
+
+void applyUTranspose(ConstVectorRef x, VectorRef y) {
+  double s = 0.0;
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    s += x[i];
+    y[i] = s;
+  }
+}
+
+void applyUInverseTranspose(ConstVectorRef x, VectorRef y) {
+  for (Eigen::Index i = x.size() - 1; i > 0; --i) y[i] = x[i] - x[i - 1];
+  y[0] = x[0];
+}
+
+void applyHessian(const ChainStructure& ws, ConstVectorRef x, VectorRef y) {
+  const int n = ws.n;
+  applyUTranspose(x, y);
+  // y ← T y in place, keeping the previous original entry
+  double prev = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double cur = y[i];
+    double v = ws.diag[i] * cur;
+    if (i > 0) v += ws.off[i - 1] * prev;
+    if (i + 1 < n) v += ws.off[i] * y[i + 1];
+    prev = cur;
+    y[i] = v;
+  }
+  applyU(y, y);
+}
+
+Matrix tridiagonalMatrix(const ChainStructure& ws) {
+  const int n = ws.n;
+  Matrix T = Matrix::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    T(i, i) = ws.diag[i];
+    if (i + 1 < n) T(i, i + 1) = T(i + 1, i) = ws.off[i];
+  }
+  return T;
+}
+
+void factorize(ChainStructure& ws, double sigma) {
+  const int n = ws.n;
+  ws.shift = sigma;
+  ws.singular = false;
+  ws.factorInertia = Inertia{};
+  double scale = 0.0;
+  for (int k = 0; k < n; ++k) {
+    scale = std::max(scale, std::abs(ws.diag[k] - sigma * metricDiagonal(k, n)));
+    if (k + 1 < n) scale = std::max(scale, std::abs(ws.off[k] + sigma));
+  }
+  if (scale == 0.0) scale = 1.0;
+  const double pivmin = kTinyPivot * scale;
+  double minRatio = std::numeric_limits<double>::infinity();
+  auto a = [&](int k) { return ws.diag[k] - sigma * metricDiagonal(k, n); };
+  auto e = [&](int k) { return ws.off[k] + sigma; };  // M off-diagonal is −1
+
+  int k = 0;
+  double dk = a(0);
+  while (k < n) {
+    const double ek = k + 1 < n ? e(k) : 0.0;
+    if (k + 1 == n || std::abs(dk) * scale >= kBunchAlpha * ek * ek) {
+      if (dk == 0.0) {
+        dk = -pivmin;
+        ws.singular = true;
+      }
+      ws.blockStart[size_t(k)] = 1;
+      ws.pivA[k] = dk;
+      if (dk < 0.0) ++ws.factorInertia.negative;
+      else ++ws.factorInertia.positive;
+      minRatio = std::min(minRatio, std::abs(dk) / scale);
+      if (k + 1 < n) {
+        ws.l1[k] = ek / dk;
+        dk = a(k + 1) - ek * ws.l1[k];
+      }
+      k += 1;
+    } else {
+      // 2×2 pivot [[dk, ek], [ek, a_{k+1}]]: det < −(1 − α) ek² < 0, one eigenvalue of each sign.
+      const double b = a(k + 1);
+      const double det = dk * b - ek * ek;
+      ws.blockStart[size_t(k)] = 2;
+      ws.blockStart[size_t(k) + 1] = 0;
+      ws.pivA[k] = dk;
+      ws.pivA[k + 1] = b;
+      ws.pivE[k] = ek;
+      ++ws.factorInertia.negative;
+      ++ws.factorInertia.positive;
+      // smallest |eigenvalue| of the block ≥ |det| / (largest |eigenvalue|)
+      const double big = 0.5 * std::abs(dk + b) + std::hypot(0.5 * (dk - b), ek);
+      minRatio = std::min(minRatio, std::abs(det) / (big * scale));
+      if (k + 2 < n) {
+        const double ek1 = e(k + 1);
+        ws.l1[k] = -ek1 * ek / det;
+        ws.l2[k] = ek1 * dk / det;
+        dk = a(k + 2) - ek1 * ek1 * dk / det;
+      }
+      k += 2;
+    }
+  }
+  ws.minPivotRatio = minRatio;
+}
+
+int countBelow(const ChainStructure& ws, double sigma) {
+  const int n = ws.n;
+  double scale = 0.0;
+  for (int k = 0; k < n; ++k) scale = std::max(scale, std::abs(ws.diag[k]) + std::abs(sigma) * 2.0);
+  if (scale == 0.0) scale = 1.0;
+  const double pivmin = kTinyPivot * scale;
+  int count = 0;
+  double d = ws.diag[0] - sigma * metricDiagonal(0, n);
+  for (int k = 0;; ++k) {
+    if (std::abs(d) < pivmin) d = -pivmin;
+    if (d < 0.0) ++count;
+    if (k + 1 == n) break;
+    const double e = ws.off[k] + sigma;
+    d = ws.diag[k + 1] - sigma * metricDiagonal(k + 1, n) - e * e / d;
+  }
+  return count;
+}
+
+void solveFactored(const ChainStructure& ws, VectorRef y) {
+  const int n = ws.n;
+  // forward: L
+  for (int k = 0; k < n;) {
+    if (ws.blockStart[size_t(k)] == 1) {
+      if (k + 1 < n) y[k + 1] -= ws.l1[k] * y[k];
+      k += 1;
+    } else {
+      if (k + 2 < n) y[k + 2] -= ws.l1[k] * y[k] + ws.l2[k] * y[k + 1];
+      k += 2;
+    }
+  }
+  // block diagonal
+  for (int k = 0; k < n;) {
+    if (ws.blockStart[size_t(k)] == 1) {
+      y[k] /= ws.pivA[k];
+      k += 1;
+    } else {
+      const double a = ws.pivA[k], b = ws.pivA[k + 1], e = ws.pivE[k];
+      const double det = a * b - e * e;
+      const double y0 = y[k], y1 = y[k + 1];
+      y[k] = (b * y0 - e * y1) / det;
+      y[k + 1] = (a * y1 - e * y0) / det;
+      k += 2;
+    }
+  }
+  // backward: Lᵀ
+  for (int k = n - 1; k >= 0;) {
+    if (ws.blockStart[size_t(k)] == 0) {  // second row of a 2×2 starting at k − 1
+      if (k + 1 < n) {
+        y[k - 1] -= ws.l1[k - 1] * y[k + 1];
+        y[k] -= ws.l2[k - 1] * y[k + 1];
+      }
+      k -= 2;
+    } else {
+      if (k + 1 < n) y[k] -= ws.l1[k] * y[k + 1];
+      k -= 1;
+    }
+  }
+}
+
+void solveFactored(const ChainStructure& ws, MatrixRef Y, int cols) {
+  for (int j = 0; j < cols; ++j) solveFactored(ws, Y.col(j));
+}
+
+double zeroThreshold(const ChainStructure& ws, double zeroTolerance) {
+  return zeroTolerance * std::max(1.0, ws.frobeniusH);
+}
+
+Inertia hessianInertia(const ChainStructure& ws, double zeroTolerance) {
+  const double tau = zeroThreshold(ws, zeroTolerance);
+  Inertia in;
+  const int below = countBelow(ws, -tau);
+  const int belowPlus = countBelow(ws, tau);
+  in.negative = below;
+  in.zero = belowPlus - below;
+  in.positive = ws.n - belowPlus;
+  return in;
+}
+
+int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double rankTolerance) {
+  const int n = ws.n;
+  if (C.rows() > ChainStructure::kMaxBorder - 1 || (C.rows() > 0 && C.cols() != n))
+    throw std::invalid_argument("setConstraints: C must be m×n with m <= 3");
+  double maxNorm = 0.0;
+  for (Eigen::Index i = 0; i < C.rows(); ++i) maxNorm = std::max(maxNorm, C.row(i).norm());
+  int r = 0;
+  if (maxNorm > 0.0) {
+    for (Eigen::Index i = 0; i < C.rows(); ++i) {
+      auto qr = ws.Q.col(r);
+      qr = C.row(i).transpose();
+      for (int pass = 0; pass < 2; ++pass)
+        for (int j = 0; j < r; ++j) qr -= ws.Q.col(j).dot(qr) * ws.Q.col(j);
+      const double nrm = qr.norm();
+      if (nrm <= rankTolerance * maxNorm) continue;
+      qr /= nrm;
+      applyUInverse(qr, ws.B.col(r));
+      ++r;
+    }
+  }
+  ws.rank = r;
+  return r;
+}
+
+int constrainedCountBelow(ChainStructure& ws, double sigma) {
+  const int r = ws.rank;
+  factorize(ws, sigma);
+  if (r == 0) return ws.factorInertia.negative;
+  ws.X.leftCols(r) = ws.B.leftCols(r);
+  solveFactored(ws, ws.X, r);
+  ws.S.resize(r, r);
+  ws.S.noalias() = -(ws.B.leftCols(r).transpose() * ws.X.leftCols(r));
+  return ws.factorInertia.negative + smallNegativeCount(ws.S) - r;
+}
+
+namespace {
+
+/// Constrained count at σ0, moving σ within [σ0/2, 2σ0] when T − σM is nearly singular.
+int robustConstrainedCount(ChainStructure& ws, double sigma0) {
+  static constexpr double factors[] = {1.0, 1.5, 0.7, 2.0, 0.5, 1.25, 0.85};
+  double bestRatio = -1.0, bestFactor = 1.0;
+  int bestCount = 0;
+  for (double f : factors) {
+    const int c = constrainedCountBelow(ws, sigma0 * f);
+    if (ws.minPivotRatio >= 1e-10 && !ws.singular) return c;
+    if (ws.minPivotRatio > bestRatio) {
+      bestRatio = ws.minPivotRatio;
+      bestFactor = f;
+      bestCount = c;
+    }
+  }
+  (void)bestFactor;
+  return bestCount;
+}
+
+}  // namespace
+
+Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double zeroTolerance,
+                           double rankTolerance) {
+  const int r = C.rows() > 0 ? setConstraints(ws, C, rankTolerance) : (ws.rank = 0);
+  if (r == 0) return hessianInertia(ws, zeroTolerance);
+  const double tau = zeroThreshold(ws, zeroTolerance);
+  const int below = robustConstrainedCount(ws, -tau);
+  const int belowPlus = robustConstrainedCount(ws, tau);
+  Inertia in;
+  in.negative = below;
+  in.zero = belowPlus - below;
+  in.positive = (ws.n - r) - belowPlus;
+  return in;
+}
+
+double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance) {
+  const int dim = ws.n - (useConstraints ? ws.rank : 0);
+  if (dim <= 0) return 0.0;
+  const double scale = std::max(1.0, ws.frobeniusH);
+  auto count = [&](double s) { return useConstraints && ws.rank > 0 ? constrainedCountBelow(ws, s) : countBelow(ws, s); };
+  double lo = -ws.frobeniusH * (1.0 + 1e-12) - 1e-300;
+  double hi = ws.frobeniusH * (1.0 + 1e-12) + tolerance * scale;
+  while (count(hi) < 1) hi = 2.0 * hi + scale;  // guards against rounding in ‖H‖_F
+  while (count(lo) >= 1) lo = 2.0 * lo - scale;
+  const double tol = tolerance * scale;
+  while (hi - lo > tol) {
+    const double mid = 0.5 * (lo + hi);
+    if (mid <= lo || mid >= hi) break;
+    if (count(mid) >= 1) hi = mid;
+    else lo = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+bool solve(ChainStructure& ws, ConstVectorRef r, VectorRef x) {
+  factorize(ws, 0.0);
+  if (ws.singular) return false;
+  applyUInverse(r, x);
+  solveFactored(ws, x);
+  applyUInverseTranspose(x, x);
+  return x.allFinite();
+}
+
+bool solveBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const Eigen::Ref<const Matrix>& W,
+                   const Eigen::Ref<const Matrix>& D, ConstVectorRef f, ConstVectorRef g, VectorRef x, VectorRef y) {
+  const int n = ws.n;
+  const int p = int(V.cols());
+  if (p > ChainStructure::kMaxBorder || W.cols() != p || D.rows() != p || D.cols() != p || V.rows() != n ||
+      W.rows() != n)
+    throw std::invalid_argument("solveBordered: V, W must be n×p and D p×p with p <= 4");
+  factorize(ws, 0.0);
+  if (ws.singular) return false;
+  if (p == 0) {
+    applyUInverse(f, x);
+    solveFactored(ws, x);
+    applyUInverseTranspose(x, x);
+    return x.allFinite();
+  }
+  for (int j = 0; j < p; ++j) {
+    applyUInverse(V.col(j), ws.V2.col(j));
+    applyUInverse(W.col(j), ws.W2.col(j));
+  }
+  solveFactored(ws, ws.V2, p);
+  ChainStructure::SmallMatrix schur(p, p);
+  schur.noalias() = D - ws.W2.leftCols(p).transpose() * ws.V2.leftCols(p);
+  Eigen::FullPivLU<ChainStructure::SmallMatrix> lu(schur);
+  if (!lu.isInvertible()) return false;
+  borderedElimination(ws, p, lu, f, g, x, y);
+  // One step of iterative refinement with the exact O(n) residual.
+  Vector& r1 = ws.t2;
+  applyHessian(ws, x.head(n), r1);
+  r1 = f - r1;
+  r1.noalias() -= V * y.head(p);
+  ChainStructure::SmallVector r2 = g.head(p);
+  r2.noalias() -= W.transpose() * x.head(n);
+  r2.noalias() -= D * y.head(p);
+  Vector& dx = ws.t3;
+  ChainStructure::SmallVector dy(p);
+  borderedElimination(ws, p, lu, r1, r2, dx, dy);
+  x.head(n) += dx;
+  y.head(p) += dy;
+  return x.allFinite() && y.allFinite();
+}
+
+bool solveKKT(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, ConstVectorRef f, ConstVectorRef g, VectorRef x,
+              VectorRef y) {
+  const int m = int(C.rows());
+  if (m > ChainStructure::kMaxBorder) throw std::invalid_argument("solveKKT: at most 4 constraint rows");
+  ws.X.leftCols(m) = C.transpose();
+  ws.zeroBorder.setZero();
+  return solveBordered(ws, ws.X.leftCols(m), ws.X.leftCols(m), ws.zeroBorder.topLeftCorner(m, m), f, g, x, y);
+}
+
+}  // namespace buckle::mechanics

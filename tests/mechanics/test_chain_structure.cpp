@@ -1,0 +1,348 @@
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "buckle/continuation/problem.h"
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/chain_structure.h"
+
+using namespace buckle::mechanics;
+using buckle::continuation::projectedInertia;
+using buckle::continuation::StabilityInfo;
+
+namespace {
+
+SegmentParameters randomSegment(std::mt19937& rng) {
+  std::uniform_real_distribution<double> A(0.1, 0.9), B(0.8, 1.4), K(0.5, 3.0), L(1.0, 2.8);
+  SegmentParameters p;
+  p.a1 = A(rng); p.a2 = A(rng);
+  p.b1 = B(rng); p.b2 = B(rng);
+  p.k1 = K(rng); p.k2 = K(rng);
+  p.L1_0 = L(rng); p.L2_0 = L(rng);
+  return p;
+}
+
+struct Instance {
+  Chain chain;
+  Vector q;
+  Wrench F;
+  Matrix H, J;
+};
+
+Instance randomInstance(int n, std::mt19937& rng, double loadScale = 1.0) {
+  std::vector<SegmentParameters> segs;
+  for (int i = 0; i < n; ++i) segs.push_back(randomSegment(rng));
+  Chain chain(segs);
+  Vector q(n);
+  for (int i = 0; i < n; ++i) {
+    std::uniform_real_distribution<double> Q(0.6 * chain.lowerLimits()[i], 0.6 * chain.upperLimits()[i]);
+    q[i] = Q(rng);
+  }
+  std::uniform_real_distribution<double> Fd(-loadScale, loadScale);
+  Wrench F(Fd(rng), Fd(rng), Fd(rng));
+  Matrix H(n, n);
+  totalPotentialHessian(chain, q, F, H);
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  Matrix J(3, n);
+  endJacobian(data, J);
+  return {chain, q, F, H, J};
+}
+
+void assembleInstance(const Instance& in, ChainStructure& ws) {
+  ChainData data(in.chain);
+  forwardKinematics(in.chain, in.q, data);
+  assemble(in.chain, data, in.q, in.F, ws);
+}
+
+Matrix rows(const Matrix& J, const std::vector<int>& idx) {
+  Matrix C(int(idx.size()), J.cols());
+  for (size_t k = 0; k < idx.size(); ++k) C.row(int(k)) = J.row(idx[k]);
+  return C;
+}
+
+const std::vector<std::vector<int>> kHeldSets = {{}, {1}, {0, 1}, {0, 1, 2}, {2}};
+
+}  // namespace
+
+TEST_CASE("T is congruent to H: H = U T Uᵀ, equal inertia", "[chain_structure]") {
+  std::mt19937 rng(11);
+  for (int n : {1, 2, 3, 17, 200}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      Instance in = randomInstance(n, rng, trial == 0 ? 0.0 : 2.0);
+      ChainStructure ws(n);
+      assembleInstance(in, ws);
+      Matrix U = Matrix::Zero(n, n);
+      for (int i = 0; i < n; ++i)
+        for (int k = i; k < n; ++k) U(i, k) = 1.0;
+      const Matrix T = tridiagonalMatrix(ws);
+      const Matrix rebuilt = U * T * U.transpose();
+      CHECK((rebuilt - in.H).norm() <= 1e-11 * std::max(1.0, in.H.norm()));
+      CHECK(ws.frobeniusH == Approx(in.H.norm()).epsilon(1e-10).margin(1e-12));
+      Eigen::SelfAdjointEigenSolver<Matrix> eT(T), eH(in.H);
+      int negT = 0, negH = 0;
+      for (int i = 0; i < n; ++i) {
+        negT += eT.eigenvalues()[i] < 0;
+        negH += eH.eigenvalues()[i] < 0;
+      }
+      CHECK(negT == negH);
+      CHECK(hessianInertia(ws).negative == negH);
+      factorize(ws, 0.0);
+      CHECK(ws.factorInertia.negative == negH);
+      // O(n) product
+      Vector x = Vector::Random(n), y(n);
+      applyHessian(ws, x, y);
+      CHECK((y - in.H * x).norm() <= 1e-11 * std::max(1.0, in.H.norm()) * x.norm());
+    }
+  }
+}
+
+TEST_CASE("counts below a shift match the dense spectrum", "[chain_structure]") {
+  std::mt19937 rng(5);
+  for (int n : {1, 3, 17, 200}) {
+    Instance in = randomInstance(n, rng, 3.0);
+    ChainStructure ws(n);
+    assembleInstance(in, ws);
+    Eigen::SelfAdjointEigenSolver<Matrix> es(in.H, Eigen::EigenvaluesOnly);
+    const Vector& mu = es.eigenvalues();
+    for (int i = 0; i + 1 < n; ++i) {
+      const double s = 0.5 * (mu[i] + mu[i + 1]);
+      if (mu[i + 1] - mu[i] < 1e-8 * std::max(1.0, in.H.norm())) continue;
+      CHECK(countBelow(ws, s) == i + 1);
+      factorize(ws, s);
+      CHECK(ws.factorInertia.negative == i + 1);
+    }
+  }
+}
+
+TEST_CASE("inertia of H and of H on ker C agree with the dense projection", "[chain_structure]") {
+  std::mt19937 rng(2024);
+  for (int n : {1, 2, 3, 17, 200}) {
+    for (int trial = 0; trial < 6; ++trial) {
+      Instance in = randomInstance(n, rng, 0.5 + trial);
+      ChainStructure ws(n);
+      assembleInstance(in, ws);
+      for (const auto& held : kHeldSets) {
+        if (int(held.size()) > n) continue;
+        const Matrix C = rows(in.J, held);
+        const StabilityInfo dense = projectedInertia(in.H, C);
+        const Inertia fast = constrainedInertia(ws, C);
+        INFO("n = " << n << ", held rows " << held.size() << ", trial " << trial);
+        CHECK(fast.negative == dense.negative);
+        CHECK(fast.zero == dense.zero);
+        CHECK(fast.size() == n - ws.rank);
+      }
+    }
+  }
+}
+
+TEST_CASE("degenerate straight chain: κ = 0 at F = 0 gives n (n − 1 on ker C) zero eigenvalues",
+          "[chain_structure]") {
+  // κ = k (b L0 − 2(b² − a²)) = 0 for a = 0.5, b = 1, k = 1, L0 = 1.5 (the L_triv case).
+  for (int n : {1, 2, 3, 17, 200}) {
+    Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.5));
+    Vector q = Vector::Zero(n);
+    ChainData data(chain);
+    forwardKinematics(chain, q, data);
+    Matrix J(3, n);
+    endJacobian(data, J);
+    ChainStructure ws(n);
+    assemble(chain, data, q, Wrench::Zero(), ws);
+    const Inertia free = hessianInertia(ws);
+    CHECK(free.zero == n);
+    CHECK(free.negative == 0);
+    const Inertia pinned = constrainedInertia(ws, rows(J, {1}));
+    CHECK(pinned.zero == n - 1);
+    CHECK(pinned.negative == 0);
+    // straight chain, x and y held: the x row (−S) vanishes, so rank(C) = 1
+    const Inertia held = constrainedInertia(ws, rows(J, {0, 1}));
+    CHECK(ws.rank == 1);
+    CHECK(held.zero == n - 1);
+    // just past F = 0 in compression the index jumps to n − 1 at once (on ker y: L_triv's 0 → 2)
+    for (double Fx : {-1e-3, 1e-3}) {
+      Matrix H(n, n);
+      totalPotentialHessian(chain, q, Wrench(Fx, 0, 0), H);
+      assemble(chain, data, q, Wrench(Fx, 0, 0), ws);
+      const StabilityInfo dense = projectedInertia(H, rows(J, {1}));
+      const Inertia fast = constrainedInertia(ws, rows(J, {1}));
+      CHECK(fast.negative == dense.negative);
+      CHECK(fast.zero == dense.zero);
+      if (Fx < 0) CHECK(fast.negative == n - 1);
+      else CHECK(fast.negative == 0);
+    }
+  }
+}
+
+TEST_CASE("clamped–pinned 3-chain: the eq 17 branch points are zeros of the reduced Hessian",
+          "[chain_structure]") {
+  const double kappa = 0.75;  // a = 0.5, b = 1, k = 1, L0 = 2.25
+  Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  Vector q = Vector::Zero(3);
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  Matrix J(3, 3);
+  endJacobian(data, J);
+  const Matrix C = rows(J, {1});
+  ChainStructure ws(3);
+  const double lamU = (std::sqrt(21.0) - 14.0) / 10.0, lamZ = -(std::sqrt(21.0) + 14.0) / 10.0;
+  int index = 0;
+  for (double lam : {lamU, lamZ}) {
+    const double Fx = lam * kappa;
+    assemble(chain, data, q, Wrench(Fx, 0, 0), ws);
+    const Inertia at = constrainedInertia(ws, C);
+    CHECK(at.zero == 1);
+    CHECK(at.negative == index);
+    // at U the zero is the lowest eigenvalue; at Z one eigenvalue is already negative
+    if (index == 0) CHECK(std::abs(smallestEigenvalue(ws, true, 1e-14)) < 1e-12);
+    else CHECK(smallestEigenvalue(ws, true, 1e-14) < -0.1);
+    for (double d : {-1e-9, 1e-9}) {
+      assemble(chain, data, q, Wrench(Fx + d, 0, 0), ws);
+      const Inertia near = constrainedInertia(ws, C);
+      CHECK(near.zero == 0);
+      CHECK(near.negative == (d < 0 ? index + 1 : index));
+    }
+    ++index;
+  }
+}
+
+TEST_CASE("near-singular H (an eigenvalue shifted to zero) on and off ker C", "[chain_structure]") {
+  std::mt19937 rng(99);
+  for (int n : {2, 3, 17, 200}) {
+    Instance in = randomInstance(n, rng, 1.5);
+    Eigen::SelfAdjointEigenSolver<Matrix> es(in.H, Eigen::EigenvaluesOnly);
+    ChainStructure ws(n);
+    ChainData data(in.chain);
+    forwardKinematics(in.chain, in.q, data);
+    Vector kappa(n), h(n);
+    jointStiffness(in.chain, in.q, kappa);
+    loadHessianGenerator(data, in.F, h);
+    for (int k : {0, n / 2}) {
+      const double mu = es.eigenvalues()[k];
+      // H − μI is again of chain form: K_q − μI is diagonal
+      Vector kap = kappa.array() - mu;
+      assemble(kap, h, ws);
+      Matrix Hs = in.H - mu * Matrix::Identity(n, n);
+      for (const auto& held : kHeldSets) {
+        if (int(held.size()) > n) continue;
+        const Matrix C = rows(in.J, held);
+        const StabilityInfo dense = projectedInertia(Hs, C);
+        const Inertia fast = constrainedInertia(ws, C);
+        INFO("n = " << n << ", k = " << k << ", held rows " << held.size());
+        CHECK(fast.negative == dense.negative);
+        CHECK(fast.zero == dense.zero);
+        if (held.empty()) CHECK(fast.zero == 1);
+      }
+    }
+  }
+}
+
+TEST_CASE("smallest eigenvalue by bisection", "[chain_structure]") {
+  std::mt19937 rng(3);
+  for (int n : {1, 3, 17, 200}) {
+    Instance in = randomInstance(n, rng, 1.0);
+    ChainStructure ws(n);
+    assembleInstance(in, ws);
+    const double scale = std::max(1.0, in.H.norm());
+    for (const auto& held : kHeldSets) {
+      if (int(held.size()) >= n) continue;
+      const Matrix C = rows(in.J, held);
+      const StabilityInfo dense = projectedInertia(in.H, C);
+      setConstraints(ws, C);
+      const double s = smallestEigenvalue(ws, !held.empty(), 1e-13);
+      CHECK(std::abs(s - dense.smallest) <= 1e-10 * scale);
+    }
+  }
+}
+
+TEST_CASE("O(n) solves of H, the KKT system and a Keller-type bordered system", "[chain_structure]") {
+  std::mt19937 rng(17);
+  for (int n : {1, 2, 3, 17, 200}) {
+    for (int trial = 0; trial < 3; ++trial) {
+      Instance in = randomInstance(n, rng, 1.0);
+      ChainStructure ws(n);
+      assembleInstance(in, ws);
+      const double cond = [&] {
+        Eigen::SelfAdjointEigenSolver<Matrix> es(in.H, Eigen::EigenvaluesOnly);
+        return es.eigenvalues().cwiseAbs().maxCoeff() / es.eigenvalues().cwiseAbs().minCoeff();
+      }();
+      const double tol = 1e-13 * n * n * std::max(1.0, cond);
+      Vector r = Vector::Random(n), x(n);
+      REQUIRE(solve(ws, r, x));
+      const Vector xd = in.H.partialPivLu().solve(r);
+      CHECK((x - xd).norm() <= tol * xd.norm());
+
+      for (const auto& held : kHeldSets) {
+        const int m = int(held.size());
+        if (m == 0 || m > n) continue;
+        const Matrix C = rows(in.J, held);
+        Matrix K = Matrix::Zero(n + m, n + m);
+        K.topLeftCorner(n, n) = in.H;
+        K.topRightCorner(n, m) = C.transpose();
+        K.bottomLeftCorner(m, n) = C;
+        Vector f = Vector::Random(n), g = Vector::Random(m), xs(n), ys(m);
+        Eigen::FullPivLU<Matrix> lu(K);
+        if (!lu.isInvertible()) continue;
+        REQUIRE(solveKKT(ws, C, f, g, xs, ys));
+        Vector rhs(n + m);
+        rhs << f, g;
+        const Vector sol = lu.solve(rhs);
+        const Vector mine = (Vector(n + m) << xs, ys).finished();
+        Eigen::JacobiSVD<Matrix> svd(K);
+        const double condK = svd.singularValues()[0] / svd.singularValues()[n + m - 1];
+        INFO("n = " << n << " m = " << m << " cond(K) = " << condK);
+        CHECK((mine - sol).norm() <= 1e-13 * n * n * std::max(1.0, condK) * sol.norm());
+      }
+
+      // Keller system [[H, V], [Wᵀ, D]] with p = 2 (a multiplier column and the F_λ / tangent column)
+      const int p = std::min(2, n);
+      Matrix V = Matrix::Random(n, p), W = Matrix::Random(n, p), D = Matrix::Random(p, p);
+      Matrix K(n + p, n + p);
+      K << in.H, V, W.transpose(), D;
+      Vector f = Vector::Random(n), g = Vector::Random(p), xs(n), ys(p);
+      REQUIRE(solveBordered(ws, V, W, D, f, g, xs, ys));
+      Vector rhs(n + p);
+      rhs << f, g;
+      const Vector sol = K.fullPivLu().solve(rhs);
+      Eigen::JacobiSVD<Matrix> svd(K);
+      const double condK = svd.singularValues()[0] / svd.singularValues()[n + p - 1];
+      const Vector mine = (Vector(n + p) << xs, ys).finished();
+      CHECK((mine - sol).norm() <= 1e-13 * n * n * std::max(1.0, condK) * sol.norm());
+    }
+  }
+}
+
+TEST_CASE("bordered solve stays accurate where H is singular but the bordered matrix is not (a fold)",
+          "[chain_structure]") {
+  std::mt19937 rng(41);
+  for (int n : {3, 17, 200}) {
+    Instance in = randomInstance(n, rng, 1.0);
+    Eigen::SelfAdjointEigenSolver<Matrix> es(in.H);
+    const double mu = es.eigenvalues()[0];
+    ChainData data(in.chain);
+    forwardKinematics(in.chain, in.q, data);
+    Vector kappa(n), h(n);
+    jointStiffness(in.chain, in.q, kappa);
+    loadHessianGenerator(data, in.F, h);
+    // shift so that H is singular up to ~1e-10 relative
+    const double shift = mu - 1e-10 * std::max(1.0, in.H.norm());
+    Vector kap = kappa.array() - shift;
+    ChainStructure ws(n);
+    assemble(kap, h, ws);
+    const Matrix Hs = in.H - shift * Matrix::Identity(n, n);
+    Matrix V = Matrix::Random(n, 1), W = Matrix::Random(n, 1), D = Matrix::Random(1, 1);
+    Matrix K(n + 1, n + 1);
+    K << Hs, V, W.transpose(), D;
+    Vector f = Vector::Random(n), g = Vector::Random(1), xs(n), ys(1);
+    REQUIRE(solveBordered(ws, V, W, D, f, g, xs, ys));
+    Vector rhs(n + 1);
+    rhs << f, g;
+    const Vector mine = (Vector(n + 1) << xs, ys).finished();
+    // backward error of the O(n) solve
+    const double backward = (K * mine - rhs).norm() / (K.norm() * mine.norm() + rhs.norm());
+    INFO("n = " << n << " backward error " << backward);
+    CHECK(backward < 1e-12);
+  }
+}
