@@ -1,0 +1,127 @@
+#include "buckle/continuation/test_functions.h"
+
+#include "toy_problems.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace buckle::continuation;
+
+TEST_CASE("PointEvaluator: tangent, fold test and bordered determinant on the circle", "[test_functions]") {
+  toys::Circle circle;
+  PointEvaluator evaluator(circle, true);
+  ContinuationPoint p;
+  p.u = (Vector(1) << 0.6).finished();
+  p.lambda = 0.8;
+  const Vector reference = (Vector(2) << -1.0, 0.0).finished();
+  REQUIRE(evaluator.complete(p, reference));
+  // ker [2u, 2λ] = span(−0.8, 0.6), oriented along the reference.
+  CHECK(std::abs(p.tangent[0] + 0.8) < 1e-15);
+  CHECK(std::abs(p.tangent[1] - 0.6) < 1e-15);
+  CHECK(p.foldTest == p.tangent[1]);
+  // det [[1.2, 1.6], [−0.8, 0.6]] = 2.
+  CHECK(p.determinantSign == 1);
+  CHECK(std::abs(p.logAbsDeterminant - std::log(2.0)) < 1e-14);
+  CHECK_FALSE(p.stability.valid());  // the circle has no stability operator
+
+  // Reversed reference: reversed tangent, and the determinant with the point's own tangent
+  // flips sign with it.
+  ContinuationPoint q = p;
+  REQUIRE(evaluator.complete(q, -reference));
+  CHECK((q.tangent + p.tangent).norm() < 1e-15);
+  CHECK(q.determinantSign == -1);
+}
+
+TEST_CASE("PointEvaluator records stability and flags exact singularity", "[test_functions]") {
+  toys::TwoPitchforks problem(0.5);
+  PointEvaluator evaluator(problem, true);
+  ContinuationPoint p;
+  p.u = Vector::Zero(2);
+  p.lambda = 0.25;
+  const Vector eLambda = (Vector(3) << 0.0, 0.0, 1.0).finished();
+  REQUIRE(evaluator.complete(p, eLambda));
+  REQUIRE(p.stability.valid());
+  CHECK(p.stability.negative == 1);
+  // det [[λ, 0, 0], [0, λ − c, 0], [0, 0, 1]] = λ(λ − c) < 0.
+  CHECK(p.determinantSign == -1);
+
+  p.lambda = 0.0;
+  CHECK_FALSE(evaluator.complete(p, eLambda));
+  CHECK(evaluator.lastWasSingular());
+  CHECK(p.determinantSign == 0);
+  CHECK(p.stability.valid());
+
+  PointEvaluator without(problem, false);
+  p.lambda = 0.25;
+  REQUIRE(without.complete(p, eLambda));
+  CHECK_FALSE(p.stability.valid());
+}
+
+TEST_CASE("Minimally augmented test function changes sign with the singular value", "[test_functions]") {
+  MinimallyAugmentedTest test;
+  Matrix A = Matrix::Identity(3, 3);
+  A(0, 0) = 0.01;
+  test.initialize(A);
+  // With b = c = e₁: ψ = −μ exactly for A = diag(μ, 1, 1).
+  for (double mu : {0.3, 0.01, 1e-9, -1e-9, -0.2}) {
+    A(0, 0) = mu;
+    double psi = 0.0;
+    Vector v;
+    REQUIRE(test.evaluate(A, psi, &v));
+    CHECK(std::abs(std::abs(psi) - std::abs(mu)) < 1e-15);
+    CHECK(std::abs(v[0]) == Approx(1.0));
+  }
+  double a = 0.0, b = 0.0;
+  A(0, 0) = 0.1;
+  test.evaluate(A, a);
+  A(0, 0) = -0.1;
+  test.evaluate(A, b);
+  CHECK(a * b < 0.0);
+}
+
+TEST_CASE("classifyInterval separates folds, determinant changes and inertia", "[test_functions]") {
+  ContinuationPoint a, b;
+  a.foldTest = 0.5;
+  b.foldTest = -0.5;
+  a.determinantSign = b.determinantSign = 1;
+  a.stability.negative = 0;
+  b.stability.negative = 1;
+  IntervalCrossings fold = classifyInterval(a, b, true, true);
+  CHECK(fold.fold);
+  CHECK_FALSE(fold.determinantChange);
+  CHECK(fold.inertiaChange == 1);
+  CHECK(fold.branchPointCrossings == 0);  // the fold explains the eigenvalue crossing
+
+  b.foldTest = 0.4;
+  b.stability.negative = 2;
+  IntervalCrossings even = classifyInterval(a, b, true, true);
+  CHECK_FALSE(even.fold);
+  CHECK(even.branchPointCrossings == 2);
+
+  b.stability.negative = 1;
+  b.determinantSign = -1;
+  IntervalCrossings simple = classifyInterval(a, b, true, true);
+  CHECK(simple.determinantChange);
+  CHECK(simple.branchPointCrossings == 1);
+
+  b.stability = StabilityInfo();  // unknown inertia: the determinant alone decides
+  IntervalCrossings noInertia = classifyInterval(a, b, true, true);
+  CHECK(noInertia.inertiaChange == -1);
+  CHECK(noInertia.branchPointCrossings == 1);
+  CHECK(classifyInterval(a, b, true, false).branchPointCrossings == 0);
+}
+
+TEST_CASE("jacobianKernel: two-dimensional kernel at a pitchfork", "[test_functions]") {
+  toys::TwoPitchforks problem(0.5);
+  KernelInfo kernel;
+  REQUIRE(jacobianKernel(problem, Vector::Zero(2), 0.0, kernel));
+  REQUIRE(kernel.singularValues.size() == 3);
+  CHECK(kernel.singularValues[0] == 0.0);
+  CHECK(kernel.singularValues[1] < 1e-15);
+  CHECK(std::abs(kernel.singularValues[2] - 0.5) < 1e-15);
+  // Right singular vectors of the zero values span (u₁, λ); the left one is e₁.
+  CHECK(std::abs(kernel.right(1, 0)) < 1e-15);
+  CHECK(std::abs(kernel.right(1, 1)) < 1e-15);
+  CHECK(std::abs(std::abs(kernel.left(0, 0)) - 1.0) < 1e-15);
+}
