@@ -1,0 +1,336 @@
+#include "scene/output.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace buckle::scene {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double commonColumn(const std::string& c, double parameter, const mechanics::Wrench& F, const mechanics::Pose& pose,
+                    const Eigen::VectorXd& q, const mechanics::Pose& pose0, bool& found) {
+  found = true;
+  if (c == "parameter") return parameter;
+  if (c == "Fx") return F[0];
+  if (c == "Fy") return F[1];
+  if (c == "Me") return F[2];
+  if (c == "x") return pose[0];
+  if (c == "y") return pose[1];
+  if (c == "phi") return pose[2];
+  if (c == "dx") return pose0[0] - pose[0];
+  if (c == "dy") return pose[1] - pose0[1];
+  if (c.size() >= 2 && c[0] == 'q') {
+    const int i = std::atoi(c.c_str() + 1);
+    return (i >= 1 && i <= q.size()) ? q[i - 1] : kNaN;
+  }
+  found = false;
+  return kNaN;
+}
+
+// JSON has no NaN: write null.
+json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json vectorJson(const Eigen::VectorXd& v) {
+  json a = json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(number(v[i]));
+  return a;
+}
+
+void writeText(const fs::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  out.close();
+  if (!out) throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
+}
+
+std::string fmt(double v) {
+  if (!std::isfinite(v)) return "nan";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  return buf;
+}
+
+void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir) {
+  const int n = scene.maxSegments();
+  std::ostringstream os;
+  os << "case,branch,point,parameter,Fx,Fy,Me,x,y,phi,dx,dy";
+  for (int i = 1; i <= n; ++i) os << ",q" << i;
+  os << ",stable,negative,min_eig";
+  if (scene.analyses.stiffness) os << ",Kxx,Kyy,Kxy";
+  os << "\n";
+  for (size_t c = 0; c < run.cases.size(); ++c) {
+    const CaseResult& cr = run.cases[c];
+    for (const PointRecord& p : cr.points) {
+      os << c << ',' << p.branch << ',' << p.index << ',' << fmt(p.parameter);
+      for (int k = 0; k < 3; ++k) os << ',' << fmt(p.F[k]);
+      for (int k = 0; k < 3; ++k) os << ',' << fmt(p.pose[k]);
+      os << ',' << fmt(cr.pose0[0] - p.pose[0]) << ',' << fmt(p.pose[1] - cr.pose0[1]);
+      for (int i = 0; i < n; ++i) os << ',' << (i < p.q.size() ? fmt(p.q[i]) : std::string());
+      os << ',' << (p.stable ? 1 : 0) << ',' << p.negative << ',' << fmt(p.minEigenvalue);
+      if (scene.analyses.stiffness) os << ',' << fmt(p.K(0, 0)) << ',' << fmt(p.K(1, 1)) << ',' << fmt(p.K(0, 1));
+      os << "\n";
+    }
+  }
+  writeText(dir / "branches.csv", os.str());
+}
+
+json wrenchJson(const mechanics::Wrench& F) { return json{{"Fx", number(F[0])}, {"Fy", number(F[1])}, {"Me", number(F[2])}}; }
+json poseJson(const mechanics::Pose& p) { return json{{"x", number(p[0])}, {"y", number(p[1])}, {"phi", number(p[2])}}; }
+
+void writeSpecialPoints(const Scene& scene, const RunResult& run, const fs::path& dir) {
+  json doc;
+  doc["scene"] = scene.file;
+  json points = json::array(), critical = json::array(), equilibria = json::array(), torque = json::array();
+  for (size_t c = 0; c < run.cases.size(); ++c) {
+    const CaseResult& cr = run.cases[c];
+    for (const SpecialRecord& s : cr.specials) {
+      json p;
+      p["case"] = c;
+      p["case_label"] = cr.label;
+      p["type"] = s.type;
+      p["field"] = s.field;
+      p["branch"] = s.branch;
+      p["parameter"] = number(s.parameter);
+      p["loads"] = wrenchJson(s.F);
+      p["position"] = poseJson(s.pose);
+      p["q"] = vectorJson(s.q);
+      p["shape"] = s.shape;
+      p["stability_before"] = s.stabilityBefore;
+      p["stability_after"] = s.stabilityAfter;
+      p["accuracy"] = {{"parameter", number(s.accuracy)}, {"residual", number(s.residual)}, {"refined", s.refined}};
+      if (!s.note.empty()) p["note"] = s.note;
+      points.push_back(p);
+    }
+    if (cr.haveCritical) {
+      for (const mechanics::BucklingMode& m : cr.critical.modes) {
+        json e{{"case", c}, {"case_label", cr.label}, {"load_factor", number(m.lambda)}, {"shape", m.shape},
+               {"mode", vectorJson(m.mode)}, {"shortening", number(m.shortening)}};
+        if (std::isfinite(m.mu)) e["mu"] = m.mu;
+        critical.push_back(e);
+      }
+    }
+    if (cr.haveLandscape) {
+      for (const mechanics::LandscapeEquilibrium& e : cr.landscape.equilibria) {
+        Eigen::VectorXd q = e.q;
+        equilibria.push_back(json{{"case", c}, {"case_label", cr.label}, {"ik_branch", e.branch}, {"q1", e.q1},
+                                  {"q", vectorJson(q)}, {"energy", number(e.energy)},
+                                  {"d2E_dq1", number(e.d2Edq1)}, {"stable", e.stable}, {"shape", e.shape},
+                                  {"loads", wrenchJson(e.F)}});
+      }
+    }
+    if (cr.haveTorque)
+      for (const auto& [q, stable] : cr.torque.equilibria)
+        torque.push_back(json{{"case", c}, {"case_label", cr.label}, {"q", q}, {"stable", stable}});
+  }
+  doc["special_points"] = points;
+  if (scene.analyses.criticalForces.enabled) doc["critical_loads"] = critical;
+  if (scene.analyses.energyCurves.enabled) doc["energy_equilibria"] = equilibria;
+  if (scene.analyses.torqueAngle.enabled) doc["torque_zeros"] = torque;
+  writeText(dir / "special_points.json", doc.dump(2) + "\n");
+}
+
+void writeCurves(const Scene& scene, const RunResult& run, const fs::path& dir) {
+  if (scene.analyses.energyCurves.enabled) {
+    std::ostringstream os;
+    os << "case,ik_branch,q1,status,E,dE_dq1,Me,q2,q3\n";
+    for (size_t c = 0; c < run.cases.size(); ++c) {
+      const CaseResult& cr = run.cases[c];
+      if (!cr.haveLandscape) continue;
+      for (int b : {1, -1}) {
+        const auto& samples = b > 0 ? cr.landscape.positive : cr.landscape.negative;
+        for (const mechanics::LandscapeSample& s : samples) {
+          const char* status = s.status == mechanics::LandscapeStatus::Feasible ? "feasible"
+                               : s.status == mechanics::LandscapeStatus::JointLimit ? "joint_limit"
+                                                                                  : "unreachable";
+          os << c << ',' << b << ',' << fmt(s.q1) << ',' << status << ',' << fmt(s.energy) << ',' << fmt(s.dEdq1)
+             << ',' << fmt(s.endTorque) << ',' << fmt(s.q[1]) << ',' << fmt(s.q[2]) << "\n";
+        }
+      }
+    }
+    writeText(dir / "energy_curves.csv", os.str());
+  }
+  if (scene.analyses.torqueAngle.enabled) {
+    std::ostringstream os;
+    os << "case,q,M,Kq\n";
+    for (size_t c = 0; c < run.cases.size(); ++c) {
+      const TorqueCurve& t = run.cases[c].torque;
+      for (size_t i = 0; i < t.q.size(); ++i)
+        os << c << ',' << fmt(t.q[i]) << ',' << fmt(t.M[i]) << ',' << fmt(t.Kq[i]) << "\n";
+    }
+    writeText(dir / "torque_angle.csv", os.str());
+  }
+}
+
+json solverJson(const SolverSpec& s) {
+  return json{{"initial_step", s.initialStep}, {"min_step", s.minStep}, {"max_step", s.maxStep},
+              {"tolerance", s.tolerance},      {"max_points", s.maxPoints}, {"time_limit", s.timeLimit}};
+}
+
+void writeSummary(const Scene& scene, const RunResult& run, const PlotReport& plots, const fs::path& dir) {
+  json doc;
+  doc["scene"] = scene.file;
+  doc["description"] = scene.description;
+  doc["complete"] = run.complete;
+  if (!run.problems.empty()) doc["problems"] = run.problems;
+  doc["computed"] = run.computed;
+  doc["solver"] = solverJson(scene.solver);
+  doc["accuracy"] = {{"max_corrector_residual", run.worstResidual},
+                     {"max_special_point_parameter_error", run.worstLocation}};
+  json timings;
+  for (const auto& [name, seconds] : run.timings) timings[name] = seconds;
+  timings["total"] = run.totalSeconds;
+  doc["timings_seconds"] = timings;
+  json cases = json::array();
+  for (const CaseResult& cr : run.cases) {
+    json c;
+    c["label"] = cr.label;
+    c["segments"] = cr.chain.size();
+    json segs = json::array();
+    for (int i = 0; i < cr.chain.size(); ++i) {
+      const mechanics::SegmentParameters& p = cr.chain.segment(i).parameters();
+      segs.push_back(json{{"a1", p.a1}, {"b1", p.b1}, {"a2", p.a2}, {"b2", p.b2}, {"k1", p.k1}, {"k2", p.k2},
+                          {"L1_0", p.L1_0}, {"L2_0", p.L2_0}, {"q_min", cr.chain.lowerLimits()[i]},
+                          {"q_max", cr.chain.upperLimits()[i]},
+                          {"straight_stiffness", cr.chain.segment(i).straightStiffness()}});
+    }
+    c["segment_parameters"] = segs;
+    c["q0"] = vectorJson(cr.q0);
+    c["start_position"] = poseJson(cr.pose0);
+    c["start_parameter"] = cr.startValue;
+    json branches = json::array();
+    for (const BranchRecord& b : cr.branches)
+      branches.push_back(json{{"id", b.id}, {"parent", b.parent}, {"origin", b.origin}, {"points", b.points},
+                              {"stop", b.stopReason}, {"stop_message", b.stopMessage}, {"finished", b.finished}});
+    if (scene.analyses.continuation.enabled) c["branches"] = branches;
+    if (cr.haveCritical) {
+      json crit;
+      crit["unloaded_stable"] = cr.critical.unloadedStable;
+      json loads = json::array();
+      for (const auto& m : cr.critical.modes) loads.push_back(json{{"load_factor", m.lambda}, {"shape", m.shape}});
+      crit["loads"] = loads;
+      if (cr.haveAnalytic) {
+        const auto& a = cr.analytic;
+        crit["closed_form_eq17"] = {{"kappa", a.kappa}, {"Fx_U", a.FxU}, {"Fx_Z", a.FxZ}};
+        // measured error of the branch points found by continuation against eq 17
+        json errors = json::object();
+        for (const auto& [name, exact] : {std::pair<std::string, double>{"U", a.FxU}, {"Z", a.FxZ}}) {
+          double best = std::numeric_limits<double>::infinity();
+          for (const SpecialRecord& s : cr.specials)
+            if (s.type == "BP") best = std::min(best, std::abs(s.F[0] - exact));
+          if (std::isfinite(best)) errors["continuation_BP_" + name] = best;
+          double lin = std::numeric_limits<double>::infinity();
+          for (const auto& m : cr.critical.modes) lin = std::min(lin, std::abs(m.lambda - exact));
+          if (std::isfinite(lin)) errors["linear_buckling_" + name] = lin;
+        }
+        crit["abs_error_vs_eq17"] = errors;
+      }
+      c["critical_forces"] = crit;
+    }
+    cases.push_back(c);
+  }
+  doc["cases"] = cases;
+  json p;
+  p["gnuplot"] = plots.gnuplotFound ? json(plots.gnuplot) : json("not found: " + plots.gnuplot);
+  p["files"] = plots.files;
+  if (!plots.failures.empty()) p["failures"] = plots.failures;
+  doc["plots"] = p;
+  writeText(dir / "summary.json", doc.dump(2) + "\n");
+}
+
+}  // namespace
+
+double columnValue(const std::string& column, const PointRecord& p, const mechanics::Pose& pose0) {
+  bool found = false;
+  const double v = commonColumn(column, p.parameter, p.F, p.pose, p.q, pose0, found);
+  if (found) return v;
+  if (column == "min_eig") return p.minEigenvalue;
+  if (column == "Kxx") return p.K(0, 0);
+  if (column == "Kyy") return p.K(1, 1);
+  if (column == "Kxy") return p.K(0, 1);
+  return kNaN;
+}
+
+double columnValue(const std::string& column, const SpecialRecord& s, const mechanics::Pose& pose0) {
+  bool found = false;
+  const double v = commonColumn(column, s.parameter, s.F, s.pose, s.q, pose0, found);
+  return found ? v : kNaN;
+}
+
+std::string columnLabel(const std::string& c) {
+  if (c == "Fx") return "F_x (units of k b)";
+  if (c == "Fy") return "F_y (units of k b)";
+  if (c == "Me") return "M_e (units of k b^2)";
+  if (c == "x" || c == "y") return c + " (units of b)";
+  if (c == "dx") return "{/Symbol d}_x = x_0 - x (units of b)";
+  if (c == "dy") return "{/Symbol d}_y = y - y_0 (units of b)";
+  if (c == "phi") return "{/Symbol f} (rad)";
+  if (c == "min_eig") return "smallest eigenvalue of the stability operator (units of k b^2)";
+  if (c == "Kxx") return "K_{xx} (units of k)";
+  if (c == "Kyy") return "K_{yy} (units of k)";
+  if (c == "Kxy") return "K_{xy} (units of k)";
+  if (c.size() >= 2 && c[0] == 'q') return "q_{" + c.substr(1) + "} (rad)";
+  return c;
+}
+
+StagingDirectory::StagingDirectory(const std::string& target) : target_(target) {
+  fs::path t = fs::absolute(fs::path(target)).lexically_normal();
+  if (t.filename().empty()) t = t.parent_path();
+  target_ = t.string();
+  fs::create_directories(t.parent_path());
+  std::string tmpl = (t.parent_path() / ("." + t.filename().string() + ".tmp-XXXXXX")).string();
+  std::vector<char> buf(tmpl.begin(), tmpl.end());
+  buf.push_back('\0');
+  if (!::mkdtemp(buf.data()))
+    throw std::runtime_error("cannot create a temporary directory next to " + target_ + ": " + std::strerror(errno));
+  path_ = buf.data();
+}
+
+StagingDirectory::~StagingDirectory() {
+  if (committed_) return;
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
+void StagingDirectory::commit() {
+  std::error_code ec;
+  std::string old;
+  if (fs::exists(target_)) {
+    old = path_ + ".old";
+    fs::rename(target_, old, ec);
+    if (ec) throw std::runtime_error("cannot move the previous " + target_ + " aside: " + ec.message());
+  }
+  fs::rename(path_, target_, ec);
+  if (ec) {
+    if (!old.empty()) fs::rename(old, target_, ec);
+    throw std::runtime_error("cannot rename " + path_ + " to " + target_ + ": " + ec.message());
+  }
+  committed_ = true;
+  if (!old.empty()) fs::remove_all(old, ec);
+}
+
+PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::string& dirName) {
+  const fs::path dir(dirName);
+  if (scene.analyses.continuation.enabled) writeBranches(scene, run, dir);
+  writeSpecialPoints(scene, run, dir);
+  writeCurves(scene, run, dir);
+  const PlotReport plots = drawPlots(scene, run, dirName);
+  writeSummary(scene, run, plots, dir);
+  return plots;
+}
+
+}  // namespace buckle::scene

@@ -1,0 +1,57 @@
+// Writing a run's results: branches.csv, special_points.json, summary.json and the plots, into
+// a temporary directory next to the target that is renamed into place at the end, so a reader
+// never sees a half-written output directory.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "scene/runner.h"
+#include "scene/scene.h"
+
+namespace buckle::scene {
+
+/// Value of a branches.csv column at a point (NaN when it does not apply).
+double columnValue(const std::string& column, const PointRecord& p, const mechanics::Pose& pose0);
+/// The same for a special point (stiffness columns are NaN there).
+double columnValue(const std::string& column, const SpecialRecord& s, const mechanics::Pose& pose0);
+/// Axis label with units ("F_x (units of k b)").
+std::string columnLabel(const std::string& column);
+
+/// A directory created next to `target` (same parent, hidden name), renamed onto `target` by
+/// commit(); removed by the destructor unless committed.
+class StagingDirectory {
+ public:
+  explicit StagingDirectory(const std::string& target);
+  ~StagingDirectory();
+  StagingDirectory(const StagingDirectory&) = delete;
+  StagingDirectory& operator=(const StagingDirectory&) = delete;
+  const std::string& path() const { return path_; }
+  /// Replaces `target` (if it exists) by the staged directory.
+  void commit();
+
+ private:
+  std::string target_, path_;
+  bool committed_ = false;
+};
+
+struct PlotReport {
+  bool gnuplotFound = false;
+  std::string gnuplot;                 ///< program used, or why none
+  std::vector<std::string> files;      ///< written image files, relative to the output dir
+  std::vector<std::string> failures;   ///< plots gnuplot failed to draw
+};
+
+/// Writes every output file of the run into `dir` (which exists); returns the plot report.
+PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::string& dir);
+
+/// Draws the scene's plots with gnuplot into dir/plots (scripts and data files kept beside the
+/// images so a plot can be re-rendered by hand). Without gnuplot only the data and scripts are
+/// written and the report says so.
+PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string& dir);
+
+/// The gnuplot executable: $BUCKLE_GNUPLOT if set (empty: none), else `gnuplot` on PATH.
+/// Returns an empty string when there is none.
+std::string findGnuplot();
+
+}  // namespace buckle::scene

@@ -1,0 +1,423 @@
+#include "scene/runner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <sstream>
+
+#include "buckle/continuation/branch_switching.h"
+#include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/equilibrium_solve.h"
+#include "buckle/mechanics/shape_name.h"
+#include "buckle/mechanics/stiffness.h"
+#include "buckle/mechanics/unloaded_shape.h"
+
+namespace buckle::scene {
+
+namespace cont = buckle::continuation;
+namespace mech = buckle::mechanics;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+std::string stabilityLabel(int negative) {
+  if (negative < 0) return "unknown";
+  if (negative == 0) return "stable";
+  return "unstable (" + std::to_string(negative) + " negative)";
+}
+
+bool regularStop(cont::StopReason r) {
+  return r == cont::StopReason::LambdaRange || r == cont::StopReason::Boundary || r == cont::StopReason::Box ||
+         r == cont::StopReason::MaxArclength;
+}
+
+/// Everything needed to trace and post-process the branches of one case.
+class CaseRunner {
+ public:
+  CaseRunner(const Scene& scene, const CaseSpec& spec, CaseResult& out, RunResult& run, Clock::time_point start)
+      : scene_(scene), spec_(spec), out_(out), run_(run), start_(start) {}
+
+  void continuation();
+  void criticalForces();
+  void energyCurves();
+  void torqueAngle();
+
+ private:
+  bool outOfTime() {
+    if (secondsSince(start_) <= scene_.solver.timeLimit) return false;
+    if (!timeReported_) {
+      run_.complete = false;
+      run_.problems.push_back("case \"" + spec_.label + "\": time limit of " +
+                              std::to_string(scene_.solver.timeLimit) + " s (/solver/time_limit) reached");
+      timeReported_ = true;
+    }
+    return true;
+  }
+  void record(const cont::Branch& b, mech::EquilibriumProblem& problem, const std::string& origin);
+  bool switchAt(cont::Tracer& tracer, const cont::Branch& parent, int spIndex, int sign, cont::Branch& child);
+
+  const Scene& scene_;
+  const CaseSpec& spec_;
+  CaseResult& out_;
+  RunResult& run_;
+  Clock::time_point start_;
+  bool timeReported_ = false;
+};
+
+void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem, const std::string& origin) {
+  const int n = out_.chain.size();
+  BranchRecord br;
+  br.id = b.id;
+  br.parent = b.parentId;
+  br.origin = origin;
+  br.stopReason = cont::stopReasonName(b.stopReason);
+  br.stopMessage = b.stopMessage;
+  br.points = static_cast<int>(b.points.size());
+  br.finished = regularStop(b.stopReason);
+  // Near a geometric joint limit the closing spring's length goes to zero and the model's
+  // derivatives blow up (L' ~ 1/L): the tracer's steps collapse just before the limit. That is
+  // the joint reaching its limit, not a failure; it is reported as such.
+  int limitJoint = -1;
+  if (!br.finished && b.stopReason == cont::StopReason::StepSizeTooSmall && !b.points.empty()) {
+    const Eigen::VectorXd q = b.points.back().u.head(n);
+    for (int i = 0; i < n; ++i) {
+      const double lo = out_.chain.lowerLimits()[i], hi = out_.chain.upperLimits()[i];
+      if (std::min(hi - q[i], q[i] - lo) < 2e-3 * (hi - lo)) limitJoint = i;
+    }
+    if (limitJoint >= 0) {
+      br.finished = true;
+      br.stopReason = "joint limit";
+      br.stopMessage = "joint " + std::to_string(limitJoint + 1) + " reached its limit (" + br.stopMessage + ")";
+    }
+  }
+  if (!br.finished) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\", branch " + std::to_string(b.id) + " (" + origin +
+                            ") stopped early: " + br.stopReason + (b.stopMessage.empty() ? "" : " — " + b.stopMessage));
+  }
+  out_.branches.push_back(br);
+
+  const size_t first = out_.points.size();
+  for (size_t i = 0; i < b.points.size(); ++i) {
+    const cont::ContinuationPoint& p = b.points[i];
+    PointRecord r;
+    r.branch = b.id;
+    r.index = static_cast<int>(i);
+    r.parameter = p.lambda;
+    r.q = p.u.head(n);
+    r.F = problem.wrench(p.u, p.lambda);
+    r.pose = mech::endPose(out_.chain, r.q);
+    r.negative = p.stability.negative;
+    r.stable = p.stability.valid() && p.stability.stable();
+    r.minEigenvalue = p.stability.smallest;
+    if (scene_.analyses.stiffness) {
+      const mech::CartesianStiffness K = mech::loadedStiffness(out_.chain, r.q, r.F, problem.endCondition());
+      r.K = K.stiffness;
+      r.haveStiffness = true;
+    }
+    run_.worstResidual = std::max(run_.worstResidual, p.residualNorm);
+    out_.points.push_back(r);
+  }
+
+  for (const cont::SpecialPoint& sp : b.specialPoints) {
+    SpecialRecord s;
+    switch (sp.type) {
+      case cont::SpecialPointType::BranchPoint:
+        s.type = "BP";
+        s.field = "buckling";
+        break;
+      case cont::SpecialPointType::Fold:
+        s.type = "LP";
+        s.field = "jumping";
+        break;
+      case cont::SpecialPointType::Boundary:
+        s.type = "BD";
+        s.field = "quasi-buckling";
+        s.note = sp.boundaryName;
+        break;
+      case cont::SpecialPointType::Endpoint: continue;
+    }
+    s.branch = b.id;
+    s.parameter = sp.lambda;
+    s.q = sp.u.head(n);
+    s.F = problem.wrench(sp.u, sp.lambda);
+    s.pose = mech::endPose(out_.chain, s.q);
+    s.stabilityBefore = stabilityLabel(sp.inertiaBefore);
+    s.stabilityAfter = stabilityLabel(sp.inertiaAfter);
+    s.accuracy = sp.lambdaAccuracy;
+    s.residual = sp.residualNorm;
+    s.refined = sp.refined;
+    if (!sp.note.empty()) s.note += (s.note.empty() ? "" : "; ") + sp.note;
+    if (sp.type == cont::SpecialPointType::BranchPoint && sp.nullVectors.cols() >= 2)
+      s.shape = mech::modeShapeName(sp.nullVectors.col(1).head(n));
+    else
+      s.shape = mech::shapeName(s.q, 1e-6);
+    if (sp.multiplicity > 1) s.note += (s.note.empty() ? "" : "; ") + std::string("multiplicity ") + std::to_string(sp.multiplicity);
+    run_.worstLocation = std::max(run_.worstLocation, sp.lambdaAccuracy);
+    out_.specials.push_back(s);
+  }
+
+  if (limitJoint >= 0) {
+    const cont::ContinuationPoint& p = b.points.back();
+    SpecialRecord s;
+    s.type = "BD";
+    s.field = "quasi-buckling";
+    s.branch = b.id;
+    s.parameter = p.lambda;
+    s.q = p.u.head(n);
+    s.F = problem.wrench(p.u, p.lambda);
+    s.pose = mech::endPose(out_.chain, s.q);
+    s.shape = mech::shapeName(s.q, 1e-6);
+    s.stabilityBefore = s.stabilityAfter = stabilityLabel(p.stability.negative);
+    s.accuracy = b.points.size() >= 2 ? std::abs(p.lambda - b.points[b.points.size() - 2].lambda) : 0.0;
+    s.residual = p.residualNorm;
+    const bool upper = s.q[limitJoint] > 0.5 * (out_.chain.lowerLimits()[limitJoint] + out_.chain.upperLimits()[limitJoint]);
+    std::ostringstream os;
+    os << "joint " << limitJoint + 1 << " " << (upper ? "upper" : "lower") << " limit: last converged point "
+       << std::abs((upper ? out_.chain.upperLimits()[limitJoint] : out_.chain.lowerLimits()[limitJoint]) - s.q[limitJoint])
+       << " rad from it (the closing spring nearly reaches zero length)";
+    s.note = os.str();
+    out_.specials.push_back(s);
+  }
+
+  // Quasi-buckling (ERRATA, "what the physics does"): a deep, smooth minimum of Kxx along a
+  // stable stretch of the branch — below half of its value at the branch start.
+  if (scene_.analyses.stiffness && out_.points.size() - first >= 3) {
+    const double k0 = out_.points[first].K(0, 0);
+    for (size_t i = first + 1; i + 1 < out_.points.size(); ++i) {
+      const PointRecord &a = out_.points[i - 1], &m = out_.points[i], &c = out_.points[i + 1];
+      const double ka = a.K(0, 0), km = m.K(0, 0), kc = c.K(0, 0);
+      if (!std::isfinite(ka) || !std::isfinite(km) || !std::isfinite(kc) || !std::isfinite(k0)) continue;
+      if (!(m.stable && a.stable && c.stable)) continue;
+      if (km < ka && km <= kc && km > 0.0 && km < 0.5 * k0) {
+        SpecialRecord s;
+        s.type = "KMIN";
+        s.field = "quasi-buckling";
+        s.branch = b.id;
+        s.parameter = m.parameter;
+        s.F = m.F;
+        s.pose = m.pose;
+        s.q = m.q;
+        s.shape = mech::shapeName(m.q, 1e-6);
+        s.stabilityBefore = s.stabilityAfter = "stable";
+        s.accuracy = 0.5 * std::max(std::abs(c.parameter - m.parameter), std::abs(m.parameter - a.parameter));
+        std::ostringstream os;
+        os << "local minimum of Kxx = " << km << " (branch start: " << k0 << "), located to the point spacing";
+        s.note = os.str();
+        out_.specials.push_back(s);
+      }
+    }
+  }
+}
+
+// Leaves the branch point `spIndex` of `parent` along the bifurcating direction (sign ±1).
+bool CaseRunner::switchAt(cont::Tracer& tracer, const cont::Branch& parent, int spIndex, int sign,
+                          cont::Branch& child) {
+  const cont::SpecialPoint& sp = parent.specialPoints[size_t(spIndex)];
+  cont::Vector direction;
+  std::string note;
+  if (!cont::bifurcatingDirection(tracer.problem(), sp, direction, &note)) return false;
+  child = cont::switchBranch(tracer, sp, direction, sign);
+  child.parentId = parent.id;
+  child.parentSpecialPoint = spIndex;
+  return child.stopReason != cont::StopReason::SwitchFailed;
+}
+
+void CaseRunner::continuation() {
+  const double s0 = out_.startValue;
+  mech::EndCondition end = spec_.end.condition;
+  end.value -= s0 * spec_.path.direction;  // prescribed(λ) = start values + (λ − s0)·direction
+  mech::EquilibriumProblem problem(out_.chain, end, spec_.path.direction);
+
+  // The unloaded shape at the start value, polished.
+  const cont::Vector guess = problem.initialGuess(out_.q0, s0);
+  const mech::NewtonResult nr = mech::solveEquilibrium(problem, guess, s0);
+  if (!nr.converged) {
+    run_.complete = false;
+    std::ostringstream os;
+    os << "case \"" << spec_.label << "\": no equilibrium found at the start " << spec_.path.parameter << " = " << s0
+       << " from the unloaded shape (Newton residual " << nr.residualNorm << ")";
+    run_.problems.push_back(os.str());
+    return;
+  }
+
+  cont::TracerOptions opt;
+  opt.initialStep = scene_.solver.initialStep;
+  opt.minStep = scene_.solver.minStep;
+  opt.maxStep = scene_.solver.maxStep;
+  opt.maxPoints = scene_.solver.maxPoints;
+  opt.newtonTolerance = scene_.solver.tolerance;
+  opt.lambdaMin = std::min(spec_.path.from, spec_.path.to);
+  opt.lambdaMax = std::max(spec_.path.from, spec_.path.to);
+  opt.computeStability = true;
+  cont::Tracer tracer(problem, opt);
+
+  std::vector<cont::Branch> branches;
+  std::vector<std::string> origins;
+  std::vector<int> depth;
+  for (double target : {spec_.path.to, spec_.path.from}) {
+    if (target == s0) continue;
+    if (outOfTime()) break;
+    const int sign = target > s0 ? 1 : -1;
+    cont::Branch b = tracer.trace(nr.u, s0, sign > 0 ? cont::InitialDirection::increasingLambda()
+                                                     : cont::InitialDirection::decreasingLambda());
+    b.id = static_cast<int>(branches.size());
+    branches.push_back(std::move(b));
+    origins.push_back(std::string("start, ") + (sign > 0 ? "increasing " : "decreasing ") + spec_.path.parameter);
+    depth.push_back(0);
+  }
+  // Branch switching, breadth first, up to the requested depth.
+  for (size_t i = 0; i < branches.size(); ++i) {
+    if (depth[i] >= scene_.analyses.continuation.branchSwitching) continue;
+    for (size_t k = 0; k < branches[i].specialPoints.size(); ++k) {
+      const cont::SpecialPoint& bp = branches[i].specialPoints[k];
+      if (bp.type != cont::SpecialPointType::BranchPoint || bp.multiplicity > 1) continue;
+      for (int sign : {1, -1}) {
+        if (outOfTime()) break;
+        cont::Branch child;
+        const bool ok = switchAt(tracer, branches[i], static_cast<int>(k), sign, child);
+        const std::string origin = "BP " + std::to_string(k) + " of branch " + std::to_string(i) +
+                                   (sign > 0 ? ", + side" : ", - side");
+        if (!ok) {
+          child.stopReason = cont::StopReason::SwitchFailed;
+          if (child.stopMessage.empty()) child.stopMessage = "no bifurcating direction at this branch point";
+          child.parentId = branches[i].id;
+        }
+        child.id = static_cast<int>(branches.size());
+        branches.push_back(std::move(child));
+        origins.push_back(origin);
+        depth.push_back(depth[i] + 1);
+      }
+    }
+  }
+  for (size_t i = 0; i < branches.size(); ++i) record(branches[i], problem, origins[i]);
+}
+
+void CaseRunner::criticalForces() {
+  mech::EndCondition end = spec_.end.condition;
+  mech::LinearBucklingOptions opt;
+  opt.count = scene_.analyses.criticalForces.modes;
+  const int c = spec_.path.coordinate;
+  if (end.isHeld(static_cast<mech::EndCoordinate>(c))) {
+    // displacement control: the critical loads of the force that drives that coordinate
+    end.control[size_t(c)] = mech::Control::Load;
+    opt.direction = Eigen::Vector3d::Zero();
+    opt.direction[c] = 1.0;
+  } else {
+    opt.direction = spec_.path.direction;
+    for (int j = 0; j < 3; ++j)
+      if (end.isHeld(static_cast<mech::EndCoordinate>(j))) opt.direction[j] = 0.0;
+  }
+  try {
+    out_.critical = mech::linearBuckling(out_.chain, out_.q0, end, opt);
+    out_.haveCritical = true;
+  } catch (const std::invalid_argument& e) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": critical forces: " + e.what());
+    return;
+  }
+  // the closed forms (eq 17) apply to three identical symmetric segments, straight, clamped–pinned
+  const auto& segs = spec_.chain.segments;
+  bool symmetric = segs.size() == 3 && out_.q0.cwiseAbs().maxCoeff() == 0.0;
+  for (const auto& s : segs)
+    symmetric = symmetric && s.a1 == segs[0].a1 && s.a2 == s.a1 && s.b1 == segs[0].b1 && s.b2 == s.b1 &&
+                s.k1 == segs[0].k1 && s.k2 == s.k1 && s.L1_0 == segs[0].L1_0 && s.L2_0 == s.L1_0;
+  const bool clampedPinned = end.isHeld(mech::EndCoordinate::Y) && !end.isHeld(mech::EndCoordinate::X) &&
+                             !end.isHeld(mech::EndCoordinate::Phi) && opt.direction[0] != 0.0 &&
+                             opt.direction[1] == 0.0;
+  if (symmetric && clampedPinned) {
+    out_.analytic = mech::analyticClampedPinned3(segs[0].a1, segs[0].b1, segs[0].k1, segs[0].L1_0);
+    out_.haveAnalytic = true;
+  }
+}
+
+void CaseRunner::energyCurves() {
+  const EnergyCurvesSpec& e = scene_.analyses.energyCurves;
+  mech::LandscapeOptions opt;
+  opt.samples = e.points;
+  opt.q1Min = std::max(e.q1From, out_.chain.lowerLimits()[0]);
+  opt.q1Max = std::min(e.q1To, out_.chain.upperLimits()[0]);
+  try {
+    out_.landscape = mech::energyLandscape(out_.chain, e.x, e.y, opt);
+    out_.haveLandscape = true;
+  } catch (const std::invalid_argument& ex) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": energy curves: " + ex.what());
+  }
+}
+
+void CaseRunner::torqueAngle() {
+  const TorqueAngleSpec& t = scene_.analyses.torqueAngle;
+  const mech::Segment& seg = out_.chain.segment(0);
+  const double margin = 1e-6;
+  const double lo = std::max(t.qFrom, seg.lowerLimit() + margin);
+  const double hi = std::min(t.qTo, seg.upperLimit() - margin);
+  TorqueCurve& c = out_.torque;
+  for (int i = 0; i < t.points; ++i) {
+    const double q = lo + (hi - lo) * i / (t.points - 1);
+    c.q.push_back(q);
+    c.M.push_back(seg.torque(q));
+    c.Kq.push_back(seg.stiffness(q));
+  }
+  const mech::SegmentUnloadedAngle roots = mech::unloadedAngle(seg);
+  auto add = [&](const mech::TorqueRoot& r) {
+    if (r.q >= lo && r.q <= hi) c.equilibria.emplace_back(r.q, r.stable);
+  };
+  if (roots.found) add(roots.root);
+  for (const auto& r : roots.others) add(r);
+  std::sort(c.equilibria.begin(), c.equilibria.end());
+  out_.haveTorque = true;
+}
+
+}  // namespace
+
+RunResult runScene(const Scene& scene) {
+  RunResult run;
+  const Clock::time_point start = Clock::now();
+  const AnalysesSpec& a = scene.analyses;
+  if (a.continuation.enabled)
+    run.computed.push_back(a.continuation.branchSwitching > 0
+                               ? "continuation with branch switching (depth " +
+                                     std::to_string(a.continuation.branchSwitching) + ")"
+                               : "continuation of the primary branch");
+  if (a.stiffness) run.computed.push_back("loaded stiffness K_F along the branches (eq 29)");
+  if (a.criticalForces.enabled) run.computed.push_back("critical forces of the start configuration (linear buckling)");
+  if (a.energyCurves.enabled) run.computed.push_back("energy curves E(q1) with the end held (eq 6-8)");
+  if (a.torqueAngle.enabled) run.computed.push_back("torque-angle curves M(q) of the first segment (eq 1)");
+
+  std::vector<std::pair<std::string, std::function<void(CaseRunner&)>>> stages;
+  if (a.torqueAngle.enabled) stages.emplace_back("torque_angle", [](CaseRunner& r) { r.torqueAngle(); });
+  if (a.criticalForces.enabled) stages.emplace_back("critical_forces", [](CaseRunner& r) { r.criticalForces(); });
+  if (a.energyCurves.enabled) stages.emplace_back("energy_curves", [](CaseRunner& r) { r.energyCurves(); });
+  if (a.continuation.enabled) stages.emplace_back("continuation", [](CaseRunner& r) { r.continuation(); });
+  std::vector<double> stageSeconds(stages.size(), 0.0);
+
+  run.cases.reserve(scene.cases.size());
+  for (const CaseSpec& spec : scene.cases) {
+    mech::Chain chain(spec.chain.segments);
+    CaseResult& out = run.cases.emplace_back(chain);
+    out.label = spec.label;
+    out.q0 = spec.chain.q0;
+    out.pose0 = mech::endPose(chain, out.q0);
+    out.startValue = spec.end.condition.value[spec.path.coordinate];
+    CaseRunner runner(scene, spec, out, run, start);
+    for (size_t s = 0; s < stages.size(); ++s) {
+      const Clock::time_point t0 = Clock::now();
+      stages[s].second(runner);
+      stageSeconds[s] += secondsSince(t0);
+    }
+  }
+  for (size_t s = 0; s < stages.size(); ++s) run.timings.emplace_back(stages[s].first, stageSeconds[s]);
+  run.totalSeconds = secondsSince(start);
+  return run;
+}
+
+}  // namespace buckle::scene

@@ -1,0 +1,96 @@
+// Runs the analyses a scene asks for — and only those — and collects the results as plain data
+// for the writers and plots (output.h, plot.h).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/energy_landscape.h"
+#include "buckle/mechanics/linear_buckling.h"
+#include "scene/scene.h"
+
+namespace buckle::scene {
+
+/// One point of a traced branch, in physical quantities.
+struct PointRecord {
+  int branch = 0;
+  int index = 0;
+  double parameter = 0.0;
+  mechanics::Wrench F = mechanics::Wrench::Zero();  ///< total end wrench (loads and reactions)
+  mechanics::Pose pose = mechanics::Pose::Zero();
+  Eigen::VectorXd q;
+  bool stable = false;
+  int negative = -1;       ///< negative eigenvalues of the stability operator
+  double minEigenvalue = 0.0;
+  bool haveStiffness = false;
+  Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
+};
+
+struct SpecialRecord {
+  std::string type;        ///< "BP" branch point, "LP" fold, "BD" joint limit, "KMIN" stiffness minimum
+  std::string field;       ///< "buckling", "quasi-buckling", "jumping"
+  int branch = 0;
+  double parameter = 0.0;
+  mechanics::Wrench F = mechanics::Wrench::Zero();
+  mechanics::Pose pose = mechanics::Pose::Zero();
+  Eigen::VectorXd q;
+  std::string shape;       ///< shapeName of the branch leaving a BP / of q elsewhere
+  std::string stabilityBefore, stabilityAfter;
+  double accuracy = 0.0;   ///< |Δλ| of the last location iterate
+  double residual = 0.0;   ///< ‖F(u, λ)‖₂ at the point
+  bool refined = false;
+  std::string note;
+};
+
+struct BranchRecord {
+  int id = 0;
+  int parent = -1;
+  std::string origin;      ///< "start (increasing)", "BP 2 of branch 0", ...
+  std::string stopReason;
+  std::string stopMessage;
+  int points = 0;
+  bool finished = true;    ///< ended on a regular stop (range, boundary); false: could not go on
+};
+
+struct TorqueCurve {
+  std::vector<double> q, M, Kq;
+  std::vector<std::pair<double, bool>> equilibria;  ///< (q, stable) with M(q) = 0
+};
+
+struct CaseResult {
+  std::string label;
+  mechanics::Chain chain;
+  Eigen::VectorXd q0;
+  mechanics::Pose pose0 = mechanics::Pose::Zero();
+  double startValue = 0.0;
+  std::vector<BranchRecord> branches;
+  std::vector<PointRecord> points;
+  std::vector<SpecialRecord> specials;
+  bool haveCritical = false;
+  mechanics::LinearBucklingResult critical;
+  bool haveAnalytic = false;       ///< the case is the paper's symmetric clamped–pinned 3-chain
+  mechanics::AnalyticBuckling3 analytic;
+  bool haveLandscape = false;
+  mechanics::EnergyLandscape landscape;
+  bool haveTorque = false;
+  TorqueCurve torque;
+  explicit CaseResult(const mechanics::Chain& c) : chain(c) {}
+};
+
+struct RunResult {
+  std::vector<CaseResult> cases;
+  std::vector<std::string> computed;   ///< names of the analyses actually run
+  bool complete = true;                ///< false: some computation could not finish (exit 1)
+  std::vector<std::string> problems;   ///< why not complete
+  std::vector<std::pair<std::string, double>> timings;  ///< seconds per stage
+  double totalSeconds = 0.0;
+  double worstResidual = 0.0;          ///< max corrector residual over all branch points
+  double worstLocation = 0.0;          ///< max |Δλ| over located special points
+};
+
+/// Runs every case of the scene. Never throws for a numerical failure (recorded in problems).
+RunResult runScene(const Scene& scene);
+
+}  // namespace buckle::scene
