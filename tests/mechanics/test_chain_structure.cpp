@@ -8,6 +8,8 @@
 #include "buckle/continuation/problem.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
+#include "buckle/mechanics/end_condition.h"
+#include "buckle/mechanics/equilibrium_problem.h"
 
 using namespace buckle::mechanics;
 using buckle::continuation::projectedInertia;
@@ -344,5 +346,71 @@ TEST_CASE("bordered solve stays accurate where H is singular but the bordered ma
     const double backward = (K * mine - rhs).norm() / (K.norm() * mine.norm() + rhs.norm());
     INFO("n = " << n << " backward error " << backward);
     CHECK(backward < 1e-12);
+  }
+}
+
+TEST_CASE("lowest eigenvalues (isolation + Illinois on det K_σ) match the dense ones", "[chain_structure]") {
+  std::mt19937 rng(8);
+  for (int n : {1, 2, 3, 17, 200}) {
+    Instance in = randomInstance(n, rng, 1.5);
+    ChainStructure ws(n);
+    assembleInstance(in, ws);
+    const double scale = std::max(1.0, in.H.norm());
+    for (const auto& held : kHeldSets) {
+      if (int(held.size()) >= n) continue;
+      const Matrix C = rows(in.J, held);
+      Matrix reduced = in.H;
+      if (!held.empty()) {
+        Eigen::ColPivHouseholderQR<Matrix> qr(C.transpose());
+        Matrix Qf = qr.householderQ() * Matrix::Identity(n, n);
+        Matrix Z = Qf.rightCols(n - qr.rank());
+        reduced = Z.transpose() * in.H * Z;
+      }
+      Eigen::SelfAdjointEigenSolver<Matrix> es(reduced, Eigen::EigenvaluesOnly);
+      setConstraints(ws, C);
+      Vector out(3);
+      const int k = lowestEigenvalues(ws, !held.empty(), 3, out);
+      REQUIRE(k == std::min<int>(3, int(reduced.rows())));
+      for (int j = 0; j < k; ++j) CHECK(std::abs(out[j] - es.eigenvalues()[j]) <= 1e-11 * scale);
+    }
+  }
+}
+
+TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense default", "[chain_structure]") {
+  std::mt19937 rng(123);
+  const std::vector<EndCondition> ends = {EndCondition::freeEnd(Eigen::Vector3d(0.3, -0.2, 0.1)),
+                                          EndCondition::clampedPinned(-0.5), EndCondition::heldPosition(3.0, 0.5)};
+  for (int n : {1, 3, 17, 100}) {
+    std::vector<SegmentParameters> segs;
+    for (int i = 0; i < n; ++i) segs.push_back(randomSegment(rng));
+    Chain chain(segs);
+    for (const EndCondition& end : ends) {
+      if (end.heldCount() >= n) continue;
+      EquilibriumOptions fastOpt, denseOpt;
+      fastOpt.structuredStability = true;
+      denseOpt.structuredStability = false;
+      EquilibriumProblem fast(chain, end, Eigen::Vector3d(-1.0, 0.2, 0.0), fastOpt);
+      EquilibriumProblem dense(chain, end, Eigen::Vector3d(-1.0, 0.2, 0.0), denseOpt);
+      for (int trial = 0; trial < 10; ++trial) {
+        Vector u(fast.dimension());
+        for (int i = 0; i < n; ++i) {
+          std::uniform_real_distribution<double> Q(0.5 * chain.lowerLimits()[i], 0.5 * chain.upperLimits()[i]);
+          u[i] = trial == 0 ? 0.0 : Q(rng);
+        }
+        std::uniform_real_distribution<double> R(-2.0, 2.0);
+        for (int k = n; k < u.size(); ++k) u[k] = R(rng);
+        const double lambda = trial == 0 ? 0.0 : R(rng);
+        StabilityInfo a, b;
+        REQUIRE(fast.stability(u, lambda, a));
+        REQUIRE(dense.stability(u, lambda, b));
+        INFO("n = " << n << " held " << end.heldCount() << " trial " << trial);
+        CHECK(a.negative == b.negative);
+        CHECK(a.zero == b.zero);
+        REQUIRE(a.lowest.size() == b.lowest.size());
+        const double scale = std::max(1.0, b.lowest.cwiseAbs().maxCoeff()) * n;
+        for (Eigen::Index j = 0; j < a.lowest.size(); ++j) CHECK(a.lowest[j] == Approx(b.lowest[j]).margin(1e-10 * scale));
+        CHECK(a.smallest == Approx(b.smallest).margin(1e-10 * scale));
+      }
+    }
   }
 }

@@ -159,6 +159,8 @@ void factorize(ChainStructure& ws, double sigma) {
   ws.shift = sigma;
   ws.singular = false;
   ws.factorInertia = Inertia{};
+  double logDet = 0.0;
+  int sign = 1;
   double scale = 0.0;
   for (int k = 0; k < n; ++k) {
     scale = std::max(scale, std::abs(ws.diag[k] - sigma * metricDiagonal(k, n)));
@@ -181,8 +183,13 @@ void factorize(ChainStructure& ws, double sigma) {
       }
       ws.blockStart[size_t(k)] = 1;
       ws.pivA[k] = dk;
-      if (dk < 0.0) ++ws.factorInertia.negative;
-      else ++ws.factorInertia.positive;
+      if (dk < 0.0) {
+        ++ws.factorInertia.negative;
+        sign = -sign;
+      } else {
+        ++ws.factorInertia.positive;
+      }
+      logDet += std::log(std::abs(dk));
       minRatio = std::min(minRatio, std::abs(dk) / scale);
       if (k + 1 < n) {
         ws.l1[k] = ek / dk;
@@ -200,6 +207,8 @@ void factorize(ChainStructure& ws, double sigma) {
       ws.pivE[k] = ek;
       ++ws.factorInertia.negative;
       ++ws.factorInertia.positive;
+      sign = -sign;
+      logDet += std::log(std::abs(det));
       // smallest |eigenvalue| of the block ≥ |det| / (largest |eigenvalue|)
       const double big = 0.5 * std::abs(dk + b) + std::hypot(0.5 * (dk - b), ek);
       minRatio = std::min(minRatio, std::abs(det) / (big * scale));
@@ -213,6 +222,8 @@ void factorize(ChainStructure& ws, double sigma) {
     }
   }
   ws.minPivotRatio = minRatio;
+  ws.logAbsDet = logDet;
+  ws.detSign = sign;
 }
 
 int countBelow(const ChainStructure& ws, double sigma) {
@@ -364,23 +375,111 @@ Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C
   return in;
 }
 
-double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance) {
-  const int dim = ws.n - (useConstraints ? ws.rank : 0);
-  if (dim <= 0) return 0.0;
-  const double scale = std::max(1.0, ws.frobeniusH);
-  auto count = [&](double s) { return useConstraints && ws.rank > 0 ? constrainedCountBelow(ws, s) : countBelow(ws, s); };
-  double lo = -ws.frobeniusH * (1.0 + 1e-12) - 1e-300;
-  double hi = ws.frobeniusH * (1.0 + 1e-12) + tolerance * scale;
-  while (count(hi) < 1) hi = 2.0 * hi + scale;  // guards against rounding in ‖H‖_F
-  while (count(lo) >= 1) lo = 2.0 * lo - scale;
-  const double tol = tolerance * scale;
-  while (hi - lo > tol) {
-    const double mid = 0.5 * (lo + hi);
-    if (mid <= lo || mid >= hi) break;
-    if (count(mid) >= 1) hi = mid;
-    else lo = mid;
+namespace {
+
+/// Count below σ and log|det|, sign of det K_σ (or of det(T − σM) without constraints).
+struct ShiftEvaluation {
+  int below = 0;
+  double logAbsDet = 0.0;
+  int sign = 1;
+};
+
+ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double sigma) {
+  ShiftEvaluation ev;
+  const int r = useConstraints ? ws.rank : 0;
+  if (r == 0) {
+    factorize(ws, sigma);
+    ev.below = ws.factorInertia.negative;
+    ev.logAbsDet = ws.logAbsDet;
+    ev.sign = ws.detSign;
+    return ev;
   }
-  return 0.5 * (lo + hi);
+  ev.below = constrainedCountBelow(ws, sigma);
+  const double detS = ws.S.determinant();
+  ev.logAbsDet = ws.logAbsDet + std::log(std::abs(detS));
+  ev.sign = ws.detSign * (detS < 0.0 ? -1 : 1);
+  return ev;
+}
+
+}  // namespace
+
+int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, VectorRef out, double tolerance) {
+  const int dim = ws.n - (useConstraints ? ws.rank : 0);
+  const int k = std::max(0, std::min(count, dim));
+  if (k == 0) return 0;
+  const double scale = std::max(1.0, ws.frobeniusH);
+  const double tol = tolerance * scale;
+  // All eigenvalues lie in [−‖H‖_F, ‖H‖_F]; widen against rounding until the counts confirm it.
+  double lo0 = -ws.frobeniusH * (1.0 + 1e-10) - tol, hi0 = ws.frobeniusH * (1.0 + 1e-10) + tol;
+  while (evaluateShift(ws, useConstraints, lo0).below > 0) lo0 = 2.0 * lo0 - scale;
+  while (evaluateShift(ws, useConstraints, hi0).below < k) hi0 = 2.0 * hi0 + scale;
+  // Brackets: eigenvalue j lies in [lo[j], hi[j]) with count(lo[j]) ≤ j < count(hi[j]).
+  ChainStructure::SmallVector lo = ChainStructure::SmallVector::Constant(k, lo0);
+  ChainStructure::SmallVector hi = ChainStructure::SmallVector::Constant(k, hi0);
+  ChainStructure::SmallVector cntLo = ChainStructure::SmallVector::Zero(k);
+  ChainStructure::SmallVector cntHi = ChainStructure::SmallVector::Constant(k, double(dim));
+  auto record = [&](double s, int c) {
+    for (int j = 0; j < k; ++j) {
+      if (c > j) {
+        if (s < hi[j]) { hi[j] = s; cntHi[j] = c; }
+      } else if (s > lo[j]) {
+        lo[j] = s;
+        cntLo[j] = c;
+      }
+    }
+  };
+  for (int j = 0; j < k; ++j) {
+    lo[j] = std::max(lo[j], j > 0 ? out[j - 1] - tol : lo[j]);
+    // isolate: exactly one eigenvalue (j) in [lo, hi)
+    while (!(int(cntLo[j]) == j && int(cntHi[j]) == j + 1) && hi[j] - lo[j] > tol) {
+      const double mid = 0.5 * (lo[j] + hi[j]);
+      if (mid <= lo[j] || mid >= hi[j]) break;
+      record(mid, evaluateShift(ws, useConstraints, mid).below);
+    }
+    if (int(cntLo[j]) == j && int(cntHi[j]) == j + 1 && hi[j] - lo[j] > tol) {
+      // Illinois on det, one simple root in the bracket; the counts keep the bracket honest.
+      ShiftEvaluation ea = evaluateShift(ws, useConstraints, lo[j]);
+      ShiftEvaluation eb = evaluateShift(ws, useConstraints, hi[j]);
+      const double ref = 0.5 * (ea.logAbsDet + eb.logAbsDet);
+      auto value = [&](const ShiftEvaluation& e) {
+        return e.sign * std::exp(std::max(-700.0, std::min(700.0, e.logAbsDet - ref)));
+      };
+      double a = lo[j], b = hi[j], fa = value(ea), fb = value(eb);
+      int side = 0;
+      for (int it = 0; it < 200 && b - a > tol; ++it) {
+        double c = (fa * b - fb * a) / (fa - fb);
+        if (!(c > a && c < b)) c = 0.5 * (a + b);
+        // keep progress: never closer than tol/2 to an end
+        c = std::min(std::max(c, a + 0.25 * tol), b - 0.25 * tol);
+        const ShiftEvaluation ec = evaluateShift(ws, useConstraints, c);
+        const double fc = value(ec);
+        if (ec.below > j) {  // the root is below c
+          b = c;
+          fb = fc;
+          if (side == -1) fa *= 0.5;
+          side = -1;
+        } else {
+          a = c;
+          fa = fc;
+          if (side == 1) fb *= 0.5;
+          side = 1;
+        }
+        if (fc == 0.0) {
+          a = b = c;
+          break;
+        }
+      }
+      lo[j] = a;
+      hi[j] = b;
+    }
+    out[j] = 0.5 * (lo[j] + hi[j]);
+  }
+  return k;
+}
+
+double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance) {
+  Eigen::Matrix<double, 1, 1> out;
+  return lowestEigenvalues(ws, useConstraints, 1, out, tolerance) == 1 ? out[0] : 0.0;
 }
 
 bool solve(ChainStructure& ws, ConstVectorRef r, VectorRef x) {

@@ -23,7 +23,9 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
       data_(chain),
       J_(3, chain.size()),
       work_(chain.size()),
-      work2_(chain.size()) {
+      work2_(chain.size()),
+      structure_(chain.size()),
+      heldRows_(static_cast<Eigen::Index>(held_.size()), chain.size()) {
   static const char* names[3] = {"x", "y", "phi"};
   for (int c = 0; c < 3; ++c) {
     requireFinite(std::string("end value ") + names[c], end.value[c]);
@@ -168,6 +170,24 @@ bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matr
   forwardKinematics(chain_, u.head(n), data_);
   endJacobian(data_, J_);
   for (int k = 0; k < heldCount(); ++k) C.row(k) = J_.row(held_[size_t(k)]);
+  return true;
+}
+
+bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, continuation::StabilityInfo& info) {
+  if (!options_.structuredStability) return Problem::stability(u, lambda, info);
+  if (!inDomain(u)) return false;
+  const int n = chain_.size();
+  forwardKinematics(chain_, u.head(n), data_);
+  endJacobian(data_, J_);
+  assemble(chain_, data_, u.head(n), wrench(u, lambda), structure_);
+  for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
+  const Inertia in = constrainedInertia(structure_, heldRows_);
+  info.negative = in.negative;
+  info.zero = in.zero;
+  const int dim = in.size();
+  info.lowest.resize(std::min(3, dim));
+  lowestEigenvalues(structure_, structure_.rank > 0, int(info.lowest.size()), info.lowest);
+  info.smallest = dim > 0 ? info.lowest[0] : 0.0;
   return true;
 }
 

@@ -15,6 +15,7 @@
 
 #include "buckle/continuation/problem.h"
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/end_condition.h"
 
 namespace buckle::mechanics {
@@ -22,6 +23,9 @@ namespace buckle::mechanics {
 struct EquilibriumOptions {
   /// Report the joint limits as boundaries g = q_max − q, q − q_min (the tracer stops on them).
   bool jointLimitsAsBoundaries = true;
+  /// stability(): O(n) inertia and lowest eigenvalues through the chain structure
+  /// (chain_structure.h); false: the dense default of Problem (kept for cross-checks).
+  bool structuredStability = true;
 };
 
 class EquilibriumProblem final : public continuation::Problem {
@@ -53,6 +57,9 @@ class EquilibriumProblem final : public continuation::Problem {
 
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
+  /// Inertia of K_q − K_g on ker J_h and its 3 lowest eigenvalues; O(n) when
+  /// options.structuredStability, else the dense Problem::stability().
+  bool stability(continuation::ConstVectorRef u, double lambda, continuation::StabilityInfo& info) override;
 
   int boundaryCount() const override;
   double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
@@ -70,6 +77,8 @@ class EquilibriumProblem final : public continuation::Problem {
   ChainData data_;
   Matrix J_;             // 3×n
   Vector work_, work2_;  // size n
+  ChainStructure structure_;  // workspace of the structured stability()
+  Matrix heldRows_;           // m×n held rows of J
 };
 
 }  // namespace buckle::mechanics
