@@ -73,6 +73,12 @@ class BlockFile {
   bool lineOpen_ = false;
 };
 
+std::vector<size_t> selected(const PlotSpec& spec) {
+  std::vector<size_t> out;
+  for (int c : spec.cases) out.push_back(static_cast<size_t>(c));
+  return out;
+}
+
 struct Script {
   std::string name;
   int width = 1000, height = 700;
@@ -80,7 +86,7 @@ struct Script {
 };
 
 std::string parameterColumnLabel(const Scene& scene, const std::string& column) {
-  if (column == "parameter") return columnLabel(scene.cases.front().path.parameter) + "  [path parameter]";
+  if (column == "parameter") return columnLabel(scene.cases.front().path.parameter);
   return columnLabel(column);
 }
 
@@ -99,8 +105,8 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     bool stable;
   };
   std::vector<Series> series;
-  const bool multiCase = run.cases.size() > 1;
-  for (size_t c = 0; c < run.cases.size(); ++c) {
+  const bool multiCase = spec.cases.size() > 1;
+  for (size_t c : selected(spec)) {
     const CaseResult& cr = run.cases[c];
     for (size_t j = 0; j < spec.y.size(); ++j) {
       for (bool stable : {true, false}) {
@@ -127,7 +133,7 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   // special points: x y label
   bool anySpecial = false;
   sp.begin();
-  for (size_t c = 0; c < run.cases.size(); ++c) {
+  for (size_t c : selected(spec)) {
     const CaseResult& cr = run.cases[c];
     for (const SpecialRecord& r : cr.specials) {
       for (size_t j = 0; j < spec.y.size(); ++j) {
@@ -189,19 +195,19 @@ void torquePlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   BlockFile data, eq;
   const std::string stem = spec.name;
   std::vector<int> blocks;
-  for (size_t c = 0; c < run.cases.size(); ++c) {
+  for (size_t c : selected(spec)) {
     blocks.push_back(data.begin());
     const TorqueCurve& t = run.cases[c].torque;
     for (size_t i = 0; i < t.q.size(); ++i) data.point({t.q[i], t.M[i]});
   }
   int stableBlock = eq.begin();
-  for (const CaseResult& cr : run.cases)
-    for (const auto& [q, st] : cr.torque.equilibria)
+  for (size_t c : selected(spec))
+    for (const auto& [q, st] : run.cases[c].torque.equilibria)
       if (st) eq.point({q, 0.0});
   int unstableBlock = eq.begin();
   eq.point({std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()});
-  for (const CaseResult& cr : run.cases)
-    for (const auto& [q, st] : cr.torque.equilibria)
+  for (size_t c : selected(spec))
+    for (const auto& [q, st] : run.cases[c].torque.equilibria)
       if (!st) eq.point({q, 0.0});
   data.write(dir / (stem + ".dat"));
   eq.write(dir / (stem + "_eq.dat"));
@@ -209,7 +215,7 @@ void torquePlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   s.body << "set xlabel 'q (rad)'\nset ylabel 'M(q) = -dE/dq (units of k b^2)'\nset xzeroaxis lt -1\n";
   s.body << "plot \\\n";
   for (size_t c = 0; c < blocks.size(); ++c) {
-    std::string title = run.cases[c].label;
+    std::string title = run.cases[size_t(spec.cases[c])].label;
     s.body << (c ? ", \\\n  " : "  ") << quote(stem + ".dat") << " index " << blocks[c]
            << " using 1:2 with lines lw 2 lc rgb " << quote(color(c)) << " title " << quote(title) << " noenhanced";
   }
@@ -225,15 +231,15 @@ void torquePlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
 void energyPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
   const std::string stem = spec.name;
   const bool torque = scene.analyses.energyCurves.torque;
-  const size_t nc = run.cases.size();
+  const size_t nc = spec.cases.size();
   const int cols = nc <= 1 ? 1 : (nc <= 4 ? 2 : 3);
   const int rows = static_cast<int>((nc + size_t(cols) - 1) / size_t(cols));
   s.width = 700 * cols;
   s.height = 520 * rows;
-  s.body << "set encoding utf8\nset grid lc rgb '#dddddd'\nset key top center font ',8' opaque\n";
+  s.body << "set encoding utf8\nset grid lc rgb '#dddddd'\nset key below horizontal font ',9' maxcols 3\n";
   s.body << "set multiplot layout " << rows << "," << cols << " title "
          << quote(spec.title.empty() ? std::string("Energy curves E(q_1) with the end held") : spec.title) << "\n";
-  for (size_t c = 0; c < nc; ++c) {
+  for (size_t c : selected(spec)) {
     const CaseResult& cr = run.cases[c];
     BlockFile data;
     // blocks: 0 positive feasible, 1 positive beyond joint limits, 2 negative feasible,
@@ -277,7 +283,21 @@ void energyPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     title << cr.label << "  (x, y) = (" << num(cr.landscape.x) << ", " << num(cr.landscape.y) << ")";
     s.body << "set title " << quote(title.str()) << " noenhanced font ',10'\n";
     s.body << "set xlabel 'q_1 (rad)'\nset ylabel 'E (units of k b^2)'\n";
-    if (torque) s.body << "set y2label 'M_e (units of k b^2)'\nset y2tics\nset ytics nomirror\nset y2zeroaxis lt 0\n";
+    if (torque) {
+      // Me has poles where J is singular (sin q2 = 0, ERRATA 7): scale the axis on the bulk
+      std::vector<double> mags;
+      for (const auto* samples : {&cr.landscape.positive, &cr.landscape.negative})
+        for (const auto& smp : *samples)
+          if (smp.status == mechanics::LandscapeStatus::Feasible && std::isfinite(smp.endTorque))
+            mags.push_back(std::abs(smp.endTorque));
+      double range = 1.0;
+      if (!mags.empty()) {
+        std::sort(mags.begin(), mags.end());
+        range = std::max(1e-6, 2.0 * mags[size_t(0.8 * double(mags.size() - 1))]);
+      }
+      s.body << "set y2label 'M_e (units of k b^2)'\nset y2tics\nset ytics nomirror\nset y2zeroaxis lt 0\n"
+             << "set y2range [" << num(-range) << ":" << num(range) << "]\n";
+    }
     s.body << "plot " << quote(file) << " index 0 using 1:2 with lines lw 2 lc rgb 'blue' title 'q_3 > 0', \\\n"
            << "  '' index 1 using 1:2 with lines lw 1 lc rgb 'black' title 'beyond a joint limit', \\\n"
            << "  '' index 2 using 1:2 with lines lw 2 lc rgb '#2ca02c' title 'q_3 < 0', \\\n"
@@ -356,7 +376,7 @@ void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFil
 
 void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
   const std::string stem = spec.name;
-  const size_t nc = run.cases.size(), na = spec.at.size();
+  const size_t nc = spec.cases.size(), na = spec.at.size();
   s.width = std::min<int>(3200, int(520 * na));
   s.height = std::min<int>(2400, int(330 * nc) + 60);
   s.body << "set encoding utf8\nset size ratio -1\nunset key\nset grid lc rgb '#eeeeee'\n";
@@ -365,8 +385,8 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
                                                    "red: joint within 5% of a limit")
                                      : spec.title)
          << " font ',11'\n";
-  const std::string param = scene.cases.front().path.parameter;
-  for (size_t c = 0; c < nc; ++c) {
+
+  for (size_t c : selected(spec)) {
     const CaseResult& cr = run.cases[c];
     std::vector<const PointRecord*> chosen;
     for (double at : spec.at) {
@@ -394,7 +414,8 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       std::ostringstream title;
       if (p) {
         drawChain(cr.chain, p->q, tri, spr, lim, jnt, near);
-        title << (nc > 1 ? cr.label + ": " : std::string()) << param << " = " << num(p->parameter);
+        title << (nc > 1 ? cr.label + ": " : std::string()) << scene.cases[c].path.parameter << " = "
+              << num(std::round(p->parameter * 1e4) / 1e4);
         if (p->haveStiffness && std::isfinite(p->K(0, 0)))
           title << "\\nK_{xx} = " << num(std::round(p->K(0, 0) * 1e4) / 1e4) << ", K_{yy} = "
                 << num(std::round(p->K(1, 1) * 1e4) / 1e4);

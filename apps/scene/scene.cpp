@@ -378,7 +378,7 @@ PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const En
   return spec;
 }
 
-CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label) {
+CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, bool needPath) {
   CaseSpec cs;
   cs.label = label;
   if (!doc.contains("chain")) r.fail(Pointer("/chain"), "missing (required): the chain to model");
@@ -389,7 +389,16 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label) {
   const mechanics::Pose pose0 = mechanics::endPose(chain, cs.chain.q0);
   for (int c = 0; c < 3; ++c)
     if (cs.end.heldAtStart[size_t(c)]) cs.end.condition.value[c] = pose0[c];
-  if (!doc.contains("path")) r.fail(Pointer("/path"), "missing (required): the load path");
+  if (!doc.contains("path")) {
+    if (needPath)
+      r.fail(Pointer("/path"), "missing (required by /analyses/continuation and /analyses/critical_forces): the load path");
+    cs.path.parameter = "Fx";
+    cs.path.coordinate = 0;
+    cs.path.direction = Eigen::Vector3d(1.0, 0.0, 0.0);
+    cs.path.from = cs.path.to = cs.end.condition.value[0];
+    if (cs.end.condition.isHeld(mechanics::EndCoordinate::X)) cs.path.parameter = "x";
+    return cs;
+  }
   const json& path = doc["path"];
   r.requireObject(path, Pointer("/path"));
   double start = 0.0;
@@ -492,11 +501,18 @@ std::set<std::string> branchColumns(int maxN, bool stiffness) {
   return c;
 }
 
-PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN) {
+PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN, int nCases) {
   PlotSpec s;
   json obj = v;
   if (v.is_string()) obj = json{{"type", v}};
-  r.onlyKeys(obj, p, {"type", "name", "x", "y", "at", "title"});
+  r.onlyKeys(obj, p, {"type", "name", "x", "y", "at", "title", "cases"});
+  if (obj.contains("cases")) {
+    const json& cs = obj["cases"];
+    if (!cs.is_array() || cs.empty()) r.expected(p / "cases", cs, "a non-empty array of case indices (0-based)");
+    for (size_t i = 0; i < cs.size(); ++i) s.cases.push_back(r.integer(cs[i], p / "cases" / i, 0, nCases - 1));
+  } else {
+    for (int i = 0; i < nCases; ++i) s.cases.push_back(i);
+  }
   if (!obj.contains("type")) r.fail(p / "type", "missing (required)");
   const Pointer pt = v.is_string() ? p : p / "type";
   const std::string type = r.string(obj["type"], pt);
@@ -567,12 +583,14 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
   return s;
 }
 
-std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a) {
+std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a, int nCases) {
+  std::vector<int> all;
+  for (int i = 0; i < nCases; ++i) all.push_back(i);
   std::vector<PlotSpec> out;
-  if (a.continuation.enabled) out.push_back({PlotType::Bifurcation, "bifurcation", "parameter", {"q1"}, {}, ""});
-  if (a.stiffness) out.push_back({PlotType::Stiffness, "stiffness", "parameter", {"Kxx", "Kyy"}, {}, ""});
-  if (a.energyCurves.enabled) out.push_back({PlotType::EnergyCurves, "energy_curves", "", {}, {}, ""});
-  if (a.torqueAngle.enabled) out.push_back({PlotType::TorqueAngle, "torque_angle", "", {}, {}, ""});
+  if (a.continuation.enabled) out.push_back({PlotType::Bifurcation, "bifurcation", "parameter", {"q1"}, {}, "", all});
+  if (a.stiffness) out.push_back({PlotType::Stiffness, "stiffness", "parameter", {"Kxx", "Kyy"}, {}, "", all});
+  if (a.energyCurves.enabled) out.push_back({PlotType::EnergyCurves, "energy_curves", "", {}, {}, "", all});
+  if (a.torqueAngle.enabled) out.push_back({PlotType::TorqueAngle, "torque_angle", "", {}, {}, "", all});
   return out;
 }
 
@@ -654,6 +672,10 @@ Scene parseScene(const std::string& text, const std::string& file) {
   scene.file = file;
   if (doc.contains("description")) scene.description = r.string(doc["description"], Pointer("/description"));
 
+  if (!doc.contains("analyses")) r.fail(Pointer("/analyses"), "missing (required): what to compute");
+  scene.analyses = parseAnalyses(r, doc["analyses"], Pointer("/analyses"));
+  const bool needPath = scene.analyses.continuation.enabled || scene.analyses.criticalForces.enabled;
+
   json base = doc;
   base.erase("cases");
   base.erase("analyses");
@@ -673,7 +695,7 @@ Scene parseScene(const std::string& text, const std::string& file) {
       json merged = base;
       merged.merge_patch(patch);
       try {
-        scene.cases.push_back(parseCase(r, merged, label));
+        scene.cases.push_back(parseCase(r, merged, label, needPath));
       } catch (const SceneError& e) {
         // point into the case when the bad value came from it
         const Pointer bad(e.path().empty() ? "" : e.path());
@@ -682,11 +704,9 @@ Scene parseScene(const std::string& text, const std::string& file) {
       }
     }
   } else {
-    scene.cases.push_back(parseCase(r, base, "main"));
+    scene.cases.push_back(parseCase(r, base, "main", needPath));
   }
 
-  if (!doc.contains("analyses")) r.fail(Pointer("/analyses"), "missing (required): what to compute");
-  scene.analyses = parseAnalyses(r, doc["analyses"], Pointer("/analyses"));
   if (scene.analyses.energyCurves.enabled)
     for (size_t i = 0; i < scene.cases.size(); ++i)
       if (scene.cases[i].chain.segments.size() != 3)
@@ -700,13 +720,14 @@ Scene parseScene(const std::string& text, const std::string& file) {
     if (!plots.is_array()) r.expected(Pointer("/plots"), plots, "an array of plot names or plot objects");
     std::set<std::string> names;
     for (size_t i = 0; i < plots.size(); ++i) {
-      PlotSpec ps = parsePlot(r, plots[i], Pointer("/plots") / i, scene.analyses, scene.maxSegments());
+      PlotSpec ps = parsePlot(r, plots[i], Pointer("/plots") / i, scene.analyses, scene.maxSegments(),
+                              static_cast<int>(scene.cases.size()));
       if (!names.insert(ps.name).second)
         r.fail(Pointer("/plots") / i, "two plots named \"" + ps.name + "\": give one a distinct \"name\"");
       scene.plots.push_back(ps);
     }
   } else {
-    scene.plots = defaultPlots(scene.analyses);
+    scene.plots = defaultPlots(scene.analyses, static_cast<int>(scene.cases.size()));
   }
   return scene;
 }

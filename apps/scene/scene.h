@@ -101,6 +101,7 @@ struct PlotSpec {
   std::vector<std::string> y;        ///< columns on the vertical axis
   std::vector<double> at;            ///< shapes: parameter values to draw the chain at
   std::string title;
+  std::vector<int> cases;            ///< indices of the cases drawn (default: all)
 };
 
 /// One complete run: a chain, an end condition and a path.
