@@ -1,5 +1,6 @@
 // gnuplot plots of a run: one data file + one script per plot, rendered to PNG (pngcairo) and
 // SVG. Scripts and data stay in <out>/plots so that a figure can be restyled by hand.
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -46,7 +47,9 @@ class BlockFile {
  public:
   int begin() {
     if (blocks_ > 0) os_ << "\n\n";
-    os_ << "# block " << blocks_ << "\n";
+    // a block that stays empty would merge with the next one and shift every later `index`:
+    // each block starts with an undefined point
+    os_ << "# block " << blocks_ << "\nNaN NaN\n\n";
     lineOpen_ = false;
     return blocks_++;
   }
@@ -386,6 +389,25 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
                                      : spec.title)
          << " font ',11'\n";
 
+  // one scale for every panel: the bounding box of all chains drawn
+  Eigen::AlignedBox2d box;
+  box.extend(Eigen::Vector2d(0.0, 0.0));
+  for (size_t c : selected(spec)) {
+    const CaseResult& cr = run.cases[c];
+    box.extend(Eigen::Vector2d(cr.chain.length(), 0.0));
+    for (const PointRecord& p : cr.points) {
+      mechanics::ChainData data(cr.chain);
+      mechanics::forwardKinematics(cr.chain, p.q, data);
+      Eigen::Vector2d joint(cr.chain.linkLengths()[0], 0.0);
+      box.extend(joint);
+      for (int i = 0; i < cr.chain.size(); ++i) {
+        joint += cr.chain.linkLengths()[i + 1] * Eigen::Vector2d(std::cos(data.theta[i]), std::sin(data.theta[i]));
+        box.extend(joint);
+      }
+    }
+  }
+  const double pad = 1.2;
+  const double x0 = box.min().x() - pad, x1 = box.max().x() + pad, y0 = box.min().y() - pad, y1 = box.max().y() + pad;
   for (size_t c : selected(spec)) {
     const CaseResult& cr = run.cases[c];
     std::vector<const PointRecord*> chosen;
@@ -417,7 +439,7 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
         title << (nc > 1 ? cr.label + ": " : std::string()) << scene.cases[c].path.parameter << " = "
               << num(std::round(p->parameter * 1e4) / 1e4);
         if (p->haveStiffness && std::isfinite(p->K(0, 0)))
-          title << "\\nK_{xx} = " << num(std::round(p->K(0, 0) * 1e4) / 1e4) << ", K_{yy} = "
+          title << ",  K_{xx} = " << num(std::round(p->K(0, 0) * 1e4) / 1e4) << ", K_{yy} = "
                 << num(std::round(p->K(1, 1) * 1e4) / 1e4);
       } else {
         title << cr.label << ": no stable point";
@@ -430,8 +452,8 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       near.write(dir / (base + "_near.dat"));
       const double L = cr.chain.length();
       s.body << "set title " << quote(title.str()) << " font ',10'\n";
-      s.body << "set xrange [" << num(-0.1 * L) << ":" << num(1.1 * L) << "]\nset yrange [" << num(-0.55 * L) << ":"
-             << num(0.55 * L) << "]\n";
+      s.body << "set xrange [" << num(std::min(x0, -0.1 * L)) << ":" << num(x1) << "]\nset yrange [" << num(y0) << ":"
+             << num(y1) << "]\n";
       s.body << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
              << " fc rgb '#bbbbbb' fs pattern 4 border lc rgb '#555555'\n";
       s.body << "plot " << quote(base + "_lim.dat") << " using 1:2 with lines lc rgb '#aaaaaa' lw 1, \\\n"
