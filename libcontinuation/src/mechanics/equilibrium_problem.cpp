@@ -193,16 +193,32 @@ bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, continuation
 
 int EquilibriumProblem::boundaryCount() const { return options_.jointLimitsAsBoundaries ? 2 * chain_.size() : 0; }
 
+// At the geometric limit itself a spring has zero length and the model is singular (its force
+// direction is undefined), so points there are refused. The boundary event for a geometric limit
+// is therefore placed kGeometricLimitMargin inside it, where it can be located exactly; user
+// limits inside the geometric range are used as they are.
+namespace {
+constexpr double kGeometricLimitMargin = 1e-5;
+}
+
 double EquilibriumProblem::boundary(int k, ConstVectorRef u, double) {
   const int n = chain_.size();
-  if (k < n) return chain_.upperLimits()[k] - u[k];
-  return u[k - n] - chain_.lowerLimits()[k - n];
+  if (k < n) {
+    const Segment& s = chain_.segment(k);
+    return std::min(s.parameters().qMaxUser, s.geometricUpperLimit() - kGeometricLimitMargin) - u[k];
+  }
+  const Segment& s = chain_.segment(k - n);
+  return u[k - n] - std::max(s.parameters().qMinUser, s.geometricLowerLimit() + kGeometricLimitMargin);
 }
 
 std::string EquilibriumProblem::boundaryName(int k) const {
   const int n = chain_.size();
-  if (k < n) return "joint " + std::to_string(k + 1) + " upper limit";
-  return "joint " + std::to_string(k - n + 1) + " lower limit";
+  const int j = k < n ? k : k - n;
+  const Segment& s = chain_.segment(j);
+  const bool geometric = k < n ? s.parameters().qMaxUser >= s.geometricUpperLimit() - kGeometricLimitMargin
+                               : s.parameters().qMinUser <= s.geometricLowerLimit() + kGeometricLimitMargin;
+  return "joint " + std::to_string(j + 1) + (k < n ? " upper" : " lower") +
+         (geometric ? " geometric limit (closing spring length -> 0)" : " limit");
 }
 
 }  // namespace buckle::mechanics

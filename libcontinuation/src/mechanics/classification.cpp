@@ -1,0 +1,79 @@
+#include "buckle/mechanics/classification.h"
+
+#include <cmath>
+
+#include "buckle/mechanics/shape_name.h"
+
+namespace buckle::mechanics {
+
+using continuation::SpecialPoint;
+using continuation::SpecialPointType;
+
+const char* phenomenonName(Phenomenon p) {
+  switch (p) {
+    case Phenomenon::Buckling: return "buckling";
+    case Phenomenon::QuasiBuckling: return "quasi-buckling";
+    case Phenomenon::Jumping: return "jumping";
+    case Phenomenon::None: return "none";
+  }
+  return "none";
+}
+
+bool isLoadControlled(const EquilibriumProblem& problem) {
+  for (int c : problem.endCondition().heldIndices())
+    if (problem.direction()[c] != 0.0) return false;
+  return true;
+}
+
+bool startIsUnstable(const continuation::Branch& branch) {
+  return !branch.points.empty() && branch.points.front().stability.valid() &&
+         branch.points.front().stability.negative > 0;
+}
+
+Classification classify(const EquilibriumProblem& problem, const SpecialPoint& point) {
+  Classification c;
+  const int n = problem.segments();
+  c.load = problem.wrench(point.u, point.lambda);
+  c.pose = endPose(problem.chain(), point.u.head(n));
+  c.stableBefore = point.inertiaBefore == 0;
+  c.stableAfter = point.inertiaAfter == 0;
+  c.shape = shapeName(point.u.head(n), 1e-7);
+  const bool loadControl = isLoadControlled(problem);
+  switch (point.type) {
+    case SpecialPointType::BranchPoint: {
+      // The bifurcating direction is the kernel vector orthogonal to the traced branch.
+      if (point.nullVectors.cols() >= 2) c.shape = modeShapeName(point.nullVectors.col(1).head(n), 1e-6);
+      c.phenomenon = Phenomenon::Buckling;
+      c.explanation = "branch point: the " + shapeName(point.u.head(n), 1e-7) +
+                      " configuration loses stability to the " + c.shape + " family";
+      if (point.multiplicity > 1)
+        c.explanation += " (multiplicity " + std::to_string(point.multiplicity) + ": degenerate)";
+      break;
+    }
+    case SpecialPointType::Fold:
+      if (!c.stableBefore && !c.stableAfter) {
+        c.phenomenon = Phenomenon::None;
+        c.explanation = "fold between two unstable parts of the branch";
+      } else if (loadControl) {
+        c.phenomenon = Phenomenon::Jumping;
+        c.explanation = "fold under load control: the stable branch ends, no nearby equilibrium beyond it";
+      } else {
+        c.phenomenon = Phenomenon::QuasiBuckling;
+        c.explanation = "fold under displacement control: the controlled force peaks and the stiffness "
+                        "in that direction vanishes";
+      }
+      break;
+    case SpecialPointType::Boundary:
+      c.phenomenon = loadControl ? Phenomenon::QuasiBuckling : Phenomenon::None;
+      c.explanation = point.boundaryName.empty() ? "boundary reached" : point.boundaryName + " reached";
+      if (loadControl) c.explanation += " under load: sharp loss of stiffness";
+      break;
+    case SpecialPointType::Endpoint:
+      c.phenomenon = Phenomenon::None;
+      c.explanation = point.boundaryName.empty() ? "end of the branch" : point.boundaryName;
+      break;
+  }
+  return c;
+}
+
+}  // namespace buckle::mechanics

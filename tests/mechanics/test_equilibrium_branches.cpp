@@ -1,0 +1,304 @@
+// The continuation core on the chain (issue 3, "Mechanics on the core"): branch points against
+// the closed forms (eq 17) and the linear-buckling eigenvalues, the post-buckling branches
+// (eq 18, Table I), folds against an independent extended-system solve, and the hard cases.
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "buckle/mechanics/equilibrium_branches.h"
+#include "buckle/mechanics/linear_buckling.h"
+#include "buckle/mechanics/shape_name.h"
+
+using namespace buckle::mechanics;
+namespace cont = buckle::continuation;
+
+namespace {
+
+EquilibriumBranchOptions pinnedOptions(double lambdaMin, int depth) {
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMin = lambdaMin;
+  o.tracer.lambdaMax = 1.0;
+  o.tracer.maxStep = 0.05;
+  o.tracer.initialStep = 0.01;
+  o.tracer.maxPoints = 2000;
+  o.switchingDepth = depth;
+  return o;
+}
+
+std::vector<const cont::SpecialPoint*> branchPoints(const cont::Branch& b) {
+  return b.specialPointsOfType(cont::SpecialPointType::BranchPoint);
+}
+
+// The classification of a special point of branch `bi`.
+const Classification& nameOf(const EquilibriumBranches& r, size_t bi, const cont::SpecialPoint* sp) {
+  const cont::Branch& b = r.tree.branches[bi];
+  return r.classifications[bi][size_t(sp - b.specialPoints.data())];
+}
+
+}  // namespace
+
+TEST_CASE("n = 3 clamped-pinned: branch points equal the closed forms (17) on a grid", "[equilibrium_branches]") {
+  for (double ab : {0.2, 0.5, 0.8}) {
+    for (double L0b : {1.9, 2.25, 3.0}) {
+      const double a = ab, b = 1.0, k = 1.0, L0 = L0b;
+      const AnalyticBuckling3 ref = analyticClampedPinned3(a, b, k, L0);
+      if (ref.kappa <= 0.05) continue;  // straight state unstable or degenerate: other tests
+      EquilibriumProblem problem(Chain::uniform(3, SegmentParameters::symmetric(a, b, k, L0)),
+                                 EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+      EquilibriumBranchOptions o = pinnedOptions(1.2 * ref.FxZ, 0);
+      const EquilibriumBranches r =
+          traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
+      const auto bps = branchPoints(r.tree.branches.at(0));
+      INFO("a/b=" << ab << " L0/b=" << L0b);
+      REQUIRE(bps.size() == 2);
+      CHECK(std::abs(bps[0]->lambda - ref.FxU) <= 1e-10);
+      CHECK(std::abs(bps[1]->lambda - ref.FxZ) <= 1e-10);
+      CHECK(bps[0]->lambdaAccuracy <= 1e-10);
+      CHECK(bps[0]->inertiaBefore == 0);
+      CHECK(bps[0]->inertiaAfter == 1);
+      CHECK(bps[1]->inertiaAfter == 2);
+      CHECK(nameOf(r, 0, bps[0]).phenomenon == Phenomenon::Buckling);
+      CHECK(nameOf(r, 0, bps[0]).shape == "U");
+      CHECK(nameOf(r, 0, bps[1]).shape == "Z");
+      CHECK(nameOf(r, 0, bps[1]).stableBefore == false);
+    }
+  }
+}
+
+TEST_CASE("n = 4..50 clamped-pinned: branch points equal the linear-buckling eigenvalues", "[equilibrium_branches]") {
+  const SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
+  for (int n = 4; n <= 50; n += (n < 12 ? 1 : 7)) {
+    const Chain chain = Chain::uniform(n, p);
+    const LinearBucklingResult lb = linearBuckling(chain, Eigen::VectorXd::Zero(n), EndCondition::clampedPinned(0.0));
+    std::vector<double> compressive;
+    for (const BucklingMode& m : lb.modes)
+      if (m.lambda < 0) compressive.push_back(m.lambda);
+    std::sort(compressive.begin(), compressive.end(), [](double x, double y) { return x > y; });
+    REQUIRE(compressive.size() >= 2);
+    // Trace through the first two critical loads (and stop before the third).
+    const double stop = compressive.size() > 2 ? 0.5 * (compressive[1] + compressive[2]) : 1.2 * compressive[1];
+    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+    EquilibriumBranchOptions o = pinnedOptions(stop, 0);
+    o.tracer.maxStep = std::abs(compressive[0]) / 8;
+    o.tracer.initialStep = o.tracer.maxStep / 2;
+    const EquilibriumBranches r =
+        traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+    const auto bps = branchPoints(r.tree.branches.at(0));
+    INFO("n=" << n);
+    REQUIRE(bps.size() == 2);
+    for (int i = 0; i < 2; ++i)
+      CHECK(std::abs(bps[size_t(i)]->lambda - compressive[size_t(i)]) <= 1e-10 * std::max(1.0, std::abs(compressive[size_t(i)])));
+  }
+}
+
+TEST_CASE("switching at the branch points: U stable with dx = mu_U b q2^2, Z unstable", "[equilibrium_branches]") {
+  const double a = 0.5, b = 1.0, k = 1.0, L0 = 2.25;
+  const AnalyticBuckling3 ref = analyticClampedPinned3(a, b, k, L0);
+  EquilibriumProblem problem(Chain::uniform(3, SegmentParameters::symmetric(a, b, k, L0)),
+                             EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(-2.5, 1);
+  o.tracer.maxStep = 0.02;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  REQUIRE(r.tree.branches.size() == 5);  // trivial + 2 directions at each of the 2 BPs
+  const double length = problem.chain().length();
+  int uBranches = 0, zBranches = 0;
+  for (size_t bi = 1; bi < r.tree.branches.size(); ++bi) {
+    const cont::Branch& br = r.tree.branches[bi];
+    REQUIRE(br.parentId == 0);
+    REQUIRE(br.points.size() > 5);
+    const double bpLambda = r.tree.branches[0].specialPoints.at(size_t(br.parentSpecialPoint)).lambda;
+    const bool isU = std::abs(bpLambda - ref.FxU) < 1e-8;
+    REQUIRE((isU || std::abs(bpLambda - ref.FxZ) < 1e-8));
+    (isU ? uBranches : zBranches)++;
+    const double mu = isU ? ref.muU : ref.muZ;
+    bool checkedSmall = false;
+    // Far out the U branch folds near the joint limits (|Fx| ≈ 1.755 here) and loses stability:
+    // the claims below are for the part before the first fold.
+    const auto folds = br.specialPointsOfType(cont::SpecialPointType::Fold);
+    const size_t end = folds.empty() ? br.points.size() : size_t(folds.front()->index) + 1;
+    REQUIRE(end > 5);
+    for (size_t pi = 1; pi < end; ++pi) {
+      const cont::ContinuationPoint& pt = br.points[pi];
+      const Eigen::VectorXd q = pt.u.head(3);
+      const double q2 = q[1];
+      if (std::abs(q2) < 0.05 && std::abs(q2) > 1e-3) {
+        // δx = μ b q2² + O(q2⁴): relative error O(q2²)
+        const double dx = length - endPose(problem.chain(), q)[0];
+        CHECK(dx == Approx(mu * b * q2 * q2).epsilon(0.02));
+        CHECK(shapeName(q, 1e-12) == (isU ? "U" : "Z"));
+        checkedSmall = true;
+      }
+      if (std::abs(q2) > 1e-3) CHECK(pt.stability.negative == (isU ? 0 : 1));
+    }
+    CHECK(checkedSmall);
+  }
+  CHECK(uBranches == 2);
+  CHECK(zBranches == 2);
+}
+
+TEST_CASE("fold: free end, kappa < 0, lateral load (AUTO case I_up) against the extended system", "[equilibrium_branches]") {
+  // L0 = 0.5 makes κ < 0: the straight state is unstable; Fy = 0.01 selects a bent path that folds.
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 0.5));
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Eigen::Vector3d(0.0, 0.01, 0.0)),
+                             Eigen::Vector3d(1, 0, 0), EquilibriumOptions{false});
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMin = -1.0;
+  o.tracer.lambdaMax = 1.0;
+  o.tracer.maxStep = 0.05;
+  o.tracer.maxPoints = 400;
+  o.switchingDepth = 0;
+  o.tracer.boxLower = Eigen::VectorXd::Constant(4, -3.0);
+  o.tracer.boxUpper = Eigen::VectorXd::Constant(4, 3.0);
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
+  CHECK(r.startUnstable);
+  const auto folds = r.tree.branches[0].specialPointsOfType(cont::SpecialPointType::Fold);
+  REQUIRE(!folds.empty());
+  const cont::SpecialPoint& lp = *folds.front();
+  CHECK(lp.lambda == Approx(0.17770974215).margin(5e-11));  // AUTO-07p, 11 digits
+  CHECK(lp.refined);
+  CHECK(lp.lambdaAccuracy <= 1e-11);
+  // λ-component of the tangent and the smallest eigenvalue of K_q − K_g vanish at the fold.
+  CHECK(std::abs(lp.tangent[3]) <= 1e-6);
+  Eigen::MatrixXd H(3, 3);
+  totalPotentialHessian(chain, lp.u, problem.wrench(lp.u, lp.lambda), H);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
+  Eigen::Index zeroIndex = 0;
+  CHECK(es.eigenvalues().cwiseAbs().minCoeff(&zeroIndex) <= 1e-8);
+  // Independent solve of the extended system (F = 0, F_u v = 0, v0ᵀv = 1) by Newton with a
+  // finite-difference Jacobian, from a perturbed start.
+  Eigen::VectorXd z(7);
+  z << lp.u + Eigen::VectorXd::Constant(3, 1e-3), lp.lambda + 1e-3, es.eigenvectors().col(zeroIndex);
+  const Eigen::Vector3d v0 = es.eigenvectors().col(zeroIndex);
+  auto G = [&](const Eigen::VectorXd& x) {
+    Eigen::VectorXd g(7), F(3), Fl(3);
+    Eigen::MatrixXd Fu(3, 3);
+    problem.residual(x.head(3), x[3], F);
+    problem.jacobian(x.head(3), x[3], Fu, Fl);
+    g << F, Fu * x.segment(4, 3), v0.dot(x.segment(4, 3)) - 1.0;
+    return g;
+  };
+  for (int it = 0; it < 30; ++it) {
+    const Eigen::VectorXd g = G(z);
+    Eigen::MatrixXd Jz(7, 7);
+    for (int j = 0; j < 7; ++j) {
+      Eigen::VectorXd zp = z, zm = z;
+      zp[j] += 1e-7;
+      zm[j] -= 1e-7;
+      Jz.col(j) = (G(zp) - G(zm)) / 2e-7;
+    }
+    z -= Jz.partialPivLu().solve(g);
+  }
+  CHECK(G(z).norm() <= 1e-12);
+  CHECK(std::abs(z[3] - lp.lambda) <= 1e-11);
+  // Unstable on both sides (index 3 → 2): a fold with no physical event.
+  CHECK(lp.inertiaBefore == 3);
+  CHECK(lp.inertiaAfter == 2);
+  CHECK(nameOf(r, 0, &lp).phenomenon == Phenomenon::None);
+}
+
+TEST_CASE("hard case: kappa = 0 double zero at Fx = 0 is detected", "[equilibrium_branches]") {
+  // L0 = 2b(1 − (a/b)²) = 1.5: the straight state's Hessian is Fx·G, zero at Fx = 0 (AUTO misses it).
+  EquilibriumProblem problem(Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.5)),
+                             EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(-2.5, 0);
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.5, cont::InitialDirection::decreasingLambda(), o);
+  const auto bps = branchPoints(r.tree.branches.at(0));
+  REQUIRE(bps.size() == 1);
+  CHECK(bps[0]->multiplicity == 2);
+  CHECK(std::abs(bps[0]->lambda) <= 1e-9);
+  CHECK(bps[0]->inertiaBefore == 0);
+  CHECK(bps[0]->inertiaAfter == 2);
+}
+
+TEST_CASE("hard case: a = b (kappa = k b L0) still gives the closed-form branch points", "[equilibrium_branches]") {
+  const double a = 1.0, b = 1.0, k = 2.0, L0 = 1.0;
+  const AnalyticBuckling3 ref = analyticClampedPinned3(a, b, k, L0);
+  EquilibriumProblem problem(Chain::uniform(3, SegmentParameters::symmetric(a, b, k, L0)),
+                             EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  const EquilibriumBranches r = traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0,
+                                                cont::InitialDirection::decreasingLambda(), pinnedOptions(1.1 * ref.FxZ, 0));
+  const auto bps = branchPoints(r.tree.branches.at(0));
+  REQUIRE(bps.size() == 2);
+  CHECK(std::abs(bps[0]->lambda - ref.FxU) <= 1e-10);
+  CHECK(std::abs(bps[1]->lambda - ref.FxZ) <= 1e-10);
+}
+
+TEST_CASE("hard case: a path that runs into a joint limit stops exactly on it", "[equilibrium_branches]") {
+  SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
+  p.qMinUser = -0.6;
+  p.qMaxUser = 0.6;
+  const Chain chain = Chain::uniform(3, p);
+  // Free end under a growing lateral force: the joints bend until one reaches 0.6.
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMax = 10.0;
+  o.tracer.maxStep = 0.1;
+  o.switchingDepth = 0;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const cont::Branch& br = r.tree.branches[0];
+  CHECK(br.stopReason == cont::StopReason::Boundary);
+  const auto bds = br.specialPointsOfType(cont::SpecialPointType::Boundary);
+  REQUIRE(bds.size() == 1);
+  CHECK(bds[0]->u.head(3).cwiseAbs().maxCoeff() == Approx(0.6).margin(1e-12));
+  CHECK_THAT(bds[0]->boundaryName, Catch::Contains("limit"));
+  CHECK(nameOf(r, 0, bds[0]).phenomenon == Phenomenon::QuasiBuckling);
+}
+
+TEST_CASE("hard case: n = 200, closely spaced critical loads all found once", "[equilibrium_branches]") {
+  const int n = 200;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const LinearBucklingResult lb = linearBuckling(chain, Eigen::VectorXd::Zero(n), EndCondition::clampedPinned(0.0));
+  std::vector<double> crit;
+  for (const BucklingMode& m : lb.modes)
+    if (m.lambda < 0) crit.push_back(m.lambda);
+  std::sort(crit.begin(), crit.end(), [](double x, double y) { return x > y; });
+  REQUIRE(crit.size() > 6);
+  // Range through the first 5 critical loads; with a step larger than their spacing several
+  // of them fall inside one step.
+  const double stop = 0.5 * (crit[4] + crit[5]);
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(stop, 0);
+  o.tracer.maxStep = std::abs(stop) / 3;
+  o.tracer.initialStep = o.tracer.maxStep;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  const auto bps = branchPoints(r.tree.branches.at(0));
+  REQUIRE(bps.size() == 5);
+  for (size_t i = 0; i < 5; ++i) {
+    INFO("critical load " << i);
+    CHECK(bps[i]->multiplicity == 1);
+    CHECK(std::abs(bps[i]->lambda - crit[i]) <= 1e-9 * std::max(1.0, std::abs(crit[i])));
+  }
+}
+
+TEST_CASE("hard case: an impossible target is reported and the points before it are kept", "[equilibrium_branches]") {
+  // The end held at (x, 0) with x pulled beyond the chain's length: no equilibrium exists past
+  // x = length, the corrector fails and the step shrinks below its minimum.
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const Eigen::VectorXd q0 = (Eigen::VectorXd(3) << 0.3, -0.6, 0.3).finished();
+  const Pose p0 = endPose(chain, q0);
+  EquilibriumProblem problem(chain, EndCondition::heldPosition(p0[0], p0[1]), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMax = 10.0;
+  o.tracer.maxStep = 0.05;
+  o.tracer.minStep = 1e-6;
+  o.switchingDepth = 0;
+  const EquilibriumBranches r = traceEquilibria(problem, q0, 0.0, cont::InitialDirection::increasingLambda(), o);
+  const cont::Branch& br = r.tree.branches[0];
+  CHECK(br.stopReason == cont::StopReason::StepSizeTooSmall);
+  CHECK_THAT(br.stopMessage, Catch::Contains("KIN_"));
+  REQUIRE(br.points.size() > 10);
+  for (const cont::ContinuationPoint& pt : br.points) {
+    Eigen::VectorXd F(problem.dimension());
+    REQUIRE(problem.residual(pt.u, pt.lambda, F));
+    CHECK(F.norm() <= 1e-8);
+  }
+  CHECK(endPose(chain, br.points.back().u.head(3))[0] <= chain.length() + 1e-9);
+}
