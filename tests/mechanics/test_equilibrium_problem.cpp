@@ -1,0 +1,134 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/equilibrium_solve.h"
+
+using namespace buckle::mechanics;
+
+namespace {
+
+SegmentParameters randomSegment(std::mt19937& rng) {
+  std::uniform_real_distribution<double> A(0.1, 0.9), B(0.6, 1.5), K(0.5, 3.0), L(1.5, 2.8);
+  SegmentParameters p;
+  p.a1 = A(rng); p.a2 = A(rng);
+  p.b1 = B(rng); p.b2 = B(rng);
+  p.k1 = K(rng); p.k2 = K(rng);
+  p.L1_0 = L(rng); p.L2_0 = L(rng);
+  return p;
+}
+
+struct Setting {
+  std::string name;
+  EndCondition end;
+};
+
+std::vector<Setting> settings(std::mt19937& rng) {
+  std::uniform_real_distribution<double> W(-1.5, 1.5);
+  return {{"free", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng)))},
+          {"clamped-pinned", EndCondition::clampedPinned(W(rng), W(rng))},
+          {"held position", EndCondition::heldPosition(3.0 + W(rng), W(rng))}};
+}
+
+}  // namespace
+
+TEST_CASE("EquilibriumProblem Jacobian and its directional derivative match finite differences", "[equilibrium]") {
+  std::mt19937 rng(101);
+  std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
+  for (int n : {1, 3, 8}) {
+    std::vector<SegmentParameters> segs;
+    for (int i = 0; i < n; ++i) segs.push_back(randomSegment(rng));
+    const Chain chain(segs);
+    for (const Setting& s : settings(rng)) {
+      INFO("n = " << n << ", end: " << s.name);
+      const Eigen::Vector3d dir(W(rng), W(rng), W(rng));
+      EquilibriumProblem problem(chain, s.end, dir);
+      const int N = problem.dimension();
+      REQUIRE(N == n + s.end.heldCount());
+      for (int trial = 0; trial < 3; ++trial) {
+        Vector u(N);
+        for (int i = 0; i < n; ++i) {
+          std::uniform_real_distribution<double> Q(0.7 * chain.lowerLimits()[i], 0.7 * chain.upperLimits()[i]);
+          u[i] = Q(rng);
+        }
+        for (int i = n; i < N; ++i) u[i] = W(rng);
+        const double lambda = Lam(rng);
+        Matrix Fu(N, N), dFu(N, N);
+        Vector Fl(N), dFl(N), F(N), Fp(N), Fm(N);
+        REQUIRE(problem.jacobian(u, lambda, Fu, Fl));
+        const double h = 1e-6;
+        double err = 0.0;
+        for (int j = 0; j < N; ++j) {
+          Vector up = u, um = u;
+          up[j] += h;
+          um[j] -= h;
+          REQUIRE(problem.residual(up, lambda, Fp));
+          REQUIRE(problem.residual(um, lambda, Fm));
+          err = std::max(err, (Fu.col(j) - (Fp - Fm) / (2 * h)).lpNorm<Eigen::Infinity>());
+        }
+        REQUIRE(problem.residual(u, lambda + h, Fp));
+        REQUIRE(problem.residual(u, lambda - h, Fm));
+        const double errL = (Fl - (Fp - Fm) / (2 * h)).lpNorm<Eigen::Infinity>();
+        CHECK(err < 1e-7 * std::max(1.0, Fu.lpNorm<Eigen::Infinity>()));
+        CHECK(errL < 1e-7 * std::max(1.0, Fl.lpNorm<Eigen::Infinity>()));
+        CHECK((Fu - Fu.transpose()).lpNorm<Eigen::Infinity>() < 1e-14 * std::max(1.0, Fu.lpNorm<Eigen::Infinity>()));
+        // directional second derivative
+        Vector du(N);
+        for (int i = 0; i < N; ++i) du[i] = W(rng);
+        const double dl = W(rng);
+        REQUIRE(problem.jacobianDirectionalDerivative(u, lambda, du, dl, dFu, dFl));
+        Matrix Jp(N, N), Jm(N, N);
+        Vector Jlp(N), Jlm(N);
+        REQUIRE(problem.jacobian(u + h * du, lambda + h * dl, Jp, Jlp));
+        REQUIRE(problem.jacobian(u - h * du, lambda - h * dl, Jm, Jlm));
+        CHECK((dFu - (Jp - Jm) / (2 * h)).lpNorm<Eigen::Infinity>() < 1e-6 * std::max(1.0, dFu.lpNorm<Eigen::Infinity>()));
+        CHECK((dFl - (Jlp - Jlm) / (2 * h)).lpNorm<Eigen::Infinity>() < 1e-6 * std::max(1.0, dFl.lpNorm<Eigen::Infinity>()));
+        // residual is ∂E/∂q − Jᵀ F(u, λ) in its first n rows
+        REQUIRE(problem.residual(u, lambda, F));
+        Vector g(n);
+        totalPotentialGradient(chain, u.head(n), problem.wrench(u, lambda), g);
+        CHECK((F.head(n) - g).lpNorm<Eigen::Infinity>() < 1e-13 * std::max(1.0, g.lpNorm<Eigen::Infinity>()));
+      }
+    }
+  }
+}
+
+TEST_CASE("the straight chain is an equilibrium under any axial load", "[equilibrium]") {
+  const Chain chain = Chain::uniform(5, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  for (double Fx : {-3.0, -0.1, 0.0, 0.7}) {
+    EquilibriumProblem freeEnd(chain, EndCondition::freeEnd(Eigen::Vector3d(Fx, 0, 0)), Eigen::Vector3d(1, 0, 0));
+    Vector F(5);
+    REQUIRE(freeEnd.residual(Vector::Zero(5), 0.0, F));
+    CHECK(F.lpNorm<Eigen::Infinity>() < 1e-15);
+    EquilibriumProblem pinned(chain, EndCondition::clampedPinned(Fx), Eigen::Vector3d(1, 0, 0));
+    Vector Fp(6);
+    REQUIRE(pinned.residual(Vector::Zero(6), 0.3, Fp));
+    CHECK(Fp.lpNorm<Eigen::Infinity>() < 1e-15);
+    // a lateral load is not balanced by the straight chain
+    EquilibriumProblem lateral(chain, EndCondition::freeEnd(Eigen::Vector3d(Fx, 0.2, 0)), Eigen::Vector3d(1, 0, 0));
+    REQUIRE(lateral.residual(Vector::Zero(5), 0.0, F));
+    CHECK(F.lpNorm<Eigen::Infinity>() > 0.1);
+  }
+}
+
+TEST_CASE("solveEquilibrium converges quadratically to an equilibrium of the loaded chain", "[equilibrium]") {
+  const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Eigen::Vector3d(-0.05, 0.08, 0.0)), Eigen::Vector3d(0, 1, 0));
+  const NewtonResult r = solveEquilibrium(problem, Vector::Zero(4), 0.0);
+  REQUIRE(r.converged);
+  CHECK(r.iterations <= 8);
+  Vector F(4);
+  REQUIRE(problem.residual(r.u, 0.0, F));
+  CHECK(F.lpNorm<Eigen::Infinity>() < 1e-12);
+  CHECK(endPose(chain, r.u)[1] > 0.0);  // bends towards the lateral load
+  // held position with a reaction
+  EquilibriumProblem held(chain, EndCondition::heldPosition(7.5, 0.6), Eigen::Vector3d::Zero());
+  const NewtonResult rh = solveEquilibrium(held, held.initialGuess(Vector::Constant(4, 0.05), 0.0), 0.0);
+  REQUIRE(rh.converged);
+  const Pose p = endPose(chain, rh.u.head(4));
+  CHECK(p[0] == Approx(7.5).margin(1e-12));
+  CHECK(p[1] == Approx(0.6).margin(1e-12));
+}

@@ -1,0 +1,238 @@
+#include <catch2/catch.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/QR>
+#include <cmath>
+#include <random>
+
+#include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/equilibrium_solve.h"
+#include "buckle/mechanics/linear_buckling.h"
+#include "buckle/mechanics/stiffness.h"
+#include "buckle/mechanics/unloaded_shape.h"
+
+using namespace buckle::mechanics;
+
+namespace {
+
+SegmentParameters randomStableSegment(std::mt19937& rng) {
+  std::uniform_real_distribution<double> A(0.1, 0.7), B(0.7, 1.3), K(0.5, 3.0), L(2.3, 3.0);
+  SegmentParameters p;
+  p.a1 = A(rng); p.a2 = A(rng);
+  p.b1 = B(rng); p.b2 = B(rng);
+  p.k1 = K(rng); p.k2 = K(rng);
+  p.L1_0 = L(rng) * p.b1; p.L2_0 = L(rng) * p.b2;
+  return p;
+}
+
+Matrix jacobian(const Chain& chain, const Vector& q) {
+  ChainData d(chain);
+  forwardKinematics(chain, q, d);
+  Matrix J(3, chain.size());
+  endJacobian(d, J);
+  return J;
+}
+
+// Position compliance with the end rotation held, from an explicit null-space basis of J_φ.
+Eigen::Matrix2d heldRotationCompliance(const Matrix& H, const Matrix& J) {
+  const Eigen::Index n = H.rows();
+  const Eigen::HouseholderQR<Matrix> qr(J.row(2).transpose());
+  const Matrix Z = (qr.householderQ() * Matrix::Identity(n, n)).rightCols(n - 1);
+  const Matrix P = Z * (Z.transpose() * H * Z).inverse() * Z.transpose();
+  return J.topRows(2) * P * J.topRows(2).transpose();
+}
+
+// Equilibrium under the end condition at (q guess), by Newton on the EquilibriumProblem.
+Vector solve(const Chain& chain, const EndCondition& end, const Vector& qGuess) {
+  EquilibriumProblem problem(chain, end, Eigen::Vector3d::Zero());
+  const NewtonResult r = solveEquilibrium(problem, problem.initialGuess(qGuess, 0.0), 0.0);
+  REQUIRE(r.converged);
+  return r.u;
+}
+
+}  // namespace
+
+TEST_CASE("unloaded stiffness: eq 21 equals the eq 23 closed form, symmetric positive definite", "[stiffness]") {
+  std::mt19937 rng(7);
+  for (int n : {3, 6, 40}) {
+    std::vector<SegmentParameters> segs;
+    for (int i = 0; i < n; ++i) segs.push_back(randomStableSegment(rng));
+    const Chain chain(segs);
+    for (int trial = 0; trial < 5; ++trial) {
+      Vector q(n);
+      std::uniform_real_distribution<double> Q(-0.5, 0.5);
+      for (int i = 0; i < n; ++i) q[i] = Q(rng);
+      Vector kq(n);
+      jointStiffness(chain, q, kq);
+      REQUIRE(kq.minCoeff() > 0.0);
+      const Matrix J = jacobian(chain, q);
+      // eq 23: C = Σ_i J_{·i} J_{·i}ᵀ / K_qi
+      Eigen::Matrix2d C23 = Eigen::Matrix2d::Zero();
+      for (int i = 0; i < n; ++i) {
+        C23(0, 0) += J(0, i) * J(0, i) / kq[i];
+        C23(1, 1) += J(1, i) * J(1, i) / kq[i];
+        C23(0, 1) += J(0, i) * J(1, i) / kq[i];
+      }
+      C23(1, 0) = C23(0, 1);
+      // eq 21 literally
+      const Eigen::Matrix2d K21 = (J.topRows(2) * kq.cwiseInverse().asDiagonal() * J.topRows(2).transpose()).inverse();
+      const CartesianStiffness s = unloadedStiffness(chain, q);
+      REQUIRE_FALSE(s.singular);
+      REQUIRE_FALSE(s.rigid);
+      CHECK((s.compliance - C23).lpNorm<Eigen::Infinity>() < 1e-12 * C23.lpNorm<Eigen::Infinity>());
+      CHECK((s.stiffness - K21).lpNorm<Eigen::Infinity>() < 1e-9 * K21.lpNorm<Eigen::Infinity>());
+      CHECK(s.stiffness(0, 1) == s.stiffness(1, 0));
+      CHECK(s.positiveDefinite);
+      CHECK(s.negativeDirections == 0);
+      CHECK(s.smallestEigenvalue == Approx(kq.minCoeff()).epsilon(1e-12));
+      CHECK((s.stiffness * s.compliance - Eigen::Matrix2d::Identity()).lpNorm<Eigen::Infinity>() < 1e-9);
+      // rotation held: independent null-space formula
+      const CartesianStiffness sh = unloadedStiffness(chain, q, true);
+      Matrix H = kq.asDiagonal();
+      const Eigen::Matrix2d Ch = heldRotationCompliance(H, J);
+      CHECK((sh.compliance - Ch).lpNorm<Eigen::Infinity>() < 1e-10 * Ch.lpNorm<Eigen::Infinity>());
+      CHECK(sh.positiveDefinite);
+      // holding the rotation can only stiffen: C_free − C_held is positive semidefinite
+      CHECK(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s.compliance - sh.compliance).eigenvalues()[0] >
+            -1e-12 * s.compliance.norm());
+    }
+  }
+}
+
+TEST_CASE("loaded stiffness tends to the unloaded one as F -> 0 and equals eq 29", "[stiffness]") {
+  std::mt19937 rng(9);
+  std::vector<SegmentParameters> segs;
+  for (int i = 0; i < 5; ++i) segs.push_back(randomStableSegment(rng));
+  const Chain chain(segs);
+  const Vector q = (Vector(5) << 0.2, -0.3, 0.1, 0.25, -0.15).finished();
+  const Wrench F(-0.4, 0.3, 0.1);
+  const CartesianStiffness K0 = unloadedStiffness(chain, q);
+  double prev = 1e300;
+  for (double eps : {1e-1, 1e-2, 1e-3, 1e-4}) {
+    const CartesianStiffness K = loadedStiffness(chain, q, eps * F);
+    const double diff = (K.stiffness - K0.stiffness).lpNorm<Eigen::Infinity>();
+    CHECK(diff < 5.0 * eps * K0.stiffness.lpNorm<Eigen::Infinity>());
+    CHECK(diff < prev);
+    prev = diff;
+    // eq 29 literally
+    Matrix H(5, 5);
+    totalPotentialHessian(chain, q, eps * F, H);
+    const Matrix J = jacobian(chain, q);
+    const Eigen::Matrix2d K29 = (J.topRows(2) * H.inverse() * J.topRows(2).transpose()).inverse();
+    CHECK((K.stiffness - K29).lpNorm<Eigen::Infinity>() < 1e-9 * K29.lpNorm<Eigen::Infinity>());
+  }
+  CHECK(prev < 1e-3 * K0.stiffness.lpNorm<Eigen::Infinity>());
+}
+
+TEST_CASE("loaded compliance equals the finite difference of the equilibrium force-deflection map", "[stiffness]") {
+  std::mt19937 rng(13);
+  // The paper's non-straight start (ERRATA): q⁰ = (θ, −2θ, θ), cos θ = 7/8, made unloaded by preloads,
+  // and a random asymmetric 6-segment chain with a random unloaded shape.
+  const double theta = std::acos(7.0 / 8.0);
+  std::vector<std::pair<std::vector<SegmentParameters>, Vector>> cases;
+  cases.emplace_back(preloadsForShape(std::vector<SegmentParameters>(3, SegmentParameters::symmetric(0.75, 1.0, 1.0, 2.25)),
+                                      Eigen::Vector3d(theta, -2 * theta, theta)),
+                     Eigen::Vector3d(theta, -2 * theta, theta));
+  {
+    std::vector<SegmentParameters> segs;
+    Vector q0(6);
+    std::uniform_real_distribution<double> Q(-0.3, 0.3);
+    for (int i = 0; i < 6; ++i) {
+      segs.push_back(randomStableSegment(rng));
+      q0[i] = Q(rng);
+    }
+    cases.emplace_back(preloadsForShape(segs, q0), q0);
+  }
+  for (const auto& [segs, q0] : cases) {
+    const Chain chain(segs);
+    const int n = chain.size();
+    INFO("n = " << n);
+    // loads at a fraction of the first (cantilever) critical load of the unloaded shape
+    const double Pc = std::abs(linearBuckling(chain, q0, EndCondition::freeEnd()).modes.at(0).lambda);
+    for (const Eigen::Vector2d& Fp : {Eigen::Vector2d(-0.5 * Pc, 0.2 * Pc), Eigen::Vector2d(0.4 * Pc, -0.6 * Pc)}) {
+      for (bool rotationHeld : {false, true}) {
+        INFO("rotation held: " << rotationHeld << ", F = " << Fp.transpose());
+        EndCondition end = EndCondition::freeEnd(Eigen::Vector3d(Fp[0], Fp[1], 0.0));
+        if (rotationHeld) {
+          end.control[2] = Control::Held;
+          end.value[2] = endPose(chain, q0)[2];
+        }
+        const Vector u = solve(chain, end, q0);
+        EquilibriumProblem problem(chain, end, Eigen::Vector3d::Zero());
+        const Wrench W = problem.wrench(u, 0.0);
+        const CartesianStiffness s = loadedStiffness(chain, u.head(n), W, end);
+        REQUIRE_FALSE(s.singular);
+        REQUIRE_FALSE(s.rigid);
+        CHECK(s.negativeDirections == 0);
+        CHECK(s.positiveDefinite);
+        const double h = 1e-5;
+        Eigen::Matrix2d Cfd;
+        for (int c = 0; c < 2; ++c) {
+          EndCondition ep = end, em = end;
+          ep.value[c] += h;
+          em.value[c] -= h;
+          const Vector up = solve(chain, ep, u.head(n)), um = solve(chain, em, u.head(n));
+          Cfd.col(c) = (endPose(chain, up.head(n)) - endPose(chain, um.head(n))).head(2) / (2 * h);
+        }
+        CHECK((s.compliance - Cfd).lpNorm<Eigen::Infinity>() < 1e-6 * Cfd.lpNorm<Eigen::Infinity>());
+        // the load changes the stiffness (the check above is not just the unloaded one)
+        const CartesianStiffness s0 = unloadedStiffness(chain, u.head(n), rotationHeld);
+        CHECK((s0.compliance - Cfd).lpNorm<Eigen::Infinity>() > 1e-3 * Cfd.lpNorm<Eigen::Infinity>());
+      }
+    }
+  }
+}
+
+TEST_CASE("singular cases: bordered solves where K_q - K_g alone is singular", "[stiffness]") {
+  const int n = 4;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const Vector straight = Vector::Zero(n);
+  // Straight chain at the first cantilever load: K_q − K_g is singular.
+  const LinearBucklingResult lb = linearBuckling(chain, straight, EndCondition::freeEnd());
+  const Wrench Fc(lb.modes[0].lambda, 0.0, 0.0);
+  Matrix H(n, n);
+  totalPotentialHessian(chain, straight, Fc, H);
+  REQUIRE(std::abs(Eigen::SelfAdjointEigenSolver<Matrix>(H).eigenvalues()[0]) < 1e-12);
+  const CartesianStiffness free = loadedStiffness(chain, straight, Fc, false);
+  CHECK(free.singular);
+  CHECK(std::isnan(free.compliance(0, 0)));
+  // With the rotation held the constrained problem is regular: finite compliance, equal to the
+  // null-space formula; the end cannot move along x to first order (rigid).
+  const CartesianStiffness held = loadedStiffness(chain, straight, Fc, true);
+  CHECK_FALSE(held.singular);
+  CHECK(held.rigid);
+  const Eigen::Matrix2d Ch = heldRotationCompliance(H, jacobian(chain, straight));
+  CHECK((held.compliance - Ch).lpNorm<Eigen::Infinity>() < 1e-9 * Ch.lpNorm<Eigen::Infinity>());
+  CHECK(held.compliance(1, 1) > 0.0);
+  CHECK(held.negativeDirections == 0);
+  // Unloaded straight chain: axially rigid.
+  const CartesianStiffness u0 = unloadedStiffness(chain, straight);
+  CHECK(u0.rigid);
+  CHECK(u0.compliance(0, 0) == 0.0);
+  CHECK(u0.compliance(1, 1) > 0.0);
+
+  // A bent chain at the load where K_q − K_g becomes singular (a force-control limit): the
+  // compliance is infinite, K_F stays finite, singular, and is the limit of the regular K_F.
+  const Vector q = (Vector(n) << 0.3, -0.2, 0.4, 0.1).finished();
+  ChainData d(chain);
+  forwardKinematics(chain, q, d);
+  Matrix G(n, n);
+  loadMatrix(d, Wrench(1.0, 0.0, 0.0), G);
+  Vector kq(n);
+  jointStiffness(chain, q, kq);
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Matrix> ges(G, Matrix(kq.asDiagonal()));
+  const Eigen::Index last = n - 1;
+  const double mu = std::abs(ges.eigenvalues()[0]) > std::abs(ges.eigenvalues()[last]) ? ges.eigenvalues()[0]
+                                                                                        : ges.eigenvalues()[last];
+  const Wrench Fs(1.0 / mu, 0.0, 0.0);
+  const CartesianStiffness at = loadedStiffness(chain, q, Fs);
+  CHECK(at.singular);
+  REQUIRE(at.stiffness.allFinite());
+  CHECK(std::abs(at.stiffness.determinant()) < 1e-8 * at.stiffness.squaredNorm());
+  const CartesianStiffness near = loadedStiffness(chain, q, Wrench(Fs[0] * (1 + 1e-7), 0.0, 0.0));
+  CHECK_FALSE(near.singular);
+  CHECK((near.stiffness - at.stiffness).lpNorm<Eigen::Infinity>() < 1e-5 * at.stiffness.lpNorm<Eigen::Infinity>());
+  // beyond it the force-controlled equilibrium has one negative direction
+  CHECK(loadedStiffness(chain, q, Wrench(Fs[0] * 1.01, 0.0, 0.0)).negativeDirections == 1);
+}
