@@ -52,7 +52,8 @@ TEST_CASE("Pitchfork: both bifurcating directions, closed-form branch and its st
     signs += static_cast<int>(side);
     for (std::size_t i = 1; i < child.points.size(); ++i) {
       const ContinuationPoint &p = child.points[i];
-      CHECK(std::abs(p.u[0] * p.u[0] - p.lambda) < 1e-10);  // u₁² = λ
+      // u₁² = λ to corrector tolerance (‖G‖∞ ≤ 1e-10 bounds |u₁|·|u₁² − λ|).
+      CHECK(std::abs(p.u[0]) * std::abs(p.u[0] * p.u[0] - p.lambda) <= 1e-10);
       CHECK(std::abs(p.u[1]) < 1e-12);
       CHECK(p.u[0] * side > 0.0);
       CHECK(p.lambda > 0.0);
@@ -125,6 +126,27 @@ TEST_CASE("Transcritical: the bifurcation equation gives the u = lambda directio
   }
   CHECK(reachedUpper == 1);
   CHECK(reachedLower == 1);
+}
+
+TEST_CASE("Switching on a curved trivial branch follows u1 = 0.3 sin(lambda) +- sqrt(lambda)", "[branch_switching]") {
+  toys::CurvedPitchforks problem(0.5);
+  TracerOptions options;
+  options.lambdaMax = 0.4;
+  const BranchTree tree = traceTree(problem, toys::CurvedPitchforks::shift(-0.3), -0.3,
+                                    InitialDirection::increasingLambda(), options, 1);
+  REQUIRE(tree.branches.size() == 3);
+  for (int k = 1; k <= 2; ++k) {
+    const Branch &child = tree.branches[k];
+    CHECK(child.stopReason == StopReason::LambdaRange);
+    REQUIRE(child.points.size() > 5);
+    for (std::size_t i = 1; i < child.points.size(); ++i) {
+      const ContinuationPoint &p = child.points[i];
+      const Vector v = p.u - toys::CurvedPitchforks::shift(p.lambda);
+      CHECK(std::abs(v[0]) * std::abs(v[0] * v[0] - p.lambda) <= 1e-10);
+      CHECK(std::abs(v[1]) < 1e-10);
+      CHECK(p.stability.negative == 0);
+    }
+  }
 }
 
 TEST_CASE("Multiplicity-2 points are reported but not switched", "[branch_switching]") {

@@ -213,3 +213,36 @@ TEST_CASE("Augmented Newton reaches the exact root and reports the last update",
   CHECK_THAT(limited.failure, Contains("left the step"));
   CHECK(far[0] == 1.5);  // restored
 }
+
+TEST_CASE("Branch points on a curved trivial branch (F_lambda != 0)", "[locator]") {
+  const double c = 0.5;
+  toys::CurvedPitchforks problem(c);
+  TracerOptions options;
+  options.lambdaMax = 1.0;
+  const Branch branch = trace(problem, toys::CurvedPitchforks::shift(-0.3), -0.3,
+                              InitialDirection::increasingLambda(), options);
+  CHECK(branch.stopReason == StopReason::LambdaRange);
+  // Every point on u = g(λ) to corrector tolerance: ‖G‖∞ ≤ 1e-10 bounds |λ − c_k|·|v_k| (v = u − g).
+  for (const ContinuationPoint &p : branch.points) {
+    const Vector v = p.u - toys::CurvedPitchforks::shift(p.lambda);
+    CHECK(std::abs(p.lambda * v[0]) <= 1e-10);
+    CHECK(std::abs((p.lambda - c) * v[1]) <= 1e-10);
+  }
+  const auto bps = branch.specialPointsOfType(SpecialPointType::BranchPoint);
+  REQUIRE(bps.size() == 2);
+  const double expected[2] = {0.0, c};
+  for (int k = 0; k < 2; ++k) {
+    const SpecialPoint &bp = *bps[k];
+    CHECK(bp.refined);
+    CHECK(std::abs(bp.lambda - expected[k]) <= tolerance(expected[k]));
+    CHECK(bp.lambdaAccuracy <= tolerance(expected[k]));
+    CHECK((bp.u - toys::CurvedPitchforks::shift(expected[k])).norm() < 1e-12);
+    CHECK(bp.augmentedResidualNorm < 1e-12);
+    CHECK(bp.locationIterations < 20);
+    // First null vector is the branch tangent (0.3 cos λ, 0.4 λ, 1)/‖·‖.
+    Vector t(3);
+    t << 0.3 * std::cos(expected[k]), 0.4 * expected[k], 1.0;
+    t.normalize();
+    CHECK(std::abs(bp.nullVectors.col(0).dot(t)) > 1.0 - 1e-10);
+  }
+}

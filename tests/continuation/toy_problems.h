@@ -77,6 +77,44 @@ class TwoPitchforks : public Problem {
   double c_;
 };
 
+/// TwoPitchforks in v = u − g(λ), g(λ) = (0.3 sin λ, 0.2 λ²): the same branch points at λ = 0
+/// and λ = c, but on a curved trivial branch u = g(λ) with F_λ ≠ 0, so the location and Moore
+/// systems see non-trivial geometry. Bifurcated branch: u₁ = 0.3 sin λ ± √λ, u₂ = 0.2 λ².
+class CurvedPitchforks : public Problem {
+ public:
+  explicit CurvedPitchforks(double c) : c_(c) {}
+  int dimension() const override { return 2; }
+  static Vector shift(double lambda) { return (Vector(2) << 0.3 * std::sin(lambda), 0.2 * lambda * lambda).finished(); }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    const Vector v = u - shift(lambda);
+    F[0] = lambda * v[0] - v[0] * v[0] * v[0];
+    F[1] = (lambda - c_) * v[1] - v[1] * v[1] * v[1];
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+    const Vector v = u - shift(lambda);
+    const Vector dg = (Vector(2) << 0.3 * std::cos(lambda), 0.4 * lambda).finished();
+    Fu.setZero();
+    Fu(0, 0) = lambda - 3.0 * v[0] * v[0];
+    Fu(1, 1) = lambda - c_ - 3.0 * v[1] * v[1];
+    Fl[0] = v[0] - Fu(0, 0) * dg[0];
+    Fl[1] = v[1] - Fu(1, 1) * dg[1];
+    return true;
+  }
+  bool hasStabilityOperator() const override { return true; }
+  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
+    Vector Fl(2);
+    H = Matrix::Zero(2, 2);
+    jacobian(u, lambda, H, Fl);
+    H = -H;
+    C.resize(0, 2);
+    return true;
+  }
+
+ private:
+  double c_;
+};
+
 /// [λu₁ − u₁³, λu₂ − u₂³]: both eigenvalues of H = −F_u cross zero at λ = 0 on u = 0 (a double
 /// zero; the bordered determinant λ² does not change sign).
 class DoubleZero : public TwoPitchforks {

@@ -34,44 +34,15 @@ bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &dire
     if (!jacobianKernel(problem, bp.u, bp.lambda, kernel)) return false;
     psi = kernel.left.col(0);
   }
-  Matrix Dt(n, n + 1), Dphi(n, n + 1);
-  const bool haveSecond =
-      problem.jacobianDirectionalDerivative(bp.u, bp.lambda, t.head(n), t[n], Dt.leftCols(n), Dt.col(n)) &&
-      problem.jacobianDirectionalDerivative(bp.u, bp.lambda, phi.head(n), phi[n], Dphi.leftCols(n), Dphi.col(n));
   direction = phi;
-  if (!haveSecond) {
-    if (note) *note = "second derivatives unavailable: kernel direction orthogonal to the parent tangent";
+  Vector d1, d2;
+  std::string why;
+  if (!bifurcationDirections(problem, bp.u, bp.lambda, psi, t, phi, d1, d2, &why)) {
+    if (note) *note = why + ": kernel direction orthogonal to the parent tangent";
     return true;
   }
-  // Coefficients of ψᵀF_xx[αt + βφ, αt + βφ] = aα² + 2bαβ + cβ².
-  const double a = psi.dot(Dt * t);
-  const double b = 0.5 * (psi.dot(Dt * phi) + psi.dot(Dphi * t));
-  const double c = psi.dot(Dphi * phi);
-  const double scale = std::max({std::abs(a), std::abs(b), std::abs(c)});
-  if (!(scale > 1e-12)) {
-    if (note) *note = "degenerate bifurcation equation: kernel direction orthogonal to the parent tangent";
-    return true;
-  }
-  const double discriminant = b * b - a * c;
-  if (discriminant < -1e-8 * scale * scale) {
-    if (note) *note = "bifurcation equation has no real roots (isolated point): kernel direction used";
-    return true;
-  }
-  const double root = std::sqrt(std::max(0.0, discriminant));
-  Vector candidates[2];
-  if (std::abs(a) <= 1e-10 * scale && std::abs(c) <= 1e-10 * scale) {
-    candidates[0] = t;
-    candidates[1] = phi;
-  } else if (std::abs(c) >= std::abs(a)) {
-    // β/α = r solves c r² + 2b r + a = 0.
-    for (int k = 0; k < 2; ++k) candidates[k] = t + ((-b + (k ? -root : root)) / c) * phi;
-  } else {
-    // α/β = r solves a r² + 2b r + c = 0.
-    for (int k = 0; k < 2; ++k) candidates[k] = ((-b + (k ? -root : root)) / a) * t + phi;
-  }
-  for (Vector &v : candidates) v.normalize();
   // The parent's own tangent is one root; the child is the one farther from it.
-  direction = std::abs(candidates[0].dot(t)) <= std::abs(candidates[1].dot(t)) ? candidates[0] : candidates[1];
+  direction = std::abs(d1.dot(t)) <= std::abs(d2.dot(t)) ? d1 : d2;
   if (note) *note = "algebraic bifurcation equation";
   return true;
 }

@@ -89,21 +89,28 @@ void Locator::setStep(const ContinuationPoint &a, const ContinuationPoint &b) {
   a_.point = a;
   xa_ = a.state();
   dx_ = b.state() - xa_;
+  ta_ = a.tangent;
+  tb_ = b.tangent;
   stepLength_ = a.tangent.dot(dx_);
   b_.s = stepLength_;
   b_.point = b;
 }
 
 bool Locator::sample(double s, StepSample &out, CorrectorSummary *summary) {
-  // Interpolating a→b (instead of extrapolating along t_a) starts Newton closer to the branch;
-  // the hyperplane t_aᵀ(x − x_a) = s is the same.
-  predictor_ = xa_ + (stepLength_ != 0.0 ? s / stepLength_ : 0.0) * dx_;
+  // Cubic Hermite predictor through (x_a, t_a) and (x_b, t_b): near a branch point a second
+  // branch crosses the hyperplane t_aᵀ(x − x_a) = s close by, and Newton started from the chord
+  // (error O(ds²)) can converge to it; the Hermite error is O(ds⁴). The hyperplane is the same.
+  const double theta = stepLength_ != 0.0 ? s / stepLength_ : 0.0;
+  const double theta2 = theta * theta, theta3 = theta2 * theta;
+  const double chord = dx_.norm();
+  predictor_ = (2.0 * theta3 - 3.0 * theta2 + 1.0) * xa_ + (theta3 - 2.0 * theta2 + theta) * chord * ta_ +
+               (-2.0 * theta3 + 3.0 * theta2) * (xa_ + dx_) + (theta3 - theta2) * chord * tb_;
   const CorrectorOptions saved = corrector_.options();
   CorrectorOptions tight = saved;
   tight.residualTolerance = std::min(saved.residualTolerance, options_.newtonTolerance);
   tight.maxIterations = std::max(saved.maxIterations, 15);
   corrector_.setOptions(tight);
-  const CorrectorSummary result = corrector_.correct(predictor_, a_.point.tangent, x_);
+  const CorrectorSummary result = corrector_.correct(predictor_, ta_, x_);
   corrector_.setOptions(saved);
   if (summary) *summary = result;
   if (!result.converged) return false;
@@ -114,12 +121,28 @@ bool Locator::sample(double s, StepSample &out, CorrectorSummary *summary) {
   out.point.stepSize = s;
   out.point.newtonIterations = result.iterations;
   out.point.residualNorm = result.residualNorm;
-  return evaluator_.complete(out.point, a_.point.tangent) || evaluator_.lastWasSingular();
+  if (!evaluator_.complete(out.point, ta_) && !evaluator_.lastWasSingular()) return false;
+  // A sample whose tangent disagrees with the interpolated one AND that Newton moved far from
+  // the predictor converged onto the crossing branch. Within a tiny distance of the branch
+  // point the computed tangent itself is unreliable (F_x nearly rank-deficient), but there both
+  // branches are close to the point we look for and the augmented refinement takes over.
+  const Vector expected = ((1.0 - theta) * ta_ + theta * tb_).normalized();
+  const double correction = (x_ - predictor_).norm();
+  if (!evaluator_.lastWasSingular() && out.point.tangent.dot(expected) < options_.minSampleCosine &&
+      correction > 1e-3 * chord) {
+    if (summary) summary->flagName = "sample on a crossing branch";
+    return false;
+  }
+  return true;
 }
 
 bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, double fHi, const TestFunction &test,
-                       Root &root) {
+                       Root &root, double relativeTolerance) {
   root = Root();
+  root.left = lo;
+  root.right = hi;
+  root.fLeft = fLo;
+  root.fRight = fHi;
   if (fLo == 0.0 || fHi == 0.0) {
     root.at = fLo == 0.0 ? lo : hi;
     root.converged = true;
@@ -133,14 +156,20 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
   double fl = fLo, fr = fHi;
   int lastSide = 0;
   double previousS = 0.0, previousLambda = 0.0;
-  const double tolS = tolerance(0.5 * (lo.point.lambda + hi.point.lambda));
+  const double tolS = (relativeTolerance > 0.0 ? relativeTolerance : options_.tolerance) *
+                      std::max(1.0, std::abs(0.5 * (lo.point.lambda + hi.point.lambda)));
   StepSample trial;
   for (int it = 0; it < options_.maxIterations; ++it) {
     // Illinois: regula falsi with the stale end's value halved, so both ends keep moving.
     double s = (left.s * fr - right.s * fl) / (fr - fl);
     if (!(s > left.s && s < right.s)) s = 0.5 * (left.s + right.s);
     CorrectorSummary summary;
-    if (!sample(s, trial, &summary)) {
+    bool sampled = sample(s, trial, &summary);
+    if (!sampled && s != 0.5 * (left.s + right.s)) {
+      s = 0.5 * (left.s + right.s);  // a secant point can sit where Newton is poorly posed
+      sampled = sample(s, trial, &summary);
+    }
+    if (!sampled) {
       root.failure = std::string("corrector failed while locating (") + summary.flagName + ")";
       return root.evaluations > 0;
     }
@@ -178,6 +207,10 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
       if (lastSide == 1) fl *= 0.5;
       lastSide = 1;
     }
+    root.left = left;
+    root.right = right;
+    root.fLeft = fl;
+    root.fRight = fr;
     if (right.s - left.s <= tolS || (root.evaluations > 1 && root.lastDs <= tolS)) {
       root.converged = true;
       break;
@@ -252,17 +285,30 @@ SpecialPoint Locator::locateFold(const StepSample &lo, const StepSample &hi) {
     f = p.foldTest;
     return true;
   };
-  const bool ok = findRoot(lo, lo.point.foldTest, hi, hi.point.foldTest, test, root);
-  const StepSample &at = ok ? root.at : (std::abs(lo.point.foldTest) < std::abs(hi.point.foldTest) ? lo : hi);
-  sp.arclength = at.point.arclength;
-  sp.u = at.point.u;
-  sp.lambda = at.point.lambda;
-  sp.tangent = at.point.tangent;
-  sp.testFunctionValue = at.point.foldTest;
-  sp.lambdaAccuracy = ok ? root.lastDLambda : std::abs(hi.point.lambda - lo.point.lambda);
-  sp.locationIterations = root.evaluations;
-  if (!root.failure.empty()) sp.note = "fold secant: " + root.failure;
-  refineFold(sp, a_.point.tangent);
+  bool ok = findRoot(lo, lo.point.foldTest, hi, hi.point.foldTest, test, root, options_.coarseTolerance);
+  int evaluations = root.evaluations;
+  auto adopt = [&](bool found) {
+    const StepSample &at = found ? root.at : (std::abs(lo.point.foldTest) < std::abs(hi.point.foldTest) ? lo : hi);
+    sp.arclength = at.point.arclength;
+    sp.u = at.point.u;
+    sp.lambda = at.point.lambda;
+    sp.tangent = at.point.tangent;
+    sp.testFunctionValue = at.point.foldTest;
+    sp.lambdaAccuracy = found ? root.lastDLambda : std::abs(hi.point.lambda - lo.point.lambda);
+    sp.locationIterations = evaluations;
+    sp.note = root.failure.empty() ? "" : "fold secant: " + root.failure;
+  };
+  adopt(ok);
+  if (!refineFold(sp, a_.point.tangent) && ok && root.fLeft * root.fRight < 0.0) {
+    // No refinement: finish the secant to the full tolerance instead.
+    const std::string refinementNote = sp.note;
+    const int refinementSteps = sp.locationIterations - evaluations;
+    const Root coarse = root;
+    ok = findRoot(coarse.left, coarse.fLeft, coarse.right, coarse.fRight, test, root);
+    evaluations += root.evaluations + refinementSteps;
+    adopt(ok);
+    sp.note = refinementNote + (sp.note.empty() ? "" : "; " + sp.note);
+  }
   sp.residualNorm = residualNorm(sp.u, sp.lambda);
   return sp;
 }
@@ -374,18 +420,33 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
 
   Root root;
   bool ok = false;
-  if (haveTest) ok = findRoot(lo, fLo, hi, fHi, test, root);
-  const StepSample &at = ok ? root.at : lo;
-  sp.arclength = at.point.arclength;
-  sp.u = at.point.u;
-  sp.lambda = at.point.lambda;
-  sp.tangent = at.point.tangent;
-  sp.testFunctionValue = ok ? root.value : fLo;
-  sp.lambdaAccuracy = ok ? root.lastDLambda : std::abs(hi.point.lambda - lo.point.lambda);
-  sp.locationIterations = root.evaluations;
-  if (!haveTest) sp.note += (sp.note.empty() ? "" : "; ") + std::string("no usable test function");
-  else if (!root.failure.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("branch point secant: " + root.failure);
-  refineBranchPoint(sp, a_.point.tangent);
+  if (haveTest) ok = findRoot(lo, fLo, hi, fHi, test, root, options_.coarseTolerance);
+  int evaluations = root.evaluations;
+  const std::string testNote = sp.note;
+  auto adopt = [&](bool found) {
+    const StepSample &at = found ? root.at : lo;
+    sp.arclength = at.point.arclength;
+    sp.u = at.point.u;
+    sp.lambda = at.point.lambda;
+    sp.tangent = at.point.tangent;
+    sp.testFunctionValue = found ? root.value : fLo;
+    sp.lambdaAccuracy = found ? root.lastDLambda : std::abs(hi.point.lambda - lo.point.lambda);
+    sp.locationIterations = evaluations;
+    sp.note = testNote;
+    if (!haveTest) sp.note += (sp.note.empty() ? "" : "; ") + std::string("no usable test function");
+    else if (!root.failure.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("branch point secant: " + root.failure);
+  };
+  adopt(ok);
+  if (!refineBranchPoint(sp, a_.point.tangent) && ok && root.fLeft * root.fRight < 0.0) {
+    const std::string refinementNote = sp.note;
+    const int refinementSteps = sp.locationIterations - evaluations;
+    const Root coarse = root;
+    ok = findRoot(coarse.left, coarse.fLeft, coarse.right, coarse.fRight, test, root);
+    evaluations += root.evaluations + refinementSteps;
+    adopt(ok);
+    sp.note = refinementNote;
+    fillBranchPointGeometry(sp, a_.point.tangent);
+  }
   sp.residualNorm = residualNorm(sp.u, sp.lambda);
   return sp;
 }
@@ -456,10 +517,18 @@ void Locator::fillBranchPointGeometry(SpecialPoint &sp, const Vector &tangentRef
     if (kernel.singularValues[k] <= 1e-8 * scale) dimension = k + 1;
   if (sp.multiplicity == 1) dimension = 2;
   const Matrix K = kernel.right.leftCols(dimension);
-  // First basis vector: the traced branch's direction projected onto the kernel.
+  // First basis vector: the traced branch's own tangent at the point. For a simple BP that is the
+  // root of the bifurcation equation closest to the step's tangent (the projection of the step
+  // tangent onto the kernel is off by O(ds·curvature)); otherwise, or if the equation fails, the
+  // projection.
   Vector t = K * (K.transpose() * tangentRef);
   if (t.norm() < 1e-12) t = K.col(0);
   t.normalize();
+  if (sp.multiplicity == 1) {
+    Vector d1, d2;
+    if (bifurcationDirections(problem_, sp.u, sp.lambda, kernel.left.col(0), K.col(0), K.col(1), d1, d2))
+      t = std::abs(d1.dot(tangentRef)) >= std::abs(d2.dot(tangentRef)) ? d1 : d2;
+  }
   if (t.dot(tangentRef) < 0.0) t = -t;
   Matrix basis(n_ + 1, dimension);
   basis.col(0) = t;

@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <cmath>
+#include <algorithm>
 #include <cstdlib>
 #include <limits>
 
@@ -129,6 +130,47 @@ bool jacobianKernel(Problem &problem, ConstVectorRef u, double lambda, KernelInf
     info.right.col(k + 1) = svd.matrixV().col(n - 1 - k);
     info.left.col(k) = svd.matrixU().col(n - 1 - k);
   }
+  return true;
+}
+
+bool bifurcationDirections(Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi, ConstVectorRef k1,
+                           ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why) {
+  const int n = problem.dimension();
+  Matrix D1(n, n + 1), D2(n, n + 1);
+  if (!problem.jacobianDirectionalDerivative(u, lambda, k1.head(n), k1[n], D1.leftCols(n), D1.col(n)) ||
+      !problem.jacobianDirectionalDerivative(u, lambda, k2.head(n), k2[n], D2.leftCols(n), D2.col(n))) {
+    if (why) *why = "second derivatives unavailable";
+    return false;
+  }
+  // ψᵀF_xx[αk₁ + βk₂, αk₁ + βk₂] = aα² + 2bαβ + cβ²; b symmetrised against finite-difference noise.
+  const double a = psi.dot(D1 * k1);
+  const double b = 0.5 * (psi.dot(D1 * k2) + psi.dot(D2 * k1));
+  const double c = psi.dot(D2 * k2);
+  const double scale = std::max({std::abs(a), std::abs(b), std::abs(c)});
+  if (!(scale > 1e-12)) {
+    if (why) *why = "degenerate bifurcation equation (vanishing second derivatives)";
+    return false;
+  }
+  const double discriminant = b * b - a * c;
+  if (discriminant < -1e-8 * scale * scale) {
+    if (why) *why = "bifurcation equation has no real roots (isolated point)";
+    return false;
+  }
+  const double root = std::sqrt(std::max(0.0, discriminant));
+  if (std::abs(a) <= 1e-12 * scale && std::abs(c) <= 1e-12 * scale) {
+    d1 = k1;
+    d2 = k2;
+  } else if (std::abs(c) >= std::abs(a)) {
+    // β/α = r solves c r² + 2b r + a = 0.
+    d1 = k1 + ((-b + root) / c) * k2;
+    d2 = k1 + ((-b - root) / c) * k2;
+  } else {
+    // α/β = r solves a r² + 2b r + c = 0.
+    d1 = ((-b + root) / a) * k1 + k2;
+    d2 = ((-b - root) / a) * k1 + k2;
+  }
+  d1.normalize();
+  d2.normalize();
   return true;
 }
 

@@ -86,6 +86,7 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   lo.maxIterations = options_.maxLocationIterations;
   lo.maxRefinementIterations = options_.maxRefinementIterations;
   lo.separationFraction = options_.separationFraction;
+  lo.minSampleCosine = options_.minTangentCosine;
   lo.detectFolds = options_.detectFolds;
   lo.detectBranchPoints = options_.detectBranchPoints;
   locator_ = std::make_unique<Locator>(problem_, *corrector_, *evaluator_, lo);

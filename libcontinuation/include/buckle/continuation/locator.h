@@ -28,10 +28,17 @@ namespace buckle::continuation {
 
 struct LocatorOptions {
   double tolerance = 1e-12;          ///< target |Δλ| ≤ tolerance·max(1, |λ|)
+  /// Secant tolerance before an augmented-Newton refinement: near a branch point the corrector
+  /// samples are ill-conditioned (the Keller Jacobian is singular there), so the secant stage
+  /// only brackets and Newton on the regular augmented system does the rest. If refinement
+  /// fails, the secant continues down to `tolerance`.
+  double coarseTolerance = 1e-7;
   double newtonTolerance = 1e-13;    ///< corrector ‖G‖∞ while locating
   int maxIterations = 60;            ///< secant/bisection evaluations
   int maxRefinementIterations = 15;
   double separationFraction = 1e-9;  ///< of the step length
+  /// A sample whose tangent makes cos < this with the interpolated step tangent is rejected.
+  double minSampleCosine = 0.9;
   bool detectFolds = true;
   bool detectBranchPoints = true;
 };
@@ -48,7 +55,8 @@ class Locator {
 
   /// The step from a to b (b was corrected on t_aᵀ(x − x_a) = ds).
   void setStep(const ContinuationPoint &a, const ContinuationPoint &b);
-  /// Branch point at offset s, predicted by interpolating a→b. False if the corrector fails.
+  /// Point of the traced branch at offset s (Hermite predictor through a and b). False if the
+  /// corrector fails or lands on a crossing branch (tangent turned against the interpolated one).
   bool sample(double s, StepSample &out, CorrectorSummary *summary = nullptr);
 
   using TestFunction = std::function<bool(const ContinuationPoint &, double &)>;
@@ -60,10 +68,13 @@ class Locator {
     int evaluations = 0;
     bool converged = false;
     std::string failure;
+    StepSample left, right;  ///< final bracket and its test values
+    double fLeft = 0.0, fRight = 0.0;
   };
-  /// Zero of test along the step inside [lo.s, hi.s], where fLo·fHi ≤ 0.
+  /// Zero of test along the step inside [lo.s, hi.s], where fLo·fHi ≤ 0, to
+  /// |Δs| ≤ relativeTolerance·max(1, |λ|) (0: options().tolerance).
   bool findRoot(const StepSample &lo, double fLo, const StepSample &hi, double fHi, const TestFunction &test,
-                Root &root);
+                Root &root, double relativeTolerance = 0.0);
 
   /// Folds and branch points inside the current step, in arclength order (index not set).
   std::vector<SpecialPoint> locateSpecialPoints(const IntervalCrossings &crossings);
@@ -89,7 +100,7 @@ class Locator {
   LocatorOptions options_;
   int n_;
   StepSample a_, b_;
-  Vector xa_, dx_, predictor_, x_;
+  Vector xa_, dx_, ta_, tb_, predictor_, x_;
   double stepLength_ = 0.0;
 };
 

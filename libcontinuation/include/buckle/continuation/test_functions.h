@@ -12,6 +12,7 @@
 #include "buckle/continuation/problem.h"
 
 #include <Eigen/LU>
+#include <string>
 
 namespace buckle::continuation {
 
@@ -79,5 +80,13 @@ struct KernelInfo {
   Matrix left;            ///< columns: left singular vectors; left.col(k) pairs with singularValues[k + 1]
 };
 bool jacobianKernel(Problem &problem, ConstVectorRef u, double lambda, KernelInfo &info);
+
+/// Tangents of the two branches crossing at a simple branch point: the real roots d ∈ span(k₁, k₂)
+/// (an orthonormal basis of ker F_x) of the algebraic bifurcation equation ψᵀF_xx[d, d] = 0,
+/// ψ the left null vector. Second derivatives from Problem::jacobianDirectionalDerivative.
+/// False (with the reason) when they are unavailable, the quadratic form vanishes, or its roots
+/// are complex (an isolated point, no crossing branches).
+bool bifurcationDirections(Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi, ConstVectorRef k1,
+                           ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why = nullptr);
 
 }  // namespace buckle::continuation
