@@ -9,6 +9,7 @@
 
 #include "buckle/continuation/branch_switching.h"
 #include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/equilibrium_solve.h"
 #include "buckle/mechanics/shape_name.h"
@@ -62,6 +63,21 @@ class CaseRunner {
     return true;
   }
   void record(const cont::Branch& b, mech::EquilibriumProblem& problem, const std::string& origin);
+  bool throughLoad() const { return spec_.path.loadLimit > 0.0; }
+  /// Stability under the scene's own end condition (displacement control of the parameter).
+  cont::StabilityInfo heldStability(const Eigen::VectorXd& q, const mech::Wrench& F) const {
+    const int n = out_.chain.size();
+    mech::Matrix H(n, n);
+    mech::totalPotentialHessian(out_.chain, q, F, H);
+    mech::ChainData data(out_.chain);
+    mech::forwardKinematics(out_.chain, q, data);
+    mech::Matrix J(3, n);
+    mech::endJacobian(data, J);
+    const std::vector<int> held = spec_.end.condition.heldIndices();
+    mech::Matrix C(held.size(), n);
+    for (size_t k = 0; k < held.size(); ++k) C.row(Eigen::Index(k)) = J.row(held[k]);
+    return cont::projectedInertia(H, C, 1e-10);
+  }
   bool switchAt(cont::Tracer& tracer, const cont::Branch& parent, int spIndex, int sign, cont::Branch& child);
 
   const Scene& scene_;
@@ -118,6 +134,16 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
     r.negative = p.stability.negative;
     r.stable = p.stability.valid() && p.stability.stable();
     r.minEigenvalue = p.stability.smallest;
+    if (throughLoad()) {
+      const int c = spec_.path.coordinate;
+      r.parameter = r.pose[c];
+      const double lo = std::min(spec_.path.from, spec_.path.to), hi = std::max(spec_.path.from, spec_.path.to);
+      if (r.parameter < lo - 1e-9 || r.parameter > hi + 1e-9) continue;
+      const cont::StabilityInfo st = heldStability(r.q, r.F);
+      r.negative = st.negative;
+      r.stable = st.valid() && st.negative == 0;
+      r.minEigenvalue = st.smallest;
+    }
     if (scene_.analyses.stiffness) {
       const mech::CartesianStiffness K = mech::loadedStiffness(out_.chain, r.q, r.F, problem.endCondition());
       r.K = K.stiffness;
@@ -152,6 +178,21 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
     s.pose = mech::endPose(out_.chain, s.q);
     s.stabilityBefore = stabilityLabel(sp.inertiaBefore);
     s.stabilityAfter = stabilityLabel(sp.inertiaAfter);
+    if (throughLoad()) {
+      // reported against the held coordinate, with displacement-control stability
+      s.parameter = s.pose[spec_.path.coordinate];
+      const size_t i0 = std::min(size_t(sp.index), b.points.size() - 1), i1 = std::min(i0 + 1, b.points.size() - 1);
+      const auto before = heldStability(b.points[i0].u.head(n), problem.wrench(b.points[i0].u, b.points[i0].lambda));
+      const auto after = heldStability(b.points[i1].u.head(n), problem.wrench(b.points[i1].u, b.points[i1].lambda));
+      s.stabilityBefore = stabilityLabel(before.negative);
+      s.stabilityAfter = stabilityLabel(after.negative);
+      s.note = "stability under displacement control of " + spec_.path.parameter + " (neighbouring points)";
+      if (sp.type == cont::SpecialPointType::Fold) {
+        s.type = "LPF";
+        s.field = "none";
+        s.note = "fold of the reaction force: no jump under displacement control";
+      }
+    }
     s.accuracy = sp.lambdaAccuracy;
     s.residual = sp.residualNorm;
     s.refined = sp.refined;
@@ -177,6 +218,10 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
     s.pose = mech::endPose(out_.chain, s.q);
     s.shape = mech::shapeName(s.q, 1e-6);
     s.stabilityBefore = s.stabilityAfter = stabilityLabel(p.stability.negative);
+    if (throughLoad()) {
+      s.parameter = s.pose[spec_.path.coordinate];
+      s.stabilityBefore = s.stabilityAfter = stabilityLabel(heldStability(s.q, s.F).negative);
+    }
     s.accuracy = b.points.size() >= 2 ? std::abs(p.lambda - b.points[b.points.size() - 2].lambda) : 0.0;
     s.residual = p.residualNorm;
     const bool upper = s.q[limitJoint] > 0.5 * (out_.chain.lowerLimits()[limitJoint] + out_.chain.upperLimits()[limitJoint]);
@@ -186,6 +231,46 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
        << " rad from it (the closing spring nearly reaches zero length)";
     s.note = os.str();
     out_.specials.push_back(s);
+  }
+
+  // Under displacement control through the reaction, a fold of the coordinate (dx/ds = 0) is
+  // where the displacement-controlled stability changes away from branch points: a jump.
+  if (throughLoad()) {
+    for (size_t i = first + 1; i < out_.points.size(); ++i) {
+      const PointRecord &a = out_.points[i - 1], &m = out_.points[i];
+      if (a.branch != m.branch || a.negative == m.negative || a.negative < 0 || m.negative < 0) continue;
+      bool nearBP = false;
+      for (const SpecialRecord& sr : out_.specials)
+        if (sr.branch == b.id && sr.type == "BP" &&
+            std::abs(sr.F[spec_.path.coordinate] - m.F[spec_.path.coordinate]) <=
+                std::abs(a.F[spec_.path.coordinate] - m.F[spec_.path.coordinate]) + 1e-12)
+          nearBP = true;
+      if (nearBP) continue;
+      SpecialRecord s;
+      s.type = "LP";
+      s.field = "jumping";
+      s.branch = b.id;
+      const PointRecord& at = a.stable ? a : m;
+      s.parameter = at.parameter;
+      s.F = at.F;
+      s.pose = at.pose;
+      s.q = at.q;
+      s.shape = mech::shapeName(at.q, 1e-6);
+      s.stabilityBefore = stabilityLabel(a.negative);
+      s.stabilityAfter = stabilityLabel(m.negative);
+      s.accuracy = std::abs(m.parameter - a.parameter);
+      s.note = "fold of " + spec_.path.parameter + " under displacement control, located to the point spacing";
+      out_.specials.push_back(s);
+    }
+  }
+
+  if (throughLoad()) {
+    const double lo = std::min(spec_.path.from, spec_.path.to), hi = std::max(spec_.path.from, spec_.path.to);
+    out_.specials.erase(std::remove_if(out_.specials.begin(), out_.specials.end(),
+                                       [&](const SpecialRecord& r) {
+                                         return r.branch == b.id && (r.parameter < lo - 1e-9 || r.parameter > hi + 1e-9);
+                                       }),
+                        out_.specials.end());
   }
 
   // Quasi-buckling (ERRATA, "what the physics does"): a deep, smooth minimum of Kxx along a
@@ -232,10 +317,27 @@ bool CaseRunner::switchAt(cont::Tracer& tracer, const cont::Branch& parent, int 
 }
 
 void CaseRunner::continuation() {
-  const double s0 = out_.startValue;
+  double s0 = out_.startValue;
   mech::EndCondition end = spec_.end.condition;
-  end.value -= s0 * spec_.path.direction;  // prescribed(λ) = start values + (λ − s0)·direction
-  mech::EquilibriumProblem problem(out_.chain, end, spec_.path.direction);
+  Eigen::Vector3d direction = spec_.path.direction;
+  double lambdaLo = std::min(spec_.path.from, spec_.path.to), lambdaHi = std::max(spec_.path.from, spec_.path.to);
+  std::vector<double> targets{spec_.path.to, spec_.path.from};
+  const int c = spec_.path.coordinate;
+  if (throughLoad()) {
+    // trace with the held coordinate's reaction as parameter (see PathSpec::loadLimit)
+    end.control[size_t(c)] = mech::Control::Load;
+    end.value[c] = 0.0;
+    direction = Eigen::Vector3d::Zero();
+    direction[c] = 1.0;
+    s0 = 0.0;
+    // both signs of the reaction: with an unstable start (κ < 0) the branch points lie on the
+    // tension side, and their branches still move the end into the requested range
+    targets = {-spec_.path.loadLimit, spec_.path.loadLimit};
+    lambdaLo = -spec_.path.loadLimit;
+    lambdaHi = spec_.path.loadLimit;
+  }
+  end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
+  mech::EquilibriumProblem problem(out_.chain, end, direction);
 
   // The unloaded shape at the start value, polished.
   const cont::Vector guess = problem.initialGuess(out_.q0, s0);
@@ -255,15 +357,15 @@ void CaseRunner::continuation() {
   opt.maxStep = scene_.solver.maxStep;
   opt.maxPoints = scene_.solver.maxPoints;
   opt.newtonTolerance = scene_.solver.tolerance;
-  opt.lambdaMin = std::min(spec_.path.from, spec_.path.to);
-  opt.lambdaMax = std::max(spec_.path.from, spec_.path.to);
+  opt.lambdaMin = lambdaLo;
+  opt.lambdaMax = lambdaHi;
   opt.computeStability = true;
   cont::Tracer tracer(problem, opt);
 
   std::vector<cont::Branch> branches;
   std::vector<std::string> origins;
   std::vector<int> depth;
-  for (double target : {spec_.path.to, spec_.path.from}) {
+  for (double target : targets) {
     if (target == s0) continue;
     if (outOfTime()) break;
     const int sign = target > s0 ? 1 : -1;
@@ -271,7 +373,9 @@ void CaseRunner::continuation() {
                                                      : cont::InitialDirection::decreasingLambda());
     b.id = static_cast<int>(branches.size());
     branches.push_back(std::move(b));
-    origins.push_back(std::string("start, ") + (sign > 0 ? "increasing " : "decreasing ") + spec_.path.parameter);
+    origins.push_back(std::string("start, ") + (sign > 0 ? "increasing " : "decreasing ") +
+                      (throughLoad() ? std::string(c == 0 ? "Fx" : c == 1 ? "Fy" : "Me") + " (through the reaction)"
+                                     : spec_.path.parameter));
     depth.push_back(0);
   }
   // Branch switching, breadth first, up to the requested depth.

@@ -329,7 +329,7 @@ EndSpec parseEnd(const Reader& r, const json& end, const Pointer& p) {
 }
 
 PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const EndSpec& end, double startValue) {
-  r.onlyKeys(path, p, {"parameter", "from", "to", "direction"});
+  r.onlyKeys(path, p, {"parameter", "from", "to", "direction", "load_limit"});
   for (const char* key : {"parameter", "from", "to"})
     if (!path.contains(key)) r.fail(p / key, "missing (required)");
   PathSpec spec;
@@ -355,6 +355,11 @@ PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const En
     os << "expected a range [from, to] that contains the start value " << spec.parameter << " = " << startValue
        << " (set by /end/" << kCoordinateNames[spec.coordinate] << "), got [" << spec.from << ", " << spec.to << "]";
     r.fail(p / (std::abs(spec.from - startValue) <= std::abs(spec.to - startValue) ? "from" : "to"), os.str());
+  }
+  if (path.contains("load_limit")) {
+    if (isLoad)
+      r.fail(p / "load_limit", "only a displacement-controlled path (parameter x, y or phi) takes a load_limit");
+    spec.loadLimit = r.positive(path["load_limit"], p / "load_limit");
   }
   spec.direction.setZero();
   spec.direction[spec.coordinate] = 1.0;
@@ -408,6 +413,18 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
     if (c >= 0) start = cs.end.condition.value[c];
   }
   cs.path = parsePath(r, path, Pointer("/path"), cs.end, start);
+  if (cs.path.loadLimit == 0.0 && cs.end.condition.isHeld(static_cast<mechanics::EndCoordinate>(cs.path.coordinate))) {
+    mechanics::ChainData data(chain);
+    mechanics::forwardKinematics(chain, cs.chain.q0, data);
+    mechanics::Matrix J(3, chain.size());
+    mechanics::endJacobian(data, J);
+    if (J.row(cs.path.coordinate).norm() <= 1e-9 * std::max(1.0, J.norm()))
+      r.fail(Pointer("/path/parameter"),
+             std::string("the unloaded shape cannot move its end along ") + kCoordinateNames[cs.path.coordinate] +
+                 " to first order (e.g. the straight chain along x): displacement control starts at a singular "
+                 "point; add /path/load_limit (the largest reaction to trace) so that the branches are traced "
+                 "through the reaction force");
+  }
   return cs;
 }
 

@@ -48,6 +48,11 @@ struct PathSpec {
   int coordinate = 0;          ///< 0 = x, 1 = y, 2 = φ
   double from = 0.0, to = 0.0; ///< parameter range; contains the start value
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  ///< d(prescribed)/d(parameter)
+  /// Displacement control from a start that is singular for the held coordinate (the straight
+  /// chain cannot move its end along x to first order): the branches are traced with the
+  /// coordinate's reaction as parameter, from 0 to ±loadLimit, and reported against the
+  /// coordinate with displacement-control stability. 0: not used.
+  double loadLimit = 0.0;
 };
 
 struct ContinuationSpec {
