@@ -18,6 +18,30 @@ Vector vec1(double a) { return (Vector(1) << a).finished(); }
 double tolerance(double lambda) { return 1e-12 * std::max(1.0, std::abs(lambda)); }
 }  // namespace
 
+TEST_CASE("Fold normal form: the fold at the origin, both halves traced", "[locator]") {
+  toys::FoldNormalForm problem;
+  TracerOptions options;
+  options.lambdaMax = 1.0;
+  const Branch branch = trace(problem, vec1(1.1), 1.0, InitialDirection::decreasingLambda(), options);
+  CHECK(branch.stopReason == StopReason::LambdaRange);
+  // Start polished onto u = 1, the branch comes back to λ = 1 on u = −1.
+  CHECK(std::abs(branch.points.front().u[0] - 1.0) < 1e-12);
+  CHECK(std::abs(branch.points.back().u[0] + 1.0) < 1e-12);
+  CHECK(branch.points.back().lambda == 1.0);
+  REQUIRE_FALSE(branch.specialPoints.empty());
+  CHECK(branch.specialPoints.front().type == SpecialPointType::Endpoint);
+  CHECK(branch.specialPoints.front().index == 0);
+  CHECK_THAT(branch.specialPoints.front().note, Contains("start"));
+  const auto folds = branch.specialPointsOfType(SpecialPointType::Fold);
+  REQUIRE(folds.size() == 1);
+  CHECK(std::abs(folds[0]->lambda) <= 1e-12);
+  CHECK(std::abs(folds[0]->u[0]) <= 1e-12);
+  CHECK(folds[0]->refined);
+  CHECK(folds[0]->inertiaBefore == -1);  // no stability operator
+  // The tangent at the fold is vertical in λ.
+  CHECK(std::abs(folds[0]->tangent[1]) < 1e-12);
+}
+
 TEST_CASE("Cubic folds at lambda = +-2/3, not reported again as branch points", "[locator]") {
   toys::CubicFold cubic;
   TracerOptions options;

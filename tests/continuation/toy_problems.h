@@ -23,6 +23,21 @@ class Circle : public Problem {
   }
 };
 
+/// Fold normal form u² − λ = 0: one fold at (u, λ) = (0, 0).
+class FoldNormalForm : public Problem {
+ public:
+  int dimension() const override { return 1; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    F[0] = u[0] * u[0] - lambda;
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+    Fu(0, 0) = 2.0 * u[0];
+    Fl[0] = -1.0;
+    return true;
+  }
+};
+
 /// λ + u − u³/3 = 0, a gradient system (H = −F_u = u² − 1): folds at u = ±1, λ = ∓2/3.
 class CubicFold : public Problem {
  public:
