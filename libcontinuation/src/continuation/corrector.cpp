@@ -19,6 +19,7 @@ bool CorrectorOptions::IsValid(std::string *why) const {
   if (!(stepTolerance > 0.0) || !std::isfinite(stepTolerance))
     return fail("stepTolerance must be positive and finite");
   if (maxIterations < 1) return fail("maxIterations must be at least 1");
+  if (!(maxNewtonStep >= 0.0) || !std::isfinite(maxNewtonStep)) return fail("maxNewtonStep must be finite and >= 0");
   if (!(stagnationFactor >= 1.0) || !std::isfinite(stagnationFactor))
     return fail("stagnationFactor must be finite and >= 1");
   return true;
@@ -69,6 +70,8 @@ void Corrector::applyOptions() {
   KINSetFuncNormTol(mem, options_.residualTolerance);
   KINSetScaledStepTol(mem, options_.stepTolerance);
   KINSetNumMaxIters(mem, options_.maxIterations);
+  // Exact Newton with step control left to the continuation: no KINSOL step truncation.
+  KINSetMaxNewtonStep(mem, options_.maxNewtonStep > 0.0 ? options_.maxNewtonStep : 1e100);
 }
 
 int Corrector::systemFunction(N_Vector x, N_Vector g, void *self) {

@@ -54,7 +54,9 @@ struct SpecialPoint {
   double lambdaAccuracy = 0.0;
   double residualNorm = 0.0;    ///< ‖F(u, λ)‖₂ at the located point
   double augmentedResidualNorm = 0.0;  ///< residual of the refinement system (fold / Moore)
-  double testFunctionValue = 0.0;      ///< test function at the located point
+  /// Test function at the located point: fold → t_λ; branch point → smallest singular value of
+  /// [F_u, F_λ]; boundary / parameter end → g (or λ_end − λ).
+  double testFunctionValue = 0.0;
   int locationIterations = 0;   ///< secant/bisection evaluations + refinement Newton steps
   bool refined = false;         ///< Newton on the augmented system converged
   std::string boundaryName;     ///< Boundary/Endpoint: which limit was hit

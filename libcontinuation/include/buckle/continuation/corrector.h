@@ -31,6 +31,9 @@ struct CorrectorOptions {
   int maxIterations = 10;
   /// KIN_LINESEARCH instead of full Newton steps (KIN_NONE).
   bool lineSearch = false;
+  /// Longest Newton step KINSOL may take (‖Δx‖₂). 0: unlimited. KINSOL's own default,
+  /// 1000·max(1, ‖x₀‖), silently truncates steps from predictors near the origin.
+  double maxNewtonStep = 0.0;
   /// A solve that stalls on the step tolerance (KIN_STEP_LT_STPTOL: rounding floor reached)
   /// still counts as converged if ‖G‖₂ ≤ stagnationFactor · residualTolerance.
   double stagnationFactor = 100.0;
