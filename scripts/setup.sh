@@ -22,6 +22,9 @@ BUILD_DIR=${BUCKLE_BUILD_DIR:-$ROOT/build}
 OUT=${BUCKLE_OUT_DIR:-$ROOT/out}
 JOBS=${BUCKLE_JOBS:-$(nproc)}
 TEST_TIMEOUT=${BUCKLE_TEST_TIMEOUT:-900}
+# ccache (used by the build when installed) hashes paths relative to the checkout, so a fresh
+# clone elsewhere, e.g. CI's, reuses objects compiled from the same sources.
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$ROOT}
 
 # Debian packages (names verified on bookworm, see shared/notes/dependencies.md).
 readonly PACKAGES=(build-essential cmake git pkg-config ccache libeigen3-dev libsundials-dev
@@ -49,6 +52,8 @@ main_job() {
     log "main job: buckle run data/scenes/default.json --out $OUT"
     "$buckle" run data/scenes/default.json --out "$OUT"
   else
+    [[ ! -f data/scenes/default.json ]] ||
+      log "main job: data/scenes/default.json exists but this buckle has no 'run' subcommand"
     # Until scenes land: the first three critical loads of a 3-segment clamped-pinned column.
     local args=(critical --segments 3 --a 0.5 --b 1 --k 1 --L0 2.25 --count 3)
     log "main job: buckle ${args[*]}"
