@@ -71,6 +71,19 @@ TEST_CASE("Cubic folds at lambda = +-2/3, not reported again as branch points", 
   CHECK(folds[1]->inertiaAfter == 0);
 }
 
+TEST_CASE("Folds with detection off are not mistaken for branch points", "[locator]") {
+  toys::CubicFold cubic;
+  TracerOptions options;
+  options.lambdaMin = -3.0;
+  options.lambdaMax = 3.0;
+  options.detectFolds = false;
+  const double u0 = -2.5, lambda0 = -u0 + u0 * u0 * u0 / 3.0;
+  const Branch branch = trace(cubic, vec1(u0), lambda0, InitialDirection::increasingLambda(), options);
+  CHECK(branch.stopReason == StopReason::LambdaRange);
+  CHECK(branch.specialPointsOfType(SpecialPointType::Fold).empty());
+  CHECK(branch.specialPointsOfType(SpecialPointType::BranchPoint).empty());
+}
+
 TEST_CASE("Bratu fold: F = 0 and F_u singular to the reported accuracy", "[locator]") {
   const int n = 20;
   toys::Bratu bratu(n);

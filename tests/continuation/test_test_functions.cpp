@@ -92,6 +92,9 @@ TEST_CASE("classifyInterval separates folds, determinant changes and inertia", "
   CHECK_FALSE(fold.determinantChange);
   CHECK(fold.inertiaChange == 1);
   CHECK(fold.branchPointCrossings == 0);  // the fold explains the eigenvalue crossing
+  IntervalCrossings foldNotReported = classifyInterval(a, b, false, true);
+  CHECK_FALSE(foldNotReported.fold);
+  CHECK(foldNotReported.branchPointCrossings == 0);  // still explained by the fold
 
   b.foldTest = 0.4;
   b.stability.negative = 2;

@@ -272,3 +272,19 @@ TEST_CASE("Per-point cost on a 50-unknown Bratu problem", "[.][timing]") {
             << " us/point (no stability, no detection)\n";
   CHECK(branch.points.size() > 10);
 }
+
+TEST_CASE("A Tracer (one KINSOL instance) can be reused for many runs", "[tracer]") {
+  toys::CubicFold cubic;
+  TracerOptions options;
+  options.lambdaMin = -3.0;
+  options.lambdaMax = 3.0;
+  Tracer tracer(cubic, options);
+  const double u0 = -2.5, lambda0 = -u0 + u0 * u0 * u0 / 3.0;
+  const Branch first = tracer.trace(vec1(u0), lambda0, InitialDirection::increasingLambda());
+  for (int k = 0; k < 5; ++k) {
+    const Branch again = tracer.trace(vec1(u0), lambda0, InitialDirection::increasingLambda());
+    REQUIRE(again.points.size() == first.points.size());
+    REQUIRE(again.specialPoints.size() == first.specialPoints.size());
+    for (std::size_t i = 0; i < first.points.size(); ++i) CHECK(again.points[i].lambda == first.points[i].lambda);
+  }
+}

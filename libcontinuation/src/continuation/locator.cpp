@@ -253,7 +253,7 @@ void Locator::separateCrossings(const StepSample &lo, const StepSample &hi,
     if (det) simple.emplace_back(lo, hi);
     return;
   }
-  const bool fold = options_.detectFolds && ((p.foldTest >= 0.0) != (q.foldTest >= 0.0));
+  const bool fold = (p.foldTest >= 0.0) != (q.foldTest >= 0.0);  // explains one crossing, reported or not
   const int inertia = std::abs(q.stability.negative - p.stability.negative);
   const int crossings = std::max(det ? 1 : 0, inertia - (fold ? 1 : 0));
   if (crossings == 0) return;

@@ -98,14 +98,16 @@ bool MinimallyAugmentedTest::evaluate(const Matrix &A, double &psi, Vector *v) {
 IntervalCrossings classifyInterval(const ContinuationPoint &a, const ContinuationPoint &b, bool detectFolds,
                                    bool detectBranchPoints) {
   IntervalCrossings crossings;
-  crossings.fold = detectFolds && ((a.foldTest >= 0.0) != (b.foldTest >= 0.0));
+  const bool foldSignChange = (a.foldTest >= 0.0) != (b.foldTest >= 0.0);
+  crossings.fold = detectFolds && foldSignChange;
   if (!detectBranchPoints) return crossings;
   crossings.determinantChange = a.determinantSign * b.determinantSign < 0;
   if (a.stability.valid() && b.stability.valid())
     crossings.inertiaChange = std::abs(b.stability.negative - a.stability.negative);
   int count = crossings.determinantChange ? 1 : 0;
   // A fold moves one eigenvalue through zero too; only the rest are branch points.
-  if (crossings.inertiaChange >= 0) count = std::max(count, crossings.inertiaChange - (crossings.fold ? 1 : 0));
+  // (whether or not folds are being reported).
+  if (crossings.inertiaChange >= 0) count = std::max(count, crossings.inertiaChange - (foldSignChange ? 1 : 0));
   crossings.branchPointCrossings = count;
   return crossings;
 }
