@@ -59,6 +59,7 @@ SegmentUnloadedAngle unloadedAngle(const Segment& s, const UnloadedShapeOptions&
   for (int i = 0; i <= N; ++i) grid.push_back(a + (b - a) * i / N);
   if (a < 0.0 && b > 0.0) grid.push_back(0.0);
   std::sort(grid.begin(), grid.end());
+  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
   double qPrev = grid[0], MPrev = s.torque(qPrev);
   if (MPrev == 0.0) roots.push_back(makeRoot(s, qPrev));
   for (size_t i = 1; i < grid.size(); ++i) {
