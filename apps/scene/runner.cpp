@@ -478,6 +478,10 @@ void CaseRunner::torqueAngle() {
   if (roots.found) add(roots.root);
   for (const auto& r : roots.others) add(r);
   std::sort(c.equilibria.begin(), c.equilibria.end());
+  // a root found from both sides of a sign change is one root
+  c.equilibria.erase(std::unique(c.equilibria.begin(), c.equilibria.end(),
+                                 [](const auto& x, const auto& y) { return std::abs(x.first - y.first) < 1e-9; }),
+                     c.equilibria.end());
   out_.haveTorque = true;
 }
 

@@ -644,16 +644,22 @@ json parseDocument(const std::string& text, const std::string& file) {
     }
     return true;
   };
-  try {
-    return json::parse(text, cb);
-  } catch (const json::parse_error& e) {
-    Pointer where;
+  auto where = [&]() {
+    Pointer w;
     for (const Frame& f : stack) {
       if (f.array)
-        where /= std::to_string(f.index + 1);
+        w /= std::to_string(f.index + 1);
       else if (!f.key.empty())
-        where /= f.key;
+        w /= f.key;
     }
+    return w;
+  };
+  try {
+    return json::parse(text, cb);
+  } catch (const json::out_of_range& e) {
+    // a number literal outside the double range (1e999)
+    throw SceneError(file, where().to_string(), std::string("expected a finite number (") + e.what() + ")");
+  } catch (const json::parse_error& e) {
     std::string what = e.what();
     const auto pos = what.find("syntax error");
     if (pos != std::string::npos) what = what.substr(pos);
@@ -662,7 +668,7 @@ json parseDocument(const std::string& text, const std::string& file) {
     for (const char* bad : {"NaN", "nan", "Infinity", "-Infinity", "inf"}) {
       const size_t b = text.rfind(bad, byte);
       if (b != std::string::npos && byte - b < 10)
-        throw SceneError(file, where.to_string(),
+        throw SceneError(file, where().to_string(),
                          std::string("expected a finite number, got ") + bad + " (not valid JSON)");
     }
     size_t line = 1, column = 1;
@@ -674,7 +680,7 @@ json parseDocument(const std::string& text, const std::string& file) {
         ++column;
       }
     }
-    throw SceneError(file, where.to_string(),
+    throw SceneError(file, where().to_string(),
                      "invalid JSON at line " + std::to_string(line) + ", column " + std::to_string(column) + ": " + what);
   }
 }

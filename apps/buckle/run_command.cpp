@@ -1,0 +1,32 @@
+#include "run_command.h"
+
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "scene/command.h"
+
+namespace buckle::cli {
+
+void addRunCommand(CLI::App& app, Outcome& outcome) {
+  auto options = std::make_shared<scene::RunCommandOptions>();
+  CLI::App* run = app.add_subcommand(
+      "run", "Run a scene file (docs/scenes.md): branches, special points, stiffness, curves and plots");
+  run->footer(
+      "Computes only what the scene asks for and writes DIR/branches.csv, DIR/special_points.json, "
+      "DIR/summary.json and DIR/plots/*.png|svg (gnuplot).\n"
+      "Exit status: 0 success, 1 a computation could not finish (what was computed is written), 2 bad input "
+      "(the message names the file and the JSON path of the bad value; nothing is written).");
+  run->add_option("scene", options->scene, "Scene file (JSON, schema: docs/scenes.md), e.g. data/scenes/default.json")
+      ->required();
+  run->add_option("--out,-o", options->out,
+                  "Output directory (default: out/<scene name>). Written to a temporary directory beside it and "
+                  "renamed at the end, so it is never half-written");
+  run->add_flag("--quiet,-q", options->quiet, "No progress messages (errors are still printed)");
+  run->callback([options, &outcome]() {
+    const int code = scene::runSceneCommand(*options, std::cout, std::cerr);
+    outcome.code = code == scene::kSuccess ? kSuccess : code == scene::kBadInput ? kBadInput : kComputationFailure;
+  });
+}
+
+}  // namespace buckle::cli

@@ -1,0 +1,74 @@
+// `buckle run` as a program: exit codes, the output files, --help.
+#include <catch2/catch.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kBuckle = std::string(BUCKLE_BINARY_DIR) + "/bin/buckle";
+
+int exitCode(const std::string& args, const fs::path& capture) {
+  const std::string cmd = "'" + kBuckle + "' " + args + " > '" + capture.string() + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+fs::path work() {
+  const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_run_" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("buckle run default.json writes the bifurcation diagram and exits 0", "[cli][run]") {
+  const fs::path out = work() / "default";
+  fs::remove_all(out);
+  const std::string scene = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/default.json";
+  const int rc = exitCode("run '" + scene + "' --out '" + out.string() + "'", work() / "log.txt");
+  INFO(slurp(work() / "log.txt"));
+  REQUIRE(rc == 0);
+  CHECK(fs::exists(out / "branches.csv"));
+  CHECK(fs::exists(out / "special_points.json"));
+  std::ifstream in(out / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  CHECK(summary["complete"] == true);
+  CHECK(summary["cases"][0]["branches"].size() >= 5);  // straight branch + U± and Z±
+  const auto eq17 = summary["cases"][0]["critical_forces"]["abs_error_vs_eq17"];
+  CHECK(eq17["continuation_BP_U"].get<double>() < 1e-8);
+  CHECK(eq17["continuation_BP_Z"].get<double>() < 1e-8);
+}
+
+TEST_CASE("buckle run on a bad scene exits 2 and writes nothing", "[cli][run]") {
+  const fs::path dir = work() / "bad";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.json") << R"({"chain": {"segments": 3, "k": -1}, "path": {"parameter": "Fx", "from": 0, "to": -1},
+    "end": {"y": {"held": 0}}, "analyses": {"continuation": true}})";
+  const int rc = exitCode("run '" + (dir / "scene.json").string() + "' --out '" + (dir / "out").string() + "'",
+                          work() / "bad.txt");
+  const std::string msg = slurp(work() / "bad.txt");
+  INFO(msg);
+  CHECK(rc == 2);
+  CHECK(msg.find((dir / "scene.json").string() + ": /chain/k: expected a number > 0") != std::string::npos);
+  CHECK(!fs::exists(dir / "out"));
+}
+
+TEST_CASE("buckle run --help and a missing scene argument", "[cli][run]") {
+  CHECK(exitCode("run --help", work() / "help.txt") == 0);
+  CHECK(slurp(work() / "help.txt").find("Exit status") != std::string::npos);
+  CHECK(exitCode("run", work() / "noarg.txt") == 2);
+}

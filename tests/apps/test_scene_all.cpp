@@ -1,0 +1,189 @@
+// Runs every scene in data/scenes/ through `buckle run` (the library entry point) and checks
+// the outputs: files present, run complete, and the special points against the model's closed
+// forms where they exist — eq 17 for the straight clamped–pinned three-segment chain
+// (Fx_U,Z = λ·κ/b, λ_U = (√21 − 14)/10, λ_Z = −(√21 + 14)/10, κ = k(b L0 − 2(b² − a²))) and the
+// torque zeros of a symmetric segment (eq 10: cos(q/2) = b L0 / (2(b² − a²))).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <unistd.h>
+#include <vector>
+
+#include "scene/command.h"
+#include "scene/output.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+fs::path sceneDir() { return fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes"; }
+
+fs::path freshDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("buckle_test_scene_all_" + std::to_string(::getpid())) / name;
+  fs::remove_all(d);
+  return d;
+}
+
+json readJson(const fs::path& p) {
+  std::ifstream in(p);
+  REQUIRE(in.good());
+  return json::parse(in);
+}
+
+struct Closed {
+  double FxU, FxZ;
+};
+
+Closed eq17(double a, double b, double k, double L0) {
+  const double kappa = k * (b * L0 - 2.0 * (b * b - a * a));
+  return {(std::sqrt(21.0) - 14.0) / 10.0 * kappa / b, -(std::sqrt(21.0) + 14.0) / 10.0 * kappa / b};
+}
+
+}  // namespace
+
+TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scene][slow]") {
+  std::vector<fs::path> scenes;
+  for (const auto& e : fs::directory_iterator(sceneDir()))
+    if (e.path().extension() == ".json") scenes.push_back(e.path());
+  std::sort(scenes.begin(), scenes.end());
+  REQUIRE(scenes.size() >= 8);
+  const bool gnuplot = !buckle::scene::findGnuplot().empty();
+  int closedFormChecks = 0;
+
+  for (const fs::path& scene : scenes) {
+    DYNAMIC_SECTION(scene.filename().string()) {
+      const fs::path out = freshDir(scene.stem().string());
+      std::ostringstream log, err;
+      buckle::scene::RunCommandOptions opt;
+      opt.scene = scene.string();
+      opt.out = out.string();
+      const int rc = buckle::scene::runSceneCommand(opt, log, err);
+      INFO(err.str());
+      REQUIRE(rc == 0);
+      REQUIRE(fs::exists(out / "summary.json"));
+      REQUIRE(fs::exists(out / "special_points.json"));
+      const json summary = readJson(out / "summary.json");
+      const json sp = readJson(out / "special_points.json");
+      CHECK(summary["complete"] == true);
+      const json src = readJson(scene);
+      if (src["analyses"].contains("continuation")) {
+        REQUIRE(fs::exists(out / "branches.csv"));
+        std::ifstream csv(out / "branches.csv");
+        std::string header;
+        std::getline(csv, header);
+        CHECK(header.rfind("case,branch,point,parameter,Fx,Fy,", 0) == 0);
+        // stiffness columns exactly when asked
+        const bool stiffness = src["analyses"].value("stiffness", false);
+        CHECK((header.find("Kxx") != std::string::npos) == stiffness);
+      }
+      if (gnuplot) {
+        for (const auto& f : summary["plots"]["files"]) CHECK(fs::exists(out / f.get<std::string>()));
+        CHECK(!summary["plots"]["files"].empty());
+        CHECK(!summary["plots"].contains("failures"));
+      }
+
+      // eq 17 against every branch point found by continuation, and the linear buckling loads
+      for (size_t c = 0; c < summary["cases"].size(); ++c) {
+        const json& cs = summary["cases"][c];
+        if (!cs.contains("critical_forces") || !cs["critical_forces"].contains("closed_form_eq17")) continue;
+        const json& seg = cs["segment_parameters"][0];
+        const Closed exact = eq17(seg["a1"], seg["b1"], seg["k1"], seg["L1_0"]);
+        CHECK(cs["critical_forces"]["closed_form_eq17"]["Fx_U"].get<double>() == Approx(exact.FxU).epsilon(1e-12));
+        int bps = 0;
+        for (const json& p : sp["special_points"]) {
+          if (p["case"] != c || p["type"] != "BP") continue;
+          double qmax = 0.0;
+          for (const json& qi : p["q"]) qmax = std::max(qmax, std::abs(qi.get<double>()));
+          if (qmax > 1e-9) continue;  // a secondary bifurcation, off the straight branch
+          const double Fx = p["loads"]["Fx"];
+          const double expected = p["shape"] == "U" ? exact.FxU : exact.FxZ;
+          INFO("case " << c << " BP " << p["shape"] << " Fx = " << Fx << ", eq 17: " << expected);
+          CHECK(std::abs(Fx - expected) < 1e-8);
+          CHECK(p["field"] == "buckling");
+          ++bps;
+          ++closedFormChecks;
+        }
+        if (src["analyses"].contains("continuation")) CHECK(bps >= 2);
+        for (const json& m : sp["critical_loads"]) {
+          if (m["case"] != c) continue;
+          const double expected = m["shape"] == "U" ? exact.FxU : exact.FxZ;
+          CHECK(std::abs(m["load_factor"].get<double>() - expected) < 1e-10);
+          ++closedFormChecks;
+        }
+      }
+      // torque zeros of a symmetric segment with equal preloads (eq 10)
+      if (sp.contains("torque_zeros")) {
+        for (size_t c = 0; c < summary["cases"].size(); ++c) {
+          const json& seg = summary["cases"][c]["segment_parameters"][0];
+          const double a = seg["a1"], b = seg["b1"], L0 = seg["L1_0"];
+          const double ratio = b * L0 / (2.0 * (b * b - a * a));
+          std::vector<double> expected{0.0};
+          if (ratio < 1.0) {
+            const double q = 2.0 * std::acos(ratio);
+            if (q < seg["q_max"].get<double>()) expected = {-q, 0.0, q};
+          }
+          std::vector<double> found;
+          for (const json& z : sp["torque_zeros"])
+            if (z["case"] == c) found.push_back(z["q"]);
+          std::sort(found.begin(), found.end());
+          REQUIRE(found.size() == expected.size());
+          for (size_t i = 0; i < found.size(); ++i) {
+            CHECK(found[i] == Approx(expected[i]).margin(1e-10));
+            ++closedFormChecks;
+          }
+        }
+      }
+      // energy equilibria are stationary: the end torque vanishes there
+      if (sp.contains("energy_equilibria")) {
+        CHECK(!sp["energy_equilibria"].empty());
+        for (const json& e : sp["energy_equilibria"]) CHECK(std::abs(e["loads"]["Me"].get<double>()) < 1e-8);
+      }
+      fs::remove_all(out);
+    }
+  }
+  (void)closedFormChecks;
+}
+
+TEST_CASE("the default scene is the paper's chain with both buckled branches", "[scene]") {
+  const fs::path out = freshDir("default_check");
+  std::ostringstream log, err;
+  buckle::scene::RunCommandOptions opt;
+  opt.scene = (sceneDir() / "default.json").string();
+  opt.out = out.string();
+  REQUIRE(buckle::scene::runSceneCommand(opt, log, err) == 0);
+  const json sp = readJson(out / "special_points.json");
+  const Closed exact = eq17(0.5, 1.0, 1.0, 2.25);
+  bool u = false, z = false;
+  for (const json& p : sp["special_points"]) {
+    if (p["type"] != "BP") continue;
+    const double Fx = p["loads"]["Fx"];
+    if (std::abs(Fx - exact.FxU) < 1e-8) {
+      u = true;
+      CHECK(p["shape"] == "U");
+      CHECK(p["stability_before"] == "stable");
+    }
+    if (std::abs(Fx - exact.FxZ) < 1e-8) z = true;
+  }
+  CHECK(u);
+  CHECK(z);
+  // the U branch is supercritical: stable just past Fx_U, with |Fx| rising
+  std::ifstream csv(out / "branches.csv");
+  std::string line;
+  std::getline(csv, line);
+  int stableBuckled = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+    const double Fx = std::stod(f[4]), q2 = std::stod(f[13]);
+    const int stable = std::stoi(f[15]);
+    if (f[1] != "0" && std::abs(q2) > 0.05 && Fx < exact.FxU && Fx > exact.FxU - 0.3 && stable == 1) ++stableBuckled;
+  }
+  CHECK(stableBuckled >= 4);
+  fs::remove_all(out);
+}

@@ -1,0 +1,214 @@
+// Bad input: every class of malformed or inconsistent scene is rejected with exit code 2, a
+// message naming the file and the JSON path of the bad value, and no output directory (not
+// even a half-written temporary one) left behind. Also: exit code 1 with partial output when a
+// computation cannot finish, and plain data when gnuplot is missing.
+#include <catch2/catch.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <unistd.h>
+#include <string>
+
+#include "scene/command.h"
+#include "scene/scene.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* const kGood = R"({
+  "description": "test chain",
+  "chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+  "end": {"x": {"load": 0.0}, "y": {"held": 0.0}, "phi": "free"},
+  "path": {"parameter": "Fx", "from": 0.0, "to": -1.0},
+  "analyses": {"continuation": {"branch_switching": 0}},
+  "plots": []
+})";
+
+fs::path workDir() {
+  const fs::path d = fs::temp_directory_path() / ("buckle_test_scene_errors_" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+std::string replaceOnce(std::string s, const std::string& from, const std::string& to) {
+  const size_t pos = s.find(from);
+  REQUIRE(pos != std::string::npos);
+  return s.replace(pos, from.size(), to);
+}
+
+struct Outcome {
+  int rc;
+  std::string err;
+  fs::path file, out;
+};
+
+Outcome runText(const std::string& name, const std::string& text) {
+  const fs::path dir = workDir() / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path file = dir / "scene.json";
+  std::ofstream(file) << text;
+  buckle::scene::RunCommandOptions opt;
+  opt.scene = file.string();
+  opt.out = (dir / "out").string();
+  std::ostringstream log, err;
+  const int rc = buckle::scene::runSceneCommand(opt, log, err);
+  return {rc, err.str(), file, dir / "out"};
+}
+
+/// Nothing but the scene file in its directory: no output, no staging directory.
+void requireNothingWritten(const Outcome& o) {
+  CHECK(!fs::exists(o.out));
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(o.file.parent_path())) {
+    (void)e;
+    ++entries;
+  }
+  CHECK(entries == 1);
+}
+
+void requireBadInput(const std::string& name, const std::string& text, const std::string& path,
+                     const std::string& expected) {
+  const Outcome o = runText(name, text);
+  INFO(o.err);
+  CHECK(o.rc == 2);
+  CHECK(o.err.find(o.file.string()) != std::string::npos);  // the file
+  CHECK(o.err.find(": " + path + ": ") != std::string::npos);  // the JSON path of the bad value
+  CHECK(o.err.find(expected) != std::string::npos);          // what was expected
+  requireNothingWritten(o);
+}
+
+}  // namespace
+
+TEST_CASE("a good scene runs (baseline for the bad-input cases)", "[scene][errors]") {
+  const Outcome o = runText("good", kGood);
+  INFO(o.err);
+  CHECK(o.rc == 0);
+  CHECK(fs::exists(o.out / "branches.csv"));
+  CHECK(fs::exists(o.out / "summary.json"));
+}
+
+TEST_CASE("bad JSON", "[scene][errors]") {
+  const std::string text = replaceOnce(kGood, "\"segments\": 3,", "\"segments\": 3");
+  // the path is that of the last value read before the syntax error
+  requireBadInput("bad_json", text, "/chain/segments", "invalid JSON at line 3");
+  requireBadInput("bad_json_truncated", "{\"chain\": {\"segments\": 3,", "/chain/segments", "unexpected end of input");
+}
+
+TEST_CASE("unknown key", "[scene][errors]") {
+  requireBadInput("unknown_key", replaceOnce(kGood, "\"a\": 0.5", "\"a\": 0.5, \"stifness\": 2"), "/chain/stifness",
+                  "unknown key \"stifness\"");
+  requireBadInput("unknown_top_key", replaceOnce(kGood, "\"plots\": []", "\"plots\": [], \"extra\": 1"), "/extra",
+                  "unknown key");
+}
+
+TEST_CASE("wrong type", "[scene][errors]") {
+  requireBadInput("wrong_type", replaceOnce(kGood, "\"k\": 1.0", "\"k\": \"stiff\""), "/chain/k",
+                  "expected a number");
+  requireBadInput("wrong_type_depth", replaceOnce(kGood, "\"branch_switching\": 0", "\"branch_switching\": 1.5"),
+                  "/analyses/continuation/branch_switching", "expected an integer");
+  requireBadInput("wrong_type_end", replaceOnce(kGood, "\"phi\": \"free\"", "\"phi\": 3"), "/end/phi",
+                  "expected \"free\"");
+}
+
+TEST_CASE("negative stiffness", "[scene][errors]") {
+  requireBadInput("negative_k", replaceOnce(kGood, "\"k\": 1.0", "\"k\": -1.0"), "/chain/k", "expected a number > 0");
+  requireBadInput("negative_k1",
+                  replaceOnce(kGood, "\"segments\": 3,", "\"segments\": [{}, {\"k1\": -2}, {}],"),
+                  "/chain/segments/1/k1", "expected a number > 0");
+}
+
+TEST_CASE("n = 0", "[scene][errors]") {
+  requireBadInput("n0", replaceOnce(kGood, "\"segments\": 3", "\"segments\": 0"), "/chain/segments",
+                  "expected an integer in [1,");
+  requireBadInput("n0_list", replaceOnce(kGood, "\"segments\": 3", "\"segments\": []"), "/chain/segments",
+                  "non-empty list");
+}
+
+TEST_CASE("a range that does not contain the start", "[scene][errors]") {
+  requireBadInput("range", replaceOnce(kGood, "\"from\": 0.0", "\"from\": -0.5"), "/path/from",
+                  "contains the start value Fx = 0");
+}
+
+TEST_CASE("NaN", "[scene][errors]") {
+  requireBadInput("nan", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": NaN"), "/chain/L0", "expected a finite number");
+  requireBadInput("inf", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": 1e999"), "/chain/L0", "expected a finite number");
+}
+
+TEST_CASE("inconsistent scenes", "[scene][errors]") {
+  requireBadInput("load_on_held", replaceOnce(kGood, "\"parameter\": \"Fx\"", "\"parameter\": \"Fy\""),
+                  "/path/parameter", "is held");
+  requireBadInput("unsupported_jump", replaceOnce(kGood, "\"continuation\": {", "\"jump\": {}, \"continuation\": {"),
+                  "/analyses/jump", "not supported");
+  requireBadInput("stiffness_without_branches",
+                  replaceOnce(kGood, "\"continuation\": {\"branch_switching\": 0}", "\"stiffness\": true, \"critical_forces\": true"),
+                  "/analyses/stiffness", "needs /analyses/continuation");
+  requireBadInput("singular_displacement_start",
+                  replaceOnce(replaceOnce(kGood, "\"x\": {\"load\": 0.0}", "\"x\": {\"held\": \"start\"}"),
+                              "\"parameter\": \"Fx\", \"from\": 0.0, \"to\": -1.0", "\"parameter\": \"x\", \"from\": 6.0, \"to\": 5.0"),
+                  "/path/parameter", "load_limit");
+  requireBadInput("plot_column", replaceOnce(kGood, "\"plots\": []", "\"plots\": [{\"type\": \"bifurcation\", \"y\": \"q7\"}]"),
+                  "/plots/0/y", "a column of branches.csv");
+  requireBadInput("case_override",
+                  replaceOnce(kGood, "\"plots\": []", "\"plots\": [], \"cases\": [{\"label\": \"A\"}, {\"chain\": {\"a\": -1}}]"),
+                  "/cases/1/chain/a", "expected a number >= 0");
+}
+
+TEST_CASE("missing file", "[scene][errors]") {
+  buckle::scene::RunCommandOptions opt;
+  opt.scene = (workDir() / "does_not_exist.json").string();
+  opt.out = (workDir() / "missing_out").string();
+  std::ostringstream log, err;
+  CHECK(buckle::scene::runSceneCommand(opt, log, err) == 2);
+  CHECK(err.str().find("cannot open") != std::string::npos);
+  CHECK(!fs::exists(opt.out));
+}
+
+TEST_CASE("a computation that cannot finish writes what it has and exits 1", "[scene][errors]") {
+  // a time limit no run can meet: the first branch is abandoned
+  const Outcome o = runText("time_limit", replaceOnce(kGood, "\"plots\": []", "\"plots\": [], \"solver\": {\"time_limit\": 1e-9}"));
+  CHECK(o.rc == 1);
+  CHECK(o.err.find("time limit") != std::string::npos);
+  REQUIRE(fs::exists(o.out / "summary.json"));
+  std::ifstream in(o.out / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  CHECK(summary["complete"] == false);
+  CHECK(!summary["problems"].empty());
+}
+
+TEST_CASE("without gnuplot the data is still written and the summary says so", "[scene][errors]") {
+  ::setenv("BUCKLE_GNUPLOT", "", 1);
+  const Outcome o = runText("no_gnuplot", replaceOnce(kGood, "\"plots\": []", "\"plots\": [\"bifurcation\"]"));
+  ::unsetenv("BUCKLE_GNUPLOT");
+  CHECK(o.rc == 0);
+  CHECK(fs::exists(o.out / "branches.csv"));
+  CHECK(fs::exists(o.out / "plots" / "bifurcation.gp"));
+  CHECK(fs::exists(o.out / "plots" / "bifurcation.dat"));
+  CHECK(!fs::exists(o.out / "plots" / "bifurcation.png"));
+  std::ifstream in(o.out / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  CHECK(summary["plots"]["gnuplot"].get<std::string>().find("not found") == 0);
+}
+
+TEST_CASE("an existing output directory is replaced as a whole", "[scene][errors]") {
+  const Outcome first = runText("replace", kGood);
+  REQUIRE(first.rc == 0);
+  std::ofstream(first.out / "stale.txt") << "old";
+  buckle::scene::RunCommandOptions opt;
+  opt.scene = first.file.string();
+  opt.out = first.out.string();
+  std::ostringstream log, err;
+  REQUIRE(buckle::scene::runSceneCommand(opt, log, err) == 0);
+  CHECK(!fs::exists(first.out / "stale.txt"));
+  CHECK(fs::exists(first.out / "summary.json"));
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(first.file.parent_path())) {
+    (void)e;
+    ++entries;
+  }
+  CHECK(entries == 2);  // scene.json and out
+}
