@@ -288,3 +288,24 @@ TEST_CASE("A Tracer (one KINSOL instance) can be reused for many runs", "[tracer
     for (std::size_t i = 0; i < first.points.size(); ++i) CHECK(again.points[i].lambda == first.points[i].lambda);
   }
 }
+
+TEST_CASE("Starting on a branch point along a chosen kernel direction", "[tracer]") {
+  toys::TwoPitchforks problem(0.5);
+  TracerOptions options;
+  options.lambdaMax = 0.3;
+  // ker F_x at the origin is span(e_u1, e_λ); e_u1 picks the bifurcated branch u1² = λ.
+  const Vector direction = (Vector(3) << 1.0, 0.0, 0.0).finished();
+  const Branch branch = trace(problem, Vector::Zero(2), 0.0, InitialDirection::along(direction), options);
+  CHECK(branch.stopReason == StopReason::LambdaRange);
+  REQUIRE(branch.points.size() > 5);
+  CHECK_THAT(branch.specialPoints.front().note, Contains("2-dimensional kernel"));
+  CHECK(branch.specialPointsOfType(SpecialPointType::BranchPoint).empty());
+  for (std::size_t i = 1; i < branch.points.size(); ++i) {
+    const ContinuationPoint &p = branch.points[i];
+    CHECK(p.u[0] > 0.0);
+    CHECK(std::abs(p.u[0]) * std::abs(p.u[0] * p.u[0] - p.lambda) <= 1e-10);
+  }
+  // Without a direction the start on the branch point is refused, not guessed.
+  const Branch refused = trace(problem, Vector::Zero(2), 0.0, InitialDirection::increasingLambda(), options);
+  CHECK(refused.stopReason == StopReason::StartFailed);
+}

@@ -187,10 +187,18 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
     if (std::abs(t[n_]) < 1e-12) startNote += " (at a fold: lambda sign cannot orient the tangent)";
     if (t[n_] * direction.lambdaSign < 0.0) t = -t;
   }
+  int skipIntervals = 0;
   if (!evaluator_->complete(start, t)) {
-    branch.stopReason = StopReason::StartFailed;
-    branch.stopMessage = "singular bordered Jacobian at the start point";
-    return branch;
+    if (!evaluator_->lastWasSingular() || !direction.tangent.size()) {
+      branch.stopReason = StopReason::StartFailed;
+      branch.stopMessage = "singular bordered Jacobian at the start point";
+      return branch;
+    }
+    // Starting on a branch point along a chosen kernel direction: the test functions are
+    // degenerate here, so the first interval is not searched (as for a switched branch).
+    start.tangent = t;
+    start.foldTest = t[n_];
+    skipIntervals = 1;
   }
   branch.points.push_back(start);
   SpecialPoint ep;
@@ -213,7 +221,7 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
       return branch;
     }
   }
-  continueBranch(branch, 0);
+  continueBranch(branch, skipIntervals);
   return branch;
 }
 
