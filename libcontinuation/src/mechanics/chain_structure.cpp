@@ -159,7 +159,18 @@ void factorize(ChainStructure& ws, double sigma) {
   ws.shift = sigma;
   ws.singular = false;
   ws.factorInertia = Inertia{};
-  double logDet = 0.0;
+  // det as mantissa · 2^exponent, rescaled occasionally (a log per pivot would dominate the cost)
+  double mant = 1.0;
+  long expo = 0;
+  auto accumulate = [&](double v) {
+    mant *= v;
+    const double am = std::abs(mant);
+    if (am > 1e150 || am < 1e-150) {
+      int e2 = 0;
+      mant = std::frexp(mant, &e2);
+      expo += e2;
+    }
+  };
   int sign = 1;
   double scale = 0.0;
   for (int k = 0; k < n; ++k) {
@@ -189,7 +200,7 @@ void factorize(ChainStructure& ws, double sigma) {
       } else {
         ++ws.factorInertia.positive;
       }
-      logDet += std::log(std::abs(dk));
+      accumulate(dk);
       minRatio = std::min(minRatio, std::abs(dk) / scale);
       if (k + 1 < n) {
         ws.l1[k] = ek / dk;
@@ -208,7 +219,7 @@ void factorize(ChainStructure& ws, double sigma) {
       ++ws.factorInertia.negative;
       ++ws.factorInertia.positive;
       sign = -sign;
-      logDet += std::log(std::abs(det));
+      accumulate(det);
       // smallest |eigenvalue| of the block ≥ |det| / (largest |eigenvalue|)
       const double big = 0.5 * std::abs(dk + b) + std::hypot(0.5 * (dk - b), ek);
       minRatio = std::min(minRatio, std::abs(det) / (big * scale));
@@ -222,7 +233,7 @@ void factorize(ChainStructure& ws, double sigma) {
     }
   }
   ws.minPivotRatio = minRatio;
-  ws.logAbsDet = logDet;
+  ws.logAbsDet = std::log(std::abs(mant)) + double(expo) * 0.6931471805599453;
   ws.detSign = sign;
 }
 
@@ -403,7 +414,8 @@ ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double si
 
 }  // namespace
 
-int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, VectorRef out, double tolerance) {
+int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, VectorRef out, double tolerance,
+                      const Vector* guess) {
   const int dim = ws.n - (useConstraints ? ws.rank : 0);
   const int k = std::max(0, std::min(count, dim));
   if (k == 0) return 0;
@@ -430,6 +442,15 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
   };
   for (int j = 0; j < k; ++j) {
     lo[j] = std::max(lo[j], j > 0 ? out[j - 1] - tol : lo[j]);
+    // Warm start (e.g. the previous continuation point): a few counts around the guess.
+    if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
+      double delta = std::max(1e-3 * scale, 0.02 * std::abs((*guess)[j]));
+      for (int attempt = 0; attempt < 3 && !(int(cntLo[j]) == j && int(cntHi[j]) == j + 1); ++attempt, delta *= 8.0) {
+        const double a = (*guess)[j] - delta, b = (*guess)[j] + delta;
+        if (a > lo[j]) record(a, evaluateShift(ws, useConstraints, a).below);
+        if (b < hi[j]) record(b, evaluateShift(ws, useConstraints, b).below);
+      }
+    }
     // isolate: exactly one eigenvalue (j) in [lo, hi)
     while (!(int(cntLo[j]) == j && int(cntHi[j]) == j + 1) && hi[j] - lo[j] > tol) {
       const double mid = 0.5 * (lo[j] + hi[j]);
@@ -479,7 +500,7 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
 
 double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance) {
   Eigen::Matrix<double, 1, 1> out;
-  return lowestEigenvalues(ws, useConstraints, 1, out, tolerance) == 1 ? out[0] : 0.0;
+  return lowestEigenvalues(ws, useConstraints, 1, out, tolerance, nullptr) == 1 ? out[0] : 0.0;
 }
 
 bool solve(ChainStructure& ws, ConstVectorRef r, VectorRef x) {

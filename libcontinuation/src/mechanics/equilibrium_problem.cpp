@@ -174,9 +174,9 @@ bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matr
 }
 
 bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, continuation::StabilityInfo& info) {
-  if (!options_.structuredStability) return Problem::stability(u, lambda, info);
-  if (!inDomain(u)) return false;
   const int n = chain_.size();
+  if (!options_.structuredStability || n < 32) return Problem::stability(u, lambda, info);
+  if (!inDomain(u)) return false;
   forwardKinematics(chain_, u.head(n), data_);
   endJacobian(data_, J_);
   assemble(chain_, data_, u.head(n), wrench(u, lambda), structure_);
@@ -186,7 +186,9 @@ bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, continuation
   info.zero = in.zero;
   const int dim = in.size();
   info.lowest.resize(std::min(3, dim));
-  lowestEigenvalues(structure_, structure_.rank > 0, int(info.lowest.size()), info.lowest);
+  lowestEigenvalues(structure_, structure_.rank > 0, int(info.lowest.size()), info.lowest, 1e-13,
+                    lastLowest_.size() > 0 ? &lastLowest_ : nullptr);
+  lastLowest_ = info.lowest;
   info.smallest = dim > 0 ? info.lowest[0] : 0.0;
   return true;
 }

@@ -136,8 +136,10 @@ Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C
 
 /// The `count` lowest eigenvalues (ascending) of H, or of Zᵀ H Z (after setConstraints()) when
 /// useConstraints, to absolute accuracy ~tolerance · max(1, ‖H‖_F), written to out[0 … k−1];
-/// returns k = min(count, dimension).
-int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, VectorRef out, double tolerance = 1e-13);
+/// returns k = min(count, dimension). `guess` (optional, e.g. the previous continuation point's
+/// values) brackets each eigenvalue with a few counts before falling back to bisection.
+int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, VectorRef out, double tolerance = 1e-13,
+                      const Vector* guess = nullptr);
 /// Smallest eigenvalue (lowestEigenvalues with count 1; 0 if the dimension is 0).
 double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance = 1e-13);
 

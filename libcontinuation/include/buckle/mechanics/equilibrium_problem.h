@@ -58,7 +58,8 @@ class EquilibriumProblem final : public continuation::Problem {
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
   /// Inertia of K_q − K_g on ker J_h and its 3 lowest eigenvalues; O(n) when
-  /// options.structuredStability, else the dense Problem::stability().
+  /// options.structuredStability and n >= 32 (below, the dense eigen-solve of the tiny reduced
+  /// matrix is faster: benchmarks/RESULTS.md), else the dense Problem::stability().
   bool stability(continuation::ConstVectorRef u, double lambda, continuation::StabilityInfo& info) override;
 
   int boundaryCount() const override;
@@ -79,6 +80,7 @@ class EquilibriumProblem final : public continuation::Problem {
   Vector work_, work2_;  // size n
   ChainStructure structure_;  // workspace of the structured stability()
   Matrix heldRows_;           // m×n held rows of J
+  Vector lastLowest_;         // warm start of the structured eigenvalue search
 };
 
 }  // namespace buckle::mechanics

@@ -1,0 +1,38 @@
+// Shared set-up of the benchmark programs: the chains and states they time.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/end_condition.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+
+namespace buckle::bench {
+
+using mechanics::Chain;
+using mechanics::EndCondition;
+using mechanics::EquilibriumOptions;
+using mechanics::EquilibriumProblem;
+using mechanics::SegmentParameters;
+
+/// The paper's main segment: a = 0.5, b = 1, k = 1, L0 = 2.25 (κ = 0.75).
+inline SegmentParameters mainSegment(double L0 = 2.25) { return SegmentParameters::symmetric(0.5, 1.0, 1.0, L0); }
+
+/// Clamped–pinned chain of n segments, λ = Fx.
+inline EquilibriumProblem clampedPinned(int n, bool structuredStability = true, double L0 = 2.25) {
+  EquilibriumOptions o;
+  o.structuredStability = structuredStability;
+  return EquilibriumProblem(Chain::uniform(n, mainSegment(L0)), EndCondition::clampedPinned(0.0),
+                            Eigen::Vector3d(1, 0, 0), o);
+}
+
+/// A generic bent state: q_i = 0.3 sin(2π i / n) + 0.05, reaction 0.1.
+inline Eigen::VectorXd bentState(int n, int held) {
+  Eigen::VectorXd u(n + held);
+  for (int i = 0; i < n; ++i) u[i] = 0.3 * std::sin(6.283185307179586 * (i + 0.5) / n) + 0.05;
+  for (int k = 0; k < held; ++k) u[n + k] = 0.1;
+  return u;
+}
+
+}  // namespace buckle::bench

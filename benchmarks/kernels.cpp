@@ -1,0 +1,243 @@
+// Kernel benchmarks over the chain length n: residual, Jacobian, stability (dense vs O(n)),
+// linear solves (dense LU vs O(n) bordered), one KINSOL corrector solve, one continuation step
+// of the core's tracer (with test functions), and the O(n) structured step.
+//
+// Dense O(n³) kernels are capped at n = 1000 (n = 3000 would take seconds per call), the core's
+// tracer step at n = 300 (it factors the dense (N+1)² bordered Jacobian several times per
+// step). Structured kernels run up to n = 10 000.
+//
+// Quick mode (CI): --benchmark_min_time=0.01 and BUCKLE_BENCH_MAX_N=100 in the environment.
+#include <benchmark/benchmark.h>
+
+#include <Eigen/Dense>
+#include <cstdlib>
+#include <random>
+#include <vector>
+
+#include "buckle/continuation/corrector.h"
+#include "buckle/continuation/problem.h"
+#include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/chain_structure.h"
+#include "common.h"
+#include "structured_step.h"
+
+using namespace buckle;
+using namespace buckle::bench;
+
+namespace {
+
+long maxN() {
+  const char* env = std::getenv("BUCKLE_BENCH_MAX_N");
+  return env ? std::atol(env) : 1000000;
+}
+
+void sizes(benchmark::internal::Benchmark* b, long cap) {
+  for (long n : {3L, 10L, 30L, 100L, 300L, 1000L, 3000L, 10000L})
+    if (n <= cap && n <= maxN()) b->Arg(n);
+}
+void denseSizes(benchmark::internal::Benchmark* b) { sizes(b, 1000); }
+void allSizes(benchmark::internal::Benchmark* b) { sizes(b, 3000); }
+void structuredSizes(benchmark::internal::Benchmark* b) { sizes(b, 10000); }
+void tracerSizes(benchmark::internal::Benchmark* b) { sizes(b, 300); }
+
+void BM_Residual(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n);
+  const Eigen::VectorXd u = bentState(n, 1);
+  Eigen::VectorXd F(n + 1);
+  for (auto _ : state) {
+    p.residual(u, -0.3, F);
+    benchmark::DoNotOptimize(F.data());
+  }
+}
+BENCHMARK(BM_Residual)->Apply(structuredSizes);
+
+void BM_JacobianDense(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n);
+  const Eigen::VectorXd u = bentState(n, 1);
+  Eigen::MatrixXd Fu(n + 1, n + 1);
+  Eigen::VectorXd Fl(n + 1);
+  for (auto _ : state) {
+    p.jacobian(u, -0.3, Fu, Fl);
+    benchmark::DoNotOptimize(Fu.data());
+  }
+}
+BENCHMARK(BM_JacobianDense)->Apply(allSizes);
+
+void BM_TridiagonalAssemble(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n);
+  const Eigen::VectorXd u = bentState(n, 1);
+  mechanics::ChainStructure ws(n);
+  mechanics::ChainData data(p.chain());
+  for (auto _ : state) {
+    mechanics::forwardKinematics(p.chain(), u.head(n), data);
+    mechanics::assemble(p.chain(), data, u.head(n), p.wrench(u, -0.3), ws);
+    benchmark::DoNotOptimize(ws.diag.data());
+  }
+}
+BENCHMARK(BM_TridiagonalAssemble)->Apply(structuredSizes);
+
+void BM_StabilityDense(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n, false);
+  const Eigen::VectorXd u = bentState(n, 1);
+  continuation::StabilityInfo info;
+  for (auto _ : state) {
+    p.stability(u, -0.3, info);
+    benchmark::DoNotOptimize(info.negative);
+  }
+}
+BENCHMARK(BM_StabilityDense)->Apply(denseSizes)->Unit(benchmark::kMicrosecond);
+
+void BM_StabilityStructured(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n, true);
+  const Eigen::VectorXd u = bentState(n, 1);
+  continuation::StabilityInfo info;
+  for (auto _ : state) {
+    p.stability(u, -0.3, info);
+    benchmark::DoNotOptimize(info.negative);
+  }
+}
+BENCHMARK(BM_StabilityStructured)->Apply(structuredSizes)->Unit(benchmark::kMicrosecond);
+
+/// Inertia only (two O(n) counts on the bordered tridiagonal), no eigenvalues.
+void BM_InertiaStructured(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n);
+  const Eigen::VectorXd u = bentState(n, 1);
+  mechanics::ChainStructure ws(n);
+  mechanics::ChainData data(p.chain());
+  Eigen::MatrixXd J(3, n);
+  mechanics::forwardKinematics(p.chain(), u.head(n), data);
+  mechanics::endJacobian(data, J);
+  const Eigen::MatrixXd C = J.row(1);
+  mechanics::assemble(p.chain(), data, u.head(n), p.wrench(u, -0.3), ws);
+  for (auto _ : state) {
+    auto in = mechanics::constrainedInertia(ws, C);
+    benchmark::DoNotOptimize(in.negative);
+  }
+}
+BENCHMARK(BM_InertiaStructured)->Apply(structuredSizes)->Unit(benchmark::kMicrosecond);
+
+/// The Keller bordered matrix [[F_u, F_λ], [tᵀ]] ((N+1)², N = n + 1): dense LU and solve.
+void BM_SolveDenseLU(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n);
+  const Eigen::VectorXd u = bentState(n, 1);
+  const int N = n + 1;
+  Eigen::MatrixXd A(N + 1, N + 1);
+  Eigen::VectorXd Fl(N);
+  p.jacobian(u, -0.3, A.topLeftCorner(N, N), Fl);
+  A.topRightCorner(N, 1) = Fl;
+  A.bottomRows(1).setConstant(1.0 / std::sqrt(N + 1.0));
+  Eigen::VectorXd rhs = Eigen::VectorXd::Ones(N + 1), x(N + 1);
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu(N + 1);
+  for (auto _ : state) {
+    lu.compute(A);
+    x = lu.solve(rhs);
+    benchmark::DoNotOptimize(x.data());
+  }
+}
+BENCHMARK(BM_SolveDenseLU)->Apply(denseSizes)->Unit(benchmark::kMicrosecond);
+
+/// The same Keller system through the chain structure: assemble T + solveBordered (p = 2).
+void BM_SolveStructured(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n);
+  const Eigen::VectorXd u = bentState(n, 1);
+  mechanics::ChainStructure ws(n);
+  mechanics::ChainData data(p.chain());
+  Eigen::MatrixXd J(3, n), V(n, 2), W(n, 2), D(2, 2);
+  Eigen::VectorXd f = Eigen::VectorXd::Ones(n), g = Eigen::VectorXd::Ones(2), x(n), y(2);
+  for (auto _ : state) {
+    mechanics::forwardKinematics(p.chain(), u.head(n), data);
+    mechanics::endJacobian(data, J);
+    mechanics::assemble(p.chain(), data, u.head(n), p.wrench(u, -0.3), ws);
+    V.col(0) = -J.row(1).transpose();
+    V.col(1) = data.S;
+    W.col(0) = V.col(0);
+    W.col(1).setConstant(1.0 / std::sqrt(n + 2.0));
+    D << 0.0, 0.0, 1.0 / std::sqrt(n + 2.0), 1.0 / std::sqrt(n + 2.0);
+    mechanics::solveBordered(ws, V, W, D, f, g, x, y);
+    benchmark::DoNotOptimize(x.data());
+  }
+}
+BENCHMARK(BM_SolveStructured)->Apply(structuredSizes)->Unit(benchmark::kMicrosecond);
+
+/// One KINSOL Keller corrector solve (dense LU inside), from a predictor 0.01 off the straight
+/// trivial branch under tension (typically 2 Newton iterations).
+void BM_CorrectorSolve(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n);
+  const int N = n + 1;
+  continuation::Corrector corrector(p);
+  Eigen::VectorXd pred = Eigen::VectorXd::Zero(N + 1), t = Eigen::VectorXd::Zero(N + 1), x(N + 1);
+  pred[N] = 0.5;
+  for (int i = 0; i < n; ++i) pred[i] = 0.01 * std::sin(0.7 * i);
+  t[N] = 1.0;
+  int iters = 0;
+  for (auto _ : state) {
+    auto s = corrector.correct(pred, t, x);
+    iters = s.iterations;
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.counters["newton_it"] = iters;
+}
+BENCHMARK(BM_CorrectorSolve)->Apply(denseSizes)->Unit(benchmark::kMicrosecond);
+
+/// The core's tracer on the trivial branch under tension (no special points), with test
+/// functions and stability at every point: time per continuation point (start-up amortised
+/// over 40 points).
+void BM_TracerStep(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n);
+  continuation::TracerOptions o;
+  o.maxPoints = 41;
+  o.initialStep = 0.02;
+  o.maxStep = 0.02;
+  o.minStep = 0.02 / 1024;
+  o.lambdaMax = 100.0;
+  continuation::Tracer tracer(p, o);
+  const Eigen::VectorXd u0 = Eigen::VectorXd::Zero(n + 1);
+  size_t points = 0;
+  for (auto _ : state) {
+    auto b = tracer.trace(u0, 0.1, continuation::InitialDirection::increasingLambda());
+    points += b.points.size() - 1;
+    benchmark::DoNotOptimize(b.points.data());
+  }
+  state.counters["per_point"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_TracerStep)->Apply(tracerSizes)->Unit(benchmark::kMillisecond);
+
+/// The O(n) structured step (structured_step.h): 2–3 Newton iterations with the bordered O(n)
+/// solve, the new tangent, the inertia test function.
+void BM_StructuredStep(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n);
+  StructuredStepper stepper(p);
+  const int N = n + 1;
+  Eigen::VectorXd t = Eigen::VectorXd::Zero(N + 1);
+  t[N] = 1.0;
+  Eigen::VectorXd u0 = Eigen::VectorXd::Zero(N);
+  stepper.start(u0, 0.1, t);
+  long steps = 0, iters = 0;
+  for (auto _ : state) {
+    if (!stepper.step(0.02)) state.SkipWithError("structured step failed");
+    iters += stepper.lastIterations();
+    ++steps;
+    if (stepper.x()[N] > 50.0) {
+      state.PauseTiming();
+      stepper.start(u0, 0.1, t);
+      state.ResumeTiming();
+    }
+  }
+  state.counters["newton_it"] = double(iters) / double(std::max(1L, steps));
+}
+BENCHMARK(BM_StructuredStep)->Apply(structuredSizes)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
