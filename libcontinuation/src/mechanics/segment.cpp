@@ -33,7 +33,6 @@ Segment::Segment(const SegmentParameters& p) : p_(p) {
   c1_ = std::hypot(p.a1, p.b1);
   c2_ = std::hypot(p.a2, p.b2);
   c1c2_ = c1_ * c2_;
-  csq_ = c1_ * c1_ + c2_ * c2_;
   beta12_ = std::atan(p.a1 / p.b1) + std::atan(p.a2 / p.b2);
   if (!(lowerLimit() < upperLimit())) {
     std::ostringstream os;
@@ -44,15 +43,21 @@ Segment::Segment(const SegmentParameters& p) : p_(p) {
 }
 
 // θ = β12 + s·q (s = +1: spring 1, s = −1: spring 2), L² = c1² + c2² + 2c1c2 cos θ (eq 1).
-// Differentiating L² and eliminating sin θ through L L' = −s c1c2 sin θ:
-//   L'' = −c1c2 cos θ / L − L'²/L,   L''' = −L' − 3 L' L''/L.
+// Near the geometric limit (θ → π) that form cancels catastrophically, so everything is written
+// with 1 + cos θ = 2cos²(θ/2) (exact to rounding): with P = c1c2, Δ = (c1 − c2)²,
+//   L² = Δ + 2P(1 + cos θ),   dL/dq = −s P sin θ / L,
+//   d²L/dq² = −[P cos θ Δ + P²(1 + cos θ)²] / L³   (= −P cos θ/L − (dL/dq)²/L, cancellation-free),
+//   d³L/dq³ = −dL/dq − 3 (dL/dq)(d²L/dq²)/L.
 Jet3 Segment::spring(double q, double s) const {
   const double theta = beta12_ + s * q;
+  const double ch = std::cos(0.5 * theta);
+  const double onePlusCos = 2.0 * ch * ch;
   const double ct = std::cos(theta), st = std::sin(theta);
+  const double delta = (c1_ - c2_) * (c1_ - c2_);
   Jet3 L;
-  L.value = std::sqrt(std::max(0.0, csq_ + 2.0 * c1c2_ * ct));
+  L.value = std::sqrt(delta + 2.0 * c1c2_ * onePlusCos);
   L.d1 = -s * c1c2_ * st / L.value;
-  L.d2 = -c1c2_ * ct / L.value - L.d1 * L.d1 / L.value;
+  L.d2 = -(c1c2_ * ct * delta + c1c2_ * c1c2_ * onePlusCos * onePlusCos) / (L.value * L.value * L.value);
   L.d3 = -L.d1 - 3.0 * L.d1 * L.d2 / L.value;
   return L;
 }

@@ -59,7 +59,7 @@ class Segment {
  private:
   Jet3 spring(double q, double sign) const;
   SegmentParameters p_;
-  double c1_, c2_, beta12_, c1c2_, csq_;
+  double c1_, c2_, beta12_, c1c2_;
 };
 
 }  // namespace buckle::mechanics
