@@ -351,6 +351,10 @@ void InertialModel::computeMassMatrix(ConstVectorRef) {
   M_ = Mtheta_;
   for (int j = n - 2; j >= 0; --j) M_.col(j) += M_.col(j + 1);
   for (int i = n - 2; i >= 0; --i) M_.row(i) += M_.row(i + 1);
+  // The two sweeps add in different orders above and below the diagonal; mirror the lower
+  // triangle so M is symmetric to the last bit (the kinetic energy sees only the symmetric part).
+  for (int j = 1; j < n; ++j)
+    for (int i = 0; i < j; ++i) M_(i, j) = M_(j, i);
 }
 
 void InertialModel::massMatrix(ConstVectorRef q, MatrixRef M) {
@@ -530,15 +534,10 @@ class Monitor {
 
   /// After an accepted step: true to stop (reason set).
   bool accepted(double t, const double* x) {
-    const int n = model_.segments();
-    const int N = model_.stateSize();
-    for (int i = 0; i < N; ++i)
-      if (!std::isfinite(x[i])) return stop(StopReason::NonFinite, "the state became non-finite at t = " + num(t));
-    Eigen::Map<const Vector> q(x, n);
+    Eigen::Map<const Vector> q(x, model_.segments());
     result_.maxConstraintViolation = std::max(result_.maxConstraintViolation, model_.constraintViolation(q));
     result_.maxEnergyBalanceError = std::max(result_.maxEnergyBalanceError, std::abs(energy(x) - result_.initialEnergy));
     record(t, x, false);
-    if (!model_.withinLimits(q)) return stop(StopReason::JointLimit, "a joint reached its limit at t = " + num(t));
     model_.velocity(x, qdot_);
     const double speed = qdot_.cwiseAbs().maxCoeff();
     if (speed <= options_.velocityTolerance && model_.equilibriumResidual(q) <= options_.residualTolerance)
@@ -613,11 +612,21 @@ class Monitor {
   double lastRecorded_ = 0.0;
 };
 
+// FSAL controllers keep dx/dt of the last accepted state: after a rollback it must be dropped.
+template <class C>
+auto resetController(C& controller, int) -> decltype(controller.reset(), void()) {
+  controller.reset();
+}
+template <class C>
+void resetController(C&, long) {}
+
 template <class Controller, class System, class State>
 void runLoop(Controller& controller, System system, State& x, const double* (*data)(const State&),
-             const IntegrationOptions& options, Monitor& monitor, DynamicsResult& result) {
+             DynamicsModel& model, const IntegrationOptions& options, Monitor& monitor, DynamicsResult& result) {
   double t = 0.0, dt = options.initialStep;
+  const int n = model.segments();
   monitor.start(data(x));
+  State previous = x;
   for (;;) {
     if (result.steps >= options.maxSteps) {
       monitor.stop(StopReason::MaxSteps, "maximum number of steps (" + std::to_string(options.maxSteps) + ") reached");
@@ -629,11 +638,49 @@ void runLoop(Controller& controller, System system, State& x, const double* (*da
     }
     dt = std::min(dt, options.maxTime - t);
     if (options.maxStep > 0.0) dt = std::min(dt, options.maxStep);
+    previous = x;
+    const double tPrevious = t, dtTried = dt;
     const odeint::controlled_step_result res = controller.try_step(system, x, t, dt);
     if (res == odeint::fail) {
       ++result.rejectedSteps;
       if (!(dt >= options.minStep)) {
         monitor.stop(StopReason::StepSizeUnderflow, "the step size fell below minStep at t = " + std::to_string(t));
+        break;
+      }
+      continue;
+    }
+    // The error control cannot see a step that leaves the model's domain (a NaN error estimate
+    // compares false and is accepted; past a joint limit a spring would pass through zero
+    // length). Such a step is rolled back and retried at half the size, which bisects the time
+    // at which a joint reaches its limit down to minStep; the chain then stops there.
+    const double* xs = data(x);
+    bool finiteState = true;
+    for (int i = 0; finiteState && i < model.stateSize(); ++i) finiteState = std::isfinite(xs[i]);
+    const bool inside = finiteState && model.withinLimits(Eigen::Map<const Vector>(xs, n));
+    if (!inside) {
+      x = previous;
+      t = tPrevious;
+      resetController(controller, 0);
+      ++result.rejectedSteps;
+      dt = 0.5 * dtTried;
+      if (dt < options.minStep) {
+        const double* xp = data(x);
+        int joint = 0;
+        double margin = std::numeric_limits<double>::infinity();
+        for (int i = 0; i < n; ++i) {
+          const double mi = std::min(xp[i] - model.chain().lowerLimits()[i], model.chain().upperLimits()[i] - xp[i]);
+          if (mi < margin) {
+            margin = mi;
+            joint = i;
+          }
+        }
+        // A trial that only failed by being non-finite far from every limit is a model failure.
+        if (!finiteState && margin > 1e-6) {
+          monitor.stop(StopReason::NonFinite, "the right-hand side became non-finite at t = " + std::to_string(t));
+        } else {
+          monitor.stop(StopReason::JointLimit, "joint " + std::to_string(joint + 1) + " reached its limit (q = " +
+                                                   std::to_string(xp[joint]) + ") at t = " + std::to_string(t));
+        }
         break;
       }
       continue;
@@ -672,18 +719,18 @@ DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef 
     std::copy(x0.data(), x0.data() + N, x.begin());
     odeint::rosenbrock4_controller<odeint::rosenbrock4<double>> controller(options.absoluteTolerance,
                                                                            options.relativeTolerance);
-    runLoop(controller, std::make_pair(StiffSystem{&model}, StiffJacobian{&model}), x, stiffData, options, monitor,
-            result);
+    runLoop(controller, std::make_pair(StiffSystem{&model}, StiffJacobian{&model}), x, stiffData, model, options,
+            monitor, result);
   } else {
     ExplicitState x(x0.data(), x0.data() + N);
     if (options.stepper == StepperKind::DormandPrince5) {
       auto controller = odeint::make_controlled(options.absoluteTolerance, options.relativeTolerance,
                                                 odeint::runge_kutta_dopri5<ExplicitState>());
-      runLoop(controller, ExplicitSystem{&model}, x, explicitData, options, monitor, result);
+      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, options, monitor, result);
     } else {
       auto controller = odeint::make_controlled(options.absoluteTolerance, options.relativeTolerance,
                                                 odeint::runge_kutta_cash_karp54<ExplicitState>());
-      runLoop(controller, ExplicitSystem{&model}, x, explicitData, options, monitor, result);
+      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, options, monitor, result);
     }
   }
   result.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();

@@ -1,0 +1,144 @@
+// Jumps (snap-through at a fold, escape from an unstable equilibrium) and sudden loads: the
+// dynamic step between two equilibria, polished back onto the quasi-static model.
+//
+// simulateJump: from an equilibrium (u, λ) that is unstable or critical (a fold: the projected
+// Hessian K_q − K_g on ker J_h has a negative or zero eigenvalue), or from a state just past a
+// fold, the loads and held targets are frozen at their λ values and the chain is released:
+//   1. δq = ε·v, v the eigenvector of the smallest eigenvalue of Zᵀ(K_q − K_g)Z (Z a basis of
+//      ker J_h, eq 27), or the caller's direction; the sign is the one with the lower Π(q ± δq)
+//      (at a fold the quadratic term vanishes and the cubic one decides where the chain goes);
+//      with held coordinates the perturbed start is projected back onto them;
+//   2. the dynamics (inertial if the scene has masses, else the gradient flow, see dynamics.h)
+//      runs until rest;
+//   3. the rest point is polished by Newton on the EquilibriumProblem residual at fixed λ — the
+//      continuation core's KINSOL corrector in its fixed-parameter mode — and its stability is
+//      checked with Problem::stability() (K_q − K_g positive definite on ker J_h).
+//
+// simulateSuddenLoad: the "sporadic" case — the full end condition is applied at once to the
+// chain at rest in its unloaded shape. The chain's dynamic answer can differ from the
+// quasi-static one at the same load (it may overshoot into another basin of Π); the result
+// says whether it does and which of the two is lower in Π.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "buckle/continuation/corrector.h"
+#include "buckle/continuation/problem.h"
+#include "buckle/mechanics/dynamics.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+
+namespace buckle::mechanics {
+
+/// Defaults of the rest-point polish: tight residual, line search, room for the iterations.
+continuation::CorrectorOptions defaultPolishOptions();
+
+struct PolishResult {
+  Vector u;                  ///< unknowns (q, reactions) at the last iterate
+  bool converged = false;
+  int iterations = 0;
+  double residual = 0.0;     ///< ‖F(u, λ)‖∞ of the EquilibriumProblem at u
+  std::string message;       ///< the corrector's flag name (and message on failure)
+};
+
+/// Newton on F(u, λ) = 0 at fixed λ from the joint angles q (reactions: least-squares guess).
+PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, double lambda,
+                               const continuation::CorrectorOptions& options = defaultPolishOptions());
+
+struct UnstableDirection {
+  Vector direction;          ///< unit vector in joint space, in ker J_h (empty if none)
+  double eigenvalue = 0.0;   ///< the smallest eigenvalue of Zᵀ(K_q − K_g)Z
+  bool valid = false;        ///< false: the stability operator could not be evaluated
+};
+
+/// Eigenvector of the smallest eigenvalue of the stability operator on ker J_h at (u, λ)
+/// (u = joint angles, or the full unknowns). Sign not chosen here.
+UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef u, double lambda);
+
+struct JumpOptions {
+  DynamicsScene scene;                   ///< masses given → inertial dynamics, else gradient flow
+  IntegrationOptions integration;
+  continuation::CorrectorOptions polish = defaultPolishOptions();
+  /// ‖δq‖₂ of the initial perturbation along the unstable direction (0: none, e.g. just past a
+  /// fold where the state is not an equilibrium any more).
+  double perturbation = 1e-3;
+  /// Caller's direction (size n, any length); empty: the unstable eigenvector.
+  Vector direction;
+  /// A landing closer than this (‖Δq‖∞) to the start means the chain did not jump.
+  double sameStateTolerance = 1e-6;
+
+  bool IsValid(const EquilibriumProblem& problem, std::string* why) const;
+};
+
+struct JumpResult {
+  bool success = false;      ///< rest reached, polish converged, landing stable and distinct
+  std::string message;       ///< why it ended (or what failed)
+  StopReason stopReason = StopReason::MaxSteps;
+  double lambda = 0.0;
+  Eigen::Vector3d prescribed = Eigen::Vector3d::Zero();  ///< loads / held targets at λ
+  Vector from, to;           ///< unknowns (q, reactions) at the start and at the polished landing
+  Vector restPoint;          ///< q where the integration stopped, before polishing
+  Vector direction;          ///< the signed perturbation direction used (unit, joint space)
+  double directionEigenvalue = 0.0;  ///< its Hessian eigenvalue (NaN if the caller gave it)
+  double potentialFrom = 0.0, potentialTo = 0.0;
+  double energyReleased = 0.0;       ///< ΔΠ = Π(from) − Π(to)
+  double distance = 0.0;             ///< ‖q_to − q_from‖∞
+  double duration = 0.0;             ///< model time until rest
+  long steps = 0, rejectedSteps = 0;
+  double wallSeconds = 0.0;
+  double residual = 0.0;             ///< ‖F‖∞ of the EquilibriumProblem at `to`
+  bool polishConverged = false;
+  int polishIterations = 0;
+  double polishShift = 0.0;          ///< ‖q_to − restPoint‖∞
+  continuation::StabilityInfo stabilityFrom, stabilityTo;
+  bool stable = false;               ///< stabilityTo.stable()
+  DynamicsResult dynamics;           ///< the trajectory and its energies
+};
+
+/// Releases the chain from (u, λ) with the problem's loads / targets frozen at λ. u is the joint
+/// angles (size n) or the full unknowns. Throws std::invalid_argument for invalid options or
+/// sizes; every other outcome is reported in JumpResult.
+JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double lambda, const JumpOptions& options);
+
+struct SuddenLoadOptions {
+  DynamicsScene scene;
+  IntegrationOptions integration;
+  continuation::CorrectorOptions polish = defaultPolishOptions();
+  /// ‖q_dynamic − q_static‖∞ above this: the two answers differ.
+  double sameStateTolerance = 1e-6;
+
+  bool IsValid(const Chain& chain, std::string* why) const;
+};
+
+enum class LowerPotential { Dynamic, Static, Equal };
+const char* toString(LowerPotential lower);
+
+struct SuddenLoadResult {
+  bool success = false;              ///< rest reached, polish converged, stable
+  std::string message;
+  bool inertial = false;             ///< which model ran
+  Vector start;                      ///< the start (unloaded shape, projected onto held targets)
+  Vector rest;                       ///< polished final rest shape q
+  Vector restUnknowns;               ///< (q, reactions)
+  double residual = 0.0;
+  bool polishConverged = false;
+  continuation::StabilityInfo stability;
+  bool stable = false;
+  double peakKinetic = 0.0;          ///< over the recorded trajectory
+  double maxExcursion = 0.0;         ///< max ‖q(t) − start‖∞ over the recorded trajectory
+  // comparison with the quasi-static answer (NaN / false when no q_static was given)
+  bool compared = false;
+  Vector staticShape;
+  double maxDifference = 0.0;        ///< ‖rest − q_static‖∞
+  bool differs = false;
+  double potentialDynamic = 0.0, potentialStatic = 0.0;
+  LowerPotential lower = LowerPotential::Equal;
+  DynamicsResult dynamics;
+};
+
+/// Applies `loaded` at once to the chain at rest in `qUnloaded` and follows it to rest; compares
+/// with `qStatic` (the quasi-static answer at the same load; pass an empty vector to skip).
+SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& loaded, ConstVectorRef qUnloaded,
+                                    ConstVectorRef qStatic, const SuddenLoadOptions& options);
+
+}  // namespace buckle::mechanics

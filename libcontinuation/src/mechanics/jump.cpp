@@ -1,0 +1,300 @@
+#include "buckle/mechanics/jump.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace buckle::mechanics {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool fail(std::string* why, const std::string& message) {
+  if (why) *why = message;
+  return false;
+}
+
+/// Full unknowns (q, reactions) from q or u.
+Vector fullUnknowns(EquilibriumProblem& problem, ConstVectorRef u, double lambda) {
+  const int n = problem.segments();
+  if (u.size() == problem.dimension()) return u;
+  if (u.size() == n) return problem.initialGuess(u, lambda);
+  throw std::invalid_argument("u must hold the n joint angles or all " + std::to_string(problem.dimension()) +
+                              " unknowns (got " + std::to_string(u.size()) + ")");
+}
+
+EndCondition frozenEnd(const EquilibriumProblem& problem, double lambda) {
+  EndCondition e = problem.endCondition();
+  e.value = problem.prescribed(lambda);
+  return e;
+}
+
+std::string describe(const continuation::StabilityInfo& s) {
+  std::ostringstream os;
+  if (!s.valid()) return "stability not computed";
+  os << (s.stable() ? "stable" : "not stable") << " (" << s.negative << " negative, " << s.zero
+     << " zero eigenvalues, smallest " << s.smallest << ")";
+  return os.str();
+}
+
+}  // namespace
+
+continuation::CorrectorOptions defaultPolishOptions() {
+  continuation::CorrectorOptions o;
+  o.residualTolerance = 1e-12;
+  o.maxIterations = 50;
+  o.lineSearch = true;
+  return o;
+}
+
+PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, double lambda,
+                               const continuation::CorrectorOptions& options) {
+  PolishResult result;
+  const int N = problem.dimension();
+  const Vector u0 = fullUnknowns(problem, q, lambda);
+  result.u.resize(N);
+  // The core's KINSOL corrector in its fixed-parameter mode: exact Jacobian of the
+  // EquilibriumProblem (the KKT matrix), so convergence from a rest point is quadratic.
+  continuation::Corrector corrector(problem, options);
+  const continuation::CorrectorSummary summary = corrector.solveAtFixedParameter(u0, lambda, result.u);
+  result.converged = summary.converged;
+  result.iterations = summary.iterations;
+  result.message = summary.flagName;
+  if (!summary.message.empty()) result.message += ": " + summary.message;
+  Vector F(N);
+  result.residual = problem.residual(result.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+  return result;
+}
+
+UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef u, double lambda) {
+  UnstableDirection d;
+  const Vector uFull = fullUnknowns(problem, u, lambda);
+  Matrix H, C;
+  if (!problem.stabilityOperator(uFull, lambda, H, C)) return d;
+  const Eigen::Index n = H.rows();
+  // Z: orthonormal basis of ker J_h (the last n − rank columns of Q in J_hᵀ = QR), as in the
+  // core's projectedInertia(); the reduced Hessian Zᵀ(K_q − K_g)Z is then the stability operator.
+  Matrix Z;
+  if (C.rows() == 0) {
+    Z = Matrix::Identity(n, n);
+  } else {
+    Eigen::ColPivHouseholderQR<Matrix> qr(C.transpose());
+    const Matrix Q = qr.householderQ() * Matrix::Identity(n, n);
+    Z = Q.rightCols(n - qr.rank());
+  }
+  if (Z.cols() == 0) return d;
+  const Matrix reduced = Z.transpose() * H * Z;
+  Eigen::SelfAdjointEigenSolver<Matrix> es(0.5 * (reduced + reduced.transpose()));
+  if (es.info() != Eigen::Success) return d;
+  d.eigenvalue = es.eigenvalues()[0];
+  d.direction = Z * es.eigenvectors().col(0);
+  d.direction.normalize();
+  d.valid = true;
+  return d;
+}
+
+bool JumpOptions::IsValid(const EquilibriumProblem& problem, std::string* why) const {
+  if (!scene.IsValid(problem.chain(), why)) return false;
+  if (!integration.IsValid(why)) return false;
+  if (!polish.IsValid(why)) return false;
+  if (!std::isfinite(perturbation) || perturbation < 0.0) return fail(why, "perturbation must be >= 0");
+  if (direction.size() != 0) {
+    if (direction.size() != problem.segments()) return fail(why, "direction must be empty or have one entry per joint");
+    if (!direction.allFinite() || direction.norm() == 0.0) return fail(why, "direction must be finite and non-zero");
+  }
+  if (!std::isfinite(sameStateTolerance) || !(sameStateTolerance > 0.0)) return fail(why, "sameStateTolerance must be > 0");
+  return true;
+}
+
+JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double lambda, const JumpOptions& options) {
+  std::string why;
+  if (!options.IsValid(problem, &why)) throw std::invalid_argument("JumpOptions: " + why);
+  if (!std::isfinite(lambda)) throw std::invalid_argument("lambda must be finite");
+  const int n = problem.segments();
+  JumpResult result;
+  result.lambda = lambda;
+  result.prescribed = problem.prescribed(lambda);
+  result.from = fullUnknowns(problem, u, lambda);
+  const Vector qFrom = result.from.head(n);
+  problem.stability(result.from, lambda, result.stabilityFrom);
+
+  const EndCondition end = frozenEnd(problem, lambda);
+  std::unique_ptr<DynamicsModel> model = makeDynamicsModel(problem.chain(), end, options.scene, qFrom);
+  result.potentialFrom = model->potential(qFrom);
+
+  // 1. The perturbation direction: the caller's, or the softest mode of the stability operator.
+  Vector v;
+  if (options.direction.size() == n) {
+    v = options.direction.normalized();
+    result.directionEigenvalue = kNaN;
+  } else {
+    const UnstableDirection ud = unstableDirection(problem, result.from, lambda);
+    if (!ud.valid) {
+      result.message = "the stability operator could not be evaluated at the start (outside the domain?)";
+      return result;
+    }
+    v = ud.direction;
+    result.directionEigenvalue = ud.eigenvalue;
+  }
+  // Sign: the one that lowers Π. At an unstable equilibrium both do to second order; at a fold
+  // the quadratic term vanishes and the cubic term (the fold's normal form) picks the side.
+  Vector qStart = qFrom;
+  if (options.perturbation > 0.0) {
+    Vector qPlus = qFrom + options.perturbation * v, qMinus = qFrom - options.perturbation * v;
+    model->projectOntoConstraints(qPlus);
+    model->projectOntoConstraints(qMinus);
+    const bool plusIn = model->withinLimits(qPlus), minusIn = model->withinLimits(qMinus);
+    const double piPlus = plusIn ? model->potential(qPlus) : std::numeric_limits<double>::infinity();
+    const double piMinus = minusIn ? model->potential(qMinus) : std::numeric_limits<double>::infinity();
+    if (!plusIn && !minusIn) {
+      result.message = "both perturbed starts leave the joint limits; use a smaller perturbation";
+      return result;
+    }
+    if (piMinus < piPlus) {
+      v = -v;
+      qStart = qMinus;
+    } else {
+      qStart = qPlus;
+    }
+  } else {
+    model->projectOntoConstraints(qStart);
+  }
+  result.direction = v;
+
+  // 2. Release: dynamics at frozen loads / targets until rest.
+  result.dynamics = simulate(*model, qStart, Vector::Zero(n), options.integration);
+  const DynamicsResult& dyn = result.dynamics;
+  result.stopReason = dyn.reason;
+  result.duration = dyn.time;
+  result.steps = dyn.steps;
+  result.rejectedSteps = dyn.rejectedSteps;
+  result.wallSeconds = dyn.wallSeconds;
+  result.restPoint = dyn.q;
+
+  // 3. Polish at fixed λ and check stability — only a rest point is worth polishing (at a joint
+  // limit or a guard the state is no equilibrium of the smooth model).
+  PolishResult polished;
+  if (dyn.reason == StopReason::Rest) {
+    polished = polishEquilibrium(problem, dyn.q, lambda, options.polish);
+  } else {
+    polished.u = problem.initialGuess(dyn.q, lambda);
+    polished.message = "not polished";
+    Vector F(problem.dimension());
+    polished.residual = problem.residual(polished.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+  }
+  result.to = polished.u;
+  result.polishConverged = polished.converged;
+  result.polishIterations = polished.iterations;
+  result.residual = polished.residual;
+  const Vector qTo = result.to.head(n);
+  result.polishShift = (qTo - dyn.q).cwiseAbs().maxCoeff();
+  result.distance = (qTo - qFrom).cwiseAbs().maxCoeff();
+  result.potentialTo = model->potential(qTo);
+  result.energyReleased = result.potentialFrom - result.potentialTo;
+  if (polished.converged) problem.stability(result.to, lambda, result.stabilityTo);
+  result.stable = result.stabilityTo.valid() && result.stabilityTo.stable();
+
+  std::ostringstream os;
+  os << "integration stopped: " << dyn.message << "; polish: " << (polished.converged ? "converged" : "not converged") << " ("
+     << polished.message << ", residual " << polished.residual << "); landing " << describe(result.stabilityTo);
+  if (dyn.reason != StopReason::Rest) {
+    os << "; no rest point reached";
+  } else if (polished.converged && result.distance <= options.sameStateTolerance) {
+    os << "; the chain came back to the start (no jump)";
+  }
+  result.message = os.str();
+  result.success = dyn.reason == StopReason::Rest && polished.converged && result.stable &&
+                   result.distance > options.sameStateTolerance;
+  return result;
+}
+
+bool SuddenLoadOptions::IsValid(const Chain& chain, std::string* why) const {
+  if (!scene.IsValid(chain, why)) return false;
+  if (!integration.IsValid(why)) return false;
+  if (!polish.IsValid(why)) return false;
+  if (!std::isfinite(sameStateTolerance) || !(sameStateTolerance > 0.0)) return fail(why, "sameStateTolerance must be > 0");
+  return true;
+}
+
+const char* toString(LowerPotential lower) {
+  switch (lower) {
+    case LowerPotential::Dynamic: return "dynamic";
+    case LowerPotential::Static: return "static";
+    case LowerPotential::Equal: return "equal";
+  }
+  return "unknown";
+}
+
+SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& loaded, ConstVectorRef qUnloaded,
+                                    ConstVectorRef qStatic, const SuddenLoadOptions& options) {
+  std::string why;
+  if (!options.IsValid(chain, &why)) throw std::invalid_argument("SuddenLoadOptions: " + why);
+  const int n = chain.size();
+  if (qUnloaded.size() != n) throw std::invalid_argument("qUnloaded must have one entry per joint");
+  if (qStatic.size() != 0 && qStatic.size() != n) throw std::invalid_argument("qStatic must be empty or have one entry per joint");
+
+  SuddenLoadResult result;
+  EquilibriumProblem problem(chain, loaded, Eigen::Vector3d::Zero());
+  std::unique_ptr<DynamicsModel> model = makeDynamicsModel(chain, loaded, options.scene, qUnloaded);
+  result.inertial = model->kind() == DynamicsKind::Inertial;
+  // A held coordinate whose target differs from the unloaded shape is imposed at once: the start
+  // is the nearest configuration (minimum-norm Gauss–Newton) that satisfies it.
+  result.start = qUnloaded;
+  if (!model->projectOntoConstraints(result.start)) {
+    result.message = "the held end coordinates cannot be reached from the unloaded shape";
+    return result;
+  }
+
+  result.dynamics = simulate(*model, result.start, Vector::Zero(n), options.integration);
+  const DynamicsResult& dyn = result.dynamics;
+  for (const TrajectorySample& s : dyn.trajectory) {
+    result.peakKinetic = std::max(result.peakKinetic, s.kinetic);
+    result.maxExcursion = std::max(result.maxExcursion, (s.q - result.start).cwiseAbs().maxCoeff());
+  }
+
+  PolishResult polished;
+  if (dyn.reason == StopReason::Rest) {
+    polished = polishEquilibrium(problem, dyn.q, 0.0, options.polish);
+  } else {
+    polished.u = problem.initialGuess(dyn.q, 0.0);
+    polished.message = "not polished";
+    Vector F(problem.dimension());
+    polished.residual = problem.residual(polished.u, 0.0, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+  }
+  result.restUnknowns = polished.u;
+  result.rest = polished.u.head(n);
+  result.residual = polished.residual;
+  result.polishConverged = polished.converged;
+  if (polished.converged) problem.stability(polished.u, 0.0, result.stability);
+  result.stable = result.stability.valid() && result.stability.stable();
+  result.potentialDynamic = model->potential(result.rest);
+
+  std::ostringstream os;
+  os << (result.inertial ? "inertial" : "gradient-flow") << " response; integration stopped: " << dyn.message
+     << "; polish: " << (polished.converged ? "converged" : "not converged") << " (" << polished.message << ", residual " << polished.residual
+     << "); rest shape " << describe(result.stability);
+  if (qStatic.size() == n) {
+    result.compared = true;
+    result.staticShape = qStatic;
+    result.potentialStatic = model->potential(qStatic);
+    result.maxDifference = (result.rest - qStatic).cwiseAbs().maxCoeff();
+    result.differs = result.maxDifference > options.sameStateTolerance;
+    const double scale = std::max({1.0, std::abs(result.potentialDynamic), std::abs(result.potentialStatic)});
+    if (std::abs(result.potentialDynamic - result.potentialStatic) <= 1e-12 * scale) result.lower = LowerPotential::Equal;
+    else result.lower = result.potentialDynamic < result.potentialStatic ? LowerPotential::Dynamic : LowerPotential::Static;
+    os << "; vs quasi-static: " << (result.differs ? "differs" : "same") << " (max |dq| " << result.maxDifference
+       << "), lower potential: " << toString(result.lower);
+  } else {
+    result.potentialStatic = kNaN;
+    result.maxDifference = kNaN;
+  }
+  result.message = os.str();
+  result.success = dyn.reason == StopReason::Rest && polished.converged && result.stable;
+  return result;
+}
+
+}  // namespace buckle::mechanics

@@ -1,0 +1,361 @@
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "buckle/mechanics/dynamics.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+
+using namespace buckle::mechanics;
+
+namespace {
+
+// κ = −0.3 < 0 with wells at q* = ±2 acos 0.8 inside the joint limits (see test_jump.cpp).
+Chain bistableChain(int n = 3) { return Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2)); }
+// The paper's main case, κ = 0.75 > 0.
+Chain stiffChain(int n = 3) { return Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)); }
+
+InertiaData unevenInertia(const Chain& chain) {
+  InertiaData data;
+  for (int i = 0; i < chain.size(); ++i) {
+    LinkInertia L;
+    L.mass = 0.7 + 0.3 * i;
+    L.inertia = 0.05 + 0.02 * i;
+    L.comOffset = (i % 2 == 0) ? 0.3 * chain.linkLengths()[i + 1] : std::numeric_limits<double>::quiet_NaN();
+    data.links.push_back(L);
+  }
+  return data;
+}
+
+// Kinetic energy from first principles: centre-of-mass velocities by central differences of the
+// COM positions along q̇, link angular rates θ̇ = prefix sums of q̇.
+double kineticByDifferences(InertialModel& model, const InertiaData& data, const Vector& q, const Vector& qdot) {
+  const int n = model.segments();
+  const double h = 1e-6;
+  Eigen::Matrix2Xd Gp(2, n), Gm(2, n);
+  model.centresOfMass(q + h * qdot, Gp);
+  model.centresOfMass(q - h * qdot, Gm);
+  double T = 0.0, thetaDot = 0.0;
+  for (int i = 0; i < n; ++i) {
+    thetaDot += qdot[i];
+    const Eigen::Vector2d v = (Gp.col(i) - Gm.col(i)) / (2 * h);
+    T += 0.5 * data.links[size_t(i)].mass * v.squaredNorm() + 0.5 * data.links[size_t(i)].inertia * thetaDot * thetaDot;
+  }
+  return T;
+}
+
+}  // namespace
+
+TEST_CASE("inertial mass matrix is SPD and matches the kinetic energy by finite differences", "[dynamics]") {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> Q(-1.5, 1.5);
+  for (int n : {1, 3, 5}) {
+    const Chain chain = bistableChain(n);
+    const InertiaData data = unevenInertia(chain);
+    InertialModel model(chain, EndCondition::freeEnd(), data, {}, 0.0, Vector::Zero(n));
+    for (int trial = 0; trial < 5; ++trial) {
+      Vector q(n);
+      for (int i = 0; i < n; ++i) q[i] = Q(rng);
+      Matrix M(n, n);
+      model.massMatrix(q, M);
+      CHECK((M - M.transpose()).cwiseAbs().maxCoeff() == 0.0);
+      CHECK(Eigen::SelfAdjointEigenSolver<Matrix>(M).eigenvalues()[0] > 0.0);
+      // M_ij by polarization of the independently computed kinetic energy
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          const Vector ei = Vector::Unit(n, i), ej = Vector::Unit(n, j);
+          const double Mij = i == j ? 2.0 * kineticByDifferences(model, data, q, ei)
+                                    : kineticByDifferences(model, data, q, ei + ej) -
+                                          kineticByDifferences(model, data, q, ei) -
+                                          kineticByDifferences(model, data, q, ej);
+          CHECK(M(i, j) == Approx(Mij).margin(1e-7));
+        }
+    }
+  }
+}
+
+TEST_CASE("velocity terms equal dM/dt qdot - 1/2 d(qdot'M qdot)/dq (Lagrange)", "[dynamics]") {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> Q(-1.5, 1.5), V(-2.0, 2.0);
+  const int n = 4;
+  const Chain chain = bistableChain(n);
+  InertialModel model(chain, EndCondition::freeEnd(), unevenInertia(chain), {}, 0.0, Vector::Zero(n));
+  for (int trial = 0; trial < 5; ++trial) {
+    Vector q(n), v(n);
+    for (int i = 0; i < n; ++i) {
+      q[i] = Q(rng);
+      v[i] = V(rng);
+    }
+    const double h = 1e-6;
+    Matrix Mp(n, n), Mm(n, n);
+    model.massMatrix(q + h * v, Mp);
+    model.massMatrix(q - h * v, Mm);
+    Vector expected = (Mp - Mm) / (2 * h) * v;
+    for (int k = 0; k < n; ++k) {
+      model.massMatrix(q + h * Vector::Unit(n, k), Mp);
+      model.massMatrix(q - h * Vector::Unit(n, k), Mm);
+      expected[k] -= 0.5 * v.dot((Mp - Mm) / (2 * h) * v);
+    }
+    Vector c(n);
+    model.velocityTerms(q, v, c);
+    for (int i = 0; i < n; ++i) CHECK(c[i] == Approx(expected[i]).margin(1e-6));
+  }
+}
+
+TEST_CASE("a scene without masses never builds the inertial model", "[dynamics]") {
+  const Chain chain = bistableChain();
+  const long before = InertialModel::constructedCount();
+  DynamicsScene scene;  // no inertia
+  scene.jointDamping = {0.1, 0.1, 0.1};
+  auto model = makeDynamicsModel(chain, EndCondition::freeEnd(), scene, Vector::Zero(3));
+  CHECK(model->kind() == DynamicsKind::GradientFlow);
+  CHECK(dynamic_cast<GradientFlowModel*>(model.get()) != nullptr);
+  const DynamicsResult r = simulate(*model, Vector::Constant(3, 0.2), Vector(), IntegrationOptions());
+  CHECK(r.kind == DynamicsKind::GradientFlow);
+  CHECK(InertialModel::constructedCount() == before);
+
+  scene.inertia = InertiaData::uniformRods(chain, 1.0);
+  auto inertial = makeDynamicsModel(chain, EndCondition::freeEnd(), scene, Vector::Zero(3));
+  CHECK(inertial->kind() == DynamicsKind::Inertial);
+  CHECK(InertialModel::constructedCount() == before + 1);
+}
+
+TEST_CASE("gradient flow: potential never increases, Pi + dissipation is conserved, rest is a stable equilibrium", "[dynamics]") {
+  const Chain chain = bistableChain();
+  const Wrench W(0.05, 0.02, 0.0);
+  DynamicsScene scene;
+  scene.flowDamping = 2.0;
+  auto model = makeDynamicsModel(chain, EndCondition::freeEnd(W), scene, Vector::Zero(3));
+  Vector q0(3);
+  q0 << 0.1, -0.05, 0.02;
+  for (StepperKind stepper : {StepperKind::DormandPrince5, StepperKind::CashKarp54, StepperKind::Rosenbrock4}) {
+    IntegrationOptions options;
+    options.stepper = stepper;
+    const DynamicsResult r = simulate(*model, q0, Vector(), options);
+    INFO("stepper " << int(stepper) << ": " << r.message);
+    REQUIRE(r.reason == StopReason::Rest);
+    CHECK(r.residual <= options.residualTolerance);
+    CHECK(r.speed <= options.velocityTolerance);
+    CHECK(r.kinetic == 0.0);
+    REQUIRE(r.trajectory.size() > 10);
+    CHECK(r.trajectory.front().t == 0.0);
+    CHECK(r.trajectory.back().t == r.time);
+    for (size_t k = 1; k < r.trajectory.size(); ++k) {
+      INFO("sample " << k);
+      REQUIRE(r.trajectory[k].potential <= r.trajectory[k - 1].potential + 1e-12);
+      REQUIRE(r.trajectory[k].dissipated >= r.trajectory[k - 1].dissipated);
+    }
+    // dΠ/dt = −c|q̇|²: potential released = energy dissipated
+    CHECK(r.maxEnergyBalanceError < 1e-8);
+    CHECK(r.potential + r.dissipated == Approx(r.initialEnergy).margin(1e-8));
+    CHECK(r.dissipated > 0.3);
+    // the rest point is an equilibrium of the EquilibriumProblem and stable
+    EquilibriumProblem problem(chain, EndCondition::freeEnd(W), Eigen::Vector3d::Zero());
+    Vector F(3);
+    REQUIRE(problem.residual(r.q, 0.0, F));
+    CHECK(F.cwiseAbs().maxCoeff() < 1e-8);
+    buckle::continuation::StabilityInfo info;
+    REQUIRE(problem.stability(r.q, 0.0, info));
+    CHECK(info.stable());
+    CHECK(r.q.cwiseAbs().minCoeff() > 1.0);  // left the unstable straight state
+  }
+}
+
+TEST_CASE("all steppers agree on the landing", "[dynamics]") {
+  const Chain chain = bistableChain();
+  auto model = makeDynamicsModel(chain, EndCondition::freeEnd(Wrench(0.0, 0.01, 0.0)), DynamicsScene(), Vector::Zero(3));
+  Vector q0(3);
+  q0 << 0.3, 0.1, -0.2;
+  IntegrationOptions options;
+  const DynamicsResult a = simulate(*model, q0, Vector(), options);
+  options.stepper = StepperKind::CashKarp54;
+  const DynamicsResult b = simulate(*model, q0, Vector(), options);
+  options.stepper = StepperKind::Rosenbrock4;
+  options.absoluteTolerance = options.relativeTolerance = 1e-11;
+  const DynamicsResult c = simulate(*model, q0, Vector(), options);
+  REQUIRE(a.reason == StopReason::Rest);
+  REQUIRE(b.reason == StopReason::Rest);
+  REQUIRE(c.reason == StopReason::Rest);
+  CHECK((a.q - b.q).cwiseAbs().maxCoeff() < 1e-7);
+  CHECK((a.q - c.q).cwiseAbs().maxCoeff() < 1e-7);
+  CHECK(a.steps > 0);
+  CHECK(c.steps > 0);
+}
+
+TEST_CASE("exact gradient-flow Jacobian matches central differences", "[dynamics]") {
+  const Chain chain = bistableChain(4);
+  DynamicsScene scene;
+  scene.flowDamping = 1.5;
+  GradientFlowModel flow(chain, EndCondition::freeEnd(Wrench(0.2, -0.1, 0.05)), scene, Vector::Zero(4));
+  const int N = flow.stateSize();
+  Vector x(N);
+  x << 0.3, -0.7, 1.1, 0.2, 0.4;
+  Matrix exact(N, N);
+  // the base-class finite-difference Jacobian through a held-free copy of the same scene
+  flow.jacobian(x.data(), exact.data());  // row-major into a column-major buffer: transpose below
+  Matrix exactRowMajor = exact.transpose();
+  Matrix fd(N, N);
+  Vector fp(N), fm(N);
+  for (int j = 0; j < N; ++j) {
+    Vector xp = x, xm = x;
+    xp[j] += 1e-6;
+    xm[j] -= 1e-6;
+    flow.rhs(xp.data(), fp.data());
+    flow.rhs(xm.data(), fm.data());
+    fd.col(j) = (fp - fm) / 2e-6;
+  }
+  CHECK((exactRowMajor - fd).cwiseAbs().maxCoeff() < 1e-6);
+}
+
+TEST_CASE("inertial with damping: kinetic + potential + dissipated = initial energy", "[dynamics]") {
+  const Chain chain = bistableChain();
+  DynamicsScene scene;
+  scene.inertia = unevenInertia(chain);
+  scene.jointDamping = {0.3, 0.2, 0.4};
+  const Wrench W(0.02, 0.03, 0.0);
+  auto model = makeDynamicsModel(chain, EndCondition::freeEnd(W), scene, Vector::Zero(3));
+  Vector q0(3), v0(3);
+  q0 << 0.2, 0.0, -0.1;
+  v0 << 0.1, -0.3, 0.2;
+  IntegrationOptions options;
+  options.recordInterval = 0.05;
+  const DynamicsResult r = simulate(*model, q0, v0, options);
+  INFO(r.message);
+  REQUIRE(r.reason == StopReason::Rest);
+  CHECK(r.kind == DynamicsKind::Inertial);
+  CHECK(r.initialEnergy == Approx(totalPotential(chain, q0, W) + r.trajectory.front().kinetic));
+  CHECK(r.trajectory.front().kinetic > 0.0);
+  double peakKinetic = 0.0;
+  for (const TrajectorySample& s : r.trajectory) {
+    REQUIRE(std::abs(s.kinetic + s.potential + s.dissipated - r.initialEnergy) < 1e-8);
+    peakKinetic = std::max(peakKinetic, s.kinetic);
+  }
+  CHECK(peakKinetic > 0.1);  // a real dynamic event, not a crawl
+  CHECK(r.maxEnergyBalanceError < 1e-8);
+  CHECK(r.dissipated > 0.3);
+  CHECK(r.kinetic < 1e-15);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(W), Eigen::Vector3d::Zero());
+  buckle::continuation::StabilityInfo info;
+  REQUIRE(problem.stability(r.q, 0.0, info));
+  CHECK(info.stable());
+}
+
+TEST_CASE("inertial without damping conserves total energy", "[dynamics]") {
+  const Chain chain = stiffChain();
+  DynamicsScene scene;
+  scene.inertia = InertiaData::uniformRods(chain, 1.0);  // no jointDamping: undamped
+  const Wrench W(0.0, 0.1, 0.0);  // a lateral load released on the straight stiff chain
+  auto model = makeDynamicsModel(chain, EndCondition::freeEnd(W), scene, Vector::Zero(3));
+  IntegrationOptions options;
+  options.maxTime = 200.0;
+  options.recordInterval = 0.1;
+  const DynamicsResult r = simulate(*model, Vector::Zero(3), Vector(), options);
+  INFO(r.message);
+  CHECK(r.reason == StopReason::MaxTime);  // never at rest without damping
+  CHECK(r.time == Approx(200.0));
+  CHECK(r.dissipated == 0.0);
+  CHECK(r.maxEnergyBalanceError < 1e-8);
+  double peakKinetic = 0.0;
+  for (const TrajectorySample& s : r.trajectory) peakKinetic = std::max(peakKinetic, s.kinetic);
+  CHECK(peakKinetic > 0.01);
+}
+
+TEST_CASE("held end coordinates stay held along the trajectory", "[dynamics]") {
+  const Chain chain = bistableChain();
+  // End held at (x, y) of a bent pose; rotation free.
+  Vector qRef(3);
+  qRef << 0.9, -0.4, 0.6;
+  const Pose p = endPose(chain, qRef);
+  const EndCondition held = EndCondition::heldPosition(p[0], p[1]);
+  Vector q0 = qRef;
+  q0[1] += 0.05;  // off the constraint: the model projects it back first
+  for (int inertial = 0; inertial < 2; ++inertial) {
+    DynamicsScene scene;
+    if (inertial) {
+      scene.inertia = InertiaData::uniformRods(chain, 1.0);
+      scene.jointDamping = {0.5, 0.5, 0.5};
+    }
+    auto model = makeDynamicsModel(chain, held, scene, q0);
+    Vector start = q0;
+    REQUIRE(model->projectOntoConstraints(start));
+    CHECK(model->constraintViolation(start) < 1e-13);
+    Vector v0 = Vector::Zero(3);
+    const DynamicsResult r = simulate(*model, start, v0, IntegrationOptions());
+    INFO("inertial " << inertial << ": " << r.message);
+    REQUIRE(r.reason == StopReason::Rest);
+    CHECK(r.maxConstraintViolation < 1e-8);
+    for (const TrajectorySample& s : r.trajectory) REQUIRE(s.constraintViolation < 1e-8);
+    CHECK(r.maxEnergyBalanceError < 1e-7);
+    EquilibriumProblem problem(chain, held, Eigen::Vector3d::Zero());
+    const Vector u = problem.initialGuess(r.q, 0.0);
+    Vector F(problem.dimension());
+    REQUIRE(problem.residual(u, 0.0, F));
+    CHECK(F.cwiseAbs().maxCoeff() < 1e-7);
+    if (inertial) CHECK(dynamic_cast<InertialModel&>(*model).baumgarteRate() > 0.0);
+  }
+}
+
+TEST_CASE("guards stop the integration with a reason", "[dynamics]") {
+  // L0 = 0.5: the segment energy falls all the way to the geometric limit — a joint limit stop.
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 0.5));
+  auto model = makeDynamicsModel(chain, EndCondition::freeEnd(), DynamicsScene(), Vector::Zero(3));
+  Vector q0(3);
+  q0 << 0.1, 0.05, -0.02;
+  const DynamicsResult a = simulate(*model, q0, Vector(), IntegrationOptions());
+  CHECK(a.reason == StopReason::JointLimit);
+  CHECK(std::string(toString(a.reason)) == "joint limit");
+  CHECK(a.message.find("limit") != std::string::npos);
+  CHECK(model->withinLimits(a.q));
+  CHECK(a.q.cwiseAbs().maxCoeff() == Approx(chain.upperLimits()[0]).epsilon(1e-6));
+
+  IntegrationOptions few;
+  few.maxSteps = 5;
+  const DynamicsResult b = simulate(*model, q0, Vector(), few);
+  CHECK(b.reason == StopReason::MaxSteps);
+  CHECK(b.steps == 5);
+  IntegrationOptions shortTime;
+  shortTime.maxTime = 0.01;
+  const DynamicsResult c = simulate(*model, q0, Vector(), shortTime);
+  CHECK(c.reason == StopReason::MaxTime);
+  CHECK(c.time == Approx(0.01));
+}
+
+TEST_CASE("dynamics options and scenes are validated with a reason", "[dynamics]") {
+  const Chain chain = bistableChain();
+  std::string why;
+  IntegrationOptions o;
+  CHECK(o.IsValid(&why));
+  o.absoluteTolerance = 0.0;
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK(why.find("absoluteTolerance") != std::string::npos);
+  o = IntegrationOptions();
+  o.maxStep = 1e-20;
+  CHECK_FALSE(o.IsValid(&why));
+  CHECK(why.find("maxStep") != std::string::npos);
+  o = IntegrationOptions();
+  o.maxSamples = 1;
+  CHECK_FALSE(o.IsValid(&why));
+  auto model = makeDynamicsModel(chain, EndCondition::freeEnd(), DynamicsScene(), Vector::Zero(3));
+  CHECK_THROWS_AS(simulate(*model, Vector::Zero(3), Vector(), o), std::invalid_argument);
+  CHECK_THROWS_AS(simulate(*model, Vector::Zero(2), Vector(), IntegrationOptions()), std::invalid_argument);
+
+  DynamicsScene s;
+  CHECK(s.IsValid(chain, &why));
+  s.jointDamping = {0.1, 0.1};
+  CHECK_FALSE(s.IsValid(chain, &why));
+  CHECK(why.find("jointDamping") != std::string::npos);
+  s = DynamicsScene();
+  s.inertia = InertiaData::uniformRods(chain, 1.0);
+  s.inertia->links[1].mass = 0.0;
+  CHECK_FALSE(s.IsValid(chain, &why));
+  CHECK(why.find("link 2") != std::string::npos);
+  s.inertia->links[1].mass = 1.0;
+  s.inertia->links[2].comOffset = 10.0;
+  CHECK_FALSE(s.IsValid(chain, &why));
+  CHECK(why.find("comOffset") != std::string::npos);
+  CHECK_THROWS_AS(makeDynamicsModel(chain, EndCondition::freeEnd(), s, Vector::Zero(3)), std::invalid_argument);
+  s.inertia->links.pop_back();
+  CHECK_FALSE(s.IsValid(chain, &why));
+}

@@ -1,0 +1,371 @@
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <string>
+
+#include "buckle/mechanics/jump.h"
+
+using namespace buckle::mechanics;
+
+namespace {
+
+// L0 = 1.2 with a = 0.5, b = 1, k = 1: κ = b·L0 − 2(b² − a²) = −0.3 < 0, so the straight segment
+// is unstable, and each segment's energy 4a² + 4(b² − a²)c² − 4bL0 c + L0² (c = cos(q/2)) has its
+// wells at c* = bL0 / (2(b² − a²)) = 0.8, q* = ±2 acos 0.8 ≈ ±1.287 — inside the geometric limit
+// ±2.214. A multistable chain: folds on stable branches, snap-through to other stable shapes.
+Chain bistableChain() { return Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2)); }
+// AUTO's I_up case (shared/peers/auto07p): L0 = 0.5, κ = −1, wells beyond the joint limits.
+Chain autoIupChain() { return Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 0.5)); }
+
+const double kWellAngle = 2.0 * std::acos(0.8);
+
+// Independent Newton on ∇Π(q) = 0 for a free end: exact Hessian from chain.h, full steps; no
+// KINSOL, no line search, nothing from dynamics.h / jump.h.
+bool independentNewton(const Chain& chain, const Wrench& F, Vector& q, double tol = 1e-12) {
+  const int n = chain.size();
+  Vector g(n);
+  Matrix H(n, n);
+  for (int it = 0; it < 50; ++it) {
+    totalPotentialGradient(chain, q, F, g);
+    if (g.cwiseAbs().maxCoeff() <= tol) return true;
+    totalPotentialHessian(chain, q, F, H);
+    q -= H.fullPivLu().solve(g);
+    if (!q.allFinite()) return false;
+  }
+  return false;
+}
+
+Eigen::VectorXd hessianEigenvalues(const Chain& chain, const Vector& q, const Wrench& F) {
+  Matrix H(chain.size(), chain.size());
+  totalPotentialHessian(chain, q, F, H);
+  return Eigen::SelfAdjointEigenSolver<Matrix>(H).eigenvalues();
+}
+
+// Fold of the free chain in Fx at fixed Fy: unknowns z = (q, v, Fx), equations ∇Π = 0, H v = 0,
+// v·v0 = 1 (the extended system of AUTO's ref.py), Newton with a central-difference Jacobian.
+bool locateFold(const Chain& chain, double Fy, Vector& q, double& Fx) {
+  const int n = chain.size();
+  const int N = 2 * n + 1;
+  Matrix H(n, n);
+  totalPotentialHessian(chain, q, Wrench(Fx, Fy, 0), H);
+  Eigen::SelfAdjointEigenSolver<Matrix> es(H);
+  Eigen::Index k;
+  es.eigenvalues().cwiseAbs().minCoeff(&k);
+  const Vector v0 = es.eigenvectors().col(k);
+  Vector z(N);
+  z << q, v0, Fx;
+  auto residual = [&](const Vector& zz) {
+    Vector r(N), g(n);
+    const Wrench W(zz[N - 1], Fy, 0);
+    totalPotentialGradient(chain, zz.head(n), W, g);
+    Matrix HH(n, n);
+    totalPotentialHessian(chain, zz.head(n), W, HH);
+    r.head(n) = g;
+    r.segment(n, n) = HH * zz.segment(n, n);
+    r[N - 1] = zz.segment(n, n).dot(v0) - 1.0;
+    return r;
+  };
+  for (int it = 0; it < 40 && residual(z).cwiseAbs().maxCoeff() >= 1e-13; ++it) {
+    Matrix Jz(N, N);
+    for (int j = 0; j < N; ++j) {
+      Vector zp = z, zm = z;
+      zp[j] += 1e-6;
+      zm[j] -= 1e-6;
+      Jz.col(j) = (residual(zp) - residual(zm)) / 2e-6;
+    }
+    z -= Jz.fullPivLu().solve(residual(z));
+  }
+  q = z.head(n);
+  Fx = z[N - 1];
+  return residual(z).cwiseAbs().maxCoeff() < 1e-11;
+}
+
+// Natural-parameter continuation in Fx (step dFx) along a stable branch from q, until the next
+// point is unstable or far away: returns the last stable point, near the fold.
+void followStableBranch(const Chain& chain, double Fy, double dFx, Vector& q, double& Fx) {
+  for (int k = 1; k < 1000; ++k) {
+    Vector qt = q;
+    const double Ft = Fx + dFx;
+    if (!independentNewton(chain, Wrench(Ft, Fy, 0), qt)) return;
+    if (hessianEigenvalues(chain, qt, Wrench(Ft, Fy, 0))[0] <= 0.0 || (qt - q).cwiseAbs().maxCoeff() > 0.2) return;
+    q = qt;
+    Fx = Ft;
+  }
+}
+
+// The fold of the bistable chain under increasing tension, Fy = 0.01, on the branch of the
+// all-positive bent shape.
+struct Fold {
+  Vector q;
+  double Fx = 0.0;
+};
+Fold bistableFold() {
+  const Chain chain = bistableChain();
+  Fold f;
+  f.q = Vector::Constant(3, kWellAngle);
+  REQUIRE(independentNewton(chain, Wrench(0, 0.01, 0), f.q));
+  REQUIRE(hessianEigenvalues(chain, f.q, Wrench(0, 0.01, 0))[0] > 0.0);
+  followStableBranch(chain, 0.01, 0.005, f.q, f.Fx);
+  REQUIRE(locateFold(chain, 0.01, f.q, f.Fx));
+  return f;
+}
+
+// Π never increases along the gradient flow (D1): dΠ/dt = −c|q̇|² on the held manifold. Off it
+// (integrator drift δh of the held coordinates, pulled back by the κ_h term) Π moves by at most
+// |reaction|·|δh| to first order, which the bound allows for (zero without held coordinates).
+void requirePotentialNonIncreasing(const DynamicsResult& d, double reactionBound = 0.0) {
+  REQUIRE(d.trajectory.size() > 10);
+  for (size_t k = 1; k < d.trajectory.size(); ++k) {
+    const TrajectorySample &a = d.trajectory[k - 1], &b = d.trajectory[k];
+    INFO("sample " << k << " t = " << b.t << " increase " << b.potential - a.potential << " drift "
+                   << b.constraintViolation);
+    REQUIRE(b.potential <= a.potential + 1e-12 + reactionBound * (a.constraintViolation + b.constraintViolation));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("fold of the bistable chain is a true fold on a stable branch", "[jump]") {
+  const Chain chain = bistableChain();
+  const Fold f = bistableFold();
+  const Eigen::VectorXd mu = hessianEigenvalues(chain, f.q, Wrench(f.Fx, 0.01, 0));
+  CHECK(std::abs(mu[0]) < 1e-9);  // the critical eigenvalue
+  CHECK(mu[1] > 0.1);             // the rest positive: the branch was stable up to here
+  CHECK(f.Fx == Approx(0.0426468434679).epsilon(1e-9));
+  CHECK(f.q[0] > 0.0);  // still the all-positive bent shape
+}
+
+TEST_CASE("from just past a fold the chain snaps to a distinct stable equilibrium", "[jump]") {
+  const Chain chain = bistableChain();
+  const Fold f = bistableFold();
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Wrench(0, 0.01, 0)), Eigen::Vector3d(1, 0, 0));
+  const double lambda = f.Fx + 1e-4;  // just past the fold: no equilibrium nearby any more
+  JumpOptions options;
+  const JumpResult r = simulateJump(problem, f.q, lambda, options);
+  INFO(r.message);
+  REQUIRE(r.success);
+  CHECK(r.stopReason == StopReason::Rest);
+  CHECK(r.polishConverged);
+  CHECK(r.residual < 1e-11);
+  CHECK(r.stable);
+  CHECK(r.stabilityTo.smallest > 0.1);
+  CHECK(r.prescribed.isApprox(Eigen::Vector3d(lambda, 0.01, 0)));
+  // distinct from the fold state: joint 1 snapped through to the other well
+  CHECK(r.distance > 1.0);
+  CHECK(r.to[0] < -1.0);
+  CHECK(r.energyReleased > 0.1);
+  CHECK(r.energyReleased == Approx(r.potentialFrom - r.potentialTo));
+  CHECK(r.polishShift < 1e-8);  // the rest point already was the equilibrium to ~tolerance
+  CHECK(r.steps > 10);
+  requirePotentialNonIncreasing(r.dynamics);
+
+  // Independent confirmation: plain Newton on ∇Π from the landing point stays there and the
+  // dense Hessian there is positive definite.
+  Vector q = r.to.head(3);
+  REQUIRE(independentNewton(chain, Wrench(lambda, 0.01, 0), q));
+  CHECK((q - r.to.head(3)).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK(hessianEigenvalues(chain, q, Wrench(lambda, 0.01, 0))[0] > 0.1);
+}
+
+TEST_CASE("jump from the fold itself: the cubic term picks the side", "[jump]") {
+  const Chain chain = bistableChain();
+  const Fold f = bistableFold();
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Wrench(0, 0.01, 0)), Eigen::Vector3d(1, 0, 0));
+  JumpOptions options;
+  const JumpResult r = simulateJump(problem, f.q, f.Fx, options);
+  INFO(r.message);
+  REQUIRE(r.success);
+  CHECK(std::abs(r.directionEigenvalue) < 1e-9);  // the fold's null direction
+  CHECK(r.direction.norm() == Approx(1.0));
+  // the chosen sign lowers Π; the opposite side goes back up the fold's cubic
+  Vector plus = f.q + 1e-3 * r.direction, minus = f.q - 1e-3 * r.direction;
+  CHECK(totalPotential(chain, plus, Wrench(f.Fx, 0.01, 0)) < totalPotential(chain, minus, Wrench(f.Fx, 0.01, 0)));
+  CHECK(r.to[0] < -1.0);
+  CHECK(r.energyReleased > 0.1);
+  requirePotentialNonIncreasing(r.dynamics);
+
+  // The inertial model (rods, light joint damping) lands on the same equilibrium here.
+  JumpOptions inertial;
+  inertial.scene.inertia = InertiaData::uniformRods(chain, 1.0);
+  inertial.scene.jointDamping = {0.5, 0.5, 0.5};
+  const JumpResult ri = simulateJump(problem, f.q, f.Fx, inertial);
+  INFO(ri.message);
+  REQUIRE(ri.success);
+  CHECK(ri.dynamics.kind == DynamicsKind::Inertial);
+  CHECK((ri.to - r.to).cwiseAbs().maxCoeff() < 1e-9);
+  CHECK(ri.dynamics.maxEnergyBalanceError < 1e-8);
+}
+
+TEST_CASE("AUTO's I_up fold is reproduced; the smooth model has no landing inside the joint limits", "[jump]") {
+  const Chain chain = autoIupChain();
+  Vector q(3);
+  q << -1.40916, -0.508436, -0.152072;
+  double Fx = 0.1777;
+  REQUIRE(locateFold(chain, 0.01, q, Fx));
+  CHECK(Fx == Approx(0.1777097421507).epsilon(1e-10));  // AUTO-07p, refined by ref.py
+  CHECK(q[0] == Approx(-1.40916).epsilon(1e-5));
+  // Index 2 at the fold (AUTO: 3 before, 2 after): the path is unstable throughout.
+  const Eigen::VectorXd mu = hessianEigenvalues(chain, q, Wrench(Fx, 0.01, 0));
+  CHECK(mu[1] < 0.0);
+  CHECK(std::abs(mu[2]) < 1e-9);
+
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Wrench(0, 0.01, 0)), Eigen::Vector3d(1, 0, 0));
+  const JumpResult r = simulateJump(problem, q, Fx + 1e-3, JumpOptions());
+  INFO(r.message);
+  // With L0 = 0.5 each segment's energy decreases all the way to the geometric limit (its wells
+  // lie beyond it), so the chain runs into a joint limit: reported, not polished, not a success.
+  CHECK_FALSE(r.success);
+  CHECK(r.stopReason == StopReason::JointLimit);
+  CHECK(r.message.find("limit") != std::string::npos);
+  CHECK_FALSE(r.polishConverged);
+  const double qmax = r.restPoint.cwiseAbs().maxCoeff();
+  CHECK(qmax == Approx(chain.upperLimits()[0]).epsilon(1e-6));
+  CHECK(qmax < chain.upperLimits()[0]);
+  CHECK(r.energyReleased > 0.0);
+  requirePotentialNonIncreasing(r.dynamics);
+}
+
+TEST_CASE("an unstable near-straight start (kappa < 0, Fx = 0, tiny Fy) jumps to a stable bent shape", "[jump]") {
+  const Chain chain = bistableChain();
+  const Wrench W(0, 1e-4, 0);
+  Vector q0 = Vector::Zero(3);
+  REQUIRE(independentNewton(chain, W, q0));  // the unstable equilibrium next to the straight state
+  REQUIRE(hessianEigenvalues(chain, q0, W)[0] < 0.0);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(W), Eigen::Vector3d(1, 0, 0));
+  const JumpResult r = simulateJump(problem, q0, 0.0, JumpOptions());
+  INFO(r.message);
+  REQUIRE(r.success);
+  CHECK(r.directionEigenvalue < -0.1);
+  CHECK(r.stabilityFrom.negative >= 1);
+  CHECK(r.stable);
+  CHECK(r.residual < 1e-11);
+  // every joint ends near a well of its segment (|q*| ≈ 1.287): a bent shape
+  for (int i = 0; i < 3; ++i) CHECK(std::abs(r.to[i]) == Approx(kWellAngle).epsilon(0.05));
+  CHECK(r.energyReleased > 0.3);
+  requirePotentialNonIncreasing(r.dynamics);
+  Vector q = r.to.head(3);
+  REQUIRE(independentNewton(chain, W, q));
+  CHECK((q - r.to.head(3)).cwiseAbs().maxCoeff() < 1e-10);
+
+  // A caller-given direction is honoured up to the Π-lowering sign: the opposite mode lands on
+  // a different shape.
+  JumpOptions other;
+  other.direction = Vector::Zero(3);
+  other.direction[1] = 1.0;
+  const JumpResult r2 = simulateJump(problem, q0, 0.0, other);
+  INFO(r2.message);
+  REQUIRE(r2.success);
+  CHECK(std::isnan(r2.directionEigenvalue));
+  CHECK(std::abs(std::abs(r2.direction[1]) - 1.0) < 1e-12);
+  CHECK((r2.to - r.to).cwiseAbs().maxCoeff() > 0.5);
+}
+
+TEST_CASE("jump with a held end coordinate keeps it held (clamped-pinned, gradient flow and inertial)", "[jump]") {
+  const Chain chain = bistableChain();
+  // y held at 0, rotation free, Fx = 0: start next to the straight state (unstable, κ < 0).
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
+  const Vector u0 = problem.initialGuess(Vector::Zero(3), 0.0);
+  for (int inertial = 0; inertial < 2; ++inertial) {
+    JumpOptions options;
+    if (inertial) {
+      options.scene.inertia = InertiaData::uniformRods(chain, 1.0);
+      options.scene.jointDamping = {1.0, 1.0, 1.0};
+    }
+    const JumpResult r = simulateJump(problem, u0, 0.0, options);
+    INFO("inertial " << inertial << ": " << r.message);
+    REQUIRE(r.success);
+    CHECK(r.from.size() == 4);
+    CHECK(r.to.size() == 4);
+    CHECK(r.stabilityFrom.negative >= 1);
+    CHECK(r.stable);
+    CHECK(std::abs(endPose(chain, r.to.head(3))[1]) < 1e-12);
+    CHECK(r.dynamics.maxConstraintViolation < 1e-8);
+    for (const TrajectorySample& s : r.dynamics.trajectory) REQUIRE(s.constraintViolation < 1e-8);
+    CHECK(r.energyReleased > 0.1);
+    if (!inertial) requirePotentialNonIncreasing(r.dynamics, 1.0 + 2.0 * std::abs(r.to[3]));
+    else CHECK(r.dynamics.maxEnergyBalanceError < 1e-7);
+  }
+}
+
+TEST_CASE("sudden load: gradient flow equals the quasi-static answer; inertia can overshoot into another well", "[jump]") {
+  const Chain chain = bistableChain();
+  const Vector qUnloaded = Vector::Constant(3, kWellAngle);  // each segment in its well: unloaded, stable
+  const Wrench W(0.0, 0.1, 0.0);
+  // Quasi-static answer: ramp the load in 100 increments with Newton, staying on the stable branch.
+  Vector qStatic = qUnloaded;
+  for (int k = 1; k <= 100; ++k) {
+    Vector qt = qStatic;
+    REQUIRE(independentNewton(chain, (k / 100.0) * W, qt));
+    REQUIRE(hessianEigenvalues(chain, qt, (k / 100.0) * W)[0] > 0.0);
+    REQUIRE((qt - qStatic).cwiseAbs().maxCoeff() < 0.05);
+    qStatic = qt;
+  }
+
+  const long before = InertialModel::constructedCount();
+  const SuddenLoadResult flow = simulateSuddenLoad(chain, EndCondition::freeEnd(W), qUnloaded, qStatic, SuddenLoadOptions());
+  INFO(flow.message);
+  CHECK(InertialModel::constructedCount() == before);  // no masses: the inertial model is never built
+  REQUIRE(flow.success);
+  CHECK_FALSE(flow.inertial);
+  CHECK(flow.compared);
+  CHECK_FALSE(flow.differs);
+  CHECK(flow.maxDifference < 1e-9);
+  CHECK(flow.lower == LowerPotential::Equal);
+  CHECK(flow.residual < 1e-11);
+  requirePotentialNonIncreasing(flow.dynamics);
+
+  SuddenLoadOptions options;
+  options.scene.inertia = InertiaData::uniformRods(chain, 1.0);
+  options.scene.jointDamping = {0.05, 0.05, 0.05};
+  options.integration.recordInterval = 0.5;
+  const SuddenLoadResult dyn = simulateSuddenLoad(chain, EndCondition::freeEnd(W), qUnloaded, qStatic, options);
+  INFO(dyn.message);
+  CHECK(InertialModel::constructedCount() == before + 1);
+  REQUIRE(dyn.success);
+  CHECK(dyn.inertial);
+  CHECK(dyn.stable);
+  CHECK(dyn.differs);
+  CHECK(dyn.maxDifference > 1.0);
+  CHECK(dyn.rest[1] < 0.0);  // joint 2 was thrown into its other well
+  CHECK(dyn.lower == LowerPotential::Dynamic);
+  CHECK(dyn.potentialDynamic < dyn.potentialStatic);
+  CHECK(dyn.peakKinetic > 0.0);
+  CHECK(dyn.maxExcursion > dyn.maxDifference * 0.5);
+  CHECK(dyn.dynamics.maxEnergyBalanceError < 1e-7);
+  // the record interval is honoured (first and last samples excepted)
+  for (size_t k = 2; k + 1 < dyn.dynamics.trajectory.size(); ++k)
+    REQUIRE(dyn.dynamics.trajectory[k].t - dyn.dynamics.trajectory[k - 1].t >= 0.5);
+  Vector q = dyn.rest;
+  REQUIRE(independentNewton(chain, W, q));
+  CHECK((q - dyn.rest).cwiseAbs().maxCoeff() < 1e-10);
+}
+
+TEST_CASE("jump and sudden-load options are validated with a reason", "[jump]") {
+  const Chain chain = bistableChain();
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(1, 0, 0));
+  std::string why;
+  JumpOptions o;
+  CHECK(o.IsValid(problem, &why));
+  o.perturbation = -1.0;
+  CHECK_FALSE(o.IsValid(problem, &why));
+  CHECK(why.find("perturbation") != std::string::npos);
+  o = JumpOptions();
+  o.direction = Vector::Zero(3);
+  CHECK_FALSE(o.IsValid(problem, &why));
+  CHECK(why.find("direction") != std::string::npos);
+  o = JumpOptions();
+  o.scene.flowDamping = 0.0;
+  CHECK_FALSE(o.IsValid(problem, &why));
+  CHECK(why.find("flowDamping") != std::string::npos);
+  CHECK_THROWS_AS(simulateJump(problem, Vector::Zero(3), 0.0, o), std::invalid_argument);
+  CHECK_THROWS_AS(simulateJump(problem, Vector::Zero(5), 0.0, JumpOptions()), std::invalid_argument);
+
+  SuddenLoadOptions s;
+  CHECK(s.IsValid(chain, &why));
+  s.sameStateTolerance = 0.0;
+  CHECK_FALSE(s.IsValid(chain, &why));
+  CHECK(why.find("sameStateTolerance") != std::string::npos);
+  CHECK_THROWS_AS(simulateSuddenLoad(chain, EndCondition::freeEnd(), Vector::Zero(2), Vector(), SuddenLoadOptions()),
+                  std::invalid_argument);
+}
