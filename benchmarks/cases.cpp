@@ -1,0 +1,46 @@
+// bench_cases: buckle on the AUTO-07p comparison cases, one line per located point and a
+// timing line per case, machine-readable (key=value) for compare_auto.sh.
+//   bench_cases [--reps R] [CASE ...]     default: all cases, R = 5 (median time)
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "cases.h"
+
+using namespace buckle::bench;
+
+int main(int argc, char** argv) {
+  int reps = 5;
+  std::vector<std::string> names;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
+    else names.emplace_back(argv[i]);
+  }
+  if (names.empty()) names = {"A_triv", "A_U", "A_Z", "A_Ufine", "L_triv", "N_triv", "I_up"};
+  int failures = 0;
+  for (const auto& name : names) {
+    std::vector<double> times;
+    CaseResult r;
+    for (int k = 0; k < reps; ++k) {
+      if (!runCase(name, Settings(), r)) {
+        std::fprintf(stderr, "unknown case %s\n", name.c_str());
+        return 2;
+      }
+      times.push_back(r.seconds);
+    }
+    std::sort(times.begin(), times.end());
+    const double med = times[times.size() / 2];
+    if (r.points <= 0) ++failures;
+    std::printf("case=%s points=%d time_ms=%.4f per_point_us=%.3f stop=%s\n", name.c_str(), r.points, 1e3 * med,
+                r.points > 0 ? 1e6 * med / r.points : 0.0, buckle::continuation::stopReasonName(r.branch.stopReason));
+    for (const auto& l : r.located) {
+      std::printf("  point case=%s type=%s Fx=%.13e", name.c_str(), l.label.c_str(), l.Fx);
+      if (std::isfinite(l.reference)) std::printf(" ref=%.13e err=%.2e", l.reference, std::abs(l.Fx - l.reference));
+      std::printf("\n");
+    }
+  }
+  return failures ? 1 : 0;
+}
