@@ -1,0 +1,275 @@
+#include "scene/atlas.h"
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "buckle/continuation/branch_switching.h"
+#include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/linear_buckling.h"
+#include "scene/output.h"
+
+namespace buckle::scene {
+
+namespace cont = buckle::continuation;
+namespace mech = buckle::mechanics;
+namespace fs = std::filesystem;
+
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+void checkAxis(const AtlasAxis& a, const std::string& opt) {
+  if (a.name != "a" && a.name != "L0" && a.name != "n")
+    throw std::invalid_argument(opt + " must be one of a, L0, n (got \"" + a.name + "\")");
+  if (!std::isfinite(a.from) || !std::isfinite(a.to))
+    throw std::invalid_argument(opt + " range must be finite");
+  if (a.count < 1 || a.count > 1000) throw std::invalid_argument(opt + " count must be in [1, 1000]");
+  const double lo = std::min(a.from, a.to);
+  if (a.name == "a" && lo < 0.0) throw std::invalid_argument(opt + ": a/b must be >= 0");
+  if (a.name == "L0" && !(lo > 0.0)) throw std::invalid_argument(opt + ": L0/b must be > 0");
+  if (a.name == "n" && (lo < 1.0 || std::max(a.from, a.to) > 200.0))
+    throw std::invalid_argument(opt + ": n must be in [1, 200]");
+}
+
+void computeCell(AtlasCell& c) {
+  const mech::SegmentParameters p = mech::SegmentParameters::symmetric(c.a, 1.0, 1.0, c.L0);
+  c.kappa = c.L0 - 2.0 * (1.0 - c.a * c.a);
+  c.firstCritical = kNaN;
+  try {
+    const mech::Chain chain = mech::Chain::uniform(c.n, p);
+    const mech::EndCondition end = mech::EndCondition::clampedPinned(0.0, 0.0);
+    const Eigen::VectorXd q0 = Eigen::VectorXd::Zero(c.n);
+    const mech::LinearBucklingResult lb = mech::linearBuckling(chain, q0, end);
+    c.straightStable = lb.unloadedStable;
+    const mech::BucklingMode* first = nullptr;
+    for (const auto& m : lb.modes)
+      if (m.lambda < 0.0 && (!first || std::abs(m.lambda) < std::abs(first->lambda))) first = &m;
+    if (!c.straightStable) {
+      c.postBuckling = "unstable start";
+      if (first) {
+        c.firstCritical = first->lambda;
+        c.firstShape = first->shape;
+      }
+      return;
+    }
+    if (!first) {
+      c.postBuckling = "none";
+      return;
+    }
+    c.firstCritical = first->lambda;
+    c.firstShape = first->shape;
+    // post-buckling: trace the straight branch past the first critical load, switch at the
+    // branch point and look at the stability and the load along the new branch
+    mech::EquilibriumProblem problem(chain, end, Eigen::Vector3d(1.0, 0.0, 0.0));
+    cont::TracerOptions opt;
+    opt.initialStep = std::min(0.05, 0.2 * std::abs(first->lambda));
+    opt.maxStep = 0.1;
+    opt.lambdaMin = 1.3 * first->lambda;
+    opt.lambdaMax = 1.0;
+    opt.maxPoints = 400;
+    cont::Tracer tracer(problem, opt);
+    const cont::Vector u0 = problem.initialGuess(q0, 0.0);
+    cont::Branch root = tracer.trace(u0, 0.0, cont::InitialDirection::decreasingLambda());
+    const cont::SpecialPoint* bp = nullptr;
+    for (const auto& sp : root.specialPoints)
+      if (sp.type == cont::SpecialPointType::BranchPoint &&
+          std::abs(sp.lambda - first->lambda) < 1e-6 * std::max(1.0, std::abs(first->lambda))) {
+        bp = &sp;
+        break;
+      }
+    if (!bp) {
+      c.postBuckling = "failed";
+      c.error = "first branch point not located on the straight branch";
+      return;
+    }
+    cont::Vector dir;
+    if (!cont::bifurcatingDirection(problem, *bp, dir)) {
+      c.postBuckling = "failed";
+      c.error = "no bifurcating direction";
+      return;
+    }
+    cont::TracerOptions childOpt = opt;
+    childOpt.maxPoints = 8;
+    childOpt.initialStep = 0.02;
+    childOpt.maxStep = 0.02;
+    cont::Tracer childTracer(problem, childOpt);
+    const cont::Branch child = cont::switchBranch(childTracer, *bp, dir, +1);
+    if (child.points.size() < 3) {
+      c.postBuckling = "failed";
+      c.error = "the new branch could not be followed";
+      return;
+    }
+    int stable = 0, checked = 0;
+    for (size_t i = 1; i < child.points.size(); ++i) {
+      if (!child.points[i].stability.valid()) continue;
+      ++checked;
+      if (child.points[i].stability.stable()) ++stable;
+    }
+    c.postSlope = std::abs(child.points.back().lambda) - std::abs(bp->lambda);
+    c.postBuckling = (checked > 0 && stable == checked) ? "supercritical" : "subcritical";
+  } catch (const std::exception& e) {
+    c.postBuckling = "failed";
+    c.error = e.what();
+  }
+}
+
+int postCode(const std::string& s) {
+  if (s == "supercritical") return 2;
+  if (s == "subcritical") return 1;
+  if (s == "unstable start") return 0;
+  if (s == "none") return 3;
+  return -1;
+}
+
+std::string axisLabel(const std::string& name) {
+  if (name == "a") return "a/b";
+  if (name == "L0") return "L^0/b";
+  return "n (segments)";
+}
+
+std::string num(double v) {
+  if (!std::isfinite(v)) return "nan";
+  std::ostringstream os;
+  os.precision(12);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+void validateAtlas(const AtlasOptions& o) {
+  checkAxis(o.x, "--x");
+  checkAxis(o.y, "--y");
+  if (o.x.name == o.y.name) throw std::invalid_argument("--x and --y must be different parameters");
+  if (!(o.a >= 0.0) || !std::isfinite(o.a)) throw std::invalid_argument("--a must be a finite number >= 0");
+  if (!(o.L0 > 0.0) || !std::isfinite(o.L0)) throw std::invalid_argument("--L0 must be a finite number > 0");
+  if (o.n < 1 || o.n > 200) throw std::invalid_argument("--segments must be in [1, 200]");
+  if (o.threads < 0) throw std::invalid_argument("--threads must be >= 0");
+}
+
+std::vector<AtlasCell> computeAtlas(const AtlasOptions& o, const std::function<void(int, int)>& progress) {
+  validateAtlas(o);
+  std::vector<AtlasCell> cells(size_t(o.x.count) * size_t(o.y.count));
+  for (int j = 0; j < o.y.count; ++j)
+    for (int i = 0; i < o.x.count; ++i) {
+      AtlasCell& c = cells[size_t(j) * size_t(o.x.count) + size_t(i)];
+      c.x = o.x.value(i);
+      c.y = o.y.value(j);
+      c.a = o.a;
+      c.L0 = o.L0;
+      c.n = o.n;
+      for (const auto& [axis, v] : {std::pair{&o.x, c.x}, std::pair{&o.y, c.y}}) {
+        if (axis->name == "a") c.a = v;
+        if (axis->name == "L0") c.L0 = v;
+        if (axis->name == "n") c.n = static_cast<int>(std::lround(v));
+      }
+    }
+  const int total = static_cast<int>(cells.size());
+  unsigned threads = o.threads > 0 ? unsigned(o.threads) : std::max(1u, std::thread::hardware_concurrency());
+  threads = std::min<unsigned>(threads, unsigned(total));
+  std::atomic<int> next{0}, done{0};
+  std::mutex progressMutex;
+  auto worker = [&]() {
+    for (int k = next++; k < total; k = next++) {
+      computeCell(cells[size_t(k)]);
+      const int d = ++done;
+      if (progress) {
+        std::lock_guard<std::mutex> lock(progressMutex);
+        progress(d, total);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
+  for (std::thread& t : pool) t.join();
+  return cells;
+}
+
+std::vector<std::string> writeAtlas(const AtlasOptions& o, const std::vector<AtlasCell>& cells,
+                                    const std::string& dirName, std::string& gnuplotNote) {
+  const fs::path dir(dirName);
+  {
+    std::ofstream csv(dir / "atlas.csv");
+    csv << o.x.name << "," << o.y.name << ",a,L0,n,kappa,straight_stable,first_critical_Fx,first_shape,post_buckling,"
+                                          "post_slope,error\n";
+    for (const AtlasCell& c : cells)
+      csv << num(c.x) << "," << num(c.y) << "," << num(c.a) << "," << num(c.L0) << "," << c.n << "," << num(c.kappa)
+          << "," << (c.straightStable ? 1 : 0) << "," << num(c.firstCritical) << "," << c.firstShape << ","
+          << c.postBuckling << "," << num(c.postSlope) << ",\"" << c.error << "\"\n";
+    if (!csv) throw std::runtime_error("cannot write " + (dir / "atlas.csv").string());
+  }
+  const fs::path plots = dir / "plots";
+  fs::create_directories(plots);
+  {
+    std::ofstream dat(plots / "atlas.dat");
+    for (int j = 0; j < o.y.count; ++j) {
+      for (int i = 0; i < o.x.count; ++i) {
+        const AtlasCell& c = cells[size_t(j) * size_t(o.x.count) + size_t(i)];
+        dat << num(c.x) << " " << num(c.y) << " " << (c.straightStable ? num(c.firstCritical) : "NaN") << " "
+            << postCode(c.postBuckling) << "\n";
+      }
+      dat << "\n";
+    }
+  }
+  const double dx = o.x.count > 1 ? std::abs(o.x.to - o.x.from) / (o.x.count - 1) : 1.0;
+  const double dy = o.y.count > 1 ? std::abs(o.y.to - o.y.from) / (o.y.count - 1) : 1.0;
+  std::ostringstream range;
+  range << "set xrange [" << num(std::min(o.x.from, o.x.to) - dx / 2) << ":" << num(std::max(o.x.from, o.x.to) + dx / 2)
+        << "]\nset yrange [" << num(std::min(o.y.from, o.y.to) - dy / 2) << ":"
+        << num(std::max(o.y.from, o.y.to) + dy / 2) << "]\n";
+  std::string others;
+  for (const char* name : {"a", "L0", "n"})
+    if (o.x.name != name && o.y.name != name)
+      others = std::string(name) == "a" ? "a/b = " + num(o.a) : std::string(name) == "L0" ? "L^0/b = " + num(o.L0)
+                                                                                            : "n = " + std::to_string(o.n);
+  const std::string common = "set xlabel '" + axisLabel(o.x.name) + "'\nset ylabel '" + axisLabel(o.y.name) + "'\n" +
+                             range.str() + "set tics out\n";
+  {
+    std::ofstream gp(plots / "atlas_critical_body.gp");
+    gp << common << "set title 'First critical force F_x of the straight clamped-pinned chain (" << others
+       << ", b = k = 1); white: straight start unstable'\n"
+       << "set cblabel 'F_x (units of k b)'\nset palette rgbformulae 33,13,10\n"
+       << "plot 'atlas.dat' using 1:2:3 with image notitle\n";
+  }
+  {
+    std::ofstream gp(plots / "atlas_post_buckling_body.gp");
+    gp << common << "set title 'Post-buckling branch (" << others << ", b = k = 1)'\n"
+       << "set palette defined (-1.5 'black', -0.5 'black', -0.5 '#bbbbbb', 0.5 '#bbbbbb', 0.5 '#d62728', "
+          "1.5 '#d62728', 1.5 '#2ca02c', 2.5 '#2ca02c', 2.5 '#1f77b4', 3.5 '#1f77b4')\nset cbrange [-1.5:3.5]\n"
+       << "set rmargin 22\n"
+       << "set cbtics ('failed' -1, 'unstable start' 0, 'subcritical' 1, 'supercritical' 2, 'no critical load' 3)\n"
+       << "plot 'atlas.dat' using 1:2:4 with image notitle\n";
+  }
+  const std::string gnuplot = findGnuplot();
+  std::vector<std::string> files;
+  gnuplotNote = gnuplot.empty() ? "not found: gnuplot is not installed (Debian: gnuplot-nox); data and scripts in plots/"
+                                : gnuplot;
+  for (const char* name : {"atlas_critical", "atlas_post_buckling"}) {
+    std::ofstream gp(plots / (std::string(name) + ".gp"));
+    gp << "set terminal pngcairo size 1000,760 enhanced font 'DejaVu Sans,11'\nset output '" << name << ".png'\nload '"
+       << name << "_body.gp'\nset output\nreset\nset terminal svg size 1000,760 enhanced font 'DejaVu Sans,11' "
+       << "background 'white'\nset output '" << name << ".svg'\nload '" << name << "_body.gp'\nset output\n";
+    gp.close();
+    if (gnuplot.empty()) continue;
+    const std::string cmd = "cd '" + plots.string() + "' && '" + gnuplot + "' '" + name + ".gp' > '" + name +
+                            ".log' 2>&1";
+    if (std::system(cmd.c_str()) == 0 && fs::exists(plots / (std::string(name) + ".png"))) {
+      files.push_back(std::string("plots/") + name + ".png");
+      files.push_back(std::string("plots/") + name + ".svg");
+      std::error_code ec;
+      fs::remove(plots / (std::string(name) + ".log"), ec);
+    }
+  }
+  return files;
+}
+
+}  // namespace buckle::scene
