@@ -29,7 +29,6 @@ const char *stopReasonName(StopReason reason) {
     case StopReason::Box: return "box";
     case StopReason::Boundary: return "boundary";
     case StopReason::StepSizeTooSmall: return "step size below minimum";
-    case StopReason::TangentFailed: return "tangent failed";
     case StopReason::SwitchFailed: return "branch switching failed";
   }
   return "unknown";

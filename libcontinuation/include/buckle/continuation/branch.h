@@ -72,8 +72,7 @@ enum class StopReason {
   MaxArclength,
   Box,
   Boundary,
-  StepSizeTooSmall,    ///< corrector failures / branch-jump rejections below minStep
-  TangentFailed,       ///< the bordered Jacobian was singular at an accepted point
+  StepSizeTooSmall,    ///< corrector failures, branch-jump rejections or singular tangents below minStep
   SwitchFailed,        ///< branch switching did not reach a point off the parent branch
 };
 

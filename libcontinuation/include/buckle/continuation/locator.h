@@ -4,7 +4,10 @@
 //  1. along the branch: a safeguarded secant (Illinois) iteration on a test function of the
 //     pseudo-arclength s ∈ (0, ds) measured along the step's tangent; every evaluation is a
 //     Keller corrector solve on the hyperplane t_aᵀ(x − x_a) = s, so every iterate is on the
-//     branch;
+//     branch. Test functions: t_λ for folds; for branch points the minimally augmented ψ when
+//     the bordered determinant changed sign, else the eigenvalue of the stability operator that
+//     crosses zero. Before a refinement the secant only brackets (coarseTolerance): near a BP
+//     the corrector samples are ill-conditioned, the augmented systems are not;
 //  2. refinement: Newton on an augmented system whose regular solution IS the special point
 //       fold          (F = 0, F_u v = 0, cᵀv = 1)                 unknowns (u, λ, v)
 //       simple BP     (F(x) + βp = 0, F_xᵀp = 0, pᵀp = 1)  (Moore)  unknowns (x, β, p)
