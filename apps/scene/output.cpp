@@ -114,6 +114,21 @@ void writeSpecialPoints(const Scene& scene, const RunResult& run, const fs::path
       p["stability_after"] = s.stabilityAfter;
       p["accuracy"] = {{"parameter", number(s.accuracy)}, {"residual", number(s.residual)}, {"refined", s.refined}};
       if (!s.note.empty()) p["note"] = s.note;
+      if (s.jumpTried) {
+        json j;
+        j["success"] = s.jumpSuccess;
+        j["landing"] = s.jumpLanding;
+        j["message"] = s.jumpMessage;
+        if (s.jumpQ.size() > 0) {
+          j["q"] = vectorJson(s.jumpQ);
+          j["loads"] = wrenchJson(s.jumpF);
+          j["position"] = poseJson(s.jumpPose);
+          j["shape"] = s.jumpShape;
+        }
+        j["energy_released"] = number(s.energyReleased);
+        j["distance"] = number(s.jumpDistance);
+        p["jump_to"] = j;
+      }
       points.push_back(p);
     }
     if (cr.haveCritical) {

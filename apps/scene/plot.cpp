@@ -151,9 +151,31 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       }
     }
   }
+  // jumps: arrows from the fold to the landing point
+  BlockFile jumps;
+  jumps.begin();
+  bool anyJump = false;
+  for (size_t c : selected(spec)) {
+    const CaseResult& cr = run.cases[c];
+    for (const SpecialRecord& r : cr.specials) {
+      if (!r.jumpSuccess || r.jumpQ.size() == 0) continue;
+      SpecialRecord to = r;
+      to.q = r.jumpQ;
+      to.F = r.jumpF;
+      to.pose = r.jumpPose;
+      for (size_t j = 0; j < spec.y.size(); ++j) {
+        const double x0 = columnValue(spec.x, r, cr.pose0), y0 = columnValue(spec.y[j], r, cr.pose0);
+        const double x1 = columnValue(spec.x, to, cr.pose0), y1 = columnValue(spec.y[j], to, cr.pose0);
+        if (!std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) continue;
+        jumps.point({x0, y0, x1 - x0, y1 - y0});
+        anyJump = true;
+      }
+    }
+  }
   const std::string stem = spec.name;
   data.write(dir / (stem + ".dat"));
   if (anySpecial) sp.write(dir / (stem + "_special.dat"));
+  if (anyJump) jumps.write(dir / (stem + "_jumps.dat"));
 
   header(s, spec.title.empty() ? (spec.type == PlotType::Stiffness ? "Loaded stiffness along the branches"
                                                                    : "Bifurcation diagram: stable solid, unstable dashed")
@@ -183,6 +205,9 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
            << (title.empty() ? std::string(" notitle") : " title " + quote(title) + " noenhanced");
     first = false;
   }
+  if (anyJump)
+    s.body << ", \\\n  " << quote(stem + "_jumps.dat")
+           << " using 1:2:3:4 with vectors head filled size screen 0.015,20 lw 1.5 lc rgb '#ff7f0e' title 'jump'";
   if (anySpecial) {
     s.body << ", \\\n  " << quote(stem + "_special.dat")
            << " using 1:2 with points pt 7 ps 1.3 lc rgb 'black' title 'special points'";

@@ -12,6 +12,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/equilibrium_solve.h"
+#include "buckle/mechanics/jump.h"
 #include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/unloaded_shape.h"
@@ -64,6 +65,52 @@ class CaseRunner {
   }
   void record(const cont::Branch& b, mech::EquilibriumProblem& problem, const std::string& origin);
   bool throughLoad() const { return spec_.path.loadLimit > 0.0; }
+  /// Releases the chain at a fold with the loads frozen there: where does it land?
+  void simulateJumpAt(mech::EquilibriumProblem& problem, const cont::SpecialPoint& sp, SpecialRecord& s) {
+    const int n = out_.chain.size();
+    mech::JumpOptions opt;
+    opt.perturbation = scene_.analyses.jump.perturbation;
+    opt.integration.recordTrajectory = false;
+    s.jumpTried = true;
+    try {
+      const mech::JumpResult j = mech::simulateJump(problem, sp.u, sp.lambda, opt);
+      s.jumpSuccess = j.success;
+      s.jumpMessage = j.message;
+      // the chain snaps onto a geometric joint limit, where the smooth model ends (a spring
+      // reaches zero length): a known outcome, reported with the state reached there
+      const bool toLimit = !j.success && j.stopReason == mech::StopReason::JointLimit && j.restPoint.size() >= n;
+      if (toLimit) {
+        s.jumpSuccess = true;
+        s.jumpLanding = "joint limit";
+        s.jumpQ = j.restPoint.head(n);
+        s.jumpF = problem.wrench(sp.u, sp.lambda);
+        s.jumpPose = mech::endPose(out_.chain, s.jumpQ);
+        s.jumpShape = mech::shapeName(s.jumpQ, 1e-6);
+        s.energyReleased = j.energyReleased;
+        s.jumpDistance = (s.jumpQ - sp.u.head(n)).cwiseAbs().maxCoeff();
+        return;
+      }
+      s.jumpLanding = "stable equilibrium";
+      if (j.to.size() >= n) {
+        s.jumpQ = j.to.head(n);
+        s.jumpF = problem.wrench(j.to, sp.lambda);
+        s.jumpPose = mech::endPose(out_.chain, s.jumpQ);
+        s.jumpShape = mech::shapeName(s.jumpQ, 1e-6);
+      }
+      s.energyReleased = j.energyReleased;
+      s.jumpDistance = j.distance;
+      if (!j.success) {
+        run_.complete = false;
+        run_.problems.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter + " = " +
+                                std::to_string(sp.lambda) + " did not land on a stable equilibrium: " + j.message);
+      }
+    } catch (const std::invalid_argument& e) {
+      s.jumpSuccess = false;
+      s.jumpMessage = e.what();
+      run_.complete = false;
+      run_.problems.push_back("case \"" + spec_.label + "\": jump: " + e.what());
+    }
+  }
   /// Stability under the scene's own end condition (displacement control of the parameter).
   cont::StabilityInfo heldStability(const Eigen::VectorXd& q, const mech::Wrench& F) const {
     const int n = out_.chain.size();
@@ -203,6 +250,7 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
       s.shape = mech::shapeName(s.q, 1e-6);
     if (sp.multiplicity > 1) s.note += (s.note.empty() ? "" : "; ") + std::string("multiplicity ") + std::to_string(sp.multiplicity);
     run_.worstLocation = std::max(run_.worstLocation, sp.lambdaAccuracy);
+    if (scene_.analyses.jump.enabled && sp.type == cont::SpecialPointType::Fold && !throughLoad()) simulateJumpAt(problem, sp, s);
     out_.specials.push_back(s);
   }
 
@@ -497,6 +545,7 @@ RunResult runScene(const Scene& scene) {
                                      std::to_string(a.continuation.branchSwitching) + ")"
                                : "continuation of the primary branch");
   if (a.stiffness) run.computed.push_back("loaded stiffness K_F along the branches (eq 29)");
+  if (a.jump.enabled) run.computed.push_back("jumps from the folds (gradient-flow dynamics, landing polished)");
   if (a.criticalForces.enabled) run.computed.push_back("critical forces of the start configuration (linear buckling)");
   if (a.energyCurves.enabled) run.computed.push_back("energy curves E(q1) with the end held (eq 6-8)");
   if (a.torqueAngle.enabled) run.computed.push_back("torque-angle curves M(q) of the first segment (eq 1)");

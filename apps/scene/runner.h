@@ -42,6 +42,17 @@ struct SpecialRecord {
   double residual = 0.0;   ///< ‖F(u, λ)‖₂ at the point
   bool refined = false;
   std::string note;
+  // jump analysis (folds only): where the chain lands when released there
+  bool jumpTried = false;
+  bool jumpSuccess = false;
+  std::string jumpLanding;   ///< "stable equilibrium" or "joint limit"
+  std::string jumpMessage;
+  Eigen::VectorXd jumpQ;
+  mechanics::Wrench jumpF = mechanics::Wrench::Zero();
+  mechanics::Pose jumpPose = mechanics::Pose::Zero();
+  std::string jumpShape;
+  double energyReleased = 0.0;
+  double jumpDistance = 0.0;
 };
 
 struct BranchRecord {

@@ -489,9 +489,19 @@ AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
       if (c.contains("modes")) s.criticalForces.modes = r.integer(c["modes"], pc / "modes", 1, 100000);
     }
   }
-  if (a.contains("jump"))
-    r.fail(p / "jump", "not supported in this build: jump dynamics (time integration of a snap-through) is not "
-                       "available yet; remove this analysis");
+  if (a.contains("jump")) {
+    const json& j = a["jump"];
+    const Pointer pj = p / "jump";
+    if (j.is_boolean()) {
+      s.jump.enabled = j.get<bool>();
+    } else {
+      r.onlyKeys(j, pj, {"perturbation"});
+      s.jump.enabled = true;
+      if (j.contains("perturbation")) s.jump.perturbation = r.positive(j["perturbation"], pj / "perturbation");
+    }
+    if (s.jump.enabled && !s.continuation.enabled)
+      r.fail(pj, "jumps are simulated from the folds of the traced branches: it needs /analyses/continuation");
+  }
   if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled)
     r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces)");
   return s;

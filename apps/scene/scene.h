@@ -79,8 +79,14 @@ struct CriticalForcesSpec {
   int modes = 3;  ///< how many critical loads of the start configuration to report
 };
 
+struct JumpSpec {
+  bool enabled = false;
+  double perturbation = 1e-3;  ///< ‖δq‖ of the release along the unstable direction
+};
+
 struct AnalysesSpec {
   ContinuationSpec continuation;
+  JumpSpec jump;
   bool stiffness = false;
   EnergyCurvesSpec energyCurves;
   TorqueAngleSpec torqueAngle;

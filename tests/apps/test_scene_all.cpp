@@ -143,6 +143,29 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
         CHECK(!sp["energy_equilibria"].empty());
         for (const json& e : sp["energy_equilibria"]) CHECK(std::abs(e["loads"]["Me"].get<double>()) < 1e-8);
       }
+      // the non-straight start q0 = (θ, −2θ, θ), cos θ = 7/8, with the end held at its unloaded
+      // position (5.5, 0): q0 itself is a stable equilibrium of the energy curve, at zero load
+      if (scene.stem() == "fig7") {
+        const double theta = std::acos(7.0 / 8.0);
+        bool found = false;
+        for (const json& e : sp["energy_equilibria"]) {
+          if (e["case"] != 0 || std::abs(e["q1"].get<double>() - theta) > 1e-8) continue;
+          found = true;
+          CHECK(e["stable"] == true);
+          CHECK(e["q"][1].get<double>() == Approx(-2.0 * theta).margin(1e-8));
+          CHECK(std::abs(e["loads"]["Fx"].get<double>()) < 1e-8);
+          CHECK(std::abs(e["loads"]["Fy"].get<double>()) < 1e-8);
+        }
+        CHECK(found);
+      }
+      // jumps from folds land somewhere else, releasing energy
+      for (const json& p : sp["special_points"]) {
+        if (!p.contains("jump_to")) continue;
+        CHECK(p["type"] == "LP");
+        CHECK(p["jump_to"]["success"] == true);
+        CHECK(p["jump_to"]["energy_released"].get<double>() > 0.0);
+        CHECK(p["jump_to"]["distance"].get<double>() > 1e-3);
+      }
       fs::remove_all(out);
     }
   }

@@ -142,8 +142,11 @@ TEST_CASE("NaN", "[scene][errors]") {
 TEST_CASE("inconsistent scenes", "[scene][errors]") {
   requireBadInput("load_on_held", replaceOnce(kGood, "\"parameter\": \"Fx\"", "\"parameter\": \"Fy\""),
                   "/path/parameter", "is held");
-  requireBadInput("unsupported_jump", replaceOnce(kGood, "\"continuation\": {", "\"jump\": {}, \"continuation\": {"),
-                  "/analyses/jump", "not supported");
+  requireBadInput("jump_without_branches",
+                  replaceOnce(kGood, "\"continuation\": {\"branch_switching\": 0}", "\"jump\": true, \"critical_forces\": true"),
+                  "/analyses/jump", "needs /analyses/continuation");
+  requireBadInput("jump_bad_key", replaceOnce(kGood, "\"continuation\": {", "\"jump\": {\"eps\": 1}, \"continuation\": {"),
+                  "/analyses/jump/eps", "unknown key");
   requireBadInput("stiffness_without_branches",
                   replaceOnce(kGood, "\"continuation\": {\"branch_switching\": 0}", "\"stiffness\": true, \"critical_forces\": true"),
                   "/analyses/stiffness", "needs /analyses/continuation");
