@@ -1,0 +1,176 @@
+#include "buckle/mechanics/load_history.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace buckle::mechanics {
+
+namespace cont = buckle::continuation;
+
+const char* toString(JumpTrigger trigger) {
+  switch (trigger) {
+    case JumpTrigger::UnstableStart: return "unstable start";
+    case JumpTrigger::Fold: return "fold";
+    case JumpTrigger::BranchPoint: return "branch point";
+    case JumpTrigger::LostStability: return "lost stability";
+  }
+  return "?";
+}
+
+bool LoadHistoryOptions::IsValid(const EquilibriumProblem& problem, std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (!(overshoot > 0.0) || !std::isfinite(overshoot)) return fail("overshoot must be > 0 and finite");
+  if (maxJumps < 0) return fail("maxJumps must be >= 0");
+  if (!jump.IsValid(problem, why)) return false;
+  cont::TracerOptions t = tracer;
+  t.lambdaMin = -1.0;
+  t.lambdaMax = 1.0;
+  return t.IsValid(why);
+}
+
+namespace {
+
+double potentialAt(EquilibriumProblem& problem, const Vector& u, double lambda) {
+  const int n = problem.segments();
+  // Π with the reactions as the forces of the held coordinates: the potential whose
+  // stationary points on the held manifold are the equilibria.
+  return totalPotential(problem.chain(), u.head(n), problem.wrench(u, lambda));
+}
+
+// Index of the first special point past which the traced branch is no longer stable, or −1.
+int firstLossOfStability(const cont::Branch& branch) {
+  for (size_t s = 0; s < branch.specialPoints.size(); ++s) {
+    const cont::SpecialPoint& sp = branch.specialPoints[s];
+    if ((sp.type == cont::SpecialPointType::Fold || sp.type == cont::SpecialPointType::BranchPoint) &&
+        sp.inertiaBefore == 0 && sp.inertiaAfter > 0)
+      return int(s);
+  }
+  return -1;
+}
+
+// Keeps the points of `branch` up to the special point `sp` and ends it there.
+cont::Branch cutAt(const cont::Branch& branch, const cont::SpecialPoint& sp) {
+  cont::Branch cut = branch;
+  cut.points.resize(std::min(cut.points.size(), size_t(sp.index) + 1));
+  cont::ContinuationPoint last = cut.points.back();
+  last.u = sp.u;
+  last.lambda = sp.lambda;
+  last.tangent = sp.tangent;
+  last.arclength = sp.arclength;
+  cut.points.push_back(last);
+  cut.specialPoints.erase(std::remove_if(cut.specialPoints.begin(), cut.specialPoints.end(),
+                                         [&](const cont::SpecialPoint& p) { return p.arclength > sp.arclength; }),
+                          cut.specialPoints.end());
+  return cut;
+}
+
+}  // namespace
+
+LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::VectorXd& q0,
+                                    const std::vector<double>& waypoints, const LoadHistoryOptions& options) {
+  std::string why;
+  if (!options.IsValid(problem, &why)) throw std::invalid_argument("load history options: " + why);
+  if (waypoints.size() < 2) throw std::invalid_argument("load history: at least two waypoints are needed");
+  for (double w : waypoints)
+    if (!std::isfinite(w)) throw std::invalid_argument("load history: waypoints must be finite");
+  if (q0.size() != problem.segments()) throw std::invalid_argument("load history: q0 has the wrong size");
+
+  LoadHistoryResult result;
+  double lambda = waypoints[0];
+  PolishResult start = polishEquilibrium(problem, q0, lambda);
+  if (!start.converged) {
+    result.message = "the start is not an equilibrium: " + start.message;
+    return result;
+  }
+  Vector u = start.u;
+
+  auto release = [&](JumpTrigger trigger, const Vector& from, double critical, double at, int fromSegment) {
+    JumpRecord rec;
+    rec.trigger = trigger;
+    rec.fromSegment = fromSegment;
+    rec.criticalLambda = critical;
+    rec.lambda = at;
+    rec.from = from;
+    const JumpResult jr = simulateJump(problem, from, at, options.jump);
+    rec.success = jr.success;
+    rec.message = jr.message;
+    if (jr.to.size() == from.size()) {
+      rec.to = jr.to;
+      rec.load = problem.wrench(jr.to, at);
+      rec.energyReleased = potentialAt(problem, from, at) - potentialAt(problem, jr.to, at);
+      rec.distance = jr.distance;
+    }
+    result.jumps.push_back(rec);
+    return jr.success;
+  };
+
+  cont::StabilityInfo info;
+  if (problem.stability(u, lambda, info) && info.negative > 0) {
+    if (!release(JumpTrigger::UnstableStart, u, lambda, lambda, -1)) {
+      result.message = "the unstable start did not come to a stable rest: " + result.jumps.back().message;
+      return result;
+    }
+    u = result.jumps.back().to;
+  }
+
+  for (size_t leg = 1; leg < waypoints.size(); ++leg) {
+    const double target = waypoints[leg];
+    while (lambda != target) {
+      if (int(result.jumps.size()) > options.maxJumps) {
+        result.message = "more than " + std::to_string(options.maxJumps) + " jumps";
+        return result;
+      }
+      const double sign = target > lambda ? 1.0 : -1.0;
+      cont::TracerOptions legOptions = options.tracer;
+      legOptions.lambdaMin = std::min(lambda, target);
+      legOptions.lambdaMax = std::max(lambda, target);
+      cont::Branch branch = cont::trace(problem, u, lambda,
+                                         sign > 0 ? cont::InitialDirection::increasingLambda()
+                                                  : cont::InitialDirection::decreasingLambda(),
+                                         legOptions);
+      if (branch.points.empty()) {
+        result.message = "continuation could not start at lambda = " + std::to_string(lambda) + ": " + branch.stopMessage;
+        return result;
+      }
+      const int lost = firstLossOfStability(branch);
+      if (lost < 0) {
+        result.segments.push_back(branch);
+        result.segmentLeg.push_back(int(leg));
+        if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
+          result.jumps.back().toSegment = int(result.segments.size()) - 1;
+        const cont::ContinuationPoint& end = branch.points.back();
+        if (branch.stopReason != cont::StopReason::LambdaRange || std::abs(end.lambda - target) > 1e-9 * std::max(1.0, std::abs(target))) {
+          result.message = "leg " + std::to_string(leg) + " stopped before its waypoint: " + branch.stopMessage;
+          return result;
+        }
+        u = end.u;
+        lambda = target;
+        break;
+      }
+      const cont::SpecialPoint sp = branch.specialPoints[size_t(lost)];
+      result.segments.push_back(cutAt(branch, sp));
+      result.segmentLeg.push_back(int(leg));
+      if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
+        result.jumps.back().toSegment = int(result.segments.size()) - 1;
+      const double at = sp.lambda + sign * options.overshoot * std::max(1.0, std::abs(sp.lambda));
+      const JumpTrigger trigger = sp.type == cont::SpecialPointType::Fold ? JumpTrigger::Fold : JumpTrigger::BranchPoint;
+      if (!release(trigger, sp.u, sp.lambda, at, int(result.segments.size()) - 1)) {
+        result.message = std::string("jump after the ") + toString(trigger) + " at lambda = " + std::to_string(sp.lambda) +
+                         " failed: " + result.jumps.back().message;
+        return result;
+      }
+      u = result.jumps.back().to;
+      lambda = at;
+      if ((target - lambda) * sign <= 0.0) break;  // the overshoot passed the waypoint
+    }
+  }
+  result.completed = true;
+  result.message = "all waypoints reached";
+  return result;
+}
+
+}  // namespace buckle::mechanics

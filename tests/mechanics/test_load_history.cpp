@@ -1,0 +1,81 @@
+// Hysteresis: a bistable segment (κ < 0) under an end torque cycled up and down snaps at the
+// folds of its torque–angle curve, from the closed form, and each snap releases energy.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "buckle/mechanics/load_history.h"
+
+using namespace buckle::mechanics;
+namespace cont = buckle::continuation;
+
+namespace {
+
+// Symmetric segment: M(q) = 2k[(b² − a²) sin q − b L0 sin(q/2)] (eq 10). Its folds under an end
+// torque are where dM/dq = 0: with c = cos(q/2), 2(b² − a²)c² − (b L0/2)c − (b² − a²) = 0.
+double foldTorque(double a, double b, double k, double L0) {
+  const double A = 2 * (b * b - a * a), B = -0.5 * b * L0, C = -(b * b - a * a);
+  const double c = (-B + std::sqrt(B * B - 4 * A * C)) / (2 * A);
+  const double q = 2 * std::acos(c);
+  return 2 * k * ((b * b - a * a) * std::sin(q) - b * L0 * std::sin(q / 2));  // M at the fold (q > 0)
+}
+
+}  // namespace
+
+TEST_CASE("bistable segment under a cycled end torque: unstable start, two snaps per cycle at the folds",
+          "[load_history]") {
+  const double a = 0.5, b = 1.0, k = 1.0, L0 = 1.4;  // κ = k(bL0 − 2(b² − a²)) = −0.1 < 0
+  EquilibriumProblem problem(Chain::uniform(1, SegmentParameters::symmetric(a, b, k, L0)), EndCondition::freeEnd(),
+                             Eigen::Vector3d(0, 0, 1));
+  const double Mfold = foldTorque(a, b, k, L0);  // equilibrium M + Me = 0: folds at Me = ±|Mfold|
+  REQUIRE(Mfold > 0.0);
+  LoadHistoryOptions o;
+  o.tracer.maxStep = 0.005;
+  o.tracer.initialStep = 0.001;
+  const std::vector<double> waypoints = {0.0, 0.05, -0.05, 0.05};
+  const LoadHistoryResult r = followLoadHistory(problem, Eigen::VectorXd::Zero(1), waypoints, o);
+  INFO(r.message);
+  REQUIRE(r.completed);
+  REQUIRE(r.jumps.size() >= 3);
+  CHECK(r.jumps[0].trigger == JumpTrigger::UnstableStart);
+  int folds = 0;
+  for (const JumpRecord& j : r.jumps) {
+    CHECK(j.success);
+    CHECK(j.energyReleased > 0.0);
+    if (j.trigger != JumpTrigger::Fold) continue;
+    ++folds;
+    CHECK(std::abs(j.criticalLambda) == Approx(Mfold).epsilon(1e-9));
+    // It snaps to the other side: the joint angle changes sign.
+    CHECK(j.from[0] * j.to[0] < 0.0);
+  }
+  // 0 → 0.05 → −0.05 → 0.05 crosses ±Mfold at least twice after the start jump.
+  CHECK(folds >= 2);
+  // Every followed piece is stable and an equilibrium.
+  for (const cont::Branch& s : r.segments)
+    for (const cont::ContinuationPoint& p : s.points) {
+      CHECK(p.stability.negative == 0);
+      Eigen::VectorXd F(1);
+      REQUIRE(problem.residual(p.u, p.lambda, F));
+      CHECK(std::abs(F[0]) <= 1e-9);
+    }
+  // Hysteresis: on the way down the snap happens at −Mfold, on the way up at +Mfold.
+  bool up = false, down = false;
+  for (const JumpRecord& j : r.jumps) {
+    if (j.trigger != JumpTrigger::Fold) continue;
+    if (j.criticalLambda > 0) up = true;
+    if (j.criticalLambda < 0) down = true;
+  }
+  CHECK(up);
+  CHECK(down);
+}
+
+TEST_CASE("load history rejects bad input", "[load_history]") {
+  EquilibriumProblem problem(Chain::uniform(1, SegmentParameters::symmetric(0.5, 1, 1, 2.25)), EndCondition::freeEnd(),
+                             Eigen::Vector3d(0, 0, 1));
+  LoadHistoryOptions o;
+  CHECK_THROWS_WITH(followLoadHistory(problem, Eigen::VectorXd::Zero(1), {0.0}, o), Catch::Contains("two waypoints"));
+  CHECK_THROWS_WITH(followLoadHistory(problem, Eigen::VectorXd::Zero(1), {0.0, std::nan("")}, o),
+                    Catch::Contains("finite"));
+  o.overshoot = -1;
+  CHECK_THROWS_WITH(followLoadHistory(problem, Eigen::VectorXd::Zero(1), {0.0, 1.0}, o), Catch::Contains("overshoot"));
+}
