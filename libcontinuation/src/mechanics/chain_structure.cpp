@@ -503,6 +503,41 @@ double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolera
   return lowestEigenvalues(ws, useConstraints, 1, out, tolerance, nullptr) == 1 ? out[0] : 0.0;
 }
 
+Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, int count, VectorRef lowest,
+                          int& found, double zeroTolerance, double rankTolerance) {
+  using SM = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kSmallDense, kSmallDense>;
+  const int n = ws.n;
+  if (n > kSmallDense) throw std::invalid_argument("smallDenseInertia: n > kSmallDense");
+  const int r = C.rows() > 0 ? setConstraints(ws, C, rankTolerance) : (ws.rank = 0);
+  SM H(n, n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) H(i, j) = -ws.h[std::max(i, j)];
+  for (int i = 0; i < n; ++i) H(i, i) += ws.kappa[i];
+  if (r > 0) {
+    // P H P + s Q Qᵀ with P = I − Q Qᵀ
+    SM HQ = H * ws.Q.leftCols(r);                      // n×r
+    SM QtHQ = ws.Q.leftCols(r).transpose() * HQ;       // r×r
+    const double shift = 1.0 + 2.0 * ws.frobeniusH;
+    H -= HQ * ws.Q.leftCols(r).transpose();
+    H -= ws.Q.leftCols(r) * HQ.transpose();
+    H += ws.Q.leftCols(r) * (QtHQ + shift * SM::Identity(r, r)) * ws.Q.leftCols(r).transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<SM> es(H, Eigen::EigenvaluesOnly);
+  const int d = n - r;
+  const auto mu = es.eigenvalues().head(d);
+  Inertia in;
+  found = std::min(count, d);
+  if (d == 0) return in;
+  const double tol = zeroTolerance * std::max(1.0, mu.cwiseAbs().maxCoeff());
+  for (int i = 0; i < d; ++i) {
+    if (std::abs(mu[i]) <= tol) ++in.zero;
+    else if (mu[i] < 0.0) ++in.negative;
+    else ++in.positive;
+  }
+  for (int i = 0; i < found; ++i) lowest[i] = mu[i];
+  return in;
+}
+
 bool solve(ChainStructure& ws, ConstVectorRef r, VectorRef x) {
   factorize(ws, 0.0);
   if (ws.singular) return false;

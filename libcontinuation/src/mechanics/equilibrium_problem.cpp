@@ -174,13 +174,24 @@ bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matr
 }
 
 bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, continuation::StabilityInfo& info) {
-  const int n = chain_.size();
-  if (!options_.structuredStability || n < 32) return Problem::stability(u, lambda, info);
+  if (!options_.structuredStability) return Problem::stability(u, lambda, info);
   if (!inDomain(u)) return false;
+  const int n = chain_.size();
   forwardKinematics(chain_, u.head(n), data_);
   endJacobian(data_, J_);
   assemble(chain_, data_, u.head(n), wrench(u, lambda), structure_);
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
+  if (n <= kSmallDense) {
+    // Small chains: one heap-free dense eigen-solve beats the counts + eigenvalue isolation.
+    Eigen::Vector3d low;
+    int found = 0;
+    const Inertia in = smallDenseInertia(structure_, heldRows_, 3, low, found);
+    info.negative = in.negative;
+    info.zero = in.zero;
+    info.lowest = low.head(found);
+    info.smallest = found > 0 ? low[0] : 0.0;
+    return true;
+  }
   const Inertia in = constrainedInertia(structure_, heldRows_);
   info.negative = in.negative;
   info.zero = in.zero;

@@ -143,6 +143,16 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
 /// Smallest eigenvalue (lowestEigenvalues with count 1; 0 if the dimension is 0).
 double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance = 1e-13);
 
+/// Small chains (n ≤ kSmallDense): inertia of H on ker C and its `count` lowest eigenvalues
+/// (written to lowest[0 … found−1]) from one dense, heap-free symmetric eigen-solve of
+/// P H P + s Q Qᵀ (Q from setConstraints(), P = I − Q Qᵀ, s = 1 + 2‖H‖_F, so the r constrained
+/// directions sit above the spectrum of ZᵀHZ). Zeros are counted as by
+/// continuation::projectedInertia: |μ| ≤ zeroTolerance · max(1, max|μ|). For n ≲ 30 this is
+/// faster than the O(n) counts plus eigenvalue isolation (benchmarks/RESULTS.md).
+constexpr int kSmallDense = 32;
+Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, int count, VectorRef lowest,
+                          int& found, double zeroTolerance = 1e-13, double rankTolerance = 1e-10);
+
 // ---- solves --------------------------------------------------------------------------------
 /// H x = r (x may alias r). Factorizes T at σ = 0; false if T is singular to working precision.
 bool solve(ChainStructure& ws, ConstVectorRef r, VectorRef x);

@@ -57,9 +57,9 @@ class EquilibriumProblem final : public continuation::Problem {
 
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
-  /// Inertia of K_q − K_g on ker J_h and its 3 lowest eigenvalues; O(n) when
-  /// options.structuredStability and n >= 32 (below, the dense eigen-solve of the tiny reduced
-  /// matrix is faster: benchmarks/RESULTS.md), else the dense Problem::stability().
+  /// Inertia of K_q − K_g on ker J_h and its 3 lowest eigenvalues. options.structuredStability:
+  /// O(n) counts for n > 32, a heap-free dense solve for n <= 32 (faster there:
+  /// benchmarks/RESULTS.md); otherwise the dense Problem::stability().
   bool stability(continuation::ConstVectorRef u, double lambda, continuation::StabilityInfo& info) override;
 
   int boundaryCount() const override;

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Regenerates every figure of benchmarks/RESULTS.md: builds the benchmark targets, runs the
+# kernels (all n), the AUTO-07p comparison, the work-precision program and its plot, and writes
+# the raw outputs to benchmarks/results/. RESULTS.md quotes these files.
+#   benchmarks/run_all.sh            (BUILD=build-bench by default; REPS=5)
+set -euo pipefail
+HERE=$(cd "$(dirname "$0")" && pwd)
+ROOT=$(cd "$HERE/.." && pwd)
+BUILD=${BUILD:-$ROOT/build-bench}
+REPS=${REPS:-5}
+R="$HERE/results"
+mkdir -p "$R"
+cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release > /dev/null
+cmake --build "$BUILD" -j2 --target bench_kernels bench_cases work_precision
+{
+  echo "date: $(date -u +%FT%TZ)"
+  echo "nproc: $(nproc)   CPUs: $(grep -c ^processor /proc/cpuinfo)   CPU: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
+  echo "load average at start: $(cut -d' ' -f1-3 /proc/loadavg)"
+  echo "git: $(git -C "$ROOT" rev-parse --short HEAD)"
+} > "$R/machine.txt"
+"$BUILD/bin/bench_kernels" --benchmark_min_time=0.2 | tee "$R/kernels.txt"
+REPS=$REPS BUILD=$BUILD "$HERE/compare_auto.sh" | tee "$R/compare_auto.txt"
+"$BUILD/bin/work_precision" --reps "$REPS" --out "$R" | tee "$R/work_precision.txt"
+gnuplot "$R/work_precision.gp"
+echo "load average at end: $(cut -d' ' -f1-3 /proc/loadavg)" >> "$R/machine.txt"
+echo "results in $R"

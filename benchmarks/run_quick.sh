@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# CI smoke run of the benchmark programs: builds nothing, runs each binary once in a quick mode
+# (small n, --benchmark_min_time=0.01, one repetition) so they don't rot. < 2 minutes; exits
+# non-zero if any program fails.
+#   benchmarks/run_quick.sh [BUILD_DIR]        (default: ./build-bench, then ./build)
+set -uo pipefail
+HERE=$(cd "$(dirname "$0")" && pwd)
+ROOT=$(cd "$HERE/.." && pwd)
+BUILD=${1:-${BUILD:-}}
+if [ -z "$BUILD" ]; then
+  for d in "$ROOT/build-bench" "$ROOT/build"; do [ -x "$d/bin/bench_kernels" ] && BUILD=$d && break; done
+fi
+BIN=${BUILD:+$BUILD/bin}
+[ -n "$BIN" ] && [ -x "$BIN/bench_kernels" ] || { echo "run_quick: no built benchmarks (pass the build dir)"; exit 1; }
+OUT=$(mktemp -d "${TMPDIR:-/tmp}/buckle-bench-quick.XXXXXX")
+trap 'rm -rf "$OUT"' EXIT
+status=0
+run() {
+  local name=$1; shift
+  local t0=$(date +%s%N)
+  if timeout 100 "$@" > "$OUT/$name.log" 2>&1; then
+    echo "ok    $name ($(( ($(date +%s%N) - t0) / 1000000 )) ms)"
+  else
+    echo "FAIL  $name (exit $?)"; tail -20 "$OUT/$name.log"; status=1
+  fi
+}
+BUCKLE_BENCH_MAX_N=30 run bench_kernels "$BIN/bench_kernels" --benchmark_min_time=0.01
+run bench_cases "$BIN/bench_cases" --reps 1
+run work_precision "$BIN/work_precision" --quick --out "$OUT"
+exit $status
