@@ -26,7 +26,8 @@ PEER=${AUTO_PEER:-/work/shared/peers/auto07p}
 BUILD=${BUILD:-$ROOT/build-bench}
 REPS=${REPS:-5}
 AUTO_DIR=${AUTO_DIR:-/usr/lib/auto-07p}
-export OMP_NUM_THREADS=1
+NPROC=$(nproc)
+export OMP_NUM_THREADS=1   # AUTO is built with -fopenmp (note: GNU nproc honours this variable)
 CASES="A_triv A_U A_Z A_Ufine L_triv N_triv I_up"
 
 BC="$BUILD/bin/bench_cases"
@@ -84,7 +85,7 @@ for r in $CASES; do
   BWALL[$r]=$(printf "%s\n" "${walls[@]}" | median)
 done
 
-echo "buckle vs AUTO-07p $(dpkg-query -W -f='${Version}' auto-07p 2>/dev/null), $(date -u +%FT%TZ), nproc $(nproc) ($(grep -c ^processor /proc/cpuinfo) CPUs), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), load $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "buckle vs AUTO-07p $(dpkg-query -W -f='${Version}' auto-07p 2>/dev/null), $(date -u +%FT%TZ), nproc $NPROC ($(grep -c ^processor /proc/cpuinfo) CPUs), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "median of $REPS; AUTO: JAC=1, IID=0; times in ms; ratio = AUTO time / buckle time (>1: buckle faster)"
 echo
 for r in $CASES; do
