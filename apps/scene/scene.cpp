@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/unloaded_shape.h"
 
 namespace buckle::scene {
 
@@ -36,28 +37,6 @@ int Scene::maxSegments() const {
   int n = 0;
   for (const CaseSpec& c : cases) n = std::max(n, static_cast<int>(c.chain.segments.size()));
   return n;
-}
-
-mechanics::SegmentParameters preloadForAngle(const mechanics::SegmentParameters& p, double q0) {
-  // M(q0) = 0 with L1⁰ = S/2 + d, L2⁰ = S/2 − d (S = L1⁰ + L2⁰ kept):
-  //   k1 (L1 − L1⁰) L1' + k2 (L2 − L2⁰) L2' = 0 is linear in d.
-  mechanics::Segment seg(p);
-  const mechanics::Jet3 L1 = seg.spring1(q0), L2 = seg.spring2(q0);
-  const double S = p.L1_0 + p.L2_0;
-  const double denom = p.k1 * L1.d1 - p.k2 * L2.d1;
-  if (!(std::abs(denom) > 1e-14))
-    throw std::invalid_argument("no preloads make this angle an unloaded equilibrium");
-  const double d = (p.k1 * (L1.value - 0.5 * S) * L1.d1 + p.k2 * (L2.value - 0.5 * S) * L2.d1) / denom;
-  mechanics::SegmentParameters out = p;
-  out.L1_0 = 0.5 * S + d;
-  out.L2_0 = 0.5 * S - d;
-  if (!(out.L1_0 > 0.0) || !(out.L2_0 > 0.0)) {
-    std::ostringstream os;
-    os << "the preloads for this angle would be L1_0=" << out.L1_0 << ", L2_0=" << out.L2_0
-       << " (a free length must be > 0)";
-    throw std::invalid_argument(os.str());
-  }
-  return out;
 }
 
 namespace {
@@ -282,7 +261,7 @@ ChainSpec parseChain(const Reader& r, const json& chain, const Pointer& p) {
         r.fail(q0Pointers[i], os.str());
       }
       try {
-        sp = preloadForAngle(sp, qi);
+        sp = mechanics::preloadsForAngle(sp, qi).parameters;
       } catch (const std::invalid_argument& e) {
         r.fail(q0Pointers[i], e.what());
       }

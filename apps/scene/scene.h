@@ -138,8 +138,4 @@ Scene loadScene(const std::string& file);
 /// Same, from text (file is only used in messages).
 Scene parseScene(const std::string& text, const std::string& file);
 
-/// Preloads (L1⁰, L2⁰) making q0 an unloaded equilibrium of a segment, keeping L1⁰ + L2⁰.
-/// Throws std::invalid_argument if no such preloads exist (both springs must stay positive).
-mechanics::SegmentParameters preloadForAngle(const mechanics::SegmentParameters& p, double q0);
-
 }  // namespace buckle::scene
