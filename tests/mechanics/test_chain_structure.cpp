@@ -414,3 +414,28 @@ TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense defa
     }
   }
 }
+
+TEST_CASE("small-chain dense path: inertia and lowest eigenvalues match the dense projection", "[chain_structure]") {
+  std::mt19937 rng(77);
+  for (int n : {1, 2, 3, 5, 17, 32}) {
+    for (int trial = 0; trial < 8; ++trial) {
+      Instance in = randomInstance(n, rng, 0.3 + trial);
+      ChainStructure ws(n);
+      assembleInstance(in, ws);
+      for (const auto& held : kHeldSets) {
+        if (int(held.size()) > n) continue;
+        const Matrix C = rows(in.J, held);
+        const StabilityInfo dense = projectedInertia(in.H, C);
+        Eigen::Vector3d low;
+        int found = 0;
+        const Inertia fast = smallDenseInertia(ws, C, 3, low, found);
+        INFO("n = " << n << " held " << held.size() << " trial " << trial);
+        CHECK(fast.negative == dense.negative);
+        CHECK(fast.zero == dense.zero);
+        REQUIRE(found == int(dense.lowest.size()));
+        const double scale = std::max(1.0, in.H.norm());
+        for (int j = 0; j < found; ++j) CHECK(std::abs(low[j] - dense.lowest[j]) <= 1e-12 * scale);
+      }
+    }
+  }
+}

@@ -509,26 +509,81 @@ Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C,
   const int n = ws.n;
   if (n > kSmallDense) throw std::invalid_argument("smallDenseInertia: n > kSmallDense");
   const int r = C.rows() > 0 ? setConstraints(ws, C, rankTolerance) : (ws.rank = 0);
-  SM H(n, n);
+  SM A(n, n);
   for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) H(i, j) = -ws.h[std::max(i, j)];
-  for (int i = 0; i < n; ++i) H(i, i) += ws.kappa[i];
-  if (r > 0) {
-    // P H P + s Q Qᵀ with P = I − Q Qᵀ
-    SM HQ = H * ws.Q.leftCols(r);                      // n×r
-    SM QtHQ = ws.Q.leftCols(r).transpose() * HQ;       // r×r
-    const double shift = 1.0 + 2.0 * ws.frobeniusH;
-    H -= HQ * ws.Q.leftCols(r).transpose();
-    H -= ws.Q.leftCols(r) * HQ.transpose();
-    H += ws.Q.leftCols(r) * (QtHQ + shift * SM::Identity(r, r)) * ws.Q.leftCols(r).transpose();
+    for (int i = 0; i < n; ++i) A(i, j) = -ws.h[std::max(i, j)];
+  for (int i = 0; i < n; ++i) A(i, i) += ws.kappa[i];
+  // Householder reflectors P_j map the orthonormal Q onto the first r coordinates; then
+  // ker C ↔ the last d coordinates and Zᵀ H Z is the trailing d×d block of P H P.
+  SM Qw = ws.Q.topLeftCorner(n, r);
+  double v[kSmallDense];
+  for (int j = 0; j < r; ++j) {
+    const int len = n - j;
+    double norm2 = 0.0;
+    for (int i = 0; i < len; ++i) {
+      v[i] = Qw(j + i, j);
+      norm2 += v[i] * v[i];
+    }
+    const double alpha = v[0] >= 0.0 ? -std::sqrt(norm2) : std::sqrt(norm2);
+    v[0] -= alpha;
+    double beta = 0.0;
+    for (int i = 0; i < len; ++i) beta += v[i] * v[i];
+    if (beta == 0.0) continue;
+    const double f = 2.0 / beta;
+    for (int c = 0; c < r; ++c) {  // Qw ← P Qw
+      double dot = 0.0;
+      for (int i = 0; i < len; ++i) dot += v[i] * Qw(j + i, c);
+      for (int i = 0; i < len; ++i) Qw(j + i, c) -= f * dot * v[i];
+    }
+    for (int c = 0; c < n; ++c) {  // A ← P A
+      double dot = 0.0;
+      for (int i = 0; i < len; ++i) dot += v[i] * A(j + i, c);
+      for (int i = 0; i < len; ++i) A(j + i, c) -= f * dot * v[i];
+    }
+    for (int c = 0; c < n; ++c) {  // A ← A P
+      double dot = 0.0;
+      for (int i = 0; i < len; ++i) dot += A(c, j + i) * v[i];
+      for (int i = 0; i < len; ++i) A(c, j + i) -= f * dot * v[i];
+    }
   }
-  Eigen::SelfAdjointEigenSolver<SM> es(H, Eigen::EigenvaluesOnly);
   const int d = n - r;
-  const auto mu = es.eigenvalues().head(d);
   Inertia in;
   found = std::min(count, d);
   if (d == 0) return in;
-  const double tol = zeroTolerance * std::max(1.0, mu.cwiseAbs().maxCoeff());
+  SM S = A.bottomRightCorner(d, d);
+  // Cyclic Jacobi: accurate and, for the tiny matrices of this path, cheaper than a QR solver.
+  double total = 0.0;
+  for (int j = 0; j < d; ++j)
+    for (int i = 0; i < d; ++i) total += S(i, j) * S(i, j);
+  for (int sweep = 0; sweep < 60; ++sweep) {
+    double off = 0.0;
+    for (int q = 1; q < d; ++q)
+      for (int p = 0; p < q; ++p) off += S(p, q) * S(p, q);
+    if (off <= 1e-34 * total || off == 0.0) break;
+    for (int q = 1; q < d; ++q)
+      for (int p = 0; p < q; ++p) {
+        const double apq = S(p, q);
+        if (apq == 0.0) continue;
+        const double theta = (S(q, q) - S(p, p)) / (2.0 * apq);
+        const double t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+        const double c = 1.0 / std::sqrt(t * t + 1.0), sn = t * c;
+        S(p, p) -= t * apq;
+        S(q, q) += t * apq;
+        S(p, q) = S(q, p) = 0.0;
+        for (int k = 0; k < d; ++k) {
+          if (k == p || k == q) continue;
+          const double skp = S(k, p), skq = S(k, q);
+          S(k, p) = S(p, k) = c * skp - sn * skq;
+          S(k, q) = S(q, k) = sn * skp + c * skq;
+        }
+      }
+  }
+  double mu[kSmallDense];
+  for (int i = 0; i < d; ++i) mu[i] = S(i, i);
+  std::sort(mu, mu + d);
+  double maxAbs = 0.0;
+  for (int i = 0; i < d; ++i) maxAbs = std::max(maxAbs, std::abs(mu[i]));
+  const double tol = zeroTolerance * std::max(1.0, maxAbs);
   for (int i = 0; i < d; ++i) {
     if (std::abs(mu[i]) <= tol) ++in.zero;
     else if (mu[i] < 0.0) ++in.negative;

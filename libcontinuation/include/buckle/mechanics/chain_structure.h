@@ -144,9 +144,10 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
 double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance = 1e-13);
 
 /// Small chains (n ≤ kSmallDense): inertia of H on ker C and its `count` lowest eigenvalues
-/// (written to lowest[0 … found−1]) from one dense, heap-free symmetric eigen-solve of
-/// P H P + s Q Qᵀ (Q from setConstraints(), P = I − Q Qᵀ, s = 1 + 2‖H‖_F, so the r constrained
-/// directions sit above the spectrum of ZᵀHZ). Zeros are counted as by
+/// (written to lowest[0 … found−1]) from a dense, heap-free eigen-solve: Householder
+/// reflectors map the orthonormalised rows of C onto the first r coordinates, the trailing
+/// (n − r)² block of the reflected H is Zᵀ H Z, and cyclic Jacobi gives its eigenvalues.
+/// Zeros are counted as by
 /// continuation::projectedInertia: |μ| ≤ zeroTolerance · max(1, max|μ|). For n ≲ 30 this is
 /// faster than the O(n) counts plus eigenvalue isolation (benchmarks/RESULTS.md).
 constexpr int kSmallDense = 32;
