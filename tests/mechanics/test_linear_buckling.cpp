@@ -9,6 +9,7 @@
 
 #include "buckle/continuation/problem.h"
 #include "buckle/mechanics/linear_buckling.h"
+#include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/unloaded_shape.h"
 
 using namespace buckle::mechanics;
@@ -219,4 +220,21 @@ TEST_CASE("clamped-pinned and cantilever chains converge to the Euler elastica l
     prevPinned = ePinned;
     prevFree = eFree;
   }
+}
+
+TEST_CASE("shape names: Table I sign patterns, straight, other, sign changes for general n", "[buckling][shape]") {
+  CHECK(shapeName(Eigen::Vector3d(-0.1, 0.2, 0.3)) == "U");
+  CHECK(shapeName(Eigen::Vector3d(0.1, -0.2, -0.3)) == "U");
+  CHECK(shapeName(Eigen::Vector3d(-0.1, 0.2, -0.3)) == "Z");
+  CHECK(shapeName(Eigen::Vector3d(0.1, -0.2, 0.3)) == "Z");
+  CHECK(shapeName(Eigen::Vector3d(0.1, 0.2, 0.3)) == "other");
+  CHECK(shapeName(Eigen::Vector3d(-0.1, -0.2, 0.3)) == "other");
+  CHECK(shapeName(Eigen::Vector3d(0.0, 0.2, 0.3)) == "other");
+  CHECK(shapeName(Eigen::Vector3d(1e-12, -1e-11, 0.0)) == "straight");
+  CHECK(modeShapeName(Eigen::Vector3d(-1e-12, 2e-12, 3e-12)) == "U");  // scale-free
+  // general n: sign changes of the link angles θ = cumulative sums of q
+  CHECK(shapeName((Vector(4) << 0.1, 0.1, 0.1, 0.1).finished()) == "mode 0");
+  CHECK(shapeName((Vector(4) << 0.1, -0.3, 0.0, 0.0).finished()) == "mode 1");   // θ = (0.1, −0.2, −0.2, −0.2)
+  CHECK(shapeName((Vector(4) << 0.1, -0.3, 0.4, 0.0).finished()) == "mode 2");   // θ = (0.1, −0.2, 0.2, 0.2)
+  CHECK(signChanges((Vector(5) << 1, 0, -1, 1e-20, 2).finished(), 1e-15) == 2);
 }

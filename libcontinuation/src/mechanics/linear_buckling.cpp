@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
+#include <limits>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -15,8 +16,77 @@ namespace buckle::mechanics {
 
 namespace {
 
+// The `wanted` eigenpairs of the symmetric C with the largest |μ| (λ = 1/μ smallest), by
+// Householder tridiagonalisation (4/3 k³), eigenvalues of the tridiagonal (O(k²)) and inverse
+// iteration on it (O(k) per vector). False if a pair is not resolved (clustered eigenvalues):
+// the caller then uses the full eigen-decomposition.
+bool fewLargestPairs(const Matrix& C, int wanted, double relTiny, std::vector<std::pair<double, Vector>>& out,
+                     int& infinite) {
+  const Eigen::Index k = C.rows();
+  const Eigen::Tridiagonalization<Matrix> tri(C);
+  const Vector d = tri.diagonal();
+  const Vector e = tri.subDiagonal();
+  Eigen::SelfAdjointEigenSolver<Matrix> es;
+  es.computeFromTridiagonal(d, e, Eigen::EigenvaluesOnly);
+  const Vector mu = es.eigenvalues();
+  const double muMax = mu.cwiseAbs().maxCoeff();
+  if (!(muMax > 0.0)) return false;
+  std::vector<Eigen::Index> order(static_cast<size_t>(k));
+  for (Eigen::Index i = 0; i < k; ++i) order[size_t(i)] = i;
+  std::sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) { return std::abs(mu[a]) > std::abs(mu[b]); });
+  int tiny = 0;
+  for (Eigen::Index i = 0; i < k; ++i)
+    if (std::abs(mu[i]) <= relTiny * muMax) ++tiny;
+  const double tnorm = d.cwiseAbs().maxCoeff() + 2.0 * (e.size() ? e.cwiseAbs().maxCoeff() : 0.0);
+  std::vector<std::pair<double, Vector>> found;
+  for (size_t r = 0; r < order.size() && int(found.size()) < wanted; ++r) {
+    const double m = mu[order[r]];
+    if (std::abs(m) <= relTiny * muMax) break;
+    // isolated enough for inverse iteration?
+    double gap = std::numeric_limits<double>::infinity();
+    for (Eigen::Index j = 0; j < k; ++j)
+      if (j != order[r]) gap = std::min(gap, std::abs(mu[j] - m));
+    if (gap <= 1e-8 * tnorm) return false;
+    // unpivoted LDLᵀ of T − σI with safeguarded pivots; σ slightly off m keeps it regular
+    const double sigma = m + 1e-14 * tnorm;
+    Vector piv(k), l(std::max<Eigen::Index>(k - 1, 0));
+    const double floorPivot = 1e-300 + std::numeric_limits<double>::epsilon() * tnorm;
+    piv[0] = d[0] - sigma;
+    for (Eigen::Index i = 1; i < k; ++i) {
+      if (std::abs(piv[i - 1]) < floorPivot) piv[i - 1] = piv[i - 1] < 0 ? -floorPivot : floorPivot;
+      l[i - 1] = e[i - 1] / piv[i - 1];
+      piv[i] = d[i] - sigma - l[i - 1] * e[i - 1];
+    }
+    if (std::abs(piv[k - 1]) < floorPivot) piv[k - 1] = floorPivot;
+    Vector y = Vector::Ones(k) / std::sqrt(double(k));
+    for (Eigen::Index i = 0; i < k; ++i) y[i] += 1e-3 * std::sin(double(i + 1) * 1.2345);  // not orthogonal to any eigvec
+    y.normalize();
+    for (int it = 0; it < 4; ++it) {
+      for (Eigen::Index i = 1; i < k; ++i) y[i] -= l[i - 1] * y[i - 1];
+      y.array() /= piv.array();
+      for (Eigen::Index i = k - 2; i >= 0; --i) y[i] -= l[i] * y[i + 1];
+      const double nrm = y.norm();
+      if (!(nrm > 0.0) || !std::isfinite(nrm)) return false;
+      y /= nrm;
+    }
+    // residual of T y = m y
+    Vector Ty = d.cwiseProduct(y);
+    if (k > 1) {
+      Ty.head(k - 1) += e.cwiseProduct(y.tail(k - 1));
+      Ty.tail(k - 1) += e.cwiseProduct(y.head(k - 1));
+    }
+    if ((Ty - m * y).norm() > 1e-10 * tnorm) return false;
+    Vector v = tri.matrixQ() * y;  // eigenvector of C
+    found.emplace_back(m, std::move(v));
+  }
+  out = std::move(found);
+  infinite = tiny;
+  return true;
+}
+
 // Eigenpairs (λ, w) of A w = λ B w with A, B symmetric; infinite λ (B w = 0) are counted, not returned.
-void generalisedEigen(const Matrix& A, const Matrix& B, std::vector<std::pair<double, Vector>>& pairs, int& infinite) {
+void generalisedEigen(const Matrix& A, const Matrix& B, int wanted, std::vector<std::pair<double, Vector>>& pairs,
+                      int& infinite) {
   const Eigen::Index k = A.rows();
   infinite = 0;
   if (k == 0) return;
@@ -26,17 +96,41 @@ void generalisedEigen(const Matrix& A, const Matrix& B, std::vector<std::pair<do
     return;
   }
   // A definite (the stable or uniformly unstable chain): B w = μ A w, λ = 1/μ, symmetric and robust.
+  // With sign·A = L Lᵀ: C = L⁻¹ (sign·B) L⁻ᵀ, C y = μ y, w = L⁻ᵀ y. A diagonal A (the free end)
+  // skips the Cholesky factorisation.
+  const bool diagonal = (Matrix(A.diagonal().asDiagonal()) - A).cwiseAbs().maxCoeff() == 0.0;
   for (double sign : {1.0, -1.0}) {
     if (!(scaleA > 0.0)) break;
     const Matrix As = sign * A;
-    const Eigen::LLT<Matrix> llt(As);
-    if (llt.info() != Eigen::Success) continue;
-    const Vector diag = llt.matrixL().toDenseMatrix().diagonal();
-    if (diag.minCoeff() <= 1e-10 * std::sqrt(scaleA)) continue;  // numerically semidefinite
-    // C = L⁻¹ (sign B) L⁻ᵀ
-    Matrix C = llt.matrixL().solve(sign * B);
-    C = llt.matrixL().solve(C.transpose()).transpose();
+    Eigen::LLT<Matrix> llt;
+    Vector sqrtDiag;
+    Matrix C;
+    if (diagonal) {
+      if (As.diagonal().minCoeff() <= 1e-20 * scaleA) continue;
+      sqrtDiag = As.diagonal().cwiseSqrt();
+      const Vector s = sqrtDiag.cwiseInverse();
+      C = s.asDiagonal() * (sign * B) * s.asDiagonal();
+    } else {
+      llt.compute(As);
+      if (llt.info() != Eigen::Success) continue;
+      if (Vector(llt.matrixLLT().diagonal()).minCoeff() <= 1e-10 * std::sqrt(scaleA)) continue;  // semidefinite
+      C = llt.matrixL().solve(sign * B);
+      C = llt.matrixL().solve(C.transpose()).transpose();
+    }
     C = 0.5 * (C + C.transpose());
+    auto back = [&](const Vector& y) -> Vector {
+      if (diagonal) return y.cwiseQuotient(sqrtDiag);
+      return llt.matrixU().solve(y);
+    };
+    if (wanted > 0 && 8 * Eigen::Index(wanted) <= k) {
+      std::vector<std::pair<double, Vector>> few;
+      int tiny = 0;
+      if (fewLargestPairs(C, wanted, 1e-12, few, tiny)) {
+        infinite = tiny;
+        for (auto& [mu, y] : few) pairs.emplace_back(1.0 / mu, back(y));
+        return;
+      }
+    }
     const Eigen::SelfAdjointEigenSolver<Matrix> es(C);
     const Vector& mu = es.eigenvalues();
     const double muMax = mu.cwiseAbs().maxCoeff();
@@ -45,8 +139,7 @@ void generalisedEigen(const Matrix& A, const Matrix& B, std::vector<std::pair<do
         ++infinite;
         continue;
       }
-      const Vector w = llt.matrixU().solve(es.eigenvectors().col(i));  // L⁻ᵀ y
-      pairs.emplace_back(1.0 / mu[i], w);
+      pairs.emplace_back(1.0 / mu[i], back(es.eigenvectors().col(i)));
     }
     return;
   }
@@ -112,29 +205,45 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
   Matrix G(n, n);
   loadMatrix(data, Wrench(options.direction[0], options.direction[1], 0.0), G);
 
-  // Orthonormal basis of ker J_h.
+  // ker J_h: the last n − rank columns of Q in J_hᵀ P = Q R. The reflectors are applied to K_q
+  // and G directly (O(m n²)) rather than forming Q.
   const std::vector<int> held = end.heldIndices();
   const int m = int(held.size());
-  Matrix Z;
-  if (m == 0) {
-    Z = Matrix::Identity(n, n);
-  } else {
-    Matrix Ch(n, m);
-    for (int k = 0; k < m; ++k) Ch.col(k) = J.row(held[size_t(k)]).transpose();
-    const Eigen::ColPivHouseholderQR<Matrix> qr(Ch);
-    const int rank = int(qr.rank());
-    const Matrix Q = qr.householderQ() * Matrix::Identity(n, n);
-    Z = Q.rightCols(n - rank);
-  }
+  Matrix Ch(n, m);
+  for (int k = 0; k < m; ++k) Ch.col(k) = J.row(held[size_t(k)]).transpose();
+  // (an n×0 factorisation is not valid Eigen input: factor a zero column instead, unused)
+  const Eigen::ColPivHouseholderQR<Matrix> qr(m > 0 ? Ch : Matrix(Matrix::Zero(n, 1)));
+  const int rank = m == 0 ? 0 : int(qr.rank());
+  const int nr = n - rank;
   LinearBucklingResult out;
-  out.constrainedDimension = int(Z.cols());
-  if (Z.cols() == 0) {
+  out.constrainedDimension = nr;
+  if (nr == 0) {
     out.unloadedStable = true;
     return out;
   }
-  const Matrix A = Z.transpose() * kq.asDiagonal() * Z;
-  Matrix B = Z.transpose() * G * Z;
+  Matrix A, B;
+  if (rank == 0) {
+    A = kq.asDiagonal();
+    B = G;
+  } else {
+    const auto Q = qr.householderQ().setLength(rank);
+    Matrix Kf = kq.asDiagonal();
+    Kf.applyOnTheLeft(Q.transpose());
+    Kf.applyOnTheRight(Q);
+    Matrix Gf = G;
+    Gf.applyOnTheLeft(Q.transpose());
+    Gf.applyOnTheRight(Q);
+    A = Kf.bottomRightCorner(nr, nr);
+    B = Gf.bottomRightCorner(nr, nr);
+  }
+  A = 0.5 * (A + A.transpose());
   B = 0.5 * (B + B.transpose());
+  auto expand = [&](const Vector& w) {
+    Vector z = Vector::Zero(n);
+    z.tail(nr) = w;
+    if (rank > 0) z.applyOnTheLeft(qr.householderQ().setLength(rank));
+    return z;
+  };
 
   const Eigen::SelfAdjointEigenSolver<Matrix> esA(A, Eigen::EigenvaluesOnly);
   out.unloadedStable = esA.eigenvalues()[0] > 0.0;
@@ -156,13 +265,13 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
       pairs.emplace_back(0.0, esB.eigenvectors().col(i));
     }
   } else {
-    generalisedEigen(A, B, pairs, out.droppedInfinite);
+    generalisedEigen(A, B, options.count, pairs, out.droppedInfinite);
   }
 
   for (auto& [lambda, w] : pairs) {
     BucklingMode mode;
     mode.lambda = lambda;
-    Vector z = Z * w;
+    Vector z = expand(w);
     const double norm = z.norm();
     if (!(norm > 0.0) || !std::isfinite(lambda)) continue;
     z /= norm;
