@@ -551,36 +551,42 @@ Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C,
   found = std::min(count, d);
   if (d == 0) return in;
   SM S = A.bottomRightCorner(d, d);
-  // Cyclic Jacobi: accurate and, for the tiny matrices of this path, cheaper than a QR solver.
-  double total = 0.0;
-  for (int j = 0; j < d; ++j)
-    for (int i = 0; i < d; ++i) total += S(i, j) * S(i, j);
-  for (int sweep = 0; sweep < 60; ++sweep) {
-    double off = 0.0;
-    for (int q = 1; q < d; ++q)
-      for (int p = 0; p < q; ++p) off += S(p, q) * S(p, q);
-    if (off <= 1e-34 * total || off == 0.0) break;
-    for (int q = 1; q < d; ++q)
-      for (int p = 0; p < q; ++p) {
-        const double apq = S(p, q);
-        if (apq == 0.0) continue;
-        const double theta = (S(q, q) - S(p, p)) / (2.0 * apq);
-        const double t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
-        const double c = 1.0 / std::sqrt(t * t + 1.0), sn = t * c;
-        S(p, p) -= t * apq;
-        S(q, q) += t * apq;
-        S(p, q) = S(q, p) = 0.0;
-        for (int k = 0; k < d; ++k) {
-          if (k == p || k == q) continue;
-          const double skp = S(k, p), skq = S(k, q);
-          S(k, p) = S(p, k) = c * skp - sn * skq;
-          S(k, q) = S(q, k) = sn * skp + c * skq;
-        }
-      }
-  }
   double mu[kSmallDense];
-  for (int i = 0; i < d; ++i) mu[i] = S(i, i);
-  std::sort(mu, mu + d);
+  if (d > 4) {
+    // Larger blocks: Eigen's tridiagonal QR (Jacobi's O(d³) sweeps lose from d ≈ 5 on).
+    Eigen::SelfAdjointEigenSolver<SM> es(S, Eigen::EigenvaluesOnly);
+    for (int i = 0; i < d; ++i) mu[i] = es.eigenvalues()[i];
+  } else {
+    // Cyclic Jacobi: accurate and, for blocks up to 4×4, cheaper than a QR solver.
+    double total = 0.0;
+    for (int j = 0; j < d; ++j)
+      for (int i = 0; i < d; ++i) total += S(i, j) * S(i, j);
+    for (int sweep = 0; sweep < 60; ++sweep) {
+      double off = 0.0;
+      for (int q = 1; q < d; ++q)
+        for (int p = 0; p < q; ++p) off += S(p, q) * S(p, q);
+      if (off <= 1e-34 * total || off == 0.0) break;
+      for (int q = 1; q < d; ++q)
+        for (int p = 0; p < q; ++p) {
+          const double apq = S(p, q);
+          if (apq == 0.0) continue;
+          const double theta = (S(q, q) - S(p, p)) / (2.0 * apq);
+          const double t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+          const double c = 1.0 / std::sqrt(t * t + 1.0), sn = t * c;
+          S(p, p) -= t * apq;
+          S(q, q) += t * apq;
+          S(p, q) = S(q, p) = 0.0;
+          for (int k = 0; k < d; ++k) {
+            if (k == p || k == q) continue;
+            const double skp = S(k, p), skq = S(k, q);
+            S(k, p) = S(p, k) = c * skp - sn * skq;
+            S(k, q) = S(q, k) = sn * skp + c * skq;
+          }
+        }
+    }
+    for (int i = 0; i < d; ++i) mu[i] = S(i, i);
+    std::sort(mu, mu + d);
+  }
   double maxAbs = 0.0;
   for (int i = 0; i < d; ++i) maxAbs = std::max(maxAbs, std::abs(mu[i]));
   const double tol = zeroTolerance * std::max(1.0, maxAbs);

@@ -146,7 +146,8 @@ double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolera
 /// Small chains (n ≤ kSmallDense): inertia of H on ker C and its `count` lowest eigenvalues
 /// (written to lowest[0 … found−1]) from a dense, heap-free eigen-solve: Householder
 /// reflectors map the orthonormalised rows of C onto the first r coordinates, the trailing
-/// (n − r)² block of the reflected H is Zᵀ H Z, and cyclic Jacobi gives its eigenvalues.
+/// (n − r)² block of the reflected H is Zᵀ H Z; cyclic Jacobi (block ≤ 4×4) or Eigen's QR solver
+/// gives its eigenvalues.
 /// Zeros are counted as by
 /// continuation::projectedInertia: |μ| ≤ zeroTolerance · max(1, max|μ|). For n ≲ 30 this is
 /// faster than the O(n) counts plus eigenvalue isolation (benchmarks/RESULTS.md).
