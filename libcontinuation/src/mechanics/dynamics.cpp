@@ -108,6 +108,7 @@ DynamicsModel::DynamicsModel(const Chain& chain, const EndCondition& end)
   for (int c = 0; c < 3; ++c)
     if (!finite(end.value[c])) throw std::invalid_argument("end condition value " + std::to_string(c) + " must be finite");
   for (int c : loaded_) loads_[c] = end.value[c];
+  llt_.compute(Matrix::Identity(heldCount(), heldCount()));  // defines its status flag
 }
 
 void DynamicsModel::evaluateStatics(ConstVectorRef q) {
@@ -312,14 +313,16 @@ InertialModel::InertialModel(const Chain& chain, const EndCondition& end, const 
   M_.resize(n, n);
   cos_.resize(n);
   sin_.resize(n);
-  mllt_ = Eigen::LLT<Matrix>(n);
+  // Size the factorizations once by factoring an identity (copy-assigning an LLT(size) would
+  // copy its not-yet-initialized status flag).
+  mllt_.compute(Matrix::Identity(n, n));
   thetaDot_.resize(n);
   cTheta_.resize(n);
   f_.resize(n);
   acc_.resize(n);
   B_.resize(n, m);
   S_.resize(m, m);
-  sllt_ = Eigen::LLT<Matrix>(m);
+  sllt_.compute(Matrix::Identity(m, m));
 
   omega_ = baumgarteRate;
   if (!(omega_ > 0.0)) {
