@@ -13,6 +13,7 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/equilibrium_solve.h"
 #include "buckle/mechanics/jump.h"
+#include "buckle/mechanics/load_history.h"
 #include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/unloaded_shape.h"
@@ -48,6 +49,7 @@ class CaseRunner {
       : scene_(scene), spec_(spec), out_(out), run_(run), start_(start) {}
 
   void continuation();
+  void loadHistory();
   void criticalForces();
   void energyCurves();
   void torqueAngle();
@@ -351,6 +353,83 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
   }
 }
 
+// The load history of the scene: stable quasi-static pieces joined by jumps. Each piece is a
+// branch of the output; each jump a special point "JUMP" (field "jumping") with its landing,
+// drawn as an arrow in the bifurcation plots.
+void CaseRunner::loadHistory() {
+  const int n = out_.chain.size();
+  const double s0 = out_.startValue;
+  mech::EndCondition end = spec_.end.condition;
+  const Eigen::Vector3d direction = spec_.path.direction;
+  end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
+  mech::EquilibriumProblem problem(out_.chain, end, direction);
+  mech::LoadHistoryOptions opt;
+  opt.tracer.initialStep = scene_.solver.initialStep;
+  opt.tracer.minStep = scene_.solver.minStep;
+  opt.tracer.maxStep = scene_.solver.maxStep;
+  opt.tracer.maxPoints = scene_.solver.maxPoints;
+  opt.tracer.newtonTolerance = scene_.solver.tolerance;
+  opt.jump.perturbation = scene_.analyses.loadHistory.perturbation;
+  mech::LoadHistoryResult h;
+  try {
+    h = mech::followLoadHistory(problem, out_.q0, scene_.analyses.loadHistory.waypoints, opt);
+  } catch (const std::exception& e) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": load history: " + e.what());
+    return;
+  }
+  const int base = out_.branches.empty() ? 0 : out_.branches.back().id + 1;
+  for (size_t k = 0; k < h.segments.size(); ++k) {
+    cont::Branch b = h.segments[k];
+    b.id = base + int(k);
+    b.parentId = k == 0 ? -1 : base + int(k) - 1;
+    const bool endsInJump = std::any_of(h.jumps.begin(), h.jumps.end(),
+                                        [&](const mech::JumpRecord& j) { return j.fromSegment == int(k); });
+    if (endsInJump) {
+      b.stopReason = cont::StopReason::Boundary;
+      b.stopMessage = "the stable state ends here: the chain jumps";
+    }
+    std::ostringstream origin;
+    origin << "load history, leg " << h.segmentLeg[k] << " (" << spec_.path.parameter << " -> "
+           << scene_.analyses.loadHistory.waypoints[size_t(h.segmentLeg[k])] << ")";
+    record(b, problem, origin.str());
+  }
+  for (const mech::JumpRecord& j : h.jumps) {
+    SpecialRecord s;
+    s.type = "JUMP";
+    s.field = "jumping";
+    s.branch = j.fromSegment >= 0 ? base + j.fromSegment : base;
+    s.parameter = j.lambda;
+    s.q = j.from.head(n);
+    s.F = problem.wrench(j.from, j.lambda);
+    s.pose = mech::endPose(out_.chain, s.q);
+    s.shape = mech::shapeName(s.q, 1e-6);
+    s.stabilityBefore = j.trigger == mech::JumpTrigger::UnstableStart ? "unstable" : "critical";
+    s.stabilityAfter = j.success ? "stable" : "unknown";
+    std::ostringstream note;
+    note << "trigger: " << mech::toString(j.trigger) << " at " << spec_.path.parameter << " = " << j.criticalLambda
+         << "; released at " << j.lambda;
+    s.note = note.str();
+    s.jumpTried = true;
+    s.jumpSuccess = j.success;
+    s.jumpLanding = j.success ? "stable equilibrium" : "none";
+    s.jumpMessage = j.message;
+    if (j.to.size() > 0) {
+      s.jumpQ = j.to.head(n);
+      s.jumpF = j.load;
+      s.jumpPose = mech::endPose(out_.chain, s.jumpQ);
+      s.jumpShape = mech::shapeName(s.jumpQ, 1e-6);
+    }
+    s.energyReleased = j.energyReleased;
+    s.jumpDistance = j.distance;
+    out_.specials.push_back(s);
+  }
+  if (!h.completed) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": load history stopped: " + h.message);
+  }
+}
+
 // Leaves the branch point `spIndex` of `parent` along the bifurcating direction (sign ±1).
 bool CaseRunner::switchAt(cont::Tracer& tracer, const cont::Branch& parent, int spIndex, int sign,
                           cont::Branch& child) {
@@ -546,6 +625,9 @@ RunResult runScene(const Scene& scene) {
                                : "continuation of the primary branch");
   if (a.stiffness) run.computed.push_back("loaded stiffness K_F along the branches (eq 29)");
   if (a.jump.enabled) run.computed.push_back("jumps from the folds (gradient-flow dynamics, landing polished)");
+  if (a.loadHistory.enabled)
+    run.computed.push_back("quasi-static load history with jumps (hysteresis), " +
+                           std::to_string(a.loadHistory.waypoints.size()) + " waypoints");
   if (a.criticalForces.enabled) run.computed.push_back("critical forces of the start configuration (linear buckling)");
   if (a.energyCurves.enabled) run.computed.push_back("energy curves E(q1) with the end held (eq 6-8)");
   if (a.torqueAngle.enabled) run.computed.push_back("torque-angle curves M(q) of the first segment (eq 1)");
@@ -555,6 +637,7 @@ RunResult runScene(const Scene& scene) {
   if (a.criticalForces.enabled) stages.emplace_back("critical_forces", [](CaseRunner& r) { r.criticalForces(); });
   if (a.energyCurves.enabled) stages.emplace_back("energy_curves", [](CaseRunner& r) { r.energyCurves(); });
   if (a.continuation.enabled) stages.emplace_back("continuation", [](CaseRunner& r) { r.continuation(); });
+  if (a.loadHistory.enabled) stages.emplace_back("load_history", [](CaseRunner& r) { r.loadHistory(); });
   std::vector<double> stageSeconds(stages.size(), 0.0);
 
   run.cases.reserve(scene.cases.size());

@@ -410,7 +410,8 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
 // ---- analyses, solver, plots ------------------------------------------------------------------
 
 AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
-  r.onlyKeys(a, p, {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump"});
+  r.onlyKeys(a, p,
+             {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump", "load_history"});
   AnalysesSpec s;
   if (a.contains("continuation")) {
     const json& c = a["continuation"];
@@ -481,8 +482,21 @@ AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
     if (s.jump.enabled && !s.continuation.enabled)
       r.fail(pj, "jumps are simulated from the folds of the traced branches: it needs /analyses/continuation");
   }
-  if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled)
-    r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces)");
+  if (a.contains("load_history")) {
+    const json& h = a["load_history"];
+    const Pointer ph = p / "load_history";
+    r.onlyKeys(h, ph, {"waypoints", "perturbation"});
+    if (!h.contains("waypoints")) r.fail(ph / "waypoints", "missing (required): the path-parameter values to visit");
+    const json& w = h["waypoints"];
+    if (!w.is_array() || w.size() < 2) r.expected(ph / "waypoints", w, "an array of at least two numbers");
+    for (size_t i = 0; i < w.size(); ++i) s.loadHistory.waypoints.push_back(r.number(w[i], ph / "waypoints" / i));
+    if (h.contains("perturbation")) s.loadHistory.perturbation = r.positive(h["perturbation"], ph / "perturbation");
+    s.loadHistory.enabled = true;
+  }
+  if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled &&
+      !s.loadHistory.enabled)
+    r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces, "
+              "load_history)");
   return s;
 }
 
@@ -536,7 +550,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
   };
   switch (s.type) {
     case PlotType::Bifurcation:
-    case PlotType::Shapes: needs(a.continuation.enabled, "continuation"); break;
+    case PlotType::Shapes: needs(a.continuation.enabled || a.loadHistory.enabled, "continuation (or load_history)"); break;
     case PlotType::Stiffness: needs(a.stiffness, "stiffness"); break;
     case PlotType::EnergyCurves: needs(a.energyCurves.enabled, "energy_curves"); break;
     case PlotType::TorqueAngle: needs(a.torqueAngle.enabled, "torque_angle"); break;
@@ -593,7 +607,8 @@ std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a, int nCases) {
   std::vector<int> all;
   for (int i = 0; i < nCases; ++i) all.push_back(i);
   std::vector<PlotSpec> out;
-  if (a.continuation.enabled) out.push_back({PlotType::Bifurcation, "bifurcation", "parameter", {"q1"}, {}, "", all});
+  if (a.continuation.enabled || a.loadHistory.enabled)
+    out.push_back({PlotType::Bifurcation, "bifurcation", "parameter", {"q1"}, {}, "", all});
   if (a.stiffness) out.push_back({PlotType::Stiffness, "stiffness", "parameter", {"Kxx", "Kyy"}, {}, "", all});
   if (a.energyCurves.enabled) out.push_back({PlotType::EnergyCurves, "energy_curves", "", {}, {}, "", all});
   if (a.torqueAngle.enabled) out.push_back({PlotType::TorqueAngle, "torque_angle", "", {}, {}, "", all});
@@ -686,7 +701,8 @@ Scene parseScene(const std::string& text, const std::string& file) {
 
   if (!doc.contains("analyses")) r.fail(Pointer("/analyses"), "missing (required): what to compute");
   scene.analyses = parseAnalyses(r, doc["analyses"], Pointer("/analyses"));
-  const bool needPath = scene.analyses.continuation.enabled || scene.analyses.criticalForces.enabled;
+  const bool needPath = scene.analyses.continuation.enabled || scene.analyses.criticalForces.enabled ||
+                        scene.analyses.loadHistory.enabled;
 
   json base = doc;
   base.erase("cases");
@@ -726,6 +742,21 @@ Scene parseScene(const std::string& text, const std::string& file) {
                "energy curves E(q1) with the end held use the 3-segment inverse kinematics (eq 6): case \"" +
                    scene.cases[i].label + "\" has " + std::to_string(scene.cases[i].chain.segments.size()) +
                    " segments");
+  if (scene.analyses.loadHistory.enabled) {
+    // The history starts where the path starts and stays inside its range.
+    const std::vector<double>& w = scene.analyses.loadHistory.waypoints;
+    const Pointer pw = Pointer("/analyses/load_history/waypoints");
+    for (const CaseSpec& c : scene.cases) {
+      const double start = c.end.condition.value[c.path.coordinate];
+      const double lo = std::min(c.path.from, c.path.to), hi = std::max(c.path.from, c.path.to);
+      if (std::abs(w[0] - start) > 1e-12 * std::max(1.0, std::abs(start)))
+        r.fail(pw / 0, "expected the start value " + c.path.parameter + " = " + std::to_string(start) + " of case \"" +
+                           c.label + "\"");
+      for (size_t i = 0; i < w.size(); ++i)
+        if (w[i] < lo - 1e-12 || w[i] > hi + 1e-12)
+          r.fail(pw / i, "expected a value inside the path range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    }
+  }
   if (doc.contains("solver")) scene.solver = parseSolver(r, doc["solver"], Pointer("/solver"));
   if (doc.contains("plots")) {
     const json& plots = doc["plots"];

@@ -84,9 +84,18 @@ struct JumpSpec {
   double perturbation = 1e-3;  ///< ‖δq‖ of the release along the unstable direction
 };
 
+/// A quasi-static load history: the path parameter visits the waypoints in turn (up, back
+/// down, …); where the stable state ends the chain jumps (mechanics/load_history.h).
+struct LoadHistorySpec {
+  bool enabled = false;
+  std::vector<double> waypoints;  ///< path-parameter values; the first is the start value
+  double perturbation = 1e-3;     ///< ‖δq‖ of each release along the unstable direction
+};
+
 struct AnalysesSpec {
   ContinuationSpec continuation;
   JumpSpec jump;
+  LoadHistorySpec loadHistory;
   bool stiffness = false;
   EnergyCurvesSpec energyCurves;
   TorqueAngleSpec torqueAngle;

@@ -95,7 +95,15 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
     rec.criticalLambda = critical;
     rec.lambda = at;
     rec.from = from;
-    const JumpResult jr = simulateJump(problem, from, at, options.jump);
+    JumpResult jr = simulateJump(problem, from, at, options.jump);
+    // A release along one unstable direction can come to rest on another unstable equilibrium
+    // (a saddle: e.g. the straight start with several equally weak joints, where the flow
+    // bends one joint and leaves the others exactly straight). Release again from there; each
+    // release strictly lowers Π, and at most n unstable directions can be shed.
+    for (int again = 0; !jr.success && jr.polishConverged && !jr.stable && again < problem.segments(); ++again) {
+      const Vector saddle = jr.to;
+      jr = simulateJump(problem, saddle, at, options.jump);
+    }
     rec.success = jr.success;
     rec.message = jr.message;
     if (jr.to.size() == from.size()) {
