@@ -156,10 +156,59 @@ void writeSpecialPoints(const Scene& scene, const RunResult& run, const fs::path
   if (scene.analyses.criticalForces.enabled) doc["critical_loads"] = critical;
   if (scene.analyses.energyCurves.enabled) doc["energy_equilibria"] = equilibria;
   if (scene.analyses.torqueAngle.enabled) doc["torque_zeros"] = torque;
+  if (scene.analyses.suddenLoad.enabled) {
+    json sudden = json::array();
+    for (size_t c = 0; c < run.cases.size(); ++c) {
+      const CaseResult& cr = run.cases[c];
+      if (!cr.haveSudden) continue;
+      const SuddenLoadRecord& r = cr.sudden;
+      json e{{"case", c},
+             {"case_label", cr.label},
+             {"value", number(r.value)},
+             {"success", r.success},
+             {"message", r.message},
+             {"model", r.inertial ? "inertial" : "gradient flow"},
+             {"stable", r.stable},
+             {"peak_kinetic", number(r.peakKinetic)},
+             {"max_excursion", number(r.maxExcursion)},
+             {"duration", number(r.duration)},
+             {"residual", number(r.residual)},
+             {"energy_balance_error", number(r.energyBalanceError)}};
+      if (r.rest.size() > 0) e["rest"] = json{{"q", vectorJson(r.rest)}, {"position", poseJson(r.restPose)}};
+      if (r.haveStatic)
+        e["quasi_static"] = json{{"q", vectorJson(r.staticShape)},
+                                 {"position", poseJson(r.staticPose)},
+                                 {"differs", r.differs},
+                                 {"max_difference", number(r.maxDifference)},
+                                 {"potential_dynamic", number(r.potentialDynamic)},
+                                 {"potential_static", number(r.potentialStatic)},
+                                 {"lower", r.lower}};
+      else
+        e["quasi_static"] = nullptr;
+      sudden.push_back(e);
+    }
+    doc["sudden_load"] = sudden;
+  }
   writeText(dir / "special_points.json", doc.dump(2) + "\n");
 }
 
 void writeCurves(const Scene& scene, const RunResult& run, const fs::path& dir) {
+  if (scene.analyses.suddenLoad.enabled) {
+    std::ostringstream os;
+    os << "case,t,potential,kinetic,dissipated,residual";
+    int maxN = 0;
+    for (const CaseResult& cr : run.cases) maxN = std::max(maxN, cr.chain.size());
+    for (int i = 1; i <= maxN; ++i) os << ",q" << i;
+    os << "\n";
+    for (size_t c = 0; c < run.cases.size(); ++c)
+      for (const mechanics::TrajectorySample& t : run.cases[c].sudden.trajectory) {
+        os << c << ',' << fmt(t.t) << ',' << fmt(t.potential) << ',' << fmt(t.kinetic) << ',' << fmt(t.dissipated) << ','
+           << fmt(t.residual);
+        for (int i = 0; i < maxN; ++i) os << ',' << (i < t.q.size() ? fmt(t.q[i]) : std::string());
+        os << "\n";
+      }
+    writeText(dir / "sudden_load.csv", os.str());
+  }
   if (scene.analyses.energyCurves.enabled) {
     std::ostringstream os;
     os << "case,ik_branch,q1,status,E,dE_dq1,Me,q2,q3\n";

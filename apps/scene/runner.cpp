@@ -50,6 +50,7 @@ class CaseRunner {
 
   void continuation();
   void loadHistory();
+  void suddenLoad();
   void criticalForces();
   void energyCurves();
   void torqueAngle();
@@ -430,6 +431,79 @@ void CaseRunner::loadHistory() {
   }
 }
 
+// The sporadic load: the path parameter is set to its value at once on the chain at rest in its
+// unloaded shape; the dynamic rest state is compared with the quasi-static answer, which is the
+// load history from the start to the same value (jumps included where the stable state ends).
+void CaseRunner::suddenLoad() {
+  const int n = out_.chain.size();
+  const SuddenLoadSpec& spec = scene_.analyses.suddenLoad;
+  const double s0 = out_.startValue;
+  const Eigen::Vector3d direction = spec_.path.direction;
+  mech::EndCondition end = spec_.end.condition;
+  end.value -= s0 * direction;
+  mech::EquilibriumProblem problem(out_.chain, end, direction);
+  SuddenLoadRecord& rec = out_.sudden;
+  out_.haveSudden = true;
+  rec.value = spec.value;
+  Eigen::VectorXd qStatic;
+  if (spec.value != s0) {
+    mech::LoadHistoryOptions opt;
+    opt.tracer.initialStep = scene_.solver.initialStep;
+    opt.tracer.minStep = scene_.solver.minStep;
+    opt.tracer.maxStep = scene_.solver.maxStep;
+    opt.tracer.maxPoints = scene_.solver.maxPoints;
+    opt.tracer.newtonTolerance = scene_.solver.tolerance;
+    try {
+      const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.q0, {s0, spec.value}, opt);
+      if (h.completed && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);
+    } catch (const std::exception&) {
+      // no quasi-static answer: the comparison is skipped and said so below
+    }
+  } else {
+    qStatic = out_.q0;
+  }
+  mech::EndCondition loaded = end;
+  loaded.value += spec.value * direction;
+  mech::SuddenLoadOptions opt;
+  if (spec.massPerLength > 0) {
+    opt.scene.inertia = mech::InertiaData::uniformRods(out_.chain, spec.massPerLength);
+    if (spec.damping > 0) opt.scene.jointDamping.assign(size_t(n), spec.damping);
+  }
+  try {
+    const mech::SuddenLoadResult r = mech::simulateSuddenLoad(out_.chain, loaded, out_.q0, qStatic, opt);
+    rec.success = r.success;
+    rec.message = r.message;
+    rec.inertial = r.inertial;
+    rec.rest = r.rest;
+    if (r.rest.size() == n) rec.restPose = mech::endPose(out_.chain, r.rest);
+    rec.stable = r.stable;
+    rec.haveStatic = r.compared;
+    if (r.compared) {
+      rec.staticShape = r.staticShape;
+      rec.staticPose = mech::endPose(out_.chain, r.staticShape);
+      rec.differs = r.differs;
+      rec.maxDifference = r.maxDifference;
+      rec.potentialDynamic = r.potentialDynamic;
+      rec.potentialStatic = r.potentialStatic;
+      rec.lower = mech::toString(r.lower);
+    }
+    rec.peakKinetic = r.peakKinetic;
+    rec.maxExcursion = r.maxExcursion;
+    rec.duration = r.dynamics.time;
+    rec.residual = r.residual;
+    rec.energyBalanceError = r.dynamics.maxEnergyBalanceError;
+    rec.trajectory = r.dynamics.trajectory;
+    if (!r.success) {
+      run_.complete = false;
+      run_.problems.push_back("case \"" + spec_.label + "\": sudden load: " + r.message);
+    }
+  } catch (const std::exception& e) {
+    rec.message = e.what();
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": sudden load: " + e.what());
+  }
+}
+
 // Leaves the branch point `spIndex` of `parent` along the bifurcating direction (sign ±1).
 bool CaseRunner::switchAt(cont::Tracer& tracer, const cont::Branch& parent, int spIndex, int sign,
                           cont::Branch& child) {
@@ -628,6 +702,10 @@ RunResult runScene(const Scene& scene) {
   if (a.loadHistory.enabled)
     run.computed.push_back("quasi-static load history with jumps (hysteresis), " +
                            std::to_string(a.loadHistory.waypoints.size()) + " waypoints");
+  if (a.suddenLoad.enabled)
+    run.computed.push_back(std::string("sudden load: ") +
+                           (a.suddenLoad.massPerLength > 0 ? "inertial dynamics (uniform rods)" : "gradient flow") +
+                           ", compared with the quasi-static load history");
   if (a.criticalForces.enabled) run.computed.push_back("critical forces of the start configuration (linear buckling)");
   if (a.energyCurves.enabled) run.computed.push_back("energy curves E(q1) with the end held (eq 6-8)");
   if (a.torqueAngle.enabled) run.computed.push_back("torque-angle curves M(q) of the first segment (eq 1)");
@@ -638,6 +716,7 @@ RunResult runScene(const Scene& scene) {
   if (a.energyCurves.enabled) stages.emplace_back("energy_curves", [](CaseRunner& r) { r.energyCurves(); });
   if (a.continuation.enabled) stages.emplace_back("continuation", [](CaseRunner& r) { r.continuation(); });
   if (a.loadHistory.enabled) stages.emplace_back("load_history", [](CaseRunner& r) { r.loadHistory(); });
+  if (a.suddenLoad.enabled) stages.emplace_back("sudden_load", [](CaseRunner& r) { r.suddenLoad(); });
   std::vector<double> stageSeconds(stages.size(), 0.0);
 
   run.cases.reserve(scene.cases.size());

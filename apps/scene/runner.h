@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/energy_landscape.h"
 #include "buckle/mechanics/linear_buckling.h"
 #include "scene/scene.h"
@@ -70,6 +71,25 @@ struct TorqueCurve {
   std::vector<std::pair<double, bool>> equilibria;  ///< (q, stable) with M(q) = 0
 };
 
+/// The dynamic answer to a sudden load, beside the quasi-static one.
+struct SuddenLoadRecord {
+  double value = 0.0;                ///< path-parameter value applied at once
+  bool success = false;
+  std::string message;
+  bool inertial = false;
+  Eigen::VectorXd rest, staticShape;
+  mechanics::Pose restPose = mechanics::Pose::Zero(), staticPose = mechanics::Pose::Zero();
+  bool stable = false;
+  bool haveStatic = false;           ///< the quasi-static history reached the value
+  bool differs = false;
+  double maxDifference = 0.0;        ///< ‖q_dynamic − q_static‖∞
+  double potentialDynamic = 0.0, potentialStatic = 0.0;
+  std::string lower;                 ///< which answer is lower in Π
+  double peakKinetic = 0.0, maxExcursion = 0.0, duration = 0.0, residual = 0.0;
+  double energyBalanceError = 0.0;
+  std::vector<mechanics::TrajectorySample> trajectory;
+};
+
 struct CaseResult {
   std::string label;
   mechanics::Chain chain;
@@ -87,6 +107,8 @@ struct CaseResult {
   mechanics::EnergyLandscape landscape;
   bool haveTorque = false;
   TorqueCurve torque;
+  bool haveSudden = false;
+  SuddenLoadRecord sudden;
   explicit CaseResult(const mechanics::Chain& c) : chain(c) {}
 };
 

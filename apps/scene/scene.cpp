@@ -411,7 +411,8 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
 
 AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
   r.onlyKeys(a, p,
-             {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump", "load_history"});
+             {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump", "load_history",
+              "sudden_load"});
   AnalysesSpec s;
   if (a.contains("continuation")) {
     const json& c = a["continuation"];
@@ -493,10 +494,22 @@ AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
     if (h.contains("perturbation")) s.loadHistory.perturbation = r.positive(h["perturbation"], ph / "perturbation");
     s.loadHistory.enabled = true;
   }
+  if (a.contains("sudden_load")) {
+    const json& d = a["sudden_load"];
+    const Pointer pd = p / "sudden_load";
+    r.onlyKeys(d, pd, {"value", "mass_per_length", "damping"});
+    if (!d.contains("value")) r.fail(pd / "value", "missing (required): the path-parameter value applied at once");
+    s.suddenLoad.value = r.number(d["value"], pd / "value");
+    if (d.contains("mass_per_length")) s.suddenLoad.massPerLength = r.positive(d["mass_per_length"], pd / "mass_per_length");
+    if (d.contains("damping")) s.suddenLoad.damping = r.nonNegative(d["damping"], pd / "damping");
+    if (d.contains("damping") && !d.contains("mass_per_length"))
+      r.fail(pd / "damping", "joint damping belongs to the inertial model: give mass_per_length too");
+    s.suddenLoad.enabled = true;
+  }
   if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled &&
-      !s.loadHistory.enabled)
+      !s.loadHistory.enabled && !s.suddenLoad.enabled)
     r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces, "
-              "load_history)");
+              "load_history, sudden_load)");
   return s;
 }
 
@@ -702,7 +715,7 @@ Scene parseScene(const std::string& text, const std::string& file) {
   if (!doc.contains("analyses")) r.fail(Pointer("/analyses"), "missing (required): what to compute");
   scene.analyses = parseAnalyses(r, doc["analyses"], Pointer("/analyses"));
   const bool needPath = scene.analyses.continuation.enabled || scene.analyses.criticalForces.enabled ||
-                        scene.analyses.loadHistory.enabled;
+                        scene.analyses.loadHistory.enabled || scene.analyses.suddenLoad.enabled;
 
   json base = doc;
   base.erase("cases");
@@ -757,6 +770,14 @@ Scene parseScene(const std::string& text, const std::string& file) {
           r.fail(pw / i, "expected a value inside the path range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     }
   }
+  if (scene.analyses.suddenLoad.enabled)
+    for (const CaseSpec& c : scene.cases) {
+      const double lo = std::min(c.path.from, c.path.to), hi = std::max(c.path.from, c.path.to);
+      const double v = scene.analyses.suddenLoad.value;
+      if (v < lo - 1e-12 || v > hi + 1e-12)
+        r.fail(Pointer("/analyses/sudden_load/value"),
+               "expected a value inside the path range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    }
   if (doc.contains("solver")) scene.solver = parseSolver(r, doc["solver"], Pointer("/solver"));
   if (doc.contains("plots")) {
     const json& plots = doc["plots"];

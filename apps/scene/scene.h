@@ -92,10 +92,21 @@ struct LoadHistorySpec {
   double perturbation = 1e-3;     ///< ‖δq‖ of each release along the unstable direction
 };
 
+/// The "sporadic" load: the path parameter jumps from its start value to `value` at once and the
+/// chain's dynamic answer is compared with the quasi-static one (mechanics/jump.h). Masses are
+/// only modelled when given: without them the response is the overdamped gradient flow.
+struct SuddenLoadSpec {
+  bool enabled = false;
+  double value = 0.0;            ///< path-parameter value applied at once
+  double massPerLength = 0.0;    ///< > 0: inertial dynamics with uniform rods
+  double damping = 0.0;          ///< viscous joint damping of the inertial model
+};
+
 struct AnalysesSpec {
   ContinuationSpec continuation;
   JumpSpec jump;
   LoadHistorySpec loadHistory;
+  SuddenLoadSpec suddenLoad;
   bool stiffness = false;
   EnergyCurvesSpec energyCurves;
   TorqueAngleSpec torqueAngle;
