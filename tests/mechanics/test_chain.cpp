@@ -9,23 +9,15 @@
 
 #include "buckle/mechanics/chain.h"
 
+#include "random_segments.h"
+
 using namespace buckle::mechanics;
 
 namespace {
 
-SegmentParameters randomSegment(std::mt19937& rng) {
-  std::uniform_real_distribution<double> A(0.1, 0.9), B(0.6, 1.5), K(0.5, 3.0), L(1.5, 2.8);
-  SegmentParameters p;
-  p.a1 = A(rng); p.a2 = A(rng);
-  p.b1 = B(rng); p.b2 = B(rng);
-  p.k1 = K(rng); p.k2 = K(rng);
-  p.L1_0 = L(rng); p.L2_0 = L(rng);
-  return p;
-}
-
 Chain randomChain(std::mt19937& rng, int n) {
   std::vector<SegmentParameters> s;
-  for (int i = 0; i < n; ++i) s.push_back(randomSegment(rng));
+  for (int i = 0; i < n; ++i) s.push_back(testing::randomSegment(rng));
   return Chain(s);
 }
 

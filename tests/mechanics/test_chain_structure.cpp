@@ -11,21 +11,16 @@
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 
+#include "random_segments.h"
+
 using namespace buckle::mechanics;
 using buckle::continuation::projectedInertia;
 using buckle::continuation::StabilityInfo;
 
 namespace {
 
-SegmentParameters randomSegment(std::mt19937& rng) {
-  std::uniform_real_distribution<double> A(0.1, 0.9), B(0.8, 1.4), K(0.5, 3.0), L(1.0, 2.8);
-  SegmentParameters p;
-  p.a1 = A(rng); p.a2 = A(rng);
-  p.b1 = B(rng); p.b2 = B(rng);
-  p.k1 = K(rng); p.k2 = K(rng);
-  p.L1_0 = L(rng); p.L2_0 = L(rng);
-  return p;
-}
+// b in [0.8, 1.4]: away from degenerate geometry.
+const testing::SegmentRanges kNarrow{0.1, 0.9, 0.8, 1.4, 0.5, 3.0, 1.0, 2.8};
 
 struct Instance {
   Chain chain;
@@ -36,7 +31,7 @@ struct Instance {
 
 Instance randomInstance(int n, std::mt19937& rng, double loadScale = 1.0) {
   std::vector<SegmentParameters> segs;
-  for (int i = 0; i < n; ++i) segs.push_back(randomSegment(rng));
+  for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng, kNarrow));
   Chain chain(segs);
   Vector q(n);
   for (int i = 0; i < n; ++i) {
@@ -382,7 +377,7 @@ TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense defa
                                           EndCondition::clampedPinned(-0.5), EndCondition::heldPosition(3.0, 0.5)};
   for (int n : {1, 3, 17, 40, 100}) {  // n >= 32 takes the O(n) path
     std::vector<SegmentParameters> segs;
-    for (int i = 0; i < n; ++i) segs.push_back(randomSegment(rng));
+    for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng, kNarrow));
     Chain chain(segs);
     for (const EndCondition& end : ends) {
       if (end.heldCount() >= n) continue;

@@ -7,19 +7,11 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/equilibrium_solve.h"
 
+#include "random_segments.h"
+
 using namespace buckle::mechanics;
 
 namespace {
-
-SegmentParameters randomSegment(std::mt19937& rng) {
-  std::uniform_real_distribution<double> A(0.1, 0.9), B(0.6, 1.5), K(0.5, 3.0), L(1.5, 2.8);
-  SegmentParameters p;
-  p.a1 = A(rng); p.a2 = A(rng);
-  p.b1 = B(rng); p.b2 = B(rng);
-  p.k1 = K(rng); p.k2 = K(rng);
-  p.L1_0 = L(rng); p.L2_0 = L(rng);
-  return p;
-}
 
 struct Setting {
   std::string name;
@@ -40,7 +32,7 @@ TEST_CASE("EquilibriumProblem Jacobian and its directional derivative match fini
   std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
   for (int n : {1, 3, 8}) {
     std::vector<SegmentParameters> segs;
-    for (int i = 0; i < n; ++i) segs.push_back(randomSegment(rng));
+    for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
     const Chain chain(segs);
     for (const Setting& s : settings(rng)) {
       INFO("n = " << n << ", end: " << s.name);
