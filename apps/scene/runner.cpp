@@ -68,6 +68,22 @@ class CaseRunner {
   }
   void record(const cont::Branch& b, mech::EquilibriumProblem& problem, const std::string& origin);
   bool throughLoad() const { return spec_.path.loadLimit > 0.0; }
+  /// The scene's /solver settings as tracer options (the λ range is set by each analysis).
+  cont::TracerOptions solverOptions() const {
+    cont::TracerOptions opt;
+    opt.initialStep = scene_.solver.initialStep;
+    opt.minStep = scene_.solver.minStep;
+    opt.maxStep = scene_.solver.maxStep;
+    opt.maxPoints = scene_.solver.maxPoints;
+    opt.newtonTolerance = scene_.solver.tolerance;
+    return opt;
+  }
+  /// The path as an EquilibriumProblem: prescribed(λ) = start values + (λ − s0)·direction.
+  mech::EquilibriumProblem pathProblem() const {
+    mech::EndCondition end = spec_.end.condition;
+    end.value -= out_.startValue * spec_.path.direction;
+    return mech::EquilibriumProblem(out_.chain, end, spec_.path.direction);
+  }
   /// Releases the chain at a fold with the loads frozen there: where does it land?
   void simulateJumpAt(mech::EquilibriumProblem& problem, const cont::SpecialPoint& sp, SpecialRecord& s) {
     const int n = out_.chain.size();
@@ -359,17 +375,9 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
 // drawn as an arrow in the bifurcation plots.
 void CaseRunner::loadHistory() {
   const int n = out_.chain.size();
-  const double s0 = out_.startValue;
-  mech::EndCondition end = spec_.end.condition;
-  const Eigen::Vector3d direction = spec_.path.direction;
-  end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
-  mech::EquilibriumProblem problem(out_.chain, end, direction);
+  mech::EquilibriumProblem problem = pathProblem();
   mech::LoadHistoryOptions opt;
-  opt.tracer.initialStep = scene_.solver.initialStep;
-  opt.tracer.minStep = scene_.solver.minStep;
-  opt.tracer.maxStep = scene_.solver.maxStep;
-  opt.tracer.maxPoints = scene_.solver.maxPoints;
-  opt.tracer.newtonTolerance = scene_.solver.tolerance;
+  opt.tracer = solverOptions();
   opt.jump.perturbation = scene_.analyses.loadHistory.perturbation;
   mech::LoadHistoryResult h;
   try {
@@ -438,21 +446,14 @@ void CaseRunner::suddenLoad() {
   const int n = out_.chain.size();
   const SuddenLoadSpec& spec = scene_.analyses.suddenLoad;
   const double s0 = out_.startValue;
-  const Eigen::Vector3d direction = spec_.path.direction;
-  mech::EndCondition end = spec_.end.condition;
-  end.value -= s0 * direction;
-  mech::EquilibriumProblem problem(out_.chain, end, direction);
+  mech::EquilibriumProblem problem = pathProblem();
   SuddenLoadRecord& rec = out_.sudden;
   out_.haveSudden = true;
   rec.value = spec.value;
   Eigen::VectorXd qStatic;
   if (spec.value != s0) {
     mech::LoadHistoryOptions opt;
-    opt.tracer.initialStep = scene_.solver.initialStep;
-    opt.tracer.minStep = scene_.solver.minStep;
-    opt.tracer.maxStep = scene_.solver.maxStep;
-    opt.tracer.maxPoints = scene_.solver.maxPoints;
-    opt.tracer.newtonTolerance = scene_.solver.tolerance;
+    opt.tracer = solverOptions();
     try {
       const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.q0, {s0, spec.value}, opt);
       if (h.completed && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);
@@ -462,8 +463,8 @@ void CaseRunner::suddenLoad() {
   } else {
     qStatic = out_.q0;
   }
-  mech::EndCondition loaded = end;
-  loaded.value += spec.value * direction;
+  mech::EndCondition loaded = problem.endCondition();
+  loaded.value += spec.value * problem.direction();
   mech::SuddenLoadOptions opt;
   if (spec.massPerLength > 0) {
     opt.scene.inertia = mech::InertiaData::uniformRods(out_.chain, spec.massPerLength);
@@ -552,12 +553,7 @@ void CaseRunner::continuation() {
     return;
   }
 
-  cont::TracerOptions opt;
-  opt.initialStep = scene_.solver.initialStep;
-  opt.minStep = scene_.solver.minStep;
-  opt.maxStep = scene_.solver.maxStep;
-  opt.maxPoints = scene_.solver.maxPoints;
-  opt.newtonTolerance = scene_.solver.tolerance;
+  cont::TracerOptions opt = solverOptions();
   opt.lambdaMin = lambdaLo;
   opt.lambdaMax = lambdaHi;
   opt.computeStability = true;
