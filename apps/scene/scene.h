@@ -13,20 +13,12 @@
 
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/segment.h"
+#include "scene/json_reader.h"
 
 namespace buckle::scene {
 
-/// Bad input: the file, the JSON path of the bad value and what was expected.
-class SceneError : public std::runtime_error {
- public:
-  SceneError(std::string file, std::string path, std::string message);
-  const std::string& file() const { return file_; }
-  const std::string& path() const { return path_; }
-  const std::string& message() const { return message_; }
-
- private:
-  std::string file_, path_, message_;
-};
+/// Bad input: the file, the JSON path of the bad value and what was expected (scene/json_reader.h).
+using SceneError = JsonInputError;
 
 /// One chain variant: segment parameters (after preloads for q0 were computed) and its
 /// unloaded shape.
