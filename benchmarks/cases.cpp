@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else names.emplace_back(argv[i]);
   }
-  if (names.empty()) names = {"A_triv", "A_U", "A_Z", "A_Ufine", "L_triv", "N_triv", "I_up"};
+  if (names.empty()) names = caseNames();
   int failures = 0;
   for (const auto& name : names) {
     std::vector<double> times;

@@ -7,6 +7,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "../apps/problems/auto_cases.h"
 
 namespace buckle::bench {
 
@@ -16,8 +17,8 @@ using mechanics::EquilibriumOptions;
 using mechanics::EquilibriumProblem;
 using mechanics::SegmentParameters;
 
-/// The paper's main segment: a = 0.5, b = 1, k = 1, L0 = 2.25 (κ = 0.75).
-inline SegmentParameters mainSegment(double L0 = 2.25) { return SegmentParameters::symmetric(0.5, 1.0, 1.0, L0); }
+/// The paper's main segment (apps/problems/auto_cases.h).
+using problems::mainSegment;
 
 /// Clamped–pinned chain of n segments, λ = Fx.
 inline EquilibriumProblem clampedPinned(int n, bool structuredStability = true, double L0 = 2.25) {
