@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates every figure of benchmarks/RESULTS.md: builds the benchmark targets, runs the
-# kernels (all n), the AUTO-07p comparison, the work-precision program and its plot, and writes
+# kernels (all n), the AUTO-07p comparison, the work-precision program and its plot, the hard
+# cases (hard_cases_auto.sh: buckle and AUTO), and writes
 # the raw outputs to benchmarks/results/. RESULTS.md quotes these files.
 #   benchmarks/run_all.sh            (BUILD=build-bench by default; REPS=5)
 set -euo pipefail
@@ -11,7 +12,7 @@ REPS=${REPS:-5}
 R="$HERE/results"
 mkdir -p "$R"
 cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build "$BUILD" -j2 --target bench_kernels bench_cases work_precision
+cmake --build "$BUILD" -j2 --target bench_kernels bench_cases work_precision hard_cases
 {
   echo "date: $(date -u +%FT%TZ)"
   echo "nproc: $(nproc)   CPUs: $(grep -c ^processor /proc/cpuinfo)   CPU: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
@@ -22,5 +23,6 @@ cmake --build "$BUILD" -j2 --target bench_kernels bench_cases work_precision
 REPS=$REPS BUILD=$BUILD "$HERE/compare_auto.sh" | tee "$R/compare_auto.txt"
 "$BUILD/bin/work_precision" --reps "$REPS" --out "$R" | tee "$R/work_precision.txt"
 gnuplot "$R/work_precision.gp"
+BUILD=$BUILD "$HERE/hard_cases_auto.sh" | tee "$R/hard_cases.txt"
 echo "load average at end: $(cut -d' ' -f1-3 /proc/loadavg)" >> "$R/machine.txt"
 echo "results in $R"

@@ -1,0 +1,113 @@
+// The user-level answer to extreme units (benchmarks/hard_cases.cpp): trace the chain in
+// nondimensional variables. The core's tolerances and step sizes are absolute (‖G‖∞, arclength
+// in mixed units, max(1, ·) floors: benchmarks/RESULTS.md, "Hard cases"), so a chain given in
+// mm and mN·mm⁻¹, or in km and MN·m⁻¹, is best handed to the tracer rescaled:
+//   angles q as they are; reactions r̃ = r / F₀; λ̃ = λ / λ₀;
+//   torque rows / (k₀ L₀²), held-position rows / L₀, held-angle rows as they are;
+//   the stability operator H / (k₀ L₀²), its constraint rows like the held rows.
+// Located values come back in physical units as λ = λ₀ λ̃, r = F₀ r̃. With a unit length L₀ and
+// stiffness k₀ (force per length): F₀ = k₀ L₀, torque k₀ L₀².
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "buckle/continuation/problem.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+
+namespace buckle::bench {
+
+/// A system of units relative to the paper's (lengths ×length, spring stiffnesses ×stiffness).
+struct UnitScale {
+  double length = 1.0;
+  double stiffness = 1.0;
+  double force() const { return stiffness * length; }            ///< loads and reactions
+  double torque() const { return stiffness * length * length; }  ///< joint torques, K_q
+};
+
+/// EquilibriumProblem seen in nondimensional variables (header comment). The load-path
+/// direction is assumed to be a force (λ₀ = F₀) unless `lambdaScale` says otherwise.
+class NondimensionalProblem final : public continuation::Problem {
+ public:
+  NondimensionalProblem(mechanics::EquilibriumProblem& problem, UnitScale scale, double lambdaScale = 0.0)
+      : p_(problem),
+        lambdaScale_(lambdaScale > 0.0 ? lambdaScale : scale.force()),
+        torque_(scale.torque()),
+        uScale_(Eigen::VectorXd::Ones(problem.dimension())),
+        rowScale_(Eigen::VectorXd::Constant(problem.dimension(), scale.torque())),
+        u_(problem.dimension()) {
+    const std::vector<int> held = problem.endCondition().heldIndices();
+    constraintScale_.resize(Eigen::Index(held.size()));
+    for (size_t c = 0; c < held.size(); ++c) {
+      const bool angle = held[c] == 2;
+      const Eigen::Index i = problem.segments() + Eigen::Index(c);
+      uScale_[i] = angle ? scale.torque() : scale.force();
+      rowScale_[i] = angle ? 1.0 : scale.length;
+      constraintScale_[Eigen::Index(c)] = rowScale_[i];
+    }
+  }
+
+  double lambdaScale() const { return lambdaScale_; }
+  /// Physical unknowns of nondimensional ones.
+  Eigen::VectorXd physical(continuation::ConstVectorRef u) const { return u.cwiseProduct(uScale_); }
+  Eigen::VectorXd nondimensional(continuation::ConstVectorRef u) const { return u.cwiseQuotient(uScale_); }
+
+  int dimension() const override { return p_.dimension(); }
+  bool residual(continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) override {
+    u_ = u.cwiseProduct(uScale_);
+    if (!p_.residual(u_, lambda * lambdaScale_, F)) return false;
+    F.array() /= rowScale_.array();
+    return true;
+  }
+  bool jacobian(continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
+                continuation::VectorRef Flambda) override {
+    u_ = u.cwiseProduct(uScale_);
+    if (!p_.jacobian(u_, lambda * lambdaScale_, Fu, Flambda)) return false;
+    scaleJacobian(Fu, Flambda);
+    return true;
+  }
+  bool jacobianDirectionalDerivative(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
+                                     double dlambda, continuation::MatrixRef dFu,
+                                     continuation::VectorRef dFlambda) override {
+    u_ = u.cwiseProduct(uScale_);
+    const Eigen::VectorXd duPhysical = du.cwiseProduct(uScale_);
+    if (!p_.jacobianDirectionalDerivative(u_, lambda * lambdaScale_, duPhysical, dlambda * lambdaScale_, dFu, dFlambda))
+      return false;
+    scaleJacobian(dFu, dFlambda);
+    return true;
+  }
+
+  // Stability: H and C rescaled; the inertia is then the default dense one of Problem (n small).
+  bool hasStabilityOperator() const override { return p_.hasStabilityOperator(); }
+  bool stabilityOperator(continuation::ConstVectorRef u, double lambda, continuation::Matrix& H,
+                         continuation::Matrix& C) override {
+    u_ = u.cwiseProduct(uScale_);
+    if (!p_.stabilityOperator(u_, lambda * lambdaScale_, H, C)) return false;
+    H /= torque_;
+    if (C.rows() == constraintScale_.size()) C.array().colwise() /= constraintScale_.array();
+    return true;
+  }
+
+  // Boundaries are joint-angle limits: unit-free.
+  int boundaryCount() const override { return p_.boundaryCount(); }
+  double boundary(int k, continuation::ConstVectorRef u, double lambda) override {
+    u_ = u.cwiseProduct(uScale_);
+    return p_.boundary(k, u_, lambda * lambdaScale_);
+  }
+  std::string boundaryName(int k) const override { return p_.boundaryName(k); }
+
+ private:
+  void scaleJacobian(continuation::MatrixRef Fu, continuation::VectorRef Flambda) const {
+    Fu.array().colwise() /= rowScale_.array();
+    Fu.array().rowwise() *= uScale_.transpose().array();
+    Flambda.array() *= lambdaScale_ / rowScale_.array();
+  }
+
+  mechanics::EquilibriumProblem& p_;
+  double lambdaScale_, torque_;
+  Eigen::VectorXd uScale_, rowScale_, constraintScale_;
+  Eigen::VectorXd u_;
+};
+
+}  // namespace buckle::bench
