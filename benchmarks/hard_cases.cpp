@@ -3,8 +3,8 @@
 //
 //   hard_cases [--quick] [--n N] [--only PREFIX]
 //     --quick     CI size: clustered loads at n = 30 and 60, κ = 0 at n = 3 and 4, joint limit at n = 10
-//     --n N       size of the large clustered case (default 1000)
-//     --only P    run only the cases whose id starts with P (units, cluster, kappa0, limit)
+//     --n N       size of the large clustered case (default 1000; the other one is n = 200)
+//     --only P    run only the cases whose id starts with P (units, cluster, cluster.top.n1000, …)
 //
 // Cases (independent answers in brackets):
 //  units.<case>.<L>x<k>.<raw|nondim>  the n = 3 chain with lengths ×L and spring stiffnesses ×k;
@@ -363,11 +363,13 @@ int main(int argc, char** argv) {
         }
   }
   if (want("cluster")) {
-    const std::vector<int> sizes = quick ? std::vector<int>{30, 60} : std::vector<int>{200, bigN};
-    for (int n : sizes) {
-      add(clustered("cluster.low.n" + std::to_string(n), n, false, 6));
-      add(clustered("cluster.top.n" + std::to_string(n), n, true, 6));
-    }
+    std::vector<int> sizes = quick ? std::vector<int>{30, 60} : std::vector<int>{200};
+    if (!quick && bigN != 200) sizes.push_back(bigN);
+    for (int n : sizes)
+      for (const char* end : {"low", "top"}) {
+        const std::string id = std::string("cluster.") + end + ".n" + std::to_string(n);
+        if (want(id.c_str())) add(clustered(id, n, end[0] == 't', 6));
+      }
   }
   if (want("kappa0"))
     for (int n : quick ? std::vector<int>{3, 4} : std::vector<int>{3, 4, 5, 10}) add(kappaZero(n));
