@@ -19,11 +19,12 @@ ROOT=$(cd "$HERE/.." && pwd)
 PEER=${AUTO_PEER:-/work/shared/peers/auto07p}
 BUILD=${BUILD:-$ROOT/build-bench}
 AUTO_DIR=${AUTO_DIR:-/usr/lib/auto-07p}
+NPROC=$(nproc)             # before OMP_NUM_THREADS: GNU nproc honours that variable
 export OMP_NUM_THREADS=1
 HC="$BUILD/bin/hard_cases"
 [ -x "$HC" ] || { echo "missing $HC: cmake --build $BUILD --target hard_cases"; exit 1; }
 
-echo "hard cases, $(date -u +%FT%TZ), git $(git -C "$ROOT" rev-parse --short HEAD), nproc $(nproc)," \
+echo "hard cases, $(date -u +%FT%TZ), git $(git -C "$ROOT" rev-parse --short HEAD), nproc $NPROC ($(grep -c ^processor /proc/cpuinfo) CPUs)," \
   "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo
 echo "== buckle: $HC $*"
@@ -139,6 +140,6 @@ cfile L_triv c.k0 "{'L0':1.5, 'Fx':0.5}" "{'Fx':-2.5}" 1
 run k0
 nbp=$(awk '$1=="BP"' pts.k0 | wc -l)
 row "$([ "$nbp" -eq 1 ] && echo PASS || echo FAIL)" kappa0.n3 - "$MS" "$nbp BP (double zero at Fx = 0; the determinant does not change sign)"
-for id in kappa0.n10 kappa0.n30 cluster.low cluster.top limit.n10 limit.n100; do
+for id in kappa0.n4 kappa0.n5 kappa0.n10 cluster.low cluster.top limit.n10 limit.n100; do
   row "n/a" "$id" - - "chain.f90 is the 3-segment chain (NDIM 3/4)"
 done
