@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -98,6 +99,50 @@ TEST_CASE("geometric joint limit: closing spring reaches zero length at pi - bet
   p.qMaxUser = 1.0;
   CHECK(Segment(p).upperLimit() == 1.0);
   CHECK(Segment(p).lowerLimit() == Approx(-qmax));
+}
+
+TEST_CASE("spring jets stay accurate up to the geometric limit (no cancellation in L)", "[segment]") {
+  // Reference: eq 1 in long double from the same double inputs (q, β12). Near the limit L → 0 (or
+  // √Δ), L² = c1² + c2² + 2c1c2 cos θ evaluated naively in double would lose half the digits
+  // (absolute error ~1e-8 in L); the half-angle form keeps absolute errors at a few ulp. dL/dq is
+  // bounded there but d²L/dq² grows like P/√Δ for nearly equal triangles (Δ = (c1 − c2)² → 0), so
+  // the derivatives are checked relative to max(1, |reference|).
+  std::mt19937 rng(19);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  double worst[3] = {0, 0, 0};
+  for (int trial = 0; trial < 400; ++trial) {
+    SegmentParameters p = testing::randomSegment(rng, kNarrow);
+    if (trial % 2) {  // symmetric triangles: L itself → 0 at the limit
+      p.a2 = p.a1;
+      p.b2 = p.b1;
+    }
+    const Segment s(p);
+    const long double c1 = std::hypot((long double)p.a1, (long double)p.b1);
+    const long double c2 = std::hypot((long double)p.a2, (long double)p.b2);
+    const long double P = c1 * c2, delta = (c1 - c2) * (c1 - c2);
+    for (int side = 0; side < 2; ++side) {
+      const double d = std::pow(10.0, -12.0 * U(rng));  // relative distance to the limit, 1e-12 … 1
+      const double q = side == 0 ? s.geometricUpperLimit() * (1.0 - d) : s.geometricLowerLimit() * (1.0 - d);
+      for (int spring = 0; spring < 2; ++spring) {
+        const long double sign = spring == 0 ? 1.0L : -1.0L;
+        const long double theta = (long double)s.beta12() + sign * (long double)q;
+        const long double ch = std::cos(0.5L * theta);
+        const long double L = std::sqrt(delta + 4.0L * P * ch * ch);
+        const long double d1 = -sign * P * std::sin(theta) / L;
+        const long double d2 = -(P * std::cos(theta) * delta + 4.0L * P * P * ch * ch * ch * ch) / (L * L * L);
+        const Jet3 got = spring == 0 ? s.spring1(q) : s.spring2(q);
+        worst[0] = std::max(worst[0], double(std::abs(got.value - L)));
+        worst[1] = std::max(worst[1], double(std::abs(got.d1 - d1) / std::max(1.0L, std::abs(d1))));
+        worst[2] = std::max(worst[2], double(std::abs(got.d2 - d2) / std::max(1.0L, std::abs(d2))));
+      }
+    }
+  }
+  INFO("worst errors: L " << worst[0] << ", dL/dq " << worst[1] << ", d2L/dq2 " << worst[2]);
+  // (measured: L 7.8e-16, dL/dq 1.0e-13, d²L/dq² 6.0e-14; the previous full-angle form gave
+  // 7.2e-16, 1.4e-13, 1.6e-13: the derivative errors come from cos(θ/2) near 0 itself, i.e. from q)
+  CHECK(worst[0] < 2e-15);
+  CHECK(worst[1] < 5e-13);
+  CHECK(worst[2] < 5e-13);
 }
 
 TEST_CASE("bad segment parameters are rejected naming the parameter", "[segment]") {

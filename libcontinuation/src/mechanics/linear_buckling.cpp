@@ -246,11 +246,12 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
   };
 
   const Eigen::SelfAdjointEigenSolver<Matrix> esA(A, Eigen::EigenvaluesOnly);
-  out.unloadedStable = esA.eigenvalues()[0] > 0.0;
   const double Ascale = esA.eigenvalues().cwiseAbs().maxCoeff();
   const double Gscale = std::max(1e-300, G.cwiseAbs().maxCoeff());
   // K_q ≈ 0 relative to the load matrix (per unit load and length): κ = 0.
   out.degenerate = Ascale <= 1e-13 * Gscale;
+  // κ = 0 is marginal, not stable: the sign of a rounding-level K_q must not decide it.
+  out.unloadedStable = !out.degenerate && esA.eigenvalues()[0] > 0.0;
 
   std::vector<std::pair<double, Vector>> pairs;
   if (out.degenerate) {

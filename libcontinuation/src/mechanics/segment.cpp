@@ -34,6 +34,9 @@ Segment::Segment(const SegmentParameters& p) : p_(p) {
   c2_ = std::hypot(p.a2, p.b2);
   c1c2_ = c1_ * c2_;
   beta12_ = std::atan(p.a1 / p.b1) + std::atan(p.a2 / p.b2);
+  delta_ = (c1_ - c2_) * (c1_ - c2_);
+  cosHalfBeta_ = std::cos(0.5 * beta12_);
+  sinHalfBeta_ = std::sin(0.5 * beta12_);
   if (!(lowerLimit() < upperLimit())) {
     std::ostringstream os;
     os << "joint limits are empty: qMinUser=" << p.qMinUser << ", qMaxUser=" << p.qMaxUser
@@ -44,32 +47,54 @@ Segment::Segment(const SegmentParameters& p) : p_(p) {
 
 // θ = β12 + s·q (s = +1: spring 1, s = −1: spring 2), L² = c1² + c2² + 2c1c2 cos θ (eq 1).
 // Near the geometric limit (θ → π) that form cancels catastrophically, so everything is written
-// with 1 + cos θ = 2cos²(θ/2) (exact to rounding): with P = c1c2, Δ = (c1 − c2)²,
-//   L² = Δ + 2P(1 + cos θ),   dL/dq = −s P sin θ / L,
-//   d²L/dq² = −[P cos θ Δ + P²(1 + cos θ)²] / L³   (= −P cos θ/L − (dL/dq)²/L, cancellation-free),
-//   d³L/dq³ = −dL/dq − 3 (dL/dq)(d²L/dq²)/L.
-Jet3 Segment::spring(double q, double s) const {
-  const double theta = beta12_ + s * q;
-  const double ch = std::cos(0.5 * theta);
-  const double onePlusCos = 2.0 * ch * ch;
-  const double ct = std::cos(theta), st = std::sin(theta);
-  const double delta = (c1_ - c2_) * (c1_ - c2_);
+// with the half angle, 1 + cos θ = 2cos²(θ/2) (exact to rounding): with P = c1c2, Δ = (c1 − c2)²,
+// c = cos(θ/2), s_h = sin(θ/2),
+//   L² = Δ + 4P c²,   dL/dq = −s P sin θ / L = −2s P s_h c / L,
+//   d²L/dq² = −[P cos θ Δ + 4P²c⁴] / L³   (= −P cos θ/L − (dL/dq)²/L, cancellation-free),
+//   d³L/dq³ = −dL/dq − 3 (dL/dq)(d²L/dq²)/L,   cos θ = c² − s_h².
+// Both springs share one sincos of q/2: θ/2 = β12/2 ± q/2, so by the addition theorems
+//   cos(θ/2) = cos(β12/2)cos(q/2) ∓ sin(β12/2)sin(q/2),  sin(θ/2) = sin(β12/2)cos(q/2) ± cos(β12/2)sin(q/2).
+// cos(θ/2) → 0 at the limit has an absolute error of a few ulp, like rounding θ = β12 + q itself
+// (the previous form, cos(0.5·θ), two sincos and two cos per segment); the relative accuracy of L
+// near the limit is unchanged (tests/mechanics/test_segment.cpp compares against long double).
+namespace {
+inline Jet3 springFromHalfAngle(double c, double sh, double sign, double P, double delta) {
+  const double c2 = c * c;
   Jet3 L;
-  L.value = std::sqrt(delta + 2.0 * c1c2_ * onePlusCos);
-  L.d1 = -s * c1c2_ * st / L.value;
-  L.d2 = -(c1c2_ * ct * delta + c1c2_ * c1c2_ * onePlusCos * onePlusCos) / (L.value * L.value * L.value);
-  L.d3 = -L.d1 - 3.0 * L.d1 * L.d2 / L.value;
+  L.value = std::sqrt(delta + 4.0 * P * c2);
+  const double inv = 1.0 / L.value;
+  L.d1 = -2.0 * sign * P * sh * c * inv;
+  L.d2 = -(P * (c2 - sh * sh) * delta + 4.0 * P * P * c2 * c2) * (inv * inv * inv);
+  L.d3 = -L.d1 - 3.0 * L.d1 * L.d2 * inv;
   return L;
 }
+}  // namespace
 
-Jet3 Segment::spring1(double q) const { return spring(q, +1.0); }
-Jet3 Segment::spring2(double q) const { return spring(q, -1.0); }
+void Segment::springs(double q, Jet3& L1, Jet3& L2) const {
+  const double sq = std::sin(0.5 * q), cq = std::cos(0.5 * q);  // one sincos call at -O2
+  const double cc = cosHalfBeta_ * cq, ss = sinHalfBeta_ * sq;
+  const double sc = sinHalfBeta_ * cq, cs = cosHalfBeta_ * sq;
+  L1 = springFromHalfAngle(cc - ss, sc + cs, +1.0, c1c2_, delta_);
+  L2 = springFromHalfAngle(cc + ss, sc - cs, -1.0, c1c2_, delta_);
+}
+
+Jet3 Segment::spring1(double q) const {
+  Jet3 L1, L2;
+  springs(q, L1, L2);
+  return L1;
+}
+Jet3 Segment::spring2(double q) const {
+  Jet3 L1, L2;
+  springs(q, L1, L2);
+  return L2;
+}
 
 Jet3 Segment::energyJet(double q) const {
-  Jet3 E;
-  const Jet3 Ls[2] = {spring1(q), spring2(q)};
+  Jet3 Ls[2];
+  springs(q, Ls[0], Ls[1]);
   const double k[2] = {p_.k1, p_.k2};
   const double L0[2] = {p_.L1_0, p_.L2_0};
+  Jet3 E;
   for (int i = 0; i < 2; ++i) {
     const Jet3& L = Ls[i];
     const double stretch = L.value - L0[i];
