@@ -42,12 +42,8 @@ trap 'rm -rf "$WORK"' EXIT
 now_ns() { date +%s%N; }
 median() { sort -g | awk '{v[NR]=$1} END{if(NR%2) print v[(NR+1)/2]; else printf "%.6f\n",(v[NR/2]+v[NR/2+1])/2}'; }
 
-FFLAGS=$(awk -F'= ' '/^FFLAGS /{print $2}' "$AUTO_DIR/cmds/cmds.make")
-OPT=$(awk -F'= ' '/^OPT /{print $2}' "$AUTO_DIR/cmds/cmds.make")
-cp "$PEER/chain.f90" "$WORK/"
-cd "$WORK"
-gfortran $FFLAGS $OPT -c chain.f90 -o chain.o
-gfortran $FFLAGS $OPT chain.o -o chain.exe "$AUTO_DIR"/lib/*.o
+. "$HERE/auto_lib.sh"   # auto_build, auto_points
+auto_build "$WORK"
 
 # ---- AUTO: every run in dependency order, REPS timed repetitions, keep b./s. files ----------
 declare -A AWALL ATOT APTS
@@ -65,13 +61,6 @@ for r in A_triv A_U A_Z A_Ufine L_triv N_triv I_home I_up; do
   mv fort.7 "b.$r"; mv fort.8 "s.$r"; rm -f fort.9
   APTS[$r]=$(awk '$1!=0' "b.$r" | wc -l)
 done
-
-# AUTO's labelled points of a b-file: "TYPE Fx" per line (BP, LP, UZ, EP)
-auto_points() {
-  awk '$1==0 && $2=="PT" { for(i=1;i<=NF;i++) col[$i]=i; next } $1==0 { next }
-       { ty=$3+0; t=""; if (ty==1||ty==6) t="BP"; else if (ty==2||ty==5) t="LP"; else if (ty==-4) t="UZ"; else if (ty==9) t="EP";
-         if (t!="") printf "%s %s\n", t, $(col["Fx"]) }' "$1"
-}
 
 # ---- buckle ------------------------------------------------------------------------------
 "$BC" --reps "$REPS" $CASES > buckle.txt

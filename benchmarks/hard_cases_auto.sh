@@ -37,12 +37,8 @@ if [ ! -d "$AUTO_DIR/lib" ] || ! command -v gfortran > /dev/null; then
 fi
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/buckle-hard-auto.XXXXXX")
 trap 'rm -rf "$WORK"' EXIT
-FFLAGS=$(awk -F'= ' '/^FFLAGS /{print $2}' "$AUTO_DIR/cmds/cmds.make")
-OPT=$(awk -F'= ' '/^OPT /{print $2}' "$AUTO_DIR/cmds/cmds.make")
-cp "$PEER/chain.f90" "$WORK/"
-cd "$WORK"
-gfortran $FFLAGS $OPT -c chain.f90 -o chain.o
-gfortran $FFLAGS $OPT chain.o -o chain.exe "$AUTO_DIR"/lib/*.o
+. "$HERE/auto_lib.sh"   # auto_build, auto_points
+auto_build "$WORK"
 
 # c-file from the peer's, with constants, stops and steps replaced: cfile CASE OUT PAR UZSTOP STEPSCALE
 cfile() {
@@ -64,9 +60,7 @@ run() {
   ./chain.exe < "c.$1" > "out.$1" 2>&1 || true
   [ -f fort.8 ] && mv fort.8 "s.$1"
   touch fort.7
-  awk '$1==0 && $2=="PT" { for(i=1;i<=NF;i++) col[$i]=i; next } $1==0 { next }
-       { ty=$3+0; t=""; if (ty==1||ty==6) t="BP"; else if (ty==2||ty==5) t="LP"; else if (ty==-4) t="UZ"; else if (ty==9) t="EP";
-         if (t!="") printf "%s %s\n", t, $(col["Fx"]) }' fort.7 > "pts.$1"
+  auto_points fort.7 > "pts.$1"
   PTS=$(awk '$1!=0' fort.7 | wc -l)
   MS=$(awk '/Total Time/{printf "%.2f", $3*1000}' "out.$1")
   [ -n "$MS" ] || MS=nan
