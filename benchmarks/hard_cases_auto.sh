@@ -11,6 +11,9 @@
 #               unscaled boundary value −1.2519370132295 × F0
 #   variant raw:   the c-files' DS, DSMIN, DSMAX (absolute arclength, as the unscaled run uses)
 #   variant steps: DS, DSMIN, DSMAX × F0 (AUTO's EPSL, EPSU, EPSS are already relative)
+#   variant weights: arclength weights THL (Fx, Fy0) and THU (the reaction Fy) = 1/F0², steps as
+#                  given: AUTO's way of nondimensionalising the pseudo-arclength (its weights multiply
+#                  the squared components)
 #   kappa0.n3   c.L_triv (κ = 0): AUTO's determinant test does not see the double zero
 # Pass: every expected point found, relative error ≤ 1e-9 (AUTO prints 11 significant digits).
 set -euo pipefail
@@ -40,11 +43,12 @@ trap 'rm -rf "$WORK"' EXIT
 . "$HERE/auto_lib.sh"   # auto_build, auto_points
 auto_build "$WORK"
 
-# c-file from the peer's, with constants, stops and steps replaced: cfile CASE OUT PAR UZSTOP STEPSCALE
+# c-file from the peer's, with constants, stops and steps replaced, EXTRA lines (e.g. THL) added:
+#   cfile CASE OUT PAR UZSTOP STEPSCALE [EXTRA]
 cfile() {
   sed -e 's/JAC=0/JAC=1/' -e 's/IID=2/IID=0/' -e "/^PAR=/d" -e "s/^UZSTOP=.*/UZSTOP=$4/" "$PEER/cases/c.$1" |
-    awk -v par="$3" -v f="$5" '
-      /^NDIM=/ { print "PAR=" par }
+    awk -v par="$3" -v f="$5" -v extra="${6:-}" '
+      /^NDIM=/ { print "PAR=" par; if (extra != "") print extra }
       { if ($0 ~ /DSMIN=/ || $0 ~ /DS=/) {
           n = split($0, kv, ", "); out = ""
           for (i = 1; i <= n; i++) { split(kv[i], p, "=")
@@ -70,17 +74,20 @@ row() {  # row PASS ID ERR MS NOTE
 }
 rel() { awk -v x="$1" -v r="$2" 'BEGIN{d=x-r; if (d<0) d=-d; if (r<0) r=-r; printf "%.1e", d/r}'; }
 
-for variant in raw steps; do
+for variant in raw steps weights; do
   for L in 1e-3 1 1e3; do
     for k in 1e-6 1 1e6; do
       F0=$(awk -v L="$L" -v k="$k" 'BEGIN{printf "%.17g", L*k}')
       f=1; [ $variant = steps ] && f=$F0
+      w=$(awk -v F="$F0" 'BEGIN{printf "%.17g", 1/(F*F)}')
+      thPinned=""; thFree=""
+      if [ $variant = weights ]; then thPinned="THL={'Fx':$w}\nTHU={4:$w}"; thFree="THL={'Fx':$w, 'Fy0':$w}"; fi
       id="$L"x"$k".$variant
       par=$(awk -v L="$L" -v k="$k" 'BEGIN{printf "{\x27a\x27:%.17g, \x27b\x27:%.17g, \x27k\x27:%.17g, \x27L0\x27:%.17g}", 0.5*L, L, k, 2.25*L}')
       # branch points: eq 17 in the scaled constants, Fx = λ κ / b
       read -r refU refZ < <(awk -v L="$L" -v k="$k" 'BEGIN{a=0.5*L; b=L; kap=k*(b*2.25*L-2*(b*b-a*a));
         printf "%.17g %.17g\n", (sqrt(21)-14)/10*kap/b, -(sqrt(21)+14)/10*kap/b}')
-      cfile A_triv c.bp "$par" "{'Fx':$(awk -v F="$F0" 'BEGIN{printf "%.17g", -2.5*F}')}" "$f"
+      cfile A_triv c.bp "$par" "{'Fx':$(awk -v F="$F0" 'BEGIN{printf "%.17g", -2.5*F}')}" "$f" "$thPinned"
       run bp
       mapfile -t B < <(awk '$1=="BP"{print $2}' pts.bp)
       if [ "${#B[@]}" -eq 2 ]; then
@@ -92,7 +99,7 @@ for variant in raw steps; do
       fi
       # joint limit: switch at BP1, stop at qmax = 1.5
       if [ "${#B[@]}" -ge 1 ]; then
-        cfile A_U c.lim "$par" "{'Fx':$(awk -v F="$F0" 'BEGIN{printf "%.17g", -3*F}'), 'qmax':1.5}" "$f"
+        cfile A_U c.lim "$par" "{'Fx':$(awk -v F="$F0" 'BEGIN{printf "%.17g", -3*F}'), 'qmax':1.5}" "$f" "$thPinned"
         sed -i "s/^s=.*/s='bp'/" c.lim
         run lim bp
         end=$(awk '$1=="UZ"{v=$2} END{print v}' pts.lim)
@@ -108,11 +115,11 @@ for variant in raw steps; do
       fi
       # fold: set-up Fy0 -> 0.01 F0, then Fx increasing
       fpar=$(awk -v L="$L" -v k="$k" 'BEGIN{printf "{\x27a\x27:%.17g, \x27b\x27:%.17g, \x27k\x27:%.17g, \x27L0\x27:%.17g}", 0.5*L, L, k, 0.5*L}')
-      cfile I_home c.home "$fpar" "{'Fy0':$(awk -v F="$F0" 'BEGIN{printf "%.17g", 0.01*F}')}" "$f"
+      cfile I_home c.home "$fpar" "{'Fy0':$(awk -v F="$F0" 'BEGIN{printf "%.17g", 0.01*F}')}" "$f" "$thFree"
       run home
       t_home=$MS
       if grep -q UZ pts.home; then
-        cfile I_up c.up "$fpar" "{'Fx':[$(awk -v F="$F0" 'BEGIN{printf "%.17g,%.17g", -3*F, 3*F}')], 'qmax':3.0}" "$f"
+        cfile I_up c.up "$fpar" "{'Fx':[$(awk -v F="$F0" 'BEGIN{printf "%.17g,%.17g", -3*F, 3*F}')], 'qmax':3.0}" "$f" "$thFree"
         sed -i "s/^s=.*/s='home'/; /^PAR=/d" c.up
         run up home
         lp=$(awk '$1=="LP"{print $2; exit}' pts.up)
