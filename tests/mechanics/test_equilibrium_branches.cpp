@@ -308,3 +308,52 @@ TEST_CASE("hard case: an impossible target is reported and the points before it 
   CHECK(closest < 1e-2);
   CHECK(br.points.back().lambda < 10.0);
 }
+
+TEST_CASE("hard case: kappa = 0 at n = 5, a 4-fold zero at Fx = 0 is one point of multiplicity 4", "[equilibrium_branches]") {
+  // K_q = 0 on the straight chain: the reduced Hessian is −Fx·G with G definite on ker J_h
+  // (dimension n − 1), so all n − 1 eigenvalues cross zero at Fx = 0. (Odd n − 1 is reported
+  // twice today, once by the determinant: benchmarks/RESULTS.md, "Hard cases".)
+  const int n = 5;
+  EquilibriumProblem problem(Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.5)),
+                             EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  const EquilibriumBranches r = traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.5,
+                                                cont::InitialDirection::decreasingLambda(), pinnedOptions(-2.5, 0));
+  const auto bps = branchPoints(r.tree.branches.at(0));
+  REQUIRE(bps.size() == 1);
+  CHECK(bps[0]->multiplicity == n - 1);
+  CHECK(std::abs(bps[0]->lambda) <= 1e-9);
+  CHECK(bps[0]->inertiaBefore == 0);
+  CHECK(bps[0]->inertiaAfter == n - 1);
+}
+
+TEST_CASE("hard case: top of the spectrum, n = 60: six critical loads 2e-3 apart, each once, relative 1e-9",
+          "[equilibrium_branches]") {
+  // Near the most compressive critical load the spacing is ~1/n² (2.1e-3 at |Fx| = 1.5 here).
+  // Start between the 7th- and 6th-last loads (index m − 7) and take steps of a third of the range.
+  const int n = 60;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const LinearBucklingResult lb = linearBuckling(chain, Eigen::VectorXd::Zero(n), EndCondition::clampedPinned(0.0));
+  std::vector<double> crit;
+  for (const BucklingMode& m : lb.modes)
+    if (m.lambda < 0) crit.push_back(m.lambda);
+  std::sort(crit.begin(), crit.end(), [](double x, double y) { return x > y; });
+  REQUIRE(crit.size() > 8);
+  const size_t first = crit.size() - 6;
+  const double start = 0.5 * (crit[first - 1] + crit[first]);
+  const double stop = crit.back() - 0.5 * (crit[crit.size() - 2] - crit.back());
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(stop, 0);
+  o.tracer.lambdaMax = start;
+  o.tracer.maxStep = o.tracer.initialStep = (start - stop) / 3;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(n), start, cont::InitialDirection::decreasingLambda(), o);
+  const auto bps = branchPoints(r.tree.branches.at(0));
+  REQUIRE(bps.size() == 6);
+  for (size_t i = 0; i < 6; ++i) {
+    INFO("critical load " << first + i);
+    CHECK(bps[i]->multiplicity == 1);
+    CHECK(bps[i]->inertiaBefore == int(first + i));
+    CHECK(bps[i]->inertiaAfter == int(first + i) + 1);
+    CHECK(std::abs(bps[i]->lambda - crit[first + i]) <= 1e-9 * std::abs(crit[first + i]));
+  }
+}
