@@ -3,7 +3,7 @@
 # kernels (all n), the AUTO-07p comparison, the work-precision program and its plot, the hard
 # cases (hard_cases_auto.sh: buckle and AUTO), and writes
 # the raw outputs to benchmarks/results/. RESULTS.md quotes these files.
-#   benchmarks/run_all.sh            (BUILD=build-bench by default; REPS=5)
+#   benchmarks/run_all.sh            (BUILD=build-bench by default; REPS=5; HARD_N=1000: large clustered case)
 set -euo pipefail
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=$(cd "$HERE/.." && pwd)
@@ -23,6 +23,6 @@ cmake --build "$BUILD" -j2 --target bench_kernels bench_cases work_precision har
 REPS=$REPS BUILD=$BUILD "$HERE/compare_auto.sh" | tee "$R/compare_auto.txt"
 "$BUILD/bin/work_precision" --reps "$REPS" --out "$R" | tee "$R/work_precision.txt"
 gnuplot "$R/work_precision.gp"
-BUILD=$BUILD "$HERE/hard_cases_auto.sh" | tee "$R/hard_cases.txt"
+BUILD=$BUILD "$HERE/hard_cases_auto.sh" --n "${HARD_N:-1000}" | tee "$R/hard_cases.txt"
 echo "load average at end: $(cut -d' ' -f1-3 /proc/loadavg)" >> "$R/machine.txt"
 echo "results in $R"
