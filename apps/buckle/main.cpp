@@ -6,6 +6,7 @@
 #include "command.h"
 #include "critical_command.h"
 #include "atlas_command.h"
+#include "regress_command.h"
 #include "run_command.h"
 
 int main(int argc, char** argv) {
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   buckle::cli::addCriticalCommand(app, outcome);
   buckle::cli::addRunCommand(app, outcome);
   buckle::cli::addAtlasCommand(app, outcome);
+  buckle::cli::addRegressCommand(app, outcome);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,130 @@
+#include "regress/measurement.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "buckle/mechanics/shape_name.h"
+#include "problems/auto_cases.h"
+#include "scene/runner.h"
+#include "scene/scene.h"
+
+namespace buckle::regress {
+
+namespace cont = buckle::continuation;
+
+double Measurement::medianSeconds() const {
+  if (seconds.empty()) return 0.0;
+  std::vector<double> s = seconds;
+  std::sort(s.begin(), s.end());
+  return s[s.size() / 2];
+}
+
+const std::vector<std::string>& problemNames() { return problems::caseNames(); }
+
+namespace {
+
+MeasuredCase fromScene(const scene::CaseResult& c) {
+  MeasuredCase m;
+  m.label = c.label;
+  for (const scene::SpecialRecord& s : c.specials) m.specials.push_back({s.branch, s.type, s.parameter, s.shape, s.accuracy});
+  // the located results of the analyses without branches, on pseudo-branch -1
+  if (c.haveCritical)
+    for (const mechanics::BucklingMode& mode : c.critical.modes) m.specials.push_back({-1, "CRIT", mode.lambda, mode.shape, 0.0});
+  if (c.haveLandscape)
+    for (const mechanics::LandscapeEquilibrium& e : c.landscape.equilibria)
+      m.specials.push_back({-1, "EQ", e.q1, e.shape + (e.stable ? " stable" : " unstable"), 0.0});
+  if (c.haveTorque)
+    for (const auto& [q, stable] : c.torque.equilibria) m.specials.push_back({-1, "TEQ", q, stable ? "stable" : "unstable", 0.0});
+  if (c.haveSudden && c.sudden.success) {
+    const std::string shape = mechanics::shapeName(c.sudden.rest, 1e-6) + (c.sudden.stable ? " stable" : " unstable");
+    for (Eigen::Index i = 0; i < c.sudden.rest.size(); ++i) m.specials.push_back({-1, "REST", c.sudden.rest[i], shape, 0.0});
+  }
+  for (const scene::PointRecord& p : c.points) {
+    if (m.branches.empty() || m.branches.back().id != p.branch) m.branches.push_back({p.branch, {}, {}, {}});
+    MeasuredBranch& b = m.branches.back();
+    b.index.push_back(p.index);
+    b.lambda.push_back(p.parameter);
+    b.q.push_back(p.q);
+  }
+  return m;
+}
+
+Measurement measureScene(const std::string& file, int repetitions) {
+  scene::Scene sc;
+  try {
+    sc = scene::loadScene(file);
+  } catch (const scene::SceneError& e) {
+    throw SourceError{std::string("bad scene: ") + e.what()};
+  }
+  Measurement m;
+  for (int r = 0; r < repetitions; ++r) {
+    const scene::RunResult run = scene::runScene(sc);
+    m.seconds.push_back(run.totalSeconds);
+    if (r > 0) continue;
+    m.complete = run.complete;
+    m.problems = run.problems;
+    for (const scene::CaseResult& c : run.cases) m.cases.push_back(fromScene(c));
+  }
+  return m;
+}
+
+// The problem's last traced branch (the one its benchmark times), named like the scene runner
+// names special points; the start point is not a result.
+MeasuredCase fromProblem(const problems::CaseResult& r) {
+  MeasuredCase m;
+  m.label = r.name;
+  const int n = r.segments;
+  const cont::Branch& b = r.branch;
+  for (const cont::SpecialPoint& sp : b.specialPoints) {
+    MeasuredSpecial s;
+    switch (sp.type) {
+      case cont::SpecialPointType::BranchPoint: s.type = "BP"; break;
+      case cont::SpecialPointType::Fold: s.type = "LP"; break;
+      case cont::SpecialPointType::Boundary: s.type = "BD"; break;
+      case cont::SpecialPointType::Endpoint: continue;
+    }
+    s.branch = b.id;
+    s.lambda = sp.lambda;
+    s.accuracy = sp.lambdaAccuracy;
+    // as the scene runner does: a branch point by the mode it bifurcates into
+    s.shape = sp.type == cont::SpecialPointType::BranchPoint && sp.nullVectors.cols() >= 2
+                  ? mechanics::modeShapeName(sp.nullVectors.col(1).head(n))
+                  : mechanics::shapeName(sp.u.head(n), 1e-6);
+    m.specials.push_back(s);
+  }
+  MeasuredBranch mb{b.id, {}, {}, {}};
+  for (size_t i = 0; i < b.points.size(); ++i) {
+    mb.index.push_back(int(i));
+    mb.lambda.push_back(b.points[i].lambda);
+    mb.q.push_back(b.points[i].u.head(n));
+  }
+  m.branches.push_back(std::move(mb));
+  return m;
+}
+
+Measurement measureProblem(const std::string& name, int repetitions) {
+  Measurement m;
+  for (int r = 0; r < repetitions; ++r) {
+    problems::CaseResult result;
+    if (!problems::runCase(name, problems::Settings(), result)) throw SourceError{"unknown benchmark problem \"" + name + "\""};
+    m.seconds.push_back(result.seconds);
+    if (r > 0) continue;
+    if (result.points <= 0) {
+      m.complete = false;
+      m.problems.push_back("problem " + name + ": no continuation point (" +
+                           cont::stopReasonName(result.branch.stopReason) + ")");
+    }
+    m.cases.push_back(fromProblem(result));
+  }
+  return m;
+}
+
+}  // namespace
+
+Measurement measure(const Source& source, const std::string& scenesDir, int repetitions) {
+  repetitions = std::max(1, repetitions);
+  if (source.kind == Source::Kind::Problem) return measureProblem(source.name, repetitions);
+  return measureScene((std::filesystem::path(scenesDir) / source.name).string(), repetitions);
+}
+
+}  // namespace buckle::regress

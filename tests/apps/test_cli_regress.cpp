@@ -1,0 +1,162 @@
+// `buckle regress` as a program: drift beyond tolerance fails (exit 1), a malformed baseline is
+// bad input naming file and JSON path (exit 2), --update writes baselines that pass and that
+// are the same bytes every time.
+#include <catch2/catch.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kBuckle = std::string(BUCKLE_BINARY_DIR) + "/bin/buckle";
+const std::string kScenes = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes";
+
+int exitCode(const std::string& args, const fs::path& capture) {
+  const std::string cmd = "'" + kBuckle + "' " + args + " > '" + capture.string() + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+fs::path work(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_regress_" + std::to_string(::getpid())) / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// A small selection: a scene with branch switching and a benchmark problem (fast).
+std::string update(const fs::path& dir, const std::string& extra = "") {
+  return "regress --update --baselines '" + dir.string() + "' --scenes '" + kScenes +
+         "' --only default --only auto_A_U --repetitions 1 " + extra;
+}
+
+std::string regress(const fs::path& dir, const std::string& extra = "") {
+  return "regress --baselines '" + dir.string() + "' --scenes '" + kScenes + "' --time-tolerance 0 --repetitions 1 " + extra;
+}
+
+/// The file without its reference timing line (the one thing two fresh runs may differ in).
+std::string withoutTiming(const fs::path& p) {
+  std::istringstream in(slurp(p));
+  std::string out;
+  for (std::string line; std::getline(in, line);)
+    if (line.find("\"reference_seconds\"") == std::string::npos) out += line + "\n";
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("buckle regress --update writes baselines that then pass", "[cli][regress]") {
+  const fs::path dir = work("fresh");
+  const fs::path log = dir.parent_path() / "fresh.txt";
+  REQUIRE(exitCode(update(dir), log) == 0);
+  INFO(slurp(log));
+  CHECK(fs::exists(dir / "default.json"));
+  CHECK(fs::exists(dir / "auto_A_U.json"));
+  CHECK(!fs::exists(dir / "fig2.json"));  // --only
+  const fs::path json = dir.parent_path() / "rows.json";
+  const int rc = exitCode(regress(dir, "--json '" + json.string() + "'"), log);
+  INFO(slurp(log));
+  CHECK(rc == 0);
+  const std::string table = slurp(log);
+  CHECK(table.find("b0 BP#0 lambda") != std::string::npos);
+  CHECK(table.find("FAIL") == std::string::npos);
+  const nlohmann::json rows = nlohmann::json::parse(slurp(json));
+  CHECK(rows["exit"] == 0);
+  CHECK(rows["failed"] == 0);
+  CHECK(rows["rows"].size() > 20);
+}
+
+TEST_CASE("buckle regress --update is deterministic", "[cli][regress]") {
+  const fs::path a = work("a"), b = work("b");
+  const fs::path log = a.parent_path() / "det.txt";
+  REQUIRE(exitCode(update(a), log) == 0);
+  REQUIRE(exitCode(update(b), log) == 0);
+  for (const char* f : {"default.json", "auto_A_U.json"}) {
+    INFO(f);
+    CHECK(withoutTiming(a / f) == withoutTiming(b / f));
+    // updating values only (reference timing kept) changes not a byte
+    const std::string before = slurp(a / f);
+    REQUIRE(exitCode(update(a, "--keep-timing"), log) == 0);
+    CHECK(slurp(a / f) == before);
+  }
+  // nothing but the baselines is left behind (the writes go through temporary files)
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(a)) files += e.is_regular_file();
+  CHECK(files == 2);
+}
+
+TEST_CASE("buckle regress reports a value shifted beyond its tolerance as FAIL, exit 1", "[cli][regress]") {
+  const fs::path dir = work("perturbed");
+  const fs::path log = dir.parent_path() / "perturbed.txt";
+  REQUIRE(exitCode(update(dir), log) == 0);
+  nlohmann::ordered_json doc = nlohmann::ordered_json::parse(slurp(dir / "default.json"));
+  auto& sp = doc["cases"][0]["special_points"][0];
+  const double tol = sp["tolerance"]["absolute"].get<double>() + sp["tolerance"]["relative"].get<double>() *
+                                                                    std::abs(sp["lambda"].get<double>());
+  sp["lambda"] = sp["lambda"].get<double>() + 10 * tol;
+  std::ofstream(dir / "default.json") << doc.dump(2);
+  const int rc = exitCode(regress(dir), log);
+  const std::string table = slurp(log);
+  INFO(table);
+  CHECK(rc == 1);
+  // exactly the shifted value fails
+  std::istringstream in(table);
+  int failed = 0;
+  for (std::string line; std::getline(in, line);)
+    if (line.size() >= 4 && line.compare(line.size() - 4, 4, "FAIL") == 0) {
+      ++failed;
+      CHECK(line.find("b0 BP#0 lambda") != std::string::npos);
+    }
+  CHECK(failed == 1);
+
+  // a shape that changed fails too
+  doc = nlohmann::ordered_json::parse(slurp(dir / "auto_A_U.json"));
+  doc["cases"][0]["special_points"][0]["shape"] = "Z";
+  std::ofstream(dir / "auto_A_U.json") << doc.dump(2);
+  CHECK(exitCode(regress(dir, "--only auto_A_U"), log) == 1);
+  CHECK(slurp(log).find("shape") != std::string::npos);
+}
+
+TEST_CASE("buckle regress on a malformed baseline exits 2 naming the file and the JSON path", "[cli][regress]") {
+  const fs::path dir = work("malformed");
+  const fs::path log = dir.parent_path() / "malformed.txt";
+  REQUIRE(exitCode(update(dir, "") , log) == 0);
+  nlohmann::ordered_json doc = nlohmann::ordered_json::parse(slurp(dir / "default.json"));
+  doc["cases"][0]["special_points"][1]["tolerance"]["absolute"] = "tiny";
+  std::ofstream(dir / "default.json") << doc.dump(2);
+  CHECK(exitCode(regress(dir), log) == 2);
+  std::string msg = slurp(log);
+  INFO(msg);
+  CHECK(msg.find((dir / "default.json").string() + ": /cases/0/special_points/1/tolerance/absolute: expected a number") !=
+        std::string::npos);
+  // --update refuses to overwrite it
+  CHECK(exitCode(update(dir), log) == 2);
+
+  std::ofstream(dir / "default.json") << "{\"format\": \"buckle-regression/1\", \"name\": NaN}";
+  CHECK(exitCode(regress(dir), log) == 2);
+  msg = slurp(log);
+  CHECK(msg.find((dir / "default.json").string() + ": /name: expected a finite number") != std::string::npos);
+
+  fs::remove(dir / "default.json");
+  doc = nlohmann::ordered_json::parse(slurp(dir / "auto_A_U.json"));
+  doc["source"]["problem"] = "A_X";
+  std::ofstream(dir / "auto_A_U.json") << doc.dump(2);
+  CHECK(exitCode(regress(dir), log) == 2);
+  CHECK(slurp(log).find("/source/problem: unknown benchmark problem \"A_X\"") != std::string::npos);
+
+  CHECK(exitCode(regress(dir, "--only nosuch"), log) == 2);
+  CHECK(exitCode(regress(dir.parent_path() / "does_not_exist"), log) == 2);
+}
