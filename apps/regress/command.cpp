@@ -19,7 +19,9 @@ namespace {
 
 std::string scenesDirectory(const RegressOptions& o) {
   if (!o.scenes.empty()) return o.scenes;
-  return (fs::path(o.baselines).lexically_normal().parent_path() / "scenes").string();
+  fs::path dir = fs::path(o.baselines).lexically_normal();
+  if (dir.filename().empty()) dir = dir.parent_path();  // "data/regression/"
+  return (dir.parent_path() / "scenes").string();
 }
 
 const char* sourceKey(const Source& s) { return s.kind == Source::Kind::Scene ? "/source/scene" : "/source/problem"; }
