@@ -85,7 +85,7 @@ void BM_StabilityDense(benchmark::State& state) {
   const Eigen::VectorXd u = bentState(n, 1);
   continuation::StabilityInfo info;
   for (auto _ : state) {
-    p.stability(u, -0.3, info);
+    p.stability(u, -0.3, 3, info);
     benchmark::DoNotOptimize(info.negative);
   }
 }
@@ -97,7 +97,7 @@ void BM_StabilityStructured(benchmark::State& state) {
   const Eigen::VectorXd u = bentState(n, 1);
   continuation::StabilityInfo info;
   for (auto _ : state) {
-    p.stability(u, -0.3, info);
+    p.stability(u, -0.3, 3, info);
     benchmark::DoNotOptimize(info.negative);
   }
 }

@@ -10,7 +10,8 @@ using namespace buckle::continuation;
 
 TEST_CASE("PointEvaluator: tangent, fold test and bordered determinant on the circle", "[test_functions]") {
   toys::Circle circle;
-  PointEvaluator evaluator(circle, true);
+  DenseBorderedSolver solver(circle);
+  PointEvaluator evaluator(circle, solver, true);
   ContinuationPoint p;
   p.u = (Vector(1) << 0.6).finished();
   p.lambda = 0.8;
@@ -35,7 +36,8 @@ TEST_CASE("PointEvaluator: tangent, fold test and bordered determinant on the ci
 
 TEST_CASE("PointEvaluator records stability and flags exact singularity", "[test_functions]") {
   toys::TwoPitchforks problem(0.5);
-  PointEvaluator evaluator(problem, true);
+  DenseBorderedSolver solver(problem);
+  PointEvaluator evaluator(problem, solver, true);
   ContinuationPoint p;
   p.u = Vector::Zero(2);
   p.lambda = 0.25;
@@ -52,7 +54,7 @@ TEST_CASE("PointEvaluator records stability and flags exact singularity", "[test
   CHECK(p.determinantSign == 0);
   CHECK(p.stability.valid());
 
-  PointEvaluator without(problem, false);
+  PointEvaluator without(problem, solver, false);
   p.lambda = 0.25;
   REQUIRE(without.complete(p, eLambda));
   CHECK_FALSE(p.stability.valid());

@@ -396,8 +396,8 @@ TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense defa
         for (int k = n; k < u.size(); ++k) u[k] = R(rng);
         const double lambda = trial == 0 ? 0.0 : R(rng);
         StabilityInfo a, b;
-        REQUIRE(fast.stability(u, lambda, a));
-        REQUIRE(dense.stability(u, lambda, b));
+        REQUIRE(fast.stability(u, lambda, 3, a));
+        REQUIRE(dense.stability(u, lambda, 3, b));
         INFO("n = " << n << " held " << end.heldCount() << " trial " << trial);
         CHECK(a.negative == b.negative);
         CHECK(a.zero == b.zero);

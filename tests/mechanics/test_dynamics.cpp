@@ -157,7 +157,7 @@ TEST_CASE("gradient flow: potential never increases, Pi + dissipation is conserv
     REQUIRE(problem.residual(r.q, 0.0, F));
     CHECK(F.cwiseAbs().maxCoeff() < 1e-8);
     buckle::continuation::StabilityInfo info;
-    REQUIRE(problem.stability(r.q, 0.0, info));
+    REQUIRE(problem.stability(r.q, 0.0, 3, info));
     CHECK(info.stable());
     CHECK(r.q.cwiseAbs().minCoeff() > 1.0);  // left the unstable straight state
   }
@@ -238,7 +238,7 @@ TEST_CASE("inertial with damping: kinetic + potential + dissipated = initial ene
   CHECK(r.kinetic < 1e-15);
   EquilibriumProblem problem(chain, EndCondition::freeEnd(W), Eigen::Vector3d::Zero());
   buckle::continuation::StabilityInfo info;
-  REQUIRE(problem.stability(r.q, 0.0, info));
+  REQUIRE(problem.stability(r.q, 0.0, 3, info));
   CHECK(info.stable());
 }
 

@@ -173,7 +173,7 @@ TEST_CASE("straight start pushed by dx > 0: U minima, Z maxima, eq 12 force, buc
     Vector u(5);
     u << 0, 0, 0, factor * an.FxU, 0;
     buckle::continuation::StabilityInfo info;
-    REQUIRE(held.stability(u, 0.0, info));
+    REQUIRE(held.stability(u, 0.0, 3, info));
     CHECK(info.stable() == (factor < 1.0));
   }
   // pulled (x > 6b): out of reach, no equilibria

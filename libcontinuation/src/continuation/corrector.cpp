@@ -25,8 +25,8 @@ bool CorrectorOptions::IsValid(std::string *why) const {
   return true;
 }
 
-Corrector::Corrector(Problem &problem, const CorrectorOptions &options)
-    : problem_(problem), options_(options), n_(problem.dimension()) {
+Corrector::Corrector(Problem &problem, const CorrectorOptions &options, BorderedSolver *structured)
+    : problem_(problem), structured_(structured), options_(options), n_(problem.dimension()) {
   std::string why;
   if (!options_.IsValid(&why)) throw std::invalid_argument("CorrectorOptions: " + why);
   if (n_ < 1) throw std::invalid_argument("Problem::dimension() must be positive");
@@ -42,8 +42,13 @@ Corrector::Corrector(Problem &problem, const CorrectorOptions &options)
   x_ = makeSerialVector(m, context_.get());
   scale_ = makeSerialVector(m, context_.get());
   N_VConst(1.0, scale_.get());
-  jacobian_ = makeDenseMatrix(m, m, context_.get());
-  linearSolver_ = makeDenseLinearSolver(x_.get(), jacobian_.get(), context_.get());
+  if (structured_) {
+    jacobian_ = makeEmptyCustomMatrix(context_.get());
+    linearSolver_ = makeCustomDirectLinearSolver(&Corrector::linearSolve, this, context_.get());
+  } else {
+    jacobian_ = makeDenseMatrix(m, m, context_.get());
+    linearSolver_ = makeDenseLinearSolver(x_.get(), jacobian_.get(), context_.get());
+  }
   kinsol_ = makeKinsolMemory(context_.get());
   void *mem = kinsol_.get();
   if (KINInit(mem, &Corrector::systemFunction, x_.get()) != KIN_SUCCESS ||
@@ -79,7 +84,22 @@ int Corrector::systemFunction(N_Vector x, N_Vector g, void *self) {
 }
 
 int Corrector::jacobianFunction(N_Vector x, N_Vector, SUNMatrix J, void *self, N_Vector, N_Vector) {
-  return static_cast<Corrector *>(self)->evaluateJacobian(N_VGetArrayPointer(x), SUNDenseMatrix_Data(J));
+  auto *corrector = static_cast<Corrector *>(self);
+  if (corrector->structured_) return corrector->factorStructured(N_VGetArrayPointer(x));
+  return corrector->evaluateJacobian(N_VGetArrayPointer(x), SUNDenseMatrix_Data(J));
+}
+
+int Corrector::linearSolve(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vector b, realtype) {
+  auto *corrector = static_cast<Corrector *>(customLinearSolverData(solver));
+  const int m = corrector->n_ + 1;
+  Eigen::Map<const Vector> rhs(N_VGetArrayPointer(b), m);
+  Eigen::Map<Vector> solution(N_VGetArrayPointer(x), m);
+  return corrector->structured_->solve(rhs, solution) ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_UNREC;
+}
+
+int Corrector::factorStructured(const double *xData) {
+  Eigen::Map<const Vector> x(xData, n_ + 1);
+  return structured_->factor(x.head(n_), x[n_], tangent_) == Factorization::Regular ? 0 : -1;
 }
 
 void Corrector::errorHandler(int, const char *, const char *function, char *message, void *self) {

@@ -25,6 +25,14 @@ bool crossingEigenvalue(const ContinuationPoint &p, int index, double &value) {
   return true;
 }
 
+// The crossing eigenvalue's index may exceed what the tracer recorded (it may record the inertia
+// only): recompute the stability of a bracket end with enough eigenvalues.
+void ensureEigenvalues(Problem &problem, ContinuationPoint &p, int count) {
+  if (!p.stability.valid() || p.stability.lowest.size() >= count) return;
+  StabilityInfo info;
+  if (problem.stability(p.u, p.lambda, count, info)) p.stability = info;
+}
+
 std::string format(const char *pattern, double value) {
   char buffer[160];
   std::snprintf(buffer, sizeof buffer, pattern, value);
@@ -228,6 +236,14 @@ double Locator::residualNorm(ConstVectorRef u, double lambda) {
 
 std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &crossings) {
   std::vector<SpecialPoint> found;
+  // Eigenvalue tests follow μ_k, k = the smaller negative count: make every sample carry it.
+  const int savedEigenvalues = evaluator_.lowestEigenvalues();
+  if (crossings.branchPointCrossings > 0 && a_.point.stability.valid() && b_.point.stability.valid()) {
+    const int needed = std::max({3, savedEigenvalues, crossingIndex(a_.point, b_.point) + 2});
+    evaluator_.setLowestEigenvalues(needed);
+    ensureEigenvalues(problem_, a_.point, needed);
+    ensureEigenvalues(problem_, b_.point, needed);
+  }
   if (crossings.fold && options_.detectFolds) found.push_back(locateFold(a_, b_));
   if (crossings.branchPointCrossings > 0 && options_.detectBranchPoints) {
     std::vector<std::pair<StepSample, StepSample>> simple, multiple;
@@ -239,6 +255,7 @@ std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &
       found.push_back(multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
     }
   }
+  evaluator_.setLowestEigenvalues(savedEigenvalues);
   std::sort(found.begin(), found.end(),
             [](const SpecialPoint &p, const SpecialPoint &q) { return p.arclength < q.arclength; });
   return found;
@@ -299,7 +316,8 @@ SpecialPoint Locator::locateFold(const StepSample &lo, const StepSample &hi) {
     sp.note = root.failure.empty() ? "" : "fold secant: " + root.failure;
   };
   adopt(ok);
-  if (!refineFold(sp, a_.point.tangent) && ok && root.fLeft * root.fRight < 0.0) {
+  if (!options_.denseAlgebra) sp.note += (sp.note.empty() ? "" : "; ") + std::string("secant only (large N)");
+  if ((!options_.denseAlgebra || !refineFold(sp, a_.point.tangent)) && ok && root.fLeft * root.fRight < 0.0) {
     // No refinement: finish the secant to the full tolerance instead.
     const std::string refinementNote = sp.note;
     const int refinementSteps = sp.locationIterations - evaluations;
@@ -318,7 +336,7 @@ bool Locator::refineFold(SpecialPoint &sp, const Vector &tangentRef) {
   Matrix Fu(n, n);
   Vector Fl(n);
   if (!problem_.jacobian(sp.u, sp.lambda, Fu, Fl)) return false;
-  Eigen::JacobiSVD<Matrix> svd(Fu, Eigen::ComputeFullV);
+  Eigen::BDCSVD<Matrix> svd(Fu, Eigen::ComputeFullV);
   const Vector c = svd.matrixV().col(n - 1);
   Vector z(2 * n + 1);
   z << sp.u, sp.lambda, c;
@@ -387,13 +405,13 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
   sp.inertiaBefore = lo.point.stability.negative;
   sp.inertiaAfter = hi.point.stability.negative;
 
-  Matrix A(n_ + 1, n_ + 1);
+  Matrix A(options_.denseAlgebra ? n_ + 1 : 0, options_.denseAlgebra ? n_ + 1 : 0);
   MinimallyAugmentedTest psi;
   TestFunction test;
   double fLo = 0.0, fHi = 0.0;
   bool haveTest = false;
   if (lo.point.determinantSign * hi.point.determinantSign < 0) {
-    if (evaluator_.borderedJacobian(lo.point.u, lo.point.lambda, lo.point.tangent, A)) {
+    if (options_.denseAlgebra && evaluator_.borderedJacobian(lo.point.u, lo.point.lambda, lo.point.tangent, A)) {
       psi.initialize(A);
       test = [&](const ContinuationPoint &p, double &f) {
         return evaluator_.borderedJacobian(p.u, p.lambda, p.tangent, A) && psi.evaluate(A, f);
@@ -417,6 +435,7 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
     haveTest = test(lo.point, fLo) && test(hi.point, fHi) && !sameSign(fLo, fHi);
     sp.note = "inertia change without determinant sign change; located on the crossing eigenvalue";
   }
+  if (!options_.denseAlgebra) sp.note += (sp.note.empty() ? "" : "; ") + std::string("secant only (large N)");
 
   Root root;
   bool ok = false;
@@ -437,7 +456,7 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
     else if (!root.failure.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("branch point secant: " + root.failure);
   };
   adopt(ok);
-  if (!refineBranchPoint(sp, a_.point.tangent) && ok && root.fLeft * root.fRight < 0.0) {
+  if ((!options_.denseAlgebra || !refineBranchPoint(sp, a_.point.tangent)) && ok && root.fLeft * root.fRight < 0.0) {
     const std::string refinementNote = sp.note;
     const int refinementSteps = sp.locationIterations - evaluations;
     const Root coarse = root;
@@ -509,6 +528,7 @@ bool Locator::refineBranchPoint(SpecialPoint &sp, const Vector &tangentRef) {
 }
 
 void Locator::fillBranchPointGeometry(SpecialPoint &sp, const Vector &tangentRef) {
+  if (!options_.denseAlgebra) return;  // null vectors need the dense kernel
   KernelInfo kernel;
   if (!jacobianKernel(problem_, sp.u, sp.lambda, kernel)) return;
   const double scale = std::max(1.0, kernel.singularValues.maxCoeff());

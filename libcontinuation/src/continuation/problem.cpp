@@ -1,5 +1,7 @@
 #include "buckle/continuation/problem.h"
 
+#include "buckle/continuation/bordered_solver.h"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
@@ -31,16 +33,18 @@ bool Problem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, Con
   return true;
 }
 
+std::unique_ptr<BorderedSolver> Problem::makeStructuredSolver() { return nullptr; }
+
 bool Problem::stabilityOperator(ConstVectorRef, double, Matrix&, Matrix&) { return false; }
 
-bool Problem::stability(ConstVectorRef u, double lambda, StabilityInfo& info) {
+bool Problem::stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo& info) {
   if (!hasStabilityOperator()) return false;
   if (!stabilityOperator(u, lambda, stabilityH_, stabilityC_)) return false;
-  info = projectedInertia(stabilityH_, stabilityC_);
+  info = projectedInertia(stabilityH_, stabilityC_, 1e-13, lowestCount);
   return true;
 }
 
-StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance) {
+StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance, int lowestCount) {
   StabilityInfo info;
   Matrix reduced;
   if (C.rows() == 0) {
@@ -69,8 +73,8 @@ StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTole
     if (std::abs(mu[i]) <= tol) ++info.zero;
     else if (mu[i] < 0.0) ++info.negative;
   }
-  info.smallest = mu[0];
-  info.lowest = mu.head(std::min<Eigen::Index>(3, mu.size()));
+  info.lowest = mu.head(std::min<Eigen::Index>(std::max(0, lowestCount), mu.size()));
+  info.smallest = info.lowest.size() ? info.lowest[0] : 0.0;
   return info;
 }
 

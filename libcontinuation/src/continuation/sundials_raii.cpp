@@ -10,6 +10,28 @@ namespace buckle::continuation {
 namespace {
 // KINSOL's default handler prints to stderr; a library must stay silent unless asked.
 void silentErrorHandler(int, const char *, const char *, char *, void *) {}
+
+SUNMatrix_ID customMatrixId(SUNMatrix) { return SUNMATRIX_CUSTOM; }
+int customMatrixZero(SUNMatrix) { return 0; }  // nothing stored: the solver holds the factors
+
+// The custom solver's content is the caller's `data`, which it does not own.
+struct CustomSolverContent {
+  CustomSolveFn solve;
+  void *data;
+};
+SUNLinearSolver_Type customSolverType(SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; }
+SUNLinearSolver_ID customSolverId(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
+int customSolverSetup(SUNLinearSolver, SUNMatrix) { return SUNLS_SUCCESS; }
+int customSolverSolve(SUNLinearSolver solver, SUNMatrix A, N_Vector x, N_Vector b, realtype tol) {
+  return static_cast<CustomSolverContent *>(solver->content)->solve(solver, A, x, b, tol);
+}
+int customSolverFree(SUNLinearSolver solver) {
+  if (solver == nullptr) return SUNLS_SUCCESS;
+  delete static_cast<CustomSolverContent *>(solver->content);
+  solver->content = nullptr;
+  SUNLinSolFreeEmpty(solver);
+  return SUNLS_SUCCESS;
+}
 }  // namespace
 
 void SunContextDeleter::operator()(std::remove_pointer_t<SUNContext> *context) const noexcept {
@@ -50,6 +72,30 @@ SunLinearSolverPtr makeDenseLinearSolver(N_Vector vector, SUNMatrix matrix, SUNC
   SunLinearSolverPtr solver(SUNLinSol_Dense(vector, matrix, context));
   if (!solver) throw std::runtime_error("SUNLinSol_Dense failed");
   return solver;
+}
+
+SunMatrixPtr makeEmptyCustomMatrix(SUNContext context) {
+  SunMatrixPtr matrix(SUNMatNewEmpty(context));
+  if (!matrix) throw std::runtime_error("SUNMatNewEmpty failed");
+  matrix->ops->getid = customMatrixId;
+  matrix->ops->zero = customMatrixZero;
+  return matrix;
+}
+
+SunLinearSolverPtr makeCustomDirectLinearSolver(CustomSolveFn solve, void *data, SUNContext context) {
+  SunLinearSolverPtr solver(SUNLinSolNewEmpty(context));
+  if (!solver) throw std::runtime_error("SUNLinSolNewEmpty failed");
+  solver->ops->gettype = customSolverType;
+  solver->ops->getid = customSolverId;
+  solver->ops->setup = customSolverSetup;
+  solver->ops->solve = customSolverSolve;
+  solver->ops->free = customSolverFree;
+  solver->content = new CustomSolverContent{solve, data};
+  return solver;
+}
+
+void *customLinearSolverData(SUNLinearSolver solver) {
+  return static_cast<CustomSolverContent *>(solver->content)->data;
 }
 
 KinsolMemoryPtr makeKinsolMemory(SUNContext context) {

@@ -8,12 +8,13 @@
 
 namespace buckle::continuation {
 
-PointEvaluator::PointEvaluator(Problem &problem, bool computeStability)
+PointEvaluator::PointEvaluator(Problem &problem, BorderedSolver &solver, bool computeStability,
+                               int lowestEigenvalues)
     : problem_(problem),
+      solver_(solver),
       n_(problem.dimension()),
       stability_(computeStability && problem.hasStabilityOperator()),
-      bordered_(Matrix::Zero(n_ + 1, n_ + 1)),
-      lu_(n_ + 1),
+      lowestEigenvalues_(lowestEigenvalues),
       rhs_(Vector::Zero(n_ + 1)),
       solution_(Vector::Zero(n_ + 1)) {
   rhs_[n_] = 1.0;
@@ -28,35 +29,24 @@ bool PointEvaluator::borderedJacobian(ConstVectorRef u, double lambda, ConstVect
 
 bool PointEvaluator::complete(ContinuationPoint &point, ConstVectorRef reference) {
   singular_ = false;
-  if (!borderedJacobian(point.u, point.lambda, reference, bordered_)) return false;
+  const Factorization f = solver_.factor(point.u, point.lambda, reference);
+  if (f == Factorization::Refused) return false;
+  singular_ = f == Factorization::Singular;
   if (stability_) {
-    if (!problem_.stability(point.u, point.lambda, point.stability)) point.stability = StabilityInfo();
+    if (!problem_.stability(point.u, point.lambda, lowestEigenvalues_, point.stability))
+      point.stability = StabilityInfo();
   } else {
     point.stability = StabilityInfo();
   }
-  lu_.compute(bordered_);
-  const auto &LU = lu_.matrixLU();
-  int sign = lu_.permutationP().determinant() > 0 ? 1 : -1;
-  double logAbs = 0.0;
-  for (int i = 0; i <= n_; ++i) {
-    const double pivot = LU(i, i);
-    if (pivot == 0.0 || !std::isfinite(pivot)) {
-      singular_ = true;
-      break;
-    }
-    if (pivot < 0.0) sign = -sign;
-    logAbs += std::log(std::abs(pivot));
-  }
   if (!singular_) {
-    solution_ = lu_.solve(rhs_);
-    const double norm = solution_.norm();
+    const double norm = solver_.solve(rhs_, solution_) ? solution_.norm() : 0.0;
     if (!(norm > 0.0) || !std::isfinite(norm)) {
       singular_ = true;
     } else {
       point.tangent = solution_ / norm;
       // det with the point's own tangent as last row: det_ref = (refᵀt)·det_t, refᵀt = 1/‖y‖ > 0.
-      point.determinantSign = sign;
-      point.logAbsDeterminant = logAbs + std::log(norm);
+      point.determinantSign = solver_.determinantSign();
+      point.logAbsDeterminant = solver_.logAbsDeterminant() + std::log(norm);
     }
   }
   if (singular_) {
@@ -118,7 +108,8 @@ bool jacobianKernel(Problem &problem, ConstVectorRef u, double lambda, KernelInf
   if (!problem.jacobian(u, lambda, Fx.leftCols(n), Fx.col(n))) return false;
   // Full SVD of the N×(N+1) matrix: V has N+1 columns, the last one spans the always-present
   // extra kernel dimension; Eigen orders singular values descending.
-  Eigen::JacobiSVD<Matrix> svd(Fx, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  // BDCSVD: divide and conquer, Jacobi below 16×16, so small problems see no difference.
+  Eigen::BDCSVD<Matrix> svd(Fx, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Vector &sigma = svd.singularValues();
   info.singularValues = Vector::Zero(n + 1);
   info.right.resize(n + 1, n + 1);

@@ -56,6 +56,9 @@ bool TracerOptions::IsValid(std::string *why) const {
   if (maxLocationIterations < 1) return fail("maxLocationIterations must be at least 1");
   if (maxRefinementIterations < 1) return fail("maxRefinementIterations must be at least 1");
   if (!(separationFraction > 0.0 && separationFraction < 1.0)) return fail("separationFraction must lie in (0, 1)");
+  if (lowestEigenvalues < 0) return fail("lowestEigenvalues must be >= 0");
+  if (structuredFromDimension < 1) return fail("structuredFromDimension must be at least 1");
+  if (maxDenseLocationDimension < 1) return fail("maxDenseLocationDimension must be at least 1");
   return true;
 }
 
@@ -78,8 +81,21 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
     invalidReason_ = "boxLower/boxUpper must be empty or have size N+1 = " + std::to_string(n_ + 1);
     return;
   }
-  corrector_ = std::make_unique<Corrector>(problem_, stepCorrectorOptions());
-  evaluator_ = std::make_unique<PointEvaluator>(problem_, options_.computeStability);
+  using LA = TracerOptions::LinearAlgebra;
+  if (options_.linearAlgebra != LA::Dense &&
+      (options_.linearAlgebra == LA::Structured || n_ >= options_.structuredFromDimension))
+    structuredSolver_ = problem_.makeStructuredSolver();
+  if (options_.linearAlgebra == LA::Structured && !structuredSolver_) {
+    invalidReason_ = "linearAlgebra = Structured, but the problem offers no structured solver";
+    return;
+  }
+  BorderedSolver *solver = structuredSolver_.get();
+  if (!solver) {
+    denseSolver_ = std::make_unique<DenseBorderedSolver>(problem_);
+    solver = denseSolver_.get();
+  }
+  corrector_ = std::make_unique<Corrector>(problem_, stepCorrectorOptions(), structuredSolver_.get());
+  evaluator_ = std::make_unique<PointEvaluator>(problem_, *solver, options_.computeStability, options_.lowestEigenvalues);
   LocatorOptions lo;
   lo.tolerance = options_.locationTolerance;
   lo.newtonTolerance = options_.locationNewtonTolerance;
@@ -89,6 +105,7 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   lo.minSampleCosine = options_.minTangentCosine;
   lo.detectFolds = options_.detectFolds;
   lo.detectBranchPoints = options_.detectBranchPoints;
+  lo.denseAlgebra = n_ <= options_.maxDenseLocationDimension;
   locator_ = std::make_unique<Locator>(problem_, *corrector_, *evaluator_, lo);
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
@@ -164,28 +181,46 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
   start.newtonIterations = polish.iterations;
   start.residualNorm = polish.residualNorm;
 
-  KernelInfo kernel;
-  if (!jacobianKernel(problem_, start.u, start.lambda, kernel)) {
-    branch.stopReason = StopReason::StartFailed;
-    branch.stopMessage = "the problem refused the Jacobian at the start point";
-    return branch;
-  }
   std::string startNote = "start";
-  Vector t = kernel.right.col(0);
-  const double sigmaScale = std::max(1.0, kernel.singularValues.maxCoeff());
-  const bool twoDimensional = kernel.singularValues.size() > 1 && kernel.singularValues[1] <= 1e-10 * sigmaScale;
-  if (direction.tangent.size()) {
-    if (twoDimensional) {
-      const Matrix K = kernel.right.leftCols(2);
-      const Vector projected = K * (K.transpose() * direction.tangent);
-      if (projected.norm() > 1e-12) t = projected.normalized();
-      startNote += " (at a singular point: direction projected onto the 2-dimensional kernel)";
+  Vector t;
+  // Large structured problems: the tangent from one bordered solve with the requested direction
+  // (or e_λ) as border row, O(N); the dense kernel (SVD) only if that matrix is singular (a start
+  // on a fold or a branch point) or for dense problems, where it also detects a 2-d kernel.
+  if (structuredSolver_) {
+    Vector reference = direction.tangent;
+    if (!reference.size()) {
+      reference = Vector::Zero(n_ + 1);
+      reference[n_] = direction.lambdaSign >= 0 ? 1.0 : -1.0;
     }
-    if (t.dot(direction.tangent) < 0.0) t = -t;
-  } else {
-    if (twoDimensional) startNote += " (at a singular point: kernel is 2-dimensional, direction arbitrary)";
-    if (std::abs(t[n_]) < 1e-12) startNote += " (at a fold: lambda sign cannot orient the tangent)";
-    if (t[n_] * direction.lambdaSign < 0.0) t = -t;
+    Vector rhs = Vector::Zero(n_ + 1), y(n_ + 1);
+    rhs[n_] = 1.0;
+    const bool regular = structuredSolver_->factor(start.u, start.lambda, reference) == Factorization::Regular &&
+                         structuredSolver_->solve(rhs, y) && y.allFinite() && y.norm() > 0.0;
+    if (regular) t = y.normalized();  // referenceᵀy = 1 > 0: oriented along the request
+  }
+  if (!t.size()) {
+    KernelInfo kernel;
+    if (!jacobianKernel(problem_, start.u, start.lambda, kernel)) {
+      branch.stopReason = StopReason::StartFailed;
+      branch.stopMessage = "the problem refused the Jacobian at the start point";
+      return branch;
+    }
+    t = kernel.right.col(0);
+    const double sigmaScale = std::max(1.0, kernel.singularValues.maxCoeff());
+    const bool twoDimensional = kernel.singularValues.size() > 1 && kernel.singularValues[1] <= 1e-10 * sigmaScale;
+    if (direction.tangent.size()) {
+      if (twoDimensional) {
+        const Matrix K = kernel.right.leftCols(2);
+        const Vector projected = K * (K.transpose() * direction.tangent);
+        if (projected.norm() > 1e-12) t = projected.normalized();
+        startNote += " (at a singular point: direction projected onto the 2-dimensional kernel)";
+      }
+      if (t.dot(direction.tangent) < 0.0) t = -t;
+    } else {
+      if (twoDimensional) startNote += " (at a singular point: kernel is 2-dimensional, direction arbitrary)";
+      if (std::abs(t[n_]) < 1e-12) startNote += " (at a fold: lambda sign cannot orient the tangent)";
+      if (t[n_] * direction.lambdaSign < 0.0) t = -t;
+    }
   }
   int skipIntervals = 0;
   if (!evaluator_->complete(start, t)) {

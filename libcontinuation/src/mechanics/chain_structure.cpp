@@ -608,31 +608,50 @@ bool solve(ChainStructure& ws, ConstVectorRef r, VectorRef x) {
   return x.allFinite();
 }
 
-bool solveBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const Eigen::Ref<const Matrix>& W,
-                   const Eigen::Ref<const Matrix>& D, ConstVectorRef f, ConstVectorRef g, VectorRef x, VectorRef y) {
+bool factorBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const Eigen::Ref<const Matrix>& W,
+                    const Eigen::Ref<const Matrix>& D) {
   const int n = ws.n;
   const int p = int(V.cols());
   if (p > ChainStructure::kMaxBorder || W.cols() != p || D.rows() != p || D.cols() != p || V.rows() != n ||
       W.rows() != n)
-    throw std::invalid_argument("solveBordered: V, W must be n×p and D p×p with p <= 4");
+    throw std::invalid_argument("factorBordered: V, W must be n×p and D p×p with p <= 4");
+  ws.borderSize = -1;
   factorize(ws, 0.0);
   if (ws.singular) return false;
+  for (int j = 0; j < p; ++j) {
+    applyUInverse(V.col(j), ws.V2.col(j));
+    applyUInverse(W.col(j), ws.W2.col(j));
+  }
+  solveFactored(ws, ws.V2, p);
+  // det [[H, V], [Wᵀ, D]] = det H · det S with det H = det T (det U = 1).
+  ws.schur.resize(p, p);
+  ws.schur.noalias() = D - ws.W2.leftCols(p).transpose() * ws.V2.leftCols(p);
+  ws.schurLU.compute(ws.schur);
+  if (p > 0 && !ws.schurLU.isInvertible()) return false;
+  ws.borderSize = p;
+  ws.borderedLogAbsDet = ws.logAbsDet;
+  ws.borderedDetSign = ws.detSign;
+  if (p > 0) {
+    const double detS = ws.schurLU.determinant();
+    ws.borderedLogAbsDet += std::log(std::abs(detS));
+    if (detS < 0.0) ws.borderedDetSign = -ws.borderedDetSign;
+  }
+  return true;
+}
+
+bool solveFactoredBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const Eigen::Ref<const Matrix>& W,
+                           const Eigen::Ref<const Matrix>& D, ConstVectorRef f, ConstVectorRef g, VectorRef x,
+                           VectorRef y) {
+  const int n = ws.n;
+  const int p = int(V.cols());
+  if (ws.borderSize != p) throw std::logic_error("solveFactoredBordered: factorBordered was not called for this border");
   if (p == 0) {
     applyUInverse(f, x);
     solveFactored(ws, x);
     applyUInverseTranspose(x, x);
     return x.allFinite();
   }
-  for (int j = 0; j < p; ++j) {
-    applyUInverse(V.col(j), ws.V2.col(j));
-    applyUInverse(W.col(j), ws.W2.col(j));
-  }
-  solveFactored(ws, ws.V2, p);
-  ChainStructure::SmallMatrix schur(p, p);
-  schur.noalias() = D - ws.W2.leftCols(p).transpose() * ws.V2.leftCols(p);
-  Eigen::FullPivLU<ChainStructure::SmallMatrix> lu(schur);
-  if (!lu.isInvertible()) return false;
-  borderedElimination(ws, p, lu, f, g, x, y);
+  borderedElimination(ws, p, ws.schurLU, f, g, x, y);
   // One step of iterative refinement with the exact O(n) residual.
   Vector& r1 = ws.t2;
   applyHessian(ws, x.head(n), r1);
@@ -643,10 +662,15 @@ bool solveBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const 
   r2.noalias() -= D * y.head(p);
   Vector& dx = ws.t3;
   ChainStructure::SmallVector dy(p);
-  borderedElimination(ws, p, lu, r1, r2, dx, dy);
+  borderedElimination(ws, p, ws.schurLU, r1, r2, dx, dy);
   x.head(n) += dx;
   y.head(p) += dy;
   return x.allFinite() && y.allFinite();
+}
+
+bool solveBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const Eigen::Ref<const Matrix>& W,
+                   const Eigen::Ref<const Matrix>& D, ConstVectorRef f, ConstVectorRef g, VectorRef x, VectorRef y) {
+  return factorBordered(ws, V, W, D) && solveFactoredBordered(ws, V, W, D, f, g, x, y);
 }
 
 bool solveKKT(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, ConstVectorRef f, ConstVectorRef g, VectorRef x,

@@ -2,8 +2,10 @@
 
 #include <Eigen/QR>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
+#include "buckle/mechanics/chain_solver.h"
 #include "buckle/mechanics/validation.h"
 
 namespace buckle::mechanics {
@@ -22,6 +24,9 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
       loaded_(end.loadedIndices()),
       data_(chain),
       J_(3, chain.size()),
+      grad_(chain.size()),
+      stiff_(chain.size()),
+      cachedQ_(chain.size()),
       work_(chain.size()),
       work2_(chain.size()),
       structure_(chain.size()),
@@ -33,9 +38,25 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
   }
 }
 
-void EquilibriumProblem::evaluateKinematics(ConstVectorRef u) {
-  forwardKinematics(chain_, u.head(chain_.size()), data_);
+bool EquilibriumProblem::prepare(ConstVectorRef u) {
+  const int n = chain_.size();
+  for (Eigen::Index k = n; k < u.size(); ++k)
+    if (!std::isfinite(u[k])) return false;
+  const auto q = u.head(n);
+  // Bitwise: a q that merely compares equal (−0.0 vs 0.0) is evaluated afresh.
+  if (cacheValid_ && std::memcmp(q.data(), cachedQ_.data(), sizeof(double) * size_t(n)) == 0) return true;
+  cacheValid_ = false;
+  if (!inDomain(u)) return false;
+  forwardKinematics(chain_, q, data_);
   endJacobian(data_, J_);
+  for (int i = 0; i < n; ++i) {
+    const Jet3 e = chain_.segment(i).energyJet(q[i]);
+    grad_[i] = e.d1;
+    stiff_[i] = e.d2;
+  }
+  cachedQ_ = q;
+  cacheValid_ = true;
+  return true;
 }
 
 Wrench EquilibriumProblem::wrench(ConstVectorRef u, double lambda) const {
@@ -80,12 +101,11 @@ bool EquilibriumProblem::inDomain(ConstVectorRef u) const {
 }
 
 bool EquilibriumProblem::residual(ConstVectorRef u, double lambda, VectorRef F) {
-  if (!inDomain(u) || !std::isfinite(lambda)) return false;
+  if (!std::isfinite(lambda) || !prepare(u)) return false;
   const int n = chain_.size();
-  evaluateKinematics(u);
   const Wrench W = wrench(u, lambda);
   auto top = F.head(n);
-  energyGradient(chain_, u.head(n), top);
+  top = grad_;
   top.noalias() -= J_.transpose() * W;
   const Eigen::Vector3d value = prescribed(lambda);
   for (size_t k = 0; k < held_.size(); ++k) F[n + int(k)] = value[held_[k]] - data_.pose[held_[k]];
@@ -93,16 +113,14 @@ bool EquilibriumProblem::residual(ConstVectorRef u, double lambda, VectorRef F) 
 }
 
 bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) {
-  if (!inDomain(u) || !std::isfinite(lambda)) return false;
+  if (!std::isfinite(lambda) || !prepare(u)) return false;
   const int n = chain_.size();
-  evaluateKinematics(u);
   const Wrench W = wrench(u, lambda);
   loadHessianGenerator(data_, W, work_);
-  jointStiffness(chain_, u.head(n), work2_);
   // K_q − K_g with K_g(i, j) = h_max(i,j)  (eq 27)
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) Fu(i, j) = -work_[std::max(i, j)];
-  for (int i = 0; i < n; ++i) Fu(i, i) += work2_[i];
+  for (int i = 0; i < n; ++i) Fu(i, i) += stiff_[i];
   const int m = heldCount();
   for (int k = 0; k < m; ++k) {
     Fu.block(0, n + k, n, 1) = -J_.row(held_[size_t(k)]).transpose();
@@ -117,10 +135,9 @@ bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu,
 
 bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
                                                        double dlambda, MatrixRef dFu, VectorRef dFlambda) {
-  if (!inDomain(u) || !std::isfinite(lambda)) return false;
+  if (!std::isfinite(lambda) || !prepare(u)) return false;
   const int n = chain_.size();
   const int m = heldCount();
-  evaluateKinematics(u);
   const Wrench W = wrench(u, lambda);
   Wrench dW = dlambda * direction_;
   for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = du[n + k];
@@ -162,46 +179,55 @@ bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double 
 }
 
 bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix& H, Matrix& C) {
-  if (!inDomain(u)) return false;
+  if (!prepare(u)) return false;
   const int n = chain_.size();
   H.resize(n, n);
   C.resize(heldCount(), n);
-  totalPotentialHessian(chain_, u.head(n), wrench(u, lambda), H);
-  forwardKinematics(chain_, u.head(n), data_);
-  endJacobian(data_, J_);
+  // totalPotentialHessian() from the cached kinematics and K_q
+  loadMatrix(data_, wrench(u, lambda), H);
+  H = -H;
+  H.diagonal() += stiff_;
   for (int k = 0; k < heldCount(); ++k) C.row(k) = J_.row(held_[size_t(k)]);
   return true;
 }
 
-bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, continuation::StabilityInfo& info) {
-  if (!options_.structuredStability) return Problem::stability(u, lambda, info);
-  if (!inDomain(u)) return false;
+bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCount,
+                                   continuation::StabilityInfo& info) {
+  if (!options_.structuredStability) return Problem::stability(u, lambda, lowestCount, info);
+  if (!prepare(u)) return false;
   const int n = chain_.size();
-  forwardKinematics(chain_, u.head(n), data_);
-  endJacobian(data_, J_);
-  assemble(chain_, data_, u.head(n), wrench(u, lambda), structure_);
+  loadHessianGenerator(data_, wrench(u, lambda), structure_.h);
+  assemble(stiff_, structure_.h, structure_);
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
-  if (n <= kSmallDense) {
+  const int wanted = std::max(0, std::min(lowestCount, kMaxLowest));
+  if (n <= kSmallDense && wanted > 0) {
     // Small chains: one heap-free dense eigen-solve beats the counts + eigenvalue isolation.
-    Eigen::Vector3d low;
+    Eigen::Matrix<double, kMaxLowest, 1> low;
     int found = 0;
-    const Inertia in = smallDenseInertia(structure_, heldRows_, 3, low, found);
+    const Inertia in = smallDenseInertia(structure_, heldRows_, wanted, low.head(wanted), found);
     info.negative = in.negative;
     info.zero = in.zero;
     info.lowest = low.head(found);
     info.smallest = found > 0 ? low[0] : 0.0;
     return true;
   }
+  // Inertia by two O(n) Sturm counts (Sylvester); eigenvalues only when asked for.
   const Inertia in = constrainedInertia(structure_, heldRows_);
   info.negative = in.negative;
   info.zero = in.zero;
   const int dim = in.size();
-  info.lowest.resize(std::min(3, dim));
-  lowestEigenvalues(structure_, structure_.rank > 0, int(info.lowest.size()), info.lowest, 1e-13,
-                    lastLowest_.size() > 0 ? &lastLowest_ : nullptr);
-  lastLowest_ = info.lowest;
-  info.smallest = dim > 0 ? info.lowest[0] : 0.0;
+  info.lowest.resize(std::min(wanted, dim));
+  if (info.lowest.size() > 0) {
+    lowestEigenvalues(structure_, structure_.rank > 0, int(info.lowest.size()), info.lowest, 1e-13,
+                      lastLowest_.size() == info.lowest.size() ? &lastLowest_ : nullptr);
+    lastLowest_ = info.lowest;
+  }
+  info.smallest = info.lowest.size() > 0 ? info.lowest[0] : 0.0;
   return true;
+}
+
+std::unique_ptr<continuation::BorderedSolver> EquilibriumProblem::makeStructuredSolver() {
+  return std::make_unique<ChainBorderedSolver>(*this);
 }
 
 int EquilibriumProblem::boundaryCount() const { return options_.jointLimitsAsBoundaries ? 2 * chain_.size() : 0; }

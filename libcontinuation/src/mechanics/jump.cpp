@@ -120,7 +120,7 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.prescribed = problem.prescribed(lambda);
   result.from = fullUnknowns(problem, u, lambda);
   const Vector qFrom = result.from.head(n);
-  problem.stability(result.from, lambda, result.stabilityFrom);
+  problem.stability(result.from, lambda, 3, result.stabilityFrom);
 
   const EndCondition end = frozenEnd(problem, lambda);
   std::unique_ptr<DynamicsModel> model = makeDynamicsModel(problem.chain(), end, options.scene, qFrom);
@@ -195,7 +195,7 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.distance = (qTo - qFrom).cwiseAbs().maxCoeff();
   result.potentialTo = model->potential(qTo);
   result.energyReleased = result.potentialFrom - result.potentialTo;
-  if (polished.converged) problem.stability(result.to, lambda, result.stabilityTo);
+  if (polished.converged) problem.stability(result.to, lambda, 3, result.stabilityTo);
   result.stable = result.stabilityTo.valid() && result.stabilityTo.stable();
 
   std::ostringstream os;
@@ -269,7 +269,7 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
   result.rest = polished.u.head(n);
   result.residual = polished.residual;
   result.polishConverged = polished.converged;
-  if (polished.converged) problem.stability(polished.u, 0.0, result.stability);
+  if (polished.converged) problem.stability(polished.u, 0.0, 3, result.stability);
   result.stable = result.stability.valid() && result.stability.stable();
   result.potentialDynamic = model->potential(result.rest);
 

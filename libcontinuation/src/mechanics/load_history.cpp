@@ -117,7 +117,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
   };
 
   cont::StabilityInfo info;
-  if (problem.stability(u, lambda, info) && info.negative > 0) {
+  if (problem.stability(u, lambda, 3, info) && info.negative > 0) {
     if (!release(JumpTrigger::UnstableStart, u, lambda, lambda, -1)) {
       result.message = "the unstable start did not come to a stable rest: " + result.jumps.back().message;
       return result;

@@ -44,6 +44,9 @@ struct LocatorOptions {
   double minSampleCosine = 0.9;
   bool detectFolds = true;
   bool detectBranchPoints = true;
+  /// Dense (N+1)² work allowed: ψ, the augmented-Newton refinements and the kernel (null
+  /// vectors, branch directions). False (large N): secant on O(N) test functions only.
+  bool denseAlgebra = true;
 };
 
 /// A point on the current step at offset s (s = 0: its start point a).

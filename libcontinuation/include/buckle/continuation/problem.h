@@ -18,9 +18,12 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 
 namespace buckle::continuation {
+
+class BorderedSolver;
 
 using Vector = Eigen::VectorXd;
 using Matrix = Eigen::MatrixXd;
@@ -33,8 +36,8 @@ using MatrixRef = Eigen::Ref<Eigen::MatrixXd>;
 struct StabilityInfo {
   int negative = -1;          ///< number of negative eigenvalues (-1: not computed)
   int zero = 0;               ///< eigenvalues with |μ| <= tolerance·‖H‖ (reported, not counted as negative)
-  double smallest = 0.0;      ///< smallest eigenvalue
-  Vector lowest;              ///< the few lowest eigenvalues, ascending
+  double smallest = 0.0;      ///< smallest eigenvalue (0 when no eigenvalue was asked for)
+  Vector lowest;              ///< the lowest eigenvalues asked for, ascending (may be empty)
   bool valid() const { return negative >= 0; }
   bool stable() const { return negative == 0 && zero == 0; }
 };
@@ -61,9 +64,17 @@ class Problem {
   virtual bool hasStabilityOperator() const { return false; }
   /// Symmetric H (n_s×n_s) and constraint rows C (m×n_s, m may be 0); resized by the problem.
   virtual bool stabilityOperator(ConstVectorRef u, double lambda, Matrix& H, Matrix& C);
-  /// Inertia of H on ker C. Default: dense eigen-decomposition of Zᵀ H Z (Z a basis of
-  /// ker C). Problems with structure override this (e.g. an O(n) Sturm count).
-  virtual bool stability(ConstVectorRef u, double lambda, StabilityInfo& info);
+  /// Inertia of H on ker C and its `lowestCount` lowest eigenvalues (info.lowest, info.smallest).
+  /// lowestCount = 0 asks for the inertia only: that is all the branch-point test needs, and for
+  /// structured problems it is much cheaper than isolating eigenvalues (benchmarks/RESULTS.md).
+  /// Default: dense eigen-decomposition of Zᵀ H Z (Z a basis of ker C), which gets every
+  /// eigenvalue anyway. Problems with structure override this (e.g. an O(n) Sturm count).
+  virtual bool stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo& info);
+
+  // ---- optional: structured linear algebra ---------------------------------------------
+  /// A solver for the bordered Jacobian [[F_u, F_λ], [cᵀ]] that exploits the problem's
+  /// structure (bordered_solver.h), or null (the default): the core then uses dense LU.
+  virtual std::unique_ptr<BorderedSolver> makeStructuredSolver();
 
   // ---- optional: domain boundaries ------------------------------------------------------
   virtual int boundaryCount() const { return 0; }
@@ -77,6 +88,7 @@ class Problem {
 
 /// Inertia of the symmetric H restricted to ker C (C may have zero rows), by a dense
 /// eigen-decomposition. `zeroTolerance` is relative to max(1, ‖H‖).
-StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance = 1e-13);
+/// At most `lowestCount` lowest eigenvalues are kept in info.lowest.
+StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance = 1e-13, int lowestCount = 3);
 
 }  // namespace buckle::continuation

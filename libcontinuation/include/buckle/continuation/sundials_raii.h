@@ -47,6 +47,15 @@ NVectorPtr makeSerialVector(sunindextype n, SUNContext context);
 SunMatrixPtr makeDenseMatrix(sunindextype rows, sunindextype cols, SUNContext context);
 /// Dense LU solver for `matrix`, templated on `vector`.
 SunLinearSolverPtr makeDenseLinearSolver(N_Vector vector, SUNMatrix matrix, SUNContext context);
+/// An empty SUNMatrix of ID SUNMATRIX_CUSTOM: a placeholder for KINSOL's matrix-based
+/// interface when a custom linear solver holds the factorization itself.
+SunMatrixPtr makeEmptyCustomMatrix(SUNContext context);
+/// A SUNLinearSolver of type DIRECT whose solve() is `solve` (setup does nothing: the
+/// factorization happens in the Jacobian callback). `data` is returned by
+/// customLinearSolverData() and is not owned.
+using CustomSolveFn = int (*)(SUNLinearSolver, SUNMatrix, N_Vector x, N_Vector b, realtype tol);
+SunLinearSolverPtr makeCustomDirectLinearSolver(CustomSolveFn solve, void *data, SUNContext context);
+void *customLinearSolverData(SUNLinearSolver solver);
 /// KINSOL memory that never prints: errors go to a handler the caller installs (or nowhere).
 KinsolMemoryPtr makeKinsolMemory(SUNContext context);
 

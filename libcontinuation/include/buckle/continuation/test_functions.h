@@ -8,6 +8,7 @@
 //                 the determinant, whose magnitude is ~ the smallest singular value.
 #pragma once
 
+#include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/problem.h"
 
@@ -17,10 +18,17 @@
 namespace buckle::continuation {
 
 /// Completes a point whose u and λ are set: tangent (oriented by a reference direction), the
-/// fold and determinant tests, and the stability inertia. Workspaces are sized once.
+/// fold and determinant tests, and the stability inertia (plus `lowestEigenvalues` lowest
+/// eigenvalues). The bordered solves go through `solver` (dense or the problem's structured
+/// one; not owned). Workspaces are sized once.
 class PointEvaluator {
  public:
-  PointEvaluator(Problem &problem, bool computeStability);
+  PointEvaluator(Problem &problem, BorderedSolver &solver, bool computeStability, int lowestEigenvalues = 3);
+
+  /// Eigenvalues asked of Problem::stability() by complete(); the locator raises it while it
+  /// works, since it follows the crossing eigenvalue.
+  void setLowestEigenvalues(int count) { lowestEigenvalues_ = count; }
+  int lowestEigenvalues() const { return lowestEigenvalues_; }
 
   /// Tangent from [[F_u, F_λ], [referenceᵀ]] t = e_{N+1}, normalised, so tᵀreference > 0.
   /// False when the problem refuses the point or the bordered matrix is exactly singular; in
@@ -37,11 +45,11 @@ class PointEvaluator {
 
  private:
   Problem &problem_;
+  BorderedSolver &solver_;
   int n_;
   bool stability_;
+  int lowestEigenvalues_;
   bool singular_ = false;
-  Matrix bordered_;
-  Eigen::PartialPivLU<Matrix> lu_;
   Vector rhs_, solution_;
 };
 

@@ -7,6 +7,7 @@
 // two points. The step adapts to the Newton iteration count and contraction.
 #pragma once
 
+#include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/corrector.h"
 #include "buckle/continuation/problem.h"
@@ -48,6 +49,27 @@ struct TracerOptions {
   bool detectBranchPoints = true;
   bool detectBoundaries = true;     ///< Problem::boundary(k) and the box
   bool computeStability = true;     ///< record Problem::stability() at every point
+  /// Lowest eigenvalues of the stability operator recorded at every point (plots, the
+  /// smallest-eigenvalue column). 0: the inertia only, which is all the branch-point test
+  /// needs and is much cheaper for structured problems; the locator still asks for the
+  /// crossing eigenvalue where it needs one.
+  int lowestEigenvalues = 3;
+
+  // ---- linear algebra --------------------------------------------------------------------
+  enum class LinearAlgebra {
+    Automatic,   ///< the problem's structured solver when it has one and N ≥ structuredFromDimension
+    Dense,       ///< dense LU (KINSOL's SUNDIALS dense solver in the corrector)
+    Structured,  ///< the problem's structured solver (Problem::makeStructuredSolver); invalid without one
+  };
+  LinearAlgebra linearAlgebra = LinearAlgebra::Automatic;
+  /// Automatic switches to the structured solver from this N on (the measured crossover of the
+  /// bordered solves: benchmarks/RESULTS.md).
+  int structuredFromDimension = 24;
+  /// Above this N the locator does not build dense (N+1)² matrices: special points are located
+  /// by the secant on O(N)-evaluable test functions (t_λ, the determinant sign and magnitude,
+  /// the crossing eigenvalue) down to locationTolerance, without the augmented-Newton
+  /// refinement or null vectors (so no branch switching there).
+  int maxDenseLocationDimension = 400;
   /// Target |Δλ| ≤ locationTolerance·max(1, |λ|) for located points and stop events.
   double locationTolerance = 1e-12;
   /// ‖G‖∞ target of the corrector solves made while locating.
@@ -98,6 +120,8 @@ class Tracer {
   Corrector &corrector() { return *corrector_; }
   Problem &problem() { return problem_; }
   const TracerOptions &options() const { return options_; }
+  /// True when the bordered solves use the problem's structured solver.
+  bool structured() const { return structuredSolver_ != nullptr; }
 
  private:
   double eventValue(int event, const ContinuationPoint &point);
@@ -109,6 +133,7 @@ class Tracer {
   TracerOptions options_;
   std::string invalidReason_;
   int n_;
+  std::unique_ptr<BorderedSolver> structuredSolver_, denseSolver_;
   std::unique_ptr<Corrector> corrector_;
   std::unique_ptr<PointEvaluator> evaluator_;
   std::unique_ptr<Locator> locator_;

@@ -43,6 +43,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <vector>
 
 #include "buckle/mechanics/chain.h"
@@ -88,6 +89,13 @@ struct ChainStructure {
   Matrix zeroBorder;  ///< kMaxBorder² zeros (the D block of solveKKT)
   SmallMatrix S;
   int rank = 0;  ///< rank of the last C (rows kept after orthonormalisation)
+
+  // Bordered factorization (factorBordered): Schur complement S = D − Wᵀ H⁻¹ V and its LU.
+  SmallMatrix schur;
+  Eigen::FullPivLU<SmallMatrix> schurLU;
+  int borderSize = -1;          ///< p of the last successful factorBordered (−1: none)
+  double borderedLogAbsDet = 0; ///< log |det [[H, V], [Wᵀ, D]]|
+  int borderedDetSign = 1;      ///< its sign
 };
 
 // ---- assembly ----------------------------------------------------------------------------
@@ -162,6 +170,16 @@ bool solve(ChainStructure& ws, ConstVectorRef r, VectorRef x);
 /// Factorizes T at σ = 0; false if T or the p×p Schur complement is singular.
 bool solveBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const Eigen::Ref<const Matrix>& W,
                    const Eigen::Ref<const Matrix>& D, ConstVectorRef f, ConstVectorRef g, VectorRef x, VectorRef y);
+/// solveBordered in two parts, for several right-hand sides with one factorization: T at σ = 0,
+/// T⁻¹U⁻¹V, U⁻¹W and the p×p Schur complement S = D − WᵀH⁻¹V with its LU, plus
+/// det [[H, V], [Wᵀ, D]] = det T · det S (borderedDetSign, borderedLogAbsDet). False if T or S is
+/// singular to working precision.
+bool factorBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const Eigen::Ref<const Matrix>& W,
+                    const Eigen::Ref<const Matrix>& D);
+/// Solve after factorBordered() with the same V, W, D; one step of iterative refinement.
+bool solveFactoredBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const Eigen::Ref<const Matrix>& W,
+                           const Eigen::Ref<const Matrix>& D, ConstVectorRef f, ConstVectorRef g, VectorRef x,
+                           VectorRef y);
 /// KKT system [[H, Cᵀ], [C, 0]] [x; y] = [f; g] (C m×n, full row rank).
 bool solveKKT(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, ConstVectorRef f, ConstVectorRef g, VectorRef x,
               VectorRef y);

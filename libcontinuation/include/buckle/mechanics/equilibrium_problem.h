@@ -57,18 +57,32 @@ class EquilibriumProblem final : public continuation::Problem {
 
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
-  /// Inertia of K_q − K_g on ker J_h and its 3 lowest eigenvalues. options.structuredStability:
-  /// O(n) counts for n > 32, a heap-free dense solve for n <= 32 (faster there:
-  /// benchmarks/RESULTS.md); otherwise the dense Problem::stability().
-  bool stability(continuation::ConstVectorRef u, double lambda, continuation::StabilityInfo& info) override;
+  /// Inertia of K_q − K_g on ker J_h and its min(lowestCount, kMaxLowest) lowest eigenvalues.
+  /// options.structuredStability: the inertia from two O(n) Sturm counts, the eigenvalues by
+  /// isolation on those counts; for n <= 32 with eigenvalues wanted, one heap-free dense solve
+  /// (faster there: benchmarks/RESULTS.md). Otherwise the dense Problem::stability().
+  static constexpr int kMaxLowest = ChainStructure::kMaxBorder;  // the isolation's fixed-size brackets
+  bool stability(continuation::ConstVectorRef u, double lambda, int lowestCount,
+                 continuation::StabilityInfo& info) override;
+
+  /// The O(n) bordered solver of the chain (chain_solver.h).
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver() override;
+
+  /// Inside the model's domain: finite, and every joint strictly within its geometric limits.
+  bool inDomain(continuation::ConstVectorRef u) const;
 
   int boundaryCount() const override;
   double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
   std::string boundaryName(int k) const override;
 
  private:
-  bool inDomain(continuation::ConstVectorRef u) const;
-  void evaluateKinematics(continuation::ConstVectorRef u);
+  /// The q-dependent part of every evaluation at u = (q, r): kinematics (data_), the end
+  /// Jacobian (J_), ∂E/∂q (grad_) and the diagonal of K_q (stiff_), from one pass of the spring
+  /// model. Cached for the last q (bitwise comparison; it does not depend on r or λ): KINSOL
+  /// evaluates F and then J at the same iterate, and the tracer then J and the stability at the
+  /// corrected point, so each distinct q evaluates the spring model once.
+  /// False (nothing cached) if u is outside the domain.
+  bool prepare(continuation::ConstVectorRef u);
 
   Chain chain_;
   EndCondition end_;
@@ -77,6 +91,9 @@ class EquilibriumProblem final : public continuation::Problem {
   std::vector<int> held_, loaded_;
   ChainData data_;
   Matrix J_;             // 3×n
+  Vector grad_, stiff_;  // ∂E/∂q, diagonal of K_q (size n); with data_ and J_: prepare()'s cache
+  Vector cachedQ_;       // q of the cache (size n)
+  bool cacheValid_ = false;
   Vector work_, work2_;  // size n
   ChainStructure structure_;  // workspace of the structured stability()
   Matrix heldRows_;           // m×n held rows of J

@@ -1,0 +1,63 @@
+// Linear algebra on the bordered Jacobian of a continuation problem.
+//
+// Everything the tracer solves per step is one matrix shape,
+//     A(c) = [[F_u, F_λ], [cᵀ]]   ((N+1)×(N+1), c a border row),
+// with c the tangent (Keller corrector, Newton steps), the previous tangent (new tangent:
+// A t = e_{N+1}) or e_λ (a solve at fixed λ). Its determinant is the branch-point test function
+// (sign change at a simple branch point, none at a fold: Keller 1977).
+//
+// The core's default is a dense LU (O(N³) per factorization). A problem with structure supplies
+// its own solver (Problem::makeStructuredSolver, e.g. the chain's O(n) block elimination in
+// mechanics/chain_solver.h); the corrector then hands it to KINSOL as a custom SUNLinearSolver,
+// so KINSOL stays the Newton driver and the cost per step follows the problem's structure.
+#pragma once
+
+#include "buckle/continuation/problem.h"
+
+#include <Eigen/LU>
+
+namespace buckle::continuation {
+
+/// How a factorization ended: a singular A(c) is a result (a test function is exactly zero, or
+/// the structured elimination broke down), a refused point is outside the problem's domain.
+enum class Factorization { Regular, Singular, Refused };
+
+class BorderedSolver {
+ public:
+  virtual ~BorderedSolver() = default;
+
+  /// Linearises at (u, λ) with border row c (size N+1) and factors A(c).
+  virtual Factorization factor(ConstVectorRef u, double lambda, ConstVectorRef c) = 0;
+
+  /// x = A(c)⁻¹ b for the last successful factor(); b, x of size N+1 and not aliased.
+  virtual bool solve(ConstVectorRef b, VectorRef x) = 0;
+
+  /// Sign of det A(c) (0: singular) and log |det A(c)| of the last factor(). Only sign changes
+  /// along a branch are used, so a solver may drop a constant positive factor.
+  virtual int determinantSign() const = 0;
+  virtual double logAbsDeterminant() const = 0;
+};
+
+/// Dense partial-pivoting LU of A(c), from Problem::jacobian(). Workspace sized once.
+class DenseBorderedSolver final : public BorderedSolver {
+ public:
+  explicit DenseBorderedSolver(Problem &problem);
+
+  Factorization factor(ConstVectorRef u, double lambda, ConstVectorRef c) override;
+  bool solve(ConstVectorRef b, VectorRef x) override;
+  int determinantSign() const override { return sign_; }
+  double logAbsDeterminant() const override { return logAbs_; }
+
+  /// A(c) of the last factor() (before factorization).
+  const Matrix &matrix() const { return A_; }
+
+ private:
+  Problem &problem_;
+  int n_;
+  Matrix A_;
+  Eigen::PartialPivLU<Matrix> lu_;
+  int sign_ = 0;
+  double logAbs_ = 0.0;
+};
+
+}  // namespace buckle::continuation

@@ -1,0 +1,57 @@
+// The chain's bordered Jacobian solved in O(n) (notes: shared/notes/chain-structure.md).
+//
+// With u = (q, r) (joint angles, reactions of the m held coordinates) the bordered Jacobian is
+//     A(c) = [[H, −J_hᵀ, F_λ,q], [−J_h, 0, F_λ,r], [c_qᵀ, c_rᵀ, c_λ]],   H = K_q − K_g = U T Uᵀ,
+// i.e. H bordered by p = m + 1 columns: V = [−J_hᵀ, F_λ,q], W = [−J_hᵀ, c_q] and the p×p corner
+// D = [[0, F_λ,r], [c_rᵀ, c_λ]]. Block elimination through the tridiagonal T
+// (factorBordered / solveFactoredBordered) costs O(n·p) and gives det A = det T · det S.
+//
+// Block elimination needs H itself regular. Where it is singular (the straight chain at a
+// critical load of the *unconstrained* problem, F = 0 with κ = 0, or a fold of a load-controlled
+// problem hit exactly) the solver falls back to a dense LU of the same matrix when
+// n + m ≤ kDenseFallback, and reports the factorization singular above that, so the tracer
+// halves its step. Det signs agree between the two routes (same matrix).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "buckle/continuation/bordered_solver.h"
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/chain_structure.h"
+
+namespace buckle::mechanics {
+
+class EquilibriumProblem;
+
+class ChainBorderedSolver final : public continuation::BorderedSolver {
+ public:
+  static constexpr int kDenseFallback = 400;
+
+  /// `problem` must outlive the solver.
+  explicit ChainBorderedSolver(EquilibriumProblem& problem);
+
+  continuation::Factorization factor(continuation::ConstVectorRef u, double lambda,
+                                     continuation::ConstVectorRef c) override;
+  bool solve(continuation::ConstVectorRef b, continuation::VectorRef x) override;
+  int determinantSign() const override { return sign_; }
+  double logAbsDeterminant() const override { return logAbs_; }
+
+  /// The last factor() went through the dense fallback.
+  bool usedDenseFallback() const { return dense_ != nullptr && usingDense_; }
+
+ private:
+  EquilibriumProblem& problem_;
+  int n_, m_, p_;
+  std::vector<int> held_, loaded_;
+  ChainStructure ws_;
+  ChainData data_;
+  Matrix J_, V_, W_, D_;
+  Vector x_, y_;
+  std::unique_ptr<continuation::DenseBorderedSolver> dense_;
+  bool usingDense_ = false;
+  int sign_ = 0;
+  double logAbs_ = 0.0;
+};
+
+}  // namespace buckle::mechanics

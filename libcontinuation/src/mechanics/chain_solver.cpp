@@ -1,0 +1,77 @@
+#include "buckle/mechanics/chain_solver.h"
+
+#include <cmath>
+#include <limits>
+
+#include "buckle/mechanics/equilibrium_problem.h"
+
+namespace buckle::mechanics {
+
+using continuation::ConstVectorRef;
+using continuation::Factorization;
+using continuation::VectorRef;
+
+ChainBorderedSolver::ChainBorderedSolver(EquilibriumProblem& problem)
+    : problem_(problem),
+      n_(problem.segments()),
+      m_(problem.heldCount()),
+      p_(problem.heldCount() + 1),
+      held_(problem.endCondition().heldIndices()),
+      loaded_(problem.endCondition().loadedIndices()),
+      ws_(problem.segments()),
+      data_(problem.chain()),
+      J_(3, problem.segments()),
+      V_(Matrix::Zero(problem.segments(), problem.heldCount() + 1)),
+      W_(Matrix::Zero(problem.segments(), problem.heldCount() + 1)),
+      D_(Matrix::Zero(problem.heldCount() + 1, problem.heldCount() + 1)),
+      x_(Vector::Zero(problem.segments())),
+      y_(Vector::Zero(problem.heldCount() + 1)) {
+  if (n_ + m_ <= kDenseFallback) dense_ = std::make_unique<continuation::DenseBorderedSolver>(problem);
+}
+
+Factorization ChainBorderedSolver::factor(ConstVectorRef u, double lambda, ConstVectorRef c) {
+  sign_ = 0;
+  logAbs_ = -std::numeric_limits<double>::infinity();
+  usingDense_ = false;
+  if (!problem_.inDomain(u) || !std::isfinite(lambda) || !c.allFinite()) return Factorization::Refused;
+  const auto q = u.head(n_);
+  forwardKinematics(problem_.chain(), q, data_);
+  endJacobian(data_, J_);
+  assemble(problem_.chain(), data_, q, problem_.wrench(u, lambda), ws_);
+  // Borders: V = [−J_hᵀ, F_λ,q], W = [−J_hᵀ, c_q], D = [[0, F_λ,r], [c_rᵀ, c_λ]] (see header).
+  const Eigen::Vector3d& dir = problem_.direction();
+  V_.col(m_).setZero();
+  for (int cc : loaded_) V_.col(m_) -= J_.row(cc).transpose() * dir[cc];
+  D_.setZero();
+  for (int k = 0; k < m_; ++k) {
+    const int h = held_[size_t(k)];
+    V_.col(k) = -J_.row(h).transpose();
+    W_.col(k) = V_.col(k);
+    D_(k, m_) = dir[h];
+    D_(m_, k) = c[n_ + k];
+  }
+  W_.col(m_) = c.head(n_);
+  D_(m_, m_) = c[n_ + m_];
+  if (factorBordered(ws_, V_, W_, D_)) {
+    sign_ = ws_.borderedDetSign;
+    logAbs_ = ws_.borderedLogAbsDet;
+    return Factorization::Regular;
+  }
+  if (!dense_) return Factorization::Singular;
+  usingDense_ = true;
+  const Factorization f = dense_->factor(u, lambda, c);
+  sign_ = dense_->determinantSign();
+  logAbs_ = dense_->logAbsDeterminant();
+  return f;
+}
+
+bool ChainBorderedSolver::solve(ConstVectorRef b, VectorRef x) {
+  if (sign_ == 0) return false;
+  if (usingDense_) return dense_->solve(b, x);
+  if (!solveFactoredBordered(ws_, V_, W_, D_, b.head(n_), b.tail(p_), x_, y_)) return false;
+  x.head(n_) = x_;
+  x.tail(p_) = y_;
+  return true;
+}
+
+}  // namespace buckle::mechanics
