@@ -124,3 +124,96 @@ TEST_CASE("solveEquilibrium converges quadratically to an equilibrium of the loa
   CHECK(p[0] == Approx(7.5).margin(1e-12));
   CHECK(p[1] == Approx(0.6).margin(1e-12));
 }
+
+TEST_CASE("EquilibriumProblem: cached evaluations equal a fresh problem's in any call order", "[equilibrium]") {
+  // residual / jacobian / stability share the kinematics and spring jets of the last q. Calls in
+  // random order at a few states (repeated q with other λ or multipliers, a q changed in place in
+  // the same buffer, points outside the domain in between) must give bitwise the
+  // results of a problem that has never seen another point.
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
+  std::uniform_int_distribution<int> Op(0, 5), Pick(0, 3);
+  for (int n : {1, 3, 8}) {
+    std::vector<SegmentParameters> segs;
+    for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
+    const Chain chain(segs);
+    for (const Setting& s : settings(rng)) {
+      INFO("n = " << n << ", end: " << s.name);
+      const Eigen::Vector3d dir(W(rng), W(rng), W(rng));
+      EquilibriumProblem cached(chain, s.end, dir);
+      const int N = cached.dimension();
+      std::vector<Vector> states;
+      for (int k = 0; k < 3; ++k) {
+        Vector u(N);
+        for (int i = 0; i < n; ++i) {
+          std::uniform_real_distribution<double> Q(0.7 * chain.lowerLimits()[i], 0.7 * chain.upperLimits()[i]);
+          u[i] = Q(rng);
+        }
+        for (int i = n; i < N; ++i) u[i] = W(rng);
+        states.push_back(u);
+      }
+      states.push_back(states[0]);
+      states[3].tail(N - n).setConstant(0.25);  // same q, other multipliers
+      Vector buffer(N);
+      for (int call = 0; call < 60; ++call) {
+        const int which = Pick(rng);
+        buffer = states[size_t(which)];
+        const bool outside = call % 17 == 5;
+        if (outside) buffer[0] = chain.segment(0).geometricUpperLimit() + 0.1;
+        const double lambda = call % 3 == 0 ? 0.1 * which : Lam(rng);
+        EquilibriumProblem fresh(chain, s.end, dir);
+        const int op = Op(rng);
+        if (op <= 1) {
+          Vector F1(N), F2(N);
+          const bool ok1 = cached.residual(buffer, lambda, F1), ok2 = fresh.residual(buffer, lambda, F2);
+          REQUIRE(ok1 == ok2);
+          CHECK(ok1 != outside);
+          if (ok1) CHECK((F1.array() == F2.array()).all());
+        } else if (op <= 3) {
+          Matrix J1(N, N), J2(N, N);
+          Vector L1(N), L2(N);
+          const bool ok1 = cached.jacobian(buffer, lambda, J1, L1), ok2 = fresh.jacobian(buffer, lambda, J2, L2);
+          REQUIRE(ok1 == ok2);
+          if (ok1) CHECK(((J1.array() == J2.array()).all() && (L1.array() == L2.array()).all()));
+        } else if (op == 4) {
+          buckle::continuation::StabilityInfo i1, i2;
+          const int count = call % 2 ? 3 : 0;
+          const bool ok1 = cached.stability(buffer, lambda, count, i1), ok2 = fresh.stability(buffer, lambda, count, i2);
+          REQUIRE(ok1 == ok2);
+          if (ok1) {
+            CHECK(i1.negative == i2.negative);
+            CHECK(i1.zero == i2.zero);
+            REQUIRE(i1.lowest.size() == i2.lowest.size());
+            CHECK((i1.lowest.array() == i2.lowest.array()).all());
+          }
+        } else {
+          Matrix H1, C1, H2, C2;
+          const bool ok1 = cached.stabilityOperator(buffer, lambda, H1, C1);
+          const bool ok2 = fresh.stabilityOperator(buffer, lambda, H2, C2);
+          REQUIRE(ok1 == ok2);
+          if (ok1) CHECK(((H1.array() == H2.array()).all() && (C1.array() == C2.array()).all()));
+          Matrix H3(n, n);
+          if (ok1) {
+            totalPotentialHessian(chain, buffer.head(n), cached.wrench(buffer, lambda), H3);
+            CHECK((H1.array() == H3.array()).all());
+          }
+        }
+        // the finite-difference check of the Jacobian still holds right after a cached call
+        if (call % 20 == 7 && !outside) {
+          Matrix Fu(N, N);
+          Vector Fl(N), Fp(N), Fm(N);
+          REQUIRE(cached.jacobian(buffer, lambda, Fu, Fl));
+          const double h = 1e-6;
+          for (int j = 0; j < N; ++j) {
+            Vector up = buffer, um = buffer;
+            up[j] += h;
+            um[j] -= h;
+            REQUIRE(cached.residual(up, lambda, Fp));
+            REQUIRE(cached.residual(um, lambda, Fm));
+            CHECK((Fu.col(j) - (Fp - Fm) / (2 * h)).lpNorm<Eigen::Infinity>() < 1e-7 * std::max(1.0, Fu.lpNorm<Eigen::Infinity>()));
+          }
+        }
+      }
+    }
+  }
+}
