@@ -14,7 +14,8 @@
 //      limit: switch at the U branch point, stop at the user joint limit |q| = 1.5 (AUTO's A_U)
 //             [the unscaled run ×F₀; the end angle must be 1.5]
 //      raw:    solver options as for the unscaled chain (AUTO's c-file values), λ range ×F₀
-//      nondim: the same options on the NondimensionalProblem view (nondimensional.h)
+//      nondim: the same options on the NondimensionalProblem view (nondimensional.h) in the
+//              chain's own units (typicalUnits: mean b and k, which here are L and k)
 //  cluster.low.n<N>  the first 6 critical loads of the clamped–pinned chain [linear_buckling]
 //  cluster.top.n<N>  the 6 most compressive critical loads, spaced ~1/n² apart [linear_buckling]
 //  kappa0.n<N>      κ = 0 (L0 = 1.5): an (N−1)-fold zero at Fx = 0 [exact: Fx = 0, index 0 → N−1]
@@ -97,8 +98,8 @@ Row unitsBranchPoints(const UnitScale& us, bool nondim) {
   const AnalyticBuckling3 ref = buckle::mechanics::analyticClampedPinned3(a, b, k, L0);
   EquilibriumProblem problem(Chain::uniform(3, SegmentParameters::symmetric(a, b, k, L0)), EndCondition::clampedPinned(0.0),
                              Eigen::Vector3d(1, 0, 0));
-  NondimensionalProblem view(problem, us);
-  const double F0 = nondim ? us.force() : 1.0;  // λ unit seen by the tracer
+  NondimensionalProblem view(problem, typicalUnits(problem.chain()));
+  const double F0 = nondim ? view.lambdaScale() : 1.0;  // λ unit seen by the tracer
   const Timer timer;
   cont::Tracer tracer(nondim ? static_cast<cont::Problem&>(view) : problem,
                       tracerOptions(Settings(), -2.5 * us.force() / F0, 0.0));
@@ -119,8 +120,8 @@ Row unitsFold(const UnitScale& us, bool nondim) {
   row.id = "units.fold." + scaleName(us.length) + "x" + scaleName(us.stiffness) + (nondim ? ".nondim" : ".raw");
   EquilibriumProblem problem(Chain::uniform(3, scaledSegment(0.5, 1.0, 1.0, 0.5, us)),
                              EndCondition::freeEnd(Eigen::Vector3d(0, 0.01 * us.force(), 0)), Eigen::Vector3d(1, 0, 0));
-  NondimensionalProblem view(problem, us);
-  const double F0 = nondim ? us.force() : 1.0;
+  NondimensionalProblem view(problem, typicalUnits(problem.chain()));
+  const double F0 = nondim ? view.lambdaScale() : 1.0;
   const Timer timer;
   cont::Tracer tracer(nondim ? static_cast<cont::Problem&>(view) : problem,
                       tracerOptions(Settings(), -3.0 * us.force() / F0, 3.0 * us.force() / F0));
@@ -148,9 +149,9 @@ LimitEnd unitsLimitEnd(const UnitScale& us, bool nondim, double& ms) {
   p.qMinUser = -1.5;
   p.qMaxUser = 1.5;
   EquilibriumProblem problem(Chain::uniform(3, p), EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
-  NondimensionalProblem view(problem, us);
+  NondimensionalProblem view(problem, typicalUnits(problem.chain()));
   cont::Problem& traced = nondim ? static_cast<cont::Problem&>(view) : problem;
-  const double F0 = nondim ? us.force() : 1.0;
+  const double F0 = nondim ? view.lambdaScale() : 1.0;
   const Timer timer;
   cont::Tracer tracer(traced, tracerOptions(Settings(), -3.0 * us.force() / F0, 0.0));
   const cont::Branch trivial = tracer.trace(Eigen::VectorXd::Zero(4), 0.0, cont::InitialDirection::decreasingLambda());

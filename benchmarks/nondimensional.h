@@ -26,6 +26,18 @@ struct UnitScale {
   double torque() const { return stiffness * length * length; }  ///< joint torques, K_q
 };
 
+/// The chain's own units: mean triangle half-length b and mean spring stiffness k. What a user
+/// who does not know "the" unit system of a model should pass to NondimensionalProblem.
+inline UnitScale typicalUnits(const mechanics::Chain& chain) {
+  double b = 0.0, k = 0.0;
+  for (int i = 0; i < chain.size(); ++i) {
+    const mechanics::SegmentParameters& p = chain.segment(i).parameters();
+    b += 0.5 * (p.b1 + p.b2);
+    k += 0.5 * (p.k1 + p.k2);
+  }
+  return UnitScale{b / chain.size(), k / chain.size()};
+}
+
 /// EquilibriumProblem seen in nondimensional variables (header comment). The load-path
 /// direction is assumed to be a force (λ₀ = F₀) unless `lambdaScale` says otherwise.
 class NondimensionalProblem final : public continuation::Problem {
