@@ -1,0 +1,153 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/chain_solver.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/linear_buckling.h"
+
+#include "random_segments.h"
+
+using namespace buckle::mechanics;
+using buckle::continuation::DenseBorderedSolver;
+using buckle::continuation::Factorization;
+
+namespace {
+
+EndCondition allHeld(double x, double y, double phi) {
+  EndCondition e;
+  e.control = {Control::Held, Control::Held, Control::Held};
+  e.value = Eigen::Vector3d(x, y, phi);
+  return e;
+}
+
+Chain randomChain(std::mt19937& rng, int n) {
+  std::vector<SegmentParameters> segs;
+  for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
+  return Chain(segs);
+}
+
+Chain uniformChain(int n) {
+  SegmentParameters p;
+  p.a1 = p.a2 = 0.5;
+  p.b1 = p.b2 = 1.0;
+  p.k1 = p.k2 = 1.0;
+  p.L1_0 = p.L2_0 = 2.25;
+  return Chain(std::vector<SegmentParameters>(size_t(n), p));
+}
+
+}  // namespace
+
+TEST_CASE("ChainBorderedSolver equals the dense LU of the same bordered Jacobian (m = 0..3 held)", "[chain_solver]") {
+  std::mt19937 rng(2026);
+  std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.4, 0.4);
+  for (int n : {1, 3, 17, 60}) {
+    const Chain chain = randomChain(rng, n);
+    const std::vector<std::pair<std::string, EndCondition>> ends = {
+        {"free", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng)))},
+        {"clamped-pinned", EndCondition::clampedPinned(W(rng), 0.1 * W(rng))},
+        {"held position", EndCondition::heldPosition(0.5 * n + W(rng), W(rng))},
+        {"all held", allHeld(0.5 * n, W(rng), W(rng))}};
+    for (const auto& [name, end] : ends) {
+      if (end.heldCount() > n) continue;  // more held coordinates than joints: singular by construction
+      INFO("n = " << n << ", " << name);
+      EquilibriumProblem problem(chain, end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
+      const int N = problem.dimension();
+      Vector u(N), c(N + 1), b(N + 1);
+      for (int i = 0; i < N; ++i) u[i] = i < n ? Q(rng) : W(rng);
+      for (int i = 0; i <= N; ++i) c[i] = W(rng), b[i] = W(rng);
+      const double lambda = W(rng);
+      ChainBorderedSolver fast(problem);
+      DenseBorderedSolver dense(problem);
+      REQUIRE(fast.factor(u, lambda, c) == Factorization::Regular);
+      REQUIRE(dense.factor(u, lambda, c) == Factorization::Regular);
+      CHECK_FALSE(fast.usedDenseFallback());
+      CHECK(fast.determinantSign() == dense.determinantSign());
+      CHECK(std::abs(fast.logAbsDeterminant() - dense.logAbsDeterminant()) < 1e-9 * std::max(1.0, std::abs(dense.logAbsDeterminant())));
+      Vector xf(N + 1), xd(N + 1);
+      REQUIRE(fast.solve(b, xf));
+      REQUIRE(dense.solve(b, xd));
+      CHECK((xf - xd).norm() <= 1e-10 * xd.norm());
+    }
+  }
+}
+
+TEST_CASE("ChainBorderedSolver near a singular H (an unconstrained critical load) stays accurate", "[chain_solver]") {
+  // Clamped-pinned straight chain: the bordered Jacobian is regular at the free end's critical
+  // loads, where H = K_q − K_g itself is singular and block elimination is at its worst.
+  const int n = 12;
+  const Chain chain = uniformChain(n);
+  const Vector q0 = Vector::Zero(n);
+  const LinearBucklingResult freeModes = linearBuckling(chain, q0, EndCondition::freeEnd());
+  REQUIRE(!freeModes.modes.empty());
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  const int N = problem.dimension();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> W(-1.0, 1.0);
+  Vector c(N + 1), b(N + 1);
+  for (int i = 0; i <= N; ++i) c[i] = W(rng), b[i] = W(rng);
+  ChainBorderedSolver fast(problem);
+  DenseBorderedSolver dense(problem);
+  for (double relative : {1e-3, 1e-8, 1e-12, 0.0}) {
+    const double lambda = freeModes.modes.front().lambda * (1.0 + relative);
+    INFO("lambda = free critical load x (1 + " << relative << ")");
+    const Vector u = Vector::Zero(N);
+    REQUIRE(dense.factor(u, lambda, c) == Factorization::Regular);
+    REQUIRE(fast.factor(u, lambda, c) == Factorization::Regular);
+    CHECK(fast.determinantSign() == dense.determinantSign());
+    Vector xf(N + 1), xd(N + 1);
+    REQUIRE(fast.solve(b, xf));
+    REQUIRE(dense.solve(b, xd));
+    CHECK((xf - xd).norm() <= 1e-8 * xd.norm());
+  }
+}
+
+TEST_CASE("Tracer on the chain: structured and dense give the same branch and branch points", "[chain_solver]") {
+  const int n = 30;
+  const Chain chain = uniformChain(n);
+  EquilibriumProblem structuredProblem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumProblem denseProblem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  buckle::continuation::TracerOptions options;
+  options.maxStep = 0.05;
+  options.lambdaMin = -0.6;
+  options.maxPoints = 400;
+  options.lowestEigenvalues = 0;  // inertia only: the branch-point test needs nothing more
+  options.linearAlgebra = buckle::continuation::TracerOptions::LinearAlgebra::Structured;
+  buckle::continuation::Tracer structured(structuredProblem, options);
+  options.linearAlgebra = buckle::continuation::TracerOptions::LinearAlgebra::Dense;
+  buckle::continuation::Tracer dense(denseProblem, options);
+  REQUIRE(structured.structured());
+  const Vector u0 = Vector::Zero(structuredProblem.dimension());
+  using buckle::continuation::InitialDirection;
+  const auto a = structured.trace(u0, 0.0, InitialDirection::decreasingLambda());
+  const auto b = dense.trace(u0, 0.0, InitialDirection::decreasingLambda());
+  CHECK(a.stopReason == b.stopReason);
+  REQUIRE(a.points.size() == b.points.size());
+  for (std::size_t k = 0; k < a.points.size(); ++k) {
+    CHECK(a.points[k].stability.negative == b.points[k].stability.negative);
+    CHECK(a.points[k].determinantSign == b.points[k].determinantSign);
+  }
+  // Every clamped-pinned critical load in the range, found once, as accurately as dense.
+  const LinearBucklingResult modes = linearBuckling(chain, Vector::Zero(n), EndCondition::clampedPinned(0.0));
+  std::vector<double> expected;
+  for (const BucklingMode& m : modes.modes)
+    if (m.lambda < 0.0 && m.lambda > -0.6) expected.push_back(m.lambda);
+  REQUIRE(!expected.empty());
+  auto branchPoints = [](const buckle::continuation::Branch& br) {
+    std::vector<double> l;
+    for (const auto& sp : br.specialPoints)
+      if (sp.type == buckle::continuation::SpecialPointType::BranchPoint) l.push_back(sp.lambda);
+    return l;
+  };
+  const std::vector<double> fa = branchPoints(a), fb = branchPoints(b);
+  REQUIRE(fa.size() == expected.size());
+  REQUIRE(fb.size() == expected.size());
+  std::sort(expected.begin(), expected.end(), std::greater<double>());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    CHECK(std::abs(fa[k] - expected[k]) <= 1e-10 * std::abs(expected[k]));
+    CHECK(std::abs(fa[k] - fb[k]) <= 1e-10 * std::abs(expected[k]));
+  }
+}
