@@ -168,12 +168,14 @@ json parseJsonDocument(const std::string& text, const std::string& file) {
   }
 }
 
-json loadJsonDocument(const std::string& file) {
+std::string readInputFile(const std::string& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw JsonInputError(file, "", "cannot open the file");
   std::ostringstream ss;
   ss << in.rdbuf();
-  return parseJsonDocument(ss.str(), file);
+  return ss.str();
 }
+
+json loadJsonDocument(const std::string& file) { return parseJsonDocument(readInputFile(file), file); }
 
 }  // namespace buckle::scene

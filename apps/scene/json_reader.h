@@ -26,6 +26,9 @@ class JsonInputError : public std::runtime_error {
 /// JsonInputError naming the JSON path of the value being read and the line and column.
 nlohmann::json parseJsonDocument(const std::string& text, const std::string& file);
 
+/// The whole file as text (JsonInputError when it cannot be opened).
+std::string readInputFile(const std::string& file);
+
 /// Reads and parses a whole file (JsonInputError when it cannot be opened).
 nlohmann::json loadJsonDocument(const std::string& file);
 

@@ -643,12 +643,6 @@ Scene parseScene(const std::string& text, const std::string& file) {
   return scene;
 }
 
-Scene loadScene(const std::string& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw SceneError(file, "", "cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parseScene(ss.str(), file);
-}
+Scene loadScene(const std::string& file) { return parseScene(readInputFile(file), file); }
 
 }  // namespace buckle::scene

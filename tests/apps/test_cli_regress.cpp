@@ -3,6 +3,8 @@
 // are the same bytes every time.
 #include <catch2/catch.hpp>
 
+#include "cli_helpers.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -13,22 +15,12 @@
 #include <unistd.h>
 
 namespace fs = std::filesystem;
+using buckle::test::exitCode;
+using buckle::test::slurp;
 
 namespace {
 
-const std::string kBuckle = std::string(BUCKLE_BINARY_DIR) + "/bin/buckle";
 const std::string kScenes = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes";
-
-int exitCode(const std::string& args, const fs::path& capture) {
-  const std::string cmd = "'" + kBuckle + "' " + args + " > '" + capture.string() + "' 2>&1";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 fs::path work(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_regress_" + std::to_string(::getpid())) / name;

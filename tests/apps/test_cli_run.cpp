@@ -1,6 +1,8 @@
 // `buckle run` as a program: exit codes, the output files, --help.
 #include <catch2/catch.hpp>
 
+#include "cli_helpers.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -10,21 +12,10 @@
 #include <unistd.h>
 
 namespace fs = std::filesystem;
+using buckle::test::exitCode;
+using buckle::test::slurp;
 
 namespace {
-
-const std::string kBuckle = std::string(BUCKLE_BINARY_DIR) + "/bin/buckle";
-
-int exitCode(const std::string& args, const fs::path& capture) {
-  const std::string cmd = "'" + kBuckle + "' " + args + " > '" + capture.string() + "' 2>&1";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 fs::path work() {
   const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_run_" + std::to_string(::getpid()));
