@@ -1,10 +1,10 @@
 // Kernel benchmarks over the chain length n: residual, Jacobian, stability (dense vs O(n)),
 // linear solves (dense LU vs O(n) bordered), one KINSOL corrector solve, one continuation step
-// of the core's tracer (with test functions), and the O(n) structured step.
+// of the core's tracer (with test functions), dense and with the chain's structured solver.
 //
 // Dense O(n³) kernels are capped at n = 1000 (n = 3000 would take seconds per call), the core's
-// tracer step at n = 300 (it factors the dense (N+1)² bordered Jacobian several times per
-// step). Structured kernels run up to n = 10 000.
+// tracer with dense LU at n = 300. Structured kernels, and the tracer with the structured solver,
+// run up to n = 10 000.
 //
 // Quick mode (CI): --benchmark_min_time=0.01 and BUCKLE_BENCH_MAX_N=100 in the environment.
 #include <benchmark/benchmark.h>
@@ -19,7 +19,6 @@
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "common.h"
-#include "structured_step.h"
 
 using namespace buckle;
 using namespace buckle::bench;
@@ -38,7 +37,6 @@ void sizes(benchmark::internal::Benchmark* b, long cap) {
 void denseSizes(benchmark::internal::Benchmark* b) { sizes(b, 1000); }
 void allSizes(benchmark::internal::Benchmark* b) { sizes(b, 3000); }
 void structuredSizes(benchmark::internal::Benchmark* b) { sizes(b, 10000); }
-void tracerSizes(benchmark::internal::Benchmark* b) { sizes(b, 300); }
 
 void BM_Residual(benchmark::State& state) {
   const int n = int(state.range(0));
@@ -102,6 +100,21 @@ void BM_StabilityStructured(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_StabilityStructured)->Apply(structuredSizes)->Unit(benchmark::kMicrosecond);
+
+/// EquilibriumProblem::stability with lowestCount = 0 (what the tracer asks at every point by
+/// default in bench_cases). Note: u is fixed, so the problem's q-cache holds the kinematics and
+/// K_q after the first call (as in the tracer, where the Jacobian at the same point precedes it).
+void BM_StabilityInertiaOnly(benchmark::State& state) {
+  const int n = int(state.range(0));
+  auto p = clampedPinned(n, true);
+  const Eigen::VectorXd u = bentState(n, 1);
+  continuation::StabilityInfo info;
+  for (auto _ : state) {
+    p.stability(u, -0.3, 0, info);
+    benchmark::DoNotOptimize(info.negative);
+  }
+}
+BENCHMARK(BM_StabilityInertiaOnly)->Apply(structuredSizes)->Unit(benchmark::kMicrosecond);
 
 /// Inertia only (two O(n) counts on the bordered tridiagonal), no eigenvalues.
 void BM_InertiaStructured(benchmark::State& state) {
@@ -188,55 +201,46 @@ void BM_CorrectorSolve(benchmark::State& state) {
 }
 BENCHMARK(BM_CorrectorSolve)->Apply(denseSizes)->Unit(benchmark::kMicrosecond);
 
-/// The core's tracer on the trivial branch under tension (no special points), with test
-/// functions and stability at every point: time per continuation point (start-up amortised
-/// over 40 points).
+/// The core's tracer, with test functions (fold, determinant sign, inertia) at every point: time
+/// per continuation point, start-up amortised over 40 points. Clamped–pinned chain whose end is
+/// held 0.02·n off the axis (so every joint bends and each step needs real Newton corrections),
+/// λ = Fx from 0.1 up. Arg 1: 0 = dense LU, 1 = the chain's O(n) structured solver; both with
+/// the inertia only (TracerOptions::lowestEigenvalues = 0), as a long continuation would run.
 void BM_TracerStep(benchmark::State& state) {
   const int n = int(state.range(0));
-  auto p = clampedPinned(n);
+  const bool structured = state.range(1) != 0;
+  EquilibriumProblem p(Chain::uniform(n, mainSegment(2.25)), EndCondition::clampedPinned(0.0, 0.02 * n),
+                       Eigen::Vector3d(1, 0, 0));
   continuation::TracerOptions o;
   o.maxPoints = 41;
   o.initialStep = 0.02;
   o.maxStep = 0.02;
   o.minStep = 0.02 / 1024;
   o.lambdaMax = 100.0;
+  o.lowestEigenvalues = 0;
+  o.linearAlgebra = structured ? continuation::TracerOptions::LinearAlgebra::Structured
+                               : continuation::TracerOptions::LinearAlgebra::Dense;
   continuation::Tracer tracer(p, o);
   const Eigen::VectorXd u0 = Eigen::VectorXd::Zero(n + 1);
-  size_t points = 0;
+  size_t points = 0, iterations = 0;
   for (auto _ : state) {
     auto b = tracer.trace(u0, 0.1, continuation::InitialDirection::increasingLambda());
+    if (b.points.size() < 41) state.SkipWithError(("tracer stopped early: " + b.stopMessage).c_str());
     points += b.points.size() - 1;
+    for (std::size_t k = 1; k < b.points.size(); ++k) iterations += size_t(b.points[k].newtonIterations);
     benchmark::DoNotOptimize(b.points.data());
   }
   state.counters["per_point"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["newton_it"] = double(iterations) / double(std::max<size_t>(1, points));
 }
-BENCHMARK(BM_TracerStep)->Apply(tracerSizes)->Unit(benchmark::kMillisecond);
-
-/// The O(n) structured step (structured_step.h): 2–3 Newton iterations with the bordered O(n)
-/// solve, the new tangent, the inertia test function.
-void BM_StructuredStep(benchmark::State& state) {
-  const int n = int(state.range(0));
-  auto p = clampedPinned(n);
-  StructuredStepper stepper(p);
-  const int N = n + 1;
-  Eigen::VectorXd t = Eigen::VectorXd::Zero(N + 1);
-  t[N] = 1.0;
-  Eigen::VectorXd u0 = Eigen::VectorXd::Zero(N);
-  stepper.start(u0, 0.1, t);
-  long steps = 0, iters = 0;
-  for (auto _ : state) {
-    if (!stepper.step(0.02)) state.SkipWithError("structured step failed");
-    iters += stepper.lastIterations();
-    ++steps;
-    if (stepper.x()[N] > 50.0) {
-      state.PauseTiming();
-      stepper.start(u0, 0.1, t);
-      state.ResumeTiming();
-    }
+void tracerArgs(benchmark::internal::Benchmark* b) {
+  for (long n : {3L, 10L, 30L, 100L, 300L, 1000L, 3000L, 10000L}) {
+    if (n > maxN()) continue;
+    if (n <= 300) b->Args({n, 0});
+    b->Args({n, 1});
   }
-  state.counters["newton_it"] = double(iters) / double(std::max(1L, steps));
 }
-BENCHMARK(BM_StructuredStep)->Apply(structuredSizes)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TracerStep)->Apply(tracerArgs)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
