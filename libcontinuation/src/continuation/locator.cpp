@@ -318,17 +318,24 @@ SpecialPoint Locator::locateFold(const StepSample &lo, const StepSample &hi) {
   adopt(ok);
   if (!options_.denseAlgebra) sp.note += (sp.note.empty() ? "" : "; ") + std::string("secant only (large N)");
   if ((!options_.denseAlgebra || !refineFold(sp, a_.point.tangent)) && ok && root.fLeft * root.fRight < 0.0) {
-    // No refinement: finish the secant to the full tolerance instead.
-    const std::string refinementNote = sp.note;
-    const int refinementSteps = sp.locationIterations - evaluations;
-    const Root coarse = root;
-    ok = findRoot(coarse.left, coarse.fLeft, coarse.right, coarse.fRight, test, root);
-    evaluations += root.evaluations + refinementSteps;
-    adopt(ok);
-    sp.note = refinementNote + (sp.note.empty() ? "" : "; " + sp.note);
+    finishSecant(sp, root, test, evaluations, adopt);
   }
   sp.residualNorm = residualNorm(sp.u, sp.lambda);
   return sp;
+}
+
+void Locator::finishSecant(SpecialPoint &sp, Root &root, const TestFunction &test, int &evaluations,
+                           const std::function<void(bool)> &adopt) {
+  // No augmented refinement: the secant goes on from its coarse bracket to the full tolerance.
+  // The refinement's own note (why it failed) is kept; adopt() rewrites the point.
+  const std::string refinementNote = sp.note;
+  const int refinementSteps = sp.locationIterations - evaluations;
+  const Root coarse = root;
+  const bool ok = findRoot(coarse.left, coarse.fLeft, coarse.right, coarse.fRight, test, root);
+  evaluations += root.evaluations + refinementSteps;
+  adopt(ok);
+  sp.note = refinementNote;
+  if (!root.failure.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("secant: " + root.failure);
 }
 
 bool Locator::refineFold(SpecialPoint &sp, const Vector &tangentRef) {
@@ -457,13 +464,7 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
   };
   adopt(ok);
   if ((!options_.denseAlgebra || !refineBranchPoint(sp, a_.point.tangent)) && ok && root.fLeft * root.fRight < 0.0) {
-    const std::string refinementNote = sp.note;
-    const int refinementSteps = sp.locationIterations - evaluations;
-    const Root coarse = root;
-    ok = findRoot(coarse.left, coarse.fLeft, coarse.right, coarse.fRight, test, root);
-    evaluations += root.evaluations + refinementSteps;
-    adopt(ok);
-    sp.note = refinementNote;
+    finishSecant(sp, root, test, evaluations, adopt);
     fillBranchPointGeometry(sp, a_.point.tangent);
   }
   sp.residualNorm = residualNorm(sp.u, sp.lambda);

@@ -96,6 +96,8 @@ class Locator {
   void separateCrossings(const StepSample &lo, const StepSample &hi, std::vector<std::pair<StepSample, StepSample>> &simple,
                          std::vector<std::pair<StepSample, StepSample>> &multiple, int depth);
   bool refineFold(SpecialPoint &point, const Vector &tangentRef);
+  void finishSecant(SpecialPoint &sp, Root &root, const TestFunction &test, int &evaluations,
+                    const std::function<void(bool)> &adopt);
   bool refineBranchPoint(SpecialPoint &point, const Vector &tangentRef);
   void fillBranchPointGeometry(SpecialPoint &point, const Vector &tangentRef);
   double residualNorm(ConstVectorRef u, double lambda);
