@@ -46,6 +46,9 @@ struct Settings {
   double newtonTolerance = 1e-10;
   double locationTolerance = 1e-12;
   bool stability = true;
+  /// Lowest eigenvalues recorded per point (TracerOptions::lowestEigenvalues). bench_cases uses
+  /// 0 (inertia only, what the branch-point test needs; AUTO with IPS = 0 computes none).
+  int lowestEigenvalues = 3;
 };
 
 inline cont::TracerOptions tracerOptions(const Settings& s, double lambdaMin, double lambdaMax) {
@@ -57,6 +60,7 @@ inline cont::TracerOptions tracerOptions(const Settings& s, double lambdaMin, do
   o.locationTolerance = s.locationTolerance;
   o.locationNewtonTolerance = std::min(1e-13, s.newtonTolerance);
   o.computeStability = s.stability;
+  o.lowestEigenvalues = s.lowestEigenvalues;
   o.lambdaMin = lambdaMin;
   o.lambdaMax = lambdaMax;
   o.maxPoints = 20000;

@@ -346,7 +346,10 @@ int constrainedCountBelow(ChainStructure& ws, double sigma) {
   ws.X.leftCols(r) = ws.B.leftCols(r);
   solveFactored(ws, ws.X, r);
   ws.S.resize(r, r);
-  ws.S.noalias() = -(ws.B.leftCols(r).transpose() * ws.X.leftCols(r));
+  // (product, then negate in place: −(BᵀX) as one expression evaluated the product into a heap
+  // temporary on every call)
+  ws.S.noalias() = ws.B.leftCols(r).transpose() * ws.X.leftCols(r);
+  ws.S = -ws.S;
   return ws.factorInertia.negative + smallNegativeCount(ws.S) - r;
 }
 

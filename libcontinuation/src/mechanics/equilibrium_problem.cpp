@@ -121,15 +121,18 @@ bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu,
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) Fu(i, j) = -work_[std::max(i, j)];
   for (int i = 0; i < n; ++i) Fu(i, i) += stiff_[i];
+  // Borders and F_λ as plain loops (n + m is tiny in the hot path; Eigen's block expressions on
+  // Refs cost more than the arithmetic there).
   const int m = heldCount();
   for (int k = 0; k < m; ++k) {
-    Fu.block(0, n + k, n, 1) = -J_.row(held_[size_t(k)]).transpose();
-    Fu.block(n + k, 0, 1, n) = -J_.row(held_[size_t(k)]);
+    const int h = held_[size_t(k)];
+    for (int i = 0; i < n; ++i) Fu(i, n + k) = Fu(n + k, i) = -J_(h, i);
+    for (int l = 0; l < m; ++l) Fu(n + l, n + k) = 0.0;
+    Flambda[n + k] = direction_[h];
   }
-  if (m > 0) Fu.bottomRightCorner(m, m).setZero();
-  Flambda.head(n).setZero();
-  for (int c : loaded_) Flambda.head(n) -= J_.row(c).transpose() * direction_[c];
-  for (int k = 0; k < m; ++k) Flambda[n + k] = direction_[held_[size_t(k)]];
+  for (int i = 0; i < n; ++i) Flambda[i] = 0.0;
+  for (int c : loaded_)
+    for (int i = 0; i < n; ++i) Flambda[i] -= J_(c, i) * direction_[c];
   return true;
 }
 
