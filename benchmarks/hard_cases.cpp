@@ -18,6 +18,7 @@
 //              chain's own units (typicalUnits: mean b and k, which here are L and k)
 //  cluster.low.n<N>  the first 6 critical loads of the clamped–pinned chain [linear_buckling]
 //  cluster.top.n<N>  the 6 most compressive critical loads, spaced ~1/n² apart [linear_buckling]
+//  cluster.low.n<N>.reltol  cluster.low with locationTolerance 1e-12·|λ_1| (relative, not max(1, |λ|))
 //  kappa0.n<N>      κ = 0 (L0 = 1.5): an (N−1)-fold zero at Fx = 0 [exact: Fx = 0, index 0 → N−1]
 //  limit.n<N>       free end, lateral end force, user limit |q| ≤ 0.3: the stop on the limit
 //                   [Newton on F(u, λ) = 0 with the limiting joint fixed, finite-difference Jacobian]
@@ -205,8 +206,10 @@ std::vector<double> compressiveCriticalLoads(const Chain& chain) {
 }
 
 // Traces the trivial branch from λ0 down to λEnd with a step of a third of the range (several
-// BPs per step) and checks it against crit[first .. first + count).
-Row clustered(const std::string& id, int n, bool top, int count) {
+// BPs per step) and checks it against crit[first .. first + count). relativeLocation: the location
+// target 1e-12 relative to the cluster's own load scale |crit[first]| instead of the default
+// locationTolerance·max(1, |λ|) (absolute below |λ| = 1).
+Row clustered(const std::string& id, int n, bool top, int count, bool relativeLocation = false) {
   Row row;
   row.id = id;
   const Chain chain = Chain::uniform(n, mainSegment());
@@ -228,7 +231,9 @@ Row clustered(const std::string& id, int n, bool top, int count) {
   Settings s;
   s.maxStep = s.initialStep = std::abs(lambdaEnd - lambda0) / 3;
   s.minStep = 1e-6 * s.maxStep;
-  cont::Tracer tracer(problem, tracerOptions(s, lambdaEnd, lambda0));
+  cont::TracerOptions o = tracerOptions(s, lambdaEnd, lambda0);
+  if (relativeLocation) o.locationTolerance = 1e-12 * std::min(1.0, std::abs(crit[first]));
+  cont::Tracer tracer(problem, o);
   const cont::Branch br = tracer.trace(Eigen::VectorXd::Zero(n + 1), lambda0, cont::InitialDirection::decreasingLambda());
   row.ms = timer.ms();
   const auto bps = br.specialPointsOfType(cont::SpecialPointType::BranchPoint);
@@ -371,6 +376,9 @@ int main(int argc, char** argv) {
         const std::string id = std::string("cluster.") + end + ".n" + std::to_string(n);
         if (want(id.c_str())) add(clustered(id, n, end[0] == 't', 6));
       }
+    // The low end of the large chain again with a location target relative to the loads there.
+    const std::string id = "cluster.low.n" + std::to_string(sizes.back()) + ".reltol";
+    if (want(id.c_str())) add(clustered(id, sizes.back(), false, 6, true));
   }
   if (want("kappa0"))
     for (int n : quick ? std::vector<int>{3, 4} : std::vector<int>{3, 4, 5, 10}) add(kappaZero(n));

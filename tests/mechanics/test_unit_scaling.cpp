@@ -8,8 +8,9 @@
 //   - branch points at L = 1e-3, k = 1e-6 (torques of order 1e-12): each BP is reported twice,
 //     once by the determinant (inertia 0 -> 0: the eigenvalue is under the absolute zero floor
 //     1e-13·max(1, ‖H‖)) and once by the inertia count;
-//   - the fold at F₀ = k·L = 1e6 (L = k = 1e3): the step sizes are absolute arclength, 20000 points
-//     do not reach the fold;
+//   - the fold at L = k = 1e3 (torques of order k·L² = 1e9): the start point does not converge
+//     (KIN_STEP_LT_STPTOL: the absolute Newton tolerance is under the rounding floor); at larger
+//     F₀ the absolute step sizes do not reach it in 20000 points;
 //   - the fold at k·L² ≤ 1e-9 (L = 1e-3, k = 1e-6): the absolute Newton tolerance ‖G‖∞ ≤ 1e-10
 //     accepts non-equilibria (torques are of order k·L² = 1e-12), the start kernel looks
 //     2-dimensional and the inertia's absolute zero floor reports a spurious multiplicity-3 BP;
@@ -104,7 +105,7 @@ TEST_CASE("unit scaling: the fold scales as k L, its joint angles are unit-free"
   CHECK(reference[0].lambda == Approx(0.1777097421507).margin(1e-12));  // ref.py (shared/peers/auto07p)
   for (double L : kScales)
     for (double k : kScales) {
-      if (L * k > 1e3) continue;  // F₀ = 1e6: absolute steps, see the header comment
+      if (L * k > 1e3) continue;  // L = k = 1e3: see the header comment
       INFO("lengths x" << L << ", stiffness x" << k);
       const std::vector<cont::SpecialPoint> lps = folds(L, k);
       REQUIRE(lps.size() == 1);
