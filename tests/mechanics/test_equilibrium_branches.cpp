@@ -38,6 +38,18 @@ const Classification& nameOf(const EquilibriumBranches& r, size_t bi, const cont
   return r.classifications[bi][size_t(sp - b.specialPoints.data())];
 }
 
+// Compressive critical loads (λ < 0) of the straight clamped–pinned chain by linear_buckling,
+// closest to 0 first.
+std::vector<double> compressiveCriticalLoads(const Chain& chain) {
+  const LinearBucklingResult lb =
+      linearBuckling(chain, Eigen::VectorXd::Zero(chain.size()), EndCondition::clampedPinned(0.0));
+  std::vector<double> crit;
+  for (const BucklingMode& m : lb.modes)
+    if (m.lambda < 0) crit.push_back(m.lambda);
+  std::sort(crit.begin(), crit.end(), [](double x, double y) { return x > y; });
+  return crit;
+}
+
 }  // namespace
 
 TEST_CASE("n = 3 clamped-pinned: branch points equal the closed forms (17) on a grid", "[equilibrium_branches]") {
@@ -72,11 +84,7 @@ TEST_CASE("n = 4..50 clamped-pinned: branch points equal the linear-buckling eig
   const SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
   for (int n = 4; n <= 50; n += (n < 12 ? 1 : 7)) {
     const Chain chain = Chain::uniform(n, p);
-    const LinearBucklingResult lb = linearBuckling(chain, Eigen::VectorXd::Zero(n), EndCondition::clampedPinned(0.0));
-    std::vector<double> compressive;
-    for (const BucklingMode& m : lb.modes)
-      if (m.lambda < 0) compressive.push_back(m.lambda);
-    std::sort(compressive.begin(), compressive.end(), [](double x, double y) { return x > y; });
+    const std::vector<double> compressive = compressiveCriticalLoads(chain);
     REQUIRE(compressive.size() >= 2);
     // Trace through the first two critical loads (and stop before the third).
     const double stop = compressive.size() > 2 ? 0.5 * (compressive[1] + compressive[2]) : 1.2 * compressive[1];
@@ -254,11 +262,7 @@ TEST_CASE("hard case: a path that runs into a joint limit stops exactly on it", 
 TEST_CASE("hard case: n = 200, closely spaced critical loads all found once", "[equilibrium_branches]") {
   const int n = 200;
   const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  const LinearBucklingResult lb = linearBuckling(chain, Eigen::VectorXd::Zero(n), EndCondition::clampedPinned(0.0));
-  std::vector<double> crit;
-  for (const BucklingMode& m : lb.modes)
-    if (m.lambda < 0) crit.push_back(m.lambda);
-  std::sort(crit.begin(), crit.end(), [](double x, double y) { return x > y; });
+  const std::vector<double> crit = compressiveCriticalLoads(chain);
   REQUIRE(crit.size() > 6);
   // Range through the first 5 critical loads; with a step larger than their spacing several
   // of them fall inside one step.
@@ -334,11 +338,7 @@ TEST_CASE("hard case: top of the spectrum, n = 60: six critical loads 2e-3 apart
   // Start between the 7th- and 6th-last loads (index m − 7) and take steps of a third of the range.
   const int n = 60;
   const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  const LinearBucklingResult lb = linearBuckling(chain, Eigen::VectorXd::Zero(n), EndCondition::clampedPinned(0.0));
-  std::vector<double> crit;
-  for (const BucklingMode& m : lb.modes)
-    if (m.lambda < 0) crit.push_back(m.lambda);
-  std::sort(crit.begin(), crit.end(), [](double x, double y) { return x > y; });
+  const std::vector<double> crit = compressiveCriticalLoads(chain);
   REQUIRE(crit.size() > 8);
   const size_t first = crit.size() - 6;
   const double start = 0.5 * (crit[first - 1] + crit[first]);
