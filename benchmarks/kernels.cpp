@@ -96,43 +96,28 @@ void BM_TridiagonalAssemble(benchmark::State& state) {
 }
 BENCHMARK(BM_TridiagonalAssemble)->Apply(structuredSizes);
 
-void BM_StabilityDense(benchmark::State& state) {
+/// EquilibriumProblem::stability(u, λ, lowestCount, …), dense (Problem's default) or structured.
+/// u is fixed, so the problem's q-cache holds the kinematics and K_q after the first call (as in
+/// the tracer, where the Jacobian at the same point precedes it).
+void stabilityLoop(benchmark::State& state, bool structured, int lowestCount) {
   const int n = int(state.range(0));
-  auto p = clampedPinned(n, false);
+  auto p = clampedPinned(n, structured);
   const Eigen::VectorXd u = bentState(n, 1);
   continuation::StabilityInfo info;
   for (auto _ : state) {
-    p.stability(u, -0.3, 3, info);
+    p.stability(u, -0.3, lowestCount, info);
     benchmark::DoNotOptimize(info.negative);
   }
 }
+
+void BM_StabilityDense(benchmark::State& state) { stabilityLoop(state, false, 3); }
 BENCHMARK(BM_StabilityDense)->Apply(denseSizes)->Unit(benchmark::kMicrosecond);
 
-void BM_StabilityStructured(benchmark::State& state) {
-  const int n = int(state.range(0));
-  auto p = clampedPinned(n, true);
-  const Eigen::VectorXd u = bentState(n, 1);
-  continuation::StabilityInfo info;
-  for (auto _ : state) {
-    p.stability(u, -0.3, 3, info);
-    benchmark::DoNotOptimize(info.negative);
-  }
-}
+void BM_StabilityStructured(benchmark::State& state) { stabilityLoop(state, true, 3); }
 BENCHMARK(BM_StabilityStructured)->Apply(structuredSizes)->Unit(benchmark::kMicrosecond);
 
-/// EquilibriumProblem::stability with lowestCount = 0 (what the tracer asks at every point by
-/// default in bench_cases). Note: u is fixed, so the problem's q-cache holds the kinematics and
-/// K_q after the first call (as in the tracer, where the Jacobian at the same point precedes it).
-void BM_StabilityInertiaOnly(benchmark::State& state) {
-  const int n = int(state.range(0));
-  auto p = clampedPinned(n, true);
-  const Eigen::VectorXd u = bentState(n, 1);
-  continuation::StabilityInfo info;
-  for (auto _ : state) {
-    p.stability(u, -0.3, 0, info);
-    benchmark::DoNotOptimize(info.negative);
-  }
-}
+/// lowestCount = 0: what the tracer asks at every point in bench_cases.
+void BM_StabilityInertiaOnly(benchmark::State& state) { stabilityLoop(state, true, 0); }
 BENCHMARK(BM_StabilityInertiaOnly)->Apply(structuredSizes)->Unit(benchmark::kMicrosecond);
 
 /// Inertia only (two O(n) counts on the bordered tridiagonal), no eigenvalues.

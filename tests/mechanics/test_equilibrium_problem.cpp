@@ -25,15 +25,32 @@ std::vector<Setting> settings(std::mt19937& rng) {
           {"held position", EndCondition::heldPosition(3.0 + W(rng), W(rng))}};
 }
 
+Chain randomChain(std::mt19937& rng, int n) {
+  std::vector<SegmentParameters> segs;
+  for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
+  return Chain(segs);
+}
+
+/// u = (q, r) of size N: joint angles within 70 % of the limits, multipliers in [−1.5, 1.5].
+Vector randomState(std::mt19937& rng, const Chain& chain, int N) {
+  std::uniform_real_distribution<double> W(-1.5, 1.5);
+  const int n = chain.size();
+  Vector u(N);
+  for (int i = 0; i < n; ++i) {
+    std::uniform_real_distribution<double> Q(0.7 * chain.lowerLimits()[i], 0.7 * chain.upperLimits()[i]);
+    u[i] = Q(rng);
+  }
+  for (int i = n; i < N; ++i) u[i] = W(rng);
+  return u;
+}
+
 }  // namespace
 
 TEST_CASE("EquilibriumProblem Jacobian and its directional derivative match finite differences", "[equilibrium]") {
   std::mt19937 rng(101);
   std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
   for (int n : {1, 3, 8}) {
-    std::vector<SegmentParameters> segs;
-    for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
-    const Chain chain(segs);
+    const Chain chain = randomChain(rng, n);
     for (const Setting& s : settings(rng)) {
       INFO("n = " << n << ", end: " << s.name);
       const Eigen::Vector3d dir(W(rng), W(rng), W(rng));
@@ -41,12 +58,7 @@ TEST_CASE("EquilibriumProblem Jacobian and its directional derivative match fini
       const int N = problem.dimension();
       REQUIRE(N == n + s.end.heldCount());
       for (int trial = 0; trial < 3; ++trial) {
-        Vector u(N);
-        for (int i = 0; i < n; ++i) {
-          std::uniform_real_distribution<double> Q(0.7 * chain.lowerLimits()[i], 0.7 * chain.upperLimits()[i]);
-          u[i] = Q(rng);
-        }
-        for (int i = n; i < N; ++i) u[i] = W(rng);
+        const Vector u = randomState(rng, chain, N);
         const double lambda = Lam(rng);
         Matrix Fu(N, N), dFu(N, N);
         Vector Fl(N), dFl(N), F(N), Fp(N), Fm(N);
@@ -134,24 +146,14 @@ TEST_CASE("EquilibriumProblem: cached evaluations equal a fresh problem's in any
   std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
   std::uniform_int_distribution<int> Op(0, 5), Pick(0, 3);
   for (int n : {1, 3, 8}) {
-    std::vector<SegmentParameters> segs;
-    for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
-    const Chain chain(segs);
+    const Chain chain = randomChain(rng, n);
     for (const Setting& s : settings(rng)) {
       INFO("n = " << n << ", end: " << s.name);
       const Eigen::Vector3d dir(W(rng), W(rng), W(rng));
       EquilibriumProblem cached(chain, s.end, dir);
       const int N = cached.dimension();
       std::vector<Vector> states;
-      for (int k = 0; k < 3; ++k) {
-        Vector u(N);
-        for (int i = 0; i < n; ++i) {
-          std::uniform_real_distribution<double> Q(0.7 * chain.lowerLimits()[i], 0.7 * chain.upperLimits()[i]);
-          u[i] = Q(rng);
-        }
-        for (int i = n; i < N; ++i) u[i] = W(rng);
-        states.push_back(u);
-      }
+      for (int k = 0; k < 3; ++k) states.push_back(randomState(rng, chain, N));
       states.push_back(states[0]);
       states[3].tail(N - n).setConstant(0.25);  // same q, other multipliers
       Vector buffer(N);
