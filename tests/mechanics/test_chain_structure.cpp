@@ -401,6 +401,11 @@ TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense defa
         INFO("n = " << n << " held " << end.heldCount() << " trial " << trial);
         CHECK(a.negative == b.negative);
         CHECK(a.zero == b.zero);
+        StabilityInfo c;  // inertia only (bench_cases' setting per point)
+        REQUIRE(fast.stability(u, lambda, 0, c));
+        CHECK(c.negative == b.negative);
+        CHECK(c.zero == b.zero);
+        CHECK(c.lowest.size() == 0);
         REQUIRE(a.lowest.size() == b.lowest.size());
         const double scale = std::max(1.0, b.lowest.cwiseAbs().maxCoeff()) * n;
         for (Eigen::Index j = 0; j < a.lowest.size(); ++j) CHECK(a.lowest[j] == Approx(b.lowest[j]).margin(1e-10 * scale));
