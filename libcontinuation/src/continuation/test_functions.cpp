@@ -60,7 +60,7 @@ bool PointEvaluator::complete(ContinuationPoint &point, ConstVectorRef reference
 
 void MinimallyAugmentedTest::initialize(const Matrix &referenceA) {
   const Eigen::Index m = referenceA.rows();
-  Eigen::JacobiSVD<Matrix> svd(referenceA, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::BDCSVD<Matrix> svd(referenceA, Eigen::ComputeFullU | Eigen::ComputeFullV);
   b_ = svd.matrixU().col(m - 1);
   c_ = svd.matrixV().col(m - 1);
   augmented_ = Matrix::Zero(m + 1, m + 1);
@@ -76,8 +76,9 @@ bool MinimallyAugmentedTest::evaluate(const Matrix &A, double &psi, Vector *v) {
   augmented_.col(m).head(m) = b_;
   augmented_.row(m).head(m) = c_.transpose();
   augmented_(m, m) = 0.0;
-  Eigen::FullPivLU<Matrix> lu(augmented_);
-  if (!lu.isInvertible()) return false;
+  // Bordered by the reference's singular vectors, the matrix is regular near the reference
+  // (Govaerts 2000): partial pivoting suffices, and a breakdown shows as a non-finite solution.
+  Eigen::PartialPivLU<Matrix> lu(augmented_);
   solution_ = lu.solve(rhs_);
   if (!solution_.allFinite()) return false;
   psi = solution_[m];
