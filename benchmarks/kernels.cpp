@@ -210,17 +210,20 @@ BENCHMARK(BM_CorrectorSolve)->Apply(denseSizes)->Unit(benchmark::kMicrosecond);
 /// held 0.02·n off the axis (so every joint bends and each step needs real Newton corrections),
 /// λ = Fx from 0.1 up. Arg 1: 0 = dense LU, 1 = the chain's O(n) structured solver; both with
 /// the inertia only (TracerOptions::lowestEigenvalues = 0), as a long continuation would run.
+/// Arg 2: 0 = steps of 0.02 in arclength (about one Newton iteration per point), 1 = steps of
+/// 1.0 (several iterations per point: the cost of a hard step).
 void BM_TracerStep(benchmark::State& state) {
   const int n = int(state.range(0));
   const bool structured = state.range(1) != 0;
+  const double step = state.range(2) != 0 ? 1.0 : 0.02;
   EquilibriumProblem p(Chain::uniform(n, mainSegment(2.25)), EndCondition::clampedPinned(0.0, 0.02 * n),
                        Eigen::Vector3d(1, 0, 0));
   continuation::TracerOptions o;
   o.maxPoints = 41;
-  o.initialStep = 0.02;
-  o.maxStep = 0.02;
-  o.minStep = 0.02 / 1024;
-  o.lambdaMax = 100.0;
+  o.initialStep = step;
+  o.maxStep = step;
+  o.minStep = step / 1024;
+  o.lambdaMax = 1000.0;
   o.lowestEigenvalues = 0;
   o.linearAlgebra = structured ? continuation::TracerOptions::LinearAlgebra::Structured
                                : continuation::TracerOptions::LinearAlgebra::Dense;
@@ -240,8 +243,9 @@ void BM_TracerStep(benchmark::State& state) {
 void tracerArgs(benchmark::internal::Benchmark* b) {
   for (long n : {3L, 10L, 30L, 100L, 300L, 1000L, 3000L, 10000L}) {
     if (n > maxN()) continue;
-    if (n <= 300) b->Args({n, 0});
-    b->Args({n, 1});
+    if (n <= 300) b->Args({n, 0, 0});
+    b->Args({n, 1, 0});
+    b->Args({n, 1, 1});
   }
 }
 BENCHMARK(BM_TracerStep)->Apply(tracerArgs)->Unit(benchmark::kMillisecond);

@@ -18,15 +18,19 @@ Factorization DenseBorderedSolver::factor(ConstVectorRef u, double lambda, Const
   lu_.compute(A_);
   const auto &LU = lu_.matrixLU();
   int sign = lu_.permutationP().determinant() > 0 ? 1 : -1;
-  double logAbs = 0.0;
+  // |det| as mantissa·2^exponent: one log per factorization instead of one per pivot.
+  double mantissa = 1.0;
+  long exponent = 0;
   for (int i = 0; i <= n_; ++i) {
     const double pivot = LU(i, i);
     if (pivot == 0.0 || !std::isfinite(pivot)) return Factorization::Singular;
     if (pivot < 0.0) sign = -sign;
-    logAbs += std::log(std::abs(pivot));
+    int e = 0;
+    mantissa = std::frexp(mantissa * std::abs(pivot), &e);
+    exponent += e;
   }
   sign_ = sign;
-  logAbs_ = logAbs;
+  logAbs_ = std::log(mantissa) + static_cast<double>(exponent) * 0.6931471805599453;
   return Factorization::Regular;
 }
 

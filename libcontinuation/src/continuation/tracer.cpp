@@ -272,6 +272,12 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     return;
   }
   const int boxEvents = options_.boxLower.size() ? 2 * (n_ + 1) : 0;
+  // Event values of the current point are kept from the step that produced it (each is O(1)
+  // to O(N), and there are 2 + 2(N+1) + boundaries of them).
+  const int events = eventCount();
+  eventsA_.resize(size_t(events));
+  eventsB_.resize(size_t(events));
+  for (int e = 0; e < events; ++e) eventsA_[size_t(e)] = eventValue(e, branch.points.back());
   double ds = options_.initialStep;
   std::string lastFailure = "no failure";
 
@@ -353,8 +359,9 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     double hitAccuracy = 0.0, hitValue = 0.0;
     ContinuationPoint hitPoint;
     bool stepSet = false;
-    for (int e = 0; e < eventCount(); ++e) {
-      const double ga = eventValue(e, a), gb = eventValue(e, b);
+    for (int e = 0; e < events; ++e) eventsB_[size_t(e)] = eventValue(e, b);
+    for (int e = 0; e < events; ++e) {
+      const double ga = eventsA_[size_t(e)], gb = eventsB_[size_t(e)];
       if (!(ga >= 0.0 && gb < 0.0)) continue;
       if (!stepSet) {
         locator_->setStep(a, b);
@@ -457,6 +464,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     factor = std::min(options_.stepGrowth, std::max(options_.stepShrink, factor));
     if (summary.contraction > options_.slowContraction) factor = std::min(factor, 0.7);
     ds = std::min(options_.maxStep, std::max(options_.minStep, ds * factor));
+    eventsA_.swap(eventsB_);
   }
 }
 

@@ -16,6 +16,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace buckle::continuation {
 
@@ -62,9 +63,9 @@ struct TracerOptions {
     Structured,  ///< the problem's structured solver (Problem::makeStructuredSolver); invalid without one
   };
   LinearAlgebra linearAlgebra = LinearAlgebra::Automatic;
-  /// Automatic switches to the structured solver from this N on (the measured crossover of the
-  /// bordered solves: benchmarks/RESULTS.md).
-  int structuredFromDimension = 24;
+  /// Automatic switches to the structured solver from this N on. The chain's tracer step
+  /// (benchmarks/RESULTS.md, BM_TracerStep) is faster dense at N = 4 and structured at N = 11.
+  int structuredFromDimension = 8;
   /// Above this N the locator does not build dense (N+1)² matrices: special points are located
   /// by the secant on O(N)-evaluable test functions (t_λ, the determinant sign and magnitude,
   /// the crossing eigenvalue) down to locationTolerance, without the augmented-Newton
@@ -138,6 +139,7 @@ class Tracer {
   std::unique_ptr<PointEvaluator> evaluator_;
   std::unique_ptr<Locator> locator_;
   Vector predictor_, x_;
+  std::vector<double> eventsA_, eventsB_;  // event values at the current point and the new one
 };
 
 /// One-shot convenience: Tracer(problem, options).trace(u0, λ0, direction).
