@@ -39,6 +39,25 @@ Chain uniformChain(int n) {
   return Chain(std::vector<SegmentParameters>(size_t(n), p));
 }
 
+/// Factor and solve A(c) x = b with the structured and the dense solver; same determinant sign,
+/// solutions within `tolerance` (relative). Returns whether the structured side used its fallback.
+bool agreesWithDense(EquilibriumProblem& problem, const Vector& u, double lambda, const Vector& c, const Vector& b,
+                     double tolerance) {
+  ChainBorderedSolver fast(problem);
+  DenseBorderedSolver dense(problem);
+  REQUIRE(dense.factor(u, lambda, c) == Factorization::Regular);
+  REQUIRE(fast.factor(u, lambda, c) == Factorization::Regular);
+  CHECK(fast.determinantSign() == dense.determinantSign());
+  CHECK(std::abs(fast.logAbsDeterminant() - dense.logAbsDeterminant()) <=
+        1e-9 * std::max(1.0, std::abs(dense.logAbsDeterminant())));
+  const int N = problem.dimension();
+  Vector xf(N + 1), xd(N + 1);
+  REQUIRE(fast.solve(b, xf));
+  REQUIRE(dense.solve(b, xd));
+  CHECK((xf - xd).norm() <= tolerance * xd.norm());
+  return fast.usedDenseFallback();
+}
+
 }  // namespace
 
 TEST_CASE("ChainBorderedSolver equals the dense LU of the same bordered Jacobian (m = 0..3 held)", "[chain_solver]") {
@@ -60,17 +79,7 @@ TEST_CASE("ChainBorderedSolver equals the dense LU of the same bordered Jacobian
       for (int i = 0; i < N; ++i) u[i] = i < n ? Q(rng) : W(rng);
       for (int i = 0; i <= N; ++i) c[i] = W(rng), b[i] = W(rng);
       const double lambda = W(rng);
-      ChainBorderedSolver fast(problem);
-      DenseBorderedSolver dense(problem);
-      REQUIRE(fast.factor(u, lambda, c) == Factorization::Regular);
-      REQUIRE(dense.factor(u, lambda, c) == Factorization::Regular);
-      CHECK_FALSE(fast.usedDenseFallback());
-      CHECK(fast.determinantSign() == dense.determinantSign());
-      CHECK(std::abs(fast.logAbsDeterminant() - dense.logAbsDeterminant()) < 1e-9 * std::max(1.0, std::abs(dense.logAbsDeterminant())));
-      Vector xf(N + 1), xd(N + 1);
-      REQUIRE(fast.solve(b, xf));
-      REQUIRE(dense.solve(b, xd));
-      CHECK((xf - xd).norm() <= 1e-10 * xd.norm());
+      CHECK_FALSE(agreesWithDense(problem, u, lambda, c, b, 1e-10));
     }
   }
 }
@@ -89,19 +98,14 @@ TEST_CASE("ChainBorderedSolver near a singular H (an unconstrained critical load
   std::uniform_real_distribution<double> W(-1.0, 1.0);
   Vector c(N + 1), b(N + 1);
   for (int i = 0; i <= N; ++i) c[i] = W(rng), b[i] = W(rng);
-  ChainBorderedSolver fast(problem);
-  DenseBorderedSolver dense(problem);
   for (double relative : {1e-3, 1e-8, 1e-12, 0.0}) {
     const double lambda = freeModes.modes.front().lambda * (1.0 + relative);
     INFO("lambda = free critical load x (1 + " << relative << ")");
-    const Vector u = Vector::Zero(N);
-    REQUIRE(dense.factor(u, lambda, c) == Factorization::Regular);
-    REQUIRE(fast.factor(u, lambda, c) == Factorization::Regular);
-    CHECK(fast.determinantSign() == dense.determinantSign());
-    Vector xf(N + 1), xd(N + 1);
-    REQUIRE(fast.solve(b, xf));
-    REQUIRE(dense.solve(b, xd));
-    CHECK((xf - xd).norm() <= 1e-8 * xd.norm());
+    const bool fallback = agreesWithDense(problem, Vector::Zero(N), lambda, c, b, 1e-8);
+    // Block elimination itself serves to 1e-8 from the singular H (and is as accurate as dense
+    // there); closer, its Schur complement is numerically singular and the dense fallback
+    // (n + m <= kDenseFallback) takes over.
+    if (relative >= 1e-8) CHECK_FALSE(fallback);
   }
 }
 
