@@ -5,6 +5,11 @@
 // a branch-jump guard on the tangent turning angle, then detection and location of special
 // points and of the stop conditions (parameter range, box, boundaries g_k = 0) between the last
 // two points. The step adapts to the Newton iteration count and contraction.
+//
+// Tolerances (newtonTolerance, locationTolerance·max(1, |λ|)) and step sizes are absolute, in the
+// problem's own units, with one Euclidean arclength over (u, λ): pose problems so that typical
+// unknowns, λ and residual rows are O(1) (benchmarks/RESULTS.md, "Extreme units", measures what
+// fails otherwise).
 #pragma once
 
 #include "buckle/continuation/bordered_solver.h"
