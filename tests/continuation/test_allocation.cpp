@@ -1,31 +1,15 @@
 // The corrector's hot loop (KINSOL iterations, residual and Jacobian callbacks on mapped
-// SUNDIALS storage) must not touch the heap once the Corrector exists. Counted by interposing
-// malloc, through which operator new, Eigen and SUNDIALS all allocate; skipped under
-// AddressSanitizer, which owns malloc itself.
+// SUNDIALS storage) must not touch the heap once the Corrector exists (malloc_counter.h).
 #include "buckle/continuation/corrector.h"
 
 #include "toy_problems.h"
 
 #include <catch2/catch.hpp>
 
-#include <atomic>
-#include <cstddef>
-
-#if defined(__SANITIZE_ADDRESS__)
-#define BUCKLE_COUNT_MALLOC 0
-#else
-#define BUCKLE_COUNT_MALLOC 1
-extern "C" void *__libc_malloc(std::size_t size);
-namespace {
-std::atomic<long> mallocCalls{0};
-}
-extern "C" void *malloc(std::size_t size) noexcept {
-  mallocCalls.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(size);
-}
-#endif
+#include "../malloc_counter.h"
 
 using namespace buckle::continuation;
+using buckle::testing::mallocCalls;
 
 TEST_CASE("Corrector solves allocate nothing after construction", "[allocation]") {
 #if BUCKLE_COUNT_MALLOC

@@ -9,6 +9,7 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/linear_buckling.h"
 
+#include "../malloc_counter.h"
 #include "random_segments.h"
 
 using namespace buckle::mechanics;
@@ -154,4 +155,37 @@ TEST_CASE("Tracer on the chain: structured and dense give the same branch and br
     CHECK(std::abs(fa[k] - expected[k]) <= 1e-10 * std::abs(expected[k]));
     CHECK(std::abs(fa[k] - fb[k]) <= 1e-10 * std::abs(expected[k]));
   }
+}
+
+TEST_CASE("Corrector on the chain's structured solver allocates nothing after construction", "[chain_solver]") {
+#if BUCKLE_COUNT_MALLOC
+  // Clamped–pinned, end held off the axis: every Newton iterate factors and solves through
+  // ChainBorderedSolver inside KINSOL (custom SUNLinearSolver).
+  const int n = 60;
+  EquilibriumProblem problem(uniformChain(n), EndCondition::clampedPinned(0.0, 0.5), Eigen::Vector3d(1, 0, 0));
+  const int N = problem.dimension();
+  auto solver = problem.makeStructuredSolver();
+  REQUIRE(solver != nullptr);
+  buckle::continuation::Corrector corrector(problem, {}, solver.get());
+  Vector u0 = Vector::Zero(N), u(N), x(N + 1), predictor(N + 1), tangent = Vector::Zero(N + 1);
+  REQUIRE(corrector.solveAtFixedParameter(u0, 0.2, u).converged);  // warm-up
+  tangent[N] = 1.0;
+  const long before = buckle::testing::mallocCalls.load();
+  int iterations = 0;
+  bool converged = true;
+  for (int k = 0; k < 10; ++k) {
+    predictor.head(N) = u;
+    predictor[N] = 0.2 + 0.05 * (k + 1);
+    const auto summary = corrector.correct(predictor, tangent, x);
+    converged = converged && summary.converged;
+    iterations += summary.iterations;
+    u = x.head(N);
+  }
+  const long after = buckle::testing::mallocCalls.load();
+  CHECK(converged);
+  CHECK(iterations >= 10);
+  CHECK(after - before == 0);
+#else
+  SUCCEED("malloc interposition is disabled under AddressSanitizer");
+#endif
 }
