@@ -12,6 +12,8 @@
 #include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/unloaded_shape.h"
 
+#include "random_segments.h"
+
 using namespace buckle::mechanics;
 
 namespace {
@@ -237,4 +239,44 @@ TEST_CASE("shape names: Table I sign patterns, straight, other, sign changes for
   CHECK(shapeName((Vector(4) << 0.1, -0.3, 0.0, 0.0).finished()) == "mode 1");   // θ = (0.1, −0.2, −0.2, −0.2)
   CHECK(shapeName((Vector(4) << 0.1, -0.3, 0.4, 0.0).finished()) == "mode 2");   // θ = (0.1, −0.2, 0.2, 0.2)
   CHECK(signChanges((Vector(5) << 1, 0, -1, 1e-20, 2).finished(), 1e-15) == 2);
+}
+
+TEST_CASE("Long chains: the O(n) Sylvester-count path equals the dense pencil (loads, modes, shapes)",
+          "[linear_buckling]") {
+  std::mt19937 rng(4242);
+  int compared = 0;
+  for (int n : {kStructuredBucklingFrom + 1, 150}) {
+    std::vector<SegmentParameters> segs;
+    for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
+    const Chain chain(segs);
+    const UnloadedShape shape = unloadedShape(chain);
+    REQUIRE(shape.allFound);
+    const Vector q0 = shape.q;
+    for (const auto& [name, end] : std::vector<std::pair<std::string, EndCondition>>{
+             {"free", EndCondition::freeEnd()},
+             {"clamped-pinned", EndCondition::clampedPinned(0.0)},
+             {"held position", EndCondition::heldPosition(0.0, 0.0)}}) {
+      INFO("n = " << n << ", " << name);
+      LinearBucklingOptions few;
+      few.count = 6;
+      const LinearBucklingResult fast = linearBuckling(chain, q0, end, few);
+      LinearBucklingOptions all;  // count = −1: the dense pencil
+      const LinearBucklingResult dense = linearBuckling(chain, q0, end, all);
+      REQUIRE(fast.unloadedStable == dense.unloadedStable);
+      if (!dense.unloadedStable) continue;  // the fast path is not taken
+      ++compared;
+      CHECK(fast.constrainedDimension == dense.constrainedDimension);
+      CHECK(fast.droppedInfinite == dense.droppedInfinite);
+      REQUIRE(fast.modes.size() == std::min<std::size_t>(6, dense.modes.size()));
+      for (std::size_t k = 0; k < fast.modes.size(); ++k) {
+        const BucklingMode &a = fast.modes[k], &b = dense.modes[k];
+        CHECK(std::abs(a.lambda - b.lambda) <= 1e-10 * std::abs(b.lambda));
+        // Modes: same up to sign convention (both normalised, largest component positive).
+        CHECK((a.mode - b.mode).norm() <= 1e-6);
+        CHECK(a.shape == b.shape);
+        CHECK(std::abs(a.shortening - b.shortening) <= 1e-6 * std::abs(b.shortening));
+      }
+    }
+  }
+  CHECK(compared == 6);
 }

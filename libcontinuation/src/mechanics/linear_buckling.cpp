@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/validation.h"
 
@@ -177,6 +178,73 @@ void generalisedEigen(const Matrix& A, const Matrix& B, int wanted, std::vector<
 
 }  // namespace
 
+namespace {
+
+// Long chains, first `count` modes (notes: shared/notes/chain-structure.md). With K_q positive
+// definite on ker J_h the pencil (K_q, G) is definite, so by Sylvester's law the number of
+// critical loads in (0, λ) (or (λ, 0)) is the number of negative eigenvalues of K_q − λG on
+// ker J_h, an O(n) count on the tridiagonal T(λ) (chain_structure.h). Each load is bisected on
+// that count to rounding, its mode taken by two steps of inverse iteration through the O(n) KKT
+// solve. Returns false (the caller goes dense) when the unloaded chain is not stable.
+bool structuredModes(const Chain& chain, const ChainData& data, ConstVectorRef kq, const Matrix& Ch,
+                     const LinearBucklingOptions& options, std::vector<std::pair<double, Vector>>& pairs,
+                     LinearBucklingResult& out) {
+  const int n = chain.size();
+  Vector g(n);
+  loadHessianGenerator(data, Wrench(options.direction[0], options.direction[1], 0.0), g);
+  ChainStructure ws(n);
+  const Matrix C = Ch.transpose();
+  auto count = [&](double lambda) {
+    assemble(kq, lambda * g, ws);
+    return constrainedInertia(ws, C).negative;
+  };
+  assemble(kq, Vector::Zero(n), ws);
+  const Inertia unloaded = constrainedInertia(ws, C);
+  if (unloaded.negative != 0 || unloaded.zero != 0) return false;
+  out.unloadedStable = true;
+  out.constrainedDimension = unloaded.size();
+  // Finite critical loads on each side: the inertia of −G on ker J_h (K_q = 0, h = g); its
+  // zero eigenvalues are the directions with λ = ∞.
+  assemble(Vector::Zero(n), g, ws);
+  const Inertia loadInertia = constrainedInertia(ws, C, 1e-12);
+  out.droppedInfinite = loadInertia.zero;
+  const double gmax = std::max(1e-300, g.cwiseAbs().maxCoeff());
+  const double kmax = kq.cwiseAbs().maxCoeff();
+  for (int side : {+1, -1}) {
+    // −G's negative eigenvalues are G's positive ones: loads that buckle for λ > 0.
+    const int available = side > 0 ? loadInertia.negative : loadInertia.positive;
+    const int wanted = std::min(options.count, available);
+    if (wanted <= 0) continue;
+    double hi = side * kmax / gmax;
+    for (int it = 0; it < 200 && count(hi) < wanted; ++it) hi *= 2.0;
+    for (int j = 1; j <= wanted; ++j) {
+      double a = 0.0, b = hi;  // count(a) < j <= count(b), |λ| growing with |a|, |b|
+      for (int it = 0; it < 200 && std::abs(b - a) > 4e-16 * std::abs(b); ++it) {
+        const double mid = 0.5 * (a + b);
+        if (count(mid) >= j) b = mid;
+        else a = mid;
+      }
+      const double lambda = 0.5 * (a + b);
+      // Inverse iteration on the KKT system at λ (nearly singular along the mode).
+      count(lambda);  // T(λ), and the orthonormalised held rows (rank-deficient C allowed) in ws.Q
+      const Matrix Q = ws.Q.leftCols(ws.rank).transpose();
+      Vector z = Vector::Ones(n), next(n), y(3);
+      for (int k = 0; k < n; ++k) z[k] += 0.1 * std::sin(1.3 * k);
+      bool ok = true;
+      for (int it = 0; it < 2 && ok; ++it) {
+        ok = solveKKT(ws, Q, z, Vector::Zero(Q.rows()), next, y.head(Q.rows())) && next.allFinite() &&
+             next.norm() > 0.0;
+        if (ok) z = next / next.norm();
+      }
+      if (!ok) return false;
+      pairs.emplace_back(lambda, z);
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const EndCondition& end,
                                     const LinearBucklingOptions& options) {
   const int n = chain.size();
@@ -211,6 +279,35 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
   const int m = int(held.size());
   Matrix Ch(n, m);
   for (int k = 0; k < m; ++k) Ch.col(k) = J.row(held[size_t(k)]).transpose();
+  // Long chains and a few modes: O(n) per mode through the chain structure.
+  if (n > kStructuredBucklingFrom && options.count > 0 && m <= 3) {
+    LinearBucklingResult fast;
+    std::vector<std::pair<double, Vector>> fastPairs;
+    if (structuredModes(chain, data, kq, Ch, options, fastPairs, fast)) {
+      Vector Gz(n), t(n), gvec(n);
+      loadHessianGenerator(data, Wrench(options.direction[0], options.direction[1], 0.0), gvec);
+      for (auto& [lambda, z] : fastPairs) {
+        Eigen::Index imax = 0;
+        z.cwiseAbs().maxCoeff(&imax);
+        if (z[imax] < 0) z = -z;
+        // G z with G(i, j) = g_max(i,j): prefix sums, times g_m − g_{m+1}, tail sums (O(n)).
+        applyUTranspose(z, t);
+        for (int i = 0; i < n; ++i) t[i] *= gvec[i] - (i + 1 < n ? gvec[i + 1] : 0.0);
+        applyU(t, Gz);
+        BucklingMode mode;
+        mode.lambda = lambda;
+        mode.mode = z;
+        mode.shape = modeShapeName(z);
+        mode.shortening = -0.5 * z.dot(Gz);
+        fast.modes.push_back(std::move(mode));
+      }
+      std::stable_sort(fast.modes.begin(), fast.modes.end(), [](const BucklingMode& a, const BucklingMode& b) {
+        return std::abs(a.lambda) < std::abs(b.lambda);
+      });
+      if (int(fast.modes.size()) > options.count) fast.modes.resize(size_t(options.count));
+      return fast;
+    }
+  }
   // (an n×0 factorisation is not valid Eigen input: factor a zero column instead, unused)
   const Eigen::ColPivHouseholderQR<Matrix> qr(m > 0 ? Ch : Matrix(Matrix::Zero(n, 1)));
   const int rank = m == 0 ? 0 : int(qr.rank());

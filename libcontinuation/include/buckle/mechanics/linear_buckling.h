@@ -52,6 +52,11 @@ struct LinearBucklingOptions {
 
 /// Critical loads and modes at q0 with the coordinates held by `end` (its values are unused).
 /// Throws std::invalid_argument when q0 is not an unloaded equilibrium or has the wrong size.
+/// Above this n, with options.count > 0 and the unloaded chain stable, the modes come from O(n)
+/// Sylvester counts on the chain structure (bisection to rounding, inverse iteration for the
+/// mode): O(n) per mode instead of the dense O(n³) pencil.
+constexpr int kStructuredBucklingFrom = 64;
+
 LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const EndCondition& end,
                                     const LinearBucklingOptions& options = {});
 
