@@ -7,14 +7,15 @@
 #include <atomic>
 #include <cstddef>
 
+namespace buckle::testing {
+inline std::atomic<long> mallocCalls{0};
+}
+
 #if defined(__SANITIZE_ADDRESS__)
 #define BUCKLE_COUNT_MALLOC 0
 #else
 #define BUCKLE_COUNT_MALLOC 1
 extern "C" void *__libc_malloc(std::size_t size);
-namespace buckle::testing {
-inline std::atomic<long> mallocCalls{0};
-}
 extern "C" void *malloc(std::size_t size) noexcept {
   buckle::testing::mallocCalls.fetch_add(1, std::memory_order_relaxed);
   return __libc_malloc(size);

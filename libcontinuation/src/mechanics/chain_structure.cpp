@@ -628,9 +628,11 @@ bool factorBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const
   solveFactored(ws, ws.V2, p);
   // det [[H, V], [Wᵀ, D]] = det H · det S with det H = det T (det U = 1).
   ws.schur.resize(p, p);
-  ws.schur.noalias() = D - ws.W2.leftCols(p).transpose() * ws.V2.leftCols(p);
-  ws.schurLU.compute(ws.schur);
-  if (p > 0 && !ws.schurLU.isInvertible()) return false;
+  if (p > 0) {  // (an empty matrix is not valid LU input)
+    ws.schur.noalias() = D - ws.W2.leftCols(p).transpose() * ws.V2.leftCols(p);
+    ws.schurLU.compute(ws.schur);
+    if (!ws.schurLU.isInvertible()) return false;
+  }
   ws.borderSize = p;
   ws.borderedLogAbsDet = ws.logAbsDet;
   ws.borderedDetSign = ws.detSign;
