@@ -19,7 +19,6 @@ ChainBorderedSolver::ChainBorderedSolver(EquilibriumProblem& problem)
       held_(problem.endCondition().heldIndices()),
       loaded_(problem.endCondition().loadedIndices()),
       ws_(problem.segments()),
-      data_(problem.chain()),
       J_(3, problem.segments()),
       V_(Matrix::Zero(problem.segments(), problem.heldCount() + 1)),
       W_(Matrix::Zero(problem.segments(), problem.heldCount() + 1)),
@@ -33,11 +32,7 @@ Factorization ChainBorderedSolver::factor(ConstVectorRef u, double lambda, Const
   sign_ = 0;
   logAbs_ = -std::numeric_limits<double>::infinity();
   usingDense_ = false;
-  if (!problem_.inDomain(u) || !std::isfinite(lambda) || !c.allFinite()) return Factorization::Refused;
-  const auto q = u.head(n_);
-  forwardKinematics(problem_.chain(), q, data_);
-  endJacobian(data_, J_);
-  assemble(problem_.chain(), data_, q, problem_.wrench(u, lambda), ws_);
+  if (!c.allFinite() || !problem_.assembleStructure(u, lambda, ws_, J_)) return Factorization::Refused;
   // Borders: V = [−J_hᵀ, F_λ,q], W = [−J_hᵀ, c_q], D = [[0, F_λ,r], [c_rᵀ, c_λ]] (see header).
   const Eigen::Vector3d& dir = problem_.direction();
   V_.col(m_).setZero();

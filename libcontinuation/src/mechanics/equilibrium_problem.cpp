@@ -194,13 +194,24 @@ bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matr
   return true;
 }
 
+void EquilibriumProblem::assembleFromCache(ConstVectorRef u, double lambda, ChainStructure& ws) {
+  loadHessianGenerator(data_, wrench(u, lambda), ws.h);
+  assemble(stiff_, ws.h, ws);
+}
+
+bool EquilibriumProblem::assembleStructure(ConstVectorRef u, double lambda, ChainStructure& ws, MatrixRef J) {
+  if (!std::isfinite(lambda) || !prepare(u)) return false;
+  assembleFromCache(u, lambda, ws);
+  J = J_;
+  return true;
+}
+
 bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCount,
                                    continuation::StabilityInfo& info) {
   if (!options_.structuredStability) return Problem::stability(u, lambda, lowestCount, info);
   if (!prepare(u)) return false;
+  assembleFromCache(u, lambda, structure_);
   const int n = chain_.size();
-  loadHessianGenerator(data_, wrench(u, lambda), structure_.h);
-  assemble(stiff_, structure_.h, structure_);
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
   const int wanted = std::max(0, std::min(lowestCount, kMaxLowest));
   if (n <= kSmallDense && wanted > 0) {

@@ -186,12 +186,10 @@ namespace {
 // ker J_h, an O(n) count on the tridiagonal T(λ) (chain_structure.h). Each load is bisected on
 // that count to rounding, its mode taken by two steps of inverse iteration through the O(n) KKT
 // solve. Returns false (the caller goes dense) when the unloaded chain is not stable.
-bool structuredModes(const Chain& chain, const ChainData& data, ConstVectorRef kq, const Matrix& Ch,
-                     const LinearBucklingOptions& options, std::vector<std::pair<double, Vector>>& pairs,
-                     LinearBucklingResult& out) {
-  const int n = chain.size();
-  Vector g(n);
-  loadHessianGenerator(data, Wrench(options.direction[0], options.direction[1], 0.0), g);
+// g: the load generator per unit λ (G(i, j) = g_max(i,j), eq 27).
+bool structuredModes(ConstVectorRef g, ConstVectorRef kq, const Matrix& Ch, const LinearBucklingOptions& options,
+                     std::vector<std::pair<double, Vector>>& pairs, LinearBucklingResult& out) {
+  const int n = int(g.size());
   ChainStructure ws(n);
   const Matrix C = Ch.transpose();
   auto count = [&](double lambda) {
@@ -270,8 +268,6 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
   forwardKinematics(chain, q0, data);
   Matrix J(3, n);
   endJacobian(data, J);
-  Matrix G(n, n);
-  loadMatrix(data, Wrench(options.direction[0], options.direction[1], 0.0), G);
 
   // ker J_h: the last n − rank columns of Q in J_hᵀ P = Q R. The reflectors are applied to K_q
   // and G directly (O(m n²)) rather than forming Q.
@@ -283,9 +279,10 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
   if (n > kStructuredBucklingFrom && options.count > 0 && m <= 3) {
     LinearBucklingResult fast;
     std::vector<std::pair<double, Vector>> fastPairs;
-    if (structuredModes(chain, data, kq, Ch, options, fastPairs, fast)) {
-      Vector Gz(n), t(n), gvec(n);
-      loadHessianGenerator(data, Wrench(options.direction[0], options.direction[1], 0.0), gvec);
+    Vector gvec(n);
+    loadHessianGenerator(data, Wrench(options.direction[0], options.direction[1], 0.0), gvec);
+    if (structuredModes(gvec, kq, Ch, options, fastPairs, fast)) {
+      Vector Gz(n), t(n);
       for (auto& [lambda, z] : fastPairs) {
         Eigen::Index imax = 0;
         z.cwiseAbs().maxCoeff(&imax);
@@ -308,6 +305,8 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
       return fast;
     }
   }
+  Matrix G(n, n);
+  loadMatrix(data, Wrench(options.direction[0], options.direction[1], 0.0), G);
   // (an n×0 factorisation is not valid Eigen input: factor a zero column instead, unused)
   const Eigen::ColPivHouseholderQR<Matrix> qr(m > 0 ? Ch : Matrix(Matrix::Zero(n, 1)));
   const int rank = m == 0 ? 0 : int(qr.rank());

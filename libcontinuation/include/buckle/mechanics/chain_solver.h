@@ -45,7 +45,6 @@ class ChainBorderedSolver final : public continuation::BorderedSolver {
   int n_, m_, p_;
   std::vector<int> held_, loaded_;
   ChainStructure ws_;
-  ChainData data_;
   Matrix J_, V_, W_, D_;
   Vector x_, y_;
   std::unique_ptr<continuation::DenseBorderedSolver> dense_;

@@ -65,17 +65,22 @@ class EquilibriumProblem final : public continuation::Problem {
   bool stability(continuation::ConstVectorRef u, double lambda, int lowestCount,
                  continuation::StabilityInfo& info) override;
 
+  /// T of H = K_q − K_g(F(u, λ)) into ws (chain_structure.h) and the end Jacobian (3×n) into J,
+  /// from the q-cache: what the structured stability and the structured solver linearise on.
+  /// False outside the domain.
+  bool assembleStructure(continuation::ConstVectorRef u, double lambda, ChainStructure& ws,
+                         continuation::MatrixRef J);
+
   /// The O(n) bordered solver of the chain (chain_solver.h).
   std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver() override;
-
-  /// Inside the model's domain: finite, and every joint strictly within its geometric limits.
-  bool inDomain(continuation::ConstVectorRef u) const;
 
   int boundaryCount() const override;
   double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
   std::string boundaryName(int k) const override;
 
  private:
+  /// Inside the model's domain: finite, and every joint strictly within its geometric limits.
+  bool inDomain(continuation::ConstVectorRef u) const;
   /// The q-dependent part of every evaluation at u = (q, r): kinematics (data_), the end
   /// Jacobian (J_), ∂E/∂q (grad_) and the diagonal of K_q (stiff_), from one pass of the spring
   /// model. Cached for the last q (bitwise comparison; it does not depend on r or λ): KINSOL
@@ -83,6 +88,8 @@ class EquilibriumProblem final : public continuation::Problem {
   /// corrected point, so each distinct q evaluates the spring model once.
   /// False (nothing cached) if u is outside the domain.
   bool prepare(continuation::ConstVectorRef u);
+  /// T at (u, λ) into ws from the cache (after prepare(u)).
+  void assembleFromCache(continuation::ConstVectorRef u, double lambda, ChainStructure& ws);
 
   Chain chain_;
   EndCondition end_;
