@@ -121,8 +121,9 @@ Baseline loadBaseline(const std::string& file) {
 
   const Pointer ps("/source");
   const json& source = r.required(doc, root, "source");
-  r.onlyKeys(source, ps, {"scene", "problem"});
-  if (source.size() != 1) r.fail(ps, "expected exactly one of \"scene\" (a file in the scenes directory) or \"problem\"");
+  r.onlyKeys(source, ps, {"scene", "problem", "time_limit"});
+  if (source.contains("scene") == source.contains("problem"))
+    r.fail(ps, "expected exactly one of \"scene\" (a file in the scenes directory) or \"problem\"");
   if (source.contains("scene")) {
     b.source = {Source::Kind::Scene, r.string(source["scene"], ps / "scene")};
   } else {
@@ -133,6 +134,10 @@ Baseline loadBaseline(const std::string& file) {
       for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
       r.fail(ps / "problem", "unknown benchmark problem \"" + b.source.name + "\" (known: " + list + ")");
     }
+  }
+  if (source.contains("time_limit")) {
+    if (!source.contains("scene")) r.fail(ps / "time_limit", "a time limit applies to scenes only");
+    b.source.timeLimit = r.positive(source["time_limit"], ps / "time_limit");
   }
   if (doc.contains("ci")) b.ci = r.boolean(doc["ci"], Pointer("/ci"));
 
@@ -155,6 +160,7 @@ std::string formatBaseline(const Baseline& b) {
   doc["format"] = kFormat;
   doc["name"] = b.name;
   doc["source"] = ordered_json{{b.source.kind == Source::Kind::Scene ? "scene" : "problem", b.source.name}};
+  if (b.source.timeLimit > 0.0) doc["source"]["time_limit"] = b.source.timeLimit;
   doc["ci"] = b.ci;
   doc["timing"] = ordered_json{{"repetitions", b.repetitions}, {"reference_seconds", b.referenceSeconds}, {"machine", b.machine}};
   doc["tolerance_policy"] = toJson(b.policy);

@@ -98,7 +98,7 @@ int update(const RegressOptions& o, std::ostream& out, std::ostream& err) {
   const std::string scenes = scenesDirectory(o);
   std::vector<Baseline> todo = existing;
   auto known = [&](const Source& s) {
-    return std::any_of(todo.begin(), todo.end(), [&](const Baseline& b) { return b.source.kind == s.kind && b.source.name == s.name; });
+    return std::any_of(todo.begin(), todo.end(), [&](const Baseline& b) { return b.source.kind == s.kind && b.source.name == s.name && b.source.timeLimit == s.timeLimit; });
   };
   std::vector<fs::path> sceneFiles;
   std::error_code ec;
@@ -133,7 +133,8 @@ int update(const RegressOptions& o, std::ostream& out, std::ostream& err) {
     const std::string file = settings.file.empty() ? (fs::path(o.baselines) / (settings.name + ".json")).string() : settings.file;
     Measurement m;
     try {
-      m = measure(settings.source, scenes, o.repetitions > 0 ? o.repetitions : settings.repetitions);
+      // a time-limited baseline stores the complete run's values: a stopped run must agree with them
+      m = measure(settings.source, scenes, o.repetitions > 0 ? o.repetitions : settings.repetitions, false);
     } catch (const SourceError& e) {
       err << "buckle regress: " << file << ": " << sourceKey(settings.source) << ": " << e.message << "\n";
       return kBadInput;

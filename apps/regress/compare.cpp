@@ -42,11 +42,14 @@ Row missing(const std::string& name, const std::string& quantity, const std::str
   return {name, quantity, base, now, "-", "-", Status::Fail};
 }
 
+/// `partial`: the run was stopped by a time limit, so what the complete run has beyond what was
+/// computed is not a failure (INFO "not reached"); everything computed must still agree.
 void compareCase(const std::string& name, const std::string& prefix, const CaseEntry& c, const MeasuredCase& m,
-                 const TolerancePolicy& policy, std::vector<Row>& rows) {
+                 const TolerancePolicy& policy, bool partial, std::vector<Row>& rows) {
   const int branches = int(m.branches.size());
+  const bool branchesOk = partial ? branches <= c.branches : branches == c.branches;
   rows.push_back({name, prefix + "branches", std::to_string(c.branches), std::to_string(branches), std::to_string(branches - c.branches),
-                  "0", branches == c.branches ? Status::Pass : Status::Fail});
+                  partial ? "<= baseline" : "0", branchesOk ? Status::Pass : Status::Fail});
 
   // special points matched by branch, type and order along the branch
   std::map<std::tuple<int, std::string, int>, SpecialEntry> now;
@@ -55,7 +58,8 @@ void compareCase(const std::string& name, const std::string& prefix, const CaseE
     const std::string q = prefix + where(s.branch) + s.type + "#" + std::to_string(s.order);
     const auto it = now.find({s.branch, s.type, s.order});
     if (it == now.end()) {
-      rows.push_back(missing(name, q, value(s.lambda), "missing"));
+      rows.push_back(missing(name, q, value(s.lambda), partial ? "not reached" : "missing"));
+      if (partial) rows.back().status = Status::Info;
       continue;
     }
     rows.push_back(numeric(name, q + " lambda", s.lambda, it->second.lambda, s.tolerance.allowed(s.lambda)));
@@ -78,6 +82,7 @@ void compareCase(const std::string& name, const std::string& prefix, const CaseE
     const SampleValue v = br ? sampleAt(*br, {s.lambda, s.crossing}, s.coordinates) : SampleValue{};
     if (!v.found) {
       rows.push_back(missing(name, q, "on branch", br ? "branch does not reach it" : "no such branch"));
+      if (partial) rows.back().status = Status::Info;
       continue;
     }
     for (size_t k = 0; k < s.values.size(); ++k) {
@@ -91,7 +96,16 @@ void compareCase(const std::string& name, const std::string& prefix, const CaseE
 
 std::vector<Row> compare(const Baseline& b, const Measurement& m, const TimingCheck& timing) {
   std::vector<Row> rows;
-  if (!m.complete) {
+  const bool limited = b.source.timeLimit > 0.0;
+  if (limited) {
+    // the run must have been stopped by its limit, and on time: within one step of it
+    const double t = m.seconds.empty() ? 0.0 : m.seconds.front();
+    const double allowed = b.source.timeLimit + timing.stopSlackSeconds;
+    rows.push_back({b.name, "stopped by the time limit", "yes", m.interrupted ? "yes" : "no", "-", "-",
+                    m.interrupted ? Status::Pass : Status::Fail});
+    rows.push_back({b.name, "stopped on time", fmt("<= %.3g s", allowed), fmt("%.3g s", t), "-", "-",
+                    t <= allowed ? Status::Pass : Status::Fail});
+  } else if (!m.complete) {
     std::string why;
     for (const std::string& p : m.problems) why += (why.empty() ? "" : "; ") + p;
     rows.push_back({b.name, "run complete", "yes", "no: " + why, "-", "-", Status::Fail});
@@ -105,7 +119,7 @@ std::vector<Row> compare(const Baseline& b, const Measurement& m, const TimingCh
       rows.push_back(missing(b.name, prefix + "case", c.label, "missing"));
       continue;
     }
-    compareCase(b.name, prefix, c, *it->second, b.policy, rows);
+    compareCase(b.name, prefix, c, *it->second, b.policy, limited && m.interrupted, rows);
     now.erase(it);
   }
   for (const auto& [label, c] : now) rows.push_back(missing(b.name, label + ": case", "none", "new"));

@@ -24,6 +24,9 @@ struct Row {
 struct TimingCheck {
   double factor = 3.0;
   double slackSeconds = 0.02;
+  /// Time-limited baselines: the run must end within the limit plus this (one step, generous
+  /// for sanitizer builds).
+  double stopSlackSeconds = 1.0;
 };
 
 std::vector<Row> compare(const Baseline& b, const Measurement& m, const TimingCheck& timing);

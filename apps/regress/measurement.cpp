@@ -49,7 +49,7 @@ MeasuredCase fromScene(const scene::CaseResult& c) {
   return m;
 }
 
-Measurement measureScene(const std::string& file, int repetitions) {
+Measurement measureScene(const std::string& file, int repetitions, double timeLimit) {
   scene::Scene sc;
   try {
     sc = scene::loadScene(file);
@@ -58,10 +58,13 @@ Measurement measureScene(const std::string& file, int repetitions) {
   }
   Measurement m;
   for (int r = 0; r < repetitions; ++r) {
-    const scene::RunResult run = scene::runScene(sc);
+    scene::RunControl control;
+    if (timeLimit > 0.0) control.interrupt = continuation::Interrupt::after(timeLimit);
+    const scene::RunResult run = scene::runScene(sc, control);
     m.seconds.push_back(run.totalSeconds);
     if (r > 0) continue;
     m.complete = run.complete;
+    m.interrupted = run.interrupted;
     m.problems = run.problems;
     for (const scene::CaseResult& c : run.cases) m.cases.push_back(fromScene(c));
   }
@@ -121,10 +124,11 @@ Measurement measureProblem(const std::string& name, int repetitions) {
 
 }  // namespace
 
-Measurement measure(const Source& source, const std::string& scenesDir, int repetitions) {
+Measurement measure(const Source& source, const std::string& scenesDir, int repetitions, bool limited) {
   repetitions = std::max(1, repetitions);
   if (source.kind == Source::Kind::Problem) return measureProblem(source.name, repetitions);
-  return measureScene((std::filesystem::path(scenesDir) / source.name).string(), repetitions);
+  return measureScene((std::filesystem::path(scenesDir) / source.name).string(), repetitions,
+                      limited ? source.timeLimit : 0.0);
 }
 
 }  // namespace buckle::regress

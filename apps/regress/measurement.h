@@ -14,6 +14,9 @@ struct Source {
   enum class Kind { Scene, Problem };
   Kind kind = Kind::Scene;
   std::string name;  ///< scene file name (relative to the scenes directory) or problem name
+  /// Scenes only: > 0, the run is stopped after this many seconds (a time-limited baseline:
+  /// it must stop on time, and what it computed must agree with the complete run's values).
+  double timeLimit = 0.0;
 };
 
 /// A located result. On branches (branch >= 0): the special points of special_points.json (BP,
@@ -48,6 +51,7 @@ struct Measurement {
   std::vector<double> seconds;        ///< one per repetition
   bool complete = true;
   std::vector<std::string> problems;  ///< why not complete
+  bool interrupted = false;           ///< stopped by the source's time limit
   double medianSeconds() const;
 };
 
@@ -58,8 +62,9 @@ struct SourceError {
 };
 
 /// Runs the source `repetitions` times (values from the first run, every run timed). Scene
-/// names are resolved against `scenesDir`.
-Measurement measure(const Source& source, const std::string& scenesDir, int repetitions);
+/// names are resolved against `scenesDir`. `limited`: honour the source's time limit (false
+/// for --update, whose values are the complete run's).
+Measurement measure(const Source& source, const std::string& scenesDir, int repetitions, bool limited = true);
 
 /// The benchmark problems a baseline can name.
 const std::vector<std::string>& problemNames();

@@ -93,8 +93,7 @@ class CaseRunner {
     return opt;
   }
   /// Integration settings of the dynamics with the run's interrupt.
-  mech::IntegrationOptions integrationOptions() const {
-    mech::IntegrationOptions opt;
+  mech::IntegrationOptions integrationOptions(mech::IntegrationOptions opt = mech::IntegrationOptions()) const {
     opt.interrupt = control_.interrupt;
     return opt;
   }
@@ -109,7 +108,7 @@ class CaseRunner {
     const int n = out_.chain.size();
     mech::JumpOptions opt;
     opt.perturbation = scene_.analyses.jump.perturbation;
-    opt.integration = integrationOptions();
+    opt.integration = integrationOptions(mech::jumpIntegrationDefaults());
     opt.integration.recordTrajectory = false;
     s.jumpTried = true;
     try {
@@ -410,7 +409,7 @@ void CaseRunner::loadHistory() {
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();
   opt.jump.perturbation = scene_.analyses.loadHistory.perturbation;
-  opt.jump.integration = integrationOptions();
+  opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults());
   mech::LoadHistoryResult h;
   try {
     h = mech::followLoadHistory(problem, out_.q0, scene_.analyses.loadHistory.waypoints, opt);
@@ -432,7 +431,8 @@ void CaseRunner::loadHistory() {
     }
     std::ostringstream origin;
     origin << "load history, leg " << h.segmentLeg[k] << " (" << spec_.path.parameter << " -> "
-           << scene_.analyses.loadHistory.waypoints[size_t(h.segmentLeg[k])] << ")";
+           << scene_.analyses.loadHistory.waypoints[size_t(h.segmentLeg[k])] << ")"
+           << (h.segmentBifurcated[k] ? ", on the stable branch born at the branch point" : "");
     record(b, problem, origin.str());
   }
   for (const mech::JumpRecord& j : h.jumps) {
@@ -486,7 +486,7 @@ void CaseRunner::suddenLoad() {
   if (spec.value != s0) {
     mech::LoadHistoryOptions opt;
     opt.tracer = solverOptions();
-    opt.jump.integration = integrationOptions();
+    opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults());
     try {
       const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.q0, {s0, spec.value}, opt);
       if (h.completed && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);

@@ -152,3 +152,40 @@ TEST_CASE("buckle regress on a malformed baseline exits 2 naming the file and th
   CHECK(exitCode(regress(dir, "--only nosuch"), log) == 2);
   CHECK(exitCode(regress(dir.parent_path() / "does_not_exist"), log) == 2);
 }
+
+TEST_CASE("a time-limited baseline: stopped on time, what it computed agrees, the rest is not reached",
+          "[cli][regress]") {
+  const fs::path dir = work("limited");
+  const fs::path log = dir.parent_path() / "limited.txt";
+  // the shipped baseline: long_chain_jumps (about 2.5 s in Release) stopped after 1 s
+  fs::copy_file(std::string(BUCKLE_SOURCE_DIR) + "/data/regression/long_chain_jumps_time_limited.json",
+                dir / "limited.json");
+  const std::string only = "--only long_chain_jumps_time_limited";
+  const int rc = exitCode(regress(dir, only), log);
+  const std::string text = slurp(log);
+  INFO(text);
+  CHECK(rc == 0);
+  CHECK(text.find("stopped by the time limit  yes                yes") != std::string::npos);
+  CHECK(text.find("stopped on time") != std::string::npos);
+
+  // A limit the run never reaches is a failure: the baseline is about stopping.
+  nlohmann::json b = nlohmann::json::parse(slurp(dir / "limited.json"));
+  b["source"]["time_limit"] = 600.0;
+  std::ofstream(dir / "limited.json") << b.dump(2);
+  CHECK(exitCode(regress(dir, only), log) == 1);
+  CHECK(slurp(log).find("stopped by the time limit  yes                no") != std::string::npos);
+
+  // A value computed before the stop that disagrees with the complete run's fails as usual.
+  b["source"]["time_limit"] = 1.0;
+  double& first = b["cases"][0]["special_points"][0]["lambda"].get_ref<double&>();
+  first *= 1.0 + 1e-6;
+  std::ofstream(dir / "limited.json") << b.dump(2);
+  CHECK(exitCode(regress(dir, only), log) == 1);
+  CHECK(slurp(log).find("b0 BP#0 lambda") != std::string::npos);
+
+  // time_limit belongs to scenes only, and must be positive
+  b["source"] = {{"problem", "A_U"}, {"time_limit", 1.0}};
+  std::ofstream(dir / "limited.json") << b.dump(2);
+  CHECK(exitCode(regress(dir, only), log) == 2);
+  CHECK(slurp(log).find("/source/time_limit: a time limit applies to scenes only") != std::string::npos);
+}

@@ -4,7 +4,9 @@
 
 #include <cmath>
 
+#include "buckle/mechanics/linear_buckling.h"
 #include "buckle/mechanics/load_history.h"
+#include "buckle/mechanics/shape_name.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -78,4 +80,70 @@ TEST_CASE("load history rejects bad input", "[load_history]") {
                     Catch::Contains("finite"));
   o.overshoot = -1;
   CHECK_THROWS_WITH(followLoadHistory(problem, Eigen::VectorXd::Zero(1), {0.0, 1.0}, o), Catch::Contains("overshoot"));
+}
+
+TEST_CASE("the default chain compressed past its buckling load follows the U branch from the pitchfork",
+          "[load_history]") {
+  // The paper's chain (a = 0.5, b = 1, k = 1, L0 = 2.25), clamped-pinned, Fx from 0 to -1.7: the
+  // straight branch loses stability at the supercritical pitchfork Fx_U (eq 17); the chain does
+  // not jump there but bends into the stable U branch and follows it, back to Fx = 0 unloading.
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  LoadHistoryOptions options;
+  options.tracer.maxStep = 0.05;
+  const AnalyticBuckling3 exact = analyticClampedPinned3(0.5, 1.0, 1.0, 2.25);
+  const LoadHistoryResult h = followLoadHistory(problem, Eigen::VectorXd::Zero(3), {0.0, -1.7, 0.0}, options);
+  INFO(h.message);
+  REQUIRE(h.completed);
+  CHECK(h.jumps.empty());  // buckling without a jump, and unloading back along the same branches
+  REQUIRE(h.segments.size() == 4);
+  REQUIRE(h.segmentBifurcated.size() == h.segments.size());
+
+  // 1. the straight branch, up to the branch point
+  const cont::Branch& straight = h.segments[0];
+  CHECK_FALSE(h.segmentBifurcated[0]);
+  CHECK(straight.points.back().lambda == Approx(exact.FxU).epsilon(1e-12));
+  for (const cont::ContinuationPoint& p : straight.points) CHECK(p.u.head(3).cwiseAbs().maxCoeff() < 1e-12);
+
+  // 2. the U branch from there to the waypoint, stable all the way
+  CHECK(h.segmentBifurcated[1]);
+  const cont::Branch& u = h.segments[1];
+  CHECK(u.points.front().lambda == Approx(exact.FxU).epsilon(1e-12));
+  CHECK(u.points.back().lambda == Approx(-1.7).margin(1e-12));
+  for (size_t i = 1; i < u.points.size(); ++i) {
+    const Eigen::VectorXd q = u.points[i].u.head(3);
+    CHECK(shapeName(q, 1e-9) == "U");       // Table I: the one-bow shape
+    CHECK(u.points[i].lambda < exact.FxU);  // supercritical: the load keeps growing
+    CHECK(u.points[i].stability.negative == 0);
+    Eigen::VectorXd F(problem.dimension());
+    problem.residual(u.points[i].u, u.points[i].lambda, F);
+    CHECK(F.norm() < 1e-9);                 // in equilibrium
+  }
+  // 3. unloading: back along U to the branch point (where U ends), then along the straight branch
+  CHECK(h.segments[2].points.back().lambda == Approx(exact.FxU).epsilon(1e-9));
+  CHECK(h.segmentBifurcated[3]);
+  CHECK(h.segments[3].points.back().lambda == Approx(0.0).margin(1e-12));
+  CHECK(h.segments[3].points.back().u.head(3).cwiseAbs().maxCoeff() < 1e-9);
+}
+
+TEST_CASE("compressed to -2.5, the default chain leaves the U branch by a jump at its fold", "[load_history]") {
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  LoadHistoryOptions options;
+  options.tracer.maxStep = 0.05;
+  const LoadHistoryResult h = followLoadHistory(problem, Eigen::VectorXd::Zero(3), {0.0, -2.5}, options);
+  INFO(h.message);
+  REQUIRE(h.segments.size() >= 2);
+  CHECK(h.segmentBifurcated[1]);
+  // the U branch is followed to its fold (the one the tracer locates on it), where the chain jumps
+  const auto folds = h.segments[1].specialPointsOfType(cont::SpecialPointType::Fold);
+  REQUIRE(folds.size() == 1);
+  CHECK(folds[0]->lambda == Approx(-1.7554).margin(1e-4));
+  REQUIRE(!h.jumps.empty());
+  CHECK(h.jumps[0].trigger == JumpTrigger::Fold);
+  CHECK(h.jumps[0].fromSegment == 1);
+  CHECK(h.jumps[0].criticalLambda == folds[0]->lambda);
+  // The snap runs a joint into its geometric limit, where the smooth model ends (contact is not
+  // modelled yet): the history stops there and says so.
+  if (!h.completed) CHECK(h.message.find("limit") != std::string::npos);
 }

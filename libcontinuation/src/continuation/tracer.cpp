@@ -440,6 +440,13 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
         found = locator_->locateSpecialPoints(crossings);
       }
     }
+    // An interrupt during location leaves the step's special points half located: the step is
+    // dropped, so every point the branch keeps is fully located, and the branch ends at a.
+    if ((!found.empty() || hitEvent >= 0) && options_.interrupt.requested()) {
+      stop(StopReason::Interrupted, options_.interrupt.describe());
+      endpoint(SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
+      return;
+    }
     const bool landedOnStart = hitEvent >= 0 && !(b.arclength > a.arclength);
     // `a` refers into branch.points: everything that reads it is done before the push.
     if (!landedOnStart) branch.points.push_back(std::move(b));

@@ -43,6 +43,12 @@ std::string describe(const continuation::StabilityInfo& s) {
 
 }  // namespace
 
+IntegrationOptions jumpIntegrationDefaults() {
+  IntegrationOptions o;
+  o.stepper = StepperKind::Rosenbrock4;
+  return o;
+}
+
 continuation::CorrectorOptions defaultPolishOptions() {
   continuation::CorrectorOptions o;
   o.residualTolerance = 1e-12;

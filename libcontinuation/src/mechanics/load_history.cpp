@@ -1,5 +1,7 @@
 #include "buckle/mechanics/load_history.h"
 
+#include "buckle/continuation/branch_switching.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -52,6 +54,29 @@ int firstLossOfStability(const cont::Branch& branch) {
   return -1;
 }
 
+// Index of the first simple branch point at which the stable traced branch turns back against
+// the loading direction `sign` (the tip of a pitchfork reached from a bifurcated branch while
+// unloading), or −1: there the history goes on along the other branch through the point.
+int firstTurnAtBranchPoint(const cont::Branch& branch, double sign) {
+  for (size_t s = 0; s < branch.specialPoints.size(); ++s) {
+    const cont::SpecialPoint& sp = branch.specialPoints[s];
+    if (sp.type != cont::SpecialPointType::BranchPoint || sp.multiplicity > 1 || sp.inertiaBefore != 0 ||
+        sp.inertiaAfter != 0)
+      continue;
+    const size_t next = std::min(size_t(sp.index) + 1, branch.points.size() - 1);
+    if ((branch.points[next].lambda - sp.lambda) * sign < 0.0) return int(s);
+  }
+  return -1;
+}
+
+// The first of a loss of stability and a turn at a branch point, by arclength (−1: neither).
+int firstLeavingPoint(const cont::Branch& branch, double sign, bool& isLoss) {
+  const int lost = firstLossOfStability(branch), turn = firstTurnAtBranchPoint(branch, sign);
+  isLoss = lost >= 0 && (turn < 0 || branch.specialPoints[size_t(lost)].arclength <=
+                                          branch.specialPoints[size_t(turn)].arclength);
+  return isLoss ? lost : turn;
+}
+
 // Keeps the points of `branch` up to the special point `sp` and ends it there.
 cont::Branch cutAt(const cont::Branch& branch, const cont::SpecialPoint& sp) {
   cont::Branch cut = branch;
@@ -66,6 +91,34 @@ cont::Branch cutAt(const cont::Branch& branch, const cont::SpecialPoint& sp) {
                                          [&](const cont::SpecialPoint& p) { return p.arclength > sp.arclength; }),
                           cut.specialPoints.end());
   return cut;
+}
+
+// At the branch point `sp` where the traced branch lost stability or turns back, loading in
+// direction `sign`:
+// the bifurcated branch the chain follows, if the pitchfork is supercritical (its first point
+// lies further along the load and is stable). Of the two sides of a symmetric pitchfork (mirror
+// images) the one whose largest joint component is positive is taken first: the documented rule
+// standing in for the imperfection that decides in a real chain.
+bool followBifurcated(EquilibriumProblem& problem, const cont::SpecialPoint& sp, const cont::TracerOptions& options,
+                      double sign, cont::Branch& child) {
+  if (sp.type != cont::SpecialPointType::BranchPoint || sp.multiplicity > 1) return false;
+  cont::Vector direction;
+  if (!cont::bifurcatingDirection(problem, sp, direction)) return false;
+  const int n = problem.segments();
+  Eigen::Index largest = 0;
+  direction.head(n).cwiseAbs().maxCoeff(&largest);
+  if (direction[largest] < 0.0) direction = -direction;
+  cont::Tracer tracer(problem, options);
+  for (int side : {1, -1}) {
+    cont::Branch c = cont::switchBranch(tracer, sp, direction, side);
+    if (c.stopReason == cont::StopReason::SwitchFailed || c.points.size() < 2) continue;
+    const cont::ContinuationPoint& first = c.points[1];
+    if ((first.lambda - sp.lambda) * sign <= 0.0) continue;  // bends back: subcritical
+    if (!first.stability.valid() || first.stability.negative != 0) continue;
+    child = std::move(c);
+    return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -148,10 +201,26 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
         result.message = "continuation could not start at lambda = " + std::to_string(lambda) + ": " + branch.stopMessage;
         return result;
       }
-      const int lost = firstLossOfStability(branch);
+      bool isLoss = false, bifurcated = false;
+      int lost = firstLeavingPoint(branch, sign, isLoss);
+      // supercritical branch points (and the pitchfork's tip reached while unloading): the chain
+      // goes on along the stable branch through the point that continues in the loading direction
+      cont::Branch child;
+      while (lost >= 0 && followBifurcated(problem, branch.specialPoints[size_t(lost)], legOptions, sign, child)) {
+        result.segments.push_back(cutAt(branch, branch.specialPoints[size_t(lost)]));
+        result.segmentLeg.push_back(int(leg));
+        result.segmentBifurcated.push_back(bifurcated);
+        if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
+          result.jumps.back().toSegment = int(result.segments.size()) - 1;
+        branch = std::move(child);
+        bifurcated = true;
+        lost = firstLeavingPoint(branch, sign, isLoss);
+      }
+      if (lost >= 0 && !isLoss) lost = firstLossOfStability(branch);  // a turn not followed: as before
       if (lost < 0) {
         result.segments.push_back(branch);
         result.segmentLeg.push_back(int(leg));
+        result.segmentBifurcated.push_back(bifurcated);
         if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
           result.jumps.back().toSegment = int(result.segments.size()) - 1;
         const cont::ContinuationPoint& end = branch.points.back();
@@ -166,6 +235,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       const cont::SpecialPoint sp = branch.specialPoints[size_t(lost)];
       result.segments.push_back(cutAt(branch, sp));
       result.segmentLeg.push_back(int(leg));
+      result.segmentBifurcated.push_back(bifurcated);
       if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
         result.jumps.back().toSegment = int(result.segments.size()) - 1;
       const double at = sp.lambda + sign * options.overshoot * std::max(1.0, std::abs(sp.lambda));

@@ -1,7 +1,9 @@
 // A quasi-static load history with jumps: the load parameter λ goes through a list of waypoints
-// (up, back down, …) and the chain follows its stable equilibrium. Where that equilibrium stops
-// being stable — a fold under load control, a branch point, or an unstable start — the chain
-// jumps: the load is held just past the critical value, the dynamics (jump.h) carries the chain
+// (up, back down, …) and the chain follows its stable equilibrium. At a supercritical branch
+// point (the branch born there goes on in the loading direction and is stable: the straight
+// column buckling into its U shape) the chain follows that branch, as a real column does with the
+// least imperfection. Where the equilibrium stops being stable otherwise — a fold under load
+// control, a subcritical branch point, or an unstable start — the chain jumps: the load is held just past the critical value, the dynamics (jump.h) carries the chain
 // to rest, and continuation resumes from the landing. Going up and back down through the same
 // folds produces the hysteresis loop: branch, fold, jump, new branch, … (issue 5).
 #pragma once
@@ -52,6 +54,9 @@ struct LoadHistoryResult {
   /// point where stability was lost, or where the history stopped.
   std::vector<continuation::Branch> segments;
   std::vector<int> segmentLeg;     ///< leg (waypoint interval) of each segment
+  /// True for a segment that starts at the supercritical branch point ending the one before it
+  /// (the chain followed the bifurcated branch there, without a jump).
+  std::vector<bool> segmentBifurcated;
   std::vector<JumpRecord> jumps;
   bool completed = false;          ///< every waypoint was reached
   std::string message;             ///< why it ended
