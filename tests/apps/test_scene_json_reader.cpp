@@ -3,6 +3,7 @@
 // document (a directory, an unreadable path, an oversized file) named as such.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
