@@ -47,8 +47,37 @@ void validate(const CriticalOptions& o) {
   requireNumber("--b", o.b, false);
   requireNumber("--k", o.k, false);
   requireNumber("--L0", o.L0, false);
+  // eq 1: the triangles' angles 2 atan(a/b) must stay below π or the joint cannot move
+  if (!(2.0 * std::atan(o.a / o.b) < M_PI))
+    throw BadArgument{(std::abs(std::log10(o.a)) > std::abs(std::log10(o.b)) ? "--a" : "--b") + std::string(" out of range: a/b = ") + str(o.a / o.b) +
+                      " leaves the joint no range of motion (2 atan(a/b) reaches pi)"};
   if (o.count < 1) throw BadArgument{"--count must be >= 1 (got " + std::to_string(o.count) + ")"};
   if (o.end != "pinned" && o.end != "free") throw BadArgument{"--end must be pinned or free (got " + o.end + ")"};
+}
+
+// The option farthest from the chain's units (b for lengths, k for stiffness) by orders of
+// magnitude: the one to name when the numbers leave the floating-point range. A half-height
+// below b cannot cause that.
+std::string mostExtremeOption(const CriticalOptions& o) {
+  const std::pair<const char*, double> options[] = {{"--a", o.a}, {"--b", o.b}, {"--k", o.k}, {"--L0", o.L0}};
+  std::string worst = "--L0";
+  double worstOrders = -1.0;
+  for (const auto& [name, v] : options) {
+    if (name == std::string("--a") && v <= o.b) continue;
+    const double orders = std::abs(std::log10(v));
+    if (orders > worstOrders) {
+      worstOrders = orders;
+      worst = name;
+    }
+  }
+  return worst;
+}
+
+[[noreturn]] void outOfRange(const CriticalOptions& o, const std::string& what) {
+  const std::string name = mostExtremeOption(o);
+  const double v = name == "--a" ? o.a : name == "--b" ? o.b : name == "--k" ? o.k : o.L0;
+  throw BadArgument{name + " = " + str(v) + " is out of the range this computation can represent (" + what +
+                    "); the loads scale as k b and kappa as k b^2: compute with values nearer 1 and rescale"};
 }
 
 int run(const CriticalOptions& o) {
@@ -59,34 +88,55 @@ int run(const CriticalOptions& o) {
   out["parameters"] = {{"segments", o.segments}, {"a", o.a}, {"b", o.b}, {"k", o.k},
                        {"L0", o.L0},             {"end", o.end}, {"count", o.count}};
   try {
-    const Chain chain = Chain::uniform(o.segments, SegmentParameters::symmetric(o.a, o.b, o.k, o.L0));
+    // The straight uniform chain is scale-free: with lengths in units of b and stiffness in k the
+    // critical loads are Fx = k b · Fx(a/b, 1, 1, L0/b), the modes and μ do not change and the
+    // shortening scales with b (eq 14-18). So the eigenproblem is solved on that unit chain and
+    // every k and b the doubles hold are handled; only results that are not doubles are refused.
+    const double aUnit = o.a / o.b, L0Unit = o.L0 / o.b, loadScale = o.k * o.b;
+    if (!std::isfinite(L0Unit) || !std::isnormal(loadScale) || !std::isnormal(loadScale * o.b))
+      outOfRange(o, "L0/b = " + str(L0Unit) + ", k b = " + str(loadScale) + ", k b^2 = " + str(loadScale * o.b));
+    const Chain chain = Chain::uniform(o.segments, SegmentParameters::symmetric(aUnit, 1.0, 1.0, L0Unit));
     const int n = chain.size();
-    const double kappa = chain.segment(0).straightStiffness();
+    const double kappaUnit = chain.segment(0).straightStiffness();
+    const double kappaClosedUnit = L0Unit - 2.0 * (1.0 - aUnit * aUnit);
     const EndCondition end = o.end == "pinned" ? EndCondition::clampedPinned(0.0) : EndCondition::freeEnd();
     LinearBucklingOptions lbo;
     lbo.count = o.count;
     const LinearBucklingResult lb = linearBuckling(chain, Vector::Zero(n), end, lbo);
     const bool analytic = n == 3 && o.end == "pinned";
-    const AnalyticBuckling3 an = analytic ? analyticClampedPinned3(o.a, o.b, o.k, o.L0) : AnalyticBuckling3{};
+    const AnalyticBuckling3 an = analytic ? analyticClampedPinned3(aUnit, 1.0, 1.0, L0Unit) : AnalyticBuckling3{};
 
+    // eq 4: the straight chain is stable exactly when κ > 0; a unit chain that says otherwise was
+    // computed past the double range (L0/b = 1e308: loads ≈ 1.9 κ/b overflow).
+    const double kappa = kappaUnit * loadScale * o.b;
+    if (!std::isfinite(kappa) || (!lb.degenerate && lb.unloadedStable != (kappaClosedUnit > 0.0)))
+      outOfRange(o, "kappa = k (b L0 - 2 (b^2 - a^2)) = " + str(kappa) +
+                        (std::isfinite(kappa) ? ", but the stiffness eigenvalues overflow" : ""));
     out["kappa"] = kappa;
-    out["kappa_closed_form"] = o.k * (o.b * o.L0 - 2.0 * (o.b * o.b - o.a * o.a));
+    out["kappa_closed_form"] = kappaClosedUnit * loadScale * o.b;
     out["straight_stable"] = lb.unloadedStable;
     out["degenerate"] = lb.degenerate;
-    out["chain_length"] = chain.length();
+    out["chain_length"] = chain.length() * o.b;
     out["critical"] = nlohmann::json::array();
+    int index = 1;
     for (const BucklingMode& m : lb.modes) {
       nlohmann::json c;
-      c["Fx"] = m.lambda;
+      const double Fx = m.lambda * loadScale;
+      if (!std::isfinite(Fx) || (m.lambda != 0.0 && Fx == 0.0) || !std::isfinite(m.shortening * o.b))
+        outOfRange(o, "critical load " + std::to_string(index) + ": Fx = " + str(m.lambda) + " k b = " + str(Fx) +
+                          (index > 1 ? "; --count " + std::to_string(index - 1) + " keeps the smaller ones" : ""));
+      ++index;
+      c["Fx"] = Fx;
       c["shape"] = m.shape;
       c["mode"] = std::vector<double>(m.mode.data(), m.mode.data() + m.mode.size());
-      c["shortening"] = m.shortening;
+      c["shortening"] = m.shortening * o.b;
       if (analytic) {
         c["mu"] = m.mu;
         if (m.shape == "U" || m.shape == "Z") {
           const bool U = m.shape == "U";
-          c["analytic_Fx"] = U ? an.FxU : an.FxZ;
-          c["error"] = m.lambda - (U ? an.FxU : an.FxZ);
+          const double exact = U ? an.FxU : an.FxZ;
+          c["analytic_Fx"] = exact * loadScale;
+          c["error"] = (m.lambda - exact) * loadScale;
           c["analytic_mu"] = U ? an.muU : an.muZ;
         }
       }

@@ -3,6 +3,7 @@
 // baselines, so every input file of the program reports mistakes the same way.
 #pragma once
 
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
@@ -22,11 +23,21 @@ class JsonInputError : public std::runtime_error {
   std::string file_, path_, message_;
 };
 
+/// Input files larger than this are refused before they are parsed (the parsed document takes
+/// several times the text's size in memory). The largest scene, kMaxSegments segment objects with
+/// every key given, pretty-printed, is below a third of it.
+constexpr std::uintmax_t kMaxInputBytes = std::uintmax_t(64) << 20;
+/// Deeper nesting is refused: no input of the program needs more than a few levels, and copying
+/// or printing a document recurses once per level.
+constexpr size_t kMaxJsonDepth = 64;
+
 /// Parses `text`; a syntax error (NaN, a missing comma, a number out of range) throws a
-/// JsonInputError naming the JSON path of the value being read and the line and column.
+/// JsonInputError naming the JSON path of the value being read and the line and column; so does
+/// a key that appears twice in one object, and nesting deeper than kMaxJsonDepth. Linear time.
 nlohmann::json parseJsonDocument(const std::string& text, const std::string& file);
 
-/// The whole file as text (JsonInputError when it cannot be opened).
+/// The whole file as text (JsonInputError when it is a directory, cannot be opened or read, or
+/// is larger than kMaxInputBytes).
 std::string readInputFile(const std::string& file);
 
 /// Reads and parses a whole file (JsonInputError when it cannot be opened).

@@ -4,12 +4,15 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/unloaded_shape.h"
 
 namespace buckle::scene {
@@ -62,6 +65,7 @@ const std::set<std::string> kSegmentKeys = {"a", "b", "k", "L0", "a1", "b1", "a2
 
 struct SegmentDefaults {
   std::map<std::string, double> values;  // resolved names a1..L2_0, q_min, q_max, q0
+  std::map<std::string, Pointer> source; // where the user set each of them (absent: the default)
 };
 
 // Applies the keys of one object (chain level or segment level) on top of `d`.
@@ -77,14 +81,21 @@ void applySegmentKeys(const Reader& r, const json& obj, const Pointer& p, Segmen
       v = r.nonNegative(obj[key], q);
     else
       v = r.positive(obj[key], q);
-    for (const std::string& t : targets) d.values[t] = v;
+    for (const std::string& t : targets) {
+      d.values[t] = v;
+      d.source[t] = q;
+    }
   }
+  auto set = [&](const char* key, double v) {
+    d.values[key] = v;
+    d.source[key] = p / key;
+  };
   for (const char* key : {"a1", "a2"})
-    if (obj.contains(key)) d.values[key] = r.nonNegative(obj[key], p / key);
+    if (obj.contains(key)) set(key, r.nonNegative(obj[key], p / key));
   for (const char* key : {"b1", "b2", "k1", "k2", "L1_0", "L2_0"})
-    if (obj.contains(key)) d.values[key] = r.positive(obj[key], p / key);
+    if (obj.contains(key)) set(key, r.positive(obj[key], p / key));
   for (const char* key : {"q_min", "q_max", "q0"})
-    if (obj.contains(key)) d.values[key] = r.number(obj[key], p / key);
+    if (obj.contains(key)) set(key, r.number(obj[key], p / key));
 }
 
 mechanics::SegmentParameters toParameters(const SegmentDefaults& d) {
@@ -100,6 +111,69 @@ mechanics::SegmentParameters toParameters(const SegmentDefaults& d) {
   if (d.values.count("q_min")) s.qMinUser = d.values.at("q_min");
   if (d.values.count("q_max")) s.qMaxUser = d.values.at("q_max");
   return s;
+}
+
+// The user's key most likely to blame among `names` of one segment: the value farthest from the
+// chain's units (b for lengths, k for stiffnesses) by orders of magnitude. A half-height a
+// smaller than its b cannot push anything out of range, so it is passed over.
+std::optional<Pointer> mostExtremeKey(const SegmentDefaults& d, const std::vector<std::string>& names) {
+  std::optional<Pointer> worst;
+  double worstOrders = -1.0;
+  for (const std::string& name : names) {
+    const auto src = d.source.find(name);
+    if (src == d.source.end()) continue;
+    const double v = d.values.at(name);
+    if (name[0] == 'a' && v <= d.values.at(name == "a1" ? "b1" : "b2")) continue;
+    const double orders = std::abs(std::log10(v));
+    if (orders > worstOrders) {
+      worstOrders = orders;
+      worst = src->second;
+    }
+  }
+  return worst;
+}
+
+std::string show(double v) {
+  std::ostringstream os;
+  os << std::setprecision(6) << v;
+  return os.str();
+}
+
+// Checks a segment as the mechanics will use it and names the user's key when it cannot work:
+// the triangles must leave the joint a range of motion (β12 < π, eq 1), the user limits must
+// overlap it, and the spring model must stay inside the floating-point range at the unloaded
+// angle (it forms products of four lengths: b = 1e300 overflows, b = 1e-200 underflows to a
+// zero spring length).
+void checkSegment(const Reader& r, const SegmentDefaults& d, const Pointer& where, double q0) {
+  mechanics::SegmentParameters sp = toParameters(d);
+  auto blame = [&](const std::vector<std::string>& names) {
+    const std::optional<Pointer> key = mostExtremeKey(d, names);
+    return key ? *key : where;
+  };
+  const double qMin = sp.qMinUser, qMax = sp.qMaxUser;
+  sp.qMinUser = -std::numeric_limits<double>::infinity();
+  sp.qMaxUser = std::numeric_limits<double>::infinity();
+  const double betaSum = std::atan(sp.a1 / sp.b1) + std::atan(sp.a2 / sp.b2);
+  if (!(betaSum < M_PI))
+    r.fail(blame({"a1", "b1", "a2", "b2"}),
+           "expected a smaller half-height a against the half-length b: with a1/b1 = " + show(sp.a1 / sp.b1) +
+               " and a2/b2 = " + show(sp.a2 / sp.b2) +
+               " the triangles' angles atan(a1/b1) + atan(a2/b2) reach pi and the joint has no range of motion");
+  const mechanics::Segment geometric(sp);
+  const double lo = std::max(geometric.geometricLowerLimit(), qMin);
+  const double hi = std::min(geometric.geometricUpperLimit(), qMax);
+  if (!(lo < hi)) {
+    const bool minWrong = d.source.count("q_min") && (qMin >= geometric.geometricUpperLimit() || qMin >= qMax);
+    const Pointer at = minWrong ? d.source.at("q_min") : d.source.count("q_max") ? d.source.at("q_max") : where;
+    r.fail(at, "expected joint limits q_min < q_max that overlap the geometric range (" +
+                   show(geometric.geometricLowerLimit()) + ", " + show(geometric.geometricUpperLimit()) +
+                   ") rad, got q_min = " + show(qMin) + ", q_max = " + show(qMax));
+  }
+  const mechanics::Jet3 e = geometric.energyJet(q0 > lo && q0 < hi ? q0 : 0.5 * (lo + hi));
+  if (!(std::isfinite(e.value) && std::isfinite(e.d1) && std::isfinite(e.d2) && std::isfinite(e.d3)))
+    r.fail(blame({"a1", "b1", "a2", "b2", "L1_0", "L2_0", "k1", "k2"}),
+           "out of the range the spring model can compute: with these values its energy at the unloaded "
+           "shape is not a finite number (lengths are in units of b, stiffnesses in k: give values near 1)");
 }
 
 ChainSpec parseChain(const Reader& r, const json& chain, const Pointer& p) {
@@ -121,11 +195,15 @@ ChainSpec parseChain(const Reader& r, const json& chain, const Pointer& p) {
   std::vector<SegmentDefaults> resolved;
   std::vector<Pointer> segPointers;
   if (segs.is_number()) {
-    const int n = r.integer(segs, ps, 1, 100000);
+    const int n = r.integer(segs, ps, 1, kMaxSegments);
     resolved.assign(size_t(n), base);
     segPointers.assign(size_t(n), p);
   } else if (segs.is_array()) {
     if (segs.empty()) r.expected(ps, segs, "a segment count >= 1 or a non-empty list of segments");
+    // the same cap as for a count: a list is no way around it
+    if (segs.size() > size_t(kMaxSegments))
+      r.fail(ps, "expected at most " + std::to_string(kMaxSegments) + " segments, got a list of " +
+                     std::to_string(segs.size()));
     for (size_t i = 0; i < segs.size(); ++i) {
       const Pointer pi = ps / i;
       r.onlyKeys(segs[i], pi, kSegmentKeys);
@@ -166,12 +244,9 @@ ChainSpec parseChain(const Reader& r, const json& chain, const Pointer& p) {
   ChainSpec spec;
   spec.q0 = q0;
   for (size_t i = 0; i < n; ++i) {
+    // the same parameters for every segment of a count: one check does
+    if (i == 0 || segs.is_array()) checkSegment(r, resolved[i], segPointers[i], haveQ0 ? q0[Eigen::Index(i)] : 0.0);
     mechanics::SegmentParameters sp = toParameters(resolved[i]);
-    try {
-      mechanics::Segment check(sp);
-    } catch (const std::invalid_argument& e) {
-      r.fail(segPointers[i], std::string("invalid segment") + (segs.is_array() ? "" : "s") + ": " + e.what());
-    }
     if (haveQ0 && q0[Eigen::Index(i)] != 0.0) {
       mechanics::Segment seg(sp);
       const double qi = q0[Eigen::Index(i)];
@@ -537,6 +612,23 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
   return s;
 }
 
+// RFC 7386: `target` patched by `patch`, without first copying the parts of `target` that the
+// patch replaces (a case replacing a long list of segments does not copy the base's).
+json mergePatched(const json& target, const json& patch) {
+  if (!patch.is_object()) return patch;
+  json out = json::object();
+  if (target.is_object())
+    for (auto it = target.begin(); it != target.end(); ++it)
+      if (!patch.contains(it.key())) out[it.key()] = *it;
+  static const json kNone;
+  for (auto it = patch.begin(); it != patch.end(); ++it) {
+    if (it->is_null()) continue;  // null removes the member
+    const bool had = target.is_object() && target.contains(it.key());
+    out[it.key()] = mergePatched(had ? target[it.key()] : kNone, *it);
+  }
+  return out;
+}
+
 std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a, int nCases) {
   std::vector<int> all;
   for (int i = 0; i < nCases; ++i) all.push_back(i);
@@ -564,12 +656,11 @@ Scene parseScene(const std::string& text, const std::string& file) {
   const bool needPath = scene.analyses.continuation.enabled || scene.analyses.criticalForces.enabled ||
                         scene.analyses.loadHistory.enabled || scene.analyses.suddenLoad.enabled;
 
-  json base = doc;
-  base.erase("cases");
-  base.erase("analyses");
-  base.erase("solver");
-  base.erase("plots");
-  base.erase("description");
+  // chain, end and path: what a case patches (copied key by key, not with the cases)
+  json base = json::object();
+  for (const char* key : {"chain", "end", "path"})
+    if (doc.contains(key)) base[key] = doc[key];
+  int totalSegments = 0;
   if (doc.contains("cases")) {
     const json& cases = doc["cases"];
     if (!cases.is_array() || cases.empty()) r.expected(Pointer("/cases"), cases, "a non-empty array of case objects");
@@ -580,16 +671,18 @@ Scene parseScene(const std::string& text, const std::string& file) {
       if (cases[i].contains("label")) label = r.string(cases[i]["label"], pi / "label");
       json patch = cases[i];
       patch.erase("label");
-      json merged = base;
-      merged.merge_patch(patch);
       try {
-        scene.cases.push_back(parseCase(r, merged, label, needPath));
+        scene.cases.push_back(parseCase(r, mergePatched(base, patch), label, needPath));
       } catch (const SceneError& e) {
         // point into the case when the bad value came from it
         const Pointer bad(e.path().empty() ? "" : e.path());
         if (!e.path().empty() && patch.contains(bad)) throw SceneError(file, (pi / bad).to_string(), e.message());
         throw SceneError(file, e.path(), e.message() + " (in " + pi.to_string() + ", \"" + label + "\")");
       }
+      totalSegments += static_cast<int>(scene.cases.back().chain.segments.size());
+      if (totalSegments > kMaxSegments)
+        r.fail(pi, "expected at most " + std::to_string(kMaxSegments) + " segments in all cases together, got " +
+                       std::to_string(totalSegments) + " up to this case");
     }
   } else {
     scene.cases.push_back(parseCase(r, base, "main", needPath));
@@ -624,6 +717,15 @@ Scene parseScene(const std::string& text, const std::string& file) {
       if (v < lo - 1e-12 || v > hi + 1e-12)
         r.fail(Pointer("/analyses/sudden_load/value"),
                "expected a value inside the path range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      // The inertial model divides by the rods' masses m = ρ l and inertias m l²/12: both must be
+      // ordinary (normal, finite) numbers.
+      const double rho = scene.analyses.suddenLoad.massPerLength;
+      if (rho > 0.0)
+        for (const mechanics::LinkInertia& link : mechanics::InertiaData::uniformRods(mechanics::Chain(c.chain.segments), rho).links)
+          if (!std::isnormal(link.mass) || !std::isnormal(link.inertia))
+            r.fail(Pointer("/analyses/sudden_load/mass_per_length"),
+                   "out of the range the inertial model can compute: the rods' masses rho l or inertias rho l^3/12 "
+                   "(l the link lengths of case \"" + c.label + "\") are not ordinary finite numbers; got " + show(rho));
     }
   if (doc.contains("solver")) scene.solver = parseSolver(r, doc["solver"], Pointer("/solver"));
   if (doc.contains("plots")) {

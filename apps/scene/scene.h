@@ -20,6 +20,10 @@ namespace buckle::scene {
 /// Bad input: the file, the JSON path of the bad value and what was expected (scene/json_reader.h).
 using SceneError = JsonInputError;
 
+/// The most segments a scene may ask for, all cases together, whether as counts or as lists of
+/// segment objects: every case is a chain to build, trace and write.
+constexpr int kMaxSegments = 100000;
+
 /// One chain variant: segment parameters (after preloads for q0 were computed) and its
 /// unloaded shape.
 struct ChainSpec {

@@ -132,3 +132,45 @@ TEST_CASE("buckle critical: bad arguments exit with 2 and name the argument", "[
   CHECK(buckle("").status == 2);  // a subcommand is required
   CHECK(buckle("critical --help").status == 0);
 }
+
+TEST_CASE("buckle critical: the whole double range, or a refusal naming the option", "[cli]") {
+  // The critical loads scale exactly as k b (κ/b · f(n), eq 17): k and b anywhere in the double
+  // range give the unit chain's loads times k b.
+  const nlohmann::json unit = critical("");
+  const double FxU = unit["critical"][0]["Fx"].get<double>(), FxZ = unit["critical"][1]["Fx"].get<double>();
+  for (const char* k : {"1e-300", "1e-100", "1e100", "1e300", "1e308"}) {
+    const nlohmann::json j = critical(std::string("--k ") + k);
+    INFO("--k " << k);
+    CHECK(j["straight_stable"].get<bool>());
+    CHECK(j["critical"][0]["Fx"].get<double>() == Approx(FxU * std::stod(k)).epsilon(1e-12));
+    CHECK(j["critical"][1]["Fx"].get<double>() == Approx(FxZ * std::stod(k)).epsilon(1e-12));
+    CHECK(j["kappa"].get<double>() == Approx(0.75 * std::stod(k)).epsilon(1e-12));
+  }
+  // b = 1e100 with a, L0 scaled along: loads × b, shortening × b, modes unchanged
+  const nlohmann::json big = critical("--a 0.5e100 --b 1e100 --L0 2.25e100");
+  CHECK(big["critical"][0]["Fx"].get<double>() == Approx(FxU * 1e100).epsilon(1e-12));
+  CHECK(big["critical"][0]["shortening"].get<double>() ==
+        Approx(unit["critical"][0]["shortening"].get<double>() * 1e100).epsilon(1e-12));
+  CHECK(big["critical"][0]["mode"][0].get<double>() ==
+        Approx(unit["critical"][0]["mode"][0].get<double>()).epsilon(1e-12));
+  // L0 = 1e300: κ > 0 and the chain is stable (the old answer at 1e308 was "unstable")
+  const nlohmann::json longSprings = critical("--L0 1e300");
+  CHECK(longSprings["straight_stable"].get<bool>());
+  CHECK(longSprings["critical"][0]["Fx"].get<double>() < 0.0);
+
+  struct Bad {
+    std::string args, name;
+  };
+  for (const Bad& b : {Bad{"--L0 1e308", "--L0"}, Bad{"--a 1e308", "--a"}, Bad{"--a 1e20", "--a"},
+                       Bad{"--b 1e-320", "--b"}, Bad{"--b 1e200", "--b"}, Bad{"--k 1e-320", "--k"},
+                       Bad{"--k 1e308 --b 1e10 --L0 2.25e10 --a 0.5e10", "--k"}, Bad{"--L0 nan", "--L0"},
+                       Bad{"--a inf", "--a"}, Bad{"--b -inf", "--b"}, Bad{"--L0 1e999", "--L0"}, Bad{"--k -0", "--k"},
+                       Bad{"--segments 99999999999", "--segments"}, Bad{"--segments 1e3", "--segments"},
+                       Bad{"--count -1", "--count"}, Bad{"--count nan", "--count"}}) {
+    const Run r = buckle("critical " + b.args, true);
+    INFO("buckle critical " << b.args << " → " << r.out);
+    CHECK(r.status == 2);
+    CHECK_THAT(r.out, Catch::Contains(b.name));
+    CHECK_THAT(r.out, !Catch::Contains("unstable"));
+  }
+}

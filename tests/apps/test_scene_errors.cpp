@@ -6,6 +6,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -137,6 +138,90 @@ TEST_CASE("a range that does not contain the start", "[scene][errors]") {
 TEST_CASE("NaN", "[scene][errors]") {
   requireBadInput("nan", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": NaN"), "/chain/L0", "expected a finite number");
   requireBadInput("inf", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": 1e999"), "/chain/L0", "expected a finite number");
+}
+
+TEST_CASE("duplicate keys are rejected with their JSON path", "[scene][errors]") {
+  requireBadInput("dup_k", replaceOnce(kGood, "\"k\": 1.0", "\"k\": 1.0, \"k\": -5"), "/chain/k", "duplicate key \"k\"");
+  requireBadInput("dup_chain", replaceOnce(kGood, "\"plots\": []", "\"plots\": [], \"chain\": {\"segments\": 4}"), "/chain",
+                  "duplicate key \"chain\"");
+}
+
+TEST_CASE("one segment cap for counts, lists and all cases together", "[scene][errors]") {
+  const std::string cap = std::to_string(buckle::scene::kMaxSegments);
+  requireBadInput("cap_count", replaceOnce(kGood, "\"segments\": 3", "\"segments\": " + std::to_string(buckle::scene::kMaxSegments + 1)),
+                  "/chain/segments", "an integer in [1, " + cap + "]");
+  std::string list = "[{}";
+  for (int i = 0; i < buckle::scene::kMaxSegments; ++i) list += ",{}";
+  requireBadInput("cap_list", replaceOnce(kGood, "\"segments\": 3", "\"segments\": " + list + "]"), "/chain/segments",
+                  "expected at most " + cap + " segments, got a list of " + std::to_string(buckle::scene::kMaxSegments + 1));
+  const int half = buckle::scene::kMaxSegments / 2 + 1;
+  const std::string cases = "\"plots\": [], \"cases\": [{\"chain\": {\"segments\": " + std::to_string(half) +
+                            "}}, {\"chain\": {\"segments\": " + std::to_string(half) + "}}]";
+  requireBadInput("cap_cases", replaceOnce(kGood, "\"plots\": []", cases), "/cases/1", "in all cases together");
+}
+
+TEST_CASE("extreme numbers are rejected at the user's key, never with internal names", "[scene][errors]") {
+  struct Bad {
+    std::string from, to, path, expected;
+  };
+  const std::string chain = "\"a\": 0.5, \"b\": 1.0, \"k\": 1.0, \"L0\": 2.25";
+  for (const Bad& b : {
+           // a/b so large that atan(a1/b1) + atan(a2/b2) rounds to π: no joint range
+           Bad{chain, "\"a\": 1e308, \"b\": 1.0", "/chain/a", "no range of motion"},
+           Bad{chain, "\"a\": 0.5, \"b\": 1e-320", "/chain/b", "no range of motion"},
+           Bad{"\"segments\": 3,", "\"segments\": [{}, {\"a\": 1e20}, {}],", "/chain/segments/1/a", "no range of motion"},
+           // spring model past the double range (products of four lengths, k L0²)
+           Bad{chain, "\"b\": 1e300", "/chain/b", "out of the range the spring model can compute"},
+           Bad{chain, "\"b\": 1e-200, \"a\": 5e-201, \"L0\": 2.25e-200", "/chain/b", "out of the range the spring model"},
+           Bad{chain, "\"L0\": 1e308", "/chain/L0", "out of the range the spring model"},
+           Bad{chain, "\"a\": 0.5, \"a1\": 1e300", "/chain/a1", "out of the range the spring model"},
+           Bad{chain, "\"k1\": 1e300, \"L1_0\": 1e200", "/chain/k1", "out of the range the spring model"},
+           // user joint limits that leave nothing
+           Bad{chain, "\"q_min\": 1e308", "/chain/q_min", "expected joint limits q_min < q_max"},
+           Bad{chain, "\"q_max\": -1e-320, \"q_min\": 0", "/chain/q_min", "expected joint limits q_min < q_max"},
+           Bad{chain, "\"q_max\": -3", "/chain/q_max", "overlap the geometric range"},
+           // masses of the sudden load's rods: overflowing or subnormal
+           Bad{"\"continuation\": {\"branch_switching\": 0}",
+               "\"continuation\": true, \"sudden_load\": {\"value\": -0.5, \"mass_per_length\": 1e308}",
+               "/analyses/sudden_load/mass_per_length", "out of the range the inertial model"},
+           Bad{"\"continuation\": {\"branch_switching\": 0}",
+               "\"continuation\": true, \"sudden_load\": {\"value\": -0.5, \"mass_per_length\": 1e-320}",
+               "/analyses/sudden_load/mass_per_length", "out of the range the inertial model"},
+           // huge integers are no integers in range
+           Bad{"\"segments\": 3", "\"segments\": 123456789012345678901234567890", "/chain/segments", "an integer in [1,"},
+           Bad{"\"segments\": 3", "\"segments\": 18446744073709551615", "/chain/segments", "an integer in [1,"},
+           Bad{"\"branch_switching\": 0", "\"branch_switching\": -9223372036854775808",
+               "/analyses/continuation/branch_switching", "an integer in [0, 4]"},
+           Bad{"\"k\": 1.0", "\"k\": -0.0", "/chain/k", "expected a number > 0"},
+           Bad{"\"k\": 1.0", "\"k\": -1e-320", "/chain/k", "expected a number > 0"},
+       }) {
+    const std::string name = "extreme_" + std::to_string(std::hash<std::string>{}(b.to) % 100000);
+    requireBadInput(name, replaceOnce(kGood, b.from, b.to), b.path, b.expected);
+    const Outcome o = runText(name, replaceOnce(kGood, b.from, b.to));
+    for (const char* internal : {"qMinUser", "qMaxUser", "invalid segment", "SuddenLoadOptions", "inertia link"})
+      CHECK(o.err.find(internal) == std::string::npos);
+  }
+}
+
+TEST_CASE("extreme numbers the model can compute are accepted", "[scene][errors]") {
+  // tiny or zero half-heights, subnormal free lengths, -0 where 0 is allowed, huge stiffness
+  for (const char* chain : {"\"a\": 1e-320", "\"a\": -0.0", "\"L0\": 1e-320", "\"k\": 1e300", "\"b\": 1e20"}) {
+    const Outcome o = runText("accepted", replaceOnce(kGood, "\"a\": 0.5, \"b\": 1.0, \"k\": 1.0, \"L0\": 2.25", chain));
+    INFO(chain << ": " << o.err);
+    CHECK(o.rc != 2);
+  }
+}
+
+TEST_CASE("a directory as the scene file says so", "[scene][errors]") {
+  const fs::path dir = workDir() / "scene_dir";
+  fs::create_directories(dir);
+  buckle::scene::RunCommandOptions opt;
+  opt.scene = dir.string();
+  opt.out = (workDir() / "dir_out").string();
+  std::ostringstream log, err;
+  CHECK(buckle::scene::runSceneCommand(opt, log, err) == 2);
+  CHECK(err.str().find(dir.string() + ": (document): is a directory") != std::string::npos);
+  CHECK(!fs::exists(opt.out));
 }
 
 TEST_CASE("inconsistent scenes", "[scene][errors]") {
