@@ -4,6 +4,7 @@
 #include <iomanip>
 
 #include "scene/output.h"
+#include "scene/output_target.h"
 #include "scene/runner.h"
 #include "scene/scene.h"
 
@@ -22,6 +23,13 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
     return kBadInput;
   }
   const std::string out = options.out.empty() ? defaultOutputDirectory(options.scene) : options.out;
+  std::string target;  // `out` with symbolic links resolved: the directory that is replaced
+  try {
+    target = checkOutputTarget(out, {options.scene}, options.force);
+  } catch (const OutputTargetError& e) {
+    err << "buckle run: " << e.what() << "\n";
+    return kBadInput;
+  }
   if (!options.quiet) {
     log << "scene " << options.scene << ": " << scene.cases.size() << " case(s)";
     if (!scene.description.empty()) log << " — " << scene.description.substr(0, 100) << (scene.description.size() > 100 ? "…" : "");
@@ -29,7 +37,7 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
   }
   const RunResult run = runScene(scene);
   try {
-    StagingDirectory staging(out);
+    StagingDirectory staging(target);
     const PlotReport plots = writeOutputs(scene, run, staging.path());
     staging.commit();
     if (!options.quiet) {

@@ -14,9 +14,11 @@ struct RunCommandOptions {
   std::string scene;        ///< scene file
   std::string out;          ///< output directory; empty: out/<scene stem>
   bool quiet = false;       ///< no progress messages on `log`
+  bool force = false;       ///< `out` may replace a regular file or a non-buckle directory (output_target.h)
 };
 
-/// Parses the scene (bad input: message on `err`, nothing written, returns kBadInput), runs
+/// Parses the scene and checks `out` (output_target.h) (bad input or a refused or unwritable
+/// `out`: message on `err`, nothing written, returns kBadInput), runs
 /// what it asks for, writes everything into a staging directory next to `out` and renames it
 /// into place. Returns kSuccess, or kIncomplete when a computation could not finish (what was
 /// computed is still written).
