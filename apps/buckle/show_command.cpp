@@ -1,5 +1,6 @@
 #include "show_command.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -176,9 +177,12 @@ void show(const std::string& dirName, std::ostream& os) {
   for (const char* key : {"energy_equilibria", "torque_zeros", "sudden_load"})
     if (sp.contains(key)) others += std::string(others.empty() ? "" : ", ") + key + " (" + std::to_string(sp[key].size()) + ")";
   if (!others.empty()) os << "\nalso in special_points.json: " << others << "\n";
-  std::string files;
+  std::vector<std::string> csv;
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
-    if (e.path().extension() == ".csv") files += " " + e.path().filename().string();
+    if (e.path().extension() == ".csv") csv.push_back(e.path().filename().string());
+  std::sort(csv.begin(), csv.end());
+  std::string files;
+  for (const std::string& f : csv) files += " " + f;
   const json& plots = list(field(summary, "plots"), "files");
   os << "files:" << files << (plots.empty() ? "" : ", " + std::to_string(plots.size()) + " plot images in plots/")
      << " (columns: docs/outputs.md)\n";

@@ -31,7 +31,7 @@ const std::string kSmall = "atlas --x a --x-range 0.4 0.6 2 --y L0 --y-range 2.0
 
 }  // namespace
 
-TEST_CASE("atlas.csv names every column once; summary.json says which are the axes", "[cli][atlas]") {
+TEST_CASE("atlas.csv names every column once and summary.json says which are the axes", "[cli][atlas]") {
   const fs::path dir = work("columns");
   REQUIRE(exitCode(kSmall + " --out '" + (dir / "out").string() + "'", dir / "log.txt") == 0);
   std::ifstream csv(dir / "out" / "atlas.csv");

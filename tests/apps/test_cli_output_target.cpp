@@ -12,6 +12,7 @@
 #include <string>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <vector>
 
 namespace fs = std::filesystem;
 using buckle::test::slurp;
@@ -75,7 +76,8 @@ TEST_CASE("buckle run --out . (however written) exits 2 and keeps every file", "
   fs::create_directories(dir / "sub");
   const auto before = snapshot(dir);
   const fs::path log = dir.parent_path() / "cwd.log";
-  for (const std::string& out : {".", "./", "sub/..", "../cwd", "../cwd/.", dir.string() + "/", dir.string() + "/."}) {
+  for (const std::string& out : std::vector<std::string>{".", "./", "sub/..", "../cwd", "../cwd/.", dir.string() + "/",
+                                                         dir.string() + "/."}) {
     for (const char* force : {"", " --force"}) {
       INFO("--out " << out << force);
       CHECK(runIn(dir, "run s.json --out '" + out + "'" + force, log) == 2);
@@ -126,7 +128,7 @@ TEST_CASE("buckle run --out over a user's file or folder exits 2 unless --force"
   CHECK(leftovers(dir) == 0);
 }
 
-TEST_CASE("buckle run over its previous output replaces it; a user file in it needs --force", "[cli][run][output]") {
+TEST_CASE("buckle run over its previous output replaces it but a user file in it needs --force", "[cli][run][output]") {
   const fs::path dir = userDir("previous");
   const fs::path log = dir.parent_path() / "previous.log";
   REQUIRE(runIn(dir, "run s.json --out out/s", log) == 0);
@@ -169,7 +171,7 @@ TEST_CASE("buckle run into an unwritable place exits 2 and writes nothing", "[cl
   }
 }
 
-TEST_CASE("no staging directory is left, after success or failure", "[cli][run][output]") {
+TEST_CASE("no staging directory is left after success or failure", "[cli][run][output]") {
   const fs::path dir = userDir("staging");
   const fs::path log = dir.parent_path() / "staging.log";
   CHECK(runIn(dir, "run s.json --out out", log) == 0);

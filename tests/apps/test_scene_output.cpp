@@ -48,7 +48,7 @@ struct Umask {
 
 }  // namespace
 
-TEST_CASE("the output directory and its files follow the umask", "[scene][output]") {
+TEST_CASE("the staging directory and its files follow the umask", "[scene][output]") {
   for (const mode_t mask : {mode_t(022), mode_t(077), mode_t(002), mode_t(027)}) {
     INFO("umask 0" << std::oct << mask);
     const fs::path dir = freshDir("umask");
@@ -88,7 +88,7 @@ TEST_CASE("a staging directory that is not committed leaves nothing behind", "[s
   CHECK(fs::exists(dir / "keep.txt"));
 }
 
-TEST_CASE("commit replaces a previous output as a whole, and only then", "[scene][output]") {
+TEST_CASE("commit replaces a previous output as a whole and only then", "[scene][output]") {
   const fs::path dir = freshDir("replace");
   fs::create_directories(dir / "out" / "plots");
   std::ofstream(dir / "out" / "summary.json") << "old";

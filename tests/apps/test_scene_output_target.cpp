@@ -73,7 +73,7 @@ void writeBuckleOutput(const fs::path& dir) {
 
 }  // namespace
 
-TEST_CASE("the current directory and its ancestors are never an output, however written", "[scene][output]") {
+TEST_CASE("the current directory and its ancestors are never an output however written", "[scene][output]") {
   InFreshDirectory here("cwd");
   fs::create_directories("sub");
   fs::create_symlink(fs::current_path(), "here_link");
@@ -104,7 +104,7 @@ TEST_CASE("the current directory and its ancestors are never an output, however 
   CHECK(snapshot(here.root) == before);
 }
 
-TEST_CASE("the scene file, and a directory holding it, are never an output", "[scene][output]") {
+TEST_CASE("the scene file and a directory holding it are never an output", "[scene][output]") {
   InFreshDirectory here("scene");
   fs::create_symlink("s.json", "scene_link");
   fs::create_hard_link("s.json", "scene_hard");
@@ -112,7 +112,7 @@ TEST_CASE("the scene file, and a directory holding it, are never an output", "[s
   std::ofstream("elsewhere/t.json") << "{}";
   const auto before = snapshot(here.root);
   for (bool force : {false, true}) {
-    for (const std::string& t : {"s.json", "./s.json", "sub/../s.json", "scene_link", "scene_hard"}) {
+    for (const char* t : {"s.json", "./s.json", "sub/../s.json", "scene_link", "scene_hard"}) {
       INFO("--out " << t << " force " << force);
       CHECK_THAT(refusal(t, force), Catch::Contains("is the scene file s.json"));
     }
@@ -146,7 +146,7 @@ TEST_CASE("an existing file or foreign directory is replaced only with --force",
   CHECK(snapshot(here.root) == before);  // the check itself writes nothing
 }
 
-TEST_CASE("new paths, empty directories and previous buckle outputs are accepted", "[scene][output]") {
+TEST_CASE("new paths and empty directories and previous buckle outputs are accepted", "[scene][output]") {
   InFreshDirectory here("accepted");
   const fs::path cwd = fs::current_path();
   CHECK(checkOutputTarget("out/new", {"s.json"}, false) == (cwd / "out" / "new").string());
