@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "cli_helpers.h"
+#include "output_helpers.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -80,5 +81,5 @@ TEST_CASE("buckle atlas --out is checked before computing", "[cli][atlas][output
   CHECK(slurp(dir / "atlas" / "atlas.csv").rfind("a,L0,n,", 0) == 0);
   CHECK(exitCode(kSmall + " --out '" + (dir / "mine").string() + "' --force", log) == 0);
   CHECK(!fs::exists(dir / "mine" / "data.csv"));
-  for (const auto& e : fs::directory_iterator(dir)) CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
+  CHECK(buckle::test::stagingLeftovers(dir) == 0);
 }

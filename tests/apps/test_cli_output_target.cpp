@@ -4,18 +4,20 @@
 #include <catch2/catch.hpp>
 
 #include "cli_helpers.h"
+#include "output_helpers.h"
 
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <sys/stat.h>
 #include <unistd.h>
 #include <vector>
 
 namespace fs = std::filesystem;
+using buckle::test::mode;
 using buckle::test::slurp;
+using buckle::test::snapshot;
+using buckle::test::stagingLeftovers;
 
 namespace {
 
@@ -40,33 +42,12 @@ fs::path userDir(const std::string& name) {
   return d;
 }
 
-/// Every path under `dir` with the bytes of the regular files.
-std::map<std::string, std::string> snapshot(const fs::path& dir) {
-  std::map<std::string, std::string> files;
-  for (const auto& e : fs::recursive_directory_iterator(dir))
-    files[fs::relative(e.path(), dir).string()] = e.is_regular_file() ? slurp(e.path()) : "<dir>";
-  return files;
-}
-
 /// `buckle ARGS` started in `dir` (so that "." is that directory); exit status, output in `log`.
 int runIn(const fs::path& dir, const std::string& args, const fs::path& log) {
   const std::string cmd =
       "cd '" + dir.string() + "' && '" + buckle::test::kBuckle + "' " + args + " > '" + log.string() + "' 2>&1";
   const int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-int leftovers(const fs::path& dir) {
-  int n = 0;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.path().filename().string().find(".tmp-") != std::string::npos) ++n;
-  return n;
-}
-
-unsigned mode(const fs::path& p) {
-  struct stat st {};
-  REQUIRE(::stat(p.c_str(), &st) == 0);
-  return st.st_mode & 07777u;
 }
 
 }  // namespace
@@ -125,7 +106,7 @@ TEST_CASE("buckle run --out over a user's file or folder exits 2 unless --force"
   CHECK(runIn(dir, "run s.json --out notes.txt --force", log) == 0);
   CHECK(fs::is_directory(dir / "notes.txt"));
   CHECK(slurp(dir / "s.json") == kScene);
-  CHECK(leftovers(dir) == 0);
+  CHECK(stagingLeftovers(dir) == 0);
 }
 
 TEST_CASE("buckle run over its previous output replaces it but a user file in it needs --force", "[cli][run][output]") {
@@ -147,7 +128,7 @@ TEST_CASE("buckle run over its previous output replaces it but a user file in it
   CHECK(slurp(dir / "out" / "s" / "my_fit.txt") == "mine");
   CHECK(runIn(dir, "run s.json --out out/s --force", log) == 0);
   CHECK(!fs::exists(dir / "out" / "s" / "my_fit.txt"));
-  CHECK(leftovers(dir / "out") == 0);
+  CHECK(stagingLeftovers(dir / "out") == 0);
 }
 
 TEST_CASE("buckle run into an unwritable place exits 2 and writes nothing", "[cli][run][output]") {
@@ -175,19 +156,19 @@ TEST_CASE("no staging directory is left after success or failure", "[cli][run][o
   const fs::path dir = userDir("staging");
   const fs::path log = dir.parent_path() / "staging.log";
   CHECK(runIn(dir, "run s.json --out out", log) == 0);
-  CHECK(leftovers(dir) == 0);
+  CHECK(stagingLeftovers(dir) == 0);
   // a computation that cannot finish (exit 1): partial results, no staging directory
   std::string scene = kScene;
   scene.replace(scene.find("\"plots\": []"), 11, "\"plots\": [], \"solver\": {\"time_limit\": 1e-9}");
   std::ofstream(dir / "slow.json") << scene;
   CHECK(runIn(dir, "run slow.json --out out", log) == 1);
   CHECK(fs::exists(dir / "out" / "summary.json"));
-  CHECK(leftovers(dir) == 0);
+  CHECK(stagingLeftovers(dir) == 0);
   // bad input (exit 2): nothing at all
   std::ofstream(dir / "bad.json") << "{\"chain\": ";
   CHECK(runIn(dir, "run bad.json --out bad_out", log) == 2);
   CHECK(!fs::exists(dir / "bad_out"));
-  CHECK(leftovers(dir) == 0);
+  CHECK(stagingLeftovers(dir) == 0);
 }
 
 TEST_CASE("buckle run's output follows the umask", "[cli][run][output]") {

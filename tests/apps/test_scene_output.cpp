@@ -9,10 +9,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "output_helpers.h"
 #include "scene/output.h"
 
 namespace fs = std::filesystem;
 using buckle::scene::StagingDirectory;
+using buckle::test::mode;
+using buckle::test::stagingLeftovers;
 
 namespace {
 
@@ -21,20 +24,6 @@ fs::path freshDir(const std::string& name) {
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
-}
-
-unsigned mode(const fs::path& p) {
-  struct stat st {};
-  REQUIRE(::stat(p.c_str(), &st) == 0);
-  return st.st_mode & 07777u;
-}
-
-/// Names in `dir` that look like a staging directory or a moved-aside previous output.
-int leftovers(const fs::path& dir) {
-  int n = 0;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.path().filename().string().find(".tmp-") != std::string::npos) ++n;
-  return n;
 }
 
 /// Sets the umask for the test's lifetime.
@@ -63,7 +52,7 @@ TEST_CASE("the staging directory and its files follow the umask", "[scene][outpu
     CHECK(mode(dir / "out") == (0777u & ~unsigned(mask)));
     CHECK(mode(dir / "out" / "plots") == (0777u & ~unsigned(mask)));
     CHECK(mode(dir / "out" / "summary.json") == (0666u & ~unsigned(mask)));
-    CHECK(leftovers(dir) == 0);
+    CHECK(stagingLeftovers(dir) == 0);
   }
 }
 
@@ -73,7 +62,7 @@ TEST_CASE("a staging directory that is not committed leaves nothing behind", "[s
   SECTION("destroyed normally") {
     StagingDirectory staging((dir / "out").string());
     std::ofstream(fs::path(staging.path()) / "branches.csv") << "partial";
-    CHECK(leftovers(dir) == 1);
+    CHECK(stagingLeftovers(dir) == 1);
   }
   SECTION("an exception while writing") {
     try {
@@ -84,7 +73,7 @@ TEST_CASE("a staging directory that is not committed leaves nothing behind", "[s
     }
   }
   CHECK(!fs::exists(dir / "out"));
-  CHECK(leftovers(dir) == 0);
+  CHECK(stagingLeftovers(dir) == 0);
   CHECK(fs::exists(dir / "keep.txt"));
 }
 
@@ -104,7 +93,7 @@ TEST_CASE("commit replaces a previous output as a whole and only then", "[scene]
   in >> text;
   CHECK(text == "new");
   CHECK(!fs::exists(dir / "out" / "plots"));
-  CHECK(leftovers(dir) == 0);
+  CHECK(stagingLeftovers(dir) == 0);
 }
 
 TEST_CASE("the staging directory's parents are created as needed", "[scene][output]") {
@@ -116,5 +105,5 @@ TEST_CASE("the staging directory's parents are created as needed", "[scene][outp
     staging.commit();
   }
   CHECK(fs::is_directory(dir / "a" / "b" / "out"));
-  CHECK(leftovers(dir / "a" / "b") == 0);
+  CHECK(stagingLeftovers(dir / "a" / "b") == 0);
 }

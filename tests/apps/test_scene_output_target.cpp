@@ -5,17 +5,18 @@
 
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <string>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "output_helpers.h"
 #include "scene/output_target.h"
 
 namespace fs = std::filesystem;
 using buckle::scene::checkOutputTarget;
 using buckle::scene::isBuckleOutput;
 using buckle::scene::OutputTargetError;
+using buckle::test::snapshot;
 
 namespace {
 
@@ -34,23 +35,6 @@ struct InFreshDirectory {
   InFreshDirectory(const InFreshDirectory&) = delete;
   InFreshDirectory& operator=(const InFreshDirectory&) = delete;
 };
-
-/// Every path under `dir` with the bytes of the regular files (directories map to "<dir>").
-std::map<std::string, std::string> snapshot(const fs::path& dir) {
-  std::map<std::string, std::string> files;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    const std::string rel = fs::relative(e.path(), dir).string();
-    if (e.is_symlink()) {
-      files[rel] = "<link " + fs::read_symlink(e.path()).string() + ">";
-    } else if (e.is_regular_file()) {
-      std::ifstream in(e.path(), std::ios::binary);
-      files[rel] = std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    } else {
-      files[rel] = "<dir>";
-    }
-  }
-  return files;
-}
 
 /// The refusal message of `target` (fails the test when it is accepted).
 std::string refusal(const std::string& target, bool force) {
