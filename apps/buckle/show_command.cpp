@@ -93,8 +93,7 @@ void show(const std::string& dirName, std::ostream& os) {
   if (!fs::is_directory(dir, ec)) throw NotAnOutput{dirName + " is not a directory (give the output directory of buckle run)"};
   const std::string generator = scene::outputGenerator(dirName);
   if (generator.empty())
-    throw NotAnOutput{dirName + " is not a buckle output: it has no summary.json with the \"generator\" marker "
-                      "buckle run writes (outputs of older versions have none: run the scene again)"};
+    throw NotAnOutput{dirName + " is not a buckle output: it has no summary.json written by buckle run"};
   if (generator != scene::kRunGenerator)
     throw NotAnOutput{dirName + " is a `" + generator + "` output, not a `buckle run` one; its table is " +
                       (dir / "atlas.csv").string() + " (columns: docs/outputs.md)"};

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sys/stat.h>
@@ -43,9 +44,21 @@ std::string outputGenerator(const std::string& dirName) {
   if (!fs::is_regular_file(fs::symlink_status(summary, ec))) return "";
   std::ifstream in(summary, std::ios::binary);
   const nlohmann::json doc = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (!doc.is_object() || !doc.contains("generator") || !doc["generator"].is_string()) return "";
-  const std::string g = doc["generator"].get<std::string>();
-  return g == kRunGenerator || g == kAtlasGenerator ? g : "";
+  if (!doc.is_object()) return "";
+  if (doc.contains("generator")) {
+    const std::string g = doc["generator"].is_string() ? doc["generator"].get<std::string>() : "";
+    return g == kRunGenerator || g == kAtlasGenerator ? g : "";
+  }
+  // Written before the marker existed (schema 0): recognised by the summary's own layout, so
+  // that an existing out/ of an earlier version is still replaced without --force.
+  auto has = [&doc](std::initializer_list<const char*> keys) {
+    for (const char* k : keys)
+      if (!doc.contains(k)) return false;
+    return true;
+  };
+  if (has({"scene", "complete", "computed", "solver", "cases", "timings_seconds"})) return kRunGenerator;
+  if (has({"x", "y", "fixed", "cells", "failed_cells", "plots"})) return kAtlasGenerator;
+  return "";
 }
 
 bool isBuckleOutput(const std::string& dirName, std::string* why) {

@@ -32,12 +32,13 @@ struct OutputTargetError : std::runtime_error {
 };
 
 /// True when `dir` is a directory written by buckle: its summary.json carries a `generator`
-/// marker (kRunGenerator or kAtlasGenerator) and it holds nothing else than the files buckle
-/// writes (top-level CSV/JSON results, plots/ with images, gnuplot scripts, data and logs).
-/// Otherwise false, with the reason in `why` when given.
+/// marker (kRunGenerator or kAtlasGenerator; or, written before the marker, the keys of a run's
+/// or an atlas's summary) and it holds nothing else than the files buckle writes (top-level
+/// CSV/JSON results, plots/ with images, gnuplot scripts, data and logs). Otherwise false, with
+/// the reason in `why` when given.
 bool isBuckleOutput(const std::string& dir, std::string* why = nullptr);
 
-/// The `generator` of the buckle output in `dir` ("" when there is no readable marker).
+/// The `generator` of the buckle output in `dir` (as above; "" when there is none).
 std::string outputGenerator(const std::string& dir);
 
 /// Applies the policy above to `target` (relative to the current directory); `inputs` are the

@@ -164,6 +164,14 @@ TEST_CASE("new paths and empty directories and previous buckle outputs are accep
     std::ofstream("previous/summary.json") << "not json";
     CHECK(!isBuckleOutput("previous"));
   }
+  SECTION("an output written before the marker existed is recognised by its summary's keys") {
+    std::ofstream("previous/summary.json") << R"({"scene": "s.json", "complete": true, "computed": [], "solver": {},
+                                                 "cases": [], "timings_seconds": {}})";
+    CHECK(isBuckleOutput("previous"));
+    CHECK(buckle::scene::outputGenerator("previous") == "buckle run");
+    std::ofstream("previous/summary.json") << R"({"scene": "s.json", "complete": true})";
+    CHECK(!isBuckleOutput("previous"));
+  }
   SECTION("an atlas output is recognised too") {
     std::ofstream("previous/summary.json") << "{\"generator\": \"buckle atlas\", \"schema\": 1}";
     CHECK(isBuckleOutput("previous"));
