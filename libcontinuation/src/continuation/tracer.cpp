@@ -106,6 +106,7 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   lo.detectFolds = options_.detectFolds;
   lo.detectBranchPoints = options_.detectBranchPoints;
   lo.denseAlgebra = n_ <= options_.maxDenseLocationDimension;
+  lo.interrupt = options_.interrupt;
   locator_ = std::make_unique<Locator>(problem_, *corrector_, *evaluator_, lo);
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
@@ -312,6 +313,11 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
   };
 
   for (;;) {
+    if (options_.interrupt.requested()) {
+      stop(StopReason::Interrupted, options_.interrupt.describe());
+      endpoint(SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
+      return;
+    }
     if (static_cast<int>(branch.points.size()) >= options_.maxPoints) {
       stop(StopReason::MaxPoints, "reached maxPoints = " + std::to_string(options_.maxPoints));
       endpoint(SpecialPointType::Endpoint, "max points", 0.0, 0.0);
@@ -440,6 +446,11 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     for (SpecialPoint &sp : found) {
       sp.index = ia;
       branch.specialPoints.push_back(std::move(sp));
+    }
+    if (options_.onStep && !landedOnStart && options_.onStep(branch) == StepAction::Stop) {
+      stop(StopReason::Interrupted, "stopped by the step callback");
+      endpoint(SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
+      return;
     }
 
     if (hitEvent >= 0) {

@@ -15,15 +15,24 @@
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/corrector.h"
+#include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/test_functions.h"
 
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
 namespace buckle::continuation {
+
+/// What a step callback tells the tracer (as Ceres' CallbackReturnType).
+enum class StepAction { Continue, Stop };
+/// Called after every accepted point, with the branch so far (its last point is the new one):
+/// progress reports, custom stop rules (BifurcationKit's finalise_solution). Stop ends the
+/// branch with StopReason::Interrupted.
+using StepCallback = std::function<StepAction(const Branch &branch)>;
 
 struct TracerOptions {
   // ---- step control -----------------------------------------------------------------------
@@ -85,6 +94,12 @@ struct TracerOptions {
   /// Two crossings inside one step that cannot be separated down to this fraction of the step
   /// are one point of higher multiplicity.
   double separationFraction = 1e-9;
+
+  // ---- stopping early ------------------------------------------------------------------
+  /// Checked before every step and every location sample: a time limit or a signal ends the
+  /// branch with StopReason::Interrupted, keeping its points.
+  Interrupt interrupt;
+  StepCallback onStep;              ///< optional; see StepCallback
 
   bool IsValid(std::string *why) const;
 };
