@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -14,6 +15,7 @@
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <pthread.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -369,6 +371,11 @@ StagingDirectory::StagingDirectory(const std::string& target) : target_(target) 
   if (t.filename().empty()) t = t.parent_path();
   target_ = t.string();
   fs::create_directories(t.parent_path());
+  sigset_t hold;
+  sigemptyset(&hold);
+  sigaddset(&hold, SIGINT);
+  sigaddset(&hold, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &hold, &previousMask_);
   // Not mkdtemp: it makes the directory 0700, and the renamed output would not follow the
   // umask. mkdir(0777) does; the random suffix and EEXIST retry give the same uniqueness.
   std::random_device seed;
@@ -384,13 +391,17 @@ StagingDirectory::StagingDirectory(const std::string& target) : target_(target) 
     }
     if (errno != EEXIST) break;
   }
-  throw std::runtime_error("cannot create a temporary directory next to " + target_ + ": " + std::strerror(errno));
+  const int error = errno;
+  pthread_sigmask(SIG_SETMASK, &previousMask_, nullptr);
+  throw std::runtime_error("cannot create a temporary directory next to " + target_ + ": " + std::strerror(error));
 }
 
 StagingDirectory::~StagingDirectory() {
-  if (committed_) return;
-  std::error_code ec;
-  fs::remove_all(path_, ec);
+  if (!committed_) {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  pthread_sigmask(SIG_SETMASK, &previousMask_, nullptr);  // a held-back signal is delivered now
 }
 
 void StagingDirectory::commit() {

@@ -2,6 +2,7 @@
 // the program creates, replaces the target only on commit, and is gone on every other path.
 #include <catch2/catch.hpp>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -106,4 +107,30 @@ TEST_CASE("the staging directory's parents are created as needed", "[scene][outp
   }
   CHECK(fs::is_directory(dir / "a" / "b" / "out"));
   CHECK(stagingLeftovers(dir / "a" / "b") == 0);
+}
+
+namespace {
+volatile std::sig_atomic_t gDelivered = 0;
+extern "C" void recordSignal(int sig) { gDelivered = sig; }
+}  // namespace
+
+TEST_CASE("a signal while the output is staged is delivered once the staging directory is gone", "[scene][output]") {
+  const fs::path dir = freshDir("signal");
+  struct sigaction record {}, previous {};
+  record.sa_handler = recordSignal;
+  sigemptyset(&record.sa_mask);
+  REQUIRE(sigaction(SIGTERM, &record, &previous) == 0);
+  gDelivered = 0;
+  {
+    StagingDirectory staging((dir / "out").string());
+    std::raise(SIGTERM);  // e.g. the second Ctrl-C, whose default action ends the program
+    sigset_t pending;
+    sigpending(&pending);
+    CHECK(gDelivered == 0);
+    CHECK(sigismember(&pending, SIGTERM) == 1);
+    CHECK(stagingLeftovers(dir) == 1);
+  }
+  CHECK(gDelivered == SIGTERM);  // delivered after the removal
+  CHECK(stagingLeftovers(dir) == 0);
+  sigaction(SIGTERM, &previous, nullptr);
 }
