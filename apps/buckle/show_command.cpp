@@ -115,13 +115,15 @@ void show(const std::string& dirName, std::ostream& os) {
   const json& cases = list(summary, "cases");
   if (cases.size() > 1) {
     os << "  cases:";
-    for (size_t c = 0; c < cases.size(); ++c) os << (c ? "," : "") << " " << c << " = " << text(field(cases[c], "label"));
+    for (size_t c = 0; c < cases.size(); ++c) os << (c ? ";" : "") << " " << c << " = " << text(field(cases[c], "label"));
     os << "\n";
   }
 
   const json& points = list(sp, "special_points");
-  os << "\nspecial points (" << points.size() << ", special_points.json):\n";
-  if (!points.empty()) {
+  if (points.empty()) {
+    os << "\nspecial points: none\n";
+  } else {
+    os << "\nspecial points (" << points.size() << ", special_points.json):\n";
     std::vector<std::vector<std::string>> rows;
     bool notes = false;
     for (const json& p : points) {
@@ -159,10 +161,13 @@ void show(const std::string& dirName, std::ostream& os) {
       rows.push_back({std::to_string(c), text(field(b, "id")), text(field(b, "parent")), text(field(b, "origin")),
                       text(field(b, "points")), text(field(b, "stop")), text(field(b, "finished")),
                       text(field(b, "stop_message"))});
-  os << "\nbranches (" << rows.size() << ", summary.json; points in branches.csv):\n";
-  if (!rows.empty())
+  if (rows.empty()) {
+    os << "\nbranches: none\n";
+  } else {
+    os << "\nbranches (" << rows.size() << ", summary.json; points in branches.csv):\n";
     printTable(os, {"case", "id", "parent", "origin", "points", "stop", "finished", "message"}, rows,
                {true, true, true, false, true, false, false, false});
+  }
 
   if (const json& critical = list(sp, "critical_loads"); !critical.empty()) {
     std::vector<std::vector<std::string>> crit;
@@ -171,11 +176,38 @@ void show(const std::string& dirName, std::ostream& os) {
     os << "\ncritical loads (" << crit.size() << ", linear buckling of the unloaded shape):\n";
     printTable(os, {"case", "load factor", "shape"}, crit, {true, true, false});
   }
-  // What else is there, and where.
-  std::string others;
-  for (const char* key : {"energy_equilibria", "torque_zeros", "sudden_load"})
-    if (sp.contains(key)) others += std::string(others.empty() ? "" : ", ") + key + " (" + std::to_string(sp[key].size()) + ")";
-  if (!others.empty()) os << "\nalso in special_points.json: " << others << "\n";
+  if (const json& eq = list(sp, "energy_equilibria"); !eq.empty()) {
+    std::vector<std::vector<std::string>> t;
+    for (const json& e : eq)
+      t.push_back({text(field(e, "case")), text(field(e, "ik_branch")), number(field(e, "q1")),
+                   number(field(e, "energy")), number(field(e, "d2E_dq1"), "%.6g"),
+                   field(e, "stable").is_boolean() ? (field(e, "stable").get<bool>() ? "stable" : "unstable") : "-",
+                   text(field(e, "shape"))});
+    os << "\nequilibria on the energy curves (" << t.size() << ", special_points.json energy_equilibria):\n";
+    printTable(os, {"case", "ik_branch", "q1", "E", "d2E/dq1^2", "stability", "shape"}, t,
+               {true, true, true, true, true, false, false});
+  }
+  if (const json& zeros = list(sp, "torque_zeros"); !zeros.empty()) {
+    std::vector<std::vector<std::string>> t;
+    for (const json& z : zeros)
+      t.push_back({text(field(z, "case")), number(field(z, "q")),
+                   field(z, "stable").is_boolean() ? (field(z, "stable").get<bool>() ? "stable" : "unstable") : "-"});
+    os << "\nzeros of the torque-angle curves (" << t.size() << ", special_points.json torque_zeros):\n";
+    printTable(os, {"case", "q", "stability"}, t, {true, true, false});
+  }
+  if (const json& sudden = list(sp, "sudden_load"); !sudden.empty()) {
+    std::vector<std::vector<std::string>> t;
+    for (const json& r : sudden) {
+      const json& qs = field(r, "quasi_static");
+      t.push_back({text(field(r, "case")), number(field(r, "value")), text(field(r, "model")),
+                   text(field(r, "success")), text(field(r, "stable")),
+                   qs.is_object() ? text(field(qs, "differs")) : "-", qs.is_object() ? text(field(qs, "lower")) : "-",
+                   text(field(r, "message"))});
+    }
+    os << "\nsudden load (" << t.size() << ", special_points.json sudden_load; trajectory in sudden_load.csv):\n";
+    printTable(os, {"case", "value", "model", "at rest", "stable", "differs from quasi-static", "lower in Π", "message"},
+               t, {true, true, false, false, false, false, false, false});
+  }
   std::vector<std::string> csv;
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
     if (e.path().extension() == ".csv") csv.push_back(e.path().filename().string());

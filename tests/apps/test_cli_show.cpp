@@ -102,6 +102,34 @@ TEST_CASE("buckle show prints every special point and branch of a run", "[cli][s
   CHECK(shown.find("complete: yes") != std::string::npos);
 }
 
+TEST_CASE("buckle show prints the equilibria of the energy curves", "[cli][show]") {
+  const fs::path out = work() / "fig4";
+  fs::remove_all(out);
+  const std::string scene = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/fig4.json";
+  REQUIRE(exitCode("run '" + scene + "' --quiet --out '" + out.string() + "'", work() / "run4.txt") == 0);
+  REQUIRE(exitCode("show '" + out.string() + "'", work() / "show4.txt") == 0);
+  const std::string shown = slurp(work() / "show4.txt");
+  INFO(shown);
+  const json eq = json::parse(slurp(out / "special_points.json"))["energy_equilibria"];
+  REQUIRE(eq.size() >= 4);
+  CHECK(shown.find("equilibria on the energy curves (" + std::to_string(eq.size()) + ",") != std::string::npos);
+  CHECK(shown.find("special points: none") != std::string::npos);
+  CHECK(shown.find("branches: none") != std::string::npos);
+  const std::vector<std::string> text = lines(shown);
+  for (const json& e : eq) {
+    // its row: case, ik_branch, q1, E, d2E/dq1^2, stability
+    const std::string stability = e["stable"].get<bool>() ? "stable" : "unstable";
+    const bool found = std::any_of(text.begin(), text.end(), [&](const std::string& l) {
+      const std::vector<std::string> w = words(l);
+      return w.size() >= 6 && w[0] == std::to_string(e["case"].get<int>()) &&
+             w[1] == std::to_string(e["ik_branch"].get<int>()) && w[2] == g(e["q1"].get<double>(), "%.10g") &&
+             w[3] == g(e["energy"].get<double>(), "%.10g") && w[5] == stability;
+    });
+    INFO(e.dump());
+    CHECK(found);
+  }
+}
+
 TEST_CASE("buckle show on something that is not a run's output exits 2", "[cli][show]") {
   const fs::path dir = work() / "not_output";
   fs::remove_all(dir);
