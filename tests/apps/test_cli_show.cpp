@@ -48,15 +48,21 @@ std::vector<std::string> words(const std::string& line) {
   return out;
 }
 
+/// Runs data/scenes/NAME.json into a fresh directory, then `buckle show` on it: its output.
+std::string runAndShow(const std::string& name, fs::path& out) {
+  out = work() / name;
+  fs::remove_all(out);
+  const std::string scene = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/" + name + ".json";
+  REQUIRE(exitCode("run '" + scene + "' --quiet --out '" + out.string() + "'", work() / (name + "_run.txt")) == 0);
+  REQUIRE(exitCode("show '" + out.string() + "'", work() / (name + "_show.txt")) == 0);
+  return slurp(work() / (name + "_show.txt"));
+}
+
 }  // namespace
 
 TEST_CASE("buckle show prints every special point and branch of a run", "[cli][show]") {
-  const fs::path out = work() / "default";
-  fs::remove_all(out);
-  const std::string scene = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/default.json";
-  REQUIRE(exitCode("run '" + scene + "' --quiet --out '" + out.string() + "'", work() / "run.txt") == 0);
-  REQUIRE(exitCode("show '" + out.string() + "'", work() / "show.txt") == 0);
-  const std::string shown = slurp(work() / "show.txt");
+  fs::path out;
+  const std::string shown = runAndShow("default", out);
   INFO(shown);
   const json sp = json::parse(slurp(out / "special_points.json"));
   const json summary = json::parse(slurp(out / "summary.json"));
@@ -103,12 +109,8 @@ TEST_CASE("buckle show prints every special point and branch of a run", "[cli][s
 }
 
 TEST_CASE("buckle show prints the equilibria of the energy curves", "[cli][show]") {
-  const fs::path out = work() / "fig4";
-  fs::remove_all(out);
-  const std::string scene = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/fig4.json";
-  REQUIRE(exitCode("run '" + scene + "' --quiet --out '" + out.string() + "'", work() / "run4.txt") == 0);
-  REQUIRE(exitCode("show '" + out.string() + "'", work() / "show4.txt") == 0);
-  const std::string shown = slurp(work() / "show4.txt");
+  fs::path out;
+  const std::string shown = runAndShow("fig4", out);
   INFO(shown);
   const json eq = json::parse(slurp(out / "special_points.json"))["energy_equilibria"];
   REQUIRE(eq.size() >= 4);
