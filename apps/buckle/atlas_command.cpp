@@ -5,6 +5,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <unistd.h>
@@ -12,6 +13,7 @@
 
 #include "scene/atlas.h"
 #include "scene/output.h"
+#include "scene/output_target.h"
 
 namespace buckle::cli {
 
@@ -22,6 +24,7 @@ struct AtlasArgs {
   std::vector<double> xRange{0.05, 1.0, 20}, yRange{1.0, 3.0, 21};
   std::string out = "out/atlas";
   bool quiet = false;
+  bool force = false;
 };
 
 scene::AtlasAxis axis(const std::string& name, const std::vector<double>& r, const std::string& opt) {
@@ -39,6 +42,12 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
   } catch (const std::invalid_argument& e) {
     throw BadArgument{e.what()};
   }
+  std::string target;  // args.out with symbolic links resolved: the directory that is replaced
+  try {
+    target = scene::checkOutputTarget(args.out, {}, args.force);
+  } catch (const scene::OutputTargetError& e) {
+    throw BadArgument{e.what()};
+  }
   const bool tty = ::isatty(STDOUT_FILENO) == 1 && !args.quiet;
   const auto t0 = std::chrono::steady_clock::now();
   auto progress = [tty](int done, int total) {
@@ -54,10 +63,12 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
   for (const auto& c : cells)
     if (c.postBuckling == "failed") ++failed;
   try {
-    scene::StagingDirectory staging(args.out);
+    scene::StagingDirectory staging(target);
     std::string note;
     const std::vector<std::string> files = scene::writeAtlas(o, cells, staging.path(), note);
     nlohmann::json summary;
+    summary["generator"] = scene::kAtlasGenerator;  // the marker that lets a later --out replace it
+    summary["schema"] = scene::kOutputSchema;
     summary["x"] = {{"name", o.x.name}, {"from", o.x.from}, {"to", o.x.to}, {"count", o.x.count}};
     summary["y"] = {{"name", o.y.name}, {"from", o.y.from}, {"to", o.y.to}, {"count", o.y.count}};
     summary["fixed"] = {{"a", o.a}, {"L0", o.L0}, {"n", o.n}, {"b", 1.0}, {"k", 1.0}};
@@ -67,7 +78,10 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
     summary["threads"] = o.threads > 0 ? unsigned(o.threads) : std::max(1u, std::thread::hardware_concurrency());
     summary["seconds"] = seconds;
     summary["plots"] = {{"gnuplot", note}, {"files", files}};
-    std::ofstream(std::string(staging.path()) + "/summary.json") << summary.dump(2) << "\n";
+    std::ofstream file(std::string(staging.path()) + "/summary.json");
+    file << summary.dump(2) << "\n";
+    file.close();
+    if (!file) throw std::runtime_error("cannot write summary.json in " + staging.path());
     staging.commit();
   } catch (const std::exception& e) {
     std::cerr << "buckle atlas: cannot write the output: " << e.what() << "\n";
@@ -102,7 +116,14 @@ void addAtlasCommand(CLI::App& app, Outcome& outcome) {
   cmd->add_option("--L0", args->atlas.L0, "L0/b when it is not an axis")->capture_default_str();
   cmd->add_option("--segments,-n", args->atlas.n, "Segment count when n is not an axis")->capture_default_str();
   cmd->add_option("--threads,-j", args->atlas.threads, "Worker threads (0: all cores)")->capture_default_str();
-  cmd->add_option("--out,-o", args->out, "Output directory")->capture_default_str();
+  cmd->add_option("--out,-o", args->out,
+                  "Output directory, written beside it and renamed at the end. Refused (exit 2, before computing) "
+                  "when it is /, the current directory or one containing it, an existing file, or an existing "
+                  "non-empty directory that is not a previous buckle output")
+      ->capture_default_str();
+  cmd->add_flag("--force", args->force,
+                "Let --out replace an existing file or a directory that is not a buckle output, with everything "
+                "in it (never /, the current directory or one containing it)");
   cmd->add_flag("--quiet,-q", args->quiet, "No progress bar or messages");
   cmd->callback([args, &outcome]() { runAtlas(*args, outcome); });
 }

@@ -8,6 +8,7 @@
 #include "atlas_command.h"
 #include "regress_command.h"
 #include "run_command.h"
+#include "show_command.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"buckle: mechanics of compliant serial manipulators made of dual-triangle segments"};
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
   buckle::cli::addRunCommand(app, outcome);
   buckle::cli::addAtlasCommand(app, outcome);
   buckle::cli::addRegressCommand(app, outcome);
+  buckle::cli::addShowCommand(app, outcome);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

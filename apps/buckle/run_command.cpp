@@ -26,7 +26,12 @@ void addRunCommand(CLI::App& app, Outcome& outcome) {
       ->required();
   run->add_option("--out,-o", options->out,
                   "Output directory (default: out/<scene name>). Written to a temporary directory beside it and "
-                  "renamed at the end, so it is never half-written");
+                  "renamed at the end, so it is never half-written. Refused (exit 2, before computing) when it is "
+                  "/, the current directory or one containing it, the scene file, an existing file, or an existing "
+                  "non-empty directory that is not a previous buckle output");
+  run->add_flag("--force", options->force,
+                "Let --out replace an existing file or a directory that is not a buckle output, with everything "
+                "in it (never /, the current directory or one containing it, or the scene file)");
   run->add_flag("--quiet,-q", options->quiet, "No progress messages (errors are still printed)");
   run->add_option("--time-limit", options->timeLimit,
                   "Seconds for the whole run (overrides the scene's /solver/time_limit); when it is reached the "

@@ -198,13 +198,16 @@ std::vector<std::string> writeAtlas(const AtlasOptions& o, const std::vector<Atl
                                     const std::string& dirName, std::string& gnuplotNote) {
   const fs::path dir(dirName);
   {
+    // The two axes are two of a, L0, n (summary.json says which): each column appears once.
     std::ofstream csv(dir / "atlas.csv");
-    csv << o.x.name << "," << o.y.name << ",a,L0,n,kappa,straight_stable,first_critical_Fx,first_shape,post_buckling,"
-                                          "post_slope,error\n";
-    for (const AtlasCell& c : cells)
-      csv << num(c.x) << "," << num(c.y) << "," << num(c.a) << "," << num(c.L0) << "," << c.n << "," << num(c.kappa)
-          << "," << (c.straightStable ? 1 : 0) << "," << num(c.firstCritical) << "," << c.firstShape << ","
-          << c.postBuckling << "," << num(c.postSlope) << ",\"" << c.error << "\"\n";
+    csv << "a,L0,n,kappa,straight_stable,first_critical_Fx,first_shape,post_buckling,post_slope,error\n";
+    for (const AtlasCell& c : cells) {
+      std::string error;  // CSV quoting: a quote inside a quoted field is doubled
+      for (char ch : c.error) error += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+      csv << num(c.a) << "," << num(c.L0) << "," << c.n << "," << num(c.kappa) << "," << (c.straightStable ? 1 : 0)
+          << "," << num(c.firstCritical) << "," << c.firstShape << "," << c.postBuckling << "," << num(c.postSlope)
+          << ",\"" << error << "\"\n";
+    }
     if (!csv) throw std::runtime_error("cannot write " + (dir / "atlas.csv").string());
   }
   const fs::path plots = dir / "plots";

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "scene/output.h"
+#include "scene/output_target.h"
 #include "scene/runner.h"
 #include "scene/scene.h"
 #include "scene/signals.h"
@@ -85,6 +86,13 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
     return kBadInput;
   }
   const std::string out = options.out.empty() ? defaultOutputDirectory(options.scene) : options.out;
+  std::string target;  // `out` with symbolic links resolved: the directory that is replaced
+  try {
+    target = checkOutputTarget(out, {options.scene}, options.force);
+  } catch (const OutputTargetError& e) {
+    err << "buckle run: " << e.what() << "\n";
+    return kBadInput;
+  }
   if (!options.quiet) {
     log << "scene " << options.scene << ": " << scene.cases.size() << " case(s)";
     if (!scene.description.empty()) log << " — " << scene.description.substr(0, 100) << (scene.description.size() > 100 ? "…" : "");
@@ -102,7 +110,7 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
   RunResult run = runScene(scene, control);
   progress.finish();
   try {
-    StagingDirectory staging(out);
+    StagingDirectory staging(target);
     const PlotReport plots = writeOutputs(scene, run, staging.path());
     staging.commit();
     if (!options.quiet) {

@@ -18,6 +18,7 @@ struct RunCommandOptions {
   std::string scene;        ///< scene file
   std::string out;          ///< output directory; empty: out/<scene stem>
   bool quiet = false;       ///< no progress messages on `log`, no progress line on `err`
+  bool force = false;       ///< `out` may replace a regular file or a non-buckle directory (output_target.h)
   /// Seconds for the whole run, overriding the scene's /solver/time_limit (NaN: the scene's).
   double timeLimit = std::numeric_limits<double>::quiet_NaN();
   /// Progress on `err`: a live line (terminal) or plain periodic lines; Off when quiet.
@@ -30,7 +31,8 @@ struct RunCommandOptions {
 /// their shape (digits ignored), each group once with its count and one example.
 std::vector<std::string> summariseProblems(const std::vector<std::string>& problems, size_t keep = 8);
 
-/// Parses the scene (bad input: message on `err`, nothing written, returns kBadInput), runs
+/// Parses the scene and checks `out` (output_target.h) (bad input or a refused or unwritable
+/// `out`: message on `err`, nothing written, returns kBadInput), runs
 /// what it asks for, writes everything into a staging directory next to `out` and renames it
 /// into place. Returns kSuccess, or kIncomplete when a computation could not finish or the time
 /// limit stopped it (what was computed is still written), or 128 + the signal number after

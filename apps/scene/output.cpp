@@ -3,6 +3,8 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -10,9 +12,14 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <sstream>
 #include <stdexcept>
+#include <pthread.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include "scene/output_target.h"
 
 namespace buckle::scene {
 
@@ -250,6 +257,8 @@ json solverJson(const SolverSpec& s) {
 
 void writeSummary(const Scene& scene, const RunResult& run, const PlotReport& plots, const fs::path& dir) {
   json doc;
+  doc["generator"] = kRunGenerator;  // the marker that lets a later --out replace this directory
+  doc["schema"] = kOutputSchema;
   doc["scene"] = scene.file;
   doc["description"] = scene.description;
   doc["complete"] = run.complete;
@@ -362,18 +371,37 @@ StagingDirectory::StagingDirectory(const std::string& target) : target_(target) 
   if (t.filename().empty()) t = t.parent_path();
   target_ = t.string();
   fs::create_directories(t.parent_path());
-  std::string tmpl = (t.parent_path() / ("." + t.filename().string() + ".tmp-XXXXXX")).string();
-  std::vector<char> buf(tmpl.begin(), tmpl.end());
-  buf.push_back('\0');
-  if (!::mkdtemp(buf.data()))
-    throw std::runtime_error("cannot create a temporary directory next to " + target_ + ": " + std::strerror(errno));
-  path_ = buf.data();
+  sigset_t hold;
+  sigemptyset(&hold);
+  sigaddset(&hold, SIGINT);
+  sigaddset(&hold, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &hold, &previousMask_);
+  // Not mkdtemp: it makes the directory 0700, and the renamed output would not follow the
+  // umask. mkdir(0777) does; the random suffix and EEXIST retry give the same uniqueness.
+  std::random_device seed;
+  std::mt19937_64 random(seed() ^ (std::uint64_t(::getpid()) << 32));
+  const char* const alphabet = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    std::string suffix(6, 'x');
+    for (char& ch : suffix) ch = alphabet[random() % 62];
+    const std::string candidate = (t.parent_path() / ("." + t.filename().string() + ".tmp-" + suffix)).string();
+    if (::mkdir(candidate.c_str(), 0777) == 0) {
+      path_ = candidate;
+      return;
+    }
+    if (errno != EEXIST) break;
+  }
+  const int error = errno;
+  pthread_sigmask(SIG_SETMASK, &previousMask_, nullptr);
+  throw std::runtime_error("cannot create a temporary directory next to " + target_ + ": " + std::strerror(error));
 }
 
 StagingDirectory::~StagingDirectory() {
-  if (committed_) return;
-  std::error_code ec;
-  fs::remove_all(path_, ec);
+  if (!committed_) {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  pthread_sigmask(SIG_SETMASK, &previousMask_, nullptr);  // a held-back signal is delivered now
 }
 
 void StagingDirectory::commit() {

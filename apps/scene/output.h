@@ -3,6 +3,7 @@
 // never sees a half-written output directory.
 #pragma once
 
+#include <csignal>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,10 @@ double columnValue(const std::string& column, const SpecialRecord& s, const mech
 std::string columnLabel(const std::string& column);
 
 /// A directory created next to `target` (same parent, hidden name), renamed onto `target` by
-/// commit(); removed by the destructor unless committed.
+/// commit(); removed by the destructor unless committed. While it exists SIGINT and SIGTERM are
+/// held back (blocked in the calling thread, then delivered when it is gone): a signal that
+/// would end the program (a second Ctrl-C, signals.h) then ends it after the output is complete
+/// or removed, never with a half-written temporary directory left behind.
 class StagingDirectory {
  public:
   explicit StagingDirectory(const std::string& target);
@@ -33,6 +37,7 @@ class StagingDirectory {
  private:
   std::string target_, path_;
   bool committed_ = false;
+  sigset_t previousMask_;
 };
 
 struct PlotReport {

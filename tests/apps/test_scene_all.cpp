@@ -15,6 +15,7 @@
 
 #include "scene/command.h"
 #include "scene/output.h"
+#include "scene/output_target.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -67,6 +68,10 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
       REQUIRE(rc == 0);
       REQUIRE(fs::exists(out / "summary.json"));
       REQUIRE(fs::exists(out / "special_points.json"));
+      std::string why;  // every file the writers make is known to the --out policy (output_target.h)
+      const bool recognised = buckle::scene::isBuckleOutput(out.string(), &why);
+      INFO(why);
+      CHECK(recognised);
       const json summary = readJson(out / "summary.json");
       const json sp = readJson(out / "special_points.json");
       CHECK(summary["complete"] == true);

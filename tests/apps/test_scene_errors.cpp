@@ -289,6 +289,7 @@ TEST_CASE("an existing output directory is replaced as a whole", "[scene][errors
   buckle::scene::RunCommandOptions opt;
   opt.scene = first.file.string();
   opt.out = first.out.string();
+  opt.force = true;  // stale.txt is not buckle's: replaced only with --force (test_scene_output_target.cpp)
   std::ostringstream log, err;
   REQUIRE(buckle::scene::runSceneCommand(opt, log, err) == 0);
   CHECK(!fs::exists(first.out / "stale.txt"));
