@@ -32,6 +32,7 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
     StagingDirectory staging(out);
     const PlotReport plots = writeOutputs(scene, run, staging.path());
     staging.commit();
+    for (const std::string& n : plots.notes) err << "buckle run: note: " << n << "\n";
     if (!options.quiet) {
       size_t points = 0, specials = 0;
       for (const CaseResult& c : run.cases) {
