@@ -35,6 +35,14 @@ std::string num(double v) {
   return buf;
 }
 
+/// Four significant digits, for titles.
+std::string short4(double v) {
+  if (!std::isfinite(v)) return "NaN";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
 /// gnuplot string literal (single quotes, doubled inside).
 std::string quote(const std::string& s) {
   std::string out = "'";
@@ -277,8 +285,8 @@ struct SpecialStyle {
   const char* key;
 };
 const SpecialStyle kSpecialStyles[] = {{"BP", 7, "BP branch point"},   {"LP", 9, "LP fold"},
-                                       {"LPF", 9, "LPF fold of the reaction"}, {"BD", 5, "BD joint limit"},
-                                       {"KMIN", 13, "KMIN stiffness minimum"}, {"JUMP", 11, "JUMP release (load history)"}};
+                                       {"LPF", 9, "LPF reaction fold"},  {"BD", 5, "BD joint limit"},
+                                       {"KMIN", 13, "KMIN Kxx minimum"}, {"JUMP", 11, "JUMP release"}};
 
 const SpecialStyle& specialStyle(const std::string& type) {
   for (const SpecialStyle& s : kSpecialStyles)
@@ -392,11 +400,24 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   Frame f;
   f.width = s.width;
   f.height = s.height;
-  size_t keyChars = 28;  // the widest special-point key entry
-  for (size_t o = 0; o < cases.size(); ++o)
-    for (size_t j = 0; j < ny; ++j)
-      keyChars = std::max(keyChars, glyphs(run.cases[cases[o]].label) + 1 + spec.y[j].size());
-  f.right = std::clamp(1.0 - (kLabelCharWidth * double(keyChars) + 70.0) / f.width, 0.55, 0.8);
+  std::vector<std::string> typesPresent;  // in the order of kSpecialStyles
+  for (const SpecialStyle& st : kSpecialStyles)
+    for (const Mark& m : marks)
+      if (m.type == st.type) {
+        typesPresent.push_back(st.type);
+        break;
+      }
+  for (const Mark& m : marks)
+    if (std::find(typesPresent.begin(), typesPresent.end(), m.type) == typesPresent.end()) typesPresent.push_back(m.type);
+  // the key's width: gnuplot sizes it with the main font's advance (11 pt: about 8.2 px per
+  // character) over the longest title plus the sample
+  size_t keyChars = 8;
+  for (const std::string& type : typesPresent) keyChars = std::max(keyChars, glyphs(specialStyle(type).key));
+  if (multiCase || ny > 1)
+    for (size_t o = 0; o < cases.size(); ++o)
+      for (size_t j = 0; j < ny; ++j)
+        keyChars = std::max(keyChars, glyphs(run.cases[cases[o]].label) + (ny > 1 ? 1 + spec.y[j].size() : 0));
+  f.right = std::clamp(1.0 - (8.2 * double(keyChars + 6) + 30.0) / f.width, 0.5, 0.8);
   std::tie(f.xlo, f.xhi) = niceRange(xlo, xhi);
   std::tie(f.ylo, f.yhi) = niceRange(ylo, yhi);
 
@@ -438,15 +459,6 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     std::string type;
   };
   std::vector<SpecialBlock> specialBlocks;
-  std::vector<std::string> typesPresent;
-  for (const SpecialStyle& st : kSpecialStyles)
-    for (const Mark& m : marks)
-      if (m.type == st.type) {
-        typesPresent.push_back(st.type);
-        break;
-      }
-  for (const Mark& m : marks)
-    if (std::find(typesPresent.begin(), typesPresent.end(), m.type) == typesPresent.end()) typesPresent.push_back(m.type);
   for (size_t o = 0; o < cases.size(); ++o)
     for (const std::string& type : typesPresent) {
       bool any = false;
@@ -544,7 +556,7 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     for (const std::string& type : typesPresent) {
       const SpecialStyle& st = specialStyle(type);
       clause("keyentry with points pt " + std::to_string(st.point) + " ps 1.4 lc rgb 'black' title " +
-             quote(*st.type ? st.key : type));
+             quote(*st.type ? st.key : type) + " noenhanced");
     }
     for (size_t o = 0; o < cases.size(); ++o)
       if (labelBlocks[o] >= 0)
@@ -909,10 +921,17 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     std::ostringstream title;
     title << (cases.size() > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(r.value)
           << " at once, " << (r.inertial ? "inertial dynamics" : "gradient flow") << "; balance error "
-          << num(r.energyBalanceError);
+          << short4(r.energyBalanceError);
     s.body << "set title " << quote(title.str()) << " noenhanced font ',10'\n";
-    s.body << "set key top right font ',9' opaque box\nset size noratio\nset autoscale xy\n"
-           << "set xlabel 't (units of the model time)'\nset ylabel 'energy (units of k b^2)'\n";
+    // the response is fast and the settling slow: time on a log scale (t = 0 is the start, off it)
+    double t1 = 0.0, tEnd = 0.0;
+    for (const mechanics::TrajectorySample& t : r.trajectory) {
+      if (t1 == 0.0 && t.t > 0.0) t1 = t.t;
+      tEnd = std::max(tEnd, t.t);
+    }
+    s.body << "set key center right font ',9' opaque box\nset size noratio\nset autoscale xy\n"
+           << "set xlabel 't (units of the model time; log scale)'\nset ylabel 'energy (units of k b^2)'\n";
+    if (t1 > 0.0 && tEnd > t1) s.body << "set logscale x\nset xrange [" << num(t1) << ":" << num(tEnd) << "]\nset format x '10^{%L}'\n";
     s.body << "plot " << quote(base + "_energy.dat") << " using 1:2 with lines lw 2 lc rgb '#1f77b4' title 'Π (total potential)', \\\n"
            << "  '' using 1:3 with lines lw 2 lc rgb '#d62728' title 'T (kinetic)', \\\n"
            << "  '' using 1:4 with lines lw 2 lc rgb '#2ca02c' title 'W_d (dissipated)', \\\n"
@@ -921,7 +940,6 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     // the two answers, one scale
     Eigen::AlignedBox2d box;
     box.extend(Eigen::Vector2d(0.0, 0.0));
-    box.extend(Eigen::Vector2d(cr.chain.length(), 0.0));
     for (const Eigen::VectorXd* q : {&cr.q0, &r.rest, &r.staticShape}) {
       if (q->size() != cr.chain.size()) continue;
       mechanics::ChainData data(cr.chain);
@@ -955,14 +973,14 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       std::ostringstream t;
       if (k == 0)
         t << "dynamic rest: " << (ok[0] ? (r.stable ? "stable" : "not stable") : "none")
-          << (r.haveStatic ? ", Π = " + num(r.potentialDynamic) : std::string());
+          << (r.haveStatic ? ", Π = " + short4(r.potentialDynamic) : std::string());
       else if (ok[1])
-        t << "quasi-static: Π = " << num(r.potentialStatic) << (r.differs ? " (differs" : " (same")
-          << ", max |Δq| = " << num(r.maxDifference) << ")";
+        t << "quasi-static: Π = " << short4(r.potentialStatic) << (r.differs ? " (differs" : " (same")
+          << ", max |Δq| = " << short4(r.maxDifference) << ")";
       else
         t << "quasi-static: not reached";
       s.body << "set title " << quote(t.str()) << " noenhanced font ',10'\n";
-      s.body << "unset key\nunset xlabel\nunset ylabel\nset size ratio -1\n";
+      s.body << "unset key\nunset logscale x\nset format x '% h'\nunset xlabel\nunset ylabel\nset size ratio -1\n";
       s.body << "set xrange [" << num(std::min(box.min().x() - pad, -0.1 * L)) << ":" << num(box.max().x() + pad)
              << "]\nset yrange [" << num(box.min().y() - pad) << ":" << num(box.max().y() + pad) << "]\n";
       s.body << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
