@@ -752,6 +752,22 @@ void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFil
   }
 }
 
+/// The plot command of one chain drawn by drawChain (files BASE_{lim,tri,spr,jnt,near}.dat),
+/// the clamped base a hatched wall; `under`: a plot clause drawn first, beneath the chain.
+void chainPanel(std::ostream& os, const std::string& base, double L, const std::string& under = std::string()) {
+  os << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
+     << " fc rgb '#bbbbbb' fs pattern 4 border lc rgb '#555555'\n";
+  os << "plot " << (under.empty() ? std::string() : under + ", \\\n  ") << quote(base + "_lim.dat")
+     << " using 1:2 with lines lc rgb '#aaaaaa' lw 1, \\\n"
+     << "  " << quote(base + "_tri.dat")
+     << " using 1:2 with filledcurves closed fc rgb '#c6dbef' fs solid 1.0 border lc rgb '#08306b', \\\n"
+     << "  " << quote(base + "_tri.dat") << " using 1:2 with lines lc rgb '#08306b' lw 1.5, \\\n"
+     << "  " << quote(base + "_spr.dat") << " using 1:2 with lines lc rgb '#e6550d' lw 1.5, \\\n"
+     << "  " << quote(base + "_jnt.dat") << " using 1:2 with points pt 7 ps 0.9 lc rgb 'black', \\\n"
+     << "  " << quote(base + "_near.dat") << " using 1:2 with points pt 6 ps 2.5 lw 2 lc rgb 'red'\n";
+  os << "unset object 1\n";
+}
+
 void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, size_t plotIndex, const fs::path& dir,
                 Script& s, std::vector<std::string>& notes) {
   const std::string stem = spec.name;
@@ -866,16 +882,8 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       s.body << "set title " << quote(title.str()) << " font ',10'\n";
       s.body << "set xrange [" << num(std::min(x0, -0.1 * L)) << ":" << num(x1) << "]\nset yrange [" << num(y0) << ":"
              << num(y1) << "]\n";
-      s.body << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
-             << " fc rgb '#bbbbbb' fs pattern 4 border lc rgb '#555555'\n";
-      s.body << "plot " << quote(base + "_lim.dat") << " using 1:2 with lines lc rgb '#aaaaaa' lw 1, \\\n"
-             << "  " << quote(base + "_tri.dat")
-             << " using 1:2 with filledcurves closed fc rgb '#c6dbef' fs solid 1.0 border lc rgb '#08306b', \\\n"
-             << "  " << quote(base + "_tri.dat") << " using 1:2 with lines lc rgb '#08306b' lw 1.5, \\\n"
-             << "  " << quote(base + "_spr.dat") << " using 1:2 with lines lc rgb '#e6550d' lw 1.5, \\\n"
-             << "  " << quote(base + "_jnt.dat") << " using 1:2 with points pt 7 ps 0.9 lc rgb 'black', \\\n"
-             << "  " << quote(base + "_near.dat") << " using 1:2 with points pt 6 ps 2.5 lw 2 lc rgb 'red'\n";
-      s.body << "unset object 1\nunset label 1\n";
+      chainPanel(s.body, base, L);
+      s.body << "unset label 1\n";
     }
   }
   s.body << "unset multiplot\n";
@@ -983,17 +991,8 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       s.body << "unset key\nunset logscale x\nset format x '% h'\nunset xlabel\nunset ylabel\nset size ratio -1\n";
       s.body << "set xrange [" << num(std::min(box.min().x() - pad, -0.1 * L)) << ":" << num(box.max().x() + pad)
              << "]\nset yrange [" << num(box.min().y() - pad) << ":" << num(box.max().y() + pad) << "]\n";
-      s.body << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
-             << " fc rgb '#bbbbbb' fs pattern 4 border lc rgb '#555555'\n";
-      s.body << "plot " << quote(b + "_start.dat") << " using 1:2 with lines lc rgb '#bbbbbb' lw 1 dt 2, \\\n"
-             << "  " << quote(b + "_lim.dat") << " using 1:2 with lines lc rgb '#aaaaaa' lw 1, \\\n"
-             << "  " << quote(b + "_tri.dat")
-             << " using 1:2 with filledcurves closed fc rgb '#c6dbef' fs solid 1.0 border lc rgb '#08306b', \\\n"
-             << "  " << quote(b + "_tri.dat") << " using 1:2 with lines lc rgb '#08306b' lw 1.5, \\\n"
-             << "  " << quote(b + "_spr.dat") << " using 1:2 with lines lc rgb '#e6550d' lw 1.5, \\\n"
-             << "  " << quote(b + "_jnt.dat") << " using 1:2 with points pt 7 ps 0.9 lc rgb 'black', \\\n"
-             << "  " << quote(b + "_near.dat") << " using 1:2 with points pt 6 ps 2.5 lw 2 lc rgb 'red'\n";
-      s.body << "unset object 1\nset autoscale xy\n";
+      chainPanel(s.body, b, L, quote(b + "_start.dat") + " using 1:2 with lines lc rgb '#bbbbbb' lw 1 dt 2");
+      s.body << "set autoscale xy\n";
     }
   }
   s.body << "unset multiplot\n";

@@ -180,14 +180,18 @@ const char* kTwoCases = R"({
             {"type": "shapes", "name": "shapes", "at": [-0.5, -2.4], "cases": [0]}]
 })";
 
+/// Writes kTwoCases as DIR.json and runs it into DIR/out.
+Run runTwoCases(const fs::path& dir) {
+  const fs::path scene = dir.string() + ".json";
+  std::ofstream(scene) << kTwoCases;
+  return run(scene, dir / "out");
+}
+
 }  // namespace
 
 TEST_CASE("multi-case bifurcation plot: one colour and key entry per case, stability in the key", "[scene][plot]") {
-  const fs::path dir = freshDir("two_cases");
-  const fs::path scene = dir.string() + ".json";
-  std::ofstream(scene) << kTwoCases;
-  const fs::path out = dir / "out";
-  const Run r = run(scene, out);
+  const fs::path dir = freshDir("two_cases"), out = dir / "out";
+  const Run r = runTwoCases(dir);
   INFO(r.err);
   REQUIRE(r.rc == 0);
   const std::string body = slurp(out / "plots" / "two_body.gp");
@@ -374,11 +378,8 @@ TEST_CASE("stiffness plots mark KMIN and joint limits at the traced stiffness", 
 }
 
 TEST_CASE("a shape requested where no stable point was traced is reported, not moved", "[scene][plot]") {
-  const fs::path dir = freshDir("shape_outside");
-  const fs::path scene = dir.string() + ".json";
-  std::ofstream(scene) << kTwoCases;
-  const fs::path out = dir / "out";
-  const Run r = run(scene, out);
+  const fs::path dir = freshDir("shape_outside"), out = dir / "out";
+  const Run r = runTwoCases(dir);
   REQUIRE(r.rc == 0);  // a plot note, not a failed computation
   const json summary = readJson(out / "summary.json");
   CHECK(summary["complete"] == true);
