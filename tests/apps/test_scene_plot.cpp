@@ -180,6 +180,15 @@ const char* kTwoCases = R"({
             {"type": "shapes", "name": "shapes", "at": [-0.5, -2.4], "cases": [0]}]
 })";
 
+/// Runs data/scenes/SCENE.json into a fresh directory NAME, which it returns; the run must succeed.
+fs::path runShipped(const std::string& scene, const std::string& name) {
+  const fs::path out = freshDir(name);
+  const Run r = run(scenePath(scene + ".json"), out);
+  INFO(r.err);
+  REQUIRE(r.rc == 0);
+  return out;
+}
+
 /// Writes kTwoCases as DIR.json and runs it into DIR/out.
 Run runTwoCases(const fs::path& dir) {
   const fs::path scene = dir.string() + ".json";
@@ -261,10 +270,7 @@ TEST_CASE("special-point labels do not overlap one another, a marker or the plot
   for (const char* sceneName : {"default", "hysteresis", "fig9_fig10"}) {
     const std::string name = sceneName;
     DYNAMIC_SECTION(name) {
-      const fs::path out = freshDir(name);
-      const Run r = run(scenePath(name + ".json"), out);
-      INFO(r.err);
-      REQUIRE(r.rc == 0);
+      const fs::path out = runShipped(name, name);
       int plots = 0;
       for (const auto& e : fs::directory_iterator(out / "plots")) {
         const std::string file = e.path().filename().string();
@@ -333,10 +339,7 @@ TEST_CASE("special-point labels do not overlap one another, a marker or the plot
 }
 
 TEST_CASE("stiffness plots mark KMIN and joint limits at the traced stiffness", "[scene][plot]") {
-  const fs::path out = freshDir("fig9_fig10_kmin");
-  const Run r = run(scenePath("fig9_fig10.json"), out);
-  INFO(r.err);
-  REQUIRE(r.rc == 0);
+  const fs::path out = runShipped("fig9_fig10", "fig9_fig10_kmin");
   const Csv csv = readCsv(out / "branches.csv");
   const json sp = readJson(out / "special_points.json");
   const std::vector<Block> special = readBlocks(out / "plots" / "fig10a_Kxx_special.dat");
@@ -399,10 +402,7 @@ TEST_CASE("a shape requested where no stable point was traced is reported, not m
 }
 
 TEST_CASE("sudden-load plot: energies with a constant sum, rest shape beside the quasi-static one", "[scene][plot]") {
-  const fs::path out = freshDir("sudden");
-  const Run r = run(scenePath("sudden_load.json"), out);
-  INFO(r.err);
-  REQUIRE(r.rc == 0);
+  const fs::path out = runShipped("sudden_load", "sudden");
   const json sp = readJson(out / "special_points.json");
   const json& s = sp["sudden_load"][0];
   const double balance = s["energy_balance_error"];
@@ -461,10 +461,7 @@ TEST_CASE("sudden-load plot: energies with a constant sum, rest shape beside the
 
 TEST_CASE("load history: its stable pieces are the branches of branches.csv, in equilibrium and stable",
           "[scene][plot]") {
-  const fs::path out = freshDir("hysteresis_branches");
-  const Run r = run(scenePath("hysteresis.json"), out);
-  INFO(r.err);
-  REQUIRE(r.rc == 0);
+  const fs::path out = runShipped("hysteresis", "hysteresis_branches");
   REQUIRE(fs::exists(out / "branches.csv"));
   const Csv csv = readCsv(out / "branches.csv");
   const json summary = readJson(out / "summary.json");
