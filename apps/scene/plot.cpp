@@ -168,11 +168,12 @@ class Occupancy {
   Occupancy(int w, int h) : w_(w), h_(h), grid_(size_t(w) * size_t(h), 0) {}
   void segment(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     if (!a.allFinite() || !b.allFinite()) return;
-    const int steps = std::min(4000, int(std::ceil((b - a).norm())) + 1);
+    // in doubles until a pixel is known to be on the canvas (a far-off point must not overflow)
+    const int steps = int(std::min(4000.0, std::ceil((b - a).norm()) + 1.0));
     for (int k = 0; k <= steps; ++k) {
       const Eigen::Vector2d p = a + (b - a) * (double(k) / steps);
-      const int x = int(p.x()), y = int(p.y());
-      if (x >= 0 && y >= 0 && x < w_ && y < h_) grid_[size_t(y) * size_t(w_) + size_t(x)] = 1;
+      if (!(p.x() >= 0.0 && p.y() >= 0.0 && p.x() < w_ && p.y() < h_)) continue;
+      grid_[size_t(p.y()) * size_t(w_) + size_t(p.x())] = 1;
     }
   }
   void finish() {
@@ -182,8 +183,8 @@ class Occupancy {
         at(x + 1, y + 1) = grid_[size_t(y) * size_t(w_) + size_t(x)] + at(x, y + 1) + at(x + 1, y) - at(x, y);
   }
   int count(const Box& b) const {
-    const int x0 = std::clamp(int(b.x0), 0, w_), x1 = std::clamp(int(b.x1), 0, w_);
-    const int y0 = std::clamp(int(b.y0), 0, h_), y1 = std::clamp(int(b.y1), 0, h_);
+    const int x0 = int(std::clamp(b.x0, 0.0, double(w_))), x1 = int(std::clamp(b.x1, 0.0, double(w_)));
+    const int y0 = int(std::clamp(b.y0, 0.0, double(h_))), y1 = int(std::clamp(b.y1, 0.0, double(h_)));
     return cat(x1, y1) - cat(x0, y1) - cat(x1, y0) + cat(x0, y0);
   }
 
