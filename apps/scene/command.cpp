@@ -113,6 +113,7 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
     StagingDirectory staging(target);
     const PlotReport plots = writeOutputs(scene, run, staging.path());
     staging.commit();
+    for (const std::string& n : plots.notes) err << "buckle run: note: " << n << "\n";
     if (!options.quiet) {
       log << "computed: ";
       for (size_t i = 0; i < run.computed.size(); ++i) log << (i ? "; " : "") << run.computed[i];

@@ -295,7 +295,7 @@ void writeSummary(const Scene& scene, const RunResult& run, const PlotReport& pl
     for (const BranchRecord& b : cr.branches)
       branches.push_back(json{{"id", b.id}, {"parent", b.parent}, {"origin", b.origin}, {"points", b.points},
                               {"stop", b.stopReason}, {"stop_message", b.stopMessage}, {"finished", b.finished}});
-    if (scene.analyses.continuation.enabled) c["branches"] = branches;
+    if (scene.analyses.continuation.enabled || scene.analyses.loadHistory.enabled) c["branches"] = branches;
     if (cr.haveCritical) {
       json crit;
       crit["unloaded_stable"] = cr.critical.unloadedStable;
@@ -328,6 +328,7 @@ void writeSummary(const Scene& scene, const RunResult& run, const PlotReport& pl
   p["files"] = plots.files;
   if (!plots.failures.empty()) p["failures"] = plots.failures;
   doc["plots"] = p;
+  if (!plots.notes.empty()) doc["notes"] = plots.notes;
   writeText(dir / "summary.json", doc.dump(2) + "\n");
 }
 
@@ -423,7 +424,8 @@ void StagingDirectory::commit() {
 
 PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::string& dirName) {
   const fs::path dir(dirName);
-  if (scene.analyses.continuation.enabled) writeBranches(scene, run, dir);
+  // the load history's stable pieces are branches too (docs/scenes.md, `load_history`)
+  if (scene.analyses.continuation.enabled || scene.analyses.loadHistory.enabled) writeBranches(scene, run, dir);
   writeSpecialPoints(scene, run, dir);
   writeCurves(scene, run, dir);
   const PlotReport plots = drawPlots(scene, run, dirName);

@@ -45,6 +45,9 @@ struct PlotReport {
   std::string gnuplot;                 ///< program used, or why none
   std::vector<std::string> files;      ///< written image files, relative to the output dir
   std::vector<std::string> failures;   ///< plots gnuplot failed to draw
+  /// What a plot could not show as asked (a shape requested where no stable point was traced):
+  /// summary.json `notes`, and printed by `buckle run`.
+  std::vector<std::string> notes;
 };
 
 /// Writes every output file of the run into `dir` (which exists); returns the plot report.

@@ -2,15 +2,19 @@
 // SVG. Scripts and data stay in <out>/plots so that a figure can be restyled by hand.
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <string>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <tuple>
 #include <unistd.h>
+#include <vector>
 
 #include "scene/output.h"
 
@@ -28,6 +32,14 @@ std::string num(double v) {
   if (!std::isfinite(v)) return "NaN";
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+/// Four significant digits, for titles.
+std::string short4(double v) {
+  if (!std::isfinite(v)) return "NaN";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
   return buf;
 }
 
@@ -98,56 +110,264 @@ void header(Script& s, const std::string& title) {
   if (!title.empty()) s.body << "set title " << quote(title) << " noenhanced\n";
 }
 
+// ---- label placement ----------------------------------------------------------------------------
+
+// A 2-D plot whose ranges and margins the script fixes, so that the pixel position of every
+// data point is known before gnuplot draws it: labels can then be placed apart (below).
+struct Frame {
+  int width = 1000, height = 700;
+  double left = 0.09, right = 0.76, bottom = 0.1, top = 0.91;  ///< plot area, screen fractions
+  double xlo = 0, xhi = 1, ylo = 0, yhi = 1;
+  Eigen::Vector2d pixel(double x, double y) const {
+    return {width * (left + (right - left) * (x - xlo) / (xhi - xlo)),
+            height * (bottom + (top - bottom) * (y - ylo) / (yhi - ylo))};
+  }
+  Eigen::Vector2d data(const Eigen::Vector2d& px) const {
+    return {xlo + (px.x() / width - left) / (right - left) * (xhi - xlo),
+            ylo + (px.y() / height - bottom) / (top - bottom) * (yhi - ylo)};
+  }
+  void script(std::ostream& os) const {
+    os << "set lmargin at screen " << num(left) << "\nset rmargin at screen " << num(right) << "\nset bmargin at screen "
+       << num(bottom) << "\nset tmargin at screen " << num(top) << "\nset xrange [" << num(xlo) << ":" << num(xhi)
+       << "]\nset yrange [" << num(ylo) << ":" << num(yhi) << "]\n";
+  }
+};
+
+/// [lo, hi] widened to multiples of a round tic step (1, 2 or 5 × 10^k, about six tics), as
+/// gnuplot's autoscale would, so that fixing the range does not change the plot's look.
+std::pair<double, double> niceRange(double lo, double hi) {
+  if (!std::isfinite(lo) || !std::isfinite(hi)) return {0.0, 1.0};
+  if (!(hi > lo)) {
+    const double half = lo != 0.0 ? 0.1 * std::abs(lo) : 1.0;
+    lo -= half;
+    hi += half;
+  }
+  const double raw = (hi - lo) / 6.0, mag = std::pow(10.0, std::floor(std::log10(raw))), f = raw / mag;
+  const double step = (f < 1.5 ? 1.0 : f < 3.0 ? 2.0 : f < 7.0 ? 5.0 : 10.0) * mag;
+  return {std::floor(lo / step + 1e-9) * step, std::ceil(hi / step - 1e-9) * step};
+}
+
+/// Characters of a UTF-8 string (the width of a label in the font's average advance).
+size_t glyphs(const std::string& s) {
+  return size_t(std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+}
+
+// Label metrics of the ',9' font of the plots (DejaVu Sans 9 pt at the terminals' 72 dpi):
+// measured advance about 6.1 px per character, line height 11 px; a margin on top.
+constexpr double kLabelCharWidth = 6.5, kLabelHeight = 13.0, kMarkerHalf = 7.0;
+
+struct Box {
+  double x0, y0, x1, y1;
+  bool overlaps(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
+};
+
+/// Pixels covered by the plotted curves, with a summed-area table so that the number of curve
+/// pixels under a candidate label box is one lookup.
+class Occupancy {
+ public:
+  Occupancy(int w, int h) : w_(w), h_(h), grid_(size_t(w) * size_t(h), 0) {}
+  void segment(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    if (!a.allFinite() || !b.allFinite()) return;
+    // in doubles until a pixel is known to be on the canvas (a far-off point must not overflow)
+    const int steps = int(std::min(4000.0, std::ceil((b - a).norm()) + 1.0));
+    for (int k = 0; k <= steps; ++k) {
+      const Eigen::Vector2d p = a + (b - a) * (double(k) / steps);
+      if (!(p.x() >= 0.0 && p.y() >= 0.0 && p.x() < w_ && p.y() < h_)) continue;
+      grid_[size_t(p.y()) * size_t(w_) + size_t(p.x())] = 1;
+    }
+  }
+  void finish() {
+    sum_.assign(size_t(w_ + 1) * size_t(h_ + 1), 0);
+    for (int y = 0; y < h_; ++y)
+      for (int x = 0; x < w_; ++x)
+        at(x + 1, y + 1) = grid_[size_t(y) * size_t(w_) + size_t(x)] + at(x, y + 1) + at(x + 1, y) - at(x, y);
+  }
+  int count(const Box& b) const {
+    const int x0 = int(std::clamp(b.x0, 0.0, double(w_))), x1 = int(std::clamp(b.x1, 0.0, double(w_)));
+    const int y0 = int(std::clamp(b.y0, 0.0, double(h_))), y1 = int(std::clamp(b.y1, 0.0, double(h_)));
+    return cat(x1, y1) - cat(x0, y1) - cat(x1, y0) + cat(x0, y0);
+  }
+
+ private:
+  int& at(int x, int y) { return sum_[size_t(y) * size_t(w_ + 1) + size_t(x)]; }
+  int cat(int x, int y) const { return sum_[size_t(y) * size_t(w_ + 1) + size_t(x)]; }
+  int w_, h_;
+  std::vector<unsigned char> grid_;
+  std::vector<int> sum_;
+};
+
+struct PlacedLabel {
+  Eigen::Vector2d anchor;          ///< the marked point (pixels)
+  std::string text;
+  Eigen::Vector2d centre;          ///< label centre (pixels)
+  Box box{0, 0, 0, 0};
+  bool leader = false;             ///< drawn away from its point: a leader line joins them
+  Eigen::Vector2d leaderEnd;       ///< where the leader meets the label box
+};
+
+/// Places every label near its point without overlapping another label, a marker or (where it
+/// can) a curve, inside the plot area: candidate positions on rings of growing radius around
+/// the point, the cheapest taken, greedily from left to right. A label put away from its point
+/// gets a leader line.
+void placeLabels(std::vector<PlacedLabel>& labels, const Frame& f, const Occupancy& curves) {
+  const Box area{f.width * f.left, f.height * f.bottom, f.width * f.right, f.height * f.top};
+  std::vector<Box> markers;
+  for (const PlacedLabel& l : labels)
+    markers.push_back({l.anchor.x() - kMarkerHalf, l.anchor.y() - kMarkerHalf, l.anchor.x() + kMarkerHalf,
+                       l.anchor.y() + kMarkerHalf});
+  std::vector<size_t> order(labels.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return labels[a].anchor.x() < labels[b].anchor.x(); });
+  std::vector<Box> placed;
+  const double pi = std::acos(-1.0);
+  for (size_t i : order) {
+    PlacedLabel& l = labels[i];
+    const double w = kLabelCharWidth * double(glyphs(l.text)) + 4.0, h = kLabelHeight;
+    double bestCost = std::numeric_limits<double>::infinity();
+    int rank = 0;
+    for (double r : {2.0, 18.0, 36.0, 58.0, 84.0, 116.0, 156.0}) {
+      for (int k = 0; k < 16; ++k, ++rank) {
+        // preferred directions first: the four diagonals, then the axes, then the rest
+        static const int kOrder[16] = {2, 6, 14, 10, 0, 8, 4, 12, 1, 3, 5, 7, 9, 11, 13, 15};
+        const double a = kOrder[k] * pi / 8.0;
+        const Eigen::Vector2d c = l.anchor + Eigen::Vector2d(std::cos(a) * (kMarkerHalf + r + w / 2),
+                                                             std::sin(a) * (kMarkerHalf + r + h / 2));
+        const Box b{c.x() - w / 2, c.y() - h / 2, c.x() + w / 2, c.y() + h / 2};
+        double cost = r + 0.5 * rank / 16.0;
+        if (b.x0 < area.x0 || b.x1 > area.x1 || b.y0 < area.y0 || b.y1 > area.y1) cost += 1e7;
+        for (const Box& o : placed)
+          if (b.overlaps(o)) cost += 1e6;
+        for (const Box& m : markers)
+          if (b.overlaps(m)) cost += 1e5;
+        cost += 3.0 * curves.count(b);
+        if (cost < bestCost) {
+          bestCost = cost;
+          l.centre = c;
+          l.box = b;
+          l.leader = r > 2.0;
+        }
+      }
+    }
+    placed.push_back(l.box);
+    // the leader ends on the box's edge nearest to the point
+    l.leaderEnd = {std::clamp(l.anchor.x(), l.box.x0, l.box.x1), std::clamp(l.anchor.y(), l.box.y0, l.box.y1)};
+  }
+}
+
 // ---- bifurcation / stiffness (columns of branches.csv) ----------------------------------------
 
+/// Column value at a special point; the columns that exist only at traced points (stiffness,
+/// smallest eigenvalue) are interpolated along the special point's branch between the two
+/// neighbouring points it lies between (exact where it is a traced point: KMIN, a joint limit).
+double specialValue(const std::string& column, const SpecialRecord& r, const CaseResult& cr) {
+  const double v = columnValue(column, r, cr.pose0);
+  if (std::isfinite(v) || r.q.size() == 0) return v;
+  double best = std::numeric_limits<double>::infinity(), value = v;
+  for (size_t i = 0; i + 1 < cr.points.size(); ++i) {
+    const PointRecord &a = cr.points[i], &b = cr.points[i + 1];
+    if (a.branch != r.branch || b.branch != r.branch || a.q.size() != r.q.size() || b.q.size() != r.q.size()) continue;
+    const Eigen::VectorXd d = b.q - a.q;
+    const double len2 = d.squaredNorm();
+    const double t = len2 > 0 ? std::clamp((r.q - a.q).dot(d) / len2, 0.0, 1.0) : 0.0;
+    const double dist = (r.q - a.q - t * d).norm();
+    // off the chord by more than half the spacing: not between these two points
+    if (dist > 0.5 * std::sqrt(len2) && dist > 0.0) continue;
+    if (dist < best) {
+      best = dist;
+      value = (1 - t) * columnValue(column, a, cr.pose0) + t * columnValue(column, b, cr.pose0);
+    }
+  }
+  return value;
+}
+
+struct SpecialStyle {
+  const char* type;
+  int point;       ///< gnuplot point type, filled; point - 1 is the open outline
+  const char* key;
+};
+const SpecialStyle kSpecialStyles[] = {{"BP", 7, "BP branch point"},   {"LP", 9, "LP fold"},
+                                       {"LPF", 9, "LPF reaction fold"},  {"BD", 5, "BD joint limit"},
+                                       {"KMIN", 13, "KMIN Kxx minimum"}, {"JUMP", 11, "JUMP release"}};
+
+const SpecialStyle& specialStyle(const std::string& type) {
+  for (const SpecialStyle& s : kSpecialStyles)
+    if (type == s.type) return s;
+  static const SpecialStyle other{"", 7, "special point"};
+  return other;
+}
+
 void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
-  BlockFile data, sp;
+  BlockFile data;
   struct Series {
     int block;
-    size_t caseIdx, yIdx;
+    size_t ordinal, yIdx;  ///< position of the case in the plot's list, column
     bool stable;
+    bool any = false;      ///< has a drawable point
   };
+  const std::vector<size_t> cases = selected(spec);
+  const bool multiCase = cases.size() > 1;
+  const size_t ny = spec.y.size();
+  auto seriesColor = [&](size_t ordinal, size_t j) { return color(multiCase ? ordinal * ny + j : j); };
   std::vector<Series> series;
-  const bool multiCase = spec.cases.size() > 1;
-  for (size_t c : selected(spec)) {
-    const CaseResult& cr = run.cases[c];
-    for (size_t j = 0; j < spec.y.size(); ++j) {
+  std::vector<std::vector<Eigen::Vector2d>> polylines;  // in data coordinates, for the label placement
+  double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo, ylo = xlo, yhi = -xlo;
+  auto extend = [&](double x, double y) {
+    if (!std::isfinite(x) || !std::isfinite(y)) return;
+    xlo = std::min(xlo, x), xhi = std::max(xhi, x), ylo = std::min(ylo, y), yhi = std::max(yhi, y);
+  };
+  for (size_t o = 0; o < cases.size(); ++o) {
+    const CaseResult& cr = run.cases[cases[o]];
+    for (size_t j = 0; j < ny; ++j) {
       for (bool stable : {true, false}) {
-        const int block = data.begin();
-        series.push_back({block, c, j, stable});
+        Series se{data.begin(), o, j, stable};
         // polylines of consecutive points with the wanted stability; a run keeps the first point
         // of the next run so that stable and unstable parts join
+        polylines.emplace_back();
+        auto add = [&](double x, double y) {
+          data.point({x, y});
+          polylines.back().emplace_back(x, y);
+          extend(x, y);
+          se.any = true;
+        };
         for (size_t i = 0; i < cr.points.size(); ++i) {
           const PointRecord& p = cr.points[i];
           const bool sameBranchNext = i + 1 < cr.points.size() && cr.points[i + 1].branch == p.branch;
           const double x = columnValue(spec.x, p, cr.pose0), y = columnValue(spec.y[j], p, cr.pose0);
           if (p.stable == stable && std::isfinite(x) && std::isfinite(y)) {
-            data.point({x, y});
+            add(x, y);
             if (sameBranchNext && cr.points[i + 1].stable != stable) {
               const PointRecord& q = cr.points[i + 1];
-              data.point({columnValue(spec.x, q, cr.pose0), columnValue(spec.y[j], q, cr.pose0)});
+              add(columnValue(spec.x, q, cr.pose0), columnValue(spec.y[j], q, cr.pose0));
             }
           }
-          if (p.stable != stable || !sameBranchNext || !std::isfinite(x) || !std::isfinite(y)) data.breakLine();
+          if (p.stable != stable || !sameBranchNext || !std::isfinite(x) || !std::isfinite(y)) {
+            data.breakLine();
+            polylines.emplace_back();
+          }
         }
+        series.push_back(se);
       }
     }
   }
-  // special points: x y label
-  bool anySpecial = false;
-  sp.begin();
-  for (size_t c : selected(spec)) {
-    const CaseResult& cr = run.cases[c];
+  // special points: one block per case and type; points of one case at the same place share a
+  // label ("BP, JUMP")
+  struct Mark {
+    size_t ordinal;
+    std::string type;
+    double x, y;
+    std::string label;
+  };
+  std::vector<Mark> marks;
+  for (size_t o = 0; o < cases.size(); ++o) {
+    const CaseResult& cr = run.cases[cases[o]];
     for (const SpecialRecord& r : cr.specials) {
-      for (size_t j = 0; j < spec.y.size(); ++j) {
-        const double x = columnValue(spec.x, r, cr.pose0), y = columnValue(spec.y[j], r, cr.pose0);
+      for (size_t j = 0; j < ny; ++j) {
+        const double x = specialValue(spec.x, r, cr), y = specialValue(spec.y[j], r, cr);
         if (!std::isfinite(x) || !std::isfinite(y)) continue;
         std::string label = r.type;
         if (r.type == "BP" && !r.shape.empty() && r.shape != "other") label += " " + r.shape;
-        std::ostringstream line;
-        line << num(x) << " " << num(y) << " \"" << label << "\"";
-        sp.text(line.str());
-        anySpecial = true;
+        marks.push_back({o, r.type, x, y, label});
+        extend(x, y);
       }
     }
   }
@@ -155,7 +375,8 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   BlockFile jumps;
   jumps.begin();
   bool anyJump = false;
-  for (size_t c : selected(spec)) {
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> arrows;
+  for (size_t c : cases) {
     const CaseResult& cr = run.cases[c];
     for (const SpecialRecord& r : cr.specials) {
       if (!r.jumpSuccess || r.jumpQ.size() == 0) continue;
@@ -163,56 +384,186 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       to.q = r.jumpQ;
       to.F = r.jumpF;
       to.pose = r.jumpPose;
-      for (size_t j = 0; j < spec.y.size(); ++j) {
+      for (size_t j = 0; j < ny; ++j) {
         const double x0 = columnValue(spec.x, r, cr.pose0), y0 = columnValue(spec.y[j], r, cr.pose0);
         const double x1 = columnValue(spec.x, to, cr.pose0), y1 = columnValue(spec.y[j], to, cr.pose0);
         if (!std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) continue;
         jumps.point({x0, y0, x1 - x0, y1 - y0});
+        arrows.push_back({{x0, y0}, {x1, y1}});
+        extend(x0, y0);
+        extend(x1, y1);
         anyJump = true;
       }
     }
   }
+
+  // the frame: ranges from the data, margins fixed, the key in the right margin
+  Frame f;
+  f.width = s.width;
+  f.height = s.height;
+  std::vector<std::string> typesPresent;  // in the order of kSpecialStyles
+  for (const SpecialStyle& st : kSpecialStyles)
+    for (const Mark& m : marks)
+      if (m.type == st.type) {
+        typesPresent.push_back(st.type);
+        break;
+      }
+  for (const Mark& m : marks)
+    if (std::find(typesPresent.begin(), typesPresent.end(), m.type) == typesPresent.end()) typesPresent.push_back(m.type);
+  // the key's width: gnuplot sizes it with the main font's advance (11 pt: about 8.2 px per
+  // character) over the longest title plus the sample
+  size_t keyChars = 8;
+  for (const std::string& type : typesPresent) keyChars = std::max(keyChars, glyphs(specialStyle(type).key));
+  if (multiCase || ny > 1)
+    for (size_t o = 0; o < cases.size(); ++o)
+      for (size_t j = 0; j < ny; ++j)
+        keyChars = std::max(keyChars, glyphs(run.cases[cases[o]].label) + (ny > 1 ? 1 + spec.y[j].size() : 0));
+  f.right = std::clamp(1.0 - (8.2 * double(keyChars + 6) + 30.0) / f.width, 0.5, 0.8);
+  std::tie(f.xlo, f.xhi) = niceRange(xlo, xhi);
+  std::tie(f.ylo, f.yhi) = niceRange(ylo, yhi);
+
+  Occupancy occupied(f.width, f.height);
+  for (const auto& line : polylines)
+    for (size_t i = 0; i + 1 < line.size(); ++i)
+      occupied.segment(f.pixel(line[i].x(), line[i].y()), f.pixel(line[i + 1].x(), line[i + 1].y()));
+  for (const auto& [a, b] : arrows) occupied.segment(f.pixel(a.x(), a.y()), f.pixel(b.x(), b.y()));
+  occupied.finish();
+
+  // merge the labels of one case's points drawn at the same place
+  std::vector<PlacedLabel> labels;
+  std::vector<size_t> labelOrdinal;
+  std::vector<std::vector<std::string>> parts;
+  for (const Mark& m : marks) {
+    const Eigen::Vector2d px = f.pixel(m.x, m.y);
+    size_t k = 0;
+    while (k < labels.size() && (labelOrdinal[k] != m.ordinal || (labels[k].anchor - px).norm() > 3.0)) ++k;
+    if (k == labels.size()) {
+      labels.emplace_back();
+      labels.back().anchor = px;
+      labelOrdinal.push_back(m.ordinal);
+      parts.emplace_back();
+    }
+    if (std::find(parts[k].begin(), parts[k].end(), m.label) == parts[k].end()) parts[k].push_back(m.label);
+  }
+  for (size_t k = 0; k < labels.size(); ++k)
+    for (size_t i = 0; i < parts[k].size(); ++i) labels[k].text += (i ? ", " : "") + parts[k][i];
+  placeLabels(labels, f, occupied);
+
   const std::string stem = spec.name;
   data.write(dir / (stem + ".dat"));
-  if (anySpecial) sp.write(dir / (stem + "_special.dat"));
+  // special points: blocks per (case, type); labels: one block per case with
+  //   x y label_x label_y "text" leader_x leader_y   (leader NaN when the label sits at its point)
+  BlockFile sp, lab;
+  struct SpecialBlock {
+    int block;
+    size_t ordinal;
+    std::string type;
+  };
+  std::vector<SpecialBlock> specialBlocks;
+  for (size_t o = 0; o < cases.size(); ++o)
+    for (const std::string& type : typesPresent) {
+      bool any = false;
+      for (const Mark& m : marks) any = any || (m.ordinal == o && m.type == type);
+      if (!any) continue;
+      const int block = sp.begin();
+      sp.text("# case " + std::to_string(cases[o]) + " (" + run.cases[cases[o]].label + "): " + type);
+      for (const Mark& m : marks)
+        if (m.ordinal == o && m.type == type) sp.point({m.x, m.y});
+      specialBlocks.push_back({block, o, type});
+    }
+  std::vector<int> labelBlocks(cases.size(), -1);
+  for (size_t o = 0; o < cases.size(); ++o) {
+    bool any = false;
+    for (size_t k = 0; k < labels.size(); ++k) any = any || labelOrdinal[k] == o;
+    if (!any) continue;
+    labelBlocks[o] = lab.begin();
+    lab.text("# case " + std::to_string(cases[o]) + ": x y label_x label_y \"label\" leader_x leader_y");
+    for (size_t k = 0; k < labels.size(); ++k) {
+      if (labelOrdinal[k] != o) continue;
+      const PlacedLabel& l = labels[k];
+      const Eigen::Vector2d p = f.data(l.anchor), c = f.data(l.centre), e = f.data(l.leaderEnd);
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      std::ostringstream line;
+      line << num(p.x()) << " " << num(p.y()) << " " << num(c.x()) << " " << num(c.y()) << " \"" << l.text << "\" "
+           << num(l.leader ? e.x() : nan) << " " << num(l.leader ? e.y() : nan);
+      lab.text(line.str());
+    }
+  }
+  const bool anySpecial = !marks.empty();
+  if (anySpecial) {
+    sp.write(dir / (stem + "_special.dat"));
+    lab.write(dir / (stem + "_labels.dat"));
+  }
   if (anyJump) jumps.write(dir / (stem + "_jumps.dat"));
 
   header(s, spec.title.empty() ? (spec.type == PlotType::Stiffness ? "Loaded stiffness along the branches"
                                                                    : "Bifurcation diagram: stable solid, unstable dashed")
                                : spec.title);
+  s.body << "set key samplen 4\n";
   s.body << "set xlabel " << quote(parameterColumnLabel(scene, spec.x)) << "\n";
   std::string ylabel;
-  for (size_t j = 0; j < spec.y.size(); ++j) ylabel += (j ? ", " : "") + columnLabel(spec.y[j]);
-  if (spec.y.size() > 1) {
+  for (size_t j = 0; j < ny; ++j) ylabel += (j ? ", " : "") + columnLabel(spec.y[j]);
+  if (ny > 1) {
     bool same = true;
     for (const std::string& y : spec.y) same = same && (y[0] == spec.y[0][0]);
     if (same && spec.y[0][0] == 'K') ylabel = "stiffness (units of k)";
     if (same && spec.y[0][0] == 'q') ylabel = "joint angles (rad)";
   }
   s.body << "set ylabel " << quote(ylabel) << "\n";
-  if (spec.type == PlotType::Stiffness) s.body << "set yrange [*:*]\n";
+  s.body << "# ranges and margins fixed so that the special-point labels (placed by buckle, "
+         << stem << "_labels.dat) do not overlap\n";
+  f.script(s.body);
   s.body << "plot \\\n";
   bool first = true;
-  for (const Series& se : series) {
-    const size_t colorIndex = multiCase ? se.caseIdx * spec.y.size() + se.yIdx : se.yIdx;
-    std::string title;
-    if (multiCase) title = run.cases[se.caseIdx].label;
-    if (spec.y.size() > 1) title += (title.empty() ? "" : " ") + spec.y[se.yIdx];
-    if (title.empty()) title = se.stable ? "stable" : "unstable";
-    else if (!se.stable) title = "";
-    s.body << (first ? "  " : ", \\\n  ") << quote(stem + ".dat") << " index " << se.block
-           << " using 1:2 with lines lw 2 lc rgb " << quote(color(colorIndex)) << " dt " << (se.stable ? 1 : 2)
-           << (title.empty() ? std::string(" notitle") : " title " + quote(title) + " noenhanced");
+  auto clause = [&](const std::string& c) {
+    s.body << (first ? "  " : ", \\\n  ") << c;
     first = false;
+  };
+  // one key entry per case (and column): its stable curve; stability itself is explained by
+  // the two entries that follow
+  const bool perSeriesKey = multiCase || ny > 1;
+  bool anyStable = false, anyUnstable = false;
+  for (const Series& se : series) {
+    (se.stable ? anyStable : anyUnstable) = (se.stable ? anyStable : anyUnstable) || se.any;
+    std::string title;
+    if (perSeriesKey && se.stable) {
+      if (multiCase) title = run.cases[cases[se.ordinal]].label;
+      if (ny > 1) title += (title.empty() ? "" : " ") + spec.y[se.yIdx];
+    }
+    clause(quote(stem + ".dat") + " index " + std::to_string(se.block) + " using 1:2 with lines lw 2 lc rgb " +
+           quote(seriesColor(se.ordinal, se.yIdx)) + " dt " + (se.stable ? "1" : "2") +
+           (title.empty() ? std::string(" notitle") : " title " + quote(title) + " noenhanced"));
   }
+  const std::string keyColor = perSeriesKey ? std::string("black") : seriesColor(0, 0);
+  if (anyStable || !anyUnstable) clause("keyentry with lines lw 2 dt 1 lc rgb " + quote(keyColor) + " title 'stable'");
+  if (anyUnstable) clause("keyentry with lines lw 2 dt 2 lc rgb " + quote(keyColor) + " title 'unstable'");
   if (anyJump)
-    s.body << ", \\\n  " << quote(stem + "_jumps.dat")
-           << " using 1:2:3:4 with vectors head filled size screen 0.015,20 lw 1.5 lc rgb '#ff7f0e' title 'jump'";
+    clause(quote(stem + "_jumps.dat") +
+           " using 1:2:3:4 with vectors head filled size screen 0.015,20 lw 1.5 lc rgb '#ff7f0e' title 'jump'");
   if (anySpecial) {
-    s.body << ", \\\n  " << quote(stem + "_special.dat")
-           << " using 1:2 with points pt 7 ps 1.3 lc rgb 'black' title 'special points'";
-    s.body << ", \\\n  " << quote(stem + "_special.dat")
-           << " using 1:2:3 with labels offset char 1.2,0.9 font ',9' tc rgb 'black' notitle";
+    // leader lines under the markers
+    for (size_t o = 0; o < cases.size(); ++o)
+      if (labelBlocks[o] >= 0)
+        clause(quote(stem + "_labels.dat") + " index " + std::to_string(labelBlocks[o]) +
+               " using 1:2:($6-$1):($7-$2) with vectors nohead lw 0.8 lc rgb '#777777' notitle");
+    for (const SpecialBlock& b : specialBlocks) {
+      const SpecialStyle& st = specialStyle(b.type);
+      const std::string fill = multiCase ? color(b.ordinal * ny) : std::string("black");
+      clause(quote(stem + "_special.dat") + " index " + std::to_string(b.block) + " using 1:2 with points pt " +
+             std::to_string(st.point) + " ps 1.4 lc rgb " + quote(fill) + " notitle");
+      clause(quote(stem + "_special.dat") + " index " + std::to_string(b.block) + " using 1:2 with points pt " +
+             std::to_string(st.point - 1) + " ps 1.4 lw 1 lc rgb 'black' notitle");
+    }
+    for (const std::string& type : typesPresent) {
+      const SpecialStyle& st = specialStyle(type);
+      clause("keyentry with points pt " + std::to_string(st.point) + " ps 1.4 lc rgb 'black' title " +
+             quote(*st.type ? st.key : type) + " noenhanced");
+    }
+    for (size_t o = 0; o < cases.size(); ++o)
+      if (labelBlocks[o] >= 0)
+        clause(quote(stem + "_labels.dat") + " index " + std::to_string(labelBlocks[o]) +
+               " using 3:4:5 with labels center font ',9' tc rgb " +
+               quote(multiCase ? color(o * ny) : std::string("black")) + " noenhanced notitle");
   }
   s.body << "\n";
 }
@@ -402,7 +753,24 @@ void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFil
   }
 }
 
-void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
+/// The plot command of one chain drawn by drawChain (files BASE_{lim,tri,spr,jnt,near}.dat),
+/// the clamped base a hatched wall; `under`: a plot clause drawn first, beneath the chain.
+void chainPanel(std::ostream& os, const std::string& base, double L, const std::string& under = std::string()) {
+  os << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
+     << " fc rgb '#bbbbbb' fs pattern 4 border lc rgb '#555555'\n";
+  os << "plot " << (under.empty() ? std::string() : under + ", \\\n  ") << quote(base + "_lim.dat")
+     << " using 1:2 with lines lc rgb '#aaaaaa' lw 1, \\\n"
+     << "  " << quote(base + "_tri.dat")
+     << " using 1:2 with filledcurves closed fc rgb '#c6dbef' fs solid 1.0 border lc rgb '#08306b', \\\n"
+     << "  " << quote(base + "_tri.dat") << " using 1:2 with lines lc rgb '#08306b' lw 1.5, \\\n"
+     << "  " << quote(base + "_spr.dat") << " using 1:2 with lines lc rgb '#e6550d' lw 1.5, \\\n"
+     << "  " << quote(base + "_jnt.dat") << " using 1:2 with points pt 7 ps 0.9 lc rgb 'black', \\\n"
+     << "  " << quote(base + "_near.dat") << " using 1:2 with points pt 6 ps 2.5 lw 2 lc rgb 'red'\n";
+  os << "unset object 1\n";
+}
+
+void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, size_t plotIndex, const fs::path& dir,
+                Script& s, std::vector<std::string>& notes) {
   const std::string stem = spec.name;
   const size_t nc = spec.cases.size(), na = spec.at.size();
   s.width = std::min<int>(3200, int(520 * na));
@@ -435,8 +803,20 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   const double x0 = box.min().x() - pad, x1 = box.max().x() + pad, y0 = box.min().y() - pad, y1 = box.max().y() + pad;
   for (size_t c : selected(spec)) {
     const CaseResult& cr = run.cases[c];
+    const std::string& parameter = scene.cases[c].path.parameter;
+    // the traced stable range, and the sampling of the parameter along the branches
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo, spacing = 0.0;
+    for (size_t i = 0; i < cr.points.size(); ++i) {
+      const PointRecord& p = cr.points[i];
+      if (p.stable) lo = std::min(lo, p.parameter), hi = std::max(hi, p.parameter);
+      if (i > 0 && cr.points[i - 1].branch == p.branch)
+        spacing = std::max(spacing, std::abs(p.parameter - cr.points[i - 1].parameter));
+    }
+    const double slack = 1e-9 * std::max(std::abs(lo), std::abs(hi));
     std::vector<const PointRecord*> chosen;
-    for (double at : spec.at) {
+    std::vector<std::string> missing(na);
+    for (size_t k = 0; k < na; ++k) {
+      const double at = spec.at[k];
       // the stable point nearest to the requested level; among equals, the most deflected
       const PointRecord* best = nullptr;
       double bestD = std::numeric_limits<double>::infinity();
@@ -447,6 +827,25 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
           bestD = d;
           best = &p;
         }
+      }
+      // a requested level with no stable point traced there is reported, not moved to the
+      // nearest point: outside the traced stable range, or in a gap of it wider than the
+      // branches' parameter sampling
+      std::ostringstream why;
+      if (!best)
+        why << "no stable point was traced";
+      else if (at < lo - slack || at > hi + slack)
+        why << "outside the traced stable range [" << num(lo) << ", " << num(hi) << "]";
+      else if (std::abs(best->parameter - at) > spacing + slack)
+        why << "no stable point traced there (nearest stable " << parameter << " = " << num(best->parameter) << ")";
+      if (!why.str().empty()) {
+        missing[k] = why.str();
+        best = nullptr;
+        std::ostringstream note;
+        note << "plot \"" << spec.name << "\"" << (nc > 1 ? ", case \"" + cr.label + "\"" : std::string())
+             << ": shape requested at " << parameter << " = " << num(at) << " (/plots/" << plotIndex << "/at/" << k
+             << ") not drawn: " << missing[k];
+        notes.push_back(note.str());
       }
       chosen.push_back(best);
     }
@@ -463,11 +862,16 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
         drawChain(cr.chain, p->q, tri, spr, lim, jnt, near);
         title << (nc > 1 ? cr.label + ": " : std::string()) << scene.cases[c].path.parameter << " = "
               << num(std::round(p->parameter * 1e4) / 1e4);
+        // the nearest traced point is drawn; the title says when it differs from the request
+        // beyond the title's rounding
+        if (std::abs(p->parameter - spec.at[k]) > 1e-4 * std::max(1.0, std::abs(spec.at[k])))
+          title << " (asked " << num(spec.at[k]) << ")";
         if (p->haveStiffness && std::isfinite(p->K(0, 0)))
           title << ",  K_{xx} = " << num(std::round(p->K(0, 0) * 1e4) / 1e4) << ", K_{yy} = "
                 << num(std::round(p->K(1, 1) * 1e4) / 1e4);
       } else {
-        title << cr.label << ": no stable point";
+        title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(spec.at[k]) << ": not drawn";
+        s.body << "set label 1 " << quote(missing[k]) << " at graph 0.5, graph 0.5 center font ',9' noenhanced\n";
       }
       const std::string base = stem + "_" + std::to_string(c) + "_" + std::to_string(k);
       tri.write(dir / (base + "_tri.dat"));
@@ -479,16 +883,117 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       s.body << "set title " << quote(title.str()) << " font ',10'\n";
       s.body << "set xrange [" << num(std::min(x0, -0.1 * L)) << ":" << num(x1) << "]\nset yrange [" << num(y0) << ":"
              << num(y1) << "]\n";
-      s.body << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
-             << " fc rgb '#bbbbbb' fs pattern 4 border lc rgb '#555555'\n";
-      s.body << "plot " << quote(base + "_lim.dat") << " using 1:2 with lines lc rgb '#aaaaaa' lw 1, \\\n"
-             << "  " << quote(base + "_tri.dat")
-             << " using 1:2 with filledcurves closed fc rgb '#c6dbef' fs solid 1.0 border lc rgb '#08306b', \\\n"
-             << "  " << quote(base + "_tri.dat") << " using 1:2 with lines lc rgb '#08306b' lw 1.5, \\\n"
-             << "  " << quote(base + "_spr.dat") << " using 1:2 with lines lc rgb '#e6550d' lw 1.5, \\\n"
-             << "  " << quote(base + "_jnt.dat") << " using 1:2 with points pt 7 ps 0.9 lc rgb 'black', \\\n"
-             << "  " << quote(base + "_near.dat") << " using 1:2 with points pt 6 ps 2.5 lw 2 lc rgb 'red'\n";
-      s.body << "unset object 1\n";
+      chainPanel(s.body, base, L);
+      s.body << "unset label 1\n";
+    }
+  }
+  s.body << "unset multiplot\n";
+}
+
+// ---- sudden load --------------------------------------------------------------------------------
+
+// Per case: the energies of the dynamic response against time (total potential Π, kinetic T,
+// dissipated W_d and their sum, constant up to the integrator's balance error), then the dynamic
+// rest shape beside the quasi-static one, to the same scale, over the unloaded start in grey.
+void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
+  const std::string stem = spec.name;
+  std::vector<size_t> cases;
+  for (size_t c : selected(spec))
+    if (run.cases[c].haveSudden) cases.push_back(c);
+  const size_t rows = std::max<size_t>(1, cases.size());
+  s.width = 1560;
+  s.height = std::min<int>(2400, int(420 * rows) + 40);
+  s.body << "set encoding utf8\nset grid lc rgb '#dddddd'\n";
+  s.body << "set multiplot layout " << rows << ",3 title "
+         << quote(spec.title.empty() ? std::string("Sudden load: energies of the response, rest shape beside the "
+                                                   "quasi-static one")
+                                     : spec.title)
+         << " noenhanced font ',11'\n";
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (size_t c : cases) {
+    const CaseResult& cr = run.cases[c];
+    const SuddenLoadRecord& r = cr.sudden;
+    const std::string& parameter = scene.cases[c].path.parameter;
+    const std::string base = stem + "_" + std::to_string(c);
+    // energies, full precision: Π + T + W_d is checked against the reported balance error
+    {
+      std::ostringstream os;
+      os << "# sudden load, case " << c << " (" << cr.label << "): t potential kinetic dissipated sum\n";
+      char buf[160];
+      for (const mechanics::TrajectorySample& t : r.trajectory) {
+        std::snprintf(buf, sizeof buf, "%.17g %.17g %.17g %.17g %.17g\n", t.t, t.potential, t.kinetic, t.dissipated,
+                      t.potential + t.kinetic + t.dissipated);
+        os << buf;
+      }
+      std::ofstream(dir / (base + "_energy.dat")) << os.str();
+    }
+    std::ostringstream title;
+    title << (cases.size() > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(r.value)
+          << " at once, " << (r.inertial ? "inertial dynamics" : "gradient flow") << "; balance error "
+          << short4(r.energyBalanceError);
+    s.body << "set title " << quote(title.str()) << " noenhanced font ',10'\n";
+    // the response is fast and the settling slow: time on a log scale (t = 0 is the start, off it)
+    double t1 = 0.0, tEnd = 0.0;
+    for (const mechanics::TrajectorySample& t : r.trajectory) {
+      if (t1 == 0.0 && t.t > 0.0) t1 = t.t;
+      tEnd = std::max(tEnd, t.t);
+    }
+    s.body << "set key center right font ',9' opaque box\nset size noratio\nset autoscale xy\n"
+           << "set xlabel 't (units of the model time; log scale)'\nset ylabel 'energy (units of k b^2)'\n";
+    if (t1 > 0.0 && tEnd > t1) s.body << "set logscale x\nset xrange [" << num(t1) << ":" << num(tEnd) << "]\nset format x '10^{%L}'\n";
+    s.body << "plot " << quote(base + "_energy.dat") << " using 1:2 with lines lw 2 lc rgb '#1f77b4' title 'Π (total potential)', \\\n"
+           << "  '' using 1:3 with lines lw 2 lc rgb '#d62728' title 'T (kinetic)', \\\n"
+           << "  '' using 1:4 with lines lw 2 lc rgb '#2ca02c' title 'W_d (dissipated)', \\\n"
+           << "  '' using 1:5 with lines lw 1.5 dt 2 lc rgb 'black' title 'Π + T + W_d'\n";
+
+    // the two answers, one scale
+    Eigen::AlignedBox2d box;
+    box.extend(Eigen::Vector2d(0.0, 0.0));
+    for (const Eigen::VectorXd* q : {&cr.q0, &r.rest, &r.staticShape}) {
+      if (q->size() != cr.chain.size()) continue;
+      mechanics::ChainData data(cr.chain);
+      mechanics::forwardKinematics(cr.chain, *q, data);
+      Eigen::Vector2d joint(cr.chain.linkLengths()[0], 0.0);
+      box.extend(joint);
+      for (int i = 0; i < cr.chain.size(); ++i) {
+        joint += cr.chain.linkLengths()[i + 1] * Eigen::Vector2d(std::cos(data.theta[i]), std::sin(data.theta[i]));
+        box.extend(joint);
+      }
+    }
+    const double pad = 1.2, L = cr.chain.length();
+    const bool ok[2] = {r.rest.size() == cr.chain.size(), r.haveStatic && r.staticShape.size() == cr.chain.size()};
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::VectorXd& q = k == 0 ? r.rest : r.staticShape;
+      const std::string b = base + (k == 0 ? "_rest" : "_static");
+      BlockFile tri, spr, lim, jnt, near, start, startSpr, startLim, startJnt, startNear;
+      for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near, &start}) {
+        f->begin();
+        f->point({nan, nan});
+        f->breakLine();
+      }
+      if (ok[k]) drawChain(cr.chain, q, tri, spr, lim, jnt, near);
+      if (cr.q0.size() == cr.chain.size()) drawChain(cr.chain, cr.q0, start, startSpr, startLim, startJnt, startNear);
+      tri.write(dir / (b + "_tri.dat"));
+      spr.write(dir / (b + "_spr.dat"));
+      lim.write(dir / (b + "_lim.dat"));
+      jnt.write(dir / (b + "_jnt.dat"));
+      near.write(dir / (b + "_near.dat"));
+      start.write(dir / (b + "_start.dat"));
+      std::ostringstream t;
+      if (k == 0)
+        t << "dynamic rest: " << (ok[0] ? (r.stable ? "stable" : "not stable") : "none")
+          << (r.haveStatic ? ", Π = " + short4(r.potentialDynamic) : std::string());
+      else if (ok[1])
+        t << "quasi-static: Π = " << short4(r.potentialStatic) << (r.differs ? " (differs" : " (same")
+          << ", max |Δq| = " << short4(r.maxDifference) << ")";
+      else
+        t << "quasi-static: not reached";
+      s.body << "set title " << quote(t.str()) << " noenhanced font ',10'\n";
+      s.body << "unset key\nunset logscale x\nset format x '% h'\nunset xlabel\nunset ylabel\nset size ratio -1\n";
+      s.body << "set xrange [" << num(std::min(box.min().x() - pad, -0.1 * L)) << ":" << num(box.max().x() + pad)
+             << "]\nset yrange [" << num(box.min().y() - pad) << ":" << num(box.max().y() + pad) << "]\n";
+      chainPanel(s.body, b, L, quote(b + "_start.dat") + " using 1:2 with lines lc rgb '#bbbbbb' lw 1 dt 2");
+      s.body << "set autoscale xy\n";
     }
   }
   s.body << "unset multiplot\n";
@@ -543,8 +1048,11 @@ PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string
       case PlotType::Bifurcation:
       case PlotType::Stiffness: branchPlot(scene, run, spec, dir, s); break;
       case PlotType::TorqueAngle: torquePlot(scene, run, spec, dir, s); break;
+      case PlotType::SuddenLoad: suddenPlot(scene, run, spec, dir, s); break;
       case PlotType::EnergyCurves: energyPlot(scene, run, spec, dir, s); break;
-      case PlotType::Shapes: shapesPlot(scene, run, spec, dir, s); break;
+      case PlotType::Shapes:
+        shapesPlot(scene, run, spec, size_t(&spec - scene.plots.data()), dir, s, report.notes);
+        break;
     }
     std::ofstream(dir / (spec.name + "_body.gp")) << s.body.str();
     std::ostringstream gp;

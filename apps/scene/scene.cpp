@@ -27,6 +27,7 @@ const char* plotTypeName(PlotType t) {
     case PlotType::EnergyCurves: return "energy_curves";
     case PlotType::TorqueAngle: return "torque_angle";
     case PlotType::Shapes: return "shapes";
+    case PlotType::SuddenLoad: return "sudden_load";
   }
   return "?";
 }
@@ -549,10 +550,11 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
                                                  {"stiffness", PlotType::Stiffness},
                                                  {"energy_curves", PlotType::EnergyCurves},
                                                  {"torque_angle", PlotType::TorqueAngle},
-                                                 {"shapes", PlotType::Shapes}};
+                                                 {"shapes", PlotType::Shapes},
+                                                 {"sudden_load", PlotType::SuddenLoad}};
   auto it = types.find(type);
   if (it == types.end())
-    r.expected(pt, obj["type"], "one of bifurcation, stiffness, energy_curves, torque_angle, shapes");
+    r.expected(pt, obj["type"], "one of bifurcation, stiffness, energy_curves, torque_angle, shapes, sudden_load");
   s.type = it->second;
   auto needs = [&](bool have, const char* analysis) {
     if (!have) r.fail(pt, std::string("a ") + type + " plot needs /analyses/" + analysis);
@@ -563,6 +565,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
     case PlotType::Stiffness: needs(a.stiffness, "stiffness"); break;
     case PlotType::EnergyCurves: needs(a.energyCurves.enabled, "energy_curves"); break;
     case PlotType::TorqueAngle: needs(a.torqueAngle.enabled, "torque_angle"); break;
+    case PlotType::SuddenLoad: needs(a.suddenLoad.enabled, "sudden_load"); break;
   }
   s.name = type;
   if (obj.contains("name")) {
@@ -638,6 +641,7 @@ std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a, int nCases) {
   if (a.stiffness) out.push_back({PlotType::Stiffness, "stiffness", "parameter", {"Kxx", "Kyy"}, {}, "", all});
   if (a.energyCurves.enabled) out.push_back({PlotType::EnergyCurves, "energy_curves", "", {}, {}, "", all});
   if (a.torqueAngle.enabled) out.push_back({PlotType::TorqueAngle, "torque_angle", "", {}, {}, "", all});
+  if (a.suddenLoad.enabled) out.push_back({PlotType::SuddenLoad, "sudden_load", "", {}, {}, "", all});
   return out;
 }
 

@@ -118,7 +118,7 @@ struct SolverSpec {
   double timeLimit = 120.0;    ///< seconds for the whole scene; past it the run stops (exit 1)
 };
 
-enum class PlotType { Bifurcation, Stiffness, EnergyCurves, TorqueAngle, Shapes };
+enum class PlotType { Bifurcation, Stiffness, EnergyCurves, TorqueAngle, Shapes, SuddenLoad };
 const char* plotTypeName(PlotType t);
 
 struct PlotSpec {

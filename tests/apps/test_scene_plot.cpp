@@ -1,0 +1,520 @@
+// The gnuplot plots of a run (apps/scene/plot.cpp), checked on the scripts and data files they
+// leave in <out>/plots: one key entry and one colour per case, stability explained in the key,
+// special points in their case's colour, labels apart from each other, stiffness minima marked
+// at the traced stiffness, shapes requested where nothing stable was traced reported, and the
+// sudden-load energies (their sum constant to the integrator's own balance error). Also the load
+// history's stable pieces in branches.csv, each point an equilibrium (recomputed with the
+// mechanics model) and stable.
+#include <catch2/catch.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "buckle/mechanics/chain.h"
+#include "scene/command.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace buckle::mechanics;
+
+namespace {
+
+fs::path scenePath(const std::string& name) { return fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes" / name; }
+
+fs::path freshDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("buckle_test_scene_plot_" + std::to_string(::getpid())) / name;
+  fs::remove_all(d);
+  fs::create_directories(d.parent_path());
+  return d;
+}
+
+struct Run {
+  int rc;
+  std::string log, err;
+};
+
+Run run(const fs::path& scene, const fs::path& out) {
+  std::ostringstream log, err;
+  buckle::scene::RunCommandOptions opt;
+  opt.scene = scene.string();
+  opt.out = out.string();
+  const int rc = buckle::scene::runSceneCommand(opt, log, err);
+  return {rc, log.str(), err.str()};
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  REQUIRE(in.good());
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+json readJson(const fs::path& p) { return json::parse(slurp(p)); }
+
+/// The blocks of a BlockFile data file (gnuplot `index`), each a list of rows of numbers; "#"
+/// comment lines of a block kept apart.
+struct Block {
+  std::vector<std::string> comments;
+  std::vector<std::vector<double>> rows;
+};
+
+std::vector<Block> readBlocks(const fs::path& p) {
+  std::vector<Block> blocks;
+  std::istringstream in(slurp(p));
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("# block ", 0) == 0) {
+      blocks.emplace_back();
+      continue;
+    }
+    if (blocks.empty() || line.empty()) continue;
+    if (line[0] == '#') {
+      blocks.back().comments.push_back(line);
+      continue;
+    }
+    std::istringstream ls(line);
+    std::vector<double> row;
+    std::string tok;
+    while (ls >> tok) {
+      if (tok[0] == '"') break;  // a label: the numbers before it are kept
+      row.push_back(tok == "NaN" ? std::nan("") : std::stod(tok));
+    }
+    if (!row.empty() && std::isfinite(row[0])) blocks.back().rows.push_back(row);
+  }
+  return blocks;
+}
+
+/// The `plot` clauses of a gnuplot body, one string each.
+std::vector<std::string> plotClauses(const std::string& body) {
+  const size_t at = body.find("plot \\\n");
+  REQUIRE(at != std::string::npos);
+  std::vector<std::string> out;
+  std::istringstream in(body.substr(at + 7));
+  std::string line;
+  while (std::getline(in, line)) {
+    const size_t b = line.find_first_not_of(' ');
+    if (b == std::string::npos) break;
+    std::string c = line.substr(b);
+    const bool more = c.size() >= 3 && c.compare(c.size() - 3, 3, ", \\") == 0;
+    if (more) c.resize(c.size() - 3);
+    out.push_back(c);
+    if (!more) break;
+  }
+  return out;
+}
+
+std::string field(const std::string& clause, const std::string& key) {
+  const std::regex re(key + " '([^']*)'");
+  std::smatch m;
+  return std::regex_search(clause, m, re) ? m[1].str() : std::string();
+}
+
+int indexOf(const std::string& clause) {
+  const std::regex re(" index ([0-9]+) ");
+  std::smatch m;
+  return std::regex_search(clause, m, re) ? std::stoi(m[1].str()) : -1;
+}
+
+double setting(const std::string& body, const std::string& name) {
+  const std::regex re("set " + name + " at screen ([-0-9.e]+)");
+  std::smatch m;
+  REQUIRE(std::regex_search(body, m, re));
+  return std::stod(m[1].str());
+}
+
+std::pair<double, double> range(const std::string& body, const std::string& axis) {
+  const std::regex re("set " + axis + "range \\[([-0-9.e+]+):([-0-9.e+]+)\\]");
+  std::smatch m;
+  REQUIRE(std::regex_search(body, m, re));
+  return {std::stod(m[1].str()), std::stod(m[2].str())};
+}
+
+/// Rows of branches.csv by column name.
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  size_t col(const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    REQUIRE(it != header.end());
+    return size_t(it - header.begin());
+  }
+};
+
+Csv readCsv(const fs::path& p) {
+  Csv csv;
+  std::istringstream in(slurp(p));
+  std::string line, tok;
+  std::getline(in, line);
+  std::istringstream hs(line);
+  while (std::getline(hs, tok, ',')) csv.header.push_back(tok);
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    std::vector<double> row;
+    while (std::getline(ls, tok, ',')) row.push_back(tok.empty() || tok == "nan" ? std::nan("") : std::stod(tok));
+    csv.rows.push_back(row);
+  }
+  return csv;
+}
+
+// A two-case variant of the paper's clamped–pinned column (default.json): stable and unstable
+// branches, branch points and folds in both cases.
+const char* kTwoCases = R"({
+  "chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+  "end": {"x": {"load": 0.0}, "y": {"held": 0.0}, "phi": "free"},
+  "path": {"parameter": "Fx", "from": 0.0, "to": -2.5},
+  "cases": [{"label": "L0 = 2.25"}, {"label": "L0 = 2.4", "chain": {"L0": 2.4}}],
+  "analyses": {"continuation": {"branch_switching": 1}, "jump": true},
+  "plots": [{"type": "bifurcation", "name": "two", "x": "Fx", "y": "q2"},
+            {"type": "shapes", "name": "shapes", "at": [-0.5, -2.4], "cases": [0]}]
+})";
+
+/// Runs data/scenes/SCENE.json into a fresh directory NAME, which it returns; the run must succeed.
+fs::path runShipped(const std::string& scene, const std::string& name) {
+  const fs::path out = freshDir(name);
+  const Run r = run(scenePath(scene + ".json"), out);
+  INFO(r.err);
+  REQUIRE(r.rc == 0);
+  return out;
+}
+
+/// Writes kTwoCases as DIR.json and runs it into DIR/out.
+Run runTwoCases(const fs::path& dir) {
+  const fs::path scene = dir.string() + ".json";
+  std::ofstream(scene) << kTwoCases;
+  return run(scene, dir / "out");
+}
+
+}  // namespace
+
+TEST_CASE("multi-case bifurcation plot: one colour and key entry per case, stability in the key", "[scene][plot]") {
+  const fs::path dir = freshDir("two_cases"), out = dir / "out";
+  const Run r = runTwoCases(dir);
+  INFO(r.err);
+  REQUIRE(r.rc == 0);
+  const std::string body = slurp(out / "plots" / "two_body.gp");
+  const std::vector<std::string> clauses = plotClauses(body);
+  const std::vector<Block> curves = readBlocks(out / "plots" / "two.dat");
+  // curves: one colour per case (its stable and unstable parts alike), distinct between cases,
+  // the stable part carrying the case label as its only key entry
+  std::map<std::string, std::set<std::string>> coloursOfLabel;
+  std::map<std::string, int> titled;
+  std::vector<std::string> caseColour;
+  int stableKey = 0, unstableKey = 0;
+  for (const std::string& c : clauses) {
+    if (c.rfind("keyentry with lines", 0) == 0) {
+      if (c.find(" dt 1 ") != std::string::npos && field(c, "title") == "stable") ++stableKey;
+      if (c.find(" dt 2 ") != std::string::npos && field(c, "title") == "unstable") ++unstableKey;
+      continue;
+    }
+    if (c.rfind("'two.dat'", 0) != 0) continue;
+    const std::string colour = field(c, "rgb"), title = field(c, "title");
+    if (!title.empty()) {
+      ++titled[title];
+      CHECK(c.find(" dt 1 ") != std::string::npos);  // the key shows the stable (solid) line
+      caseColour.push_back(colour);
+    }
+  }
+  CHECK(titled == std::map<std::string, int>{{"L0 = 2.25", 1}, {"L0 = 2.4", 1}});
+  REQUIRE(caseColour.size() == 2);
+  CHECK(caseColour[0] != caseColour[1]);
+  CHECK(stableKey == 1);
+  CHECK(unstableKey == 1);
+  // every curve clause of case k (blocks in case order: stable, unstable) uses the case colour
+  int curveClauses = 0, unstableDrawn = 0;
+  for (const std::string& c : clauses) {
+    if (c.rfind("'two.dat'", 0) != 0) continue;
+    const int block = indexOf(c);
+    REQUIRE(block >= 0);
+    const size_t k = size_t(block) / 2;  // two blocks (stable, unstable) per case
+    REQUIRE(k < 2);
+    CHECK(field(c, "rgb") == caseColour[k]);
+    CHECK(c.find(block % 2 == 0 ? " dt 1 " : " dt 2 ") != std::string::npos);
+    if (block % 2 == 1 && !curves[size_t(block)].rows.empty()) ++unstableDrawn;
+    ++curveClauses;
+  }
+  CHECK(curveClauses == 4);
+  CHECK(unstableDrawn == 2);  // both cases have unstable branches, drawn dashed
+  // special points: filled markers in the colour of their case, one key entry per type
+  const std::vector<Block> special = readBlocks(out / "plots" / "two_special.dat");
+  std::set<std::string> typesKeyed;
+  int colouredMarkers = 0;
+  for (const std::string& c : clauses) {
+    if (c.rfind("keyentry with points", 0) == 0) typesKeyed.insert(field(c, "title"));
+    if (c.rfind("'two_special.dat'", 0) != 0 || c.find("lw 1 lc rgb 'black'") != std::string::npos) continue;
+    const Block& b = special.at(size_t(indexOf(c)));
+    REQUIRE(!b.comments.empty());
+    const size_t k = b.comments[0].find("# case 1") == 0 ? 1 : 0;
+    CHECK(b.comments[0].find("# case " + std::to_string(k)) == 0);
+    CHECK(field(c, "rgb") == caseColour[k]);
+    ++colouredMarkers;
+  }
+  CHECK(colouredMarkers >= 4);  // BP and LP (and BD) in both cases
+  CHECK(typesKeyed.count("BP branch point") == 1);
+  CHECK(typesKeyed.count("LP fold") == 1);
+  fs::remove_all(dir.parent_path());
+}
+
+TEST_CASE("special-point labels do not overlap one another, a marker or the plot border", "[scene][plot]") {
+  for (const char* sceneName : {"default", "hysteresis", "fig9_fig10"}) {
+    const std::string name = sceneName;
+    DYNAMIC_SECTION(name) {
+      const fs::path out = runShipped(name, name);
+      int plots = 0;
+      for (const auto& e : fs::directory_iterator(out / "plots")) {
+        const std::string file = e.path().filename().string();
+        if (file.size() < 11 || file.compare(file.size() - 11, 11, "_labels.dat") != 0) continue;
+        const std::string stem = file.substr(0, file.size() - 11);
+        INFO(stem);
+        ++plots;
+        const std::string body = slurp(out / "plots" / (stem + "_body.gp"));
+        const double l = setting(body, "lmargin"), rr = setting(body, "rmargin"), b = setting(body, "bmargin"),
+                     t = setting(body, "tmargin");
+        const auto [x0, x1] = range(body, "x");
+        const auto [y0, y1] = range(body, "y");
+        const double W = 1000, H = 700;  // the terminal size of these plots (NAME.gp)
+        CHECK(slurp(out / "plots" / (stem + ".gp")).find("size 1000,700") != std::string::npos);
+        auto px = [&](double x, double y) {
+          return std::pair<double, double>{W * (l + (rr - l) * (x - x0) / (x1 - x0)), H * (b + (t - b) * (y - y0) / (y1 - y0))};
+        };
+        // labels: x y label_x label_y "text" leader_x leader_y
+        struct Box {
+          double x0, y0, x1, y1;
+        };
+        std::vector<Box> boxes, markers;
+        std::ifstream in(out / "plots" / file);
+        std::string line;
+        const std::regex re(R"re(^(\S+) (\S+) (\S+) (\S+) "([^"]*)" (\S+) (\S+)$)re");
+        while (std::getline(in, line)) {
+          std::smatch m;
+          if (!std::regex_match(line, m, re)) continue;
+          const auto [ax, ay] = px(std::stod(m[1]), std::stod(m[2]));
+          const auto [cx, cy] = px(std::stod(m[3]), std::stod(m[4]));
+          // 9 pt DejaVu Sans: at most 6.2 px per character, 11 px high
+          const double w = 6.2 * double(m[5].str().size()), h = 11.0;
+          boxes.push_back({cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2});
+          markers.push_back({ax - 5, ay - 5, ax + 5, ay + 5});
+          const Box& bx = boxes.back();
+          CHECK(bx.x0 >= W * l - 1e-6);
+          CHECK(bx.x1 <= W * rr + 1e-6);
+          CHECK(bx.y0 >= H * b - 1e-6);
+          CHECK(bx.y1 <= H * t + 1e-6);
+          // a leader, when drawn, runs from the point to the label
+          if (m[6] != "NaN") {
+            const auto [ex, ey] = px(std::stod(m[6]), std::stod(m[7]));
+            CHECK(ex >= bx.x0 - 3);
+            CHECK(ex <= bx.x1 + 3);
+            CHECK(ey >= bx.y0 - 3);
+            CHECK(ey <= bx.y1 + 3);
+          }
+        }
+        REQUIRE(!boxes.empty());
+        auto overlap = [](const Box& p, const Box& q) { return p.x0 < q.x1 && q.x0 < p.x1 && p.y0 < q.y1 && q.y0 < p.y1; };
+        for (size_t i = 0; i < boxes.size(); ++i)
+          for (size_t j = 0; j < boxes.size(); ++j) {
+            if (i != j) CHECK(!overlap(boxes[i], boxes[j]));
+            CHECK(!overlap(boxes[i], markers[j]));
+          }
+      }
+      CHECK(plots >= 2);
+      if (name == "hysteresis") {
+        // the fold's branch point and the jump released there share one label
+        const std::string labels = slurp(out / "plots" / "hysteresis_q1_labels.dat");
+        CHECK(labels.find(", JUMP\"") != std::string::npos);
+      }
+      fs::remove_all(out);
+    }
+  }
+}
+
+TEST_CASE("stiffness plots mark KMIN and joint limits at the traced stiffness", "[scene][plot]") {
+  const fs::path out = runShipped("fig9_fig10", "fig9_fig10_kmin");
+  const Csv csv = readCsv(out / "branches.csv");
+  const json sp = readJson(out / "special_points.json");
+  const std::vector<Block> special = readBlocks(out / "plots" / "fig10a_Kxx_special.dat");
+  std::map<std::string, int> marked;
+  for (const Block& b : special) {
+    if (b.comments.empty()) continue;
+    const std::string& c = b.comments[0];
+    const int k = std::stoi(c.substr(7));
+    const std::string type = c.substr(c.rfind(": ") + 2);
+    for (const std::vector<double>& row : b.rows) {
+      ++marked[type];
+      // the special point of that type in special_points.json at this Fx
+      bool found = false;
+      for (const json& p : sp["special_points"]) {
+        if (p["case"] != k || p["type"] != type || std::abs(double(p["loads"]["Fx"]) - row[0]) > 1e-9) continue;
+        found = true;
+        if (type != "KMIN" && type != "BD") continue;
+        // at a traced point: the marker's Kxx is that point's Kxx in branches.csv
+        bool atPoint = false;
+        for (const auto& rowCsv : csv.rows) {
+          if (int(rowCsv[csv.col("case")]) != k || int(rowCsv[csv.col("branch")]) != int(p["branch"])) continue;
+          if (std::abs(rowCsv[csv.col("Fx")] - row[0]) > 1e-9 * (1 + std::abs(row[0]))) continue;
+          bool sameQ = true;
+          for (int i = 0; i < 3; ++i)
+            sameQ = sameQ && std::abs(rowCsv[csv.col("q" + std::to_string(i + 1))] - double(p["q"][size_t(i)])) < 1e-9;
+          if (!sameQ) continue;
+          atPoint = true;
+          CHECK(row[1] == Approx(rowCsv[csv.col("Kxx")]).epsilon(1e-9));
+        }
+        if (type == "KMIN") CHECK(atPoint);
+      }
+      CHECK(found);
+    }
+  }
+  // fig9_fig10: a deep Kxx minimum for a/b = 0.75 and 0.9, the joint limit in all three cases
+  CHECK(marked["KMIN"] == 2);
+  CHECK(marked["BD"] == 3);
+  fs::remove_all(out);
+}
+
+TEST_CASE("a shape requested where no stable point was traced is reported, not moved", "[scene][plot]") {
+  const fs::path dir = freshDir("shape_outside"), out = dir / "out";
+  const Run r = runTwoCases(dir);
+  REQUIRE(r.rc == 0);  // a plot note, not a failed computation
+  const json summary = readJson(out / "summary.json");
+  CHECK(summary["complete"] == true);
+  REQUIRE(summary.contains("notes"));
+  REQUIRE(summary["notes"].size() == 1);  // Fx = -0.5 is on the stable straight branch
+  const std::string note = summary["notes"][0];
+  CHECK(note.find("/plots/1/at/1") != std::string::npos);
+  CHECK(note.find("Fx = -2.4") != std::string::npos);
+  CHECK(note.find("outside the traced stable range") != std::string::npos);
+  CHECK(r.err.find("note: " + note) != std::string::npos);
+  // the panel at -2.4 has no chain in it; the one at -0.5 has the three joints
+  CHECK(readBlocks(out / "plots" / "shapes_0_1_jnt.dat")[0].rows.empty());
+  CHECK(readBlocks(out / "plots" / "shapes_0_0_jnt.dat")[0].rows.size() == 3);
+  const std::string body = slurp(out / "plots" / "shapes_body.gp");
+  CHECK(body.find("Fx = -2.4: not drawn") != std::string::npos);
+  fs::remove_all(dir.parent_path());
+}
+
+TEST_CASE("sudden-load plot: energies with a constant sum, rest shape beside the quasi-static one", "[scene][plot]") {
+  const fs::path out = runShipped("sudden_load", "sudden");
+  const json sp = readJson(out / "special_points.json");
+  const json& s = sp["sudden_load"][0];
+  const double balance = s["energy_balance_error"];
+  const std::vector<Block> energy = readBlocks(out / "plots" / "sudden_load_0_energy.dat");
+  // the energy file has no block header: one table t Π T W_d sum
+  std::ifstream in(out / "plots" / "sudden_load_0_energy.dat");
+  std::string line;
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    std::vector<double> row(5);
+    for (double& v : row) ls >> v;
+    rows.push_back(row);
+  }
+  REQUIRE(rows.size() > 100);
+  CHECK(rows[0][0] == 0.0);
+  CHECK(rows[0][2] == 0.0);
+  CHECK(rows[0][3] == 0.0);
+  const double total0 = rows[0][1];
+  double drift = 0.0, peakKinetic = 0.0, dissipated = 0.0;
+  for (const auto& row : rows) {
+    CHECK(row[4] == Approx(row[1] + row[2] + row[3]).epsilon(1e-15).margin(1e-15));
+    drift = std::max(drift, std::abs(row[1] + row[2] + row[3] - total0));
+    peakKinetic = std::max(peakKinetic, row[2]);
+    dissipated = std::max(dissipated, row[3]);
+  }
+  // Π + T + W_d is constant to the balance error the integrator reports, which is tiny against
+  // the energy that changes form
+  CHECK(drift <= balance * (1 + 1e-9) + 4e-16 * std::abs(total0));
+  CHECK(peakKinetic == Approx(double(s["peak_kinetic"])).epsilon(1e-9));
+  CHECK(balance < 1e-6 * peakKinetic);
+  CHECK(dissipated > 0.0);
+  // the drawn chains: the last joint plus the last link along φ is the end position reported
+  // for each answer
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
+  for (const auto& [file, pos] : {std::pair<std::string, json>{"sudden_load_0_rest_jnt.dat", s["rest"]["position"]},
+                                  {"sudden_load_0_static_jnt.dat", s["quasi_static"]["position"]}}) {
+    const std::vector<Block> joints = readBlocks(out / "plots" / file);
+    REQUIRE(joints[0].rows.size() == 3);
+    const std::vector<double>& last = joints[0].rows.back();
+    const double phi = pos["phi"], L = chain.linkLengths()[3];
+    CHECK(last[0] + L * std::cos(phi) == Approx(double(pos["x"])).margin(1e-8));
+    CHECK(last[1] + L * std::sin(phi) == Approx(double(pos["y"])).margin(1e-8));
+  }
+  // the two answers differ in this scene, and the plot says so
+  const std::string body = slurp(out / "plots" / "sudden_load_body.gp");
+  CHECK(body.find("quasi-static: ") != std::string::npos);
+  CHECK(body.find(bool(s["quasi_static"]["differs"]) ? "(differs" : "(same") != std::string::npos);
+  const json summary = readJson(out / "summary.json");
+  if (!summary["plots"]["gnuplot"].get<std::string>().empty() &&
+      summary["plots"]["gnuplot"].get<std::string>().rfind("not found", 0) != 0)
+    CHECK(fs::exists(out / "plots" / "sudden_load.png"));
+  fs::remove_all(out);
+}
+
+TEST_CASE("load history: its stable pieces are the branches of branches.csv, in equilibrium and stable",
+          "[scene][plot]") {
+  const fs::path out = runShipped("hysteresis", "hysteresis_branches");
+  REQUIRE(fs::exists(out / "branches.csv"));
+  const Csv csv = readCsv(out / "branches.csv");
+  const json summary = readJson(out / "summary.json");
+  const json& branches = summary["cases"][0]["branches"];
+  REQUIRE(branches.size() >= 4);  // up to the fold, back down to the other fold, up again
+  std::map<int, int> pointsOf;
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
+  const double scale = 1.0 * 1.0 * 1.0;  // k b²: the torques' unit
+  double worstGradient = 0.0, worstEigen = std::numeric_limits<double>::infinity(), stiffest = 0.0;
+  for (const auto& row : csv.rows) {
+    ++pointsOf[int(row[csv.col("branch")])];
+    Eigen::VectorXd q(3), g(3);
+    for (int i = 0; i < 3; ++i) q[i] = row[csv.col("q" + std::to_string(i + 1))];
+    const Wrench F(row[csv.col("Fx")], row[csv.col("Fy")], row[csv.col("Me")]);
+    CHECK(F[0] == 0.0);
+    CHECK(F[1] == 0.0);
+    CHECK(F[2] == Approx(row[csv.col("parameter")]).margin(1e-15));
+    totalPotentialGradient(chain, q, F, g);
+    worstGradient = std::max(worstGradient, g.cwiseAbs().maxCoeff());
+    // stable: the Hessian of Π (free end: all of it) has no negative eigenvalue; at the pieces'
+    // last points (the folds) the smallest is zero to the location accuracy
+    Eigen::MatrixXd H(3, 3);
+    totalPotentialHessian(chain, q, F, H);
+    const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues()[0];
+    worstEigen = std::min(worstEigen, smallest);
+    stiffest = std::max(stiffest, H.norm());
+    CHECK(row[csv.col("stable")] == 1.0);
+  }
+  CHECK(worstGradient < 1e-8 * scale);
+  CHECK(worstEigen > -1e-9 * stiffest);
+  for (const json& b : branches) {
+    CHECK(b["origin"].get<std::string>().rfind("load history", 0) == 0);
+    CHECK(pointsOf[int(b["id"])] == int(b["points"]));
+    CHECK(pointsOf[int(b["id"])] >= 2);
+  }
+  CHECK(pointsOf.size() == branches.size());
+  // each jump lands where the next piece starts; the history ends at the last waypoint
+  const json sp = readJson(out / "special_points.json");
+  int jumps = 0;
+  for (const json& p : sp["special_points"]) {
+    if (p["type"] != "JUMP") continue;
+    ++jumps;
+    bool startsPiece = false;
+    for (const auto& row : csv.rows) {
+      if (row[csv.col("point")] != 0.0) continue;
+      double d = 0.0;
+      for (int i = 0; i < 3; ++i)
+        d = std::max(d, std::abs(row[csv.col("q" + std::to_string(i + 1))] - double(p["jump_to"]["q"][size_t(i)])));
+      startsPiece = startsPiece || d < 1e-9;
+    }
+    CHECK(startsPiece);
+  }
+  CHECK(jumps == 3);
+  CHECK(csv.rows.back()[csv.col("parameter")] == Approx(0.3).margin(1e-12));
+  fs::remove_all(out);
+}
