@@ -160,10 +160,26 @@ void sameWrench(const json& a, const json& b, const Units& u, const std::string&
   same(a["Me"], b["Me"], u.torque(), what + " Me");
 }
 
-void samePose(const json& a, const json& b, const Units& u, const std::string& what) {
-  same(a["x"], b["x"], u.length, what + " x");
-  same(a["y"], b["y"], u.length, what + " y");
-  same(a["phi"], b["phi"], 1.0, what + " phi");
+void samePose(const json& a, const json& b, const Units& u, const std::string& what, double tolerance = 1e-10) {
+  same(a["x"], b["x"], u.length, what + " x", tolerance);
+  same(a["y"], b["y"], u.length, what + " y", tolerance);
+  same(a["phi"], b["phi"], 1.0, what + " phi", tolerance);
+}
+
+// A branch point of multiplicity ≥ 2 is not refined (no regular augmented system): it is the
+// sample of the branch inside a bracket of |ds| ~ 1e-11, where the Keller system is singular
+// to that order, so its joint angles are determined only to ~eps/|ds| ≈ 1e-5·(scale) in any unit
+// system (its λ still to rounding). Such points, and the jumps released from them (same q),
+// are compared to 1e-6 in q and position.
+bool nearMultiplePoint(const json& point, const json& all) {
+  for (const json& p : all) {
+    if (p["type"] != "BP" || p["accuracy"]["refined"] == true) continue;
+    if (!p.contains("note") || p["note"].get<std::string>().find("multiplicity") == std::string::npos) continue;
+    double d = 0.0;
+    for (size_t i = 0; i < p["q"].size(); ++i) d = std::max(d, std::abs(p["q"][i].get<double>() - point["q"][i].get<double>()));
+    if (d <= 1e-5) return true;
+  }
+  return false;
 }
 
 void compare(const json& got, const json& ref, const json& scene, const Units& u) {
@@ -175,13 +191,28 @@ void compare(const json& got, const json& ref, const json& scene, const Units& u
     const json &g = gs[i], &r = rs[i];
     const std::string what = "special point " + std::to_string(i) + " (" + r["type"].get<std::string>() + ")";
     INFO(what << ": " << r.dump());
-    for (const char* key : {"type", "field", "case", "branch", "shape", "stability_before", "stability_after"})
+    const bool degenerate = r["q"].size() == g["q"].size() && nearMultiplePoint(r, rs);
+    for (const char* key : {"type", "field", "case", "branch", "shape", "stability_before", "stability_after"}) {
+      INFO(key << ": " << g[key].dump() << " vs " << r[key].dump());
+      // At the hysteresis scene's symmetric point a fold and a double branch point coincide
+      // exactly (free end under Me, equal joints: H = K_q(q)·I, all three eigenvalues cross at
+      // the fold). Which branch through it the tracer continues on, and so whether the point is
+      // reported as BP (multiplicity 3) or LP, is decided by rounding in any unit system: there
+      // the location (λ, and q to 1e-6) is compared, not the classification.
+      const bool classification = std::string(key) == "type" || std::string(key) == "field" ||
+                                  std::string(key) == "shape" || std::string(key) == "stability_after";
+      if (degenerate && classification && r["type"] == "BP") {
+        CHECK((g["type"] == "BP" || g["type"] == "LP"));
+        continue;
+      }
       CHECK(g[key] == r[key]);
+    }
     const std::string parameter = parameterOf(scene, scene.contains("cases") ? scene["cases"][r["case"].get<size_t>()] : json::object());
     same(g["parameter"], r["parameter"], u.of(parameter), what + " parameter");
-    sameVector(g["q"], r["q"], 1.0, what + " q");
+    const double angleTolerance = degenerate ? 1e-6 : 1e-10;
+    sameVector(g["q"], r["q"], 1.0, what + " q", angleTolerance);
     sameWrench(g["loads"], r["loads"], u, what);
-    samePose(g["position"], r["position"], u, what);
+    samePose(g["position"], r["position"], u, what, angleTolerance);
     REQUIRE(g.contains("jump_to") == r.contains("jump_to"));
     if (!r.contains("jump_to")) continue;
     const json &gj = g["jump_to"], &rj = r["jump_to"];

@@ -70,11 +70,11 @@ bool Problem::stabilityOperator(ConstVectorRef, double, Matrix&, Matrix&) { retu
 bool Problem::stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo& info) {
   if (!hasStabilityOperator()) return false;
   if (!stabilityOperator(u, lambda, stabilityH_, stabilityC_)) return false;
-  info = projectedInertia(stabilityH_, stabilityC_, 1e-13, lowestCount);
+  info = projectedInertia(stabilityH_, stabilityC_, 1e-13, lowestCount, scales().stability);
   return true;
 }
 
-StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance, int lowestCount) {
+StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance, int lowestCount, double scale) {
   StabilityInfo info;
   Matrix reduced;
   if (C.rows() == 0) {
@@ -96,7 +96,7 @@ StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTole
   }
   Eigen::SelfAdjointEigenSolver<Matrix> es(0.5 * (reduced + reduced.transpose()), Eigen::EigenvaluesOnly);
   const Vector& mu = es.eigenvalues();
-  const double tol = zeroTolerance * mu.cwiseAbs().maxCoeff();
+  const double tol = zeroTolerance * std::max(scale, mu.cwiseAbs().maxCoeff());
   info.negative = 0;
   info.zero = 0;
   for (Eigen::Index i = 0; i < mu.size(); ++i) {

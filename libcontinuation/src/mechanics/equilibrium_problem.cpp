@@ -37,6 +37,7 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
     requireFinite(std::string("end value ") + names[c], end.value[c]);
     requireFinite(std::string("load path direction ") + names[c], direction[c]);
   }
+  structure_.typicalScale = stiffnessUnit() * lengthUnit() * lengthUnit();  // the inertia's zero floor
 }
 
 bool EquilibriumProblem::prepare(ConstVectorRef u) {

@@ -113,9 +113,11 @@ class Problem {
 };
 
 /// Inertia of the symmetric H restricted to ker C (C may have zero rows), by a dense
-/// eigen-decomposition. `zeroTolerance` is relative to ‖H‖ (the largest |eigenvalue| on ker C),
-/// so the count does not depend on the units of H.
-/// At most `lowestCount` lowest eigenvalues are kept in info.lowest.
-StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance = 1e-13, int lowestCount = 3);
+/// eigen-decomposition. `zeroTolerance` is relative to max(scale, ‖H‖) (‖H‖ the largest
+/// |eigenvalue| on ker C, `scale` the typical eigenvalue, ProblemScales::stability), so the count
+/// does not depend on the units of H. At most `lowestCount` lowest eigenvalues are kept in
+/// info.lowest.
+StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance = 1e-13, int lowestCount = 3,
+                               double scale = 1.0);
 
 }  // namespace buckle::continuation
