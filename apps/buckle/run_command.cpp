@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <unistd.h>
 
 #include "scene/command.h"
 
@@ -15,17 +16,31 @@ void addRunCommand(CLI::App& app, Outcome& outcome) {
   run->footer(
       "Computes only what the scene asks for and writes DIR/branches.csv, DIR/special_points.json, "
       "DIR/summary.json and DIR/plots/*.png|svg (gnuplot).\n"
-      "Exit status: 0 success, 1 a computation could not finish (what was computed is written), 2 bad input "
-      "(the message names the file and the JSON path of the bad value; nothing is written).");
+      "Exit status: 0 success, 1 a computation could not finish or the time limit stopped it (what was computed "
+      "is written), 2 bad input (the message names the file and the JSON path of the bad value; nothing is "
+      "written), 130 / 143 stopped by SIGINT / SIGTERM (what was computed is written; a second signal ends the "
+      "program at once).\n"
+      "Progress goes to stderr: a live line on a terminal, a plain line every few seconds otherwise; --quiet "
+      "silences it.");
   run->add_option("scene", options->scene, "Scene file (JSON, schema: docs/scenes.md), e.g. data/scenes/default.json")
       ->required();
   run->add_option("--out,-o", options->out,
                   "Output directory (default: out/<scene name>). Written to a temporary directory beside it and "
                   "renamed at the end, so it is never half-written");
   run->add_flag("--quiet,-q", options->quiet, "No progress messages (errors are still printed)");
+  run->add_option("--time-limit", options->timeLimit,
+                  "Seconds for the whole run (overrides the scene's /solver/time_limit); when it is reached the "
+                  "run stops within a step, writes what it computed (summary.json: \"complete\": false) and exits 1")
+      ->check(CLI::PositiveNumber);
   run->callback([options, &outcome]() {
+    options->handleSignals = true;
+    options->progress = ::isatty(STDERR_FILENO) == 1 ? scene::Progress::Mode::Live : scene::Progress::Mode::Lines;
     const int code = scene::runSceneCommand(*options, std::cout, std::cerr);
-    outcome.code = code == scene::kSuccess ? kSuccess : code == scene::kBadInput ? kBadInput : kComputationFailure;
+    // 128 + signal after SIGINT/SIGTERM (partial results written), as a shell reports it
+    outcome.code = code == scene::kSuccess    ? kSuccess
+                   : code == scene::kBadInput ? kBadInput
+                   : code > 128               ? code
+                                              : kComputationFailure;
   });
 }
 

@@ -2,8 +2,12 @@
 // and the tests call this directly).
 #pragma once
 
+#include <limits>
 #include <ostream>
 #include <string>
+#include <vector>
+
+#include "scene/progress.h"
 
 namespace buckle::scene {
 
@@ -13,13 +17,24 @@ enum ExitCode : int { kSuccess = 0, kIncomplete = 1, kBadInput = 2 };
 struct RunCommandOptions {
   std::string scene;        ///< scene file
   std::string out;          ///< output directory; empty: out/<scene stem>
-  bool quiet = false;       ///< no progress messages on `log`
+  bool quiet = false;       ///< no progress messages on `log`, no progress line on `err`
+  /// Seconds for the whole run, overriding the scene's /solver/time_limit (NaN: the scene's).
+  double timeLimit = std::numeric_limits<double>::quiet_NaN();
+  /// Progress on `err`: a live line (terminal) or plain periodic lines; Off when quiet.
+  Progress::Mode progress = Progress::Mode::Lines;
+  /// Stop on SIGINT/SIGTERM with partial results (the CLI); off for in-process callers.
+  bool handleSignals = false;
 };
+
+/// The problems of a run for a human: the first `keep` as they are, then the rest grouped by
+/// their shape (digits ignored), each group once with its count and one example.
+std::vector<std::string> summariseProblems(const std::vector<std::string>& problems, size_t keep = 8);
 
 /// Parses the scene (bad input: message on `err`, nothing written, returns kBadInput), runs
 /// what it asks for, writes everything into a staging directory next to `out` and renames it
-/// into place. Returns kSuccess, or kIncomplete when a computation could not finish (what was
-/// computed is still written).
+/// into place. Returns kSuccess, or kIncomplete when a computation could not finish or the time
+/// limit stopped it (what was computed is still written), or 128 + the signal number after
+/// SIGINT/SIGTERM (with handleSignals; what was computed is still written).
 int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::ostream& err);
 
 /// Default output directory for a scene file: out/<stem>.

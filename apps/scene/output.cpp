@@ -1,6 +1,7 @@
 #include "scene/output.h"
 
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -60,9 +61,11 @@ void writeText(const fs::path& file, const std::string& text) {
 
 std::string fmt(double v) {
   if (!std::isfinite(v)) return "nan";
+  // as printf's %.12g (the C++17 definition of to_chars), several times faster: long chains
+  // write millions of numbers, inside the run's time limit
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.12g", v);
-  return buf;
+  const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 12);
+  return std::string(buf, r.ptr);
 }
 
 void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir) {
@@ -250,6 +253,9 @@ void writeSummary(const Scene& scene, const RunResult& run, const PlotReport& pl
   doc["scene"] = scene.file;
   doc["description"] = scene.description;
   doc["complete"] = run.complete;
+  // stopped early by the time limit or a signal: the results are what was computed until then
+  doc["interrupted"] = run.interrupted;
+  if (run.interrupted) doc["interruption"] = run.interruption;
   if (!run.problems.empty()) doc["problems"] = run.problems;
   doc["computed"] = run.computed;
   doc["solver"] = solverJson(scene.solver);

@@ -45,8 +45,8 @@ bool regularStop(cont::StopReason r) {
 /// Everything needed to trace and post-process the branches of one case.
 class CaseRunner {
  public:
-  CaseRunner(const Scene& scene, const CaseSpec& spec, CaseResult& out, RunResult& run, Clock::time_point start)
-      : scene_(scene), spec_(spec), out_(out), run_(run), start_(start) {}
+  CaseRunner(const Scene& scene, const CaseSpec& spec, CaseResult& out, RunResult& run, const RunControl& control)
+      : scene_(scene), spec_(spec), out_(out), run_(run), control_(control) {}
 
   void continuation();
   void loadHistory();
@@ -55,17 +55,20 @@ class CaseRunner {
   void energyCurves();
   void torqueAngle();
 
- private:
-  bool outOfTime() {
-    if (secondsSince(start_) <= scene_.solver.timeLimit) return false;
-    if (!timeReported_) {
-      run_.complete = false;
-      run_.problems.push_back("case \"" + spec_.label + "\": time limit of " +
-                              std::to_string(scene_.solver.timeLimit) + " s (/solver/time_limit) reached");
-      timeReported_ = true;
-    }
+  /// True once the time limit passed or a signal came: the run is then marked incomplete,
+  /// once, with the reason.
+  bool interrupted() {
+    if (run_.interrupted) return true;
+    if (!control_.interrupt.requested()) return false;
+    run_.interrupted = true;
+    run_.complete = false;
+    run_.interruption = control_.interrupt.describe();
+    run_.problems.push_back("stopped early in case \"" + spec_.label + "\": " + run_.interruption +
+                            "; everything computed until then is written");
     return true;
   }
+
+ private:
   void record(const cont::Branch& b, mech::EquilibriumProblem& problem, const std::string& origin);
   bool throughLoad() const { return spec_.path.loadLimit > 0.0; }
   /// The scene's /solver settings as tracer options (the λ range is set by each analysis).
@@ -76,6 +79,23 @@ class CaseRunner {
     opt.maxStep = scene_.solver.maxStep;
     opt.maxPoints = scene_.solver.maxPoints;
     opt.newtonTolerance = scene_.solver.tolerance;
+    opt.interrupt = control_.interrupt;
+    if (control_.progress) {
+      Progress* progress = control_.progress;
+      const CaseResult* out = &out_;
+      const int* branches = &branchesSoFar_;
+      opt.onStep = [progress, out, branches](const cont::Branch& b) {
+        progress->step(*branches + 1, static_cast<int>(b.points.size()), b.points.back().lambda,
+                       static_cast<int>(out->specials.size() + b.specialPoints.size()));
+        return cont::StepAction::Continue;
+      };
+    }
+    return opt;
+  }
+  /// Integration settings of the dynamics with the run's interrupt.
+  mech::IntegrationOptions integrationOptions() const {
+    mech::IntegrationOptions opt;
+    opt.interrupt = control_.interrupt;
     return opt;
   }
   /// The path as an EquilibriumProblem: prescribed(λ) = start values + (λ − s0)·direction.
@@ -89,6 +109,7 @@ class CaseRunner {
     const int n = out_.chain.size();
     mech::JumpOptions opt;
     opt.perturbation = scene_.analyses.jump.perturbation;
+    opt.integration = integrationOptions();
     opt.integration.recordTrajectory = false;
     s.jumpTried = true;
     try {
@@ -118,7 +139,9 @@ class CaseRunner {
       }
       s.energyReleased = j.energyReleased;
       s.jumpDistance = j.distance;
-      if (!j.success) {
+      if (!j.success && j.stopReason == mech::StopReason::Interrupted) {
+        interrupted();
+      } else if (!j.success) {
         run_.complete = false;
         run_.problems.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter + " = " +
                                 std::to_string(sp.lambda) + " did not land on a stable equilibrium: " + j.message);
@@ -144,14 +167,13 @@ class CaseRunner {
     for (size_t k = 0; k < held.size(); ++k) C.row(Eigen::Index(k)) = J.row(held[k]);
     return cont::projectedInertia(H, C, 1e-10);
   }
-  bool switchAt(cont::Tracer& tracer, const cont::Branch& parent, int spIndex, int sign, cont::Branch& child);
 
   const Scene& scene_;
   const CaseSpec& spec_;
   CaseResult& out_;
   RunResult& run_;
-  Clock::time_point start_;
-  bool timeReported_ = false;
+  const RunControl& control_;
+  int branchesSoFar_ = 0;  // for progress reports
 };
 
 void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem, const std::string& origin) {
@@ -180,7 +202,9 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
       br.stopMessage = "joint " + std::to_string(limitJoint + 1) + " reached its limit (" + br.stopMessage + ")";
     }
   }
-  if (!br.finished) {
+  if (b.stopReason == cont::StopReason::Interrupted) {
+    interrupted();  // reported once for the run, not per branch
+  } else if (!br.finished) {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\", branch " + std::to_string(b.id) + " (" + origin +
                             ") stopped early: " + br.stopReason + (b.stopMessage.empty() ? "" : " — " + b.stopMessage));
@@ -269,7 +293,14 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
       s.shape = mech::shapeName(s.q, 1e-6);
     if (sp.multiplicity > 1) s.note += (s.note.empty() ? "" : "; ") + std::string("multiplicity ") + std::to_string(sp.multiplicity);
     run_.worstLocation = std::max(run_.worstLocation, sp.lambdaAccuracy);
-    if (scene_.analyses.jump.enabled && sp.type == cont::SpecialPointType::Fold && !throughLoad()) simulateJumpAt(problem, sp, s);
+    if (scene_.analyses.jump.enabled && sp.type == cont::SpecialPointType::Fold && !throughLoad()) {
+      if (interrupted()) {
+        s.jumpMessage = "not simulated: " + run_.interruption;
+      } else {
+        if (control_.progress) control_.progress->note("jump from the fold at " + std::to_string(sp.lambda));
+        simulateJumpAt(problem, sp, s);
+      }
+    }
     out_.specials.push_back(s);
   }
 
@@ -379,6 +410,7 @@ void CaseRunner::loadHistory() {
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();
   opt.jump.perturbation = scene_.analyses.loadHistory.perturbation;
+  opt.jump.integration = integrationOptions();
   mech::LoadHistoryResult h;
   try {
     h = mech::followLoadHistory(problem, out_.q0, scene_.analyses.loadHistory.waypoints, opt);
@@ -433,7 +465,7 @@ void CaseRunner::loadHistory() {
     s.jumpDistance = j.distance;
     out_.specials.push_back(s);
   }
-  if (!h.completed) {
+  if (!h.completed && !interrupted()) {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": load history stopped: " + h.message);
   }
@@ -454,6 +486,7 @@ void CaseRunner::suddenLoad() {
   if (spec.value != s0) {
     mech::LoadHistoryOptions opt;
     opt.tracer = solverOptions();
+    opt.jump.integration = integrationOptions();
     try {
       const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.q0, {s0, spec.value}, opt);
       if (h.completed && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);
@@ -466,6 +499,7 @@ void CaseRunner::suddenLoad() {
   mech::EndCondition loaded = problem.endCondition();
   loaded.value += spec.value * problem.direction();
   mech::SuddenLoadOptions opt;
+  opt.integration = integrationOptions();
   if (spec.massPerLength > 0) {
     opt.scene.inertia = mech::InertiaData::uniformRods(out_.chain, spec.massPerLength);
     if (spec.damping > 0) opt.scene.jointDamping.assign(size_t(n), spec.damping);
@@ -494,7 +528,7 @@ void CaseRunner::suddenLoad() {
     rec.residual = r.residual;
     rec.energyBalanceError = r.dynamics.maxEnergyBalanceError;
     rec.trajectory = r.dynamics.trajectory;
-    if (!r.success) {
+    if (!r.success && !interrupted()) {
       run_.complete = false;
       run_.problems.push_back("case \"" + spec_.label + "\": sudden load: " + r.message);
     }
@@ -503,19 +537,6 @@ void CaseRunner::suddenLoad() {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": sudden load: " + e.what());
   }
-}
-
-// Leaves the branch point `spIndex` of `parent` along the bifurcating direction (sign ±1).
-bool CaseRunner::switchAt(cont::Tracer& tracer, const cont::Branch& parent, int spIndex, int sign,
-                          cont::Branch& child) {
-  const cont::SpecialPoint& sp = parent.specialPoints[size_t(spIndex)];
-  cont::Vector direction;
-  std::string note;
-  if (!cont::bifurcatingDirection(tracer.problem(), sp, direction, &note)) return false;
-  child = cont::switchBranch(tracer, sp, direction, sign);
-  child.parentId = parent.id;
-  child.parentSpecialPoint = spIndex;
-  return child.stopReason != cont::StopReason::SwitchFailed;
 }
 
 void CaseRunner::continuation() {
@@ -557,49 +578,33 @@ void CaseRunner::continuation() {
   opt.lambdaMin = lambdaLo;
   opt.lambdaMax = lambdaHi;
   opt.computeStability = true;
-  cont::Tracer tracer(problem, opt);
 
-  std::vector<cont::Branch> branches;
+  // The start branches (one per requested direction), then branch switching breadth first, by
+  // the core's tree driver (its guards: never back at the BP a branch started from, never twice
+  // at the same point).
+  std::vector<cont::InitialDirection> starts;
   std::vector<std::string> origins;
-  std::vector<int> depth;
   for (double target : targets) {
     if (target == s0) continue;
-    if (outOfTime()) break;
-    const int sign = target > s0 ? 1 : -1;
-    cont::Branch b = tracer.trace(nr.u, s0, sign > 0 ? cont::InitialDirection::increasingLambda()
-                                                     : cont::InitialDirection::decreasingLambda());
-    b.id = static_cast<int>(branches.size());
-    branches.push_back(std::move(b));
-    origins.push_back(std::string("start, ") + (sign > 0 ? "increasing " : "decreasing ") +
+    const bool up = target > s0;
+    starts.push_back(up ? cont::InitialDirection::increasingLambda() : cont::InitialDirection::decreasingLambda());
+    origins.push_back(std::string("start, ") + (up ? "increasing " : "decreasing ") +
                       (throughLoad() ? std::string(c == 0 ? "Fx" : c == 1 ? "Fy" : "Me") + " (through the reaction)"
                                      : spec_.path.parameter));
-    depth.push_back(0);
   }
-  // Branch switching, breadth first, up to the requested depth.
-  for (size_t i = 0; i < branches.size(); ++i) {
-    if (depth[i] >= scene_.analyses.continuation.branchSwitching) continue;
-    for (size_t k = 0; k < branches[i].specialPoints.size(); ++k) {
-      const cont::SpecialPoint& bp = branches[i].specialPoints[k];
-      if (bp.type != cont::SpecialPointType::BranchPoint || bp.multiplicity > 1) continue;
-      for (int sign : {1, -1}) {
-        if (outOfTime()) break;
-        cont::Branch child;
-        const bool ok = switchAt(tracer, branches[i], static_cast<int>(k), sign, child);
-        const std::string origin = "BP " + std::to_string(k) + " of branch " + std::to_string(i) +
-                                   (sign > 0 ? ", + side" : ", - side");
-        if (!ok) {
-          child.stopReason = cont::StopReason::SwitchFailed;
-          if (child.stopMessage.empty()) child.stopMessage = "no bifurcating direction at this branch point";
-          child.parentId = branches[i].id;
-        }
-        child.id = static_cast<int>(branches.size());
-        branches.push_back(std::move(child));
-        origins.push_back(origin);
-        depth.push_back(depth[i] + 1);
-      }
-    }
+  cont::TreeOptions tree;
+  tree.maxDepth = scene_.analyses.continuation.branchSwitching;
+  tree.onBranch = [this](const cont::BranchTree& t, const cont::Branch&) {
+    branchesSoFar_ = static_cast<int>(t.branches.size());
+  };
+  const cont::BranchTree result = cont::traceTree(problem, nr.u, s0, starts, opt, tree);
+  for (const cont::Branch& b : result.branches) {
+    std::string origin = b.parentId < 0 ? origins[size_t(b.id)]
+                                        : "BP " + std::to_string(b.parentSpecialPoint) + " of branch " +
+                                              std::to_string(b.parentId) + (b.direction > 0 ? ", + side" : ", - side");
+    record(b, problem, origin);
   }
-  for (size_t i = 0; i < branches.size(); ++i) record(branches[i], problem, origins[i]);
+  if (result.interrupted) interrupted();
 }
 
 void CaseRunner::criticalForces() {
@@ -684,9 +689,20 @@ void CaseRunner::torqueAngle() {
 
 }  // namespace
 
-RunResult runScene(const Scene& scene) {
+RunResult runScene(const Scene& scene, const RunControl& given) {
   RunResult run;
   const Clock::time_point start = Clock::now();
+  RunControl control = given;
+  if (!control.interrupt.hasDeadline()) {
+    // The limit bounds the whole run, writing the results included: the computation stops a
+    // fifth of the limit (at most 1 s) before it, room for writing a long chain's points and
+    // plots (a 50-segment tree stopped at 4.5 s writes its 19 000 points in 0.45 s on an idle
+    // machine, twice that on a loaded one).
+    const double limit = std::min(scene.solver.timeLimit, 1e9);
+    const double compute = limit - std::min(0.2 * limit, 1.0);
+    control.interrupt.setDeadline(
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(compute)), limit);
+  }
   const AnalysesSpec& a = scene.analyses;
   if (a.continuation.enabled)
     run.computed.push_back(a.continuation.branchSwitching > 0
@@ -715,6 +731,7 @@ RunResult runScene(const Scene& scene) {
   if (a.suddenLoad.enabled) stages.emplace_back("sudden_load", [](CaseRunner& r) { r.suddenLoad(); });
   std::vector<double> stageSeconds(stages.size(), 0.0);
 
+  std::vector<std::string> skipped;
   run.cases.reserve(scene.cases.size());
   for (const CaseSpec& spec : scene.cases) {
     mech::Chain chain(spec.chain.segments);
@@ -723,12 +740,23 @@ RunResult runScene(const Scene& scene) {
     out.q0 = spec.chain.q0;
     out.pose0 = mech::endPose(chain, out.q0);
     out.startValue = spec.end.condition.value[spec.path.coordinate];
-    CaseRunner runner(scene, spec, out, run, start);
+    CaseRunner runner(scene, spec, out, run, control);
     for (size_t s = 0; s < stages.size(); ++s) {
+      if (runner.interrupted()) {
+        skipped.push_back(stages[s].first + (scene.cases.size() > 1 ? " (case \"" + spec.label + "\")" : ""));
+        continue;
+      }
+      if (control.progress)
+        control.progress->stage(stages[s].first, spec.label, int(&spec - scene.cases.data()), int(scene.cases.size()));
       const Clock::time_point t0 = Clock::now();
       stages[s].second(runner);
       stageSeconds[s] += secondsSince(t0);
     }
+  }
+  if (!skipped.empty()) {
+    std::string list;
+    for (const std::string& k : skipped) list += (list.empty() ? "" : ", ") + k;
+    run.problems.push_back("not run after the stop: " + list);
   }
   for (size_t s = 0; s < stages.size(); ++s) run.timings.emplace_back(stages[s].first, stageSeconds[s]);
   run.totalSeconds = secondsSince(start);

@@ -6,10 +6,12 @@
 #include <string>
 #include <vector>
 
+#include "buckle/continuation/interrupt.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/energy_landscape.h"
 #include "buckle/mechanics/linear_buckling.h"
+#include "scene/progress.h"
 #include "scene/scene.h"
 
 namespace buckle::scene {
@@ -121,9 +123,21 @@ struct RunResult {
   double totalSeconds = 0.0;
   double worstResidual = 0.0;          ///< max corrector residual over all branch points
   double worstLocation = 0.0;          ///< max |Δλ| over located special points
+  /// Stopped early by the time limit or a signal: what was computed until then is kept.
+  bool interrupted = false;
+  std::string interruption;            ///< why ("time limit of 5 s reached", "SIGINT received")
+};
+
+/// How a run is steered from outside: when to stop (the scene's time limit, a signal), and where
+/// progress goes.
+struct RunControl {
+  continuation::Interrupt interrupt;   ///< checked at every step of every stage
+  Progress* progress = nullptr;        ///< optional
 };
 
 /// Runs every case of the scene. Never throws for a numerical failure (recorded in problems).
-RunResult runScene(const Scene& scene);
+/// The time limit is the scene's /solver/time_limit unless `control.interrupt` already has a
+/// deadline (the command line's --time-limit).
+RunResult runScene(const Scene& scene, const RunControl& control = RunControl());
 
 }  // namespace buckle::scene

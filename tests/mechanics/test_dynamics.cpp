@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Dense>
+#include <atomic>
 #include <cmath>
 #include <random>
 #include <string>
@@ -322,6 +323,22 @@ TEST_CASE("guards stop the integration with a reason", "[dynamics]") {
   const DynamicsResult c = simulate(*model, q0, Vector(), shortTime);
   CHECK(c.reason == StopReason::MaxTime);
   CHECK(c.time == Approx(0.01));
+
+  // A time limit or a signal (the run's Interrupt) stops the integration before the next step,
+  // with the state reached: here after exactly the steps taken until the flag was raised.
+  std::atomic<bool> flag{true};
+  IntegrationOptions stopped;
+  stopped.interrupt.watch(&flag, "SIGTERM received");
+  const DynamicsResult d = simulate(*model, q0, Vector(), stopped);
+  CHECK(d.reason == StopReason::Interrupted);
+  CHECK(d.steps == 0);
+  CHECK(d.message.find("SIGTERM received") != std::string::npos);
+  CHECK((d.q - q0).norm() == 0.0);
+  IntegrationOptions expired;
+  expired.interrupt = buckle::continuation::Interrupt::after(0.0);
+  const DynamicsResult e = simulate(*model, q0, Vector(), expired);
+  CHECK(e.reason == StopReason::Interrupted);
+  CHECK(e.message.find("time limit") != std::string::npos);
 }
 
 TEST_CASE("dynamics options and scenes are validated with a reason", "[dynamics]") {

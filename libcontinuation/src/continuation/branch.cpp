@@ -30,6 +30,7 @@ const char *stopReasonName(StopReason reason) {
     case StopReason::Boundary: return "boundary";
     case StopReason::StepSizeTooSmall: return "step size below minimum";
     case StopReason::SwitchFailed: return "branch switching failed";
+    case StopReason::Interrupted: return "interrupted";
   }
   return "unknown";
 }

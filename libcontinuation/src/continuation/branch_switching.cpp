@@ -140,19 +140,38 @@ Branch switchBranch(Tracer &tracer, const SpecialPoint &userBp, const Vector &us
   return child;
 }
 
-BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
-                     const TracerOptions &options, int maxDepth, const BranchSwitchingOptions &switching) {
+BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
+                     const TracerOptions &options, const TreeOptions &treeOptions) {
   BranchTree tree;
   Tracer tracer(problem, options);
-  tree.branches.push_back(tracer.trace(u0, lambda0, direction));
-  tree.branches[0].id = 0;
-  std::vector<int> depth{0};
+  std::vector<int> depth;
+  auto interrupted = [&]() {
+    if (!options.interrupt.requested()) return false;
+    tree.interrupted = true;
+    tree.message = options.interrupt.describe();
+    return true;
+  };
+  auto add = [&](Branch &&b, int generation) {
+    b.id = static_cast<int>(tree.branches.size());
+    tree.branches.push_back(std::move(b));
+    depth.push_back(generation);
+    if (tree.branches.back().stopReason == StopReason::Interrupted) {
+      tree.interrupted = true;
+      tree.message = tree.branches.back().stopMessage;
+    }
+    if (treeOptions.onBranch) treeOptions.onBranch(tree, tree.branches.back());
+  };
+  for (const InitialDirection &direction : starts) {
+    if (tree.interrupted || interrupted()) return tree;
+    add(tracer.trace(u0, lambda0, direction), 0);
+  }
   std::vector<Vector> switchedAt;
   const int n = problem.dimension();
+  const BranchSwitchingOptions &switching = treeOptions.switching;
   const double h = switching.amplitude > 0.0 ? switching.amplitude : options.initialStep;
 
   for (std::size_t i = 0; i < tree.branches.size(); ++i) {
-    if (depth[i] >= maxDepth) continue;
+    if (depth[i] >= treeOptions.maxDepth) continue;
     for (std::size_t k = 0; k < tree.branches[i].specialPoints.size(); ++k) {
       SpecialPoint bp = tree.branches[i].specialPoints[k];
       if (bp.type != SpecialPointType::BranchPoint) continue;
@@ -160,6 +179,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       // The BP a child starts from is the parent's; never switch back at it.
       if (!tree.branches[i].points.empty() && bp.arclength - tree.branches[i].points.front().arclength <= 1e-6 * h)
         continue;
+      if (tree.interrupted || interrupted()) return tree;
       Vector xBP(n + 1);
       xBP << bp.u, bp.lambda;
       bool seen = false;
@@ -179,19 +199,26 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       }
       std::string children;
       for (int sign : {1, -1}) {
+        if (sign < 0 && (tree.interrupted || interrupted())) break;
         Branch child = switchBranch(tracer, bp, dir, sign, switching);
-        child.id = static_cast<int>(tree.branches.size());
         child.parentId = static_cast<int>(i);
         child.parentSpecialPoint = static_cast<int>(k);
-        children += (children.empty() ? "" : ", ") + std::to_string(child.id);
-        tree.branches.push_back(std::move(child));
-        depth.push_back(depth[i] + 1);
+        children += (children.empty() ? "" : ", ") + std::to_string(tree.branches.size());
+        add(std::move(child), depth[i] + 1);
       }
       std::string &noteAfter = tree.branches[i].specialPoints[k].note;
       noteAfter += (noteAfter.empty() ? "" : "; ") + ("switched (" + how + "): branches " + children);
     }
   }
   return tree;
+}
+
+BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
+                     const TracerOptions &options, int maxDepth, const BranchSwitchingOptions &switching) {
+  TreeOptions tree;
+  tree.maxDepth = maxDepth;
+  tree.switching = switching;
+  return traceTree(problem, u0, lambda0, std::vector<InitialDirection>{direction}, options, tree);
 }
 
 }  // namespace buckle::continuation

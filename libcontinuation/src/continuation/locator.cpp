@@ -105,6 +105,10 @@ void Locator::setStep(const ContinuationPoint &a, const ContinuationPoint &b) {
 }
 
 bool Locator::sample(double s, StepSample &out, CorrectorSummary *summary) {
+  if (options_.interrupt.requested()) {
+    if (summary) summary->flagName = "interrupted";
+    return false;
+  }
   // Cubic Hermite predictor through (x_a, t_a) and (x_b, t_b): near a branch point a second
   // branch crosses the hyperplane t_aᵀ(x − x_a) = s close by, and Newton started from the chord
   // (error O(ds²)) can converge to it; the Hermite error is O(ds⁴). The hyperplane is the same.

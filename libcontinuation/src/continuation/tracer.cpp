@@ -126,6 +126,7 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   lo.detectFolds = options_.detectFolds;
   lo.detectBranchPoints = options_.detectBranchPoints;
   lo.denseAlgebra = n_ <= options_.maxDenseLocationDimension;
+  lo.interrupt = options_.interrupt;
   locator_ = std::make_unique<Locator>(*work_, *corrector_, *evaluator_, lo);
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
@@ -159,6 +160,21 @@ double Tracer::eventValue(int event, const ContinuationPoint &p) {
     e -= 2 * (n_ + 1);
   }
   return work_->boundary(e, p.u, p.lambda);
+}
+
+StepAction Tracer::notifyStep(Branch &branch) {
+  if (units_.identity()) return options_.onStep(branch);
+  // The callback sees the new point and the special points in the problem's units; converting
+  // only those keeps a step O(N) (the earlier points are converted when the tracer returns).
+  // Restored from copies afterwards, so the tracer's own values are untouched bit for bit.
+  const ContinuationPoint last = branch.points.back();
+  const std::vector<SpecialPoint> specials = branch.specialPoints;
+  units_.toUser(branch.points.back());
+  for (SpecialPoint &sp : branch.specialPoints) units_.toUser(sp);
+  const StepAction action = options_.onStep(branch);
+  branch.points.back() = last;
+  branch.specialPoints = specials;
+  return action;
 }
 
 double Tracer::eventScale(int event) const {
@@ -348,6 +364,11 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
   };
 
   for (;;) {
+    if (options_.interrupt.requested()) {
+      stop(StopReason::Interrupted, options_.interrupt.describe());
+      endpoint(SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
+      return;
+    }
     if (static_cast<int>(branch.points.size()) >= options_.maxPoints) {
       stop(StopReason::MaxPoints, "reached maxPoints = " + std::to_string(options_.maxPoints));
       endpoint(SpecialPointType::Endpoint, "max points", 0.0, 0.0);
@@ -476,6 +497,11 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     for (SpecialPoint &sp : found) {
       sp.index = ia;
       branch.specialPoints.push_back(std::move(sp));
+    }
+    if (options_.onStep && !landedOnStart && notifyStep(branch) == StepAction::Stop) {
+      stop(StopReason::Interrupted, "stopped by the step callback");
+      endpoint(SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
+      return;
     }
 
     if (hitEvent >= 0) {

@@ -512,6 +512,7 @@ const char* toString(StopReason reason) {
     case StopReason::JointLimit: return "joint limit";
     case StopReason::StepSizeUnderflow: return "step size underflow";
     case StopReason::NonFinite: return "non-finite state";
+    case StopReason::Interrupted: return "interrupted";
   }
   return "unknown";
 }
@@ -649,6 +650,10 @@ void runLoop(Controller& controller, System system, State& x, const double* (*da
   monitor.start(data(x));
   State previous = x;
   for (;;) {
+    if (options.interrupt.requested()) {
+      monitor.stop(StopReason::Interrupted, options.interrupt.describe() + " at t = " + std::to_string(t));
+      break;
+    }
     if (result.steps >= options.maxSteps) {
       monitor.stop(StopReason::MaxSteps, "maximum number of steps (" + std::to_string(options.maxSteps) + ") reached");
       break;

@@ -130,6 +130,10 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
   for (size_t leg = 1; leg < waypoints.size(); ++leg) {
     const double target = waypoints[leg];
     while (lambda != target) {
+      if (options.tracer.interrupt.requested()) {
+        result.message = options.tracer.interrupt.describe();
+        return result;
+      }
       if (int(result.jumps.size()) > options.maxJumps) {
         result.message = "more than " + std::to_string(options.maxJumps) + " jumps";
         return result;

@@ -74,6 +74,7 @@ enum class StopReason {
   Boundary,
   StepSizeTooSmall,    ///< corrector failures, branch-jump rejections or singular tangents below minStep
   SwitchFailed,        ///< branch switching did not reach a point off the parent branch
+  Interrupted,         ///< the Interrupt (time limit, signal) or the step callback asked to stop
 };
 
 const char *stopReasonName(StopReason reason);
@@ -94,6 +95,8 @@ struct Branch {
 
 struct BranchTree {
   std::vector<Branch> branches;  ///< branches[i].id == i; children after their parent
+  bool interrupted = false;      ///< stopped early by the Interrupt: later branches not traced
+  std::string message;           ///< why it was interrupted
 };
 
 }  // namespace buckle::continuation

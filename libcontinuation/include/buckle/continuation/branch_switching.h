@@ -14,7 +14,9 @@
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/tracer.h"
 
+#include <functional>
 #include <string>
+#include <vector>
 
 namespace buckle::continuation {
 
@@ -39,9 +41,25 @@ bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &dire
 Branch switchBranch(Tracer &tracer, const SpecialPoint &bp, const Vector &direction, int sign,
                     const BranchSwitchingOptions &options = BranchSwitchingOptions());
 
-/// Traces the branch from (u0, λ0), then switches at every simple branch point in both
-/// directions, recursively, down to maxDepth generations (0: only the first branch).
-/// Multiplicity-2 points are reported but not switched.
+struct TreeOptions {
+  int maxDepth = 0;                    ///< switching generations (0: only the start branches)
+  BranchSwitchingOptions switching;
+  /// Called when a branch is finished (traced or switched), before the next one starts: for
+  /// progress reports. The tracer's own per-step callback and interrupt are in TracerOptions.
+  std::function<void(const BranchTree &tree, const Branch &finished)> onBranch;
+};
+
+/// The bifurcation tree from one start point, breadth first: the start branches, one per entry
+/// of `starts` (roots, in that order, whether or not they got off the start), then, down to
+/// maxDepth generations, both sides of every simple branch point that is not the one a branch
+/// started from and was not already switched from another branch (the guards are noted on the
+/// branch point). Multiple points (multiplicity ≥ 2) are reported but not switched. A requested
+/// TracerOptions::interrupt stops the branch in progress and every later one; the tree then
+/// says so (`interrupted`, `message`).
+BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
+                     const TracerOptions &options, const TreeOptions &tree);
+
+/// One start direction: traceTree(problem, u0, λ0, {direction}, options, {maxDepth, switching}).
 BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
                      const TracerOptions &options, int maxDepth,
                      const BranchSwitchingOptions &switching = BranchSwitchingOptions());

@@ -20,6 +20,7 @@
 
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/corrector.h"
+#include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/test_functions.h"
 
@@ -47,6 +48,9 @@ struct LocatorOptions {
   /// Dense (N+1)² work allowed: ψ, the augmented-Newton refinements and the kernel (null
   /// vectors, branch directions). False (large N): secant on O(N) test functions only.
   bool denseAlgebra = true;
+  /// A requested interrupt makes every further sample fail: the point in hand is reported as
+  /// located so far, and the tracer stops at its next step.
+  Interrupt interrupt;
 };
 
 /// A point on the current step at offset s (s = 0: its start point a).

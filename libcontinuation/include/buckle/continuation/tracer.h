@@ -20,16 +20,27 @@
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/corrector.h"
+#include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/scaled_problem.h"
 #include "buckle/continuation/test_functions.h"
 
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
 namespace buckle::continuation {
+
+/// What a step callback tells the tracer (as Ceres' CallbackReturnType).
+enum class StepAction { Continue, Stop };
+/// Called after every accepted point, with the branch so far (its last point is the new one):
+/// progress reports, custom stop rules (BifurcationKit's finalise_solution). Stop ends the
+/// branch with StopReason::Interrupted. The new point and the special points are in the
+/// problem's units; the earlier points may still be in the tracer's scaled variables (they are
+/// converted when trace()/continueBranch() return), so read the last point only.
+using StepCallback = std::function<StepAction(const Branch &branch)>;
 
 struct TracerOptions {
   // ---- step control (dimensionless: arclength in the scaled variables, header comment) -------
@@ -93,6 +104,12 @@ struct TracerOptions {
   /// are one point of higher multiplicity.
   double separationFraction = 1e-9;
 
+  // ---- stopping early ------------------------------------------------------------------
+  /// Checked before every step and every location sample: a time limit or a signal ends the
+  /// branch with StopReason::Interrupted, keeping its points.
+  Interrupt interrupt;
+  StepCallback onStep;              ///< optional; see StepCallback
+
   bool IsValid(std::string *why) const;
 };
 
@@ -149,6 +166,8 @@ class Tracer {
 
   /// Scale of event `event`'s value g (user value = g · scale).
   double eventScale(int event) const;
+  /// options_.onStep(branch) with the new point and the special points in the problem's units.
+  StepAction notifyStep(Branch &branch);
 
   Problem &problem_;
   TracerOptions options_;

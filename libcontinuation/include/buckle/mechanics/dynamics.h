@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "buckle/continuation/interrupt.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/end_condition.h"
 
@@ -272,11 +273,14 @@ struct IntegrationOptions {
   double recordInterval = 0.0;
   bool recordTrajectory = true;
   std::size_t maxSamples = 200000;   ///< recording stops (trajectoryTruncated) beyond this
+  /// Checked before every step: a time limit or a signal stops the integration
+  /// (StopReason::Interrupted) with the state reached.
+  continuation::Interrupt interrupt;
 
   bool IsValid(std::string* why) const;
 };
 
-enum class StopReason { Rest, MaxTime, MaxSteps, JointLimit, StepSizeUnderflow, NonFinite };
+enum class StopReason { Rest, MaxTime, MaxSteps, JointLimit, StepSizeUnderflow, NonFinite, Interrupted };
 const char* toString(StopReason reason);
 
 struct TrajectorySample {

@@ -1,0 +1,54 @@
+// Stopping a long computation early, from outside: a wall-clock deadline and/or a flag that a
+// signal handler or another thread sets. The loops of the core (continuation steps, location
+// samples, the branch tree) and of the dynamics (integration steps) ask requested() once per
+// iteration; a computation stopped this way keeps everything it computed and says why
+// (StopReason::Interrupted, with describe() as its message). Copies share the flag, so one
+// Interrupt can be handed to every stage of a run.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <string>
+
+namespace buckle::continuation {
+
+class Interrupt {
+ public:
+  using Clock = std::chrono::steady_clock;
+  enum class Reason { None, TimeLimit, Flag };
+
+  /// Never requested.
+  Interrupt() = default;
+  /// Requested once `seconds` have passed from now (infinite or NaN: never).
+  static Interrupt after(double seconds);
+
+  /// Requested from `deadline` on; `seconds` is the limit as the user gave it (for messages).
+  Interrupt &setDeadline(Clock::time_point deadline, double seconds);
+  /// Requested while *flag is true; `what` names the source in messages ("SIGINT received").
+  /// The flag must outlive every copy of this Interrupt.
+  Interrupt &watch(const std::atomic<bool> *flag, std::string what = "interrupted");
+
+  /// One relaxed atomic load and, with a deadline, one steady-clock read: cheap enough for
+  /// every step of every loop.
+  Reason reason() const {
+    if (flag_ && flag_->load(std::memory_order_relaxed)) return Reason::Flag;
+    if (hasDeadline_ && Clock::now() >= deadline_) return Reason::TimeLimit;
+    return Reason::None;
+  }
+  bool requested() const { return reason() != Reason::None; }
+  /// "time limit of 5 s reached", the flag's `what`, or "" when not requested.
+  std::string describe() const;
+
+  bool hasDeadline() const { return hasDeadline_; }
+  /// Seconds left before the deadline (+inf without one, ≤ 0 once passed).
+  double secondsLeft() const;
+
+ private:
+  bool hasDeadline_ = false;
+  Clock::time_point deadline_{};
+  double seconds_ = 0.0;
+  const std::atomic<bool> *flag_ = nullptr;
+  std::string flagWhat_;
+};
+
+}  // namespace buckle::continuation

@@ -1,0 +1,52 @@
+#include "buckle/continuation/interrupt.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace buckle::continuation {
+
+Interrupt Interrupt::after(double seconds) {
+  Interrupt i;
+  if (std::isfinite(seconds)) {
+    // Clamp far-future limits: Clock::duration overflows for limits beyond ~292 years.
+    const double capped = std::min(std::max(seconds, 0.0), 1e9);
+    i.setDeadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(capped)),
+                  seconds);
+  }
+  return i;
+}
+
+Interrupt &Interrupt::setDeadline(Clock::time_point deadline, double seconds) {
+  hasDeadline_ = true;
+  deadline_ = deadline;
+  seconds_ = seconds;
+  return *this;
+}
+
+Interrupt &Interrupt::watch(const std::atomic<bool> *flag, std::string what) {
+  flag_ = flag;
+  flagWhat_ = std::move(what);
+  return *this;
+}
+
+std::string Interrupt::describe() const {
+  switch (reason()) {
+    case Reason::None: return "";
+    case Reason::Flag: return flagWhat_;
+    case Reason::TimeLimit: {
+      std::ostringstream os;
+      os << "time limit of " << seconds_ << " s reached";
+      return os.str();
+    }
+  }
+  return "";
+}
+
+double Interrupt::secondsLeft() const {
+  if (!hasDeadline_) return std::numeric_limits<double>::infinity();
+  return std::chrono::duration<double>(deadline_ - Clock::now()).count();
+}
+
+}  // namespace buckle::continuation

@@ -1,0 +1,145 @@
+// `buckle run` under a time limit and under SIGINT / SIGTERM: it stops within a step, writes
+// what it computed (summary.json "complete": false, "interrupted": true, and why), exits 1
+// (time limit) or 128 + the signal, and leaves no temporary directory behind.
+#include <catch2/catch.hpp>
+
+#include "cli_helpers.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using buckle::test::exitCode;
+using buckle::test::slurp;
+using Catch::Matchers::Contains;
+
+namespace {
+
+fs::path work() {
+  const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_time_" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+/// The default scene (branch switching, jumps) with 50 segments: far more than a few seconds of
+/// work (the jumps at its many folds alone take minutes).
+fs::path longScene(const fs::path& dir, double timeLimit) {
+  std::ifstream in(std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/default.json");
+  nlohmann::json scene = nlohmann::json::parse(in);
+  scene["chain"]["segments"] = 50;
+  scene["solver"]["time_limit"] = timeLimit;
+  const fs::path file = dir / ("long_" + std::to_string(int(timeLimit)) + ".json");
+  std::ofstream(file) << scene.dump(2);
+  return file;
+}
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+nlohmann::json summaryOf(const fs::path& out) {
+  std::ifstream in(out / "summary.json");
+  return nlohmann::json::parse(in);
+}
+
+/// Partial results are results: the files are complete JSON / CSV with the points computed.
+void requirePartialResults(const fs::path& out) {
+  REQUIRE(fs::exists(out / "summary.json"));
+  const nlohmann::json summary = summaryOf(out);
+  CHECK(summary["complete"] == false);
+  CHECK(summary["interrupted"] == true);
+  std::ifstream sp(out / "special_points.json");
+  CHECK_NOTHROW(nlohmann::json::parse(sp));
+  const std::string csv = slurp(out / "branches.csv");
+  CHECK(std::count(csv.begin(), csv.end(), '\n') > 10);  // header and the points traced
+}
+
+/// No staging directory (.NAME.tmp-XXXXXX) left beside the output.
+void requireNoTemporaries(const fs::path& parent) {
+  for (const auto& e : fs::directory_iterator(parent)) {
+    INFO(e.path());
+    CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("a 50-segment default scene with time_limit 5 returns within 6 s with partial results", "[cli][time]") {
+  const fs::path dir = work() / "limit";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path scene = longScene(dir, 5.0);
+  const fs::path out = dir / "out";
+  const auto t0 = std::chrono::steady_clock::now();
+  const int rc = exitCode("run '" + scene.string() + "' --out '" + out.string() + "'", dir / "log.txt");
+  const double wall = secondsSince(t0);
+  const std::string log = slurp(dir / "log.txt");
+  INFO(log);
+  CHECK(rc == 1);
+  CHECK(wall > 3.9);   // it used its time (the computation stops 1 s before the limit)
+#if defined(__SANITIZE_ADDRESS__)
+  CHECK(wall < 15.0);  // the writers and plots are slower under the sanitizers
+#else
+  CHECK(wall < 6.0);
+#endif
+  requirePartialResults(out);
+  const nlohmann::json summary = summaryOf(out);
+  CHECK_THAT(summary["interruption"].get<std::string>(), Contains("time limit of 5 s reached"));
+  CHECK_THAT(log, Contains("stopped early"));
+  // progress went to stderr as plain lines (not a terminal), at least the first one after ~1 s
+  CHECK_THAT(log, Contains("buckle: ["));
+  CHECK(log.find('\r') == std::string::npos);
+  requireNoTemporaries(dir);
+}
+
+TEST_CASE("the command line's time limit overrides the scene's; quiet silences the progress", "[cli][time]") {
+  const fs::path dir = work() / "override";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path scene = longScene(dir, 600.0);
+  const fs::path out = dir / "out";
+  const auto t0 = std::chrono::steady_clock::now();
+  const int rc = exitCode("run '" + scene.string() + "' --out '" + out.string() + "' --time-limit 1.5 --quiet",
+                          dir / "log.txt");
+  const double wall = secondsSince(t0);
+  const std::string log = slurp(dir / "log.txt");
+  INFO(log);
+  CHECK(rc == 1);
+  CHECK(wall < 10.0);
+  requirePartialResults(out);
+  CHECK(summaryOf(out)["solver"]["time_limit"] == 1.5);
+  CHECK(log.find("buckle: [") == std::string::npos);
+  CHECK(exitCode("run '" + scene.string() + "' --time-limit -1", dir / "bad.txt") == 2);
+}
+
+TEST_CASE("SIGINT and SIGTERM stop a long run with partial results and no temporary directory", "[cli][time]") {
+  for (const auto& [name, expected] : {std::pair<std::string, int>{"INT", 130}, {"TERM", 143}}) {
+    DYNAMIC_SECTION("SIG" << name) {
+      const fs::path dir = work() / ("signal_" + name);
+      fs::remove_all(dir);
+      fs::create_directories(dir);
+      const fs::path scene = longScene(dir, 600.0);
+      const fs::path out = dir / "out";
+      // timeout(1) sends the signal after 2 s and, with --preserve-status, exits as buckle did
+      const std::string cmd = "timeout --preserve-status -s " + name + " 2 '" + buckle::test::kBuckle + "' run '" +
+                              scene.string() + "' --out '" + out.string() + "' > '" + (dir / "log.txt").string() +
+                              "' 2>&1";
+      const auto t0 = std::chrono::steady_clock::now();
+      const int status = std::system(cmd.c_str());
+      const double wall = secondsSince(t0);
+      const std::string log = slurp(dir / "log.txt");
+      INFO(log);
+      REQUIRE(WIFEXITED(status));
+      CHECK(WEXITSTATUS(status) == expected);
+      CHECK(wall < 12.0);  // 2 s, then a step and the writers (generous for the sanitizers)
+      requirePartialResults(out);
+      CHECK_THAT(summaryOf(out)["interruption"].get<std::string>(), Contains("signal"));
+      requireNoTemporaries(dir);
+    }
+  }
+}

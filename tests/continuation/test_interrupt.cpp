@@ -1,0 +1,164 @@
+// Stopping early: the Interrupt itself, the tracer (per-step check and callback), the locator and
+// the branch tree. Every stopped computation must keep what it computed and say why.
+#include "buckle/continuation/interrupt.h"
+
+#include "buckle/continuation/branch_switching.h"
+#include "buckle/continuation/tracer.h"
+#include "toy_problems.h"
+
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+using namespace buckle::continuation;
+using Catch::Matchers::Contains;
+
+namespace {
+
+/// The points of a branch lie on the circle u² + λ² = 1 (the computation stopped, the points
+/// kept are still solutions).
+void requireOnCircle(const Branch &b) {
+  for (const ContinuationPoint &p : b.points) REQUIRE(std::abs(p.u[0] * p.u[0] + p.lambda * p.lambda - 1.0) < 1e-9);
+}
+
+/// Counts residual evaluations: a stopped tracer must stop evaluating.
+class CountingCircle : public toys::Circle {
+ public:
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    ++evaluations;
+    return toys::Circle::residual(u, lambda, F);
+  }
+  long evaluations = 0;
+};
+
+}  // namespace
+
+TEST_CASE("Interrupt: never, a deadline, a flag, and copies share the flag", "[interrupt]") {
+  const Interrupt never;
+  CHECK_FALSE(never.requested());
+  CHECK(never.describe().empty());
+  CHECK(std::isinf(never.secondsLeft()));
+
+  const Interrupt past = Interrupt::after(0.0);
+  CHECK(past.requested());
+  CHECK(past.reason() == Interrupt::Reason::TimeLimit);
+  CHECK_THAT(past.describe(), Contains("time limit of 0 s"));
+
+  const Interrupt future = Interrupt::after(3600.0);
+  CHECK_FALSE(future.requested());
+  CHECK(future.secondsLeft() > 3500.0);
+  CHECK_FALSE(Interrupt::after(std::numeric_limits<double>::infinity()).hasDeadline());
+  CHECK_FALSE(Interrupt::after(1e300).requested());  // far-future limits do not overflow
+
+  std::atomic<bool> flag{false};
+  Interrupt a;
+  a.watch(&flag, "SIGINT received");
+  const Interrupt b = a;  // a copy handed to another stage
+  CHECK_FALSE(b.requested());
+  flag = true;
+  CHECK(b.requested());
+  CHECK(b.reason() == Interrupt::Reason::Flag);
+  CHECK(b.describe() == "SIGINT received");
+}
+
+TEST_CASE("Tracer: a requested interrupt stops the branch at once and keeps the start", "[interrupt]") {
+  CountingCircle problem;
+  TracerOptions options;
+  options.interrupt = Interrupt::after(0.0);
+  const Branch b = trace(problem, Vector::Constant(1, 1.0), 0.0, InitialDirection::increasingLambda(), options);
+  REQUIRE(b.stopReason == StopReason::Interrupted);
+  CHECK_THAT(b.stopMessage, Contains("time limit"));
+  REQUIRE(b.points.size() == 1);  // the polished start, nothing else
+  requireOnCircle(b);
+  CHECK(b.specialPoints.back().type == SpecialPointType::Endpoint);
+  CHECK(b.specialPoints.back().boundaryName == "interrupted");
+  CHECK(problem.evaluations < 20);  // the start polish only: no step was tried
+}
+
+TEST_CASE("Tracer: a flag set while tracing stops within one step", "[interrupt]") {
+  toys::Circle problem;
+  std::atomic<bool> flag{false};
+  TracerOptions options;
+  options.maxStep = 0.01;
+  options.initialStep = 0.01;
+  options.maxPoints = 100000;  // the whole circle many times over: only the flag ends it
+  options.interrupt.watch(&flag, "stop requested");
+  int calls = 0;
+  options.onStep = [&](const Branch &branch) {
+    ++calls;
+    if (branch.points.size() == 20) flag = true;  // as a signal handler would
+    return StepAction::Continue;
+  };
+  const Branch b = trace(problem, Vector::Constant(1, 1.0), 0.0, InitialDirection::increasingLambda(), options);
+  REQUIRE(b.stopReason == StopReason::Interrupted);
+  CHECK(b.stopMessage == "stop requested");
+  CHECK(b.points.size() == 20);  // checked before the next step
+  CHECK(calls == 19);            // once per accepted point after the start
+  requireOnCircle(b);
+}
+
+TEST_CASE("Tracer: the step callback sees every point and can stop the branch", "[interrupt]") {
+  toys::Circle problem;
+  TracerOptions options;
+  options.maxStep = 0.05;
+  std::vector<double> seen;
+  options.onStep = [&](const Branch &branch) {
+    seen.push_back(branch.points.back().lambda);
+    return branch.points.size() >= 7 ? StepAction::Stop : StepAction::Continue;
+  };
+  const Branch b = trace(problem, Vector::Constant(1, 1.0), 0.0, InitialDirection::increasingLambda(), options);
+  REQUIRE(b.stopReason == StopReason::Interrupted);
+  CHECK_THAT(b.stopMessage, Contains("callback"));
+  REQUIRE(b.points.size() == 7);
+  REQUIRE(seen.size() == 6);
+  for (size_t i = 0; i < seen.size(); ++i) CHECK(seen[i] == b.points[i + 1].lambda);
+}
+
+TEST_CASE("Tracer: without an interrupt the same branch runs to its regular end", "[interrupt]") {
+  // The control for the cases above: the circle traced from (1, 0) up to λ = 0.5.
+  toys::Circle problem;
+  TracerOptions options;
+  options.lambdaMax = 0.5;
+  const Branch b = trace(problem, Vector::Constant(1, 1.0), 0.0, InitialDirection::increasingLambda(), options);
+  CHECK(b.stopReason == StopReason::LambdaRange);
+  CHECK(b.points.back().lambda == Approx(0.5).margin(1e-12));
+}
+
+TEST_CASE("traceTree: both start directions, and an interrupt stops the tree with what it has", "[interrupt]") {
+  toys::TwoPitchforks problem(0.5);
+  TracerOptions options;
+  options.lambdaMin = -0.3;
+  options.lambdaMax = 0.8;
+  options.maxStep = 0.05;
+  TreeOptions treeOptions;
+  treeOptions.maxDepth = 1;
+  int finished = 0;
+  treeOptions.onBranch = [&](const BranchTree &tree, const Branch &b) {
+    ++finished;
+    CHECK(b.id == static_cast<int>(tree.branches.size()) - 1);
+  };
+  const std::vector<InitialDirection> both{InitialDirection::increasingLambda(), InitialDirection::decreasingLambda()};
+  const BranchTree full = traceTree(problem, Vector::Zero(2), 0.2, both, options, treeOptions);
+  // Roots in the order asked: up (through the BP at λ = 0.5) and down (through λ = 0).
+  REQUIRE(full.branches.size() == 6);
+  CHECK_FALSE(full.interrupted);
+  CHECK(finished == 6);
+  CHECK(full.branches[0].direction == 1);
+  CHECK(full.branches[1].direction == -1);
+  CHECK(full.branches[0].points.back().lambda == Approx(0.8));
+  CHECK(full.branches[1].points.back().lambda == Approx(-0.3));
+  for (size_t i = 2; i < full.branches.size(); ++i) CHECK(full.branches[i].parentId >= 0);
+
+  // Stop after the first root: the second root and every switch are not traced.
+  std::atomic<bool> flag{false};
+  options.interrupt.watch(&flag, "enough");
+  treeOptions.onBranch = [&](const BranchTree &, const Branch &) { flag = true; };
+  const BranchTree partial = traceTree(problem, Vector::Zero(2), 0.2, both, options, treeOptions);
+  REQUIRE(partial.branches.size() == 1);
+  CHECK(partial.interrupted);
+  CHECK(partial.message == "enough");
+  CHECK(partial.branches[0].points.size() == full.branches[0].points.size());
+}
