@@ -12,6 +12,7 @@
 #include <cmath>
 #include <vector>
 
+#include "buckle/continuation/branch_switching.h"
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/linear_buckling.h"
@@ -63,7 +64,39 @@ std::vector<cont::SpecialPoint> folds(double L, double k) {
   return out;
 }
 
+// The U branch of the clamped–pinned chain, switched to at the first branch point (the
+// library's bifurcatingDirection and switchBranch, given the point in the user's units), to its
+// end on the user joint limit |q| = 1.5 (AUTO's A_U): (Fx there, max |q|).
+std::pair<double, double> limitEnd(double L, double k) {
+  SegmentParameters p = SegmentParameters::symmetric(0.5 * L, L, k, 2.25 * L);
+  p.qMinUser = -1.5;
+  p.qMaxUser = 1.5;
+  EquilibriumProblem problem(Chain::uniform(3, p), EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  cont::Tracer tracer(problem, options(-3.0 * k * L, 0.0));
+  const cont::Branch trivial = tracer.trace(Eigen::VectorXd::Zero(4), 0.0, cont::InitialDirection::decreasingLambda());
+  const auto bps = trivial.specialPointsOfType(cont::SpecialPointType::BranchPoint);
+  REQUIRE(!bps.empty());
+  Eigen::VectorXd direction;
+  REQUIRE(cont::bifurcatingDirection(problem, *bps[0], direction));
+  const cont::Branch u = cont::switchBranch(tracer, *bps[0], direction, 1);
+  const auto bds = u.specialPointsOfType(cont::SpecialPointType::Boundary);
+  REQUIRE(bds.size() == 1);
+  return {bds[0]->lambda, bds[0]->u.head(3).cwiseAbs().maxCoeff()};
+}
+
 }  // namespace
+
+TEST_CASE("unit scaling: branch switching reaches the same joint limit in every unit system", "[unit_scaling]") {
+  const std::pair<double, double> reference = limitEnd(1.0, 1.0);
+  CHECK(std::abs(reference.second - 1.5) <= 1e-12);
+  for (double L : kScales)
+    for (double k : {1e-6, 1.0, 1e6}) {
+      INFO("lengths x" << L << ", stiffness x" << k);
+      const std::pair<double, double> end = limitEnd(L, k);
+      CHECK(relativeError(end.first, k * L * reference.first) <= 1e-10);
+      CHECK(std::abs(end.second - 1.5) <= 1e-12);
+    }
+}
 
 TEST_CASE("unit scaling: branch points scale as k L and match eq 17 for lengths x1e-3..x1e3, stiffness x1e-6..x1e6",
           "[unit_scaling]") {

@@ -182,6 +182,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       if (tree.interrupted || interrupted()) return tree;
       Vector xBP(n + 1);
       xBP << bp.u, bp.lambda;
+      for (int j = 0; j <= n; ++j) xBP[j] /= tracer.units().state(j);  // compared in the scaled variables
       bool seen = false;
       for (const Vector &y : switchedAt)
         if ((y - xBP).norm() <= 1e-7 * std::max(1.0, xBP.norm())) seen = true;
