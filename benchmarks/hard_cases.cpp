@@ -7,15 +7,18 @@
 //     --only P    run only the cases whose id starts with P (units, cluster, cluster.top.n1000, …)
 //
 // Cases (independent answers in brackets):
-//  units.<case>.<L>x<k>.<raw|nondim>  the n = 3 chain with lengths ×L and spring stiffnesses ×k;
+//  units.<case>.<L>x<k>.<default|nondim>  the n = 3 chain with lengths ×L and spring stiffnesses ×k;
 //      loads scale as F₀ = k·L (eq 17: Fx = λ k [b L0 − 2(b² − a²)] / b), angles are unit-free.
 //      bp:    trivial branch, both branch points [eq 17 in the scaled constants]
 //      fold:  free end, L0 = 0.5, Fy = 0.01 F₀ (AUTO's I_up) [ref.py's extended-system Newton ×F₀]
 //      limit: switch at the U branch point, stop at the user joint limit |q| = 1.5 (AUTO's A_U)
 //             [the unscaled run ×F₀; the end angle must be 1.5]
-//      raw:    solver options as for the unscaled chain (AUTO's c-file values), λ range ×F₀
-//      nondim: the same options on the NondimensionalProblem view (nondimensional.h) in the
-//              chain's own units (typicalUnits: mean b and k, which here are L and k)
+//      default: solver options as for the unscaled chain (AUTO's c-file values), λ range ×F₀, on
+//               the EquilibriumProblem itself: the library's default path, which works in the
+//               chain's own units (EquilibriumProblem::scales(), continuation/scaled_problem.h)
+//      nondim:  the same options on the NondimensionalProblem view (nondimensional.h), an
+//               independent, outside change of variables (its scales() are ones, so the core
+//               does not scale again)
 //  cluster.low.n<N>  the first 6 critical loads of the clamped–pinned chain [linear_buckling]
 //  cluster.top.n<N>  the 6 most compressive critical loads, spaced ~1/n² apart [linear_buckling]
 //  cluster.low.n<N>.reltol  cluster.low with locationTolerance 1e-12·|λ_1| (relative, not max(1, |λ|))
@@ -94,7 +97,7 @@ std::string stopNote(const cont::Branch& b) {
 
 Row unitsBranchPoints(const UnitScale& us, bool nondim) {
   Row row;
-  row.id = "units.bp." + scaleName(us.length) + "x" + scaleName(us.stiffness) + (nondim ? ".nondim" : ".raw");
+  row.id = "units.bp." + scaleName(us.length) + "x" + scaleName(us.stiffness) + (nondim ? ".nondim" : ".default");
   const double a = 0.5 * us.length, b = us.length, k = us.stiffness, L0 = 2.25 * us.length;
   const AnalyticBuckling3 ref = buckle::mechanics::analyticClampedPinned3(a, b, k, L0);
   EquilibriumProblem problem(Chain::uniform(3, SegmentParameters::symmetric(a, b, k, L0)), EndCondition::clampedPinned(0.0),
@@ -118,7 +121,7 @@ Row unitsBranchPoints(const UnitScale& us, bool nondim) {
 
 Row unitsFold(const UnitScale& us, bool nondim) {
   Row row;
-  row.id = "units.fold." + scaleName(us.length) + "x" + scaleName(us.stiffness) + (nondim ? ".nondim" : ".raw");
+  row.id = "units.fold." + scaleName(us.length) + "x" + scaleName(us.stiffness) + (nondim ? ".nondim" : ".default");
   EquilibriumProblem problem(Chain::uniform(3, scaledSegment(0.5, 1.0, 1.0, 0.5, us)),
                              EndCondition::freeEnd(Eigen::Vector3d(0, 0.01 * us.force(), 0)), Eigen::Vector3d(1, 0, 0));
   NondimensionalProblem view(problem, typicalUnits(problem.chain()));
@@ -182,7 +185,7 @@ LimitEnd unitsLimitEnd(const UnitScale& us, bool nondim, double& ms) {
 
 Row unitsLimit(const UnitScale& us, bool nondim, double referenceFx) {
   Row row;
-  row.id = "units.limit." + scaleName(us.length) + "x" + scaleName(us.stiffness) + (nondim ? ".nondim" : ".raw");
+  row.id = "units.limit." + scaleName(us.length) + "x" + scaleName(us.stiffness) + (nondim ? ".nondim" : ".default");
   const LimitEnd end = unitsLimitEnd(us, nondim, row.ms);
   row.note = end.note;
   if (!end.ok) return row;

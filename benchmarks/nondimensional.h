@@ -1,7 +1,8 @@
-// The user-level answer to extreme units (benchmarks/hard_cases.cpp): trace the chain in
-// nondimensional variables. The core's tolerances and step sizes are absolute (‖G‖∞, arclength
-// in mixed units, max(1, ·) floors: benchmarks/RESULTS.md, "Hard cases"), so a chain given in
-// mm and mN·mm⁻¹, or in km and MN·m⁻¹, is best handed to the tracer rescaled:
+// An independent check of the core's own unit handling (benchmarks/hard_cases.cpp, "nondim"
+// rows): the chain traced in nondimensional variables built from outside, by hand. The core
+// itself does the same change of variables from EquilibriumProblem::scales()
+// (continuation/scaled_problem.h); this view's scales() are the default ones, so the tracer
+// does not scale again, and both paths must agree:
 //   angles q as they are; reactions r̃ = r / F₀; λ̃ = λ / λ₀;
 //   torque rows / (k₀ L₀²), held-position rows / L₀, held-angle rows as they are;
 //   the stability operator H / (k₀ L₀²), its constraint rows like the held rows.

@@ -1,5 +1,6 @@
 #include "buckle/continuation/branch_switching.h"
 
+#include "buckle/continuation/scaled_problem.h"
 #include "buckle/continuation/test_functions.h"
 
 #include <algorithm>
@@ -22,6 +23,16 @@ bool BranchSwitchingOptions::IsValid(std::string *why) const {
 
 bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note) {
   const int n = problem.dimension();
+  // In the problem's scaled variables (scaled_problem.h), where the kernel and the
+  // bifurcation-equation thresholds are relative; the direction comes back in its units.
+  const ProblemScales scales = problem.scales();
+  if (!scales.identity() && scales.check(n).empty()) {
+    const UnitScaling units(scales);
+    ScaledProblem scaled(problem, units);  // its own scales are ones: no further recursion
+    const bool found = bifurcatingDirection(scaled, units.scaled(bp), direction, note);
+    if (found) direction = units.directionToUser(direction);
+    return found;
+  }
   if (bp.type != SpecialPointType::BranchPoint || bp.nullVectors.cols() < 2 || bp.nullVectors.rows() != n + 1) {
     if (note) *note = "not a branch point with a 2-dimensional kernel";
     return false;
@@ -47,8 +58,11 @@ bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &dire
   return true;
 }
 
-Branch switchBranch(Tracer &tracer, const SpecialPoint &bp, const Vector &direction, int sign,
+Branch switchBranch(Tracer &tracer, const SpecialPoint &userBp, const Vector &userDirection, int sign,
                     const BranchSwitchingOptions &options) {
+  // The tracer's corrector and completePoint work in its scaled variables (dimensionless h).
+  const SpecialPoint bp = tracer.units().scaled(userBp);
+  const Vector direction = tracer.units().directionToScaled(userDirection);
   Branch child;
   child.direction = sign >= 0 ? 1 : -1;
   std::string why;
@@ -121,6 +135,7 @@ Branch switchBranch(Tracer &tracer, const SpecialPoint &bp, const Vector &direct
   ep.note = "start: branch point of the parent branch";
   child.specialPoints.push_back(ep);
   // The branch point sits at point 0, where the test functions are degenerate: skip interval 0.
+  tracer.units().toUser(child);
   tracer.continueBranch(child, 1);
   return child;
 }
@@ -167,6 +182,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       if (tree.interrupted || interrupted()) return tree;
       Vector xBP(n + 1);
       xBP << bp.u, bp.lambda;
+      for (int j = 0; j <= n; ++j) xBP[j] /= tracer.units().state(j);  // compared in the scaled variables
       bool seen = false;
       for (const Vector &y : switchedAt)
         if ((y - xBP).norm() <= 1e-7 * std::max(1.0, xBP.norm())) seen = true;

@@ -9,14 +9,44 @@
 
 namespace buckle::continuation {
 
+ProblemScales ProblemScales::ones(int n) {
+  ProblemScales s;
+  s.unknowns = Vector::Ones(std::max(0, n));
+  s.residuals = Vector::Ones(std::max(0, n));
+  return s;
+}
+
+bool ProblemScales::identity() const {
+  return parameter == 1.0 && stability == 1.0 && (unknowns.array() == 1.0).all() && (residuals.array() == 1.0).all();
+}
+
+std::string ProblemScales::check(int n) const {
+  auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
+  if (unknowns.size() != n || residuals.size() != n)
+    return "scales of the unknowns and residuals must have size N = " + std::to_string(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!positive(unknowns[i])) return "scale of unknown " + std::to_string(i) + " must be positive and finite";
+    if (!positive(residuals[i])) return "scale of residual row " + std::to_string(i) + " must be positive and finite";
+  }
+  if (!positive(parameter)) return "parameter scale must be positive and finite";
+  if (!positive(stability)) return "stability scale must be positive and finite";
+  return "";
+}
+
 bool Problem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
                                             double dlambda, MatrixRef dFu, VectorRef dFlambda) {
   const int n = dimension();
   // Step scaled to the point so that the O(h²) truncation and O(ε/h) rounding errors balance
   // (h ~ ε^{1/3}); Newton on the augmented systems only needs an approximate Jacobian, the
-  // located point's accuracy is set by the exact residuals.
-  const double scale = std::max({1.0, u.norm(), std::abs(lambda)});
-  const double dirNorm = std::sqrt(du.squaredNorm() + dlambda * dlambda);
+  // located point's accuracy is set by the exact residuals. Norms in the problem's own scales,
+  // so that "1" is a typical size in every unit system.
+  const ProblemScales s = scales();
+  const bool weighted = s.check(n).empty();
+  const double uNorm = weighted ? u.cwiseQuotient(s.unknowns).norm() : u.norm();
+  const double lNorm = weighted ? std::abs(lambda) / s.parameter : std::abs(lambda);
+  const double scale = std::max({1.0, uNorm, lNorm});
+  const double dirNorm = weighted ? std::hypot(du.cwiseQuotient(s.unknowns).norm(), dlambda / s.parameter)
+                                  : std::sqrt(du.squaredNorm() + dlambda * dlambda);
   if (dirNorm == 0.0) {
     dFu.setZero();
     dFlambda.setZero();
@@ -40,11 +70,11 @@ bool Problem::stabilityOperator(ConstVectorRef, double, Matrix&, Matrix&) { retu
 bool Problem::stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo& info) {
   if (!hasStabilityOperator()) return false;
   if (!stabilityOperator(u, lambda, stabilityH_, stabilityC_)) return false;
-  info = projectedInertia(stabilityH_, stabilityC_, 1e-13, lowestCount);
+  info = projectedInertia(stabilityH_, stabilityC_, 1e-13, lowestCount, scales().stability);
   return true;
 }
 
-StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance, int lowestCount) {
+StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance, int lowestCount, double scale) {
   StabilityInfo info;
   Matrix reduced;
   if (C.rows() == 0) {
@@ -66,7 +96,7 @@ StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTole
   }
   Eigen::SelfAdjointEigenSolver<Matrix> es(0.5 * (reduced + reduced.transpose()), Eigen::EigenvaluesOnly);
   const Vector& mu = es.eigenvalues();
-  const double tol = zeroTolerance * std::max(1.0, mu.cwiseAbs().maxCoeff());
+  const double tol = zeroTolerance * std::max(scale, mu.cwiseAbs().maxCoeff());
   info.negative = 0;
   info.zero = 0;
   for (Eigen::Index i = 0; i < mu.size(); ++i) {

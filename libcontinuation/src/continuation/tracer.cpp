@@ -72,7 +72,7 @@ CorrectorOptions Tracer::stepCorrectorOptions() const {
 }
 
 Tracer::Tracer(Problem &problem, const TracerOptions &options)
-    : problem_(problem), options_(options), n_(problem.dimension()) {
+    : problem_(problem), options_(options), n_(problem.dimension()), work_(&problem) {
   if (!options_.IsValid(&invalidReason_)) {
     if (invalidReason_.empty()) invalidReason_ = "invalid options";
     return;
@@ -81,21 +81,41 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
     invalidReason_ = "boxLower/boxUpper must be empty or have size N+1 = " + std::to_string(n_ + 1);
     return;
   }
+  // The problem's units: everything below works in its scaled variables (scaled_problem.h).
+  const ProblemScales scales = problem_.scales();
+  const std::string badScales = scales.check(n_);
+  if (!badScales.empty()) {
+    invalidReason_ = "Problem::scales(): " + badScales;
+    return;
+  }
+  units_ = UnitScaling(scales);
+  if (!units_.identity()) {
+    scaled_ = std::make_unique<ScaledProblem>(problem_, units_);
+    work_ = scaled_.get();
+  }
+  lambdaMin_ = options_.lambdaMin / units_.parameter();
+  lambdaMax_ = options_.lambdaMax / units_.parameter();
+  boxLower_ = options_.boxLower;
+  boxUpper_ = options_.boxUpper;
+  for (Eigen::Index i = 0; i < boxLower_.size(); ++i) {
+    boxLower_[i] /= units_.state(int(i));
+    boxUpper_[i] /= units_.state(int(i));
+  }
   using LA = TracerOptions::LinearAlgebra;
   if (options_.linearAlgebra != LA::Dense &&
       (options_.linearAlgebra == LA::Structured || n_ >= options_.structuredFromDimension))
-    structuredSolver_ = problem_.makeStructuredSolver();
+    structuredSolver_ = work_->makeStructuredSolver();
   if (options_.linearAlgebra == LA::Structured && !structuredSolver_) {
     invalidReason_ = "linearAlgebra = Structured, but the problem offers no structured solver";
     return;
   }
   BorderedSolver *solver = structuredSolver_.get();
   if (!solver) {
-    denseSolver_ = std::make_unique<DenseBorderedSolver>(problem_);
+    denseSolver_ = std::make_unique<DenseBorderedSolver>(*work_);
     solver = denseSolver_.get();
   }
-  corrector_ = std::make_unique<Corrector>(problem_, stepCorrectorOptions(), structuredSolver_.get());
-  evaluator_ = std::make_unique<PointEvaluator>(problem_, *solver, options_.computeStability, options_.lowestEigenvalues);
+  corrector_ = std::make_unique<Corrector>(*work_, stepCorrectorOptions(), structuredSolver_.get());
+  evaluator_ = std::make_unique<PointEvaluator>(*work_, *solver, options_.computeStability, options_.lowestEigenvalues);
   LocatorOptions lo;
   lo.tolerance = options_.locationTolerance;
   lo.newtonTolerance = options_.locationNewtonTolerance;
@@ -107,7 +127,7 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   lo.detectBranchPoints = options_.detectBranchPoints;
   lo.denseAlgebra = n_ <= options_.maxDenseLocationDimension;
   lo.interrupt = options_.interrupt;
-  locator_ = std::make_unique<Locator>(problem_, *corrector_, *evaluator_, lo);
+  locator_ = std::make_unique<Locator>(*work_, *corrector_, *evaluator_, lo);
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
 }
@@ -126,19 +146,42 @@ int Tracer::eventCount() const {
   return 2 + box + boundaries;
 }
 
+// Event values of a point in the scaled variables.
 double Tracer::eventValue(int event, const ContinuationPoint &p) {
-  if (event == 0) return p.lambda - options_.lambdaMin;
-  if (event == 1) return options_.lambdaMax - p.lambda;
+  if (event == 0) return p.lambda - lambdaMin_;
+  if (event == 1) return lambdaMax_ - p.lambda;
   int e = event - 2;
-  if (options_.boxLower.size()) {
+  if (boxLower_.size()) {
     if (e < 2 * (n_ + 1)) {
       const int i = e / 2;
       const double xi = i < n_ ? p.u[i] : p.lambda;
-      return e % 2 == 0 ? xi - options_.boxLower[i] : options_.boxUpper[i] - xi;
+      return e % 2 == 0 ? xi - boxLower_[i] : boxUpper_[i] - xi;
     }
     e -= 2 * (n_ + 1);
   }
-  return problem_.boundary(e, p.u, p.lambda);
+  return work_->boundary(e, p.u, p.lambda);
+}
+
+StepAction Tracer::notifyStep(Branch &branch) {
+  if (units_.identity()) return options_.onStep(branch);
+  // The callback sees the new point and the special points in the problem's units; converting
+  // only those keeps a step O(N) (the earlier points are converted when the tracer returns).
+  // Restored from copies afterwards, so the tracer's own values are untouched bit for bit.
+  const ContinuationPoint last = branch.points.back();
+  const std::vector<SpecialPoint> specials = branch.specialPoints;
+  units_.toUser(branch.points.back());
+  for (SpecialPoint &sp : branch.specialPoints) units_.toUser(sp);
+  const StepAction action = options_.onStep(branch);
+  branch.points.back() = last;
+  branch.specialPoints = specials;
+  return action;
+}
+
+double Tracer::eventScale(int event) const {
+  if (event < 2) return units_.parameter();
+  const int e = event - 2;
+  if (boxLower_.size() && e < 2 * (n_ + 1)) return units_.state(e / 2);
+  return 1.0;  // the problem's boundaries g_k are evaluated in its own units
 }
 
 std::string Tracer::eventName(int event) const {
@@ -170,15 +213,21 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
     return branch;
   }
 
+  // Inputs in the scaled variables; the branch goes back to the user's units before
+  // continueBranch (which converts it for its own work).
+  const Vector su0 = units_.identity() ? Vector(u0) : Vector(u0.cwiseQuotient(units_.scales().unknowns));
+  const double slambda0 = lambda0 / units_.parameter();
+  InitialDirection scaledDirection = direction;
+  scaledDirection.tangent = units_.directionToScaled(direction.tangent);
   ContinuationPoint start;
   start.u = Vector::Zero(n_);
-  const CorrectorSummary polish = corrector_->solveAtFixedParameter(u0, lambda0, start.u);
+  const CorrectorSummary polish = corrector_->solveAtFixedParameter(su0, slambda0, start.u);
   if (!polish.converged) {
     branch.stopReason = StopReason::StartFailed;
     branch.stopMessage = std::string("start point did not converge at fixed lambda (") + polish.flagName + ")";
     return branch;
   }
-  start.lambda = lambda0;
+  start.lambda = slambda0;
   start.newtonIterations = polish.iterations;
   start.residualNorm = polish.residualNorm;
 
@@ -188,7 +237,7 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
   // (or e_λ) as border row, O(N); the dense kernel (SVD) only if that matrix is singular (a start
   // on a fold or a branch point) or for dense problems, where it also detects a 2-d kernel.
   if (structuredSolver_) {
-    Vector reference = direction.tangent;
+    Vector reference = scaledDirection.tangent;
     if (!reference.size()) {
       reference = Vector::Zero(n_ + 1);
       reference[n_] = direction.lambdaSign >= 0 ? 1.0 : -1.0;
@@ -201,7 +250,7 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
   }
   if (!t.size()) {
     KernelInfo kernel;
-    if (!jacobianKernel(problem_, start.u, start.lambda, kernel)) {
+    if (!jacobianKernel(*work_, start.u, start.lambda, kernel)) {
       branch.stopReason = StopReason::StartFailed;
       branch.stopMessage = "the problem refused the Jacobian at the start point";
       return branch;
@@ -209,14 +258,14 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
     t = kernel.right.col(0);
     const double sigmaScale = std::max(1.0, kernel.singularValues.maxCoeff());
     const bool twoDimensional = kernel.singularValues.size() > 1 && kernel.singularValues[1] <= 1e-10 * sigmaScale;
-    if (direction.tangent.size()) {
+    if (scaledDirection.tangent.size()) {
       if (twoDimensional) {
         const Matrix K = kernel.right.leftCols(2);
-        const Vector projected = K * (K.transpose() * direction.tangent);
+        const Vector projected = K * (K.transpose() * scaledDirection.tangent);
         if (projected.norm() > 1e-12) t = projected.normalized();
         startNote += " (at a singular point: direction projected onto the 2-dimensional kernel)";
       }
-      if (t.dot(direction.tangent) < 0.0) t = -t;
+      if (t.dot(scaledDirection.tangent) < 0.0) t = -t;
     } else {
       if (twoDimensional) startNote += " (at a singular point: kernel is 2-dimensional, direction arbitrary)";
       if (std::abs(t[n_]) < 1e-12) startNote += " (at a fold: lambda sign cannot orient the tangent)";
@@ -225,7 +274,7 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
   }
   int skipIntervals = 0;
   if (!evaluator_->complete(start, t)) {
-    if (!evaluator_->lastWasSingular() || !direction.tangent.size()) {
+    if (!evaluator_->lastWasSingular() || !scaledDirection.tangent.size()) {
       branch.stopReason = StopReason::StartFailed;
       branch.stopMessage = "singular bordered Jacobian at the start point";
       return branch;
@@ -247,6 +296,7 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
   ep.inertiaBefore = ep.inertiaAfter = start.stability.negative;
   ep.note = startNote;
   branch.specialPoints.push_back(ep);
+  units_.toUser(branch);
 
   for (int e = 0; e < eventCount(); ++e) {
     if (eventValue(e, start) < 0.0) {
@@ -262,6 +312,7 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
 }
 
 void Tracer::continueBranch(Branch &branch, int skipIntervals) {
+  const ScopedScaling scaledBranch(units_, branch);  // the work is done in the scaled variables
   if (!invalidReason_.empty()) {
     branch.stopReason = StopReason::InvalidOptions;
     branch.stopMessage = invalidReason_;
@@ -391,9 +442,9 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       // λ and box faces are coordinates: a last solve with that coordinate held lands exactly.
       if (e < 2 + boxEvents && ga != 0.0) {
         const int coordinate = e < 2 ? n_ : (e - 2) / 2;
-        const double bound = e == 0 ? options_.lambdaMin
-                             : e == 1 ? options_.lambdaMax
-                             : ((e - 2) % 2 == 0 ? options_.boxLower[coordinate] : options_.boxUpper[coordinate]);
+        const double bound = e == 0 ? lambdaMin_
+                             : e == 1 ? lambdaMax_
+                             : ((e - 2) % 2 == 0 ? boxLower_[coordinate] : boxUpper_[coordinate]);
         predictor_.head(n_) = located.u;
         predictor_[n_] = located.lambda;
         predictor_[coordinate] = bound;
@@ -420,7 +471,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
         hitEvent = e;
         hitPoint = located;
         hitAccuracy = accuracy;
-        hitValue = eventValue(e, located);
+        hitValue = eventValue(e, located) * eventScale(e);
       }
     }
     if (hitEvent >= 0) {
@@ -454,7 +505,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       sp.index = ia;
       branch.specialPoints.push_back(std::move(sp));
     }
-    if (options_.onStep && !landedOnStart && options_.onStep(branch) == StepAction::Stop) {
+    if (options_.onStep && !landedOnStart && notifyStep(branch) == StepAction::Stop) {
       stop(StopReason::Interrupted, "stopped by the step callback");
       endpoint(SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
       return;

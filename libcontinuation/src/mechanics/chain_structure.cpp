@@ -301,7 +301,7 @@ void solveFactored(const ChainStructure& ws, MatrixRef Y, int cols) {
 }
 
 double zeroThreshold(const ChainStructure& ws, double zeroTolerance) {
-  return zeroTolerance * std::max(1.0, ws.frobeniusH);
+  return zeroTolerance * std::max(ws.typicalScale, ws.frobeniusH);  // the same count in any units
 }
 
 Inertia hessianInertia(const ChainStructure& ws, double zeroTolerance) {
@@ -422,7 +422,7 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
   const int dim = ws.n - (useConstraints ? ws.rank : 0);
   const int k = std::max(0, std::min(count, dim));
   if (k == 0) return 0;
-  const double scale = std::max(1.0, ws.frobeniusH);
+  const double scale = std::max(ws.typicalScale, ws.frobeniusH);  // as zeroThreshold: any units
   const double tol = tolerance * scale;
   // All eigenvalues lie in [−‖H‖_F, ‖H‖_F]; widen against rounding until the counts confirm it.
   double lo0 = -ws.frobeniusH * (1.0 + 1e-10) - tol, hi0 = ws.frobeniusH * (1.0 + 1e-10) + tol;
@@ -592,7 +592,7 @@ Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C,
   }
   double maxAbs = 0.0;
   for (int i = 0; i < d; ++i) maxAbs = std::max(maxAbs, std::abs(mu[i]));
-  const double tol = zeroTolerance * std::max(1.0, maxAbs);
+  const double tol = zeroTolerance * std::max(ws.typicalScale, maxAbs);  // the same count in any units
   for (int i = 0; i < d; ++i) {
     if (std::abs(mu[i]) <= tol) ++in.zero;
     else if (mu[i] < 0.0) ++in.negative;

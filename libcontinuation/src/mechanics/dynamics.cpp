@@ -92,6 +92,8 @@ bool DynamicsScene::IsValid(const Chain& chain, std::string* why) const {
 DynamicsModel::DynamicsModel(const Chain& chain, const EndCondition& end)
     : chain_(chain),
       end_(end),
+      lengthUnit_(0.0),
+      torqueUnit_(0.0),
       held_(end.heldIndices()),
       loaded_(end.loadedIndices()),
       loads_(Wrench::Zero()),
@@ -109,6 +111,13 @@ DynamicsModel::DynamicsModel(const Chain& chain, const EndCondition& end)
     if (!finite(end.value[c])) throw std::invalid_argument("end condition value " + std::to_string(c) + " must be finite");
   for (int c : loaded_) loads_[c] = end.value[c];
   llt_.compute(Matrix::Identity(heldCount(), heldCount()));  // defines its status flag
+  double b = 0.0, k = 0.0;
+  for (int i = 0; i < chain.size(); ++i) {
+    b += 0.5 * (chain.segment(i).parameters().b1 + chain.segment(i).parameters().b2);
+    k += 0.5 * (chain.segment(i).parameters().k1 + chain.segment(i).parameters().k2);
+  }
+  lengthUnit_ = b / chain.size();
+  torqueUnit_ = k / chain.size() * lengthUnit_ * lengthUnit_;
 }
 
 void DynamicsModel::evaluateStatics(ConstVectorRef q) {
@@ -127,7 +136,7 @@ void DynamicsModel::evaluateStatics(ConstVectorRef q) {
   A_.noalias() = Jh_ * Jh_.transpose();
   // J_h loses rank where the held coordinate is stationary (x held on the straight chain): a
   // relative 1e-12 shift keeps the factorization defined and is invisible at regular points.
-  A_.diagonal().array() += 1e-12 * std::max(1.0, A_.trace());
+  A_.diagonal().array() += 1e-12 * std::max(lengthUnit_ * lengthUnit_, A_.trace());
   llt_.compute(A_);
 }
 
@@ -152,6 +161,12 @@ double DynamicsModel::equilibriumResidual(ConstVectorRef q) {
   return std::max(tmpN_.cwiseAbs().maxCoeff(), h_.cwiseAbs().maxCoeff());
 }
 
+double DynamicsModel::naturalResidual(ConstVectorRef q) {
+  const double raw = equilibriumResidual(q);  // fills grad_ / tmpN_ and h_
+  if (heldCount() == 0) return raw / torqueUnit_;
+  return std::max(tmpN_.cwiseAbs().maxCoeff() / torqueUnit_, h_.cwiseAbs().maxCoeff() / lengthUnit_);
+}
+
 double DynamicsModel::constraintViolation(ConstVectorRef q) {
   if (heldCount() == 0) return 0.0;
   forwardKinematics(chain_, q, data_);
@@ -164,7 +179,7 @@ bool DynamicsModel::projectOntoConstraints(VectorRef q, double tolerance, int ma
   if (heldCount() == 0) return true;
   for (int it = 0; it <= maxIterations; ++it) {
     evaluateStatics(q);
-    if (h_.cwiseAbs().maxCoeff() <= tolerance) return true;
+    if (h_.cwiseAbs().maxCoeff() <= tolerance * lengthUnit_) return true;
     if (it == maxIterations) break;
     // Minimum-norm Gauss–Newton correction δq = −J_hᵀ (J_h J_hᵀ)⁻¹ h.
     tmpM_ = h_;
@@ -210,7 +225,7 @@ GradientFlowModel::GradientFlowModel(const Chain& chain, const EndCondition& end
   if (!(kappaH_ > 0.0)) {
     Vector kq(chain.size());
     jointStiffness(chain_, q0, kq);
-    kappaH_ = 10.0 * std::max(1.0, kq.cwiseAbs().maxCoeff());
+    kappaH_ = 10.0 * std::max(torqueUnit_, kq.cwiseAbs().maxCoeff());
   }
 }
 
@@ -324,6 +339,9 @@ InertialModel::InertialModel(const Chain& chain, const EndCondition& end, const 
   S_.resize(m, m);
   sllt_.compute(Matrix::Identity(m, m));
 
+  double meanInertia = 0.0;
+  for (int i = 0; i < n; ++i) meanInertia += mu_(i, i) / n;
+  timeUnit_ = std::sqrt(meanInertia / torqueUnit_);
   omega_ = baumgarteRate;
   if (!(omega_ > 0.0)) {
     // Ten times the fastest uncoupled joint frequency √(|∂²Π/∂q_i²| / M_ii): the constraint
@@ -544,7 +562,7 @@ class Monitor {
     record(t, x, false);
     model_.velocity(x, qdot_);
     const double speed = qdot_.cwiseAbs().maxCoeff();
-    if (speed <= options_.velocityTolerance && model_.equilibriumResidual(q) <= options_.residualTolerance)
+    if (speed <= options_.velocityTolerance && model_.naturalResidual(q) <= options_.residualTolerance)
       return stop(StopReason::Rest, "at rest: |qdot| and the equilibrium residual are below tolerance at t = " + num(t));
     return false;
   }
@@ -714,31 +732,40 @@ DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef 
     if (!std::isfinite(q0[i]) || (qdot0.size() == n && !std::isfinite(qdot0[i])))
       throw std::invalid_argument("the initial state must be finite");
 
+  // The options' times and rest tolerances are in the model's natural units (dynamics.h).
+  const double T = model.timeUnit();
+  IntegrationOptions natural = options;
+  natural.initialStep *= T;
+  natural.maxStep *= T;
+  natural.minStep *= T;
+  natural.maxTime *= T;
+  natural.recordInterval *= T;
+  natural.velocityTolerance /= T;
   const auto wallStart = std::chrono::steady_clock::now();
   DynamicsResult result;
   result.kind = model.kind();
   const int N = model.stateSize();
   Vector x0(N);
   model.packState(q0, qdot0, x0);
-  Monitor monitor(model, options, result);
+  Monitor monitor(model, natural, result);
 
-  if (options.stepper == StepperKind::Rosenbrock4) {
+  if (natural.stepper == StepperKind::Rosenbrock4) {
     StiffState x(static_cast<size_t>(N));
     std::copy(x0.data(), x0.data() + N, x.begin());
-    odeint::rosenbrock4_controller<odeint::rosenbrock4<double>> controller(options.absoluteTolerance,
-                                                                           options.relativeTolerance);
-    runLoop(controller, std::make_pair(StiffSystem{&model}, StiffJacobian{&model}), x, stiffData, model, options,
+    odeint::rosenbrock4_controller<odeint::rosenbrock4<double>> controller(natural.absoluteTolerance,
+                                                                           natural.relativeTolerance);
+    runLoop(controller, std::make_pair(StiffSystem{&model}, StiffJacobian{&model}), x, stiffData, model, natural,
             monitor, result);
   } else {
     ExplicitState x(x0.data(), x0.data() + N);
-    if (options.stepper == StepperKind::DormandPrince5) {
-      auto controller = odeint::make_controlled(options.absoluteTolerance, options.relativeTolerance,
+    if (natural.stepper == StepperKind::DormandPrince5) {
+      auto controller = odeint::make_controlled(natural.absoluteTolerance, natural.relativeTolerance,
                                                 odeint::runge_kutta_dopri5<ExplicitState>());
-      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, options, monitor, result);
+      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, natural, monitor, result);
     } else {
-      auto controller = odeint::make_controlled(options.absoluteTolerance, options.relativeTolerance,
+      auto controller = odeint::make_controlled(natural.absoluteTolerance, natural.relativeTolerance,
                                                 odeint::runge_kutta_cash_karp54<ExplicitState>());
-      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, options, monitor, result);
+      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, natural, monitor, result);
     }
   }
   result.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();

@@ -2,6 +2,7 @@
 
 #include <Eigen/QR>
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <stdexcept>
 
@@ -36,6 +37,7 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
     requireFinite(std::string("end value ") + names[c], end.value[c]);
     requireFinite(std::string("load path direction ") + names[c], direction[c]);
   }
+  structure_.typicalScale = stiffnessUnit() * lengthUnit() * lengthUnit();  // the inertia's zero floor
 }
 
 bool EquilibriumProblem::prepare(ConstVectorRef u) {
@@ -242,6 +244,42 @@ bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCo
 
 std::unique_ptr<continuation::BorderedSolver> EquilibriumProblem::makeStructuredSolver() {
   return std::make_unique<ChainBorderedSolver>(*this);
+}
+
+double EquilibriumProblem::lengthUnit() const {
+  double b = 0.0;
+  for (int i = 0; i < chain_.size(); ++i) b += 0.5 * (chain_.segment(i).parameters().b1 + chain_.segment(i).parameters().b2);
+  return b / chain_.size();
+}
+
+double EquilibriumProblem::stiffnessUnit() const {
+  double k = 0.0;
+  for (int i = 0; i < chain_.size(); ++i) k += 0.5 * (chain_.segment(i).parameters().k1 + chain_.segment(i).parameters().k2);
+  return k / chain_.size();
+}
+
+continuation::ProblemScales EquilibriumProblem::scales() const {
+  const int n = chain_.size(), m = heldCount();
+  const double length = lengthUnit(), force = stiffnessUnit() * length, torque = force * length;
+  continuation::ProblemScales s = continuation::ProblemScales::ones(n + m);
+  s.residuals.head(n).setConstant(torque);  // ∂E/∂q − JᵀF: torques
+  for (int k = 0; k < m; ++k) {
+    const bool angle = held_[size_t(k)] == 2;
+    s.unknowns[n + k] = angle ? torque : force;   // the reaction of a held coordinate
+    s.residuals[n + k] = angle ? 1.0 : length;    // value − pose
+  }
+  // λ moves value_c by λ·direction_c; value_c is a load where the coordinate is loaded, a
+  // position or angle where it is held.
+  double lambda = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < 3; ++c) {
+    if (direction_[c] == 0.0) continue;
+    const bool held = end_.isHeld(static_cast<EndCoordinate>(c));
+    const double unit = held ? (c < 2 ? length : 1.0) : (c < 2 ? force : torque);
+    lambda = std::min(lambda, unit / std::abs(direction_[c]));
+  }
+  s.parameter = std::isfinite(lambda) && lambda > 0.0 ? lambda : force;
+  s.stability = torque;  // K_q − K_g
+  return s;
 }
 
 int EquilibriumProblem::boundaryCount() const { return options_.jointLimitsAsBoundaries ? 2 * chain_.size() : 0; }

@@ -14,11 +14,18 @@ NewtonResult solveEquilibrium(continuation::Problem& problem, const Eigen::Ref<c
   r.u = u0;
   Eigen::VectorXd F(N), Ftrial(N), Flambda(N), du(N), trial(N);
   Eigen::MatrixXd Fu(N, N);
+  // Norms in the problem's own scales (Problem::scales()): the tolerances are relative, the
+  // same for the same chain in any units.
+  const continuation::ProblemScales scales = problem.scales();
+  const bool scaled = scales.check(N).empty();
+  const Eigen::VectorXd rowScale = scaled ? scales.residuals : Eigen::VectorXd::Ones(N);
+  const Eigen::VectorXd unknownScale = scaled ? scales.unknowns : Eigen::VectorXd::Ones(N);
+  auto residualNorm = [&](const Eigen::VectorXd& v) { return v.size() ? v.cwiseQuotient(rowScale).lpNorm<Eigen::Infinity>() : 0.0; };
   if (!problem.residual(r.u, lambda, F)) {
     r.residualNorm = std::numeric_limits<double>::infinity();
     return r;
   }
-  double norm = F.size() ? F.lpNorm<Eigen::Infinity>() : 0.0;
+  double norm = residualNorm(F);
   const double target = options.tolerance * std::max(1.0, norm);
   r.residualNorm = norm;
   for (int it = 0; it < options.maxIterations; ++it) {
@@ -36,7 +43,7 @@ NewtonResult solveEquilibrium(continuation::Problem& problem, const Eigen::Ref<c
     for (int h = 0; h <= options.maxHalvings; ++h, t *= 0.5) {
       trial = r.u + t * du;
       if (problem.residual(trial, lambda, Ftrial)) {
-        const double trialNorm = Ftrial.lpNorm<Eigen::Infinity>();
+        const double trialNorm = residualNorm(Ftrial);
         // Full steps are always taken near the solution (quadratic convergence), damped ones
         // only if they reduce the residual.
         if (std::isfinite(trialNorm) && (trialNorm < norm || (h == 0 && trialNorm <= 2 * norm && norm < 1e-6))) {
@@ -48,9 +55,10 @@ NewtonResult solveEquilibrium(continuation::Problem& problem, const Eigen::Ref<c
     if (!accepted) return r;
     r.u = trial;
     F = Ftrial;
-    norm = F.lpNorm<Eigen::Infinity>();
+    norm = residualNorm(F);
     r.residualNorm = norm;
-    if (t == 1.0 && du.lpNorm<Eigen::Infinity>() <= options.stepTolerance * std::max(1.0, r.u.lpNorm<Eigen::Infinity>())) {
+    if (t == 1.0 && du.cwiseQuotient(unknownScale).lpNorm<Eigen::Infinity>() <=
+                        options.stepTolerance * std::max(1.0, r.u.cwiseQuotient(unknownScale).lpNorm<Eigen::Infinity>())) {
       r.converged = true;
       return r;
     }

@@ -1,5 +1,7 @@
 #include "buckle/mechanics/jump.h"
 
+#include "buckle/continuation/scaled_problem.h"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <cmath>
@@ -64,9 +66,15 @@ PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, do
   const Vector u0 = fullUnknowns(problem, q, lambda);
   result.u.resize(N);
   // The core's KINSOL corrector in its fixed-parameter mode: exact Jacobian of the
-  // EquilibriumProblem (the KKT matrix), so convergence from a rest point is quadratic.
-  continuation::Corrector corrector(problem, options);
-  const continuation::CorrectorSummary summary = corrector.solveAtFixedParameter(u0, lambda, result.u);
+  // EquilibriumProblem (the KKT matrix), so convergence from a rest point is quadratic. In the
+  // problem's scaled variables (scaled_problem.h): the tolerance is relative, in any units.
+  const continuation::UnitScaling units(problem.scales());
+  continuation::ScaledProblem scaled(problem, units);
+  continuation::Corrector corrector(scaled, options);
+  const Vector& D = units.scales().unknowns;
+  const continuation::CorrectorSummary summary =
+      corrector.solveAtFixedParameter(u0.cwiseQuotient(D), lambda / units.parameter(), result.u);
+  result.u = result.u.cwiseProduct(D);
   result.converged = summary.converged;
   result.iterations = summary.iterations;
   result.message = summary.flagName;

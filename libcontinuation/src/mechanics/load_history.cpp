@@ -131,6 +131,8 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
   for (double w : waypoints)
     if (!std::isfinite(w)) throw std::invalid_argument("load history: waypoints must be finite");
   if (q0.size() != problem.segments()) throw std::invalid_argument("load history: q0 has the wrong size");
+  // λ's own scale (EquilibriumProblem::scales()): the load history's λ tolerances are relative to it.
+  const double lambdaUnit = problem.scales().parameter;
 
   LoadHistoryResult result;
   double lambda = waypoints[0];
@@ -224,7 +226,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
         if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
           result.jumps.back().toSegment = int(result.segments.size()) - 1;
         const cont::ContinuationPoint& end = branch.points.back();
-        if (branch.stopReason != cont::StopReason::LambdaRange || std::abs(end.lambda - target) > 1e-9 * std::max(1.0, std::abs(target))) {
+        if (branch.stopReason != cont::StopReason::LambdaRange || std::abs(end.lambda - target) > 1e-9 * std::max(lambdaUnit, std::abs(target))) {
           result.message = "leg " + std::to_string(leg) + " stopped before its waypoint: " + branch.stopMessage;
           return result;
         }
@@ -238,7 +240,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       result.segmentBifurcated.push_back(bifurcated);
       if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
         result.jumps.back().toSegment = int(result.segments.size()) - 1;
-      const double at = sp.lambda + sign * options.overshoot * std::max(1.0, std::abs(sp.lambda));
+      const double at = sp.lambda + sign * options.overshoot * std::max(lambdaUnit, std::abs(sp.lambda));
       const JumpTrigger trigger = sp.type == cont::SpecialPointType::Fold ? JumpTrigger::Fold : JumpTrigger::BranchPoint;
       if (!release(trigger, sp.u, sp.lambda, at, int(result.segments.size()) - 1)) {
         result.message = std::string("jump after the ") + toString(trigger) + " at lambda = " + std::to_string(sp.lambda) +

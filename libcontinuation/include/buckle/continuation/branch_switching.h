@@ -35,7 +35,9 @@ bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &dire
 
 /// A new branch leaving bp along sign·direction: point 0 is the branch point itself, point 1
 /// the first corrected point (confirmed off the parent branch), then traced with `tracer`.
-/// Branch::stopReason == SwitchFailed when the first point could not be found.
+/// Branch::stopReason == SwitchFailed when the first point could not be found. bp and direction
+/// are in the problem's units; the first step (amplitude or initialStep) is dimensionless, in the
+/// tracer's scaled variables.
 Branch switchBranch(Tracer &tracer, const SpecialPoint &bp, const Vector &direction, int sign,
                     const BranchSwitchingOptions &options = BranchSwitchingOptions());
 

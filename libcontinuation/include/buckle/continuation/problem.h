@@ -9,7 +9,10 @@
 //   - directional second derivatives (used to locate folds and branch points;
 //     the default takes central differences of the analytic Jacobian);
 //   - boundaries g_k(u, λ) > 0 (joint limits, a box): the tracer stops exactly on
-//     g_k = 0.
+//     g_k = 0;
+//   - typical scales of the unknowns, the residual rows, λ and the stability operator
+//     (ProblemScales). The tracer works in u/scale, λ/scale, F/scale (scaled_problem.h), so
+//     its tolerances, step sizes and thresholds mean the same in any system of units.
 // A problem refuses a point outside its domain by returning false, never by
 // throwing; the corrector then treats the step as failed and halves it.
 //
@@ -40,6 +43,24 @@ struct StabilityInfo {
   Vector lowest;              ///< the lowest eigenvalues asked for, ascending (may be empty)
   bool valid() const { return negative >= 0; }
   bool stable() const { return negative == 0 && zero == 0; }
+};
+
+/// Typical magnitudes of a problem's quantities, all positive and finite: what "1" is for the
+/// continuation core. A diagonal change of variables ũ = u/unknowns, λ̃ = λ/parameter,
+/// F̃ = F/residuals (and H̃ = H/stability) makes the scaled problem O(1) (AUTO's THU/THL weights
+/// for the arclength, KINSOL's uscale/fscale for the Newton norm).
+struct ProblemScales {
+  Vector unknowns;         ///< size N: typical |u_i|
+  Vector residuals;        ///< size N: typical |F_i| (the size of the terms that balance in row i)
+  double parameter = 1.0;  ///< typical |λ|
+  double stability = 1.0;  ///< typical eigenvalue of the stability operator
+
+  /// All ones for dimension n.
+  static ProblemScales ones(int n);
+  /// True when every scale is exactly 1 (the change of variables is the identity).
+  bool identity() const;
+  /// Empty string when valid for dimension n, else what is wrong.
+  std::string check(int n) const;
 };
 
 class Problem {
@@ -82,13 +103,21 @@ class Problem {
   virtual double boundary(int /*k*/, ConstVectorRef /*u*/, double /*lambda*/) { return 1.0; }
   virtual std::string boundaryName(int k) const { return "boundary " + std::to_string(k); }
 
+  // ---- optional: units ------------------------------------------------------------------
+  /// Typical scales (ProblemScales). Default: all ones, i.e. the problem is already posed in
+  /// O(1) variables. Evaluated once per Tracer.
+  virtual ProblemScales scales() const { return ProblemScales::ones(dimension()); }
+
  private:
   Matrix stabilityH_, stabilityC_;  // workspace of the default stability()
 };
 
 /// Inertia of the symmetric H restricted to ker C (C may have zero rows), by a dense
-/// eigen-decomposition. `zeroTolerance` is relative to max(1, ‖H‖).
-/// At most `lowestCount` lowest eigenvalues are kept in info.lowest.
-StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance = 1e-13, int lowestCount = 3);
+/// eigen-decomposition. `zeroTolerance` is relative to max(scale, ‖H‖) (‖H‖ the largest
+/// |eigenvalue| on ker C, `scale` the typical eigenvalue, ProblemScales::stability), so the count
+/// does not depend on the units of H. At most `lowestCount` lowest eigenvalues are kept in
+/// info.lowest.
+StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance = 1e-13, int lowestCount = 3,
+                               double scale = 1.0);
 
 }  // namespace buckle::continuation

@@ -6,10 +6,15 @@
 // points and of the stop conditions (parameter range, box, boundaries g_k = 0) between the last
 // two points. The step adapts to the Newton iteration count and contraction.
 //
-// Tolerances (newtonTolerance, locationTolerance·max(1, |λ|)) and step sizes are absolute, in the
-// problem's own units, with one Euclidean arclength over (u, λ): pose problems so that typical
-// unknowns, λ and residual rows are O(1) (benchmarks/RESULTS.md, "Extreme units", measures what
-// fails otherwise).
+// Units: the tracer works in the problem's scaled variables ũ = u/D_u, λ̃ = λ/λ₀, F̃ = F/D_F
+// (Problem::scales(), scaled_problem.h). So the arclength is AUTO's weighted one, the step sizes
+// (initialStep, minStep, maxStep, maxArclength) are dimensionless, newtonTolerance bounds ‖F̃‖∞
+// (relative to the size of the terms that balance in each row), the location target is
+// locationTolerance·max(λ₀, |λ|), and every internal threshold is relative: the same chain in
+// any units gives the same points. What trace() and continueBranch() return (u, λ, tangents,
+// eigenvalues, accuracies) is in the user's units; arclength, step sizes, residual norms and
+// the fold / branch-point test-function values are the scaled, dimensionless ones. The λ range
+// and the box are given in the user's units.
 #pragma once
 
 #include "buckle/continuation/bordered_solver.h"
@@ -17,6 +22,7 @@
 #include "buckle/continuation/corrector.h"
 #include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
+#include "buckle/continuation/scaled_problem.h"
 #include "buckle/continuation/test_functions.h"
 
 #include <functional>
@@ -31,11 +37,13 @@ namespace buckle::continuation {
 enum class StepAction { Continue, Stop };
 /// Called after every accepted point, with the branch so far (its last point is the new one):
 /// progress reports, custom stop rules (BifurcationKit's finalise_solution). Stop ends the
-/// branch with StopReason::Interrupted.
+/// branch with StopReason::Interrupted. The new point and the special points are in the
+/// problem's units; the earlier points may still be in the tracer's scaled variables (they are
+/// converted when trace()/continueBranch() return), so read the last point only.
 using StepCallback = std::function<StepAction(const Branch &branch)>;
 
 struct TracerOptions {
-  // ---- step control -----------------------------------------------------------------------
+  // ---- step control (dimensionless: arclength in the scaled variables, header comment) -------
   double initialStep = 0.01;
   double minStep = 1e-8;
   double maxStep = 0.1;
@@ -54,7 +62,7 @@ struct TracerOptions {
   Vector boxLower, boxUpper;
 
   // ---- corrector -------------------------------------------------------------------------
-  double newtonTolerance = 1e-10;   ///< ‖G‖∞ of the Keller system
+  double newtonTolerance = 1e-10;   ///< ‖G̃‖∞ of the Keller system in the scaled variables
   double newtonStepTolerance = 1e-14;
   int maxNewtonIterations = 10;
   bool lineSearch = false;
@@ -85,9 +93,10 @@ struct TracerOptions {
   /// the crossing eigenvalue) down to locationTolerance, without the augmented-Newton
   /// refinement or null vectors (so no branch switching there).
   int maxDenseLocationDimension = 400;
-  /// Target |Δλ| ≤ locationTolerance·max(1, |λ|) for located points and stop events.
+  /// Target |Δλ| ≤ locationTolerance·max(λ₀, |λ|) for located points and stop events (λ₀: the
+  /// problem's parameter scale).
   double locationTolerance = 1e-12;
-  /// ‖G‖∞ target of the corrector solves made while locating.
+  /// ‖G̃‖∞ target of the corrector solves made while locating.
   double locationNewtonTolerance = 1e-13;
   int maxLocationIterations = 60;   ///< secant/bisection evaluations per located point
   int maxRefinementIterations = 15; ///< Newton steps on the augmented (fold / Moore) systems
@@ -135,11 +144,16 @@ class Tracer {
   /// (a branch that starts at a branch point).
   void continueBranch(Branch &branch, int skipIntervals = 0);
 
-  /// Fills tangent, test functions and stability of a point from its u, λ.
+  /// Fills tangent, test functions and stability of a point from its u, λ. In the scaled
+  /// variables (units()), like corrector().
   bool completePoint(ContinuationPoint &point, ConstVectorRef referenceDirection);
 
+  /// The corrector on the scaled problem: its x = (ũ, λ̃), units().toScaled/toUser convert.
   Corrector &corrector() { return *corrector_; }
+  /// The problem as given (user units).
   Problem &problem() { return problem_; }
+  /// The change of variables between the problem's units and the tracer's (scaled_problem.h).
+  const UnitScaling &units() const { return units_; }
   const TracerOptions &options() const { return options_; }
   /// True when the bordered solves use the problem's structured solver.
   bool structured() const { return structuredSolver_ != nullptr; }
@@ -150,10 +164,20 @@ class Tracer {
   int eventCount() const;
   CorrectorOptions stepCorrectorOptions() const;
 
+  /// Scale of event `event`'s value g (user value = g · scale).
+  double eventScale(int event) const;
+  /// options_.onStep(branch) with the new point and the special points in the problem's units.
+  StepAction notifyStep(Branch &branch);
+
   Problem &problem_;
   TracerOptions options_;
   std::string invalidReason_;
   int n_;
+  UnitScaling units_;
+  std::unique_ptr<ScaledProblem> scaled_;  // null for the identity scaling
+  Problem *work_;                          // what the core evaluates: scaled_ or problem_
+  double lambdaMin_ = 0.0, lambdaMax_ = 0.0;  // the λ range and the box in the scaled variables
+  Vector boxLower_, boxUpper_;
   std::unique_ptr<BorderedSolver> structuredSolver_, denseSolver_;
   std::unique_ptr<Corrector> corrector_;
   std::unique_ptr<PointEvaluator> evaluator_;

@@ -16,7 +16,9 @@
 //  - countBelow(): the same count by the plain Sturm recurrence (no storage; Kahan's backward-
 //    stable count, zero pivots replaced by −pivmin as in LAPACK dstebz).
 //  - hessianInertia(): negative = #{μ < −τ}, zero = #{|μ| ≤ τ} from two counts at σ = ∓τ,
-//    τ = zeroTolerance · max(1, ‖H‖_F) (‖H‖_F computed exactly in O(n)).
+//    τ = zeroTolerance · max(s, ‖H‖_F) (‖H‖_F computed exactly in O(n); s = typicalScale, the
+//    chain's stiffness unit k̄b̄², so that the count is the same in any units and H ≈ 0 still
+//    counts as zero).
 //  - constrainedInertia(): inertia of H on ker C. The rows of C are orthonormalised (modified
 //    Gram–Schmidt, twice, rank-revealing with rankTolerance): Q (n×r). With B = U⁻¹Q the bordered
 //    matrix K_σ = [[T − σM, B], [Bᵀ, 0]] is congruent to [[H − σI, Q], [Qᵀ, 0]], whose inertia is
@@ -71,6 +73,9 @@ struct ChainStructure {
   Vector kappa, h;     ///< inputs of the last assemble(): K_q diagonal and h_m
   Vector diag, off;    ///< T: diagonal (n) and off-diagonal (n − 1 used)
   double frobeniusH = 0.0;  ///< ‖H‖_F
+  /// The typical eigenvalue of H (the chain's k̄b̄²): floor of the zero thresholds. Set by the
+  /// owner (EquilibriumProblem, linearBuckling); 1 for a chain in the paper's units.
+  double typicalScale = 1.0;
 
   // Factorization of T − σM (Bunch pivoting); valid after factorize().
   double shift = 0.0;
@@ -126,7 +131,7 @@ int countBelow(const ChainStructure& ws, double sigma);
 void solveFactored(const ChainStructure& ws, MatrixRef Y, int cols);
 void solveFactored(const ChainStructure& ws, VectorRef y);
 
-/// Zero threshold τ = zeroTolerance · max(1, ‖H‖_F).
+/// Zero threshold τ = zeroTolerance · max(typicalScale, ‖H‖_F).
 double zeroThreshold(const ChainStructure& ws, double zeroTolerance);
 
 /// Inertia of H (n eigenvalues). Two O(n) Sturm counts.
@@ -157,7 +162,7 @@ double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolera
 /// (n − r)² block of the reflected H is Zᵀ H Z; cyclic Jacobi (block ≤ 4×4) or Eigen's QR solver
 /// gives its eigenvalues.
 /// Zeros are counted as by
-/// continuation::projectedInertia: |μ| ≤ zeroTolerance · max(1, max|μ|). For n ≲ 30 this is
+/// continuation::projectedInertia: |μ| ≤ zeroTolerance · max(typicalScale, max|μ|). For n ≲ 30 this is
 /// faster than the O(n) counts plus eigenvalue isolation (benchmarks/RESULTS.md).
 constexpr int kSmallDense = 32;
 Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, int count, VectorRef lowest,

@@ -80,7 +80,7 @@ struct DynamicsScene {
   /// Damping scale c > 0 of the gradient flow (D1): time is measured in units of c / stiffness.
   double flowDamping = 1.0;
   /// Gradient flow: constraint restoring stiffness κ_h in (D1) (same units as a joint
-  /// stiffness). <= 0: automatic, 10·max(1, max_i |K_q,ii(q0)|).
+  /// stiffness). <= 0: automatic, 10·max(k̄b̄², max_i |K_q,ii(q0)|).
   double constraintStiffness = 0.0;
   /// Inertial model: Baumgarte rate ω (1/time) of the held coordinates. <= 0: automatic,
   /// 10·max_i √(|∂²Π/∂q_i²| / M_ii) at the start (ten times the fastest joint frequency).
@@ -129,9 +129,18 @@ class DynamicsModel {
   void potentialGradient(ConstVectorRef q, VectorRef g);
   /// Equilibrium residual max(‖P ∇Π‖∞, ‖h‖∞): zero exactly at an equilibrium of the scene.
   double equilibriumResidual(ConstVectorRef q);
+  /// The same in the chain's units: max(‖P ∇Π‖∞ / torqueUnit(), ‖h‖∞ / lengthUnit()).
+  double naturalResidual(ConstVectorRef q);
+  /// The chain's units: b̄ (mean triangle half-length) and k̄b̄² (k̄ the mean spring stiffness:
+  /// the size of a joint stiffness and of a torque).
+  double lengthUnit() const { return lengthUnit_; }
+  double torqueUnit() const { return torqueUnit_; }
+  /// The model's natural time unit: c / k̄b̄² for the gradient flow (D1), √(Ī / k̄b̄²) for the
+  /// inertial model (Ī the mean joint inertia μ_ii). IntegrationOptions' times are in this unit.
+  virtual double timeUnit() const = 0;
   /// ‖h(q)‖∞ = max over held coordinates |p_c(q) − target_c| (0 without held coordinates).
   double constraintViolation(ConstVectorRef q);
-  /// Gauss–Newton onto h(q) = 0 (minimum-norm corrections J_h⁺ h); true when ‖h‖∞ <= tol.
+  /// Gauss–Newton onto h(q) = 0 (minimum-norm corrections J_h⁺ h); true when ‖h‖∞ <= tol·b̄.
   bool projectOntoConstraints(VectorRef q, double tolerance = 1e-13, int maxIterations = 20);
   /// Inside the joint limits (geometric ∩ user, open interval)?
   bool withinLimits(ConstVectorRef q) const;
@@ -143,6 +152,7 @@ class DynamicsModel {
 
   Chain chain_;
   EndCondition end_;
+  double lengthUnit_, torqueUnit_;
   std::vector<int> held_, loaded_;
   Wrench loads_;  ///< F_l on loaded coordinates, 0 on held ones
   ChainData data_;
@@ -174,6 +184,7 @@ class GradientFlowModel final : public DynamicsModel {
 
   double damping() const { return c_; }
   double constraintStiffness() const { return kappaH_; }
+  double timeUnit() const override { return c_ / torqueUnit_; }
 
  private:
   double c_, kappaH_;
@@ -209,6 +220,7 @@ class InertialModel final : public DynamicsModel {
   void centresOfMass(ConstVectorRef q, Eigen::Ref<Eigen::Matrix2Xd> G) const;
   const Vector& jointDamping() const { return d_; }
   double baumgarteRate() const { return omega_; }
+  double timeUnit() const override { return timeUnit_; }
 
  private:
   void computeMassMatrix(ConstVectorRef q);  // fills Mtheta_, M_ (uses theta from data_)
@@ -223,6 +235,7 @@ class InertialModel final : public DynamicsModel {
   Matrix B_, S_;  // M⁻¹ J_hᵀ (n×m), J_h M⁻¹ J_hᵀ (m×m)
   Eigen::LLT<Matrix> sllt_;
   double omega_;
+  double timeUnit_;
 };
 
 /// The only way scenes build a model: the inertial one if and only if scene.inertia is set.
@@ -238,6 +251,11 @@ enum class StepperKind {
   Rosenbrock4,     ///< rosenbrock4 (L-stable, uses the model's Jacobian) for stiff scenes
 };
 
+/// Times (initialStep, maxStep, minStep, maxTime, recordInterval) are in the model's natural
+/// time unit (DynamicsModel::timeUnit()), velocityTolerance in rad per that unit and
+/// residualTolerance bounds DynamicsModel::naturalResidual(): the horizon and the rest criterion
+/// mean the same for the same chain in any units. Results (times, residuals) are in the model's
+/// own units.
 struct IntegrationOptions {
   StepperKind stepper = StepperKind::DormandPrince5;
   double absoluteTolerance = 1e-10;  ///< per-step local error control (odeint eps_abs)

@@ -74,6 +74,16 @@ class EquilibriumProblem final : public continuation::Problem {
   /// The O(n) bordered solver of the chain (chain_solver.h).
   std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver() override;
 
+  /// The chain's own units (ProblemScales): with b̄, k̄ the mean triangle half-length and spring
+  /// stiffness, angles 1, torque rows and the stability operator k̄b̄², held-position rows b̄,
+  /// held-angle rows 1, force reactions k̄b̄, torque reactions k̄b̄², and λ the size that moves the
+  /// first prescribed value by its unit (a force k̄b̄, a torque k̄b̄², a position b̄, an angle 1):
+  /// min over the direction's components c of unit_c / |direction_c|.
+  continuation::ProblemScales scales() const override;
+  /// b̄ and k̄ of scales(): the mean triangle half-length and the mean spring stiffness.
+  double lengthUnit() const;
+  double stiffnessUnit() const;
+
   int boundaryCount() const override;
   double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
   std::string boundaryName(int k) const override;

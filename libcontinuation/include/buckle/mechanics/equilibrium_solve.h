@@ -11,7 +11,9 @@ namespace buckle::mechanics {
 
 struct NewtonOptions {
   int maxIterations = 60;
-  /// Converged when ‖F‖∞ <= tolerance·max(1, ‖F(u0)‖∞) or the Newton step ‖δu‖∞ <= stepTolerance.
+  /// Converged when ‖F‖∞ <= tolerance·max(1, ‖F(u0)‖∞) or the Newton step ‖δu‖∞ <= stepTolerance,
+  /// both measured in the problem's scales (F_i / residual scale, δu_i / unknown scale:
+  /// Problem::scales()), so the same in any units.
   double tolerance = 1e-13;
   double stepTolerance = 1e-15;
   int maxHalvings = 40;
@@ -21,7 +23,7 @@ struct NewtonResult {
   Eigen::VectorXd u;          ///< last iterate
   bool converged = false;
   int iterations = 0;
-  double residualNorm = 0.0;  ///< ‖F(u)‖∞ at the last iterate
+  double residualNorm = 0.0;  ///< ‖F(u)‖∞ at the last iterate, in the problem's scales
 };
 
 /// Solves F(u, λ) = 0 from u0. Never throws for a failed solve (converged = false).

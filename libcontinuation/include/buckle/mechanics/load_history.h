@@ -23,8 +23,9 @@ struct LoadHistoryOptions {
   /// Step control, tolerances and detection; the λ range is set per leg.
   continuation::TracerOptions tracer;
   JumpOptions jump;
-  /// The jump is released at λ_c + overshoot·max(1, |λ_c|) in the loading direction, just past
-  /// the critical load λ_c where the stable state ceased to exist.
+  /// The jump is released at λ_c + overshoot·max(λ₀, |λ_c|) (λ₀ the problem's parameter scale)
+  /// in the loading direction, just past the critical load λ_c where the stable state ceased to
+  /// exist.
   double overshoot = 1e-6;
   int maxJumps = 50;
 

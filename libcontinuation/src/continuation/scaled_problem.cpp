@@ -1,0 +1,205 @@
+#include "buckle/continuation/scaled_problem.h"
+
+#include <cmath>
+
+namespace buckle::continuation {
+
+namespace {
+
+// v / ‖v‖, zero left alone.
+void normalize(VectorRef v) {
+  const double norm = v.norm();
+  if (norm > 0.0 && std::isfinite(norm)) v /= norm;
+}
+
+// Columns normalised; with two or more columns Gram–Schmidt keeps the first one's direction
+// (the traced branch's tangent at a branch point) and makes the basis orthonormal again.
+void orthonormalizeColumns(Matrix &K) {
+  for (Eigen::Index j = 0; j < K.cols(); ++j) {
+    for (Eigen::Index i = 0; i < j; ++i) K.col(j) -= K.col(i).dot(K.col(j)) * K.col(i);
+    normalize(K.col(j));
+  }
+}
+
+}  // namespace
+
+UnitScaling::UnitScaling(const ProblemScales &scales)
+    : scales_(scales), n_(static_cast<int>(scales.unknowns.size())), identity_(scales.identity()) {
+  stateScales_.resize(n_ + 1);
+  stateScales_.head(n_) = scales_.unknowns;
+  stateScales_[n_] = scales_.parameter;
+}
+
+Vector UnitScaling::directionToScaled(ConstVectorRef t) const {
+  if (identity_ || t.size() != n_ + 1) return t;
+  Vector s = t.cwiseQuotient(stateScales_);
+  normalize(s);
+  return s;
+}
+
+Vector UnitScaling::directionToUser(ConstVectorRef t) const {
+  if (identity_ || t.size() != n_ + 1) return t;
+  Vector s = t.cwiseProduct(stateScales_);
+  normalize(s);
+  return s;
+}
+
+void UnitScaling::toScaled(ContinuationPoint &p) const {
+  if (identity_) return;
+  if (p.u.size() == n_) p.u = p.u.cwiseQuotient(scales_.unknowns);
+  p.lambda /= scales_.parameter;
+  if (p.tangent.size() == n_ + 1) p.tangent = directionToScaled(p.tangent);
+  p.stability.lowest /= scales_.stability;
+  p.stability.smallest /= scales_.stability;
+}
+
+void UnitScaling::toUser(ContinuationPoint &p) const {
+  if (identity_) return;
+  if (p.u.size() == n_) p.u = p.u.cwiseProduct(scales_.unknowns);
+  p.lambda *= scales_.parameter;
+  if (p.tangent.size() == n_ + 1) p.tangent = directionToUser(p.tangent);
+  p.stability.lowest *= scales_.stability;
+  p.stability.smallest *= scales_.stability;
+}
+
+void UnitScaling::toScaled(SpecialPoint &p) const {
+  if (identity_) return;
+  if (p.u.size() == n_) p.u = p.u.cwiseQuotient(scales_.unknowns);
+  p.lambda /= scales_.parameter;
+  p.lambdaAccuracy /= scales_.parameter;
+  if (p.tangent.size() == n_ + 1) p.tangent = directionToScaled(p.tangent);
+  // Kernel vectors of F_x map like directions (F̃_x = D_F⁻¹ F_x S), left null vectors like
+  // rows (ψ̃ ∝ D_F ψ).
+  if (p.nullVectors.rows() == n_ + 1) {
+    p.nullVectors.array().colwise() /= stateScales_.array();
+    orthonormalizeColumns(p.nullVectors);
+  } else if (p.nullVectors.rows() == n_) {
+    p.nullVectors.array().colwise() /= scales_.unknowns.array();
+    orthonormalizeColumns(p.nullVectors);
+  }
+  if (p.leftNullVector.size() == n_) {
+    p.leftNullVector = p.leftNullVector.cwiseProduct(scales_.residuals);
+    normalize(p.leftNullVector);
+  }
+}
+
+void UnitScaling::toUser(SpecialPoint &p) const {
+  if (identity_) return;
+  if (p.u.size() == n_) p.u = p.u.cwiseProduct(scales_.unknowns);
+  p.lambda *= scales_.parameter;
+  p.lambdaAccuracy *= scales_.parameter;
+  if (p.tangent.size() == n_ + 1) p.tangent = directionToUser(p.tangent);
+  // Columns only normalised: orthogonality is a property of the scaled basis, which toScaled()
+  // restores.
+  if (p.nullVectors.rows() == n_ + 1) {
+    p.nullVectors.array().colwise() *= stateScales_.array();
+    for (Eigen::Index j = 0; j < p.nullVectors.cols(); ++j) normalize(p.nullVectors.col(j));
+  } else if (p.nullVectors.rows() == n_) {
+    p.nullVectors.array().colwise() *= scales_.unknowns.array();
+    for (Eigen::Index j = 0; j < p.nullVectors.cols(); ++j) normalize(p.nullVectors.col(j));
+  }
+  if (p.leftNullVector.size() == n_) {
+    p.leftNullVector = p.leftNullVector.cwiseQuotient(scales_.residuals);
+    normalize(p.leftNullVector);
+  }
+}
+
+void UnitScaling::toScaled(Branch &b) const {
+  if (identity_) return;
+  for (ContinuationPoint &p : b.points) toScaled(p);
+  for (SpecialPoint &p : b.specialPoints) toScaled(p);
+}
+
+void UnitScaling::toUser(Branch &b) const {
+  if (identity_) return;
+  for (ContinuationPoint &p : b.points) toUser(p);
+  for (SpecialPoint &p : b.specialPoints) toUser(p);
+}
+
+ScaledProblem::ScaledProblem(Problem &problem, const UnitScaling &units)
+    : problem_(problem), units_(units), n_(problem.dimension()), u_(Vector::Zero(n_)), du_(Vector::Zero(n_)) {}
+
+const Vector &ScaledProblem::user(ConstVectorRef u) {
+  u_ = u.cwiseProduct(units_.scales().unknowns);
+  return u_;
+}
+
+void ScaledProblem::scaleJacobian(MatrixRef Fu, VectorRef Flambda) const {
+  const ProblemScales &s = units_.scales();
+  Fu.array().colwise() /= s.residuals.array();
+  Fu.array().rowwise() *= s.unknowns.transpose().array();
+  Flambda.array() *= s.parameter / s.residuals.array();
+}
+
+bool ScaledProblem::residual(ConstVectorRef u, double lambda, VectorRef F) {
+  if (!problem_.residual(user(u), lambda * units_.parameter(), F)) return false;
+  F.array() /= units_.scales().residuals.array();
+  return true;
+}
+
+bool ScaledProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) {
+  if (!problem_.jacobian(user(u), lambda * units_.parameter(), Fu, Flambda)) return false;
+  scaleJacobian(Fu, Flambda);
+  return true;
+}
+
+bool ScaledProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                                  MatrixRef dFu, VectorRef dFlambda) {
+  du_ = du.cwiseProduct(units_.scales().unknowns);
+  const double lp = units_.parameter();
+  if (!problem_.jacobianDirectionalDerivative(user(u), lambda * lp, du_, dlambda * lp, dFu, dFlambda)) return false;
+  scaleJacobian(dFu, dFlambda);
+  return true;
+}
+
+bool ScaledProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) {
+  if (!problem_.stabilityOperator(user(u), lambda * units_.parameter(), H, C)) return false;
+  H /= units_.scales().stability;
+  return true;
+}
+
+bool ScaledProblem::stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo &info) {
+  if (!problem_.stability(user(u), lambda * units_.parameter(), lowestCount, info)) return false;
+  info.lowest /= units_.scales().stability;
+  info.smallest /= units_.scales().stability;
+  return true;
+}
+
+std::unique_ptr<BorderedSolver> ScaledProblem::makeStructuredSolver() {
+  std::unique_ptr<BorderedSolver> solver = problem_.makeStructuredSolver();
+  if (!solver) return nullptr;
+  return std::make_unique<ScaledBorderedSolver>(std::move(solver), units_);
+}
+
+double ScaledProblem::boundary(int k, ConstVectorRef u, double lambda) {
+  return problem_.boundary(k, user(u), lambda * units_.parameter());
+}
+
+ScaledBorderedSolver::ScaledBorderedSolver(std::unique_ptr<BorderedSolver> solver, const UnitScaling &units)
+    : solver_(std::move(solver)), units_(units) {
+  const ProblemScales &s = units_.scales();
+  const Eigen::Index n = s.unknowns.size();
+  stateScales_.resize(n + 1);
+  stateScales_ << s.unknowns, s.parameter;
+  rowScales_.resize(n + 1);
+  rowScales_ << s.residuals, 1.0;
+  u_ = Vector::Zero(n);
+  c_ = Vector::Zero(n + 1);
+  b_ = Vector::Zero(n + 1);
+}
+
+Factorization ScaledBorderedSolver::factor(ConstVectorRef u, double lambda, ConstVectorRef c) {
+  u_ = u.cwiseProduct(units_.scales().unknowns);
+  c_ = c.cwiseQuotient(stateScales_);
+  return solver_->factor(u_, lambda * units_.parameter(), c_);
+}
+
+bool ScaledBorderedSolver::solve(ConstVectorRef b, VectorRef x) {
+  // Ã x̃ = b̃  ⇔  A (S x̃) = diag(D_F, 1) b̃.
+  b_ = b.cwiseProduct(rowScales_);
+  if (!solver_->solve(b_, x)) return false;
+  x.array() /= stateScales_.array();
+  return x.allFinite();
+}
+
+}  // namespace buckle::continuation

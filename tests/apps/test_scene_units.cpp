@@ -1,0 +1,321 @@
+// The same answer in any units (issue 12): every scene in data/scenes/, rewritten in other unit
+// systems — every length × L, every spring stiffness × K, so forces × K·L, torques and energies
+// × K·L², masses per length × K/L and joint damping × K·L² (the time unit unchanged), angles and
+// the solver settings as shipped — run through `buckle run` (runSceneCommand) must give the same
+// special points: same count, order, types, fields, shapes and stabilities, parameters, loads and
+// positions equal after rescaling to 1e-10 relative (to the quantity's own unit: the shipped
+// scenes have b = k = 1), joint angles to 1e-10, the same jumps and landings, the same critical
+// loads, energy-curve equilibria, torque zeros and sudden-load answers.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "scene/command.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+fs::path sceneDir() { return fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes"; }
+
+fs::path workDir() {
+  return fs::temp_directory_path() / ("buckle_test_scene_units_" + std::to_string(::getpid()));
+}
+
+json readJson(const fs::path& p) {
+  std::ifstream in(p);
+  REQUIRE(in.good());
+  return json::parse(in);
+}
+
+struct Units {
+  const char* name;
+  double length, stiffness;
+  double force() const { return stiffness * length; }
+  double torque() const { return stiffness * length * length; }
+  /// Unit of a load name (Fx, Fy, Me) or an end coordinate (x, y, phi).
+  double of(const std::string& key) const {
+    if (key == "Fx" || key == "Fy") return force();
+    if (key == "Me") return torque();
+    if (key == "x" || key == "y") return length;
+    return 1.0;  // phi
+  }
+  /// Unit of the reaction of a held coordinate.
+  double reactionOf(const std::string& coordinate) const { return coordinate == "phi" ? torque() : force(); }
+};
+
+// The unit systems of the issue, relative to the shipped scenes (b = 1, k = 1): b = 20 mm with
+// k = 2 N/mm; b = 0.02 m with k = 2000 N/m; lengths × 1e3 with stiffness × 1e-6.
+const Units kSystems[] = {{"mm, N/mm", 20.0, 2.0}, {"m, N/m", 0.02, 2000.0}, {"x1e3, x1e-6", 1e3, 1e-6}};
+
+void scaleChain(json& chain, const Units& u) {
+  for (const char* key : {"a", "b", "L0", "a1", "a2", "b1", "b2", "L1_0", "L2_0"})
+    if (chain.contains(key)) chain[key] = chain[key].get<double>() * u.length;
+  for (const char* key : {"k", "k1", "k2"})
+    if (chain.contains(key)) chain[key] = chain[key].get<double>() * u.stiffness;
+  if (chain.contains("segments") && chain["segments"].is_array())
+    for (json& s : chain["segments"]) scaleChain(s, u);
+}
+
+void scaleEnd(json& end, const Units& u) {
+  for (const char* c : {"x", "y", "phi"}) {
+    if (!end.contains(c) || !end[c].is_object()) continue;
+    json& v = end[c];
+    const std::string coordinate = c;
+    if (v.contains("load")) v["load"] = v["load"].get<double>() * (coordinate == "phi" ? u.torque() : u.force());
+    if (v.contains("held") && v["held"].is_number()) v["held"] = v["held"].get<double>() * u.of(coordinate);
+  }
+}
+
+void scalePath(json& path, const std::string& parameter, const Units& u) {
+  const double unit = u.of(parameter);
+  for (const char* key : {"from", "to"})
+    if (path.contains(key)) path[key] = path[key].get<double>() * unit;
+  if (path.contains("load_limit")) path["load_limit"] = path["load_limit"].get<double>() * u.reactionOf(parameter);
+  if (path.contains("direction"))
+    for (auto& [key, rate] : path["direction"].items()) rate = rate.get<double>() * u.of(key) / unit;
+}
+
+std::string parameterOf(const json& scene, const json& patch) {
+  if (patch.contains("path") && patch["path"].contains("parameter")) return patch["path"]["parameter"];
+  if (scene.contains("path") && scene["path"].contains("parameter")) return scene["path"]["parameter"];
+  return "";
+}
+
+/// The scene in the unit system u (the module comment); plots off (they are not compared).
+json rewrite(json scene, const Units& u) {
+  const json original = scene;
+  const std::string parameter = parameterOf(original, json::object());
+  if (scene.contains("chain")) scaleChain(scene["chain"], u);
+  if (scene.contains("end")) scaleEnd(scene["end"], u);
+  if (scene.contains("path")) scalePath(scene["path"], parameter, u);
+  if (scene.contains("cases"))
+    for (json& c : scene["cases"]) {
+      if (c.contains("chain")) scaleChain(c["chain"], u);
+      if (c.contains("end")) scaleEnd(c["end"], u);
+      if (c.contains("path")) scalePath(c["path"], parameterOf(original, c), u);
+    }
+  json& a = scene["analyses"];
+  if (a.contains("energy_curves"))
+    for (const char* key : {"x", "y"})
+      if (a["energy_curves"].contains(key)) a["energy_curves"][key] = a["energy_curves"][key].get<double>() * u.length;
+  if (a.contains("load_history"))
+    for (json& w : a["load_history"]["waypoints"]) w = w.get<double>() * u.of(parameter);
+  if (a.contains("sudden_load")) {
+    json& s = a["sudden_load"];
+    s["value"] = s["value"].get<double>() * u.of(parameter);
+    if (s.contains("mass_per_length")) s["mass_per_length"] = s["mass_per_length"].get<double>() * u.stiffness / u.length;
+    if (s.contains("damping")) s["damping"] = s["damping"].get<double>() * u.torque();
+  }
+  scene["plots"] = json::array();
+  return scene;
+}
+
+json run(const json& scene, const fs::path& dir, const std::string& name) {
+  fs::create_directories(dir);
+  const fs::path file = dir / (name + ".json");
+  {
+    std::ofstream out(file);
+    out << scene.dump(2);
+  }
+  std::ostringstream log, err;
+  buckle::scene::RunCommandOptions opt;
+  opt.scene = file.string();
+  opt.out = (dir / name).string();
+  opt.quiet = true;
+  const int rc = buckle::scene::runSceneCommand(opt, log, err);
+  INFO(name << ": " << err.str());
+  REQUIRE(rc == 0);
+  json result = readJson(dir / name / "special_points.json");
+  result["complete"] = readJson(dir / name / "summary.json")["complete"];
+  return result;
+}
+
+// |a/unit − b| within 1e-10 of the quantity's unit (and of |b|): "1e-10 relative".
+void same(const json& a, const json& b, double unit, const std::string& what, double tolerance = 1e-10) {
+  INFO(what);
+  REQUIRE(a.is_number() == b.is_number());
+  if (!b.is_number()) return;
+  const double x = a.get<double>() / unit, y = b.get<double>();
+  CHECK(std::abs(x - y) <= tolerance * std::max(1.0, std::abs(y)));
+}
+
+void sameVector(const json& a, const json& b, double unit, const std::string& what, double tolerance = 1e-10) {
+  INFO(what);
+  REQUIRE(a.size() == b.size());
+  for (size_t i = 0; i < b.size(); ++i) same(a[i], b[i], unit, what + "[" + std::to_string(i) + "]", tolerance);
+}
+
+void sameWrench(const json& a, const json& b, const Units& u, const std::string& what) {
+  same(a["Fx"], b["Fx"], u.force(), what + " Fx");
+  same(a["Fy"], b["Fy"], u.force(), what + " Fy");
+  same(a["Me"], b["Me"], u.torque(), what + " Me");
+}
+
+void samePose(const json& a, const json& b, const Units& u, const std::string& what, double tolerance = 1e-10) {
+  same(a["x"], b["x"], u.length, what + " x", tolerance);
+  same(a["y"], b["y"], u.length, what + " y", tolerance);
+  same(a["phi"], b["phi"], 1.0, what + " phi", tolerance);
+}
+
+// A branch point of multiplicity ≥ 2 is not refined (no regular augmented system): it is the
+// sample of the branch inside a bracket of |ds| ~ 1e-11, where the Keller system is singular
+// to that order, so its joint angles are determined only to ~eps/|ds| ≈ 1e-5·(scale) in any unit
+// system (its λ still to rounding). Such points, and the jumps released from them (same q),
+// are compared to 1e-6 in q and position.
+bool nearMultiplePoint(const json& point, const json& all) {
+  for (const json& p : all) {
+    if (p["type"] != "BP" || p["accuracy"]["refined"] == true) continue;
+    if (!p.contains("note") || p["note"].get<std::string>().find("multiplicity") == std::string::npos) continue;
+    double d = 0.0;
+    for (size_t i = 0; i < p["q"].size(); ++i) d = std::max(d, std::abs(p["q"][i].get<double>() - point["q"][i].get<double>()));
+    if (d <= 1e-5) return true;
+  }
+  return false;
+}
+
+void compare(const json& got, const json& ref, const json& scene, const Units& u) {
+  CHECK(got["complete"] == ref["complete"]);
+  const json& gs = got["special_points"];
+  const json& rs = ref["special_points"];
+  REQUIRE(gs.size() == rs.size());
+  for (size_t i = 0; i < rs.size(); ++i) {
+    const json &g = gs[i], &r = rs[i];
+    const std::string what = "special point " + std::to_string(i) + " (" + r["type"].get<std::string>() + ")";
+    INFO(what << ": " << r.dump());
+    const bool degenerate = r["q"].size() == g["q"].size() && nearMultiplePoint(r, rs);
+    for (const char* key : {"type", "field", "case", "branch", "shape", "stability_before", "stability_after"}) {
+      INFO(key << ": " << g[key].dump() << " vs " << r[key].dump());
+      // At the hysteresis scene's symmetric point a fold and a double branch point coincide
+      // exactly (free end under Me, equal joints: H = K_q(q)·I, all three eigenvalues cross at
+      // the fold). Which branch through it the tracer continues on, and so whether the point is
+      // reported as BP (multiplicity 3) or LP, is decided by rounding in any unit system: there
+      // the location (λ, and q to 1e-6) is compared, not the classification.
+      const bool classification = std::string(key) == "type" || std::string(key) == "field" ||
+                                  std::string(key) == "shape" || std::string(key) == "stability_after";
+      if (degenerate && classification && r["type"] == "BP") {
+        CHECK((g["type"] == "BP" || g["type"] == "LP"));
+        continue;
+      }
+      CHECK(g[key] == r[key]);
+    }
+    const std::string parameter = parameterOf(scene, scene.contains("cases") ? scene["cases"][r["case"].get<size_t>()] : json::object());
+    same(g["parameter"], r["parameter"], u.of(parameter), what + " parameter");
+    const double angleTolerance = degenerate ? 1e-6 : 1e-10;
+    sameVector(g["q"], r["q"], 1.0, what + " q", angleTolerance);
+    sameWrench(g["loads"], r["loads"], u, what);
+    samePose(g["position"], r["position"], u, what, angleTolerance);
+    REQUIRE(g.contains("jump_to") == r.contains("jump_to"));
+    if (!r.contains("jump_to")) continue;
+    const json &gj = g["jump_to"], &rj = r["jump_to"];
+    CHECK(gj["success"] == rj["success"]);
+    CHECK(gj["landing"] == rj["landing"]);
+    REQUIRE(gj.contains("q") == rj.contains("q"));
+    if (!rj.contains("q")) continue;
+    CHECK(gj["shape"] == rj["shape"]);
+    // A polished landing is an equilibrium: 1e-10. A joint-limit landing is where the
+    // integration stopped on the limit: the trajectory's own accuracy (1e-10 per step).
+    const double qTolerance = rj["landing"] == "joint limit" ? 1e-6 : 1e-10;
+    sameVector(gj["q"], rj["q"], 1.0, what + " landing q", qTolerance);
+    sameWrench(gj["loads"], rj["loads"], u, what + " landing");
+    same(gj["energy_released"], rj["energy_released"], u.torque(), what + " energy released", 1e-8);
+  }
+  if (ref.contains("critical_loads")) {
+    REQUIRE(got["critical_loads"].size() == ref["critical_loads"].size());
+    for (size_t i = 0; i < ref["critical_loads"].size(); ++i) {
+      const json &g = got["critical_loads"][i], &r = ref["critical_loads"][i];
+      CHECK(g["shape"] == r["shape"]);
+      // the load of the path's coordinate (a force for x, y, Fx, Fy)
+      const std::string parameter = parameterOf(scene, json::object());
+      const double unit = parameter == "phi" || parameter == "Me" ? u.torque() : u.force();
+      same(g["load_factor"], r["load_factor"], unit, "critical load " + std::to_string(i));
+    }
+  }
+  if (ref.contains("energy_equilibria")) {
+    REQUIRE(got["energy_equilibria"].size() == ref["energy_equilibria"].size());
+    for (size_t i = 0; i < ref["energy_equilibria"].size(); ++i) {
+      const json &g = got["energy_equilibria"][i], &r = ref["energy_equilibria"][i];
+      CHECK(g["stable"] == r["stable"]);
+      CHECK(g["ik_branch"] == r["ik_branch"]);
+      same(g["q1"], r["q1"], 1.0, "energy equilibrium q1");
+      sameVector(g["q"], r["q"], 1.0, "energy equilibrium q");
+      same(g["energy"], r["energy"], u.torque(), "energy equilibrium energy");
+    }
+  }
+  if (ref.contains("torque_zeros")) {
+    REQUIRE(got["torque_zeros"].size() == ref["torque_zeros"].size());
+    for (size_t i = 0; i < ref["torque_zeros"].size(); ++i) {
+      CHECK(got["torque_zeros"][i]["stable"] == ref["torque_zeros"][i]["stable"]);
+      same(got["torque_zeros"][i]["q"], ref["torque_zeros"][i]["q"], 1.0, "torque zero");
+    }
+  }
+  if (ref.contains("sudden_load")) {
+    REQUIRE(got["sudden_load"].size() == ref["sudden_load"].size());
+    for (size_t i = 0; i < ref["sudden_load"].size(); ++i) {
+      const json &g = got["sudden_load"][i], &r = ref["sudden_load"][i];
+      for (const char* key : {"success", "model", "stable"}) CHECK(g[key] == r[key]);
+      REQUIRE(g.contains("rest") == r.contains("rest"));
+      if (r.contains("rest")) sameVector(g["rest"]["q"], r["rest"]["q"], 1.0, "sudden-load rest q");
+      REQUIRE(g["quasi_static"].is_null() == r["quasi_static"].is_null());
+      if (!r["quasi_static"].is_null()) {
+        CHECK(g["quasi_static"]["differs"] == r["quasi_static"]["differs"]);
+        CHECK(g["quasi_static"]["lower"] == r["quasi_static"]["lower"]);
+        sameVector(g["quasi_static"]["q"], r["quasi_static"]["q"], 1.0, "quasi-static q");
+      }
+    }
+  }
+}
+
+}  // namespace
+
+TEST_CASE("every shipped scene gives the same special points in three other unit systems", "[scene][units][slow]") {
+  std::vector<fs::path> scenes;
+  for (const auto& e : fs::directory_iterator(sceneDir()))
+    if (e.path().extension() == ".json") scenes.push_back(e.path());
+  std::sort(scenes.begin(), scenes.end());
+  REQUIRE(scenes.size() >= 10);
+  const fs::path dir = workDir();
+  for (const fs::path& file : scenes) {
+    DYNAMIC_SECTION(file.stem().string()) {
+      const json shipped = readJson(file);
+      const json reference = run(rewrite(shipped, Units{"shipped", 1.0, 1.0}), dir, file.stem().string());
+      // the comparison must have something to compare
+      CHECK((!reference["special_points"].empty() || reference.contains("energy_equilibria") ||
+             reference.contains("torque_zeros") || reference.contains("sudden_load")));
+      for (const Units& u : kSystems) {
+        INFO("unit system " << u.name << " (lengths x " << u.length << ", stiffness x " << u.stiffness << ")");
+        const json scaled = rewrite(shipped, u);
+        const json got = run(scaled, dir, file.stem().string() + "_" + std::to_string(&u - kSystems));
+        compare(got, reference, shipped, u);
+      }
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("the rewrite scales what it should", "[scene][units]") {
+  const json scene = json::parse(R"({"chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+    "end": {"x": {"load": 0.5}, "y": {"held": 0.25}, "phi": {"load": 0.1}},
+    "path": {"parameter": "Fx", "from": 0.0, "to": -2.5, "direction": {"Me": 0.2, "y": 0.5}},
+    "analyses": {"continuation": true}, "solver": {"initial_step": 0.02}})");
+  const Units u{"test", 10.0, 3.0};
+  const json s = rewrite(scene, u);
+  CHECK(s["chain"]["b"] == Approx(10.0));
+  CHECK(s["chain"]["k"] == Approx(3.0));
+  CHECK(s["chain"]["L0"] == Approx(22.5));
+  CHECK(s["end"]["x"]["load"] == Approx(0.5 * 30.0));
+  CHECK(s["end"]["y"]["held"] == Approx(2.5));
+  CHECK(s["end"]["phi"]["load"] == Approx(0.1 * 300.0));
+  CHECK(s["path"]["to"] == Approx(-75.0));
+  CHECK(s["path"]["direction"]["Me"] == Approx(0.2 * 300.0 / 30.0));  // torque per force
+  CHECK(s["path"]["direction"]["y"] == Approx(0.5 * 10.0 / 30.0));    // length per force
+  CHECK(s["solver"]["initial_step"] == Approx(0.02));                  // dimensionless: as shipped
+}
