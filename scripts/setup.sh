@@ -49,8 +49,10 @@ usage() {
 main_job() {
   local buckle=$BUILD_DIR/bin/buckle
   if [[ -f data/scenes/default.json ]] && has_subcommand "$buckle" run; then
-    log "main job: buckle run data/scenes/default.json --out $OUT"
-    "$buckle" run data/scenes/default.json --out "$OUT"
+    # into its own folder: buckle refuses to replace a directory holding anything but its own
+    # output (out/ may hold other runs, e.g. out/atlas), so out/ itself is never the target
+    log "main job: buckle run data/scenes/default.json --out $OUT/default"
+    "$buckle" run data/scenes/default.json --out "$OUT/default"
   else
     [[ ! -f data/scenes/default.json ]] ||
       log "main job: data/scenes/default.json exists but this buckle has no 'run' subcommand"

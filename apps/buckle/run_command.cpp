@@ -19,7 +19,7 @@ void addRunCommand(CLI::App& app, Outcome& outcome) {
       "Exit status: 0 success, 1 a computation could not finish or the time limit stopped it (what was computed "
       "is written), 2 bad input (the message names the file and the JSON path of the bad value; nothing is "
       "written), 130 / 143 stopped by SIGINT / SIGTERM (what was computed is written; a second signal ends the "
-      "program at once).\n"
+      "program, once the output directory is complete or removed).\n"
       "Progress goes to stderr: a live line on a terminal, a plain line every few seconds otherwise; --quiet "
       "silences it.");
   run->add_option("scene", options->scene, "Scene file (JSON, schema: docs/scenes.md), e.g. data/scenes/default.json")

@@ -108,7 +108,7 @@ class CaseRunner {
     const int n = out_.chain.size();
     mech::JumpOptions opt;
     opt.perturbation = scene_.analyses.jump.perturbation;
-    opt.integration = integrationOptions(mech::jumpIntegrationDefaults());
+    opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
     opt.integration.recordTrajectory = false;
     s.jumpTried = true;
     try {
@@ -409,7 +409,7 @@ void CaseRunner::loadHistory() {
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();
   opt.jump.perturbation = scene_.analyses.loadHistory.perturbation;
-  opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults());
+  opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
   mech::LoadHistoryResult h;
   try {
     h = mech::followLoadHistory(problem, out_.q0, scene_.analyses.loadHistory.waypoints, opt);
@@ -486,7 +486,7 @@ void CaseRunner::suddenLoad() {
   if (spec.value != s0) {
     mech::LoadHistoryOptions opt;
     opt.tracer = solverOptions();
-    opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults());
+    opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
     try {
       const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.q0, {s0, spec.value}, opt);
       if (h.completed && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);

@@ -1,6 +1,7 @@
 #include "scene/signals.h"
 
 #include <csignal>
+#include <ctime>
 
 namespace buckle::scene {
 
@@ -10,9 +11,31 @@ std::atomic<bool> gReceived{false};
 volatile std::sig_atomic_t gSignal = 0;
 struct sigaction gPreviousInt, gPreviousTerm;
 
+volatile std::sig_atomic_t gFirstSecond = 0;  // CLOCK_MONOTONIC time of the first signal (whole s)
+volatile std::sig_atomic_t gFirstMilli = 0;   // ... and its milliseconds
+
+long long nowMilliseconds() {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);  // async-signal-safe (POSIX)
+  return static_cast<long long>(t.tv_sec) * 1000 + t.tv_nsec / 1000000;
+}
+
+// Only async-signal-safe calls here. The first signal sets the flag; a later one ends the
+// program the usual way (default action, re-raised). One sent twice at once — timeout(1) sends
+// it to the child and to its process group — counts once: a repeat within 200 ms is ignored.
 extern "C" void onSignal(int sig) {
-  gSignal = sig;
-  gReceived.store(true, std::memory_order_relaxed);  // lock-free: async-signal-safe
+  const long long now = nowMilliseconds();
+  if (gSignal == 0) {
+    gSignal = sig;
+    gFirstSecond = static_cast<std::sig_atomic_t>(now / 1000);
+    gFirstMilli = static_cast<std::sig_atomic_t>(now % 1000);
+    gReceived.store(true, std::memory_order_relaxed);  // lock-free: async-signal-safe
+    return;
+  }
+  const long long first = static_cast<long long>(gFirstSecond) * 1000 + gFirstMilli;
+  if (now - first < 200) return;
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
 }
 
 }  // namespace
@@ -22,10 +45,11 @@ static_assert(std::atomic<bool>::is_always_lock_free, "the signal flag must be l
 SignalGuard::SignalGuard() {
   gReceived.store(false);
   gSignal = 0;
+  gFirstSecond = gFirstMilli = 0;
   struct sigaction action {};
   action.sa_handler = onSignal;
   sigemptyset(&action.sa_mask);
-  action.sa_flags = SA_RESETHAND;  // a second signal: default action (the program ends)
+  action.sa_flags = 0;  // a second signal: default action, from the handler
   sigaction(SIGINT, &action, &gPreviousInt);
   sigaction(SIGTERM, &action, &gPreviousTerm);
 }

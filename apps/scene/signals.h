@@ -1,7 +1,7 @@
 // SIGINT / SIGTERM during a long run: the first one only sets a flag, which every loop of the
 // computation checks through a continuation::Interrupt, so the run stops within a step and
-// writes what it computed; the handlers are one-shot (SA_RESETHAND), so a second signal ends the
-// program at once the usual way.
+// writes what it computed; a second signal (later than 200 ms after the first: the same signal
+// delivered twice at once counts once) ends the program the usual way.
 #pragma once
 
 #include <atomic>

@@ -21,6 +21,19 @@ bool BranchSwitchingOptions::IsValid(std::string *why) const {
   return true;
 }
 
+namespace {
+
+// The sign of a kernel vector is whatever the factorization gave: fix it so that the "+ side"
+// of a branch point is the same in every unit system and with every linear algebra (the
+// component of largest magnitude among the unknowns, in scaled variables, is positive).
+void orient(Vector &direction, int n) {
+  Eigen::Index largest = 0;
+  direction.head(n).cwiseAbs().maxCoeff(&largest);
+  if (direction[largest] < 0.0) direction = -direction;
+}
+
+}  // namespace
+
 bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note) {
   const int n = problem.dimension();
   // In the problem's scaled variables (scaled_problem.h), where the kernel and the
@@ -49,11 +62,13 @@ bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &dire
   Vector d1, d2;
   std::string why;
   if (!bifurcationDirections(problem, bp.u, bp.lambda, psi, t, phi, d1, d2, &why)) {
+    orient(direction, n);
     if (note) *note = why + ": kernel direction orthogonal to the parent tangent";
     return true;
   }
   // The parent's own tangent is one root; the child is the one farther from it.
   direction = std::abs(d1.dot(t)) <= std::abs(d2.dot(t)) ? d1 : d2;
+  orient(direction, n);
   if (note) *note = "algebraic bifurcation equation";
   return true;
 }

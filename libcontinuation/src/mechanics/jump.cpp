@@ -45,9 +45,9 @@ std::string describe(const continuation::StabilityInfo& s) {
 
 }  // namespace
 
-IntegrationOptions jumpIntegrationDefaults() {
+IntegrationOptions jumpIntegrationDefaults(int segments) {
   IntegrationOptions o;
-  o.stepper = StepperKind::Rosenbrock4;
+  if (segments >= 10) o.stepper = StepperKind::Rosenbrock4;
   return o;
 }
 

@@ -97,17 +97,13 @@ cont::Branch cutAt(const cont::Branch& branch, const cont::SpecialPoint& sp) {
 // direction `sign`:
 // the bifurcated branch the chain follows, if the pitchfork is supercritical (its first point
 // lies further along the load and is stable). Of the two sides of a symmetric pitchfork (mirror
-// images) the one whose largest joint component is positive is taken first: the documented rule
+// images) the + side of bifurcatingDirection (its largest component positive) is taken first: the documented rule
 // standing in for the imperfection that decides in a real chain.
 bool followBifurcated(EquilibriumProblem& problem, const cont::SpecialPoint& sp, const cont::TracerOptions& options,
                       double sign, cont::Branch& child) {
   if (sp.type != cont::SpecialPointType::BranchPoint || sp.multiplicity > 1) return false;
   cont::Vector direction;
   if (!cont::bifurcatingDirection(problem, sp, direction)) return false;
-  const int n = problem.segments();
-  Eigen::Index largest = 0;
-  direction.head(n).cwiseAbs().maxCoeff(&largest);
-  if (direction[largest] < 0.0) direction = -direction;
   cont::Tracer tracer(problem, options);
   for (int side : {1, -1}) {
     cont::Branch c = cont::switchBranch(tracer, sp, direction, side);

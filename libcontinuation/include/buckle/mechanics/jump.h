@@ -55,15 +55,17 @@ struct UnstableDirection {
 /// (u = joint angles, or the full unknowns). Sign not chosen here.
 UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef u, double lambda);
 
-/// A jump starts at a fold, where the flow is slowest (critical slowing down) while the chain's
-/// other modes stay fast: a stiff problem whose stiffness ratio grows with n. The L-stable
-/// Rosenbrock method takes its steps by the slow mode; dopri5 is held to the fast ones (on the
-/// default scene with 50 segments: 15 s per jump, one not at rest after maxTime, against 0.2 s).
-IntegrationOptions jumpIntegrationDefaults();
+/// Integration settings for a jump of a chain of `segments` segments. A jump starts at a fold,
+/// where the flow is slowest (critical slowing down) while the chain's other modes stay fast: a
+/// stiff problem whose stiffness ratio grows with n. From 10 segments on the L-stable Rosenbrock
+/// method, which steps by the slow mode (the default scene with 50 segments: 0.2 s per jump,
+/// against 15 s with dopri5, one of which did not reach rest by maxTime); below, dopri5, whose
+/// finite-difference-free steps are as fast there and which the short chains' tests pin.
+IntegrationOptions jumpIntegrationDefaults(int segments);
 
 struct JumpOptions {
   DynamicsScene scene;                   ///< masses given → inertial dynamics, else gradient flow
-  IntegrationOptions integration = jumpIntegrationDefaults();
+  IntegrationOptions integration;       ///< see jumpIntegrationDefaults for long chains
   continuation::CorrectorOptions polish = defaultPolishOptions();
   /// ‖δq‖₂ of the initial perturbation along the unstable direction (0: none, e.g. just past a
   /// fold where the state is not an equilibrium any more).
