@@ -67,18 +67,36 @@ void requireNoTemporaries(const fs::path& parent) {
   }
 }
 
+/// `buckle run` on the long scene (scene time limit `timeLimit`) in a fresh work/`name`, with
+/// `extra` arguments: exit code, wall time and the captured output; the output in work/name/out.
+struct LongRun {
+  fs::path dir, out;
+  int rc = -1;
+  double wall = 0.0;
+  std::string log;
+};
+LongRun runLong(const std::string& name, double timeLimit, const std::string& extra = "") {
+  LongRun r;
+  r.dir = work() / name;
+  fs::remove_all(r.dir);
+  fs::create_directories(r.dir);
+  const fs::path scene = longScene(r.dir, timeLimit);
+  r.out = r.dir / "out";
+  const auto t0 = std::chrono::steady_clock::now();
+  r.rc = exitCode("run '" + scene.string() + "' --out '" + r.out.string() + "' " + extra, r.dir / "log.txt");
+  r.wall = secondsSince(t0);
+  r.log = slurp(r.dir / "log.txt");
+  return r;
+}
+
 }  // namespace
 
 TEST_CASE("a 50-segment default scene with time_limit 5 returns within 6 s with partial results", "[cli][time]") {
-  const fs::path dir = work() / "limit";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const fs::path scene = longScene(dir, 5.0);
-  const fs::path out = dir / "out";
-  const auto t0 = std::chrono::steady_clock::now();
-  const int rc = exitCode("run '" + scene.string() + "' --out '" + out.string() + "'", dir / "log.txt");
-  const double wall = secondsSince(t0);
-  const std::string log = slurp(dir / "log.txt");
+  const LongRun run = runLong("limit", 5.0);
+  const fs::path &dir = run.dir, &out = run.out;
+  const int rc = run.rc;
+  const double wall = run.wall;
+  const std::string& log = run.log;
   INFO(log);
   CHECK(rc == 1);
   CHECK(wall > 3.9);   // it used its time (the computation stops 1 s before the limit)
@@ -98,23 +116,18 @@ TEST_CASE("a 50-segment default scene with time_limit 5 returns within 6 s with 
 }
 
 TEST_CASE("the command line's time limit overrides the scene's; quiet silences the progress", "[cli][time]") {
-  const fs::path dir = work() / "override";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const fs::path scene = longScene(dir, 600.0);
-  const fs::path out = dir / "out";
-  const auto t0 = std::chrono::steady_clock::now();
-  const int rc = exitCode("run '" + scene.string() + "' --out '" + out.string() + "' --time-limit 1.5 --quiet",
-                          dir / "log.txt");
-  const double wall = secondsSince(t0);
-  const std::string log = slurp(dir / "log.txt");
+  const LongRun run = runLong("override", 600.0, "--time-limit 1.5 --quiet");
+  const fs::path &dir = run.dir, &out = run.out;
+  const int rc = run.rc;
+  const double wall = run.wall;
+  const std::string& log = run.log;
   INFO(log);
   CHECK(rc == 1);
   CHECK(wall < 10.0);
   requirePartialResults(out);
   CHECK(summaryOf(out)["solver"]["time_limit"] == 1.5);
   CHECK(log.find("buckle: [") == std::string::npos);
-  CHECK(exitCode("run '" + scene.string() + "' --time-limit -1", dir / "bad.txt") == 2);
+  CHECK(exitCode("run '" + (dir / "long_600.json").string() + "' --time-limit -1", dir / "bad.txt") == 2);
 }
 
 TEST_CASE("SIGINT and SIGTERM stop a long run with partial results and no temporary directory", "[cli][time]") {
