@@ -26,7 +26,7 @@ TEST_TIMEOUT=${BUCKLE_TEST_TIMEOUT:-900}
 # clone elsewhere, e.g. CI's, reuses objects compiled from the same sources.
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$ROOT}
 
-# Debian packages (names verified on bookworm, see shared/notes/dependencies.md).
+# Debian packages (names verified on bookworm).
 readonly PACKAGES=(build-essential cmake git pkg-config ccache libeigen3-dev libsundials-dev
                    libboost-dev catch2 libcli11-dev nlohmann-json3-dev libbenchmark-dev gnuplot-nox)
 

@@ -663,7 +663,7 @@ void energyPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     s.body << "set title " << quote(title.str()) << " noenhanced font ',10'\n";
     s.body << "set xlabel 'q_1 (rad)'\nset ylabel 'E (units of k b^2)'\n";
     if (torque) {
-      // Me has poles where J is singular (sin q2 = 0, ERRATA 7): scale the axis on the bulk
+      // Me has poles where J is singular (sin q2 = 0, docs/mechanics.md erratum 7): scale the axis on the bulk
       std::vector<double> mags;
       for (const auto* samples : {&cr.landscape.positive, &cr.landscape.negative})
         for (const auto& smp : *samples)

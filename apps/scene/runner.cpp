@@ -370,7 +370,7 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
                         out_.specials.end());
   }
 
-  // Quasi-buckling (ERRATA, "what the physics does"): a deep, smooth minimum of Kxx along a
+  // Quasi-buckling (docs/mechanics.md, "What the physics does"): a deep, smooth minimum of Kxx along a
   // stable stretch of the branch — below half of its value at the branch start.
   if (scene_.analyses.stiffness && out_.points.size() - first >= 3) {
     const double k0 = out_.points[first].K(0, 0);

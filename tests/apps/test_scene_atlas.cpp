@@ -1,5 +1,5 @@
 // The atlas: straight-chain stability ⇔ κ > 0, the first critical force against eq 17 for three
-// segments, supercritical post-buckling in the paper's range (ERRATA: "what the physics does"),
+// segments, supercritical post-buckling in the paper's range (docs/mechanics.md, "What the physics does"),
 // and the same answers whatever the thread count.
 #include <catch2/catch.hpp>
 

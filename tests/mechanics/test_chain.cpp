@@ -162,7 +162,7 @@ TEST_CASE("eq 12: closed-form J^-T of three identical segments equals the numeri
     const double b = B(rng);
     const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.3 * b, b, 1.0, 2.2 * b));
     const Vector q = Vector::NullaryExpr(3, [&](Eigen::Index) { return Q(rng); });
-    if (std::abs(std::sin(q[1])) < 0.05) continue;  // J3 singular at sin q2 = 0 (ERRATA 7)
+    if (std::abs(std::sin(q[1])) < 0.05) continue;  // J3 singular at sin q2 = 0 (docs/mechanics.md erratum 7)
     ChainData data(chain);
     forwardKinematics(chain, q, data);
     Matrix J(3, 3);

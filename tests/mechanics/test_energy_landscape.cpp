@@ -143,7 +143,7 @@ TEST_CASE("straight start pushed by dx > 0: U minima, Z maxima, eq 12 force, buc
         CHECK(e.stable);
         EU = e.energy;
         FxU = e.F[0];
-        // δx = μ_U b q2² to leading order (eq 18, ERRATA 3)
+        // δx = μ_U b q2² to leading order (eq 18, docs/mechanics.md erratum 3)
         CHECK(std::abs(an.muU * b * e.q[1] * e.q[1] / delta - 1.0) < 2.0 * delta);
       } else if (e.shape == "Z") {
         ++Z;

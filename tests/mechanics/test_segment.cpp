@@ -58,7 +58,7 @@ TEST_CASE("general torque (eq 1) equals the symmetric closed forms (eq 3, 10, 19
     CHECK(s.torque(q) == Approx(eq3).margin(1e-12));
     CHECK(s.torque(q) == Approx(eq10).margin(1e-12));
     CHECK(s.torqueDerivative(q) == Approx(eq3d).margin(1e-12));
-    // spring lengths, ERRATA: 2(b cos(q/2) ∓ a sin(q/2))
+    // spring lengths, docs/mechanics.md "Conventions": 2(b cos(q/2) ∓ a sin(q/2))
     CHECK(s.spring1(q).value == Approx(2 * (b * std::cos(q / 2) - a * std::sin(q / 2))).margin(1e-13));
     CHECK(s.spring2(q).value == Approx(2 * (b * std::cos(q / 2) + a * std::sin(q / 2))).margin(1e-13));
   }

@@ -127,7 +127,8 @@ TEST_CASE("loaded stiffness tends to the unloaded one as F -> 0 and equals eq 29
 
 TEST_CASE("loaded compliance equals the finite difference of the equilibrium force-deflection map", "[stiffness]") {
   std::mt19937 rng(13);
-  // The paper's non-straight start (ERRATA): q⁰ = (θ, −2θ, θ), cos θ = 7/8, made unloaded by preloads,
+  // The paper's non-straight start (docs/mechanics.md, "What the physics does"):
+  // q⁰ = (θ, −2θ, θ), cos θ = 7/8, made unloaded by preloads,
   // and a random asymmetric 6-segment chain with a random unloaded shape.
   const double theta = std::acos(7.0 / 8.0);
   std::vector<std::pair<std::vector<SegmentParameters>, Vector>> cases;

@@ -64,7 +64,7 @@ BranchDerivatives branchDerivatives(const Chain& chain, const Eigen::Vector3d& q
     for (int i = 0; i < 3; ++i) quad += kq[i] * d.t[i] * d.t[i];
     d.d2E = quad + g[1] * s23[0] + g[2] * s23[1];
   }
-  // Me from ∇E = Jᵀ F (eq 12), where the 3×3 J is regular (sin q2 ≠ 0, ERRATA 7).
+  // Me from ∇E = Jᵀ F (eq 12), where the 3×3 J is regular (sin q2 ≠ 0, docs/mechanics.md erratum 7).
   const Eigen::Matrix3d J3 = J;
   const Eigen::PartialPivLU<Eigen::Matrix3d> lu(J3.transpose());
   if (lu.rcond() > 1e-13) d.Me = lu.solve(d.grad)[2];

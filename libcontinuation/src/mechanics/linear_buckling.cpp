@@ -180,7 +180,7 @@ void generalisedEigen(const Matrix& A, const Matrix& B, int wanted, std::vector<
 
 namespace {
 
-// Long chains, first `count` modes (notes: shared/notes/chain-structure.md). With K_q positive
+// Long chains, first `count` modes (docs/mechanics.md, "The O(n) chain structure"). With K_q positive
 // definite on ker J_h the pencil (K_q, G) is definite, so by Sylvester's law the number of
 // critical loads in (0, λ) (or (λ, 0)) is the number of negative eigenvalues of K_q − λG on
 // ker J_h, an O(n) count on the tridiagonal T(λ) (chain_structure.h). Each load is bisected on

@@ -1,4 +1,4 @@
-// The chain's bordered Jacobian solved in O(n) (notes: shared/notes/chain-structure.md).
+// The chain's bordered Jacobian solved in O(n) (docs/mechanics.md, "The O(n) chain structure").
 //
 // With u = (q, r) (joint angles, reactions of the m held coordinates) the bordered Jacobian is
 //     A(c) = [[H, −J_hᵀ, F_λ,q], [−J_h, 0, F_λ,r], [c_qᵀ, c_rᵀ, c_λ]],   H = K_q − K_g = U T Uᵀ,

@@ -1,4 +1,4 @@
-// Linear-time linear algebra for the chain's Hessian (notes: shared/notes/chain-structure.md).
+// Linear-time linear algebra for the chain's Hessian (docs/mechanics.md, "The O(n) chain structure").
 //
 // With K_q = diag(κ) and K_g(i, j) = h_max(i,j) (eq 27), the Hessian of the total potential is
 //     H = K_q − K_g = U · T · Uᵀ,

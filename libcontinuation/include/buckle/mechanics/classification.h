@@ -1,5 +1,5 @@
-// Special points of an equilibrium branch in the field's words (paper §III, ERRATA "What the
-// physics does"):
+// Special points of an equilibrium branch in the field's words (paper §III; docs/mechanics.md,
+// "What the physics does"):
 //   buckling        a branch point on the loaded path: the configuration loses stability to a
 //                   new family of shapes (U / Z for three segments);
 //   jumping         a fold under load control whose stable side ends there: past the fold no

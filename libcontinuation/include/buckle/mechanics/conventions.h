@@ -1,4 +1,4 @@
-// Sign conventions of the mechanics layer, stated once (see shared/paper/ERRATA.md).
+// Sign conventions of the mechanics layer, stated once (explained in docs/mechanics.md, "Conventions" and "Errata").
 //
 // Geometry
 //   Segment i: two rigid triangles, proximal (a_i1, b_i1) and distal (a_i2, b_i2), on a passive
@@ -14,7 +14,7 @@
 //   E = ½ Σ k (L − L⁰)²                                                     (eq 7)
 //   restoring joint torque M = −∂E/∂q                                       (eq 1, 3, 10, 19)
 //   joint stiffness K_q = ∂²E/∂q² = −dM/dq  (positive for a stable segment). The paper's eq 20
-//   prints dM/dq and calls it stiffness: that sign is NOT used here (ERRATA 1).
+//   prints dM/dq and calls it stiffness: that sign is NOT used here (docs/mechanics.md, erratum 1).
 //   Straight-state stiffness with equal preloads: κ = k (b·L⁰ − 2(b² − a²)); κ > 0 ⇔ eq 4.
 //
 // Loads

@@ -2,7 +2,7 @@
 // (eq 6–8, Fig 4, 5, 7).
 //
 // For a given q1 the remaining two joints follow from the inverse kinematics of the two-link
-// arm (ℓ2, ℓ3) from joint 2 to the end (ERRATA 6, with the chain's link lengths ℓ0 … ℓ3):
+// arm (ℓ2, ℓ3) from joint 2 to the end (docs/mechanics.md erratum 6, with the chain's link lengths ℓ0 … ℓ3):
 //   d = (x − ℓ0 − ℓ1 cos q1, y − ℓ1 sin q1),  C3 = (|d|² − ℓ2² − ℓ3²) / (2 ℓ2 ℓ3),
 //   S3 = ±√(1 − C3²) (branch: sign S3 = sign q3),
 //   q3 = atan2(S3, C3),  q2 = atan2(d_y, d_x) − atan2(ℓ3 S3, ℓ2 + ℓ3 C3) − q1  (wrapped to (−π, π]).

@@ -12,7 +12,8 @@
 //
 // Post-buckling shortening: along q = q0 + ε z the end moves along d by
 //   δ(d·p) = ½ ε² zᵀ G z + O(ε³),  reported as shortening = −½ zᵀ G z (> 0 for a compressive
-//   buckle); for three segments, δx = μ·b·q2² (eq 18, ERRATA 3) with μ = shortening/(ℓ0 z2²).
+//   buckle); for three segments, δx = μ·b·q2² (eq 18, docs/mechanics.md erratum 3) with
+//   μ = shortening/(ℓ0 z2²).
 #pragma once
 
 #include <Eigen/Core>
