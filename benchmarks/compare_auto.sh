@@ -3,7 +3,7 @@
 #
 #   benchmarks/compare_auto.sh            # REPS=5 timed repetitions per case (median)
 #   REPS=1 benchmarks/compare_auto.sh     # quick
-#   BUILD=build-dir AUTO_PEER=dir ...     # defaults: ./build-bench, /work/shared/peers/auto07p
+#   BUILD=build-dir AUTO_PEER=dir ...     # defaults: ./build-bench, ../shared/peers/auto07p beside the checkout
 #
 # AUTO: installed from Debian if missing (apt-get install -y auto-07p gfortran); chain.f90 is
 # compiled and linked with the flags of AUTO's cmds.make, run with the analytic Jacobian (JAC=1)
@@ -22,7 +22,8 @@
 set -euo pipefail
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=$(cd "$HERE/.." && pwd)
-PEER=${AUTO_PEER:-/work/shared/peers/auto07p}
+# the harness beside the checkout (shared/ next to the repository), overridable
+PEER=${AUTO_PEER:-$ROOT/../shared/peers/auto07p}
 BUILD=${BUILD:-$ROOT/build-bench}
 REPS=${REPS:-5}
 AUTO_DIR=${AUTO_DIR:-/usr/lib/auto-07p}

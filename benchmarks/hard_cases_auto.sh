@@ -19,7 +19,8 @@
 set -euo pipefail
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=$(cd "$HERE/.." && pwd)
-PEER=${AUTO_PEER:-/work/shared/peers/auto07p}
+# the harness beside the checkout (shared/ next to the repository), overridable
+PEER=${AUTO_PEER:-$ROOT/../shared/peers/auto07p}
 BUILD=${BUILD:-$ROOT/build-bench}
 AUTO_DIR=${AUTO_DIR:-/usr/lib/auto-07p}
 NPROC=$(nproc)             # before OMP_NUM_THREADS: GNU nproc honours that variable
