@@ -14,7 +14,6 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -115,30 +114,64 @@ std::vector<std::string> plotClauses(const std::string& body) {
   return out;
 }
 
+// Plain string scanning, not <regex>: GCC 12 warns (-Wmaybe-uninitialized) inside <regex>
+// at -O1 with the sanitizers, and the builds are warning-free.
 std::string field(const std::string& clause, const std::string& key) {
-  const std::regex re(key + " '([^']*)'");
-  std::smatch m;
-  return std::regex_search(clause, m, re) ? m[1].str() : std::string();
+  const std::string open = key + " '";
+  const size_t at = clause.find(open);
+  if (at == std::string::npos) return std::string();
+  const size_t from = at + open.size(), to = clause.find('\'', from);
+  return to == std::string::npos ? std::string() : clause.substr(from, to - from);
 }
 
 int indexOf(const std::string& clause) {
-  const std::regex re(" index ([0-9]+) ");
-  std::smatch m;
-  return std::regex_search(clause, m, re) ? std::stoi(m[1].str()) : -1;
+  const std::string open = " index ";
+  const size_t at = clause.find(open);
+  if (at == std::string::npos) return -1;
+  const size_t from = at + open.size(), to = clause.find(' ', from);
+  if (to == std::string::npos || to == from) return -1;
+  const std::string digits = clause.substr(from, to - from);
+  if (digits.find_first_not_of("0123456789") != std::string::npos) return -1;
+  return std::stoi(digits);
 }
 
 double setting(const std::string& body, const std::string& name) {
-  const std::regex re("set " + name + " at screen ([-0-9.e]+)");
-  std::smatch m;
-  REQUIRE(std::regex_search(body, m, re));
-  return std::stod(m[1].str());
+  const std::string open = "set " + name + " at screen ";
+  const size_t at = body.find(open);
+  REQUIRE(at != std::string::npos);
+  return std::stod(body.substr(at + open.size()));
 }
 
 std::pair<double, double> range(const std::string& body, const std::string& axis) {
-  const std::regex re("set " + axis + "range \\[([-0-9.e+]+):([-0-9.e+]+)\\]");
-  std::smatch m;
-  REQUIRE(std::regex_search(body, m, re));
-  return {std::stod(m[1].str()), std::stod(m[2].str())};
+  const std::string open = "set " + axis + "range [";
+  const size_t at = body.find(open);
+  REQUIRE(at != std::string::npos);
+  const size_t colon = body.find(':', at), close = body.find(']', at);
+  REQUIRE((colon != std::string::npos && close != std::string::npos && colon < close));
+  return {std::stod(body.substr(at + open.size(), colon - at - open.size())),
+          std::stod(body.substr(colon + 1, close - colon - 1))};
+}
+
+/// `x y label_x label_y "text" leader_x leader_y`: the numbers and the text, or false.
+bool labelLine(const std::string& line, double (&v)[6], std::string& text) {
+  const size_t q0 = line.find('"'), q1 = q0 == std::string::npos ? q0 : line.find('"', q0 + 1);
+  if (q1 == std::string::npos) return false;
+  // tokens read with std::stod, which takes gnuplot's "NaN" (a label without a leader)
+  std::istringstream head(line.substr(0, q0)), tail(line.substr(q1 + 1));
+  std::string token;
+  int k = 0;
+  for (std::istringstream* part : {&head, &tail})
+    while (*part >> token) {
+      if (k == 6) return false;
+      try {
+        v[k++] = std::stod(token);
+      } catch (const std::exception&) {
+        return false;
+      }
+    }
+  if (k != 6) return false;
+  text = line.substr(q0 + 1, q1 - q0 - 1);
+  return true;
 }
 
 /// Rows of branches.csv by column name.
@@ -295,14 +328,14 @@ TEST_CASE("special-point labels do not overlap one another, a marker or the plot
         std::vector<Box> boxes, markers;
         std::ifstream in(out / "plots" / file);
         std::string line;
-        const std::regex re(R"re(^(\S+) (\S+) (\S+) (\S+) "([^"]*)" (\S+) (\S+)$)re");
         while (std::getline(in, line)) {
-          std::smatch m;
-          if (!std::regex_match(line, m, re)) continue;
-          const auto [ax, ay] = px(std::stod(m[1]), std::stod(m[2]));
-          const auto [cx, cy] = px(std::stod(m[3]), std::stod(m[4]));
+          double v[6];
+          std::string text;
+          if (!labelLine(line, v, text)) continue;
+          const auto [ax, ay] = px(v[0], v[1]);
+          const auto [cx, cy] = px(v[2], v[3]);
           // 9 pt DejaVu Sans: at most 6.2 px per character, 11 px high
-          const double w = 6.2 * double(m[5].str().size()), h = 11.0;
+          const double w = 6.2 * double(text.size()), h = 11.0;
           boxes.push_back({cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2});
           markers.push_back({ax - 5, ay - 5, ax + 5, ay + 5});
           const Box& bx = boxes.back();
@@ -311,8 +344,8 @@ TEST_CASE("special-point labels do not overlap one another, a marker or the plot
           CHECK(bx.y0 >= H * b - 1e-6);
           CHECK(bx.y1 <= H * t + 1e-6);
           // a leader, when drawn, runs from the point to the label
-          if (m[6] != "NaN") {
-            const auto [ex, ey] = px(std::stod(m[6]), std::stod(m[7]));
+          if (!std::isnan(v[4])) {
+            const auto [ex, ey] = px(v[4], v[5]);
             CHECK(ex >= bx.x0 - 3);
             CHECK(ex <= bx.x1 + 3);
             CHECK(ey >= bx.y0 - 3);
