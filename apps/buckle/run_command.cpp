@@ -35,8 +35,7 @@ void addRunCommand(CLI::App& app, Outcome& outcome) {
   run->add_flag("--quiet,-q", options->quiet, "No progress messages (errors are still printed)");
   run->add_option("--time-limit", options->timeLimit,
                   "Seconds for the whole run (overrides the scene's /solver/time_limit); when it is reached the "
-                  "run stops within a step, writes what it computed (summary.json: \"complete\": false) and exits 1")
-      ->check(CLI::PositiveNumber);
+                  "run stops within a step, writes what it computed (summary.json: \"complete\": false) and exits 1");  // checked in runSceneCommand, with a readable message
   run->callback([options, &outcome]() {
     options->handleSignals = true;
     options->progress = ::isatty(STDERR_FILENO) == 1 ? scene::Progress::Mode::Live : scene::Progress::Mode::Lines;

@@ -93,41 +93,33 @@ LongRun runLong(const std::string& name, double timeLimit, const std::string& ex
 
 TEST_CASE("a 50-segment default scene with time_limit 5 returns within 6 s with partial results", "[cli][time]") {
   const LongRun run = runLong("limit", 5.0);
-  const fs::path &dir = run.dir, &out = run.out;
-  const int rc = run.rc;
-  const double wall = run.wall;
-  const std::string& log = run.log;
-  INFO(log);
-  CHECK(rc == 1);
-  CHECK(wall > 3.9);   // it used its time (the computation stops 1 s before the limit)
+  INFO(run.log);
+  CHECK(run.rc == 1);
+  CHECK(run.wall > 3.9);   // it used its time (the computation stops 1 s before the limit)
 #if defined(__SANITIZE_ADDRESS__)
-  CHECK(wall < 15.0);  // the writers and plots are slower under the sanitizers
+  CHECK(run.wall < 15.0);  // the writers and plots are slower under the sanitizers
 #else
-  CHECK(wall < 6.0);
+  CHECK(run.wall < 6.0);
 #endif
-  requirePartialResults(out);
-  const nlohmann::json summary = summaryOf(out);
+  requirePartialResults(run.out);
+  const nlohmann::json summary = summaryOf(run.out);
   CHECK_THAT(summary["interruption"].get<std::string>(), Contains("time limit of 5 s reached"));
-  CHECK_THAT(log, Contains("stopped early"));
+  CHECK_THAT(run.log, Contains("stopped early"));
   // progress went to stderr as plain lines (not a terminal), at least the first one after ~1 s
-  CHECK_THAT(log, Contains("buckle: ["));
-  CHECK(log.find('\r') == std::string::npos);
-  requireNoTemporaries(dir);
+  CHECK_THAT(run.log, Contains("buckle: ["));
+  CHECK(run.log.find('\r') == std::string::npos);
+  requireNoTemporaries(run.dir);
 }
 
 TEST_CASE("the command line's time limit overrides the scene's; quiet silences the progress", "[cli][time]") {
   const LongRun run = runLong("override", 600.0, "--time-limit 1.5 --quiet");
-  const fs::path &dir = run.dir, &out = run.out;
-  const int rc = run.rc;
-  const double wall = run.wall;
-  const std::string& log = run.log;
-  INFO(log);
-  CHECK(rc == 1);
-  CHECK(wall < 10.0);
-  requirePartialResults(out);
-  CHECK(summaryOf(out)["solver"]["time_limit"] == 1.5);
-  CHECK(log.find("buckle: [") == std::string::npos);
-  CHECK(exitCode("run '" + (dir / "long_600.json").string() + "' --time-limit -1", dir / "bad.txt") == 2);
+  INFO(run.log);
+  CHECK(run.rc == 1);
+  CHECK(run.wall < 10.0);
+  requirePartialResults(run.out);
+  CHECK(summaryOf(run.out)["solver"]["time_limit"] == 1.5);
+  CHECK(run.log.find("buckle: [") == std::string::npos);
+  CHECK(exitCode("run '" + (run.dir / "long_600.json").string() + "' --time-limit -1", run.dir / "bad.txt") == 2);
 }
 
 TEST_CASE("SIGINT and SIGTERM stop a long run with partial results and no temporary directory", "[cli][time]") {
