@@ -11,15 +11,12 @@
 #include <stdexcept>
 #include <thread>
 
-#include "buckle/continuation/branch_switching.h"
-#include "buckle/continuation/tracer.h"
-#include "buckle/mechanics/equilibrium_problem.h"
-#include "buckle/mechanics/linear_buckling.h"
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/post_buckling.h"
 #include "scene/output.h"
 
 namespace buckle::scene {
 
-namespace cont = buckle::continuation;
 namespace mech = buckle::mechanics;
 namespace fs = std::filesystem;
 
@@ -43,80 +40,18 @@ void checkAxis(const AtlasAxis& a, const std::string& opt) {
 void computeCell(AtlasCell& c) {
   const mech::SegmentParameters p = mech::SegmentParameters::symmetric(c.a, 1.0, 1.0, c.L0);
   c.kappa = c.L0 - 2.0 * (1.0 - c.a * c.a);
-  c.firstCritical = kNaN;
   try {
-    const mech::Chain chain = mech::Chain::uniform(c.n, p);
-    const mech::EndCondition end = mech::EndCondition::clampedPinned(0.0, 0.0);
-    const Eigen::VectorXd q0 = Eigen::VectorXd::Zero(c.n);
-    const mech::LinearBucklingResult lb = mech::linearBuckling(chain, q0, end);
-    c.straightStable = lb.unloadedStable;
-    const mech::BucklingMode* first = nullptr;
-    for (const auto& m : lb.modes)
-      if (m.lambda < 0.0 && (!first || std::abs(m.lambda) < std::abs(first->lambda))) first = &m;
-    if (!c.straightStable) {
-      c.postBuckling = "unstable start";
-      if (first) {
-        c.firstCritical = first->lambda;
-        c.firstShape = first->shape;
-      }
-      return;
-    }
-    if (!first) {
-      c.postBuckling = "none";
-      return;
-    }
-    c.firstCritical = first->lambda;
-    c.firstShape = first->shape;
-    // post-buckling: trace the straight branch past the first critical load, switch at the
-    // branch point and look at the stability and the load along the new branch
-    mech::EquilibriumProblem problem(chain, end, Eigen::Vector3d(1.0, 0.0, 0.0));
-    cont::TracerOptions opt;
-    opt.initialStep = std::min(0.05, 0.2 * std::abs(first->lambda));
-    opt.maxStep = 0.1;
-    opt.lambdaMin = 1.3 * first->lambda;
-    opt.lambdaMax = 1.0;
-    opt.maxPoints = 400;
-    cont::Tracer tracer(problem, opt);
-    const cont::Vector u0 = problem.initialGuess(q0, 0.0);
-    cont::Branch root = tracer.trace(u0, 0.0, cont::InitialDirection::decreasingLambda());
-    const cont::SpecialPoint* bp = nullptr;
-    for (const auto& sp : root.specialPoints)
-      if (sp.type == cont::SpecialPointType::BranchPoint &&
-          std::abs(sp.lambda - first->lambda) < 1e-6 * std::max(1.0, std::abs(first->lambda))) {
-        bp = &sp;
-        break;
-      }
-    if (!bp) {
-      c.postBuckling = "failed";
-      c.error = "first branch point not located on the straight branch";
-      return;
-    }
-    cont::Vector dir;
-    if (!cont::bifurcatingDirection(problem, *bp, dir)) {
-      c.postBuckling = "failed";
-      c.error = "no bifurcating direction";
-      return;
-    }
-    cont::TracerOptions childOpt = opt;
-    childOpt.maxPoints = 8;
-    childOpt.initialStep = 0.02;
-    childOpt.maxStep = 0.02;
-    cont::Tracer childTracer(problem, childOpt);
-    const cont::Branch child = cont::switchBranch(childTracer, *bp, dir, +1);
-    if (child.points.size() < 3) {
-      c.postBuckling = "failed";
-      c.error = "the new branch could not be followed";
-      return;
-    }
-    int stable = 0, checked = 0;
-    for (size_t i = 1; i < child.points.size(); ++i) {
-      if (!child.points[i].stability.valid()) continue;
-      ++checked;
-      if (child.points[i].stability.stable()) ++stable;
-    }
-    c.postSlope = std::abs(child.points.back().lambda) - std::abs(bp->lambda);
-    c.postBuckling = (checked > 0 && stable == checked) ? "supercritical" : "subcritical";
-  } catch (const std::exception& e) {
+    const mech::FirstBuckling fb =
+        mech::firstBuckling(mech::Chain::uniform(c.n, p), mech::EndCondition::clampedPinned(0.0, 0.0),
+                            Eigen::Vector3d(1.0, 0.0, 0.0), Eigen::VectorXd::Zero(c.n));
+    c.straightStable = fb.startStable;
+    c.firstCritical = fb.critical;
+    c.firstShape = fb.shape;
+    c.postBuckling = mech::toString(fb.kind);
+    c.postSlope = fb.slope;
+    c.error = fb.error;
+  } catch (const std::exception& e) {  // an invalid segment (e.g. a/b too large) names itself
+    c.firstCritical = kNaN;
     c.postBuckling = "failed";
     c.error = e.what();
   }

@@ -7,15 +7,14 @@
 #include <limits>
 #include <sstream>
 
-#include "buckle/continuation/branch_switching.h"
 #include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/branch_report.h"
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/equilibrium_problem.h"
-#include "buckle/mechanics/equilibrium_solve.h"
 #include "buckle/mechanics/jump.h"
+#include "buckle/mechanics/landing.h"
 #include "buckle/mechanics/load_history.h"
-#include "buckle/mechanics/shape_name.h"
-#include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/unloaded_shape.h"
 
 namespace buckle::scene {
@@ -29,17 +28,6 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-std::string stabilityLabel(int negative) {
-  if (negative < 0) return "unknown";
-  if (negative == 0) return "stable";
-  return "unstable (" + std::to_string(negative) + " negative)";
-}
-
-bool regularStop(cont::StopReason r) {
-  return r == cont::StopReason::LambdaRange || r == cont::StopReason::Boundary || r == cont::StopReason::Box ||
-         r == cont::StopReason::MaxArclength;
 }
 
 /// Everything needed to trace and post-process the branches of one case.
@@ -69,7 +57,8 @@ class CaseRunner {
   }
 
  private:
-  void record(const cont::Branch& b, mech::EquilibriumProblem& problem, const std::string& origin);
+  void record(const cont::Branch& b, const mech::BranchReport& report, mech::EquilibriumProblem& problem,
+              const std::string& origin);
   bool throughLoad() const { return spec_.path.loadLimit > 0.0; }
   /// The scene's /solver settings as tracer options (the λ range is set by each analysis).
   cont::TracerOptions solverOptions() const {
@@ -103,68 +92,16 @@ class CaseRunner {
     end.value -= out_.startValue * spec_.path.direction;
     return mech::EquilibriumProblem(out_.chain, end, spec_.path.direction);
   }
-  /// Releases the chain at a fold with the loads frozen there: where does it land?
-  void simulateJumpAt(mech::EquilibriumProblem& problem, const cont::SpecialPoint& sp, SpecialRecord& s) {
-    const int n = out_.chain.size();
-    mech::JumpOptions opt;
-    opt.perturbation = scene_.analyses.jump.perturbation;
-    opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
-    opt.integration.recordTrajectory = false;
-    s.jumpTried = true;
-    try {
-      const mech::JumpResult j = mech::simulateJump(problem, sp.u, sp.lambda, opt);
-      s.jumpSuccess = j.success;
-      s.jumpMessage = j.message;
-      // the chain snaps onto a geometric joint limit, where the smooth model ends (a spring
-      // reaches zero length): a known outcome, reported with the state reached there
-      const bool toLimit = !j.success && j.stopReason == mech::StopReason::JointLimit && j.restPoint.size() >= n;
-      if (toLimit) {
-        s.jumpSuccess = true;
-        s.jumpLanding = "joint limit";
-        s.jumpQ = j.restPoint.head(n);
-        s.jumpF = problem.wrench(sp.u, sp.lambda);
-        s.jumpPose = mech::endPose(out_.chain, s.jumpQ);
-        s.jumpShape = mech::shapeName(s.jumpQ, 1e-6);
-        s.energyReleased = j.energyReleased;
-        s.jumpDistance = (s.jumpQ - sp.u.head(n)).cwiseAbs().maxCoeff();
-        return;
-      }
-      s.jumpLanding = "stable equilibrium";
-      if (j.to.size() >= n) {
-        s.jumpQ = j.to.head(n);
-        s.jumpF = problem.wrench(j.to, sp.lambda);
-        s.jumpPose = mech::endPose(out_.chain, s.jumpQ);
-        s.jumpShape = mech::shapeName(s.jumpQ, 1e-6);
-      }
-      s.energyReleased = j.energyReleased;
-      s.jumpDistance = j.distance;
-      if (!j.success && j.stopReason == mech::StopReason::Interrupted) {
-        interrupted();
-      } else if (!j.success) {
-        run_.complete = false;
-        run_.problems.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter + " = " +
-                                std::to_string(sp.lambda) + " did not land on a stable equilibrium: " + j.message);
-      }
-    } catch (const std::invalid_argument& e) {
-      s.jumpSuccess = false;
-      s.jumpMessage = e.what();
-      run_.complete = false;
-      run_.problems.push_back("case \"" + spec_.label + "\": jump: " + e.what());
+  /// How the mechanics layer reports this case's branches (branch_report.h).
+  mech::ReportOptions reportOptions() const {
+    mech::ReportOptions o;
+    o.stiffness = scene_.analyses.stiffness;
+    if (throughLoad()) {
+      o.heldCoordinate = spec_.path.coordinate;
+      o.rangeLow = std::min(spec_.path.from, spec_.path.to);
+      o.rangeHigh = std::max(spec_.path.from, spec_.path.to);
     }
-  }
-  /// Stability under the scene's own end condition (displacement control of the parameter).
-  cont::StabilityInfo heldStability(const Eigen::VectorXd& q, const mech::Wrench& F) const {
-    const int n = out_.chain.size();
-    mech::Matrix H(n, n);
-    mech::totalPotentialHessian(out_.chain, q, F, H);
-    mech::ChainData data(out_.chain);
-    mech::forwardKinematics(out_.chain, q, data);
-    mech::Matrix J(3, n);
-    mech::endJacobian(data, J);
-    const std::vector<int> held = spec_.end.condition.heldIndices();
-    mech::Matrix C(held.size(), n);
-    for (size_t k = 0; k < held.size(); ++k) C.row(Eigen::Index(k)) = J.row(held[k]);
-    return cont::projectedInertia(H, C, 1e-10);
+    return o;
   }
 
   const Scene& scene_;
@@ -175,32 +112,49 @@ class CaseRunner {
   int branchesSoFar_ = 0;  // for progress reports
 };
 
-void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem, const std::string& origin) {
-  const int n = out_.chain.size();
+void copyLanding(const mech::Landing& l, SpecialRecord& s) {
+  s.jumpTried = l.tried;
+  s.jumpSuccess = l.success;
+  s.jumpLanding = l.kind;
+  s.jumpMessage = l.message;
+  s.jumpQ = l.q;
+  s.jumpF = l.F;
+  s.jumpPose = l.pose;
+  s.jumpShape = l.shape;
+  s.energyReleased = l.energyReleased;
+  s.jumpDistance = l.distance;
+}
+
+SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
+  SpecialRecord s;
+  s.type = mech::eventLabel(sp.type);
+  s.field = mech::phenomenonName(sp.phenomenon);
+  s.branch = branch;
+  s.parameter = sp.parameter;
+  s.F = sp.F;
+  s.pose = sp.pose;
+  s.q = sp.q;
+  s.shape = sp.shape;
+  s.stabilityBefore = sp.stabilityBefore;
+  s.stabilityAfter = sp.stabilityAfter;
+  s.accuracy = sp.accuracy;
+  s.residual = sp.residual;
+  s.refined = sp.refined;
+  s.note = sp.note;
+  copyLanding(sp.landing, s);
+  return s;
+}
+
+void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report, mech::EquilibriumProblem& problem,
+                        const std::string& origin) {
   BranchRecord br;
   br.id = b.id;
   br.parent = b.parentId;
   br.origin = origin;
-  br.stopReason = cont::stopReasonName(b.stopReason);
-  br.stopMessage = b.stopMessage;
+  br.stopReason = report.stopReason;
+  br.stopMessage = report.stopMessage;
   br.points = static_cast<int>(b.points.size());
-  br.finished = regularStop(b.stopReason);
-  // Near a geometric joint limit the closing spring's length goes to zero and the model's
-  // derivatives blow up (L' ~ 1/L): the tracer's steps collapse just before the limit. That is
-  // the joint reaching its limit, not a failure; it is reported as such.
-  int limitJoint = -1;
-  if (!br.finished && b.stopReason == cont::StopReason::StepSizeTooSmall && !b.points.empty()) {
-    const Eigen::VectorXd q = b.points.back().u.head(n);
-    for (int i = 0; i < n; ++i) {
-      const double lo = out_.chain.lowerLimits()[i], hi = out_.chain.upperLimits()[i];
-      if (std::min(hi - q[i], q[i] - lo) < 2e-3 * (hi - lo)) limitJoint = i;
-    }
-    if (limitJoint >= 0) {
-      br.finished = true;
-      br.stopReason = "joint limit";
-      br.stopMessage = "joint " + std::to_string(limitJoint + 1) + " reached its limit (" + br.stopMessage + ")";
-    }
-  }
+  br.finished = report.finished;
   if (b.stopReason == cont::StopReason::Interrupted) {
     interrupted();  // reported once for the run, not per branch
   } else if (!br.finished) {
@@ -210,193 +164,49 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
   }
   out_.branches.push_back(br);
 
-  const size_t first = out_.points.size();
-  for (size_t i = 0; i < b.points.size(); ++i) {
-    const cont::ContinuationPoint& p = b.points[i];
+  for (const mech::PointReport& p : report.points) {
     PointRecord r;
     r.branch = b.id;
-    r.index = static_cast<int>(i);
-    r.parameter = p.lambda;
-    r.q = p.u.head(n);
-    r.F = problem.wrench(p.u, p.lambda);
-    r.pose = mech::endPose(out_.chain, r.q);
-    r.negative = p.stability.negative;
-    r.stable = p.stability.valid() && p.stability.stable();
-    r.minEigenvalue = p.stability.smallest;
-    if (throughLoad()) {
-      const int c = spec_.path.coordinate;
-      r.parameter = r.pose[c];
-      const double lo = std::min(spec_.path.from, spec_.path.to), hi = std::max(spec_.path.from, spec_.path.to);
-      if (r.parameter < lo - 1e-9 || r.parameter > hi + 1e-9) continue;
-      const cont::StabilityInfo st = heldStability(r.q, r.F);
-      r.negative = st.negative;
-      r.stable = st.valid() && st.negative == 0;
-      r.minEigenvalue = st.smallest;
-    }
-    if (scene_.analyses.stiffness) {
-      const mech::CartesianStiffness K = mech::loadedStiffness(out_.chain, r.q, r.F, problem.endCondition());
-      r.K = K.stiffness;
-      r.haveStiffness = true;
-    }
-    run_.worstResidual = std::max(run_.worstResidual, p.residualNorm);
+    r.index = p.index;
+    r.parameter = p.parameter;
+    r.q = p.q;
+    r.F = p.F;
+    r.pose = p.pose;
+    r.negative = p.negative;
+    r.stable = p.stable;
+    r.minEigenvalue = p.minEigenvalue;
+    r.haveStiffness = p.haveStiffness;
+    r.K = p.K;
     out_.points.push_back(r);
   }
+  run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
 
-  for (const cont::SpecialPoint& sp : b.specialPoints) {
-    SpecialRecord s;
-    switch (sp.type) {
-      case cont::SpecialPointType::BranchPoint:
-        s.type = "BP";
-        s.field = "buckling";
-        break;
-      case cont::SpecialPointType::Fold:
-        s.type = "LP";
-        s.field = "jumping";
-        break;
-      case cont::SpecialPointType::Boundary:
-        s.type = "BD";
-        s.field = "quasi-buckling";
-        s.note = sp.boundaryName;
-        break;
-      case cont::SpecialPointType::Endpoint: continue;
-    }
-    s.branch = b.id;
-    s.parameter = sp.lambda;
-    s.q = sp.u.head(n);
-    s.F = problem.wrench(sp.u, sp.lambda);
-    s.pose = mech::endPose(out_.chain, s.q);
-    s.stabilityBefore = stabilityLabel(sp.inertiaBefore);
-    s.stabilityAfter = stabilityLabel(sp.inertiaAfter);
-    if (throughLoad()) {
-      // reported against the held coordinate, with displacement-control stability
-      s.parameter = s.pose[spec_.path.coordinate];
-      const size_t i0 = std::min(size_t(sp.index), b.points.size() - 1), i1 = std::min(i0 + 1, b.points.size() - 1);
-      const auto before = heldStability(b.points[i0].u.head(n), problem.wrench(b.points[i0].u, b.points[i0].lambda));
-      const auto after = heldStability(b.points[i1].u.head(n), problem.wrench(b.points[i1].u, b.points[i1].lambda));
-      s.stabilityBefore = stabilityLabel(before.negative);
-      s.stabilityAfter = stabilityLabel(after.negative);
-      s.note = "stability under displacement control of " + spec_.path.parameter + " (neighbouring points)";
-      if (sp.type == cont::SpecialPointType::Fold) {
-        s.type = "LPF";
-        s.field = "none";
-        s.note = "fold of the reaction force: no jump under displacement control";
-      }
-    }
-    s.accuracy = sp.lambdaAccuracy;
-    s.residual = sp.residualNorm;
-    s.refined = sp.refined;
-    if (!sp.note.empty()) s.note += (s.note.empty() ? "" : "; ") + sp.note;
-    if (sp.type == cont::SpecialPointType::BranchPoint && sp.nullVectors.cols() >= 2)
-      s.shape = mech::modeShapeName(sp.nullVectors.col(1).head(n));
-    else
-      s.shape = mech::shapeName(s.q, 1e-6);
-    if (sp.multiplicity > 1) s.note += (s.note.empty() ? "" : "; ") + std::string("multiplicity ") + std::to_string(sp.multiplicity);
-    run_.worstLocation = std::max(run_.worstLocation, sp.lambdaAccuracy);
-    if (scene_.analyses.jump.enabled && sp.type == cont::SpecialPointType::Fold && !throughLoad()) {
+  for (const mech::SpecialPointReport& sp : report.specialPoints) {
+    SpecialRecord s = toRecord(sp, b.id);
+    if (sp.source >= 0) run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
+    if (scene_.analyses.jump.enabled && sp.jumps && sp.source >= 0 && !throughLoad()) {
+      const cont::SpecialPoint& fold = b.specialPoints[size_t(sp.source)];
       if (interrupted()) {
         s.jumpMessage = "not simulated: " + run_.interruption;
       } else {
-        if (control_.progress) control_.progress->note("jump from the fold at " + std::to_string(sp.lambda));
-        simulateJumpAt(problem, sp, s);
+        if (control_.progress) control_.progress->note("jump from the fold at " + std::to_string(fold.lambda));
+        mech::JumpOptions opt;
+        opt.perturbation = scene_.analyses.jump.perturbation;
+        opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
+        opt.integration.recordTrajectory = false;
+        const mech::Landing landing = mech::jumpFromFold(problem, fold, opt);
+        copyLanding(landing, s);
+        if (landing.interrupted) {
+          interrupted();
+        } else if (!landing.success) {
+          run_.complete = false;
+          run_.problems.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter +
+                                  " = " + std::to_string(fold.lambda) +
+                                  " did not land on a stable equilibrium: " + landing.message);
+        }
       }
     }
     out_.specials.push_back(s);
-  }
-
-  if (limitJoint >= 0) {
-    const cont::ContinuationPoint& p = b.points.back();
-    SpecialRecord s;
-    s.type = "BD";
-    s.field = "quasi-buckling";
-    s.branch = b.id;
-    s.parameter = p.lambda;
-    s.q = p.u.head(n);
-    s.F = problem.wrench(p.u, p.lambda);
-    s.pose = mech::endPose(out_.chain, s.q);
-    s.shape = mech::shapeName(s.q, 1e-6);
-    s.stabilityBefore = s.stabilityAfter = stabilityLabel(p.stability.negative);
-    if (throughLoad()) {
-      s.parameter = s.pose[spec_.path.coordinate];
-      s.stabilityBefore = s.stabilityAfter = stabilityLabel(heldStability(s.q, s.F).negative);
-    }
-    s.accuracy = b.points.size() >= 2 ? std::abs(p.lambda - b.points[b.points.size() - 2].lambda) : 0.0;
-    s.residual = p.residualNorm;
-    const bool upper = s.q[limitJoint] > 0.5 * (out_.chain.lowerLimits()[limitJoint] + out_.chain.upperLimits()[limitJoint]);
-    std::ostringstream os;
-    os << "joint " << limitJoint + 1 << " " << (upper ? "upper" : "lower") << " limit: last converged point "
-       << std::abs((upper ? out_.chain.upperLimits()[limitJoint] : out_.chain.lowerLimits()[limitJoint]) - s.q[limitJoint])
-       << " rad from it (the closing spring nearly reaches zero length)";
-    s.note = os.str();
-    out_.specials.push_back(s);
-  }
-
-  // Under displacement control through the reaction, a fold of the coordinate (dx/ds = 0) is
-  // where the displacement-controlled stability changes away from branch points: a jump.
-  if (throughLoad()) {
-    for (size_t i = first + 1; i < out_.points.size(); ++i) {
-      const PointRecord &a = out_.points[i - 1], &m = out_.points[i];
-      if (a.branch != m.branch || a.negative == m.negative || a.negative < 0 || m.negative < 0) continue;
-      bool nearBP = false;
-      for (const SpecialRecord& sr : out_.specials)
-        if (sr.branch == b.id && sr.type == "BP" &&
-            std::abs(sr.F[spec_.path.coordinate] - m.F[spec_.path.coordinate]) <=
-                std::abs(a.F[spec_.path.coordinate] - m.F[spec_.path.coordinate]) + 1e-12)
-          nearBP = true;
-      if (nearBP) continue;
-      SpecialRecord s;
-      s.type = "LP";
-      s.field = "jumping";
-      s.branch = b.id;
-      const PointRecord& at = a.stable ? a : m;
-      s.parameter = at.parameter;
-      s.F = at.F;
-      s.pose = at.pose;
-      s.q = at.q;
-      s.shape = mech::shapeName(at.q, 1e-6);
-      s.stabilityBefore = stabilityLabel(a.negative);
-      s.stabilityAfter = stabilityLabel(m.negative);
-      s.accuracy = std::abs(m.parameter - a.parameter);
-      s.note = "fold of " + spec_.path.parameter + " under displacement control, located to the point spacing";
-      out_.specials.push_back(s);
-    }
-  }
-
-  if (throughLoad()) {
-    const double lo = std::min(spec_.path.from, spec_.path.to), hi = std::max(spec_.path.from, spec_.path.to);
-    out_.specials.erase(std::remove_if(out_.specials.begin(), out_.specials.end(),
-                                       [&](const SpecialRecord& r) {
-                                         return r.branch == b.id && (r.parameter < lo - 1e-9 || r.parameter > hi + 1e-9);
-                                       }),
-                        out_.specials.end());
-  }
-
-  // Quasi-buckling (docs/mechanics.md, "What the physics does"): a deep, smooth minimum of Kxx along a
-  // stable stretch of the branch — below half of its value at the branch start.
-  if (scene_.analyses.stiffness && out_.points.size() - first >= 3) {
-    const double k0 = out_.points[first].K(0, 0);
-    for (size_t i = first + 1; i + 1 < out_.points.size(); ++i) {
-      const PointRecord &a = out_.points[i - 1], &m = out_.points[i], &c = out_.points[i + 1];
-      const double ka = a.K(0, 0), km = m.K(0, 0), kc = c.K(0, 0);
-      if (!std::isfinite(ka) || !std::isfinite(km) || !std::isfinite(kc) || !std::isfinite(k0)) continue;
-      if (!(m.stable && a.stable && c.stable)) continue;
-      if (km < ka && km <= kc && km > 0.0 && km < 0.5 * k0) {
-        SpecialRecord s;
-        s.type = "KMIN";
-        s.field = "quasi-buckling";
-        s.branch = b.id;
-        s.parameter = m.parameter;
-        s.F = m.F;
-        s.pose = m.pose;
-        s.q = m.q;
-        s.shape = mech::shapeName(m.q, 1e-6);
-        s.stabilityBefore = s.stabilityAfter = "stable";
-        s.accuracy = 0.5 * std::max(std::abs(c.parameter - m.parameter), std::abs(m.parameter - a.parameter));
-        std::ostringstream os;
-        os << "local minimum of Kxx = " << km << " (branch start: " << k0 << "), located to the point spacing";
-        s.note = os.str();
-        out_.specials.push_back(s);
-      }
-    }
   }
 }
 
@@ -404,7 +214,6 @@ void CaseRunner::record(const cont::Branch& b, mech::EquilibriumProblem& problem
 // branch of the output; each jump a special point "JUMP" (field "jumping") with its landing,
 // drawn as an arrow in the bifurcation plots.
 void CaseRunner::loadHistory() {
-  const int n = out_.chain.size();
   mech::EquilibriumProblem problem = pathProblem();
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();
@@ -433,38 +242,11 @@ void CaseRunner::loadHistory() {
     origin << "load history, leg " << h.segmentLeg[k] << " (" << spec_.path.parameter << " -> "
            << scene_.analyses.loadHistory.waypoints[size_t(h.segmentLeg[k])] << ")"
            << (h.segmentBifurcated[k] ? ", on the stable branch born at the branch point" : "");
-    record(b, problem, origin.str());
+    record(b, mech::reportBranch(problem, b, reportOptions()), problem, origin.str());
   }
-  for (const mech::JumpRecord& j : h.jumps) {
-    SpecialRecord s;
-    s.type = "JUMP";
-    s.field = "jumping";
-    s.branch = j.fromSegment >= 0 ? base + j.fromSegment : base;
-    s.parameter = j.lambda;
-    s.q = j.from.head(n);
-    s.F = problem.wrench(j.from, j.lambda);
-    s.pose = mech::endPose(out_.chain, s.q);
-    s.shape = mech::shapeName(s.q, 1e-6);
-    s.stabilityBefore = j.trigger == mech::JumpTrigger::UnstableStart ? "unstable" : "critical";
-    s.stabilityAfter = j.success ? "stable" : "unknown";
-    std::ostringstream note;
-    note << "trigger: " << mech::toString(j.trigger) << " at " << spec_.path.parameter << " = " << j.criticalLambda
-         << "; released at " << j.lambda;
-    s.note = note.str();
-    s.jumpTried = true;
-    s.jumpSuccess = j.success;
-    s.jumpLanding = j.success ? "stable equilibrium" : "none";
-    s.jumpMessage = j.message;
-    if (j.to.size() > 0) {
-      s.jumpQ = j.to.head(n);
-      s.jumpF = j.load;
-      s.jumpPose = mech::endPose(out_.chain, s.jumpQ);
-      s.jumpShape = mech::shapeName(s.jumpQ, 1e-6);
-    }
-    s.energyReleased = j.energyReleased;
-    s.jumpDistance = j.distance;
-    out_.specials.push_back(s);
-  }
+  for (const mech::JumpRecord& j : h.jumps)
+    out_.specials.push_back(
+        toRecord(mech::reportJump(problem, j, spec_.path.parameter), j.fromSegment >= 0 ? base + j.fromSegment : base));
   if (!h.completed && !interrupted()) {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": load history stopped: " + h.message);
@@ -562,26 +344,21 @@ void CaseRunner::continuation() {
   end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
   mech::EquilibriumProblem problem(out_.chain, end, direction);
 
-  // The unloaded shape at the start value, polished.
-  const cont::Vector guess = problem.initialGuess(out_.q0, s0);
-  const mech::NewtonResult nr = mech::solveEquilibrium(problem, guess, s0);
-  if (!nr.converged) {
-    run_.complete = false;
-    std::ostringstream os;
-    os << "case \"" << spec_.label << "\": no equilibrium found at the start " << spec_.path.parameter << " = " << s0
-       << " from the unloaded shape (Newton residual " << nr.residualNorm << ")";
-    run_.problems.push_back(os.str());
-    return;
-  }
-
-  cont::TracerOptions opt = solverOptions();
-  opt.lambdaMin = lambdaLo;
-  opt.lambdaMax = lambdaHi;
-  opt.computeStability = true;
+  mech::EquilibriumBranchOptions opt;
+  opt.tracer = solverOptions();
+  opt.tracer.lambdaMin = lambdaLo;
+  opt.tracer.lambdaMax = lambdaHi;
+  opt.tracer.computeStability = true;
+  opt.switchingDepth = scene_.analyses.continuation.branchSwitching;
+  opt.report = reportOptions();
+  opt.onBranch = [this](const cont::BranchTree& t, const cont::Branch&) {
+    branchesSoFar_ = static_cast<int>(t.branches.size());
+  };
 
   // The start branches (one per requested direction), then branch switching breadth first, by
   // the core's tree driver (its guards: never back at the BP a branch started from, never twice
-  // at the same point).
+  // at the same point). The start point is the unloaded shape at the start value, polished by the
+  // tracer's fixed-parameter corrector.
   std::vector<cont::InitialDirection> starts;
   std::vector<std::string> origins;
   for (double target : targets) {
@@ -592,19 +369,24 @@ void CaseRunner::continuation() {
                       (throughLoad() ? std::string(c == 0 ? "Fx" : c == 1 ? "Fy" : "Me") + " (through the reaction)"
                                      : spec_.path.parameter));
   }
-  cont::TreeOptions tree;
-  tree.maxDepth = scene_.analyses.continuation.branchSwitching;
-  tree.onBranch = [this](const cont::BranchTree& t, const cont::Branch&) {
-    branchesSoFar_ = static_cast<int>(t.branches.size());
-  };
-  const cont::BranchTree result = cont::traceTree(problem, nr.u, s0, starts, opt, tree);
-  for (const cont::Branch& b : result.branches) {
+  const mech::EquilibriumBranches result = mech::traceEquilibria(problem, out_.q0, s0, starts, opt);
+  const auto& branches = result.tree.branches;
+  if (!branches.empty() && branches.front().stopReason == cont::StopReason::StartFailed) {
+    run_.complete = false;
+    std::ostringstream os;
+    os << "case \"" << spec_.label << "\": no equilibrium found at the start " << spec_.path.parameter << " = " << s0
+       << " from the unloaded shape (" << branches.front().stopMessage << ")";
+    run_.problems.push_back(os.str());
+    return;
+  }
+  for (size_t i = 0; i < branches.size(); ++i) {
+    const cont::Branch& b = branches[i];
     std::string origin = b.parentId < 0 ? origins[size_t(b.id)]
                                         : "BP " + std::to_string(b.parentSpecialPoint) + " of branch " +
                                               std::to_string(b.parentId) + (b.direction > 0 ? ", + side" : ", - side");
-    record(b, problem, origin);
+    record(b, result.reports[i], problem, origin);
   }
-  if (result.interrupted) interrupted();
+  if (result.tree.interrupted) interrupted();
 }
 
 void CaseRunner::criticalForces() {
@@ -662,28 +444,7 @@ void CaseRunner::energyCurves() {
 
 void CaseRunner::torqueAngle() {
   const TorqueAngleSpec& t = scene_.analyses.torqueAngle;
-  const mech::Segment& seg = out_.chain.segment(0);
-  const double margin = 1e-6;
-  const double lo = std::max(t.qFrom, seg.lowerLimit() + margin);
-  const double hi = std::min(t.qTo, seg.upperLimit() - margin);
-  TorqueCurve& c = out_.torque;
-  for (int i = 0; i < t.points; ++i) {
-    const double q = lo + (hi - lo) * i / (t.points - 1);
-    c.q.push_back(q);
-    c.M.push_back(seg.torque(q));
-    c.Kq.push_back(seg.stiffness(q));
-  }
-  const mech::SegmentUnloadedAngle roots = mech::unloadedAngle(seg);
-  auto add = [&](const mech::TorqueRoot& r) {
-    if (r.q >= lo && r.q <= hi) c.equilibria.emplace_back(r.q, r.stable);
-  };
-  if (roots.found) add(roots.root);
-  for (const auto& r : roots.others) add(r);
-  std::sort(c.equilibria.begin(), c.equilibria.end());
-  // a root found from both sides of a sign change is one root
-  c.equilibria.erase(std::unique(c.equilibria.begin(), c.equilibria.end(),
-                                 [](const auto& x, const auto& y) { return std::abs(x.first - y.first) < 1e-9; }),
-                     c.equilibria.end());
+  out_.torque = mech::torqueCurve(out_.chain.segment(0), t.qFrom, t.qTo, t.points);
   out_.haveTorque = true;
 }
 

@@ -11,6 +11,7 @@
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/energy_landscape.h"
 #include "buckle/mechanics/linear_buckling.h"
+#include "buckle/mechanics/unloaded_shape.h"
 #include "scene/progress.h"
 #include "scene/scene.h"
 
@@ -68,10 +69,7 @@ struct BranchRecord {
   bool finished = true;    ///< ended on a regular stop (range, boundary); false: could not go on
 };
 
-struct TorqueCurve {
-  std::vector<double> q, M, Kq;
-  std::vector<std::pair<double, bool>> equilibria;  ///< (q, stable) with M(q) = 0
-};
+using TorqueCurve = mechanics::TorqueCurve;
 
 /// The dynamic answer to a sudden load, beside the quasi-static one.
 struct SuddenLoadRecord {

@@ -164,6 +164,37 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
         }
         CHECK(found);
       }
+      // every special point is named by the one classifier (mechanics/classification.h, the
+      // table in docs/mechanics.md): type, field and stability agree
+      const bool jumpsAsked = src["analyses"].contains("jump");
+      for (const json& p : sp["special_points"]) {
+        const std::string type = p["type"], field = p["field"];
+        const std::string before = p["stability_before"], after = p["stability_after"];
+        INFO(scene.stem().string() << ": " << type << " at " << p["parameter"] << " (" << field << ", " << before
+                                   << " -> " << after << ")");
+        if (type == "BP") {
+          CHECK(field == "buckling");
+        } else if (type == "LP") {
+          const bool stableSide = before == "stable" || after == "stable";
+          CHECK(field == (stableSide ? "jumping" : "none"));
+          // a jump is simulated exactly where the chain must jump (under load control: the jump
+          // of a chain whose held coordinate turns back is not simulated)
+          const bool held = p.value("note", "").find("displacement control") != std::string::npos;
+          if (jumpsAsked && !held) CHECK(p.contains("jump_to") == stableSide);
+          if (p.contains("jump_to")) CHECK(stableSide);
+        } else if (type == "LPF" || type == "BD") {
+          CHECK(field == "quasi-buckling");
+          CHECK(!p.contains("jump_to"));
+        } else if (type == "KMIN") {
+          CHECK(field == "quasi-buckling");
+          CHECK(before == "stable");
+          CHECK(after == "stable");
+        } else if (type == "JUMP") {
+          CHECK(field == "jumping");
+        } else {
+          FAIL("unknown special point type " << type);
+        }
+      }
       // jumps (from folds, or the load history's JUMP records) land somewhere else, releasing energy
       for (const json& p : sp["special_points"]) {
         if (!p.contains("jump_to")) continue;

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "buckle/mechanics/equilibrium_problem.h"
-#include "buckle/mechanics/equilibrium_solve.h"
+#include "buckle/mechanics/jump.h"
 
 #include "random_segments.h"
 
@@ -118,10 +118,11 @@ TEST_CASE("the straight chain is an equilibrium under any axial load", "[equilib
   }
 }
 
-TEST_CASE("solveEquilibrium converges quadratically to an equilibrium of the loaded chain", "[equilibrium]") {
+TEST_CASE("the corrector's fixed-parameter solve converges quadratically to an equilibrium of the loaded chain",
+          "[equilibrium]") {
   const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   EquilibriumProblem problem(chain, EndCondition::freeEnd(Eigen::Vector3d(-0.05, 0.08, 0.0)), Eigen::Vector3d(0, 1, 0));
-  const NewtonResult r = solveEquilibrium(problem, Vector::Zero(4), 0.0);
+  const PolishResult r = polishEquilibrium(problem, Vector::Zero(4), 0.0);
   REQUIRE(r.converged);
   CHECK(r.iterations <= 8);
   Vector F(4);
@@ -130,7 +131,7 @@ TEST_CASE("solveEquilibrium converges quadratically to an equilibrium of the loa
   CHECK(endPose(chain, r.u)[1] > 0.0);  // bends towards the lateral load
   // held position with a reaction
   EquilibriumProblem held(chain, EndCondition::heldPosition(7.5, 0.6), Eigen::Vector3d::Zero());
-  const NewtonResult rh = solveEquilibrium(held, held.initialGuess(Vector::Constant(4, 0.05), 0.0), 0.0);
+  const PolishResult rh = polishEquilibrium(held, Vector::Constant(4, 0.05), 0.0);
   REQUIRE(rh.converged);
   const Pose p = endPose(chain, rh.u.head(4));
   CHECK(p[0] == Approx(7.5).margin(1e-12));

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 namespace buckle::continuation {
 
@@ -159,6 +160,9 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
                      const TracerOptions &options, const TreeOptions &treeOptions) {
   BranchTree tree;
   Tracer tracer(problem, options);
+  std::unique_ptr<Tracer> childTracer;  // only when the children have options of their own
+  if (treeOptions.childTracer) childTracer = std::make_unique<Tracer>(problem, *treeOptions.childTracer);
+  Tracer &switchTracer = childTracer ? *childTracer : tracer;
   std::vector<int> depth;
   auto interrupted = [&]() {
     if (!options.interrupt.requested()) return false;
@@ -191,6 +195,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       SpecialPoint bp = tree.branches[i].specialPoints[k];
       if (bp.type != SpecialPointType::BranchPoint) continue;
       if (bp.multiplicity > 1) continue;  // its note already says it is not switched
+      if (treeOptions.switchAt && !treeOptions.switchAt(tree.branches[i], bp)) continue;
       // The BP a child starts from is the parent's; never switch back at it.
       if (!tree.branches[i].points.empty() && bp.arclength - tree.branches[i].points.front().arclength <= 1e-6 * h)
         continue;
@@ -216,7 +221,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       std::string children;
       for (int sign : {1, -1}) {
         if (sign < 0 && (tree.interrupted || interrupted())) break;
-        Branch child = switchBranch(tracer, bp, dir, sign, switching);
+        Branch child = switchBranch(switchTracer, bp, dir, sign, switching);
         child.parentId = static_cast<int>(i);
         child.parentSpecialPoint = static_cast<int>(k);
         children += (children.empty() ? "" : ", ") + std::to_string(tree.branches.size());

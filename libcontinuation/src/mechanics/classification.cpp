@@ -51,22 +51,24 @@ Classification classify(const EquilibriumProblem& problem, const SpecialPoint& p
       break;
     }
     case SpecialPointType::Fold:
+      // A fold of the traced parameter ends the equilibrium the chain was in, whatever the
+      // parameter moves (a load, or a held coordinate directly): past it no nearby equilibrium
+      // exists, so the chain jumps — unless both sides are unstable. (A fold of a *reaction*
+      // under displacement control is no fold of the controlled parameter: branch_report.h.)
       if (!c.stableBefore && !c.stableAfter) {
         c.phenomenon = Phenomenon::None;
         c.explanation = "fold between two unstable parts of the branch";
-      } else if (loadControl) {
-        c.phenomenon = Phenomenon::Jumping;
-        c.explanation = "fold under load control: the stable branch ends, no nearby equilibrium beyond it";
       } else {
-        c.phenomenon = Phenomenon::QuasiBuckling;
-        c.explanation = "fold under displacement control: the controlled force peaks and the stiffness "
-                        "in that direction vanishes";
+        c.phenomenon = Phenomenon::Jumping;
+        c.explanation = loadControl ? "fold under load control: the stable branch ends, no nearby equilibrium beyond it"
+                                    : "fold of the controlled displacement: the stable branch ends, the chain jumps";
       }
       break;
     case SpecialPointType::Boundary:
-      c.phenomenon = loadControl ? Phenomenon::QuasiBuckling : Phenomenon::None;
+      // a joint reaching its limit: the stiffness changes sharply there, under any control
+      c.phenomenon = Phenomenon::QuasiBuckling;
       c.explanation = point.boundaryName.empty() ? "boundary reached" : point.boundaryName + " reached";
-      if (loadControl) c.explanation += " under load: sharp loss of stiffness";
+      c.explanation += ": sharp change of stiffness";
       break;
     case SpecialPointType::Endpoint:
       c.phenomenon = Phenomenon::None;

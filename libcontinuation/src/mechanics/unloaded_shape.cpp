@@ -164,4 +164,29 @@ std::vector<SegmentParameters> preloadsForShape(const std::vector<SegmentParamet
   return out;
 }
 
+TorqueCurve torqueCurve(const Segment& seg, double from, double to, int points) {
+  const double margin = 1e-6;  // radians: the angles' own unit
+  const double lo = std::max(from, seg.lowerLimit() + margin);
+  const double hi = std::min(to, seg.upperLimit() - margin);
+  TorqueCurve c;
+  for (int i = 0; i < points; ++i) {
+    const double q = points > 1 ? lo + (hi - lo) * i / (points - 1) : lo;
+    c.q.push_back(q);
+    c.M.push_back(seg.torque(q));
+    c.Kq.push_back(seg.stiffness(q));
+  }
+  const SegmentUnloadedAngle roots = unloadedAngle(seg);
+  auto add = [&](const TorqueRoot& r) {
+    if (r.q >= lo && r.q <= hi) c.equilibria.emplace_back(r.q, r.stable);
+  };
+  if (roots.found) add(roots.root);
+  for (const auto& r : roots.others) add(r);
+  std::sort(c.equilibria.begin(), c.equilibria.end());
+  // a root found from both sides of a sign change is one root
+  c.equilibria.erase(std::unique(c.equilibria.begin(), c.equilibria.end(),
+                                 [](const auto& x, const auto& y) { return std::abs(x.first - y.first) < 1e-9; }),
+                     c.equilibria.end());
+  return c;
+}
+
 }  // namespace buckle::mechanics

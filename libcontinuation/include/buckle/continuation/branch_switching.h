@@ -15,6 +15,7 @@
 #include "buckle/continuation/tracer.h"
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,12 @@ Branch switchBranch(Tracer &tracer, const SpecialPoint &bp, const Vector &direct
 struct TreeOptions {
   int maxDepth = 0;                    ///< switching generations (0: only the start branches)
   BranchSwitchingOptions switching;
+  /// Which branch points to switch at, among those the guards allow (default: all of them);
+  /// e.g. only the first one, to see which way the first bifurcated branch goes.
+  std::function<bool(const Branch &branch, const SpecialPoint &bp)> switchAt;
+  /// Tracer options of the switched branches (default: those of the start branches), e.g. a
+  /// few points only.
+  std::optional<TracerOptions> childTracer;
   /// Called when a branch is finished (traced or switched), before the next one starts: for
   /// progress reports. The tracer's own per-step callback and interrupt are in TracerOptions.
   std::function<void(const BranchTree &tree, const Branch &finished)> onBranch;

@@ -1,13 +1,15 @@
 // Special points of an equilibrium branch in the field's words (paper §III; docs/mechanics.md,
-// "What the physics does"):
+// "What the physics does"); the one classifier, used by branch_report.h:
 //   buckling        a branch point on the loaded path: the configuration loses stability to a
 //                   new family of shapes (U / Z for three segments);
-//   jumping         a fold under load control whose stable side ends there: past the fold no
-//                   nearby equilibrium exists, so the chain must jump (dynamics) — or an unloaded
-//                   start that is itself unstable (Fig 6b);
-//   quasi-buckling  a fold under displacement control (the controlled force peaks, the stiffness
-//                   in the controlled direction passes through zero but nothing jumps), or a
-//                   joint running into its limit under load (sharp loss of stiffness, Fig 10);
+//   jumping         a fold of the traced parameter (a load, or a held coordinate) with a stable
+//                   side: past the fold no nearby equilibrium exists, so the chain must jump
+//                   (dynamics) — or an unloaded start that is itself unstable (Fig 6b);
+//   quasi-buckling  a joint running into its limit (sharp change of stiffness, Fig 10),
+//                   a deep minimum of the stiffness, or — under displacement control traced
+//                   through the reaction — a fold of the reaction force (the controlled force
+//                   peaks, the stiffness in the controlled direction passes through zero, but
+//                   nothing jumps): branch_report.h;
 //   none            a fold between two unstable parts, or a plain end point: no physical event.
 #pragma once
 

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <utility>
 #include <vector>
 
 #include "buckle/mechanics/chain.h"
@@ -43,6 +44,15 @@ struct UnloadedShapeOptions {
 
 /// Roots of M(q) in the joint limits of one segment, and the chosen one.
 SegmentUnloadedAngle unloadedAngle(const Segment& segment, const UnloadedShapeOptions& options = {});
+
+/// The torque–angle curve of one segment (eq 1, Fig 2): M(q) = −dE/dq and K_q(q) = d²E/dq² on
+/// `points` evenly spaced angles of [from, to] ∩ the joint's range (kept 1e-6 rad inside a
+/// geometric limit, where the closing spring's length vanishes), with its unloaded equilibria.
+struct TorqueCurve {
+  std::vector<double> q, M, Kq;
+  std::vector<std::pair<double, bool>> equilibria;  ///< (q, stable) with M(q) = 0, ascending
+};
+TorqueCurve torqueCurve(const Segment& segment, double from, double to, int points);
 /// All segments of a chain.
 UnloadedShape unloadedShape(const Chain& chain, const UnloadedShapeOptions& options = {});
 

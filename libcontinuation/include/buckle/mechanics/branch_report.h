@@ -1,0 +1,121 @@
+// What a traced equilibrium branch means physically: its points in physical quantities and its
+// special points named in the field's words (paper §III; docs/mechanics.md, "What the physics
+// does"). The one place that decides what a branch point, a fold, a joint limit or a stiffness
+// minimum of the chain is, under any mix of load and displacement control — the command line,
+// the atlas and the tests only read what it says.
+//
+// A path under displacement control of one end coordinate c may be traced *through the
+// reaction*: coordinate c is released, its force F_c is the continuation parameter and the
+// report maps everything back onto the held coordinate (ReportOptions::heldCoordinate): the
+// reported parameter is the end's coordinate c, stability is that of the chain with c held
+// (K_q − K_g on ker J_h including row c), a fold of the force F_c(s) is no event there (LPF),
+// and a turning point of the coordinate c(s) — where the displacement-controlled stability
+// changes away from branch points — is where the chain jumps under displacement control.
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "buckle/continuation/branch.h"
+#include "buckle/mechanics/classification.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/landing.h"
+#include "buckle/mechanics/load_history.h"
+
+namespace buckle::mechanics {
+
+/// What kind of event a reported special point is. Labels (eventLabel): AUTO/MATCONT's where
+/// they exist.
+enum class EventType {
+  BranchPoint,       ///< "BP": a branch point of the traced equilibria
+  Fold,              ///< "LP": a fold of the traced parameter (or of the held coordinate)
+  ReactionFold,      ///< "LPF": a fold of the reaction force of a held coordinate: no jump
+  Boundary,          ///< "BD": a joint limit or another boundary of the model, located
+  JointLimit,        ///< "BD": the steps collapsed at a geometric joint limit (not located)
+  StiffnessMinimum,  ///< "KMIN": a deep local minimum of K_xx along a stable stretch
+  Jump,              ///< "JUMP": a load history leaves its stable state (load_history.h)
+};
+
+/// "BP", "LP", "LPF", "BD", "KMIN", "JUMP": the one spelling of the labels in every output.
+const char* eventLabel(EventType type);
+
+/// "stable", "unstable (k negative)", or "unknown" for a count that was not computed (< 0).
+std::string stabilityLabel(int negativeEigenvalues);
+
+struct ReportOptions {
+  /// ≥ 0: the branch was traced through the reaction of this end coordinate (0 x, 1 y, 2 φ),
+  /// which the path holds (file comment); −1: report the traced parameter as it is.
+  int heldCoordinate = -1;
+  /// Range of the reported parameter (the held coordinate when traced through the reaction):
+  /// points and special points outside it, by more than 1e-9 of its width, are left out.
+  double rangeLow = -std::numeric_limits<double>::infinity();
+  double rangeHigh = std::numeric_limits<double>::infinity();
+  /// The loaded Cartesian stiffness K_F (eq 29) at every point, and KMIN events.
+  bool stiffness = false;
+  /// KMIN: a local minimum of K_xx along a stable stretch is "deep" (quasi-buckling) when it is
+  /// below this fraction of K_xx at the branch start (scale-free: a ratio of stiffnesses).
+  double deepStiffnessRatio = 0.5;
+};
+
+/// One point of a branch, in physical quantities.
+struct PointReport {
+  int index = 0;                       ///< index of the point in the traced branch
+  double parameter = 0.0;              ///< the traced λ, or the held coordinate (ReportOptions)
+  Wrench F = Wrench::Zero();           ///< total end wrench (loads and reactions)
+  Pose pose = Pose::Zero();
+  Eigen::VectorXd q;
+  int negative = -1;                   ///< negative eigenvalues of the stability operator (−1: unknown)
+  double minEigenvalue = 0.0;
+  bool stable = false;
+  double residual = 0.0;               ///< corrector residual (scaled, dimensionless)
+  bool haveStiffness = false;
+  Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
+};
+
+/// One special point of a branch, named in the field's words.
+struct SpecialPointReport {
+  EventType type = EventType::BranchPoint;
+  Phenomenon phenomenon = Phenomenon::None;
+  int source = -1;                     ///< index into the traced branch's specialPoints (−1: found here)
+  int index = 0;                       ///< the point lies between points[index] and [index + 1]
+  double parameter = 0.0;
+  double lambda = 0.0;                 ///< the traced λ at the point
+  Wrench F = Wrench::Zero();
+  Pose pose = Pose::Zero();
+  Eigen::VectorXd q;
+  std::string shape;                   ///< of the bifurcating mode at a BP, of q elsewhere
+  int negativeBefore = -1, negativeAfter = -1;
+  std::string stabilityBefore, stabilityAfter;  ///< stabilityLabel of the counts, or "critical"
+  double accuracy = 0.0;               ///< achieved |Δ parameter| of the location
+  double residual = 0.0;
+  bool refined = false;                ///< Newton on an augmented system converged
+  int multiplicity = 1;
+  std::string note;
+  /// A fold whose stable side ends there: the chain must jump (jumpFromFold, landing.h).
+  bool jumps = false;
+  Landing landing;                     ///< filled by whoever simulates the jump
+};
+
+struct BranchReport {
+  std::vector<PointReport> points;            ///< within the range, in branch order
+  std::vector<SpecialPointReport> specialPoints;
+  /// The branch ended on a regular stop (range, boundary, box, arclength, a joint limit);
+  /// false: it could not go on.
+  bool finished = true;
+  std::string stopReason;                     ///< continuation::stopReasonName, or "joint limit"
+  std::string stopMessage;
+  double worstResidual = 0.0;                 ///< max corrector residual over the points
+};
+
+/// Reports `branch`, traced on `problem`. Never throws for a numerical condition.
+BranchReport reportBranch(EquilibriumProblem& problem, const continuation::Branch& branch,
+                          const ReportOptions& options = {});
+
+/// A load history's jump (load_history.h) as a special point "JUMP" (jumping) with its landing;
+/// `parameterName` names λ in the note.
+SpecialPointReport reportJump(const EquilibriumProblem& problem, const JumpRecord& jump,
+                              const std::string& parameterName);
+
+}  // namespace buckle::mechanics

@@ -1,0 +1,313 @@
+#include "buckle/mechanics/branch_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "buckle/mechanics/shape_name.h"
+#include "buckle/mechanics/stiffness.h"
+
+namespace buckle::mechanics {
+
+namespace cont = buckle::continuation;
+
+const char* eventLabel(EventType type) {
+  switch (type) {
+    case EventType::BranchPoint: return "BP";
+    case EventType::Fold: return "LP";
+    case EventType::ReactionFold: return "LPF";
+    case EventType::Boundary:
+    case EventType::JointLimit: return "BD";
+    case EventType::StiffnessMinimum: return "KMIN";
+    case EventType::Jump: return "JUMP";
+  }
+  return "?";
+}
+
+std::string stabilityLabel(int negative) {
+  if (negative < 0) return "unknown";
+  if (negative == 0) return "stable";
+  return "unstable (" + std::to_string(negative) + " negative)";
+}
+
+namespace {
+
+// Shapes of equilibria are named with a small straightness tolerance relative to the angles'
+// own unit (radians): a chain bent by less than 1e-6 rad at every joint is straight.
+constexpr double kStraightTolerance = 1e-6;
+
+bool regularStop(cont::StopReason r) {
+  return r == cont::StopReason::LambdaRange || r == cont::StopReason::Boundary || r == cont::StopReason::Box ||
+         r == cont::StopReason::MaxArclength;
+}
+
+/// The chain under the path's own end condition, for a branch traced through the reaction of
+/// held coordinate c: the same loads on the loaded coordinates, c held again. Its stability
+/// operator is K_q − K_g(F) on ker J_h with row c in J_h (displacement control of c).
+class HeldStability {
+ public:
+  HeldStability(const EquilibriumProblem& traced, int c)
+      : problem_(traced.chain(), heldEnd(traced.endCondition(), c), Eigen::Vector3d::Zero()),
+        held_(problem_.endCondition().heldIndices()),
+        u_(traced.segments() + int(held_.size())) {}
+
+  int negative(const Eigen::VectorXd& q, const Wrench& F, double* smallest = nullptr) {
+    const int n = int(q.size());
+    u_.head(n) = q;
+    for (size_t k = 0; k < held_.size(); ++k) u_[n + int(k)] = F[held_[k]];
+    cont::StabilityInfo info;
+    if (!problem_.stability(u_, 0.0, smallest ? 1 : 0, info)) return -1;
+    if (smallest) *smallest = info.smallest;
+    return info.negative;
+  }
+
+ private:
+  static EndCondition heldEnd(EndCondition end, int c) {
+    end.control[size_t(c)] = Control::Held;
+    return end;
+  }
+  EquilibriumProblem problem_;
+  std::vector<int> held_;
+  Eigen::VectorXd u_;
+};
+
+bool inRange(double v, const ReportOptions& o) {
+  if (!std::isfinite(o.rangeLow) || !std::isfinite(o.rangeHigh)) return true;
+  const double slack = 1e-9 * std::max({o.rangeHigh - o.rangeLow, std::abs(o.rangeLow), std::abs(o.rangeHigh)});
+  return v >= o.rangeLow - slack && v <= o.rangeHigh + slack;
+}
+
+SpecialPointReport atPoint(const PointReport& p, EventType type, Phenomenon phenomenon) {
+  SpecialPointReport s;
+  s.type = type;
+  s.phenomenon = phenomenon;
+  s.index = p.index;
+  s.parameter = p.parameter;
+  s.F = p.F;
+  s.pose = p.pose;
+  s.q = p.q;
+  s.shape = shapeName(p.q, kStraightTolerance);
+  s.residual = p.residual;
+  return s;
+}
+
+/// A joint within 0.2 % of its range of a limit at the last point of a branch whose steps
+/// collapsed: near a geometric limit the closing spring's length goes to zero and the model's
+/// derivatives blow up (L' ~ 1/L), so the steps collapse just before it. −1: none.
+int jointAtLimit(const Chain& chain, const Eigen::VectorXd& q) {
+  int joint = -1;
+  for (int i = 0; i < chain.size(); ++i) {
+    const double lo = chain.lowerLimits()[i], hi = chain.upperLimits()[i];
+    if (std::min(hi - q[i], q[i] - lo) < 2e-3 * (hi - lo)) joint = i;
+  }
+  return joint;
+}
+
+}  // namespace
+
+BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options) {
+  const Chain& chain = problem.chain();
+  const int n = chain.size();
+  const int c = options.heldCoordinate;
+  const bool throughReaction = c >= 0;
+  std::unique_ptr<HeldStability> held;
+  if (throughReaction) held = std::make_unique<HeldStability>(problem, c);
+
+  BranchReport r;
+  r.stopReason = cont::stopReasonName(b.stopReason);
+  r.stopMessage = b.stopMessage;
+  r.finished = regularStop(b.stopReason);
+  int limitJoint = -1;
+  if (!r.finished && b.stopReason == cont::StopReason::StepSizeTooSmall && !b.points.empty()) {
+    limitJoint = jointAtLimit(chain, b.points.back().u.head(n));
+    if (limitJoint >= 0) {
+      r.finished = true;
+      r.stopReason = "joint limit";
+      r.stopMessage = "joint " + std::to_string(limitJoint + 1) + " reached its limit (" + b.stopMessage + ")";
+    }
+  }
+
+  // ---- points ----------------------------------------------------------------------------
+  std::vector<PointReport> all;  // every point, also out of range (stability of neighbours)
+  all.reserve(b.points.size());
+  for (size_t i = 0; i < b.points.size(); ++i) {
+    const cont::ContinuationPoint& p = b.points[i];
+    PointReport pr;
+    pr.index = int(i);
+    pr.parameter = p.lambda;
+    pr.q = p.u.head(n);
+    pr.F = problem.wrench(p.u, p.lambda);
+    pr.pose = endPose(chain, pr.q);
+    pr.negative = p.stability.negative;
+    pr.stable = p.stability.valid() && p.stability.stable();
+    pr.minEigenvalue = p.stability.smallest;
+    pr.residual = p.residualNorm;
+    if (throughReaction) {
+      pr.parameter = pr.pose[c];
+      pr.negative = held->negative(pr.q, pr.F, &pr.minEigenvalue);
+      pr.stable = pr.negative == 0;
+    }
+    all.push_back(pr);
+  }
+  for (const PointReport& p : all) {
+    if (throughReaction && !inRange(p.parameter, options)) continue;
+    PointReport pr = p;
+    if (options.stiffness) {
+      pr.K = loadedStiffness(chain, pr.q, pr.F, problem.endCondition()).stiffness;
+      pr.haveStiffness = true;
+    }
+    r.worstResidual = std::max(r.worstResidual, pr.residual);
+    r.points.push_back(std::move(pr));
+  }
+
+  // ---- special points located by the tracer ------------------------------------------------
+  for (size_t k = 0; k < b.specialPoints.size(); ++k) {
+    const cont::SpecialPoint& sp = b.specialPoints[k];
+    if (sp.type == cont::SpecialPointType::Endpoint) continue;
+    SpecialPointReport s;
+    s.source = int(k);
+    s.index = sp.index;
+    s.lambda = sp.lambda;
+    s.parameter = sp.lambda;
+    s.q = sp.u.head(n);
+    s.F = problem.wrench(sp.u, sp.lambda);
+    s.pose = endPose(chain, s.q);
+    s.negativeBefore = sp.inertiaBefore;
+    s.negativeAfter = sp.inertiaAfter;
+    s.accuracy = sp.lambdaAccuracy;
+    s.residual = sp.residualNorm;
+    s.refined = sp.refined;
+    s.multiplicity = sp.multiplicity;
+    const Classification cl = classify(problem, sp);
+    s.phenomenon = cl.phenomenon;
+    s.shape = cl.shape;
+    switch (sp.type) {
+      case cont::SpecialPointType::BranchPoint: s.type = EventType::BranchPoint; break;
+      case cont::SpecialPointType::Fold: s.type = EventType::Fold; break;
+      default:
+        s.type = EventType::Boundary;
+        s.note = sp.boundaryName;
+        break;
+    }
+    if (throughReaction) {
+      // Reported against the held coordinate, with the displacement-controlled stability of the
+      // neighbouring points (the traced problem's inertia is the load-controlled one).
+      s.parameter = s.pose[c];
+      if (!b.points.empty()) {
+        const size_t i0 = std::min(size_t(std::max(sp.index, 0)), b.points.size() - 1);
+        const size_t i1 = std::min(i0 + 1, b.points.size() - 1);
+        s.negativeBefore = all[i0].negative;
+        s.negativeAfter = all[i1].negative;
+      }
+      s.note = "stability under displacement control of the held coordinate (neighbouring points)";
+      if (sp.type == cont::SpecialPointType::Fold) {
+        // The reaction peaks while the held coordinate moves on: the stiffness in that direction
+        // passes through zero, nothing jumps.
+        s.type = EventType::ReactionFold;
+        s.phenomenon = Phenomenon::QuasiBuckling;
+        s.note = "fold of the reaction force: no jump under displacement control";
+      }
+    }
+    s.jumps = s.type == EventType::Fold && s.phenomenon == Phenomenon::Jumping;
+    if (!sp.note.empty()) s.note += (s.note.empty() ? "" : "; ") + sp.note;
+    if (sp.multiplicity > 1)
+      s.note += (s.note.empty() ? "" : "; ") + std::string("multiplicity ") + std::to_string(sp.multiplicity);
+    r.specialPoints.push_back(std::move(s));
+  }
+
+  // ---- a joint limit where the steps collapsed ----------------------------------------------
+  if (limitJoint >= 0) {
+    const PointReport& p = all.back();
+    SpecialPointReport s = atPoint(p, EventType::JointLimit, Phenomenon::QuasiBuckling);
+    s.lambda = b.points.back().lambda;
+    s.negativeBefore = s.negativeAfter = p.negative;
+    s.accuracy = all.size() >= 2 ? std::abs(p.parameter - all[all.size() - 2].parameter) : 0.0;
+    const double lo = chain.lowerLimits()[limitJoint], hi = chain.upperLimits()[limitJoint];
+    const bool upper = s.q[limitJoint] > 0.5 * (lo + hi);
+    std::ostringstream os;
+    os << "joint " << limitJoint + 1 << " " << (upper ? "upper" : "lower") << " limit: last converged point "
+       << std::abs((upper ? hi : lo) - s.q[limitJoint]) << " rad from it (the closing spring nearly reaches zero length)";
+    s.note = os.str();
+    r.specialPoints.push_back(std::move(s));
+  }
+
+  // ---- displacement control: turning points of the held coordinate --------------------------
+  // Where the displacement-controlled stability changes between two points away from a branch
+  // point, the held coordinate c(s) turns back (dc/ds = 0): the chain jumps there.
+  if (throughReaction) {
+    for (size_t i = 1; i < all.size(); ++i) {
+      const PointReport &a = all[i - 1], &m = all[i];
+      if (a.negative == m.negative || a.negative < 0 || m.negative < 0) continue;
+      if (!inRange(a.parameter, options) || !inRange(m.parameter, options)) continue;
+      const double gap = std::abs(a.F[c] - m.F[c]);
+      bool nearBP = false;
+      for (const SpecialPointReport& sr : r.specialPoints)
+        if (sr.type == EventType::BranchPoint &&
+            std::abs(sr.F[c] - m.F[c]) <= gap * (1.0 + 1e-12) + 1e-15 * std::abs(m.F[c]))
+          nearBP = true;
+      if (nearBP) continue;
+      const PointReport& at = a.stable ? a : m;
+      SpecialPointReport s = atPoint(at, EventType::Fold, Phenomenon::Jumping);
+      s.index = a.index;
+      s.lambda = b.points[size_t(at.index)].lambda;
+      s.negativeBefore = a.negative;
+      s.negativeAfter = m.negative;
+      s.accuracy = std::abs(m.parameter - a.parameter);
+      s.note = "fold of the held coordinate under displacement control, located to the point spacing";
+      r.specialPoints.push_back(std::move(s));
+    }
+    r.specialPoints.erase(std::remove_if(r.specialPoints.begin(), r.specialPoints.end(),
+                                         [&](const SpecialPointReport& s) { return !inRange(s.parameter, options); }),
+                          r.specialPoints.end());
+  }
+
+  // ---- quasi-buckling: a deep, smooth minimum of Kxx along a stable stretch -----------------
+  if (options.stiffness && r.points.size() >= 3) {
+    const double k0 = r.points.front().K(0, 0);
+    for (size_t i = 1; i + 1 < r.points.size(); ++i) {
+      const PointReport &a = r.points[i - 1], &m = r.points[i], &cc = r.points[i + 1];
+      const double ka = a.K(0, 0), km = m.K(0, 0), kc = cc.K(0, 0);
+      if (!std::isfinite(ka) || !std::isfinite(km) || !std::isfinite(kc) || !std::isfinite(k0)) continue;
+      if (!(m.stable && a.stable && cc.stable)) continue;
+      if (km < ka && km <= kc && km > 0.0 && km < options.deepStiffnessRatio * k0) {
+        SpecialPointReport s = atPoint(m, EventType::StiffnessMinimum, Phenomenon::QuasiBuckling);
+        s.lambda = b.points[size_t(m.index)].lambda;
+        s.negativeBefore = s.negativeAfter = 0;
+        s.accuracy = 0.5 * std::max(std::abs(cc.parameter - m.parameter), std::abs(m.parameter - a.parameter));
+        std::ostringstream os;
+        os << "local minimum of Kxx = " << km << " (branch start: " << k0 << "), located to the point spacing";
+        s.note = os.str();
+        r.specialPoints.push_back(std::move(s));
+      }
+    }
+  }
+  for (SpecialPointReport& s : r.specialPoints) {
+    s.stabilityBefore = stabilityLabel(s.negativeBefore);
+    s.stabilityAfter = stabilityLabel(s.negativeAfter);
+  }
+  return r;
+}
+
+SpecialPointReport reportJump(const EquilibriumProblem& problem, const JumpRecord& j, const std::string& parameterName) {
+  const int n = problem.segments();
+  SpecialPointReport s;
+  s.type = EventType::Jump;
+  s.phenomenon = Phenomenon::Jumping;
+  s.parameter = s.lambda = j.lambda;
+  s.q = j.from.head(n);
+  s.F = problem.wrench(j.from, j.lambda);
+  s.pose = endPose(problem.chain(), s.q);
+  s.shape = shapeName(s.q, kStraightTolerance);
+  s.stabilityBefore = j.trigger == JumpTrigger::UnstableStart ? "unstable" : "critical";
+  s.stabilityAfter = j.success ? "stable" : "unknown";
+  std::ostringstream note;
+  note << "trigger: " << toString(j.trigger) << " at " << parameterName << " = " << j.criticalLambda
+       << "; released at " << j.lambda;
+  s.note = note.str();
+  s.jumps = true;
+  s.landing = landingOf(problem, j);
+  return s;
+}
+
+}  // namespace buckle::mechanics

@@ -1,0 +1,61 @@
+#include "buckle/mechanics/landing.h"
+
+#include <stdexcept>
+
+#include "buckle/mechanics/shape_name.h"
+
+namespace buckle::mechanics {
+
+namespace {
+// Shapes are named with a straightness tolerance in radians (the angles' own unit).
+constexpr double kStraightTolerance = 1e-6;
+
+void setState(const EquilibriumProblem& problem, const Eigen::VectorXd& q, const Wrench& F, Landing& l) {
+  l.q = q;
+  l.F = F;
+  l.pose = endPose(problem.chain(), q);
+  l.shape = shapeName(q, kStraightTolerance);
+}
+}  // namespace
+
+Landing jumpFromFold(EquilibriumProblem& problem, const continuation::SpecialPoint& fold, const JumpOptions& options) {
+  const int n = problem.segments();
+  Landing l;
+  l.tried = true;
+  try {
+    const JumpResult j = simulateJump(problem, fold.u, fold.lambda, options);
+    l.success = j.success;
+    l.message = j.message;
+    l.energyReleased = j.energyReleased;
+    if (!j.success && j.stopReason == StopReason::JointLimit && j.restPoint.size() >= n) {
+      l.success = true;
+      l.kind = "joint limit";
+      setState(problem, j.restPoint.head(n), problem.wrench(fold.u, fold.lambda), l);
+      l.distance = (l.q - fold.u.head(n)).cwiseAbs().maxCoeff();
+      return l;
+    }
+    l.kind = "stable equilibrium";
+    l.interrupted = !j.success && j.stopReason == StopReason::Interrupted;
+    if (j.to.size() >= n) setState(problem, j.to.head(n), problem.wrench(j.to, fold.lambda), l);
+    l.distance = j.distance;
+  } catch (const std::invalid_argument& e) {
+    l.success = false;
+    l.message = e.what();
+  }
+  return l;
+}
+
+Landing landingOf(const EquilibriumProblem& problem, const JumpRecord& j) {
+  const int n = problem.segments();
+  Landing l;
+  l.tried = true;
+  l.success = j.success;
+  l.kind = j.success ? "stable equilibrium" : "none";
+  l.message = j.message;
+  if (j.to.size() >= n) setState(problem, j.to.head(n), j.load, l);
+  l.energyReleased = j.energyReleased;
+  l.distance = j.distance;
+  return l;
+}
+
+}  // namespace buckle::mechanics

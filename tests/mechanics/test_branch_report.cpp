@@ -1,0 +1,151 @@
+// The report of a traced branch (mechanics/branch_report.h): physical quantities, the
+// displacement-controlled stability of a branch traced through a reaction (against an
+// independent dense projected Hessian), the range filter, KMIN's deep-minimum rule, and the
+// classification table of docs/mechanics.md.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <vector>
+
+#include "buckle/continuation/problem.h"
+#include "buckle/mechanics/branch_report.h"
+#include "buckle/mechanics/equilibrium_branches.h"
+#include "buckle/mechanics/unloaded_shape.h"
+
+using namespace buckle::mechanics;
+namespace cont = buckle::continuation;
+
+namespace {
+
+// Independent: inertia of K_q − K_g(F) on the kernel of the rows of J that `end` holds, from
+// the dense Hessian of the total potential.
+int denseHeldNegative(const Chain& chain, const Eigen::VectorXd& q, const Wrench& F, const EndCondition& end) {
+  const int n = chain.size();
+  Matrix H(n, n);
+  totalPotentialHessian(chain, q, F, H);
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  Matrix J(3, n);
+  endJacobian(data, J);
+  const std::vector<int> held = end.heldIndices();
+  Matrix C(held.size(), n);
+  for (size_t k = 0; k < held.size(); ++k) C.row(Eigen::Index(k)) = J.row(held[k]);
+  return cont::projectedInertia(H, C, 1e-10 * std::max(1.0, H.norm())).negative;
+}
+
+}  // namespace
+
+TEST_CASE("traced through the reaction, a branch is reported against the held coordinate", "[branch_report]") {
+  // The paper's chain with its end on the x-axis (y held), x driven through its reaction Fx:
+  // the report must read as the chain with x held as well.
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const EndCondition traced = EndCondition::clampedPinned(0.0);
+  EndCondition held = traced;
+  held.control[0] = Control::Held;
+  EquilibriumProblem problem(chain, traced, Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions opt;
+  opt.tracer.lambdaMin = -2.5;
+  opt.tracer.lambdaMax = 0.0;
+  opt.tracer.maxStep = 0.05;
+  opt.switchingDepth = 1;
+  opt.report.heldCoordinate = 0;
+  const double x0 = endPose(chain, Eigen::VectorXd::Zero(3))[0];
+  opt.report.rangeLow = x0 - 1.0;  // the end moved in by at most one b
+  opt.report.rangeHigh = x0;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), opt);
+  REQUIRE(r.tree.branches.size() >= 3);  // the straight branch, U and Z (both sides)
+  int compared = 0, filtered = 0;
+  for (size_t b = 0; b < r.tree.branches.size(); ++b) {
+    const BranchReport& rep = r.reports[b];
+    filtered += int(r.tree.branches[b].points.size()) - int(rep.points.size());
+    for (const PointReport& p : rep.points) {
+      const cont::ContinuationPoint& tp = r.tree.branches[b].points[size_t(p.index)];
+      CHECK(p.q == tp.u.head(3));
+      CHECK(p.F == problem.wrench(tp.u, tp.lambda));
+      CHECK(p.parameter == endPose(chain, p.q)[0]);
+      CHECK(p.parameter >= opt.report.rangeLow - 1e-9);
+      CHECK(p.parameter <= opt.report.rangeHigh + 1e-9);
+      CHECK(p.negative == denseHeldNegative(chain, p.q, p.F, held));
+      CHECK(p.stable == (p.negative == 0));
+      ++compared;
+    }
+    for (const SpecialPointReport& s : rep.specialPoints) {
+      CHECK(s.parameter >= opt.report.rangeLow - 1e-9);
+      CHECK(s.parameter <= opt.report.rangeHigh + 1e-9);
+      // a fold of the traced reaction is no fold of the held coordinate
+      if (s.source >= 0) CHECK(s.type != EventType::Fold);
+    }
+  }
+  CHECK(compared > 50);
+  CHECK(filtered > 0);  // the tree goes beyond the range: the filter had something to do
+}
+
+TEST_CASE("a fold with a stable side is a jump, between unstable parts no event", "[branch_report]") {
+  // Fig 8 setting: a nearly non-monotonic segment chain folds under Fx.
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions opt;
+  opt.tracer.lambdaMin = -3.0;
+  opt.tracer.lambdaMax = 0.5;
+  opt.tracer.maxStep = 0.05;
+  opt.switchingDepth = 1;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), opt);
+  int folds = 0;
+  for (const BranchReport& rep : r.reports)
+    for (const SpecialPointReport& s : rep.specialPoints) {
+      CHECK(std::string(eventLabel(s.type)) != "?");
+      CHECK(s.stabilityBefore == stabilityLabel(s.negativeBefore));
+      if (s.type == EventType::BranchPoint) CHECK(s.phenomenon == Phenomenon::Buckling);
+      if (s.type != EventType::Fold) continue;
+      ++folds;
+      const bool stableSide = s.negativeBefore == 0 || s.negativeAfter == 0;
+      CHECK(s.phenomenon == (stableSide ? Phenomenon::Jumping : Phenomenon::None));
+      CHECK(s.jumps == stableSide);
+    }
+  CHECK(folds >= 1);  // the U branch folds back (Fx ≈ −1.755) before its joint limit
+}
+
+TEST_CASE("KMIN: a deep local minimum of Kxx along a stable stretch, scale-free", "[branch_report]") {
+  // Fig 9/10: the non-straight chain a/b = 0.75 under Fx quasi-buckles.
+  const double theta = std::acos(7.0 / 8.0);
+  Eigen::VectorXd q0(3);
+  q0 << theta, -2.0 * theta, theta;
+  for (double unit : {1.0, 1e-3, 1e3}) {  // lengths in b; stiffness 1: the same minimum, scaled
+    const SegmentParameters p = SegmentParameters::symmetric(0.75 * unit, unit, 1.0, 2.25 * unit);
+    const Chain chain(preloadsForShape(std::vector<SegmentParameters>(3, p), q0));
+    EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(1, 0, 0));
+    EquilibriumBranchOptions opt;
+    opt.tracer.lambdaMin = -2.0 * unit;
+    opt.tracer.lambdaMax = 0.0;
+    opt.switchingDepth = 0;
+    opt.report.stiffness = true;
+    const EquilibriumBranches r =
+        traceEquilibria(problem, q0, 0.0, cont::InitialDirection::decreasingLambda(), opt);
+    const BranchReport& rep = r.reports.front();
+    REQUIRE(rep.points.size() >= 3);
+    const double k0 = rep.points.front().K(0, 0);
+    int kmin = 0;
+    for (const SpecialPointReport& s : rep.specialPoints) {
+      if (s.type != EventType::StiffnessMinimum) continue;
+      ++kmin;
+      CHECK(s.phenomenon == Phenomenon::QuasiBuckling);
+      const PointReport* at = nullptr;
+      size_t i = 0;
+      for (; i < rep.points.size(); ++i)
+        if (rep.points[i].index == s.index) {
+          at = &rep.points[i];
+          break;
+        }
+      REQUIRE(at);
+      REQUIRE(i > 0);
+      REQUIRE(i + 1 < rep.points.size());
+      CHECK(at->K(0, 0) < opt.report.deepStiffnessRatio * k0);
+      CHECK(at->K(0, 0) < rep.points[i - 1].K(0, 0));
+      CHECK(at->K(0, 0) <= rep.points[i + 1].K(0, 0));
+      CHECK(at->stable);
+    }
+    CHECK(kmin == 1);
+  }
+}
