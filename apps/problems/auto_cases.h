@@ -100,12 +100,8 @@ inline void collect(const cont::Branch& b, CaseResult& r) {
   r.points += int(b.points.size()) - 1;
   for (const auto& sp : b.specialPoints) {
     Located l;
-    switch (sp.type) {
-      case cont::SpecialPointType::BranchPoint: l.label = sp.multiplicity > 1 ? "BP" + std::to_string(sp.multiplicity) : "BP"; break;
-      case cont::SpecialPointType::Fold: l.label = "LP"; break;
-      case cont::SpecialPointType::Boundary: l.label = "BD"; break;
-      case cont::SpecialPointType::Endpoint: l.label = "EP"; break;
-    }
+    l.label = cont::specialPointLabel(sp.type);  // AUTO's labels; a multiple BP as BP<m>
+    if (sp.type == cont::SpecialPointType::BranchPoint && sp.multiplicity > 1) l.label += std::to_string(sp.multiplicity);
     if (sp.type == cont::SpecialPointType::Endpoint && sp.note == "start") continue;
     l.Fx = sp.lambda;
     r.located.push_back(l);

@@ -698,12 +698,13 @@ void energyPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
 void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFile& triangles, BlockFile& springs,
                BlockFile& limits, BlockFile& joints, BlockFile& nearLimit) {
   const int n = chain.size();
+  const Eigen::Matrix2Xd P = mechanics::jointPositions(chain, q);
   double theta = 0.0;
-  Eigen::Vector2d joint(chain.linkLengths()[0], 0.0);
   auto dir = [](double t) { return Eigen::Vector2d(std::cos(t), std::sin(t)); };
   auto nrm = [](double t) { return Eigen::Vector2d(-std::sin(t), std::cos(t)); };
   for (int i = 0; i < n; ++i) {
     const mechanics::SegmentParameters& p = chain.segment(i).parameters();
+    const Eigen::Vector2d joint = P.col(i + 1);
     const double before = theta, after = theta + q[i];
     // proximal triangle: apex at the joint, base b1 behind it, half-height a1
     const Eigen::Vector2d A1 = joint - p.b1 * dir(before) + p.a1 * nrm(before);
@@ -749,7 +750,6 @@ void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFil
     const double margin = std::min(hi - q[i], q[i] - lo) / (hi - lo);
     if (margin < 0.05) nearLimit.point({joint.x(), joint.y()});
     theta = after;
-    joint += chain.linkLengths()[i + 1] * dir(theta);
   }
 }
 
@@ -789,14 +789,8 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     const CaseResult& cr = run.cases[c];
     box.extend(Eigen::Vector2d(cr.chain.length(), 0.0));
     for (const PointRecord& p : cr.points) {
-      mechanics::ChainData data(cr.chain);
-      mechanics::forwardKinematics(cr.chain, p.q, data);
-      Eigen::Vector2d joint(cr.chain.linkLengths()[0], 0.0);
-      box.extend(joint);
-      for (int i = 0; i < cr.chain.size(); ++i) {
-        joint += cr.chain.linkLengths()[i + 1] * Eigen::Vector2d(std::cos(data.theta[i]), std::sin(data.theta[i]));
-        box.extend(joint);
-      }
+      const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, p.q);
+      for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
     }
   }
   const double pad = 1.2;
@@ -951,14 +945,8 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     box.extend(Eigen::Vector2d(0.0, 0.0));
     for (const Eigen::VectorXd* q : {&cr.q0, &r.rest, &r.staticShape}) {
       if (q->size() != cr.chain.size()) continue;
-      mechanics::ChainData data(cr.chain);
-      mechanics::forwardKinematics(cr.chain, *q, data);
-      Eigen::Vector2d joint(cr.chain.linkLengths()[0], 0.0);
-      box.extend(joint);
-      for (int i = 0; i < cr.chain.size(); ++i) {
-        joint += cr.chain.linkLengths()[i + 1] * Eigen::Vector2d(std::cos(data.theta[i]), std::sin(data.theta[i]));
-        box.extend(joint);
-      }
+      const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, *q);
+      for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
     }
     const double pad = 1.2, L = cr.chain.length();
     const bool ok[2] = {r.rest.size() == cr.chain.size(), r.haveStatic && r.staticShape.size() == cr.chain.size()};

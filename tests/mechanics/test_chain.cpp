@@ -202,3 +202,21 @@ TEST_CASE("bad chain parameters are rejected naming the parameter and the segmen
   s[0] = {};
   CHECK(rejection([&] { Chain c(s); }) == "accepted");
 }
+
+TEST_CASE("joint positions: links of the chain's lengths, ending at the end pose", "[chain]") {
+  std::mt19937 rng(11);
+  for (int n : {1, 3, 40}) {
+    const Chain chain = randomChain(rng, n);
+    const Vector q = randomAngles(rng, chain);
+    const Eigen::Matrix2Xd P = jointPositions(chain, q);
+    REQUIRE(P.cols() == n + 2);
+    CHECK(P.col(0).norm() == 0.0);
+    CHECK(P(1, 1) == 0.0);  // the first link lies along the clamp's x-axis
+    const double L = chain.length();
+    for (int i = 0; i <= n; ++i)
+      CHECK((P.col(i + 1) - P.col(i)).norm() == Approx(chain.linkLengths()[i]).margin(1e-14 * L));
+    const Pose end = endPose(chain, q);
+    CHECK(P(0, n + 1) == Approx(end[0]).margin(1e-13 * L));
+    CHECK(P(1, n + 1) == Approx(end[1]).margin(1e-13 * L));
+  }
+}

@@ -62,6 +62,19 @@ Pose endPose(const Chain& chain, ConstVectorRef q) {
   return data.pose;
 }
 
+Eigen::Matrix2Xd jointPositions(const Chain& chain, ConstVectorRef q) {
+  const int n = chain.size();
+  Eigen::Matrix2Xd P(2, n + 2);
+  P.col(0).setZero();
+  P.col(1) << chain.linkLengths()[0], 0.0;
+  double theta = 0.0;
+  for (int i = 0; i < n; ++i) {
+    theta += q[i];
+    P.col(i + 2) = P.col(i + 1) + chain.linkLengths()[i + 1] * Eigen::Vector2d(std::cos(theta), std::sin(theta));
+  }
+  return P;
+}
+
 void endJacobian(const ChainData& data, MatrixRef J) {
   J.row(0) = -data.S.transpose();
   J.row(1) = data.C.transpose();

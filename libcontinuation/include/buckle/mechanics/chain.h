@@ -53,6 +53,9 @@ struct ChainData {
 /// θ, the tail sums and the end pose (eq 5 generalised). O(n).
 void forwardKinematics(const Chain& chain, ConstVectorRef q, ChainData& data);
 Pose endPose(const Chain& chain, ConstVectorRef q);
+/// The chain's centre line at q: column 0 the base (0, 0), column i the joint i (i = 1 … n),
+/// column n + 1 the end; 2×(n + 2). O(n). For drawing and reporting shapes.
+Eigen::Matrix2Xd jointPositions(const Chain& chain, ConstVectorRef q);
 
 /// Jacobian of (x, y, φ) with respect to q, 3×n (eq 11): rows (−S_j, C_j, 1).
 void endJacobian(const ChainData& data, MatrixRef J);
