@@ -156,6 +156,18 @@ Branch switchBranch(Tracer &tracer, const SpecialPoint &userBp, const Vector &us
   return child;
 }
 
+std::vector<Branch> switchBothSides(Tracer &tracer, const SpecialPoint &bp, const BranchSwitchingOptions &options,
+                                    std::string *how, const std::function<bool(const Branch &child)> &accept) {
+  std::vector<Branch> sides;
+  Vector direction;
+  if (!bifurcatingDirection(tracer.problem(), bp, direction, how)) return sides;
+  for (int sign : {1, -1}) {
+    sides.push_back(switchBranch(tracer, bp, direction, sign, options));
+    if (accept && accept(sides.back())) break;
+  }
+  return sides;
+}
+
 BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
                      const TracerOptions &options, const TreeOptions &treeOptions) {
   BranchTree tree;
@@ -212,16 +224,17 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
         continue;
       }
       switchedAt.push_back(xBP);
-      Vector dir;
       std::string how;
-      if (!bifurcatingDirection(problem, bp, dir, &how)) {
+      // after the + side, the − side only if no stop was asked for meanwhile
+      std::vector<Branch> sides = switchBothSides(switchTracer, bp, switching, &how, [&](const Branch &) {
+        return options.interrupt.requested();
+      });
+      if (sides.empty()) {
         note += (note.empty() ? "" : "; ") + std::string("not switched: ") + how;
         continue;
       }
       std::string children;
-      for (int sign : {1, -1}) {
-        if (sign < 0 && (tree.interrupted || interrupted())) break;
-        Branch child = switchBranch(switchTracer, bp, dir, sign, switching);
+      for (Branch &child : sides) {
         child.parentId = static_cast<int>(i);
         child.parentSpecialPoint = static_cast<int>(k);
         children += (children.empty() ? "" : ", ") + std::to_string(tree.branches.size());

@@ -102,19 +102,18 @@ cont::Branch cutAt(const cont::Branch& branch, const cont::SpecialPoint& sp) {
 bool followBifurcated(EquilibriumProblem& problem, const cont::SpecialPoint& sp, const cont::TracerOptions& options,
                       double sign, cont::Branch& child) {
   if (sp.type != cont::SpecialPointType::BranchPoint || sp.multiplicity > 1) return false;
-  cont::Vector direction;
-  if (!cont::bifurcatingDirection(problem, sp, direction)) return false;
-  cont::Tracer tracer(problem, options);
-  for (int side : {1, -1}) {
-    cont::Branch c = cont::switchBranch(tracer, sp, direction, side);
-    if (c.stopReason == cont::StopReason::SwitchFailed || c.points.size() < 2) continue;
+  // the tree driver's switching step, stopped at the first side the chain can follow
+  auto supercritical = [&](const cont::Branch& c) {
+    if (c.stopReason == cont::StopReason::SwitchFailed || c.points.size() < 2) return false;
     const cont::ContinuationPoint& first = c.points[1];
-    if ((first.lambda - sp.lambda) * sign <= 0.0) continue;  // bends back: subcritical
-    if (!first.stability.valid() || first.stability.negative != 0) continue;
-    child = std::move(c);
-    return true;
-  }
-  return false;
+    if ((first.lambda - sp.lambda) * sign <= 0.0) return false;  // bends back: subcritical
+    return first.stability.valid() && first.stability.negative == 0;
+  };
+  cont::Tracer tracer(problem, options);
+  std::vector<cont::Branch> sides = cont::switchBothSides(tracer, sp, cont::BranchSwitchingOptions(), nullptr, supercritical);
+  if (sides.empty() || !supercritical(sides.back())) return false;
+  child = std::move(sides.back());
+  return true;
 }
 
 }  // namespace

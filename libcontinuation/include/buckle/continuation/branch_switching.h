@@ -42,6 +42,16 @@ bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &dire
 Branch switchBranch(Tracer &tracer, const SpecialPoint &bp, const Vector &direction, int sign,
                     const BranchSwitchingOptions &options = BranchSwitchingOptions());
 
+/// The branches crossing the traced one at the simple branch point bp, the tree driver's
+/// switching step: bifurcatingDirection, then switchBranch on the + side and then the − side
+/// (the + side: the direction's largest scaled component positive), each child traced with
+/// `tracer`. `accept(child)`, when given, ends the search at the first child it accepts (the
+/// later side is then not traced). `how` says how the direction was obtained, or why there is
+/// none (then no branch is returned).
+std::vector<Branch> switchBothSides(Tracer &tracer, const SpecialPoint &bp, const BranchSwitchingOptions &options,
+                                    std::string *how = nullptr,
+                                    const std::function<bool(const Branch &child)> &accept = nullptr);
+
 struct TreeOptions {
   int maxDepth = 0;                    ///< switching generations (0: only the start branches)
   BranchSwitchingOptions switching;
