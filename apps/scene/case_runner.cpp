@@ -1,0 +1,356 @@
+#include "scene/case_runner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/equilibrium_branches.h"
+#include "buckle/mechanics/jump.h"
+#include "buckle/mechanics/landing.h"
+#include "buckle/mechanics/load_history.h"
+#include "buckle/mechanics/unloaded_shape.h"
+
+namespace buckle::scene {
+
+namespace {
+
+void copyLanding(const mech::Landing& l, SpecialRecord& s) {
+  s.jumpTried = l.tried;
+  s.jumpSuccess = l.success;
+  s.jumpLanding = l.kind;
+  s.jumpMessage = l.message;
+  s.jumpQ = l.q;
+  s.jumpF = l.F;
+  s.jumpPose = l.pose;
+  s.jumpShape = l.shape;
+  s.energyReleased = l.energyReleased;
+  s.jumpDistance = l.distance;
+}
+
+SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
+  SpecialRecord s;
+  s.type = mech::eventLabel(sp.type);
+  s.field = mech::phenomenonName(sp.phenomenon);
+  s.branch = branch;
+  s.parameter = sp.parameter;
+  s.F = sp.F;
+  s.pose = sp.pose;
+  s.q = sp.q;
+  s.shape = sp.shape;
+  s.stabilityBefore = sp.stabilityBefore;
+  s.stabilityAfter = sp.stabilityAfter;
+  s.accuracy = sp.accuracy;
+  s.residual = sp.residual;
+  s.refined = sp.refined;
+  s.note = sp.note;
+  copyLanding(sp.landing, s);
+  return s;
+}
+
+}  // namespace
+
+void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report, mech::EquilibriumProblem& problem,
+                        const std::string& origin) {
+  BranchRecord br;
+  br.id = b.id;
+  br.parent = b.parentId;
+  br.origin = origin;
+  br.stopReason = report.stopReason;
+  br.stopMessage = report.stopMessage;
+  br.points = static_cast<int>(b.points.size());
+  br.finished = report.finished;
+  if (b.stopReason == cont::StopReason::Interrupted) {
+    interrupted();  // reported once for the run, not per branch
+  } else if (!br.finished) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\", branch " + std::to_string(b.id) + " (" + origin +
+                            ") stopped early: " + br.stopReason + (b.stopMessage.empty() ? "" : " — " + b.stopMessage));
+  }
+  out_.branches.push_back(br);
+
+  for (const mech::PointReport& p : report.points) {
+    PointRecord r;
+    r.branch = b.id;
+    r.index = p.index;
+    r.parameter = p.parameter;
+    r.q = p.q;
+    r.F = p.F;
+    r.pose = p.pose;
+    r.negative = p.negative;
+    r.stable = p.stable;
+    r.minEigenvalue = p.minEigenvalue;
+    r.haveStiffness = p.haveStiffness;
+    r.K = p.K;
+    out_.points.push_back(r);
+  }
+  run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
+
+  for (const mech::SpecialPointReport& sp : report.specialPoints) {
+    SpecialRecord s = toRecord(sp, b.id);
+    if (sp.source >= 0) run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
+    if (scene_.analyses.jump.enabled && sp.jumps && sp.source >= 0 && !throughLoad()) {
+      const cont::SpecialPoint& fold = b.specialPoints[size_t(sp.source)];
+      if (interrupted()) {
+        s.jumpMessage = "not simulated: " + run_.interruption;
+      } else {
+        if (control_.progress) control_.progress->note("jump from the fold at " + std::to_string(fold.lambda));
+        mech::JumpOptions opt;
+        opt.perturbation = scene_.analyses.jump.perturbation;
+        opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
+        opt.integration.recordTrajectory = false;
+        const mech::Landing landing = mech::jumpFromFold(problem, fold, opt);
+        copyLanding(landing, s);
+        if (landing.interrupted) {
+          interrupted();
+        } else if (!landing.success) {
+          run_.complete = false;
+          run_.problems.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter +
+                                  " = " + std::to_string(fold.lambda) +
+                                  " did not land on a stable equilibrium: " + landing.message);
+        }
+      }
+    }
+    out_.specials.push_back(s);
+  }
+}
+
+// The load history of the scene: stable quasi-static pieces joined by jumps. Each piece is a
+// branch of the output; each jump a special point "JUMP" (field "jumping") with its landing,
+// drawn as an arrow in the bifurcation plots.
+void CaseRunner::loadHistory() {
+  mech::EquilibriumProblem problem = pathProblem();
+  mech::LoadHistoryOptions opt;
+  opt.tracer = solverOptions();
+  opt.jump.perturbation = scene_.analyses.loadHistory.perturbation;
+  opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
+  mech::LoadHistoryResult h;
+  try {
+    h = mech::followLoadHistory(problem, out_.q0, scene_.analyses.loadHistory.waypoints, opt);
+  } catch (const std::exception& e) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": load history: " + e.what());
+    return;
+  }
+  const int base = out_.branches.empty() ? 0 : out_.branches.back().id + 1;
+  for (size_t k = 0; k < h.segments.size(); ++k) {
+    cont::Branch b = h.segments[k];
+    b.id = base + int(k);
+    b.parentId = k == 0 ? -1 : base + int(k) - 1;
+    const bool endsInJump = std::any_of(h.jumps.begin(), h.jumps.end(),
+                                        [&](const mech::JumpRecord& j) { return j.fromSegment == int(k); });
+    if (endsInJump) {
+      b.stopReason = cont::StopReason::Boundary;
+      b.stopMessage = "the stable state ends here: the chain jumps";
+    }
+    std::ostringstream origin;
+    origin << "load history, leg " << h.segmentLeg[k] << " (" << spec_.path.parameter << " -> "
+           << scene_.analyses.loadHistory.waypoints[size_t(h.segmentLeg[k])] << ")"
+           << (h.segmentBifurcated[k] ? ", on the stable branch born at the branch point" : "");
+    record(b, mech::reportBranch(problem, b, reportOptions()), problem, origin.str());
+  }
+  for (const mech::JumpRecord& j : h.jumps)
+    out_.specials.push_back(
+        toRecord(mech::reportJump(problem, j, spec_.path.parameter), j.fromSegment >= 0 ? base + j.fromSegment : base));
+  if (!h.completed && !interrupted()) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": load history stopped: " + h.message);
+  }
+}
+
+// The sporadic load: the path parameter is set to its value at once on the chain at rest in its
+// unloaded shape; the dynamic rest state is compared with the quasi-static answer, which is the
+// load history from the start to the same value (jumps included where the stable state ends).
+void CaseRunner::suddenLoad() {
+  const int n = out_.chain.size();
+  const SuddenLoadSpec& spec = scene_.analyses.suddenLoad;
+  const double s0 = out_.startValue;
+  mech::EquilibriumProblem problem = pathProblem();
+  SuddenLoadRecord& rec = out_.sudden;
+  out_.haveSudden = true;
+  rec.value = spec.value;
+  Eigen::VectorXd qStatic;
+  if (spec.value != s0) {
+    mech::LoadHistoryOptions opt;
+    opt.tracer = solverOptions();
+    opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
+    try {
+      const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.q0, {s0, spec.value}, opt);
+      if (h.completed && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);
+    } catch (const std::exception&) {
+      // no quasi-static answer: the comparison is skipped and said so below
+    }
+  } else {
+    qStatic = out_.q0;
+  }
+  mech::EndCondition loaded = problem.endCondition();
+  loaded.value += spec.value * problem.direction();
+  mech::SuddenLoadOptions opt;
+  opt.integration = integrationOptions();
+  if (spec.massPerLength > 0) {
+    opt.scene.inertia = mech::InertiaData::uniformRods(out_.chain, spec.massPerLength);
+    if (spec.damping > 0) opt.scene.jointDamping.assign(size_t(n), spec.damping);
+  }
+  try {
+    const mech::SuddenLoadResult r = mech::simulateSuddenLoad(out_.chain, loaded, out_.q0, qStatic, opt);
+    rec.success = r.success;
+    rec.message = r.message;
+    rec.inertial = r.inertial;
+    rec.rest = r.rest;
+    if (r.rest.size() == n) rec.restPose = mech::endPose(out_.chain, r.rest);
+    rec.stable = r.stable;
+    rec.haveStatic = r.compared;
+    if (r.compared) {
+      rec.staticShape = r.staticShape;
+      rec.staticPose = mech::endPose(out_.chain, r.staticShape);
+      rec.differs = r.differs;
+      rec.maxDifference = r.maxDifference;
+      rec.potentialDynamic = r.potentialDynamic;
+      rec.potentialStatic = r.potentialStatic;
+      rec.lower = mech::toString(r.lower);
+    }
+    rec.peakKinetic = r.peakKinetic;
+    rec.maxExcursion = r.maxExcursion;
+    rec.duration = r.dynamics.time;
+    rec.residual = r.residual;
+    rec.energyBalanceError = r.dynamics.maxEnergyBalanceError;
+    rec.trajectory = r.dynamics.trajectory;
+    if (!r.success && !interrupted()) {
+      run_.complete = false;
+      run_.problems.push_back("case \"" + spec_.label + "\": sudden load: " + r.message);
+    }
+  } catch (const std::exception& e) {
+    rec.message = e.what();
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": sudden load: " + e.what());
+  }
+}
+
+void CaseRunner::continuation() {
+  double s0 = out_.startValue;
+  mech::EndCondition end = spec_.end.condition;
+  Eigen::Vector3d direction = spec_.path.direction;
+  double lambdaLo = std::min(spec_.path.from, spec_.path.to), lambdaHi = std::max(spec_.path.from, spec_.path.to);
+  std::vector<double> targets{spec_.path.to, spec_.path.from};
+  const int c = spec_.path.coordinate;
+  if (throughLoad()) {
+    // trace with the held coordinate's reaction as parameter (see PathSpec::loadLimit)
+    end.control[size_t(c)] = mech::Control::Load;
+    end.value[c] = 0.0;
+    direction = Eigen::Vector3d::Zero();
+    direction[c] = 1.0;
+    s0 = 0.0;
+    // both signs of the reaction: with an unstable start (κ < 0) the branch points lie on the
+    // tension side, and their branches still move the end into the requested range
+    targets = {-spec_.path.loadLimit, spec_.path.loadLimit};
+    lambdaLo = -spec_.path.loadLimit;
+    lambdaHi = spec_.path.loadLimit;
+  }
+  end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
+  mech::EquilibriumProblem problem(out_.chain, end, direction);
+
+  mech::EquilibriumBranchOptions opt;
+  opt.tracer = solverOptions();
+  opt.tracer.lambdaMin = lambdaLo;
+  opt.tracer.lambdaMax = lambdaHi;
+  opt.tracer.computeStability = true;
+  opt.switchingDepth = scene_.analyses.continuation.branchSwitching;
+  opt.report = reportOptions();
+  opt.onBranch = [this](const cont::BranchTree& t, const cont::Branch&) {
+    branchesSoFar_ = static_cast<int>(t.branches.size());
+  };
+
+  // The start branches (one per requested direction), then branch switching breadth first, by
+  // the core's tree driver (its guards: never back at the BP a branch started from, never twice
+  // at the same point). The start point is the unloaded shape at the start value, polished by the
+  // tracer's fixed-parameter corrector.
+  std::vector<cont::InitialDirection> starts;
+  std::vector<std::string> origins;
+  for (double target : targets) {
+    if (target == s0) continue;
+    const bool up = target > s0;
+    starts.push_back(up ? cont::InitialDirection::increasingLambda() : cont::InitialDirection::decreasingLambda());
+    origins.push_back(std::string("start, ") + (up ? "increasing " : "decreasing ") +
+                      (throughLoad() ? std::string(c == 0 ? "Fx" : c == 1 ? "Fy" : "Me") + " (through the reaction)"
+                                     : spec_.path.parameter));
+  }
+  const mech::EquilibriumBranches result = mech::traceEquilibria(problem, out_.q0, s0, starts, opt);
+  const auto& branches = result.tree.branches;
+  if (!branches.empty() && branches.front().stopReason == cont::StopReason::StartFailed) {
+    run_.complete = false;
+    std::ostringstream os;
+    os << "case \"" << spec_.label << "\": no equilibrium found at the start " << spec_.path.parameter << " = " << s0
+       << " from the unloaded shape (" << branches.front().stopMessage << ")";
+    run_.problems.push_back(os.str());
+    return;
+  }
+  for (size_t i = 0; i < branches.size(); ++i) {
+    const cont::Branch& b = branches[i];
+    std::string origin = b.parentId < 0 ? origins[size_t(b.id)]
+                                        : "BP " + std::to_string(b.parentSpecialPoint) + " of branch " +
+                                              std::to_string(b.parentId) + (b.direction > 0 ? ", + side" : ", - side");
+    record(b, result.reports[i], problem, origin);
+  }
+  if (result.tree.interrupted) interrupted();
+}
+
+void CaseRunner::criticalForces() {
+  mech::EndCondition end = spec_.end.condition;
+  mech::LinearBucklingOptions opt;
+  opt.count = scene_.analyses.criticalForces.modes;
+  const int c = spec_.path.coordinate;
+  if (end.isHeld(static_cast<mech::EndCoordinate>(c))) {
+    // displacement control: the critical loads of the force that drives that coordinate
+    end.control[size_t(c)] = mech::Control::Load;
+    opt.direction = Eigen::Vector3d::Zero();
+    opt.direction[c] = 1.0;
+  } else {
+    opt.direction = spec_.path.direction;
+    for (int j = 0; j < 3; ++j)
+      if (end.isHeld(static_cast<mech::EndCoordinate>(j))) opt.direction[j] = 0.0;
+  }
+  try {
+    out_.critical = mech::linearBuckling(out_.chain, out_.q0, end, opt);
+    out_.haveCritical = true;
+  } catch (const std::invalid_argument& e) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": critical forces: " + e.what());
+    return;
+  }
+  // the closed forms (eq 17) apply to three identical symmetric segments, straight, clamped–pinned
+  const auto& segs = spec_.chain.segments;
+  bool symmetric = segs.size() == 3 && out_.q0.cwiseAbs().maxCoeff() == 0.0;
+  for (const auto& s : segs)
+    symmetric = symmetric && s.a1 == segs[0].a1 && s.a2 == s.a1 && s.b1 == segs[0].b1 && s.b2 == s.b1 &&
+                s.k1 == segs[0].k1 && s.k2 == s.k1 && s.L1_0 == segs[0].L1_0 && s.L2_0 == s.L1_0;
+  const bool clampedPinned = end.isHeld(mech::EndCoordinate::Y) && !end.isHeld(mech::EndCoordinate::X) &&
+                             !end.isHeld(mech::EndCoordinate::Phi) && opt.direction[0] != 0.0 &&
+                             opt.direction[1] == 0.0;
+  if (symmetric && clampedPinned) {
+    out_.analytic = mech::analyticClampedPinned3(segs[0].a1, segs[0].b1, segs[0].k1, segs[0].L1_0);
+    out_.haveAnalytic = true;
+  }
+}
+
+void CaseRunner::energyCurves() {
+  const EnergyCurvesSpec& e = scene_.analyses.energyCurves;
+  mech::LandscapeOptions opt;
+  opt.samples = e.points;
+  opt.q1Min = std::max(e.q1From, out_.chain.lowerLimits()[0]);
+  opt.q1Max = std::min(e.q1To, out_.chain.upperLimits()[0]);
+  try {
+    out_.landscape = mech::energyLandscape(out_.chain, e.x, e.y, opt);
+    out_.haveLandscape = true;
+  } catch (const std::invalid_argument& ex) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": energy curves: " + ex.what());
+  }
+}
+
+void CaseRunner::torqueAngle() {
+  const TorqueAngleSpec& t = scene_.analyses.torqueAngle;
+  out_.torque = mech::torqueCurve(out_.chain.segment(0), t.qFrom, t.qTo, t.points);
+  out_.haveTorque = true;
+}
+
+}  // namespace buckle::scene

@@ -1,0 +1,100 @@
+// One case of a scene, stage by stage: what each analysis asks of the library, and the
+// conversion of the library's reports into the records the writers read (runner.h). Internal
+// to the scene runner.
+#pragma once
+
+#include <string>
+
+#include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/branch_report.h"
+#include "buckle/mechanics/dynamics.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+#include "scene/runner.h"
+
+namespace buckle::scene {
+
+namespace cont = buckle::continuation;
+namespace mech = buckle::mechanics;
+
+class CaseRunner {
+ public:
+  CaseRunner(const Scene& scene, const CaseSpec& spec, CaseResult& out, RunResult& run, const RunControl& control)
+      : scene_(scene), spec_(spec), out_(out), run_(run), control_(control) {}
+
+  void continuation();
+  void loadHistory();
+  void suddenLoad();
+  void criticalForces();
+  void energyCurves();
+  void torqueAngle();
+
+  /// True once the time limit passed or a signal came: the run is then marked incomplete,
+  /// once, with the reason.
+  bool interrupted() {
+    if (run_.interrupted) return true;
+    if (!control_.interrupt.requested()) return false;
+    run_.interrupted = true;
+    run_.complete = false;
+    run_.interruption = control_.interrupt.describe();
+    run_.problems.push_back("stopped early in case \"" + spec_.label + "\": " + run_.interruption +
+                            "; everything computed until then is written");
+    return true;
+  }
+
+ private:
+  void record(const cont::Branch& b, const mech::BranchReport& report, mech::EquilibriumProblem& problem,
+              const std::string& origin);
+  bool throughLoad() const { return spec_.path.loadLimit > 0.0; }
+  /// The scene's /solver settings as tracer options (the λ range is set by each analysis).
+  cont::TracerOptions solverOptions() const {
+    cont::TracerOptions opt;
+    opt.initialStep = scene_.solver.initialStep;
+    opt.minStep = scene_.solver.minStep;
+    opt.maxStep = scene_.solver.maxStep;
+    opt.maxPoints = scene_.solver.maxPoints;
+    opt.newtonTolerance = scene_.solver.tolerance;
+    opt.interrupt = control_.interrupt;
+    if (control_.progress) {
+      Progress* progress = control_.progress;
+      const CaseResult* out = &out_;
+      const int* branches = &branchesSoFar_;
+      opt.onStep = [progress, out, branches](const cont::Branch& b) {
+        progress->step(*branches + 1, static_cast<int>(b.points.size()), b.points.back().lambda,
+                       static_cast<int>(out->specials.size() + b.specialPoints.size()));
+        return cont::StepAction::Continue;
+      };
+    }
+    return opt;
+  }
+  /// Integration settings of the dynamics with the run's interrupt.
+  mech::IntegrationOptions integrationOptions(mech::IntegrationOptions opt = mech::IntegrationOptions()) const {
+    opt.interrupt = control_.interrupt;
+    return opt;
+  }
+  /// The path as an EquilibriumProblem: prescribed(λ) = start values + (λ − s0)·direction.
+  mech::EquilibriumProblem pathProblem() const {
+    mech::EndCondition end = spec_.end.condition;
+    end.value -= out_.startValue * spec_.path.direction;
+    return mech::EquilibriumProblem(out_.chain, end, spec_.path.direction);
+  }
+  /// How the mechanics layer reports this case's branches (branch_report.h).
+  mech::ReportOptions reportOptions() const {
+    mech::ReportOptions o;
+    o.stiffness = scene_.analyses.stiffness;
+    if (throughLoad()) {
+      o.heldCoordinate = spec_.path.coordinate;
+      o.rangeLow = std::min(spec_.path.from, spec_.path.to);
+      o.rangeHigh = std::max(spec_.path.from, spec_.path.to);
+    }
+    return o;
+  }
+
+  const Scene& scene_;
+  const CaseSpec& spec_;
+  CaseResult& out_;
+  RunResult& run_;
+  const RunControl& control_;
+  int branchesSoFar_ = 0;  // for progress reports
+};
+
+}  // namespace buckle::scene
