@@ -73,6 +73,12 @@ CorrectorOptions Tracer::stepCorrectorOptions() const {
 
 Tracer::Tracer(Problem &problem, const TracerOptions &options)
     : problem_(problem), options_(options), n_(problem.dimension()), work_(&problem) {
+  // Invalid input is reported by trace()/continueBranch() as StopReason::InvalidOptions, never
+  // thrown (docs/continuation.md, "Errors"): nothing below is built for it.
+  if (n_ < 1) {
+    invalidReason_ = "Problem::dimension() must be at least 1, got " + std::to_string(n_);
+    return;
+  }
   if (!options_.IsValid(&invalidReason_)) {
     if (invalidReason_.empty()) invalidReason_ = "invalid options";
     return;
@@ -330,8 +336,8 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     return;
   }
   if (branch.points.empty()) {
-    branch.stopReason = StopReason::StartFailed;
-    branch.stopMessage = "continueBranch needs a start point";
+    branch.stopReason = StopReason::InvalidOptions;
+    branch.stopMessage = "continueBranch needs a branch with a start point";
     return;
   }
   // Event values of the current point are kept from the step that produced it (each is O(1)

@@ -136,13 +136,14 @@ class Tracer {
   Tracer &operator=(const Tracer &) = delete;
 
   /// Polishes (u0, λ0) at fixed λ, takes the start tangent from the kernel of [F_u, F_λ] and
-  /// traces until a stop condition. Invalid options give an empty branch with
-  /// StopReason::InvalidOptions.
+  /// traces until a stop condition. Never throws for bad input: invalid options, a problem of
+  /// dimension 0 or vectors of the wrong size give an empty branch with
+  /// StopReason::InvalidOptions and the reason in stopMessage (docs/continuation.md, "Errors").
   Branch trace(ConstVectorRef u0, double lambda0, const InitialDirection &direction);
 
   /// Continues `branch`, whose points are complete (tangent set); the last point is the
   /// current one. Special points are not searched in the first `skipIntervals` intervals
-  /// (a branch that starts at a branch point).
+  /// (a branch that starts at a branch point). A branch without points: InvalidOptions.
   void continueBranch(Branch &branch, int skipIntervals = 0);
 
   /// Fills tangent, test functions and stability of a point from its u, λ. In the scaled
