@@ -19,6 +19,24 @@ std::string formatDouble(const char *pattern, double value) {
   return buffer;
 }
 
+// The point the branch ends on (its last point) as a special point of the given type.
+void appendEndpoint(Branch &branch, SpecialPointType type, const std::string &name, double accuracy, double value) {
+  const ContinuationPoint &last = branch.points.back();
+  SpecialPoint sp;
+  sp.type = type;
+  sp.index = static_cast<int>(branch.points.size()) - 1;
+  sp.arclength = last.arclength;
+  sp.u = last.u;
+  sp.lambda = last.lambda;
+  sp.tangent = last.tangent;
+  sp.residualNorm = last.residualNorm;
+  sp.inertiaBefore = sp.inertiaAfter = last.stability.negative;
+  sp.lambdaAccuracy = accuracy;
+  sp.testFunctionValue = value;
+  sp.boundaryName = name;
+  branch.specialPoints.push_back(sp);
+}
+
 }  // namespace
 
 bool TracerOptions::IsValid(std::string *why) const {
@@ -248,16 +266,8 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
     skipIntervals = 1;
   }
   branch.points.push_back(start);
-  SpecialPoint ep;
-  ep.type = SpecialPointType::Endpoint;
-  ep.index = 0;
-  ep.u = start.u;
-  ep.lambda = start.lambda;
-  ep.tangent = start.tangent;
-  ep.residualNorm = start.residualNorm;
-  ep.inertiaBefore = ep.inertiaAfter = start.stability.negative;
-  ep.note = startNote;
-  branch.specialPoints.push_back(ep);
+  appendEndpoint(branch, SpecialPointType::Endpoint, "", 0.0, 0.0);
+  branch.specialPoints.back().note = startNote;
   units_.toUser(branch);
 
   for (int e = 0; e < eventCount(); ++e) {
@@ -270,28 +280,6 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
   continueBranch(branch, skipIntervals);
   return branch;
 }
-
-namespace {
-
-// The point the branch ended on (its last point) as a special point of the given type.
-void appendEndpoint(Branch &branch, SpecialPointType type, const std::string &name, double accuracy, double value) {
-  const ContinuationPoint &last = branch.points.back();
-  SpecialPoint sp;
-  sp.type = type;
-  sp.index = static_cast<int>(branch.points.size()) - 1;
-  sp.arclength = last.arclength;
-  sp.u = last.u;
-  sp.lambda = last.lambda;
-  sp.tangent = last.tangent;
-  sp.residualNorm = last.residualNorm;
-  sp.inertiaBefore = sp.inertiaAfter = last.stability.negative;
-  sp.lambdaAccuracy = accuracy;
-  sp.testFunctionValue = value;
-  sp.boundaryName = name;
-  branch.specialPoints.push_back(sp);
-}
-
-}  // namespace
 
 bool Tracer::takeStep(const ContinuationPoint &a, double ds, ContinuationPoint &b, CorrectorSummary &summary,
                       std::string &failure) {
