@@ -4,6 +4,7 @@
 
 #include "cli_helpers.h"
 #include "output_helpers.h"
+#include "temp_dir.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -20,12 +21,7 @@ using buckle::test::slurp;
 
 namespace {
 
-fs::path work(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_atlas_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path work(const std::string& name) { return buckle::test::freshDirectory("cli_atlas", name); }
 
 // A 2 x 2 atlas: a few hundred milliseconds.
 const std::string kSmall = "atlas --x a --x-range 0.4 0.6 2 --y L0 --y-range 2.0 2.5 2 -j 1 --quiet";

@@ -5,6 +5,8 @@
 
 #include "cli_helpers.h"
 #include "output_helpers.h"
+#include "small_scene.h"
+#include "temp_dir.h"
 
 #include <filesystem>
 #include <fstream>
@@ -21,19 +23,11 @@ using buckle::test::stagingLeftovers;
 
 namespace {
 
-const char* const kScene = R"({
-  "description": "small test chain",
-  "chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
-  "end": {"x": {"load": 0.0}, "y": {"held": 0.0}, "phi": "free"},
-  "path": {"parameter": "Fx", "from": 0.0, "to": -1.0},
-  "analyses": {"continuation": {"branch_switching": 1}},
-  "plots": []
-})";
+const std::string kScene = buckle::test::smallScene(1);
 
 /// A fresh directory holding s.json (the scene), notes.txt and a user folder mine/.
 fs::path userDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_out_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
+  const fs::path d = buckle::test::freshDirectory("cli_out", name);
   fs::create_directories(d / "mine" / "deeper");
   std::ofstream(d / "s.json") << kScene;
   std::ofstream(d / "notes.txt") << "my notes\n";

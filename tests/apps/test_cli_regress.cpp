@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "cli_helpers.h"
+#include "temp_dir.h"
 
 #include <cstdlib>
 #include <filesystem>
@@ -22,12 +23,7 @@ namespace {
 
 const std::string kScenes = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes";
 
-fs::path work(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_regress_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path work(const std::string& name) { return buckle::test::freshDirectory("cli_regress", name); }
 
 // A small selection: a scene with branch switching and a benchmark problem (fast).
 std::string update(const fs::path& dir, const std::string& extra = "") {

@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include "cli_helpers.h"
+#include "temp_dir.h"
 
 #include <cstdlib>
 #include <filesystem>
@@ -17,11 +18,7 @@ using buckle::test::slurp;
 
 namespace {
 
-fs::path work() {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_run_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
-}
+fs::path work() { return buckle::test::scratchDirectory("cli_run"); }
 
 }  // namespace
 

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "cli_helpers.h"
+#include "temp_dir.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -21,11 +22,7 @@ using nlohmann::json;
 
 namespace {
 
-fs::path work() {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_show_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
-}
+fs::path work() { return buckle::test::scratchDirectory("cli_show"); }
 
 std::string g(double v, const char* format) {
   char buf[48];

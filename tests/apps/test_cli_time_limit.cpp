@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "cli_helpers.h"
+#include "temp_dir.h"
 
 #include <algorithm>
 #include <chrono>
@@ -20,11 +21,7 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-fs::path work() {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_cli_time_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
-}
+fs::path work() { return buckle::test::scratchDirectory("cli_time"); }
 
 /// The default scene (branch switching, jumps) with 200 segments: far more than a few seconds of
 /// work (its 50-segment version takes about 5 s in Release).

@@ -16,6 +16,7 @@
 #include "scene/command.h"
 #include "scene/output.h"
 #include "scene/output_target.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -24,11 +25,7 @@ namespace {
 
 fs::path sceneDir() { return fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes"; }
 
-fs::path freshDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_scene_all_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
-  return d;
-}
+fs::path freshDir(const std::string& name) { return buckle::test::absentPath("scene_all", name); }
 
 json readJson(const fs::path& p) {
   std::ifstream in(p);

@@ -15,25 +15,16 @@
 
 #include "scene/command.h"
 #include "scene/scene.h"
+#include "small_scene.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-const char* const kGood = R"({
-  "description": "test chain",
-  "chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
-  "end": {"x": {"load": 0.0}, "y": {"held": 0.0}, "phi": "free"},
-  "path": {"parameter": "Fx", "from": 0.0, "to": -1.0},
-  "analyses": {"continuation": {"branch_switching": 0}},
-  "plots": []
-})";
+const std::string kGood = buckle::test::smallScene(0);
 
-fs::path workDir() {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_scene_errors_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
-}
+fs::path workDir() { return buckle::test::scratchDirectory("scene_errors"); }
 
 std::string replaceOnce(std::string s, const std::string& from, const std::string& to) {
   const size_t pos = s.find(from);

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "scene/command.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -29,8 +30,7 @@ double foldTorque(double a, double b, double k, double L0) {
 }  // namespace
 
 TEST_CASE("hysteresis scene: unstable start jumps, then two snaps at the closed-form folds", "[scene]") {
-  const fs::path out = fs::temp_directory_path() / ("buckle_test_hysteresis_" + std::to_string(::getpid()));
-  fs::remove_all(out);
+  const fs::path out = buckle::test::absentPath("hysteresis", "out");
   std::ostringstream log, err;
   buckle::scene::RunCommandOptions opt;
   opt.scene = (fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes" / "hysteresis.json").string();

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "scene/json_reader.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using buckle::scene::JsonInputError;
@@ -22,11 +23,7 @@ using buckle::scene::readInputFile;
 
 namespace {
 
-fs::path workDir() {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_json_reader_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
-}
+fs::path workDir() { return buckle::test::scratchDirectory("json_reader"); }
 
 // An array of n small objects, the shape that took O(n²) with nlohmann's callback parser.
 std::string arrayOfObjects(int n) {

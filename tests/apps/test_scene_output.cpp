@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "output_helpers.h"
+#include "temp_dir.h"
 #include "scene/output.h"
 
 namespace fs = std::filesystem;
@@ -20,12 +21,7 @@ using buckle::test::stagingLeftovers;
 
 namespace {
 
-fs::path freshDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_output_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path freshDir(const std::string& name) { return buckle::test::freshDirectory("output", name); }
 
 /// Sets the umask for the test's lifetime.
 struct Umask {

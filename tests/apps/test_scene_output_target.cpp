@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "output_helpers.h"
+#include "temp_dir.h"
 #include "scene/output_target.h"
 
 namespace fs = std::filesystem;
@@ -25,8 +26,7 @@ struct InFreshDirectory {
   fs::path previous = fs::current_path();
   fs::path root;
   explicit InFreshDirectory(const std::string& name) {
-    root = fs::temp_directory_path() / ("buckle_test_output_target_" + std::to_string(::getpid())) / name;
-    fs::remove_all(root);
+    root = buckle::test::freshDirectory("output_target", name);
     fs::create_directories(root / "work");
     fs::current_path(root / "work");
     std::ofstream("s.json") << "{\"chain\": {\"segments\": 3}}";

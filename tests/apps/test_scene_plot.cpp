@@ -22,6 +22,7 @@
 
 #include "buckle/mechanics/chain.h"
 #include "scene/command.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -31,12 +32,7 @@ namespace {
 
 fs::path scenePath(const std::string& name) { return fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes" / name; }
 
-fs::path freshDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("buckle_test_scene_plot_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
-  fs::create_directories(d.parent_path());
-  return d;
-}
+fs::path freshDir(const std::string& name) { return buckle::test::absentPath("scene_plot", name); }
 
 struct Run {
   int rc;

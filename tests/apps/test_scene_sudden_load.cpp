@@ -11,14 +11,14 @@
 
 #include "buckle/mechanics/chain.h"
 #include "scene/command.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace buckle::mechanics;
 
 TEST_CASE("sudden-load scene: dynamic and quasi-static answers are equilibria; energy balance", "[scene]") {
-  const fs::path out = fs::temp_directory_path() / ("buckle_test_sudden_" + std::to_string(::getpid()));
-  fs::remove_all(out);
+  const fs::path out = buckle::test::absentPath("sudden", "out");
   std::ostringstream log, err;
   buckle::scene::RunCommandOptions opt;
   opt.scene = (fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes" / "sudden_load.json").string();

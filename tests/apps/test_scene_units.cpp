@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "scene/command.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -26,9 +27,7 @@ namespace {
 
 fs::path sceneDir() { return fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes"; }
 
-fs::path workDir() {
-  return fs::temp_directory_path() / ("buckle_test_scene_units_" + std::to_string(::getpid()));
-}
+fs::path workDir() { return buckle::test::scratchDirectory("scene_units"); }
 
 json readJson(const fs::path& p) {
   std::ifstream in(p);

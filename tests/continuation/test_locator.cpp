@@ -226,31 +226,6 @@ TEST_CASE("Fold detection can be switched off", "[locator]") {
   CHECK(branch.stopReason == StopReason::MaxArclength);
 }
 
-TEST_CASE("Augmented Newton reaches the exact root and reports the last update", "[locator]") {
-  // z = (x, λ): x² − 2 = 0, λ − x = 0  →  λ = √2.
-  const AugmentedSystem system = [](const Vector &z, Vector &R, Matrix *J) {
-    R.resize(2);
-    R << z[0] * z[0] - 2.0, z[1] - z[0];
-    if (J) *J << 2.0 * z[0], 0.0, -1.0, 1.0;
-    return true;
-  };
-  Vector z(2);
-  z << 1.5, 1.4;
-  const AugmentedNewtonResult result = augmentedNewton(system, z, 1, 1e-12, 20, 10.0);
-  CHECK(result.converged);
-  CHECK(std::abs(z[1] - std::sqrt(2.0)) < 1e-14);
-  CHECK(result.lastDLambda <= 1e-12 * std::sqrt(2.0));
-  CHECK(result.residualNorm < 1e-14);
-  CHECK(result.iterations >= 3);
-
-  Vector far(2);
-  far << 1.5, 1.4;
-  const AugmentedNewtonResult limited = augmentedNewton(system, far, 1, 1e-12, 20, 1e-3);
-  CHECK_FALSE(limited.converged);
-  CHECK_THAT(limited.failure, Contains("left the step"));
-  CHECK(far[0] == 1.5);  // restored
-}
-
 TEST_CASE("Branch points on a curved trivial branch (F_lambda != 0)", "[locator]") {
   const double c = 0.5;
   toys::CurvedPitchforks problem(c);

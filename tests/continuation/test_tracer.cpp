@@ -80,6 +80,29 @@ TEST_CASE("TracerOptions::IsValid rejects bad options and names them", "[tracer]
   CHECK(branch.points.empty());
 }
 
+TEST_CASE("Bad input to the tracer is reported in the branch, never thrown", "[tracer]") {
+  // A problem without unknowns: the tracer cannot build a corrector for it.
+  struct Empty : Problem {
+    int dimension() const override { return 0; }
+    bool residual(ConstVectorRef, double, VectorRef) override { return true; }
+    bool jacobian(ConstVectorRef, double, MatrixRef, VectorRef) override { return true; }
+  } empty;
+  Branch none;
+  CHECK_NOTHROW(none = trace(empty, Vector(), 0.0, InitialDirection::increasingLambda()));
+  CHECK(none.stopReason == StopReason::InvalidOptions);
+  CHECK_THAT(none.stopMessage, Contains("dimension"));
+
+  toys::Circle circle;
+  Tracer tracer(circle, TracerOptions());
+  const Branch wrongSize = tracer.trace(Vector::Zero(2), 0.0, InitialDirection::increasingLambda());
+  CHECK(wrongSize.stopReason == StopReason::InvalidOptions);
+  CHECK_THAT(wrongSize.stopMessage, Contains("wrong size"));
+  Branch noStart;
+  tracer.continueBranch(noStart);
+  CHECK(noStart.stopReason == StopReason::InvalidOptions);
+  CHECK_THAT(noStart.stopMessage, Contains("start point"));
+}
+
 TEST_CASE("Circle: both folds located exactly, points on the circle", "[tracer]") {
   toys::Circle circle;
   TracerOptions options;

@@ -1,6 +1,5 @@
 #include "buckle/continuation/locator.h"
 
-#include <Eigen/LU>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -10,8 +9,6 @@
 namespace buckle::continuation {
 
 namespace {
-
-bool sameSign(double a, double b) { return (a > 0.0) == (b > 0.0); }
 
 int crossingIndex(const ContinuationPoint &lo, const ContinuationPoint &hi) {
   return std::min(lo.stability.negative, hi.stability.negative);
@@ -40,51 +37,6 @@ std::string format(const char *pattern, double value) {
 }
 
 }  // namespace
-
-AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, int lambdaIndex, double tolerance,
-                                      int maxIterations, double maxDistance) {
-  AugmentedNewtonResult result;
-  const Eigen::Index m = z.size();
-  const Vector z0 = z;
-  Vector R(m), delta(m);
-  Matrix J(m, m);
-  double lastUpdate = std::numeric_limits<double>::infinity();
-  for (int it = 0; it < maxIterations; ++it) {
-    if (!system(z, R, &J)) {
-      result.failure = "the problem refused an iterate";
-      break;
-    }
-    Eigen::FullPivLU<Matrix> lu(J);
-    if (!lu.isInvertible()) {
-      result.failure = "singular augmented Jacobian";
-      break;
-    }
-    delta = -lu.solve(R);
-    if (!delta.allFinite()) {
-      result.failure = "non-finite Newton update";
-      break;
-    }
-    z += delta;
-    ++result.iterations;
-    result.lastDLambda = std::abs(delta[lambdaIndex]);
-    lastUpdate = delta.cwiseAbs().maxCoeff();
-    if ((z - z0).norm() > maxDistance) {
-      result.failure = "Newton iterate left the step";
-      break;
-    }
-    if (lastUpdate <= tolerance * std::max(1.0, std::abs(z[lambdaIndex]))) break;
-  }
-  if (!result.failure.empty()) {
-    z = z0;
-    return result;
-  }
-  if (system(z, R, nullptr)) result.residualNorm = R.norm();
-  const double tol = tolerance * std::max(1.0, std::abs(z[lambdaIndex]));
-  // λ must meet the target; the other unknowns (null vectors) only need to have settled.
-  result.converged = result.lastDLambda <= tol && lastUpdate <= 1e-6;
-  if (!result.converged) result.failure = format("no convergence: last |dlambda| = %.3g", result.lastDLambda);
-  return result;
-}
 
 Locator::Locator(Problem &problem, Corrector &corrector, PointEvaluator &evaluator, const LocatorOptions &options)
     : problem_(problem), corrector_(corrector), evaluator_(evaluator), options_(options), n_(problem.dimension()) {
@@ -165,20 +117,21 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
     return false;
   }
   StepSample left = lo, right = hi;
-  double fl = fLo, fr = fHi;
-  int lastSide = 0;
+  IllinoisBracket bracket;
+  bracket.left = lo.s;
+  bracket.right = hi.s;
+  bracket.fLeft = fLo;
+  bracket.fRight = fHi;
   double previousS = 0.0, previousLambda = 0.0;
   const double tolS = (relativeTolerance > 0.0 ? relativeTolerance : options_.tolerance) *
                       std::max(1.0, std::abs(0.5 * (lo.point.lambda + hi.point.lambda)));
   StepSample trial;
   for (int it = 0; it < options_.maxIterations; ++it) {
-    // Illinois: regula falsi with the stale end's value halved, so both ends keep moving.
-    double s = (left.s * fr - right.s * fl) / (fr - fl);
-    if (!(s > left.s && s < right.s)) s = 0.5 * (left.s + right.s);
+    double s = bracket.next();
     CorrectorSummary summary;
     bool sampled = sample(s, trial, &summary);
-    if (!sampled && s != 0.5 * (left.s + right.s)) {
-      s = 0.5 * (left.s + right.s);  // a secant point can sit where Newton is poorly posed
+    if (!sampled && s != bracket.midpoint()) {
+      s = bracket.midpoint();  // a secant point can sit where Newton is poorly posed
       sampled = sample(s, trial, &summary);
     }
     if (!sampled) {
@@ -208,22 +161,13 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
       root.converged = true;
       break;
     }
-    if (sameSign(f, fl)) {
-      left = trial;
-      fl = f;
-      if (lastSide == -1) fr *= 0.5;
-      lastSide = -1;
-    } else {
-      right = trial;
-      fr = f;
-      if (lastSide == 1) fl *= 0.5;
-      lastSide = 1;
-    }
+    // The bracket's ends are the samples left.s and right.s.
+    (bracket.update(s, f) < 0 ? left : right) = trial;
     root.left = left;
     root.right = right;
-    root.fLeft = fl;
-    root.fRight = fr;
-    if (right.s - left.s <= tolS || (root.evaluations > 1 && root.lastDs <= tolS)) {
+    root.fLeft = bracket.fLeft;
+    root.fRight = bracket.fRight;
+    if (bracket.width() <= tolS || (root.evaluations > 1 && root.lastDs <= tolS)) {
       root.converged = true;
       break;
     }

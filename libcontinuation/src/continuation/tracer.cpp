@@ -19,6 +19,24 @@ std::string formatDouble(const char *pattern, double value) {
   return buffer;
 }
 
+// The point the branch ends on (its last point) as a special point of the given type.
+void appendEndpoint(Branch &branch, SpecialPointType type, const std::string &name, double accuracy, double value) {
+  const ContinuationPoint &last = branch.points.back();
+  SpecialPoint sp;
+  sp.type = type;
+  sp.index = static_cast<int>(branch.points.size()) - 1;
+  sp.arclength = last.arclength;
+  sp.u = last.u;
+  sp.lambda = last.lambda;
+  sp.tangent = last.tangent;
+  sp.residualNorm = last.residualNorm;
+  sp.inertiaBefore = sp.inertiaAfter = last.stability.negative;
+  sp.lambdaAccuracy = accuracy;
+  sp.testFunctionValue = value;
+  sp.boundaryName = name;
+  branch.specialPoints.push_back(sp);
+}
+
 }  // namespace
 
 bool TracerOptions::IsValid(std::string *why) const {
@@ -73,6 +91,12 @@ CorrectorOptions Tracer::stepCorrectorOptions() const {
 
 Tracer::Tracer(Problem &problem, const TracerOptions &options)
     : problem_(problem), options_(options), n_(problem.dimension()), work_(&problem) {
+  // Invalid input is reported by trace()/continueBranch() as StopReason::InvalidOptions, never
+  // thrown (docs/continuation.md, "Errors"): nothing below is built for it.
+  if (n_ < 1) {
+    invalidReason_ = "Problem::dimension() must be at least 1, got " + std::to_string(n_);
+    return;
+  }
   if (!options_.IsValid(&invalidReason_)) {
     if (invalidReason_.empty()) invalidReason_ = "invalid options";
     return;
@@ -128,6 +152,8 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   lo.denseAlgebra = n_ <= options_.maxDenseLocationDimension;
   lo.interrupt = options_.interrupt;
   locator_ = std::make_unique<Locator>(*work_, *corrector_, *evaluator_, lo);
+  stepControl_ = StepSizeControl{options_.minStep,    options_.maxStep,    options_.targetNewtonIterations,
+                                 options_.stepGrowth, options_.stepShrink, options_.slowContraction};
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
 }
@@ -136,30 +162,6 @@ Tracer::~Tracer() = default;
 
 bool Tracer::completePoint(ContinuationPoint &point, ConstVectorRef referenceDirection) {
   return evaluator_ && evaluator_->complete(point, referenceDirection);
-}
-
-// Events, g ≥ 0 inside: 0 λ ≥ λmin, 1 λ ≤ λmax, then the box faces of x = (u, λ) (lower,
-// upper per coordinate), then the problem's boundaries.
-int Tracer::eventCount() const {
-  const int box = options_.boxLower.size() ? 2 * (n_ + 1) : 0;
-  const int boundaries = options_.detectBoundaries ? problem_.boundaryCount() : 0;
-  return 2 + box + boundaries;
-}
-
-// Event values of a point in the scaled variables.
-double Tracer::eventValue(int event, const ContinuationPoint &p) {
-  if (event == 0) return p.lambda - lambdaMin_;
-  if (event == 1) return lambdaMax_ - p.lambda;
-  int e = event - 2;
-  if (boxLower_.size()) {
-    if (e < 2 * (n_ + 1)) {
-      const int i = e / 2;
-      const double xi = i < n_ ? p.u[i] : p.lambda;
-      return e % 2 == 0 ? xi - boxLower_[i] : boxUpper_[i] - xi;
-    }
-    e -= 2 * (n_ + 1);
-  }
-  return work_->boundary(e, p.u, p.lambda);
 }
 
 StepAction Tracer::notifyStep(Branch &branch) {
@@ -175,28 +177,6 @@ StepAction Tracer::notifyStep(Branch &branch) {
   branch.points.back() = last;
   branch.specialPoints = specials;
   return action;
-}
-
-double Tracer::eventScale(int event) const {
-  if (event < 2) return units_.parameter();
-  const int e = event - 2;
-  if (boxLower_.size() && e < 2 * (n_ + 1)) return units_.state(e / 2);
-  return 1.0;  // the problem's boundaries g_k are evaluated in its own units
-}
-
-std::string Tracer::eventName(int event) const {
-  if (event == 0) return "lambda min";
-  if (event == 1) return "lambda max";
-  int e = event - 2;
-  if (options_.boxLower.size()) {
-    if (e < 2 * (n_ + 1)) {
-      const int i = e / 2;
-      const std::string coordinate = i < n_ ? "u[" + std::to_string(i) + "]" : std::string("lambda");
-      return std::string(e % 2 == 0 ? "box lower " : "box upper ") + coordinate;
-    }
-    e -= 2 * (n_ + 1);
-  }
-  return problem_.boundaryName(e);
 }
 
 Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &direction) {
@@ -286,29 +266,54 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
     skipIntervals = 1;
   }
   branch.points.push_back(start);
-  SpecialPoint ep;
-  ep.type = SpecialPointType::Endpoint;
-  ep.index = 0;
-  ep.u = start.u;
-  ep.lambda = start.lambda;
-  ep.tangent = start.tangent;
-  ep.residualNorm = start.residualNorm;
-  ep.inertiaBefore = ep.inertiaAfter = start.stability.negative;
-  ep.note = startNote;
-  branch.specialPoints.push_back(ep);
+  appendEndpoint(branch, SpecialPointType::Endpoint, "", 0.0, 0.0);
+  branch.specialPoints.back().note = startNote;
   units_.toUser(branch);
 
   for (int e = 0; e < eventCount(); ++e) {
     if (eventValue(e, start) < 0.0) {
-      branch.stopReason = e < 2 ? StopReason::LambdaRange
-                                : (e < 2 + (options_.boxLower.size() ? 2 * (n_ + 1) : 0) ? StopReason::Box
-                                                                                         : StopReason::Boundary);
+      branch.stopReason = eventStopReason(e);
       branch.stopMessage = "start point outside the admissible set: " + eventName(e);
       return branch;
     }
   }
   continueBranch(branch, skipIntervals);
   return branch;
+}
+
+bool Tracer::takeStep(const ContinuationPoint &a, double ds, ContinuationPoint &b, CorrectorSummary &summary,
+                      std::string &failure) {
+  predictor_.head(n_) = a.u + ds * a.tangent.head(n_);
+  predictor_[n_] = a.lambda + ds * a.tangent[n_];
+  summary = corrector_->correct(predictor_, a.tangent, x_);
+  if (!summary.converged) {
+    failure = summary.flagName;
+    return false;
+  }
+  b.u = x_.head(n_);
+  b.lambda = x_[n_];
+  if (!evaluator_->complete(b, a.tangent)) {
+    failure = "singular bordered Jacobian at the corrected point";
+    return false;
+  }
+  const double cosine = b.tangent.dot(a.tangent);
+  if (cosine < options_.minTangentCosine) {
+    failure = formatDouble("branch-jump guard (tangent turned by %.3g degrees)",
+                           std::acos(std::max(-1.0, std::min(1.0, cosine))) * 180.0 / std::acos(-1.0));
+    return false;
+  }
+  b.arclength = a.arclength + ds;
+  b.stepSize = ds;
+  b.newtonIterations = summary.iterations;
+  b.residualNorm = summary.residualNorm;
+  return true;
+}
+
+std::vector<SpecialPoint> Tracer::locateSpecialPoints(const ContinuationPoint &a, const ContinuationPoint &b) {
+  const IntervalCrossings crossings = classifyInterval(a, b, options_.detectFolds, options_.detectBranchPoints);
+  if (!crossings.fold && crossings.branchPointCrossings == 0) return {};
+  locator_->setStep(a, b);
+  return locator_->locateSpecialPoints(crossings);
 }
 
 void Tracer::continueBranch(Branch &branch, int skipIntervals) {
@@ -319,11 +324,10 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     return;
   }
   if (branch.points.empty()) {
-    branch.stopReason = StopReason::StartFailed;
-    branch.stopMessage = "continueBranch needs a start point";
+    branch.stopReason = StopReason::InvalidOptions;
+    branch.stopMessage = "continueBranch needs a branch with a start point";
     return;
   }
-  const int boxEvents = options_.boxLower.size() ? 2 * (n_ + 1) : 0;
   // Event values of the current point are kept from the step that produced it (each is O(1)
   // to O(N), and there are 2 + 2(N+1) + boundaries of them).
   const int events = eventCount();
@@ -333,172 +337,62 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
   double ds = options_.initialStep;
   std::string lastFailure = "no failure";
 
-  auto stop = [&branch](StopReason reason, const std::string &message) {
+  // Ends the branch at its last point.
+  auto stop = [&branch](StopReason reason, const std::string &message, SpecialPointType type, const std::string &name,
+                        double accuracy = 0.0, double value = 0.0) {
     branch.stopReason = reason;
     branch.stopMessage = message;
+    appendEndpoint(branch, type, name, accuracy, value);
   };
-  auto endpoint = [&branch](SpecialPointType type, const std::string &name, double accuracy, double value) {
-    const ContinuationPoint &last = branch.points.back();
-    SpecialPoint sp;
-    sp.type = type;
-    sp.index = static_cast<int>(branch.points.size()) - 1;
-    sp.arclength = last.arclength;
-    sp.u = last.u;
-    sp.lambda = last.lambda;
-    sp.tangent = last.tangent;
-    sp.residualNorm = last.residualNorm;
-    sp.inertiaBefore = sp.inertiaAfter = last.stability.negative;
-    sp.lambdaAccuracy = accuracy;
-    sp.testFunctionValue = value;
-    sp.boundaryName = name;
-    branch.specialPoints.push_back(sp);
+  auto interrupted = [&](const std::string &message) {
+    stop(StopReason::Interrupted, message, SpecialPointType::Endpoint, "interrupted");
   };
-  // Halve after a failure; false (and the branch stopped) once below minStep.
+  // After a failure: false (and the branch stopped, without an endpoint) once below minStep.
   auto halve = [&]() {
-    ds *= 0.5;
-    if (ds < options_.minStep) {
-      stop(StopReason::StepSizeTooSmall, "step size below minimum after " + lastFailure);
-      return false;
-    }
-    return true;
+    if (stepControl_.halve(ds)) return true;
+    branch.stopReason = StopReason::StepSizeTooSmall;
+    branch.stopMessage = "step size below minimum after " + lastFailure;
+    return false;
   };
 
   for (;;) {
     if (options_.interrupt.requested()) {
-      stop(StopReason::Interrupted, options_.interrupt.describe());
-      endpoint(SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
+      interrupted(options_.interrupt.describe());
       return;
     }
     if (static_cast<int>(branch.points.size()) >= options_.maxPoints) {
-      stop(StopReason::MaxPoints, "reached maxPoints = " + std::to_string(options_.maxPoints));
-      endpoint(SpecialPointType::Endpoint, "max points", 0.0, 0.0);
+      stop(StopReason::MaxPoints, "reached maxPoints = " + std::to_string(options_.maxPoints),
+           SpecialPointType::Endpoint, "max points");
       return;
     }
     const int ia = static_cast<int>(branch.points.size()) - 1;
     const ContinuationPoint &a = branch.points[ia];
     const double remaining = options_.maxArclength - a.arclength;
     if (!(remaining > 0.0)) {
-      stop(StopReason::MaxArclength, "reached maxArclength");
-      endpoint(SpecialPointType::Endpoint, "max arclength", 0.0, 0.0);
+      stop(StopReason::MaxArclength, "reached maxArclength", SpecialPointType::Endpoint, "max arclength");
       return;
     }
     const double dsTry = std::min(ds, remaining);
-    predictor_.head(n_) = a.u + dsTry * a.tangent.head(n_);
-    predictor_[n_] = a.lambda + dsTry * a.tangent[n_];
-    const CorrectorSummary summary = corrector_->correct(predictor_, a.tangent, x_);
-    if (!summary.converged) {
-      lastFailure = summary.flagName;
-      if (!halve()) return;
-      continue;
-    }
     ContinuationPoint b;
-    b.u = x_.head(n_);
-    b.lambda = x_[n_];
-    if (!evaluator_->complete(b, a.tangent)) {
-      lastFailure = "singular bordered Jacobian at the corrected point";
+    CorrectorSummary summary;
+    if (!takeStep(a, dsTry, b, summary, lastFailure)) {
       if (!halve()) return;
       continue;
     }
-    const double cosine = b.tangent.dot(a.tangent);
-    if (cosine < options_.minTangentCosine) {
-      lastFailure = formatDouble("branch-jump guard (tangent turned by %.3g degrees)",
-                                 std::acos(std::max(-1.0, std::min(1.0, cosine))) * 180.0 / std::acos(-1.0));
-      if (!halve()) return;
-      continue;
-    }
-    b.arclength = a.arclength + dsTry;
-    b.stepSize = dsTry;
-    b.newtonIterations = summary.iterations;
-    b.residualNorm = summary.residualNorm;
 
-    // ---- stop events inside the step: keep the earliest, land exactly on it ----------------
-    int hitEvent = -1;
-    double hitAccuracy = 0.0, hitValue = 0.0;
-    ContinuationPoint hitPoint;
-    bool stepSet = false;
-    for (int e = 0; e < events; ++e) eventsB_[size_t(e)] = eventValue(e, b);
-    for (int e = 0; e < events; ++e) {
-      const double ga = eventsA_[size_t(e)], gb = eventsB_[size_t(e)];
-      if (!(ga >= 0.0 && gb < 0.0)) continue;
-      if (!stepSet) {
-        locator_->setStep(a, b);
-        stepSet = true;
-      }
-      Locator::Root root;
-      const auto test = [this, e](const ContinuationPoint &p, double &f) {
-        f = eventValue(e, p);
-        return std::isfinite(f);
-      };
-      ContinuationPoint located;
-      double accuracy = 0.0;
-      if (ga == 0.0) {
-        located = a;
-      } else if (locator_->findRoot(locator_->start(), ga, locator_->end(), gb, test, root)) {
-        located = root.at.point;
-        accuracy = root.lastDLambda;
-      } else {
-        continue;
-      }
-      // λ and box faces are coordinates: a last solve with that coordinate held lands exactly.
-      if (e < 2 + boxEvents && ga != 0.0) {
-        const int coordinate = e < 2 ? n_ : (e - 2) / 2;
-        const double bound = e == 0 ? lambdaMin_
-                             : e == 1 ? lambdaMax_
-                             : ((e - 2) % 2 == 0 ? boxLower_[coordinate] : boxUpper_[coordinate]);
-        predictor_.head(n_) = located.u;
-        predictor_[n_] = located.lambda;
-        predictor_[coordinate] = bound;
-        const CorrectorOptions saved = corrector_->options();
-        CorrectorOptions tight = saved;
-        tight.residualTolerance = std::min(saved.residualTolerance, options_.locationNewtonTolerance);
-        corrector_->setOptions(tight);
-        const CorrectorSummary fixed = corrector_->solveWithFixedCoordinate(predictor_, coordinate, x_);
-        corrector_->setOptions(saved);
-        if (fixed.converged) {
-          ContinuationPoint polished;
-          polished.u = x_.head(n_);
-          polished.lambda = x_[n_];
-          polished.newtonIterations = fixed.iterations;
-          polished.residualNorm = fixed.residualNorm;
-          if (evaluator_->complete(polished, a.tangent)) {
-            accuracy = std::abs(polished.lambda - located.lambda);
-            located = polished;
-          }
-        }
-      }
-      const double s = a.tangent.dot(located.state() - a.state());
-      if (hitEvent < 0 || s < a.tangent.dot(hitPoint.state() - a.state())) {
-        hitEvent = e;
-        hitPoint = located;
-        hitAccuracy = accuracy;
-        hitValue = eventValue(e, located) * eventScale(e);
-      }
-    }
-    if (hitEvent >= 0) {
-      const double s = a.tangent.dot(hitPoint.state() - a.state());
-      hitPoint.arclength = a.arclength + s;
-      hitPoint.stepSize = s;
-      b = hitPoint;
-    }
+    // Stop events inside the step: the earliest one, landed on exactly, ends the step there.
+    EventHit hit = locateStopEvent(a, b);
+    if (hit.event >= 0) b = std::move(hit.point);
 
-    // ---- special points between a and b -----------------------------------------------------
     std::vector<SpecialPoint> found;
-    if (ia >= skipIntervals && (hitEvent < 0 || b.arclength > a.arclength)) {
-      const IntervalCrossings crossings =
-          classifyInterval(a, b, options_.detectFolds, options_.detectBranchPoints);
-      if (crossings.fold || crossings.branchPointCrossings > 0) {
-        locator_->setStep(a, b);
-        found = locator_->locateSpecialPoints(crossings);
-      }
-    }
+    if (ia >= skipIntervals && (hit.event < 0 || b.arclength > a.arclength)) found = locateSpecialPoints(a, b);
     // An interrupt during location leaves the step's special points half located: the step is
     // dropped, so every point the branch keeps is fully located, and the branch ends at a.
-    if ((!found.empty() || hitEvent >= 0) && options_.interrupt.requested()) {
-      stop(StopReason::Interrupted, options_.interrupt.describe());
-      endpoint(SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
+    if ((!found.empty() || hit.event >= 0) && options_.interrupt.requested()) {
+      interrupted(options_.interrupt.describe());
       return;
     }
-    const bool landedOnStart = hitEvent >= 0 && !(b.arclength > a.arclength);
+    const bool landedOnStart = hit.event >= 0 && !(b.arclength > a.arclength);
     // `a` refers into branch.points: everything that reads it is done before the push.
     if (!landedOnStart) branch.points.push_back(std::move(b));
     for (SpecialPoint &sp : found) {
@@ -506,33 +400,21 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       branch.specialPoints.push_back(std::move(sp));
     }
     if (options_.onStep && !landedOnStart && notifyStep(branch) == StepAction::Stop) {
-      stop(StopReason::Interrupted, "stopped by the step callback");
-      endpoint(SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
+      interrupted("stopped by the step callback");
       return;
     }
 
-    if (hitEvent >= 0) {
-      const bool lambdaEvent = hitEvent < 2;
-      const bool boxEvent = !lambdaEvent && hitEvent < 2 + boxEvents;
-      const std::string name = eventName(hitEvent);
-      stop(lambdaEvent ? StopReason::LambdaRange : (boxEvent ? StopReason::Box : StopReason::Boundary),
-           "reached " + name);
-      endpoint(lambdaEvent ? SpecialPointType::Endpoint : SpecialPointType::Boundary, name, hitAccuracy, hitValue);
+    if (hit.event >= 0) {
+      const std::string name = eventName(hit.event);
+      stop(eventStopReason(hit.event), "reached " + name,
+           hit.event < 2 ? SpecialPointType::Endpoint : SpecialPointType::Boundary, name, hit.accuracy, hit.value);
       return;
     }
     if (branch.points.back().arclength >= options_.maxArclength * (1.0 - 1e-15)) {
-      stop(StopReason::MaxArclength, "reached maxArclength");
-      endpoint(SpecialPointType::Endpoint, "max arclength", 0.0, 0.0);
+      stop(StopReason::MaxArclength, "reached maxArclength", SpecialPointType::Endpoint, "max arclength");
       return;
     }
-
-    // ---- step adaptation ---------------------------------------------------------------------
-    double factor = summary.iterations <= 1
-                        ? options_.stepGrowth
-                        : static_cast<double>(options_.targetNewtonIterations) / summary.iterations;
-    factor = std::min(options_.stepGrowth, std::max(options_.stepShrink, factor));
-    if (summary.contraction > options_.slowContraction) factor = std::min(factor, 0.7);
-    ds = std::min(options_.maxStep, std::max(options_.minStep, ds * factor));
+    ds = stepControl_.next(ds, summary.iterations, summary.contraction);
     eventsA_.swap(eventsB_);
   }
 }

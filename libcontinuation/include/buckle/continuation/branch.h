@@ -65,7 +65,7 @@ struct SpecialPoint {
 
 enum class StopReason {
   NotStarted,
-  InvalidOptions,
+  InvalidOptions,      ///< invalid options or input (sizes, dimension, no start point); stopMessage names it
   StartFailed,         ///< the start point could not be polished or has no unique tangent
   MaxPoints,
   LambdaRange,

@@ -22,6 +22,7 @@
 #include "buckle/continuation/corrector.h"
 #include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
+#include "buckle/continuation/root_finding.h"
 #include "buckle/continuation/test_functions.h"
 
 #include <functional>
@@ -115,19 +116,5 @@ class Locator {
   Vector xa_, dx_, ta_, tb_, predictor_, x_;
   double stepLength_ = 0.0;
 };
-
-/// Newton on a square augmented system z ↦ R(z) with Jacobian J(z); the λ unknown sits at
-/// lambdaIndex. Stops when the whole update is below tolerance·max(1,|λ|) or after maxIterations;
-/// converged iff the last |Δλ| met the tolerance. Reports the last |Δλ| and ‖R‖₂ at the end.
-struct AugmentedNewtonResult {
-  bool converged = false;
-  int iterations = 0;
-  double lastDLambda = 0.0;
-  double residualNorm = 0.0;
-  std::string failure;
-};
-using AugmentedSystem = std::function<bool(const Vector &z, Vector &R, Matrix *J)>;
-AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, int lambdaIndex, double tolerance,
-                                      int maxIterations, double maxDistance);
 
 }  // namespace buckle::continuation

@@ -23,6 +23,7 @@
 #include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/scaled_problem.h"
+#include "buckle/continuation/step_control.h"
 #include "buckle/continuation/test_functions.h"
 
 #include <functional>
@@ -135,13 +136,14 @@ class Tracer {
   Tracer &operator=(const Tracer &) = delete;
 
   /// Polishes (u0, λ0) at fixed λ, takes the start tangent from the kernel of [F_u, F_λ] and
-  /// traces until a stop condition. Invalid options give an empty branch with
-  /// StopReason::InvalidOptions.
+  /// traces until a stop condition. Never throws for bad input: invalid options, a problem of
+  /// dimension 0 or vectors of the wrong size give an empty branch with
+  /// StopReason::InvalidOptions and the reason in stopMessage (docs/continuation.md, "Errors").
   Branch trace(ConstVectorRef u0, double lambda0, const InitialDirection &direction);
 
   /// Continues `branch`, whose points are complete (tangent set); the last point is the
   /// current one. Special points are not searched in the first `skipIntervals` intervals
-  /// (a branch that starts at a branch point).
+  /// (a branch that starts at a branch point). A branch without points: InvalidOptions.
   void continueBranch(Branch &branch, int skipIntervals = 0);
 
   /// Fills tangent, test functions and stability of a point from its u, λ. In the scaled
@@ -159,9 +161,31 @@ class Tracer {
   bool structured() const { return structuredSolver_ != nullptr; }
 
  private:
+  // ---- one step (tracer.cpp) -------------------------------------------------------------
+  /// Predictor x_a + ds·t_a, Keller corrector, new tangent and the branch-jump guard. False
+  /// with `failure` set when the step must be retried smaller.
+  bool takeStep(const ContinuationPoint &a, double ds, ContinuationPoint &b, CorrectorSummary &summary,
+                std::string &failure);
+  /// Folds and branch points between a and b (index not set).
+  std::vector<SpecialPoint> locateSpecialPoints(const ContinuationPoint &a, const ContinuationPoint &b);
+
+  // ---- stop events (tracer_events.cpp) ---------------------------------------------------
+  /// The earliest stop event crossed between a and b, located on the branch.
+  struct EventHit {
+    int event = -1;  ///< -1: none
+    ContinuationPoint point;
+    double accuracy = 0.0;  ///< |Δλ| of the last location update
+    double value = 0.0;     ///< the event's value at the point, in the user's units
+  };
+  /// Fills eventsB_ with the values at b (eventsA_ holds those at a).
+  EventHit locateStopEvent(const ContinuationPoint &a, const ContinuationPoint &b);
+  /// λ range and box faces are coordinates: one solve with that coordinate held at the bound.
+  void landOnCoordinateBound(int event, const ContinuationPoint &a, ContinuationPoint &located, double &accuracy);
   double eventValue(int event, const ContinuationPoint &point);
   std::string eventName(int event) const;
   int eventCount() const;
+  int boxEventCount() const;
+  StopReason eventStopReason(int event) const;
   CorrectorOptions stepCorrectorOptions() const;
 
   /// Scale of event `event`'s value g (user value = g · scale).
@@ -182,6 +206,7 @@ class Tracer {
   std::unique_ptr<Corrector> corrector_;
   std::unique_ptr<PointEvaluator> evaluator_;
   std::unique_ptr<Locator> locator_;
+  StepSizeControl stepControl_;
   Vector predictor_, x_;
   std::vector<double> eventsA_, eventsB_;  // event values at the current point and the new one
 };

@@ -1,0 +1,282 @@
+#include "scene/scene_parsing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/dynamics.h"
+
+namespace buckle::scene::detail {
+
+using Reader = JsonReader;
+
+namespace {
+
+std::set<std::string> branchColumns(int maxN, bool stiffness) {
+  std::set<std::string> c = {"parameter", "Fx", "Fy", "Me", "x", "y", "phi", "dx", "dy", "min_eig"};
+  for (int i = 1; i <= maxN; ++i) c.insert("q" + std::to_string(i));
+  if (stiffness) c.insert({"Kxx", "Kyy", "Kxy"});
+  return c;
+}
+
+}  // namespace
+
+AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
+  r.onlyKeys(a, p,
+             {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump", "load_history",
+              "sudden_load"});
+  AnalysesSpec s;
+  if (a.contains("continuation")) {
+    const json& c = a["continuation"];
+    const Pointer pc = p / "continuation";
+    if (c.is_boolean()) {
+      s.continuation.enabled = c.get<bool>();
+    } else {
+      r.onlyKeys(c, pc, {"branch_switching"});
+      s.continuation.enabled = true;
+      if (c.contains("branch_switching"))
+        s.continuation.branchSwitching = r.integer(c["branch_switching"], pc / "branch_switching", 0, 4);
+    }
+  }
+  if (a.contains("stiffness")) {
+    s.stiffness = r.boolean(a["stiffness"], p / "stiffness");
+    if (s.stiffness && !s.continuation.enabled)
+      r.fail(p / "stiffness", "stiffness is computed along the traced branches: it needs /analyses/continuation");
+  }
+  if (a.contains("energy_curves")) {
+    const json& e = a["energy_curves"];
+    const Pointer pe = p / "energy_curves";
+    r.onlyKeys(e, pe, {"x", "y", "q1_from", "q1_to", "points", "torque"});
+    s.energyCurves.enabled = true;
+    if (!e.contains("x") || !e.contains("y")) r.fail(pe / (e.contains("x") ? "y" : "x"), "missing (required): the held end position");
+    s.energyCurves.x = r.number(e["x"], pe / "x");
+    s.energyCurves.y = r.number(e["y"], pe / "y");
+    if (e.contains("q1_from")) s.energyCurves.q1From = r.number(e["q1_from"], pe / "q1_from");
+    if (e.contains("q1_to")) s.energyCurves.q1To = r.number(e["q1_to"], pe / "q1_to");
+    if (!(s.energyCurves.q1From < s.energyCurves.q1To)) r.fail(pe / "q1_to", "expected q1_to > q1_from");
+    if (e.contains("points")) s.energyCurves.points = r.integer(e["points"], pe / "points", 3, 1000000);
+    if (e.contains("torque")) s.energyCurves.torque = r.boolean(e["torque"], pe / "torque");
+  }
+  if (a.contains("torque_angle")) {
+    const json& t = a["torque_angle"];
+    const Pointer pt = p / "torque_angle";
+    if (t.is_boolean()) {
+      s.torqueAngle.enabled = t.get<bool>();
+    } else {
+      r.onlyKeys(t, pt, {"q_from", "q_to", "points"});
+      s.torqueAngle.enabled = true;
+      if (t.contains("q_from")) s.torqueAngle.qFrom = r.number(t["q_from"], pt / "q_from");
+      if (t.contains("q_to")) s.torqueAngle.qTo = r.number(t["q_to"], pt / "q_to");
+      if (!(s.torqueAngle.qFrom < s.torqueAngle.qTo)) r.fail(pt / "q_to", "expected q_to > q_from");
+      if (t.contains("points")) s.torqueAngle.points = r.integer(t["points"], pt / "points", 3, 1000000);
+    }
+  }
+  if (a.contains("critical_forces")) {
+    const json& c = a["critical_forces"];
+    const Pointer pc = p / "critical_forces";
+    if (c.is_boolean()) {
+      s.criticalForces.enabled = c.get<bool>();
+    } else {
+      r.onlyKeys(c, pc, {"modes"});
+      s.criticalForces.enabled = true;
+      if (c.contains("modes")) s.criticalForces.modes = r.integer(c["modes"], pc / "modes", 1, 100000);
+    }
+  }
+  if (a.contains("jump")) {
+    const json& j = a["jump"];
+    const Pointer pj = p / "jump";
+    if (j.is_boolean()) {
+      s.jump.enabled = j.get<bool>();
+    } else {
+      r.onlyKeys(j, pj, {"perturbation"});
+      s.jump.enabled = true;
+      if (j.contains("perturbation")) s.jump.perturbation = r.positive(j["perturbation"], pj / "perturbation");
+    }
+    if (s.jump.enabled && !s.continuation.enabled)
+      r.fail(pj, "jumps are simulated from the folds of the traced branches: it needs /analyses/continuation");
+  }
+  if (a.contains("load_history")) {
+    const json& h = a["load_history"];
+    const Pointer ph = p / "load_history";
+    r.onlyKeys(h, ph, {"waypoints", "perturbation"});
+    if (!h.contains("waypoints")) r.fail(ph / "waypoints", "missing (required): the path-parameter values to visit");
+    const json& w = h["waypoints"];
+    if (!w.is_array() || w.size() < 2) r.expected(ph / "waypoints", w, "an array of at least two numbers");
+    for (size_t i = 0; i < w.size(); ++i) s.loadHistory.waypoints.push_back(r.number(w[i], ph / "waypoints" / i));
+    if (h.contains("perturbation")) s.loadHistory.perturbation = r.positive(h["perturbation"], ph / "perturbation");
+    s.loadHistory.enabled = true;
+  }
+  if (a.contains("sudden_load")) {
+    const json& d = a["sudden_load"];
+    const Pointer pd = p / "sudden_load";
+    r.onlyKeys(d, pd, {"value", "mass_per_length", "damping"});
+    if (!d.contains("value")) r.fail(pd / "value", "missing (required): the path-parameter value applied at once");
+    s.suddenLoad.value = r.number(d["value"], pd / "value");
+    if (d.contains("mass_per_length")) s.suddenLoad.massPerLength = r.positive(d["mass_per_length"], pd / "mass_per_length");
+    if (d.contains("damping")) s.suddenLoad.damping = r.nonNegative(d["damping"], pd / "damping");
+    if (d.contains("damping") && !d.contains("mass_per_length"))
+      r.fail(pd / "damping", "joint damping belongs to the inertial model: give mass_per_length too");
+    s.suddenLoad.enabled = true;
+  }
+  if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled &&
+      !s.loadHistory.enabled && !s.suddenLoad.enabled)
+    r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces, "
+              "load_history, sudden_load)");
+  return s;
+}
+
+SolverSpec parseSolver(const Reader& r, const json& s, const Pointer& p) {
+  r.onlyKeys(s, p, {"initial_step", "min_step", "max_step", "tolerance", "max_points", "time_limit"});
+  SolverSpec o;
+  if (s.contains("initial_step")) o.initialStep = r.positive(s["initial_step"], p / "initial_step");
+  if (s.contains("min_step")) o.minStep = r.positive(s["min_step"], p / "min_step");
+  if (s.contains("max_step")) o.maxStep = r.positive(s["max_step"], p / "max_step");
+  if (s.contains("tolerance")) o.tolerance = r.positive(s["tolerance"], p / "tolerance");
+  if (s.contains("max_points")) o.maxPoints = r.integer(s["max_points"], p / "max_points", 2, 10000000);
+  if (s.contains("time_limit")) o.timeLimit = r.positive(s["time_limit"], p / "time_limit");
+  if (!(o.minStep <= o.initialStep)) r.fail(p / "min_step", "expected min_step <= initial_step");
+  if (!(o.initialStep <= o.maxStep)) r.fail(p / "max_step", "expected max_step >= initial_step");
+  return o;
+}
+
+PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN, int nCases) {
+  PlotSpec s;
+  json obj = v;
+  if (v.is_string()) obj = json{{"type", v}};
+  r.onlyKeys(obj, p, {"type", "name", "x", "y", "at", "title", "cases"});
+  if (obj.contains("cases")) {
+    const json& cs = obj["cases"];
+    if (!cs.is_array() || cs.empty()) r.expected(p / "cases", cs, "a non-empty array of case indices (0-based)");
+    for (size_t i = 0; i < cs.size(); ++i) s.cases.push_back(r.integer(cs[i], p / "cases" / i, 0, nCases - 1));
+  } else {
+    for (int i = 0; i < nCases; ++i) s.cases.push_back(i);
+  }
+  if (!obj.contains("type")) r.fail(p / "type", "missing (required)");
+  const Pointer pt = v.is_string() ? p : p / "type";
+  const std::string type = r.string(obj["type"], pt);
+  const std::map<std::string, PlotType> types = {{"bifurcation", PlotType::Bifurcation},
+                                                 {"stiffness", PlotType::Stiffness},
+                                                 {"energy_curves", PlotType::EnergyCurves},
+                                                 {"torque_angle", PlotType::TorqueAngle},
+                                                 {"shapes", PlotType::Shapes},
+                                                 {"sudden_load", PlotType::SuddenLoad}};
+  auto it = types.find(type);
+  if (it == types.end())
+    r.expected(pt, obj["type"], "one of bifurcation, stiffness, energy_curves, torque_angle, shapes, sudden_load");
+  s.type = it->second;
+  auto needs = [&](bool have, const char* analysis) {
+    if (!have) r.fail(pt, std::string("a ") + type + " plot needs /analyses/" + analysis);
+  };
+  switch (s.type) {
+    case PlotType::Bifurcation:
+    case PlotType::Shapes: needs(a.continuation.enabled || a.loadHistory.enabled, "continuation (or load_history)"); break;
+    case PlotType::Stiffness: needs(a.stiffness, "stiffness"); break;
+    case PlotType::EnergyCurves: needs(a.energyCurves.enabled, "energy_curves"); break;
+    case PlotType::TorqueAngle: needs(a.torqueAngle.enabled, "torque_angle"); break;
+    case PlotType::SuddenLoad: needs(a.suddenLoad.enabled, "sudden_load"); break;
+  }
+  s.name = type;
+  if (obj.contains("name")) {
+    s.name = r.string(obj["name"], p / "name");
+    const bool ok = !s.name.empty() && std::all_of(s.name.begin(), s.name.end(), [](char ch) {
+      return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-';
+    });
+    if (!ok) r.expected(p / "name", obj["name"], "a file stem of letters, digits, '_' and '-'");
+  }
+  if (obj.contains("title")) s.title = r.string(obj["title"], p / "title");
+  const bool columns = s.type == PlotType::Bifurcation || s.type == PlotType::Stiffness;
+  if (!columns) {
+    for (const char* key : {"x", "y"})
+      if (obj.contains(key)) r.fail(p / key, std::string("a ") + type + " plot has fixed axes; remove this key");
+  } else {
+    const std::set<std::string> allowed = branchColumns(maxN, a.stiffness);
+    std::string list;
+    for (const std::string& c : allowed) list += (list.empty() ? "" : ", ") + c;
+    auto column = [&](const json& c, const Pointer& pc) {
+      const std::string name = r.string(c, pc);
+      if (!allowed.count(name)) r.expected(pc, c, "a column of branches.csv (" + list + ")");
+      return name;
+    };
+    s.x = obj.contains("x") ? column(obj["x"], p / "x") : "parameter";
+    if (obj.contains("y")) {
+      const json& y = obj["y"];
+      if (y.is_array()) {
+        if (y.empty()) r.expected(p / "y", y, "a column name or a non-empty list of them");
+        for (size_t i = 0; i < y.size(); ++i) s.y.push_back(column(y[i], p / "y" / i));
+      } else {
+        s.y.push_back(column(y, p / "y"));
+      }
+    } else if (s.type == PlotType::Stiffness) {
+      s.y = {"Kxx", "Kyy"};
+    } else {
+      s.y = {"q1"};
+    }
+  }
+  if (s.type == PlotType::Shapes) {
+    if (!obj.contains("at")) r.fail(p / "at", "missing (required): parameter values at which to draw the chain");
+    const json& at = obj["at"];
+    if (!at.is_array() || at.empty()) r.expected(p / "at", at, "a non-empty array of parameter values");
+    for (size_t i = 0; i < at.size(); ++i) s.at.push_back(r.number(at[i], p / "at" / i));
+  } else if (obj.contains("at")) {
+    r.fail(p / "at", "only a shapes plot takes \"at\"");
+  }
+  return s;
+}
+
+void checkAnalysesAgainstCases(const Reader& r, const Scene& scene) {
+  if (scene.analyses.energyCurves.enabled)
+    for (size_t i = 0; i < scene.cases.size(); ++i)
+      if (scene.cases[i].chain.segments.size() != 3)
+        r.fail(Pointer("/analyses/energy_curves"),
+               "energy curves E(q1) with the end held use the 3-segment inverse kinematics (eq 6): case \"" +
+                   scene.cases[i].label + "\" has " + std::to_string(scene.cases[i].chain.segments.size()) +
+                   " segments");
+  if (scene.analyses.loadHistory.enabled) {
+    // The history starts where the path starts and stays inside its range.
+    const std::vector<double>& w = scene.analyses.loadHistory.waypoints;
+    const Pointer pw = Pointer("/analyses/load_history/waypoints");
+    for (const CaseSpec& c : scene.cases) {
+      const double start = c.end.condition.value[c.path.coordinate];
+      const double lo = std::min(c.path.from, c.path.to), hi = std::max(c.path.from, c.path.to);
+      if (std::abs(w[0] - start) > 1e-12 * std::max(1.0, std::abs(start)))
+        r.fail(pw / 0, "expected the start value " + c.path.parameter + " = " + std::to_string(start) + " of case \"" +
+                           c.label + "\"");
+      for (size_t i = 0; i < w.size(); ++i)
+        if (w[i] < lo - 1e-12 || w[i] > hi + 1e-12)
+          r.fail(pw / i, "expected a value inside the path range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    }
+  }
+  if (scene.analyses.suddenLoad.enabled)
+    for (const CaseSpec& c : scene.cases) {
+      const double lo = std::min(c.path.from, c.path.to), hi = std::max(c.path.from, c.path.to);
+      const double v = scene.analyses.suddenLoad.value;
+      if (v < lo - 1e-12 || v > hi + 1e-12)
+        r.fail(Pointer("/analyses/sudden_load/value"),
+               "expected a value inside the path range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      // The inertial model divides by the rods' masses m = ρ l and inertias m l²/12: both must be
+      // ordinary (normal, finite) numbers.
+      const double rho = scene.analyses.suddenLoad.massPerLength;
+      if (rho > 0.0)
+        for (const mechanics::LinkInertia& link : mechanics::InertiaData::uniformRods(mechanics::Chain(c.chain.segments), rho).links)
+          if (!std::isnormal(link.mass) || !std::isnormal(link.inertia))
+            r.fail(Pointer("/analyses/sudden_load/mass_per_length"),
+                   "out of the range the inertial model can compute: the rods' masses rho l or inertias rho l^3/12 "
+                   "(l the link lengths of case \"" + c.label + "\") are not ordinary finite numbers; got " + show(rho));
+    }
+}
+
+std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a, int nCases) {
+  std::vector<int> all;
+  for (int i = 0; i < nCases; ++i) all.push_back(i);
+  std::vector<PlotSpec> out;
+  if (a.continuation.enabled || a.loadHistory.enabled)
+    out.push_back({PlotType::Bifurcation, "bifurcation", "parameter", {"q1"}, {}, "", all});
+  if (a.stiffness) out.push_back({PlotType::Stiffness, "stiffness", "parameter", {"Kxx", "Kyy"}, {}, "", all});
+  if (a.energyCurves.enabled) out.push_back({PlotType::EnergyCurves, "energy_curves", "", {}, {}, "", all});
+  if (a.torqueAngle.enabled) out.push_back({PlotType::TorqueAngle, "torque_angle", "", {}, {}, "", all});
+  if (a.suddenLoad.enabled) out.push_back({PlotType::SuddenLoad, "sudden_load", "", {}, {}, "", all});
+  return out;
+}
+
+}  // namespace buckle::scene::detail

@@ -1,0 +1,82 @@
+#include "buckle/continuation/root_finding.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace buckle::continuation {
+
+bool sameSign(double a, double b) { return (a > 0.0) == (b > 0.0); }
+
+double IllinoisBracket::next() const {
+  const double s = (left * fRight - right * fLeft) / (fRight - fLeft);
+  return s > left && s < right ? s : midpoint();
+}
+
+int IllinoisBracket::update(double s, double f) {
+  if (sameSign(f, fLeft)) {
+    left = s;
+    fLeft = f;
+    if (lastSide == -1) fRight *= 0.5;
+    lastSide = -1;
+  } else {
+    right = s;
+    fRight = f;
+    if (lastSide == 1) fLeft *= 0.5;
+    lastSide = 1;
+  }
+  return lastSide;
+}
+
+AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, int lambdaIndex, double tolerance,
+                                      int maxIterations, double maxDistance) {
+  AugmentedNewtonResult result;
+  const Eigen::Index m = z.size();
+  const Vector z0 = z;
+  Vector R(m), delta(m);
+  Matrix J(m, m);
+  double lastUpdate = std::numeric_limits<double>::infinity();
+  for (int it = 0; it < maxIterations; ++it) {
+    if (!system(z, R, &J)) {
+      result.failure = "the problem refused an iterate";
+      break;
+    }
+    Eigen::FullPivLU<Matrix> lu(J);
+    if (!lu.isInvertible()) {
+      result.failure = "singular augmented Jacobian";
+      break;
+    }
+    delta = -lu.solve(R);
+    if (!delta.allFinite()) {
+      result.failure = "non-finite Newton update";
+      break;
+    }
+    z += delta;
+    ++result.iterations;
+    result.lastDLambda = std::abs(delta[lambdaIndex]);
+    lastUpdate = delta.cwiseAbs().maxCoeff();
+    if ((z - z0).norm() > maxDistance) {
+      result.failure = "Newton iterate left the step";
+      break;
+    }
+    if (lastUpdate <= tolerance * std::max(1.0, std::abs(z[lambdaIndex]))) break;
+  }
+  if (!result.failure.empty()) {
+    z = z0;
+    return result;
+  }
+  if (system(z, R, nullptr)) result.residualNorm = R.norm();
+  const double tol = tolerance * std::max(1.0, std::abs(z[lambdaIndex]));
+  // λ must meet the target; the other unknowns (null vectors) only need to have settled.
+  result.converged = result.lastDLambda <= tol && lastUpdate <= 1e-6;
+  if (!result.converged) {
+    char message[80];
+    std::snprintf(message, sizeof message, "no convergence: last |dlambda| = %.3g", result.lastDLambda);
+    result.failure = message;
+  }
+  return result;
+}
+
+}  // namespace buckle::continuation
