@@ -359,11 +359,7 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
   }
   cs.path = parsePath(r, path, Pointer("/path"), cs.end, start);
   if (cs.path.loadLimit == 0.0 && cs.end.condition.isHeld(static_cast<mechanics::EndCoordinate>(cs.path.coordinate))) {
-    mechanics::ChainData data(chain);
-    mechanics::forwardKinematics(chain, cs.chain.q0, data);
-    mechanics::Matrix J(3, chain.size());
-    mechanics::endJacobian(data, J);
-    if (J.row(cs.path.coordinate).norm() <= 1e-9 * std::max(1.0, J.norm()))
+    if (!mechanics::endMovesAlong(chain, cs.chain.q0, cs.path.coordinate))
       r.fail(Pointer("/path/parameter"),
              std::string("the unloaded shape cannot move its end along ") + kCoordinateNames[cs.path.coordinate] +
                  " to first order (e.g. the straight chain along x): displacement control starts at a singular "

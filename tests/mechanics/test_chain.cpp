@@ -220,3 +220,15 @@ TEST_CASE("joint positions: links of the chain's lengths, ending at the end pose
     CHECK(P(1, n + 1) == Approx(end[1]).margin(1e-13 * L));
   }
 }
+
+TEST_CASE("endMovesAlong: the straight chain cannot move its end along x, in any units", "[chain]") {
+  for (double unit : {1e-3, 1.0, 1e3}) {
+    const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5 * unit, unit, 1.0, 2.25 * unit));
+    const Vector straight = Vector::Zero(3);
+    CHECK_FALSE(endMovesAlong(chain, straight, 0));
+    CHECK(endMovesAlong(chain, straight, 1));
+    CHECK(endMovesAlong(chain, straight, 2));
+    const Vector bent = Vector::Constant(3, 1e-3);  // a small bend moves x to first order
+    CHECK(endMovesAlong(chain, bent, 0));
+  }
+}

@@ -14,11 +14,11 @@ namespace cont = buckle::continuation;
 
 const char* eventLabel(EventType type) {
   switch (type) {
-    case EventType::BranchPoint: return "BP";
-    case EventType::Fold: return "LP";
+    case EventType::BranchPoint: return cont::specialPointLabel(cont::SpecialPointType::BranchPoint);
+    case EventType::Fold: return cont::specialPointLabel(cont::SpecialPointType::Fold);
     case EventType::ReactionFold: return "LPF";
     case EventType::Boundary:
-    case EventType::JointLimit: return "BD";
+    case EventType::JointLimit: return cont::specialPointLabel(cont::SpecialPointType::Boundary);
     case EventType::StiffnessMinimum: return "KMIN";
     case EventType::Jump: return "JUMP";
   }
@@ -165,18 +165,19 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
   for (size_t k = 0; k < b.specialPoints.size(); ++k) {
     const cont::SpecialPoint& sp = b.specialPoints[k];
     if (sp.type == cont::SpecialPointType::Endpoint) continue;
-    SpecialPointReport s;
+    PointReport at;  // the located point, as a point of the branch
+    at.index = sp.index;
+    at.parameter = sp.lambda;
+    at.q = sp.u.head(n);
+    at.F = problem.wrench(sp.u, sp.lambda);
+    at.pose = endPose(chain, at.q);
+    at.residual = sp.residualNorm;
+    SpecialPointReport s = atPoint(at, EventType::BranchPoint, Phenomenon::None);
     s.source = int(k);
-    s.index = sp.index;
     s.lambda = sp.lambda;
-    s.parameter = sp.lambda;
-    s.q = sp.u.head(n);
-    s.F = problem.wrench(sp.u, sp.lambda);
-    s.pose = endPose(chain, s.q);
     s.negativeBefore = sp.inertiaBefore;
     s.negativeAfter = sp.inertiaAfter;
     s.accuracy = sp.lambdaAccuracy;
-    s.residual = sp.residualNorm;
     s.refined = sp.refined;
     s.multiplicity = sp.multiplicity;
     const Classification cl = classify(problem, sp);

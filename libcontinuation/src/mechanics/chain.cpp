@@ -62,6 +62,15 @@ Pose endPose(const Chain& chain, ConstVectorRef q) {
   return data.pose;
 }
 
+bool endMovesAlong(const Chain& chain, ConstVectorRef q, int c) {
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  Matrix J(3, chain.size());
+  endJacobian(data, J);
+  const double unit = c < 2 ? chain.length() : 1.0;
+  return J.row(c).norm() > 1e-9 * unit;
+}
+
 Eigen::Matrix2Xd jointPositions(const Chain& chain, ConstVectorRef q) {
   const int n = chain.size();
   Eigen::Matrix2Xd P(2, n + 2);

@@ -59,6 +59,11 @@ Eigen::Matrix2Xd jointPositions(const Chain& chain, ConstVectorRef q);
 
 /// Jacobian of (x, y, φ) with respect to q, 3×n (eq 11): rows (−S_j, C_j, 1).
 void endJacobian(const ChainData& data, MatrixRef J);
+/// True when the end moves along coordinate c (0 x, 1 y, 2 φ) to first order at q: row c of
+/// the end Jacobian is not zero relative to its own unit (the chain's length for x and y, 1 for
+/// φ). False, e.g., for x on the straight chain: displacement control of c starts at a singular
+/// point there.
+bool endMovesAlong(const Chain& chain, ConstVectorRef q, int c);
 
 /// h_m = −Fx·C_m − Fy·S_m: K_g(i, j) = h_max(i,j) (eq 27). The torque Me does not enter.
 void loadHessianGenerator(const ChainData& data, const Wrench& F, VectorRef h);
