@@ -108,9 +108,11 @@ void bindMechanics(py::module_& m) {
                              [](const mech::Segment& s) {
                                const mech::SegmentParameters& p = s.parameters();
                                py::dict d;
-                               d["a1"] = p.a1, d["b1"] = p.b1, d["a2"] = p.a2, d["b2"] = p.b2;
-                               d["k1"] = p.k1, d["k2"] = p.k2, d["L1_0"] = p.L1_0, d["L2_0"] = p.L2_0;
-                               d["q_min"] = p.qMinUser, d["q_max"] = p.qMaxUser;
+                               for (const auto& [key, value] :
+                                    {std::pair<const char*, double>{"a1", p.a1}, {"b1", p.b1}, {"a2", p.a2},
+                                     {"b2", p.b2}, {"k1", p.k1}, {"k2", p.k2}, {"L1_0", p.L1_0},
+                                     {"L2_0", p.L2_0}, {"q_min", p.qMinUser}, {"q_max", p.qMaxUser}})
+                                 d[key] = value;
                                return d;
                              },
                              "The parameters as a dict (a1, b1, a2, b2, k1, k2, L1_0, L2_0, user q_min, q_max).")

@@ -6,6 +6,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -34,12 +35,12 @@ py::object toPython(const json& v) {
     case json::value_t::array: {
       py::list l;
       for (const json& e : v) l.append(toPython(e));
-      return std::move(l);
+      return l;
     }
     case json::value_t::object: {
       py::dict d;
       for (auto it = v.begin(); it != v.end(); ++it) d[py::str(it.key())] = toPython(it.value());
-      return std::move(d);
+      return d;
     }
     default: return py::none();  // binary and discarded values do not occur in buckle's documents
   }

@@ -8,7 +8,7 @@ namespace {
 
 std::atomic<bool> gInterrupted{false};
 
-extern "C" void onSigint(int) { gInterrupted.store(true); }
+void onSigint(int) { gInterrupted.store(true); }
 
 }  // namespace
 

@@ -81,7 +81,8 @@ json caseJson(const Scene& scene, const CaseResult& cr, size_t index, const std:
   c["point"] = point;
   c["stable"] = stable;
   c["shapes"] = shapes;
-  c["unloaded"] = jointsJson(cr.chain, cr.q0.size() == cr.chain.size() ? cr.q0 : Eigen::VectorXd::Zero(cr.chain.size()));
+  c["unloaded"] = jointsJson(cr.chain, cr.q0.size() == cr.chain.size() ? cr.q0
+                                                                        : Eigen::VectorXd(Eigen::VectorXd::Zero(cr.chain.size())));
   json branches = json::array();
   for (const BranchRecord& b : cr.branches)
     branches.push_back(json{{"id", b.id}, {"origin", b.origin}, {"points", b.points}, {"stop", b.stopReason}});
@@ -177,8 +178,8 @@ h1 { font-size: 1.4em; margin: 0 0 .2em; } h2 { font-size: 1.15em; margin: 1.4em
 .panel { border: 1px solid #ddd; border-radius: 4px; padding: .4em; background: #fff; }
 svg.chart { width: 640px; max-width: 100%; height: auto; display: block; }
 svg.shape { width: 560px; max-width: 100%; height: auto; display: block; }
-.chart text { font-size: 11px; fill: #333; } .chart .title { font-size: 13px; font-weight: 600; }
-.chart .grid { stroke: #eee; } .chart .axis { stroke: #555; fill: none; }
+svg text { font-size: 11px; fill: #333; } svg .title { font-size: 13px; font-weight: 600; }
+svg .grid { stroke: #eee; } svg .axis { stroke: #555; fill: none; }
 table { border-collapse: collapse; font-size: 13px; }
 th, td { border: 1px solid #ddd; padding: 2px 6px; text-align: right; white-space: nowrap; }
 th { background: #f4f4f4; } td.t { text-align: left; }
