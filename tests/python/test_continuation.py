@@ -62,7 +62,7 @@ def test_pitchfork_normal_form_branch_point_and_switching():
 
 def test_a_callback_exception_is_raised_in_python():
     def bad(u, lam):
-        if lam > 0.1:
+        if u[0] > 0.5:  # past the fold, on the upper half of the branch
             raise RuntimeError("residual refused")
         return fold_residual(u, lam)
 
@@ -92,7 +92,7 @@ def slow_line_jacobian(u, lam):
 
 def test_time_limit_stops_the_trace_and_keeps_the_points():
     started = time.monotonic()
-    r = buckle.trace(slow_line, slow_line_jacobian, np.array([0.0]), 0.0, max_points=10 ** 6, max_step=1e-3,
+    r = buckle.trace(slow_line, slow_line_jacobian, np.array([0.0]), 0.0, max_points=10 ** 6, initial_step=1e-3, max_step=1e-3,
                      time_limit=0.3)
     elapsed = time.monotonic() - started
     assert r["interrupted"]
@@ -107,7 +107,7 @@ def test_keyboard_interrupt_stops_the_trace():
     started = time.monotonic()
     try:
         with pytest.raises(KeyboardInterrupt):
-            buckle.trace(slow_line, slow_line_jacobian, np.array([0.0]), 0.0, max_points=10 ** 6, max_step=1e-3)
+            buckle.trace(slow_line, slow_line_jacobian, np.array([0.0]), 0.0, max_points=10 ** 6, initial_step=1e-3, max_step=1e-3)
     finally:
         timer.cancel()
     assert time.monotonic() - started < 5
