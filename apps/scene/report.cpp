@@ -182,7 +182,7 @@ svg text { font-size: 11px; fill: #333; } svg .title { font-size: 13px; font-wei
 svg .grid { stroke: #eee; } svg .axis { stroke: #555; fill: none; }
 table { border-collapse: collapse; font-size: 13px; }
 th, td { border: 1px solid #ddd; padding: 2px 6px; text-align: right; white-space: nowrap; }
-th { background: #f4f4f4; } td.t { text-align: left; }
+th { background: #f4f4f4; text-align: center; } td.t { text-align: left; }
 tr.sp { cursor: pointer; } tr.sp:hover, tr.sp.on { background: #fff4cc; }
 #shape-info { min-height: 2.8em; font-size: 13px; max-width: 560px; }
 #errors { color: #b00; background: #fee; padding: .5em; white-space: pre-wrap; }

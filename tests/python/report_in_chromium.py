@@ -7,7 +7,9 @@ Runs `BUCKLE run SCENE`, opens the report from disk with the network features of
 and checks through the DOM that the page's script ran to its end without errors
 (body[data-status=ok], the error box empty), that the diagram has stable and unstable branches
 and special-point markers, and that the special-point table has one row per special point of
-special_points.json; Chromium's log must hold no console message. Then a screenshot
+special_points.json; Chromium's log must hold no console message. A copy of the page with a
+script appended clicks a table row and moves the mouse onto a branch point of the diagram: the
+shape panel must then describe that special point / branch point. Then a screenshot
 (ARTEFACT_DIR/report.png, kept with report.html beside it) must show the diagram's colours.
 Exit 0 pass, 1 fail, 77 chromium is not installed (ctest SKIP_RETURN_CODE).
 """
@@ -24,6 +26,25 @@ import zlib
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync",
          "--disable-extensions", "--hide-scrollbars"]
+
+
+# Appended to a copy of the page: a click on special-point row ROW, then a mouse move onto the
+# first branch-point marker of the diagram; each writes what the shape panel says.
+INTERACTION = """<script>
+(function () {
+  function said() {
+    return document.querySelector('#shape .title').textContent + ' | ' + document.getElementById('shape-info').textContent;
+  }
+  function note(id, text) { var d = document.createElement('div'); d.id = id; d.textContent = text; document.body.appendChild(d); }
+  document.querySelectorAll('#special-points tr.sp')[ROW].click();
+  note('probe-click', said());
+  var mark = document.querySelector('#diagram circle.special'), box = mark.getBoundingClientRect();
+  document.getElementById('diagram').dispatchEvent(new MouseEvent('mousemove', {
+    clientX: box.left + box.width / 2, clientY: box.top + box.height / 2, bubbles: true}));
+  note('probe-hover', said());
+})();
+</script>
+"""
 
 
 def fail(message):
@@ -118,11 +139,30 @@ def main():
         if marks == 0:
             fail("no special point is marked on the diagram")
 
+        # interaction: click the first fold's row, then hover the diagram at the first branch point
+        folds = [i for i, p in enumerate(specials) if p["type"] == "LP"]
+        if not folds:
+            fail("the default scene should have a fold")
+        probe = tmp / "probe.html"
+        probe.write_text(report.read_text().replace("</body>", INTERACTION.replace("ROW", str(folds[0])) + "</body>"))
+        dom = subprocess.run([browser, *flags, "--enable-logging=stderr", "--v=0", "--dump-dom", probe.as_uri()],
+                             capture_output=True, text=True, timeout=180)
+        clicked = re.search(r'<div id="probe-click">(.*?)</div>', dom.stdout, re.S)
+        hovered = re.search(r'<div id="probe-hover">(.*?)</div>', dom.stdout, re.S)
+        if not clicked or not hovered:
+            fail("the interaction probe did not run: " + dom.stderr[-2000:])
+        if "LP" not in clicked.group(1) or "jump" not in clicked.group(1):
+            fail("clicking the fold's row did not show its shape and jump: " + clicked.group(1))
+        # the nearest traced point: on the straight branch or the first point of the U branch
+        if not hovered.group(1).startswith("branch ") or "Fx = -0.70" not in hovered.group(1):
+            fail("hovering the first branch point did not show the chain there: " + hovered.group(1))
+        print(f"interaction: click -> {clicked.group(1)!r}; hover -> {hovered.group(1)!r}")
+
         artefacts.mkdir(parents=True, exist_ok=True)
         shutil.copy(report, artefacts / "report.html")
         png = artefacts / "report.png"
         png.unlink(missing_ok=True)
-        shot = subprocess.run([browser, *flags, "--window-size=1400,1000", f"--screenshot={png}", report.as_uri()],
+        shot = subprocess.run([browser, *flags, "--window-size=1400,1900", f"--screenshot={png}", report.as_uri()],
                               capture_output=True, text=True, timeout=180)
         if shot.returncode != 0 or not png.is_file():
             fail(f"chromium --screenshot exited {shot.returncode}: {shot.stderr[-2000:]}")
