@@ -385,7 +385,7 @@ const char* const kTail = R"PAGE(</script>
                            legend: info.legend});
     while (g.firstChild) target.appendChild(g.firstChild);
     target.removeChild(g);
-    document.getElementById('shape-info').textContent = info.text || '';
+    if (target.id === 'shape') document.getElementById('shape-info').textContent = info.text || '';
   }
   function nearestShape(c, i) {  // the point itself, or the nearest on its branch that carries a shape
     for (var d = 0; d < c.shapes.length; ++d) {
@@ -566,6 +566,21 @@ const char* const kTail = R"PAGE(</script>
       }
     });
     chart(panel, {lines: lines, marks: marks, legend: legend.slice(0, 8), title: p.title || p.name, xlabel: xlabel, ylabel: ylabel});
+    if (p.type === 'sudden_load') {  // where the chain comes to rest, beside the quasi-static answer
+      chosen.forEach(function (c) {
+        if (!c.sudden || !c.sudden.rest) return;
+        var shapes = [{joints: c.sudden.rest, color: '#d62728'}], legend = [{color: '#d62728', label: 'at rest after the sudden load'}];
+        if (c.sudden['static']) {
+          shapes.push({joints: c.sudden['static'], color: '#1f77b4', dash: '6 4'});
+          legend.push({color: '#1f77b4', dash: '6 4', label: 'quasi-static'});
+        }
+        var xs = [0], ys = [0];
+        shapes.forEach(function (sh) { for (var j = 0; j < sh.joints.length; j += 2) { xs.push(sh.joints[j]); ys.push(sh.joints[j + 1]); } });
+        drawShapes(svg('svg', {viewBox: '0 0 560 400', 'class': 'shape'}, panel), c, shapes,
+                   {title: (chosen.length > 1 ? c.label + ': ' : '') + 'shapes after the sudden load', legend: legend, text: c.sudden.message},
+                   {xs: xs, ys: ys});
+      });
+    }
   });
 
   // run facts
@@ -636,10 +651,13 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   }
   data["cases"] = cases;
   if (anyPoints)
+  {
     data["main"] = json{{"x", mainX},
                         {"y", json::array({mainY})},
                         {"xlabel", mainX},
                         {"title", first && !first->title.empty() ? first->title : "Bifurcation diagram"}};
+    if (first && !first->cases.empty()) data["main"]["cases"] = first->cases;
+  }
   else
     data["main"] = nullptr;
   json plots = json::array();
