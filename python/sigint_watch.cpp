@@ -13,11 +13,11 @@ void onSigint(int) { gInterrupted.store(true); }
 }  // namespace
 
 SigintWatch::SigintWatch() {
-  gInterrupted.store(false);
   py::module_ threading = py::module_::import("threading");
   if (!threading.attr("current_thread")().is(threading.attr("main_thread")())) return;
   py::module_ signal = py::module_::import("signal");
   if (!signal.attr("getsignal")(signal.attr("SIGINT")).is(signal.attr("default_int_handler"))) return;
+  gInterrupted.store(false);
   struct sigaction action {};
   action.sa_handler = onSigint;
   sigemptyset(&action.sa_mask);
@@ -28,7 +28,7 @@ SigintWatch::~SigintWatch() {
   if (installed_) ::sigaction(SIGINT, &previous_, nullptr);
 }
 
-const std::atomic<bool>* SigintWatch::flag() const { return &gInterrupted; }
+const std::atomic<bool>* SigintWatch::flag() const { return installed_ ? &gInterrupted : &never_; }
 
 void SigintWatch::raiseIfInterrupted() const {
   if (!installed_ || !gInterrupted.load()) return;

@@ -22,13 +22,15 @@ class SigintWatch {
   SigintWatch(const SigintWatch&) = delete;
   SigintWatch& operator=(const SigintWatch&) = delete;
 
-  /// The flag for continuation::Interrupt::watch (never set when nothing is watched).
+  /// The flag for continuation::Interrupt::watch (one that is never set when nothing is watched,
+  /// so a computation in another thread is not stopped by the main thread's Ctrl-C).
   const std::atomic<bool>* flag() const;
   /// Raises KeyboardInterrupt (pybind11::error_already_set) when SIGINT arrived. Needs the GIL.
   void raiseIfInterrupted() const;
 
  private:
   bool installed_ = false;
+  std::atomic<bool> never_{false};  // what a watch that installed nothing hands out
   struct sigaction previous_ {};
 };
 

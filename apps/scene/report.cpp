@@ -569,7 +569,7 @@ const char* const kTail = R"PAGE(</script>
     if (p.type === 'sudden_load') {  // where the chain comes to rest, beside the quasi-static answer
       chosen.forEach(function (c) {
         if (!c.sudden || !c.sudden.rest) return;
-        var shapes = [{joints: c.sudden.rest, color: '#d62728'}], legend = [{color: '#d62728', label: 'at rest after the sudden load'}];
+        var shapes = [{joints: c.sudden.rest, color: '#d62728'}], legend = [{color: '#d62728', label: 'sudden: at rest'}];
         if (c.sudden['static']) {
           shapes.push({joints: c.sudden['static'], color: '#1f77b4', dash: '6 4'});
           legend.push({color: '#1f77b4', dash: '6 4', label: 'quasi-static'});

@@ -119,3 +119,17 @@ def test_keyboard_interrupt_stops_a_run(source_dir):
     finally:
         timer.cancel()
     assert time.monotonic() - started < 10
+
+
+def test_the_gil_is_released_while_a_scene_runs(source_dir):
+    # while another thread computes, this one keeps running Python code: with the GIL held for
+    # the whole computation it could not count at all until the run is over
+    scene = source_dir / "data" / "scenes" / "long_chain_jumps.json"
+    worker = threading.Thread(target=buckle.run_scene, args=(scene,), kwargs={"time_limit": 1.0})
+    counted = 0
+    worker.start()
+    time.sleep(0.05)
+    while worker.is_alive():
+        counted += 1
+    worker.join()
+    assert counted > 10000
