@@ -175,8 +175,9 @@ if [[ $CMD == run ]]; then
     die "build finished but $BUILD_DIR/bin/buckle is missing (does apps/buckle define the buckle target?)"
   mkdir -p "$OUT"
   main_job
-  log "done: results in $OUT/ (open $OUT/default/report.html in a browser)"
+  log "done: results in $OUT/"
   ls -l "$OUT"
+  if [[ -f $OUT/default/report.html ]]; then log "report: open $OUT/default/report.html in a browser"; fi
   python_hint
 else
   configure ON
