@@ -3,7 +3,9 @@
 #
 #   scripts/setup.sh run    install missing Debian packages, build Release into build/,
 #                           run the main job (results in out/)
-#   scripts/setup.sh test   install missing packages, build with the tests, run ctest
+#   scripts/setup.sh test   install missing packages (and chromium, for the browser test of
+#                           report.html), build with the tests, run ctest (pytest included)
+# Both build the Python module into build/python: PYTHONPATH=build/python python3 -c 'import buckle'
 #
 # Supports Debian bookworm (also a minimal image). Installing needs root: the script uses
 # sudo when not root, and touches apt only when a package is missing (checked with
@@ -26,9 +28,13 @@ TEST_TIMEOUT=${BUCKLE_TEST_TIMEOUT:-900}
 # clone elsewhere, e.g. CI's, reuses objects compiled from the same sources.
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$ROOT}
 
-# Debian packages (names verified on bookworm).
+# Debian packages (names verified on bookworm). pybind11-dev, python3-dev, python3-numpy: the
+# Python module (build/python); python3-pytest: its tests. TEST_PACKAGES only for `test`:
+# chromium renders report.html in the browser test.
 readonly PACKAGES=(build-essential cmake git pkg-config ccache libeigen3-dev libsundials-dev
-                   libboost-dev catch2 libcli11-dev nlohmann-json3-dev libbenchmark-dev gnuplot-nox)
+                   libboost-dev catch2 libcli11-dev nlohmann-json3-dev libbenchmark-dev gnuplot-nox
+                   pybind11-dev python3-dev python3-numpy python3-pytest)
+readonly TEST_PACKAGES=(chromium)
 
 START=$SECONDS
 log() { printf '==> [setup %4ds] %s\n' "$((SECONDS - START))" "$*"; }
@@ -73,8 +79,9 @@ has_subcommand() {
 }
 
 missing_packages() {
-  local p
-  for p in "${PACKAGES[@]}"; do
+  local p wanted=("${PACKAGES[@]}")
+  [[ ${CMD:-} != test ]] || wanted+=("${TEST_PACKAGES[@]}")
+  for p in "${wanted[@]}"; do
     [[ $(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null) == installed ]] || echo "$p"
   done
 }
@@ -90,7 +97,7 @@ install_packages() {
   local missing
   mapfile -t missing < <(missing_packages)
   if ((${#missing[@]} == 0)); then
-    log "packages: all ${#PACKAGES[@]} present, apt not needed"
+    log "packages: all present, apt not needed"
     return
   fi
   log "packages: missing ${missing[*]}"
@@ -142,6 +149,12 @@ build() {
   log "build: done"
 }
 
+# The Python module is used from the build tree: PYTHONPATH names it (README, Python).
+python_hint() {
+  [[ -n $(compgen -G "$BUILD_DIR/python/buckle*.so") ]] || return 0
+  log "Python: PYTHONPATH=$BUILD_DIR/python /usr/bin/python3 -c 'import buckle'"
+}
+
 CMD=${1:-}
 case $CMD in
   run | test) ;;
@@ -164,6 +177,8 @@ if [[ $CMD == run ]]; then
   main_job
   log "done: results in $OUT/"
   ls -l "$OUT"
+  if [[ -f $OUT/default/report.html ]]; then log "report: open $OUT/default/report.html in a browser"; fi
+  python_hint
 else
   configure ON
   build
@@ -171,4 +186,5 @@ else
   ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" --timeout "$TEST_TIMEOUT" ||
     die "tests failed (see the output above)"
   log "test: all passed"
+  python_hint
 fi

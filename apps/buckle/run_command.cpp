@@ -15,7 +15,8 @@ void addRunCommand(CLI::App& app, Outcome& outcome) {
       "run", "Run a scene file (docs/scenes.md): branches, special points, stiffness, curves and plots");
   run->footer(
       "Computes only what the scene asks for and writes DIR/branches.csv, DIR/special_points.json, "
-      "DIR/summary.json and DIR/plots/*.png|svg (gnuplot).\n"
+      "DIR/summary.json, DIR/plots/*.png|svg (gnuplot) and DIR/report.html (one self-contained page: diagram, "
+      "special points, chain shapes; open it in a browser).\n"
       "Exit status: 0 success, 1 a computation could not finish or the time limit stopped it (what was computed "
       "is written), 2 bad input (the message names the file and the JSON path of the bad value; nothing is "
       "written), 130 / 143 stopped by SIGINT / SIGTERM (what was computed is written; a second signal ends the "

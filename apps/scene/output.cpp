@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "scene/output_target.h"
+#include "scene/report.h"
 
 namespace buckle::scene {
 
@@ -102,7 +103,9 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
 json wrenchJson(const mechanics::Wrench& F) { return json{{"Fx", number(F[0])}, {"Fy", number(F[1])}, {"Me", number(F[2])}}; }
 json poseJson(const mechanics::Pose& p) { return json{{"x", number(p[0])}, {"y", number(p[1])}, {"phi", number(p[2])}}; }
 
-void writeSpecialPoints(const Scene& scene, const RunResult& run, const fs::path& dir) {
+}  // namespace
+
+json specialPointsJson(const Scene& scene, const RunResult& run) {
   json doc;
   doc["scene"] = scene.file;
   json points = json::array(), critical = json::array(), equilibria = json::array(), torque = json::array();
@@ -199,8 +202,10 @@ void writeSpecialPoints(const Scene& scene, const RunResult& run, const fs::path
     }
     doc["sudden_load"] = sudden;
   }
-  writeText(dir / "special_points.json", doc.dump(2) + "\n");
+  return doc;
 }
+
+namespace {
 
 void writeCurves(const Scene& scene, const RunResult& run, const fs::path& dir) {
   if (scene.analyses.suddenLoad.enabled) {
@@ -255,7 +260,9 @@ json solverJson(const SolverSpec& s) {
               {"tolerance", s.tolerance},      {"max_points", s.maxPoints}, {"time_limit", s.timeLimit}};
 }
 
-void writeSummary(const Scene& scene, const RunResult& run, const PlotReport& plots, const fs::path& dir) {
+}  // namespace
+
+json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plots) {
   json doc;
   doc["generator"] = kRunGenerator;  // the marker that lets a later --out replace this directory
   doc["schema"] = kOutputSchema;
@@ -329,10 +336,8 @@ void writeSummary(const Scene& scene, const RunResult& run, const PlotReport& pl
   if (!plots.failures.empty()) p["failures"] = plots.failures;
   doc["plots"] = p;
   if (!plots.notes.empty()) doc["notes"] = plots.notes;
-  writeText(dir / "summary.json", doc.dump(2) + "\n");
+  return doc;
 }
-
-}  // namespace
 
 double columnValue(const std::string& column, const PointRecord& p, const mechanics::Pose& pose0) {
   bool found = false;
@@ -426,10 +431,13 @@ PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::str
   const fs::path dir(dirName);
   // the load history's stable pieces are branches too (docs/scenes.md, `load_history`)
   if (scene.analyses.continuation.enabled || scene.analyses.loadHistory.enabled) writeBranches(scene, run, dir);
-  writeSpecialPoints(scene, run, dir);
+  const json specials = specialPointsJson(scene, run);
+  writeText(dir / "special_points.json", specials.dump(2) + "\n");
   writeCurves(scene, run, dir);
   const PlotReport plots = drawPlots(scene, run, dirName);
-  writeSummary(scene, run, plots, dir);
+  const json summary = summaryJson(scene, run, plots);
+  writeText(dir / "summary.json", summary.dump(2) + "\n");
+  writeReport(scene, run, specials, summary, dirName);
   return plots;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <csignal>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -50,7 +51,14 @@ struct PlotReport {
   std::vector<std::string> notes;
 };
 
-/// Writes every output file of the run into `dir` (which exists); returns the plot report.
+/// The document written as special_points.json (docs/outputs.md): special points, critical loads
+/// and the other per-analysis results the scene asked for.
+nlohmann::json specialPointsJson(const Scene& scene, const RunResult& run);
+/// The document written as summary.json (docs/outputs.md), with `plots` describing what was drawn.
+nlohmann::json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plots);
+
+/// Writes every output file of the run into `dir` (which exists), report.html included;
+/// returns the plot report.
 PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::string& dir);
 
 /// Draws the scene's plots with gnuplot into dir/plots (scripts and data files kept beside the

@@ -1,0 +1,137 @@
+// report.html (scene/report.h): joint positions against the chain's own kinematics, and the
+// embedded data against the run they describe (every point and special point, nothing that
+// would end the <script> element early); the page is accepted as part of a buckle output.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <unistd.h>
+
+#include "buckle/mechanics/chain.h"
+#include "scene/output.h"
+#include "scene/output_target.h"
+#include "scene/report.h"
+#include "scene/runner.h"
+#include "scene/scene.h"
+
+namespace fs = std::filesystem;
+namespace mech = buckle::mechanics;
+using namespace buckle::scene;
+using nlohmann::json;
+
+namespace {
+
+/// The document embedded in the page's <script type="application/json" id="buckle-data">.
+json embedded(const std::string& page) {
+  const std::string open = "<script type=\"application/json\" id=\"buckle-data\">";
+  const size_t begin = page.find(open);
+  REQUIRE(begin != std::string::npos);
+  CHECK(page.find(open, begin + 1) == std::string::npos);
+  const size_t from = begin + open.size();
+  const size_t end = page.find("</script>", from);
+  REQUIRE(end != std::string::npos);
+  return json::parse(page.substr(from, end - from));
+}
+
+Scene smallScene(const std::string& description) {
+  json s = {{"description", description},
+            {"chain", {{"segments", 3}, {"a", 0.5}, {"b", 1.0}, {"k", 1.0}, {"L0", 2.25}}},
+            {"end", {{"x", {{"load", 0.0}}}, {"y", {{"held", 0.0}}}, {"phi", "free"}}},
+            {"path", {{"parameter", "Fx"}, {"from", 0.0}, {"to", -1.0}}},
+            {"analyses", {{"continuation", {{"branch_switching", 1}}}, {"critical_forces", true}}},
+            {"solver", {{"max_step", 0.05}}},
+            {"plots", json::array({{{"type", "bifurcation"}, {"x", "Fx"}, {"y", "q2"}},
+                                   {{"type", "shapes"}, {"at", {-0.5}}}})}};
+  return parseScene(s.dump(), "small.json");
+}
+
+}  // namespace
+
+TEST_CASE("joint positions: links of the chain's lengths, ending at the end pose", "[scene][report]") {
+  std::vector<mech::SegmentParameters> segments;
+  for (int i = 0; i < 5; ++i) {
+    mech::SegmentParameters p = mech::SegmentParameters::symmetric(0.3 + 0.05 * i, 1.0 + 0.1 * i, 1.0, 2.25 + 0.2 * i);
+    segments.push_back(p);
+  }
+  const mech::Chain chain(segments);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> angle(-0.6, 0.6);
+  Eigen::VectorXd q(chain.size());
+  for (int trial = 0; trial < 20; ++trial) {
+    for (Eigen::Index i = 0; i < q.size(); ++i) q[i] = angle(random);
+    const Eigen::Matrix2Xd p = jointPositions(chain, q);
+    REQUIRE(p.cols() == chain.size() + 2);
+    CHECK(p.col(0).norm() == 0.0);
+    const double L = chain.length();
+    for (int j = 0; j + 1 < p.cols(); ++j)
+      CHECK(std::abs((p.col(j + 1) - p.col(j)).norm() - chain.linkLengths()[j]) <= 1e-14 * L);
+    const mech::Pose pose = mech::endPose(chain, q);
+    CHECK((p.col(p.cols() - 1) - pose.head<2>()).norm() <= 1e-14 * L);
+  }
+  CHECK_THROWS_AS(jointPositions(chain, Eigen::VectorXd::Zero(4)), std::invalid_argument);
+}
+
+TEST_CASE("the report embeds every traced point and special point of the run", "[scene][report]") {
+  const Scene scene = smallScene("a </script><b> in the description must not end the data");
+  const RunResult run = runScene(scene);
+  REQUIRE(run.cases.size() == 1);
+  const CaseResult& cr = run.cases[0];
+  REQUIRE(!cr.points.empty());
+  REQUIRE(!cr.specials.empty());
+  const json specials = specialPointsJson(scene, run);
+  const json summary = summaryJson(scene, run, PlotReport{});
+  const std::string page = reportHtml(scene, run, specials, summary);
+  const json data = embedded(page);
+  CHECK(data["description"] == scene.description);
+  const json& c = data["cases"][0];
+  CHECK(c["columns"]["parameter"].size() == cr.points.size());
+  CHECK(c["columns"]["q2"].size() == cr.points.size());
+  CHECK(c["shapes"].size() == cr.points.size());
+  REQUIRE(c["specials"].size() == cr.specials.size());
+  for (size_t i = 0; i < cr.specials.size(); ++i) {
+    const SpecialRecord& s = cr.specials[i];
+    const json& e = c["specials"][i];
+    CHECK(e["type"] == s.type);
+    CHECK(e["branch"] == s.branch);
+    // 10 significant digits in the table
+    CHECK(std::abs(e["parameter"].get<double>() - s.parameter) <= 1e-9 * std::max(1.0, std::abs(s.parameter)));
+    const Eigen::Matrix2Xd p = jointPositions(cr.chain, s.q);
+    const json& joints = e["joints"];
+    REQUIRE(joints.size() == size_t(2 * p.cols()));
+    const double L = cr.chain.length();
+    for (Eigen::Index j = 0; j < p.cols(); ++j) {  // 4 significant digits
+      CHECK(std::abs(joints[size_t(2 * j)].get<double>() - p(0, j)) <= 1e-3 * L);
+      CHECK(std::abs(joints[size_t(2 * j + 1)].get<double>() - p(1, j)) <= 1e-3 * L);
+    }
+  }
+  // stability per point as traced
+  for (size_t i = 0; i < cr.points.size(); ++i) CHECK(c["stable"][i] == (cr.points[i].stable ? 1 : 0));
+  CHECK(data["main"]["x"] == "Fx");
+  CHECK(data["main"]["y"][0] == "q2");
+  REQUIRE(data["plots"].size() == 2);
+  CHECK(data["plots"][1]["type"] == "shapes");
+  CHECK(data["critical"].size() == specials["critical_loads"].size());
+}
+
+TEST_CASE("report.html is written with the outputs and keeps the directory a buckle output", "[scene][report]") {
+  const Scene scene = smallScene("report written by writeOutputs");
+  const RunResult run = runScene(scene);
+  const fs::path dir = fs::temp_directory_path() / ("buckle_test_report_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  writeOutputs(scene, run, dir.string());
+  REQUIRE(fs::is_regular_file(dir / "report.html"));
+  std::ifstream in(dir / "report.html", std::ios::binary);
+  const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(embedded(page)["scene"] == "small.json");
+  std::string why;
+  CHECK(isBuckleOutput(dir.string(), &why));
+  INFO(why);
+  fs::remove_all(dir);
+}

@@ -1,0 +1,185 @@
+#!/usr/bin/env python3
+"""The default scene's report.html in a real browser (headless Chromium, Debian `chromium`).
+
+Usage: report_in_chromium.py BUCKLE SCENE ARTEFACT_DIR
+
+Runs `BUCKLE run SCENE`, opens the report from disk with the network features of Chromium off,
+and checks through the DOM that the page's script ran to its end without errors
+(body[data-status=ok], the error box empty), that the diagram has stable and unstable branches
+and special-point markers, and that the special-point table has one row per special point of
+special_points.json; Chromium's log must hold no console message. A copy of the page with a
+script appended clicks a table row and moves the mouse onto a branch point of the diagram: the
+shape panel must then describe that special point / branch point. Then a screenshot
+(ARTEFACT_DIR/report.png, kept with report.html beside it) must show the diagram's colours.
+Exit 0 pass, 1 fail, 77 chromium is not installed (ctest SKIP_RETURN_CODE).
+"""
+import json
+import pathlib
+import re
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import zlib
+
+FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync",
+         "--disable-extensions", "--hide-scrollbars"]
+
+
+# Appended to a copy of the page: a click on special-point row ROW, then a mouse move onto the
+# first branch-point marker of the diagram; each writes what the shape panel says.
+INTERACTION = """<script>
+(function () {
+  function said() {
+    return document.querySelector('#shape .title').textContent + ' | ' + document.getElementById('shape-info').textContent;
+  }
+  function note(id, text) { var d = document.createElement('div'); d.id = id; d.textContent = text; document.body.appendChild(d); }
+  document.querySelectorAll('#special-points tr.sp')[ROW].click();
+  note('probe-click', said());
+  var mark = document.querySelector('#diagram circle.special'), box = mark.getBoundingClientRect();
+  document.getElementById('diagram').dispatchEvent(new MouseEvent('mousemove', {
+    clientX: box.left + box.width / 2, clientY: box.top + box.height / 2, bubbles: true}));
+  note('probe-hover', said());
+})();
+</script>
+"""
+
+
+def fail(message):
+    print("FAIL: " + message)
+    sys.exit(1)
+
+
+def png_pixels(path):
+    """(width, height, rows of RGB tuples) of an 8-bit RGB/RGBA PNG (what Chromium writes)."""
+    data = path.read_bytes()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        fail(f"{path} is not a PNG")
+    pos, idat, width = 8, b"", 0
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, colour = struct.unpack(">IIBB", body[:10])
+            if depth != 8 or colour not in (2, 6):
+                fail(f"unexpected PNG format (depth {depth}, colour type {colour})")
+            channels = 3 if colour == 2 else 4
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + length
+    raw, stride, rows, previous = zlib.decompress(idat), width * channels, [], bytearray(width * channels)
+    for y in range(height):
+        line = raw[y * (stride + 1):(y + 1) * (stride + 1)]
+        kind, row = line[0], bytearray(line[1:])
+        for i in range(stride):  # PNG filters (RFC 2083, 6.3)
+            a = row[i - channels] if i >= channels else 0
+            b = previous[i]
+            c = previous[i - channels] if i >= channels else 0
+            if kind == 1:
+                row[i] = (row[i] + a) & 255
+            elif kind == 2:
+                row[i] = (row[i] + b) & 255
+            elif kind == 3:
+                row[i] = (row[i] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                row[i] = (row[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append([tuple(row[x * channels:x * channels + 3]) for x in range(width)])
+        previous = row
+    return width, height, rows
+
+
+def main():
+    if len(sys.argv) != 4:
+        fail(__doc__)
+    buckle, scene, artefacts = sys.argv[1], pathlib.Path(sys.argv[2]), pathlib.Path(sys.argv[3])
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    if not browser:
+        print("SKIP: chromium is not installed (Debian package chromium)")
+        return 77
+    with tempfile.TemporaryDirectory(prefix="buckle-report-") as tmp:
+        tmp = pathlib.Path(tmp)
+        out = tmp / "out"
+        run = subprocess.run([buckle, "run", str(scene), "--out", str(out), "--quiet"], capture_output=True,
+                             text=True, timeout=300)
+        if run.returncode != 0:
+            fail(f"buckle run exited {run.returncode}: {run.stderr}")
+        report = out / "report.html"
+        specials = json.loads((out / "special_points.json").read_text())["special_points"]
+        flags = FLAGS + [f"--user-data-dir={tmp / 'profile'}"]
+        dom = subprocess.run([browser, *flags, "--enable-logging=stderr", "--v=0", "--dump-dom", report.as_uri()],
+                             capture_output=True, text=True, timeout=180)
+        if dom.returncode != 0:
+            fail(f"chromium --dump-dom exited {dom.returncode}: {dom.stderr[-2000:]}")
+        html, log = dom.stdout, dom.stderr
+        console = [line for line in log.splitlines() if "CONSOLE" in line or "Uncaught" in line]
+        if console:
+            fail("console messages while rendering:\n" + "\n".join(console))
+        if not re.search(r'<body[^>]*data-status="ok"', html):
+            errors = re.search(r'<pre id="errors"[^>]*>(.*?)</pre>', html, re.S)
+            fail("the page's script did not finish: " + (errors.group(1) if errors else html[:500]))
+        if not re.search(r'<pre id="errors" hidden=""></pre>', html):
+            fail("the error box is not empty")
+        diagram = re.search(r'<svg[^>]*id="diagram".*?</svg>', html, re.S)
+        if not diagram:
+            fail("no diagram (svg#diagram) in the page")
+        for cls in ("branch stable", "branch unstable"):
+            if f'class="{cls}"' not in diagram.group(0):
+                fail(f"the diagram has no {cls} branch")
+        marks = diagram.group(0).count('class="special"')
+        table = re.search(r'<table id="special-points">.*?</table>', html, re.S)
+        if not table:
+            fail("no special-point table (table#special-points)")
+        rows = table.group(0).count('<tr class="sp"')
+        if rows != len(specials) or rows == 0:
+            fail(f"the table has {rows} rows, special_points.json {len(specials)} special points")
+        if marks == 0:
+            fail("no special point is marked on the diagram")
+
+        # interaction: click the first fold's row, then hover the diagram at the first branch point
+        folds = [i for i, p in enumerate(specials) if p["type"] == "LP"]
+        if not folds:
+            fail("the default scene should have a fold")
+        probe = tmp / "probe.html"
+        probe.write_text(report.read_text().replace("</body>", INTERACTION.replace("ROW", str(folds[0])) + "</body>"))
+        dom = subprocess.run([browser, *flags, "--enable-logging=stderr", "--v=0", "--dump-dom", probe.as_uri()],
+                             capture_output=True, text=True, timeout=180)
+        clicked = re.search(r'<div id="probe-click">(.*?)</div>', dom.stdout, re.S)
+        hovered = re.search(r'<div id="probe-hover">(.*?)</div>', dom.stdout, re.S)
+        if not clicked or not hovered:
+            fail("the interaction probe did not run: " + dom.stderr[-2000:])
+        if "LP" not in clicked.group(1) or "jump" not in clicked.group(1):
+            fail("clicking the fold's row did not show its shape and jump: " + clicked.group(1))
+        # the nearest traced point: on the straight branch or the first point of the U branch
+        if not hovered.group(1).startswith("branch ") or "Fx = -0.70" not in hovered.group(1):
+            fail("hovering the first branch point did not show the chain there: " + hovered.group(1))
+        print(f"interaction: click -> {clicked.group(1)!r}; hover -> {hovered.group(1)!r}")
+
+        artefacts.mkdir(parents=True, exist_ok=True)
+        shutil.copy(report, artefacts / "report.html")
+        png = artefacts / "report.png"
+        png.unlink(missing_ok=True)
+        shot = subprocess.run([browser, *flags, "--window-size=1400,1900", f"--screenshot={png}", report.as_uri()],
+                              capture_output=True, text=True, timeout=180)
+        if shot.returncode != 0 or not png.is_file():
+            fail(f"chromium --screenshot exited {shot.returncode}: {shot.stderr[-2000:]}")
+    width, height, pixels = png_pixels(png)
+
+    def near(p, rgb):
+        return all(abs(p[i] - rgb[i]) <= 40 for i in range(3))
+
+    # the diagram is drawn in the page's stable blue (#1f77b4) and unstable red (#d62728)
+    blue = sum(near(p, (0x1f, 0x77, 0xb4)) for row in pixels for p in row)
+    red = sum(near(p, (0xd6, 0x27, 0x28)) for row in pixels for p in row)
+    if blue < 200 or red < 200:
+        fail(f"the screenshot shows too little of the diagram ({blue} blue, {red} red pixels of {width}×{height})")
+    print(f"PASS: {rows} special points in the table, {marks} on the diagram; screenshot {png} "
+          f"({width}×{height}, {blue} stable-blue and {red} unstable-red pixels)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,115 @@
+# buckle.Segment / Chain / EndCondition / linear_buckling against closed forms and finite
+# differences of the module's own functions.
+import math
+
+import numpy as np
+import pytest
+
+import buckle
+
+
+def central_difference(f, x, h):
+    """Derivative of the scalar or vector function f at the vector x, column by column."""
+    x = np.asarray(x, dtype=float)
+    columns = []
+    for i in range(x.size):
+        e = np.zeros_like(x)
+        e[i] = h
+        columns.append((np.asarray(f(x + e)) - np.asarray(f(x - e))) / (2 * h))
+    return np.array(columns).T
+
+
+def test_segment_torque_and_stiffness_are_derivatives_of_the_energy():
+    s = buckle.Segment(a=0.4, b=1.1, k=2.0, L0=2.4, k2=1.5)
+    q = np.linspace(-0.8, 0.8, 17)
+    h = 1e-5
+    dE = (s.energy(q + h) - s.energy(q - h)) / (2 * h)
+    dM = (s.torque(q + h) - s.torque(q - h)) / (2 * h)
+    scale = np.max(np.abs(s.stiffness(q)))
+    assert np.max(np.abs(s.torque(q) + dE)) < 1e-7 * scale
+    assert np.max(np.abs(s.stiffness(q) + dM)) < 1e-7 * scale
+    assert s.energy(0.3) == pytest.approx(float(s.energy(np.array([0.3]))[0]), rel=0, abs=0)
+
+
+def test_straight_stiffness_is_kappa():
+    a, b, k, L0 = 0.5, 1.0, 1.0, 2.25
+    s = buckle.Segment(a, b, k, L0)
+    kappa = k * (b * L0 - 2 * (b * b - a * a))  # eq 17
+    assert s.straight_stiffness == pytest.approx(kappa, rel=1e-14)
+    assert s.lower_limit == pytest.approx(-s.upper_limit, rel=1e-14)
+
+
+def test_chain_parameters_lists_and_limits():
+    segs = [buckle.Segment(a=0.3 + 0.1 * i, b=1.0, k=1.0 + i, L0=2.25, q_max=0.5) for i in range(3)]
+    c = buckle.Chain(segs)
+    assert len(c) == 3 and c.n == 3
+    np.testing.assert_array_equal(c.parameters["k1"], [1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(c.parameters["a2"], [0.3, 0.4, 0.5])
+    assert np.all(c.upper_limits <= 0.5)
+    assert c.length == pytest.approx(np.sum(c.link_lengths), rel=1e-15)
+    np.testing.assert_allclose(c.unloaded_shape(), np.zeros(3), atol=1e-12)
+
+
+def test_chain_with_unloaded_shape_has_that_shape():
+    q0 = np.array([0.2, -0.1, 0.05])
+    c = buckle.Chain.with_unloaded_shape([buckle.Segment()] * 3, q0)
+    np.testing.assert_allclose(c.unloaded_shape(), q0, atol=1e-12)
+    assert np.max(np.abs(c.torques(q0))) < 1e-12 * np.max(c.joint_stiffness(q0))
+
+
+def test_chain_kinematics_and_energy_derivatives():
+    c = buckle.Chain([buckle.Segment(a=0.5, b=1.0 + 0.1 * i, k=1.0, L0=2.3) for i in range(4)])
+    q = np.array([0.3, -0.2, 0.4, 0.1])
+    F = np.array([-0.4, 0.2, 0.1])
+    h = 1e-6
+    J = c.end_jacobian(q)
+    np.testing.assert_allclose(J, central_difference(c.end_pose, q, h), atol=1e-8 * c.length)
+    g = c.total_potential_gradient(q, F)
+    np.testing.assert_allclose(g, central_difference(lambda x: c.total_potential(x, F), q, h), atol=1e-8)
+    H = c.total_potential_hessian(q, F)
+    np.testing.assert_allclose(H, central_difference(lambda x: c.total_potential_gradient(x, F), q, h), atol=1e-7)
+    np.testing.assert_allclose(-c.torques(q) - J.T @ F, g, atol=1e-13)
+    P = c.joint_positions(q)
+    assert P.shape == (6, 2)
+    np.testing.assert_allclose(P[-1], c.end_pose(q)[:2], atol=1e-14 * c.length)
+
+
+def test_unloaded_stiffness_is_the_inverse_of_the_compliance_eq21():
+    c = buckle.Chain.uniform(3)
+    q = np.array([0.3, -0.2, 0.25])
+    r = c.stiffness(q)
+    J = c.end_jacobian(q)[:2]
+    C = J @ np.diag(1 / c.joint_stiffness(q)) @ J.T  # eq 21, rotation free
+    np.testing.assert_allclose(r["compliance"], C, rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(r["stiffness"] @ C, np.eye(2), atol=1e-10)
+    assert r["positive_definite"] and not r["singular"]
+
+
+def test_linear_buckling_matches_the_closed_form_eq17():
+    a, b, k, L0 = 0.5, 1.0, 1.0, 2.25
+    c = buckle.Chain.uniform(3, buckle.Segment(a, b, k, L0))
+    kappa = k * (b * L0 - 2 * (b * b - a * a))
+    r = buckle.linear_buckling(c, end=buckle.EndCondition.clamped_pinned())
+    compressive = sorted(x for x in r["loads"] if x < 0)[::-1]
+    FxU = (math.sqrt(21) - 14) / 10 * kappa / b
+    FxZ = -(math.sqrt(21) + 14) / 10 * kappa / b
+    assert compressive[0] == pytest.approx(FxU, rel=1e-12)
+    assert compressive[1] == pytest.approx(FxZ, rel=1e-12)
+    assert r["unloaded_stable"]
+    mode = next(m for m in r["modes"] if m["load_factor"] == compressive[0])
+    assert mode["shape"] == "U"
+    # the mode is a null vector of the loaded Hessian on ker J_y (y held)
+    H = c.total_potential_hessian(np.zeros(3), np.array([compressive[0], 0, 0]))
+    z = mode["mode"]
+    Jy = c.end_jacobian(np.zeros(3))[1]
+    residual = H @ z
+    residual -= Jy * (Jy @ residual) / (Jy @ Jy)
+    assert np.linalg.norm(residual) < 1e-10 * np.linalg.norm(H)
+
+
+def test_end_condition_controls():
+    e = buckle.EndCondition.clamped_pinned(-0.5)
+    assert e.control == ("load", "held", "load")
+    assert e.value[0] == -0.5
+    e = buckle.EndCondition(x="held", y="held", value=[2.5, 0.1, 0])
+    assert e.control == ("held", "held", "load")

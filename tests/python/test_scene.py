@@ -1,0 +1,135 @@
+# buckle.run_scene against `buckle run`: the same scene gives the same special points, branches
+# and summary through the module as through the command line; time limits and Ctrl-C.
+import csv
+import json
+import os
+import pathlib
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import buckle
+
+# Every shipped scene (each runs in well under 3 s in a release build).
+SCENES = sorted(p.name for p in (pathlib.Path(__file__).resolve().parents[2] / "data" / "scenes").glob("*.json"))
+
+
+def read_branches_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    return rows
+
+
+def close(a, b, rel=1e-9):
+    """Equal to rounding: both None/NaN, or relatively close against the larger magnitude and 1."""
+    if a is None or b is None:
+        return a is None and b is None
+    return abs(a - b) <= rel * max(1.0, abs(a), abs(b))
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_module_results_equal_the_command_line(name, source_dir, run_cli, tmp_path):
+    scene = source_dir / "data" / "scenes" / name
+    out = tmp_path / "out"
+    cli = run_cli("run", scene, "--out", out, "--quiet")
+    assert cli.returncode == 0, cli.stderr
+    expected = json.loads((out / "special_points.json").read_text())
+    summary = json.loads((out / "summary.json").read_text())
+
+    r = buckle.run_scene(str(scene))
+    assert r["complete"] is True and r["interrupted"] is False
+    assert r["computed"] == summary["computed"]
+    got = r["special_points"]
+    assert len(got) == len(expected["special_points"])
+    for g, e in zip(got, expected["special_points"]):
+        for key in ("case", "type", "field", "branch", "shape", "stability_before", "stability_after"):
+            assert g[key] == e[key], key
+        assert close(g["parameter"], e["parameter"])
+        assert all(close(x, y) for x, y in zip(g["q"], e["q"]))
+        assert close(g["accuracy"]["parameter"], e["accuracy"]["parameter"], rel=1e-6) or \
+            max(g["accuracy"]["parameter"], e["accuracy"]["parameter"]) <= 1e-12 * max(1.0, abs(e["parameter"]))
+    for key in ("critical_loads", "energy_equilibria", "torque_zeros"):
+        assert (key in r["results"]) == (key in expected)
+        if key in expected:
+            assert len(r["results"][key]) == len(expected[key])
+    for c, case in enumerate(r["cases"]):
+        s = summary["cases"][c]
+        assert case["label"] == s["label"] and case["segments"] == s["segments"]
+        if "branches" in s:
+            assert set(np.unique(case["branches"]["branch"]).tolist()) <= {b["id"] for b in s["branches"]}
+    if (out / "branches.csv").exists():
+        rows = read_branches_csv(out / "branches.csv")
+        for c, case in enumerate(r["cases"]):
+            mine = [row for row in rows if int(row["case"]) == c]
+            b = case["branches"]
+            assert len(mine) == len(b["parameter"])
+            csv_parameter = np.array([float(row["parameter"]) for row in mine])
+            # branches.csv has 12 significant digits
+            np.testing.assert_allclose(b["parameter"], csv_parameter, rtol=1e-11, atol=1e-11)
+            for i in range(case["segments"]):
+                csv_q = np.array([float(row[f"q{i + 1}"]) for row in mine])
+                np.testing.assert_allclose(b["q"][:, i], csv_q, rtol=1e-11, atol=1e-11)
+            np.testing.assert_array_equal(b["stable"], [row["stable"] == "1" for row in mine])
+
+
+def test_a_dict_runs_like_its_file(source_dir):
+    path = source_dir / "data" / "scenes" / "fig2.json"
+    from_file = buckle.run_scene(path)
+    from_dict = buckle.run_scene(json.loads(path.read_text()))
+    assert len(from_file["special_points"]) == len(from_dict["special_points"])
+    for a, b in zip(from_file["special_points"], from_dict["special_points"]):
+        assert a["type"] == b["type"] and a["parameter"] == b["parameter"]
+    assert from_dict["summary"]["scene"] == "<dict>"
+
+
+def test_out_writes_the_command_lines_directory_with_the_report(source_dir, tmp_path):
+    out = tmp_path / "run"
+    r = buckle.run_scene(source_dir / "data" / "scenes" / "fig2.json", out=str(out))
+    assert r["complete"]
+    for f in ("summary.json", "special_points.json", "report.html"):
+        assert (out / f).is_file(), f
+    written = json.loads((out / "special_points.json").read_text())
+    assert [p["parameter"] for p in written["special_points"]] == [p["parameter"] for p in r["special_points"]]
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep")
+    with pytest.raises(ValueError, match="not a buckle output"):
+        buckle.run_scene(source_dir / "data" / "scenes" / "fig2.json", out=str(tmp_path / "mine"))
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
+
+
+def test_time_limit_returns_what_was_computed(source_dir):
+    started = time.monotonic()
+    r = buckle.run_scene(source_dir / "data" / "scenes" / "long_chain_jumps.json", time_limit=0.5)
+    assert time.monotonic() - started < 10
+    assert r["interrupted"] is True and r["complete"] is False
+    assert "time limit" in r["interruption"]
+    assert r["summary"]["solver"]["time_limit"] == 0.5
+
+
+def test_keyboard_interrupt_stops_a_run(source_dir):
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    started = time.monotonic()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            buckle.run_scene(source_dir / "data" / "scenes" / "long_chain_jumps.json")
+    finally:
+        timer.cancel()
+    assert time.monotonic() - started < 10
+
+
+def test_the_gil_is_released_while_a_scene_runs(source_dir):
+    # while another thread computes, this one keeps running Python code: with the GIL held for
+    # the whole computation it could not count at all until the run is over
+    scene = source_dir / "data" / "scenes" / "long_chain_jumps.json"
+    worker = threading.Thread(target=buckle.run_scene, args=(scene,), kwargs={"time_limit": 1.0})
+    counted = 0
+    worker.start()
+    time.sleep(0.05)
+    while worker.is_alive():
+        counted += 1
+    worker.join()
+    assert counted > 10000
