@@ -243,7 +243,7 @@ void bindMechanics(py::module_& m) {
           "joint_positions",
           [](const mech::Chain& c, const VectorXd& q) {
             checkSize(c, q, "q");
-            return Eigen::MatrixXd(scene::jointPositions(c, q).transpose());
+            return Eigen::MatrixXd(mechanics::jointPositions(c, q).transpose());
           },
           py::arg("q"), "(n+2)×2 array: the base, the n joints and the end (x, y), units of b.")
       .def(

@@ -29,7 +29,7 @@ json rounded(double v, int digits = 6) {
 
 /// Joint positions flattened as [x0, y0, x1, y1, …] (4 significant digits).
 json jointsJson(const mechanics::Chain& chain, const Eigen::VectorXd& q) {
-  const Eigen::Matrix2Xd p = jointPositions(chain, q);
+  const Eigen::Matrix2Xd p = mechanics::jointPositions(chain, q);
   json a = json::array();
   for (Eigen::Index j = 0; j < p.cols(); ++j) {
     a.push_back(rounded(p(0, j), 4));
@@ -609,23 +609,6 @@ const char* const kTail = R"PAGE(</script>
 )PAGE";
 
 }  // namespace
-
-Eigen::Matrix2Xd jointPositions(const mechanics::Chain& chain, const Eigen::VectorXd& q) {
-  const int n = chain.size();
-  if (q.size() != n)
-    throw std::invalid_argument("joint angles: " + std::to_string(q.size()) + " values for a chain of " +
-                                std::to_string(n) + " segments");
-  Eigen::Matrix2Xd p(2, n + 2);
-  p.col(0).setZero();
-  const Eigen::VectorXd& l = chain.linkLengths();
-  p.col(1) = Eigen::Vector2d(l[0], 0.0);
-  double theta = 0.0;
-  for (int i = 0; i < n; ++i) {
-    theta += q[i];
-    p.col(i + 2) = p.col(i + 1) + l[i + 1] * Eigen::Vector2d(std::cos(theta), std::sin(theta));
-  }
-  return p;
-}
 
 std::string reportHtml(const Scene& scene, const RunResult& run, const json& specialPoints, const json& summary) {
   json data;

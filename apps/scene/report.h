@@ -15,12 +15,6 @@
 
 namespace buckle::scene {
 
-/// Positions of the base, the n joints and the end of the chain at joint angles q, as the
-/// columns of a 2×(n+2) matrix (units of b): the base link ℓ0 lies along x, then link i+1
-/// leaves joint i at the absolute angle θ_i = q_1 + … + q_i (eq 5); the last column is the end
-/// position (x, y) of forwardKinematics().
-Eigen::Matrix2Xd jointPositions(const mechanics::Chain& chain, const Eigen::VectorXd& q);
-
 /// The complete page for a run; `specialPoints` and `summary` are the documents written as
 /// special_points.json and summary.json (output.h), shown as tables.
 std::string reportHtml(const Scene& scene, const RunResult& run, const nlohmann::json& specialPoints,

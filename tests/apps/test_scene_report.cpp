@@ -8,7 +8,6 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
-#include <random>
 #include <stdexcept>
 #include <string>
 #include <unistd.h>
@@ -53,30 +52,6 @@ Scene smallScene(const std::string& description) {
 
 }  // namespace
 
-TEST_CASE("joint positions: links of the chain's lengths, ending at the end pose", "[scene][report]") {
-  std::vector<mech::SegmentParameters> segments;
-  for (int i = 0; i < 5; ++i) {
-    mech::SegmentParameters p = mech::SegmentParameters::symmetric(0.3 + 0.05 * i, 1.0 + 0.1 * i, 1.0, 2.25 + 0.2 * i);
-    segments.push_back(p);
-  }
-  const mech::Chain chain(segments);
-  std::mt19937 random(7);
-  std::uniform_real_distribution<double> angle(-0.6, 0.6);
-  Eigen::VectorXd q(chain.size());
-  for (int trial = 0; trial < 20; ++trial) {
-    for (Eigen::Index i = 0; i < q.size(); ++i) q[i] = angle(random);
-    const Eigen::Matrix2Xd p = jointPositions(chain, q);
-    REQUIRE(p.cols() == chain.size() + 2);
-    CHECK(p.col(0).norm() == 0.0);
-    const double L = chain.length();
-    for (int j = 0; j + 1 < p.cols(); ++j)
-      CHECK(std::abs((p.col(j + 1) - p.col(j)).norm() - chain.linkLengths()[j]) <= 1e-14 * L);
-    const mech::Pose pose = mech::endPose(chain, q);
-    CHECK((p.col(p.cols() - 1) - pose.head<2>()).norm() <= 1e-14 * L);
-  }
-  CHECK_THROWS_AS(jointPositions(chain, Eigen::VectorXd::Zero(4)), std::invalid_argument);
-}
-
 TEST_CASE("the report embeds every traced point and special point of the run", "[scene][report]") {
   const Scene scene = smallScene("a </script><b> in the description must not end the data");
   const RunResult run = runScene(scene);
@@ -101,7 +76,7 @@ TEST_CASE("the report embeds every traced point and special point of the run", "
     CHECK(e["branch"] == s.branch);
     // 10 significant digits in the table
     CHECK(std::abs(e["parameter"].get<double>() - s.parameter) <= 1e-9 * std::max(1.0, std::abs(s.parameter)));
-    const Eigen::Matrix2Xd p = jointPositions(cr.chain, s.q);
+    const Eigen::Matrix2Xd p = mech::jointPositions(cr.chain, s.q);
     const json& joints = e["joints"];
     REQUIRE(joints.size() == size_t(2 * p.cols()));
     const double L = cr.chain.length();

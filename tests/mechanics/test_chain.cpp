@@ -218,6 +218,7 @@ TEST_CASE("joint positions: links of the chain's lengths, ending at the end pose
     const Pose end = endPose(chain, q);
     CHECK(P(0, n + 1) == Approx(end[0]).margin(1e-13 * L));
     CHECK(P(1, n + 1) == Approx(end[1]).margin(1e-13 * L));
+    CHECK_THROWS_AS(jointPositions(chain, Vector::Zero(n + 1)), std::invalid_argument);
   }
 }
 

@@ -73,6 +73,9 @@ bool endMovesAlong(const Chain& chain, ConstVectorRef q, int c) {
 
 Eigen::Matrix2Xd jointPositions(const Chain& chain, ConstVectorRef q) {
   const int n = chain.size();
+  if (q.size() != n)
+    throw std::invalid_argument("joint angles: " + std::to_string(q.size()) + " values for a chain of " +
+                                std::to_string(n) + " segments");
   Eigen::Matrix2Xd P(2, n + 2);
   P.col(0).setZero();
   P.col(1) << chain.linkLengths()[0], 0.0;

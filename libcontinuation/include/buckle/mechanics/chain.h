@@ -54,7 +54,8 @@ struct ChainData {
 void forwardKinematics(const Chain& chain, ConstVectorRef q, ChainData& data);
 Pose endPose(const Chain& chain, ConstVectorRef q);
 /// The chain's centre line at q: column 0 the base (0, 0), column i the joint i (i = 1 … n),
-/// column n + 1 the end; 2×(n + 2). O(n). For drawing and reporting shapes.
+/// column n + 1 the end; 2×(n + 2). O(n). For drawing and reporting shapes. Throws
+/// std::invalid_argument when q does not have one angle per segment.
 Eigen::Matrix2Xd jointPositions(const Chain& chain, ConstVectorRef q);
 
 /// Jacobian of (x, y, φ) with respect to q, 3×n (eq 11): rows (−S_j, C_j, 1).
