@@ -79,13 +79,9 @@ MeasuredCase fromProblem(const problems::CaseResult& r) {
   const int n = r.segments;
   const cont::Branch& b = r.branch;
   for (const cont::SpecialPoint& sp : b.specialPoints) {
+    if (sp.type == cont::SpecialPointType::Endpoint) continue;
     MeasuredSpecial s;
-    switch (sp.type) {
-      case cont::SpecialPointType::BranchPoint: s.type = "BP"; break;
-      case cont::SpecialPointType::Fold: s.type = "LP"; break;
-      case cont::SpecialPointType::Boundary: s.type = "BD"; break;
-      case cont::SpecialPointType::Endpoint: continue;
-    }
+    s.type = cont::specialPointLabel(sp.type);
     s.branch = b.id;
     s.lambda = sp.lambda;
     s.accuracy = sp.lambdaAccuracy;

@@ -1,5 +1,7 @@
 #include "scene/output.h"
 
+#include "buckle/mechanics/shape_name.h"
+
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -76,11 +78,43 @@ std::string fmt(double v) {
   return std::string(buf, r.ptr);
 }
 
+// Joint angles of every point, rows in branches.csv's order, as a NumPy .npy file (format 1.0:
+// magic, a Python-dict header padded to 64 bytes, then little-endian float64 in C order), which
+// numpy.load reads as it is. Shorter cases are padded with NaN.
+void writeJointAngles(const RunResult& run, int n, const fs::path& file) {
+  std::size_t rows = 0;
+  for (const CaseResult& cr : run.cases) rows += cr.points.size();
+  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(rows) + ", " +
+                       std::to_string(n) + "), }";
+  const std::size_t preamble = 10;  // magic (6), version (2), header length (2)
+  header.append(63 - (preamble + header.size()) % 64, ' ');
+  header += '\n';
+  std::string bytes = std::string("\x93NUMPY\x01\x00", 8);
+  bytes += char(header.size() & 0xff);
+  bytes += char(header.size() >> 8);
+  bytes += header;
+  static_assert(sizeof(double) == 8);
+  std::vector<double> row(static_cast<std::size_t>(n));
+  bytes.reserve(bytes.size() + rows * row.size() * sizeof(double));
+  for (const CaseResult& cr : run.cases)
+    for (const PointRecord& p : cr.points) {
+      for (int i = 0; i < n; ++i) row[std::size_t(i)] = i < p.q.size() ? p.q[i] : std::numeric_limits<double>::quiet_NaN();
+      bytes.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(double));  // x86-64/ARM: little-endian
+    }
+  writeText(file, bytes);
+}
+
 void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir) {
   const int n = scene.maxSegments();
+  // a long chain's joint angles go to joint_angles.npy: the CSV stays a table of loads, poses and
+  // stability (200 segments: 143 MB of CSV before)
+  const bool sideFile = n > kBranchesCsvJointColumns;
   std::ostringstream os;
   os << "case,branch,point,parameter,Fx,Fy,Me,x,y,phi,dx,dy";
-  for (int i = 1; i <= n; ++i) os << ",q" << i;
+  if (sideFile)
+    os << ",max_abs_q,sign_changes";
+  else
+    for (int i = 1; i <= n; ++i) os << ",q" << i;
   os << ",stable,negative,min_eig";
   if (scene.analyses.stiffness) os << ",Kxx,Kyy,Kxy";
   os << "\n";
@@ -91,13 +125,20 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
       for (int k = 0; k < 3; ++k) os << ',' << fmt(p.F[k]);
       for (int k = 0; k < 3; ++k) os << ',' << fmt(p.pose[k]);
       os << ',' << fmt(cr.pose0[0] - p.pose[0]) << ',' << fmt(p.pose[1] - cr.pose0[1]);
-      for (int i = 0; i < n; ++i) os << ',' << (i < p.q.size() ? fmt(p.q[i]) : std::string());
+      if (sideFile) {
+        const double qmax = p.q.size() > 0 ? p.q.cwiseAbs().maxCoeff() : 0.0;
+        // sign changes of the bend, ignoring joints bent by less than 1e-9 of the largest
+        os << ',' << fmt(qmax) << ',' << mechanics::signChanges(p.q, 1e-9 * qmax);
+      } else {
+        for (int i = 0; i < n; ++i) os << ',' << (i < p.q.size() ? fmt(p.q[i]) : std::string());
+      }
       os << ',' << (p.stable ? 1 : 0) << ',' << p.negative << ',' << fmt(p.minEigenvalue);
       if (scene.analyses.stiffness) os << ',' << fmt(p.K(0, 0)) << ',' << fmt(p.K(1, 1)) << ',' << fmt(p.K(0, 1));
       os << "\n";
     }
   }
   writeText(dir / "branches.csv", os.str());
+  if (sideFile) writeJointAngles(run, n, dir / "joint_angles.npy");
 }
 
 json wrenchJson(const mechanics::Wrench& F) { return json{{"Fx", number(F[0])}, {"Fy", number(F[1])}, {"Me", number(F[2])}}; }

@@ -13,6 +13,10 @@
 
 namespace buckle::scene {
 
+/// Above this many segments branches.csv carries max_abs_q and sign_changes instead of the joint
+/// angles, which go to joint_angles.npy (docs/outputs.md).
+constexpr int kBranchesCsvJointColumns = 12;
+
 /// Value of a branches.csv column at a point (NaN when it does not apply).
 double columnValue(const std::string& column, const PointRecord& p, const mechanics::Pose& pose0);
 /// The same for a special point (stiffness columns are NaN there).

@@ -2,16 +2,25 @@
 // the program creates, replaces the target only on commit, and is gone on every other path.
 #include <catch2/catch.hpp>
 
+#include <Eigen/Core>
 #include <csignal>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "output_helpers.h"
 #include "temp_dir.h"
+#include "buckle/mechanics/shape_name.h"
+#include "scene/command.h"
 #include "scene/output.h"
 
 namespace fs = std::filesystem;
@@ -129,4 +138,60 @@ TEST_CASE("a signal while the output is staged is delivered once the staging dir
   CHECK(gDelivered == SIGTERM);  // delivered after the removal
   CHECK(stagingLeftovers(dir) == 0);
   sigaction(SIGTERM, &previous, nullptr);
+}
+
+TEST_CASE("a long chain's joint angles go to joint_angles.npy, rows as in branches.csv", "[scene][output]") {
+  // 20 segments, past the first branch points with switching: straight and bent rows
+  const fs::path dir = freshDir("npy");
+  fs::create_directories(dir);
+  std::ofstream(dir / "long.json") << R"({
+  "chain": {"segments": 20, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+  "end": {"x": {"load": 0.0}, "y": {"held": 0.0}, "phi": "free"},
+  "path": {"parameter": "Fx", "from": 0.0, "to": -0.05},
+  "analyses": {"continuation": {"branch_switching": 1}},
+  "plots": []
+})";
+  buckle::scene::RunCommandOptions opt;
+  opt.scene = (dir / "long.json").string();
+  opt.out = (dir / "out").string();
+  std::ostringstream log, err;
+  REQUIRE(buckle::scene::runSceneCommand(opt, log, err) == 0);
+
+  std::ifstream csv(dir / "out" / "branches.csv");
+  std::string header;
+  std::getline(csv, header);
+  CHECK(header.find(",max_abs_q,sign_changes,") != std::string::npos);
+  CHECK(header.find(",q1,") == std::string::npos);
+  std::vector<std::pair<double, int>> rows;  // (max_abs_q, sign_changes) of every row
+  for (std::string line; std::getline(csv, line);) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+    rows.emplace_back(std::stod(f[12]), std::stoi(f[13]));
+  }
+  REQUIRE(rows.size() > 20);
+
+  // the .npy file: preamble, a header naming the shape, then rows × 20 little-endian doubles
+  std::ifstream npy(dir / "out" / "joint_angles.npy", std::ios::binary);
+  REQUIRE(npy.good());
+  std::string data((std::istreambuf_iterator<char>(npy)), std::istreambuf_iterator<char>());
+  REQUIRE(data.size() > 10);
+  CHECK(data.substr(0, 8) == std::string("\x93NUMPY\x01\x00", 8));
+  const std::size_t headerLength = std::size_t(uint8_t(data[8])) | std::size_t(uint8_t(data[9])) << 8;
+  CHECK((10 + headerLength) % 64 == 0);
+  const std::string npyHeader = data.substr(10, headerLength);
+  CHECK(npyHeader.find("'descr': '<f8'") != std::string::npos);
+  CHECK(npyHeader.find("'shape': (" + std::to_string(rows.size()) + ", 20)") != std::string::npos);
+  REQUIRE(data.size() == 10 + headerLength + rows.size() * 20 * sizeof(double));
+  int bent = 0;
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    Eigen::VectorXd q(20);
+    std::memcpy(q.data(), data.data() + 10 + headerLength + r * 20 * sizeof(double), 20 * sizeof(double));
+    const double qmax = q.cwiseAbs().maxCoeff();
+    CHECK(qmax == Approx(rows[r].first).epsilon(1e-11).margin(1e-300));
+    CHECK(buckle::mechanics::signChanges(q, 1e-9 * qmax) == rows[r].second);
+    if (qmax > 0.0) ++bent;
+  }
+  CHECK(bent > 0);
+  fs::remove_all(dir);
 }
