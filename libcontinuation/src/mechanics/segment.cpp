@@ -53,8 +53,8 @@ Segment::Segment(const SegmentParameters& p) : p_(p) {
 //   L² = Δ + 4P c²,   dL/dq = −s P sin θ / L = −2s P s_h r,
 //   d²L/dq² = −[P cos θ Δ + 4P²c⁴] / L³ = L·g,  g = −P cos θ Δ/L⁴ − 4P² r⁴,
 //   d³L/dq³ = −dL/dq − 3 (dL/dq)(d²L/dq²)/L = −dL/dq (1 + 3g),   cos θ = c² − s_h².
-// Written with r and g, nothing is 0/0 where L → 0: for identical triangles (Δ = 0) L = 2√P c
-// and r = 1/(2√P) exactly, so L, L′, L″, L‴ are the smooth functions of q they are on the
+// Near the limit, written with r and g, nothing is 0/0 where L → 0: for identical triangles
+// (Δ = 0) L = 2√P c and r = 1/(2√P) exactly, so L, L′, L″, L‴ are the smooth functions of q they are on the
 // admissible side, up to and at the limit itself (c = 0, L = 0), and continue analytically
 // beyond it (c < 0, L < 0: what the boundary location of the tracer needs to bracket the limit;
 // equilibrium_problem.cpp). For Δ > 0, L ≥ √Δ > 0 is smooth through the limit anyway.
@@ -67,7 +67,20 @@ Segment::Segment(const SegmentParameters& p) : p_(p) {
 namespace {
 constexpr double kNearLimit = 0.25;
 
-inline Jet3 springFromHalfAngle(double c, double sh, double sign, double P, double delta, double sqrtP) {
+// Away from the limit (|c| ≥ kNearLimit, L ≥ 2√P·kNearLimit): the direct forms.
+inline Jet3 springFromHalfAngle(double c, double sh, double sign, double P, double delta) {
+  const double c2 = c * c;
+  Jet3 L;
+  L.value = std::sqrt(delta + 4.0 * P * c2);
+  const double inv = 1.0 / L.value;
+  L.d1 = -2.0 * sign * P * sh * c * inv;
+  L.d2 = -(P * (c2 - sh * sh) * delta + 4.0 * P * P * c2 * c2) * (inv * inv * inv);
+  L.d3 = -L.d1 - 3.0 * L.d1 * L.d2 * inv;
+  return L;
+}
+
+// Near the limit: the same quantities through r = c/L and g = L″/L, never 0/0.
+inline Jet3 springNearLimit(double c, double sh, double sign, double P, double delta, double sqrtP) {
   Jet3 L;
   double r, w;
   if (delta > 0.0) {
@@ -93,19 +106,19 @@ void Segment::springs(double q, Jet3& L1, Jet3& L2) const {
   const double sq = std::sin(0.5 * q), cq = std::cos(0.5 * q);  // one sincos call at -O2
   const double cc = cosHalfBeta_ * cq, ss = sinHalfBeta_ * sq;
   const double sc = sinHalfBeta_ * cq, cs = cosHalfBeta_ * sq;
-  double c1 = cc - ss, s1 = sc + cs, c2 = cc + ss, s2 = sc - cs;
+  const double c1 = cc - ss, c2 = cc + ss;
   if (std::abs(c1) < kNearLimit) {  // spring 1 near its limit q_max = π − β12
     const double h = 0.5 * (geometricUpperLimit() - q);
-    c1 = std::sin(h);
-    s1 = std::cos(h);
+    L1 = springNearLimit(std::sin(h), std::cos(h), +1.0, c1c2_, delta_, sqrtP_);
+  } else {
+    L1 = springFromHalfAngle(c1, sc + cs, +1.0, c1c2_, delta_);
   }
   if (std::abs(c2) < kNearLimit) {  // spring 2 near q_min = β12 − π
     const double h = 0.5 * (q - geometricLowerLimit());
-    c2 = std::sin(h);
-    s2 = std::cos(h);
+    L2 = springNearLimit(std::sin(h), std::cos(h), -1.0, c1c2_, delta_, sqrtP_);
+  } else {
+    L2 = springFromHalfAngle(c2, sc - cs, -1.0, c1c2_, delta_);
   }
-  L1 = springFromHalfAngle(c1, s1, +1.0, c1c2_, delta_, sqrtP_);
-  L2 = springFromHalfAngle(c2, s2, -1.0, c1c2_, delta_, sqrtP_);
 }
 
 Jet3 Segment::spring1(double q) const {
