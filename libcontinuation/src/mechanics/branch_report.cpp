@@ -305,6 +305,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
         s.shape = shapeName(s.q, kStraightTolerance);
         s.accuracy = x.accuracy;
         s.residual = x.residual;
+        s.K = x.K;
         os << "located on the branch where d" << name << "/ds = 0 (|dλ| of the last iterates " << x.accuracy << ")";
       } else {
         s.accuracy = std::abs(p1.parameter - p0.parameter);

@@ -94,6 +94,8 @@ struct SpecialPointReport {
   int negativeBefore = -1, negativeAfter = -1;
   std::string stabilityBefore, stabilityAfter;  ///< stabilityLabel of the counts, or "critical"
   double accuracy = 0.0;               ///< achieved |Δ parameter| of the location
+  /// The loaded stiffness K_F at the point where the report computed it (KMIN), else NaN.
+  Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
   double residual = 0.0;
   bool refined = false;                ///< Newton on an augmented system converged
   int multiplicity = 1;
