@@ -203,7 +203,9 @@ TEST_CASE("KMIN of the smallest eigenvalue of K_F: its rate vanishes there", "[s
   EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(1, 0, 0));
   for (StiffnessMeasure m : {StiffnessMeasure::MinEigenvalue, StiffnessMeasure::Kxx}) {
     CAPTURE(stiffnessMeasureName(m));
-    for (const SpecialPointReport& s : kmin(problem, 1.0, 0.0, m)) {
+    const std::vector<SpecialPointReport> found = kmin(problem, 1.0, 0.0, m);
+    REQUIRE(found.size() == 1);
+    for (const SpecialPointReport& s : found) {
       REQUIRE(s.refined);
       // The measure along λ (monotone here): equal values at λ ± h within O(h²)·m'' of each other,
       // and both above the located value.
