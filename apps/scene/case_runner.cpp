@@ -42,6 +42,7 @@ SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
   s.stabilityAfter = sp.stabilityAfter;
   s.accuracy = sp.accuracy;
   s.residual = sp.residual;
+  s.K = sp.K;
   s.refined = sp.refined;
   s.note = sp.note;
   copyLanding(sp.landing, s);

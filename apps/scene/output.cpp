@@ -394,7 +394,11 @@ double columnValue(const std::string& column, const PointRecord& p, const mechan
 double columnValue(const std::string& column, const SpecialRecord& s, const mechanics::Pose& pose0) {
   bool found = false;
   const double v = commonColumn(column, s.parameter, s.F, s.pose, s.q, pose0, found);
-  return found ? v : kNaN;
+  if (found) return v;
+  if (column == "Kxx") return s.K(0, 0);  // NaN unless the point carries its own K_F (KMIN)
+  if (column == "Kyy") return s.K(1, 1);
+  if (column == "Kxy") return s.K(0, 1);
+  return kNaN;
 }
 
 std::string columnLabel(const std::string& c) {

@@ -258,7 +258,8 @@ void placeLabels(std::vector<PlacedLabel>& labels, const Frame& f, const Occupan
 
 /// Column value at a special point; the columns that exist only at traced points (stiffness,
 /// smallest eigenvalue) are interpolated along the special point's branch between the two
-/// neighbouring points it lies between (exact where it is a traced point: KMIN, a joint limit).
+/// neighbouring points it lies between (exact where it is a traced point: a joint limit), unless
+/// the special point carries its own stiffness (KMIN, located between traced points).
 double specialValue(const std::string& column, const SpecialRecord& r, const CaseResult& cr) {
   const double v = columnValue(column, r, cr.pose0);
   if (std::isfinite(v) || r.q.size() == 0) return v;

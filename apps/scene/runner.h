@@ -43,6 +43,8 @@ struct SpecialRecord {
   std::string shape;       ///< shapeName of the branch leaving a BP / of q elsewhere
   std::string stabilityBefore, stabilityAfter;
   double accuracy = 0.0;   ///< |Δλ| of the last location iterate
+  /// K_F at the point where the report computed it (KMIN, located between traced points), else NaN
+  Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
   double residual = 0.0;   ///< ‖F(u, λ)‖₂ at the point
   bool refined = false;
   std::string note;

@@ -367,7 +367,7 @@ TEST_CASE("special-point labels do not overlap one another, a marker or the plot
   }
 }
 
-TEST_CASE("stiffness plots mark KMIN and joint limits at the traced stiffness", "[scene][plot]") {
+TEST_CASE("stiffness plots mark KMIN at its located stiffness and joint limits at the traced one", "[scene][plot]") {
   const fs::path out = runShipped("fig9_fig10", "fig9_fig10_kmin");
   const Csv csv = readCsv(out / "branches.csv");
   const json sp = readJson(out / "special_points.json");
@@ -398,7 +398,20 @@ TEST_CASE("stiffness plots mark KMIN and joint limits at the traced stiffness", 
           atPoint = true;
           CHECK(row[1] == Approx(rowCsv[csv.col("Kxx")]).epsilon(1e-9));
         }
-        if (type == "KMIN") CHECK(atPoint);
+        if (type == "KMIN") {
+          // located between traced points, at its own K_xx: below the traced points nearest in Fx
+          CHECK(!atPoint);
+          double below = -1e300, above = 1e300, kBelow = 0.0, kAbove = 0.0;
+          for (const auto& rowCsv : csv.rows) {
+            if (int(rowCsv[csv.col("case")]) != k || int(rowCsv[csv.col("branch")]) != int(p["branch"])) continue;
+            const double fx = rowCsv[csv.col("Fx")];
+            if (fx <= row[0] && fx > below) below = fx, kBelow = rowCsv[csv.col("Kxx")];
+            if (fx >= row[0] && fx < above) above = fx, kAbove = rowCsv[csv.col("Kxx")];
+          }
+          CHECK(row[1] > 0.0);
+          CHECK(row[1] <= kBelow);
+          CHECK(row[1] <= kAbove);
+        }
       }
       CHECK(found);
     }

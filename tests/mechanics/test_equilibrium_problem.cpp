@@ -4,6 +4,10 @@
 #include <random>
 #include <string>
 
+#include <Eigen/LU>
+#include <limits>
+
+#include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/jump.h"
 
@@ -219,4 +223,105 @@ TEST_CASE("EquilibriumProblem: cached evaluations equal a fresh problem's in any
       }
     }
   }
+}
+
+namespace {
+
+// The BD special point of the first branch traced from the straight chain along `direction`.
+const buckle::continuation::SpecialPoint* tracedLimit(EquilibriumProblem& problem, EquilibriumBranches& r,
+                                                       double lambdaMax) {
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMax = lambdaMax;
+  o.tracer.maxStep = 0.1;
+  o.switchingDepth = 0;
+  r = traceEquilibria(problem, Eigen::VectorXd::Zero(problem.segments()), 0.0,
+                      buckle::continuation::InitialDirection::increasingLambda(), o);
+  const auto bds = r.tree.branches.at(0).specialPointsOfType(buckle::continuation::SpecialPointType::Boundary);
+  return bds.size() == 1 ? bds[0] : nullptr;
+}
+
+// Independent: Newton on the equilibrium with joint k fixed at `limit` and λ free (the unknowns
+// are the other joint angles and λ; free end, so no multipliers), to the rounding floor.
+Vector solveWithJointAt(EquilibriumProblem& problem, Vector u, double& lambda, int k, double limit) {
+  const int n = problem.segments();
+  u[k] = limit;
+  Vector F(n), Fl(n), z(n);
+  Matrix Fu(n, n), A(n, n);
+  int small = 0;
+  for (int it = 0; it < 60 && small < 3; ++it) {
+    REQUIRE(problem.residual(u, lambda, F));
+    REQUIRE(problem.jacobian(u, lambda, Fu, Fl));
+    A = Fu;
+    A.col(k) = Fl;  // column k now moves λ
+    z = A.partialPivLu().solve(F);
+    for (int i = 0; i < n; ++i)
+      if (i != k) u[i] -= z[i];
+    lambda -= z[k];
+    if (z.lpNorm<Eigen::Infinity>() < 1e-15 * std::max(1.0, std::abs(lambda))) ++small;
+  }
+  REQUIRE(small >= 3);
+  return u;
+}
+
+}  // namespace
+
+TEST_CASE("a geometric joint limit is located at the limit itself, with the exact limit load", "[equilibrium]") {
+  // One segment under an end torque Me = λ: the torque balance dE/dq = Me (J_φ = 1) at
+  // q = q_max = π − β12 in closed form from eq 1. Spring 1 has zero length there (identical
+  // triangles): L1 = 0, dL1/dq = −√P; spring 2: θ2 = β12 − q_max = 2β12 − π, L2 = 2√P sin β12,
+  // dL2/dq = −√P cos β12 (P = a² + b², β12 = 2 atan(a/b)).
+  const double a = 0.5, b = 1.0, k = 1.0, L0 = 2.25;
+  for (double qMaxUser : {std::numeric_limits<double>::infinity(), 1.0}) {
+    SegmentParameters p = SegmentParameters::symmetric(a, b, k, L0);
+    p.qMaxUser = qMaxUser;
+    const Chain chain = Chain::uniform(1, p);
+    EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 0, 1));
+    EquilibriumBranches r;
+    const buckle::continuation::SpecialPoint* bd = tracedLimit(problem, r, 50.0);
+    REQUIRE(bd);
+    const double P = a * a + b * b, beta = 2.0 * std::atan(a / b);
+    double limit, exact;
+    if (std::isinf(qMaxUser)) {
+      limit = M_PI - beta;
+      exact = k * L0 * std::sqrt(P) - k * (2.0 * std::sqrt(P) * std::sin(beta) - L0) * std::sqrt(P) * std::cos(beta);
+      CHECK_THAT(bd->boundaryName, Catch::Contains("geometric"));
+    } else {  // a user limit: eq 1 at θ = β12 ± q directly
+      limit = qMaxUser;
+      exact = 0.0;
+      for (double sgn : {1.0, -1.0}) {
+        const double th = beta + sgn * limit, L = std::sqrt(2.0 * P * (1.0 + std::cos(th)));
+        exact += k * (L - L0) * (-sgn * P * std::sin(th) / L);
+      }
+    }
+    INFO("limit " << limit << ", exact limit torque " << exact << ", located " << bd->lambda << " at q = " << bd->u[0]);
+    CHECK(std::abs(bd->u[0] - limit) <= 1e-12);
+    CHECK(std::abs(bd->lambda - exact) <= 1e-12 * std::abs(exact));
+  }
+}
+
+TEST_CASE("a chain's geometric joint limit: the load equals Newton's with the joint fixed there", "[equilibrium]") {
+  // Three segments of different heights under an end torque and a small lateral force: the
+  // joints are coupled through the force, and one of them reaches its geometric limit first.
+  std::vector<SegmentParameters> segs = {SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25),
+                                         SegmentParameters::symmetric(0.45, 1.0, 1.0, 2.25),
+                                         SegmentParameters::symmetric(0.4, 1.0, 1.0, 2.25)};
+  const Chain chain(segs);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 0.2, 1));
+  EquilibriumBranches r;
+  const buckle::continuation::SpecialPoint* bd = tracedLimit(problem, r, 50.0);
+  const buckle::continuation::Branch& br = r.tree.branches.at(0);
+  INFO(br.stopMessage << " after " << br.points.size() << " points, last q " << br.points.back().u.transpose()
+                      << " at " << br.points.back().lambda);
+  REQUIRE(bd);
+  int joint = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(bd->u[i]) / chain.upperLimits()[i] > std::abs(bd->u[joint]) / chain.upperLimits()[joint]) joint = i;
+  const double limit = bd->u[joint] > 0 ? chain.upperLimits()[joint] : chain.lowerLimits()[joint];
+  CHECK(limit == (bd->u[joint] > 0 ? chain.segment(joint).geometricUpperLimit() : chain.segment(joint).geometricLowerLimit()));
+  double lambda = bd->lambda;
+  const Vector u = solveWithJointAt(problem, bd->u, lambda, joint, limit);
+  INFO("joint " << joint + 1 << ": located " << bd->lambda << ", Newton with the joint fixed " << lambda);
+  CHECK(std::abs(bd->u[joint] - limit) <= 1e-12);
+  CHECK(std::abs(bd->lambda - lambda) <= 1e-12 * std::abs(lambda));
+  CHECK((bd->u - u).norm() <= 1e-11);
 }

@@ -145,6 +145,71 @@ TEST_CASE("spring jets stay accurate up to the geometric limit (no cancellation 
   CHECK(worst[2] < 5e-13);
 }
 
+TEST_CASE("spring jets keep their relative accuracy as L -> 0, at the limit and past it", "[segment]") {
+  // Reference in long double from the distance to the (double) limit δ = q_max − q, exact in
+  // double near the limit: c = cos(θ/2) = sin(δ/2), s_h = cos(δ/2). For identical triangles
+  // L = 2√P c → 0 with δ, smooth and signed past the limit (its analytic continuation); the jet
+  // must keep relative accuracy down to δ = 1e-15 and be finite at δ = 0 (no 0/0).
+  std::mt19937 rng(23);
+  double worst = 0.0;
+  for (int trial = 0; trial < 200; ++trial) {
+    SegmentParameters p = testing::randomSegment(rng, kNarrow);
+    if (trial % 2) {
+      p.a2 = p.a1;
+      p.b2 = p.b1;
+    }
+    const Segment s(p);
+    const long double c1 = std::hypot((long double)p.a1, (long double)p.b1);
+    const long double c2 = std::hypot((long double)p.a2, (long double)p.b2);
+    const long double P = c1 * c2, delta = (long double)((double(c1) - double(c2)) * (double(c1) - double(c2)));
+    for (int k = -3; k <= 16; ++k) {
+      // k = 16: at the limit; k < 0: past it by 10^k
+      const double d = k == 16 ? 0.0 : (k < 0 ? -std::pow(10.0, double(k)) : std::pow(10.0, -double(k)));
+      for (int spring = 0; spring < 2; ++spring) {
+        const double q = spring == 0 ? s.geometricUpperLimit() - d : s.geometricLowerLimit() + d;
+        const long double sign = spring == 0 ? 1.0L : -1.0L;
+        const long double h = 0.5L * (spring == 0 ? (long double)s.geometricUpperLimit() - q
+                                                  : q - (long double)s.geometricLowerLimit());
+        const long double c = std::sin(h), sh = std::cos(h), cosT = c * c - sh * sh;
+        long double L, d1, d2;
+        if (delta > 0) {
+          L = std::sqrt(delta + 4.0L * P * c * c);
+          d1 = -2.0L * sign * P * sh * c / L;
+          d2 = -(P * cosT * delta + 4.0L * P * P * c * c * c * c) / (L * L * L);
+        } else {
+          L = 2.0L * std::sqrt(P) * c;
+          d1 = -sign * std::sqrt(P) * sh;
+          d2 = -0.5L * std::sqrt(P) * c;
+        }
+        const Jet3 got = spring == 0 ? s.spring1(q) : s.spring2(q);
+        REQUIRE(std::isfinite(got.value));
+        REQUIRE(std::isfinite(got.d1));
+        REQUIRE(std::isfinite(got.d2));
+        REQUIRE(std::isfinite(got.d3));
+        const auto rel = [](double x, long double ref) {
+          return ref == 0 ? double(std::abs(x)) : double(std::abs(x - ref) / std::abs(ref));
+        };
+        worst = std::max({worst, rel(got.value, L), rel(got.d1, d1), rel(got.d2, d2)});
+        if (delta == 0 && d == 0.0) CHECK(got.value == 0.0);  // exactly zero length at the limit
+      }
+    }
+  }
+  INFO("worst relative error of L, L', L'' near the limit: " << worst);
+  CHECK(worst < 1e-13);
+}
+
+TEST_CASE("the third derivative of L is continuous through the geometric limit", "[segment]") {
+  // Identical triangles: L = 2√P sin(δ/2), so L‴ = √P s_h/4·(sign) stays bounded and continuous
+  // where L = 0; finite differences of L″ on both sides agree with it.
+  const Segment s(SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const double qmax = s.geometricUpperLimit(), h = 1e-5;
+  for (double q : {qmax - 1e-3, qmax, qmax + 1e-3}) {
+    const double fd = (s.spring1(q + h).d2 - s.spring1(q - h).d2) / (2 * h);
+    CHECK(std::abs(s.spring1(q).d3 - fd) <= 1e-8);
+  }
+  CHECK(std::abs(s.spring1(qmax).d3 - std::sqrt(std::hypot(0.5, 1.0) * std::hypot(0.5, 1.0)) / 4) <= 1e-15);
+}
+
 TEST_CASE("bad segment parameters are rejected naming the parameter", "[segment]") {
   auto message = [](SegmentParameters p) {
     try {

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 #include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/stiffness.h"
+#include "buckle/mechanics/stiffness_extremum.h"
 
 namespace buckle::mechanics {
 
@@ -263,24 +265,55 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
                           r.specialPoints.end());
   }
 
-  // ---- quasi-buckling: a deep, smooth minimum of Kxx along a stable stretch -----------------
-  if (options.stiffness && r.points.size() >= 3) {
-    const double k0 = r.points.front().K(0, 0);
-    for (size_t i = 1; i + 1 < r.points.size(); ++i) {
-      const PointReport &a = r.points[i - 1], &m = r.points[i], &cc = r.points[i + 1];
-      const double ka = a.K(0, 0), km = m.K(0, 0), kc = cc.K(0, 0);
-      if (!std::isfinite(ka) || !std::isfinite(km) || !std::isfinite(kc) || !std::isfinite(k0)) continue;
-      if (!(m.stable && a.stable && cc.stable)) continue;
-      if (km < ka && km <= kc && km > 0.0 && km < options.deepStiffnessRatio * k0) {
-        SpecialPointReport s = atPoint(m, EventType::StiffnessMinimum, Phenomenon::QuasiBuckling);
-        s.lambda = b.points[size_t(m.index)].lambda;
-        s.negativeBefore = s.negativeAfter = 0;
-        s.accuracy = 0.5 * std::max(std::abs(cc.parameter - m.parameter), std::abs(m.parameter - a.parameter));
-        std::ostringstream os;
-        os << "local minimum of Kxx = " << km << " (branch start: " << k0 << "), located to the point spacing";
-        s.note = os.str();
-        r.specialPoints.push_back(std::move(s));
+  // ---- quasi-buckling: a deep local minimum of the stiffness measure along a stable stretch ---
+  // Bracketed where the exact rate dm/ds along the traced tangents changes from negative to
+  // positive between two consecutive stable points, then located on the branch itself
+  // (stiffness_extremum.h): neither the step size nor the units move it.
+  if (options.stiffness && r.points.size() >= 2 && !b.points.empty()) {
+    const StiffnessMeasure measure = options.stiffnessMeasure;
+    const char* name = stiffnessMeasureName(measure);
+    const int N = problem.dimension();
+    const double m0 = stiffnessMeasure(r.points.front().K, measure);
+    std::vector<double> rate(r.points.size(), std::numeric_limits<double>::quiet_NaN());
+    for (size_t i = 0; i < r.points.size(); ++i) {
+      const cont::ContinuationPoint& p = b.points[size_t(r.points[i].index)];
+      if (p.tangent.size() != N + 1 || !r.points[i].stable) continue;
+      const StiffnessRate sr = stiffnessRate(problem, p.u, p.lambda, p.tangent.head(N), p.tangent[N], measure);
+      if (sr.valid) rate[i] = sr.rate;
+    }
+    for (size_t i = 0; i + 1 < r.points.size(); ++i) {
+      const PointReport &p0 = r.points[i], &p1 = r.points[i + 1];
+      if (p1.index != p0.index + 1 || !(rate[i] < 0.0 && rate[i + 1] > 0.0) || !std::isfinite(m0)) continue;
+      const StiffnessExtremum x =
+          locateStiffnessMinimum(problem, b.points[size_t(p0.index)], b.points[size_t(p1.index)], measure);
+      const double ma = stiffnessMeasure(p0.K, measure), mc = stiffnessMeasure(p1.K, measure);
+      const double value = x.located ? x.value : std::min(ma, mc);
+      if (!(value > 0.0 && value < options.deepStiffnessRatio * m0)) continue;
+      SpecialPointReport s = atPoint(ma <= mc ? p0 : p1, EventType::StiffnessMinimum, Phenomenon::QuasiBuckling);
+      s.index = p0.index;
+      s.lambda = b.points[size_t(ma <= mc ? p0.index : p1.index)].lambda;
+      s.negativeBefore = s.negativeAfter = 0;
+      std::ostringstream os;
+      os.precision(12);
+      os << "local minimum of " << name << " = " << value << " (branch start: " << m0 << "), ";
+      if (x.located) {
+        s.refined = true;
+        s.lambda = x.lambda;
+        s.q = x.u.head(n);
+        s.F = problem.wrench(x.u, x.lambda);
+        s.pose = endPose(chain, s.q);
+        s.parameter = throughReaction ? s.pose[c] : x.lambda;
+        s.shape = shapeName(s.q, kStraightTolerance);
+        s.accuracy = x.accuracy;
+        s.residual = x.residual;
+        s.K = x.K;
+        os << "located on the branch where d" << name << "/ds = 0 (|dλ| of the last iterates " << x.accuracy << ")";
+      } else {
+        s.accuracy = std::abs(p1.parameter - p0.parameter);
+        os << "not located (" << x.message << "): to the point spacing";
       }
+      s.note = os.str();
+      r.specialPoints.push_back(std::move(s));
     }
   }
   for (SpecialPointReport& s : r.specialPoints) {

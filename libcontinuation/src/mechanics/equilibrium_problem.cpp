@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "buckle/mechanics/chain_solver.h"
+#include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/validation.h"
 
 namespace buckle::mechanics {
@@ -89,13 +90,26 @@ Vector EquilibriumProblem::initialGuess(ConstVectorRef q, double lambda) const {
   return u;
 }
 
+// The geometric limits: the spring model (segment.cpp) is smooth up to and at a geometric limit
+// — the closing spring's length L → 0 is evaluated without 0/0 — and continues analytically a
+// little beyond it. With the joint limits as boundaries the tracer needs that continuation: it
+// detects a boundary by a step that ends on its far side and then locates the crossing exactly
+// (boundary() below has no margin), so points up to kGeometricOvershoot past a geometric limit
+// are evaluated; the branch stops at the located limit and never reports them. Farther out, or
+// with the limits not traced as boundaries, points beyond a geometric limit are refused: there
+// the triangles would overlap and the model no longer describes the mechanism.
+namespace {
+constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step that crosses a limit
+}
+
 bool EquilibriumProblem::inDomain(ConstVectorRef u) const {
-  // Beyond the geometric limit a spring would pass through zero length: the smooth model no
-  // longer describes the mechanism, so such points are refused (not extrapolated).
   const int n = chain_.size();
+  const double overshoot = options_.jointLimitsAsBoundaries ? kGeometricOvershoot : 0.0;
   for (int i = 0; i < n; ++i) {
     const Segment& s = chain_.segment(i);
-    if (!std::isfinite(u[i]) || u[i] >= s.geometricUpperLimit() || u[i] <= s.geometricLowerLimit()) return false;
+    if (!std::isfinite(u[i]) || u[i] > s.geometricUpperLimit() + overshoot ||
+        u[i] < s.geometricLowerLimit() - overshoot)
+      return false;
   }
   for (int k = n; k < u.size(); ++k)
     if (!std::isfinite(u[k])) return false;
@@ -146,33 +160,16 @@ bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double 
   const Wrench W = wrench(u, lambda);
   Wrench dW = dlambda * direction_;
   for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = du[n + k];
-  // Tail-sum derivatives: dS_m = Σ_{p≥m} ℓ cos θ_p dθ_p, dC_m = −Σ_{p≥m} ℓ sin θ_p dθ_p.
-  const Vector& l = chain_.linkLengths();
-  Vector dS(n), dC(n);
-  double dtheta = 0.0;
-  Vector dth(n);
-  for (int p = 0; p < n; ++p) {
-    dtheta += du[p];
-    dth[p] = dtheta;
-  }
-  double s = 0.0, c = 0.0;
-  for (int p = n - 1; p >= 0; --p) {
-    s += l[p + 1] * std::cos(data_.theta[p]) * dth[p];
-    c -= l[p + 1] * std::sin(data_.theta[p]) * dth[p];
-    dS[p] = s;
-    dC[p] = c;
-  }
+  // dJ rows: (−dS, dC, 0) with the tail-sum derivatives of stiffness.h
+  Matrix dJ(3, n);
+  endJacobianDerivative(chain_, data_, du.head(n), dJ);
+  const Vector dS = -dJ.row(0).transpose(), dC = dJ.row(1).transpose();
   // dh_m for h_m = −Fx C_m − Fy S_m
   Vector dh = -dW[0] * data_.C - W[0] * dC - dW[1] * data_.S - W[1] * dS;
   jointStiffnessDerivative(chain_, u.head(n), work2_);
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) dFu(i, j) = -dh[std::max(i, j)];
   for (int i = 0; i < n; ++i) dFu(i, i) += work2_[i] * du[i];
-  // dJ rows: (−dS, dC, 0)
-  Matrix dJ(3, n);
-  dJ.row(0) = -dS.transpose();
-  dJ.row(1) = dC.transpose();
-  dJ.row(2).setZero();
   for (int k = 0; k < m; ++k) {
     dFu.block(0, n + k, n, 1) = -dJ.row(held_[size_t(k)]).transpose();
     dFu.block(n + k, 0, 1, n) = -dJ.row(held_[size_t(k)]);
@@ -284,30 +281,20 @@ continuation::ProblemScales EquilibriumProblem::scales() const {
 
 int EquilibriumProblem::boundaryCount() const { return options_.jointLimitsAsBoundaries ? 2 * chain_.size() : 0; }
 
-// At the geometric limit itself a spring has zero length and the model is singular (its force
-// direction is undefined), so points there are refused. The boundary event for a geometric limit
-// is therefore placed kGeometricLimitMargin inside it, where it can be located exactly; user
-// limits inside the geometric range are used as they are.
-namespace {
-constexpr double kGeometricLimitMargin = 1e-5;
-}
-
+// A joint limit is the joint angle at the limit itself, geometric (the closing spring's length
+// is zero, or |c1 − c2|) or the user's: the spring model is regular there (inDomain above).
 double EquilibriumProblem::boundary(int k, ConstVectorRef u, double) {
   const int n = chain_.size();
-  if (k < n) {
-    const Segment& s = chain_.segment(k);
-    return std::min(s.parameters().qMaxUser, s.geometricUpperLimit() - kGeometricLimitMargin) - u[k];
-  }
-  const Segment& s = chain_.segment(k - n);
-  return u[k - n] - std::max(s.parameters().qMinUser, s.geometricLowerLimit() + kGeometricLimitMargin);
+  if (k < n) return chain_.upperLimits()[k] - u[k];
+  return u[k - n] - chain_.lowerLimits()[k - n];
 }
 
 std::string EquilibriumProblem::boundaryName(int k) const {
   const int n = chain_.size();
   const int j = k < n ? k : k - n;
   const Segment& s = chain_.segment(j);
-  const bool geometric = k < n ? s.parameters().qMaxUser >= s.geometricUpperLimit() - kGeometricLimitMargin
-                               : s.parameters().qMinUser <= s.geometricLowerLimit() + kGeometricLimitMargin;
+  const bool geometric = k < n ? s.parameters().qMaxUser >= s.geometricUpperLimit()
+                               : s.parameters().qMinUser <= s.geometricLowerLimit();
   return "joint " + std::to_string(j + 1) + (k < n ? " upper" : " lower") +
          (geometric ? " geometric limit (closing spring length -> 0)" : " limit");
 }

@@ -33,6 +33,7 @@ Segment::Segment(const SegmentParameters& p) : p_(p) {
   c1_ = std::hypot(p.a1, p.b1);
   c2_ = std::hypot(p.a2, p.b2);
   c1c2_ = c1_ * c2_;
+  sqrtP_ = std::sqrt(c1c2_);
   beta12_ = std::atan(p.a1 / p.b1) + std::atan(p.a2 / p.b2);
   delta_ = (c1_ - c2_) * (c1_ - c2_);
   cosHalfBeta_ = std::cos(0.5 * beta12_);
@@ -48,16 +49,25 @@ Segment::Segment(const SegmentParameters& p) : p_(p) {
 // θ = β12 + s·q (s = +1: spring 1, s = −1: spring 2), L² = c1² + c2² + 2c1c2 cos θ (eq 1).
 // Near the geometric limit (θ → π) that form cancels catastrophically, so everything is written
 // with the half angle, 1 + cos θ = 2cos²(θ/2) (exact to rounding): with P = c1c2, Δ = (c1 − c2)²,
-// c = cos(θ/2), s_h = sin(θ/2),
-//   L² = Δ + 4P c²,   dL/dq = −s P sin θ / L = −2s P s_h c / L,
-//   d²L/dq² = −[P cos θ Δ + 4P²c⁴] / L³   (= −P cos θ/L − (dL/dq)²/L, cancellation-free),
-//   d³L/dq³ = −dL/dq − 3 (dL/dq)(d²L/dq²)/L,   cos θ = c² − s_h².
+// c = cos(θ/2), s_h = sin(θ/2), r = c/L,
+//   L² = Δ + 4P c²,   dL/dq = −s P sin θ / L = −2s P s_h r,
+//   d²L/dq² = −[P cos θ Δ + 4P²c⁴] / L³ = L·g,  g = −P cos θ Δ/L⁴ − 4P² r⁴,
+//   d³L/dq³ = −dL/dq − 3 (dL/dq)(d²L/dq²)/L = −dL/dq (1 + 3g),   cos θ = c² − s_h².
+// Near the limit, written with r and g, nothing is 0/0 where L → 0: for identical triangles
+// (Δ = 0) L = 2√P c and r = 1/(2√P) exactly, so L, L′, L″, L‴ are the smooth functions of q they are on the
+// admissible side, up to and at the limit itself (c = 0, L = 0), and continue analytically
+// beyond it (c < 0, L < 0: what the boundary location of the tracer needs to bracket the limit;
+// equilibrium_problem.cpp). For Δ > 0, L ≥ √Δ > 0 is smooth through the limit anyway.
 // Both springs share one sincos of q/2: θ/2 = β12/2 ± q/2, so by the addition theorems
 //   cos(θ/2) = cos(β12/2)cos(q/2) ∓ sin(β12/2)sin(q/2),  sin(θ/2) = sin(β12/2)cos(q/2) ± cos(β12/2)sin(q/2).
-// cos(θ/2) → 0 at the limit has an absolute error of a few ulp, like rounding θ = β12 + q itself
-// (the previous form, cos(0.5·θ), two sincos and two cos per segment); the relative accuracy of L
-// near the limit is unchanged (tests/mechanics/test_segment.cpp compares against long double).
+// cos(θ/2) → 0 at the limit loses its relative accuracy in that difference (absolute error of
+// a few ulp), so near the limit (|c| < kNearLimit) c and s_h come from the distance to the limit
+// instead, δ = q_max − q (exact by Sterbenz there): c = sin(δ/2), s_h = cos(δ/2) — relative
+// accuracy to the end, and c = 0 exactly at q = geometricUpperLimit() (the double limit).
 namespace {
+constexpr double kNearLimit = 0.25;
+
+// Away from the limit (|c| ≥ kNearLimit, L ≥ 2√P·kNearLimit): the direct forms.
 inline Jet3 springFromHalfAngle(double c, double sh, double sign, double P, double delta) {
   const double c2 = c * c;
   Jet3 L;
@@ -68,14 +78,47 @@ inline Jet3 springFromHalfAngle(double c, double sh, double sign, double P, doub
   L.d3 = -L.d1 - 3.0 * L.d1 * L.d2 * inv;
   return L;
 }
+
+// Near the limit: the same quantities through r = c/L and g = L″/L, never 0/0.
+inline Jet3 springNearLimit(double c, double sh, double sign, double P, double delta, double sqrtP) {
+  Jet3 L;
+  double r, w;
+  if (delta > 0.0) {
+    L.value = std::sqrt(delta + 4.0 * P * c * c);
+    const double inv = 1.0 / L.value;
+    r = c * inv;
+    w = delta * (inv * inv) * (inv * inv);
+  } else {  // identical triangles: L = 2√P c, signed (its analytic continuation through c = 0)
+    L.value = 2.0 * sqrtP * c;
+    r = 0.5 / sqrtP;
+    w = 0.0;
+  }
+  const double r2 = r * r;
+  const double g = -P * (c * c - sh * sh) * w - 4.0 * P * P * r2 * r2;
+  L.d1 = -2.0 * sign * P * sh * r;
+  L.d2 = g * L.value;
+  L.d3 = -L.d1 * (1.0 + 3.0 * g);
+  return L;
+}
 }  // namespace
 
 void Segment::springs(double q, Jet3& L1, Jet3& L2) const {
   const double sq = std::sin(0.5 * q), cq = std::cos(0.5 * q);  // one sincos call at -O2
   const double cc = cosHalfBeta_ * cq, ss = sinHalfBeta_ * sq;
   const double sc = sinHalfBeta_ * cq, cs = cosHalfBeta_ * sq;
-  L1 = springFromHalfAngle(cc - ss, sc + cs, +1.0, c1c2_, delta_);
-  L2 = springFromHalfAngle(cc + ss, sc - cs, -1.0, c1c2_, delta_);
+  const double c1 = cc - ss, c2 = cc + ss;
+  if (std::abs(c1) < kNearLimit) {  // spring 1 near its limit q_max = π − β12
+    const double h = 0.5 * (geometricUpperLimit() - q);
+    L1 = springNearLimit(std::sin(h), std::cos(h), +1.0, c1c2_, delta_, sqrtP_);
+  } else {
+    L1 = springFromHalfAngle(c1, sc + cs, +1.0, c1c2_, delta_);
+  }
+  if (std::abs(c2) < kNearLimit) {  // spring 2 near q_min = β12 − π
+    const double h = 0.5 * (q - geometricLowerLimit());
+    L2 = springNearLimit(std::sin(h), std::cos(h), -1.0, c1c2_, delta_, sqrtP_);
+  } else {
+    L2 = springFromHalfAngle(c2, sc - cs, -1.0, c1c2_, delta_);
+  }
 }
 
 Jet3 Segment::spring1(double q) const {

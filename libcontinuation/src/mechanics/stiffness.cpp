@@ -107,6 +107,66 @@ CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const W
   return loadedStiffness(chain, q, F, end.isHeld(EndCoordinate::Phi), options);
 }
 
+void endJacobianDerivative(const Chain& chain, const ChainData& data, ConstVectorRef dq, MatrixRef dJ) {
+  const int n = chain.size();
+  const Vector& l = chain.linkLengths();
+  double thetaDot = 0.0, s = 0.0, c = 0.0;
+  for (int p = 0; p < n; ++p) {  // θ̇ first (head sums), then the tail sums from the end
+    thetaDot += dq[p];
+    dJ(2, p) = thetaDot;
+  }
+  for (int p = n - 1; p >= 0; --p) {
+    s += l[p + 1] * std::cos(data.theta[p]) * dJ(2, p);
+    c -= l[p + 1] * std::sin(data.theta[p]) * dJ(2, p);
+    dJ(0, p) = -s;
+    dJ(1, p) = c;
+  }
+  dJ.row(2).setZero();
+}
+
+bool loadedStiffnessDerivative(const Chain& chain, ConstVectorRef q, const Wrench& F, bool rotationHeld,
+                               ConstVectorRef dq, const Wrench& dF, Eigen::Matrix2d& K, Eigen::Matrix2d& dK,
+                               const StiffnessOptions& options) {
+  const int n = chain.size();
+  if (q.size() != n || dq.size() != n)
+    throw std::invalid_argument("q and dq must have one angle per segment (size " + std::to_string(n) + ")");
+  if (!q.allFinite() || !dq.allFinite() || !F.allFinite() || !dF.allFinite())
+    throw std::invalid_argument("q, dq, F and dF must be finite");
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  Matrix J(3, n), dJ(3, n);
+  endJacobian(data, J);
+  endJacobianDerivative(chain, data, dq, dJ);
+  Matrix H(n, n);
+  totalPotentialHessian(chain, q, F, H);
+  // dH = diag(dK_q ⊙ dq) − dK_g, dK_g(i, j) = dh_max(i,j) (eq 27), with S = −J_x, C = J_y.
+  Vector dkq(n);
+  jointStiffnessDerivative(chain, q, dkq);
+  const Vector dh = -dF[0] * data.C - F[0] * dJ.row(1).transpose() - dF[1] * data.S + F[1] * dJ.row(0).transpose();
+  Matrix dH(n, n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) dH(i, j) = -dh[std::max(i, j)];
+  dH.diagonal() += dkq.cwiseProduct(dq);
+
+  Matrix Cphi(rotationHeld ? 1 : 0, n);
+  if (rotationHeld) Cphi.row(0) = J.row(2);
+  Matrix R = Matrix::Zero(n + Cphi.rows(), 2);
+  R.topRows(n) = J.topRows(2).transpose();
+  Matrix X;
+  if (!borderedSolve(H, Cphi, R, options.singularTolerance, X)) return false;
+  const Matrix Xq = X.topRows(n);
+  Eigen::Matrix2d C = J.topRows(2) * Xq;
+  C = 0.5 * (C + C.transpose());
+  if (!(conditioning(C) > options.singularTolerance)) return false;
+  K = C.inverse();
+  K = 0.5 * (K + K.transpose());
+  const Eigen::Matrix2d dJXq = dJ.topRows(2) * Xq;
+  const Eigen::Matrix2d dC = dJXq + dJXq.transpose() - Xq.transpose() * dH * Xq;
+  dK = -K * dC * K;
+  dK = 0.5 * (dK + dK.transpose());
+  return K.allFinite() && dK.allFinite();
+}
+
 CartesianStiffness unloadedStiffness(const Chain& chain, ConstVectorRef q, bool rotationHeld,
                                      const StiffnessOptions& options) {
   return loadedStiffness(chain, q, Wrench::Zero(), rotationHeld, options);

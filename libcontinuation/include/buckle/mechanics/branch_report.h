@@ -23,6 +23,7 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/landing.h"
 #include "buckle/mechanics/load_history.h"
+#include "buckle/mechanics/stiffness_extremum.h"
 
 namespace buckle::mechanics {
 
@@ -34,7 +35,7 @@ enum class EventType {
   ReactionFold,      ///< "LPF": a fold of the reaction force of a held coordinate: no jump
   Boundary,          ///< "BD": a joint limit or another boundary of the model, located
   JointLimit,        ///< "BD": the steps collapsed at a geometric joint limit (not located)
-  StiffnessMinimum,  ///< "KMIN": a deep local minimum of K_xx along a stable stretch
+  StiffnessMinimum,  ///< "KMIN": a deep local minimum of a stiffness measure along a stable stretch
   Jump,              ///< "JUMP": a load history leaves its stable state (load_history.h)
 };
 
@@ -54,8 +55,12 @@ struct ReportOptions {
   double rangeHigh = std::numeric_limits<double>::infinity();
   /// The loaded Cartesian stiffness K_F (eq 29) at every point, and KMIN events.
   bool stiffness = false;
-  /// KMIN: a local minimum of K_xx along a stable stretch is "deep" (quasi-buckling) when it is
-  /// below this fraction of K_xx at the branch start (scale-free: a ratio of stiffnesses).
+  /// KMIN: the stiffness measure watched (stiffness_extremum.h): K_xx, K_yy or the smallest
+  /// eigenvalue of K_F.
+  StiffnessMeasure stiffnessMeasure = StiffnessMeasure::Kxx;
+  /// KMIN: a local minimum of the measure along a stable stretch, located where its rate along
+  /// the branch vanishes, is "deep" (quasi-buckling) when it is below this fraction of the
+  /// measure at the branch start (scale-free: a ratio of stiffnesses).
   double deepStiffnessRatio = 0.5;
 };
 
@@ -89,6 +94,8 @@ struct SpecialPointReport {
   int negativeBefore = -1, negativeAfter = -1;
   std::string stabilityBefore, stabilityAfter;  ///< stabilityLabel of the counts, or "critical"
   double accuracy = 0.0;               ///< achieved |Δ parameter| of the location
+  /// The loaded stiffness K_F at the point where the report computed it (KMIN), else NaN.
+  Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
   double residual = 0.0;
   bool refined = false;                ///< Newton on an augmented system converged
   int multiplicity = 1;

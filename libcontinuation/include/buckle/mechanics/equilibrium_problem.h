@@ -89,7 +89,8 @@ class EquilibriumProblem final : public continuation::Problem {
   std::string boundaryName(int k) const override;
 
  private:
-  /// Inside the model's domain: finite, and every joint strictly within its geometric limits.
+  /// Inside the model's domain: finite, every joint within its geometric limits (or just past one,
+  /// while the limits are traced as boundaries: equilibrium_problem.cpp).
   bool inDomain(continuation::ConstVectorRef u) const;
   /// The q-dependent part of every evaluation at u = (q, r): kinematics (data_), the end
   /// Jacobian (J_), ∂E/∂q (grad_) and the diagonal of K_q (stiff_), from one pass of the spring

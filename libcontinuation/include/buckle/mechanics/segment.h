@@ -60,7 +60,7 @@ class Segment {
   /// Both spring jets from one sincos of q/2 (the hot path of energyJet).
   void springs(double q, Jet3& L1, Jet3& L2) const;
   SegmentParameters p_;
-  double c1_, c2_, beta12_, c1c2_;
+  double c1_, c2_, beta12_, c1c2_, sqrtP_;
   double delta_;                         ///< (c1 − c2)²
   double cosHalfBeta_, sinHalfBeta_;     ///< cos(β12/2), sin(β12/2)
 };

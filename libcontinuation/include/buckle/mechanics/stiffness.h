@@ -58,6 +58,22 @@ CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const W
 /// are reactions in F, not the definition of K_F).
 CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, const EndCondition& end,
                                    const StiffnessOptions& options = {});
+/// Derivative of the end Jacobian J (rows (−S_j, C_j, 1), eq 5) along a joint increment dq:
+/// dS_j = Σ_{m≥j} ℓ_m cos θ_m θ̇_m, dC_j = −Σ_{m≥j} ℓ_m sin θ_m θ̇_m, θ̇_m = Σ_{i≤m} dq_i; the φ row
+/// is constant (zero). `data` from forwardKinematics at q; dJ is 3×n.
+void endJacobianDerivative(const Chain& chain, const ChainData& data, ConstVectorRef dq, MatrixRef dJ);
+
+/// K_F of loadedStiffness and its exact directional derivative dK_F along (dq, dF) (the total end
+/// wrench moving with the joints, e.g. a tangent of an equilibrium branch). With the bordered
+/// form of loadedStiffness, B = [[H, J_φᵀ], [J_φ, 0]], X = B⁻¹[J_pᵀ; 0], C_F = J_p X_q:
+///   dC_F = dJ_p X_q + X_qᵀ dJ_pᵀ − X_qᵀ dH X_q   (J_φ = (1 … 1) is constant),
+///   dK_F = −K_F dC_F K_F,
+/// dH = diag(dK_q) dq − dK_g (eq 27 differentiated: dh_m = −dFx C_m − Fx dC_m − dFy S_m − Fy dS_m).
+/// False where C_F or K_F is singular (no derivative there).
+bool loadedStiffnessDerivative(const Chain& chain, ConstVectorRef q, const Wrench& F, bool rotationHeld,
+                               ConstVectorRef dq, const Wrench& dF, Eigen::Matrix2d& K, Eigen::Matrix2d& dK,
+                               const StiffnessOptions& options = {});
+
 /// Unloaded stiffness K_F⁰ = (J K_q⁻¹ Jᵀ)⁻¹ (eq 21–23): loadedStiffness with F = 0.
 CartesianStiffness unloadedStiffness(const Chain& chain, ConstVectorRef q, bool rotationHeld = false,
                                      const StiffnessOptions& options = {});
