@@ -247,15 +247,24 @@ namespace {
 // ‖P (K_q − λG) z‖ / (‖K_q z‖ + |λ| ‖G z‖) with P the projector onto ker C: the pencil's relative
 // residual on the null space of the held rows. G z from its entries G(i, j) = g_max(i,j) (eq 27)
 // as (G z)_i = g_i Σ_{j≤i} z_j + Σ_{j>i} g_j z_j, O(n) and independent of the factored route.
+// The pencil's data at q0 for d = (1, 0): end Jacobian J, K_q diagonal, load generator g.
+struct PencilData {
+  Matrix J;
+  Vector kq, g;
+  PencilData(const Chain& chain, const Vector& q0) : J(3, chain.size()), kq(chain.size()), g(chain.size()) {
+    ChainData data(chain);
+    forwardKinematics(chain, q0, data);
+    endJacobian(data, J);
+    jointStiffness(chain, q0, kq);
+    loadHessianGenerator(data, Wrench(1.0, 0.0, 0.0), g);
+  }
+};
+
 double pencilResidual(const Chain& chain, const Vector& q0, const EndCondition& end, const BucklingMode& m) {
   const int n = chain.size();
-  ChainData data(chain);
-  forwardKinematics(chain, q0, data);
-  Matrix J(3, n);
-  endJacobian(data, J);
-  Vector kq(n), g(n);
-  jointStiffness(chain, q0, kq);
-  loadHessianGenerator(data, Wrench(1.0, 0.0, 0.0), g);
+  const PencilData pd(chain, q0);
+  const Matrix& J = pd.J;
+  const Vector &kq = pd.kq, &g = pd.g;
   const Vector Kz = kq.cwiseProduct(m.mode);
   Vector Gz(n);
   double head = 0.0, tail = 0.0;
@@ -371,16 +380,11 @@ TEST_CASE("Long chains: clamped-pinned loads are Sturm-isolated, residual-small,
     REQUIRE(r.unloadedStable);
     // Independent count: the projected Hessian K_q − λG through the chain structure, on the
     // held row J_y, just below and above each load (the count's own rounding is ≈ ε n² relative).
-    ChainData data(chain);
-    forwardKinematics(chain, q0, data);
-    Matrix J(3, n);
-    endJacobian(data, J);
-    Vector kq(n), g(n);
-    jointStiffness(chain, q0, kq);
-    loadHessianGenerator(data, Wrench(1.0, 0.0, 0.0), g);
+    const PencilData pd(chain, q0);
+    const Matrix& J = pd.J;
     ChainStructure ws(n);
     auto countAt = [&](double lambda) {
-      assemble(kq, lambda * g, ws);
+      assemble(pd.kq, lambda * pd.g, ws);
       return constrainedInertia(ws, J.row(1), 0.0).negative;
     };
     const double delta = 1e-5;
