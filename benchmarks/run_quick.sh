@@ -29,4 +29,5 @@ run bench_cases "$BIN/bench_cases" --reps 1
 run work_precision "$BIN/work_precision" --quick --out "$OUT"
 run hard_cases "$BIN/hard_cases" --quick
 run critical_loads "$BIN/critical_loads" --quick
+run jump_timing "$BIN/jump_timing" --quick
 exit $status

@@ -117,7 +117,7 @@ class CaseRunner {
       s.jumpMessage = j.message;
       // the chain snaps onto a geometric joint limit, where the smooth model ends (a spring
       // reaches zero length): a known outcome, reported with the state reached there
-      const bool toLimit = !j.success && j.stopReason == mech::StopReason::JointLimit && j.restPoint.size() >= n;
+      const bool toLimit = !j.success && j.stopReason == mech::IntegrationStop::JointLimit && j.restPoint.size() >= n;
       if (toLimit) {
         s.jumpSuccess = true;
         s.jumpLanding = "joint limit";
@@ -138,7 +138,7 @@ class CaseRunner {
       }
       s.energyReleased = j.energyReleased;
       s.jumpDistance = j.distance;
-      if (!j.success && j.stopReason == mech::StopReason::Interrupted) {
+      if (!j.success && j.stopReason == mech::IntegrationStop::Interrupted) {
         interrupted();
       } else if (!j.success) {
         run_.complete = false;
