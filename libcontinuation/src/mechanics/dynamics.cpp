@@ -310,32 +310,42 @@ bool GradientFlowModel::solveLinearized(const double* x, double a, const double*
   // Jacobian of (D1) is J̃ = −(P H_r + κ_h J_h⁺J_h − J_h⁺E)/c with H_r the Hessian of Π under the
   // end wrench F_l + r (the reactions load the chain like end forces: eq 26–27) and the rows
   // E_k = −c (∇²p_k q̇)ᵀ (from differentiating J_h in r = A⁻¹(J_h∇Π − κ_h h)).
-  velocity(x, qdot_);
-  Wrench total = loads_;
-  for (int j = 0; j < m; ++j) total[held_[size_t(j)]] += r_[j];
-  assemble(chain_, data_, q, total, structure_);  // H_r = U T Uᵀ
-  // (I − aJ̃) k = b with s = a/c: (I + s(P H_r + κ_h J_h⁺J_h − J_h⁺E)) k = b. With
-  // y = s A⁻¹(J_h(κ_h − H_r) − E) k this is (I + sH_r) k + J_hᵀ y = b, A y + s (J_h(H_r − κ_h I) + E) k
-  // = 0; dividing the first row by s (y' = y/s):
-  //   [[H_r + I/s, J_hᵀ], [J_h (H_r − κ_h I) + E, A]] [k; y'] = [b/s; 0].
-  if (m > 0) {
-    V_ = Jh_.transpose();
-    for (int j = 0; j < m; ++j) {
-      applyHessian(structure_, V_.col(j), W_.col(j));
-      W_.col(j) -= kappaH_ * V_.col(j);
-      applyEndHessian(data_, held_[size_t(j)], qdot_, tmpN_);
-      W_.col(j) -= c_ * tmpN_;
+  // A Rosenbrock step solves its stages at one x and a: factor once, reuse (the key is x and a).
+  const bool cached = factoredFor_ == a && lastState_.size() == n + 1 &&
+                      std::equal(x, x + n + 1, lastState_.data());
+  if (!cached) {
+    factoredFor_ = std::numeric_limits<double>::quiet_NaN();
+    velocity(x, qdot_);
+    Wrench total = loads_;
+    for (int j = 0; j < m; ++j) total[held_[size_t(j)]] += r_[j];
+    assemble(chain_, data_, q, total, structure_);  // H_r = U T Uᵀ
+    // (I − aJ̃) k = b with s = a/c: (I + s(P H_r + κ_h J_h⁺J_h − J_h⁺E)) k = b. With
+    // y = s A⁻¹(J_h(κ_h − H_r) − E) k this is (I + sH_r) k + J_hᵀ y = b, A y + s (J_h(H_r − κ_h I) + E) k
+    // = 0; dividing the first row by s (y' = y/s):
+    //   [[H_r + I/s, J_hᵀ], [J_h (H_r − κ_h I) + E, A]] [k; y'] = [b/s; 0].
+    if (m > 0) {
+      V_ = Jh_.transpose();
+      for (int j = 0; j < m; ++j) {
+        applyHessian(structure_, V_.col(j), W_.col(j));
+        W_.col(j) -= kappaH_ * V_.col(j);
+        applyEndHessian(data_, held_[size_t(j)], qdot_, tmpN_);
+        W_.col(j) -= c_ * tmpN_;
+      }
     }
+    // H_r + σI is the chain structure of K_q + σI (U (T + σM) Uᵀ, chain_structure.h)
+    shifted_ = structure_.kappa.array() + c_ / a;
+    assemble(shifted_, structure_.h, structure_);
+    // (own copies: rhs() between the stages overwrites A_ and qdot_ at other states)
+    factoredA_ = A_;
+    factoredQdot_ = qdot_;
+    if (!factorBordered(structure_, V_, W_, factoredA_)) return false;
+    factoredFor_ = a;
+    lastState_ = Eigen::Map<const Vector>(x, n + 1);
   }
-  const double shift = c_ / a;
-  // H_r + σI is the chain structure of K_q + σI (U (T + σM) Uᵀ, chain_structure.h)
-  shifted_ = structure_.kappa.array() + shift;
-  assemble(shifted_, structure_.h, structure_);
-  scaledRhs_ = shift * bq;
-  const bool ok = m == 0 ? solve(structure_, scaledRhs_, kq)
-                         : solveBordered(structure_, V_, W_, A_, scaledRhs_, zeroM_, kq, y_);
+  scaledRhs_ = (c_ / a) * bq;
+  const bool ok = solveFactoredBordered(structure_, V_, W_, factoredA_, scaledRhs_, zeroM_, kq, y_);
   // the dissipated energy's row: d(c|q̇|²)/dq = 2c q̇ᵀ J̃ and aJ̃ k_q = k_q − b_q
-  k[n] = b[n] + 2.0 * c_ * qdot_.dot(kq - bq);
+  k[n] = b[n] + 2.0 * c_ * factoredQdot_.dot(kq - bq);
   return ok && kq.allFinite() && std::isfinite(k[n]);
 }
 

@@ -204,7 +204,10 @@ class GradientFlowModel final : public DynamicsModel {
   // solveLinearized workspace
   ChainStructure structure_;
   Vector shifted_, scaledRhs_, y_, zeroM_;
-  Matrix V_, W_;
+  Matrix V_, W_, factoredA_;
+  Vector factoredQdot_;
+  Vector lastState_;  ///< x of the factored system (with factoredFor_ = a; NaN: none)
+  double factoredFor_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// (D2). x = (q, q̇, W_d), dx/dt = (q̇, q̈, q̇ᵀ D q̇). Only constructible from explicit mass data.
