@@ -28,4 +28,6 @@ BUCKLE_BENCH_MAX_N=30 run bench_kernels "$BIN/bench_kernels" --benchmark_min_tim
 run bench_cases "$BIN/bench_cases" --reps 1
 run work_precision "$BIN/work_precision" --quick --out "$OUT"
 run hard_cases "$BIN/hard_cases" --quick
+run critical_loads "$BIN/critical_loads" --quick
+run jump_timing "$BIN/jump_timing" --quick
 exit $status

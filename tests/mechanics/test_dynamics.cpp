@@ -131,12 +131,13 @@ TEST_CASE("gradient flow: potential never increases, Pi + dissipation is conserv
   auto model = makeDynamicsModel(chain, EndCondition::freeEnd(W), scene, Vector::Zero(3));
   Vector q0(3);
   q0 << 0.1, -0.05, 0.02;
-  for (StepperKind stepper : {StepperKind::DormandPrince5, StepperKind::CashKarp54, StepperKind::Rosenbrock4}) {
+  for (StepperKind stepper : {StepperKind::DormandPrince5, StepperKind::CashKarp54, StepperKind::Rosenbrock4,
+                              StepperKind::StructuredRosenbrock4}) {
     IntegrationOptions options;
     options.stepper = stepper;
     const DynamicsResult r = simulate(*model, q0, Vector(), options);
     INFO("stepper " << int(stepper) << ": " << r.message);
-    REQUIRE(r.reason == StopReason::Rest);
+    REQUIRE(r.reason == IntegrationStop::Rest);
     CHECK(r.residual <= options.residualTolerance);
     CHECK(r.speed <= options.velocityTolerance);
     CHECK(r.kinetic == 0.0);
@@ -176,11 +177,15 @@ TEST_CASE("all steppers agree on the landing", "[dynamics]") {
   options.stepper = StepperKind::Rosenbrock4;
   options.absoluteTolerance = options.relativeTolerance = 1e-11;
   const DynamicsResult c = simulate(*model, q0, Vector(), options);
-  REQUIRE(a.reason == StopReason::Rest);
-  REQUIRE(b.reason == StopReason::Rest);
-  REQUIRE(c.reason == StopReason::Rest);
+  REQUIRE(a.reason == IntegrationStop::Rest);
+  REQUIRE(b.reason == IntegrationStop::Rest);
+  options.stepper = StepperKind::StructuredRosenbrock4;
+  const DynamicsResult d = simulate(*model, q0, Vector(), options);
+  REQUIRE(c.reason == IntegrationStop::Rest);
+  REQUIRE(d.reason == IntegrationStop::Rest);
   CHECK((a.q - b.q).cwiseAbs().maxCoeff() < 1e-7);
   CHECK((a.q - c.q).cwiseAbs().maxCoeff() < 1e-7);
+  CHECK((a.q - d.q).cwiseAbs().maxCoeff() < 1e-7);
   CHECK(a.steps > 0);
   CHECK(c.steps > 0);
 }
@@ -224,7 +229,7 @@ TEST_CASE("inertial with damping: kinetic + potential + dissipated = initial ene
   options.recordInterval = 0.05;
   const DynamicsResult r = simulate(*model, q0, v0, options);
   INFO(r.message);
-  REQUIRE(r.reason == StopReason::Rest);
+  REQUIRE(r.reason == IntegrationStop::Rest);
   CHECK(r.kind == DynamicsKind::Inertial);
   CHECK(r.initialEnergy == Approx(totalPotential(chain, q0, W) + r.trajectory.front().kinetic));
   CHECK(r.trajectory.front().kinetic > 0.0);
@@ -254,7 +259,7 @@ TEST_CASE("inertial without damping conserves total energy", "[dynamics]") {
   options.recordInterval = 0.1;
   const DynamicsResult r = simulate(*model, Vector::Zero(3), Vector(), options);
   INFO(r.message);
-  CHECK(r.reason == StopReason::MaxTime);  // never at rest without damping
+  CHECK(r.reason == IntegrationStop::MaxTime);  // never at rest without damping
   // maxTime is in the model's natural time unit √(Ī / k̄b̄²) (dynamics.h)
   CHECK(model->timeUnit() > 0.0);
   CHECK(r.time == Approx(200.0 * model->timeUnit()));
@@ -287,7 +292,7 @@ TEST_CASE("held end coordinates stay held along the trajectory", "[dynamics]") {
     Vector v0 = Vector::Zero(3);
     const DynamicsResult r = simulate(*model, start, v0, IntegrationOptions());
     INFO("inertial " << inertial << ": " << r.message);
-    REQUIRE(r.reason == StopReason::Rest);
+    REQUIRE(r.reason == IntegrationStop::Rest);
     CHECK(r.maxConstraintViolation < 1e-8);
     for (const TrajectorySample& s : r.trajectory) REQUIRE(s.constraintViolation < 1e-8);
     CHECK(r.maxEnergyBalanceError < 1e-7);
@@ -307,7 +312,7 @@ TEST_CASE("guards stop the integration with a reason", "[dynamics]") {
   Vector q0(3);
   q0 << 0.1, 0.05, -0.02;
   const DynamicsResult a = simulate(*model, q0, Vector(), IntegrationOptions());
-  CHECK(a.reason == StopReason::JointLimit);
+  CHECK(a.reason == IntegrationStop::JointLimit);
   CHECK(std::string(toString(a.reason)) == "joint limit");
   CHECK(a.message.find("limit") != std::string::npos);
   CHECK(model->withinLimits(a.q));
@@ -316,12 +321,12 @@ TEST_CASE("guards stop the integration with a reason", "[dynamics]") {
   IntegrationOptions few;
   few.maxSteps = 5;
   const DynamicsResult b = simulate(*model, q0, Vector(), few);
-  CHECK(b.reason == StopReason::MaxSteps);
+  CHECK(b.reason == IntegrationStop::MaxSteps);
   CHECK(b.steps == 5);
   IntegrationOptions shortTime;
   shortTime.maxTime = 0.01;
   const DynamicsResult c = simulate(*model, q0, Vector(), shortTime);
-  CHECK(c.reason == StopReason::MaxTime);
+  CHECK(c.reason == IntegrationStop::MaxTime);
   CHECK(c.time == Approx(0.01));
 
   // A time limit or a signal (the run's Interrupt) stops the integration before the next step,
@@ -330,14 +335,14 @@ TEST_CASE("guards stop the integration with a reason", "[dynamics]") {
   IntegrationOptions stopped;
   stopped.interrupt.watch(&flag, "SIGTERM received");
   const DynamicsResult d = simulate(*model, q0, Vector(), stopped);
-  CHECK(d.reason == StopReason::Interrupted);
+  CHECK(d.reason == IntegrationStop::Interrupted);
   CHECK(d.steps == 0);
   CHECK(d.message.find("SIGTERM received") != std::string::npos);
   CHECK((d.q - q0).norm() == 0.0);
   IntegrationOptions expired;
   expired.interrupt = buckle::continuation::Interrupt::after(0.0);
   const DynamicsResult e = simulate(*model, q0, Vector(), expired);
-  CHECK(e.reason == StopReason::Interrupted);
+  CHECK(e.reason == IntegrationStop::Interrupted);
   CHECK(e.message.find("time limit") != std::string::npos);
 }
 
@@ -377,4 +382,88 @@ TEST_CASE("dynamics options and scenes are validated with a reason", "[dynamics]
   CHECK_THROWS_AS(makeDynamicsModel(chain, EndCondition::freeEnd(), s, Vector::Zero(3)), std::invalid_argument);
   s.inertia->links.pop_back();
   CHECK_FALSE(s.IsValid(chain, &why));
+}
+
+TEST_CASE("structured linearized solve equals the dense (I - a J)^-1 b; J is the flow's Jacobian (differences)",
+          "[dynamics]") {
+  const int n = 12;
+  const Chain chain = bistableChain(n);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-0.6, 0.6);
+  Vector q(n);
+  for (int i = 0; i < n; ++i) q[i] = U(rng);
+  DynamicsScene scene;
+  scene.flowDamping = 1.5;
+  for (const EndCondition& end : {EndCondition::freeEnd(Wrench(0.2, -0.1, 0.05)),
+                                  EndCondition::clampedPinned(0.3, 0.1), EndCondition::heldPosition(10.0, 2.0)}) {
+    GradientFlowModel flow(chain, end, scene, q);
+    const int N = n + 1, m = flow.heldCount();
+    Vector x(N), b(N), k(N);
+    x.head(n) = q;
+    x[n] = 0.0;
+    for (int i = 0; i < N; ++i) b[i] = U(rng);
+    // Dense J̃ from the chain's own Hessian and Jacobian: −(P H_r + κ_h J_h⁺ J_h)/c, H_r the Hessian
+    // under the loads plus the reactions r = A⁻¹(J_h ∇Π − κ_h h) on the held coordinates; the
+    // energy row 2c q̇ᵀ J̃ with c q̇ = −(∇Π − J_hᵀ r).
+    const double c = scene.flowDamping;
+    Matrix H(n, n), J(3, n);
+    Vector grad(n);
+    Wrench loads = Wrench::Zero();  // held coordinates do no work
+    for (int co : end.loadedIndices()) loads[co] = end.value[co];
+    totalPotentialGradient(chain, q, loads, grad);
+    ChainData data(chain);
+    forwardKinematics(chain, q, data);
+    endJacobian(data, J);
+    Matrix Jh(m, n);
+    Vector hgap(m);
+    for (int r = 0; r < m; ++r) {
+      const int co = end.heldIndices()[size_t(r)];
+      Jh.row(r) = J.row(co);
+      hgap[r] = data.pose[co] - end.value[co];
+    }
+    const Matrix A = Jh * Jh.transpose();
+    const Vector reactions = m > 0 ? Vector(A.ldlt().solve(Jh * grad - flow.constraintStiffness() * hgap)) : Vector();
+    Wrench total = loads;
+    for (int r = 0; r < m; ++r) total[end.heldIndices()[size_t(r)]] += reactions[r];
+    totalPotentialHessian(chain, q, total, H);
+    const Vector qdot = -(grad - Jh.transpose() * reactions) / c;
+    Matrix Jt = -H;
+    if (m > 0) {
+      // E_k = −c (∇²p_k q̇)ᵀ with ∇²p_k from totalPotentialHessian's load part (unit end force)
+      Matrix E(m, n), K0(n, n), Kc(n, n);
+      totalPotentialHessian(chain, q, Wrench::Zero(), K0);
+      for (int r = 0; r < m; ++r) {
+        Wrench unit = Wrench::Zero();
+        unit[end.heldIndices()[size_t(r)]] = 1.0;
+        totalPotentialHessian(chain, q, unit, Kc);
+        E.row(r) = -c * ((K0 - Kc) * qdot).transpose();  // ∇²p = K_q − (K_q − ∇²p)
+      }
+      const Matrix pinv = Jh.transpose() * A.inverse();
+      Jt = -((Matrix::Identity(n, n) - pinv * Jh) * H + flow.constraintStiffness() * pinv * Jh - pinv * E);
+    }
+    Jt /= c;
+    Matrix Jfull = Matrix::Zero(N, N);
+    Jfull.topLeftCorner(n, n) = Jt;
+    Jfull.bottomLeftCorner(1, n) = 2.0 * c * qdot.transpose() * Jt;
+    for (double a : {1e-3, 0.1, 10.0}) {
+      INFO("held " << m << ", a = " << a);
+      REQUIRE(flow.solveLinearized(x.data(), a, b.data(), k.data()));
+      const Vector residual = k - a * Jfull * k - b;
+      CHECK(residual.norm() <= 1e-10 * (b.norm() + (a * Jfull).norm() * k.norm()));
+    }
+    {
+      // J̃ is the flow's exact Jacobian, so it equals central differences of rhs()
+      Vector fp(N), fm(N);
+      const double h = 1e-6;
+      for (int j = 0; j < n; ++j) {
+        Vector xp = x, xm = x;
+        xp[j] += h;
+        xm[j] -= h;
+        flow.rhs(xp.data(), fp.data());
+        flow.rhs(xm.data(), fm.data());
+        const Vector column = (fp - fm) / (2.0 * h);
+        CHECK((column - Jfull.col(j)).norm() <= 1e-7 * std::max(1.0, Jfull.norm()));
+      }
+    }
+  }
 }

@@ -145,7 +145,7 @@ TEST_CASE("from just past a fold the chain snaps to a distinct stable equilibriu
   const JumpResult r = simulateJump(problem, f.q, lambda, options);
   INFO(r.message);
   REQUIRE(r.success);
-  CHECK(r.stopReason == StopReason::Rest);
+  CHECK(r.stopReason == IntegrationStop::Rest);
   CHECK(r.polishConverged);
   CHECK(r.residual < 1e-11);
   CHECK(r.stable);
@@ -216,7 +216,7 @@ TEST_CASE("AUTO's I_up fold is reproduced; the smooth model has no landing insid
   // With L0 = 0.5 each segment's energy decreases all the way to the geometric limit (its wells
   // lie beyond it), so the chain runs into a joint limit: reported, not polished, not a success.
   CHECK_FALSE(r.success);
-  CHECK(r.stopReason == StopReason::JointLimit);
+  CHECK(r.stopReason == IntegrationStop::JointLimit);
   CHECK(r.message.find("limit") != std::string::npos);
   CHECK_FALSE(r.polishConverged);
   const double qmax = r.restPoint.cwiseAbs().maxCoeff();
@@ -368,4 +368,30 @@ TEST_CASE("jump and sudden-load options are validated with a reason", "[jump]") 
   CHECK(why.find("sameStateTolerance") != std::string::npos);
   CHECK_THROWS_AS(simulateSuddenLoad(chain, EndCondition::freeEnd(), Vector::Zero(2), Vector(), SuddenLoadOptions()),
                   std::invalid_argument);
+}
+
+TEST_CASE("long chain: the structured Rosenbrock method lands where dense Rosenbrock4 does (n = 50, y held)", "[jump]") {
+  const int n = 50;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));  // κ < 0
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
+  const Vector u0 = problem.initialGuess(Vector::Zero(n), 0.0);
+  JumpOptions options;
+  options.integration = jumpIntegrationDefaults(n);
+  REQUIRE(options.integration.stepper == StepperKind::Rosenbrock4);
+  const JumpResult dense = simulateJump(problem, u0, 0.0, options);
+  options.integration.stepper = StepperKind::StructuredRosenbrock4;
+  const JumpResult structured = simulateJump(problem, u0, 0.0, options);
+  INFO(dense.message << " / " << structured.message);
+  REQUIRE(dense.success);
+  REQUIRE(structured.success);
+  CHECK(structured.stopReason == IntegrationStop::Rest);
+  CHECK(structured.stable);
+  // the same rest point (both polished to the equilibrium), reached along the same flow
+  CHECK((structured.to - dense.to).cwiseAbs().maxCoeff() < 1e-9);
+  CHECK(structured.energyReleased == Approx(dense.energyReleased).epsilon(1e-9));
+  CHECK(std::abs(endPose(chain, structured.to.head(n))[1]) < 1e-12);
+  // drift of y_end: the per-step tolerance 1e-10 on each joint angle, summed over the chain's length
+  CHECK(structured.dynamics.maxConstraintViolation < 1e-9 * chain.length());
+  requirePotentialNonIncreasing(structured.dynamics, 1.0 + 2.0 * std::abs(structured.to[n]));
+  CHECK(jumpIntegrationDefaults(kStructuredJumpFrom + 1).stepper == StepperKind::StructuredRosenbrock4);
 }

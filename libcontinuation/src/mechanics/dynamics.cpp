@@ -1,16 +1,12 @@
+// The dynamics models of dynamics.h: scene data, the common statics, the gradient flow (D1) and
+// the inertial model (D2). Their integration (simulate) is in dynamics_integration.cpp.
 #include "buckle/mechanics/dynamics.h"
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
-
-#include <boost/numeric/odeint.hpp>
-#include <boost/numeric/ublas/matrix.hpp>
-#include <boost/numeric/ublas/vector.hpp>
 
 namespace buckle::mechanics {
 
@@ -24,6 +20,26 @@ bool fail(std::string* why, const std::string& message) {
 }
 
 bool finite(double v) { return std::isfinite(v); }
+
+/// out = ∇²p_c v for the end coordinate c: ∂²x/∂q_i∂q_j = −C_max(i,j), ∂²y/∂q_i∂q_j = −S_max(i,j)
+/// (eq 26–27), ∂²φ = 0; as (G v)_i = g_i Σ_{j≤i} v_j + Σ_{j>i} g_j v_j, O(n).
+void applyEndHessian(const ChainData& data, int c, ConstVectorRef v, VectorRef out) {
+  const Eigen::Index n = v.size();
+  if (c == static_cast<int>(EndCoordinate::Phi)) {
+    out.setZero();
+    return;
+  }
+  const Vector& g = c == 0 ? data.C : data.S;
+  double head = 0.0, tail = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    head += v[i];
+    out[i] = -g[i] * head;
+  }
+  for (Eigen::Index i = n - 1; i >= 0; --i) {
+    out[i] -= tail;
+    tail += g[i] * v[i];
+  }
+}
 
 }  // namespace
 
@@ -214,12 +230,16 @@ void DynamicsModel::jacobian(const double* x, double* jacobianRowMajor) {
   }
 }
 
+bool DynamicsModel::solveLinearized(const double*, double, const double*, double*) { return false; }
+
 // ---- gradient flow (D1) ---------------------------------------------------------------------
 
 GradientFlowModel::GradientFlowModel(const Chain& chain, const EndCondition& end, const DynamicsScene& scene,
                                      ConstVectorRef q0)
     : DynamicsModel(chain, end), c_(scene.flowDamping), kappaH_(scene.constraintStiffness),
-      H_(chain.size(), chain.size()), qdot_(chain.size()) {
+      H_(chain.size(), chain.size()), qdot_(chain.size()), structure_(chain.size()), shifted_(chain.size()),
+      scaledRhs_(chain.size()), y_(end.heldCount()), zeroM_(Vector::Zero(end.heldCount())),
+      V_(chain.size(), end.heldCount()), W_(chain.size(), end.heldCount()) {
   if (!finite(c_) || !(c_ > 0.0)) throw std::invalid_argument("flowDamping must be > 0");
   if (q0.size() != chain.size()) throw std::invalid_argument("q0 must have one entry per joint");
   if (!(kappaH_ > 0.0)) {
@@ -278,6 +298,55 @@ void GradientFlowModel::jacobian(const double* x, double* jacobianRowMajor) {
   Jac.topLeftCorner(n, n) = -H_ / c_;
   tmpN_.noalias() = H_ * qdot_;
   Jac.bottomLeftCorner(1, n) = -2.0 * tmpN_.transpose();
+}
+
+bool GradientFlowModel::solveLinearized(const double* x, double a, const double* b, double* k) {
+  const int n = segments();
+  const int m = heldCount();
+  if (!(a > 0.0)) return false;
+  Eigen::Map<const Vector> q(x, n), bq(b, n);
+  Eigen::Map<Vector> kq(k, n);
+  // q̇ and the reactions r at x (kinematics, J_h and A = J_h J_hᵀ as the flow uses them). The
+  // Jacobian of (D1) is J̃ = −(P H_r + κ_h J_h⁺J_h − J_h⁺E)/c with H_r the Hessian of Π under the
+  // end wrench F_l + r (the reactions load the chain like end forces: eq 26–27) and the rows
+  // E_k = −c (∇²p_k q̇)ᵀ (from differentiating J_h in r = A⁻¹(J_h∇Π − κ_h h)).
+  // A Rosenbrock step solves its stages at one x and a: factor once, reuse (the key is x and a).
+  const bool cached = factoredFor_ == a && lastState_.size() == n + 1 &&
+                      std::equal(x, x + n + 1, lastState_.data());
+  if (!cached) {
+    factoredFor_ = std::numeric_limits<double>::quiet_NaN();
+    velocity(x, qdot_);
+    Wrench total = loads_;
+    for (int j = 0; j < m; ++j) total[held_[size_t(j)]] += r_[j];
+    assemble(chain_, data_, q, total, structure_);  // H_r = U T Uᵀ
+    // (I − aJ̃) k = b with s = a/c: (I + s(P H_r + κ_h J_h⁺J_h − J_h⁺E)) k = b. With
+    // y = s A⁻¹(J_h(κ_h − H_r) − E) k this is (I + sH_r) k + J_hᵀ y = b, A y + s (J_h(H_r − κ_h I) + E) k
+    // = 0; dividing the first row by s (y' = y/s):
+    //   [[H_r + I/s, J_hᵀ], [J_h (H_r − κ_h I) + E, A]] [k; y'] = [b/s; 0].
+    if (m > 0) {
+      V_ = Jh_.transpose();
+      for (int j = 0; j < m; ++j) {
+        applyHessian(structure_, V_.col(j), W_.col(j));
+        W_.col(j) -= kappaH_ * V_.col(j);
+        applyEndHessian(data_, held_[size_t(j)], qdot_, tmpN_);
+        W_.col(j) -= c_ * tmpN_;
+      }
+    }
+    // H_r + σI is the chain structure of K_q + σI (U (T + σM) Uᵀ, chain_structure.h)
+    shifted_ = structure_.kappa.array() + c_ / a;
+    assemble(shifted_, structure_.h, structure_);
+    // (own copies: rhs() between the stages overwrites A_ and qdot_ at other states)
+    factoredA_ = A_;
+    factoredQdot_ = qdot_;
+    if (!factorBordered(structure_, V_, W_, factoredA_)) return false;
+    factoredFor_ = a;
+    lastState_ = Eigen::Map<const Vector>(x, n + 1);
+  }
+  scaledRhs_ = (c_ / a) * bq;
+  const bool ok = solveFactoredBordered(structure_, V_, W_, factoredA_, scaledRhs_, zeroM_, kq, y_);
+  // the dissipated energy's row: d(c|q̇|²)/dq = 2c q̇ᵀ J̃ and aJ̃ k_q = k_q − b_q
+  k[n] = b[n] + 2.0 * c_ * factoredQdot_.dot(kq - bq);
+  return ok && kq.allFinite() && std::isfinite(k[n]);
 }
 
 // ---- inertial (D2) ---------------------------------------------------------------------------
@@ -484,292 +553,6 @@ std::unique_ptr<DynamicsModel> makeDynamicsModel(const Chain& chain, const EndCo
   if (scene.inertia)
     return std::make_unique<InertialModel>(chain, end, *scene.inertia, scene.jointDamping, scene.baumgarteRate, q0);
   return std::make_unique<GradientFlowModel>(chain, end, scene, q0);
-}
-
-// ---- integration -----------------------------------------------------------------------------
-
-bool IntegrationOptions::IsValid(std::string* why) const {
-  if (!finite(absoluteTolerance) || !(absoluteTolerance > 0.0)) return fail(why, "absoluteTolerance must be > 0");
-  if (!finite(relativeTolerance) || relativeTolerance < 0.0) return fail(why, "relativeTolerance must be >= 0");
-  if (!finite(initialStep) || !(initialStep > 0.0)) return fail(why, "initialStep must be > 0");
-  if (!finite(maxStep) || maxStep < 0.0) return fail(why, "maxStep must be >= 0 (0: unlimited)");
-  if (!finite(minStep) || !(minStep > 0.0)) return fail(why, "minStep must be > 0");
-  if (maxStep > 0.0 && maxStep < minStep) return fail(why, "maxStep must be >= minStep");
-  if (!(maxTime > 0.0) || std::isnan(maxTime)) return fail(why, "maxTime must be > 0");
-  if (maxSteps < 1) return fail(why, "maxSteps must be >= 1");
-  if (!finite(velocityTolerance) || !(velocityTolerance > 0.0)) return fail(why, "velocityTolerance must be > 0");
-  if (!finite(residualTolerance) || !(residualTolerance > 0.0)) return fail(why, "residualTolerance must be > 0");
-  if (!finite(recordInterval) || recordInterval < 0.0) return fail(why, "recordInterval must be >= 0");
-  if (maxSamples < 2) return fail(why, "maxSamples must be >= 2");
-  return true;
-}
-
-const char* toString(StopReason reason) {
-  switch (reason) {
-    case StopReason::Rest: return "rest";
-    case StopReason::MaxTime: return "max time";
-    case StopReason::MaxSteps: return "max steps";
-    case StopReason::JointLimit: return "joint limit";
-    case StopReason::StepSizeUnderflow: return "step size underflow";
-    case StopReason::NonFinite: return "non-finite state";
-    case StopReason::Interrupted: return "interrupted";
-  }
-  return "unknown";
-}
-
-namespace {
-
-namespace odeint = boost::numeric::odeint;
-namespace ublas = boost::numeric::ublas;
-using ExplicitState = std::vector<double>;
-using StiffState = ublas::vector<double>;
-
-struct ExplicitSystem {
-  DynamicsModel* model;
-  void operator()(const ExplicitState& x, ExplicitState& dxdt, double) const { model->rhs(x.data(), dxdt.data()); }
-};
-
-struct StiffSystem {
-  DynamicsModel* model;
-  void operator()(const StiffState& x, StiffState& dxdt, double) const { model->rhs(&x.data()[0], &dxdt.data()[0]); }
-};
-
-struct StiffJacobian {
-  DynamicsModel* model;
-  void operator()(const StiffState& x, ublas::matrix<double>& J, const double&, StiffState& dfdt) const {
-    // ublas::matrix is row-major by default: its storage is exactly the layout jacobian() fills.
-    model->jacobian(&x.data()[0], &J.data()[0]);
-    std::fill(dfdt.begin(), dfdt.end(), 0.0);  // autonomous
-  }
-};
-
-/// The accepted-step loop shared by all steppers: guards, monitoring, recording, rest.
-class Monitor {
- public:
-  Monitor(DynamicsModel& model, const IntegrationOptions& options, DynamicsResult& result)
-      : model_(model), options_(options), result_(result), qdot_(model.segments()) {}
-
-  void start(const double* x) {
-    result_.initialEnergy = energy(x);
-    record(0.0, x, true);
-  }
-
-  /// After an accepted step: true to stop (reason set).
-  bool accepted(double t, const double* x) {
-    Eigen::Map<const Vector> q(x, model_.segments());
-    result_.maxConstraintViolation = std::max(result_.maxConstraintViolation, model_.constraintViolation(q));
-    result_.maxEnergyBalanceError = std::max(result_.maxEnergyBalanceError, std::abs(energy(x) - result_.initialEnergy));
-    record(t, x, false);
-    model_.velocity(x, qdot_);
-    const double speed = qdot_.cwiseAbs().maxCoeff();
-    if (speed <= options_.velocityTolerance && model_.naturalResidual(q) <= options_.residualTolerance)
-      return stop(StopReason::Rest, "at rest: |qdot| and the equilibrium residual are below tolerance at t = " + num(t));
-    return false;
-  }
-
-  bool stop(StopReason reason, const std::string& message) {
-    result_.reason = reason;
-    result_.message = message;
-    return true;
-  }
-
-  void finish(double t, const double* x) {
-    const int n = model_.segments();
-    Eigen::Map<const Vector> q(x, n);
-    result_.time = t;
-    result_.q = q;
-    model_.velocity(x, qdot_);
-    result_.qdot = qdot_;
-    result_.speed = qdot_.cwiseAbs().maxCoeff();
-    result_.potential = model_.potential(q);
-    result_.kinetic = model_.kineticEnergy(x);
-    result_.dissipated = model_.dissipated(x);
-    result_.residual = model_.equilibriumResidual(q);
-    if (options_.recordTrajectory && (result_.trajectory.empty() || result_.trajectory.back().t < t)) forceRecord(t, x);
-  }
-
- private:
-  static std::string num(double v) {
-    std::ostringstream os;
-    os << v;
-    return os.str();
-  }
-
-  double energy(const double* x) {
-    Eigen::Map<const Vector> q(x, model_.segments());
-    return model_.potential(q) + model_.kineticEnergy(x) + model_.dissipated(x);
-  }
-
-  void record(double t, const double* x, bool first) {
-    if (!options_.recordTrajectory) return;
-    if (!first && t - lastRecorded_ < options_.recordInterval) return;
-    forceRecord(t, x);
-  }
-
-  void forceRecord(double t, const double* x) {
-    if (result_.trajectory.size() >= options_.maxSamples) {
-      result_.trajectoryTruncated = true;
-      return;
-    }
-    const int n = model_.segments();
-    Eigen::Map<const Vector> q(x, n);
-    TrajectorySample s;
-    s.t = t;
-    s.q = q;
-    model_.velocity(x, qdot_);
-    s.qdot = qdot_;
-    s.potential = model_.potential(q);
-    s.kinetic = model_.kineticEnergy(x);
-    s.dissipated = model_.dissipated(x);
-    s.residual = model_.equilibriumResidual(q);
-    s.constraintViolation = model_.constraintViolation(q);
-    result_.trajectory.push_back(std::move(s));
-    lastRecorded_ = t;
-  }
-
-  DynamicsModel& model_;
-  const IntegrationOptions& options_;
-  DynamicsResult& result_;
-  Vector qdot_;
-  double lastRecorded_ = 0.0;
-};
-
-// FSAL controllers keep dx/dt of the last accepted state: after a rollback it must be dropped.
-template <class C>
-auto resetController(C& controller, int) -> decltype(controller.reset(), void()) {
-  controller.reset();
-}
-template <class C>
-void resetController(C&, long) {}
-
-template <class Controller, class System, class State>
-void runLoop(Controller& controller, System system, State& x, const double* (*data)(const State&),
-             DynamicsModel& model, const IntegrationOptions& options, Monitor& monitor, DynamicsResult& result) {
-  double t = 0.0, dt = options.initialStep;
-  const int n = model.segments();
-  monitor.start(data(x));
-  State previous = x;
-  for (;;) {
-    if (options.interrupt.requested()) {
-      monitor.stop(StopReason::Interrupted, options.interrupt.describe() + " at t = " + std::to_string(t));
-      break;
-    }
-    if (result.steps >= options.maxSteps) {
-      monitor.stop(StopReason::MaxSteps, "maximum number of steps (" + std::to_string(options.maxSteps) + ") reached");
-      break;
-    }
-    if (t >= options.maxTime * (1.0 - 1e-15)) {
-      monitor.stop(StopReason::MaxTime, "maximum time reached before rest");
-      break;
-    }
-    dt = std::min(dt, options.maxTime - t);
-    if (options.maxStep > 0.0) dt = std::min(dt, options.maxStep);
-    previous = x;
-    const double tPrevious = t, dtTried = dt;
-    const odeint::controlled_step_result res = controller.try_step(system, x, t, dt);
-    if (res == odeint::fail) {
-      ++result.rejectedSteps;
-      if (!(dt >= options.minStep)) {
-        monitor.stop(StopReason::StepSizeUnderflow, "the step size fell below minStep at t = " + std::to_string(t));
-        break;
-      }
-      continue;
-    }
-    // The error control cannot see a step that leaves the model's domain (a NaN error estimate
-    // compares false and is accepted; past a joint limit a spring would pass through zero
-    // length). Such a step is rolled back and retried at half the size, which bisects the time
-    // at which a joint reaches its limit down to minStep; the chain then stops there.
-    const double* xs = data(x);
-    bool finiteState = true;
-    for (int i = 0; finiteState && i < model.stateSize(); ++i) finiteState = std::isfinite(xs[i]);
-    const bool inside = finiteState && model.withinLimits(Eigen::Map<const Vector>(xs, n));
-    if (!inside) {
-      x = previous;
-      t = tPrevious;
-      resetController(controller, 0);
-      ++result.rejectedSteps;
-      dt = 0.5 * dtTried;
-      if (dt < options.minStep) {
-        const double* xp = data(x);
-        int joint = 0;
-        double margin = std::numeric_limits<double>::infinity();
-        for (int i = 0; i < n; ++i) {
-          const double mi = std::min(xp[i] - model.chain().lowerLimits()[i], model.chain().upperLimits()[i] - xp[i]);
-          if (mi < margin) {
-            margin = mi;
-            joint = i;
-          }
-        }
-        // A trial that only failed by being non-finite far from every limit is a model failure.
-        if (!finiteState && margin > 1e-6) {
-          monitor.stop(StopReason::NonFinite, "the right-hand side became non-finite at t = " + std::to_string(t));
-        } else {
-          monitor.stop(StopReason::JointLimit, "joint " + std::to_string(joint + 1) + " reached its limit (q = " +
-                                                   std::to_string(xp[joint]) + ") at t = " + std::to_string(t));
-        }
-        break;
-      }
-      continue;
-    }
-    ++result.steps;
-    if (monitor.accepted(t, data(x))) break;
-  }
-  monitor.finish(t, data(x));
-}
-
-const double* explicitData(const ExplicitState& x) { return x.data(); }
-const double* stiffData(const StiffState& x) { return &x.data()[0]; }
-
-}  // namespace
-
-DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef qdot0, const IntegrationOptions& options) {
-  std::string why;
-  if (!options.IsValid(&why)) throw std::invalid_argument("IntegrationOptions: " + why);
-  const int n = model.segments();
-  if (q0.size() != n) throw std::invalid_argument("q0 must have one entry per joint");
-  if (qdot0.size() != 0 && qdot0.size() != n) throw std::invalid_argument("qdot0 must be empty or have one entry per joint");
-  for (int i = 0; i < n; ++i)
-    if (!std::isfinite(q0[i]) || (qdot0.size() == n && !std::isfinite(qdot0[i])))
-      throw std::invalid_argument("the initial state must be finite");
-
-  // The options' times and rest tolerances are in the model's natural units (dynamics.h).
-  const double T = model.timeUnit();
-  IntegrationOptions natural = options;
-  natural.initialStep *= T;
-  natural.maxStep *= T;
-  natural.minStep *= T;
-  natural.maxTime *= T;
-  natural.recordInterval *= T;
-  natural.velocityTolerance /= T;
-  const auto wallStart = std::chrono::steady_clock::now();
-  DynamicsResult result;
-  result.kind = model.kind();
-  const int N = model.stateSize();
-  Vector x0(N);
-  model.packState(q0, qdot0, x0);
-  Monitor monitor(model, natural, result);
-
-  if (natural.stepper == StepperKind::Rosenbrock4) {
-    StiffState x(static_cast<size_t>(N));
-    std::copy(x0.data(), x0.data() + N, x.begin());
-    odeint::rosenbrock4_controller<odeint::rosenbrock4<double>> controller(natural.absoluteTolerance,
-                                                                           natural.relativeTolerance);
-    runLoop(controller, std::make_pair(StiffSystem{&model}, StiffJacobian{&model}), x, stiffData, model, natural,
-            monitor, result);
-  } else {
-    ExplicitState x(x0.data(), x0.data() + N);
-    if (natural.stepper == StepperKind::DormandPrince5) {
-      auto controller = odeint::make_controlled(natural.absoluteTolerance, natural.relativeTolerance,
-                                                odeint::runge_kutta_dopri5<ExplicitState>());
-      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, natural, monitor, result);
-    } else {
-      auto controller = odeint::make_controlled(natural.absoluteTolerance, natural.relativeTolerance,
-                                                odeint::runge_kutta_cash_karp54<ExplicitState>());
-      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, natural, monitor, result);
-    }
-  }
-  result.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
-  return result;
 }
 
 }  // namespace buckle::mechanics

@@ -48,6 +48,8 @@ std::string describe(const continuation::StabilityInfo& s) {
 IntegrationOptions jumpIntegrationDefaults(int segments) {
   IntegrationOptions o;
   if (segments >= 10) o.stepper = StepperKind::Rosenbrock4;
+  // dense Rosenbrock4 costs O(n³) per step: long chains take the O(n) structured solve
+  if (segments > kStructuredJumpFrom) o.stepper = StepperKind::StructuredRosenbrock4;
   return o;
 }
 
@@ -192,7 +194,7 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   // 3. Polish at fixed λ and check stability — only a rest point is worth polishing (at a joint
   // limit or a guard the state is no equilibrium of the smooth model).
   PolishResult polished;
-  if (dyn.reason == StopReason::Rest) {
+  if (dyn.reason == IntegrationStop::Rest) {
     polished = polishEquilibrium(problem, dyn.q, lambda, options.polish);
   } else {
     polished.u = problem.initialGuess(dyn.q, lambda);
@@ -215,13 +217,13 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   std::ostringstream os;
   os << "integration stopped: " << dyn.message << "; polish: " << (polished.converged ? "converged" : "not converged") << " ("
      << polished.message << ", residual " << polished.residual << "); landing " << describe(result.stabilityTo);
-  if (dyn.reason != StopReason::Rest) {
+  if (dyn.reason != IntegrationStop::Rest) {
     os << "; no rest point reached";
   } else if (polished.converged && result.distance <= options.sameStateTolerance) {
     os << "; the chain came back to the start (no jump)";
   }
   result.message = os.str();
-  result.success = dyn.reason == StopReason::Rest && polished.converged && result.stable &&
+  result.success = dyn.reason == IntegrationStop::Rest && polished.converged && result.stable &&
                    result.distance > options.sameStateTolerance;
   return result;
 }
@@ -271,7 +273,7 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
   }
 
   PolishResult polished;
-  if (dyn.reason == StopReason::Rest) {
+  if (dyn.reason == IntegrationStop::Rest) {
     polished = polishEquilibrium(problem, dyn.q, 0.0, options.polish);
   } else {
     polished.u = problem.initialGuess(dyn.q, 0.0);
@@ -307,7 +309,7 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
     result.maxDifference = kNaN;
   }
   result.message = os.str();
-  result.success = dyn.reason == StopReason::Rest && polished.converged && result.stable;
+  result.success = dyn.reason == IntegrationStop::Rest && polished.converged && result.stable;
   return result;
 }
 

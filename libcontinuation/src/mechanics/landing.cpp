@@ -27,7 +27,7 @@ Landing jumpFromFold(EquilibriumProblem& problem, const continuation::SpecialPoi
     l.success = j.success;
     l.message = j.message;
     l.energyReleased = j.energyReleased;
-    if (!j.success && j.stopReason == StopReason::JointLimit && j.restPoint.size() >= n) {
+    if (!j.success && j.stopReason == IntegrationStop::JointLimit && j.restPoint.size() >= n) {
       l.success = true;
       l.kind = "joint limit";
       setState(problem, j.restPoint.head(n), problem.wrench(fold.u, fold.lambda), l);
@@ -35,7 +35,7 @@ Landing jumpFromFold(EquilibriumProblem& problem, const continuation::SpecialPoi
       return l;
     }
     l.kind = "stable equilibrium";
-    l.interrupted = !j.success && j.stopReason == StopReason::Interrupted;
+    l.interrupted = !j.success && j.stopReason == IntegrationStop::Interrupted;
     if (j.to.size() >= n) setState(problem, j.to.head(n), problem.wrench(j.to, fold.lambda), l);
     l.distance = j.distance;
   } catch (const std::invalid_argument& e) {

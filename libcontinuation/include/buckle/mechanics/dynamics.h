@@ -43,6 +43,7 @@
 
 #include "buckle/continuation/interrupt.h"
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/end_condition.h"
 
 namespace buckle::mechanics {
@@ -115,6 +116,10 @@ class DynamicsModel {
   /// ∂(dx/dt)/∂x, row-major stateSize² (for the stiff stepper). Exact for the unconstrained
   /// gradient flow, central differences of rhs() otherwise.
   virtual void jacobian(const double* x, double* jacobianRowMajor);
+  /// k = (I − a·J̃(x))⁻¹ b for a > 0, J̃ the model's structured approximation of ∂(dx/dt)/∂x
+  /// (the stage systems of a Rosenbrock stepper), in O(n). False when the
+  /// model has none (the default) or the system is singular to working precision.
+  virtual bool solveLinearized(const double* x, double a, const double* b, double* k);
 
   /// Joint angles / velocities / dissipated energy stored in x.
   Eigen::Map<const Vector> angles(const double* x) const { return Eigen::Map<const Vector>(x, segments()); }
@@ -182,6 +187,12 @@ class GradientFlowModel final : public DynamicsModel {
   double dissipated(const double* x) const override { return x[segments()]; }
   double kineticEnergy(const double*) override { return 0.0; }
 
+  /// The exact Jacobian J̃ = −(P H_r + κ_h J_h⁺ J_h − J_h⁺E)/c with H_r = K_q − K_g(F_l + r)
+  /// (eq 27, the reactions r acting as end loads) and E_k = −c (∇²p_k q̇)ᵀ; the energy row
+  /// 2c q̇ᵀJ̃. With H_r = U T Uᵀ (chain_structure.h), I − aJ̃ is the bordered system
+  /// [[H_r + (c/a) I, J_hᵀ], [J_h (H_r − κ_h I) + E, J_h J_hᵀ]], block elimination: O(n m).
+  bool solveLinearized(const double* x, double a, const double* b, double* k) override;
+
   double damping() const { return c_; }
   double constraintStiffness() const { return kappaH_; }
   double timeUnit() const override { return c_ / torqueUnit_; }
@@ -190,6 +201,13 @@ class GradientFlowModel final : public DynamicsModel {
   double c_, kappaH_;
   Matrix H_;  // Hessian workspace for the exact Jacobian
   Vector qdot_;
+  // solveLinearized workspace
+  ChainStructure structure_;
+  Vector shifted_, scaledRhs_, y_, zeroM_;
+  Matrix V_, W_, factoredA_;
+  Vector factoredQdot_;
+  Vector lastState_;  ///< x of the factored system (with factoredFor_ = a; NaN: none)
+  double factoredFor_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// (D2). x = (q, q̇, W_d), dx/dt = (q̇, q̈, q̇ᵀ D q̇). Only constructible from explicit mass data.
@@ -249,6 +267,10 @@ enum class StepperKind {
   DormandPrince5,  ///< runge_kutta_dopri5, FSAL, error-controlled (default)
   CashKarp54,      ///< runge_kutta_cash_karp54, error-controlled
   Rosenbrock4,     ///< rosenbrock4 (L-stable, uses the model's Jacobian) for stiff scenes
+  /// rosenbrock4's coefficients with the model's O(n) solveLinearized() instead of a dense LU
+  /// (O(n) per step instead of O(n³)): stiff long chains.
+  /// Models without a structured solve (the inertial one) are integrated with Rosenbrock4.
+  StructuredRosenbrock4,
 };
 
 /// Times (initialStep, maxStep, minStep, maxTime, recordInterval) are in the model's natural
@@ -274,14 +296,14 @@ struct IntegrationOptions {
   bool recordTrajectory = true;
   std::size_t maxSamples = 200000;   ///< recording stops (trajectoryTruncated) beyond this
   /// Checked before every step: a time limit or a signal stops the integration
-  /// (StopReason::Interrupted) with the state reached.
+  /// (IntegrationStop::Interrupted) with the state reached.
   continuation::Interrupt interrupt;
 
   bool IsValid(std::string* why) const;
 };
 
-enum class StopReason { Rest, MaxTime, MaxSteps, JointLimit, StepSizeUnderflow, NonFinite, Interrupted };
-const char* toString(StopReason reason);
+enum class IntegrationStop { Rest, MaxTime, MaxSteps, JointLimit, StepSizeUnderflow, NonFinite, Interrupted };
+const char* toString(IntegrationStop reason);
 
 struct TrajectorySample {
   double t = 0.0;
@@ -294,7 +316,7 @@ struct TrajectorySample {
 };
 
 struct DynamicsResult {
-  StopReason reason = StopReason::MaxSteps;
+  IntegrationStop reason = IntegrationStop::MaxSteps;
   std::string message;              ///< human-readable reason
   DynamicsKind kind = DynamicsKind::GradientFlow;
   double time = 0.0;                ///< duration (model time)

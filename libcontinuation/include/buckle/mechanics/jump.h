@@ -60,7 +60,11 @@ UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef 
 /// stiff problem whose stiffness ratio grows with n. From 10 segments on the L-stable Rosenbrock
 /// method, which steps by the slow mode (the default scene with 50 segments: 0.2 s per jump,
 /// against 15 s with dopri5, one of which did not reach rest by maxTime); below, dopri5, whose
-/// finite-difference-free steps are as fast there and which the short chains' tests pin.
+/// finite-difference-free steps are as fast there and which the short chains' tests pin. Above
+/// kStructuredJumpFrom segments the dense Rosenbrock method's O(n³) per step dominates: the same
+/// method on the chain structure (StepperKind::StructuredRosenbrock4, O(n) per step; the inertial
+/// model keeps Rosenbrock4).
+constexpr int kStructuredJumpFrom = 64;
 IntegrationOptions jumpIntegrationDefaults(int segments);
 
 struct JumpOptions {
@@ -81,7 +85,7 @@ struct JumpOptions {
 struct JumpResult {
   bool success = false;      ///< rest reached, polish converged, landing stable and distinct
   std::string message;       ///< why it ended (or what failed)
-  StopReason stopReason = StopReason::MaxSteps;
+  IntegrationStop stopReason = IntegrationStop::MaxSteps;
   double lambda = 0.0;
   Eigen::Vector3d prescribed = Eigen::Vector3d::Zero();  ///< loads / held targets at λ
   Vector from, to;           ///< unknowns (q, reactions) at the start and at the polished landing

@@ -53,10 +53,13 @@ struct LinearBucklingOptions {
 
 /// Critical loads and modes at q0 with the coordinates held by `end` (its values are unused).
 /// Throws std::invalid_argument when q0 is not an unloaded equilibrium or has the wrong size.
-/// Above this n, with options.count > 0 and the unloaded chain stable, the modes come from O(n)
-/// Sylvester counts on the chain structure (bisection to rounding, inverse iteration for the
-/// mode): O(n) per mode instead of the dense O(n³) pencil.
+/// Above kStructuredBucklingFrom segments, with options.count > 0 and K_q definite on ker J_h
+/// (the stable or the uniformly unstable chain), the modes come from O(n) Sylvester counts on the
+/// chain structure that isolate each load, finished by Rayleigh-quotient iteration through the
+/// O(n) KKT solve: O(n) per mode instead of the dense O(n³) pencil, to rounding. Otherwise the
+/// dense pencil is solved, and refused (std::invalid_argument) above kMaxDensePencil segments.
 constexpr int kStructuredBucklingFrom = 64;
+constexpr int kMaxDensePencil = 4000;
 
 LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const EndCondition& end,
                                     const LinearBucklingOptions& options = {});

@@ -1,0 +1,167 @@
+// LDLᵀ of T − σM with Bunch pivoting, the plain Sturm count and the factored solves
+// (chain_structure.h, "factorization and counts").
+#include "buckle/mechanics/chain_structure.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace buckle::mechanics {
+
+namespace {
+
+constexpr double kBunchAlpha = 0.6180339887498949;  // (√5 − 1)/2
+constexpr double kTinyPivot = 1e-290;
+
+/// Diagonal of the q-space identity in θ-coordinates, M = U⁻¹U⁻ᵀ (off-diagonal −1).
+inline double metricDiagonal(int k, int n) { return k + 1 < n ? 2.0 : 1.0; }
+
+}  // namespace
+
+void factorize(ChainStructure& ws, double sigma) {
+  const int n = ws.n;
+  ws.shift = sigma;
+  ws.singular = false;
+  ws.factorInertia = Inertia{};
+  // det as mantissa · 2^exponent, rescaled occasionally (a log per pivot would dominate the cost)
+  double mant = 1.0;
+  long expo = 0;
+  auto accumulate = [&](double v) {
+    mant *= v;
+    const double am = std::abs(mant);
+    if (am > 1e150 || am < 1e-150) {
+      int e2 = 0;
+      mant = std::frexp(mant, &e2);
+      expo += e2;
+    }
+  };
+  int sign = 1;
+  double scale = 0.0;
+  for (int k = 0; k < n; ++k) {
+    scale = std::max(scale, std::abs(ws.diag[k] - sigma * metricDiagonal(k, n)));
+    if (k + 1 < n) scale = std::max(scale, std::abs(ws.off[k] + sigma));
+  }
+  if (scale == 0.0) scale = 1.0;
+  const double pivmin = kTinyPivot * scale;
+  double minRatio = std::numeric_limits<double>::infinity();
+  auto a = [&](int k) { return ws.diag[k] - sigma * metricDiagonal(k, n); };
+  auto e = [&](int k) { return ws.off[k] + sigma; };  // M off-diagonal is −1
+
+  int k = 0;
+  double dk = a(0);
+  while (k < n) {
+    const double ek = k + 1 < n ? e(k) : 0.0;
+    if (k + 1 == n || std::abs(dk) * scale >= kBunchAlpha * ek * ek) {
+      if (dk == 0.0) {
+        dk = -pivmin;
+        ws.singular = true;
+      }
+      ws.blockStart[size_t(k)] = 1;
+      ws.pivA[k] = dk;
+      if (dk < 0.0) {
+        ++ws.factorInertia.negative;
+        sign = -sign;
+      } else {
+        ++ws.factorInertia.positive;
+      }
+      accumulate(dk);
+      minRatio = std::min(minRatio, std::abs(dk) / scale);
+      if (k + 1 < n) {
+        ws.l1[k] = ek / dk;
+        dk = a(k + 1) - ek * ws.l1[k];
+      }
+      k += 1;
+    } else {
+      // 2×2 pivot [[dk, ek], [ek, a_{k+1}]]: det < −(1 − α) ek² < 0, one eigenvalue of each sign.
+      const double b = a(k + 1);
+      const double det = dk * b - ek * ek;
+      ws.blockStart[size_t(k)] = 2;
+      ws.blockStart[size_t(k) + 1] = 0;
+      ws.pivA[k] = dk;
+      ws.pivA[k + 1] = b;
+      ws.pivE[k] = ek;
+      ++ws.factorInertia.negative;
+      ++ws.factorInertia.positive;
+      sign = -sign;
+      accumulate(det);
+      // smallest |eigenvalue| of the block ≥ |det| / (largest |eigenvalue|)
+      const double big = 0.5 * std::abs(dk + b) + std::hypot(0.5 * (dk - b), ek);
+      minRatio = std::min(minRatio, std::abs(det) / (big * scale));
+      if (k + 2 < n) {
+        const double ek1 = e(k + 1);
+        ws.l1[k] = -ek1 * ek / det;
+        ws.l2[k] = ek1 * dk / det;
+        dk = a(k + 2) - ek1 * ek1 * dk / det;
+      }
+      k += 2;
+    }
+  }
+  ws.minPivotRatio = minRatio;
+  ws.logAbsDet = std::log(std::abs(mant)) + double(expo) * 0.6931471805599453;
+  ws.detSign = sign;
+}
+
+int countBelow(const ChainStructure& ws, double sigma) {
+  const int n = ws.n;
+  double scale = 0.0;
+  for (int k = 0; k < n; ++k) scale = std::max(scale, std::abs(ws.diag[k]) + std::abs(sigma) * 2.0);
+  if (scale == 0.0) scale = 1.0;
+  const double pivmin = kTinyPivot * scale;
+  int count = 0;
+  double d = ws.diag[0] - sigma * metricDiagonal(0, n);
+  for (int k = 0;; ++k) {
+    if (std::abs(d) < pivmin) d = -pivmin;
+    if (d < 0.0) ++count;
+    if (k + 1 == n) break;
+    const double e = ws.off[k] + sigma;
+    d = ws.diag[k + 1] - sigma * metricDiagonal(k + 1, n) - e * e / d;
+  }
+  return count;
+}
+
+void solveFactored(const ChainStructure& ws, VectorRef y) {
+  const int n = ws.n;
+  // forward: L
+  for (int k = 0; k < n;) {
+    if (ws.blockStart[size_t(k)] == 1) {
+      if (k + 1 < n) y[k + 1] -= ws.l1[k] * y[k];
+      k += 1;
+    } else {
+      if (k + 2 < n) y[k + 2] -= ws.l1[k] * y[k] + ws.l2[k] * y[k + 1];
+      k += 2;
+    }
+  }
+  // block diagonal
+  for (int k = 0; k < n;) {
+    if (ws.blockStart[size_t(k)] == 1) {
+      y[k] /= ws.pivA[k];
+      k += 1;
+    } else {
+      const double a = ws.pivA[k], b = ws.pivA[k + 1], e = ws.pivE[k];
+      const double det = a * b - e * e;
+      const double y0 = y[k], y1 = y[k + 1];
+      y[k] = (b * y0 - e * y1) / det;
+      y[k + 1] = (a * y1 - e * y0) / det;
+      k += 2;
+    }
+  }
+  // backward: Lᵀ
+  for (int k = n - 1; k >= 0;) {
+    if (ws.blockStart[size_t(k)] == 0) {  // second row of a 2×2 starting at k − 1
+      if (k + 1 < n) {
+        y[k - 1] -= ws.l1[k - 1] * y[k + 1];
+        y[k] -= ws.l2[k - 1] * y[k + 1];
+      }
+      k -= 2;
+    } else {
+      if (k + 1 < n) y[k] -= ws.l1[k] * y[k + 1];
+      k -= 1;
+    }
+  }
+}
+
+void solveFactored(const ChainStructure& ws, MatrixRef Y, int cols) {
+  for (int j = 0; j < cols; ++j) solveFactored(ws, Y.col(j));
+}
+
+}  // namespace buckle::mechanics

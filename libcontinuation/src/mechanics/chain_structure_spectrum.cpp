@@ -1,0 +1,335 @@
+// Inertia and lowest eigenvalues of H and of H on the null space of held rows, by O(n) counts
+// on the chain structure (chain_structure.h, "factorization and counts"); the small dense route.
+#include "buckle/mechanics/chain_structure.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace buckle::mechanics {
+
+namespace {
+
+/// Number of negative eigenvalues of a small symmetric matrix (r ≤ kMaxBorder).
+int smallNegativeCount(const ChainStructure::SmallMatrix& S) {
+  const Eigen::Index r = S.rows();
+  if (r == 0) return 0;
+  if (r == 1) return S(0, 0) < 0.0 ? 1 : 0;
+  if (r == 2) {
+    const double mean = 0.5 * (S(0, 0) + S(1, 1));
+    const double rad = std::hypot(0.5 * (S(0, 0) - S(1, 1)), 0.5 * (S(0, 1) + S(1, 0)));
+    return (mean - rad < 0.0 ? 1 : 0) + (mean + rad < 0.0 ? 1 : 0);
+  }
+  Eigen::SelfAdjointEigenSolver<ChainStructure::SmallMatrix> es(0.5 * (S + S.transpose()), Eigen::EigenvaluesOnly);
+  int neg = 0;
+  for (Eigen::Index i = 0; i < r; ++i)
+    if (es.eigenvalues()[i] < 0.0) ++neg;
+  return neg;
+}
+
+}  // namespace
+
+double zeroThreshold(const ChainStructure& ws, double zeroTolerance) {
+  return zeroTolerance * std::max(ws.typicalScale, ws.frobeniusH);  // the same count in any units
+}
+
+Inertia hessianInertia(const ChainStructure& ws, double zeroTolerance) {
+  const double tau = zeroThreshold(ws, zeroTolerance);
+  Inertia in;
+  const int below = countBelow(ws, -tau);
+  const int belowPlus = countBelow(ws, tau);
+  in.negative = below;
+  in.zero = belowPlus - below;
+  in.positive = ws.n - belowPlus;
+  return in;
+}
+
+int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double rankTolerance) {
+  const int n = ws.n;
+  if (C.rows() > ChainStructure::kMaxBorder - 1 || (C.rows() > 0 && C.cols() != n))
+    throw std::invalid_argument("setConstraints: C must be m×n with m <= 3");
+  double maxNorm = 0.0;
+  for (Eigen::Index i = 0; i < C.rows(); ++i) maxNorm = std::max(maxNorm, C.row(i).norm());
+  int r = 0;
+  if (maxNorm > 0.0) {
+    for (Eigen::Index i = 0; i < C.rows(); ++i) {
+      auto qr = ws.Q.col(r);
+      qr = C.row(i).transpose();
+      for (int pass = 0; pass < 2; ++pass)
+        for (int j = 0; j < r; ++j) qr -= ws.Q.col(j).dot(qr) * ws.Q.col(j);
+      const double nrm = qr.norm();
+      if (nrm <= rankTolerance * maxNorm) continue;
+      qr /= nrm;
+      applyUInverse(qr, ws.B.col(r));
+      ++r;
+    }
+  }
+  ws.rank = r;
+  return r;
+}
+
+int constrainedCountBelow(ChainStructure& ws, double sigma) {
+  const int r = ws.rank;
+  factorize(ws, sigma);
+  if (r == 0) return ws.factorInertia.negative;
+  ws.X.leftCols(r) = ws.B.leftCols(r);
+  solveFactored(ws, ws.X, r);
+  ws.S.resize(r, r);
+  // (product, then negate in place: −(BᵀX) as one expression evaluated the product into a heap
+  // temporary on every call)
+  ws.S.noalias() = ws.B.leftCols(r).transpose() * ws.X.leftCols(r);
+  ws.S = -ws.S;
+  return ws.factorInertia.negative + smallNegativeCount(ws.S) - r;
+}
+
+namespace {
+
+/// Constrained count at σ0, moving σ within [σ0/2, 2σ0] when T − σM is nearly singular.
+int robustConstrainedCount(ChainStructure& ws, double sigma0) {
+  static constexpr double factors[] = {1.0, 1.5, 0.7, 2.0, 0.5, 1.25, 0.85};
+  double bestRatio = -1.0, bestFactor = 1.0;
+  int bestCount = 0;
+  for (double f : factors) {
+    const int c = constrainedCountBelow(ws, sigma0 * f);
+    if (ws.minPivotRatio >= 1e-10 && !ws.singular) return c;
+    if (ws.minPivotRatio > bestRatio) {
+      bestRatio = ws.minPivotRatio;
+      bestFactor = f;
+      bestCount = c;
+    }
+  }
+  (void)bestFactor;
+  return bestCount;
+}
+
+}  // namespace
+
+Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double zeroTolerance,
+                           double rankTolerance) {
+  const int r = C.rows() > 0 ? setConstraints(ws, C, rankTolerance) : (ws.rank = 0);
+  if (r == 0) return hessianInertia(ws, zeroTolerance);
+  const double tau = zeroThreshold(ws, zeroTolerance);
+  const int below = robustConstrainedCount(ws, -tau);
+  const int belowPlus = robustConstrainedCount(ws, tau);
+  Inertia in;
+  in.negative = below;
+  in.zero = belowPlus - below;
+  in.positive = (ws.n - r) - belowPlus;
+  return in;
+}
+
+namespace {
+
+/// Count below σ and log|det|, sign of det K_σ (or of det(T − σM) without constraints).
+struct ShiftEvaluation {
+  int below = 0;
+  double logAbsDet = 0.0;
+  int sign = 1;
+};
+
+ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double sigma) {
+  ShiftEvaluation ev;
+  const int r = useConstraints ? ws.rank : 0;
+  if (r == 0) {
+    factorize(ws, sigma);
+    ev.below = ws.factorInertia.negative;
+    ev.logAbsDet = ws.logAbsDet;
+    ev.sign = ws.detSign;
+    return ev;
+  }
+  ev.below = constrainedCountBelow(ws, sigma);
+  const double detS = ws.S.determinant();
+  ev.logAbsDet = ws.logAbsDet + std::log(std::abs(detS));
+  ev.sign = ws.detSign * (detS < 0.0 ? -1 : 1);
+  return ev;
+}
+
+}  // namespace
+
+int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, VectorRef out, double tolerance,
+                      const Vector* guess) {
+  const int dim = ws.n - (useConstraints ? ws.rank : 0);
+  const int k = std::max(0, std::min(count, dim));
+  if (k == 0) return 0;
+  const double scale = std::max(ws.typicalScale, ws.frobeniusH);  // as zeroThreshold: any units
+  const double tol = tolerance * scale;
+  // All eigenvalues lie in [−‖H‖_F, ‖H‖_F]; widen against rounding until the counts confirm it.
+  double lo0 = -ws.frobeniusH * (1.0 + 1e-10) - tol, hi0 = ws.frobeniusH * (1.0 + 1e-10) + tol;
+  while (evaluateShift(ws, useConstraints, lo0).below > 0) lo0 = 2.0 * lo0 - scale;
+  while (evaluateShift(ws, useConstraints, hi0).below < k) hi0 = 2.0 * hi0 + scale;
+  // Brackets: eigenvalue j lies in [lo[j], hi[j]) with count(lo[j]) ≤ j < count(hi[j]).
+  ChainStructure::SmallVector lo = ChainStructure::SmallVector::Constant(k, lo0);
+  ChainStructure::SmallVector hi = ChainStructure::SmallVector::Constant(k, hi0);
+  ChainStructure::SmallVector cntLo = ChainStructure::SmallVector::Zero(k);
+  ChainStructure::SmallVector cntHi = ChainStructure::SmallVector::Constant(k, double(dim));
+  auto record = [&](double s, int c) {
+    for (int j = 0; j < k; ++j) {
+      if (c > j) {
+        if (s < hi[j]) { hi[j] = s; cntHi[j] = c; }
+      } else if (s > lo[j]) {
+        lo[j] = s;
+        cntLo[j] = c;
+      }
+    }
+  };
+  for (int j = 0; j < k; ++j) {
+    lo[j] = std::max(lo[j], j > 0 ? out[j - 1] - tol : lo[j]);
+    // Warm start (e.g. the previous continuation point): a few counts around the guess.
+    if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
+      double delta = std::max(1e-3 * scale, 0.02 * std::abs((*guess)[j]));
+      for (int attempt = 0; attempt < 3 && !(int(cntLo[j]) == j && int(cntHi[j]) == j + 1); ++attempt, delta *= 8.0) {
+        const double a = (*guess)[j] - delta, b = (*guess)[j] + delta;
+        if (a > lo[j]) record(a, evaluateShift(ws, useConstraints, a).below);
+        if (b < hi[j]) record(b, evaluateShift(ws, useConstraints, b).below);
+      }
+    }
+    // isolate: exactly one eigenvalue (j) in [lo, hi)
+    while (!(int(cntLo[j]) == j && int(cntHi[j]) == j + 1) && hi[j] - lo[j] > tol) {
+      const double mid = 0.5 * (lo[j] + hi[j]);
+      if (mid <= lo[j] || mid >= hi[j]) break;
+      record(mid, evaluateShift(ws, useConstraints, mid).below);
+    }
+    if (int(cntLo[j]) == j && int(cntHi[j]) == j + 1 && hi[j] - lo[j] > tol) {
+      // Illinois on det, one simple root in the bracket; the counts keep the bracket honest.
+      ShiftEvaluation ea = evaluateShift(ws, useConstraints, lo[j]);
+      ShiftEvaluation eb = evaluateShift(ws, useConstraints, hi[j]);
+      const double ref = 0.5 * (ea.logAbsDet + eb.logAbsDet);
+      auto value = [&](const ShiftEvaluation& e) {
+        return e.sign * std::exp(std::max(-700.0, std::min(700.0, e.logAbsDet - ref)));
+      };
+      double a = lo[j], b = hi[j], fa = value(ea), fb = value(eb);
+      int side = 0;
+      for (int it = 0; it < 200 && b - a > tol; ++it) {
+        double c = (fa * b - fb * a) / (fa - fb);
+        if (!(c > a && c < b)) c = 0.5 * (a + b);
+        // keep progress: never closer than tol/2 to an end
+        c = std::min(std::max(c, a + 0.25 * tol), b - 0.25 * tol);
+        const ShiftEvaluation ec = evaluateShift(ws, useConstraints, c);
+        const double fc = value(ec);
+        if (ec.below > j) {  // the root is below c
+          b = c;
+          fb = fc;
+          if (side == -1) fa *= 0.5;
+          side = -1;
+        } else {
+          a = c;
+          fa = fc;
+          if (side == 1) fb *= 0.5;
+          side = 1;
+        }
+        if (fc == 0.0) {
+          a = b = c;
+          break;
+        }
+      }
+      lo[j] = a;
+      hi[j] = b;
+    }
+    out[j] = 0.5 * (lo[j] + hi[j]);
+  }
+  return k;
+}
+
+double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance) {
+  Eigen::Matrix<double, 1, 1> out;
+  return lowestEigenvalues(ws, useConstraints, 1, out, tolerance, nullptr) == 1 ? out[0] : 0.0;
+}
+
+Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, int count, VectorRef lowest,
+                          int& found, double zeroTolerance, double rankTolerance) {
+  using SM = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kSmallDense, kSmallDense>;
+  const int n = ws.n;
+  if (n > kSmallDense) throw std::invalid_argument("smallDenseInertia: n > kSmallDense");
+  const int r = C.rows() > 0 ? setConstraints(ws, C, rankTolerance) : (ws.rank = 0);
+  SM A(n, n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) A(i, j) = -ws.h[std::max(i, j)];
+  for (int i = 0; i < n; ++i) A(i, i) += ws.kappa[i];
+  // Householder reflectors P_j map the orthonormal Q onto the first r coordinates; then
+  // ker C ↔ the last d coordinates and Zᵀ H Z is the trailing d×d block of P H P.
+  SM Qw = ws.Q.topLeftCorner(n, r);
+  double v[kSmallDense];
+  for (int j = 0; j < r; ++j) {
+    const int len = n - j;
+    double norm2 = 0.0;
+    for (int i = 0; i < len; ++i) {
+      v[i] = Qw(j + i, j);
+      norm2 += v[i] * v[i];
+    }
+    const double alpha = v[0] >= 0.0 ? -std::sqrt(norm2) : std::sqrt(norm2);
+    v[0] -= alpha;
+    double beta = 0.0;
+    for (int i = 0; i < len; ++i) beta += v[i] * v[i];
+    if (beta == 0.0) continue;
+    const double f = 2.0 / beta;
+    for (int c = 0; c < r; ++c) {  // Qw ← P Qw
+      double dot = 0.0;
+      for (int i = 0; i < len; ++i) dot += v[i] * Qw(j + i, c);
+      for (int i = 0; i < len; ++i) Qw(j + i, c) -= f * dot * v[i];
+    }
+    for (int c = 0; c < n; ++c) {  // A ← P A
+      double dot = 0.0;
+      for (int i = 0; i < len; ++i) dot += v[i] * A(j + i, c);
+      for (int i = 0; i < len; ++i) A(j + i, c) -= f * dot * v[i];
+    }
+    for (int c = 0; c < n; ++c) {  // A ← A P
+      double dot = 0.0;
+      for (int i = 0; i < len; ++i) dot += A(c, j + i) * v[i];
+      for (int i = 0; i < len; ++i) A(c, j + i) -= f * dot * v[i];
+    }
+  }
+  const int d = n - r;
+  Inertia in;
+  found = std::min(count, d);
+  if (d == 0) return in;
+  SM S = A.bottomRightCorner(d, d);
+  double mu[kSmallDense];
+  if (d > 4) {
+    // Larger blocks: Eigen's tridiagonal QR (Jacobi's O(d³) sweeps lose from d ≈ 5 on).
+    Eigen::SelfAdjointEigenSolver<SM> es(S, Eigen::EigenvaluesOnly);
+    for (int i = 0; i < d; ++i) mu[i] = es.eigenvalues()[i];
+  } else {
+    // Cyclic Jacobi: accurate and, for blocks up to 4×4, cheaper than a QR solver.
+    double total = 0.0;
+    for (int j = 0; j < d; ++j)
+      for (int i = 0; i < d; ++i) total += S(i, j) * S(i, j);
+    for (int sweep = 0; sweep < 60; ++sweep) {
+      double off = 0.0;
+      for (int q = 1; q < d; ++q)
+        for (int p = 0; p < q; ++p) off += S(p, q) * S(p, q);
+      if (off <= 1e-34 * total || off == 0.0) break;
+      for (int q = 1; q < d; ++q)
+        for (int p = 0; p < q; ++p) {
+          const double apq = S(p, q);
+          if (apq == 0.0) continue;
+          const double theta = (S(q, q) - S(p, p)) / (2.0 * apq);
+          const double t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+          const double c = 1.0 / std::sqrt(t * t + 1.0), sn = t * c;
+          S(p, p) -= t * apq;
+          S(q, q) += t * apq;
+          S(p, q) = S(q, p) = 0.0;
+          for (int k = 0; k < d; ++k) {
+            if (k == p || k == q) continue;
+            const double skp = S(k, p), skq = S(k, q);
+            S(k, p) = S(p, k) = c * skp - sn * skq;
+            S(k, q) = S(q, k) = sn * skp + c * skq;
+          }
+        }
+    }
+    for (int i = 0; i < d; ++i) mu[i] = S(i, i);
+    std::sort(mu, mu + d);
+  }
+  double maxAbs = 0.0;
+  for (int i = 0; i < d; ++i) maxAbs = std::max(maxAbs, std::abs(mu[i]));
+  const double tol = zeroTolerance * std::max(ws.typicalScale, maxAbs);  // the same count in any units
+  for (int i = 0; i < d; ++i) {
+    if (std::abs(mu[i]) <= tol) ++in.zero;
+    else if (mu[i] < 0.0) ++in.negative;
+    else ++in.positive;
+  }
+  for (int i = 0; i < found; ++i) lowest[i] = mu[i];
+  return in;
+}
+
+}  // namespace buckle::mechanics

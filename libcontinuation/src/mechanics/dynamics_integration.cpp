@@ -1,0 +1,409 @@
+// Integration of the dynamics models (dynamics.h, "integration"): options, odeint steppers with
+// the rest / guard monitor, and simulate().
+#include "buckle/mechanics/dynamics.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <initializer_list>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include <boost/numeric/odeint.hpp>
+#include <boost/numeric/ublas/matrix.hpp>
+#include <boost/numeric/ublas/vector.hpp>
+
+namespace buckle::mechanics {
+
+namespace {
+
+bool fail(std::string* why, const std::string& message) {
+  if (why) *why = message;
+  return false;
+}
+
+bool finite(double v) { return std::isfinite(v); }
+
+}  // namespace
+
+// ---- integration -----------------------------------------------------------------------------
+
+bool IntegrationOptions::IsValid(std::string* why) const {
+  if (!finite(absoluteTolerance) || !(absoluteTolerance > 0.0)) return fail(why, "absoluteTolerance must be > 0");
+  if (!finite(relativeTolerance) || relativeTolerance < 0.0) return fail(why, "relativeTolerance must be >= 0");
+  if (!finite(initialStep) || !(initialStep > 0.0)) return fail(why, "initialStep must be > 0");
+  if (!finite(maxStep) || maxStep < 0.0) return fail(why, "maxStep must be >= 0 (0: unlimited)");
+  if (!finite(minStep) || !(minStep > 0.0)) return fail(why, "minStep must be > 0");
+  if (maxStep > 0.0 && maxStep < minStep) return fail(why, "maxStep must be >= minStep");
+  if (!(maxTime > 0.0) || std::isnan(maxTime)) return fail(why, "maxTime must be > 0");
+  if (maxSteps < 1) return fail(why, "maxSteps must be >= 1");
+  if (!finite(velocityTolerance) || !(velocityTolerance > 0.0)) return fail(why, "velocityTolerance must be > 0");
+  if (!finite(residualTolerance) || !(residualTolerance > 0.0)) return fail(why, "residualTolerance must be > 0");
+  if (!finite(recordInterval) || recordInterval < 0.0) return fail(why, "recordInterval must be >= 0");
+  if (maxSamples < 2) return fail(why, "maxSamples must be >= 2");
+  return true;
+}
+
+const char* toString(IntegrationStop reason) {
+  switch (reason) {
+    case IntegrationStop::Rest: return "rest";
+    case IntegrationStop::MaxTime: return "max time";
+    case IntegrationStop::MaxSteps: return "max steps";
+    case IntegrationStop::JointLimit: return "joint limit";
+    case IntegrationStop::StepSizeUnderflow: return "step size underflow";
+    case IntegrationStop::NonFinite: return "non-finite state";
+    case IntegrationStop::Interrupted: return "interrupted";
+  }
+  return "unknown";
+}
+
+namespace {
+
+namespace odeint = boost::numeric::odeint;
+namespace ublas = boost::numeric::ublas;
+using ExplicitState = std::vector<double>;
+using StiffState = ublas::vector<double>;
+
+struct ExplicitSystem {
+  DynamicsModel* model;
+  void operator()(const ExplicitState& x, ExplicitState& dxdt, double) const { model->rhs(x.data(), dxdt.data()); }
+};
+
+struct StiffSystem {
+  DynamicsModel* model;
+  void operator()(const StiffState& x, StiffState& dxdt, double) const { model->rhs(&x.data()[0], &dxdt.data()[0]); }
+};
+
+struct StiffJacobian {
+  DynamicsModel* model;
+  void operator()(const StiffState& x, ublas::matrix<double>& J, const double&, StiffState& dfdt) const {
+    // ublas::matrix is row-major by default: its storage is exactly the layout jacobian() fills.
+    model->jacobian(&x.data()[0], &J.data()[0]);
+    std::fill(dfdt.begin(), dfdt.end(), 0.0);  // autonomous
+  }
+};
+
+/// odeint's rosenbrock4 (Shampine's L-stable order-4 method with an embedded order-3 estimate,
+/// odeint::default_rosenbrock_coefficients) with the model's O(n) structured solve
+/// (DynamicsModel::solveLinearized) in place of the dense LU of (1/(γτ)) I − J: each stage
+/// (1/(γτ) − J̃) g = r is (I − γτJ̃) g = γτ r. Autonomous (∂f/∂t = 0). Step-size control as
+/// rosenbrock4_controller: factor err^{1/4}/0.9 within [1/6, 5], max-norm of the estimate over
+/// atol + rtol·max(|x|, |x⁺|).
+class StructuredRosenbrock4 {
+ public:
+  StructuredRosenbrock4(DynamicsModel& model, double absoluteTolerance, double relativeTolerance)
+      : model_(model), atol_(absoluteTolerance), rtol_(relativeTolerance) {
+    for (ExplicitState* v : {&f_, &r_, &xtmp_, &err_, &xout_, &g_[0], &g_[1], &g_[2], &g_[3], &g_[4]})
+      v->assign(size_t(model.stateSize()), 0.0);
+  }
+
+  odeint::controlled_step_result try_step(const ExplicitSystem&, ExplicitState& x, double& t, double& dt) {
+    if (!step(x, dt)) {
+      dt *= 0.5;
+      return odeint::fail;
+    }
+    double err = 0.0;
+    for (size_t i = 0; i < x.size(); ++i)
+      err = std::max(err, std::abs(err_[i]) / (atol_ + rtol_ * std::max(std::abs(x[i]), std::abs(xout_[i]))));
+    const double fac = std::isfinite(err) ? std::max(1.0 / 6.0, std::min(5.0, std::pow(err, 0.25) / 0.9)) : 5.0;
+    if (!(err <= 1.0)) {
+      dt /= std::max(fac, 1.0 + 1e-3);
+      return odeint::fail;
+    }
+    x.swap(xout_);
+    t += dt;
+    dt /= fac;
+    return odeint::success;
+  }
+
+ private:
+  // One step: stages g1 … g5 and the error estimate, as odeint's rosenbrock4::do_step.
+  bool step(const ExplicitState& x, double dt) {
+    static const odeint::default_rosenbrock_coefficients<double> c;
+    const size_t N = x.size();
+    const double a = c.gamma * dt;
+    auto stage = [&](ExplicitState& g) { return model_.solveLinearized(x.data(), a, r_.data(), g.data()); };
+    auto combine = [&](const ExplicitState& fx, std::initializer_list<double> cs, ExplicitState& out) {
+      for (size_t i = 0; i < N; ++i) {
+        double v = 0.0;
+        size_t k = 0;
+        for (double ck : cs) v += ck * g_[k++][i];
+        out[i] = a * (fx[i] + v / dt);  // γτ (f + Σ c_k g_k / τ)
+      }
+    };
+    auto advance = [&](std::initializer_list<double> as) {
+      for (size_t i = 0; i < N; ++i) {
+        double v = x[i];
+        size_t k = 0;
+        for (double ak : as) v += ak * g_[k++][i];
+        xtmp_[i] = v;
+      }
+      model_.rhs(xtmp_.data(), f_.data());
+    };
+    model_.rhs(x.data(), f_.data());
+    combine(f_, {}, r_);
+    if (!stage(g_[0])) return false;
+    advance({c.a21});
+    combine(f_, {c.c21}, r_);
+    if (!stage(g_[1])) return false;
+    advance({c.a31, c.a32});
+    combine(f_, {c.c31, c.c32}, r_);
+    if (!stage(g_[2])) return false;
+    advance({c.a41, c.a42, c.a43});
+    combine(f_, {c.c41, c.c42, c.c43}, r_);
+    if (!stage(g_[3])) return false;
+    advance({c.a51, c.a52, c.a53, c.a54});
+    combine(f_, {c.c51, c.c52, c.c53, c.c54}, r_);
+    if (!stage(g_[4])) return false;
+    for (size_t i = 0; i < N; ++i) xtmp_[i] += g_[4][i];
+    model_.rhs(xtmp_.data(), f_.data());
+    combine(f_, {c.c61, c.c62, c.c63, c.c64, c.c65}, r_);
+    if (!model_.solveLinearized(x.data(), a, r_.data(), err_.data())) return false;
+    for (size_t i = 0; i < N; ++i) xout_[i] = xtmp_[i] + err_[i];
+    return true;
+  }
+
+  DynamicsModel& model_;
+  double atol_, rtol_;
+  ExplicitState f_, r_, xtmp_, err_, xout_;
+  ExplicitState g_[5];
+};
+
+/// The accepted-step loop shared by all steppers: guards, monitoring, recording, rest.
+class Monitor {
+ public:
+  Monitor(DynamicsModel& model, const IntegrationOptions& options, DynamicsResult& result)
+      : model_(model), options_(options), result_(result), qdot_(model.segments()) {}
+
+  void start(const double* x) {
+    result_.initialEnergy = energy(x);
+    record(0.0, x, true);
+  }
+
+  /// After an accepted step: true to stop (reason set).
+  bool accepted(double t, const double* x) {
+    Eigen::Map<const Vector> q(x, model_.segments());
+    result_.maxConstraintViolation = std::max(result_.maxConstraintViolation, model_.constraintViolation(q));
+    result_.maxEnergyBalanceError = std::max(result_.maxEnergyBalanceError, std::abs(energy(x) - result_.initialEnergy));
+    record(t, x, false);
+    model_.velocity(x, qdot_);
+    const double speed = qdot_.cwiseAbs().maxCoeff();
+    if (speed <= options_.velocityTolerance && model_.naturalResidual(q) <= options_.residualTolerance)
+      return stop(IntegrationStop::Rest, "at rest: |qdot| and the equilibrium residual are below tolerance at t = " + num(t));
+    return false;
+  }
+
+  bool stop(IntegrationStop reason, const std::string& message) {
+    result_.reason = reason;
+    result_.message = message;
+    return true;
+  }
+
+  void finish(double t, const double* x) {
+    const int n = model_.segments();
+    Eigen::Map<const Vector> q(x, n);
+    result_.time = t;
+    result_.q = q;
+    model_.velocity(x, qdot_);
+    result_.qdot = qdot_;
+    result_.speed = qdot_.cwiseAbs().maxCoeff();
+    result_.potential = model_.potential(q);
+    result_.kinetic = model_.kineticEnergy(x);
+    result_.dissipated = model_.dissipated(x);
+    result_.residual = model_.equilibriumResidual(q);
+    if (options_.recordTrajectory && (result_.trajectory.empty() || result_.trajectory.back().t < t)) forceRecord(t, x);
+  }
+
+ private:
+  static std::string num(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  }
+
+  double energy(const double* x) {
+    Eigen::Map<const Vector> q(x, model_.segments());
+    return model_.potential(q) + model_.kineticEnergy(x) + model_.dissipated(x);
+  }
+
+  void record(double t, const double* x, bool first) {
+    if (!options_.recordTrajectory) return;
+    if (!first && t - lastRecorded_ < options_.recordInterval) return;
+    forceRecord(t, x);
+  }
+
+  void forceRecord(double t, const double* x) {
+    if (result_.trajectory.size() >= options_.maxSamples) {
+      result_.trajectoryTruncated = true;
+      return;
+    }
+    const int n = model_.segments();
+    Eigen::Map<const Vector> q(x, n);
+    TrajectorySample s;
+    s.t = t;
+    s.q = q;
+    model_.velocity(x, qdot_);
+    s.qdot = qdot_;
+    s.potential = model_.potential(q);
+    s.kinetic = model_.kineticEnergy(x);
+    s.dissipated = model_.dissipated(x);
+    s.residual = model_.equilibriumResidual(q);
+    s.constraintViolation = model_.constraintViolation(q);
+    result_.trajectory.push_back(std::move(s));
+    lastRecorded_ = t;
+  }
+
+  DynamicsModel& model_;
+  const IntegrationOptions& options_;
+  DynamicsResult& result_;
+  Vector qdot_;
+  double lastRecorded_ = 0.0;
+};
+
+// FSAL controllers keep dx/dt of the last accepted state: after a rollback it must be dropped.
+template <class C>
+auto resetController(C& controller, int) -> decltype(controller.reset(), void()) {
+  controller.reset();
+}
+template <class C>
+void resetController(C&, long) {}
+
+template <class Controller, class System, class State>
+void runLoop(Controller& controller, System system, State& x, const double* (*data)(const State&),
+             DynamicsModel& model, const IntegrationOptions& options, Monitor& monitor, DynamicsResult& result) {
+  double t = 0.0, dt = options.initialStep;
+  const int n = model.segments();
+  monitor.start(data(x));
+  State previous = x;
+  for (;;) {
+    if (options.interrupt.requested()) {
+      monitor.stop(IntegrationStop::Interrupted, options.interrupt.describe() + " at t = " + std::to_string(t));
+      break;
+    }
+    if (result.steps >= options.maxSteps) {
+      monitor.stop(IntegrationStop::MaxSteps, "maximum number of steps (" + std::to_string(options.maxSteps) + ") reached");
+      break;
+    }
+    if (t >= options.maxTime * (1.0 - 1e-15)) {
+      monitor.stop(IntegrationStop::MaxTime, "maximum time reached before rest");
+      break;
+    }
+    dt = std::min(dt, options.maxTime - t);
+    if (options.maxStep > 0.0) dt = std::min(dt, options.maxStep);
+    previous = x;
+    const double tPrevious = t, dtTried = dt;
+    const odeint::controlled_step_result res = controller.try_step(system, x, t, dt);
+    if (res == odeint::fail) {
+      ++result.rejectedSteps;
+      if (!(dt >= options.minStep)) {
+        monitor.stop(IntegrationStop::StepSizeUnderflow, "the step size fell below minStep at t = " + std::to_string(t));
+        break;
+      }
+      continue;
+    }
+    // The error control cannot see a step that leaves the model's domain (a NaN error estimate
+    // compares false and is accepted; past a joint limit a spring would pass through zero
+    // length). Such a step is rolled back and retried at half the size, which bisects the time
+    // at which a joint reaches its limit down to minStep; the chain then stops there.
+    const double* xs = data(x);
+    bool finiteState = true;
+    for (int i = 0; finiteState && i < model.stateSize(); ++i) finiteState = std::isfinite(xs[i]);
+    const bool inside = finiteState && model.withinLimits(Eigen::Map<const Vector>(xs, n));
+    if (!inside) {
+      x = previous;
+      t = tPrevious;
+      resetController(controller, 0);
+      ++result.rejectedSteps;
+      dt = 0.5 * dtTried;
+      if (dt < options.minStep) {
+        const double* xp = data(x);
+        int joint = 0;
+        double margin = std::numeric_limits<double>::infinity();
+        for (int i = 0; i < n; ++i) {
+          const double mi = std::min(xp[i] - model.chain().lowerLimits()[i], model.chain().upperLimits()[i] - xp[i]);
+          if (mi < margin) {
+            margin = mi;
+            joint = i;
+          }
+        }
+        // A trial that only failed by being non-finite far from every limit is a model failure.
+        if (!finiteState && margin > 1e-6) {
+          monitor.stop(IntegrationStop::NonFinite, "the right-hand side became non-finite at t = " + std::to_string(t));
+        } else {
+          monitor.stop(IntegrationStop::JointLimit, "joint " + std::to_string(joint + 1) + " reached its limit (q = " +
+                                                   std::to_string(xp[joint]) + ") at t = " + std::to_string(t));
+        }
+        break;
+      }
+      continue;
+    }
+    ++result.steps;
+    if (monitor.accepted(t, data(x))) break;
+  }
+  monitor.finish(t, data(x));
+}
+
+const double* explicitData(const ExplicitState& x) { return x.data(); }
+const double* stiffData(const StiffState& x) { return &x.data()[0]; }
+
+}  // namespace
+
+DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef qdot0, const IntegrationOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("IntegrationOptions: " + why);
+  const int n = model.segments();
+  if (q0.size() != n) throw std::invalid_argument("q0 must have one entry per joint");
+  if (qdot0.size() != 0 && qdot0.size() != n) throw std::invalid_argument("qdot0 must be empty or have one entry per joint");
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(q0[i]) || (qdot0.size() == n && !std::isfinite(qdot0[i])))
+      throw std::invalid_argument("the initial state must be finite");
+
+  // The options' times and rest tolerances are in the model's natural units (dynamics.h).
+  const double T = model.timeUnit();
+  IntegrationOptions natural = options;
+  natural.initialStep *= T;
+  natural.maxStep *= T;
+  natural.minStep *= T;
+  natural.maxTime *= T;
+  natural.recordInterval *= T;
+  natural.velocityTolerance /= T;
+  const auto wallStart = std::chrono::steady_clock::now();
+  DynamicsResult result;
+  result.kind = model.kind();
+  const int N = model.stateSize();
+  Vector x0(N);
+  model.packState(q0, qdot0, x0);
+  Monitor monitor(model, natural, result);
+
+  // The structured Rosenbrock method needs the model's O(n) linear solve (the gradient flow has it).
+  const bool structured =
+      natural.stepper == StepperKind::StructuredRosenbrock4 && model.kind() == DynamicsKind::GradientFlow;
+  if (structured) {
+    ExplicitState x(x0.data(), x0.data() + N);
+    StructuredRosenbrock4 controller(model, natural.absoluteTolerance, natural.relativeTolerance);
+    runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, natural, monitor, result);
+  } else if (natural.stepper == StepperKind::Rosenbrock4 || natural.stepper == StepperKind::StructuredRosenbrock4) {
+    StiffState x(static_cast<size_t>(N));
+    std::copy(x0.data(), x0.data() + N, x.begin());
+    odeint::rosenbrock4_controller<odeint::rosenbrock4<double>> controller(natural.absoluteTolerance,
+                                                                           natural.relativeTolerance);
+    runLoop(controller, std::make_pair(StiffSystem{&model}, StiffJacobian{&model}), x, stiffData, model, natural,
+            monitor, result);
+  } else {
+    ExplicitState x(x0.data(), x0.data() + N);
+    if (natural.stepper == StepperKind::DormandPrince5) {
+      auto controller = odeint::make_controlled(natural.absoluteTolerance, natural.relativeTolerance,
+                                                odeint::runge_kutta_dopri5<ExplicitState>());
+      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, natural, monitor, result);
+    } else {
+      auto controller = odeint::make_controlled(natural.absoluteTolerance, natural.relativeTolerance,
+                                                odeint::runge_kutta_cash_karp54<ExplicitState>());
+      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, natural, monitor, result);
+    }
+  }
+  result.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+  return result;
+}
+
+}  // namespace buckle::mechanics
