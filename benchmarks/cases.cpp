@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
     const double med = times[times.size() / 2];
     if (r.points <= 0) ++failures;
     std::printf("case=%s points=%d time_ms=%.4f per_point_us=%.3f stop=%s\n", name.c_str(), r.points, 1e3 * med,
-                r.points > 0 ? 1e6 * med / r.points : 0.0, buckle::continuation::stopReasonName(r.branch.stopReason));
+                r.points > 0 ? 1e6 * med / r.points : 0.0, buckle::continuation::toString(r.branch.stopReason));
     for (const auto& l : r.located) {
       std::printf("  point case=%s type=%s Fx=%.13e", name.c_str(), l.label.c_str(), l.Fx);
       if (std::isfinite(l.reference)) std::printf(" ref=%.13e err=%.2e", l.reference, std::abs(l.Fx - l.reference));

@@ -87,7 +87,7 @@ SegmentParameters scaledSegment(double a, double b, double k, double L0, const U
 }
 
 std::string stopNote(const cont::Branch& b) {
-  std::string s = std::string("stop ") + cont::stopReasonName(b.stopReason);
+  std::string s = std::string("stop ") + cont::toString(b.stopReason);
   if (!b.stopMessage.empty() && b.stopReason != cont::StopReason::LambdaRange && b.stopReason != cont::StopReason::Boundary)
     s += " (" + b.stopMessage.substr(0, 60) + ")";
   return s;

@@ -63,10 +63,10 @@ int main() {
   options.lambdaMax = 2.0 * truss.limitLoad(1.0);  // past the snap back to the inverted truss
   const bc::Branch branch =
       bc::trace(truss, bc::Vector::Constant(1, 0.3), 0.0, bc::InitialDirection::increasingLambda(), options);
-  std::printf("branch: %zu points, stopped: %s\n", branch.points.size(), bc::stopReasonName(branch.stopReason));
+  std::printf("branch: %zu points, stopped: %s\n", branch.points.size(), bc::toString(branch.stopReason));
   int folds = 0, failures = 0;
   for (const bc::SpecialPoint &sp : branch.specialPoints) {
-    std::printf("%-2s w = %-10.6g P = %-14.10g stability %d -> %d", bc::specialPointLabel(sp.type), sp.u[0],
+    std::printf("%-2s w = %-10.6g P = %-14.10g stability %d -> %d", bc::label(sp.type), sp.u[0],
                 sp.lambda, sp.inertiaBefore, sp.inertiaAfter);
     if (sp.type == bc::SpecialPointType::Fold) {
       const double exact = truss.limitLoad(sp.u[0] > 0.0 ? 1.0 : -1.0);

@@ -117,7 +117,7 @@ class PythonProblem : public cont::Problem {
 
 py::dict specialPointDict(const cont::SpecialPoint& s) {
   py::dict d;
-  d["type"] = cont::specialPointLabel(s.type);
+  d["type"] = cont::label(s.type);
   d["index"] = s.index;
   d["u"] = s.u;
   d["lambda"] = s.lambda;
@@ -157,7 +157,7 @@ py::dict branchDict(const cont::Branch& b, int n) {
   py::list specials;
   for (const cont::SpecialPoint& s : b.specialPoints) specials.append(specialPointDict(s));
   d["special_points"] = specials;
-  d["stop_reason"] = cont::stopReasonName(b.stopReason);
+  d["stop_reason"] = cont::toString(b.stopReason);
   d["stop_message"] = b.stopMessage;
   return d;
 }

@@ -100,7 +100,7 @@ inline void collect(const cont::Branch& b, CaseResult& r) {
   r.points += int(b.points.size()) - 1;
   for (const auto& sp : b.specialPoints) {
     Located l;
-    l.label = cont::specialPointLabel(sp.type);  // AUTO's labels; a multiple BP as BP<m>
+    l.label = cont::label(sp.type);  // AUTO's labels; a multiple BP as BP<m>
     if (sp.type == cont::SpecialPointType::BranchPoint && sp.multiplicity > 1) l.label += std::to_string(sp.multiplicity);
     if (sp.type == cont::SpecialPointType::Endpoint && sp.note == "start") continue;
     l.Fx = sp.lambda;

@@ -87,7 +87,7 @@ void printTable(const std::vector<Row>& rows, std::ostream& out) {
   line(hp, head[6]);
   for (const Row& r : rows) {
     const std::string* cells[6] = {&r.name, &r.quantity, &r.baseline, &r.now, &r.drift, &r.tolerance};
-    line(cells, statusName(r.status));
+    line(cells, toString(r.status));
   }
 }
 
@@ -175,7 +175,7 @@ void writeJson(const std::string& file, const std::vector<Row>& rows, int code) 
   for (const Row& r : rows) {
     failed += r.status == Status::Fail;
     list.push_back({{"case", r.name}, {"quantity", r.quantity}, {"baseline", r.baseline}, {"now", r.now},
-                    {"drift", r.drift}, {"tolerance", r.tolerance}, {"status", statusName(r.status)}});
+                    {"drift", r.drift}, {"tolerance", r.tolerance}, {"status", toString(r.status)}});
   }
   doc["exit"] = code;
   doc["failed"] = failed;

@@ -9,7 +9,7 @@
 
 namespace buckle::regress {
 
-const char* statusName(Status s) {
+const char* toString(Status s) {
   switch (s) {
     case Status::Pass: return "PASS";
     case Status::Fail: return "FAIL";

@@ -10,7 +10,7 @@
 namespace buckle::regress {
 
 enum class Status { Pass, Fail, Info };
-const char* statusName(Status s);
+const char* toString(Status s);
 
 struct Row {
   std::string name;      ///< baseline name

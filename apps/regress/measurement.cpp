@@ -81,7 +81,7 @@ MeasuredCase fromProblem(const problems::CaseResult& r) {
   for (const cont::SpecialPoint& sp : b.specialPoints) {
     if (sp.type == cont::SpecialPointType::Endpoint) continue;
     MeasuredSpecial s;
-    s.type = cont::specialPointLabel(sp.type);
+    s.type = cont::label(sp.type);
     s.branch = b.id;
     s.lambda = sp.lambda;
     s.accuracy = sp.lambdaAccuracy;
@@ -111,7 +111,7 @@ Measurement measureProblem(const std::string& name, int repetitions) {
     if (result.points <= 0) {
       m.complete = false;
       m.problems.push_back("problem " + name + ": no continuation point (" +
-                           cont::stopReasonName(result.branch.stopReason) + ")");
+                           cont::toString(result.branch.stopReason) + ")");
     }
     m.cases.push_back(fromProblem(result));
   }

@@ -30,8 +30,8 @@ void copyLanding(const mech::Landing& l, SpecialRecord& s) {
 
 SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
   SpecialRecord s;
-  s.type = mech::eventLabel(sp.type);
-  s.field = mech::phenomenonName(sp.phenomenon);
+  s.type = mech::label(sp.type);
+  s.field = mech::toString(sp.phenomenon);
   s.branch = branch;
   s.parameter = sp.parameter;
   s.F = sp.F;

@@ -645,7 +645,7 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
     data["main"] = nullptr;
   json plots = json::array();
   for (const PlotSpec& p : scene.plots) {
-    json e{{"type", plotTypeName(p.type)}, {"name", p.name}, {"title", p.title}, {"x", p.x},
+    json e{{"type", toString(p.type)}, {"name", p.name}, {"title", p.title}, {"x", p.x},
            {"y", p.y},                    {"at", p.at},     {"xlabel", p.x}};
     if (!p.cases.empty()) e["cases"] = p.cases;
     plots.push_back(e);

@@ -22,7 +22,7 @@ std::string show(double v) {
 
 using namespace detail;
 
-const char* plotTypeName(PlotType t) {
+const char* toString(PlotType t) {
   switch (t) {
     case PlotType::Bifurcation: return "bifurcation";
     case PlotType::Stiffness: return "stiffness";

@@ -119,7 +119,7 @@ struct SolverSpec {
 };
 
 enum class PlotType { Bifurcation, Stiffness, EnergyCurves, TorqueAngle, Shapes, SuddenLoad };
-const char* plotTypeName(PlotType t);
+const char* toString(PlotType t);
 
 struct PlotSpec {
   PlotType type = PlotType::Bifurcation;

@@ -18,7 +18,7 @@ void print(const char *name, const Branch &branch, const double *exact, int coun
     if (sp.type != SpecialPointType::Fold && sp.type != SpecialPointType::BranchPoint) continue;
     const double error = k < count ? std::abs(sp.lambda - exact[k]) : std::nan("");
     std::printf("%-26s %s m=%d lambda=%+.16f |err|=%.2e reported|dl|=%.2e |F|=%.2e aug=%.2e it=%d refined=%d\n", name,
-                specialPointLabel(sp.type), sp.multiplicity, sp.lambda, error, sp.lambdaAccuracy, sp.residualNorm,
+                label(sp.type), sp.multiplicity, sp.lambda, error, sp.lambdaAccuracy, sp.residualNorm,
                 sp.augmentedResidualNorm, sp.locationIterations, sp.refined ? 1 : 0);
     ++k;
   }

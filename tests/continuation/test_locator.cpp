@@ -62,7 +62,7 @@ TEST_CASE("Cubic folds at lambda = +-2/3, not reported again as branch points", 
     CHECK(fold->refined);
     CHECK(fold->lambdaAccuracy <= tolerance(fold->lambda));
     CHECK(fold->residualNorm < 1e-13);
-    CHECK(std::string(specialPointLabel(fold->type)) == "LP");
+    CHECK(std::string(label(fold->type)) == "LP");
   }
   // Outer branch stable, middle branch unstable: the fold is where one eigenvalue crosses.
   CHECK(folds[0]->inertiaBefore == 0);
@@ -128,7 +128,7 @@ TEST_CASE("Symmetric pitchforks located at lambda = 0 and lambda = c", "[locator
   const double expected[2] = {0.0, c};
   for (int k = 0; k < 2; ++k) {
     const SpecialPoint &bp = *bps[k];
-    CHECK(std::string(specialPointLabel(bp.type)) == "BP");
+    CHECK(std::string(label(bp.type)) == "BP");
     CHECK(bp.refined);
     CHECK(bp.multiplicity == 1);
     CHECK(std::abs(bp.lambda - expected[k]) <= tolerance(expected[k]));

@@ -165,7 +165,7 @@ TEST_CASE("Parameter range end is landed on exactly", "[tracer]") {
   CHECK(std::abs(last.u[0] - std::sqrt(0.75)) < 1e-12);
   const SpecialPoint &ep = branch.specialPoints.back();
   CHECK(ep.type == SpecialPointType::Endpoint);
-  CHECK(std::string(specialPointLabel(ep.type)) == "EP");
+  CHECK(std::string(label(ep.type)) == "EP");
   CHECK(ep.boundaryName == "lambda max");
   CHECK(ep.index == static_cast<int>(branch.points.size()) - 1);
   for (const ContinuationPoint &p : branch.points) CHECK(p.lambda <= 0.5);
@@ -190,7 +190,7 @@ TEST_CASE("Boundary g = 0.5 - u is located exactly", "[tracer]") {
   CHECK(branch.stopReason == StopReason::Boundary);
   const SpecialPoint &bd = branch.specialPoints.back();
   CHECK(bd.type == SpecialPointType::Boundary);
-  CHECK(std::string(specialPointLabel(bd.type)) == "BD");
+  CHECK(std::string(label(bd.type)) == "BD");
   CHECK(bd.boundaryName == "u limit");
   CHECK(std::abs(bd.lambda - 0.5) < 1e-12);
   CHECK(std::abs(branch.points.back().u[0] - 0.5) < 1e-12);

@@ -96,7 +96,7 @@ TEST_CASE("a fold with a stable side is a jump, between unstable parts no event"
   int folds = 0;
   for (const BranchReport& rep : r.reports)
     for (const SpecialPointReport& s : rep.specialPoints) {
-      CHECK(std::string(eventLabel(s.type)) != "?");
+      CHECK(std::string(label(s.type)) != "?");
       CHECK(s.stabilityBefore == stabilityLabel(s.negativeBefore));
       if (s.type == EventType::BranchPoint) CHECK(s.phenomenon == Phenomenon::Buckling);
       if (s.type != EventType::Fold) continue;

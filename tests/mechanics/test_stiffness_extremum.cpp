@@ -139,7 +139,7 @@ TEST_CASE("the derivative of K_F along (dq, dF) equals finite differences of loa
 TEST_CASE("stiffness measure names round-trip", "[stiffness_extremum]") {
   for (StiffnessMeasure m : {StiffnessMeasure::Kxx, StiffnessMeasure::Kyy, StiffnessMeasure::MinEigenvalue}) {
     StiffnessMeasure back = StiffnessMeasure::Kxx;
-    REQUIRE(parseStiffnessMeasure(stiffnessMeasureName(m), back));
+    REQUIRE(parseStiffnessMeasure(toString(m), back));
     CHECK(back == m);
   }
   StiffnessMeasure unused;
@@ -202,7 +202,7 @@ TEST_CASE("KMIN of the smallest eigenvalue of K_F: its rate vanishes there", "[s
   const Chain chain = figureChain(0.75);
   EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(1, 0, 0));
   for (StiffnessMeasure m : {StiffnessMeasure::MinEigenvalue, StiffnessMeasure::Kxx}) {
-    CAPTURE(stiffnessMeasureName(m));
+    CAPTURE(toString(m));
     const std::vector<SpecialPointReport> found = kmin(problem, 1.0, 0.0, m);
     REQUIRE(found.size() == 1);
     for (const SpecialPointReport& s : found) {

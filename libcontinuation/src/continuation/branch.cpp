@@ -8,7 +8,7 @@ Vector ContinuationPoint::state() const {
   return x;
 }
 
-const char *specialPointLabel(SpecialPointType type) {
+const char *label(SpecialPointType type) {
   switch (type) {
     case SpecialPointType::Fold: return "LP";
     case SpecialPointType::BranchPoint: return "BP";
@@ -18,7 +18,7 @@ const char *specialPointLabel(SpecialPointType type) {
   return "??";
 }
 
-const char *stopReasonName(StopReason reason) {
+const char *toString(StopReason reason) {
   switch (reason) {
     case StopReason::NotStarted: return "not started";
     case StopReason::InvalidOptions: return "invalid options";

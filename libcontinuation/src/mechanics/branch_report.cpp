@@ -14,13 +14,13 @@ namespace buckle::mechanics {
 
 namespace cont = buckle::continuation;
 
-const char* eventLabel(EventType type) {
+const char* label(EventType type) {
   switch (type) {
-    case EventType::BranchPoint: return cont::specialPointLabel(cont::SpecialPointType::BranchPoint);
-    case EventType::Fold: return cont::specialPointLabel(cont::SpecialPointType::Fold);
+    case EventType::BranchPoint: return cont::label(cont::SpecialPointType::BranchPoint);
+    case EventType::Fold: return cont::label(cont::SpecialPointType::Fold);
     case EventType::ReactionFold: return "LPF";
     case EventType::Boundary:
-    case EventType::JointLimit: return cont::specialPointLabel(cont::SpecialPointType::Boundary);
+    case EventType::JointLimit: return cont::label(cont::SpecialPointType::Boundary);
     case EventType::StiffnessMinimum: return "KMIN";
     case EventType::Jump: return "JUMP";
   }
@@ -117,7 +117,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
   if (throughReaction) held = std::make_unique<HeldStability>(problem, c);
 
   BranchReport r;
-  r.stopReason = cont::stopReasonName(b.stopReason);
+  r.stopReason = cont::toString(b.stopReason);
   r.stopMessage = b.stopMessage;
   r.finished = regularStop(b.stopReason);
   int limitJoint = -1;
@@ -271,7 +271,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
   // (stiffness_extremum.h): neither the step size nor the units move it.
   if (options.stiffness && r.points.size() >= 2 && !b.points.empty()) {
     const StiffnessMeasure measure = options.stiffnessMeasure;
-    const char* name = stiffnessMeasureName(measure);
+    const char* name = toString(measure);
     const int N = problem.dimension();
     const double m0 = stiffnessMeasure(r.points.front().K, measure);
     std::vector<double> rate(r.points.size(), std::numeric_limits<double>::quiet_NaN());

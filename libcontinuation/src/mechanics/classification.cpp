@@ -9,7 +9,7 @@ namespace buckle::mechanics {
 using continuation::SpecialPoint;
 using continuation::SpecialPointType;
 
-const char* phenomenonName(Phenomenon p) {
+const char* toString(Phenomenon p) {
   switch (p) {
     case Phenomenon::Buckling: return "buckling";
     case Phenomenon::QuasiBuckling: return "quasi-buckling";

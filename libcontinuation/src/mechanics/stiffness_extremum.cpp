@@ -14,7 +14,7 @@ namespace buckle::mechanics {
 
 namespace cont = buckle::continuation;
 
-const char* stiffnessMeasureName(StiffnessMeasure measure) {
+const char* toString(StiffnessMeasure measure) {
   switch (measure) {
     case StiffnessMeasure::Kxx: return "Kxx";
     case StiffnessMeasure::Kyy: return "Kyy";
@@ -25,7 +25,7 @@ const char* stiffnessMeasureName(StiffnessMeasure measure) {
 
 bool parseStiffnessMeasure(const std::string& name, StiffnessMeasure& measure) {
   for (StiffnessMeasure m : {StiffnessMeasure::Kxx, StiffnessMeasure::Kyy, StiffnessMeasure::MinEigenvalue})
-    if (name == stiffnessMeasureName(m)) {
+    if (name == toString(m)) {
       measure = m;
       return true;
     }

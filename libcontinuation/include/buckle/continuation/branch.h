@@ -31,7 +31,7 @@ struct ContinuationPoint {
 enum class SpecialPointType { Fold, BranchPoint, Boundary, Endpoint };
 
 /// AUTO/MATCONT labels: "LP", "BP", "BD", "EP".
-const char *specialPointLabel(SpecialPointType type);
+const char *label(SpecialPointType type);
 
 struct SpecialPoint {
   SpecialPointType type = SpecialPointType::Endpoint;
@@ -77,7 +77,7 @@ enum class StopReason {
   Interrupted,         ///< the Interrupt (time limit, signal) or the step callback asked to stop
 };
 
-const char *stopReasonName(StopReason reason);
+const char *toString(StopReason reason);
 
 struct Branch {
   int id = 0;

@@ -27,7 +27,7 @@
 
 namespace buckle::mechanics {
 
-/// What kind of event a reported special point is. Labels (eventLabel): AUTO/MATCONT's where
+/// What kind of event a reported special point is. Labels (label): AUTO/MATCONT's where
 /// they exist.
 enum class EventType {
   BranchPoint,       ///< "BP": a branch point of the traced equilibria
@@ -40,7 +40,7 @@ enum class EventType {
 };
 
 /// "BP", "LP", "LPF", "BD", "KMIN", "JUMP": the one spelling of the labels in every output.
-const char* eventLabel(EventType type);
+const char* label(EventType type);
 
 /// "stable", "unstable (k negative)", or "unknown" for a count that was not computed (< 0).
 std::string stabilityLabel(int negativeEigenvalues);
@@ -111,7 +111,7 @@ struct BranchReport {
   /// The branch ended on a regular stop (range, boundary, box, arclength, a joint limit);
   /// false: it could not go on.
   bool finished = true;
-  std::string stopReason;                     ///< continuation::stopReasonName, or "joint limit"
+  std::string stopReason;                     ///< continuation::toString(StopReason), or "joint limit"
   std::string stopMessage;
   double worstResidual = 0.0;                 ///< max corrector residual over the points
 };

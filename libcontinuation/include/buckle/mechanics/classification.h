@@ -23,7 +23,7 @@ namespace buckle::mechanics {
 enum class Phenomenon { Buckling, QuasiBuckling, Jumping, None };
 
 /// "buckling", "quasi-buckling", "jumping", "none".
-const char* phenomenonName(Phenomenon p);
+const char* toString(Phenomenon p);
 
 struct Classification {
   Phenomenon phenomenon = Phenomenon::None;

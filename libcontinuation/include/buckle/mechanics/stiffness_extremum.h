@@ -27,7 +27,7 @@ enum class StiffnessMeasure {
 };
 
 /// "Kxx", "Kyy", "Kmin" (the scene spelling).
-const char* stiffnessMeasureName(StiffnessMeasure measure);
+const char* toString(StiffnessMeasure measure);
 /// Inverse of stiffnessMeasureName; false for an unknown name.
 bool parseStiffnessMeasure(const std::string& name, StiffnessMeasure& measure);
 
