@@ -81,6 +81,7 @@ class CaseRunner {
   mech::ReportOptions reportOptions() const {
     mech::ReportOptions o;
     o.stiffness = scene_.analyses.stiffness;
+    o.stiffnessMeasure = scene_.analyses.stiffnessMeasure;
     if (throughLoad()) {
       o.heldCoordinate = spec_.path.coordinate;
       o.rangeLow = std::min(spec_.path.from, spec_.path.to);

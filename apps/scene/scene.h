@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "buckle/mechanics/end_condition.h"
+#include "buckle/mechanics/stiffness_extremum.h"
 #include "buckle/mechanics/segment.h"
 #include "scene/json_reader.h"
 
@@ -104,6 +105,8 @@ struct AnalysesSpec {
   LoadHistorySpec loadHistory;
   SuddenLoadSpec suddenLoad;
   bool stiffness = false;
+  /// The measure whose deep minima along a branch are reported as KMIN (quasi-buckling).
+  mechanics::StiffnessMeasure stiffnessMeasure = mechanics::StiffnessMeasure::Kxx;
   EnergyCurvesSpec energyCurves;
   TorqueAngleSpec torqueAngle;
   CriticalForcesSpec criticalForces;

@@ -6,6 +6,7 @@
 
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/dynamics.h"
+#include "buckle/mechanics/stiffness_extremum.h"
 
 namespace buckle::scene::detail {
 
@@ -40,7 +41,20 @@ AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
     }
   }
   if (a.contains("stiffness")) {
-    s.stiffness = r.boolean(a["stiffness"], p / "stiffness");
+    const json& k = a["stiffness"];
+    const Pointer pk = p / "stiffness";
+    if (k.is_object()) {
+      // {"measure": M}: the stiffness measure whose deep minima are quasi-buckling (KMIN)
+      r.onlyKeys(k, pk, {"measure"});
+      s.stiffness = true;
+      if (k.contains("measure")) {
+        const std::string m = r.string(k["measure"], pk / "measure");
+        if (!mechanics::parseStiffnessMeasure(m, s.stiffnessMeasure))
+          r.expected(pk / "measure", k["measure"], "one of Kxx, Kyy, Kmin (the smallest eigenvalue of K_F)");
+      }
+    } else {
+      s.stiffness = r.boolean(k, pk);
+    }
     if (s.stiffness && !s.continuation.enabled)
       r.fail(p / "stiffness", "stiffness is computed along the traced branches: it needs /analyses/continuation");
   }

@@ -292,3 +292,17 @@ TEST_CASE("an existing output directory is replaced as a whole", "[scene][errors
   }
   CHECK(entries == 2);  // scene.json and out
 }
+
+TEST_CASE("the stiffness measure of KMIN is one of Kxx, Kyy, Kmin", "[scene][errors]") {
+  const std::string base = R"({"chain": {"segments": 3}, "path": {"parameter": "Fx", "from": 0, "to": -1},
+    "analyses": {"continuation": true, "stiffness": )";
+  const buckle::scene::Scene ok = buckle::scene::parseScene(base + R"({"measure": "Kmin"}}})", "s.json");
+  CHECK(ok.analyses.stiffness);
+  CHECK(ok.analyses.stiffnessMeasure == buckle::mechanics::StiffnessMeasure::MinEigenvalue);
+  CHECK(buckle::scene::parseScene(base + "true}}", "s.json").analyses.stiffnessMeasure ==
+        buckle::mechanics::StiffnessMeasure::Kxx);
+  CHECK_THROWS_WITH(buckle::scene::parseScene(base + R"({"measure": "Kzz"}}})", "s.json"),
+                    Catch::Contains("/analyses/stiffness/measure") && Catch::Contains("Kxx, Kyy, Kmin"));
+  CHECK_THROWS_WITH(buckle::scene::parseScene(base + R"({"kind": "Kxx"}}})", "s.json"),
+                    Catch::Contains("/analyses/stiffness"));
+}
