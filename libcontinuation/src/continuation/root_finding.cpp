@@ -15,8 +15,10 @@ double IllinoisBracket::next() const {
   return s > left && s < right ? s : midpoint();
 }
 
-int IllinoisBracket::update(double s, double f) {
-  if (sameSign(f, fLeft)) {
+int IllinoisBracket::update(double s, double f) { return replace(sameSign(f, fLeft) ? -1 : 1, s, f); }
+
+int IllinoisBracket::replace(int side, double s, double f) {
+  if (side < 0) {
     left = s;
     fLeft = f;
     if (lastSide == -1) fRight *= 0.5;

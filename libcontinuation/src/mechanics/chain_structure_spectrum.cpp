@@ -1,5 +1,6 @@
 // Inertia and lowest eigenvalues of H and of H on the null space of held rows, by O(n) counts
 // on the chain structure (chain_structure.h, "factorization and counts"); the small dense route.
+#include "buckle/continuation/root_finding.h"
 #include "buckle/mechanics/chain_structure.h"
 
 #include <Eigen/Eigenvalues>
@@ -198,33 +199,21 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
       auto value = [&](const ShiftEvaluation& e) {
         return e.sign * std::exp(std::max(-700.0, std::min(700.0, e.logAbsDet - ref)));
       };
-      double a = lo[j], b = hi[j], fa = value(ea), fb = value(eb);
-      int side = 0;
-      for (int it = 0; it < 200 && b - a > tol; ++it) {
-        double c = (fa * b - fb * a) / (fa - fb);
-        if (!(c > a && c < b)) c = 0.5 * (a + b);
-        // keep progress: never closer than tol/2 to an end
-        c = std::min(std::max(c, a + 0.25 * tol), b - 0.25 * tol);
+      // Illinois on the determinant, the side of the root decided by the count (exact)
+      continuation::IllinoisBracket br{lo[j], hi[j], value(ea), value(eb), 0};
+      for (int it = 0; it < 200 && br.width() > tol; ++it) {
+        // keep progress: never closer than tol/4 to an end
+        const double c = std::min(std::max(br.next(), br.left + 0.25 * tol), br.right - 0.25 * tol);
         const ShiftEvaluation ec = evaluateShift(ws, useConstraints, c);
         const double fc = value(ec);
-        if (ec.below > j) {  // the root is below c
-          b = c;
-          fb = fc;
-          if (side == -1) fa *= 0.5;
-          side = -1;
-        } else {
-          a = c;
-          fa = fc;
-          if (side == 1) fb *= 0.5;
-          side = 1;
-        }
+        br.replace(ec.below > j ? 1 : -1, c, fc);  // the root is below c: c is the new right end
         if (fc == 0.0) {
-          a = b = c;
+          br.left = br.right = c;
           break;
         }
       }
-      lo[j] = a;
-      hi[j] = b;
+      lo[j] = br.left;
+      hi[j] = br.right;
     }
     out[j] = 0.5 * (lo[j] + hi[j]);
   }

@@ -30,6 +30,9 @@ struct IllinoisBracket {
   /// twice in a row, the other end's value is halved (Illinois). Returns the side replaced
   /// (-1 left, +1 right).
   int update(double s, double f);
+  /// The same with the side given by the caller (-1 left, +1 right), for functions whose sign
+  /// is less reliable than another test of which side the root is on (e.g. an eigenvalue count).
+  int replace(int side, double s, double f);
 };
 
 /// Newton on a square augmented system z ↦ R(z) with Jacobian J(z); the λ unknown sits at
