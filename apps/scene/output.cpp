@@ -167,6 +167,8 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       p["stability_before"] = s.stabilityBefore;
       p["stability_after"] = s.stabilityAfter;
       p["accuracy"] = {{"parameter", number(s.accuracy)}, {"residual", number(s.residual)}, {"refined", s.refined}};
+      // K_F where the report computed it (a located KMIN: the stiffness at the minimum itself)
+      if (s.K.allFinite()) p["stiffness"] = {{"Kxx", number(s.K(0, 0))}, {"Kyy", number(s.K(1, 1))}, {"Kxy", number(s.K(0, 1))}};
       if (!s.note.empty()) p["note"] = s.note;
       if (s.jumpTried) {
         json j;

@@ -186,6 +186,8 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
           CHECK(field == "quasi-buckling");
           CHECK(before == "stable");
           CHECK(after == "stable");
+          REQUIRE(p.contains("stiffness"));  // K_F at the located minimum itself
+          CHECK(p["stiffness"]["Kxx"].get<double>() > 0.0);
         } else if (type == "JUMP") {
           CHECK(field == "jumping");
         } else {
