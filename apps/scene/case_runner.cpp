@@ -13,6 +13,9 @@
 
 namespace buckle::scene {
 
+namespace cont = buckle::continuation;
+namespace mech = buckle::mechanics;
+
 namespace {
 
 void copyLanding(const mech::Landing& l, SpecialRecord& s) {

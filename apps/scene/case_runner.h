@@ -13,9 +13,6 @@
 
 namespace buckle::scene {
 
-namespace cont = buckle::continuation;
-namespace mech = buckle::mechanics;
-
 class CaseRunner {
  public:
   CaseRunner(const Scene& scene, const CaseSpec& spec, CaseResult& out, RunResult& run, const RunControl& control)
@@ -42,12 +39,12 @@ class CaseRunner {
   }
 
  private:
-  void record(const cont::Branch& b, const mech::BranchReport& report, mech::EquilibriumProblem& problem,
+  void record(const continuation::Branch& b, const mechanics::BranchReport& report, mechanics::EquilibriumProblem& problem,
               const std::string& origin);
   bool throughLoad() const { return spec_.path.loadLimit > 0.0; }
   /// The scene's /solver settings as tracer options (the λ range is set by each analysis).
-  cont::TracerOptions solverOptions() const {
-    cont::TracerOptions opt;
+  continuation::TracerOptions solverOptions() const {
+    continuation::TracerOptions opt;
     opt.initialStep = scene_.solver.initialStep;
     opt.minStep = scene_.solver.minStep;
     opt.maxStep = scene_.solver.maxStep;
@@ -58,28 +55,28 @@ class CaseRunner {
       Progress* progress = control_.progress;
       const CaseResult* out = &out_;
       const int* branches = &branchesSoFar_;
-      opt.onStep = [progress, out, branches](const cont::Branch& b) {
+      opt.onStep = [progress, out, branches](const continuation::Branch& b) {
         progress->step(*branches + 1, static_cast<int>(b.points.size()), b.points.back().lambda,
                        static_cast<int>(out->specials.size() + b.specialPoints.size()));
-        return cont::StepAction::Continue;
+        return continuation::StepAction::Continue;
       };
     }
     return opt;
   }
   /// Integration settings of the dynamics with the run's interrupt.
-  mech::IntegrationOptions integrationOptions(mech::IntegrationOptions opt = mech::IntegrationOptions()) const {
+  mechanics::IntegrationOptions integrationOptions(mechanics::IntegrationOptions opt = mechanics::IntegrationOptions()) const {
     opt.interrupt = control_.interrupt;
     return opt;
   }
   /// The path as an EquilibriumProblem: prescribed(λ) = start values + (λ − s0)·direction.
-  mech::EquilibriumProblem pathProblem() const {
-    mech::EndCondition end = spec_.end.condition;
+  mechanics::EquilibriumProblem pathProblem() const {
+    mechanics::EndCondition end = spec_.end.condition;
     end.value -= out_.startValue * spec_.path.direction;
-    return mech::EquilibriumProblem(out_.chain, end, spec_.path.direction);
+    return mechanics::EquilibriumProblem(out_.chain, end, spec_.path.direction);
   }
   /// How the mechanics layer reports this case's branches (branch_report.h).
-  mech::ReportOptions reportOptions() const {
-    mech::ReportOptions o;
+  mechanics::ReportOptions reportOptions() const {
+    mechanics::ReportOptions o;
     o.stiffness = scene_.analyses.stiffness;
     o.stiffnessMeasure = scene_.analyses.stiffnessMeasure;
     if (throughLoad()) {
