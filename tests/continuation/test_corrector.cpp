@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 using namespace buckle::continuation;
@@ -128,4 +129,30 @@ TEST_CASE("CorrectorOptions::IsValid names the bad option", "[corrector]") {
   options.stepTolerance = std::nan("");
   CHECK_FALSE(options.IsValid(&why));
   CHECK_THAT(why, Contains("stepTolerance"));
+}
+
+namespace {
+// A circle whose residual throws once u passes a threshold: the exception must come out of
+// correct() intact (not be lost, and not unwind through KINSOL's C frames).
+struct ThrowingCircle final : toys::Circle {
+  double limit = 0.7;
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    if (u[0] > limit) throw std::domain_error("residual refused to evaluate past the limit");
+    return toys::Circle::residual(u, lambda, F);
+  }
+};
+}  // namespace
+
+TEST_CASE("Corrector rethrows an exception thrown inside a KINSOL callback", "[corrector]") {
+  ThrowingCircle circle;
+  Corrector corrector(circle);
+  Vector predictor(2), tangent(2), x(2);
+  predictor << 0.75, 0.65;
+  tangent << 1.0 / std::sqrt(2.0), 1.0 / std::sqrt(2.0);
+  CHECK_THROWS_WITH(corrector.correct(predictor, tangent, x), Contains("past the limit"));
+  // The same corrector is usable afterwards: the stored exception does not leak into the next solve.
+  circle.limit = 10.0;
+  const CorrectorSummary summary = corrector.correct(predictor, tangent, x);
+  REQUIRE(summary.converged);
+  CHECK(std::abs(x[0] - 0.8) < 1e-12);
 }

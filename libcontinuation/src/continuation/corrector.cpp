@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
 
 namespace buckle::continuation {
 
@@ -80,13 +81,24 @@ void Corrector::applyOptions() {
 }
 
 int Corrector::systemFunction(N_Vector x, N_Vector g, void *self) {
-  return static_cast<Corrector *>(self)->evaluate(N_VGetArrayPointer(x), N_VGetArrayPointer(g));
+  auto *corrector = static_cast<Corrector *>(self);
+  try {
+    return corrector->evaluate(N_VGetArrayPointer(x), N_VGetArrayPointer(g));
+  } catch (...) {
+    corrector->pending_ = std::current_exception();
+    return -1;  // unrecoverable: KINSOL returns at once and correct() rethrows
+  }
 }
 
 int Corrector::jacobianFunction(N_Vector x, N_Vector, SUNMatrix J, void *self, N_Vector, N_Vector) {
   auto *corrector = static_cast<Corrector *>(self);
-  if (corrector->structured_) return corrector->factorStructured(N_VGetArrayPointer(x));
-  return corrector->evaluateJacobian(N_VGetArrayPointer(x), SUNDenseMatrix_Data(J));
+  try {
+    if (corrector->structured_) return corrector->factorStructured(N_VGetArrayPointer(x));
+    return corrector->evaluateJacobian(N_VGetArrayPointer(x), SUNDenseMatrix_Data(J));
+  } catch (...) {
+    corrector->pending_ = std::current_exception();
+    return -1;
+  }
 }
 
 int Corrector::linearSolve(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vector b, realtype) {
@@ -94,7 +106,12 @@ int Corrector::linearSolve(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vect
   const int m = corrector->n_ + 1;
   Eigen::Map<const Vector> rhs(N_VGetArrayPointer(b), m);
   Eigen::Map<Vector> solution(N_VGetArrayPointer(x), m);
-  return corrector->structured_->solve(rhs, solution) ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_UNREC;
+  try {
+    return corrector->structured_->solve(rhs, solution) ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_UNREC;
+  } catch (...) {
+    corrector->pending_ = std::current_exception();
+    return SUNLS_PACKAGE_FAIL_UNREC;
+  }
 }
 
 int Corrector::factorStructured(const double *xData) {
@@ -145,8 +162,10 @@ CorrectorSummary Corrector::correct(ConstVectorRef predictor, ConstVectorRef tan
   lastError_[0] = '\0';
 
   void *mem = kinsol_.get();
+  pending_ = nullptr;
   const int flag = KINSol(mem, x_.get(), options_.lineSearch ? KIN_LINESEARCH : KIN_NONE, scale_.get(),
                           scale_.get());
+  if (pending_) std::rethrow_exception(std::exchange(pending_, nullptr));
   CorrectorSummary summary;
   summary.flag = flag;
   summary.flagName = kinsolFlagName(flag);

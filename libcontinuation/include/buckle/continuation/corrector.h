@@ -26,6 +26,7 @@
 #include "buckle/continuation/sundials_raii.h"
 
 #include <array>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -109,6 +110,9 @@ class Corrector {
   bool refused_ = false;
   int evaluations_ = 0;
   std::array<char, 256> lastError_{};
+  // An exception thrown by the problem inside a KINSOL callback must not unwind through KINSOL's
+  // C frames: the callback stores it, fails the solve, and correct() rethrows it.
+  std::exception_ptr pending_;
 
   // Declaration order is release order reversed: KINSOL memory goes first, context last.
   SunContextPtr context_;
