@@ -462,13 +462,14 @@ void writePlot(const std::vector<Row>& rows, const std::string& task, const std:
       }
   }
   const char* titles[] = {"diagram: full n = 3 clamped-pinned diagram (trivial, BP1, BP2, U and Z to |q| = 1.5)",
-                          "fold: free end, L0 = 0.5, Fy = 0.01 (I\\_up) to the joint limit",
-                          "long: U branch from BP1 to |q| = 1.5 (A\\_U restarted)"};
+                          "fold: free end, L0 = 0.5, Fy = 0.01 (AUTO I-up) to the joint limit",
+                          "long: U branch from BP1 to |q| = 1.5 (AUTO A-U, restarted)"};
   const int t = task == "diagram" ? 0 : task == "fold" ? 1 : 2;
   std::ofstream g(gp);
   g << "set terminal pngcairo size 1400,1000 font ',10'\nset output '" << out << "/work_precision_" << task << ".png'\n"
     << "set logscale xy\nset format x '10^{%L}'\nset format y '10^{%L}'\nset grid\nset key bottom left\n"
-    << "set multiplot layout 2,2 title '" << titles[t] << "\\nbuckle vs AUTO-07p vs naive load grid (lines: lower envelopes; errors of 0 at 1e-17)'\n";
+    << "set multiplot layout 2,2 title \"" << titles[t]
+    << "\\nbuckle vs AUTO-07p vs naive load grid (lines: lower envelopes; errors of 0 at 1e-17)\"\n";
   const char* colors[] = {"#1f77b4", "#d62728", "#2ca02c"};
   const char* panels[4][3] = {{"special-point error |dFx|", "wall time per run [ms]", "3:5"},
                               {"branch error (max distance to the true curve)", "wall time per run [ms]", "3:6"},
