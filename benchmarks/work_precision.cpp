@@ -263,9 +263,12 @@ bool naiveBuckledBranch(EquilibriumProblem& p, GridSolver& g, double fxStart, do
   const Eigen::VectorXd mode = svd.matrixV().col(3) / svd.matrixV().col(3).head(3).lpNorm<Eigen::Infinity>();
   Eigen::VectorXd u;
   bool found = false;
-  for (double a : {0.3, 0.1, 0.03, 0.01, 0.6}) {
+  // A guess is accepted when Newton lands on a bent state along the mode (not on the trivial
+  // state, nor on the other buckled branch, which also exists past the second branch point).
+  for (double a : {0.3, 0.1, 0.03, 0.01, 0.003, 0.001, 0.6, 1.0}) {
     u = a * mode;
-    if (g.solve(u, fxStart) && maxAngle(u) > 1e-6) {
+    if (g.solve(u, fxStart) && maxAngle(u) > 1e-6 &&
+        std::abs(u.head(3).normalized().dot(mode.head(3).normalized())) > 0.7) {
       found = true;
       break;
     }
@@ -421,7 +424,9 @@ std::vector<const Row*> front(const std::vector<Row>& rows, const std::string& p
                               double Row::*err, double Row::*time) {
   std::vector<const Row*> v;
   for (const auto& r : rows)
-    if (r.program == program && r.task == task && std::isfinite(r.*err) && std::isfinite(r.*time)) v.push_back(&r);
+    if (r.program == program && r.task == task && std::isfinite(r.special) && std::isfinite(r.branch) &&
+        std::isfinite(r.*time))
+      v.push_back(&r);
   std::sort(v.begin(), v.end(), [&](const Row* a, const Row* b) { return a->*err < b->*err; });
   std::vector<const Row*> f;
   for (const Row* r : v)
@@ -493,15 +498,16 @@ void writePlot(const std::vector<Row>& rows, const std::string& task, const std:
 
 int main(int argc, char** argv) {
   int reps = 5;
-  bool quick = false;
+  bool quick = false, buckleOnly = false;
   std::string out = BUCKLE_BENCH_DIR "/results", autoDir;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
     else if (!std::strcmp(argv[i], "--auto") && i + 1 < argc) autoDir = argv[++i];
     else if (!std::strcmp(argv[i], "--quick")) quick = true;
+    else if (!std::strcmp(argv[i], "--buckle-only")) buckleOnly = true;
     else {
-      std::fprintf(stderr, "usage: work_precision [--quick] [--reps R] [--out DIR] [--auto DIR]\n  unknown argument %s\n", argv[i]);
+      std::fprintf(stderr, "usage: work_precision [--quick] [--reps R] [--out DIR] [--auto DIR] [--buckle-only]\n  unknown argument %s\n", argv[i]);
       return 2;
     }
   }
@@ -589,6 +595,7 @@ int main(int argc, char** argv) {
     }
 
   // naive: the uniform load grid.
+  if (buckleOnly) grid.clear();
   for (double h : grid) {
     const std::string cfg = fmt("grid%g", h);
     Outcome o;
