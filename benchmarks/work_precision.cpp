@@ -4,7 +4,8 @@
 //             previous solution), a stability count at every grid point; the special points are
 //             the grid points where the stability index changes (or the solution is lost: a
 //             fold, or the joint limit is passed), refined by nothing;
-//   AUTO-07p: read from the b-files and timings that work_precision.sh writes (--auto DIR).
+//   AUTO-07p: read from the b-files and timings that work_precision.sh writes (--auto DIR);
+//   buckle-P2: buckle with the second-order predictor (TracerOptions::secondOrderPredictor).
 // Tasks (3-segment chain, main segment a = 0.5, b = 1, k = 1):
 //   diagram: the full clamped–pinned diagram (L0 = 2.25): trivial branch Fx 0 → −2.5, both
 //            branch points, the U and Z branches to the joint limit |q_i| = 1.5 (AUTO's A_auto);
@@ -46,7 +47,9 @@ namespace cont = buckle::continuation;
 namespace {
 
 const char* const kTasks[] = {"diagram", "fold", "long"};
-const char* const kPrograms[] = {"buckle", "AUTO", "naive"};
+// buckle-P2: buckle with TracerOptions::secondOrderPredictor (off by default).
+const char* const kPrograms[] = {"buckle", "AUTO", "naive", "buckle-P2"};
+constexpr int kProgramCount = 4;
 constexpr double kQLimit = 1.5;
 // Geometric joint limit of the main segment: tan(q/2) = b/a (one spring at zero length).
 const double kGeometricLimit = 2.0 * std::atan(2.0);
@@ -174,11 +177,17 @@ double boundaryValue(const cont::Branch& b) {
   return NAN;
 }
 
+cont::TracerOptions options(const Settings& s, double lambdaMin, double lambdaMax, bool secondOrder) {
+  cont::TracerOptions o = tracerOptions(s, lambdaMin, lambdaMax);
+  o.secondOrderPredictor = secondOrder;
+  return o;
+}
+
 /// The full diagram: trivial branch, both BPs, U and Z branches to |q_i| = 1.5.
-void buckleDiagram(const Settings& s, std::vector<cont::Branch>& out) {
+void buckleDiagram(const Settings& s, bool secondOrder, std::vector<cont::Branch>& out) {
   out.clear();
   auto problem = pinned3(2.25, kQLimit);
-  cont::Tracer tracer(problem, tracerOptions(s, -2.5, 0.0));
+  cont::Tracer tracer(problem, options(s, -2.5, 0.0, secondOrder));
   out.push_back(tracer.trace(Eigen::VectorXd::Zero(4), 0.0, cont::InitialDirection::decreasingLambda()));
   const auto bps = out[0].specialPointsOfType(cont::SpecialPointType::BranchPoint);
   for (size_t i = 0; i < std::min<size_t>(2, bps.size()); ++i) {
@@ -199,9 +208,9 @@ Outcome diagramOutcome(const std::vector<cont::Branch>& branches) {
   return o;
 }
 
-void buckleFold(const Settings& s, cont::Branch& out) {
+void buckleFold(const Settings& s, bool secondOrder, cont::Branch& out) {
   auto problem = free3(0.5, 0.01);
-  cont::Tracer tracer(problem, tracerOptions(s, -3.0, 3.0));
+  cont::Tracer tracer(problem, options(s, -3.0, 3.0, secondOrder));
   out = tracer.trace(Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda());
 }
 
@@ -474,8 +483,8 @@ void writePlot(const std::vector<Row>& rows, const std::string& task, const std:
   g << "set terminal pngcairo size 1400,1000 font ',10'\nset output '" << out << "/work_precision_" << task << ".png'\n"
     << "set logscale xy\nset format x '10^{%L}'\nset format y '10^{%L}'\nset grid\nset key bottom left\n"
     << "set multiplot layout 2,2 title \"" << titles[t]
-    << "\\nbuckle vs AUTO-07p vs naive load grid (lines: lower envelopes; errors of 0 at 1e-17)\"\n";
-  const char* colors[] = {"#1f77b4", "#d62728", "#2ca02c"};
+    << "\\nbuckle vs AUTO-07p vs naive load grid; buckle-P2: second-order predictor (lines: lower envelopes; errors of 0 at 1e-17)\"\n";
+  const char* colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
   const char* panels[4][3] = {{"special-point error |dFx|", "wall time per run [ms]", "3:5"},
                               {"branch error (max distance to the true curve)", "wall time per run [ms]", "3:6"},
                               {"special-point error |dFx|", "CPU time per run [ms]", "4:5"},
@@ -484,7 +493,7 @@ void writePlot(const std::vector<Row>& rows, const std::string& task, const std:
     const std::string using_ = std::string(panels[k][2]);
     const std::string xy = using_.substr(2) + ":" + using_.substr(0, 1);  // x = error, y = time
     g << "set xlabel '" << panels[k][0] << "'\nset ylabel '" << panels[k][1] << "'\nplot ";
-    for (int p = 0; p < 3; ++p) {
+    for (int p = 0; p < kProgramCount; ++p) {
       g << (p ? ", \\\n     " : "") << "'" << dat << "' index " << 5 * p << " using " << xy << " with points pt 7 ps 0.8 lc rgb '"
         << colors[p] << "' title '" << kPrograms[p] << "', \\\n     '' index " << 5 * p + 1 + k << " using " << xy
         << " with lines lw 2 lc rgb '" << colors[p] << "' notitle";
@@ -528,12 +537,12 @@ int main(int argc, char** argv) {
   References ref;
   {
     std::vector<cont::Branch> d;
-    buckleDiagram(tight, d);
+    buckleDiagram(tight, false, d);
     const Outcome o = diagramOutcome(d);
     ref.endU = o.endU;
     ref.endZ = o.endZ;
     cont::Branch f;
-    buckleFold(tight, f);
+    buckleFold(tight, false, f);
     ref.fold = foldOutcome(f).fold;
   }
   std::printf("# references: BP1 %.15f BP2 %.15f (eq 17); ends at |q| = 1.5: U %.14f Z %.14f; fold %.14f "
@@ -555,8 +564,10 @@ int main(int argc, char** argv) {
   };
 
   // buckle: every task over the grid of settings (lowest eigenvalue recorded: AUTO's PVLS computes emin).
+  for (const bool secondOrder : {false, true})
   for (const auto& tol : tols)
     for (double h : steps) {
+      const std::string program = secondOrder ? "buckle-P2" : "buckle";
       Settings s;
       s.maxStep = h;
       s.initialStep = std::min(0.01, h);
@@ -565,18 +576,18 @@ int main(int argc, char** argv) {
       s.lowestEigenvalues = 1;
       const std::string cfg = fmt("h%g_tol%g_loc%g", h, tol.first, tol.second);
       std::vector<cont::Branch> d;
-      Row row{"buckle", "diagram", cfg};
-      timeRuns([&] { buckleDiagram(s, d); }, reps, quick, row.wall, row.cpu);
+      Row row{program, "diagram", cfg};
+      timeRuns([&] { buckleDiagram(s, secondOrder, d); }, reps, quick, row.wall, row.cpu);
       finish(row, diagramOutcome(d));
 
       cont::Branch f;
       row.task = "fold";
-      timeRuns([&] { buckleFold(s, f); }, reps, quick, row.wall, row.cpu);
+      timeRuns([&] { buckleFold(s, secondOrder, f); }, reps, quick, row.wall, row.cpu);
       finish(row, foldOutcome(f));
 
       // long: the switch and the U branch (the trivial branch traced once, untimed).
       auto problem = pinned3(2.25, kQLimit);
-      cont::Tracer tracer(problem, tracerOptions(s, -3.0, 0.0));
+      cont::Tracer tracer(problem, options(s, -3.0, 0.0, secondOrder));
       const cont::Branch trivial = tracer.trace(Eigen::VectorXd::Zero(4), 0.0, cont::InitialDirection::decreasingLambda());
       const auto bps = trivial.specialPointsOfType(cont::SpecialPointType::BranchPoint);
       row.task = "long";
@@ -666,27 +677,29 @@ int main(int argc, char** argv) {
         std::printf("%-7s %-28s %7d %10.4f %10.4f %11.2e %11.2e\n", r.program.c_str(), r.config.c_str(), r.points,
                     1e3 * r.wall, 1e3 * r.cpu, r.special, r.branch);
   }
-  std::printf("\n## least time to reach both errors (special points and branch) <= level; ratios = other / buckle\n");
-  std::printf("%-8s %7s | %9s %9s %9s | %9s %9s %9s | %8s %8s | %8s %8s\n", "task", "level", "buckle_w", "AUTO_w",
-              "naive_w", "buckle_c", "AUTO_c", "naive_c", "AUTO/b_w", "AUTO/b_c", "naive/b_w", "naive/b_c");
+  std::printf("\n## least time to reach both errors (special points and branch) <= level; ratios = other / buckle;"
+              " _w wall, _c CPU, ms per run\n");
+  std::printf("%-8s %7s | %9s %9s %9s | %9s %9s %9s | %8s %8s | %8s %8s | %9s %8s\n", "task", "level", "buckle_w",
+              "AUTO_w", "naive_w", "buckle_c", "AUTO_c", "naive_c", "AUTO/b_w", "AUTO/b_c", "naive/b_w", "naive/b_c", "P2_c",
+              "AUTO/P2_c");
   for (const char* task : kTasks)
     for (double level : {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12}) {
-      double t[3][2];
-      for (int p = 0; p < 3; ++p)
+      double t[kProgramCount][2];
+      for (int p = 0; p < kProgramCount; ++p)
         for (int k = 0; k < 2; ++k) t[p][k] = 1e3 * timeAtLevel(rows, kPrograms[p], task, level, k ? &Row::cpu : &Row::wall);
       auto ratio = [](double a, double b) { return std::isfinite(a) && std::isfinite(b) ? fmt("%8.2f", a / b) : std::string("       -"); };
       auto ms = [](double a) { return std::isfinite(a) ? fmt("%9.4f", a) : std::string("        -"); };
-      std::printf("%-8s %7.0e | %s %s %s | %s %s %s | %s %s | %s %s\n", task, level, ms(t[0][0]).c_str(),
+      std::printf("%-8s %7.0e | %s %s %s | %s %s %s | %s %s | %s %s | %s %s\n", task, level, ms(t[0][0]).c_str(),
                   ms(t[1][0]).c_str(), ms(t[2][0]).c_str(), ms(t[0][1]).c_str(), ms(t[1][1]).c_str(), ms(t[2][1]).c_str(),
                   ratio(t[1][0], t[0][0]).c_str(), ratio(t[1][1], t[0][1]).c_str(), ratio(t[2][0], t[0][0]).c_str(),
-                  ratio(t[2][1], t[0][1]).c_str());
+                  ratio(t[2][1], t[0][1]).c_str(), ms(t[3][1]).c_str(), ratio(t[1][1], t[3][1]).c_str());
     }
   for (const char* task : kTasks) writePlot(rows, task, out);
   std::printf("# wrote %s/work_precision_{diagram,fold,long}.{dat,gp} (gnuplot FILE.gp → .png)%s\n", out.c_str(),
               autoDir.empty() ? "; AUTO not included (no --auto DIR)" : "");
   // Every buckle run must have found its special points (the quick mode is CI's smoke test).
   for (const auto& r : rows)
-    if (r.program == "buckle" && !std::isfinite(r.special)) {
+    if (r.program.rfind("buckle", 0) == 0 && !std::isfinite(r.special)) {
       std::fprintf(stderr, "buckle missed a special point: %s %s\n", r.task.c_str(), r.config.c_str());
       return 1;
     }
