@@ -6,19 +6,18 @@
 #
 #   benchmarks/callgrind_points.sh          (BUILD=build-bench, AUTO_PEER=..., needs valgrind)
 set -euo pipefail
+command -v valgrind > /dev/null || { echo "needs valgrind (apt-get install -y valgrind)"; exit 1; }
+export OMP_NUM_THREADS=1
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=$(cd "$HERE/.." && pwd)
-PEER=${AUTO_PEER:-$ROOT/../shared/peers/auto07p}
-[ -d "$PEER" ] || PEER=/work/shared/peers/auto07p   # the harness of a worktree under /work/wt
 BUILD=${BUILD:-$ROOT/build-bench}
 AUTO_DIR=${AUTO_DIR:-/usr/lib/auto-07p}
-export OMP_NUM_THREADS=1
-command -v valgrind > /dev/null || { echo "needs valgrind (apt-get install -y valgrind)"; exit 1; }
+. "$HERE/auto_lib.sh"   # auto_peer, auto_build
+PEER=$(auto_peer "$ROOT")
 BC=$(cd "$BUILD/bin" && pwd)/bench_cases
 [ -x "$BC" ] || { echo "missing $BC"; exit 1; }
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/buckle-cg.XXXXXX")
 trap 'rm -rf "$WORK"' EXIT
-. "$HERE/auto_lib.sh"
 auto_build "$WORK"
 for r in A_triv A_Ufine; do sed -e 's/JAC=0/JAC=1/' -e 's/IID=2/IID=0/' "$PEER/cases/c.$r" > "c.$r"; done
 ./chain.exe < c.A_triv > /dev/null 2>&1; mv fort.8 s.A_triv

@@ -20,8 +20,8 @@
 set -euo pipefail
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=$(cd "$HERE/.." && pwd)
-PEER=${AUTO_PEER:-$ROOT/../shared/peers/auto07p}
-[ -d "$PEER" ] || PEER=/work/shared/peers/auto07p   # the harness of a worktree under /work/wt
+. "$HERE/auto_lib.sh"   # auto_peer, auto_build
+PEER=$(auto_peer "$ROOT")
 BUILD=${BUILD:-$ROOT/build-bench}
 OUT=${OUT:-$HERE/results}
 REPS=${REPS:-5}
@@ -55,7 +55,6 @@ WORK=$(mktemp -d "${TMPDIR:-/tmp}/buckle-wp.XXXXXX")
 trap 'rm -rf "$WORK"' EXIT
 AUTO_ARGS=()
 if (( have_auto )); then
-  . "$HERE/auto_lib.sh"   # auto_build
   auto_build "$WORK"      # cd's into $WORK
   mkdir -p auto
   TIMEFORMAT='%3U %3S'

@@ -5,7 +5,7 @@ set format x '10^{%L}'
 set format y '10^{%L}'
 set grid
 set key bottom left
-set multiplot layout 2,2 title "long: U branch from BP1 to |q| = 1.5 (AUTO A-U, restarted)\nbuckle vs AUTO-07p vs naive load grid (lines: lower envelopes; errors of 0 at 1e-17)"
+set multiplot layout 2,2 title "long: U branch from BP1 to |q| = 1.5 (AUTO A-U, restarted)\nbuckle vs AUTO-07p vs naive load grid; buckle-P2: second-order predictor (lines: lower envelopes; errors of 0 at 1e-17)"
 set xlabel 'special-point error |dFx|'
 set ylabel 'wall time per run [ms]'
 plot '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 0 using 5:3 with points pt 7 ps 0.8 lc rgb '#1f77b4' title 'buckle', \
@@ -13,7 +13,9 @@ plot '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 0 usin
      '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 5 using 5:3 with points pt 7 ps 0.8 lc rgb '#d62728' title 'AUTO', \
      '' index 6 using 5:3 with lines lw 2 lc rgb '#d62728' notitle, \
      '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 10 using 5:3 with points pt 7 ps 0.8 lc rgb '#2ca02c' title 'naive', \
-     '' index 11 using 5:3 with lines lw 2 lc rgb '#2ca02c' notitle
+     '' index 11 using 5:3 with lines lw 2 lc rgb '#2ca02c' notitle, \
+     '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 15 using 5:3 with points pt 7 ps 0.8 lc rgb '#9467bd' title 'buckle-P2', \
+     '' index 16 using 5:3 with lines lw 2 lc rgb '#9467bd' notitle
 set xlabel 'branch error (max distance to the true curve)'
 set ylabel 'wall time per run [ms]'
 plot '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 0 using 6:3 with points pt 7 ps 0.8 lc rgb '#1f77b4' title 'buckle', \
@@ -21,7 +23,9 @@ plot '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 0 usin
      '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 5 using 6:3 with points pt 7 ps 0.8 lc rgb '#d62728' title 'AUTO', \
      '' index 7 using 6:3 with lines lw 2 lc rgb '#d62728' notitle, \
      '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 10 using 6:3 with points pt 7 ps 0.8 lc rgb '#2ca02c' title 'naive', \
-     '' index 12 using 6:3 with lines lw 2 lc rgb '#2ca02c' notitle
+     '' index 12 using 6:3 with lines lw 2 lc rgb '#2ca02c' notitle, \
+     '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 15 using 6:3 with points pt 7 ps 0.8 lc rgb '#9467bd' title 'buckle-P2', \
+     '' index 17 using 6:3 with lines lw 2 lc rgb '#9467bd' notitle
 set xlabel 'special-point error |dFx|'
 set ylabel 'CPU time per run [ms]'
 plot '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 0 using 5:4 with points pt 7 ps 0.8 lc rgb '#1f77b4' title 'buckle', \
@@ -29,7 +33,9 @@ plot '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 0 usin
      '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 5 using 5:4 with points pt 7 ps 0.8 lc rgb '#d62728' title 'AUTO', \
      '' index 8 using 5:4 with lines lw 2 lc rgb '#d62728' notitle, \
      '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 10 using 5:4 with points pt 7 ps 0.8 lc rgb '#2ca02c' title 'naive', \
-     '' index 13 using 5:4 with lines lw 2 lc rgb '#2ca02c' notitle
+     '' index 13 using 5:4 with lines lw 2 lc rgb '#2ca02c' notitle, \
+     '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 15 using 5:4 with points pt 7 ps 0.8 lc rgb '#9467bd' title 'buckle-P2', \
+     '' index 18 using 5:4 with lines lw 2 lc rgb '#9467bd' notitle
 set xlabel 'branch error (max distance to the true curve)'
 set ylabel 'CPU time per run [ms]'
 plot '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 0 using 6:4 with points pt 7 ps 0.8 lc rgb '#1f77b4' title 'buckle', \
@@ -37,5 +43,7 @@ plot '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 0 usin
      '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 5 using 6:4 with points pt 7 ps 0.8 lc rgb '#d62728' title 'AUTO', \
      '' index 9 using 6:4 with lines lw 2 lc rgb '#d62728' notitle, \
      '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 10 using 6:4 with points pt 7 ps 0.8 lc rgb '#2ca02c' title 'naive', \
-     '' index 14 using 6:4 with lines lw 2 lc rgb '#2ca02c' notitle
+     '' index 14 using 6:4 with lines lw 2 lc rgb '#2ca02c' notitle, \
+     '/work/wt/workprec/benchmarks/results/work_precision_long.dat' index 15 using 6:4 with points pt 7 ps 0.8 lc rgb '#9467bd' title 'buckle-P2', \
+     '' index 19 using 6:4 with lines lw 2 lc rgb '#9467bd' notitle
 unset multiplot
