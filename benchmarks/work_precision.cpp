@@ -262,7 +262,7 @@ class GridSolver {
 double maxAngle(const Eigen::VectorXd& u) { return u.head(3).lpNorm<Eigen::Infinity>(); }
 
 /// March from the first grid point past a branch point along the buckled branch until the joint
-/// limit is first exceeded; that grid point is the end. The start guess is the trivial state plus
+/// limit is first exceeded; that grid point is the end. False when the branch is lost. The start guess is the trivial state plus
 /// a multiple of the critical mode (the smallest singular vector of F_u there).
 bool naiveBuckledBranch(EquilibriumProblem& p, GridSolver& g, double fxStart, double h, Outcome& o, double& end) {
   Eigen::MatrixXd J(4, 4);
@@ -286,9 +286,18 @@ bool naiveBuckledBranch(EquilibriumProblem& p, GridSolver& g, double fxStart, do
   std::vector<std::pair<Eigen::VectorXd, double>> pts;
   double fx = fxStart;
   pts.emplace_back(u.head(3), fx);
+  // Newton's start at the next load: the linear extrapolation of the last two solutions (from
+  // the previous one alone, the amplitude ~ √|Fx − Fx_c| near the branch point is not kept and
+  // Newton falls back onto the trivial state).
+  Eigen::VectorXd prev = u, next(u.size());
   for (int k = 1; k < 1000000 && fx > -2.5; ++k) {
     fx = fxStart - k * h;
-    if (!g.solve(u, fx)) return false;
+    if (k > 1) {
+      next.noalias() = 2.0 * u - prev;
+      prev = u;
+      u.swap(next);
+    }
+    if (!g.solve(u, fx) || maxAngle(u) < 1e-8) return false;  // lost, or back on the trivial state
     g.index(u, fx);
     pts.emplace_back(u.head(3), fx);
     if (maxAngle(u) >= kQLimit) {
