@@ -18,8 +18,8 @@
 // largest distance max(‖Δq‖∞, |ΔFx|) of any computed point from the true curve, found by Newton
 // projection to 1e-14 along the normal of the point's own tangent (tangent from the kernel of
 // [F_u, F_λ] at the point). Times: in-process wall (steady_clock) and CPU (getrusage), per run,
-// median of --reps batches; AUTO's are its own "Total Time" (in-process wall) and its process CPU
-// minus the CPU of a start-up-only run (work_precision.sh).
+// median of --reps batches; AUTO's are its own "Total Time" (in-process wall) and that time scaled
+// by its process's CPU/wall ratio (work_precision.sh).
 // Output: a table per task, a ratio table (time to reach a combined error level), and for each
 // task results/work_precision_<task>.{dat,gp} (gnuplot → .png).
 #include <sys/resource.h>
@@ -65,11 +65,18 @@ double median(std::vector<double> v) {
   return v.empty() ? NAN : v[v.size() / 2];
 }
 
+std::string fmt(const char* f, double a, double b = 0, double c = 0) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+
 /// A computed diagram, whatever the program: the points of each branch (q, Fx) and its special points.
 struct Outcome {
   std::vector<std::vector<std::pair<Eigen::VectorXd, double>>> branches;
   double bp1 = NAN, bp2 = NAN, endU = NAN, endZ = NAN, fold = NAN;
   int points = 0;
+  std::string note;  ///< naive: where a buckled branch was not found or lost
 };
 
 struct Row {
@@ -77,6 +84,7 @@ struct Row {
   int points = 0;
   double wall = NAN, cpu = NAN;  ///< seconds per run
   double special = INFINITY, branch = INFINITY;
+  std::string note{};
 };
 
 /// Times f() (one run) in batches lasting ≥ 20 ms; per-run wall and CPU, median of `reps` batches.
@@ -264,7 +272,8 @@ double maxAngle(const Eigen::VectorXd& u) { return u.head(3).lpNorm<Eigen::Infin
 /// March from the first grid point past a branch point along the buckled branch until the joint
 /// limit is first exceeded; that grid point is the end. False when the branch is lost. The start guess is the trivial state plus
 /// a multiple of the critical mode (the smallest singular vector of F_u there).
-bool naiveBuckledBranch(EquilibriumProblem& p, GridSolver& g, double fxStart, double h, Outcome& o, double& end) {
+bool naiveBuckledBranch(EquilibriumProblem& p, GridSolver& g, const char* name, double fxStart, double h, Outcome& o,
+                        double& end) {
   Eigen::MatrixXd J(4, 4);
   Eigen::VectorXd Fl(4), zero = Eigen::VectorXd::Zero(4);
   p.jacobian(zero, fxStart, J, Fl);
@@ -282,7 +291,10 @@ bool naiveBuckledBranch(EquilibriumProblem& p, GridSolver& g, double fxStart, do
       break;
     }
   }
-  if (!found) return false;
+  if (!found) {
+    o.note += std::string(" ") + name + ": not found at Fx = " + fmt("%.4g", fxStart);
+    return false;
+  }
   std::vector<std::pair<Eigen::VectorXd, double>> pts;
   double fx = fxStart;
   pts.emplace_back(u.head(3), fx);
@@ -297,7 +309,10 @@ bool naiveBuckledBranch(EquilibriumProblem& p, GridSolver& g, double fxStart, do
       prev = u;
       u.swap(next);
     }
-    if (!g.solve(u, fx) || maxAngle(u) < 1e-8) return false;  // lost, or back on the trivial state
+    if (!g.solve(u, fx) || maxAngle(u) < 1e-8) {  // lost, or back on the trivial state
+      o.note += std::string(" ") + name + ": lost at Fx = " + fmt("%.4g", fx);
+      return false;
+    }
     g.index(u, fx);
     pts.emplace_back(u.head(3), fx);
     if (maxAngle(u) >= kQLimit) {
@@ -331,8 +346,8 @@ Outcome naiveDiagram(double h) {
   o.branches.push_back(std::move(pts));
   if (changes.size() >= 1) o.bp1 = changes[0];
   if (changes.size() >= 2) o.bp2 = changes[1];
-  if (std::isfinite(o.bp1)) naiveBuckledBranch(p, g, o.bp1, h, o, o.endU);
-  if (std::isfinite(o.bp2)) naiveBuckledBranch(p, g, o.bp2, h, o, o.endZ);
+  if (std::isfinite(o.bp1)) naiveBuckledBranch(p, g, "U", o.bp1, h, o, o.endU);
+  if (std::isfinite(o.bp2)) naiveBuckledBranch(p, g, "Z", o.bp2, h, o, o.endZ);
   return o;
 }
 
@@ -343,7 +358,7 @@ Outcome naiveLong(double h) {
   auto p = pinned3(2.25);
   GridSolver g(p);
   const double bp = std::ceil(analyticFx(2.25, false) / -h) * -h;  // the grid point the trivial march flags
-  naiveBuckledBranch(p, g, bp, h, o, o.endU);
+  naiveBuckledBranch(p, g, "U", bp, h, o, o.endU);
   return o;
 }
 
@@ -429,12 +444,6 @@ double specialError(const std::string& task, const Outcome& o, const References&
     return std::max({absErr(o.bp1, r.bp1), absErr(o.bp2, r.bp2), absErr(o.endU, r.endU), absErr(o.endZ, r.endZ)});
   if (task == "fold") return absErr(o.fold, r.fold);
   return absErr(o.endU, r.endU);
-}
-
-std::string fmt(const char* f, double a, double b = 0, double c = 0) {
-  char buf[128];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
 }
 
 /// Rows on the lower envelope: sorted by error, each faster than every more accurate one.
@@ -567,6 +576,7 @@ int main(int argc, char** argv) {
   std::vector<Row> rows;
   auto finish = [&](Row row, const Outcome& o) {
     row.points = o.points;
+    row.note = o.note;
     row.special = specialError(row.task, o, ref);
     row.branch = o.branches.empty() ? INFINITY : projectorFor(row.task).maxDistance(o);
     rows.push_back(row);
@@ -642,7 +652,7 @@ int main(int argc, char** argv) {
       std::istringstream ls(line);
       std::string task, cfg, wall, cpu, bfile;
       if (!(ls >> task >> cfg >> wall >> cpu >> bfile)) continue;
-      // CPU is "nan" when the start-up CPU was not below the run's (quick mode: too few runs).
+      // strtod: a value may be "nan" (then the row has no CPU time).
       const double wallMs = std::strtod(wall.c_str(), nullptr), cpuMs = std::strtod(cpu.c_str(), nullptr);
       Outcome o;
       std::vector<std::pair<int, double>> labelled;
@@ -683,8 +693,8 @@ int main(int argc, char** argv) {
                 "special", "branch");
     for (const auto& r : rows)
       if (r.task == task)
-        std::printf("%-7s %-28s %7d %10.4f %10.4f %11.2e %11.2e\n", r.program.c_str(), r.config.c_str(), r.points,
-                    1e3 * r.wall, 1e3 * r.cpu, r.special, r.branch);
+        std::printf("%-7s %-28s %7d %10.4f %10.4f %11.2e %11.2e%s\n", r.program.c_str(), r.config.c_str(), r.points,
+                    1e3 * r.wall, 1e3 * r.cpu, r.special, r.branch, r.note.c_str());
   }
   std::printf("\n## least time to reach both errors (special points and branch) <= level; ratios = other / buckle;"
               " _w wall, _c CPU, ms per run\n");

@@ -12,8 +12,10 @@
 #   fold   : c.I_up restarted from I_home, stopped at the geometric joint limit qmax = 2 atan 2
 #            (where buckle stops);
 #   long   : c.A_U restarted from the A_triv run of the same setting (only A_U is timed).
-# Per setting: "Total Time" (AUTO's in-process wall clock, median of the runs) and the process CPU
-# time (user + sys of K runs / K) minus that of a start-up-only run (NMX = 1); the b-files go to
+# Per setting: "Total Time" (AUTO's in-process wall clock, omp_get_wtime: start-up excluded, its
+# fort.7 output included; median of K runs) and an in-process CPU time: Total Time × the process's
+# (user + sys)/real over the K runs (the share of the wall time the process was on a CPU; a CPU
+# time measured from outside would include the start-up, ≈ 3 ms here); the b-files go to
 # $WORK/auto, listed in index.txt, which work_precision --auto reads (errors are computed there,
 # with the same measures as for buckle and the naive method). Without AUTO (not installed) the
 # quick mode skips it and says so; the full mode installs it (apt-get install auto-07p gfortran).
@@ -57,7 +59,7 @@ AUTO_ARGS=()
 if (( have_auto )); then
   auto_build "$WORK"      # cd's into $WORK
   mkdir -p auto
-  TIMEFORMAT='%3U %3S'
+  TIMEFORMAT='%3R %3U %3S'
   # cfile SRC DSMAX EPSL EPSS: the constants file with the setting applied (stdout)
   cfile() {
     local src=$1 dsmax=$2 epsl=$3 epss=$4
@@ -67,7 +69,7 @@ if (( have_auto )); then
         -e "s/NMX=[0-9]*, DS=\(-\{0,1\}\)[0-9.e-]*/NMX=50000, DS=\1$(awk -v d="$dsmax" 'BEGIN{print (d < 0.01) ? d : 0.01}')/" \
         "$PEER/cases/$src"
   }
-  # timed NAME CFILE: K runs; echoes "wall_ms cpu_ms" (Total Time median, process CPU per run)
+  # timed NAME CFILE: K runs; echoes "wall_ms cpu_ms" (Total Time median, scaled by CPU/real)
   timed() {
     local name=$1 cf=$2 i t
     t=$( { time (for ((i = 1; i <= K; i++)); do ./chain.exe < "$cf" > "out.$name.$i" 2>&1; done) ; } 2>&1 )
@@ -75,16 +77,11 @@ if (( have_auto )); then
     wall=$(for ((i = 1; i <= K; i++)); do awk '/Total Time/{printf "%.6f\n", $3*1000}' "out.$name.$i"; done | sort -g \
            | awk '{v[NR]=$1} END{print v[int((NR+1)/2)]}')
     rm -f out."$name".*
-    echo "$wall $(awk -v t="$t" -v k="$K" 'BEGIN{split(t, a, " "); printf "%.6f", 1000*(a[1]+a[2])/k}')"
+    echo "$wall $(awk -v t="$t" -v w="$wall" 'BEGIN{split(t, a, " "); printf "%.6f", w*(a[2]+a[3])/a[1]}')"
   }
-  cpu_minus_startup() { awk -v c="$1" -v s="$STARTUP" 'BEGIN{ if (c > s) printf "%.6f", c - s; else print "nan" }'; }
   # set-up run for the fold task (untimed): Fy0 homotopy to 0.01
   sed -e 's/JAC=0/JAC=1/' -e 's/IID=2/IID=0/' "$PEER/cases/c.I_home" > c.I_home
   ./chain.exe < c.I_home > /dev/null 2>&1; mv fort.8 s.I_home; rm -f fort.7 fort.9
-  # start-up CPU: A_triv stopped after its first step
-  sed -e 's/JAC=0/JAC=1/' -e 's/IID=2/IID=0/' -e 's/NMX=[0-9]*/NMX=1/' "$PEER/cases/c.A_triv" > c.startup
-  read -r _ STARTUP <<< "$(timed startup c.startup)"
-  echo "AUTO start-up CPU (NMX=1 run): $STARTUP ms per process (subtracted from AUTO's CPU times)"
   QGEOM=$(awk 'BEGIN{printf "%.15f", 2*atan2(2, 1)}')
   : > auto/index.txt
   for eps in $EPS; do
@@ -95,19 +92,19 @@ if (( have_auto )); then
       cfile c.A_auto "$dsmax" "$epsl" "$epss" > c.diag
       read -r w c <<< "$(timed diag c.diag)"
       ./chain.exe < c.diag > /dev/null 2>&1; mv fort.7 "auto/diagram_$cfg.b"; rm -f fort.8 fort.9
-      echo "diagram $cfg $w $(cpu_minus_startup "$c") diagram_$cfg.b" >> auto/index.txt
+      echo "diagram $cfg $w $c diagram_$cfg.b" >> auto/index.txt
       # fold (UZSTOP qmax moved to the geometric joint limit)
       cfile c.I_up "$dsmax" "$epsl" "$epss" | sed "s/'qmax':3.0/'qmax':$QGEOM/" > c.fold
       read -r w c <<< "$(timed fold c.fold)"
       ./chain.exe < c.fold > /dev/null 2>&1; mv fort.7 "auto/fold_$cfg.b"; rm -f fort.8 fort.9
-      echo "fold $cfg $w $(cpu_minus_startup "$c") fold_$cfg.b" >> auto/index.txt
+      echo "fold $cfg $w $c fold_$cfg.b" >> auto/index.txt
       # long: A_U restarted from this setting's A_triv
       cfile c.A_triv "$dsmax" "$epsl" "$epss" > c.triv
       ./chain.exe < c.triv > /dev/null 2>&1; mv fort.8 s.A_triv; rm -f fort.7 fort.9
       cfile c.A_U "$dsmax" "$epsl" "$epss" > c.long
       read -r w c <<< "$(timed long c.long)"
       ./chain.exe < c.long > /dev/null 2>&1; mv fort.7 "auto/long_$cfg.b"; rm -f fort.8 fort.9
-      echo "long $cfg $w $(cpu_minus_startup "$c") long_$cfg.b" >> auto/index.txt
+      echo "long $cfg $w $c long_$cfg.b" >> auto/index.txt
     done
   done
   AUTO_ARGS=(--auto "$WORK/auto")
