@@ -394,8 +394,16 @@ Outcome naiveFold(double h) {
 
 // ---- AUTO: b-files written by work_precision.sh -----------------------------------------------
 
+/// A labelled point of AUTO's b-file: its type (1, 6 BP; 2, 5 LP; −4 UZ; 9 EP), Fx, and the index
+/// of its branch in the file's order.
+struct AutoLabel {
+  int type;
+  double fx;
+  int branch;
+};
+
 /// Reads AUTO's fort.7: the continuation points (q1..q3, Fx) of every branch and the labelled ones.
-bool readAutoBFile(const std::string& path, Outcome& o, std::vector<std::pair<int, double>>& labelled) {
+bool readAutoBFile(const std::string& path, Outcome& o, std::vector<AutoLabel>& labelled) {
   std::ifstream in(path);
   if (!in) return false;
   std::string line;
@@ -425,7 +433,7 @@ bool readAutoBFile(const std::string& path, Outcome& o, std::vector<std::pair<in
     lastBranch = br;
     o.branches.back().emplace_back(q, fx);
     ++o.points;
-    if (type != 0) labelled.emplace_back(type, fx);
+    if (type != 0) labelled.push_back({type, fx, int(o.branches.size()) - 1});
   }
   return o.points > 0;
 }
@@ -655,7 +663,7 @@ int main(int argc, char** argv) {
       // strtod: a value may be "nan" (then the row has no CPU time).
       const double wallMs = std::strtod(wall.c_str(), nullptr), cpuMs = std::strtod(cpu.c_str(), nullptr);
       Outcome o;
-      std::vector<std::pair<int, double>> labelled;
+      std::vector<AutoLabel> labelled;
       Row row{"AUTO", task, cfg};
       row.wall = 1e-3 * wallMs;
       row.cpu = 1e-3 * cpuMs;
@@ -664,25 +672,19 @@ int main(int argc, char** argv) {
         rows.push_back(row);
         continue;
       }
-      std::vector<double> bps, ends;
+      // A_auto: the BPs on the trivial branch (the file's first), the U and Z branches switched
+      // onto at the first two (second and third), each ending on its last UZ (qmax); the trivial
+      // branch's own UZ at Fx = −2.5 is not an end at the joint limit. A_U: one branch.
+      std::vector<double> bps;
+      const int uBranch = task == "diagram" ? 1 : 0;
       for (const auto& l : labelled) {
-        if (l.first == 1 || l.first == 6) bps.push_back(l.second);
-        if ((l.first == 2 || l.first == 5) && !std::isfinite(o.fold)) o.fold = l.second;
-        if (l.first == -4) ends.push_back(l.second);
+        if ((l.type == 1 || l.type == 6) && l.branch == 0) bps.push_back(l.fx);
+        if ((l.type == 2 || l.type == 5) && !std::isfinite(o.fold)) o.fold = l.fx;
+        if (l.type == -4 && l.branch == uBranch) o.endU = l.fx;
+        if (l.type == -4 && l.branch == 2 && task == "diagram") o.endZ = l.fx;
       }
-      if (task == "diagram") {
-        // A_auto: BPs on branch 1, then one UZ (qmax) per switched branch, U first; the trivial
-        // branch's own UZ at Fx = −2.5 is not an end at the joint limit.
-        if (bps.size() >= 1) o.bp1 = bps[0];
-        if (bps.size() >= 2) o.bp2 = bps[1];
-        std::vector<double> qEnds;
-        for (double e : ends)
-          if (std::abs(e + 2.5) > 1e-6) qEnds.push_back(e);
-        if (qEnds.size() >= 1) o.endU = qEnds[0];
-        if (qEnds.size() >= 2) o.endZ = qEnds[1];
-      } else if (task == "long" && !ends.empty()) {
-        o.endU = ends.back();
-      }
+      if (task == "diagram" && bps.size() >= 1) o.bp1 = bps[0];
+      if (task == "diagram" && bps.size() >= 2) o.bp2 = bps[1];
       finish(row, o);
     }
   }
