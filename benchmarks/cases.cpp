@@ -1,6 +1,7 @@
 // bench_cases: buckle on the AUTO-07p comparison cases, one line per located point and a
 // timing line per case, machine-readable (key=value) for compare_auto.sh.
-//   bench_cases [--reps R] [CASE ...]     default: all cases, R = 5 (median time)
+//   bench_cases [--reps R] [--second-order] [CASE ...]   default: all cases, R = 5 (median time);
+//   --second-order: TracerOptions::secondOrderPredictor
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -15,8 +16,10 @@ using namespace buckle::bench;
 int main(int argc, char** argv) {
   int reps = 5;
   std::vector<std::string> names;
+  bool secondOrder = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--second-order")) secondOrder = true;
     else names.emplace_back(argv[i]);
   }
   if (names.empty()) names = caseNames();
@@ -24,6 +27,7 @@ int main(int argc, char** argv) {
   // eigenvalue itself), like AUTO's IPS = 0 runs, which compute no eigenvalues at all.
   Settings settings;
   settings.lowestEigenvalues = 0;
+  settings.secondOrderPredictor = secondOrder;
   int failures = 0;
   for (const auto& name : names) {
     std::vector<double> times;

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates every figure of benchmarks/RESULTS.md: builds the benchmark targets, runs the
-# kernels (all n), the AUTO-07p comparison, the work-precision program and its plot, the hard
+# kernels (all n), the AUTO-07p comparison, the side-by-side work-precision sweep and its plots,
+# the instruction counts per point (callgrind, when valgrind is installed), the hard
 # cases (hard_cases_auto.sh: buckle and AUTO), and writes
 # the raw outputs to benchmarks/results/. RESULTS.md quotes these files.
 #   benchmarks/run_all.sh            (BUILD=build-bench by default; REPS=5; HARD_N=1000: large clustered case)
@@ -21,8 +22,8 @@ cmake --build "$BUILD" -j2 --target bench_kernels bench_cases work_precision har
 } > "$R/machine.txt"
 "$BUILD/bin/bench_kernels" --benchmark_min_time=0.2 | tee "$R/kernels.txt"
 REPS=$REPS BUILD=$BUILD "$HERE/compare_auto.sh" | tee "$R/compare_auto.txt"
-"$BUILD/bin/work_precision" --reps "$REPS" --out "$R" | tee "$R/work_precision.txt"
-gnuplot "$R/work_precision.gp"
+BUILD=$BUILD REPS=$REPS OUT=$R "$HERE/work_precision.sh" | tee "$R/work_precision.txt"   # and its plots
+if command -v valgrind > /dev/null; then BUILD=$BUILD "$HERE/callgrind_points.sh" | tee "$R/callgrind_points.txt"; fi
 BUILD=$BUILD "$HERE/hard_cases_auto.sh" --n "${HARD_N:-1000}" | tee "$R/hard_cases.txt"
 echo "load average at end: $(cut -d' ' -f1-3 /proc/loadavg)" >> "$R/machine.txt"
 echo "results in $R"

@@ -26,7 +26,7 @@ run() {
 }
 BUCKLE_BENCH_MAX_N=30 run bench_kernels "$BIN/bench_kernels" --benchmark_min_time=0.01
 run bench_cases "$BIN/bench_cases" --reps 1
-run work_precision "$BIN/work_precision" --quick --out "$OUT"
+BUILD=$BUILD OUT=$OUT run work_precision "$HERE/work_precision.sh" --quick   # AUTO only if installed
 run hard_cases "$BIN/hard_cases" --quick
 run critical_loads "$BIN/critical_loads" --quick
 run jump_timing "$BIN/jump_timing" --quick

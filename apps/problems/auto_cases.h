@@ -49,6 +49,7 @@ struct Settings {
   /// Lowest eigenvalues recorded per point (TracerOptions::lowestEigenvalues). bench_cases uses
   /// 0 (inertia only, what the branch-point test needs; AUTO with IPS = 0 computes none).
   int lowestEigenvalues = 3;
+  bool secondOrderPredictor = false;  ///< TracerOptions::secondOrderPredictor
 };
 
 inline cont::TracerOptions tracerOptions(const Settings& s, double lambdaMin, double lambdaMax) {
@@ -61,6 +62,7 @@ inline cont::TracerOptions tracerOptions(const Settings& s, double lambdaMin, do
   o.locationNewtonTolerance = std::min(1e-13, s.newtonTolerance);
   o.computeStability = s.stability;
   o.lowestEigenvalues = s.lowestEigenvalues;
+  o.secondOrderPredictor = s.secondOrderPredictor;
   o.lambdaMin = lambdaMin;
   o.lambdaMax = lambdaMax;
   o.maxPoints = 20000;

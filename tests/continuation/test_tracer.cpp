@@ -140,6 +140,30 @@ TEST_CASE("Circle: both folds located exactly, points on the circle", "[tracer]"
   }
 }
 
+TEST_CASE("Second-order predictor: same circle and folds with fewer Newton iterations", "[tracer]") {
+  toys::Circle circle;
+  TracerOptions options;
+  options.initialStep = options.maxStep = 0.1;  // the same steps for both predictors
+  options.maxArclength = 2.0 * M_PI - 0.3;
+  const Branch first = trace(circle, vec1(1.02), 0.0, InitialDirection::increasingLambda(), options);
+  options.secondOrderPredictor = true;
+  const Branch second = trace(circle, vec1(1.02), 0.0, InitialDirection::increasingLambda(), options);
+  REQUIRE(first.points.size() > 10);
+  REQUIRE(second.points.size() > 10);
+  auto iterationsPerPoint = [](const Branch &b) {
+    double sum = 0.0;
+    for (size_t i = 1; i < b.points.size(); ++i) sum += b.points[i].newtonIterations;
+    return sum / double(b.points.size() - 1);
+  };
+  for (const ContinuationPoint &p : second.points) CHECK(std::abs(p.u[0] * p.u[0] + p.lambda * p.lambda - 1.0) < 1e-9);
+  // Euler's predictor is ds²/2 = 5e-3 off the unit circle, the second-order one O(ds³).
+  CHECK(iterationsPerPoint(second) < iterationsPerPoint(first));
+  const auto folds = second.specialPointsOfType(SpecialPointType::Fold);
+  REQUIRE(folds.size() == 2);
+  CHECK(std::abs(folds[0]->lambda - 1.0) < 1e-12);
+  CHECK(std::abs(folds[1]->lambda + 1.0) < 1e-12);
+}
+
 TEST_CASE("Consecutive tangents respect the branch-jump guard", "[tracer]") {
   toys::Circle circle;
   TracerOptions options;

@@ -281,10 +281,18 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
   return branch;
 }
 
-bool Tracer::takeStep(const ContinuationPoint &a, double ds, ContinuationPoint &b, CorrectorSummary &summary,
-                      std::string &failure) {
+bool Tracer::takeStep(const ContinuationPoint &a, const ContinuationPoint *previous, double ds, ContinuationPoint &b,
+                      CorrectorSummary &summary, std::string &failure) {
   predictor_.head(n_) = a.u + ds * a.tangent.head(n_);
   predictor_[n_] = a.lambda + ds * a.tangent[n_];
+  // Second-order (Taylor) predictor: (t_a − t_p)/Δs_a is the branch's curvature vector x'' to
+  // O(Δs), so adding ½ds²·x'' leaves the predictor O(ds³) from the branch instead of O(ds²):
+  // fewer Newton iterations per step for the same step (both tangents are already known).
+  if (previous && a.stepSize > 0.0) {
+    const double c = 0.5 * ds * ds / a.stepSize;
+    predictor_.head(n_) += c * (a.tangent.head(n_) - previous->tangent.head(n_));
+    predictor_[n_] += c * (a.tangent[n_] - previous->tangent[n_]);
+  }
   summary = corrector_->correct(predictor_, a.tangent, x_);
   if (!summary.converged) {
     failure = summary.flagName;
@@ -375,7 +383,8 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     const double dsTry = std::min(ds, remaining);
     ContinuationPoint b;
     CorrectorSummary summary;
-    if (!takeStep(a, dsTry, b, summary, lastFailure)) {
+    const ContinuationPoint *previous = options_.secondOrderPredictor && ia > 0 ? &branch.points[ia - 1] : nullptr;
+    if (!takeStep(a, previous, dsTry, b, summary, lastFailure)) {
       if (!halve()) return;
       continue;
     }

@@ -53,6 +53,11 @@ struct TracerOptions {
   double stepShrink = 0.5;
   double slowContraction = 0.3;     ///< contraction above this shrinks the next step
   double minTangentCosine = 0.9;    ///< branch-jump guard: t_newᵀt_old must stay ≥ this (MATCONT)
+  /// Second-order predictor x_a + ds·t_a + ½ds²·(t_a − t_p)/Δs_a (the curvature from the last
+  /// two tangents) instead of x_a + ds·t_a: fewer Newton iterations per step on curved branches
+  /// (benchmarks/RESULTS.md, work-precision). Off by default: it moves the points, and on the
+  /// hysteresis scene's degenerate branch point that changes the reported mode shape.
+  bool secondOrderPredictor = false;
 
   // ---- stop conditions -------------------------------------------------------------------
   int maxPoints = 500;              ///< including the start point
@@ -162,10 +167,11 @@ class Tracer {
 
  private:
   // ---- one step (tracer.cpp) -------------------------------------------------------------
-  /// Predictor x_a + ds·t_a, Keller corrector, new tangent and the branch-jump guard. False
-  /// with `failure` set when the step must be retried smaller.
-  bool takeStep(const ContinuationPoint &a, double ds, ContinuationPoint &b, CorrectorSummary &summary,
-                std::string &failure);
+  /// Predictor x_a + ds·t_a (+ ½ds²·(t_a − t_p)/Δs_a when the point `previous` before a is
+  /// given), Keller corrector, new tangent and the branch-jump guard. False with `failure` set
+  /// when the step must be retried smaller.
+  bool takeStep(const ContinuationPoint &a, const ContinuationPoint *previous, double ds, ContinuationPoint &b,
+                CorrectorSummary &summary, std::string &failure);
   /// Folds and branch points between a and b (index not set).
   std::vector<SpecialPoint> locateSpecialPoints(const ContinuationPoint &a, const ContinuationPoint &b);
 
