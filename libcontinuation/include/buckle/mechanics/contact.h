@@ -143,6 +143,17 @@ class ContactProblem final : public continuation::Problem {
   Vector lastLowest_;
 };
 
+/// A stretch of a traced branch with one set of locked joints: points [firstPoint, the next
+/// stretch's firstPoint) of the branch (equilibrium_branches.h). The point where a contact
+/// starts or releases ends the stretch before it.
+struct ContactStretch {
+  int firstPoint = 0;
+  ContactSet locked;
+};
+
+/// The locked joints at point `index` of a branch with these stretches (empty set when none).
+const ContactSet& lockedAt(const std::vector<ContactStretch>& stretches, int index);
+
 /// Boundary k of ContactProblem / EquilibriumProblem as (joint, side).
 LockedJoint limitOfBoundary(int k, int segments);
 
