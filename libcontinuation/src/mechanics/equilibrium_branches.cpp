@@ -64,26 +64,50 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       break;
     }
     continuation::Tracer tracer(*next, o);
+    // The stretch leaves the point to the admissible side of the changed joint's boundary g
+    // (compression of a new contact, distance to the limit of a released joint): dg/ds > 0 along
+    // its tangent. The parent's direction decides only when that is ambiguous: on an unstable
+    // branch a joint can reach its limit with the locked branch turning back in λ (a corner).
+    const int changed = hit.side == LimitSide::Upper ? hit.joint : hit.joint + n;
+    const int N = problem.dimension();
+    auto startPoint = [&](const continuation::Vector& direction, continuation::ContinuationPoint& p) {
+      p = continuation::ContinuationPoint();
+      p.u = start.u;
+      p.lambda = at.lambda;
+      tracer.units().toScaled(p);
+      if (!tracer.completePoint(p, tracer.units().directionToScaled(direction))) return false;
+      tracer.units().toUser(p);
+      return true;
+    };
+    continuation::Vector direction =
+        t.size() == N + 1 && t.norm() > 0.0 ? t : continuation::Vector(continuation::Vector::Unit(N + 1, N));
     continuation::ContinuationPoint p0;
-    p0.u = start.u;
-    p0.lambda = at.lambda;
-    tracer.units().toScaled(p0);
-    const continuation::Vector reference =
-        t.size() == problem.dimension() + 1 && t.norm() > 0.0 ? tracer.units().directionToScaled(t)
-                                                              : continuation::Vector::Unit(problem.dimension() + 1,
-                                                                                           problem.dimension());
-    if (!tracer.completePoint(p0, reference)) {
+    if (!startPoint(direction, p0)) {
       giveUp("no unique tangent at the point");
       break;
     }
-    tracer.units().toUser(p0);
+    // dg/ds: a released joint's g = side·(q̄ − q) moves with −side·t_q; a contact's compression
+    // −side·τ_c with −side·(F_u,i t_u + F_λ,i t_λ) (the free equilibrium's row i, exact).
+    double rate = 0.0;
+    const double sideSign = hit.side == LimitSide::Upper ? 1.0 : -1.0;
+    if (release) {
+      rate = -sideSign * p0.tangent[hit.joint];
+    } else {
+      continuation::Matrix Fu(N, N);
+      continuation::Vector Fl(N);
+      if (problem.jacobian(p0.u, p0.lambda, Fu, Fl))
+        rate = -sideSign * (Fu.row(hit.joint).dot(p0.tangent.head(N)) + Fl[hit.joint] * p0.tangent[N]);
+    }
+    if (rate < 0.0 && !startPoint(-p0.tangent, p0)) {
+      giveUp("no unique tangent at the point");
+      break;
+    }
     p0.arclength = 0.0;
     continuation::Branch stretch;
     stretch.points.push_back(p0);
     tracer.continueBranch(stretch);
     // A stretch that does not leave its start, or leaves it to the wrong side (a contact that
     // pulls at once, or a released joint that goes on past its limit), would chatter: stop.
-    const int changed = hit.side == LimitSide::Upper ? hit.joint : hit.joint + n;
     if (stretch.points.size() < 2 || !(stretch.points.back().arclength > options.minStep)) {
       giveUp("the branch does not leave the point (" + stretch.stopMessage + ")");
       break;
