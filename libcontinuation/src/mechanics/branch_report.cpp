@@ -135,6 +135,7 @@ void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, cons
   const LimitSide side = contact ? after.side(joint) : before.side(joint);
   ContactProblem locked(problem, contact ? after : before);
   s.type = contact ? EventType::Contact : EventType::Release;
+  s.phenomenon = Phenomenon::None;  // a change of the constraints, none of the paper's three phenomena
   s.joint = joint;
   s.contactTorque = locked.contactTorque(sp.u, sp.lambda, joint);
   s.lockedAfter = after;
