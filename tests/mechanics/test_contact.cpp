@@ -372,3 +372,37 @@ TEST_CASE("contact: a curled chain's root joint locks and releases where the fre
     CHECK((f < 1.0 ? g[0] > 0.0 : g[0] < 0.0));  // lower limit: compression = +τ_c
   }
 }
+
+TEST_CASE("contact: the loaded stiffness with locked joints is the free joints' compliance inverted", "[contact]") {
+  std::mt19937 rng(99);
+  std::vector<SegmentParameters> segs;
+  for (int i = 0; i < 6; ++i) segs.push_back(testing::randomSegment(rng));
+  const Chain chain(segs);
+  Eigen::VectorXd q(6);
+  q << 0.3, -0.2, 0.5, 0.1, -0.4, 0.2;
+  const Wrench F(-0.2, 0.15, 0.05);
+  ContactSet locked;
+  locked.lock(1, LimitSide::Upper);
+  locked.lock(4, LimitSide::Lower);
+  const CartesianStiffness k = lockedLoadedStiffness(chain, q, F, EndCondition::freeEnd(), locked);
+  // independent: C_F = J_p,F H_FF⁻¹ J_p,Fᵀ on the free joints F = {0, 2, 3, 5}
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  Matrix J(3, 6), H(6, 6);
+  endJacobian(data, J);
+  totalPotentialHessian(chain, q, F, H);
+  const std::vector<int> free{0, 2, 3, 5};
+  Matrix Hf(4, 4), Jf(2, 4);
+  for (int a = 0; a < 4; ++a) {
+    Jf.col(a) = J.col(free[size_t(a)]).head(2);
+    for (int b = 0; b < 4; ++b) Hf(a, b) = H(free[size_t(a)], free[size_t(b)]);
+  }
+  const Eigen::Matrix2d C = Jf * Hf.fullPivLu().solve(Jf.transpose());
+  const Eigen::Matrix2d K = C.inverse();
+  CHECK((k.stiffness - K).cwiseAbs().maxCoeff() <= 1e-10 * K.cwiseAbs().maxCoeff());
+  CHECK((k.compliance - C).cwiseAbs().maxCoeff() <= 1e-10 * C.cwiseAbs().maxCoeff());
+  // no joint locked: the plain loaded stiffness
+  const CartesianStiffness plain = lockedLoadedStiffness(chain, q, F, EndCondition::freeEnd(), ContactSet());
+  CHECK((plain.stiffness - loadedStiffness(chain, q, F, false).stiffness).cwiseAbs().maxCoeff() == 0.0);
+  CHECK_THROWS_AS(loadedStiffness(chain, q, F, false, Matrix::Zero(1, 5)), std::invalid_argument);
+}

@@ -1,6 +1,5 @@
 #include "buckle/mechanics/contact.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -426,88 +425,13 @@ continuation::StabilityInfo constrainedStability(EquilibriumProblem& base, const
   return info;
 }
 
-namespace {
-
-// Relative conditioning of a symmetric 2×2 matrix: min |eig| / max |eig| (0 for the zero matrix).
-double conditioning2(const Eigen::Matrix2d& A) {
-  const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(A, Eigen::EigenvaluesOnly).eigenvalues();
-  const double big = ev.cwiseAbs().maxCoeff();
-  if (!(big > 0.0) || !std::isfinite(big)) return 0.0;
-  return ev.cwiseAbs().minCoeff() / big;
-}
-
-// [[H, Cᵀ], [C, 0]]⁻¹ R, false when the KKT matrix is singular to `tolerance` (reciprocal condition).
-bool kktSolve(const Matrix& H, const Matrix& C, const Matrix& R, double tolerance, Matrix& X) {
-  const Eigen::Index n = H.rows(), m = C.rows();
-  Matrix B = Matrix::Zero(n + m, n + m);
-  B.topLeftCorner(n, n) = H;
-  B.topRightCorner(n, m) = C.transpose();
-  B.bottomLeftCorner(m, n) = C;
-  const Eigen::PartialPivLU<Matrix> lu(B);
-  if (!(lu.rcond() > tolerance)) return false;
-  X = lu.solve(R);
-  return X.allFinite();
-}
-
-}  // namespace
-
 CartesianStiffness lockedLoadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, const EndCondition& end,
                                          const ContactSet& locked, const StiffnessOptions& options) {
   if (locked.empty()) return loadedStiffness(chain, q, F, end, options);
-  const int n = chain.size();
-  if (q.size() != n) throw std::invalid_argument("q must have one angle per segment (size " + std::to_string(n) + ")");
-  if (!q.allFinite() || !F.allFinite()) throw std::invalid_argument("q and F must be finite");
-  locked.check(n);
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  CartesianStiffness out;
-  out.rotationHeld = end.isHeld(EndCoordinate::Phi);
-  ChainData data(chain);
-  forwardKinematics(chain, q, data);
-  Matrix J(3, n), H(n, n);
-  endJacobian(data, J);
-  totalPotentialHessian(chain, q, F, H);
-  const int r = locked.count() + (out.rotationHeld ? 1 : 0);
-  Matrix C = Matrix::Zero(r, n);
-  for (int k = 0; k < locked.count(); ++k) C(k, locked.joints()[size_t(k)].joint) = 1.0;
-  if (out.rotationHeld) C.row(r - 1) = J.row(2);
-  const Matrix Jp = J.topRows(2);
-  Matrix R = Matrix::Zero(n + r, 2), X;
-  R.topRows(n) = Jp.transpose();
-  if (kktSolve(H, C, R, options.singularTolerance, X)) {
-    Eigen::Matrix2d Cf = Jp * X.topRows(n);
-    out.compliance = 0.5 * (Cf + Cf.transpose());
-    if (conditioning2(out.compliance) > options.singularTolerance) {
-      out.stiffness = out.compliance.inverse();
-      out.stiffness = 0.5 * (out.stiffness + out.stiffness.transpose());
-    } else {
-      out.rigid = true;
-      out.stiffness.setConstant(nan);
-    }
-  } else {
-    // Infinite compliance: the position-held KKT inverse has −K_F as its position multiplier corner.
-    out.singular = true;
-    out.compliance.setConstant(nan);
-    Matrix Cp(r + 2, n);
-    Cp.topRows(r) = C;
-    Cp.bottomRows(2) = Jp;
-    Matrix Rp = Matrix::Zero(n + r + 2, 2);
-    Rp.bottomRows(2) = Eigen::Matrix2d::Identity();
-    Matrix Xp;
-    if (kktSolve(H, Cp, Rp, options.singularTolerance, Xp)) {
-      out.stiffness = -Xp.bottomRows(2);
-      out.stiffness = 0.5 * (out.stiffness + out.stiffness.transpose());
-    } else {
-      out.stiffness.setConstant(nan);
-    }
-  }
-  if (options.computeInertia) {
-    const continuation::StabilityInfo in = continuation::projectedInertia(H, C, 1e-13, 1);
-    out.negativeDirections = in.negative;
-    out.smallestEigenvalue = in.smallest;
-  }
-  out.positiveDefinite = !out.rigid && !out.singular && out.stiffness.allFinite() &&
-                         Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(out.stiffness).eigenvalues().minCoeff() > 0.0;
-  return out;
+  locked.check(chain.size());
+  Matrix E = Matrix::Zero(locked.count(), chain.size());  // δq_i = 0 at the locked joints
+  for (int k = 0; k < locked.count(); ++k) E(k, locked.joints()[size_t(k)].joint) = 1.0;
+  return loadedStiffness(chain, q, F, end.isHeld(EndCoordinate::Phi), E, options);
 }
 
 }  // namespace buckle::mechanics
