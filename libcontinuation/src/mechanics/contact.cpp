@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 namespace buckle::mechanics {
@@ -246,9 +247,10 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
 
 // ---- ContactProblem ---------------------------------------------------------------------------
 
-ContactProblem::ContactProblem(EquilibriumProblem& base, ContactSet locked)
+ContactProblem::ContactProblem(EquilibriumProblem& base, ContactSet locked, double maxCompression)
     : base_(base),
       locked_((locked.check(base.segments()), std::move(locked))),
+      maxCompression_(maxCompression),
       free_(freeJointsOf(locked_, base.segments())),
       held_(base.endCondition().heldIndices()),
       full_(base.segments()),
@@ -256,6 +258,9 @@ ContactProblem::ContactProblem(EquilibriumProblem& base, ContactSet locked)
       J_(3, base.segments()),
       Jf_(3, Eigen::Index(free_.size())),
       heldRows_(Eigen::Index(held_.size()), Eigen::Index(free_.size())) {
+  if (!(maxCompression > 0.0))
+    throw std::invalid_argument("contact: the bound of the contact torque must be positive, got " +
+                                std::to_string(maxCompression));
   reduced_.typicalScale = base.stiffnessUnit() * base.lengthUnit() * base.lengthUnit();
   full_.typicalScale = reduced_.typicalScale;
 }
@@ -339,13 +344,26 @@ continuation::ProblemScales ContactProblem::scales() const {
   return s;
 }
 
+int ContactProblem::boundaryCount() const {
+  return 2 * base_.segments() + (std::isfinite(maxCompression_) ? locked_.count() : 0);
+}
+
 double ContactProblem::boundary(int k, ConstVectorRef u, double lambda) {
+  const int n = base_.segments();
+  if (k >= 2 * n) return maxCompression_ - compression(u, lambda, locked_.joints()[size_t(k - 2 * n)].joint);
   const LockedJoint b = limitOfBoundary(k, base_.segments());
   if (locked_.locked(b.joint) && locked_.side(b.joint) == b.side) return compression(u, lambda, b.joint);
   return base_.boundary(k, u, lambda);
 }
 
 std::string ContactProblem::boundaryName(int k) const {
+  const int n = base_.segments();
+  if (k >= 2 * n) {
+    std::ostringstream os;
+    os << "joint " << locked_.joints()[size_t(k - 2 * n)].joint + 1 << " contact torque reached its bound "
+       << maxCompression_ << " (the locked chain is pressed far beyond what its springs carry)";
+    return os.str();
+  }
   const LockedJoint b = limitOfBoundary(k, base_.segments());
   if (locked_.locked(b.joint) && locked_.side(b.joint) == b.side)
     return "joint " + std::to_string(b.joint + 1) + " " + toString(b.side) + " contact released (contact torque -> 0)";

@@ -13,16 +13,16 @@ LockedJoint endBoundary(const continuation::Problem& problem, const continuation
   if (branch.stopReason != continuation::StopReason::Boundary || branch.specialPoints.empty()) return {};
   const continuation::SpecialPoint& sp = branch.specialPoints.back();
   if (sp.type != continuation::SpecialPointType::Boundary) return {};
-  for (int k = 0; k < problem.boundaryCount(); ++k)
+  for (int k = 0; k < std::min(problem.boundaryCount(), 2 * segments); ++k)  // the joints' limits and contacts
     if (problem.boundaryName(k) == sp.boundaryName) return limitOfBoundary(k, segments);
-  (void)segments;
   return {};
 }
 
 }  // namespace
 
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
-                                                 const continuation::TracerOptions& options, int maxContactEvents) {
+                                                 const continuation::TracerOptions& options, int maxContactEvents,
+                                                 double maxContactTorque) {
   const int n = problem.segments();
   std::vector<ContactStretch> stretches{ContactStretch{}};
   std::unique_ptr<ContactProblem> current;  // the problem of the last stretch (null: `problem`)
@@ -46,7 +46,8 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // locked branch cannot move it); orientation only.
     continuation::Vector t = at.tangent;
     if (!release && t.size() == problem.dimension() + 1) t[hit.joint] = 0.0;
-    auto next = std::make_unique<ContactProblem>(problem, locked);
+    const double torqueUnit = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();
+    auto next = std::make_unique<ContactProblem>(problem, locked, maxContactTorque * torqueUnit);
     const std::string what = std::string(release ? "release of joint " : "contact of joint ") +
                              std::to_string(hit.joint + 1) + " " + toString(hit.side);
     auto giveUp = [&branch, &what](const std::string& why) {
@@ -151,7 +152,8 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
     const continuation::TracerOptions& o =
         branch.parentId >= 0 && options.childTracer ? *options.childTracer : options.tracer;
     result.contact.push_back(options.contact && !result.tree.interrupted
-                                 ? continueUnderContact(problem, branch, o, options.maxContactEvents)
+                                 ? continueUnderContact(problem, branch, o, options.maxContactEvents,
+                                                        options.maxContactTorque)
                                  : std::vector<ContactStretch>{ContactStretch{}});
   }
   for (size_t b = 0; b < result.tree.branches.size(); ++b) {

@@ -25,6 +25,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -86,11 +87,14 @@ double limitAngle(const Chain& chain, int joint, LimitSide side);
 /// Boundaries (2n, as EquilibriumProblem): k < n the upper side of joint k, k ≥ n the lower side
 /// of joint k − n; for a free joint the joint limit g = q_max − q / q − q_min, for a joint locked
 /// on that side its compression c ≥ 0 (release), for the other side of a locked joint the
-/// (positive) distance to that limit.
+/// (positive) distance to that limit. With a finite `maxCompression` (a torque, the problem's
+/// units) one more boundary per locked joint, 2n + k for the k-th: maxCompression − c ≥ 0.
 class ContactProblem final : public continuation::Problem {
  public:
-  /// Throws std::invalid_argument if a locked joint is outside the chain.
-  ContactProblem(EquilibriumProblem& base, ContactSet locked);
+  /// Throws std::invalid_argument if a locked joint is outside the chain or maxCompression is
+  /// not positive.
+  ContactProblem(EquilibriumProblem& base, ContactSet locked,
+                 double maxCompression = std::numeric_limits<double>::infinity());
 
   EquilibriumProblem& base() { return base_; }
   const ContactSet& contacts() const { return locked_; }
@@ -124,7 +128,7 @@ class ContactProblem final : public continuation::Problem {
   /// base.scales(), with the locked rows (angles) at scale 1.
   continuation::ProblemScales scales() const override;
 
-  int boundaryCount() const override { return 2 * base_.segments(); }
+  int boundaryCount() const override;
   double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
   std::string boundaryName(int k) const override;
 
@@ -136,6 +140,7 @@ class ContactProblem final : public continuation::Problem {
  private:
   EquilibriumProblem& base_;
   ContactSet locked_;
+  double maxCompression_;
   std::vector<int> free_;
   std::vector<int> held_;
   ChainStructure full_, reduced_;

@@ -38,6 +38,11 @@ struct EquilibriumBranchOptions {
   bool contact = true;
   /// At most this many contact / release events per branch (a guard against chattering).
   int maxContactEvents = 50;
+  /// A locked stretch ends (a located boundary, "BD") where a contact torque reaches this many
+  /// torque units k̄b̄² of the chain (EquilibriumProblem::scales()): beyond, the chain is pressed
+  /// against its stops far harder than its springs carry (e.g. a locked mechanism at a kinematic
+  /// singularity under displacement control, whose reaction grows without bound).
+  double maxContactTorque = 10.0;
 };
 
 struct EquilibriumBranches {
@@ -58,7 +63,7 @@ struct EquilibriumBranches {
 /// (maxPoints and maxArclength count the whole branch).
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
                                                  const continuation::TracerOptions& options,
-                                                 int maxContactEvents = 50);
+                                                 int maxContactEvents = 50, double maxContactTorque = 10.0);
 
 /// Traces from joint angles q0 at λ0 (the held reactions are initialised by least squares, then
 /// polished by the tracer's fixed-parameter corrector), one start branch per entry of `starts`.
