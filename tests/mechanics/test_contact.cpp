@@ -140,6 +140,19 @@ TEST_CASE("contact: a single segment pushed past its limit carries applied torqu
   CHECK(locked >= 5);
   CHECK(rep.points.back().parameter == Approx(3.0 * springAtLimit).epsilon(1e-12));
 
+  SECTION("a bound on the contact torque ends the locked stretch exactly there") {
+    o.maxContactTorque = 0.5;  // torque units k̄b̄² = 1 here
+    const EquilibriumBranches bounded =
+        traceEquilibria(problem, Eigen::VectorXd::Zero(1), 0.0, cont::InitialDirection::increasingLambda(), o);
+    CHECK(bounded.tree.branches[0].stopReason == cont::StopReason::Boundary);
+    const BranchReport& br = bounded.reports[0];
+    REQUIRE(countType(br, EventType::Boundary) == 1);
+    CHECK(std::abs(br.points.back().contactTorque - 0.5) <= 1e-12);
+    CHECK(std::abs(br.points.back().parameter - (springAtLimit + 0.5)) <= 1e-12 * springAtLimit);
+    CHECK_THAT(br.specialPoints.back().note, Catch::Contains("bound"));
+    CHECK_THROWS_AS(ContactProblem(problem, ContactSet(), 0.0), std::invalid_argument);
+  }
+
   SECTION("switched off: the branch ends at the limit") {
     o.contact = false;
     const EquilibriumBranches off =
@@ -161,6 +174,7 @@ TEST_CASE("contact: a chain's locked branch agrees with an independent Newton so
   o.tracer.lambdaMax = 6.0;
   o.tracer.maxStep = 0.1;
   o.tracer.newtonTolerance = 1e-14;  // the traced points themselves to the comparison's accuracy
+  o.maxContactTorque = 1e3;          // Fy = 6 presses the locked joints with ~40 torque units
   o.switchingDepth = 0;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
