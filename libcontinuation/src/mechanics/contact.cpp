@@ -257,7 +257,10 @@ ContactProblem::ContactProblem(EquilibriumProblem& base, ContactSet locked, doub
       reduced_(std::max(1, int(free_.size()))),
       J_(3, base.segments()),
       Jf_(3, Eigen::Index(free_.size())),
-      heldRows_(Eigen::Index(held_.size()), Eigen::Index(free_.size())) {
+      heldRows_(Eigen::Index(held_.size()), Eigen::Index(free_.size())),
+      kf_(free_.size()),
+      hf_(free_.size()),
+      residual_(base.dimension()) {
   if (!(maxCompression > 0.0))
     throw std::invalid_argument("contact: the bound of the contact torque must be positive, got " +
                                 std::to_string(maxCompression));
@@ -266,9 +269,8 @@ ContactProblem::ContactProblem(EquilibriumProblem& base, ContactSet locked, doub
 }
 
 double ContactProblem::contactTorque(ConstVectorRef u, double lambda, int joint) {
-  Vector F(base_.dimension());
-  if (!base_.residual(u, lambda, F)) return std::numeric_limits<double>::quiet_NaN();
-  return F[joint];
+  if (!base_.residual(u, lambda, residual_)) return std::numeric_limits<double>::quiet_NaN();
+  return residual_[joint];
 }
 
 double ContactProblem::compression(ConstVectorRef u, double lambda, int joint) {
@@ -312,17 +314,15 @@ bool ContactProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix& 
 }
 
 bool ContactProblem::assembleReduced(ConstVectorRef u, double lambda, ChainStructure& ws, MatrixRef Jf) {
-  if (!base_.assembleStructure(u, lambda, full_, J_)) return false;
-  Vector kf(free_.size()), hf(free_.size());
-  reduceStructure(full_, free_, kf, hf, ws);
+  if (free_.empty() || !base_.assembleStructure(u, lambda, full_, J_)) return false;
+  reduceStructure(full_, free_, kf_, hf_, ws);
   for (size_t a = 0; a < free_.size(); ++a) Jf.col(Eigen::Index(a)) = J_.col(free_[a]);
   return true;
 }
 
 bool ContactProblem::stability(ConstVectorRef u, double lambda, int lowestCount, continuation::StabilityInfo& info) {
   if (free_.empty()) {  // every joint locked: nothing can move
-    Vector F(dimension());
-    if (!residual(u, lambda, F)) return false;
+    if (!residual(u, lambda, residual_)) return false;
     info = continuation::StabilityInfo();
     info.negative = 0;
     return true;

@@ -133,7 +133,7 @@ class ContactProblem final : public continuation::Problem {
   std::string boundaryName(int k) const override;
 
   /// T of K_q − K_g on the free joints into ws (size freeJoints().size()) and the end Jacobian's
-  /// free columns into Jf (3×|F|); false outside the domain.
+  /// free columns into Jf (3×|F|); false outside the domain or when every joint is locked.
   bool assembleReduced(continuation::ConstVectorRef u, double lambda, ChainStructure& ws,
                        continuation::MatrixRef Jf);
 
@@ -145,6 +145,8 @@ class ContactProblem final : public continuation::Problem {
   std::vector<int> held_;
   ChainStructure full_, reduced_;
   Matrix J_, Jf_, heldRows_;
+  Vector kf_, hf_;       // κ_F, h_F of the reduced structure
+  Vector residual_;      // the free equilibrium's rows (contact torques), size N
   Vector lastLowest_;
 };
 
