@@ -103,6 +103,9 @@ TEST_CASE("wrong type", "[scene][errors]") {
                   "expected a number");
   requireBadInput("wrong_type_depth", replaceOnce(kGood, "\"branch_switching\": 0", "\"branch_switching\": 1.5"),
                   "/analyses/continuation/branch_switching", "expected an integer");
+  requireBadInput("wrong_type_contact",
+                  replaceOnce(kGood, "\"branch_switching\": 0", "\"branch_switching\": 0, \"contact\": \"yes\""),
+                  "/analyses/continuation/contact", "expected true or false");
   requireBadInput("wrong_type_end", replaceOnce(kGood, "\"phi\": \"free\"", "\"phi\": 3"), "/end/phi",
                   "expected \"free\"");
 }
