@@ -49,7 +49,7 @@ TEST_CASE("Fold curve: traced through the cusp, on μ = 3x²/2, λ = −x³", "[
   const Vector U0 = foldStart(toy, 1.0, c);
   FoldCurveProblem curve(toy, c);
   TracerOptions options;
-  options.maxPoints = 200;
+  options.maxPoints = 2000;
   options.lambdaMax = 2.0;  // μ
   options.maxStep = 0.05;
   options.detectBranchPoints = false;

@@ -284,9 +284,10 @@ TEST_CASE("fold curve of the imperfect subcritical chain: pointwise folds, the c
   REQUIRE(c.points.size() > 20);
   // the fold curve against the tracer's own fold location at a few μ
   int compared = 0;
-  for (size_t i = 0; i < c.points.size(); i += 9) {
+  for (size_t i = 0; i < c.points.size(); i += 5) {
     const CriticalPoint& q = c.points[i];
-    if (std::abs(q.mu) < 1e-3) continue;  // the fold is at λc itself there
+    // near μ = 0 the fold is at λc itself; for |Me| ≳ 0.2 the path meets a joint limit first
+    if (std::abs(q.mu) < 1e-3 || std::abs(q.mu) > 0.15) continue;
     EndCondition e = end;
     e.value[2] = q.mu;
     ChainParameterProblem pi(paperChain(3, a, 1.0, 1.0, L0), e, kAxial, SecondParameter::parse("phi"));
