@@ -10,6 +10,7 @@
 #include "buckle/continuation/branch_point_curve.h"
 #include "buckle/continuation/curve_zeros.h"
 #include "buckle/continuation/fold_curve.h"
+#include "buckle/continuation/root_finding.h"
 #include "buckle/mechanics/linear_buckling.h"
 
 namespace buckle::mechanics {
@@ -116,6 +117,47 @@ void addZeros(cont::Problem& curve, const cont::Branch& branch, const cont::Curv
     p.lambda = z.u[n];
     p.accuracy = z.accuracy;
     p.converged = z.converged;
+    special.push_back(p);
+  }
+}
+
+// "K0": where the branch-point curve crosses λ = 0 the unloaded chain is singular on ker J_h. For
+// identical segments every mode's curve crosses there at once (K_q = κ·I vanishes: a multiple
+// zero, where the curve's own system is singular), so the point is located in μ alone, by the
+// Illinois iteration on the smallest eigenvalue of the unloaded stability operator.
+void addZeroLoadPoints(ChainParameterProblem& problem, const cont::Branch& branch, int N,
+                       std::vector<Codim2Point>& special) {
+  const Vector u0 = Vector::Zero(N);
+  const double scale = problem.secondParameterScale();
+  auto smallest = [&](double mu, double& g) {
+    cont::StabilityInfo info;
+    if (!problem.setSecondParameter(mu) || !problem.stability(u0, 0.0, 1, info) || info.lowest.size() < 1) return false;
+    g = info.lowest[0];
+    return true;
+  };
+  for (size_t i = 0; i + 1 < branch.points.size(); ++i) {
+    const cont::ContinuationPoint &a = branch.points[i], &b = branch.points[i + 1];
+    if (cont::sameSign(a.u[N], b.u[N])) continue;
+    double ga = 0.0, gb = 0.0;
+    Codim2Point p;
+    p.label = "K0";
+    if (!smallest(a.lambda, ga) || !smallest(b.lambda, gb) || cont::sameSign(ga, gb)) continue;
+    cont::IllinoisBracket bracket{std::min(a.lambda, b.lambda), std::max(a.lambda, b.lambda),
+                                  a.lambda < b.lambda ? ga : gb, a.lambda < b.lambda ? gb : ga, 0};
+    for (int it = 0; it < 100 && bracket.width() > 1e-13 * scale; ++it) {
+      const double mu = bracket.next();
+      double g = 0.0;
+      if (!smallest(mu, g)) break;
+      if (g == 0.0) {
+        bracket.left = bracket.right = mu;
+        break;
+      }
+      bracket.update(mu, g);
+    }
+    p.mu = bracket.midpoint();
+    p.lambda = 0.0;
+    p.accuracy = bracket.width() / scale;
+    p.converged = bracket.width() <= 1e-13 * scale;
     special.push_back(p);
   }
 }
@@ -403,11 +445,6 @@ CriticalCurve branchPointCurve(ChainParameterProblem& problem, int mode, const C
     }
     out.points.push_back(cp);
   }
-  const double lambdaScale = scales.parameter;
-  const cont::CurveTest zeroLoad = [&](cont::ConstVectorRef W, double, double& g) {
-    g = W[N] / lambdaScale;
-    return true;
-  };
   const cont::CurveTest pitchfork = [&](cont::ConstVectorRef W, double mu, double& g) {
     cont::BifurcationCoefficients bc;
     if (!coefficients(W, mu, bc)) return false;
@@ -415,7 +452,7 @@ CriticalCurve branchPointCurve(ChainParameterProblem& problem, int mode, const C
     return true;
   };
   for (const cont::Branch& b : branches) {
-    addZeros(curve, b, zeroLoad, "K0", N, out.special);
+    addZeroLoadPoints(problem, b, N, out.special);
     if (options.coefficients) addZeros(curve, b, pitchfork, "DP", N, out.special);
   }
   problem.setSecondParameter(mu0);

@@ -133,7 +133,9 @@ struct Codim2Point {
   std::string label;      ///< "K0" zero critical load (κ = 0), "DP" degenerate pitchfork, "CP" cusp, "BD" joint limit
   double mu = 0.0;
   double lambda = 0.0;
-  double accuracy = 0.0;  ///< along the curve, scaled variables (curve_zeros.h); 0 for "BD" (the tracer's own)
+  /// along the curve in the scaled variables (curve_zeros.h); "K0": the bracket in μ over its
+  /// scale; 0 for "BD" (located by the tracer)
+  double accuracy = 0.0;
   bool converged = false;
   std::string note;       ///< "BD": which limit
 };
