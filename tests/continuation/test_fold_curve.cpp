@@ -46,15 +46,17 @@ TEST_CASE("Fold curve: the exact Jacobian against central differences of the res
 TEST_CASE("Fold curve: traced through the cusp, on μ = 3x²/2, λ = −x³", "[fold_curve]") {
   toys::CuspToy toy;
   Vector c;
-  const Vector U0 = foldStart(toy, 1.0, c);
+  // c ∥ (1, 1) from the start at x = 0.8: the normalisation cᵀv = 1 holds down to x > −1
+  const Vector U0 = foldStart(toy, 0.8, c);
   FoldCurveProblem curve(toy, c);
   TracerOptions options;
-  options.maxPoints = 2000;
-  options.lambdaMax = 2.0;  // μ
+  options.maxPoints = 500;
+  options.lambdaMax = 0.97;  // μ: back out to x ≈ −0.804
+  options.newtonTolerance = 1e-12;
   options.maxStep = 0.05;
   options.detectBranchPoints = false;
   options.computeStability = false;
-  const Branch branch = trace(curve, U0, 1.5, InitialDirection::decreasingLambda(), options);
+  const Branch branch = trace(curve, U0, 0.96, InitialDirection::decreasingLambda(), options);
   REQUIRE(branch.stopReason == StopReason::LambdaRange);
   double xMin = 1.0;
   for (const ContinuationPoint& p : branch.points) {
@@ -65,7 +67,7 @@ TEST_CASE("Fold curve: traced through the cusp, on μ = 3x²/2, λ = −x³", "[
     CHECK(std::abs(p.u[1] - 0.5 * x * x) <= 1e-10);
     CHECK(std::abs(p.u[4] - x * p.u[3]) <= 1e-10);  // v ∥ (1, x)
   }
-  CHECK(xMin < -1.0);  // past the cusp onto the other fold
+  CHECK(xMin < -0.8);  // past the cusp onto the other fold
   // the cusp is a fold of the fold curve (μ turns there)
   const auto folds = branch.specialPointsOfType(SpecialPointType::Fold);
   REQUIRE(folds.size() == 1);
