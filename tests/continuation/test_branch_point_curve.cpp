@@ -11,9 +11,8 @@ using namespace buckle::continuation;
 
 TEST_CASE("Branch-point curve: the lower eigenvalue of A(μ), λ = 3/2 − √(1/4 + μ²)", "[branch_point_curve]") {
   toys::EigenToy toy;
-  toy.mu = 0.0;
   Vector c;
-  const Vector W0 = BranchPointCurveProblem::start(toy, 1.0, (Vector(2) << 0.0, 1.0).finished(), c);
+  const Vector W0 = toys::eigenToyCurveStart(toy, c);
   BranchPointCurveProblem curve(toy, Vector::Zero(2), c);
   TracerOptions options;
   options.lambdaMin = -2.0;

@@ -14,7 +14,7 @@ using namespace buckle::continuation;
 TEST_CASE("Curve zeros: the branch-point curve crosses λ = 0 at μ = ±√2", "[curve_zeros]") {
   toys::EigenToy toy;
   Vector c;
-  const Vector W0 = BranchPointCurveProblem::start(toy, 1.0, (Vector(2) << 0.0, 1.0).finished(), c);
+  const Vector W0 = toys::eigenToyCurveStart(toy, c);
   BranchPointCurveProblem curve(toy, Vector::Zero(2), c);
   TracerOptions options;
   options.lambdaMin = -3.0;
@@ -61,7 +61,7 @@ TEST_CASE("Curve zeros: the cusp located on a fold curve, where μ turns", "[cur
 TEST_CASE("Curve zeros: none without a sign change, none on a one-point branch", "[curve_zeros]") {
   toys::EigenToy toy;
   Vector c;
-  const Vector W0 = BranchPointCurveProblem::start(toy, 1.0, (Vector(2) << 0.0, 1.0).finished(), c);
+  const Vector W0 = toys::eigenToyCurveStart(toy, c);
   BranchPointCurveProblem curve(toy, Vector::Zero(2), c);
   TracerOptions options;
   options.lambdaMax = 1.0;
