@@ -22,6 +22,8 @@ class CaseRunner {
   void loadHistory();
   void suddenLoad();
   void criticalForces();
+  /// two_parameter (two_parameter.cpp)
+  void twoParameter();
   void energyCurves();
   void torqueAngle();
 

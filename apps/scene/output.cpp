@@ -213,6 +213,7 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
   }
   doc["special_points"] = points;
   if (scene.analyses.criticalForces.enabled) doc["critical_loads"] = critical;
+  if (scene.analyses.twoParameter.enabled) doc["critical_curves"] = criticalCurvesJson(run);
   if (scene.analyses.energyCurves.enabled) doc["energy_equilibria"] = equilibria;
   if (scene.analyses.torqueAngle.enabled) doc["torque_zeros"] = torque;
   if (scene.analyses.suddenLoad.enabled) {
@@ -484,6 +485,7 @@ PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::str
   const json specials = specialPointsJson(scene, run);
   writeText(dir / "special_points.json", specials.dump(2) + "\n");
   writeCurves(scene, run, dir);
+  if (scene.analyses.twoParameter.enabled) writeCriticalCurvesCsv(run, dirName);
   const PlotReport plots = drawPlots(scene, run, dirName);
   const json summary = summaryJson(scene, run, plots);
   writeText(dir / "summary.json", summary.dump(2) + "\n");

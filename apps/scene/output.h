@@ -61,6 +61,14 @@ nlohmann::json specialPointsJson(const Scene& scene, const RunResult& run);
 /// The document written as summary.json (docs/outputs.md), with `plots` describing what was drawn.
 nlohmann::json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plots);
 
+/// critical_curves.csv of the two_parameter analysis (two_parameter.cpp, docs/outputs.md).
+void writeCriticalCurvesCsv(const RunResult& run, const std::string& dir);
+/// Every case's critical curves with their codimension-two points, for special_points.json.
+nlohmann::json criticalCurvesJson(const RunResult& run);
+/// The gnuplot body of a critical_curves plot: λ against μ, supercritical parts solid,
+/// subcritical dashed, fold curves dotted, codimension-two points marked; data files in `dir`.
+void criticalCurvesPlotBody(const Scene& scene, const RunResult& run, const PlotSpec& spec, const std::string& dir,
+                            std::ostream& body);
 /// Writes every output file of the run into `dir` (which exists), report.html included;
 /// returns the plot report.
 PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::string& dir);

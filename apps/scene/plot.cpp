@@ -1041,6 +1041,7 @@ PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string
       case PlotType::TorqueAngle: torquePlot(scene, run, spec, dir, s); break;
       case PlotType::SuddenLoad: suddenPlot(scene, run, spec, dir, s); break;
       case PlotType::EnergyCurves: energyPlot(scene, run, spec, dir, s); break;
+      case PlotType::CriticalCurves: criticalCurvesPlotBody(scene, run, spec, dir.string(), s.body); break;
       case PlotType::Shapes:
         shapesPlot(scene, run, spec, size_t(&spec - scene.plots.data()), dir, s, report.notes);
         break;

@@ -8,6 +8,7 @@
 
 #include "buckle/continuation/interrupt.h"
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/critical_curves.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/energy_landscape.h"
 #include "buckle/mechanics/linear_buckling.h"
@@ -118,6 +119,7 @@ struct CaseResult {
   TorqueCurve torque;
   bool haveSudden = false;
   SuddenLoadRecord sudden;
+  std::vector<mechanics::CriticalCurve> criticalCurves;  ///< two_parameter: BP curves by mode, then LP curves
   explicit CaseResult(const mechanics::Chain& c) : chain(c) {}
 };
 

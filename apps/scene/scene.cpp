@@ -30,6 +30,7 @@ const char* toString(PlotType t) {
     case PlotType::TorqueAngle: return "torque_angle";
     case PlotType::Shapes: return "shapes";
     case PlotType::SuddenLoad: return "sudden_load";
+    case PlotType::CriticalCurves: return "critical_curves";
   }
   return "?";
 }
@@ -74,7 +75,7 @@ Scene parseScene(const std::string& text, const std::string& file) {
   if (!doc.contains("analyses")) r.fail(Pointer("/analyses"), "missing (required): what to compute");
   scene.analyses = parseAnalyses(r, doc["analyses"], Pointer("/analyses"));
   const bool needPath = scene.analyses.continuation.enabled || scene.analyses.criticalForces.enabled ||
-                        scene.analyses.loadHistory.enabled || scene.analyses.suddenLoad.enabled;
+                        scene.analyses.twoParameter.enabled || scene.analyses.loadHistory.enabled || scene.analyses.suddenLoad.enabled;
 
   // chain, end and path: what a case patches (copied key by key, not with the cases)
   json base = json::object();

@@ -79,6 +79,17 @@ struct CriticalForcesSpec {
   int modes = 3;  ///< how many critical loads of the start configuration to report
 };
 
+/// Two-parameter continuation (mechanics/critical_curves.h): the critical loads of the case as
+/// curves in a second parameter μ.
+struct TwoParameterSpec {
+  bool enabled = false;
+  std::string parameter;       ///< a, b, k, L0, dL0 (segment parameters) or x, y, phi (end values)
+  int segment = -1;            ///< 0-based; −1: every segment
+  double from = 0.0, to = 0.0; ///< range of μ (contains the case's value)
+  int modes = 1;               ///< BP curves of the straight chain's first `modes` compressive modes
+  bool folds = false;          ///< LP curves from the folds of the path traced from the start
+};
+
 struct JumpSpec {
   bool enabled = false;
   double perturbation = 1e-3;  ///< ‖δq‖ of the release along the unstable direction
@@ -113,6 +124,7 @@ struct AnalysesSpec {
   EnergyCurvesSpec energyCurves;
   TorqueAngleSpec torqueAngle;
   CriticalForcesSpec criticalForces;
+  TwoParameterSpec twoParameter;
 };
 
 struct SolverSpec {
@@ -124,7 +136,7 @@ struct SolverSpec {
   double timeLimit = 120.0;    ///< seconds for the whole scene; past it the run stops (exit 1)
 };
 
-enum class PlotType { Bifurcation, Stiffness, EnergyCurves, TorqueAngle, Shapes, SuddenLoad };
+enum class PlotType { Bifurcation, Stiffness, EnergyCurves, TorqueAngle, Shapes, SuddenLoad, CriticalCurves };
 const char* toString(PlotType t);
 
 struct PlotSpec {

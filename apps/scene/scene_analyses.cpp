@@ -26,7 +26,7 @@ std::set<std::string> branchColumns(int maxN, bool stiffness) {
 AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
   r.onlyKeys(a, p,
              {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump", "load_history",
-              "sudden_load"});
+              "sudden_load", "two_parameter"});
   AnalysesSpec s;
   if (a.contains("continuation")) {
     const json& c = a["continuation"];
@@ -134,10 +134,11 @@ AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
       r.fail(pd / "damping", "joint damping belongs to the inertial model: give mass_per_length too");
     s.suddenLoad.enabled = true;
   }
+  if (a.contains("two_parameter")) s.twoParameter = parseTwoParameter(r, a["two_parameter"], p / "two_parameter");
   if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled &&
-      !s.loadHistory.enabled && !s.suddenLoad.enabled)
+      !s.loadHistory.enabled && !s.suddenLoad.enabled && !s.twoParameter.enabled)
     r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces, "
-              "load_history, sudden_load)");
+              "load_history, sudden_load, two_parameter)");
   return s;
 }
 
@@ -175,10 +176,12 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
                                                  {"energy_curves", PlotType::EnergyCurves},
                                                  {"torque_angle", PlotType::TorqueAngle},
                                                  {"shapes", PlotType::Shapes},
-                                                 {"sudden_load", PlotType::SuddenLoad}};
+                                                 {"sudden_load", PlotType::SuddenLoad},
+                                                 {"critical_curves", PlotType::CriticalCurves}};
   auto it = types.find(type);
   if (it == types.end())
-    r.expected(pt, obj["type"], "one of bifurcation, stiffness, energy_curves, torque_angle, shapes, sudden_load");
+    r.expected(pt, obj["type"],
+               "one of bifurcation, stiffness, energy_curves, torque_angle, shapes, sudden_load, critical_curves");
   s.type = it->second;
   auto needs = [&](bool have, const char* analysis) {
     if (!have) r.fail(pt, std::string("a ") + type + " plot needs /analyses/" + analysis);
@@ -190,6 +193,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
     case PlotType::EnergyCurves: needs(a.energyCurves.enabled, "energy_curves"); break;
     case PlotType::TorqueAngle: needs(a.torqueAngle.enabled, "torque_angle"); break;
     case PlotType::SuddenLoad: needs(a.suddenLoad.enabled, "sudden_load"); break;
+    case PlotType::CriticalCurves: needs(a.twoParameter.enabled, "two_parameter"); break;
   }
   s.name = type;
   if (obj.contains("name")) {
@@ -240,6 +244,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
 }
 
 void checkAnalysesAgainstCases(const Reader& r, const Scene& scene) {
+  checkTwoParameterAgainstCases(r, scene);
   if (scene.analyses.energyCurves.enabled)
     for (size_t i = 0; i < scene.cases.size(); ++i)
       if (scene.cases[i].chain.segments.size() != 3)
@@ -291,6 +296,7 @@ std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a, int nCases) {
   if (a.energyCurves.enabled) out.push_back({PlotType::EnergyCurves, "energy_curves", "", {}, {}, "", all});
   if (a.torqueAngle.enabled) out.push_back({PlotType::TorqueAngle, "torque_angle", "", {}, {}, "", all});
   if (a.suddenLoad.enabled) out.push_back({PlotType::SuddenLoad, "sudden_load", "", {}, {}, "", all});
+  if (a.twoParameter.enabled) out.push_back({PlotType::CriticalCurves, "critical_curves", "", {}, {}, "", all});
   return out;
 }
 

@@ -28,6 +28,10 @@ CaseSpec parseCase(const JsonReader& r, const json& doc, const std::string& labe
 // ---- analyses, solver, plots (scene_analyses.cpp) -------------------------------------------
 
 AnalysesSpec parseAnalyses(const JsonReader& r, const json& a, const Pointer& p);
+/// /analyses/two_parameter (scene_two_parameter.cpp).
+TwoParameterSpec parseTwoParameter(const JsonReader& r, const json& v, const Pointer& p);
+/// Its segment exists and its range contains every case's value of the parameter.
+void checkTwoParameterAgainstCases(const JsonReader& r, const Scene& scene);
 /// What the analyses require of every case: 3 segments for energy curves, load-history
 /// waypoints and the sudden load inside the path range, rod masses the inertial model can use.
 void checkAnalysesAgainstCases(const JsonReader& r, const Scene& scene);

@@ -6,6 +6,7 @@
 #include <limits>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 #include "buckle/mechanics/segment.h"
 
@@ -242,4 +243,55 @@ TEST_CASE("bad segment parameters are rejected naming the parameter", "[segment]
   p.qMaxUser = 0.5;
   CHECK_THAT(message(p), Catch::Contains("joint limits"));
   CHECK(message(SegmentParameters{}) == "accepted");
+}
+
+TEST_CASE("energy jet parameter derivatives match finite differences in every parameter", "[segment]") {
+  std::mt19937 rng(11);
+  // one unit direction per parameter, then a mixed one
+  std::vector<SegmentParameterDirection> dirs(9);
+  dirs[0].a1 = 1;
+  dirs[1].b1 = 1;
+  dirs[2].a2 = 1;
+  dirs[3].b2 = 1;
+  dirs[4].k1 = 1;
+  dirs[5].k2 = 1;
+  dirs[6].L1_0 = 1;
+  dirs[7].L2_0 = 1;
+  dirs[8] = {0.3, -0.2, 0.5, 0.7, 1.1, -0.4, 0.5, -0.5};
+  for (int trial = 0; trial < 10; ++trial) {
+    const SegmentParameters p = testing::randomSegment(rng, kNarrow);
+    const Segment s(p);
+    std::uniform_real_distribution<double> Q(0.7 * s.geometricLowerLimit(), 0.7 * s.geometricUpperLimit());
+    const double q = Q(rng);
+    for (const SegmentParameterDirection& d : dirs) {
+      auto moved = [&](double h) {
+        SegmentParameters m = p;
+        m.a1 += h * d.a1;
+        m.b1 += h * d.b1;
+        m.a2 += h * d.a2;
+        m.b2 += h * d.b2;
+        m.k1 += h * d.k1;
+        m.k2 += h * d.k2;
+        m.L1_0 += h * d.L1_0;
+        m.L2_0 += h * d.L2_0;
+        return Segment(m).energyJet(q);
+      };
+      const double h = 1e-5;
+      const Jet3 plus = moved(h), minus = moved(-h);
+      const Jet3 exact = s.energyJetParameterDerivative(q, d);
+      CHECK(exact.value == Approx((plus.value - minus.value) / (2 * h)).margin(1e-8));
+      CHECK(exact.d1 == Approx((plus.d1 - minus.d1) / (2 * h)).margin(1e-8));
+      CHECK(exact.d2 == Approx((plus.d2 - minus.d2) / (2 * h)).margin(1e-8));
+      CHECK(exact.d3 == Approx((plus.d3 - minus.d3) / (2 * h)).margin(1e-7));
+    }
+  }
+  // symmetric closed form: κ = k(b L0 − 2(b² − a²)), so ∂κ/∂a = 4ka, ∂κ/∂b = k(L0 − 4b), ∂κ/∂L0 = kb
+  const Segment sym(SegmentParameters::symmetric(0.4, 1.1, 2.0, 2.3));
+  SegmentParameterDirection da, db, dL;
+  da.a1 = da.a2 = 1;
+  db.b1 = db.b2 = 1;
+  dL.L1_0 = dL.L2_0 = 1;
+  CHECK(sym.energyJetParameterDerivative(0.0, da).d2 == Approx(4 * 2.0 * 0.4).epsilon(1e-13));
+  CHECK(sym.energyJetParameterDerivative(0.0, db).d2 == Approx(2.0 * (2.3 - 4 * 1.1)).epsilon(1e-13));
+  CHECK(sym.energyJetParameterDerivative(0.0, dL).d2 == Approx(2.0 * 1.1).epsilon(1e-13));
 }

@@ -161,3 +161,65 @@ double Segment::upperLimit() const { return std::min(geometricUpperLimit(), p_.q
 double Segment::lowerLimit() const { return std::max(geometricLowerLimit(), p_.qMinUser); }
 
 }  // namespace buckle::mechanics
+
+namespace buckle::mechanics {
+
+namespace {
+// A number with one directional derivative (forward mode), for the parameter derivatives.
+struct Dual {
+  double v = 0, d = 0;
+};
+inline Dual operator+(Dual x, Dual y) { return {x.v + y.v, x.d + y.d}; }
+inline Dual operator-(Dual x, Dual y) { return {x.v - y.v, x.d - y.d}; }
+inline Dual operator-(Dual x) { return {-x.v, -x.d}; }
+inline Dual operator*(Dual x, Dual y) { return {x.v * y.v, x.d * y.v + x.v * y.d}; }
+inline Dual operator*(double s, Dual x) { return {s * x.v, s * x.d}; }
+inline Dual operator/(Dual x, Dual y) { return {x.v / y.v, (x.d * y.v - x.v * y.d) / (y.v * y.v)}; }
+inline Dual sqrtD(Dual x) {
+  const double r = std::sqrt(x.v);
+  return {r, 0.5 * x.d / r};
+}
+inline Dual cosD(Dual x) { return {std::cos(x.v), -std::sin(x.v) * x.d}; }
+inline Dual sinD(Dual x) { return {std::sin(x.v), std::cos(x.v) * x.d}; }
+inline Dual atanRatio(Dual a, Dual b) {  // atan(a/b), b > 0
+  return {std::atan(a.v / b.v), (b.v * a.d - a.v * b.d) / (a.v * a.v + b.v * b.v)};
+}
+
+struct DualJet {
+  Dual value, d1, d2, d3;
+};
+}  // namespace
+
+Jet3 Segment::energyJetParameterDerivative(double q, const SegmentParameterDirection& dp) const {
+  const Dual a1{p_.a1, dp.a1}, b1{p_.b1, dp.b1}, a2{p_.a2, dp.a2}, b2{p_.b2, dp.b2};
+  const Dual cc1 = a1 * a1 + b1 * b1, cc2 = a2 * a2 + b2 * b2;  // c1², c2²
+  const Dual P = sqrtD(cc1 * cc2);                                // c1 c2
+  const Dual beta = atanRatio(a1, b1) + atanRatio(a2, b2);        // β12
+  const Dual k[2] = {{p_.k1, dp.k1}, {p_.k2, dp.k2}};
+  const Dual L0[2] = {{p_.L1_0, dp.L1_0}, {p_.L2_0, dp.L2_0}};
+  const double sign[2] = {1.0, -1.0};
+  DualJet E;
+  for (int i = 0; i < 2; ++i) {
+    // θ = β12 ± q; L² = c1² + c2² + 2c1c2 cos θ (eq 1); q-derivatives from L L′ = ∓P sin θ.
+    const Dual theta = beta + Dual{sign[i] * q, 0.0};
+    const Dual cosT = cosD(theta), sinT = sinD(theta);
+    DualJet L;
+    L.value = sqrtD(cc1 + cc2 + 2.0 * (P * cosT));
+    L.d1 = -sign[i] * (P * sinT) / L.value;
+    L.d2 = -(P * cosT + L.d1 * L.d1) / L.value;
+    L.d3 = (sign[i] * (P * sinT) - 3.0 * (L.d1 * L.d2)) / L.value;
+    const Dual stretch = L.value - L0[i];
+    E.value = E.value + 0.5 * (k[i] * stretch * stretch);
+    E.d1 = E.d1 + k[i] * stretch * L.d1;
+    E.d2 = E.d2 + k[i] * (L.d1 * L.d1 + stretch * L.d2);
+    E.d3 = E.d3 + k[i] * (3.0 * (L.d1 * L.d2) + stretch * L.d3);
+  }
+  Jet3 out;
+  out.value = E.value.d;
+  out.d1 = E.d1.d;
+  out.d2 = E.d2.d;
+  out.d3 = E.d3.d;
+  return out;
+}
+
+}  // namespace buckle::mechanics

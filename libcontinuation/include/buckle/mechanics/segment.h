@@ -24,6 +24,12 @@ struct Jet3 {
   double value = 0, d1 = 0, d2 = 0, d3 = 0;
 };
 
+/// A direction in a segment's parameter space (dp/dμ for a second continuation parameter μ):
+/// all zero by default.
+struct SegmentParameterDirection {
+  double a1 = 0, b1 = 0, a2 = 0, b2 = 0, k1 = 0, k2 = 0, L1_0 = 0, L2_0 = 0;
+};
+
 class Segment {
  public:
   /// Validates the parameters; throws std::invalid_argument naming the bad one.
@@ -42,6 +48,11 @@ class Segment {
   double stiffness(double q) const;          ///< K_q = d²E/dq²
   /// E and its first three derivatives in one pass (hot loop).
   Jet3 energyJet(double q) const;
+
+  /// d/dμ of energyJet(q) (E, E′, E″, E‴ at fixed q) when the parameters move along `dp`: exact
+  /// (forward-mode derivative of eq 1 in the form L² = c1² + c2² + 2c1c2 cos(β12 ± q)), so away
+  /// from a spring's zero length (the geometric limit), where that form loses accuracy.
+  Jet3 energyJetParameterDerivative(double q, const SegmentParameterDirection& dp) const;
 
   /// Straight-state joint stiffness K_q(0) (κ in the symmetric case).
   double straightStiffness() const { return stiffness(0.0); }

@@ -1,0 +1,43 @@
+// Branch-point curves of a trivial branch: when F(u0, λ; μ) = 0 for every λ and μ (a symmetric
+// state that stays an equilibrium, e.g. the straight column under an axial load), its branch
+// points are where F_u(u0, λ; μ) is singular, and they form a curve in (λ, μ). The
+// symmetry-preserving system (the trivial branch is known, so no Moore system is needed)
+//     F_u(u0, λ; μ) w = 0,   cᵀw − 1 = 0,
+// unknowns W = (w, λ) (size N + 1), continuation parameter μ, with the exact Jacobian
+//     [[F_u, F_uλ w], [cᵀ, 0]],   ∂/∂μ = [F_uμ w; 0]
+// (F_uλ w from Problem::jacobianDirectionalDerivative in the direction (w, 0); F_uμ w from
+// TwoParameterProblem). Regular where the zero eigenvalue is simple and crosses transversally
+// in λ (ψᵀF_uλ w ≠ 0).
+#pragma once
+
+#include "buckle/continuation/problem.h"
+#include "buckle/continuation/two_parameter.h"
+
+namespace buckle::continuation {
+
+class BranchPointCurveProblem final : public Problem {
+ public:
+  /// u0: the trivial solution (size N); c: the normalisation cᵀw = 1.
+  BranchPointCurveProblem(TwoParameterProblem &problem, const Vector &u0, const Vector &c);
+
+  /// The start W = (w, λ) from a null vector w of F_u(u0, λ) at the current μ: w of unit length
+  /// in the problem's scaled variables, c = D_u⁻² w so that cᵀw = 1.
+  static Vector start(const Problem &problem, double lambda, ConstVectorRef w, Vector &c);
+
+  const Vector &trivialSolution() const { return u0_; }
+  int base() const { return n_; }
+
+  int dimension() const override { return n_ + 1; }
+  bool residual(ConstVectorRef W, double mu, VectorRef G) override;
+  bool jacobian(ConstVectorRef W, double mu, MatrixRef GW, VectorRef Gmu) override;
+  ProblemScales scales() const override;
+
+ private:
+  TwoParameterProblem &problem_;
+  int n_;
+  Vector u0_, c_;
+  Matrix Fu_, dFu_;
+  Vector Flambda_, dFlambda_, Fmu_, FuMuW_;
+};
+
+}  // namespace buckle::continuation

@@ -1,0 +1,509 @@
+#include "buckle/mechanics/critical_curves.h"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "buckle/continuation/bifurcation_coefficients.h"
+#include "buckle/continuation/branch_point_curve.h"
+#include "buckle/continuation/curve_zeros.h"
+#include "buckle/continuation/fold_curve.h"
+#include "buckle/continuation/root_finding.h"
+#include "buckle/mechanics/linear_buckling.h"
+
+namespace buckle::mechanics {
+
+namespace cont = buckle::continuation;
+using Kind = SecondParameter::Kind;
+
+namespace {
+const char* kindName(Kind kind, int component) {
+  switch (kind) {
+    case Kind::A: return "a";
+    case Kind::B: return "b";
+    case Kind::K: return "k";
+    case Kind::L0: return "L0";
+    case Kind::PreloadDifference: return "dL0";
+    case Kind::End: return component == 0 ? "x" : component == 1 ? "y" : "phi";
+  }
+  return "?";
+}
+
+// dp/dμ of one affected segment.
+SegmentParameterDirection segmentDirection(Kind kind) {
+  SegmentParameterDirection d;
+  switch (kind) {
+    case Kind::A: d.a1 = d.a2 = 1.0; break;
+    case Kind::B: d.b1 = d.b2 = 1.0; break;
+    case Kind::K: d.k1 = d.k2 = 1.0; break;
+    case Kind::L0: d.L1_0 = d.L2_0 = 1.0; break;
+    case Kind::PreloadDifference: d.L1_0 = 0.5; d.L2_0 = -0.5; break;
+    case Kind::End: break;
+  }
+  return d;
+}
+
+// (Σ_j h_max(i,j) x_j)_i in O(n): h_i Σ_{j≤i} x_j + Σ_{j>i} h_j x_j (the K_g structure, eq 27).
+void maxIndexProduct(const Vector& h, const Eigen::Ref<const Vector>& x, Eigen::Ref<Vector> out) {
+  const Eigen::Index n = h.size();
+  double prefix = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    prefix += x[i];
+    out[i] = h[i] * prefix;
+  }
+  double suffix = 0.0;
+  for (Eigen::Index i = n - 1; i >= 0; --i) {
+    out[i] += suffix;
+    suffix += h[i] * x[i];
+  }
+}
+
+double smallestStraightStiffness(const Chain& chain) {
+  double kappa = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < chain.size(); ++i) kappa = std::min(kappa, chain.segment(i).straightStiffness());
+  return kappa;
+}
+
+// The null vector's joint-angle part as a unit vector, largest-|·| component positive.
+Vector unitMode(const Vector& w, int n) {
+  Vector z = w.head(n);
+  const double norm = z.norm();
+  if (norm > 0.0) z /= norm;
+  Eigen::Index k = 0;
+  z.cwiseAbs().maxCoeff(&k);
+  if (z[k] < 0.0) z = -z;
+  return z;
+}
+
+// Right singular vector of the smallest singular value of F_u at (u, λ).
+Vector nullVector(cont::Problem& problem, const Vector& u, double lambda) {
+  const int N = problem.dimension();
+  Matrix Fu(N, N);
+  Vector Fl(N);
+  if (!problem.jacobian(u, lambda, Fu, Fl)) throw std::invalid_argument("critical curve: the start point is outside the domain");
+  Eigen::BDCSVD<Matrix> svd(Fu, Eigen::ComputeFullV);
+  return svd.matrixV().col(N - 1);
+}
+
+// The tracer on a curve problem in both directions from W0; the second branch is reversed in
+// front of the first when joined.
+std::vector<cont::Branch> traceBoth(cont::Problem& curve, const Vector& W0, double mu0, const CriticalCurveOptions& options) {
+  cont::TracerOptions to = options.tracer;
+  to.lambdaMin = options.muMin;
+  to.lambdaMax = options.muMax;
+  to.computeStability = false;
+  to.detectBranchPoints = false;
+  std::vector<cont::Branch> out;
+  cont::Tracer tracer(curve, to);
+  out.push_back(tracer.trace(W0, mu0, cont::InitialDirection::increasingLambda()));
+  if (options.bothDirections) out.push_back(tracer.trace(W0, mu0, cont::InitialDirection::decreasingLambda()));
+  return out;
+}
+
+void addZeros(cont::Problem& curve, const cont::Branch& branch, const cont::CurveTest& g, const std::string& label,
+              int n, std::vector<Codim2Point>& special) {
+  for (const cont::CurveZero& z : cont::locateCurveZeros(curve, branch, g)) {
+    // a sign change through a pole of g (not a zero): |g| grows while the bracket shrinks
+    const auto& a = branch.points[size_t(z.index)];
+    const auto& b = branch.points[size_t(z.index) + 1];
+    double ga = 0.0, gb = 0.0;
+    if (g(a.u, a.lambda, ga) && g(b.u, b.lambda, gb) && std::abs(z.value) > std::max(std::abs(ga), std::abs(gb)))
+      continue;
+    Codim2Point p;
+    p.label = label;
+    p.mu = z.lambda;
+    p.lambda = z.u[n];
+    p.accuracy = z.accuracy;
+    p.converged = z.converged;
+    special.push_back(p);
+  }
+}
+
+// "K0": where the branch-point curve crosses λ = 0 the unloaded chain is singular on ker J_h. For
+// identical segments every mode's curve crosses there at once (K_q = κ·I vanishes: a multiple
+// zero, where the curve's own system is singular), so the point is located in μ alone, by the
+// Illinois iteration on the smallest eigenvalue of the unloaded stability operator.
+void addZeroLoadPoints(ChainParameterProblem& problem, const cont::Branch& branch, int N,
+                       std::vector<Codim2Point>& special) {
+  const Vector u0 = Vector::Zero(N);
+  const double scale = problem.secondParameterScale();
+  auto smallest = [&](double mu, double& g) {
+    cont::StabilityInfo info;
+    if (!problem.setSecondParameter(mu) || !problem.stability(u0, 0.0, 1, info) || info.lowest.size() < 1) return false;
+    g = info.lowest[0];
+    return true;
+  };
+  for (size_t i = 0; i + 1 < branch.points.size(); ++i) {
+    const cont::ContinuationPoint &a = branch.points[i], &b = branch.points[i + 1];
+    if (cont::sameSign(a.u[N], b.u[N])) continue;
+    double ga = 0.0, gb = 0.0;
+    Codim2Point p;
+    p.label = "K0";
+    if (!smallest(a.lambda, ga) || !smallest(b.lambda, gb) || cont::sameSign(ga, gb)) continue;
+    cont::IllinoisBracket bracket{std::min(a.lambda, b.lambda), std::max(a.lambda, b.lambda),
+                                  a.lambda < b.lambda ? ga : gb, a.lambda < b.lambda ? gb : ga, 0};
+    for (int it = 0; it < 100 && bracket.width() > 1e-13 * scale; ++it) {
+      const double mu = bracket.next();
+      double g = 0.0;
+      if (!smallest(mu, g)) break;
+      if (g == 0.0) {
+        bracket.left = bracket.right = mu;
+        break;
+      }
+      bracket.update(mu, g);
+    }
+    p.mu = bracket.midpoint();
+    p.lambda = 0.0;
+    p.accuracy = bracket.width() / scale;
+    p.converged = bracket.width() <= 1e-13 * scale;
+    special.push_back(p);
+  }
+}
+
+std::string stopText(const std::vector<cont::Branch>& branches) {
+  std::string s;
+  for (size_t i = 0; i < branches.size(); ++i) {
+    if (i) s += "; ";
+    s += (i == 0 ? "increasing μ: " : "decreasing μ: ") + std::string(cont::toString(branches[i].stopReason));
+    if (!branches[i].stopMessage.empty()) s += " (" + branches[i].stopMessage + ")";
+  }
+  return s;
+}
+
+// Points of both branches in one arclength order: the decreasing one reversed, then the other.
+std::vector<const cont::ContinuationPoint*> joined(const std::vector<cont::Branch>& branches) {
+  std::vector<const cont::ContinuationPoint*> pts;
+  if (branches.size() > 1)
+    for (size_t i = branches[1].points.size(); i-- > 1;) pts.push_back(&branches[1].points[i]);
+  for (const auto& p : branches[0].points) pts.push_back(&p);
+  return pts;
+}
+}  // namespace
+
+std::string SecondParameter::name() const {
+  std::string s = kindName(kind, component);
+  if (kind != Kind::End && segment >= 0) s += "[" + std::to_string(segment + 1) + "]";
+  return s;
+}
+
+SecondParameter SecondParameter::parse(const std::string& kind, int segment) {
+  SecondParameter p;
+  p.segment = segment;
+  if (kind == "a") p.kind = Kind::A;
+  else if (kind == "b") p.kind = Kind::B;
+  else if (kind == "k") p.kind = Kind::K;
+  else if (kind == "L0") p.kind = Kind::L0;
+  else if (kind == "dL0") p.kind = Kind::PreloadDifference;
+  else if (kind == "x" || kind == "y" || kind == "phi") {
+    p.kind = Kind::End;
+    p.component = kind == "x" ? 0 : kind == "y" ? 1 : 2;
+    if (segment >= 0) throw std::invalid_argument("second parameter \"" + kind + "\" is an end coordinate: no segment");
+  } else {
+    throw std::invalid_argument("second parameter \"" + kind +
+                                "\" is not one of a, b, k, L0, dL0 (segment parameters), x, y, phi (end values)");
+  }
+  return p;
+}
+
+ChainParameterProblem::ChainParameterProblem(std::vector<SegmentParameters> segments, const EndCondition& end,
+                                             const Eigen::Vector3d& direction, const SecondParameter& parameter,
+                                             EquilibriumOptions options)
+    : segments_(std::move(segments)), end_(end), direction_(direction), parameter_(parameter), options_(options) {
+  const int n = int(segments_.size());
+  if (n < 1) throw std::invalid_argument("second parameter: the chain has no segments");
+  if (parameter_.segment < -1 || parameter_.segment >= n)
+    throw std::invalid_argument("second parameter: segment " + std::to_string(parameter_.segment + 1) +
+                                " outside 1.." + std::to_string(n));
+  if (parameter_.component < 0 || parameter_.component > 2)
+    throw std::invalid_argument("second parameter: end component must be 0 (x), 1 (y) or 2 (phi)");
+  const SegmentParameters& s = segments_[size_t(std::max(parameter_.segment, 0))];
+  switch (parameter_.kind) {
+    case Kind::A: mu_ = s.a1; break;
+    case Kind::B: mu_ = s.b1; break;
+    case Kind::K: mu_ = s.k1; break;
+    case Kind::L0: mu_ = 0.5 * (s.L1_0 + s.L2_0); break;
+    case Kind::PreloadDifference: mu_ = s.L1_0 - s.L2_0; break;
+    case Kind::End: mu_ = end_.value[parameter_.component]; break;
+  }
+  std::vector<SegmentParameters> segs;
+  EndCondition e;
+  applied(mu_, segs, e);
+  segments_ = segs;
+  end_ = e;
+  equilibrium_ = std::make_unique<EquilibriumProblem>(Chain(segments_), end_, direction_, options_);
+  data_ = std::make_unique<ChainData>(equilibrium_->chain());
+  dl_.resize(n + 1);
+  dS_.resize(n);
+  dC_.resize(n);
+  dE1_.resize(n);
+  dE2_.resize(n);
+  dh_.resize(n);
+}
+
+bool ChainParameterProblem::applied(double mu, std::vector<SegmentParameters>& out, EndCondition& end) const {
+  if (!std::isfinite(mu)) return false;
+  out = segments_;
+  end = end_;
+  if (parameter_.kind == Kind::End) {
+    end.value[parameter_.component] = mu;
+    return true;
+  }
+  for (int i = 0; i < int(out.size()); ++i) {
+    if (!affects(i)) continue;
+    SegmentParameters& p = out[size_t(i)];
+    switch (parameter_.kind) {
+      case Kind::A: p.a1 = p.a2 = mu; break;
+      case Kind::B: p.b1 = p.b2 = mu; break;
+      case Kind::K: p.k1 = p.k2 = mu; break;
+      case Kind::L0: {
+        const double d = p.L1_0 - p.L2_0;
+        p.L1_0 = mu + 0.5 * d;
+        p.L2_0 = mu - 0.5 * d;
+        break;
+      }
+      case Kind::PreloadDifference: {
+        const double m = 0.5 * (p.L1_0 + p.L2_0);
+        p.L1_0 = m + 0.5 * mu;
+        p.L2_0 = m - 0.5 * mu;
+        break;
+      }
+      case Kind::End: break;
+    }
+  }
+  return true;
+}
+
+bool ChainParameterProblem::setSecondParameter(double mu) {
+  if (mu == mu_) return true;
+  std::vector<SegmentParameters> segs;
+  EndCondition end;
+  if (!applied(mu, segs, end)) return false;
+  try {
+    auto eq = std::make_unique<EquilibriumProblem>(Chain(segs), end, direction_, options_);
+    equilibrium_ = std::move(eq);
+  } catch (const std::invalid_argument&) {
+    return false;  // a parameter outside a segment's domain (e.g. a < 0, empty joint range)
+  }
+  data_ = std::make_unique<ChainData>(equilibrium_->chain());
+  mu_ = mu;
+  return true;
+}
+
+double ChainParameterProblem::secondParameterScale() const {
+  const double length = equilibrium_->lengthUnit(), stiffness = equilibrium_->stiffnessUnit();
+  switch (parameter_.kind) {
+    case Kind::K: return stiffness;
+    case Kind::End: {
+      const int c = parameter_.component;
+      if (end_.control[size_t(c)] == Control::Held) return c == 2 ? 1.0 : length;
+      return c == 2 ? stiffness * length * length : stiffness * length;
+    }
+    default: return length;
+  }
+}
+
+bool ChainParameterProblem::secondParameterDerivatives(cont::ConstVectorRef u, double lambda, cont::ConstVectorRef v,
+                                                       cont::VectorRef Fmu, cont::VectorRef FuMuV) {
+  const Chain& chain = equilibrium_->chain();
+  const int n = chain.size();
+  const int N = equilibrium_->dimension();
+  if (u.size() != N || v.size() != N) return false;
+  const auto q = u.head(n);
+  for (int i = 0; i < N; ++i)
+    if (!std::isfinite(u[i])) return false;
+  forwardKinematics(chain, q, *data_);
+  const ChainData& d = *data_;
+  const Wrench W = equilibrium_->wrench(u, lambda);
+  const std::vector<int> held = end_.heldIndices();
+  const int m = int(held.size());
+
+  // ∂/∂μ of the end value (End kind) and of the segments' energies
+  Wrench dValue = Wrench::Zero();
+  Wrench dW = Wrench::Zero();  // ∂/∂μ of the loads (the multipliers are unknowns, not μ-dependent)
+  if (parameter_.kind == Kind::End) {
+    dValue[parameter_.component] = 1.0;
+    if (end_.control[size_t(parameter_.component)] == Control::Load) dW[parameter_.component] = 1.0;
+  }
+  const SegmentParameterDirection dir = segmentDirection(parameter_.kind);
+  for (int i = 0; i < n; ++i) {
+    if (parameter_.kind == Kind::End || !affects(i)) {
+      dE1_[i] = dE2_[i] = 0.0;
+      continue;
+    }
+    const Jet3 e = chain.segment(i).energyJetParameterDerivative(q[i], dir);
+    dE1_[i] = e.d1;
+    dE2_[i] = e.d2;
+  }
+  // link lengths ℓ0 = b1(1), ℓi = b2(i) + b1(i+1), ℓn = b2(n) (chain.h) and their tail sums
+  dl_.setZero();
+  if (parameter_.kind == Kind::B)
+    for (int i = 0; i < n; ++i)
+      if (affects(i)) {
+        dl_[i] += 1.0;      // b1 of segment i sits in link i
+        dl_[i + 1] += 1.0;  // b2 in link i + 1
+      }
+  double s = 0.0, c = 0.0;
+  for (int j = n - 1; j >= 0; --j) {
+    s += dl_[j + 1] * std::sin(d.theta[j]);
+    c += dl_[j + 1] * std::cos(d.theta[j]);
+    dS_[j] = s;
+    dC_[j] = c;
+  }
+  const Pose dPose(dl_[0] + dC_[0], dS_[0], 0.0);
+
+  // F = ∂E/∂q − JᵀW (J rows −S, C, 1) and value − pose on the held rows
+  for (int i = 0; i < n; ++i)
+    Fmu[i] = dE1_[i] - (-dS_[i] * W[0] + dC_[i] * W[1]) - (-d.S[i] * dW[0] + d.C[i] * dW[1] + dW[2]);
+  for (int k = 0; k < m; ++k) Fmu[n + k] = dValue[held[size_t(k)]] - dPose[held[size_t(k)]];
+
+  // F_u = [[diag K_q − [h_max(i,j)], −J_hᵀ], [−J_h, 0]] with h = −Fx C − Fy S (eq 27)
+  dh_ = -dW[0] * d.C - W[0] * dC_ - dW[1] * d.S - W[1] * dS_;
+  const auto vq = v.head(n);
+  maxIndexProduct(dh_, vq, FuMuV.head(n));
+  for (int i = 0; i < n; ++i) FuMuV[i] = dE2_[i] * vq[i] - FuMuV[i];
+  for (int k = 0; k < m; ++k) {
+    const int h = held[size_t(k)];
+    double row = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double dJ = h == 0 ? -dS_[i] : h == 1 ? dC_[i] : 0.0;
+      FuMuV[i] -= dJ * v[n + k];
+      row += dJ * vq[i];
+    }
+    FuMuV[n + k] = -row;
+  }
+  return true;
+}
+
+PostBuckling koiterKind(double a, double b, double transversality, double aTolerance) {
+  if (std::abs(a) > aTolerance) return PostBuckling::Subcritical;
+  return b * transversality < 0.0 ? PostBuckling::Supercritical : PostBuckling::Subcritical;
+}
+
+CriticalCurve branchPointCurve(ChainParameterProblem& problem, int mode, const CriticalCurveOptions& options) {
+  EquilibriumProblem& eq = problem.equilibrium();
+  const int n = eq.segments();
+  const int N = eq.dimension();
+  const double mu0 = problem.secondParameter();
+  const Vector u0 = Vector::Zero(N);
+  // the straight chain must stay an equilibrium along the load path
+  const cont::ProblemScales scales = eq.scales();
+  Vector F(N);
+  for (double lambda : {0.0, scales.parameter}) {
+    if (!eq.residual(u0, lambda, F) || F.cwiseQuotient(scales.residuals).lpNorm<Eigen::Infinity>() > 1e-12)
+      throw std::invalid_argument(
+          "branch-point curve: the straight chain is not an equilibrium along the load path (unequal preloads, "
+          "an off-axis load or a held coordinate off the axis)");
+  }
+  LinearBucklingOptions lbo;
+  lbo.direction = eq.direction();
+  const LinearBucklingResult lb = linearBuckling(eq.chain(), Vector::Zero(n), eq.endCondition(), lbo);
+  std::vector<double> compressive;
+  for (const BucklingMode& b : lb.modes)
+    if (b.lambda < 0.0) compressive.push_back(b.lambda);
+  std::sort(compressive.begin(), compressive.end(), [](double x, double y) { return std::abs(x) < std::abs(y); });
+  if (mode < 0 || mode >= int(compressive.size()))
+    throw std::invalid_argument("branch-point curve: the straight chain has " + std::to_string(compressive.size()) +
+                                " compressive buckling modes, mode " + std::to_string(mode) + " asked");
+  const double lambdaC = compressive[size_t(mode)];
+  Vector c;
+  const Vector W0 = cont::BranchPointCurveProblem::start(problem, lambdaC, nullVector(problem, u0, lambdaC), c);
+  cont::BranchPointCurveProblem curve(problem, u0, c);
+  const std::vector<cont::Branch> branches = traceBoth(curve, W0, mu0, options);
+
+  CriticalCurve out;
+  out.type = "BP";
+  out.parameter = problem.parameter();
+  out.stopMessage = stopText(branches);
+  // b at a point of the curve: the Koiter coefficients with ξ the amplitude of the unit mode
+  auto coefficients = [&](cont::ConstVectorRef W, double mu, cont::BifurcationCoefficients& bc) {
+    if (!problem.setSecondParameter(mu)) return false;
+    const Vector w = W.head(N);
+    Vector cm = Vector::Zero(N);
+    cm.head(n) = unitMode(w, n);
+    return cont::bifurcationCoefficients(problem, u0, W[N], w, cm, bc);
+  };
+  for (const cont::ContinuationPoint* p : joined(branches)) {
+    CriticalPoint cp;
+    cp.mu = p->lambda;
+    cp.lambda = p->u[N];
+    cp.u = u0;
+    cp.mode = unitMode(p->u.head(N), n);
+    cp.cusp = std::numeric_limits<double>::quiet_NaN();
+    if (!problem.setSecondParameter(cp.mu)) continue;
+    cp.kappa = smallestStraightStiffness(problem.equilibrium().chain());
+    cp.koiterA = cp.koiterB = std::numeric_limits<double>::quiet_NaN();
+    cont::BifurcationCoefficients bc;
+    if (options.coefficients && coefficients(p->u, cp.mu, bc)) {
+      cp.koiterA = bc.a;
+      cp.koiterB = bc.b;
+      // a vanishes by symmetry; its rounding is relative to b·(mode scale)
+      cp.kind = koiterKind(bc.a, bc.b, bc.transversality, 1e-8 * scales.parameter);
+    } else {
+      cp.kind = PostBuckling::Failed;
+    }
+    out.points.push_back(cp);
+  }
+  const cont::CurveTest pitchfork = [&](cont::ConstVectorRef W, double mu, double& g) {
+    cont::BifurcationCoefficients bc;
+    if (!coefficients(W, mu, bc)) return false;
+    g = bc.b;
+    return true;
+  };
+  for (const cont::Branch& b : branches) {
+    addZeroLoadPoints(problem, b, N, out.special);
+    if (options.coefficients) addZeros(curve, b, pitchfork, "DP", N, out.special);
+  }
+  problem.setSecondParameter(mu0);
+  return out;
+}
+
+CriticalCurve foldCurve(ChainParameterProblem& problem, const cont::SpecialPoint& fold,
+                        const CriticalCurveOptions& options) {
+  const int N = problem.dimension();
+  const int n = problem.equilibrium().segments();
+  const double mu0 = problem.secondParameter();
+  if (fold.type != cont::SpecialPointType::Fold || fold.u.size() != N)
+    throw std::invalid_argument("fold curve: the start is not a fold of this problem");
+  const Vector v = fold.nullVectors.rows() == N && fold.nullVectors.cols() >= 1 ? Vector(fold.nullVectors.col(0))
+                                                                                : nullVector(problem, fold.u, fold.lambda);
+  Vector c;
+  const Vector U0 = cont::FoldCurveProblem::start(problem, fold.u, fold.lambda, v, c);
+  cont::FoldCurveProblem curve(problem, c);
+  const std::vector<cont::Branch> branches = traceBoth(curve, U0, mu0, options);
+
+  CriticalCurve out;
+  out.type = "LP";
+  out.parameter = problem.parameter();
+  out.stopMessage = stopText(branches);
+  for (const cont::ContinuationPoint* p : joined(branches)) {
+    CriticalPoint cp;
+    cp.mu = p->lambda;
+    cp.lambda = p->u[N];
+    cp.u = p->u.head(N);
+    cp.mode = unitMode(p->u.tail(N), n);
+    cp.koiterA = cp.koiterB = std::numeric_limits<double>::quiet_NaN();
+    if (!curve.cuspTest(p->u, cp.mu, cp.cusp)) cp.cusp = std::numeric_limits<double>::quiet_NaN();
+    cp.kappa = smallestStraightStiffness(problem.equilibrium().chain());
+    out.points.push_back(cp);
+  }
+  const cont::CurveTest cusp = [&](cont::ConstVectorRef U, double mu, double& g) { return curve.cuspTest(U, mu, g); };
+  for (const cont::Branch& b : branches) {
+    addZeros(curve, b, cusp, "CP", N, out.special);
+    for (const cont::SpecialPoint& sp : b.specialPoints)
+      if (sp.type == cont::SpecialPointType::Boundary) {
+        Codim2Point bd;
+        bd.label = "BD";
+        bd.mu = sp.lambda;
+        bd.lambda = sp.u[N];
+        bd.converged = true;
+        bd.note = sp.boundaryName;
+        out.special.push_back(bd);
+      }
+  }
+  problem.setSecondParameter(mu0);
+  return out;
+}
+
+}  // namespace buckle::mechanics

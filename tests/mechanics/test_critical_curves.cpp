@@ -1,0 +1,326 @@
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/critical_curves.h"
+#include "buckle/mechanics/linear_buckling.h"
+#include "buckle/mechanics/post_buckling.h"
+
+#include "random_segments.h"
+
+using namespace buckle::mechanics;
+namespace cont = buckle::continuation;
+
+namespace {
+const Eigen::Vector3d kAxial(1.0, 0.0, 0.0);
+
+std::vector<SegmentParameters> paperChain(int n, double a, double b, double k, double L0) {
+  return std::vector<SegmentParameters>(size_t(n), SegmentParameters::symmetric(a, b, k, L0));
+}
+
+CriticalCurveOptions curveOptions(double muMin, double muMax) {
+  CriticalCurveOptions o;
+  o.muMin = muMin;
+  o.muMax = muMax;
+  o.tracer.maxStep = 0.05;
+  o.tracer.maxPoints = 400;
+  o.tracer.newtonTolerance = 1e-12;
+  return o;
+}
+
+// Every point of a clamped–pinned three-segment curve on eq 17: Fx_U = λ_U κ/b.
+void checkEq17(const CriticalCurve& c, const ChainParameterProblem& p) {
+  const SegmentParameters s0 = p.segments()[0];
+  REQUIRE(c.points.size() > 20);
+  for (const CriticalPoint& q : c.points) {
+    double a = s0.a1, b = s0.b1, k = s0.k1, L0 = s0.L1_0;
+    switch (p.parameter().kind) {
+      case SecondParameter::Kind::A: a = q.mu; break;
+      case SecondParameter::Kind::B: b = q.mu; break;
+      case SecondParameter::Kind::K: k = q.mu; break;
+      case SecondParameter::Kind::L0: L0 = q.mu; break;
+      default: FAIL("unexpected parameter");
+    }
+    const AnalyticBuckling3 an = analyticClampedPinned3(a, b, k, L0);
+    CHECK(std::abs(q.lambda - an.FxU) <= 1e-12 * k * b);
+    CHECK(std::abs(q.kappa - an.kappa) <= 1e-12 * k * b * b);
+  }
+}
+}  // namespace
+
+TEST_CASE("chain second-parameter derivatives match central differences for every kind", "[critical_curves]") {
+  std::mt19937 rng(5);
+  const testing::SegmentRanges ranges{0.2, 0.7, 0.8, 1.3, 0.5, 2.0, 1.6, 2.6};
+  struct Case {
+    const char* kind;
+    int segment;
+  };
+  const Case cases[] = {{"a", -1}, {"b", -1}, {"k", -1}, {"L0", -1}, {"dL0", -1}, {"a", 1},
+                        {"b", 2},  {"b", 0},  {"L0", 3}, {"x", -1}, {"y", -1}, {"phi", -1}};
+  const EndCondition ends[] = {EndCondition::clampedPinned(-0.3), EndCondition::heldPosition(5.0, 0.4),
+                               EndCondition::freeEnd(Eigen::Vector3d(-0.2, 0.1, 0.05))};
+  for (const EndCondition& end : ends) {
+    for (const Case& cs : cases) {
+      std::vector<SegmentParameters> segs;
+      for (int i = 0; i < 4; ++i) segs.push_back(testing::randomSegment(rng, ranges));
+      ChainParameterProblem p(segs, end, Eigen::Vector3d(0.7, -0.2, 0.1), SecondParameter::parse(cs.kind, cs.segment));
+      const int N = p.dimension();
+      std::uniform_real_distribution<double> U(-0.3, 0.3);
+      Vector u(N), v(N);
+      for (int i = 0; i < N; ++i) {
+        u[i] = U(rng);
+        v[i] = U(rng);
+      }
+      const double lambda = 0.4, mu = p.secondParameter();
+      Vector Fmu(N), FuMuV(N);
+      REQUIRE(p.secondParameterDerivatives(u, lambda, v, Fmu, FuMuV));
+      const double h = 1e-6 * std::max(1.0, std::abs(mu));
+      Vector Fp(N), Fm(N), Fl(N);
+      Matrix Jp(N, N), Jm(N, N);
+      REQUIRE(p.setSecondParameter(mu + h));
+      REQUIRE(p.residual(u, lambda, Fp));
+      REQUIRE(p.jacobian(u, lambda, Jp, Fl));
+      REQUIRE(p.setSecondParameter(mu - h));
+      REQUIRE(p.residual(u, lambda, Fm));
+      REQUIRE(p.jacobian(u, lambda, Jm, Fl));
+      REQUIRE(p.setSecondParameter(mu));
+      INFO(cs.kind << " segment " << cs.segment);
+      CHECK(((Fp - Fm) / (2 * h) - Fmu).norm() <= 1e-7 * (1.0 + Fmu.norm()));
+      CHECK(((Jp - Jm) * v / (2 * h) - FuMuV).norm() <= 1e-7 * (1.0 + FuMuV.norm()));
+    }
+  }
+}
+
+TEST_CASE("second parameter: names, parsing and refused values", "[critical_curves]") {
+  CHECK(SecondParameter::parse("L0").name() == "L0");
+  CHECK(SecondParameter::parse("a", 1).name() == "a[2]");
+  CHECK(SecondParameter::parse("y").component == 1);
+  CHECK_THROWS_WITH(SecondParameter::parse("c"), Catch::Matchers::Contains("\"c\""));
+  CHECK_THROWS_WITH(SecondParameter::parse("y", 2), Catch::Matchers::Contains("no segment"));
+  CHECK_THROWS_WITH(ChainParameterProblem(paperChain(3, 0.5, 1, 1, 2.25), EndCondition::clampedPinned(0.0), kAxial,
+                                          SecondParameter::parse("a", 3)),
+                    Catch::Matchers::Contains("segment 4"));
+  ChainParameterProblem p(paperChain(3, 0.5, 1, 1, 2.25), EndCondition::clampedPinned(0.0), kAxial,
+                          SecondParameter::parse("k"));
+  CHECK(p.secondParameter() == 1.0);
+  CHECK_FALSE(p.setSecondParameter(-1.0));  // k must be > 0
+  CHECK(p.secondParameter() == 1.0);
+  CHECK_FALSE(p.setSecondParameter(std::nan("")));
+}
+
+TEST_CASE("BP curve of the n = 3 clamped-pinned chain is eq 17 in L0, a, b and k", "[critical_curves]") {
+  struct Case {
+    const char* kind;
+    double muMin, muMax;
+  };
+  for (const Case& cs : {Case{"L0", 1.2, 3.0}, Case{"a", 0.1, 0.8}, Case{"b", 0.8, 1.3}, Case{"k", 0.3, 3.0}}) {
+    INFO(cs.kind);
+    ChainParameterProblem p(paperChain(3, 0.5, 1.0, 1.0, 1.8), EndCondition::clampedPinned(0.0), kAxial,
+                            SecondParameter::parse(cs.kind));
+    const CriticalCurve c = branchPointCurve(p, 0, curveOptions(cs.muMin, cs.muMax));
+    CHECK(c.type == "BP");
+    CHECK(c.points.front().mu == Approx(cs.muMin).epsilon(1e-12));
+    CHECK(c.points.back().mu == Approx(cs.muMax).epsilon(1e-12));
+    checkEq17(c, p);
+  }
+}
+
+TEST_CASE("the kappa = 0 line: the BP curve passes zero load where b L0 = 2(b^2 - a^2)", "[critical_curves]") {
+  // in L0 at a = 0.5, b = 1: L0* = 1.5; in a at L0 = 1.8: a* = √0.1
+  struct Case {
+    const char* kind;
+    double muMin, muMax, expected;
+  };
+  for (const Case& cs : {Case{"L0", 1.2, 3.0, 1.5}, Case{"a", 0.1, 0.8, std::sqrt(0.1)}}) {
+    INFO(cs.kind);
+    ChainParameterProblem p(paperChain(3, 0.5, 1.0, 1.0, 1.8), EndCondition::clampedPinned(0.0), kAxial,
+                            SecondParameter::parse(cs.kind));
+    const CriticalCurve c = branchPointCurve(p, 0, curveOptions(cs.muMin, cs.muMax));
+    int found = 0;
+    for (const Codim2Point& s : c.special)
+      if (s.label == "K0") {
+        ++found;
+        CHECK(s.converged);
+        CHECK(std::abs(s.mu - cs.expected) <= 1e-11);
+        CHECK(std::abs(s.lambda) <= 1e-11);
+      }
+    CHECK(found == 1);
+  }
+}
+
+TEST_CASE("BP curve in scaled units (lengths x 1e-3, stiffness x 1e6) is the same curve", "[critical_curves]") {
+  const double ls = 1e-3, ks = 1e6;
+  ChainParameterProblem p(paperChain(3, 0.5, 1.0, 1.0, 1.8), EndCondition::clampedPinned(0.0), kAxial,
+                          SecondParameter::parse("L0"));
+  ChainParameterProblem ps(paperChain(3, 0.5 * ls, ls, ks, 1.8 * ls), EndCondition::clampedPinned(0.0), kAxial,
+                           SecondParameter::parse("L0"));
+  const CriticalCurve c = branchPointCurve(p, 0, curveOptions(1.2, 3.0));
+  const CriticalCurve cs = branchPointCurve(ps, 0, curveOptions(1.2 * ls, 3.0 * ls));
+  REQUIRE(c.points.size() == cs.points.size());
+  for (size_t i = 0; i < c.points.size(); ++i) {
+    CHECK(cs.points[i].mu == Approx(c.points[i].mu * ls).epsilon(1e-10));
+    CHECK(std::abs(cs.points[i].lambda - c.points[i].lambda * ks * ls) <= 1e-10 * ks * ls);
+    // Koiter b: λ in force units, ξ in radians
+    CHECK(std::abs(cs.points[i].koiterB - c.points[i].koiterB * ks * ls) <= 1e-6 * ks * ls);
+  }
+  checkEq17(cs, ps);
+}
+
+namespace {
+// λ on the bifurcated branch at modal amplitude ξ = zᵀq (z the unit joint-angle mode): Newton on
+// F(u, λ) = 0, zᵀq = ξ from the linearised guess, independent of the Lyapunov–Schmidt formulas.
+double lambdaAtAmplitude(ChainParameterProblem& p, const Vector& z, double lambdaC, double xi) {
+  const int N = p.dimension(), n = int(z.size());
+  Vector x = Vector::Zero(N + 1);
+  x.head(n) = xi * z;
+  x[N] = lambdaC;
+  Vector R(N + 1), F(N), Fl(N);
+  Matrix J(N + 1, N + 1), Fu(N, N);
+  for (int it = 0; it < 30; ++it) {
+    REQUIRE(p.residual(x.head(N), x[N], F));
+    REQUIRE(p.jacobian(x.head(N), x[N], Fu, Fl));
+    R << F, z.dot(x.head(n)) - xi;
+    J.setZero();
+    J.topLeftCorner(N, N) = Fu;
+    J.block(0, N, N, 1) = Fl;
+    J.block(N, 0, 1, n) = z.transpose();
+    const Vector dx = J.fullPivLu().solve(R);
+    x -= dx;
+    if (dx.norm() < 1e-15) break;
+  }
+  return x[N];
+}
+}  // namespace
+
+TEST_CASE("Koiter coefficients of the straight chain against the branch at fixed modal amplitude",
+          "[critical_curves]") {
+  // the paper's chain (supercritical) and a tall-triangle one (subcritical)
+  for (double a : {0.5, 2.5}) {
+    const double L0 = a < 1 ? 2.25 : 0.5;
+    INFO("a = " << a);
+    ChainParameterProblem p(paperChain(3, a, 1.0, 1.0, L0), EndCondition::clampedPinned(0.0), kAxial,
+                            SecondParameter::parse("L0"));
+    CriticalCurveOptions o = curveOptions(L0, L0 + 1e-3);
+    o.bothDirections = false;
+    const CriticalCurve c = branchPointCurve(p, 0, o);
+    const CriticalPoint& cp = c.points.front();
+    REQUIRE(cp.mu == L0);
+    CHECK(cp.koiterA == 0.0);  // symmetric pitchfork (E even in q)
+    const double xi = 0.01;
+    auto R = [&](double x) { return (lambdaAtAmplitude(p, cp.mode, cp.lambda, x) - cp.lambda) / (x * x); };
+    const double bfd = (4.0 * R(0.5 * xi) - R(xi)) / 3.0;  // Richardson: error O(ξ⁴)
+    CHECK(std::abs(cp.koiterB - bfd) <= 1e-6);
+    CHECK(std::abs(R(-xi) - R(xi)) <= 1e-9);  // even in ξ
+    const FirstBuckling fb = firstBuckling(p.equilibrium().chain(), EndCondition::clampedPinned(0.0), kAxial,
+                                           Vector::Zero(3));
+    CHECK(cp.kind == fb.kind);
+    CHECK(cp.kind == (a < 1 ? PostBuckling::Supercritical : PostBuckling::Subcritical));
+  }
+}
+
+TEST_CASE("degenerate pitchfork: b changes sign where the atlas' classification flips", "[critical_curves]") {
+  // L0/b = 0.5: the first (U) mode turns subcritical for tall triangles, a/b ≈ 1.85
+  ChainParameterProblem p(paperChain(3, 1.2, 1.0, 1.0, 0.5), EndCondition::clampedPinned(0.0), kAxial,
+                          SecondParameter::parse("a"));
+  const CriticalCurve c = branchPointCurve(p, 0, curveOptions(0.9, 3.0));
+  std::vector<Codim2Point> dp;
+  for (const Codim2Point& s : c.special)
+    if (s.label == "DP") dp.push_back(s);
+  REQUIRE(dp.size() == 1);
+  CHECK(dp[0].converged);
+  const double aStar = dp[0].mu;
+  CHECK(aStar > 1.5);
+  CHECK(aStar < 2.2);
+  // on the curve: b < 0 before, > 0 after, and the kinds agree with the atlas' firstBuckling
+  int compared = 0;
+  for (size_t i = 0; i < c.points.size(); i += 7) {
+    const CriticalPoint& q = c.points[i];
+    if (std::abs(q.mu - aStar) < 1e-3) continue;
+    CHECK((q.koiterB > 0.0) == (q.mu > aStar));
+    REQUIRE(p.setSecondParameter(q.mu));
+    const FirstBuckling fb = firstBuckling(p.equilibrium().chain(), EndCondition::clampedPinned(0.0), kAxial,
+                                           Vector::Zero(3));
+    INFO("a = " << q.mu);
+    CHECK(fb.kind == q.kind);
+    CHECK(fb.kind == (q.mu < aStar ? PostBuckling::Supercritical : PostBuckling::Subcritical));
+    ++compared;
+  }
+  CHECK(compared >= 5);
+  // b at the located point vanishes to the location accuracy
+  const auto near = std::min_element(c.points.begin(), c.points.end(), [&](const CriticalPoint& x, const CriticalPoint& y) {
+    return std::abs(x.mu - aStar) < std::abs(y.mu - aStar);
+  });
+  CHECK(std::abs(near->koiterB) <= 0.1 * std::abs(near->mu - aStar) + 1e-12);
+}
+
+namespace {
+// The first fold of the chain under an end torque Me (the eccentricity), traced from zero load.
+cont::Branch imperfectPath(ChainParameterProblem& p) {
+  cont::TracerOptions to;
+  to.maxStep = 0.05;
+  to.lambdaMin = -20;
+  to.maxPoints = 400;
+  const Vector u0 = p.equilibrium().initialGuess(Vector::Zero(3), 0.0);
+  return cont::trace(p, u0, 0.0, cont::InitialDirection::decreasingLambda(), to);
+}
+}  // namespace
+
+TEST_CASE("fold curve of the imperfect subcritical chain: pointwise folds, the cusp at eq 17, joint limits",
+          "[critical_curves]") {
+  const double a = 2.5, L0 = 0.5;
+  EndCondition end = EndCondition::clampedPinned(0.0);
+  end.value[2] = 0.01;  // Me
+  ChainParameterProblem p(paperChain(3, a, 1.0, 1.0, L0), end, kAxial, SecondParameter::parse("phi"));
+  const cont::Branch path = imperfectPath(p);
+  const auto folds = path.specialPointsOfType(cont::SpecialPointType::Fold);
+  REQUIRE(!folds.empty());
+  CriticalCurveOptions o = curveOptions(-1.0, 1.0);
+  const CriticalCurve c = foldCurve(p, *folds.front(), o);
+  CHECK(c.type == "LP");
+  REQUIRE(c.points.size() > 20);
+  // the fold curve against the tracer's own fold location at a few μ
+  int compared = 0;
+  for (size_t i = 0; i < c.points.size(); i += 5) {
+    const CriticalPoint& q = c.points[i];
+    // near μ = 0 the fold is at λc itself; for |Me| ≳ 0.2 the path meets a joint limit first
+    if (std::abs(q.mu) < 1e-3 || std::abs(q.mu) > 0.15) continue;
+    EndCondition e = end;
+    e.value[2] = q.mu;
+    ChainParameterProblem pi(paperChain(3, a, 1.0, 1.0, L0), e, kAxial, SecondParameter::parse("phi"));
+    const cont::Branch b = imperfectPath(pi);
+    const auto f = b.specialPointsOfType(cont::SpecialPointType::Fold);
+    REQUIRE(!f.empty());
+    INFO("Me = " << q.mu);
+    CHECK(std::abs(f.front()->lambda - q.lambda) <= 1e-10);
+    CHECK((f.front()->u - q.u).lpNorm<Eigen::Infinity>() <= 1e-6);
+    ++compared;
+  }
+  CHECK(compared >= 4);
+  // the perfect chain's pitchfork is the cusp of the imperfect folds: μ = 0, λ = Fx_U (eq 17)
+  const AnalyticBuckling3 an = analyticClampedPinned3(a, 1.0, 1.0, L0);
+  int cusps = 0, limits = 0;
+  for (const Codim2Point& s : c.special) {
+    if (s.label == "CP") {
+      ++cusps;
+      CHECK(s.converged);
+      CHECK(std::abs(s.mu) <= 1e-12);
+      CHECK(std::abs(s.lambda - an.FxU) <= 1e-10);
+    } else if (s.label == "BD") {
+      ++limits;
+      CHECK(s.note.find("joint 2") != std::string::npos);
+    }
+  }
+  CHECK(cusps == 1);
+  CHECK(limits == 2);  // mirror images: ±Me reach the upper / lower limit of the middle joint
+  // the knockdown follows Koiter's 2/3 law near the cusp: λc − λ_fold ∝ |Me|^(2/3)
+  std::vector<std::pair<double, double>> small;
+  for (const CriticalPoint& q : c.points)
+    if (q.mu > 1e-6 && q.mu < 1e-3) small.push_back({std::log(q.mu), std::log(q.lambda - an.FxU)});
+  REQUIRE(small.size() >= 2);
+  const double slope = (small.back().second - small.front().second) / (small.back().first - small.front().first);
+  CHECK(std::abs(slope - 2.0 / 3.0) <= 0.05);
+}
