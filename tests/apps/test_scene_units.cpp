@@ -89,6 +89,18 @@ std::string parameterOf(const json& scene, const json& patch) {
   return "";
 }
 
+/// Unit of the two_parameter analysis' second parameter μ (docs/scenes.md): a length for the
+/// triangle sizes and free lengths, a stiffness for k, and for an end coordinate the unit of its
+/// value (a load or a held coordinate).
+double secondParameterUnit(const json& scene, const Units& u) {
+  const std::string p = scene["analyses"]["two_parameter"]["parameter"];
+  if (p == "a" || p == "b" || p == "L0" || p == "dL0") return u.length;
+  if (p == "k") return u.stiffness;
+  const json& v = scene["end"][p];
+  if (v.is_object() && v.contains("load")) return p == "phi" ? u.torque() : u.force();
+  return u.of(p);
+}
+
 /// The scene in the unit system u (the module comment); plots off (they are not compared).
 json rewrite(json scene, const Units& u) {
   const json original = scene;
@@ -108,6 +120,10 @@ json rewrite(json scene, const Units& u) {
       if (a["energy_curves"].contains(key)) a["energy_curves"][key] = a["energy_curves"][key].get<double>() * u.length;
   if (a.contains("load_history"))
     for (json& w : a["load_history"]["waypoints"]) w = w.get<double>() * u.of(parameter);
+  if (a.contains("two_parameter")) {
+    const double unit = secondParameterUnit(original, u);
+    for (const char* key : {"from", "to"}) a["two_parameter"][key] = a["two_parameter"][key].get<double>() * unit;
+  }
   if (a.contains("sudden_load")) {
     json& s = a["sudden_load"];
     s["value"] = s["value"].get<double>() * u.of(parameter);
@@ -238,6 +254,24 @@ void compare(const json& got, const json& ref, const json& scene, const Units& u
       same(g["load_factor"], r["load_factor"], unit, "critical load " + std::to_string(i));
     }
   }
+  if (ref.contains("critical_curves")) {
+    // the codimension-two points of every critical curve: μ in its own unit, λ in the path's
+    const json &gc = got["critical_curves"], &rc = ref["critical_curves"];
+    REQUIRE(gc.size() == rc.size());
+    const double muUnit = secondParameterUnit(scene, u);
+    const double lambdaUnit = u.of(parameterOf(scene, json::object()));
+    for (size_t i = 0; i < rc.size(); ++i) {
+      const std::string what = "critical curve " + std::to_string(i);
+      for (const char* key : {"case", "curve", "type", "stop"}) CHECK(gc[i][key] == rc[i][key]);
+      REQUIRE(gc[i]["codim2"].size() == rc[i]["codim2"].size());
+      for (size_t k = 0; k < rc[i]["codim2"].size(); ++k) {
+        const json &g = gc[i]["codim2"][k], &r = rc[i]["codim2"][k];
+        CHECK(g["label"] == r["label"]);
+        same(g["mu"], r["mu"], muUnit, what + " " + r["label"].get<std::string>() + " mu");
+        same(g["lambda"], r["lambda"], lambdaUnit, what + " " + r["label"].get<std::string>() + " lambda");
+      }
+    }
+  }
   if (ref.contains("energy_equilibria")) {
     REQUIRE(got["energy_equilibria"].size() == ref["energy_equilibria"].size());
     for (size_t i = 0; i < ref["energy_equilibria"].size(); ++i) {
@@ -287,7 +321,8 @@ TEST_CASE("every shipped scene gives the same special points in three other unit
       const json shipped = readJson(file);
       const json reference = run(rewrite(shipped, Units{"shipped", 1.0, 1.0}), dir, file.stem().string());
       // the comparison must have something to compare
-      CHECK((!reference["special_points"].empty() || reference.contains("energy_equilibria") ||
+      CHECK((!reference["special_points"].empty() || reference.contains("critical_curves") ||
+             reference.contains("energy_equilibria") ||
              reference.contains("torque_zeros") || reference.contains("sudden_load")));
       for (const Units& u : kSystems) {
         INFO("unit system " << u.name << " (lengths x " << u.length << ", stiffness x " << u.stiffness << ")");
