@@ -3,6 +3,8 @@
 #include "buckle/continuation/scaled_problem.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
 #include <Eigen/QR>
 #include <cmath>
 #include <limits>
@@ -33,6 +35,63 @@ EndCondition frozenEnd(const EquilibriumProblem& problem, double lambda) {
   EndCondition e = problem.endCondition();
   e.value = problem.prescribed(lambda);
   return e;
+}
+
+bool anyContact(const std::vector<int>& sides) {
+  return std::any_of(sides.begin(), sides.end(), [](int s) { return s != 0; });
+}
+
+/// The rest point of `dyn` as an equilibrium at λ: polished (with its contacts fixed), its
+/// stability (of the constrained system in contact) and contact torques.
+struct RestPoint {
+  PolishResult polished;
+  continuation::StabilityInfo stability;
+  std::vector<int> sides;
+  Vector torques;
+  bool stable = false;
+};
+
+RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn, double lambda,
+                          const continuation::CorrectorOptions& options) {
+  RestPoint rp;
+  const int n = problem.segments();
+  rp.sides = dyn.contactSides.size() == size_t(n) ? dyn.contactSides : std::vector<int>(size_t(n), 0);
+  rp.torques = Vector::Zero(n);
+  if (dyn.reason != IntegrationStop::Rest) {
+    // only a rest point is worth polishing (at a guard the state is no equilibrium)
+    rp.polished.u = problem.initialGuess(dyn.q, lambda);
+    rp.polished.message = "not polished";
+    Vector F(problem.dimension());
+    rp.polished.residual =
+        problem.residual(rp.polished.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+    return rp;
+  }
+  if (!anyContact(rp.sides)) {
+    rp.polished = polishEquilibrium(problem, dyn.q, lambda, options);
+    if (rp.polished.converged) problem.stability(rp.polished.u, lambda, 3, rp.stability);
+    rp.stable = rp.stability.valid() && rp.stability.stable();
+    return rp;
+  }
+  rp.polished = polishConstrained(problem, dyn.q, lambda, rp.sides, options.residualTolerance);
+  if (!rp.polished.converged) return rp;
+  rp.torques = contactTorques(problem, rp.polished.u, lambda, rp.sides);
+  rp.stability = constrainedStability(problem, rp.polished.u, lambda, rp.sides);
+  // a stable constrained equilibrium: the reduced Hessian positive definite and every contact
+  // compressive (a contact torque of zero would release at the slightest disturbance)
+  bool compressive = true;
+  for (int i = 0; i < n; ++i)
+    if (rp.sides[size_t(i)] != 0 && !(-rp.sides[size_t(i)] * rp.torques[i] > 0.0)) compressive = false;
+  rp.stable = rp.stability.valid() && rp.stability.stable() && compressive;
+  return rp;
+}
+
+std::string describeContacts(const std::vector<int>& sides, const Vector& torques) {
+  std::ostringstream os;
+  for (size_t i = 0; i < sides.size(); ++i)
+    if (sides[i] != 0)
+      os << (os.str().empty() ? "" : ", ") << "joint " << i + 1 << (sides[i] > 0 ? " upper" : " lower")
+         << " (contact torque " << torques[Eigen::Index(i)] << ")";
+  return os.str();
 }
 
 std::string describe(const continuation::StabilityInfo& s) {
@@ -84,6 +143,128 @@ PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, do
   Vector F(N);
   result.residual = problem.residual(result.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
   return result;
+}
+
+PolishResult polishConstrained(EquilibriumProblem& problem, ConstVectorRef q, double lambda, const std::vector<int>& sides,
+                               double tolerance, int maxIterations) {
+  const int n = problem.segments();
+  const int N = problem.dimension();
+  if (sides.size() != size_t(n)) throw std::invalid_argument("contact sides must have one entry per joint");
+  PolishResult result;
+  Vector u = fullUnknowns(problem, q, lambda);
+  const Chain& chain = problem.chain();
+  auto limit = [&](int i) { return sides[size_t(i)] > 0 ? chain.upperLimits()[i] : chain.lowerLimits()[i]; };
+  for (int i = 0; i < n; ++i)
+    if (sides[size_t(i)] != 0) u[i] = limit(i);
+  // rows relative to their own scales (the locked rows are angles: scale 1)
+  Vector scale = problem.scales().residuals;
+  for (int i = 0; i < n; ++i)
+    if (sides[size_t(i)] != 0) scale[i] = 1.0;
+  Vector F(N), Fl(N), step(N);
+  Matrix Fu(N, N);
+  // R(u): the problem's rows, the locked joints' rows replaced by q_i − q̄_i (0 from the start)
+  auto rows = [&](const Vector& v, Vector& R) {
+    if (!problem.residual(v, lambda, R)) return false;
+    for (int i = 0; i < n; ++i)
+      if (sides[size_t(i)] != 0) R[i] = v[i] - limit(i);
+    return R.allFinite();
+  };
+  auto norm = [&](const Vector& R) { return R.cwiseQuotient(scale).cwiseAbs().maxCoeff(); };
+  if (!rows(u, F)) {
+    result.u = u;
+    result.residual = std::numeric_limits<double>::infinity();
+    result.message = "outside the model's domain";
+    return result;
+  }
+  double r = norm(F);
+  for (int it = 0; it < maxIterations && !(r <= tolerance); ++it) {
+    if (!problem.jacobian(u, lambda, Fu, Fl)) break;
+    for (int i = 0; i < n; ++i)
+      if (sides[size_t(i)] != 0) {
+        Fu.row(i).setZero();
+        Fu(i, i) = 1.0;
+      }
+    step = Fu.partialPivLu().solve(F);
+    if (!step.allFinite()) break;
+    // backtracking on the scaled max-norm: full Newton steps near the solution
+    double t = 1.0;
+    Vector trial(N), Ft(N);
+    bool accepted = false;
+    for (int k = 0; k < 30 && !accepted; ++k, t *= 0.5) {
+      trial = u - t * step;
+      accepted = rows(trial, Ft) && norm(Ft) < r * (1.0 - 1e-4 * t) + 1e-300;
+    }
+    if (!accepted) {
+      // no decrease: take the full step once more if it stays finite (round-off level)
+      trial = u - step;
+      if (!rows(trial, Ft) || !(norm(Ft) <= r)) break;
+    }
+    u = trial;
+    F = Ft;
+    r = norm(F);
+    result.iterations = it + 1;
+  }
+  result.u = u;
+  result.converged = r <= tolerance;
+  result.message = result.converged ? "converged" : "did not converge (scaled residual " + std::to_string(r) + ")";
+  Vector Fp(N);
+  // the problem's own residual, the locked rows excluded (their contact torques close them)
+  result.residual = 0.0;
+  if (problem.residual(u, lambda, Fp))
+    for (int i = 0; i < N; ++i)
+      if (i >= n || sides[size_t(i)] == 0) result.residual = std::max(result.residual, std::abs(Fp[i]));
+  return result;
+}
+
+Vector contactTorques(EquilibriumProblem& problem, ConstVectorRef u, double lambda, const std::vector<int>& sides) {
+  const int n = problem.segments();
+  const Vector uFull = fullUnknowns(problem, u, lambda);
+  Vector F(problem.dimension()), tau = Vector::Zero(n);
+  if (!problem.residual(uFull, lambda, F)) return Vector::Constant(n, kNaN);
+  // the joint rows of the residual are ∂E/∂q − JᵀF(u, λ) (equilibrium_problem.h): at a locked
+  // joint exactly the contact torque that closes its equilibrium
+  for (int i = 0; i < n; ++i)
+    if (sides[size_t(i)] != 0) tau[i] = F[i];
+  return tau;
+}
+
+continuation::StabilityInfo constrainedStability(EquilibriumProblem& problem, ConstVectorRef u, double lambda,
+                                                 const std::vector<int>& sides) {
+  continuation::StabilityInfo info;
+  const Vector uFull = fullUnknowns(problem, u, lambda);
+  Matrix H, C;
+  if (!problem.stabilityOperator(uFull, lambda, H, C)) return info;
+  const Eigen::Index n = H.rows();
+  int locked = 0;
+  for (int s : sides) locked += s != 0;
+  Matrix rowsC = Matrix::Zero(C.rows() + locked, n);
+  rowsC.topRows(C.rows()) = C;
+  for (Eigen::Index i = 0, k = C.rows(); i < n; ++i)
+    if (sides[size_t(i)] != 0) rowsC(k++, i) = 1.0;
+  Matrix Z = Matrix::Identity(n, n);
+  if (rowsC.rows() > 0) {
+    Eigen::ColPivHouseholderQR<Matrix> qr(rowsC.transpose());
+    const Matrix Q = qr.householderQ() * Matrix::Identity(n, n);
+    Z = Q.rightCols(n - qr.rank());
+  }
+  info.negative = 0;
+  if (Z.cols() == 0) return info;  // every direction blocked: rigid, stable
+  const Matrix reduced = Z.transpose() * H * Z;
+  Eigen::SelfAdjointEigenSolver<Matrix> es(0.5 * (reduced + reduced.transpose()), Eigen::EigenvaluesOnly);
+  if (es.info() != Eigen::Success) {
+    info.negative = -1;
+    return info;
+  }
+  // zero: relative to the operator's own size (the chain's stiffness scale)
+  const double zero = 1e-10 * std::max(problem.scales().stability, H.cwiseAbs().maxCoeff());
+  for (Eigen::Index k = 0; k < es.eigenvalues().size(); ++k) {
+    const double mu = es.eigenvalues()[k];
+    if (std::abs(mu) <= zero) ++info.zero;
+    else if (mu < 0.0) ++info.negative;
+  }
+  info.smallest = es.eigenvalues()[0];
+  info.lowest = es.eigenvalues().head(std::min<Eigen::Index>(3, es.eigenvalues().size()));
+  return info;
 }
 
 UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef u, double lambda) {
@@ -191,17 +372,9 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.wallSeconds = dyn.wallSeconds;
   result.restPoint = dyn.q;
 
-  // 3. Polish at fixed λ and check stability — only a rest point is worth polishing (at a joint
-  // limit or a guard the state is no equilibrium of the smooth model).
-  PolishResult polished;
-  if (dyn.reason == IntegrationStop::Rest) {
-    polished = polishEquilibrium(problem, dyn.q, lambda, options.polish);
-  } else {
-    polished.u = problem.initialGuess(dyn.q, lambda);
-    polished.message = "not polished";
-    Vector F(problem.dimension());
-    polished.residual = problem.residual(polished.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
-  }
+  // 3. Polish at fixed λ (with the joints in contact fixed) and check stability.
+  const RestPoint rest = polishRestPoint(problem, dyn, lambda, options.polish);
+  const PolishResult& polished = rest.polished;
   result.to = polished.u;
   result.polishConverged = polished.converged;
   result.polishIterations = polished.iterations;
@@ -211,12 +384,15 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.distance = (qTo - qFrom).cwiseAbs().maxCoeff();
   result.potentialTo = model->potential(qTo);
   result.energyReleased = result.potentialFrom - result.potentialTo;
-  if (polished.converged) problem.stability(result.to, lambda, 3, result.stabilityTo);
-  result.stable = result.stabilityTo.valid() && result.stabilityTo.stable();
+  result.stabilityTo = rest.stability;
+  result.stable = rest.stable;
+  result.contactSides = rest.sides;
+  result.contactTorques = rest.torques;
 
   std::ostringstream os;
   os << "integration stopped: " << dyn.message << "; polish: " << (polished.converged ? "converged" : "not converged") << " ("
      << polished.message << ", residual " << polished.residual << "); landing " << describe(result.stabilityTo);
+  if (anyContact(rest.sides)) os << " with the joints locked; in contact: " << describeContacts(rest.sides, rest.torques);
   if (dyn.reason != IntegrationStop::Rest) {
     os << "; no rest point reached";
   } else if (polished.converged && result.distance <= options.sameStateTolerance) {
@@ -272,27 +448,24 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
     result.maxExcursion = std::max(result.maxExcursion, (s.q - result.start).cwiseAbs().maxCoeff());
   }
 
-  PolishResult polished;
-  if (dyn.reason == IntegrationStop::Rest) {
-    polished = polishEquilibrium(problem, dyn.q, 0.0, options.polish);
-  } else {
-    polished.u = problem.initialGuess(dyn.q, 0.0);
-    polished.message = "not polished";
-    Vector F(problem.dimension());
-    polished.residual = problem.residual(polished.u, 0.0, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
-  }
+  const RestPoint restPoint = polishRestPoint(problem, dyn, 0.0, options.polish);
+  const PolishResult& polished = restPoint.polished;
   result.restUnknowns = polished.u;
   result.rest = polished.u.head(n);
   result.residual = polished.residual;
   result.polishConverged = polished.converged;
-  if (polished.converged) problem.stability(polished.u, 0.0, 3, result.stability);
-  result.stable = result.stability.valid() && result.stability.stable();
+  result.stability = restPoint.stability;
+  result.stable = restPoint.stable;
+  result.contactSides = restPoint.sides;
+  result.contactTorques = restPoint.torques;
   result.potentialDynamic = model->potential(result.rest);
 
   std::ostringstream os;
   os << (result.inertial ? "inertial" : "gradient-flow") << " response; integration stopped: " << dyn.message
      << "; polish: " << (polished.converged ? "converged" : "not converged") << " (" << polished.message << ", residual " << polished.residual
      << "); rest shape " << describe(result.stability);
+  if (anyContact(restPoint.sides))
+    os << " with the joints locked; in contact: " << describeContacts(restPoint.sides, restPoint.torques);
   if (qStatic.size() == n) {
     result.compared = true;
     result.staticShape = qStatic;

@@ -161,6 +161,8 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       rec.load = problem.wrench(jr.to, at);
       rec.energyReleased = potentialAt(problem, from, at) - potentialAt(problem, jr.to, at);
       rec.distance = jr.distance;
+      rec.contactSides = jr.contactSides;
+      rec.contactTorques = jr.contactTorques;
     }
     result.jumps.push_back(rec);
     return jr.success;
