@@ -48,6 +48,9 @@ SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
   s.K = sp.K;
   s.refined = sp.refined;
   s.note = sp.note;
+  s.joint = sp.joint;
+  s.contactTorque = sp.contactTorque;
+  s.lockedAfter = sp.lockedAfter.label();
   copyLanding(sp.landing, s);
   return s;
 }
@@ -86,6 +89,8 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
     r.minEigenvalue = p.minEigenvalue;
     r.haveStiffness = p.haveStiffness;
     r.K = p.K;
+    r.locked = p.locked.label();
+    r.contactTorque = p.contactTorque;
     out_.points.push_back(r);
   }
   run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
@@ -259,6 +264,7 @@ void CaseRunner::continuation() {
   opt.tracer.lambdaMax = lambdaHi;
   opt.tracer.computeStability = true;
   opt.switchingDepth = scene_.analyses.continuation.branchSwitching;
+  opt.contact = scene_.analyses.continuation.contact;
   opt.report = reportOptions();
   opt.onBranch = [this](const cont::BranchTree& t, const cont::Branch&) {
     branchesSoFar_ = static_cast<int>(t.branches.size());

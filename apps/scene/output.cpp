@@ -115,7 +115,7 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
     os << ",max_abs_q,sign_changes";
   else
     for (int i = 1; i <= n; ++i) os << ",q" << i;
-  os << ",stable,negative,min_eig";
+  os << ",stable,negative,min_eig,locked,contact_torque";
   if (scene.analyses.stiffness) os << ",Kxx,Kyy,Kxy";
   os << "\n";
   for (size_t c = 0; c < run.cases.size(); ++c) {
@@ -133,6 +133,7 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
         for (int i = 0; i < n; ++i) os << ',' << (i < p.q.size() ? fmt(p.q[i]) : std::string());
       }
       os << ',' << (p.stable ? 1 : 0) << ',' << p.negative << ',' << fmt(p.minEigenvalue);
+      os << ',' << p.locked << ',' << fmt(p.contactTorque);
       if (scene.analyses.stiffness) os << ',' << fmt(p.K(0, 0)) << ',' << fmt(p.K(1, 1)) << ',' << fmt(p.K(0, 1));
       os << "\n";
     }
@@ -170,6 +171,8 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       // K_F where the report computed it (a located KMIN: the stiffness at the minimum itself)
       if (s.K.allFinite()) p["stiffness"] = {{"Kxx", number(s.K(0, 0))}, {"Kyy", number(s.K(1, 1))}, {"Kxy", number(s.K(0, 1))}};
       if (!s.note.empty()) p["note"] = s.note;
+      if (s.joint >= 0)  // CT / RL
+        p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", number(s.contactTorque)}, {"locked_after", s.lockedAfter}};
       if (s.jumpTried) {
         json j;
         j["success"] = s.jumpSuccess;

@@ -288,7 +288,8 @@ struct SpecialStyle {
 };
 const SpecialStyle kSpecialStyles[] = {{"BP", 7, "BP branch point"},   {"LP", 9, "LP fold"},
                                        {"LPF", 9, "LPF reaction fold"},  {"BD", 5, "BD joint limit"},
-                                       {"KMIN", 13, "KMIN Kxx minimum"}, {"JUMP", 11, "JUMP release"}};
+                                       {"KMIN", 13, "KMIN Kxx minimum"}, {"JUMP", 11, "JUMP release"},
+                                       {"CT", 15, "CT contact (joint locks)"}, {"RL", 3, "RL contact released"}};
 
 const SpecialStyle& specialStyle(const std::string& type) {
   for (const SpecialStyle& s : kSpecialStyles)
@@ -864,6 +865,7 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
         if (p->haveStiffness && std::isfinite(p->K(0, 0)))
           title << ",  K_{xx} = " << num(std::round(p->K(0, 0) * 1e4) / 1e4) << ", K_{yy} = "
                 << num(std::round(p->K(1, 1) * 1e4) / 1e4);
+        if (!p->locked.empty()) title << ",  contact: joint " << p->locked;  // locked at a limit
       } else {
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(spec.at[k]) << ": not drawn";
         s.body << "set label 1 " << quote(missing[k]) << " at graph 0.5, graph 0.5 center font ',9' noenhanced\n";

@@ -224,7 +224,7 @@ const char* const kTail = R"PAGE(</script>
 
   var NS = 'http://www.w3.org/2000/svg';
   var PALETTE = ['#1f77b4', '#d62728', '#2ca02c', '#9467bd', '#ff7f0e', '#8c564b', '#e377c2', '#17becf'];
-  var TYPE_COLOR = {BP: '#d62728', LP: '#ff7f0e', BD: '#7f7f7f', KMIN: '#9467bd'};
+  var TYPE_COLOR = {BP: '#d62728', LP: '#ff7f0e', BD: '#7f7f7f', KMIN: '#9467bd', CT: '#8c564b', RL: '#17becf'};
   function ok(v) { return typeof v === 'number' && isFinite(v); }
   function svg(tag, attrs, parent) {
     var e = document.createElementNS(NS, tag);

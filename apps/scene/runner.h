@@ -30,6 +30,8 @@ struct PointRecord {
   double minEigenvalue = 0.0;
   bool haveStiffness = false;
   Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::string locked;         ///< joints locked at their limits, "3U 5L" (ContactSet::label), "" none
+  double contactTorque = 0.0; ///< largest compression of the locked joints (0: none locked)
 };
 
 struct SpecialRecord {
@@ -48,6 +50,11 @@ struct SpecialRecord {
   double residual = 0.0;   ///< ‖F(u, λ)‖₂ at the point
   bool refined = false;
   std::string note;
+  // contact (CT / RL): the joint (0-based, −1 otherwise), its contact torque at the point, and
+  // the joints locked after it (ContactSet::label)
+  int joint = -1;
+  double contactTorque = std::numeric_limits<double>::quiet_NaN();
+  std::string lockedAfter;
   // jump analysis (folds only): where the chain lands when released there
   bool jumpTried = false;
   bool jumpSuccess = false;

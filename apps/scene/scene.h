@@ -55,6 +55,9 @@ struct PathSpec {
 struct ContinuationSpec {
   bool enabled = false;
   int branchSwitching = 0;  ///< depth of the branch tree (0: primary branch only)
+  /// Joints that reach a limit lock and the branch goes on under contact (mechanics/contact.h);
+  /// false: the branch ends at the limit ("BD").
+  bool contact = true;
 };
 
 struct EnergyCurvesSpec {

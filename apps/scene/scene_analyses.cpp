@@ -34,10 +34,11 @@ AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
     if (c.is_boolean()) {
       s.continuation.enabled = c.get<bool>();
     } else {
-      r.onlyKeys(c, pc, {"branch_switching"});
+      r.onlyKeys(c, pc, {"branch_switching", "contact"});
       s.continuation.enabled = true;
       if (c.contains("branch_switching"))
         s.continuation.branchSwitching = r.integer(c["branch_switching"], pc / "branch_switching", 0, 4);
+      if (c.contains("contact")) s.continuation.contact = r.boolean(c["contact"], pc / "contact");
     }
   }
   if (a.contains("stiffness")) {

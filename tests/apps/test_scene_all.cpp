@@ -190,6 +190,13 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
           CHECK(p["stiffness"]["Kxx"].get<double>() > 0.0);
         } else if (type == "JUMP") {
           CHECK(field == "jumping");
+        } else if (type == "CT" || type == "RL") {
+          // contact at a joint (mechanics/contact.h): the free and the locked equilibria meet
+          // there, so the contact torque is zero to the location's accuracy
+          CHECK(field == "none");
+          CHECK(!p.contains("jump_to"));
+          REQUIRE(p.contains("contact"));
+          CHECK(std::abs(p["contact"]["contact_torque"].get<double>()) <= 1e-9);
         } else {
           FAIL("unknown special point type " << type);
         }

@@ -385,7 +385,7 @@ TEST_CASE("stiffness plots mark KMIN at its located stiffness and joint limits a
       for (const json& p : sp["special_points"]) {
         if (p["case"] != k || p["type"] != type || std::abs(double(p["loads"]["Fx"]) - row[0]) > 1e-9) continue;
         found = true;
-        if (type != "KMIN" && type != "BD") continue;
+        if (type != "KMIN" && type != "BD" && type != "CT") continue;
         // at a traced point: the marker's Kxx is that point's Kxx in branches.csv
         bool atPoint = false;
         for (const auto& rowCsv : csv.rows) {
@@ -417,8 +417,9 @@ TEST_CASE("stiffness plots mark KMIN at its located stiffness and joint limits a
     }
   }
   // fig9_fig10: a deep Kxx minimum for a/b = 0.75 and 0.9, the joint limit in all three cases
+  // (where the joint locks and the branch goes on under contact: CT)
   CHECK(marked["KMIN"] == 2);
-  CHECK(marked["BD"] == 3);
+  CHECK(marked["BD"] + marked["CT"] == 3);
   fs::remove_all(out);
 }
 

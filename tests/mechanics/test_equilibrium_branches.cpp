@@ -248,6 +248,7 @@ TEST_CASE("hard case: a path that runs into a joint limit stops exactly on it", 
   o.tracer.lambdaMax = 10.0;
   o.tracer.maxStep = 0.1;
   o.switchingDepth = 0;
+  o.contact = false;  // the old behaviour: the branch ends at the limit (contact: test_contact.cpp)
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
   const cont::Branch& br = r.tree.branches[0];

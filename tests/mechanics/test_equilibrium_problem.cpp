@@ -234,6 +234,7 @@ const buckle::continuation::SpecialPoint* tracedLimit(EquilibriumProblem& proble
   o.tracer.lambdaMax = lambdaMax;
   o.tracer.maxStep = 0.1;
   o.switchingDepth = 0;
+  o.contact = false;  // the limit itself (contact past it: test_contact.cpp)
   r = traceEquilibria(problem, Eigen::VectorXd::Zero(problem.segments()), 0.0,
                       buckle::continuation::InitialDirection::increasingLambda(), o);
   const auto bds = r.tree.branches.at(0).specialPointsOfType(buckle::continuation::SpecialPointType::Boundary);

@@ -23,6 +23,8 @@ const char* label(EventType type) {
     case EventType::JointLimit: return cont::label(cont::SpecialPointType::Boundary);
     case EventType::StiffnessMinimum: return "KMIN";
     case EventType::Jump: return "JUMP";
+    case EventType::Contact: return "CT";
+    case EventType::Release: return "RL";
   }
   return "?";
 }
@@ -54,12 +56,17 @@ class HeldStability {
         held_(problem_.endCondition().heldIndices()),
         u_(traced.segments() + int(held_.size())) {}
 
-  int negative(const Eigen::VectorXd& q, const Wrench& F, double* smallest = nullptr) {
+  int negative(const Eigen::VectorXd& q, const Wrench& F, double* smallest = nullptr,
+               const ContactSet& locked = ContactSet()) {
     const int n = int(q.size());
     u_.head(n) = q;
     for (size_t k = 0; k < held_.size(); ++k) u_[n + int(k)] = F[held_[k]];
     cont::StabilityInfo info;
-    if (!problem_.stability(u_, 0.0, smallest ? 1 : 0, info)) return -1;
+    if (!locked.empty())
+      info = constrainedStability(problem_, locked, u_, 0.0, smallest ? 1 : 0);
+    else if (!problem_.stability(u_, 0.0, smallest ? 1 : 0, info))
+      return -1;
+    if (!info.valid()) return -1;
     if (smallest) *smallest = info.smallest;
     return info.negative;
   }
@@ -106,9 +113,52 @@ int jointAtLimit(const Chain& chain, const Eigen::VectorXd& q) {
   return joint;
 }
 
+/// A boundary after which the branch's locked joints change (continueUnderContact): CT when a
+/// joint locks, RL when one releases; s is left a plain boundary otherwise.
+void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
+                        const std::vector<ContactStretch>& stretches, const std::vector<PointReport>& all,
+                        SpecialPointReport& s) {
+  const ContactStretch* next = nullptr;
+  for (const ContactStretch& st : stretches)
+    if (st.firstPoint == sp.index + 1) next = &st;
+  if (!next) return;
+  const ContactSet& before = lockedAt(stretches, sp.index);
+  const ContactSet& after = next->locked;
+  int joint = -1;
+  for (const LockedJoint& l : after.joints())
+    if (!before.locked(l.joint)) joint = l.joint;
+  const bool contact = joint >= 0;
+  if (!contact)
+    for (const LockedJoint& l : before.joints())
+      if (!after.locked(l.joint)) joint = l.joint;
+  if (joint < 0) return;
+  const LimitSide side = contact ? after.side(joint) : before.side(joint);
+  ContactProblem locked(problem, contact ? after : before);
+  s.type = contact ? EventType::Contact : EventType::Release;
+  s.phenomenon = Phenomenon::None;  // a change of the constraints, none of the paper's three phenomena
+  s.joint = joint;
+  s.contactTorque = locked.contactTorque(sp.u, sp.lambda, joint);
+  s.lockedAfter = after;
+  if (size_t(sp.index + 1) < all.size()) s.negativeAfter = all[size_t(sp.index + 1)].negative;
+  if (sp.index < int(b.points.size())) s.negativeBefore = all[size_t(sp.index)].negative;
+  const double limit = limitAngle(problem.chain(), joint, side);
+  std::ostringstream os;
+  os.precision(6);
+  os << "joint " << joint + 1 << " " << toString(side) << " limit " << limit << " rad: "
+     << (contact ? "locks (contact starts)" : "contact torque returns to zero: released")
+     << "; contact torque tau_c = " << s.contactTorque << ", |q - limit| = " << std::abs(sp.u[joint] - limit)
+     << "; locked after: " << (after.empty() ? std::string("none") : after.label());
+  s.note = os.str();
+}
+
 }  // namespace
 
 BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options) {
+  return reportBranch(problem, b, options, {});
+}
+
+BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options,
+                          const std::vector<ContactStretch>& stretches) {
   const Chain& chain = problem.chain();
   const int n = chain.size();
   const int c = options.heldCoordinate;
@@ -145,9 +195,15 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     pr.stable = p.stability.valid() && p.stability.stable();
     pr.minEigenvalue = p.stability.smallest;
     pr.residual = p.residualNorm;
+    pr.locked = lockedAt(stretches, int(i));
+    if (!pr.locked.empty()) {
+      ContactProblem contact(problem, pr.locked);
+      for (const LockedJoint& l : pr.locked.joints())
+        pr.contactTorque = std::max(pr.contactTorque, contact.compression(p.u, p.lambda, l.joint));
+    }
     if (throughReaction) {
       pr.parameter = pr.pose[c];
-      pr.negative = held->negative(pr.q, pr.F, &pr.minEigenvalue);
+      pr.negative = held->negative(pr.q, pr.F, &pr.minEigenvalue, pr.locked);
       pr.stable = pr.negative == 0;
     }
     all.push_back(pr);
@@ -156,7 +212,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     if (throughReaction && !inRange(p.parameter, options)) continue;
     PointReport pr = p;
     if (options.stiffness) {
-      pr.K = loadedStiffness(chain, pr.q, pr.F, problem.endCondition()).stiffness;
+      pr.K = lockedLoadedStiffness(chain, pr.q, pr.F, problem.endCondition(), pr.locked).stiffness;
       pr.haveStiffness = true;
     }
     r.worstResidual = std::max(r.worstResidual, pr.residual);
@@ -191,6 +247,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
       default:
         s.type = EventType::Boundary;
         s.note = sp.boundaryName;
+        reportContactEvent(problem, b, sp, stretches, all, s);
         break;
     }
     if (throughReaction) {
@@ -277,7 +334,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     std::vector<double> rate(r.points.size(), std::numeric_limits<double>::quiet_NaN());
     for (size_t i = 0; i < r.points.size(); ++i) {
       const cont::ContinuationPoint& p = b.points[size_t(r.points[i].index)];
-      if (p.tangent.size() != N + 1 || !r.points[i].stable) continue;
+      if (p.tangent.size() != N + 1 || !r.points[i].stable || !r.points[i].locked.empty()) continue;  // free stretches only
       const StiffnessRate sr = stiffnessRate(problem, p.u, p.lambda, p.tangent.head(N), p.tangent[N], measure);
       if (sr.valid) rate[i] = sr.rate;
     }

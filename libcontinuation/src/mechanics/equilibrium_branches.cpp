@@ -1,6 +1,139 @@
 #include "buckle/mechanics/equilibrium_branches.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace buckle::mechanics {
+
+namespace {
+
+// The boundary (joint, side) a branch's last special point stopped on, found by its name among
+// the problem's boundaries; joint −1 when the branch did not end on one.
+LockedJoint endBoundary(const continuation::Problem& problem, const continuation::Branch& branch, int segments) {
+  if (branch.stopReason != continuation::StopReason::Boundary || branch.specialPoints.empty()) return {};
+  const continuation::SpecialPoint& sp = branch.specialPoints.back();
+  if (sp.type != continuation::SpecialPointType::Boundary) return {};
+  for (int k = 0; k < problem.boundaryCount(); ++k)
+    if (problem.boundaryName(k) == sp.boundaryName) return limitOfBoundary(k, segments);
+  (void)segments;
+  return {};
+}
+
+}  // namespace
+
+std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
+                                                 const continuation::TracerOptions& options, int maxContactEvents) {
+  const int n = problem.segments();
+  std::vector<ContactStretch> stretches{ContactStretch{}};
+  std::unique_ptr<ContactProblem> current;  // the problem of the last stretch (null: `problem`)
+  for (int events = 0; events < maxContactEvents && !branch.points.empty(); ++events) {
+    const continuation::Problem& traced = current ? static_cast<const continuation::Problem&>(*current) : problem;
+    const LockedJoint hit = endBoundary(traced, branch, n);
+    if (hit.joint < 0) break;
+    ContactSet locked = stretches.back().locked;
+    const bool release = locked.locked(hit.joint) && locked.side(hit.joint) == hit.side;
+    if (release)
+      locked.release(hit.joint);
+    else
+      locked.lock(hit.joint, hit.side);
+    const continuation::SpecialPoint& at = branch.specialPoints.back();
+    // The budget of points and arclength is the whole branch's.
+    continuation::TracerOptions o = options;
+    o.maxPoints = options.maxPoints - int(branch.points.size()) + 1;
+    o.maxArclength = options.maxArclength - branch.points.back().arclength;
+    if (o.maxPoints < 2 || !(o.maxArclength > 0.0)) break;
+    // Leave along the branch's tangent with the newly locked joint's component removed (the
+    // locked branch cannot move it); orientation only.
+    continuation::Vector t = at.tangent;
+    if (!release && t.size() == problem.dimension() + 1) t[hit.joint] = 0.0;
+    auto next = std::make_unique<ContactProblem>(problem, locked);
+    const std::string what = std::string(release ? "release of joint " : "contact of joint ") +
+                             std::to_string(hit.joint + 1) + " " + toString(hit.side);
+    auto giveUp = [&branch, &what](const std::string& why) {
+      std::string& note = branch.specialPoints.back().note;
+      note += (note.empty() ? "" : "; ") + what + ": " + why;
+    };
+    // The start: the located point polished with the new set of locked joints. It lies on the
+    // changed joint's boundary (g = 0 to the location's accuracy, either sign), so it is started
+    // by continueBranch, which only looks for crossings from g ≥ 0, not by trace(), which refuses a
+    // start with g < 0.
+    const ConstrainedEquilibrium start =
+        solveConstrainedEquilibrium(problem, locked, at.u, at.lambda, std::max(o.locationNewtonTolerance, 1e-12));
+    if (!start.converged) {
+      giveUp("the equilibrium could not be polished (" + start.message + ")");
+      break;
+    }
+    continuation::Tracer tracer(*next, o);
+    // The stretch leaves the point to the admissible side of the changed joint's boundary g
+    // (compression of a new contact, distance to the limit of a released joint): dg/ds > 0 along
+    // its tangent. The parent's direction decides only when that is ambiguous: on an unstable
+    // branch a joint can reach its limit with the locked branch turning back in λ (a corner).
+    const int changed = hit.side == LimitSide::Upper ? hit.joint : hit.joint + n;
+    const int N = problem.dimension();
+    auto startPoint = [&](const continuation::Vector& direction, continuation::ContinuationPoint& p) {
+      p = continuation::ContinuationPoint();
+      p.u = start.u;
+      p.lambda = at.lambda;
+      tracer.units().toScaled(p);
+      if (!tracer.completePoint(p, tracer.units().directionToScaled(direction))) return false;
+      tracer.units().toUser(p);
+      return true;
+    };
+    continuation::Vector direction =
+        t.size() == N + 1 && t.norm() > 0.0 ? t : continuation::Vector(continuation::Vector::Unit(N + 1, N));
+    continuation::ContinuationPoint p0;
+    if (!startPoint(direction, p0)) {
+      giveUp("no unique tangent at the point");
+      break;
+    }
+    // dg/ds: a released joint's g = side·(q̄ − q) moves with −side·t_q; a contact's compression
+    // −side·τ_c with −side·(F_u,i t_u + F_λ,i t_λ) (the free equilibrium's row i, exact).
+    double rate = 0.0;
+    const double sideSign = hit.side == LimitSide::Upper ? 1.0 : -1.0;
+    if (release) {
+      rate = -sideSign * p0.tangent[hit.joint];
+    } else {
+      continuation::Matrix Fu(N, N);
+      continuation::Vector Fl(N);
+      if (problem.jacobian(p0.u, p0.lambda, Fu, Fl))
+        rate = -sideSign * (Fu.row(hit.joint).dot(p0.tangent.head(N)) + Fl[hit.joint] * p0.tangent[N]);
+    }
+    if (rate < 0.0 && !startPoint(-p0.tangent, p0)) {
+      giveUp("no unique tangent at the point");
+      break;
+    }
+    p0.arclength = 0.0;
+    continuation::Branch stretch;
+    stretch.points.push_back(p0);
+    tracer.continueBranch(stretch);
+    // A stretch that does not leave its start, or leaves it to the wrong side (a contact that
+    // pulls at once, or a released joint that goes on past its limit), would chatter: stop.
+    if (stretch.points.size() < 2 || !(stretch.points.back().arclength > options.minStep)) {
+      giveUp("the branch does not leave the point (" + stretch.stopMessage + ")");
+      break;
+    }
+    if (next->boundary(changed, stretch.points[1].u, stretch.points[1].lambda) < 0.0) {
+      giveUp(release ? "the free joint would go past its limit" : "the contact would pull (tension)");
+      break;
+    }
+    const int base = int(branch.points.size()) - 1;  // the stretch's point 0 is the branch's last point
+    const double s0 = branch.points.back().arclength;
+    for (size_t i = 1; i < stretch.points.size(); ++i) {
+      stretch.points[i].arclength += s0;
+      branch.points.push_back(std::move(stretch.points[i]));
+    }
+    for (continuation::SpecialPoint& sp : stretch.specialPoints) {
+      sp.index += base;
+      sp.arclength += s0;
+      branch.specialPoints.push_back(std::move(sp));
+    }
+    branch.stopReason = stretch.stopReason;
+    branch.stopMessage = stretch.stopMessage;
+    stretches.push_back(ContactStretch{base + 1, locked});
+    current = std::move(next);
+  }
+  return stretches;
+}
 
 EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::VectorXd& q0, double lambda0,
                                     const std::vector<continuation::InitialDirection>& starts,
@@ -14,11 +147,19 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
   tree.childTracer = options.childTracer;
   tree.onBranch = options.onBranch;
   result.tree = continuation::traceTree(problem, u0, lambda0, starts, options.tracer, tree);
-  for (const continuation::Branch& branch : result.tree.branches) {
+  for (continuation::Branch& branch : result.tree.branches) {
+    const continuation::TracerOptions& o =
+        branch.parentId >= 0 && options.childTracer ? *options.childTracer : options.tracer;
+    result.contact.push_back(options.contact && !result.tree.interrupted
+                                 ? continueUnderContact(problem, branch, o, options.maxContactEvents)
+                                 : std::vector<ContactStretch>{ContactStretch{}});
+  }
+  for (size_t b = 0; b < result.tree.branches.size(); ++b) {
+    const continuation::Branch& branch = result.tree.branches[b];
     std::vector<Classification> names;
     for (const continuation::SpecialPoint& sp : branch.specialPoints) names.push_back(classify(problem, sp));
     result.classifications.push_back(std::move(names));
-    result.reports.push_back(reportBranch(problem, branch, options.report));
+    result.reports.push_back(reportBranch(problem, branch, options.report, result.contact[b]));
   }
   if (!result.tree.branches.empty()) result.startUnstable = startIsUnstable(result.tree.branches.front());
   return result;

@@ -61,6 +61,7 @@ FirstBuckling firstBuckling(const Chain& chain, const EndCondition& end, const E
     child.maxStep = 0.02;
     opt.childTracer = child;
     opt.switchingDepth = 1;
+    opt.contact = false;  // the classification only looks at the branches near the first BP
     opt.switchAt = [lc](const cont::Branch& b, const cont::SpecialPoint& bp) {
       return b.parentId < 0 && std::abs(bp.lambda - lc) <= 1e-6 * std::abs(lc);
     };

@@ -41,7 +41,14 @@ bool borderedSolve(const Matrix& H, const Matrix& C, const Matrix& R, double tol
 
 CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, bool rotationHeld,
                                    const StiffnessOptions& options) {
+  return loadedStiffness(chain, q, F, rotationHeld, Matrix(0, chain.size()), options);
+}
+
+CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, bool rotationHeld,
+                                   const Eigen::Ref<const Matrix>& jointConstraints, const StiffnessOptions& options) {
   const int n = chain.size();
+  if (jointConstraints.cols() != n)
+    throw std::invalid_argument("joint constraints must have one column per segment (" + std::to_string(n) + ")");
   if (q.size() != n) throw std::invalid_argument("q must have one angle per segment (size " + std::to_string(n) + ")");
   if (!q.allFinite()) throw std::invalid_argument("q must be finite");
   if (!F.allFinite()) throw std::invalid_argument("F must be finite");
@@ -56,8 +63,11 @@ CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const W
   Matrix H(n, n);
   totalPotentialHessian(chain, q, F, H);
   const Matrix Jp = J.topRows(2);
-  Matrix Cphi(rotationHeld ? 1 : 0, n);
-  if (rotationHeld) Cphi.row(0) = J.row(2);
+  // the constraints on δq: E δq = 0 (jointConstraints), and J_φ δq = 0 when the rotation is held
+  const Eigen::Index e = jointConstraints.rows();
+  Matrix Cphi(e + (rotationHeld ? 1 : 0), n);
+  Cphi.topRows(e) = jointConstraints;
+  if (rotationHeld) Cphi.row(e) = J.row(2);
 
   // Force control: (K_q − K_g) δq = J_pᵀ δF (+ J_φᵀ δMe with J_φ δq = 0).
   Matrix R = Matrix::Zero(n + Cphi.rows(), 2);
@@ -78,7 +88,9 @@ CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const W
     // Infinite compliance: K_F from the position-held system, B⁻¹ multiplier corner = −K.
     out.singular = true;
     out.compliance.setConstant(nan);
-    const Matrix Ch = J.topRows(rotationHeld ? 3 : 2);
+    Matrix Ch(Cphi.rows() + 2, n);  // J_p first: its multipliers are the corner read below
+    Ch.topRows(2) = Jp;
+    Ch.bottomRows(Cphi.rows()) = Cphi;
     Matrix Rp = Matrix::Zero(n + Ch.rows(), 2);
     Rp(n, 0) = 1.0;
     Rp(n + 1, 1) = 1.0;

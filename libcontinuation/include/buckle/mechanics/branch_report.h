@@ -20,6 +20,7 @@
 
 #include "buckle/continuation/branch.h"
 #include "buckle/mechanics/classification.h"
+#include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/landing.h"
 #include "buckle/mechanics/load_history.h"
@@ -37,9 +38,11 @@ enum class EventType {
   JointLimit,        ///< "BD": the steps collapsed at a geometric joint limit (not located)
   StiffnessMinimum,  ///< "KMIN": a deep local minimum of a stiffness measure along a stable stretch
   Jump,              ///< "JUMP": a load history leaves its stable state (load_history.h)
+  Contact,           ///< "CT": a joint reaches its limit and locks there (contact.h)
+  Release,           ///< "RL": a locked joint's contact torque returns to zero: it is free again
 };
 
-/// "BP", "LP", "LPF", "BD", "KMIN", "JUMP": the one spelling of the labels in every output.
+/// "BP", "LP", "LPF", "BD", "KMIN", "JUMP", "CT", "RL": the one spelling of the labels in every output.
 const char* label(EventType type);
 
 /// "stable", "unstable (k negative)", or "unknown" for a count that was not computed (< 0).
@@ -77,6 +80,11 @@ struct PointReport {
   double residual = 0.0;               ///< corrector residual (scaled, dimensionless)
   bool haveStiffness = false;
   Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// Joints locked at their limits at this point (contact.h); stability and K are those of the
+  /// constrained chain.
+  ContactSet locked;
+  /// Largest compression −side·τ_c over the locked joints (0 when none is locked).
+  double contactTorque = 0.0;
 };
 
 /// One special point of a branch, named in the field's words.
@@ -103,6 +111,12 @@ struct SpecialPointReport {
   /// A fold whose stable side ends there: the chain must jump (jumpFromFold, landing.h).
   bool jumps = false;
   Landing landing;                     ///< filled by whoever simulates the jump
+  /// CT / RL: the joint (0-based) that locks or releases, and its contact torque τ_c at the point
+  /// (≈ 0 there: the free and the locked equilibria meet); NaN / −1 for other events.
+  int joint = -1;
+  double contactTorque = std::numeric_limits<double>::quiet_NaN();
+  /// The locked joints after the point (CT, RL).
+  ContactSet lockedAfter;
 };
 
 struct BranchReport {
@@ -119,6 +133,11 @@ struct BranchReport {
 /// Reports `branch`, traced on `problem`. Never throws for a numerical condition.
 BranchReport reportBranch(EquilibriumProblem& problem, const continuation::Branch& branch,
                           const ReportOptions& options = {});
+/// Same, for a branch continued through contact (continueUnderContact, equilibrium_branches.h):
+/// its points carry their locked joints, and a boundary where the set changes is reported as
+/// CT (a joint locks) or RL (it releases).
+BranchReport reportBranch(EquilibriumProblem& problem, const continuation::Branch& branch, const ReportOptions& options,
+                          const std::vector<ContactStretch>& stretches);
 
 /// A load history's jump (load_history.h) as a special point "JUMP" (jumping) with its landing;
 /// `parameterName` names λ in the note.

@@ -14,6 +14,7 @@
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/branch_report.h"
 #include "buckle/mechanics/classification.h"
+#include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 
 namespace buckle::mechanics {
@@ -30,6 +31,13 @@ struct EquilibriumBranchOptions {
   ReportOptions report;            ///< how the branches are reported (stiffness, held coordinate)
   /// Called when a branch is finished, before the next one starts (progress reports).
   std::function<void(const continuation::BranchTree&, const continuation::Branch&)> onBranch;
+  /// Contact at the joints (contact.h): a branch that ends on a located joint limit goes on with
+  /// that joint locked, in the same branch (its points appended), and with the joint free again
+  /// where its contact torque returns to zero. False: the branch ends at the limit ("BD").
+  /// Needs the problem's joint limits traced as boundaries (EquilibriumOptions).
+  bool contact = true;
+  /// At most this many contact / release events per branch (a guard against chattering).
+  int maxContactEvents = 50;
 };
 
 struct EquilibriumBranches {
@@ -39,7 +47,18 @@ struct EquilibriumBranches {
   /// classifications[b][s] names tree.branches[b].specialPoints[s].
   std::vector<std::vector<Classification>> classifications;
   bool startUnstable = false;      ///< the start state itself is unstable: "jumping" (Fig 6b)
+  /// contact[b]: the stretches of tree.branches[b] with their locked joints (one stretch with no
+  /// joint locked when the branch never touched a limit).
+  std::vector<std::vector<ContactStretch>> contact;
 };
+
+/// Continues `branch`, traced on `problem`, through contact and release events (contact.h)
+/// while it ends on a located joint limit or contact release; appends the new points and
+/// special points to it and returns its stretches. `options` are the branch's tracer options
+/// (maxPoints and maxArclength count the whole branch).
+std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
+                                                 const continuation::TracerOptions& options,
+                                                 int maxContactEvents = 50);
 
 /// Traces from joint angles q0 at λ0 (the held reactions are initialised by least squares, then
 /// polished by the tracer's fixed-parameter corrector), one start branch per entry of `starts`.

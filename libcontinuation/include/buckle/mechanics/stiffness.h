@@ -54,6 +54,12 @@ struct StiffnessOptions {
 /// Loaded stiffness K_F at (q, F) (eq 24–29); rotation free or held.
 CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, bool rotationHeld = false,
                                    const StiffnessOptions& options = {});
+/// Same, with the joint increments also constrained by E δq = 0 (the rows of `jointConstraints`,
+/// n columns; e.g. joints locked at a limit, contact.h): K_q − K_g is then inverted on ker E (and
+/// ker J_φ when the rotation is held), and negativeDirections / smallestEigenvalue are on that space.
+CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, bool rotationHeld,
+                                   const Eigen::Ref<const Matrix>& jointConstraints,
+                                   const StiffnessOptions& options = {});
 /// Same, with the end rotation held iff `end` holds φ (the held x / y only decide which forces
 /// are reactions in F, not the definition of K_F).
 CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, const EndCondition& end,

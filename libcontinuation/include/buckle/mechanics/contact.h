@@ -1,0 +1,192 @@
+// Contact at the joints: a joint that reaches its limit (geometric: the closing spring's length
+// goes to zero and the triangles meet; or the scene's limit) is locked there, a unilateral
+// constraint (docs/mechanics.md, "Contact at the joints").
+//
+// Locked joints are eliminated, not bordered: with the set L locked at their limits q̄_i, the
+// unknowns stay u = (q, r) (the same vector as EquilibriumProblem's, so branches, reports and
+// shapes read it unchanged) and the rows of the locked joints become q̄_i − q_i = 0:
+//   free i:    ∂E/∂q_i − (Jᵀ F)_i = 0
+//   locked i:  q̄_i − q_i = 0
+//   held c:    value_c(λ) − p_c(q) = 0.
+// The contact torque of a locked joint is the reaction that closes its equilibrium row,
+//   τ_c,i = ∂E/∂q_i − (Jᵀ F)_i,
+// the generalised torque the contact applies to joint i (positive towards increasing q_i).
+// A compressive contact pushes the joint back into its admissible range: τ_c ≤ 0 at an upper
+// limit, τ_c ≥ 0 at a lower one; the *compression* c_i = −side·τ_c (side +1 upper, −1 lower) is
+// ≥ 0 while the contact holds. It is exactly 0 where the branch reaches the limit (the free
+// equilibrium holds there) and the contact releases where it returns to 0: that is a boundary
+// g = c_i ≥ 0 of ContactProblem, located by the tracer like a joint limit.
+//
+// Structure (O(n)): with the locked rows eliminated, F_u restricted to the free joints is
+// K_q − K_g on the free indices F, whose entries are κ_a δ_ab − h_max(a,b) (eq 27): the same
+// generator form, so the free block is U T Uᵀ of a chain structure of size |F| (chain_structure.h)
+// assembled from κ_F and h_F. The bordered solves and the constrained stability (K_q − K_g on
+// the free joints and on ker of the held rows J_h,F) are those of that reduced structure, O(n).
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "buckle/continuation/bordered_solver.h"
+#include "buckle/continuation/problem.h"
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/chain_structure.h"
+#include "buckle/mechanics/end_condition.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/stiffness.h"
+
+namespace buckle::mechanics {
+
+/// Which limit of its range a joint touches: +1 upper (q_max), −1 lower (q_min).
+enum class LimitSide { Lower = -1, Upper = 1 };
+
+/// "upper" / "lower".
+const char* toString(LimitSide side);
+
+/// One locked joint (0-based index) at one of its limits.
+struct LockedJoint {
+  int joint = -1;
+  LimitSide side = LimitSide::Upper;
+  bool operator==(const LockedJoint& o) const { return joint == o.joint && side == o.side; }
+};
+
+/// The joints locked at their limits, sorted by joint, at most one side per joint.
+class ContactSet {
+ public:
+  ContactSet() = default;
+  /// Locks `joint` at `side` (replaces an existing lock of that joint). Throws
+  /// std::invalid_argument for a negative joint.
+  void lock(int joint, LimitSide side);
+  /// Unlocks `joint` (no-op when it is free).
+  void release(int joint);
+  bool locked(int joint) const;
+  /// Side of a locked joint (Upper for a free one: check locked() first).
+  LimitSide side(int joint) const;
+  int count() const { return int(joints_.size()); }
+  bool empty() const { return joints_.empty(); }
+  const std::vector<LockedJoint>& joints() const { return joints_; }
+  /// 1-based joint numbers with their side, "3U 5L" ("" when empty): the `locked` column.
+  std::string label() const;
+  /// Throws std::invalid_argument naming the problem when a joint is outside [0, segments).
+  void check(int segments) const;
+  bool operator==(const ContactSet& o) const { return joints_ == o.joints_; }
+  bool operator!=(const ContactSet& o) const { return !(*this == o); }
+
+ private:
+  std::vector<LockedJoint> joints_;
+};
+
+/// The limit angle q̄ of joint i on `side` (the chain's limits: geometric or the scene's).
+double limitAngle(const Chain& chain, int joint, LimitSide side);
+
+/// The chain's equilibrium with the joints of `locked` held at their limits (file comment).
+/// Same unknowns, parameter, scales and held-coordinate rows as `base`, which must outlive it.
+/// Boundaries (2n, as EquilibriumProblem): k < n the upper side of joint k, k ≥ n the lower side
+/// of joint k − n; for a free joint the joint limit g = q_max − q / q − q_min, for a joint locked
+/// on that side its compression c ≥ 0 (release), for the other side of a locked joint the
+/// (positive) distance to that limit.
+class ContactProblem final : public continuation::Problem {
+ public:
+  /// Throws std::invalid_argument if a locked joint is outside the chain.
+  ContactProblem(EquilibriumProblem& base, ContactSet locked);
+
+  EquilibriumProblem& base() { return base_; }
+  const ContactSet& contacts() const { return locked_; }
+  /// Free joints in increasing order.
+  const std::vector<int>& freeJoints() const { return free_; }
+
+  /// Contact torque τ_c,i = ∂E/∂q_i − (JᵀF)_i of joint i at (u, λ) (any joint; ~0 for a free
+  /// one at an equilibrium). NaN outside the domain.
+  double contactTorque(continuation::ConstVectorRef u, double lambda, int joint);
+  /// Compression −side·τ_c,i of a locked joint (≥ 0 while the contact holds).
+  double compression(continuation::ConstVectorRef u, double lambda, int joint);
+
+  int dimension() const override { return base_.dimension(); }
+  bool residual(continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) override;
+  bool jacobian(continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
+                continuation::VectorRef Flambda) override;
+  bool jacobianDirectionalDerivative(continuation::ConstVectorRef u, double lambda,
+                                     continuation::ConstVectorRef du, double dlambda,
+                                     continuation::MatrixRef dFu, continuation::VectorRef dFlambda) override;
+
+  bool hasStabilityOperator() const override { return true; }
+  /// H = K_q − K_g (n×n), C = the held rows J_h and one row e_iᵀ per locked joint.
+  bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
+  /// Inertia and lowest eigenvalues of K_q − K_g on the free joints and ker J_h,F, O(n) through
+  /// the reduced chain structure (file comment).
+  bool stability(continuation::ConstVectorRef u, double lambda, int lowestCount,
+                 continuation::StabilityInfo& info) override;
+  /// The reduced structure's O(n) bordered solver (locked rows eliminated).
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver() override;
+
+  /// base.scales(), with the locked rows (angles) at scale 1.
+  continuation::ProblemScales scales() const override;
+
+  int boundaryCount() const override { return 2 * base_.segments(); }
+  double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
+  std::string boundaryName(int k) const override;
+
+  /// T of K_q − K_g on the free joints into ws (size freeJoints().size()) and the end Jacobian's
+  /// free columns into Jf (3×|F|); false outside the domain.
+  bool assembleReduced(continuation::ConstVectorRef u, double lambda, ChainStructure& ws,
+                       continuation::MatrixRef Jf);
+
+ private:
+  EquilibriumProblem& base_;
+  ContactSet locked_;
+  std::vector<int> free_;
+  std::vector<int> held_;
+  ChainStructure full_, reduced_;
+  Matrix J_, Jf_, heldRows_;
+  Vector lastLowest_;
+};
+
+/// A stretch of a traced branch with one set of locked joints: points [firstPoint, the next
+/// stretch's firstPoint) of the branch (equilibrium_branches.h). The point where a contact
+/// starts or releases ends the stretch before it.
+struct ContactStretch {
+  int firstPoint = 0;
+  ContactSet locked;
+};
+
+/// The locked joints at point `index` of a branch with these stretches (empty set when none).
+const ContactSet& lockedAt(const std::vector<ContactStretch>& stretches, int index);
+
+/// Boundary k of ContactProblem / EquilibriumProblem as (joint, side).
+LockedJoint limitOfBoundary(int k, int segments);
+
+/// An equilibrium at fixed λ with the joints of `locked` held at their limits: Newton on the
+/// ContactProblem's rows with its O(n) solver from u0 (q of locked joints set to their limits
+/// first). `tolerance` bounds the scaled residual (rows over ProblemScales::residuals).
+struct ConstrainedEquilibrium {
+  bool converged = false;
+  continuation::Vector u;          ///< (q, r)
+  double residual = 0.0;           ///< max scaled |F_i| at u
+  int iterations = 0;
+  continuation::Vector torques;    ///< contact torque τ_c,i of every joint (0 at free ones)
+  /// Smallest compression among the locked joints (+inf when none): < 0 means the contact
+  /// would pull, so that joint should be released.
+  double minCompression = 0.0;
+  std::string message;             ///< why it did not converge
+};
+ConstrainedEquilibrium solveConstrainedEquilibrium(EquilibriumProblem& base, const ContactSet& locked,
+                                                   continuation::ConstVectorRef u0, double lambda,
+                                                   double tolerance = 1e-12, int maxIterations = 30);
+
+/// Stability of the constrained system at (u, λ): K_q − K_g on the free joints and ker J_h,F.
+continuation::StabilityInfo constrainedStability(EquilibriumProblem& base, const ContactSet& locked,
+                                                 continuation::ConstVectorRef u, double lambda,
+                                                 int lowestCount = 1);
+
+/// The joints within `tolerance` (radians) of a limit at q, on that side.
+ContactSet jointsAtLimits(const Chain& chain, continuation::ConstVectorRef q, double tolerance);
+
+/// Loaded stiffness K_F (eq 29) with the locked joints rigid (δq_i = 0): C_F = J_p P J_pᵀ, P the
+/// inverse of K_q − K_g on ker [E_L; J_φ if the rotation is held], E_L the locked rows.
+CartesianStiffness lockedLoadedStiffness(const Chain& chain, continuation::ConstVectorRef q, const Wrench& F,
+                                         const EndCondition& end, const ContactSet& locked,
+                                         const StiffnessOptions& options = {});
+
+}  // namespace buckle::mechanics

@@ -1,0 +1,408 @@
+#include <catch2/catch.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "buckle/continuation/bordered_solver.h"
+#include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/equilibrium_branches.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/unloaded_shape.h"
+
+#include "random_segments.h"
+
+using namespace buckle::mechanics;
+namespace cont = buckle::continuation;
+
+namespace {
+
+/// Independent formulation: Newton on the gradient of the total potential restricted to the
+/// free joints (dense Eigen), the locked joints held at their limits. Returns q.
+Eigen::VectorXd lockedNewton(const Chain& chain, const ContactSet& locked, Eigen::VectorXd q, const Wrench& F) {
+  const int n = chain.size();
+  std::vector<int> free;
+  for (int i = 0; i < n; ++i)
+    if (!locked.locked(i)) free.push_back(i);
+  for (const LockedJoint& l : locked.joints()) q[l.joint] = limitAngle(chain, l.joint, l.side);
+  const int nf = int(free.size());
+  Eigen::VectorXd g(n), gf(nf);
+  Eigen::MatrixXd H(n, n), Hf(nf, nf);
+  for (int it = 0; it < 50; ++it) {
+    totalPotentialGradient(chain, q, F, g);
+    totalPotentialHessian(chain, q, F, H);
+    for (int a = 0; a < nf; ++a) {
+      gf[a] = g[free[size_t(a)]];
+      for (int b = 0; b < nf; ++b) Hf(a, b) = H(free[size_t(a)], free[size_t(b)]);
+    }
+    const Eigen::VectorXd dq = Hf.fullPivLu().solve(gf);
+    for (int a = 0; a < nf; ++a) q[free[size_t(a)]] -= dq[a];
+    if (dq.cwiseAbs().maxCoeff() < 1e-15) break;
+  }
+  return q;
+}
+
+/// Lowest eigenvalues of H restricted to the free joints and ker of the held rows C (free
+/// columns), by a dense self-adjoint eigen-solve.
+Eigen::VectorXd reducedSpectrum(const Eigen::MatrixXd& H, const Eigen::MatrixXd& C, const ContactSet& locked) {
+  const int n = int(H.rows());
+  std::vector<int> free;
+  for (int i = 0; i < n; ++i)
+    if (!locked.locked(i)) free.push_back(i);
+  const int nf = int(free.size());
+  Eigen::MatrixXd Hf(nf, nf), Cf(C.rows(), nf);
+  for (int a = 0; a < nf; ++a) {
+    for (int b = 0; b < nf; ++b) Hf(a, b) = H(free[size_t(a)], free[size_t(b)]);
+    Cf.col(a) = C.col(free[size_t(a)]);
+  }
+  Eigen::MatrixXd Z = Eigen::MatrixXd::Identity(nf, nf);
+  if (Cf.rows() > 0) {
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(Cf);
+    Z = lu.kernel();
+    Z = Eigen::HouseholderQR<Eigen::MatrixXd>(Z).householderQ() * Eigen::MatrixXd::Identity(nf, Z.cols());
+  }
+  const Eigen::MatrixXd R = Z.transpose() * Hf * Z;
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(0.5 * (R + R.transpose())).eigenvalues();
+}
+
+const SpecialPointReport* firstOfType(const BranchReport& r, EventType type) {
+  for (const SpecialPointReport& s : r.specialPoints)
+    if (s.type == type) return &s;
+  return nullptr;
+}
+
+int countType(const BranchReport& r, EventType type) {
+  return int(std::count_if(r.specialPoints.begin(), r.specialPoints.end(),
+                           [type](const SpecialPointReport& s) { return s.type == type; }));
+}
+
+}  // namespace
+
+TEST_CASE("ContactSet keeps its joints sorted, one side each, and labels them", "[contact]") {
+  ContactSet s;
+  s.lock(4, LimitSide::Lower);
+  s.lock(2, LimitSide::Upper);
+  s.lock(4, LimitSide::Upper);
+  REQUIRE(s.count() == 2);
+  CHECK(s.joints()[0].joint == 2);
+  CHECK(s.side(4) == LimitSide::Upper);
+  CHECK(s.label() == "3U 5U");
+  s.release(2);
+  CHECK(s.label() == "5U");
+  CHECK_THROWS_WITH(s.check(3), Catch::Contains("joint 5 does not exist"));
+  CHECK_THROWS_AS(s.lock(-1, LimitSide::Upper), std::invalid_argument);
+  CHECK(toString(LimitSide::Lower) == std::string("lower"));
+  CHECK(std::string(label(EventType::Contact)) == "CT");
+  CHECK(std::string(label(EventType::Release)) == "RL");
+}
+
+TEST_CASE("contact: a single segment pushed past its limit carries applied torque minus spring torque", "[contact]") {
+  SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
+  p.qMaxUser = 0.6;
+  const Chain chain = Chain::uniform(1, p);
+  const double springAtLimit = chain.segment(0).energyJet(0.6).d1;  // E'(q̄): the limit load
+  REQUIRE(springAtLimit > 0.0);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 0, 1));  // Me = λ
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMax = 3.0 * springAtLimit;
+  o.tracer.maxStep = 0.1;
+  o.switchingDepth = 0;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(1), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const BranchReport& rep = r.reports[0];
+  CHECK(r.tree.branches[0].stopReason == cont::StopReason::LambdaRange);
+  REQUIRE(countType(rep, EventType::Contact) == 1);
+  CHECK(countType(rep, EventType::Boundary) == 0);
+  const SpecialPointReport& ct = *firstOfType(rep, EventType::Contact);
+  CHECK(ct.joint == 0);
+  CHECK(std::abs(ct.parameter - springAtLimit) <= 1e-12 * springAtLimit);
+  CHECK(std::abs(ct.contactTorque) <= 1e-12 * springAtLimit);
+  CHECK(ct.lockedAfter.label() == "1U");
+  int locked = 0;
+  ContactProblem contact(problem, ct.lockedAfter);
+  for (const PointReport& pt : rep.points) {
+    if (pt.locked.empty()) {
+      CHECK(pt.parameter <= springAtLimit * (1.0 + 1e-12));
+      continue;
+    }
+    ++locked;
+    CHECK(pt.q[0] == Approx(0.6).margin(1e-14));
+    // compression = applied torque − spring torque at the limit (closed form)
+    CHECK(std::abs(pt.contactTorque - (pt.parameter - springAtLimit)) <= 1e-12 * springAtLimit);
+    const cont::ContinuationPoint& cp = r.tree.branches[0].points[size_t(pt.index)];
+    CHECK(std::abs(contact.contactTorque(cp.u, cp.lambda, 0) - (springAtLimit - cp.lambda)) <= 1e-12 * springAtLimit);
+    CHECK(pt.stable);
+  }
+  CHECK(locked >= 5);
+  CHECK(rep.points.back().parameter == Approx(3.0 * springAtLimit).epsilon(1e-12));
+
+  SECTION("switched off: the branch ends at the limit") {
+    o.contact = false;
+    const EquilibriumBranches off =
+        traceEquilibria(problem, Eigen::VectorXd::Zero(1), 0.0, cont::InitialDirection::increasingLambda(), o);
+    CHECK(off.tree.branches[0].stopReason == cont::StopReason::Boundary);
+    CHECK(countType(off.reports[0], EventType::Contact) == 0);
+    CHECK(countType(off.reports[0], EventType::Boundary) == 1);
+  }
+}
+
+TEST_CASE("contact: a chain's locked branch agrees with an independent Newton solve with the joint fixed",
+          "[contact]") {
+  SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
+  p.qMinUser = -0.6;
+  p.qMaxUser = 0.6;
+  const Chain chain = Chain::uniform(3, p);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));  // Fy = λ
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMax = 6.0;
+  o.tracer.maxStep = 0.1;
+  o.tracer.newtonTolerance = 1e-14;  // the traced points themselves to the comparison's accuracy
+  o.switchingDepth = 0;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const BranchReport& rep = r.reports[0];
+  const cont::Branch& b = r.tree.branches[0];
+  CHECK(b.stopReason == cont::StopReason::LambdaRange);
+  REQUIRE(countType(rep, EventType::Contact) >= 1);
+  const SpecialPointReport& ct = *firstOfType(rep, EventType::Contact);
+  CHECK(ct.joint == 0);  // the largest moment arm
+  int checked = 0;
+  for (const PointReport& pt : rep.points) {
+    if (pt.locked.empty()) continue;
+    const Wrench F(0.0, pt.parameter, 0.0);
+    const Eigen::VectorXd q = lockedNewton(chain, pt.locked, pt.q, F);
+    CHECK((q - pt.q).cwiseAbs().maxCoeff() <= 1e-12 * std::max(1.0, q.cwiseAbs().maxCoeff()));
+    Eigen::VectorXd g(3);
+    totalPotentialGradient(chain, q, F, g);
+    for (const LockedJoint& l : pt.locked.joints()) {
+      ContactProblem contact(problem, pt.locked);
+      const cont::ContinuationPoint& cp = b.points[size_t(pt.index)];
+      CHECK(std::abs(contact.contactTorque(cp.u, cp.lambda, l.joint) - g[l.joint]) <= 1e-11 * std::max(1.0, std::abs(g[l.joint])));
+      CHECK(contact.compression(cp.u, cp.lambda, l.joint) >= 0.0);
+    }
+    ++checked;
+  }
+  CHECK(checked >= 5);
+
+  SECTION("the O(n) solver of the locked problem matches the dense LU") {
+    const cont::ContinuationPoint& cp = b.points.back();
+    ContactProblem contact(problem, rep.points.back().locked);
+    auto structured = contact.makeStructuredSolver();
+    cont::DenseBorderedSolver dense(contact);
+    std::mt19937 rng(7);
+    std::normal_distribution<double> N(0.0, 1.0);
+    const int dim = contact.dimension() + 1;
+    cont::Vector c(dim), rhs(dim), x1(dim), x2(dim);
+    for (int i = 0; i < dim; ++i) c[i] = N(rng), rhs[i] = N(rng);
+    REQUIRE(structured->factor(cp.u, cp.lambda, c) == cont::Factorization::Regular);
+    REQUIRE(dense.factor(cp.u, cp.lambda, c) == cont::Factorization::Regular);
+    REQUIRE(structured->solve(rhs, x1));
+    REQUIRE(dense.solve(rhs, x2));
+    CHECK((x1 - x2).norm() <= 1e-11 * x2.norm());
+    CHECK(structured->determinantSign() == dense.determinantSign());
+  }
+}
+
+TEST_CASE("contact: constrained stability equals a dense eigen-solve of the reduced Hessian", "[contact]") {
+  std::mt19937 rng(2024);
+  for (int n : {6, 40}) {
+    std::vector<SegmentParameters> segs;
+    for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
+    const Chain chain(segs);
+    for (const EndCondition& end : {EndCondition::freeEnd(Eigen::Vector3d(-0.3, 0.2, 0.1)), EndCondition::clampedPinned(-0.4),
+                                    EndCondition::heldPosition(0.8 * chain.length(), 0.5)}) {
+      EquilibriumProblem problem(chain, end, Eigen::Vector3d(1.0, 0.0, 0.0));
+      ContactSet locked;
+      locked.lock(1, LimitSide::Upper);
+      locked.lock(n - 2, LimitSide::Lower);
+      ContactProblem contact(problem, locked);
+      Eigen::VectorXd u(problem.dimension());
+      std::uniform_real_distribution<double> W(-0.5, 0.5);
+      for (int i = 0; i < u.size(); ++i) u[i] = W(rng);
+      for (const LockedJoint& l : locked.joints()) u[l.joint] = limitAngle(chain, l.joint, l.side);
+      const double lambda = -0.7;
+      cont::StabilityInfo info;
+      REQUIRE(contact.stability(u, lambda, 3, info));
+      Matrix H, C;
+      REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+      const Eigen::VectorXd ev = reducedSpectrum(H, C, locked);
+      const double scale = std::max(1.0, ev.cwiseAbs().maxCoeff());
+      INFO("n = " << n << ", held " << end.heldCount());
+      CHECK(info.negative == int((ev.array() < 0.0).count()));
+      const int wanted = std::min(3, int(ev.size()));  // n − |L| − rank(C_F) eigenvalues in all
+      REQUIRE(info.lowest.size() == wanted);
+      for (int k = 0; k < wanted; ++k) CHECK(std::abs(info.lowest[k] - ev[k]) <= 1e-10 * scale);
+      // the same through the convenience function and the dense operator of the problem
+      const cont::StabilityInfo again = constrainedStability(problem, locked, u, lambda, 1);
+      CHECK(again.negative == info.negative);
+      Matrix Hc, Cc;
+      REQUIRE(contact.stabilityOperator(u, lambda, Hc, Cc));
+      const cont::StabilityInfo dense = cont::projectedInertia(Hc, Cc, 1e-13, 3);
+      CHECK(dense.negative == info.negative);
+    }
+  }
+}
+
+TEST_CASE("contact: scaled units give the same contact events after rescaling", "[contact]") {
+  const double Ls = 1e-3, Ks = 1e6;  // lengths ×1e−3, stiffness ×1e6: forces ×1e3, torques ×1
+  auto run = [](double ls, double ks) {
+    SegmentParameters p = SegmentParameters::symmetric(0.5 * ls, 1.0 * ls, 1.0 * ks, 2.25 * ls);
+    p.qMinUser = -0.6;
+    p.qMaxUser = 0.6;
+    const Chain chain = Chain::uniform(3, p);
+    EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));
+    EquilibriumBranchOptions o;
+    o.tracer.lambdaMax = 6.0 * ks * ls;
+    o.tracer.maxStep = 0.1;
+    o.switchingDepth = 0;
+    return traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
+  };
+  const EquilibriumBranches a = run(1.0, 1.0), b = run(Ls, Ks);
+  std::vector<const SpecialPointReport*> ea, eb;
+  for (const SpecialPointReport& s : a.reports[0].specialPoints)
+    if (s.type == EventType::Contact || s.type == EventType::Release) ea.push_back(&s);
+  for (const SpecialPointReport& s : b.reports[0].specialPoints)
+    if (s.type == EventType::Contact || s.type == EventType::Release) eb.push_back(&s);
+  REQUIRE(ea.size() >= 1);
+  REQUIRE(ea.size() == eb.size());
+  for (size_t k = 0; k < ea.size(); ++k) {
+    CHECK(ea[k]->type == eb[k]->type);
+    CHECK(ea[k]->joint == eb[k]->joint);
+    CHECK(std::abs(eb[k]->parameter / (Ks * Ls) - ea[k]->parameter) <= 1e-10 * std::abs(ea[k]->parameter));
+    CHECK((eb[k]->q - ea[k]->q).cwiseAbs().maxCoeff() <= 1e-10);
+  }
+  CHECK(a.reports[0].points.back().locked == b.reports[0].points.back().locked);
+  CHECK(std::abs(b.reports[0].points.back().contactTorque / (Ks * Ls * Ls) - a.reports[0].points.back().contactTorque) <=
+        1e-9 * std::abs(a.reports[0].points.back().contactTorque));
+}
+
+TEST_CASE("contact: a long chain (n = 50) continues locked, O(n) solver and independent Newton agree", "[contact]") {
+  const int n = 50;
+  SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
+  std::vector<SegmentParameters> segs(size_t(n), p);
+  segs[0].qMaxUser = 0.02;  // the root joint carries the largest moment and locks first
+  const Chain chain(segs);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMax = 0.01;
+  o.tracer.maxStep = 0.1;
+  o.tracer.newtonTolerance = 1e-14;
+  o.switchingDepth = 0;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const BranchReport& rep = r.reports[0];
+  REQUIRE(countType(rep, EventType::Contact) >= 1);
+  CHECK(firstOfType(rep, EventType::Contact)->joint == 0);
+  CHECK(r.tree.branches[0].stopReason == cont::StopReason::LambdaRange);
+  const PointReport& last = rep.points.back();
+  REQUIRE(last.locked.locked(0));
+  const Eigen::VectorXd q = lockedNewton(chain, last.locked, last.q, Wrench(0.0, last.parameter, 0.0));
+  CHECK((q - last.q).cwiseAbs().maxCoeff() <= 1e-12 * std::max(1.0, q.cwiseAbs().maxCoeff()));
+  // the constrained equilibrium polish (contact.h) from a perturbed start lands on the same point
+  Eigen::VectorXd u0 = r.tree.branches[0].points.back().u;
+  u0.head(n) += 1e-3 * Eigen::VectorXd::LinSpaced(n, -1.0, 1.0);
+  const ConstrainedEquilibrium polished = solveConstrainedEquilibrium(problem, last.locked, u0, last.parameter);
+  REQUIRE(polished.converged);
+  CHECK((polished.u.head(n) - q).cwiseAbs().maxCoeff() <= 1e-12 * std::max(1.0, q.cwiseAbs().maxCoeff()));
+  CHECK(polished.minCompression == Approx(last.contactTorque).epsilon(1e-9));
+  CHECK(polished.minCompression > 0.0);
+}
+
+TEST_CASE("contact: a curled chain's root joint locks and releases where the free branch touches the limit",
+          "[contact]") {
+  // Five segments curled by their unloaded shape (q0 = 0.2, 1.3, 1.3, 1.3, 1.3) so that the end
+  // lies behind the root's moment arm: a growing Fy first bends joint 1 down onto its limit 0.1,
+  // then, as the free joints swing the end round, pulls it back up (data/scenes/contact_release.json).
+  std::vector<SegmentParameters> segs(5, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  segs[0].qMinUser = 0.1;
+  Eigen::VectorXd q0(5);
+  q0 << 0.2, 1.3, 1.3, 1.3, 1.3;
+  const Chain chain(preloadsForShape(segs, q0));
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));  // Fy = λ
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMax = 1.0;
+  o.tracer.maxStep = 0.1;
+  o.switchingDepth = 0;
+  const EquilibriumBranches r = traceEquilibria(problem, q0, 0.0, cont::InitialDirection::increasingLambda(), o);
+  const BranchReport& rep = r.reports[0];
+  REQUIRE(countType(rep, EventType::Contact) == 1);
+  REQUIRE(countType(rep, EventType::Release) == 1);
+  const SpecialPointReport& ct = *firstOfType(rep, EventType::Contact);
+  const SpecialPointReport& rl = *firstOfType(rep, EventType::Release);
+  CHECK(ct.joint == 0);
+  CHECK(rl.joint == 0);
+  CHECK(ct.parameter < rl.parameter);
+  CHECK(rl.lockedAfter.empty());
+  CHECK(r.tree.branches[0].stopReason == cont::StopReason::LambdaRange);
+  const double torqueUnit = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();
+  for (const SpecialPointReport* e : {&ct, &rl}) {
+    INFO(label(e->type));
+    // Both events are points of the free branch too: τ_c = 0 there and joint 1 exactly at its
+    // limit. An independent dense Newton of the *free* equilibrium at that load converges to it.
+    CHECK(std::abs(e->contactTorque) <= 1e-11 * torqueUnit);
+    CHECK(e->q[0] == Approx(0.1).margin(1e-14));
+    const Eigen::VectorXd q = lockedNewton(chain, ContactSet(), e->q, Wrench(0.0, e->parameter, 0.0));
+    CHECK(std::abs(q[0] - 0.1) <= 1e-10);
+    CHECK((q - e->q).cwiseAbs().maxCoeff() <= 1e-10);
+  }
+  // The locked stretch lies between the two events and pushes (compression > 0); before and
+  // after, joint 1 is free and inside its range.
+  for (const PointReport& pt : rep.points) {
+    if (pt.parameter < ct.parameter * (1 - 1e-12) || pt.parameter > rl.parameter * (1 + 1e-12)) {
+      CHECK(pt.locked.empty());
+      CHECK(pt.q[0] >= 0.1 - 1e-14);
+    } else if (!pt.locked.empty()) {
+      CHECK(pt.contactTorque >= -1e-12 * torqueUnit);
+      CHECK(pt.q[0] == Approx(0.1).margin(1e-14));
+    }
+  }
+  // the release load is where the locked branch's compression returns to zero: the contact
+  // torque of the locked problem, by the independent Newton, changes sign across it
+  ContactSet locked;
+  locked.lock(0, LimitSide::Lower);
+  for (double f : {0.999, 1.001}) {
+    const double lambda = f * rl.parameter;
+    const Eigen::VectorXd q = lockedNewton(chain, locked, rl.q, Wrench(0.0, lambda, 0.0));
+    Eigen::VectorXd g(5);
+    totalPotentialGradient(chain, q, Wrench(0.0, lambda, 0.0), g);
+    CHECK((f < 1.0 ? g[0] > 0.0 : g[0] < 0.0));  // lower limit: compression = +τ_c
+  }
+}
+
+TEST_CASE("contact: the loaded stiffness with locked joints is the free joints' compliance inverted", "[contact]") {
+  std::mt19937 rng(99);
+  std::vector<SegmentParameters> segs;
+  for (int i = 0; i < 6; ++i) segs.push_back(testing::randomSegment(rng));
+  const Chain chain(segs);
+  Eigen::VectorXd q(6);
+  q << 0.3, -0.2, 0.5, 0.1, -0.4, 0.2;
+  const Wrench F(-0.2, 0.15, 0.05);
+  ContactSet locked;
+  locked.lock(1, LimitSide::Upper);
+  locked.lock(4, LimitSide::Lower);
+  const CartesianStiffness k = lockedLoadedStiffness(chain, q, F, EndCondition::freeEnd(), locked);
+  // independent: C_F = J_p,F H_FF⁻¹ J_p,Fᵀ on the free joints F = {0, 2, 3, 5}
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  Matrix J(3, 6), H(6, 6);
+  endJacobian(data, J);
+  totalPotentialHessian(chain, q, F, H);
+  const std::vector<int> free{0, 2, 3, 5};
+  Matrix Hf(4, 4), Jf(2, 4);
+  for (int a = 0; a < 4; ++a) {
+    Jf.col(a) = J.col(free[size_t(a)]).head(2);
+    for (int b = 0; b < 4; ++b) Hf(a, b) = H(free[size_t(a)], free[size_t(b)]);
+  }
+  const Eigen::Matrix2d C = Jf * Hf.fullPivLu().solve(Jf.transpose());
+  const Eigen::Matrix2d K = C.inverse();
+  CHECK((k.stiffness - K).cwiseAbs().maxCoeff() <= 1e-10 * K.cwiseAbs().maxCoeff());
+  CHECK((k.compliance - C).cwiseAbs().maxCoeff() <= 1e-10 * C.cwiseAbs().maxCoeff());
+  // no joint locked: the plain loaded stiffness
+  const CartesianStiffness plain = lockedLoadedStiffness(chain, q, F, EndCondition::freeEnd(), ContactSet());
+  CHECK((plain.stiffness - loadedStiffness(chain, q, F, false).stiffness).cwiseAbs().maxCoeff() == 0.0);
+  CHECK_THROWS_AS(loadedStiffness(chain, q, F, false, Matrix::Zero(1, 5)), std::invalid_argument);
+}
