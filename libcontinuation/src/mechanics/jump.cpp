@@ -1,9 +1,9 @@
 #include "buckle/mechanics/jump.h"
 
 #include "buckle/continuation/scaled_problem.h"
+#include "buckle/mechanics/contact.h"
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 #include <algorithm>
 #include <Eigen/QR>
 #include <cmath>
@@ -72,10 +72,19 @@ RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn
     rp.stable = rp.stability.valid() && rp.stability.stable();
     return rp;
   }
-  rp.polished = polishConstrained(problem, dyn.q, lambda, rp.sides, options.residualTolerance);
+  ContactSet locked;
+  for (int i = 0; i < n; ++i)
+    if (rp.sides[size_t(i)] != 0) locked.lock(i, rp.sides[size_t(i)] > 0 ? LimitSide::Upper : LimitSide::Lower);
+  const ConstrainedEquilibrium ce = solveConstrainedEquilibrium(problem, locked, problem.initialGuess(dyn.q, lambda), lambda,
+                                                                options.residualTolerance, options.maxIterations);
+  rp.polished.u = ce.u;
+  rp.polished.converged = ce.converged;
+  rp.polished.iterations = ce.iterations;
+  rp.polished.residual = ce.residual;
+  rp.polished.message = ce.converged ? "converged with the joints in contact locked" : ce.message;
   if (!rp.polished.converged) return rp;
-  rp.torques = contactTorques(problem, rp.polished.u, lambda, rp.sides);
-  rp.stability = constrainedStability(problem, rp.polished.u, lambda, rp.sides);
+  rp.torques = ce.torques;
+  rp.stability = constrainedStability(problem, locked, ce.u, lambda, 3);
   // a stable constrained equilibrium: the reduced Hessian positive definite and every contact
   // compressive (a contact torque of zero would release at the slightest disturbance)
   bool compressive = true;
@@ -143,128 +152,6 @@ PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, do
   Vector F(N);
   result.residual = problem.residual(result.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
   return result;
-}
-
-PolishResult polishConstrained(EquilibriumProblem& problem, ConstVectorRef q, double lambda, const std::vector<int>& sides,
-                               double tolerance, int maxIterations) {
-  const int n = problem.segments();
-  const int N = problem.dimension();
-  if (sides.size() != size_t(n)) throw std::invalid_argument("contact sides must have one entry per joint");
-  PolishResult result;
-  Vector u = fullUnknowns(problem, q, lambda);
-  const Chain& chain = problem.chain();
-  auto limit = [&](int i) { return sides[size_t(i)] > 0 ? chain.upperLimits()[i] : chain.lowerLimits()[i]; };
-  for (int i = 0; i < n; ++i)
-    if (sides[size_t(i)] != 0) u[i] = limit(i);
-  // rows relative to their own scales (the locked rows are angles: scale 1)
-  Vector scale = problem.scales().residuals;
-  for (int i = 0; i < n; ++i)
-    if (sides[size_t(i)] != 0) scale[i] = 1.0;
-  Vector F(N), Fl(N), step(N);
-  Matrix Fu(N, N);
-  // R(u): the problem's rows, the locked joints' rows replaced by q_i − q̄_i (0 from the start)
-  auto rows = [&](const Vector& v, Vector& R) {
-    if (!problem.residual(v, lambda, R)) return false;
-    for (int i = 0; i < n; ++i)
-      if (sides[size_t(i)] != 0) R[i] = v[i] - limit(i);
-    return R.allFinite();
-  };
-  auto norm = [&](const Vector& R) { return R.cwiseQuotient(scale).cwiseAbs().maxCoeff(); };
-  if (!rows(u, F)) {
-    result.u = u;
-    result.residual = std::numeric_limits<double>::infinity();
-    result.message = "outside the model's domain";
-    return result;
-  }
-  double r = norm(F);
-  for (int it = 0; it < maxIterations && !(r <= tolerance); ++it) {
-    if (!problem.jacobian(u, lambda, Fu, Fl)) break;
-    for (int i = 0; i < n; ++i)
-      if (sides[size_t(i)] != 0) {
-        Fu.row(i).setZero();
-        Fu(i, i) = 1.0;
-      }
-    step = Fu.partialPivLu().solve(F);
-    if (!step.allFinite()) break;
-    // backtracking on the scaled max-norm: full Newton steps near the solution
-    double t = 1.0;
-    Vector trial(N), Ft(N);
-    bool accepted = false;
-    for (int k = 0; k < 30 && !accepted; ++k, t *= 0.5) {
-      trial = u - t * step;
-      accepted = rows(trial, Ft) && norm(Ft) < r * (1.0 - 1e-4 * t) + 1e-300;
-    }
-    if (!accepted) {
-      // no decrease: take the full step once more if it stays finite (round-off level)
-      trial = u - step;
-      if (!rows(trial, Ft) || !(norm(Ft) <= r)) break;
-    }
-    u = trial;
-    F = Ft;
-    r = norm(F);
-    result.iterations = it + 1;
-  }
-  result.u = u;
-  result.converged = r <= tolerance;
-  result.message = result.converged ? "converged" : "did not converge (scaled residual " + std::to_string(r) + ")";
-  Vector Fp(N);
-  // the problem's own residual, the locked rows excluded (their contact torques close them)
-  result.residual = 0.0;
-  if (problem.residual(u, lambda, Fp))
-    for (int i = 0; i < N; ++i)
-      if (i >= n || sides[size_t(i)] == 0) result.residual = std::max(result.residual, std::abs(Fp[i]));
-  return result;
-}
-
-Vector contactTorques(EquilibriumProblem& problem, ConstVectorRef u, double lambda, const std::vector<int>& sides) {
-  const int n = problem.segments();
-  const Vector uFull = fullUnknowns(problem, u, lambda);
-  Vector F(problem.dimension()), tau = Vector::Zero(n);
-  if (!problem.residual(uFull, lambda, F)) return Vector::Constant(n, kNaN);
-  // the joint rows of the residual are ∂E/∂q − JᵀF(u, λ) (equilibrium_problem.h): at a locked
-  // joint exactly the contact torque that closes its equilibrium
-  for (int i = 0; i < n; ++i)
-    if (sides[size_t(i)] != 0) tau[i] = F[i];
-  return tau;
-}
-
-continuation::StabilityInfo constrainedStability(EquilibriumProblem& problem, ConstVectorRef u, double lambda,
-                                                 const std::vector<int>& sides) {
-  continuation::StabilityInfo info;
-  const Vector uFull = fullUnknowns(problem, u, lambda);
-  Matrix H, C;
-  if (!problem.stabilityOperator(uFull, lambda, H, C)) return info;
-  const Eigen::Index n = H.rows();
-  int locked = 0;
-  for (int s : sides) locked += s != 0;
-  Matrix rowsC = Matrix::Zero(C.rows() + locked, n);
-  rowsC.topRows(C.rows()) = C;
-  for (Eigen::Index i = 0, k = C.rows(); i < n; ++i)
-    if (sides[size_t(i)] != 0) rowsC(k++, i) = 1.0;
-  Matrix Z = Matrix::Identity(n, n);
-  if (rowsC.rows() > 0) {
-    Eigen::ColPivHouseholderQR<Matrix> qr(rowsC.transpose());
-    const Matrix Q = qr.householderQ() * Matrix::Identity(n, n);
-    Z = Q.rightCols(n - qr.rank());
-  }
-  info.negative = 0;
-  if (Z.cols() == 0) return info;  // every direction blocked: rigid, stable
-  const Matrix reduced = Z.transpose() * H * Z;
-  Eigen::SelfAdjointEigenSolver<Matrix> es(0.5 * (reduced + reduced.transpose()), Eigen::EigenvaluesOnly);
-  if (es.info() != Eigen::Success) {
-    info.negative = -1;
-    return info;
-  }
-  // zero: relative to the operator's own size (the chain's stiffness scale)
-  const double zero = 1e-10 * std::max(problem.scales().stability, H.cwiseAbs().maxCoeff());
-  for (Eigen::Index k = 0; k < es.eigenvalues().size(); ++k) {
-    const double mu = es.eigenvalues()[k];
-    if (std::abs(mu) <= zero) ++info.zero;
-    else if (mu < 0.0) ++info.negative;
-  }
-  info.smallest = es.eigenvalues()[0];
-  info.lowest = es.eigenvalues().head(std::min<Eigen::Index>(3, es.eigenvalues().size()));
-  return info;
 }
 
 UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef u, double lambda) {
@@ -336,6 +223,19 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
     }
     v = ud.direction;
     result.directionEigenvalue = ud.eigenvalue;
+  }
+  // A start on a joint limit (a fold of a branch traced in contact, contact.h) starts in
+  // contact: the joint stays locked until its contact torque would pull (dynamics.h).
+  std::vector<int> startSides(size_t(n), 0);
+  for (int i = 0; i < n; ++i) {
+    const double hi = problem.chain().upperLimits()[i], lo = problem.chain().lowerLimits()[i];
+    if (std::abs(qFrom[i] - hi) <= 1e-12 * std::max(1.0, std::abs(hi))) startSides[size_t(i)] = 1;
+    else if (std::abs(qFrom[i] - lo) <= 1e-12 * std::max(1.0, std::abs(lo))) startSides[size_t(i)] = -1;
+    if (startSides[size_t(i)] != 0) v[i] = 0.0;
+  }
+  if (anyContact(startSides)) {
+    model->setContacts(startSides);
+    if (v.norm() > 0.0) v.normalize();
   }
   // Sign: the one that lowers Π. At an unstable equilibrium both do to second order; at a fold
   // the quadratic term vanishes and the cubic term (the fold's normal form) picks the side.

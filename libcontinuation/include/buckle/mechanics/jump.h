@@ -14,10 +14,10 @@
 //      continuation core's KINSOL corrector in its fixed-parameter mode — and its stability is
 //      checked with Problem::stability() (K_q − K_g positive definite on ker J_h).
 //      A chain that came to rest with joints in contact (dynamics.h: joint limits are one-sided
-//      constraints) is polished with those joints fixed at their limits (polishConstrained), and
-//      its stability is that of the constrained system: the reduced Hessian K_q − K_g on
-//      ker [J_h; e_iᵀ of the locked joints] positive definite and every contact compressive
-//      (−side·τ_c,i > 0).
+//      constraints) is polished with those joints fixed at their limits (contact.h,
+//      solveConstrainedEquilibrium), and its stability is that of the constrained system
+//      (constrainedStability: the reduced Hessian K_q − K_g on the free joints and ker J_h
+//      positive definite) with every contact compressive (−side·τ_c,i > 0).
 //
 // simulateSuddenLoad: the "sporadic" case — the full end condition is applied at once to the
 // chain at rest in its unloaded shape. The chain's dynamic answer can differ from the
@@ -50,22 +50,6 @@ struct PolishResult {
 /// Newton on F(u, λ) = 0 at fixed λ from the joint angles q (reactions: least-squares guess).
 PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, double lambda,
                                const continuation::CorrectorOptions& options = defaultPolishOptions());
-
-/// Newton at fixed λ on the EquilibriumProblem's rows with the joints of `sides` (per joint: 0
-/// free, +1 / −1 locked at the upper / lower limit) fixed: their rows become q_i − q̄_i = 0. Dense
-/// (a landing is polished once). Converged when every row is below `tolerance` relative to its
-/// scale (EquilibriumProblem::scales(); the locked rows in radians).
-PolishResult polishConstrained(EquilibriumProblem& problem, ConstVectorRef q, double lambda, const std::vector<int>& sides,
-                               double tolerance = 1e-12, int maxIterations = 50);
-
-/// Contact torques τ_c,i = ∂E/∂q_i − (JᵀF)_i at (u, λ) of the joints in contact (sides ≠ 0; 0 at
-/// the free ones): the torque the contact applies to the joint, positive towards increasing q_i.
-Vector contactTorques(EquilibriumProblem& problem, ConstVectorRef u, double lambda, const std::vector<int>& sides);
-
-/// Stability of the equilibrium with the joints of `sides` locked: inertia of K_q − K_g on
-/// ker [J_h; e_iᵀ (i locked)], its lowest eigenvalue in `smallest` (dense).
-continuation::StabilityInfo constrainedStability(EquilibriumProblem& problem, ConstVectorRef u, double lambda,
-                                                 const std::vector<int>& sides);
 
 struct UnstableDirection {
   Vector direction;          ///< unit vector in joint space, in ker J_h (empty if none)
@@ -127,7 +111,7 @@ struct JumpResult {
   continuation::StabilityInfo stabilityFrom, stabilityTo;
   bool stable = false;               ///< stabilityTo.stable() (and, in contact, every contact compressive)
   /// Joints in contact at the landing (per joint 0, +1 upper, −1 lower; all 0 without contact)
-  /// and their contact torques τ_c,i (contactTorques()).
+  /// and their contact torques τ_c,i (contact.h: ∂E/∂q_i − (JᵀF)_i, 0 at free joints).
   std::vector<int> contactSides;
   Vector contactTorques;
   DynamicsResult dynamics;           ///< the trajectory and its energies
