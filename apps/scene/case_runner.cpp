@@ -29,6 +29,7 @@ void copyLanding(const mech::Landing& l, SpecialRecord& s) {
   s.jumpShape = l.shape;
   s.energyReleased = l.energyReleased;
   s.jumpDistance = l.distance;
+  s.jumpContacts = l.contacts;
 }
 
 SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
@@ -51,6 +52,7 @@ SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
   s.joint = sp.joint;
   s.contactTorque = sp.contactTorque;
   s.lockedAfter = sp.lockedAfter.label();
+  s.contactPoint = sp.contactPoint;
   copyLanding(sp.landing, s);
   return s;
 }
@@ -206,6 +208,8 @@ void CaseRunner::suddenLoad() {
     rec.message = r.message;
     rec.inertial = r.inertial;
     rec.rest = r.rest;
+    for (size_t i = 0; i < r.contactSides.size(); ++i)
+      if (r.contactSides[i] != 0) rec.contacts.push_back({int(i), r.contactSides[i], r.contactTorques[Eigen::Index(i)]});
     if (r.rest.size() == n) rec.restPose = mech::endPose(out_.chain, r.rest);
     rec.stable = r.stable;
     rec.haveStatic = r.compared;

@@ -144,6 +144,13 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
 
 json wrenchJson(const mechanics::Wrench& F) { return json{{"Fx", number(F[0])}, {"Fy", number(F[1])}, {"Me", number(F[2])}}; }
 json poseJson(const mechanics::Pose& p) { return json{{"x", number(p[0])}, {"y", number(p[1])}, {"phi", number(p[2])}}; }
+/// Joints resting against their limits: 1-based joint, side, contact torque τ_c (k b²).
+json contactsJson(const std::vector<mechanics::JointContact>& contacts) {
+  json a = json::array();
+  for (const mechanics::JointContact& c : contacts)
+    a.push_back({{"joint", c.joint + 1}, {"side", c.side > 0 ? "upper" : "lower"}, {"contact_torque", number(c.torque)}});
+  return a;
+}
 
 }  // namespace
 
@@ -171,6 +178,7 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       // K_F where the report computed it (a located KMIN: the stiffness at the minimum itself)
       if (s.K.allFinite()) p["stiffness"] = {{"Kxx", number(s.K(0, 0))}, {"Kyy", number(s.K(1, 1))}, {"Kxy", number(s.K(0, 1))}};
       if (!s.note.empty()) p["note"] = s.note;
+      if (s.contactPoint.allFinite()) p["contact_point"] = json::array({number(s.contactPoint.x()), number(s.contactPoint.y())});
       if (s.joint >= 0)  // CT / RL
         p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", number(s.contactTorque)}, {"locked_after", s.lockedAfter}};
       if (s.jumpTried) {
@@ -186,6 +194,7 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
         }
         j["energy_released"] = number(s.energyReleased);
         j["distance"] = number(s.jumpDistance);
+        j["contacts"] = contactsJson(s.jumpContacts);
         p["jump_to"] = j;
       }
       points.push_back(p);
@@ -234,7 +243,8 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
              {"duration", number(r.duration)},
              {"residual", number(r.residual)},
              {"energy_balance_error", number(r.energyBalanceError)}};
-      if (r.rest.size() > 0) e["rest"] = json{{"q", vectorJson(r.rest)}, {"position", poseJson(r.restPose)}};
+      if (r.rest.size() > 0)
+        e["rest"] = json{{"q", vectorJson(r.rest)}, {"position", poseJson(r.restPose)}, {"contacts", contactsJson(r.contacts)}};
       if (r.haveStatic)
         e["quasi_static"] = json{{"q", vectorJson(r.staticShape)},
                                  {"position", poseJson(r.staticPose)},

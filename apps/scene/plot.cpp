@@ -16,6 +16,8 @@
 #include <unistd.h>
 #include <vector>
 
+#include "buckle/mechanics/contact_geometry.h"
+
 #include "scene/output.h"
 
 namespace buckle::scene {
@@ -289,7 +291,8 @@ struct SpecialStyle {
 const SpecialStyle kSpecialStyles[] = {{"BP", 7, "BP branch point"},   {"LP", 9, "LP fold"},
                                        {"LPF", 9, "LPF reaction fold"},  {"BD", 5, "BD joint limit"},
                                        {"KMIN", 13, "KMIN Kxx minimum"}, {"JUMP", 11, "JUMP release"},
-                                       {"CT", 15, "CT contact (joint locks)"}, {"RL", 3, "RL contact released"}};
+                                       {"CT", 15, "CT contact (joint locks)"}, {"RL", 3, "RL contact released"},
+                                       {"BC", 5, "BC base contact (detected)"}, {"SC", 5, "SC self contact (detected)"}};
 
 const SpecialStyle& specialStyle(const std::string& type) {
   for (const SpecialStyle& s : kSpecialStyles)
@@ -696,9 +699,16 @@ void energyPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
 // ---- chain shapes ------------------------------------------------------------------------------
 
 // Outline of one chain at joint angles q: triangles (closed polygons), springs (zigzags),
-// joint-limit arcs; appended to the given block files.
+// joint-limit arcs; appended to the given block files. `touch`: where the chain has gone through
+// the clamp's wall or through itself (contact_geometry.h: the deepest vertex / the crossing).
 void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFile& triangles, BlockFile& springs,
-               BlockFile& limits, BlockFile& joints, BlockFile& nearLimit) {
+               BlockFile& limits, BlockFile& joints, BlockFile& nearLimit, BlockFile* touch = nullptr) {
+  if (touch) {
+    const mechanics::BaseClearance base = mechanics::baseClearance(chain, q);
+    if (base.distance <= 0.0) touch->point({base.point.x(), base.point.y()});
+    const mechanics::SelfClearance self = mechanics::selfClearance(chain, q);
+    if (self.distance <= 0.0) touch->point({self.point.x(), self.point.y()});
+  }
   const int n = chain.size();
   const Eigen::Matrix2Xd P = mechanics::jointPositions(chain, q);
   double theta = 0.0;
@@ -757,7 +767,8 @@ void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFil
 
 /// The plot command of one chain drawn by drawChain (files BASE_{lim,tri,spr,jnt,near}.dat),
 /// the clamped base a hatched wall; `under`: a plot clause drawn first, beneath the chain.
-void chainPanel(std::ostream& os, const std::string& base, double L, const std::string& under = std::string()) {
+void chainPanel(std::ostream& os, const std::string& base, double L, const std::string& under = std::string(),
+                bool touch = false) {
   os << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
      << " fc rgb '#bbbbbb' fs pattern 4 border lc rgb '#555555'\n";
   os << "plot " << (under.empty() ? std::string() : under + ", \\\n  ") << quote(base + "_lim.dat")
@@ -767,7 +778,9 @@ void chainPanel(std::ostream& os, const std::string& base, double L, const std::
      << "  " << quote(base + "_tri.dat") << " using 1:2 with lines lc rgb '#08306b' lw 1.5, \\\n"
      << "  " << quote(base + "_spr.dat") << " using 1:2 with lines lc rgb '#e6550d' lw 1.5, \\\n"
      << "  " << quote(base + "_jnt.dat") << " using 1:2 with points pt 7 ps 0.9 lc rgb 'black', \\\n"
-     << "  " << quote(base + "_near.dat") << " using 1:2 with points pt 6 ps 2.5 lw 2 lc rgb 'red'\n";
+     << "  " << quote(base + "_near.dat") << " using 1:2 with points pt 6 ps 2.5 lw 2 lc rgb 'red'"
+     << (touch ? ", \\\n  " + quote(base + "_touch.dat") + " using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'magenta'" : std::string())
+     << "\n";
   os << "unset object 1\n";
 }
 
@@ -780,7 +793,7 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   s.body << "set encoding utf8\nset size ratio -1\nunset key\nset grid lc rgb '#eeeeee'\n";
   s.body << "set multiplot layout " << nc << "," << na << " title "
          << quote(spec.title.empty() ? std::string("Chain shapes to scale (units of b); grey arcs: joint limits, "
-                                                   "red: joint within 5% of a limit")
+                                                   "red: joint within 5% of a limit, magenta star: through the clamp or itself")
                                      : spec.title)
          << " font ',11'\n";
 
@@ -847,15 +860,15 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     }
     for (size_t k = 0; k < na; ++k) {
       const PointRecord* p = chosen[k];
-      BlockFile tri, spr, lim, jnt, near;
-      for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near}) {
+      BlockFile tri, spr, lim, jnt, near, touch;
+      for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near, &touch}) {
         f->begin();
         f->point({std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()});
         f->breakLine();
       }
       std::ostringstream title;
       if (p) {
-        drawChain(cr.chain, p->q, tri, spr, lim, jnt, near);
+        drawChain(cr.chain, p->q, tri, spr, lim, jnt, near, &touch);
         title << (nc > 1 ? cr.label + ": " : std::string()) << scene.cases[c].path.parameter << " = "
               << num(std::round(p->parameter * 1e4) / 1e4);
         // the nearest traced point is drawn; the title says when it differs from the request
@@ -876,11 +889,12 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       lim.write(dir / (base + "_lim.dat"));
       jnt.write(dir / (base + "_jnt.dat"));
       near.write(dir / (base + "_near.dat"));
+      touch.write(dir / (base + "_touch.dat"));
       const double L = cr.chain.length();
       s.body << "set title " << quote(title.str()) << " font ',10'\n";
       s.body << "set xrange [" << num(std::min(x0, -0.1 * L)) << ":" << num(x1) << "]\nset yrange [" << num(y0) << ":"
              << num(y1) << "]\n";
-      chainPanel(s.body, base, L);
+      chainPanel(s.body, base, L, std::string(), true);
       s.body << "unset label 1\n";
     }
   }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "buckle/mechanics/critical_curves.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/energy_landscape.h"
+#include "buckle/mechanics/landing.h"
 #include "buckle/mechanics/linear_buckling.h"
 #include "buckle/mechanics/unloaded_shape.h"
 #include "scene/progress.h"
@@ -67,6 +69,9 @@ struct SpecialRecord {
   std::string jumpShape;
   double energyReleased = 0.0;
   double jumpDistance = 0.0;
+  std::vector<mechanics::JointContact> jumpContacts;  ///< joints in contact at the landing
+  /// BC / SC: where the chain touches the wall or itself (NaN otherwise)
+  Eigen::Vector2d contactPoint = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 struct BranchRecord {
@@ -97,6 +102,7 @@ struct SuddenLoadRecord {
   std::string lower;                 ///< which answer is lower in Π
   double peakKinetic = 0.0, maxExcursion = 0.0, duration = 0.0, residual = 0.0;
   double energyBalanceError = 0.0;
+  std::vector<mechanics::JointContact> contacts;  ///< joints resting against their limits
   std::vector<mechanics::TrajectorySample> trajectory;
 };
 

@@ -197,6 +197,14 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
           CHECK(!p.contains("jump_to"));
           REQUIRE(p.contains("contact"));
           CHECK(std::abs(p["contact"]["contact_torque"].get<double>()) <= 1e-9);
+        } else if (type == "BC" || type == "SC") {
+          // base / self contact (mechanics/contact_geometry.h): detected, no phenomenon, the
+          // touching point on the wall x = 0 for BC
+          CHECK(field == "none");
+          CHECK(!p.contains("jump_to"));
+          REQUIRE(p.contains("contact_point"));
+          if (type == "BC" && p["accuracy"]["refined"].get<bool>())
+            CHECK(std::abs(p["contact_point"][0].get<double>()) <= 1e-9 * std::max(1.0, std::abs(p["position"]["x"].get<double>())));
         } else {
           FAIL("unknown special point type " << type);
         }

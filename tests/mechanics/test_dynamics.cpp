@@ -306,12 +306,15 @@ TEST_CASE("held end coordinates stay held along the trajectory", "[dynamics]") {
 }
 
 TEST_CASE("guards stop the integration with a reason", "[dynamics]") {
-  // L0 = 0.5: the segment energy falls all the way to the geometric limit — a joint limit stop.
+  // L0 = 0.5: the segment energy falls all the way to the geometric limit — without contact, a
+  // joint limit stop.
   const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 0.5));
   auto model = makeDynamicsModel(chain, EndCondition::freeEnd(), DynamicsScene(), Vector::Zero(3));
   Vector q0(3);
   q0 << 0.1, 0.05, -0.02;
-  const DynamicsResult a = simulate(*model, q0, Vector(), IntegrationOptions());
+  IntegrationOptions noContact;
+  noContact.contact = false;
+  const DynamicsResult a = simulate(*model, q0, Vector(), noContact);
   CHECK(a.reason == IntegrationStop::JointLimit);
   CHECK(std::string(toString(a.reason)) == "joint limit");
   CHECK(a.message.find("limit") != std::string::npos);
@@ -464,6 +467,121 @@ TEST_CASE("structured linearized solve equals the dense (I - a J)^-1 b; J is the
         const Vector column = (fp - fm) / (2.0 * h);
         CHECK((column - Jfull.col(j)).norm() <= 1e-7 * std::max(1.0, Jfull.norm()));
       }
+    }
+  }
+}
+
+namespace {
+
+// One segment with identical triangles (a, b), springs k, free lengths L0: c = √(a² + b²),
+// β = 2 atan(a/b), L1 = 2c cos((β + q)/2), L2 = 2c cos((β − q)/2) (eq 1 with Δ = 0), so
+// E′(q) = k c [(L1 − L0) (−sin((β + q)/2)) + (L2 − L0) sin((β − q)/2)], closed form.
+struct ClosedFormSegment {
+  double a = 0.5, b = 1.0, k = 1.0, L0 = 2.25;
+  double c() const { return std::hypot(a, b); }
+  double beta() const { return 2.0 * std::atan(a / b); }
+  double upperLimit() const { return M_PI - beta(); }
+  double dE(double q) const {
+    const double L1 = 2.0 * c() * std::cos(0.5 * (beta() + q)), L2 = 2.0 * c() * std::cos(0.5 * (beta() - q));
+    return k * c() * (-(L1 - L0) * std::sin(0.5 * (beta() + q)) + (L2 - L0) * std::sin(0.5 * (beta() - q)));
+  }
+  /// At the limit L1 = 0: E′(q̄) = k c [L0 (1 + cos β) − c sin 2β].
+  double dEAtLimit() const { return k * c() * (L0 * (1.0 + std::cos(beta())) - c() * std::sin(2.0 * beta())); }
+};
+
+}  // namespace
+
+TEST_CASE("one-sided joint limit: a segment driven past its limit locks there at the located contact instant",
+          "[dynamics][contact]") {
+  const ClosedFormSegment seg;
+  const Chain chain = Chain::uniform(1, SegmentParameters::symmetric(seg.a, seg.b, seg.k, seg.L0));
+  const double qbar = seg.upperLimit();
+  REQUIRE(chain.upperLimits()[0] == Approx(qbar).epsilon(1e-15));
+  CHECK(seg.dE(qbar) == Approx(seg.dEAtLimit()).epsilon(1e-12));
+  // an end torque above the largest spring torque on [0, q̄]: no equilibrium before the limit
+  double most = 0.0;
+  for (int k = 0; k <= 1000; ++k) most = std::max(most, seg.dE(qbar * k / 1000.0));
+  const double Me = 1.5 * most + 0.1;
+  auto model = makeDynamicsModel(chain, EndCondition::freeEnd(Wrench(0, 0, Me)), DynamicsScene(), Vector::Zero(1));
+  const DynamicsResult r = simulate(*model, Vector::Zero(1), Vector(), IntegrationOptions());
+  INFO(r.message);
+  REQUIRE(r.reason == IntegrationStop::Rest);
+  REQUIRE(r.contactEvents.size() == 1);
+  const ContactEvent& e = r.contactEvents[0];
+  CHECK(e.contact);
+  CHECK(e.joint == 0);
+  CHECK(e.side == 1);
+  CHECK(r.q[0] == qbar);  // exactly on the limit
+  REQUIRE(r.contactSides == std::vector<int>{1});
+  // contact torque: it balances the applied torque against the spring's, τ_c = E′(q̄) − Me < 0
+  CHECK(r.contactTorques[0] == Approx(seg.dEAtLimit() - Me).epsilon(1e-12));
+  CHECK(e.torque == Approx(seg.dEAtLimit() - Me).epsilon(1e-12));
+  // the contact instant against quadrature of the 1-D flow c dq/dt = Me − E′(q) (c = 1):
+  // t* = ∫₀^q̄ dq / (Me − E′(q)), composite Simpson with 4000 intervals
+  const int m = 4000;
+  double t = 0.0;
+  for (int k = 0; k <= m; ++k) {
+    const double q = qbar * k / m, w = (k == 0 || k == m) ? 1.0 : (k % 2 ? 4.0 : 2.0);
+    t += w / (Me - seg.dE(q));
+  }
+  t *= qbar / m / 3.0;
+  CHECK(e.t == Approx(t).epsilon(1e-8));
+  // Π + W_d conserved across the event (the lock moves q by the located instant's error only)
+  CHECK(r.maxEnergyBalanceError < 1e-8);
+  // the model's own contact set is left as it was: a second run is identical
+  CHECK(model->lockedCount() == 0);
+  const DynamicsResult again = simulate(*model, Vector::Zero(1), Vector(), IntegrationOptions());
+  CHECK(again.contactEvents.size() == 1);
+  CHECK(again.contactEvents[0].t == e.t);
+
+  // Without contact the integration stops at the limit instead.
+  IntegrationOptions noContact;
+  noContact.contact = false;
+  CHECK(simulate(*model, Vector::Zero(1), Vector(), noContact).reason == IntegrationStop::JointLimit);
+
+  // A start locked on the limit under a torque that pulls it back is released at once.
+  std::vector<int> locked{1};
+  auto back = makeDynamicsModel(chain, EndCondition::freeEnd(Wrench(0, 0, -0.5)), DynamicsScene(), Vector::Zero(1));
+  back->setContacts(locked);
+  Vector q0(1);
+  q0 << 2.0;  // moved onto the limit by the lock
+  const DynamicsResult rel = simulate(*back, q0, Vector(), IntegrationOptions());
+  REQUIRE(rel.contactEvents.size() >= 1);
+  CHECK_FALSE(rel.contactEvents[0].contact);
+  CHECK(rel.contactEvents[0].t == 0.0);
+  CHECK(rel.contactEvents[0].torque > 0.0);  // the contact would have to pull: released
+  CHECK(rel.q[0] < qbar);
+}
+
+TEST_CASE("one-sided joint limit, inertial: the inelastic impact's energy is counted, the chain rests locked",
+          "[dynamics][contact]") {
+  const ClosedFormSegment seg;
+  const Chain chain = Chain::uniform(2, SegmentParameters::symmetric(seg.a, seg.b, seg.k, seg.L0));
+  DynamicsScene scene;
+  scene.inertia = InertiaData::uniformRods(chain, 1.0);
+  scene.jointDamping = {0.3, 0.3};
+  const double Me = 3.0;
+  auto model = makeDynamicsModel(chain, EndCondition::freeEnd(Wrench(0, 0, Me)), scene, Vector::Zero(2));
+  const DynamicsResult r = simulate(*model, Vector::Zero(2), Vector(), IntegrationOptions());
+  INFO(r.message);
+  REQUIRE(r.reason == IntegrationStop::Rest);
+  REQUIRE_FALSE(r.contactEvents.empty());
+  double lost = 0.0;
+  for (const ContactEvent& e : r.contactEvents) lost += e.kineticLost;
+  CHECK(lost > 0.0);  // the joints hit their limits with speed
+  // K + Π + W_d (W_d including the impacts' losses) stays at the initial energy
+  CHECK(r.maxEnergyBalanceError < 1e-7 * std::abs(r.initialEnergy - r.potential));
+  // at rest, the joints in contact carry compressive torques that close the static balance:
+  // τ_c = ∂Π/∂q at the locked joints, and the free joints are in equilibrium
+  Vector g(2);
+  totalPotentialGradient(chain, r.q, Wrench(0, 0, Me), g);
+  for (int i = 0; i < 2; ++i) {
+    if (r.contactSides[size_t(i)] != 0) {
+      CHECK(r.q[i] == (r.contactSides[size_t(i)] > 0 ? chain.upperLimits()[i] : chain.lowerLimits()[i]));
+      CHECK(r.contactTorques[i] == Approx(g[i]).epsilon(1e-6));
+      CHECK(-r.contactSides[size_t(i)] * r.contactTorques[i] > 0.0);
+    } else {
+      CHECK(std::abs(g[i]) < 1e-8);
     }
   }
 }

@@ -197,7 +197,7 @@ TEST_CASE("jump from the fold itself: the cubic term picks the side", "[jump]") 
   CHECK(ri.dynamics.maxEnergyBalanceError < 1e-8);
 }
 
-TEST_CASE("AUTO's I_up fold is reproduced; the smooth model has no landing inside the joint limits", "[jump]") {
+TEST_CASE("AUTO's I_up fold is reproduced; the chain lands against its joint limits, confirmed independently", "[jump]") {
   const Chain chain = autoIupChain();
   Vector q(3);
   q << -1.40916, -0.508436, -0.152072;
@@ -210,20 +210,76 @@ TEST_CASE("AUTO's I_up fold is reproduced; the smooth model has no landing insid
   CHECK(mu[1] < 0.0);
   CHECK(std::abs(mu[2]) < 1e-9);
 
+  const double lambda = Fx + 1e-3;
+  const Wrench W(lambda, 0.01, 0);
   EquilibriumProblem problem(chain, EndCondition::freeEnd(Wrench(0, 0.01, 0)), Eigen::Vector3d(1, 0, 0));
-  const JumpResult r = simulateJump(problem, q, Fx + 1e-3, JumpOptions());
+  const JumpResult r = simulateJump(problem, q, lambda, JumpOptions());
   INFO(r.message);
   // With L0 = 0.5 each segment's energy decreases all the way to the geometric limit (its wells
-  // lie beyond it), so the chain runs into a joint limit: reported, not polished, not a success.
-  CHECK_FALSE(r.success);
-  CHECK(r.stopReason == IntegrationStop::JointLimit);
-  CHECK(r.message.find("limit") != std::string::npos);
-  CHECK_FALSE(r.polishConverged);
-  const double qmax = r.restPoint.cwiseAbs().maxCoeff();
-  CHECK(qmax == Approx(chain.upperLimits()[0]).epsilon(1e-6));
-  CHECK(qmax < chain.upperLimits()[0]);
+  // lie beyond it): the chain runs into its limits, which hold it (one-sided contact), and comes
+  // to rest on a stable constrained equilibrium.
+  REQUIRE(r.success);
+  CHECK(r.stopReason == IntegrationStop::Rest);
+  REQUIRE(r.contactSides.size() == 3);
+  int locked = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (r.contactSides[size_t(i)] == 0) continue;
+    ++locked;
+    const double limit = r.contactSides[size_t(i)] > 0 ? chain.upperLimits()[i] : chain.lowerLimits()[i];
+    CHECK(r.to[i] == limit);                               // exactly on the limit
+    CHECK(-r.contactSides[size_t(i)] * r.contactTorques[i] > 0.0);  // compressive
+  }
+  REQUIRE(locked >= 1);
+  CHECK_FALSE(r.dynamics.contactEvents.empty());
+  // Independent check: Newton on the free joints' rows of ∇Π = 0 (chain.h only), the locked
+  // joints fixed, from a perturbed landing; the contact torques are ∇Π at the locked joints.
+  Vector qi = r.to.head(3);
+  std::vector<int> freeJoints;
+  for (int i = 0; i < 3; ++i)
+    if (r.contactSides[size_t(i)] == 0) freeJoints.push_back(i);
+    else qi[i] = r.contactSides[size_t(i)] > 0 ? chain.upperLimits()[i] : chain.lowerLimits()[i];
+  const int nf = int(freeJoints.size());
+  for (int a = 0; a < nf; ++a) qi[freeJoints[size_t(a)]] += 1e-3;
+  Vector g(3);
+  Matrix H(3, 3);
+  for (int it = 0; it < 50; ++it) {
+    totalPotentialGradient(chain, qi, W, g);
+    totalPotentialHessian(chain, qi, W, H);
+    Vector gf(nf);
+    Matrix Hf(nf, nf);
+    for (int a = 0; a < nf; ++a) {
+      gf[a] = g[freeJoints[size_t(a)]];
+      for (int b = 0; b < nf; ++b) Hf(a, b) = H(freeJoints[size_t(a)], freeJoints[size_t(b)]);
+    }
+    if (nf == 0 || gf.cwiseAbs().maxCoeff() < 1e-14) break;
+    const Vector d = Hf.fullPivLu().solve(gf);
+    for (int a = 0; a < nf; ++a) qi[freeJoints[size_t(a)]] -= d[a];
+  }
+  CHECK((qi - r.to.head(3)).cwiseAbs().maxCoeff() <= 1e-10 * qi.cwiseAbs().maxCoeff());
+  totalPotentialGradient(chain, qi, W, g);
+  totalPotentialHessian(chain, qi, W, H);
+  for (int i = 0; i < 3; ++i)
+    if (r.contactSides[size_t(i)] != 0) CHECK(r.contactTorques[i] == Approx(g[i]).epsilon(1e-9));
+  // the reduced Hessian (free joints) positive definite
+  if (nf > 0) {
+    Matrix Hf(nf, nf);
+    for (int a = 0; a < nf; ++a)
+      for (int b = 0; b < nf; ++b) Hf(a, b) = H(freeJoints[size_t(a)], freeJoints[size_t(b)]);
+    CHECK(Eigen::SelfAdjointEigenSolver<Matrix>(Hf).eigenvalues()[0] > 0.0);
+  }
+  CHECK(r.stabilityTo.stable());
   CHECK(r.energyReleased > 0.0);
+  // Π never increases along the projected gradient flow, across the contact events too
   requirePotentialNonIncreasing(r.dynamics);
+  CHECK(r.dynamics.maxEnergyBalanceError < 1e-8);
+
+  // Without contact the integration stops at the first limit reached, as the smooth model did.
+  JumpOptions stop;
+  stop.integration.contact = false;
+  const JumpResult s = simulateJump(problem, q, lambda, stop);
+  CHECK_FALSE(s.success);
+  CHECK(s.stopReason == IntegrationStop::JointLimit);
+  CHECK_FALSE(s.polishConverged);
 }
 
 TEST_CASE("an unstable near-straight start (kappa < 0, Fx = 0, tiny Fy) jumps to a stable bent shape", "[jump]") {

@@ -143,7 +143,23 @@ TEST_CASE("compressed to -2.5, the default chain leaves the U branch by a jump a
   CHECK(h.jumps[0].trigger == JumpTrigger::Fold);
   CHECK(h.jumps[0].fromSegment == 1);
   CHECK(h.jumps[0].criticalLambda == folds[0]->lambda);
-  // The snap runs a joint into its geometric limit, where the smooth model ends (contact is not
-  // modelled yet): the history stops there and says so.
-  if (!h.completed) CHECK(h.message.find("limit") != std::string::npos);
+  // The snap runs joint 2 into its geometric limit, which holds it (one-sided contact): the
+  // chain lands on a stable constrained equilibrium and the history goes on, locked, to -2.5.
+  REQUIRE(h.jumps[0].success);
+  REQUIRE(h.jumps[0].contactSides.size() == 3);
+  CHECK(h.jumps[0].contactSides[1] == 1);
+  CHECK(h.jumps[0].to[1] == chain.upperLimits()[1]);
+  CHECK(h.jumps[0].contactTorques[1] < 0.0);  // compressive at an upper limit
+  // the contact torque closes joint 2's balance: τ_c = ∂E/∂q_2 − (JᵀF)_2 with the landing's wrench
+  Eigen::VectorXd g(3);
+  totalPotentialGradient(chain, h.jumps[0].to.head(3), h.jumps[0].load, g);
+  CHECK(h.jumps[0].contactTorques[1] == Approx(g[1]).epsilon(1e-9));
+  CHECK(std::abs(g[0]) < 1e-10);
+  CHECK(std::abs(g[2]) < 1e-10);
+  CHECK(h.completed);
+  INFO(h.message);
+  REQUIRE(h.jumps[0].toSegment >= 0);
+  const cont::Branch& after = h.segments[size_t(h.jumps[0].toSegment)];
+  CHECK(after.points.back().lambda == Approx(-2.5));
+  for (const cont::ContinuationPoint& p : after.points) CHECK(p.u[1] == chain.upperLimits()[1]);  // still locked
 }

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "buckle/mechanics/contact_geometry.h"
 #include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/stiffness_extremum.h"
@@ -25,6 +26,8 @@ const char* label(EventType type) {
     case EventType::Jump: return "JUMP";
     case EventType::Contact: return "CT";
     case EventType::Release: return "RL";
+    case EventType::BaseContact: return "BC";
+    case EventType::SelfContact: return "SC";
   }
   return "?";
 }
@@ -373,6 +376,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
       r.specialPoints.push_back(std::move(s));
     }
   }
+  reportGeometricContacts(problem, b, all, options, r);  // base / self contact (contact_geometry.h)
   for (SpecialPointReport& s : r.specialPoints) {
     s.stabilityBefore = stabilityLabel(s.negativeBefore);
     s.stabilityAfter = stabilityLabel(s.negativeAfter);

@@ -112,6 +112,7 @@ DynamicsModel::DynamicsModel(const Chain& chain, const EndCondition& end)
       torqueUnit_(0.0),
       held_(end.heldIndices()),
       loaded_(end.loadedIndices()),
+      sides_(size_t(chain.size()), 0),
       loads_(Wrench::Zero()),
       data_(chain),
       J_(3, chain.size()),
@@ -142,17 +143,24 @@ void DynamicsModel::evaluateStatics(ConstVectorRef q) {
   // ∇Π = ∂E/∂q − J_lᵀ F_l (eq 9); loads_ is zero on held coordinates.
   energyGradient(chain_, q, grad_);
   grad_.noalias() -= J_.transpose() * loads_;
-  const int m = heldCount();
+  const int mh = heldCount(), m = constraintCount();
   if (m == 0) return;
-  for (int k = 0; k < m; ++k) {
+  for (int k = 0; k < mh; ++k) {
     const int c = held_[size_t(k)];
     Jh_.row(k) = J_.row(c);
     h_[k] = data_.pose[c] - end_.value[c];
   }
+  // locked joints: rows e_iᵀ, h = q_i − q̄_i (Jh_ holds their zeros since setContacts)
+  for (int k = mh; k < m; ++k) {
+    const int i = locked_[size_t(k - mh)];
+    h_[k] = q[i] - limitAngle(i, sides_[size_t(i)]);
+  }
   A_.noalias() = Jh_ * Jh_.transpose();
   // J_h loses rank where the held coordinate is stationary (x held on the straight chain): a
   // relative 1e-12 shift keeps the factorization defined and is invisible at regular points.
-  A_.diagonal().array() += 1e-12 * std::max(lengthUnit_ * lengthUnit_, A_.trace());
+  // (Not on the locked rows: unit rows, and the shift would let a locked joint creep.)
+  if (mh > 0)
+    A_.diagonal().head(mh).array() += 1e-12 * std::max(lengthUnit_ * lengthUnit_, A_.topLeftCorner(mh, mh).trace());
   llt_.compute(A_);
 }
 
@@ -168,7 +176,7 @@ void DynamicsModel::potentialGradient(ConstVectorRef q, VectorRef g) {
 
 double DynamicsModel::equilibriumResidual(ConstVectorRef q) {
   evaluateStatics(q);
-  if (heldCount() == 0) return grad_.cwiseAbs().maxCoeff();
+  if (constraintCount() == 0) return grad_.cwiseAbs().maxCoeff();
   // P∇Π = ∇Π − J_hᵀ r with the least-squares reactions r = (J_h J_hᵀ)⁻¹ J_h ∇Π.
   tmpM_.noalias() = Jh_ * grad_;
   llt_.solveInPlace(tmpM_);
@@ -179,8 +187,12 @@ double DynamicsModel::equilibriumResidual(ConstVectorRef q) {
 
 double DynamicsModel::naturalResidual(ConstVectorRef q) {
   const double raw = equilibriumResidual(q);  // fills grad_ / tmpN_ and h_
-  if (heldCount() == 0) return raw / torqueUnit_;
-  return std::max(tmpN_.cwiseAbs().maxCoeff() / torqueUnit_, h_.cwiseAbs().maxCoeff() / lengthUnit_);
+  if (constraintCount() == 0) return raw / torqueUnit_;
+  const int mh = heldCount();
+  // held rows in lengths, locked rows in radians (their own unit)
+  double h = mh > 0 ? h_.head(mh).cwiseAbs().maxCoeff() / lengthUnit_ : 0.0;
+  if (lockedCount() > 0) h = std::max(h, h_.tail(lockedCount()).cwiseAbs().maxCoeff());
+  return std::max(tmpN_.cwiseAbs().maxCoeff() / torqueUnit_, h);
 }
 
 double DynamicsModel::constraintViolation(ConstVectorRef q) {
@@ -192,10 +204,10 @@ double DynamicsModel::constraintViolation(ConstVectorRef q) {
 }
 
 bool DynamicsModel::projectOntoConstraints(VectorRef q, double tolerance, int maxIterations) {
-  if (heldCount() == 0) return true;
+  if (constraintCount() == 0) return true;
   for (int it = 0; it <= maxIterations; ++it) {
     evaluateStatics(q);
-    if (h_.cwiseAbs().maxCoeff() <= tolerance * lengthUnit_) return true;
+    if (h_.cwiseAbs().maxCoeff() <= tolerance * std::max(1.0, lengthUnit_)) return true;
     if (it == maxIterations) break;
     // Minimum-norm Gauss–Newton correction δq = −J_hᵀ (J_h J_hᵀ)⁻¹ h.
     tmpM_ = h_;
@@ -207,8 +219,54 @@ bool DynamicsModel::projectOntoConstraints(VectorRef q, double tolerance, int ma
 
 bool DynamicsModel::withinLimits(ConstVectorRef q) const {
   for (int i = 0; i < segments(); ++i)
-    if (!(q[i] > chain_.lowerLimits()[i] && q[i] < chain_.upperLimits()[i])) return false;
+    if (sides_[size_t(i)] == 0 && !(q[i] > chain_.lowerLimits()[i] && q[i] < chain_.upperLimits()[i])) return false;
   return true;
+}
+
+double DynamicsModel::limitAngle(int joint, int side) const {
+  return side > 0 ? chain_.upperLimits()[joint] : chain_.lowerLimits()[joint];
+}
+
+void DynamicsModel::setContacts(const std::vector<int>& sides) {
+  const int n = segments();
+  if (static_cast<int>(sides.size()) != n)
+    throw std::invalid_argument("contact sides: " + std::to_string(sides.size()) + " entries for " + std::to_string(n) + " joints");
+  for (int s : sides)
+    if (s < -1 || s > 1) throw std::invalid_argument("contact sides must be -1, 0 or +1");
+  sides_ = sides;
+  locked_.clear();
+  for (int i = 0; i < n; ++i)
+    if (sides_[size_t(i)] != 0) locked_.push_back(i);
+  const int mh = heldCount(), m = constraintCount();
+  Matrix held = Jh_.topRows(mh);
+  Jh_ = Matrix::Zero(m, n);
+  Jh_.topRows(mh) = held;
+  for (int k = mh; k < m; ++k) Jh_(k, locked_[size_t(k - mh)]) = 1.0;
+  h_ = Vector::Zero(m);
+  A_ = Matrix::Identity(m, m);
+  llt_.compute(A_);
+  r_ = Vector::Zero(m);
+  tmpM_ = Vector::Zero(m);
+  resizeConstraints();
+}
+
+void DynamicsModel::contactTorques(const double* x, VectorRef torques) {
+  torques.setZero();
+  if (locked_.empty()) return;
+  fdPlus_.resize(size_t(stateSize()));
+  rhs(x, fdPlus_.data());  // the multipliers r_ at x
+  for (int k = 0; k < lockedCount(); ++k) torques[locked_[size_t(k)]] = r_[heldCount() + k];
+}
+
+double DynamicsModel::restSpeed(const double* x) {
+  tmpN_.resize(segments());
+  velocity(x, tmpN_);
+  return tmpN_.cwiseAbs().maxCoeff();
+}
+
+double DynamicsModel::impact(double* x) {
+  for (int i : locked_) x[i] = limitAngle(i, sides_[size_t(i)]);
+  return 0.0;
 }
 
 void DynamicsModel::jacobian(const double* x, double* jacobianRowMajor) {
@@ -240,6 +298,7 @@ GradientFlowModel::GradientFlowModel(const Chain& chain, const EndCondition& end
       H_(chain.size(), chain.size()), qdot_(chain.size()), structure_(chain.size()), shifted_(chain.size()),
       scaledRhs_(chain.size()), y_(end.heldCount()), zeroM_(Vector::Zero(end.heldCount())),
       V_(chain.size(), end.heldCount()), W_(chain.size(), end.heldCount()) {
+  // (held rows only until setContacts() adds locked joints: resizeConstraints())
   if (!finite(c_) || !(c_ > 0.0)) throw std::invalid_argument("flowDamping must be > 0");
   if (q0.size() != chain.size()) throw std::invalid_argument("q0 must have one entry per joint");
   if (!(kappaH_ > 0.0)) {
@@ -247,6 +306,15 @@ GradientFlowModel::GradientFlowModel(const Chain& chain, const EndCondition& end
     jointStiffness(chain_, q0, kq);
     kappaH_ = 10.0 * std::max(torqueUnit_, kq.cwiseAbs().maxCoeff());
   }
+}
+
+void GradientFlowModel::resizeConstraints() {
+  const int m = constraintCount();
+  y_ = Vector::Zero(m);
+  zeroM_ = Vector::Zero(m);
+  V_.resize(segments(), m);
+  W_.resize(segments(), m);
+  factoredFor_ = std::numeric_limits<double>::quiet_NaN();  // the factored system had other rows
 }
 
 void GradientFlowModel::packState(ConstVectorRef q, ConstVectorRef, VectorRef x) const {
@@ -257,7 +325,7 @@ void GradientFlowModel::packState(ConstVectorRef q, ConstVectorRef, VectorRef x)
 void GradientFlowModel::velocity(const double* x, VectorRef qdot) {
   const int n = segments();
   evaluateStatics(Eigen::Map<const Vector>(x, n));
-  if (heldCount() == 0) {
+  if (constraintCount() == 0) {
     qdot = -grad_ / c_;
     return;
   }
@@ -271,6 +339,16 @@ void GradientFlowModel::velocity(const double* x, VectorRef qdot) {
   qdot /= -c_;
 }
 
+double GradientFlowModel::restSpeed(const double* x) {
+  const int n = segments();
+  if (constraintCount() == 0) {
+    velocity(x, qdot_);
+    return qdot_.cwiseAbs().maxCoeff();
+  }
+  equilibriumResidual(Eigen::Map<const Vector>(x, n));  // P∇Π into tmpN_
+  return tmpN_.cwiseAbs().maxCoeff() / c_;
+}
+
 void GradientFlowModel::rhs(const double* x, double* dxdt) {
   const int n = segments();
   velocity(x, qdot_);
@@ -280,7 +358,7 @@ void GradientFlowModel::rhs(const double* x, double* dxdt) {
 }
 
 void GradientFlowModel::jacobian(const double* x, double* jacobianRowMajor) {
-  if (heldCount() > 0) {
+  if (constraintCount() > 0) {
     DynamicsModel::jacobian(x, jacobianRowMajor);
     return;
   }
@@ -302,7 +380,7 @@ void GradientFlowModel::jacobian(const double* x, double* jacobianRowMajor) {
 
 bool GradientFlowModel::solveLinearized(const double* x, double a, const double* b, double* k) {
   const int n = segments();
-  const int m = heldCount();
+  const int mh = heldCount(), m = constraintCount();
   if (!(a > 0.0)) return false;
   Eigen::Map<const Vector> q(x, n), bq(b, n);
   Eigen::Map<Vector> kq(k, n);
@@ -317,7 +395,7 @@ bool GradientFlowModel::solveLinearized(const double* x, double a, const double*
     factoredFor_ = std::numeric_limits<double>::quiet_NaN();
     velocity(x, qdot_);
     Wrench total = loads_;
-    for (int j = 0; j < m; ++j) total[held_[size_t(j)]] += r_[j];
+    for (int j = 0; j < mh; ++j) total[held_[size_t(j)]] += r_[j];
     assemble(chain_, data_, q, total, structure_);  // H_r = U T Uᵀ
     // (I − aJ̃) k = b with s = a/c: (I + s(P H_r + κ_h J_h⁺J_h − J_h⁺E)) k = b. With
     // y = s A⁻¹(J_h(κ_h − H_r) − E) k this is (I + sH_r) k + J_hᵀ y = b, A y + s (J_h(H_r − κ_h I) + E) k
@@ -328,6 +406,7 @@ bool GradientFlowModel::solveLinearized(const double* x, double a, const double*
       for (int j = 0; j < m; ++j) {
         applyHessian(structure_, V_.col(j), W_.col(j));
         W_.col(j) -= kappaH_ * V_.col(j);
+        if (j >= mh) continue;  // a locked joint's row e_iᵀ is constant: no E term
         applyEndHessian(data_, held_[size_t(j)], qdot_, tmpN_);
         W_.col(j) -= c_ * tmpN_;
       }
@@ -488,6 +567,37 @@ void InertialModel::centresOfMass(ConstVectorRef q, Eigen::Ref<Eigen::Matrix2Xd>
   }
 }
 
+void InertialModel::resizeConstraints() {
+  const int m = constraintCount();
+  B_.resize(segments(), m);
+  S_.resize(m, m);
+  sllt_.compute(Matrix::Identity(m, m));
+}
+
+double InertialModel::impact(double* x) {
+  DynamicsModel::impact(x);
+  const int n = segments();
+  const int m = constraintCount();
+  if (m == 0) return 0.0;
+  Eigen::Map<const Vector> q(x, n);
+  Eigen::Map<Vector> v(x + n, n);
+  const double before = kineticEnergy(x);  // also the mass matrix M_ at q
+  evaluateStatics(q);                     // the constraint rows C = Jh_ at q
+  // Inelastic impact: the admissible velocity nearest in the kinetic metric,
+  // q̇⁺ = q̇⁻ − M⁻¹Cᵀ(CM⁻¹Cᵀ)⁻¹C q̇⁻ (C q̇⁺ = 0: locked joints stop, held coordinates stay held).
+  mllt_.compute(M_);
+  B_ = Jh_.transpose();
+  mllt_.solveInPlace(B_);
+  S_.noalias() = Jh_ * B_;
+  sllt_.compute(S_);
+  tmpM_.noalias() = Jh_ * v;
+  sllt_.solveInPlace(tmpM_);
+  v.noalias() -= B_ * tmpM_;
+  const double lost = std::max(0.0, before - kineticEnergy(x));
+  x[2 * n] += lost;
+  return lost;
+}
+
 void InertialModel::packState(ConstVectorRef q, ConstVectorRef qdot, VectorRef x) const {
   const int n = segments();
   x.head(n) = q;
@@ -508,7 +618,7 @@ double InertialModel::kineticEnergy(const double* x) {
 
 void InertialModel::rhs(const double* x, double* dxdt) {
   const int n = segments();
-  const int m = heldCount();
+  const int mh = heldCount(), m = constraintCount();
   Eigen::Map<const Vector> q(x, n), v(x + n, n);
   evaluateStatics(q);  // kinematics, ∇Π, J_h, h
   velocityTerms(q, v, f_);  // c(q, q̇) into f_ (mass matrix and θ̇ as by-products)
@@ -524,10 +634,10 @@ void InertialModel::rhs(const double* x, double* dxdt) {
     // system: q̈ = M⁻¹(f + J_hᵀ r), (J_h M⁻¹ J_hᵀ) r = γ − J_h M⁻¹ f.
     const Vector& l = chain_.linkLengths();
     for (int k = 0; k < m; ++k) {
-      const int c = held_[size_t(k)];
+      const int c = k < mh ? held_[size_t(k)] : -1;
       // J̇_h q̇: ẍ = −Σ ℓ_i (cos θ_i θ̇_i² + sin θ_i θ̈_i), ÿ = −Σ ℓ_i (sin θ_i θ̇_i² − cos θ_i θ̈_i), φ̈ = Σ q̈.
-      double jdot = 0.0;
-      if (c != static_cast<int>(EndCoordinate::Phi))
+      double jdot = 0.0;  // 0 for a locked joint's constant row e_iᵀ
+      if (k < mh && c != static_cast<int>(EndCoordinate::Phi))
         for (int i = 0; i < n; ++i)
           jdot -= l[i + 1] * (c == 0 ? cos_[i] : sin_[i]) * thetaDot_[i] * thetaDot_[i];
       tmpM_[k] = -jdot - 2.0 * omega_ * Jh_.row(k).dot(v) - omega_ * omega_ * h_[k];

@@ -11,6 +11,8 @@
 #include <utility>
 
 #include <boost/numeric/odeint.hpp>
+
+#include "buckle/continuation/root_finding.h"
 #include <boost/numeric/ublas/matrix.hpp>
 #include <boost/numeric/ublas/vector.hpp>
 
@@ -117,6 +119,14 @@ class StructuredRosenbrock4 {
     return odeint::success;
   }
 
+  /// One step of size dt from x into out, without error control (the trial steps of the event
+  /// location: shorter than a step the control accepted).
+  bool advance(const ExplicitState& x, double dt, ExplicitState& out) {
+    if (!step(x, dt)) return false;
+    out = xout_;
+    return true;
+  }
+
  private:
   // One step: stages g1 … g5 and the error estimate, as odeint's rosenbrock4::do_step.
   bool step(const ExplicitState& x, double dt) {
@@ -187,8 +197,7 @@ class Monitor {
     result_.maxConstraintViolation = std::max(result_.maxConstraintViolation, model_.constraintViolation(q));
     result_.maxEnergyBalanceError = std::max(result_.maxEnergyBalanceError, std::abs(energy(x) - result_.initialEnergy));
     record(t, x, false);
-    model_.velocity(x, qdot_);
-    const double speed = qdot_.cwiseAbs().maxCoeff();
+    const double speed = model_.restSpeed(x);
     if (speed <= options_.velocityTolerance && model_.naturalResidual(q) <= options_.residualTolerance)
       return stop(IntegrationStop::Rest, "at rest: |qdot| and the equilibrium residual are below tolerance at t = " + num(t));
     return false;
@@ -212,6 +221,9 @@ class Monitor {
     result_.kinetic = model_.kineticEnergy(x);
     result_.dissipated = model_.dissipated(x);
     result_.residual = model_.equilibriumResidual(q);
+    result_.contactSides = model_.contactSides();
+    result_.contactTorques = Vector::Zero(n);
+    model_.contactTorques(x, result_.contactTorques);
     if (options_.recordTrajectory && (result_.trajectory.empty() || result_.trajectory.back().t < t)) forceRecord(t, x);
   }
 
@@ -269,13 +281,105 @@ auto resetController(C& controller, int) -> decltype(controller.reset(), void())
 template <class C>
 void resetController(C&, long) {}
 
-template <class Controller, class System, class State>
-void runLoop(Controller& controller, System system, State& x, const double* (*data)(const State&),
+/// The one-sided joint limits during an integration (dynamics.h, file comment): event functions,
+/// their location inside an accepted step, and the contact set's update at an event.
+class ContactTracker {
+ public:
+  ContactTracker(DynamicsModel& model, DynamicsResult& result)
+      : model_(model), result_(result), g_(size_t(model.segments())), torques_(model.segments()) {}
+
+  /// Event functions at x, in the chain's own units: for a free joint the distance to its nearer
+  /// limit (radians, > 0 inside), for a locked one its compression −side·τ_c / k̄b̄² (> 0 while
+  /// the contact pushes).
+  const std::vector<double>& events(const double* x) {
+    const int n = model_.segments();
+    const Vector& lo = model_.chain().lowerLimits();
+    const Vector& hi = model_.chain().upperLimits();
+    model_.contactTorques(x, torques_);
+    for (int i = 0; i < n; ++i) {
+      const int side = model_.contactSides()[size_t(i)];
+      g_[size_t(i)] = side == 0 ? std::min(x[i] - lo[i], hi[i] - x[i]) : -side * torques_[i] / model_.torqueUnit();
+    }
+    return g_;
+  }
+
+  /// Locks `joint` at its nearer limit (side 0) or releases it, at time t; x is made admissible.
+  void toggle(double* x, double t, int joint) {
+    std::vector<int> sides = model_.contactSides();
+    const bool lock = sides[size_t(joint)] == 0;
+    ContactEvent e;
+    e.t = t;
+    e.joint = joint;
+    if (lock) {
+      const double lo = model_.chain().lowerLimits()[joint], hi = model_.chain().upperLimits()[joint];
+      sides[size_t(joint)] = hi - x[joint] <= x[joint] - lo ? 1 : -1;
+    } else {
+      model_.contactTorques(x, torques_);
+      e.torque = torques_[joint];
+      sides[size_t(joint)] = 0;
+    }
+    e.side = lock ? sides[size_t(joint)] : model_.contactSides()[size_t(joint)];
+    e.contact = lock;
+    model_.setContacts(sides);
+    if (lock) {
+      e.kineticLost = model_.impact(x);
+      model_.contactTorques(x, torques_);
+      e.torque = torques_[joint];
+    }
+    result_.contactEvents.push_back(e);
+  }
+
+  /// The contact set consistent at x (after an event or at the start): free joints beyond a
+  /// limit are locked, then the locked joint pulling hardest is released, one at a time (an
+  /// active-set iteration; at most 2n + 2 changes). False when it does not settle.
+  bool settle(double* x, double t) {
+    const int n = model_.segments();
+    for (int change = 0; change <= 2 * n + 2; ++change) {
+      const std::vector<double>& g = events(x);
+      int beyond = -1, pulling = -1;
+      double worst = 0.0;
+      for (int i = 0; i < n; ++i) {
+        if (model_.contactSides()[size_t(i)] == 0) {
+          if (g[size_t(i)] < 0.0 && beyond < 0) beyond = i;
+        } else if (g[size_t(i)] < worst) {
+          worst = g[size_t(i)];
+          pulling = i;
+        }
+      }
+      if (beyond >= 0) toggle(x, t, beyond);
+      else if (pulling >= 0) toggle(x, t, pulling);
+      else return true;
+    }
+    return false;
+  }
+
+ private:
+  DynamicsModel& model_;
+  DynamicsResult& result_;
+  std::vector<double> g_;
+  Vector torques_;
+};
+
+template <class Controller, class System, class State, class SubStep>
+void runLoop(Controller& controller, System system, State& x, const double* (*data)(const State&), SubStep subStep,
              DynamicsModel& model, const IntegrationOptions& options, Monitor& monitor, DynamicsResult& result) {
   double t = 0.0, dt = options.initialStep;
   const int n = model.segments();
+  auto mutableData = [&](State& s) { return const_cast<double*>(data(s)); };
+  ContactTracker contacts(model, result);
+  std::vector<double> gPrevious;
+  if (options.contact) {
+    model.impact(mutableData(x));  // the caller's locked joints sit on their limits
+    if (!contacts.settle(mutableData(x), t)) {
+      monitor.stop(IntegrationStop::JointLimit, "the contact set at the start did not settle");
+      monitor.finish(t, data(x));
+      return;
+    }
+    gPrevious = contacts.events(data(x));
+  }
   monitor.start(data(x));
-  State previous = x;
+  State previous = x, trial = x;
+  int eventsWithoutProgress = 0;
   for (;;) {
     if (options.interrupt.requested()) {
       monitor.stop(IntegrationStop::Interrupted, options.interrupt.describe() + " at t = " + std::to_string(t));
@@ -303,13 +407,15 @@ void runLoop(Controller& controller, System system, State& x, const double* (*da
       continue;
     }
     // The error control cannot see a step that leaves the model's domain (a NaN error estimate
-    // compares false and is accepted; past a joint limit a spring would pass through zero
-    // length). Such a step is rolled back and retried at half the size, which bisects the time
-    // at which a joint reaches its limit down to minStep; the chain then stops there.
+    // compares false and is accepted). Such a step is rolled back and retried at half the size.
+    // Without contact, a step past a joint limit is too (past a geometric limit a spring would
+    // pass through zero length), which bisects the time at which a joint reaches its limit down
+    // to minStep; the chain then stops there. With contact the model is evaluated just past a
+    // limit (its analytic continuation, segment.cpp) and the crossing is located as an event.
     const double* xs = data(x);
     bool finiteState = true;
     for (int i = 0; finiteState && i < model.stateSize(); ++i) finiteState = std::isfinite(xs[i]);
-    const bool inside = finiteState && model.withinLimits(Eigen::Map<const Vector>(xs, n));
+    const bool inside = finiteState && (options.contact || model.withinLimits(Eigen::Map<const Vector>(xs, n)));
     if (!inside) {
       x = previous;
       t = tPrevious;
@@ -328,7 +434,7 @@ void runLoop(Controller& controller, System system, State& x, const double* (*da
           }
         }
         // A trial that only failed by being non-finite far from every limit is a model failure.
-        if (!finiteState && margin > 1e-6) {
+        if (!finiteState && (options.contact || margin > 1e-6)) {
           monitor.stop(IntegrationStop::NonFinite, "the right-hand side became non-finite at t = " + std::to_string(t));
         } else {
           monitor.stop(IntegrationStop::JointLimit, "joint " + std::to_string(joint + 1) + " reached its limit (q = " +
@@ -337,6 +443,68 @@ void runLoop(Controller& controller, System system, State& x, const double* (*da
         break;
       }
       continue;
+    }
+    if (options.contact) {
+      // Events in the step: an event function that went from >= 0 to < 0. Each crossing is
+      // located by Illinois iteration on the step length τ in (0, t − tPrevious], each trial a
+      // step of the integrator's method from the last accepted state; the earliest one is taken.
+      const std::vector<double> gNow = contacts.events(data(x));
+      const double h = t - tPrevious;
+      int joint = -1;
+      double at = h;
+      for (int i = 0; i < n; ++i) {
+        const double g0 = gPrevious[size_t(i)], g1 = gNow[size_t(i)];
+        if (!(g0 >= 0.0 && g1 < 0.0)) continue;
+        double root = 0.0;
+        if (g0 > 0.0) {
+          continuation::IllinoisBracket bracket{0.0, h, g0, g1};
+          for (int it = 0; it < 200 && bracket.width() > 1e-13 * std::max(t, h); ++it) {
+            const double s = std::min(bracket.next(), at);  // no later than the earliest so far
+            if (!subStep(previous, tPrevious, s, trial)) break;
+            const double gs = contacts.events(data(trial))[size_t(i)];
+            if (gs == 0.0) {
+              bracket.left = bracket.right = s;
+              break;
+            }
+            if (s >= at && gs >= 0.0) {  // not before the earliest event found: not this one
+              bracket.left = at;
+              break;
+            }
+            bracket.update(s, gs);
+          }
+          root = bracket.left;  // the admissible side (g >= 0) of the located instant
+        }
+        if (root < at || joint < 0) {
+          at = root;
+          joint = i;
+        }
+      }
+      if (joint >= 0) {
+        if (at < h) {  // back to the located instant
+          if (at > 0.0 && subStep(previous, tPrevious, at, trial)) {
+            x = trial;
+          } else {
+            x = previous;
+            at = 0.0;
+          }
+          t = tPrevious + at;
+        }
+        contacts.toggle(mutableData(x), t, joint);
+        if (!contacts.settle(mutableData(x), t)) {
+          monitor.stop(IntegrationStop::JointLimit, "the contact set did not settle at t = " + std::to_string(t));
+          break;
+        }
+        resetController(controller, 0);
+        eventsWithoutProgress = at > 0.0 ? 0 : eventsWithoutProgress + 1;
+        if (eventsWithoutProgress > 2 * n + 2) {
+          monitor.stop(IntegrationStop::JointLimit, "contacts keep changing without progress at t = " + std::to_string(t));
+          break;
+        }
+        dt = std::max(dt, options.minStep);
+        gPrevious = contacts.events(data(x));
+      } else {
+        gPrevious = gNow;
+      }
     }
     ++result.steps;
     if (monitor.accepted(t, data(x))) break;
@@ -375,6 +543,7 @@ DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef 
   Vector x0(N);
   model.packState(q0, qdot0, x0);
   Monitor monitor(model, natural, result);
+  const std::vector<int> initialSides = model.contactSides();
 
   // The structured Rosenbrock method needs the model's O(n) linear solve (the gradient flow has it).
   const bool structured =
@@ -382,26 +551,43 @@ DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef 
   if (structured) {
     ExplicitState x(x0.data(), x0.data() + N);
     StructuredRosenbrock4 controller(model, natural.absoluteTolerance, natural.relativeTolerance);
-    runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, natural, monitor, result);
+    StructuredRosenbrock4 trial(model, natural.absoluteTolerance, natural.relativeTolerance);
+    auto subStep = [&](const ExplicitState& from, double, double h, ExplicitState& to) { return trial.advance(from, h, to); };
+    runLoop(controller, ExplicitSystem{&model}, x, explicitData, subStep, model, natural, monitor, result);
   } else if (natural.stepper == StepperKind::Rosenbrock4 || natural.stepper == StepperKind::StructuredRosenbrock4) {
     StiffState x(static_cast<size_t>(N));
     std::copy(x0.data(), x0.data() + N, x.begin());
     odeint::rosenbrock4_controller<odeint::rosenbrock4<double>> controller(natural.absoluteTolerance,
                                                                            natural.relativeTolerance);
-    runLoop(controller, std::make_pair(StiffSystem{&model}, StiffJacobian{&model}), x, stiffData, model, natural,
-            monitor, result);
+    odeint::rosenbrock4<double> trial;
+    StiffState error(static_cast<size_t>(N));
+    auto subStep = [&](const StiffState& from, double t0, double h, StiffState& to) {
+      to = from;
+      trial.do_step(std::make_pair(StiffSystem{&model}, StiffJacobian{&model}), to, t0, h, error);
+      return true;
+    };
+    runLoop(controller, std::make_pair(StiffSystem{&model}, StiffJacobian{&model}), x, stiffData, subStep, model,
+            natural, monitor, result);
   } else {
     ExplicitState x(x0.data(), x0.data() + N);
+    // event trials: one Cash–Karp step (fifth order, no first-same-as-last state to keep)
+    odeint::runge_kutta_cash_karp54<ExplicitState> trial;
+    auto subStep = [&](const ExplicitState& from, double t0, double h, ExplicitState& to) {
+      trial.do_step(ExplicitSystem{&model}, from, t0, to, h);
+      return true;
+    };
     if (natural.stepper == StepperKind::DormandPrince5) {
       auto controller = odeint::make_controlled(natural.absoluteTolerance, natural.relativeTolerance,
                                                 odeint::runge_kutta_dopri5<ExplicitState>());
-      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, natural, monitor, result);
+      runLoop(controller, ExplicitSystem{&model}, x, explicitData, subStep, model, natural, monitor, result);
     } else {
       auto controller = odeint::make_controlled(natural.absoluteTolerance, natural.relativeTolerance,
                                                 odeint::runge_kutta_cash_karp54<ExplicitState>());
-      runLoop(controller, ExplicitSystem{&model}, x, explicitData, model, natural, monitor, result);
+      runLoop(controller, ExplicitSystem{&model}, x, explicitData, subStep, model, natural, monitor, result);
     }
   }
+  // the contacts found are the result's; the model is left as the caller set it (repeatable runs)
+  model.setContacts(initialSides);
   result.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
   return result;
 }

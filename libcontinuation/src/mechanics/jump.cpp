@@ -1,8 +1,10 @@
 #include "buckle/mechanics/jump.h"
 
 #include "buckle/continuation/scaled_problem.h"
+#include "buckle/mechanics/contact.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <Eigen/QR>
 #include <cmath>
 #include <limits>
@@ -33,6 +35,72 @@ EndCondition frozenEnd(const EquilibriumProblem& problem, double lambda) {
   EndCondition e = problem.endCondition();
   e.value = problem.prescribed(lambda);
   return e;
+}
+
+bool anyContact(const std::vector<int>& sides) {
+  return std::any_of(sides.begin(), sides.end(), [](int s) { return s != 0; });
+}
+
+/// The rest point of `dyn` as an equilibrium at λ: polished (with its contacts fixed), its
+/// stability (of the constrained system in contact) and contact torques.
+struct RestPoint {
+  PolishResult polished;
+  continuation::StabilityInfo stability;
+  std::vector<int> sides;
+  Vector torques;
+  bool stable = false;
+};
+
+RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn, double lambda,
+                          const continuation::CorrectorOptions& options) {
+  RestPoint rp;
+  const int n = problem.segments();
+  rp.sides = dyn.contactSides.size() == size_t(n) ? dyn.contactSides : std::vector<int>(size_t(n), 0);
+  rp.torques = Vector::Zero(n);
+  if (dyn.reason != IntegrationStop::Rest) {
+    // only a rest point is worth polishing (at a guard the state is no equilibrium)
+    rp.polished.u = problem.initialGuess(dyn.q, lambda);
+    rp.polished.message = "not polished";
+    Vector F(problem.dimension());
+    rp.polished.residual =
+        problem.residual(rp.polished.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+    return rp;
+  }
+  if (!anyContact(rp.sides)) {
+    rp.polished = polishEquilibrium(problem, dyn.q, lambda, options);
+    if (rp.polished.converged) problem.stability(rp.polished.u, lambda, 3, rp.stability);
+    rp.stable = rp.stability.valid() && rp.stability.stable();
+    return rp;
+  }
+  ContactSet locked;
+  for (int i = 0; i < n; ++i)
+    if (rp.sides[size_t(i)] != 0) locked.lock(i, rp.sides[size_t(i)] > 0 ? LimitSide::Upper : LimitSide::Lower);
+  const ConstrainedEquilibrium ce = solveConstrainedEquilibrium(problem, locked, problem.initialGuess(dyn.q, lambda), lambda,
+                                                                options.residualTolerance, options.maxIterations);
+  rp.polished.u = ce.u;
+  rp.polished.converged = ce.converged;
+  rp.polished.iterations = ce.iterations;
+  rp.polished.residual = ce.residual;
+  rp.polished.message = ce.converged ? "converged with the joints in contact locked" : ce.message;
+  if (!rp.polished.converged) return rp;
+  rp.torques = ce.torques;
+  rp.stability = constrainedStability(problem, locked, ce.u, lambda, 3);
+  // a stable constrained equilibrium: the reduced Hessian positive definite and every contact
+  // compressive (a contact torque of zero would release at the slightest disturbance)
+  bool compressive = true;
+  for (int i = 0; i < n; ++i)
+    if (rp.sides[size_t(i)] != 0 && !(-rp.sides[size_t(i)] * rp.torques[i] > 0.0)) compressive = false;
+  rp.stable = rp.stability.valid() && rp.stability.stable() && compressive;
+  return rp;
+}
+
+std::string describeContacts(const std::vector<int>& sides, const Vector& torques) {
+  std::ostringstream os;
+  for (size_t i = 0; i < sides.size(); ++i)
+    if (sides[i] != 0)
+      os << (os.str().empty() ? "" : ", ") << "joint " << i + 1 << (sides[i] > 0 ? " upper" : " lower")
+         << " (contact torque " << torques[Eigen::Index(i)] << ")";
+  return os.str();
 }
 
 std::string describe(const continuation::StabilityInfo& s) {
@@ -156,6 +224,19 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
     v = ud.direction;
     result.directionEigenvalue = ud.eigenvalue;
   }
+  // A start on a joint limit (a fold of a branch traced in contact, contact.h) starts in
+  // contact: the joint stays locked until its contact torque would pull (dynamics.h).
+  std::vector<int> startSides(size_t(n), 0);
+  for (int i = 0; i < n; ++i) {
+    const double hi = problem.chain().upperLimits()[i], lo = problem.chain().lowerLimits()[i];
+    if (std::abs(qFrom[i] - hi) <= 1e-12 * std::max(1.0, std::abs(hi))) startSides[size_t(i)] = 1;
+    else if (std::abs(qFrom[i] - lo) <= 1e-12 * std::max(1.0, std::abs(lo))) startSides[size_t(i)] = -1;
+    if (startSides[size_t(i)] != 0) v[i] = 0.0;
+  }
+  if (anyContact(startSides)) {
+    model->setContacts(startSides);
+    if (v.norm() > 0.0) v.normalize();
+  }
   // Sign: the one that lowers Π. At an unstable equilibrium both do to second order; at a fold
   // the quadratic term vanishes and the cubic term (the fold's normal form) picks the side.
   Vector qStart = qFrom;
@@ -191,17 +272,9 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.wallSeconds = dyn.wallSeconds;
   result.restPoint = dyn.q;
 
-  // 3. Polish at fixed λ and check stability — only a rest point is worth polishing (at a joint
-  // limit or a guard the state is no equilibrium of the smooth model).
-  PolishResult polished;
-  if (dyn.reason == IntegrationStop::Rest) {
-    polished = polishEquilibrium(problem, dyn.q, lambda, options.polish);
-  } else {
-    polished.u = problem.initialGuess(dyn.q, lambda);
-    polished.message = "not polished";
-    Vector F(problem.dimension());
-    polished.residual = problem.residual(polished.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
-  }
+  // 3. Polish at fixed λ (with the joints in contact fixed) and check stability.
+  const RestPoint rest = polishRestPoint(problem, dyn, lambda, options.polish);
+  const PolishResult& polished = rest.polished;
   result.to = polished.u;
   result.polishConverged = polished.converged;
   result.polishIterations = polished.iterations;
@@ -211,12 +284,15 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.distance = (qTo - qFrom).cwiseAbs().maxCoeff();
   result.potentialTo = model->potential(qTo);
   result.energyReleased = result.potentialFrom - result.potentialTo;
-  if (polished.converged) problem.stability(result.to, lambda, 3, result.stabilityTo);
-  result.stable = result.stabilityTo.valid() && result.stabilityTo.stable();
+  result.stabilityTo = rest.stability;
+  result.stable = rest.stable;
+  result.contactSides = rest.sides;
+  result.contactTorques = rest.torques;
 
   std::ostringstream os;
   os << "integration stopped: " << dyn.message << "; polish: " << (polished.converged ? "converged" : "not converged") << " ("
      << polished.message << ", residual " << polished.residual << "); landing " << describe(result.stabilityTo);
+  if (anyContact(rest.sides)) os << " with the joints locked; in contact: " << describeContacts(rest.sides, rest.torques);
   if (dyn.reason != IntegrationStop::Rest) {
     os << "; no rest point reached";
   } else if (polished.converged && result.distance <= options.sameStateTolerance) {
@@ -272,27 +348,24 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
     result.maxExcursion = std::max(result.maxExcursion, (s.q - result.start).cwiseAbs().maxCoeff());
   }
 
-  PolishResult polished;
-  if (dyn.reason == IntegrationStop::Rest) {
-    polished = polishEquilibrium(problem, dyn.q, 0.0, options.polish);
-  } else {
-    polished.u = problem.initialGuess(dyn.q, 0.0);
-    polished.message = "not polished";
-    Vector F(problem.dimension());
-    polished.residual = problem.residual(polished.u, 0.0, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
-  }
+  const RestPoint restPoint = polishRestPoint(problem, dyn, 0.0, options.polish);
+  const PolishResult& polished = restPoint.polished;
   result.restUnknowns = polished.u;
   result.rest = polished.u.head(n);
   result.residual = polished.residual;
   result.polishConverged = polished.converged;
-  if (polished.converged) problem.stability(polished.u, 0.0, 3, result.stability);
-  result.stable = result.stability.valid() && result.stability.stable();
+  result.stability = restPoint.stability;
+  result.stable = restPoint.stable;
+  result.contactSides = restPoint.sides;
+  result.contactTorques = restPoint.torques;
   result.potentialDynamic = model->potential(result.rest);
 
   std::ostringstream os;
   os << (result.inertial ? "inertial" : "gradient-flow") << " response; integration stopped: " << dyn.message
      << "; polish: " << (polished.converged ? "converged" : "not converged") << " (" << polished.message << ", residual " << polished.residual
      << "); rest shape " << describe(result.stability);
+  if (anyContact(restPoint.sides))
+    os << " with the joints locked; in contact: " << describeContacts(restPoint.sides, restPoint.torques);
   if (qStatic.size() == n) {
     result.compared = true;
     result.staticShape = qStatic;

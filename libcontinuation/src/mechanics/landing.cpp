@@ -16,6 +16,14 @@ void setState(const EquilibriumProblem& problem, const Eigen::VectorXd& q, const
   l.pose = endPose(problem.chain(), q);
   l.shape = shapeName(q, kStraightTolerance);
 }
+
+/// The joints in contact (sides ≠ 0) with their torques; the kind of a successful landing.
+void setContacts(const std::vector<int>& sides, const Eigen::VectorXd& torques, Landing& l) {
+  l.contacts.clear();
+  for (size_t i = 0; i < sides.size(); ++i)
+    if (sides[i] != 0) l.contacts.push_back({int(i), sides[i], torques.size() > Eigen::Index(i) ? torques[Eigen::Index(i)] : 0.0});
+  if (l.success && !l.contacts.empty()) l.kind = "stable equilibrium in contact";
+}
 }  // namespace
 
 Landing jumpFromFold(EquilibriumProblem& problem, const continuation::SpecialPoint& fold, const JumpOptions& options) {
@@ -37,6 +45,7 @@ Landing jumpFromFold(EquilibriumProblem& problem, const continuation::SpecialPoi
     l.kind = "stable equilibrium";
     l.interrupted = !j.success && j.stopReason == IntegrationStop::Interrupted;
     if (j.to.size() >= n) setState(problem, j.to.head(n), problem.wrench(j.to, fold.lambda), l);
+    setContacts(j.contactSides, j.contactTorques, l);
     l.distance = j.distance;
   } catch (const std::invalid_argument& e) {
     l.success = false;
@@ -53,6 +62,7 @@ Landing landingOf(const EquilibriumProblem& problem, const JumpRecord& j) {
   l.kind = j.success ? "stable equilibrium" : "none";
   l.message = j.message;
   if (j.to.size() >= n) setState(problem, j.to.head(n), j.load, l);
+  setContacts(j.contactSides, j.contactTorques, l);
   l.energyReleased = j.energyReleased;
   l.distance = j.distance;
   return l;

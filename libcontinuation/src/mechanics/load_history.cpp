@@ -1,9 +1,12 @@
 #include "buckle/mechanics/load_history.h"
 
 #include "buckle/continuation/branch_switching.h"
+#include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/equilibrium_branches.h"
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 namespace buckle::mechanics {
@@ -116,6 +119,23 @@ bool followBifurcated(EquilibriumProblem& problem, const cont::SpecialPoint& sp,
   return true;
 }
 
+// The boundary (joint, side) the branch traced on `traced` stopped on; joint −1: none.
+LockedJoint stoppedOn(const cont::Problem& traced, const cont::Branch& branch, int segments) {
+  if (branch.stopReason != cont::StopReason::Boundary || branch.specialPoints.empty()) return {};
+  const cont::SpecialPoint& sp = branch.specialPoints.back();
+  if (sp.type != cont::SpecialPointType::Boundary) return {};
+  for (int k = 0; k < traced.boundaryCount(); ++k)
+    if (traced.boundaryName(k) == sp.boundaryName) return limitOfBoundary(k, segments);
+  return {};
+}
+
+ContactSet contactSetOf(const std::vector<int>& sides) {
+  ContactSet set;
+  for (size_t i = 0; i < sides.size(); ++i)
+    if (sides[i] != 0) set.lock(int(i), sides[i] > 0 ? LimitSide::Upper : LimitSide::Lower);
+  return set;
+}
+
 }  // namespace
 
 LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::VectorXd& q0,
@@ -161,10 +181,15 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       rec.load = problem.wrench(jr.to, at);
       rec.energyReleased = potentialAt(problem, from, at) - potentialAt(problem, jr.to, at);
       rec.distance = jr.distance;
+      rec.contactSides = jr.contactSides;
+      rec.contactTorques = jr.contactTorques;
     }
     result.jumps.push_back(rec);
     return jr.success;
   };
+  // Joints in contact with their limits (a landing against them, or a branch run into them):
+  // the quasi-static pieces are traced with them locked (contact.h) until they release.
+  ContactSet locked;
 
   cont::StabilityInfo info;
   if (problem.stability(u, lambda, 3, info) && info.negative > 0) {
@@ -173,6 +198,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       return result;
     }
     u = result.jumps.back().to;
+    locked = contactSetOf(result.jumps.back().contactSides);
   }
 
   for (size_t leg = 1; leg < waypoints.size(); ++leg) {
@@ -190,10 +216,40 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       cont::TracerOptions legOptions = options.tracer;
       legOptions.lambdaMin = std::min(lambda, target);
       legOptions.lambdaMax = std::max(lambda, target);
-      cont::Branch branch = cont::trace(problem, u, lambda,
-                                         sign > 0 ? cont::InitialDirection::increasingLambda()
-                                                  : cont::InitialDirection::decreasingLambda(),
-                                         legOptions);
+      const cont::InitialDirection direction =
+          sign > 0 ? cont::InitialDirection::increasingLambda() : cont::InitialDirection::decreasingLambda();
+      std::unique_ptr<ContactProblem> lockedProblem;
+      if (!locked.empty()) lockedProblem = std::make_unique<ContactProblem>(problem, locked);
+      cont::Branch branch = lockedProblem ? cont::trace(*lockedProblem, u, lambda, direction, legOptions)
+                                          : cont::trace(problem, u, lambda, direction, legOptions);
+      if (!lockedProblem) {
+        // a free piece that runs into a joint limit goes on with the joint locked (and released
+        // again where its contact torque vanishes), in the same piece
+        const std::vector<ContactStretch> stretches = continueUnderContact(problem, branch, legOptions);
+        locked = stretches.back().locked;
+      } else {
+        // a locked piece that ends where a contact releases or another joint reaches its limit:
+        // the next piece starts there with the new set (polished), at the end of this one
+        const LockedJoint hit = stoppedOn(*lockedProblem, branch, problem.segments());
+        if (hit.joint >= 0 && firstLossOfStability(branch) < 0) {
+          ContactSet next = locked;
+          if (next.locked(hit.joint) && next.side(hit.joint) == hit.side) next.release(hit.joint);
+          else next.lock(hit.joint, hit.side);
+          const cont::SpecialPoint& at = branch.specialPoints.back();
+          const ConstrainedEquilibrium ce = solveConstrainedEquilibrium(problem, next, at.u, at.lambda);
+          if (ce.converged) {
+            result.segments.push_back(branch);
+            result.segmentLeg.push_back(int(leg));
+            result.segmentBifurcated.push_back(false);
+            if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
+              result.jumps.back().toSegment = int(result.segments.size()) - 1;
+            locked = next;
+            u = ce.u;
+            lambda = at.lambda;
+            continue;
+          }
+        }
+      }
       if (branch.points.empty()) {
         result.message = "continuation could not start at lambda = " + std::to_string(lambda) + ": " + branch.stopMessage;
         return result;
@@ -244,6 +300,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       }
       u = result.jumps.back().to;
       lambda = at;
+      locked = contactSetOf(result.jumps.back().contactSides);
       if ((target - lambda) * sign <= 0.0) break;  // the overshoot passed the waypoint
     }
   }

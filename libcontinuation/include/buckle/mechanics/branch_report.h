@@ -40,6 +40,8 @@ enum class EventType {
   Jump,              ///< "JUMP": a load history leaves its stable state (load_history.h)
   Contact,           ///< "CT": a joint reaches its limit and locks there (contact.h)
   Release,           ///< "RL": a locked joint's contact torque returns to zero: it is free again
+  BaseContact,       ///< "BC": the chain reaches (or leaves) the clamp's wall (contact_geometry.h)
+  SelfContact,       ///< "SC": two non-adjacent links meet (or separate) (contact_geometry.h)
 };
 
 /// "BP", "LP", "LPF", "BD", "KMIN", "JUMP", "CT", "RL": the one spelling of the labels in every output.
@@ -117,6 +119,8 @@ struct SpecialPointReport {
   double contactTorque = std::numeric_limits<double>::quiet_NaN();
   /// The locked joints after the point (CT, RL).
   ContactSet lockedAfter;
+  /// BC / SC: where the chain touches the wall or itself (NaN otherwise).
+  Eigen::Vector2d contactPoint = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 struct BranchReport {

@@ -27,10 +27,25 @@
 //    In joint angles M = Tᵀ M_θ T and c = Tᵀ c_θ. The dissipated energy ∫ q̇ᵀ D q̇ dt is an extra
 //    state, so K + Π + W_d = const is checkable to the integrator tolerance.
 //
+// Joint limits are one-sided constraints (IntegrationOptions::contact, the default): a joint i
+// that reaches a limit q̄_i (geometric or the scene's) is locked there, its row e_iᵀ joining the
+// constraint rows of the held coordinates (h_i = q_i − q̄_i, held by the same κ_h / Baumgarte
+// terms), so the gradient flow becomes the projected gradient flow (q̇_i = 0) and the inertial
+// model a contact with an inelastic impact: at the contact instant the velocity is projected
+// M-orthogonally onto the constraints, q̇⁺ = q̇⁻ − M⁻¹Cᵀ(CM⁻¹Cᵀ)⁻¹C q̇⁻ (C all constraint rows:
+// q̇_i⁺ = 0), the kinetic energy lost counted as dissipated. The multiplier of row e_i is the
+// contact torque τ_c,i = ∂E/∂q_i − (JᵀF)_i at rest (the torque the contact applies, positive
+// towards increasing q_i); the contact is compressive while −side·τ_c,i ≥ 0 (side +1 at an upper
+// limit, −1 at a lower one) and released where that compression returns to zero. Contact and
+// release instants are events located by root finding (Illinois on the step length, each trial
+// one step of the integrator's own method from the last accepted state) on q̄_i − q_i (its sign
+// towards the inside) and on the compression — not by clamping steps.
+//
 // Both models append the dissipated energy to the state; the integrator (simulate) stops at
 // rest (velocity and equilibrium residual below tolerance) or at a guard (time, steps, a joint
-// limit, step-size underflow, a non-finite state) and says which. Models own their workspace:
-// the right-hand side allocates nothing. A model is not thread-safe (one per thread).
+// limit without contact, step-size underflow, a non-finite state) and says which. Models own
+// their workspace: the right-hand side allocates nothing (locking or releasing a joint resizes
+// it, at events only). A model is not thread-safe (one per thread).
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -109,6 +124,25 @@ class DynamicsModel {
   const EndCondition& endCondition() const { return end_; }
   int heldCount() const { return static_cast<int>(held_.size()); }
 
+  /// One-sided contact at the joint limits (file comment): per joint 0 free, +1 locked at its
+  /// upper limit, −1 at its lower one.
+  const std::vector<int>& contactSides() const { return sides_; }
+  int lockedCount() const { return static_cast<int>(locked_.size()); }
+  /// Locked joints in increasing order.
+  const std::vector<int>& lockedJoints() const { return locked_; }
+  /// Sets the locked joints (size n, entries −1, 0, +1); resizes the constraint workspace.
+  /// Throws std::invalid_argument for a wrong size or entry.
+  void setContacts(const std::vector<int>& sides);
+  /// The limit angle of joint i on `side` (+1 upper, −1 lower).
+  double limitAngle(int joint, int side) const;
+  /// Contact torques τ_c,i at state x (size n): the multipliers of the locked joints' constraint
+  /// rows (file comment), 0 at free joints. Evaluates the right-hand side once.
+  void contactTorques(const double* x, VectorRef torques);
+  /// At a contact instant: sets the locked joints' angles to their limits and (inertial) makes
+  /// the velocity admissible by the inelastic impact; returns the kinetic energy lost (added to
+  /// the dissipated energy in x).
+  virtual double impact(double* x);
+
   /// x0 from q and q̇ (q̇ ignored by the gradient flow), dissipated energy 0.
   virtual void packState(ConstVectorRef q, ConstVectorRef qdot, VectorRef x) const = 0;
   /// dx/dt at x. Allocation-free.
@@ -125,6 +159,8 @@ class DynamicsModel {
   Eigen::Map<const Vector> angles(const double* x) const { return Eigen::Map<const Vector>(x, segments()); }
   /// Joint velocity q̇ at x (the flow evaluates (D1); needs rhs(), hence non-const).
   virtual void velocity(const double* x, VectorRef qdot) = 0;
+  /// The speed the rest criterion watches: ‖q̇‖∞ (the gradient flow: see its override).
+  virtual double restSpeed(const double* x);
   virtual double dissipated(const double* x) const = 0;
   virtual double kineticEnergy(const double* x) = 0;
 
@@ -147,11 +183,15 @@ class DynamicsModel {
   double constraintViolation(ConstVectorRef q);
   /// Gauss–Newton onto h(q) = 0 (minimum-norm corrections J_h⁺ h); true when ‖h‖∞ <= tol·b̄.
   bool projectOntoConstraints(VectorRef q, double tolerance = 1e-13, int maxIterations = 20);
-  /// Inside the joint limits (geometric ∩ user, open interval)?
+  /// Inside the joint limits (geometric ∩ user, open interval)? A locked joint counts as inside.
   bool withinLimits(ConstVectorRef q) const;
 
  protected:
   DynamicsModel(const Chain& chain, const EndCondition& end);
+  /// Constraint rows: the held coordinates, then the locked joints.
+  int constraintCount() const { return heldCount() + lockedCount(); }
+  /// The derived model's constraint-sized workspace after setContacts().
+  virtual void resizeConstraints() {}
   /// Kinematics, J, ∇Π and (with held coordinates) J_h, h, the Cholesky of J_h J_hᵀ at q.
   void evaluateStatics(ConstVectorRef q);
 
@@ -159,15 +199,16 @@ class DynamicsModel {
   EndCondition end_;
   double lengthUnit_, torqueUnit_;
   std::vector<int> held_, loaded_;
+  std::vector<int> sides_, locked_;  ///< contact side per joint; the locked joints
   Wrench loads_;  ///< F_l on loaded coordinates, 0 on held ones
   ChainData data_;
   Matrix J_;      ///< 3×n end Jacobian
   Vector grad_;   ///< ∇Π
-  Matrix Jh_;     ///< m×n held rows
-  Vector h_;      ///< p_h − target
+  Matrix Jh_;     ///< m×n constraint rows: held coordinates, then e_iᵀ of the locked joints
+  Vector h_;      ///< p_h − target, then q_i − q̄_i
   Matrix A_;      ///< J_h J_hᵀ
   Eigen::LLT<Matrix> llt_;
-  Vector r_, tmpM_;  // size m
+  Vector r_, tmpM_;  // size m (r_: the multipliers of the last right-hand side)
   Vector tmpN_;      // size n
   std::vector<double> fdPlus_, fdMinus_, fdState_;  // for the finite-difference jacobian()
 };
@@ -184,6 +225,10 @@ class GradientFlowModel final : public DynamicsModel {
   void rhs(const double* x, double* dxdt) override;
   void jacobian(const double* x, double* jacobianRowMajor) override;
   void velocity(const double* x, VectorRef qdot) override;
+  /// ‖P∇Π‖∞ / c: the flow's speed along the constraints, without the κ_h term, which only
+  /// pulls back the integrator's drift of the constraints (of the size of its tolerance) and
+  /// would otherwise keep a chain at rest "moving" by κ_h/c times that drift.
+  double restSpeed(const double* x) override;
   double dissipated(const double* x) const override { return x[segments()]; }
   double kineticEnergy(const double*) override { return 0.0; }
 
@@ -196,6 +241,9 @@ class GradientFlowModel final : public DynamicsModel {
   double damping() const { return c_; }
   double constraintStiffness() const { return kappaH_; }
   double timeUnit() const override { return c_ / torqueUnit_; }
+
+ protected:
+  void resizeConstraints() override;
 
  private:
   double c_, kappaH_;
@@ -239,6 +287,10 @@ class InertialModel final : public DynamicsModel {
   const Vector& jointDamping() const { return d_; }
   double baumgarteRate() const { return omega_; }
   double timeUnit() const override { return timeUnit_; }
+  double impact(double* x) override;
+
+ protected:
+  void resizeConstraints() override;
 
  private:
   void computeMassMatrix(ConstVectorRef q);  // fills Mtheta_, M_ (uses theta from data_)
@@ -287,7 +339,8 @@ struct IntegrationOptions {
   double minStep = 1e-13;            ///< below this the step size has underflowed: stop
   double maxTime = 1e5;              ///< guard
   long maxSteps = 1000000;           ///< guard (accepted steps)
-  /// Rest: ‖q̇‖∞ <= velocityTolerance and equilibrium residual <= residualTolerance.
+  /// Rest: speed <= velocityTolerance and equilibrium residual <= residualTolerance; the speed
+  /// is DynamicsModel::restSpeed() (the gradient flow's without its drift correction).
   double velocityTolerance = 1e-9;
   double residualTolerance = 1e-9;
   /// Record a sample when at least this much time passed since the last one (0: every
@@ -298,6 +351,9 @@ struct IntegrationOptions {
   /// Checked before every step: a time limit or a signal stops the integration
   /// (IntegrationStop::Interrupted) with the state reached.
   continuation::Interrupt interrupt;
+  /// Joint limits as one-sided constraints (file comment); false: stop at the first limit
+  /// reached (IntegrationStop::JointLimit), the time bisected down to minStep.
+  bool contact = true;
 
   bool IsValid(std::string* why) const;
 };
@@ -315,6 +371,16 @@ struct TrajectorySample {
   double constraintViolation = 0.0;
 };
 
+/// A contact or release instant of the one-sided joint limits.
+struct ContactEvent {
+  double t = 0.0;          ///< model time
+  int joint = -1;          ///< 0-based
+  int side = 0;            ///< +1 upper limit, −1 lower
+  bool contact = true;     ///< true: the joint locked; false: released
+  double torque = 0.0;     ///< contact torque τ_c,i just after locking / at the release
+  double kineticLost = 0.0;  ///< inertial: the impact's kinetic-energy loss
+};
+
 struct DynamicsResult {
   IntegrationStop reason = IntegrationStop::MaxSteps;
   std::string message;              ///< human-readable reason
@@ -328,12 +394,19 @@ struct DynamicsResult {
   double maxConstraintViolation = 0.0;  ///< over every accepted step
   double maxEnergyBalanceError = 0.0;   ///< max |Π + K + W_d − initialEnergy| over accepted steps
   double wallSeconds = 0.0;
+  std::vector<ContactEvent> contactEvents;  ///< in time order
+  std::vector<int> contactSides;            ///< the model's locked joints at the end (per joint)
+  Vector contactTorques;                    ///< τ_c,i at the end (0 at free joints)
   std::vector<TrajectorySample> trajectory;
   bool trajectoryTruncated = false;
 };
 
-/// Integrates the model from (q0, q̇0) until rest or a guard. Throws std::invalid_argument for
-/// invalid options or sizes; every other ending is reported in DynamicsResult::reason.
+/// Integrates the model from (q0, q̇0) until rest or a guard, starting with the model's locked
+/// joints (setContacts; their angles are set to the limits). With options.contact the contacts
+/// change at the located events (DynamicsResult::contactEvents, contactSides at the end); the
+/// model's own contact set is restored on return. Throws
+/// std::invalid_argument for invalid options or sizes; every other ending is reported in
+/// DynamicsResult::reason.
 DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef qdot0, const IntegrationOptions& options);
 
 }  // namespace buckle::mechanics

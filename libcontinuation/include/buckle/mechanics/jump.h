@@ -13,6 +13,11 @@
 //   3. the rest point is polished by Newton on the EquilibriumProblem residual at fixed λ — the
 //      continuation core's KINSOL corrector in its fixed-parameter mode — and its stability is
 //      checked with Problem::stability() (K_q − K_g positive definite on ker J_h).
+//      A chain that came to rest with joints in contact (dynamics.h: joint limits are one-sided
+//      constraints) is polished with those joints fixed at their limits (contact.h,
+//      solveConstrainedEquilibrium), and its stability is that of the constrained system
+//      (constrainedStability: the reduced Hessian K_q − K_g on the free joints and ker J_h
+//      positive definite) with every contact compressive (−side·τ_c,i > 0).
 //
 // simulateSuddenLoad: the "sporadic" case — the full end condition is applied at once to the
 // chain at rest in its unloaded shape. The chain's dynamic answer can differ from the
@@ -22,6 +27,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
 #include "buckle/continuation/corrector.h"
 #include "buckle/continuation/problem.h"
@@ -103,7 +109,11 @@ struct JumpResult {
   int polishIterations = 0;
   double polishShift = 0.0;          ///< ‖q_to − restPoint‖∞
   continuation::StabilityInfo stabilityFrom, stabilityTo;
-  bool stable = false;               ///< stabilityTo.stable()
+  bool stable = false;               ///< stabilityTo.stable() (and, in contact, every contact compressive)
+  /// Joints in contact at the landing (per joint 0, +1 upper, −1 lower; all 0 without contact)
+  /// and their contact torques τ_c,i (contact.h: ∂E/∂q_i − (JᵀF)_i, 0 at free joints).
+  std::vector<int> contactSides;
+  Vector contactTorques;
   DynamicsResult dynamics;           ///< the trajectory and its energies
 };
 
@@ -135,7 +145,9 @@ struct SuddenLoadResult {
   double residual = 0.0;
   bool polishConverged = false;
   continuation::StabilityInfo stability;
-  bool stable = false;
+  bool stable = false;               ///< (in contact: of the constrained system, contacts compressive)
+  std::vector<int> contactSides;     ///< joints in contact at rest (as JumpResult)
+  Vector contactTorques;             ///< their contact torques τ_c,i
   double peakKinetic = 0.0;          ///< over the recorded trajectory
   double maxExcursion = 0.0;         ///< max ‖q(t) − start‖∞ over the recorded trajectory
   // comparison with the quasi-static answer (NaN / false when no q_static was given)

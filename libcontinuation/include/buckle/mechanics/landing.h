@@ -1,11 +1,14 @@
 // Where a chain lands when it jumps: the outcome of a jump from a fold (jump.h) or of a load
-// history's jump (load_history.h), in physical quantities, with the one rule for a jump that
-// ends on a geometric joint limit (the triangles meet: the smooth model ends there, a known
-// outcome reported with the state reached, not a failure).
+// history's jump (load_history.h), in physical quantities. Joint limits are one-sided contacts
+// during the jump (dynamics.h): a chain that comes to rest against limits lands on a stable
+// constrained equilibrium ("stable equilibrium in contact"), reported with the joints in contact
+// and their contact torques. Only dynamics run without contact (IntegrationOptions::contact =
+// false) still stop at a limit ("joint limit": the state reached, a known outcome, not a failure).
 #pragma once
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
 #include "buckle/continuation/branch.h"
 #include "buckle/mechanics/equilibrium_problem.h"
@@ -14,11 +17,20 @@
 
 namespace buckle::mechanics {
 
+/// A joint in contact with its limit at a landing.
+struct JointContact {
+  int joint = -1;        ///< 0-based
+  int side = 0;          ///< +1 upper limit, −1 lower
+  double torque = 0.0;   ///< contact torque τ_c (jump.h, contactTorques): −side·τ_c > 0
+};
+
 struct Landing {
   bool tried = false;
-  bool success = false;         ///< came to rest on a stable equilibrium or on a joint limit
+  bool success = false;         ///< came to rest on a stable (constrained) equilibrium or on a joint limit
   bool interrupted = false;     ///< the integration was stopped by the time limit or a signal
-  std::string kind;             ///< "stable equilibrium", "joint limit" or "none"
+  /// "stable equilibrium", "stable equilibrium in contact", "joint limit" or "none"
+  std::string kind;
+  std::vector<JointContact> contacts;  ///< joints in contact at the landing (empty: none)
   std::string message;
   Eigen::VectorXd q;            ///< joint angles at the landing (empty: none)
   Wrench F = Wrench::Zero();    ///< end wrench there (loads and reactions)

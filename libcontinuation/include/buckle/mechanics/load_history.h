@@ -46,6 +46,10 @@ struct JumpRecord {
   Vector from, to;              ///< unknowns (q, reactions) before / after
   double energyReleased = 0.0;  ///< Π(from) − Π(to) at the release load
   double distance = 0.0;        ///< ‖q_to − q_from‖∞
+  /// Joints in contact at the landing (per joint 0, +1 upper, −1 lower; empty or all 0: none)
+  /// and their contact torques (jump.h).
+  std::vector<int> contactSides;
+  Vector contactTorques;
   bool success = false;
   std::string message;
 };

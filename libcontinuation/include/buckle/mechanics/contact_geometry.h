@@ -1,0 +1,89 @@
+// Contact of the chain with its base and with itself (detection; the joints' own contact with
+// their limits is contact.h). Conventions: conventions.h.
+//
+//  * Base contact. The chain is clamped to a wall, the plane x = 0 (the material fills x < 0;
+//    the shape plots draw it hatched). The moving bodies are the segments' triangles except the
+//    first segment's proximal one (clamped, its base edge on the wall); the springs run between
+//    triangle vertices. A convex body's smallest x is at a vertex, so the signed distance
+//        d_base(q) = min over the moving triangles' vertices of x          (> 0: clear)
+//    is exact for this geometry and costs O(n).
+//  * Self contact. Link m (the base link ℓ_0 from the base to joint 1, and ℓ_m from joint m to
+//    m + 1 or to the end) is the straight centre line of the rigid body made of segment m's
+//    distal and segment m + 1's proximal triangle. Two links that share a joint always touch
+//    there; links two or more apart are in contact when their centre lines meet. The signed
+//    distance of a pair is the segment–segment distance while they are disjoint and minus the
+//    smallest distance of an end point to the other segment while they cross (continuous at the
+//    first touch, negative after it), and
+//        d_self(q) = min over non-adjacent pairs                            (> 0: clear).
+//    Pairs are tested all against all, O(n²), with a bounding-circle rejection (a pair whose
+//    mid-points are farther apart than half their lengths' sum is never evaluated exactly): the
+//    cut-off costs one distance per pair, nothing is missed; 200 segments take ~20 000 pairs per
+//    point. The triangles' widths are not part of the self-contact test (the centre lines meet
+//    only after the bodies do: a detection, not a contact model).
+//
+// Along a traced branch (branch_report.h) a sign change of d_base or d_self between two
+// consecutive points is a special point "BC" / "SC", located by root finding on the signed
+// distance with an equilibrium solve at each trial load (the stretch's locked joints fixed).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "buckle/continuation/branch.h"
+#include "buckle/mechanics/branch_report.h"
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+
+namespace buckle::mechanics {
+
+/// The nearest approach of the chain to its base wall x = 0.
+struct BaseClearance {
+  double distance = 0.0;  ///< d_base: smallest x over the moving triangles' vertices
+  int segment = -1;       ///< 0-based segment whose triangle holds that vertex
+  bool distal = true;     ///< that triangle is the segment's distal (true) or proximal one
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();  ///< the vertex
+};
+/// O(n). Throws std::invalid_argument when q does not have one angle per segment.
+BaseClearance baseClearance(const Chain& chain, ConstVectorRef q);
+
+/// The nearest approach of two non-adjacent links (file comment).
+struct SelfClearance {
+  double distance = 0.0;  ///< d_self (+inf with fewer than three links)
+  int linkA = -1, linkB = -1;  ///< links m (0: the base link ℓ_0), linkA < linkB − 1
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();  ///< nearest / crossing point on link A
+};
+/// O(n²) pairs with a bounding-circle cut-off (file comment).
+SelfClearance selfClearance(const Chain& chain, ConstVectorRef q);
+
+/// Base (true) or self (false) contact located on a branch.
+struct GeometricContact {
+  bool base = true;
+  bool located = false;      ///< the root finding converged (else: to the point spacing)
+  bool entering = true;      ///< the distance goes from > 0 to < 0 along the branch
+  int index = 0;             ///< between points[index] and [index + 1]
+  double lambda = 0.0;
+  continuation::Vector u;    ///< (q, r) at the contact
+  double accuracy = 0.0;     ///< |Δλ| of the last bracket
+  int segment = -1;          ///< base: the touching segment (0-based)
+  int linkA = -1, linkB = -1;  ///< self: the links
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();
+};
+
+/// The base and self contacts along `branch` traced on `problem`; `locked[i]` the joints locked
+/// at point i (empty: none anywhere). Each sign change of d_base / d_self between consecutive
+/// points is located by Illinois iteration on λ, each trial an equilibrium solved at fixed λ with
+/// the interval's locked joints fixed (solveConstrainedEquilibrium), to |Δλ| <= tolerance·max(λ
+/// scale, |λ|). Not located (to the point spacing) across a fold inside the interval, where λ
+/// does not parametrize the branch.
+std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
+                                                      const std::vector<ContactSet>& locked, double tolerance = 1e-12);
+
+/// The located contacts of `branch` as special points "BC" / "SC" of its report `r` (its points
+/// `all`: every point of the branch, with their locked joints), the reported parameter as the
+/// report's (ReportOptions::heldCoordinate). Called by reportBranch.
+void reportGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
+                             const std::vector<PointReport>& all, const ReportOptions& options, BranchReport& r);
+
+}  // namespace buckle::mechanics

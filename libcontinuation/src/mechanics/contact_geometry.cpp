@@ -1,0 +1,232 @@
+#include "buckle/mechanics/contact_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "buckle/continuation/root_finding.h"
+#include "buckle/mechanics/shape_name.h"
+
+namespace buckle::mechanics {
+
+namespace {
+
+using Point = Eigen::Vector2d;
+
+Point dir(double t) { return Point(std::cos(t), std::sin(t)); }
+Point nrm(double t) { return Point(-std::sin(t), std::cos(t)); }
+
+double pointSegment(const Point& p, const Point& a, const Point& b, Point* nearest = nullptr) {
+  const Point d = b - a;
+  const double len2 = d.squaredNorm();
+  const double t = len2 > 0.0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+  const Point c = a + t * d;
+  if (nearest) *nearest = c;
+  return (p - c).norm();
+}
+
+double cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+/// Signed distance of segments [a, b] and [c, d] (file comment of the header): the distance
+/// while disjoint, minus the smallest end-point-to-other-segment distance while they cross.
+double segmentSegment(const Point& a, const Point& b, const Point& c, const Point& d, Point& onAB) {
+  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
+  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
+  const bool crossing = ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0));
+  Point pc, pd, tmp;
+  const double dc = pointSegment(c, a, b, &pc), dd = pointSegment(d, a, b, &pd);
+  const double da = pointSegment(a, c, d, &tmp), db = pointSegment(b, c, d, &tmp);
+  double best = dc;
+  onAB = pc;
+  if (dd < best) best = dd, onAB = pd;
+  if (da < best) best = da, onAB = a;
+  if (db < best) best = db, onAB = b;
+  if (crossing) {
+    // the crossing point itself is where the links meet
+    const double t = d1 / (d1 - d2);
+    onAB = c + t * (d - c);
+    return -best;
+  }
+  return best;
+}
+
+double distanceAt(const Chain& chain, ConstVectorRef q, bool base) {
+  return base ? baseClearance(chain, q).distance : selfClearance(chain, q).distance;
+}
+
+}  // namespace
+
+BaseClearance baseClearance(const Chain& chain, ConstVectorRef q) {
+  const int n = chain.size();
+  const Eigen::Matrix2Xd P = jointPositions(chain, q);  // checks the size
+  BaseClearance c;
+  c.distance = std::numeric_limits<double>::infinity();
+  auto consider = [&](const Point& v, int segment, bool distal) {
+    if (v.x() < c.distance) {
+      c.distance = v.x();
+      c.segment = segment;
+      c.distal = distal;
+      c.point = v;
+    }
+  };
+  double theta = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const SegmentParameters& p = chain.segment(i).parameters();
+    const Point joint = P.col(i + 1);
+    const double before = theta, after = theta + q[i];
+    if (i > 0) {  // segment 1's proximal triangle is clamped to the wall
+      consider(joint, i, false);
+      consider(joint - p.b1 * dir(before) + p.a1 * nrm(before), i, false);
+      consider(joint - p.b1 * dir(before) - p.a1 * nrm(before), i, false);
+    }
+    consider(joint + p.b2 * dir(after) + p.a2 * nrm(after), i, true);
+    consider(joint + p.b2 * dir(after) - p.a2 * nrm(after), i, true);
+    theta = after;
+  }
+  return c;
+}
+
+SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) {
+  const Eigen::Matrix2Xd P = jointPositions(chain, q);
+  const int links = int(P.cols()) - 1;  // ℓ_0 … ℓ_n: link m from column m to m + 1
+  SelfClearance c;
+  c.distance = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < links; ++a) {
+    const Point a0 = P.col(a), a1 = P.col(a + 1);
+    const Point ma = 0.5 * (a0 + a1);
+    const double ra = 0.5 * (a1 - a0).norm();
+    for (int b = a + 2; b < links; ++b) {
+      const Point b0 = P.col(b), b1 = P.col(b + 1);
+      const double rb = 0.5 * (b1 - b0).norm();
+      // bounding circles: a lower bound of the pair's distance, exact evaluation only if it
+      // could beat the best so far
+      const double bound = (0.5 * (b0 + b1) - ma).norm() - ra - rb;
+      if (bound >= c.distance) continue;
+      Point on;
+      const double d = segmentSegment(a0, a1, b0, b1, on);
+      if (d < c.distance) {
+        c.distance = d;
+        c.linkA = a;
+        c.linkB = b;
+        c.point = on;
+      }
+    }
+  }
+  return c;
+}
+
+std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
+                                                      const std::vector<ContactSet>& locked, double tolerance) {
+  std::vector<GeometricContact> found;
+  const Chain& chain = problem.chain();
+  const int n = chain.size();
+  const size_t count = branch.points.size();
+  if (count < 2) return found;
+  const double lambdaScale = problem.scales().parameter;
+  for (bool base : {true, false}) {
+    std::vector<double> d(count);
+    for (size_t i = 0; i < count; ++i) d[i] = distanceAt(chain, branch.points[i].u.head(n), base);
+    for (size_t i = 0; i + 1 < count; ++i) {
+      if ((d[i] > 0.0) == (d[i + 1] > 0.0) || !std::isfinite(d[i]) || !std::isfinite(d[i + 1])) continue;
+      const continuation::ContinuationPoint &p0 = branch.points[i], &p1 = branch.points[i + 1];
+      GeometricContact g;
+      g.base = base;
+      g.entering = d[i] > 0.0;
+      g.index = int(i);
+      // to the point spacing: the point nearer the wall / the other link
+      const bool first = std::abs(d[i]) <= std::abs(d[i + 1]);
+      g.lambda = first ? p0.lambda : p1.lambda;
+      g.u = first ? p0.u : p1.u;
+      g.accuracy = std::abs(p1.lambda - p0.lambda);
+      const ContactSet set = locked.empty() ? ContactSet() : locked[std::min(i, locked.size() - 1)];
+      const bool sameSet = locked.empty() || (i + 1 < locked.size() && locked[i + 1] == set);
+      if (p0.lambda != p1.lambda && sameSet) {
+        // Illinois on λ over the interval: each trial an equilibrium at fixed λ from the
+        // interpolated unknowns (the stretch's locked joints fixed)
+        const bool increasing = p1.lambda > p0.lambda;
+        continuation::IllinoisBracket bracket{increasing ? p0.lambda : p1.lambda, increasing ? p1.lambda : p0.lambda,
+                                              increasing ? d[i] : d[i + 1], increasing ? d[i + 1] : d[i]};
+        double bestF = std::numeric_limits<double>::infinity();
+        bool solved = true;
+        for (int it = 0; it < 100; ++it) {
+          const double s = bracket.next();
+          const double w = (s - p0.lambda) / (p1.lambda - p0.lambda);
+          const continuation::Vector guess = (1.0 - w) * p0.u + w * p1.u;
+          const ConstrainedEquilibrium e = solveConstrainedEquilibrium(problem, set, guess, s);
+          if (!e.converged) {
+            solved = false;
+            break;
+          }
+          const double f = distanceAt(chain, e.u.head(n), base);
+          if (std::abs(f) < bestF) {
+            bestF = std::abs(f);
+            g.lambda = s;
+            g.u = e.u;
+          }
+          if (f == 0.0) {
+            bracket.left = bracket.right = s;
+            break;
+          }
+          bracket.update(s, f);
+          if (bracket.width() <= tolerance * std::max(lambdaScale, std::abs(s))) break;
+        }
+        g.located = solved && bracket.width() <= tolerance * std::max(lambdaScale, std::abs(g.lambda));
+        if (g.located) g.accuracy = bracket.width();
+      }
+      const continuation::Vector q = g.u.head(n);
+      if (base) {
+        const BaseClearance c = baseClearance(chain, q);
+        g.segment = c.segment;
+        g.point = c.point;
+      } else {
+        const SelfClearance c = selfClearance(chain, q);
+        g.linkA = c.linkA;
+        g.linkB = c.linkB;
+        g.point = c.point;
+      }
+      found.push_back(std::move(g));
+    }
+  }
+  return found;
+}
+
+void reportGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
+                             const std::vector<PointReport>& all, const ReportOptions& options, BranchReport& r) {
+  const int n = problem.segments();
+  std::vector<ContactSet> locked;
+  for (const PointReport& p : all) locked.push_back(p.locked);
+  for (const GeometricContact& g : locateGeometricContacts(problem, branch, locked)) {
+    SpecialPointReport s;
+    s.type = g.base ? EventType::BaseContact : EventType::SelfContact;
+    s.index = g.index;
+    s.lambda = g.lambda;
+    s.q = g.u.head(n);
+    s.F = problem.wrench(g.u, g.lambda);
+    s.pose = endPose(problem.chain(), s.q);
+    s.parameter = options.heldCoordinate >= 0 ? s.pose[options.heldCoordinate] : g.lambda;
+    s.shape = shapeName(s.q, 1e-6);  // straightness in radians, as the report's
+    s.accuracy = g.accuracy;
+    s.refined = g.located;
+    if (size_t(g.index) + 1 < all.size()) {
+      s.negativeBefore = all[size_t(g.index)].negative;
+      s.negativeAfter = all[size_t(g.index) + 1].negative;
+    }
+    std::ostringstream os;
+    os.precision(6);
+    if (g.base)
+      os << "base contact: segment " << g.segment + 1 << "'s triangle " << (g.entering ? "reaches" : "leaves")
+         << " the clamp's wall x = 0 at y = " << g.point.y();
+    else
+      os << "self contact: links " << g.linkA << " and " << g.linkB << " " << (g.entering ? "meet" : "separate")
+         << " at (" << g.point.x() << ", " << g.point.y() << ")";
+    os << (g.located ? "; located on the branch (equilibria at fixed load)" : "; to the point spacing")
+       << " — detected only: the model lets the chain pass through";
+    s.note = os.str();
+    s.contactPoint = g.point;
+    r.specialPoints.push_back(std::move(s));
+  }
+}
+
+}  // namespace buckle::mechanics

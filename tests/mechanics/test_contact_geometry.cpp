@@ -1,0 +1,181 @@
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "buckle/mechanics/contact_geometry.h"
+#include "buckle/mechanics/equilibrium_branches.h"
+#include "buckle/mechanics/unloaded_shape.h"
+
+using namespace buckle::mechanics;
+namespace cont = buckle::continuation;
+
+namespace {
+
+// The Fig 9/10 chain of data/scenes/fig9_fig10.json, case a/b = 0.75 (fig10_shapes_Fx): three
+// segments a = 0.75, b = k = 1, preloads making q0 = (θ, −2θ, θ), cos θ = 7/8, the unloaded
+// shape (L0 = 2.25 before), all lengths times `length` and stiffnesses times `stiffness`.
+Chain fig10Chain(double length = 1.0, double stiffness = 1.0) {
+  const double theta = std::acos(7.0 / 8.0);
+  const double q0[3] = {theta, -2.0 * theta, theta};
+  std::vector<SegmentParameters> segments;
+  for (double q : q0) {
+    SegmentParameters p = preloadsForAngle(SegmentParameters::symmetric(0.75, 1.0, 1.0, 2.25), q).parameters;
+    p.a1 *= length, p.a2 *= length, p.b1 *= length, p.b2 *= length, p.L1_0 *= length, p.L2_0 *= length;
+    p.k1 *= stiffness, p.k2 *= stiffness;
+    segments.push_back(p);
+  }
+  return Chain(segments);
+}
+Vector fig10Q0() {
+  const double theta = std::acos(7.0 / 8.0);
+  Vector q(3);
+  q << theta, -2.0 * theta, theta;
+  return q;
+}
+
+// Independent signed distance to the wall x = 0: every triangle vertex written out from the
+// segment geometry (absolute angles, apexes at the joints), the clamped first triangle left out.
+double wallDistance(const Chain& chain, const Vector& q) {
+  double px = chain.linkLengths()[0], py = 0.0, theta = 0.0, d = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < chain.size(); ++i) {
+    const SegmentParameters& p = chain.segment(i).parameters();
+    const double before = theta, after = theta + q[i];
+    if (i > 0) {
+      d = std::min(d, px);
+      for (double s : {-1.0, 1.0}) d = std::min(d, px - p.b1 * std::cos(before) - s * p.a1 * std::sin(before));
+    }
+    for (double s : {-1.0, 1.0}) d = std::min(d, px + p.b2 * std::cos(after) - s * p.a2 * std::sin(after));
+    px += chain.linkLengths()[i + 1] * std::cos(after);
+    py += chain.linkLengths()[i + 1] * std::sin(after);
+    theta = after;
+  }
+  return d;
+}
+
+// Newton on ∇Π(q) = 0 of the free end under the end force (Fx, 0) (chain.h only).
+bool equilibrium(const Chain& chain, double Fx, Vector& q) {
+  const int n = chain.size();
+  Vector g(n);
+  Matrix H(n, n);
+  const Wrench W(Fx, 0.0, 0.0);
+  const double unit = chain.segment(0).parameters().k1 * std::pow(chain.segment(0).parameters().b1, 2);
+  for (int it = 0; it < 60; ++it) {
+    totalPotentialGradient(chain, q, W, g);
+    if (g.cwiseAbs().maxCoeff() <= 1e-14 * unit) return true;
+    totalPotentialHessian(chain, q, W, H);
+    q -= H.fullPivLu().solve(g);
+  }
+  totalPotentialGradient(chain, q, W, g);
+  return g.cwiseAbs().maxCoeff() <= 1e-12 * unit;
+}
+
+// The BC special points of the Fx path 0 → −2 of the chain.
+std::vector<SpecialPointReport> baseContacts(const Chain& chain) {
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Wrench::Zero()), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions options;
+  const double forceUnit = chain.segment(0).parameters().k1 * chain.segment(0).parameters().b1;
+  options.tracer.lambdaMin = -2.0 * forceUnit;
+  options.tracer.lambdaMax = 0.0;
+  options.switchingDepth = 0;
+  const EquilibriumBranches b =
+      traceEquilibria(problem, fig10Q0(), 0.0, cont::InitialDirection::decreasingLambda(), options);
+  std::vector<SpecialPointReport> found;
+  for (const SpecialPointReport& s : b.reports.at(0).specialPoints)
+    if (s.type == EventType::BaseContact) found.push_back(s);
+  return found;
+}
+
+}  // namespace
+
+TEST_CASE("fig10_shapes_Fx: the chain reaches the clamp's wall at the load an independent bisection finds",
+          "[contact_geometry]") {
+  const Chain chain = fig10Chain();
+  const std::vector<SpecialPointReport> bc = baseContacts(chain);
+  REQUIRE(bc.size() == 1);  // it goes through the wall once, before the shapes drawn at Fx = −1, −1.4
+  const SpecialPointReport& s = bc[0];
+  CHECK(std::string(label(s.type)) == "BC");
+  CHECK(s.refined);
+  CHECK(std::abs(wallDistance(chain, s.q)) < 1e-9);
+  CHECK(s.contactPoint.x() == Approx(0.0).margin(1e-9));
+  // independent: bisection on the signed distance along the branch, equilibria by Newton
+  // continued in small load steps from the unloaded shape (no tracer, no KINSOL)
+  Vector q = fig10Q0();
+  double F = 0.0, step = -0.01;
+  Vector qPrev = q;
+  double FPrev = F;
+  while (wallDistance(chain, q) > 0.0) {
+    qPrev = q;
+    FPrev = F;
+    F += step;
+    REQUIRE(equilibrium(chain, F, q));
+    REQUIRE(F > -2.0);
+  }
+  double lo = F, hi = FPrev;  // d(lo) <= 0 < d(hi)
+  Vector qLo = q, qHi = qPrev;
+  for (int it = 0; it < 200 && hi - lo > 1e-14; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    Vector qm = 0.5 * (qLo + qHi);
+    REQUIRE(equilibrium(chain, mid, qm));
+    if (wallDistance(chain, qm) > 0.0) hi = mid, qHi = qm;
+    else lo = mid, qLo = qm;
+  }
+  CHECK(s.F[0] == Approx(0.5 * (lo + hi)).epsilon(1e-9));
+  CHECK(s.F[0] == Approx(-0.4616).margin(1e-4));
+
+  // scaled units: lengths × 1e-3, stiffnesses × 1e6: the same event at Fx × (k b) = Fx × 1e3
+  const std::vector<SpecialPointReport> scaled = baseContacts(fig10Chain(1e-3, 1e6));
+  REQUIRE(scaled.size() == 1);
+  CHECK(scaled[0].F[0] == Approx(1e3 * s.F[0]).epsilon(1e-9));
+  CHECK((scaled[0].q - s.q).cwiseAbs().maxCoeff() < 1e-9);
+}
+
+TEST_CASE("base and self clearance: closed forms, crossing links, and the cut-off misses nothing (n = 50)",
+          "[contact_geometry]") {
+  // straight chain: the nearest moving vertices are segment 1's distal corners at x = b1 + b2
+  // (its apex is joint 1, fixed at x = b1) and segment 2's proximal corners, also at x = 2
+  const Chain straight = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const BaseClearance c0 = baseClearance(straight, Vector::Zero(3));
+  CHECK(c0.distance == Approx(2.0).epsilon(1e-15));
+  CHECK(selfClearance(straight, Vector::Zero(3)).distance > 0.0);
+  // four segments folded back: link 3 runs from (1.823, 1.617) down across link 1 (y = 0)
+  const Chain four = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  Vector q(4);
+  q << 0.0, 2.2, 2.2, 0.0;
+  const SelfClearance crossed = selfClearance(four, q);
+  CHECK(crossed.distance < 0.0);
+  CHECK(crossed.linkA == 1);
+  CHECK(crossed.linkB == 3);
+  CHECK(crossed.point.y() == Approx(0.0).margin(1e-12));  // on link 1, the x axis
+  q << 0.0, 1.0, 1.0, 0.0;
+  CHECK(selfClearance(four, q).distance > 0.0);
+
+  // n = 50, random shapes: the O(n) base clearance equals the independent vertex loop, and the
+  // bounding-circle cut-off gives the all-pairs minimum
+  const Chain chain = Chain::uniform(50, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> angle(-0.9, 0.9);
+  for (int trial = 0; trial < 20; ++trial) {
+    Vector qr(50);
+    for (int i = 0; i < 50; ++i) qr[i] = angle(rng);
+    CHECK(baseClearance(chain, qr).distance == Approx(wallDistance(chain, qr)).epsilon(1e-14));
+    const Eigen::Matrix2Xd P = jointPositions(chain, qr);
+    double all = std::numeric_limits<double>::infinity();
+    for (int a = 0; a + 1 < P.cols(); ++a)
+      for (int b = a + 2; b + 1 < P.cols(); ++b) {
+        // distance of two disjoint segments: the smallest end-point-to-segment distance
+        auto pointSeg = [](const Eigen::Vector2d& p, const Eigen::Vector2d& s0, const Eigen::Vector2d& s1) {
+          const Eigen::Vector2d d = s1 - s0;
+          const double t = std::clamp((p - s0).dot(d) / d.squaredNorm(), 0.0, 1.0);
+          return (p - s0 - t * d).norm();
+        };
+        const Eigen::Vector2d a0 = P.col(a), a1 = P.col(a + 1), b0 = P.col(b), b1 = P.col(b + 1);
+        all = std::min({all, pointSeg(a0, b0, b1), pointSeg(a1, b0, b1), pointSeg(b0, a0, a1), pointSeg(b1, a0, a1)});
+      }
+    const SelfClearance sc = selfClearance(chain, qr);
+    if (sc.distance > 0.0) CHECK(sc.distance == Approx(all).epsilon(1e-14));
+  }
+}
