@@ -63,6 +63,45 @@ bool Problem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, Con
   return true;
 }
 
+bool Problem::jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) {
+  const int n = dimension();
+  applyFu_.resize(n, n + 1);
+  if (!jacobian(u, lambda, applyFu_.leftCols(n), applyFu_.col(n))) return false;
+  y.noalias() = applyFu_ * x;
+  return true;
+}
+
+bool Problem::jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) {
+  const int n = dimension();
+  applyFu_.resize(n, n + 1);
+  if (!jacobian(u, lambda, applyFu_.leftCols(n), applyFu_.col(n))) return false;
+  y.noalias() = applyFu_.transpose() * w;
+  return true;
+}
+
+bool Problem::secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
+                                             VectorRef y) {
+  const int n = dimension();
+  // Step as in jacobianDirectionalDerivative (h ~ ε^{1/3} in the problem's scales).
+  const ProblemScales s = scales();
+  const bool weighted = s.check(n).empty();
+  const double uNorm = weighted ? u.cwiseQuotient(s.unknowns).norm() : u.norm();
+  const double lNorm = weighted ? std::abs(lambda) / s.parameter : std::abs(lambda);
+  const double scale = std::max({1.0, uNorm, lNorm});
+  const double dirNorm = weighted ? std::hypot(x.head(n).cwiseQuotient(s.unknowns).norm(), x[n] / s.parameter)
+                                  : x.norm();
+  if (dirNorm == 0.0) {
+    y.setZero();
+    return true;
+  }
+  const double h = 6e-6 * scale / dirNorm;
+  Vector yp(n + 1), ym(n + 1);
+  if (!jacobianTransposeApply(u + h * x.head(n), lambda + h * x[n], w, yp)) return false;
+  if (!jacobianTransposeApply(u - h * x.head(n), lambda - h * x[n], w, ym)) return false;
+  y = (yp - ym) / (2.0 * h);
+  return y.allFinite();
+}
+
 std::unique_ptr<BorderedSolver> Problem::makeStructuredSolver() { return nullptr; }
 
 bool Problem::stabilityOperator(ConstVectorRef, double, Matrix&, Matrix&) { return false; }
