@@ -186,7 +186,7 @@ bool EquilibriumProblem::jacobianApply(ConstVectorRef u, double lambda, ConstVec
   const int m = heldCount();
   Vector h(n);
   loadHessianGenerator(data_, wrench(u, lambda), h);
-  const double xl = x[n];
+  const double xl = x[n + m];  // the λ component
   // (K_g x)_i = h_i Σ_{j≤i} x_j + Σ_{j>i} h_j x_j  (K_g(i, j) = h_max(i,j), eq 27)
   double suffix = 0.0;
   for (int i = n - 1; i >= 0; --i) {
