@@ -22,6 +22,9 @@
 //  cluster.low.n<N>  the first 6 critical loads of the clamped–pinned chain [linear_buckling]
 //  cluster.top.n<N>  the 6 most compressive critical loads, spaced ~1/n² apart [linear_buckling]
 //  cluster.low.n<N>.reltol  cluster.low with locationTolerance 1e-12·|λ_1| (relative, not max(1, |λ|))
+//  switch.n<N>      the first critical load's branch point switched on both sides at n = N (above
+//                   the dense crossover at the default N = 1000) [linear_buckling; children off the
+//                   straight chain, on opposite sides]
 //  kappa0.n<N>      κ = 0 (L0 = 1.5): an (N−1)-fold zero at Fx = 0 [exact: Fx = 0, index 0 → N−1]
 //  limit.n<N>       free end, lateral end force, user limit |q| ≤ 0.3: the stop on the limit
 //                   [Newton on F(u, λ) = 0 with the limiting joint fixed, finite-difference Jacobian]
@@ -256,6 +259,59 @@ Row clustered(const std::string& id, int n, bool top, int count, bool relativeLo
   return row;
 }
 
+// Branch switching above the dense crossover: the trivial branch through the first critical
+// load of the clamped–pinned chain, both sides of it switched (tree depth 1, 20 points each).
+// Pass: the BP within 1e-12 relative of linear_buckling, two children off the straight chain
+// (‖q‖ ≥ half the arclength from the BP, as a pitchfork leaving along its mode) on opposite sides.
+Row switched(int n) {
+  Row row;
+  row.id = "switch.n" + std::to_string(n);
+  const Chain chain = Chain::uniform(n, mainSegment());
+  const Timer timer;
+  const std::vector<double> crit = compressiveCriticalLoads(chain);
+  const double lbMs = timer.ms();
+  if (crit.size() < 2) {
+    row.note = "too few critical loads";
+    return row;
+  }
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  Settings s;
+  s.maxStep = s.initialStep = std::abs(crit[0]) / 2.7;  // no step ends on the point
+  s.minStep = 1e-6 * s.maxStep;
+  const cont::TracerOptions o = tracerOptions(s, 0.5 * (crit[0] + crit[1]), 0.0);
+  cont::TreeOptions tree;
+  tree.maxDepth = 1;
+  cont::TracerOptions children = o;
+  children.maxPoints = 20;
+  children.lambdaMin = 2.0 * crit[1];
+  tree.childTracer = children;
+  const Timer traceTimer;
+  const cont::BranchTree t = cont::traceTree(problem, Eigen::VectorXd::Zero(n + 1), 0.0,
+                                             {cont::InitialDirection::decreasingLambda()}, o, tree);
+  row.ms = traceTimer.ms();
+  const auto bps = t.branches.at(0).specialPointsOfType(cont::SpecialPointType::BranchPoint);
+  row.note = std::to_string(bps.size()) + " BP, " + std::to_string(t.branches.size() - 1) + " children, linear_buckling " +
+             fmt("%.0f ms", lbMs) + " (not in the time)";
+  if (bps.size() != 1 || t.branches.size() != 3) return row;
+  row.error = relErr(bps[0]->lambda, crit[0]);
+  bool off = true;
+  double side[2] = {0.0, 0.0};
+  for (size_t b = 1; b < 3; ++b) {
+    const cont::Branch& child = t.branches[b];
+    if (child.points.size() < 3) {
+      off = false;
+      continue;
+    }
+    const cont::ContinuationPoint& p = child.points.back();
+    off = off && p.u.head(n).norm() >= 0.5 * (p.arclength - child.points.front().arclength);
+    side[b - 1] = p.u[n / 2];
+    row.note += ", child " + std::to_string(b) + ": " + std::to_string(child.points.size()) + " points, |q| " +
+                fmt("%.2e", p.u.head(n).norm());
+  }
+  row.pass = row.error <= 1e-12 && off && side[0] * side[1] < 0.0;
+  return row;
+}
+
 // ---- degenerate pitchfork --------------------------------------------------------------------
 
 Row kappaZero(int n) {
@@ -383,6 +439,7 @@ int main(int argc, char** argv) {
     const std::string id = "cluster.low.n" + std::to_string(sizes.back()) + ".reltol";
     if (want(id.c_str())) add(clustered(id, sizes.back(), false, 6, true));
   }
+  if (want("switch")) add(switched(quick ? 60 : bigN));
   if (want("kappa0"))
     for (int n : quick ? std::vector<int>{3, 4} : std::vector<int>{3, 4, 5, 10}) add(kappaZero(n));
   if (want("limit"))

@@ -85,6 +85,58 @@ TEST_CASE("ChainBorderedSolver equals the dense LU of the same bordered Jacobian
   }
 }
 
+TEST_CASE("ChainBorderedSolver::factorGeneral equals the dense LU with the same borders (k = 1, 2, transposed)",
+          "[chain_solver]") {
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.4, 0.4);
+  for (int n : {3, 17, 60}) {
+    const Chain chain = randomChain(rng, n);
+    const std::vector<std::pair<std::string, EndCondition>> ends = {
+        {"free", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng)))},
+        {"clamped-pinned", EndCondition::clampedPinned(W(rng), 0.1 * W(rng))},
+        {"all held", allHeld(0.5 * n, W(rng), W(rng))}};
+    for (const auto& [name, end] : ends) {
+      EquilibriumProblem problem(chain, end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
+      const int N = problem.dimension();
+      ChainBorderedSolver fast(problem);
+      DenseBorderedSolver dense(problem);
+      Vector u(N);
+      for (int i = 0; i < N; ++i) u[i] = i < n ? Q(rng) : W(rng);
+      const double lambda = W(rng);
+      for (int k : {1, 2}) {
+        for (bool transposed : {false, true}) {
+          INFO("n = " << n << ", " << name << ", k = " << k << ", transposed " << transposed);
+          REQUIRE(fast.maxGeneralBorder() >= k);
+          Matrix B(N, k), C(N, k), D(k, k);
+          for (int j = 0; j < k; ++j) {
+            for (int i = 0; i < N; ++i) B(i, j) = W(rng), C(i, j) = W(rng);
+            for (int i = 0; i < k; ++i) D(i, j) = W(rng);
+          }
+          Vector b(N + k), xf(N + k), xd(N + k);
+          for (int i = 0; i < N + k; ++i) b[i] = W(rng);
+          REQUIRE(dense.factorGeneral(u, lambda, B, C, D, transposed) == Factorization::Regular);
+          REQUIRE(fast.factorGeneral(u, lambda, B, C, D, transposed) == Factorization::Regular);
+          CHECK_FALSE(fast.usedDenseFallback());
+          CHECK(fast.determinantSign() == dense.determinantSign());
+          REQUIRE(dense.solve(b, xd));
+          REQUIRE(fast.solve(b, xf));
+          CHECK((xf - xd).norm() <= 1e-9 * xd.norm());
+        }
+      }
+      // factor() afterwards solves A(c) again, with A(c)'s determinant.
+      Vector c(N + 1), b(N + 1), xf(N + 1), xd(N + 1);
+      for (int i = 0; i <= N; ++i) c[i] = W(rng), b[i] = W(rng);
+      INFO("n = " << n << ", " << name << ": A(c) after general borders");
+      REQUIRE(fast.factor(u, lambda, c) == Factorization::Regular);
+      REQUIRE(dense.factor(u, lambda, c) == Factorization::Regular);
+      CHECK(fast.determinantSign() == dense.determinantSign());
+      REQUIRE(fast.solve(b, xf));
+      REQUIRE(dense.solve(b, xd));
+      CHECK((xf - xd).norm() <= 1e-10 * xd.norm());
+    }
+  }
+}
+
 TEST_CASE("ChainBorderedSolver near a singular H (an unconstrained critical load) stays accurate", "[chain_solver]") {
   // Clamped-pinned straight chain: the bordered Jacobian is regular at the free end's critical
   // loads, where H = K_q − K_g itself is singular and block elimination is at its worst.

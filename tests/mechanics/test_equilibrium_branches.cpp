@@ -360,3 +360,142 @@ TEST_CASE("hard case: top of the spectrum, n = 60: six critical loads 2e-3 apart
     CHECK(std::abs(bps[i]->lambda - crit[first + i]) <= 1e-9 * std::abs(crit[first + i]));
   }
 }
+
+// ---- above the dense crossover (maxDenseLocationDimension): the O(n) refinements -----------
+
+TEST_CASE("n = 500 clamped-pinned, default options: the clustered low end to 1e-12 relative, with null vectors",
+          "[equilibrium_branches]") {
+  // N = 501 > maxDenseLocationDimension = 400: located and refined by the structured path. The
+  // first critical loads are ~κ/n² with gaps of the same order; a step of a third of the range
+  // puts two of them in one step.
+  const int n = 500;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const std::vector<double> crit = compressiveCriticalLoads(chain);
+  REQUIRE(crit.size() > 4);
+  const double stop = 0.5 * (crit[3] + crit[4]);
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(stop, 0);
+  REQUIRE(problem.dimension() > o.tracer.maxDenseLocationDimension);
+  o.tracer.maxStep = o.tracer.initialStep = std::abs(stop) / 3;
+  o.tracer.minStep = 1e-6 * o.tracer.maxStep;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  const auto bps = branchPoints(r.tree.branches.at(0));
+  REQUIRE(bps.size() == 4);
+  const int N = problem.dimension();
+  for (size_t i = 0; i < 4; ++i) {
+    const cont::SpecialPoint& bp = *bps[i];
+    INFO("critical load " << i << ": " << bp.note);
+    CHECK(bp.refined);
+    CHECK(bp.multiplicity == 1);
+    CHECK(std::abs(bp.lambda - crit[i]) <= 1e-12 * std::abs(crit[i]));
+    CHECK(bp.u.head(n).cwiseAbs().maxCoeff() <= 1e-14);  // on the straight chain
+    // Kernel of F_x: the trivial tangent e_λ and the buckling mode; left null vector = the mode
+    // (F_u symmetric, F_λ = 0 on the straight chain).
+    REQUIRE(bp.nullVectors.cols() == 2);
+    REQUIRE(bp.leftNullVector.size() == N);
+    CHECK(std::abs(std::abs(bp.nullVectors(N, 0)) - 1.0) <= 1e-10);
+    Vector y(N);
+    Vector phi = bp.nullVectors.col(1);
+    REQUIRE(problem.jacobianApply(bp.u, bp.lambda, phi, y));
+    CHECK(y.norm() <= 1e-10);
+    CHECK(std::abs(phi.head(N).dot(bp.leftNullVector)) >= 1.0 - 1e-10);
+  }
+}
+
+TEST_CASE("structured and dense refinement agree on the same chain (crossover forced)", "[equilibrium_branches]") {
+  SECTION("branch points of a clamped-pinned chain of 40 segments") {
+    const int n = 40;
+    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+    const std::vector<double> crit = compressiveCriticalLoads(chain);
+    REQUIRE(crit.size() > 3);
+    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+    EquilibriumBranchOptions o = pinnedOptions(0.5 * (crit[2] + crit[3]), 0);
+    o.tracer.maxStep = o.tracer.initialStep = std::abs(crit[0]) / 2.7;
+    const EquilibriumBranches dense =
+        traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+    o.tracer.maxDenseLocationDimension = 10;
+    const EquilibriumBranches fast =
+        traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+    const auto d = branchPoints(dense.tree.branches.at(0)), s = branchPoints(fast.tree.branches.at(0));
+    REQUIRE(d.size() == 3);
+    REQUIRE(s.size() == 3);
+    for (size_t i = 0; i < 3; ++i) {
+      INFO("branch point " << i);
+      CHECK(s[i]->refined);
+      CHECK(std::abs(s[i]->lambda - d[i]->lambda) <= 1e-12 * std::abs(d[i]->lambda));
+      CHECK(std::abs(s[i]->lambda - crit[i]) <= 1e-12 * std::abs(crit[i]));
+      CHECK(std::abs(s[i]->leftNullVector.dot(d[i]->leftNullVector)) >= 1.0 - 1e-9);
+      CHECK(std::abs(s[i]->nullVectors.col(1).dot(d[i]->nullVectors.col(1))) >= 1.0 - 1e-9);
+      CHECK(std::abs(s[i]->tangent.dot(d[i]->tangent)) >= 1.0 - 1e-9);
+    }
+  }
+  SECTION("the fold of the free end under a lateral load (AUTO case I_up)") {
+    const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 0.5));
+    EquilibriumProblem problem(chain, EndCondition::freeEnd(Eigen::Vector3d(0.0, 0.01, 0.0)),
+                               Eigen::Vector3d(1, 0, 0));
+    EquilibriumBranchOptions o;
+    o.tracer.lambdaMin = -1.0;
+    o.tracer.lambdaMax = 1.0;
+    o.tracer.maxStep = 0.05;
+    o.tracer.maxPoints = 400;
+    o.switchingDepth = 0;
+    o.tracer.boxLower = Eigen::VectorXd::Constant(4, -3.0);
+    o.tracer.boxUpper = Eigen::VectorXd::Constant(4, 3.0);
+    const EquilibriumBranches dense =
+        traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
+    o.tracer.maxDenseLocationDimension = 1;
+    const EquilibriumBranches fast =
+        traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
+    const auto d = dense.tree.branches[0].specialPointsOfType(cont::SpecialPointType::Fold);
+    const auto s = fast.tree.branches[0].specialPointsOfType(cont::SpecialPointType::Fold);
+    REQUIRE(!d.empty());
+    REQUIRE(s.size() == d.size());
+    for (size_t i = 0; i < d.size(); ++i) {
+      INFO("fold " << i << ": " << s[i]->note);
+      CHECK(s[i]->refined);
+      CHECK(std::abs(s[i]->lambda - d[i]->lambda) <= 1e-12 * std::max(1.0, std::abs(d[i]->lambda)));
+      CHECK((s[i]->u - d[i]->u).norm() <= 1e-6);
+      CHECK(std::abs(s[i]->nullVectors.col(0).dot(d[i]->nullVectors.col(0))) >= 1.0 - 1e-9);
+    }
+    CHECK(s.front()->lambda == Approx(0.17770974215).margin(5e-11));  // AUTO-07p, 11 digits
+  }
+}
+
+TEST_CASE("n = 500: the first branch point is switched on both sides above the dense crossover",
+          "[equilibrium_branches]") {
+  const int n = 500;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const std::vector<double> crit = compressiveCriticalLoads(chain);
+  REQUIRE(crit.size() > 2);
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(0.5 * (crit[0] + crit[1]), 1);
+  o.tracer.maxStep = o.tracer.initialStep = std::abs(crit[0]) / 2.7;  // no step ends on the point
+  o.tracer.minStep = 1e-6 * o.tracer.maxStep;
+  cont::TracerOptions children = o.tracer;
+  children.maxPoints = 8;
+  children.lambdaMin = 2.0 * crit[1];
+  o.childTracer = children;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  const auto bps = branchPoints(r.tree.branches.at(0));
+  REQUIRE(bps.size() == 1);
+  INFO(bps[0]->note);
+  CHECK(std::abs(bps[0]->lambda - crit[0]) <= 1e-12 * std::abs(crit[0]));
+  REQUIRE(r.tree.branches.size() == 3);
+  double sideSign[2] = {0.0, 0.0};
+  for (size_t bi = 1; bi < 3; ++bi) {
+    const cont::Branch& child = r.tree.branches[bi];
+    INFO("child " << bi << ": " << child.stopMessage);
+    REQUIRE(child.points.size() >= 3);
+    const cont::ContinuationPoint& p = child.points.back();
+    // Off the straight chain (a pitchfork leaves along the mode: ‖q‖ ≈ the arclength from the
+    // branch point) and an equilibrium; the two sides are mirror images.
+    CHECK(p.u.head(n).norm() >= 0.5 * (p.arclength - child.points.front().arclength));
+    Vector F(problem.dimension());
+    REQUIRE(problem.residual(p.u, p.lambda, F));
+    CHECK(F.norm() <= 1e-8);
+    sideSign[bi - 1] = p.u[n / 2];
+  }
+  CHECK(sideSign[0] * sideSign[1] < 0.0);  // the two sides of the pitchfork
+}

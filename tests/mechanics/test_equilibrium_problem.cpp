@@ -326,3 +326,38 @@ TEST_CASE("a chain's geometric joint limit: the load equals Newton's with the jo
   CHECK(std::abs(bd->lambda - lambda) <= 1e-12 * std::abs(lambda));
   CHECK((bd->u - u).norm() <= 1e-11);
 }
+
+TEST_CASE("EquilibriumProblem O(n) products equal the dense F_x, F_x^T and second derivative", "[equilibrium]") {
+  std::mt19937 rng(303);
+  std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
+  for (int n : {1, 4, 30}) {
+    const Chain chain = randomChain(rng, n);
+    for (const Setting& s : settings(rng)) {
+      INFO("n = " << n << ", end: " << s.name);
+      EquilibriumProblem problem(chain, s.end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
+      const int N = problem.dimension();
+      const Vector u = randomState(rng, chain, N);
+      const double lambda = Lam(rng);
+      Vector x(N + 1), w(N), dx(N + 1);
+      for (int i = 0; i <= N; ++i) x[i] = W(rng), dx[i] = W(rng);
+      for (int i = 0; i < N; ++i) w[i] = W(rng);
+      Matrix Fx(N, N + 1), dFx(N, N + 1);
+      REQUIRE(problem.jacobian(u, lambda, Fx.leftCols(N), Fx.col(N)));
+      // Rounding bound of the dense product: eps·|F_x|·|x| row by row.
+      const double eps = std::numeric_limits<double>::epsilon();
+      Vector y(N), yt(N + 1), y2(N + 1);
+      REQUIRE(problem.jacobianApply(u, lambda, x, y));
+      const Vector bound = Fx.cwiseAbs() * x.cwiseAbs();
+      for (int i = 0; i < N; ++i) CHECK(std::abs(y[i] - Fx.row(i).dot(x)) <= 8.0 * (n + 3) * eps * bound[i]);
+      REQUIRE(problem.jacobianTransposeApply(u, lambda, w, yt));
+      const Vector boundT = Fx.transpose().cwiseAbs() * w.cwiseAbs();
+      for (int i = 0; i <= N; ++i) CHECK(std::abs(yt[i] - Fx.col(i).dot(w)) <= 8.0 * (n + 3) * eps * boundT[i]);
+      // (F_xx[dx, ·])ᵀw (central differences of jacobianTransposeApply) against the exact
+      // directional derivative of F_x.
+      REQUIRE(problem.secondDerivativeTransposeApply(u, lambda, dx, w, y2));
+      REQUIRE(problem.jacobianDirectionalDerivative(u, lambda, dx.head(N), dx[N], dFx.leftCols(N), dFx.col(N)));
+      const Vector exact = dFx.transpose() * w;
+      CHECK((y2 - exact).norm() <= 1e-7 * std::max(1.0, exact.norm()));
+    }
+  }
+}

@@ -35,7 +35,8 @@ void orient(Vector &direction, int n) {
 
 }  // namespace
 
-bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note) {
+bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note,
+                          bool structured) {
   const int n = problem.dimension();
   // In the problem's scaled variables (scaled_problem.h), where the kernel and the
   // bifurcation-equation thresholds are relative; the direction comes back in its units.
@@ -43,7 +44,7 @@ bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &dire
   if (!scales.identity() && scales.check(n).empty()) {
     const UnitScaling units(scales);
     ScaledProblem scaled(problem, units);  // its own scales are ones: no further recursion
-    const bool found = bifurcatingDirection(scaled, units.scaled(bp), direction, note);
+    const bool found = bifurcatingDirection(scaled, units.scaled(bp), direction, note, structured);
     if (found) direction = units.directionToUser(direction);
     return found;
   }
@@ -55,6 +56,10 @@ bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &dire
   const Vector phi = bp.nullVectors.col(1);
   Vector psi = bp.leftNullVector;
   if (psi.size() != n) {
+    if (structured) {
+      if (note) *note = "no left null vector (structured location did not refine the point)";
+      return false;
+    }
     KernelInfo kernel;
     if (!jacobianKernel(problem, bp.u, bp.lambda, kernel)) return false;
     psi = kernel.left.col(0);
@@ -62,7 +67,9 @@ bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &dire
   direction = phi;
   Vector d1, d2;
   std::string why;
-  if (!bifurcationDirections(problem, bp.u, bp.lambda, psi, t, phi, d1, d2, &why)) {
+  const bool roots = structured ? bifurcationDirectionsApplied(problem, bp.u, bp.lambda, psi, t, phi, d1, d2, &why)
+                                : bifurcationDirections(problem, bp.u, bp.lambda, psi, t, phi, d1, d2, &why);
+  if (!roots) {
     orient(direction, n);
     if (note) *note = why + ": kernel direction orthogonal to the parent tangent";
     return true;
@@ -160,7 +167,8 @@ std::vector<Branch> switchBothSides(Tracer &tracer, const SpecialPoint &bp, cons
                                     std::string *how, const std::function<bool(const Branch &child)> &accept) {
   std::vector<Branch> sides;
   Vector direction;
-  if (!bifurcatingDirection(tracer.problem(), bp, direction, how)) return sides;
+  const bool structured = tracer.problem().dimension() > tracer.options().maxDenseLocationDimension;
+  if (!bifurcatingDirection(tracer.problem(), bp, direction, how, structured)) return sides;
   for (int sign : {1, -1}) {
     sides.push_back(switchBranch(tracer, bp, direction, sign, options));
     if (accept && accept(sides.back())) break;

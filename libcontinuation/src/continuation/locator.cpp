@@ -264,10 +264,9 @@ SpecialPoint Locator::locateFold(const StepSample &lo, const StepSample &hi) {
     sp.note = root.failure.empty() ? "" : "fold secant: " + root.failure;
   };
   adopt(ok);
-  if (!options_.denseAlgebra) sp.note += (sp.note.empty() ? "" : "; ") + std::string("secant only (large N)");
-  if ((!options_.denseAlgebra || !refineFold(sp, a_.point.tangent)) && ok && root.fLeft * root.fRight < 0.0) {
-    finishSecant(sp, root, test, evaluations, adopt);
-  }
+  const bool refined =
+      options_.denseAlgebra ? refineFold(sp, a_.point.tangent) : refineFoldStructured(sp, a_.point.tangent);
+  if (!refined && ok && root.fLeft * root.fRight < 0.0) finishSecant(sp, root, test, evaluations, adopt);
   sp.residualNorm = residualNorm(sp.u, sp.lambda);
   return sp;
 }
@@ -328,12 +327,35 @@ bool Locator::refineFold(SpecialPoint &sp, const Vector &tangentRef) {
     sp.nullVectors = c;
     return false;
   }
-  sp.refined = true;
   sp.u = z.head(n);
   sp.lambda = z[n];
-  sp.lambdaAccuracy = result.lastDLambda;
-  sp.augmentedResidualNorm = result.residualNorm;
-  const Vector v = z.tail(n);
+  adoptRefinedFold(sp, tangentRef, z.tail(n), result.lastDLambda, result.residualNorm);
+  return true;
+}
+
+bool Locator::refineFoldStructured(SpecialPoint &sp, const Vector &tangentRef) {
+  Vector u = sp.u, v;
+  double lambda = sp.lambda;
+  const double maxDistance = 4.0 * dx_.norm() + 1e-8 + 4.0;
+  const StructuredRefinementResult result = structured().fold(
+      u, lambda, sp.tangent.size() == n_ + 1 ? sp.tangent : tangentRef, v, maxDistance);
+  sp.locationIterations += result.iterations;
+  if (!result.converged) {
+    sp.note += (sp.note.empty() ? "" : "; ") + std::string("fold refinement (structured): ") + result.failure;
+    return false;
+  }
+  sp.u = u;
+  sp.lambda = lambda;
+  adoptRefinedFold(sp, tangentRef, v, result.lastDLambda, result.residualNorm);
+  return true;
+}
+
+void Locator::adoptRefinedFold(SpecialPoint &sp, const Vector &tangentRef, const Vector &v, double lastDLambda,
+                               double augmentedResidual) {
+  const int n = n_;
+  sp.refined = true;
+  sp.lambdaAccuracy = lastDLambda;
+  sp.augmentedResidualNorm = augmentedResidual;
   sp.nullVectors = v.normalized();
   ContinuationPoint p;
   p.u = sp.u;
@@ -350,7 +372,6 @@ bool Locator::refineFold(SpecialPoint &sp, const Vector &tangentRef) {
   // Along the located fold the arclength is interpolated in the step coordinate.
   sp.arclength = a_.point.arclength + tangentRef.dot(
                      (Vector(n + 1) << sp.u, sp.lambda).finished() - xa_);
-  return true;
 }
 
 SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSample &hi) {
@@ -390,7 +411,6 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
     haveTest = test(lo.point, fLo) && test(hi.point, fHi) && !sameSign(fLo, fHi);
     sp.note = "inertia change without determinant sign change; located on the crossing eigenvalue";
   }
-  if (!options_.denseAlgebra) sp.note += (sp.note.empty() ? "" : "; ") + std::string("secant only (large N)");
 
   Root root;
   bool ok = false;
@@ -411,9 +431,18 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
     else if (!root.failure.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("branch point secant: " + root.failure);
   };
   adopt(ok);
-  if ((!options_.denseAlgebra || !refineBranchPoint(sp, a_.point.tangent)) && ok && root.fLeft * root.fRight < 0.0) {
+  const bool refined = options_.denseAlgebra ? refineBranchPoint(sp, a_.point.tangent)
+                                             : refineBranchPointStructured(sp, a_.point.tangent);
+  if (!refined && ok && root.fLeft * root.fRight < 0.0) {
     finishSecant(sp, root, test, evaluations, adopt);
-    fillBranchPointGeometry(sp, a_.point.tangent);
+    if (options_.denseAlgebra) {
+      fillBranchPointGeometry(sp, a_.point.tangent);
+    } else {
+      Matrix K;
+      Vector psi;
+      if (structured().approximateKernel(sp.u, sp.lambda, sp.tangent, K, psi))
+        setBranchPointGeometry(sp, a_.point.tangent, K, psi, sp.testFunctionValue);
+    }
   }
   sp.residualNorm = residualNorm(sp.u, sp.lambda);
   return sp;
@@ -474,6 +503,63 @@ bool Locator::refineBranchPoint(SpecialPoint &sp, const Vector &tangentRef) {
   }
   fillBranchPointGeometry(sp, tangentRef);
   return result.converged;
+}
+
+bool Locator::refineBranchPointStructured(SpecialPoint &sp, const Vector &tangentRef) {
+  Vector u = sp.u, psi;
+  double lambda = sp.lambda;
+  Matrix K;
+  const double maxDistance = 4.0 * dx_.norm() + 1e-8 + 4.0;
+  const StructuredRefinementResult result = structured().branchPoint(
+      u, lambda, sp.tangent.size() == n_ + 1 ? sp.tangent : tangentRef, K, psi, maxDistance);
+  sp.locationIterations += result.iterations;
+  if (!result.converged) {
+    sp.note += (sp.note.empty() ? "" : "; ") + std::string("branch-point refinement (structured): ") + result.failure;
+    return false;
+  }
+  sp.refined = true;
+  sp.u = u;
+  sp.lambda = lambda;
+  sp.lambdaAccuracy = result.lastDLambda;
+  sp.augmentedResidualNorm = result.residualNorm;
+  sp.arclength = a_.point.arclength + tangentRef.dot((Vector(n_ + 1) << sp.u, sp.lambda).finished() - xa_);
+  setBranchPointGeometry(sp, tangentRef, K, psi, result.testValue);
+  return true;
+}
+
+StructuredRefinement &Locator::structured() {
+  if (!structured_) {
+    refinementSolver_ = problem_.makeStructuredSolver();
+    if (!refinementSolver_ || refinementSolver_->maxGeneralBorder() < 2)
+      refinementSolver_ = std::make_unique<DenseBorderedSolver>(problem_);
+    structured_ = std::make_unique<StructuredRefinement>(problem_, *refinementSolver_, options_.tolerance,
+                                                         options_.maxRefinementIterations);
+  }
+  return *structured_;
+}
+
+void Locator::setBranchPointGeometry(SpecialPoint &sp, const Vector &tangentRef, const Matrix &K, const Vector &psi,
+                                     double testValue) {
+  // As fillBranchPointGeometry for a simple point: the traced branch's own tangent is the root of
+  // the bifurcation equation closest to the step's tangent (else the projection onto the kernel).
+  Vector t = K * (K.transpose() * tangentRef);
+  if (t.norm() < 1e-12) t = K.col(0);
+  t.normalize();
+  Vector d1, d2;
+  if (bifurcationDirectionsApplied(problem_, sp.u, sp.lambda, psi, K.col(0), K.col(1), d1, d2))
+    t = std::abs(d1.dot(tangentRef)) >= std::abs(d2.dot(tangentRef)) ? d1 : d2;
+  if (t.dot(tangentRef) < 0.0) t = -t;
+  Matrix basis(n_ + 1, 2);
+  basis.col(0) = t;
+  int filled = 1;
+  for (int k = 0; k < 2 && filled < 2; ++k) {
+    Vector w = K.col(k) - t.dot(K.col(k)) * t;
+    if (w.norm() > 1e-6) basis.col(filled++) = w.normalized();
+  }
+  sp.nullVectors = basis.leftCols(filled);
+  sp.tangent = t;
+  sp.leftNullVector = psi;
+  sp.testFunctionValue = testValue;
 }
 
 void Locator::fillBranchPointGeometry(SpecialPoint &sp, const Vector &tangentRef) {

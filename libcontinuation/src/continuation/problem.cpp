@@ -33,26 +33,34 @@ std::string ProblemScales::check(int n) const {
   return "";
 }
 
-bool Problem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
-                                            double dlambda, MatrixRef dFu, VectorRef dFlambda) {
-  const int n = dimension();
-  // Step scaled to the point so that the O(h²) truncation and O(ε/h) rounding errors balance
-  // (h ~ ε^{1/3}); Newton on the augmented systems only needs an approximate Jacobian, the
-  // located point's accuracy is set by the exact residuals. Norms in the problem's own scales,
-  // so that "1" is a typical size in every unit system.
-  const ProblemScales s = scales();
-  const bool weighted = s.check(n).empty();
+namespace {
+
+// Central-difference step along (du, dλ), 0 for a zero direction. Scaled to the point so that
+// the O(h²) truncation and O(ε/h) rounding errors balance (h ~ ε^{1/3}); Newton on the augmented
+// systems only needs an approximate Jacobian, the located point's accuracy is set by the exact
+// residuals. Norms in the problem's own scales, so that "1" is a typical size in every unit system.
+double differenceStep(const Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda) {
+  const ProblemScales s = problem.scales();
+  const bool weighted = s.check(problem.dimension()).empty();
   const double uNorm = weighted ? u.cwiseQuotient(s.unknowns).norm() : u.norm();
   const double lNorm = weighted ? std::abs(lambda) / s.parameter : std::abs(lambda);
   const double scale = std::max({1.0, uNorm, lNorm});
   const double dirNorm = weighted ? std::hypot(du.cwiseQuotient(s.unknowns).norm(), dlambda / s.parameter)
                                   : std::sqrt(du.squaredNorm() + dlambda * dlambda);
-  if (dirNorm == 0.0) {
+  return dirNorm == 0.0 ? 0.0 : 6e-6 * scale / dirNorm;
+}
+
+}  // namespace
+
+bool Problem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
+                                            double dlambda, MatrixRef dFu, VectorRef dFlambda) {
+  const int n = dimension();
+  const double h = differenceStep(*this, u, lambda, du, dlambda);
+  if (h == 0.0) {
     dFu.setZero();
     dFlambda.setZero();
     return true;
   }
-  const double h = 6e-6 * scale / dirNorm;
   Vector up = u + h * du, um = u - h * du;
   Matrix Jp(n, n), Jm(n, n);
   Vector lp(n), lm(n);
@@ -61,6 +69,37 @@ bool Problem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, Con
   dFu = (Jp - Jm) / (2.0 * h);
   dFlambda = (lp - lm) / (2.0 * h);
   return true;
+}
+
+bool Problem::jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) {
+  const int n = dimension();
+  applyFu_.resize(n, n + 1);
+  if (!jacobian(u, lambda, applyFu_.leftCols(n), applyFu_.col(n))) return false;
+  y.noalias() = applyFu_ * x;
+  return true;
+}
+
+bool Problem::jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) {
+  const int n = dimension();
+  applyFu_.resize(n, n + 1);
+  if (!jacobian(u, lambda, applyFu_.leftCols(n), applyFu_.col(n))) return false;
+  y.noalias() = applyFu_.transpose() * w;
+  return true;
+}
+
+bool Problem::secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
+                                             VectorRef y) {
+  const int n = dimension();
+  const double h = differenceStep(*this, u, lambda, x.head(n), x[n]);
+  if (h == 0.0) {
+    y.setZero();
+    return true;
+  }
+  Vector yp(n + 1), ym(n + 1);
+  if (!jacobianTransposeApply(u + h * x.head(n), lambda + h * x[n], w, yp)) return false;
+  if (!jacobianTransposeApply(u - h * x.head(n), lambda - h * x[n], w, ym)) return false;
+  y = (yp - ym) / (2.0 * h);
+  return y.allFinite();
 }
 
 std::unique_ptr<BorderedSolver> Problem::makeStructuredSolver() { return nullptr; }

@@ -152,6 +152,38 @@ bool ScaledProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lambd
   return true;
 }
 
+bool ScaledProblem::jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) {
+  // F̃_x x̃ = D_F⁻¹ F_x S x̃, S = diag(D_u, λ₀).
+  x_.resize(n_ + 1);
+  x_.head(n_) = x.head(n_).cwiseProduct(units_.scales().unknowns);
+  x_[n_] = x[n_] * units_.parameter();
+  if (!problem_.jacobianApply(user(u), lambda * units_.parameter(), x_, y)) return false;
+  y.array() /= units_.scales().residuals.array();
+  return true;
+}
+
+bool ScaledProblem::jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) {
+  // F̃_xᵀ w̃ = S F_xᵀ D_F⁻¹ w̃.
+  w_ = w.cwiseQuotient(units_.scales().residuals);
+  if (!problem_.jacobianTransposeApply(user(u), lambda * units_.parameter(), w_, y)) return false;
+  y.head(n_).array() *= units_.scales().unknowns.array();
+  y[n_] *= units_.parameter();
+  return true;
+}
+
+bool ScaledProblem::secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x,
+                                                   ConstVectorRef w, VectorRef y) {
+  // F̃(x̃) = D_F⁻¹ F(S x̃): (F̃_xx[x̃, ·])ᵀ w̃ = S (F_xx[S x̃, ·])ᵀ D_F⁻¹ w̃.
+  x_.resize(n_ + 1);
+  x_.head(n_) = x.head(n_).cwiseProduct(units_.scales().unknowns);
+  x_[n_] = x[n_] * units_.parameter();
+  w_ = w.cwiseQuotient(units_.scales().residuals);
+  if (!problem_.secondDerivativeTransposeApply(user(u), lambda * units_.parameter(), x_, w_, y)) return false;
+  y.head(n_).array() *= units_.scales().unknowns.array();
+  y[n_] *= units_.parameter();
+  return true;
+}
+
 bool ScaledProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) {
   if (!problem_.stabilityOperator(user(u), lambda * units_.parameter(), H, C)) return false;
   H /= units_.scales().stability;
@@ -189,12 +221,39 @@ ScaledBorderedSolver::ScaledBorderedSolver(std::unique_ptr<BorderedSolver> solve
 }
 
 Factorization ScaledBorderedSolver::factor(ConstVectorRef u, double lambda, ConstVectorRef c) {
+  general_ = false;
   u_ = u.cwiseProduct(units_.scales().unknowns);
   c_ = c.cwiseQuotient(stateScales_);
   return solver_->factor(u_, lambda * units_.parameter(), c_);
 }
 
+Factorization ScaledBorderedSolver::factorGeneral(ConstVectorRef u, double lambda, ConstMatrixRef B, ConstMatrixRef C,
+                                                  ConstMatrixRef D, bool transposed) {
+  general_ = true;
+  const ProblemScales &s = units_.scales();
+  u_ = u.cwiseProduct(s.unknowns);
+  // Plain: G̃ = diag(D_F⁻¹, I) G diag(D_u, I), so B = D_F B̃, C = D_u⁻¹ C̃, and G̃x̃ = b̃ is
+  // G (D_u x̃) = D_F b̃. Transposed: G̃ = diag(D_u, I) G diag(D_F⁻¹, I), so B = D_u⁻¹ B̃,
+  // C = D_F C̃, and G (D_F⁻¹ x̃) = D_u⁻¹ b̃.
+  const Vector &left = transposed ? s.unknowns : s.residuals;
+  const Vector &right = transposed ? s.residuals : s.unknowns;
+  inScale_ = transposed ? Vector(left.cwiseInverse()) : left;
+  outScale_ = transposed ? right : Vector(right.cwiseInverse());
+  const Matrix Bu = transposed ? Matrix(B.array().colwise() / left.array()) : Matrix(B.array().colwise() * left.array());
+  const Matrix Cu =
+      transposed ? Matrix(C.array().colwise() * right.array()) : Matrix(C.array().colwise() / right.array());
+  return solver_->factorGeneral(u_, lambda * units_.parameter(), Bu, Cu, D, transposed);
+}
+
 bool ScaledBorderedSolver::solve(ConstVectorRef b, VectorRef x) {
+  if (general_) {
+    const Eigen::Index n = inScale_.size();
+    b_ = b;
+    b_.head(n).array() *= inScale_.array();
+    if (!solver_->solve(b_, x)) return false;
+    x.head(n).array() *= outScale_.array();
+    return x.allFinite();
+  }
   // Ã x̃ = b̃  ⇔  A (S x̃) = diag(D_F, 1) b̃.
   b_ = b.cwiseProduct(rowScales_);
   if (!solver_->solve(b_, x)) return false;

@@ -127,6 +127,12 @@ bool jacobianKernel(Problem &problem, ConstVectorRef u, double lambda, KernelInf
   return true;
 }
 
+namespace {
+// Real roots d = αk₁ + βk₂ of aα² + 2bαβ + cβ² = 0, normalised.
+bool bifurcationRoots(double a, double b, double c, ConstVectorRef k1, ConstVectorRef k2, Vector &d1, Vector &d2,
+                      std::string *why);
+}  // namespace
+
 bool bifurcationDirections(Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi, ConstVectorRef k1,
                            ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why) {
   const int n = problem.dimension();
@@ -140,6 +146,29 @@ bool bifurcationDirections(Problem &problem, ConstVectorRef u, double lambda, Co
   const double a = psi.dot(D1 * k1);
   const double b = 0.5 * (psi.dot(D1 * k2) + psi.dot(D2 * k1));
   const double c = psi.dot(D2 * k2);
+  return bifurcationRoots(a, b, c, k1, k2, d1, d2, why);
+}
+
+bool bifurcationDirectionsApplied(Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi,
+                                  ConstVectorRef k1, ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why) {
+  const int n = problem.dimension();
+  Vector y1(n + 1), y2(n + 1);
+  // y_i = (F_xx[k_i, ·])ᵀψ, so ψᵀF_xx[k_i, k_j] = y_i · k_j.
+  if (!problem.secondDerivativeTransposeApply(u, lambda, k1, psi, y1) ||
+      !problem.secondDerivativeTransposeApply(u, lambda, k2, psi, y2)) {
+    if (why) *why = "second derivatives unavailable";
+    return false;
+  }
+  const double a = y1.dot(k1);
+  const double b = 0.5 * (y1.dot(k2) + y2.dot(k1));
+  const double c = y2.dot(k2);
+  return bifurcationRoots(a, b, c, k1, k2, d1, d2, why);
+}
+
+namespace {
+
+bool bifurcationRoots(double a, double b, double c, ConstVectorRef k1, ConstVectorRef k2, Vector &d1, Vector &d2,
+                      std::string *why) {
   const double scale = std::max({std::abs(a), std::abs(b), std::abs(c)});
   if (!(scale > 1e-12)) {
     if (why) *why = "degenerate bifurcation equation (vanishing second derivatives)";
@@ -167,5 +196,7 @@ bool bifurcationDirections(Problem &problem, ConstVectorRef u, double lambda, Co
   d2.normalize();
   return true;
 }
+
+}  // namespace
 
 }  // namespace buckle::continuation

@@ -29,6 +29,7 @@ ChainBorderedSolver::ChainBorderedSolver(EquilibriumProblem& problem)
 }
 
 Factorization ChainBorderedSolver::factor(ConstVectorRef u, double lambda, ConstVectorRef c) {
+  general_ = false;
   sign_ = 0;
   logAbs_ = -std::numeric_limits<double>::infinity();
   usingDense_ = false;
@@ -60,9 +61,53 @@ Factorization ChainBorderedSolver::factor(ConstVectorRef u, double lambda, Const
   return f;
 }
 
+Factorization ChainBorderedSolver::factorGeneral(ConstVectorRef u, double lambda, continuation::ConstMatrixRef B,
+                                                 continuation::ConstMatrixRef C, continuation::ConstMatrixRef D,
+                                                 bool transposed) {
+  general_ = true;
+  sign_ = 0;
+  logAbs_ = -std::numeric_limits<double>::infinity();
+  usingDense_ = false;
+  const int k = int(B.cols()), p = m_ + k;
+  if (k < 1 || p > ChainStructure::kMaxBorder || B.rows() != n_ + m_ || C.rows() != n_ + m_ || C.cols() != k ||
+      D.rows() != k || D.cols() != k || !B.allFinite() || !C.allFinite() || !D.allFinite())
+    return Factorization::Refused;
+  if (!problem_.assembleStructure(u, lambda, ws_, J_)) return Factorization::Refused;
+  Vg_.resize(n_, p);
+  Wg_.resize(n_, p);
+  Dg_ = Matrix::Zero(p, p);
+  yg_.resize(p);
+  for (int j = 0; j < m_; ++j) {
+    Vg_.col(j) = -J_.row(held_[size_t(j)]).transpose();
+    Wg_.col(j) = Vg_.col(j);
+  }
+  Vg_.rightCols(k) = B.topRows(n_);
+  Wg_.rightCols(k) = C.topRows(n_);
+  Dg_.topRightCorner(m_, k) = B.bottomRows(m_);
+  Dg_.bottomLeftCorner(k, m_) = C.bottomRows(m_).transpose();
+  Dg_.bottomRightCorner(k, k) = D;
+  if (factorBordered(ws_, Vg_, Wg_, Dg_)) {
+    sign_ = ws_.borderedDetSign;
+    logAbs_ = ws_.borderedLogAbsDet;
+    return Factorization::Regular;
+  }
+  if (!dense_) return Factorization::Singular;
+  usingDense_ = true;
+  const Factorization f = dense_->factorGeneral(u, lambda, B, C, D, transposed);
+  sign_ = dense_->determinantSign();
+  return f;
+}
+
 bool ChainBorderedSolver::solve(ConstVectorRef b, VectorRef x) {
   if (sign_ == 0) return false;
   if (usingDense_) return dense_->solve(b, x);
+  if (general_) {
+    const int p = int(Vg_.cols());
+    if (!solveFactoredBordered(ws_, Vg_, Wg_, Dg_, b.head(n_), b.tail(p), x_, yg_)) return false;
+    x.head(n_) = x_;
+    x.tail(p) = yg_;
+    return true;
+  }
   if (!solveFactoredBordered(ws_, V_, W_, D_, b.head(n_), b.tail(p_), x_, y_)) return false;
   x.head(n_) = x_;
   x.tail(p_) = y_;

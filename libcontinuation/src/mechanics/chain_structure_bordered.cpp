@@ -45,7 +45,7 @@ bool factorBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const
   const int p = int(V.cols());
   if (p > ChainStructure::kMaxBorder || W.cols() != p || D.rows() != p || D.cols() != p || V.rows() != n ||
       W.rows() != n)
-    throw std::invalid_argument("factorBordered: V, W must be n×p and D p×p with p <= 4");
+    throw std::invalid_argument("factorBordered: V, W must be n×p and D p×p with p <= kMaxBorder");
   ws.borderSize = -1;
   factorize(ws, 0.0);
   if (ws.singular) return false;

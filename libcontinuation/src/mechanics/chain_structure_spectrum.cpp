@@ -48,7 +48,7 @@ Inertia hessianInertia(const ChainStructure& ws, double zeroTolerance) {
 
 int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double rankTolerance) {
   const int n = ws.n;
-  if (C.rows() > ChainStructure::kMaxBorder - 1 || (C.rows() > 0 && C.cols() != n))
+  if (C.rows() > 3 || (C.rows() > 0 && C.cols() != n))
     throw std::invalid_argument("setConstraints: C must be m×n with m <= 3");
   double maxNorm = 0.0;
   for (Eigen::Index i = 0; i < C.rows(); ++i) maxNorm = std::max(maxNorm, C.row(i).norm());

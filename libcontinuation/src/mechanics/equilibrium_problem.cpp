@@ -180,6 +180,48 @@ bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double 
   return true;
 }
 
+bool EquilibriumProblem::jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) {
+  if (!std::isfinite(lambda) || !prepare(u)) return false;
+  const int n = chain_.size();
+  const int m = heldCount();
+  Vector h(n);
+  loadHessianGenerator(data_, wrench(u, lambda), h);
+  const double xl = x[n + m];  // the λ component
+  // (K_g x)_i = h_i Σ_{j≤i} x_j + Σ_{j>i} h_j x_j  (K_g(i, j) = h_max(i,j), eq 27)
+  double suffix = 0.0;
+  for (int i = n - 1; i >= 0; --i) {
+    y[i] = -suffix;
+    suffix += h[i] * x[i];
+  }
+  double prefix = 0.0;
+  for (int i = 0; i < n; ++i) {
+    prefix += x[i];
+    y[i] += stiff_[i] * x[i] - h[i] * prefix;
+  }
+  for (int c : loaded_) y.head(n) -= (xl * direction_[c]) * J_.row(c).transpose();
+  for (int k = 0; k < m; ++k) {
+    const int c = held_[size_t(k)];
+    y.head(n) -= x[n + k] * J_.row(c).transpose();
+    y[n + k] = -J_.row(c).dot(x.head(n)) + direction_[c] * xl;
+  }
+  return y.allFinite();
+}
+
+bool EquilibriumProblem::jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) {
+  const int n = chain_.size();
+  const int N = dimension();
+  Vector x(N + 1);
+  x.head(N) = w;
+  x[N] = 0.0;
+  if (!jacobianApply(u, lambda, x, y.head(N))) return false;  // F_u is symmetric
+  // F_λ · w: −Σ_loaded dir_c J_c·w_q + Σ_held dir_c w_r
+  double dot = 0.0;
+  for (int c : loaded_) dot -= direction_[c] * J_.row(c).dot(w.head(n));
+  for (int k = 0; k < heldCount(); ++k) dot += direction_[held_[size_t(k)]] * w[n + k];
+  y[N] = dot;
+  return std::isfinite(dot);
+}
+
 bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix& H, Matrix& C) {
   if (!prepare(u)) return false;
   const int n = chain_.size();

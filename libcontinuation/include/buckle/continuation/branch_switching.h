@@ -32,7 +32,11 @@ struct BranchSwitchingOptions {
 
 /// Unit tangent (N+1) of the branch that crosses the traced one at the simple branch point bp
 /// (bp.nullVectors has the parent tangent and φ as columns). `note` says how it was obtained.
-bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note = nullptr);
+/// `structured`: the bifurcation equation from O(N) products (bifurcationDirectionsApplied) and
+/// bp.leftNullVector required, no N×N matrix (switchBothSides: above the tracer's
+/// maxDenseLocationDimension).
+bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note = nullptr,
+                          bool structured = false);
 
 /// A new branch leaving bp along sign·direction: point 0 is the branch point itself, point 1
 /// the first corrected point (confirmed off the parent branch), then traced with `tracer`.

@@ -13,6 +13,9 @@
 //       simple BP     (F(x) + βp = 0, F_xᵀp = 0, pᵀp = 1)  (Moore)  unknowns (x, β, p)
 //     with second derivatives from Problem::jacobianDirectionalDerivative. The residuals are
 //     exact, so even finite-difference second derivatives converge to the exact point.
+//     Above the dense crossover (denseAlgebra false) the same points are refined by the
+//     minimally augmented systems of structured_refinement.h with O(N) bordered solves, and
+//     get the same geometry (null vectors, left null vector, bifurcation directions).
 // Even numbers of eigenvalue crossings in one step (seen by the stability inertia only) are
 // separated by bisection on the inertia count; crossings that stay together down to a tiny
 // fraction of the step are reported as one point of higher multiplicity, unrefined.
@@ -23,9 +26,11 @@
 #include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/root_finding.h"
+#include "buckle/continuation/structured_refinement.h"
 #include "buckle/continuation/test_functions.h"
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -47,7 +52,9 @@ struct LocatorOptions {
   bool detectFolds = true;
   bool detectBranchPoints = true;
   /// Dense (N+1)² work allowed: ψ, the augmented-Newton refinements and the kernel (null
-  /// vectors, branch directions). False (large N): secant on O(N) test functions only.
+  /// vectors, branch directions). False (large N): the same refinements and geometry with O(N)
+  /// algebra (structured_refinement.h: the problem's structured solver, or dense LU without one);
+  /// the secant brackets on O(N) test functions (t_λ, the determinant, the crossing eigenvalue).
   bool denseAlgebra = true;
   /// A requested interrupt makes every further sample fail: the point in hand is reported as
   /// located so far, and the tracer stops at its next step.
@@ -105,6 +112,16 @@ class Locator {
                     const std::function<void(bool)> &adopt);
   bool refineBranchPoint(SpecialPoint &point, const Vector &tangentRef);
   void fillBranchPointGeometry(SpecialPoint &point, const Vector &tangentRef);
+  // The O(N) path (denseAlgebra false).
+  StructuredRefinement &structured();
+  bool refineFoldStructured(SpecialPoint &point, const Vector &tangentRef);
+  bool refineBranchPointStructured(SpecialPoint &point, const Vector &tangentRef);
+  /// Tangent and kernel basis from an orthonormal kernel K ((N+1)×2) and left null vector psi.
+  void setBranchPointGeometry(SpecialPoint &point, const Vector &tangentRef, const Matrix &K, const Vector &psi,
+                              double testValue);
+  /// The refined fold's fields (refined, accuracy, null vector, tangent, arclength) once u, λ are set.
+  void adoptRefinedFold(SpecialPoint &point, const Vector &tangentRef, const Vector &v, double lastDLambda,
+                        double augmentedResidual);
   double residualNorm(ConstVectorRef u, double lambda);
 
   Problem &problem_;
@@ -115,6 +132,8 @@ class Locator {
   StepSample a_, b_;
   Vector xa_, dx_, ta_, tb_, predictor_, x_;
   double stepLength_ = 0.0;
+  std::unique_ptr<BorderedSolver> refinementSolver_;  // created on first use (denseAlgebra false)
+  std::unique_ptr<StructuredRefinement> structured_;
 };
 
 }  // namespace buckle::continuation

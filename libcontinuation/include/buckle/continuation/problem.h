@@ -81,6 +81,22 @@ class Problem {
   virtual bool jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
                                              double dlambda, MatrixRef dFu, VectorRef dFlambda);
 
+  // ---- optional: O(N) products (special points above the dense crossover) --------------
+  // The locator's structured refinements evaluate their residuals with these products, so a
+  // problem whose Jacobian has structure should override them with exact O(N) versions in its
+  // own coordinates (the attainable accuracy of a refined point is that of these residuals).
+  // Defaults: dense, through jacobian() (O(N²) memory and time); the second derivative by
+  // central differences of jacobianTransposeApply() (only used in Newton matrices and in the
+  // bifurcation equation, never in a residual).
+  /// y = F_x x = F_u x_u + F_λ x_λ (x size N+1, y size N).
+  virtual bool jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y);
+  /// y = F_xᵀ w (w size N, y size N+1).
+  virtual bool jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y);
+  /// y = (F_xx[x, ·])ᵀ w = d/dε F_x(z + εx)ᵀ w at ε = 0, z = (u, λ) (x size N+1, w size N,
+  /// y size N+1): the gradient of wᵀF_x x, i.e. y_j = wᵀF_xx[x, e_j].
+  virtual bool secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
+                                              VectorRef y);
+
   // ---- optional: mechanical stability ---------------------------------------------------
   virtual bool hasStabilityOperator() const { return false; }
   /// Symmetric H (n_s×n_s) and constraint rows C (m×n_s, m may be 0); resized by the problem.
@@ -110,6 +126,7 @@ class Problem {
 
  private:
   Matrix stabilityH_, stabilityC_;  // workspace of the default stability()
+  Matrix applyFu_;                   // workspace of the dense product defaults
 };
 
 /// Inertia of the symmetric H restricted to ker C (C may have zero rows), by a dense

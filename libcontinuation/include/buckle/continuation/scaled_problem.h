@@ -86,6 +86,11 @@ class ScaledProblem final : public Problem {
   bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) override;
   bool jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
                                      MatrixRef dFu, VectorRef dFlambda) override;
+  /// The problem's own O(N) products, through the change of variables.
+  bool jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) override;
+  bool jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) override;
+  bool secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
+                                      VectorRef y) override;
   bool hasStabilityOperator() const override { return problem_.hasStabilityOperator(); }
   bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override;
   /// The problem's own stability() (its inertia count must be relative to ‖H‖), eigenvalues / μ₀.
@@ -104,6 +109,7 @@ class ScaledProblem final : public Problem {
   UnitScaling units_;
   int n_;
   Vector u_, du_;
+  Vector x_, w_;  // (D_u, λ₀)·x̃ and w̃/D_F of the products
 };
 
 /// A problem's BorderedSolver for A(c) seen in the scaled variables:
@@ -118,12 +124,20 @@ class ScaledBorderedSolver final : public BorderedSolver {
   bool solve(ConstVectorRef b, VectorRef x) override;
   int determinantSign() const override { return solver_->determinantSign(); }
   double logAbsDeterminant() const override { return solver_->logAbsDeterminant(); }
+  /// G̃ = diag(D_F⁻¹, I) G diag(D_u, I) (transposed: diag(D_u, I) G diag(D_F⁻¹, I)): the
+  /// problem's solver gets the borders in its units, solve() maps right-hand side and solution.
+  int maxGeneralBorder() const override { return solver_->maxGeneralBorder(); }
+  Factorization factorGeneral(ConstVectorRef u, double lambda, ConstMatrixRef B, ConstMatrixRef C, ConstMatrixRef D,
+                              bool transposed) override;
 
  private:
   std::unique_ptr<BorderedSolver> solver_;
   UnitScaling units_;
   Vector stateScales_, rowScales_;  // S (N+1) and (D_F, 1) (N+1)
   Vector u_, c_, b_;
+  // After factorGeneral(): solve() maps b by inScale_ and x by outScale_ on the first N rows.
+  bool general_ = false;
+  Vector inScale_, outScale_;
 };
 
 }  // namespace buckle::continuation

@@ -96,5 +96,10 @@ bool jacobianKernel(Problem &problem, ConstVectorRef u, double lambda, KernelInf
 /// are complex (an isolated point, no crossing branches).
 bool bifurcationDirections(Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi, ConstVectorRef k1,
                            ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why = nullptr);
+/// The same from O(N) products (Problem::secondDerivativeTransposeApply), with no N×N matrix:
+/// for problems above the dense crossover.
+bool bifurcationDirectionsApplied(Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi,
+                                  ConstVectorRef k1, ConstVectorRef k2, Vector &d1, Vector &d2,
+                                  std::string *why = nullptr);
 
 }  // namespace buckle::continuation

@@ -94,10 +94,11 @@ struct TracerOptions {
   /// Automatic switches to the structured solver from this N on. The chain's tracer step
   /// (benchmarks/RESULTS.md, BM_TracerStep) is faster dense at N = 4 and structured at N = 11.
   int structuredFromDimension = 8;
-  /// Above this N the locator does not build dense (N+1)² matrices: special points are located
-  /// by the secant on O(N)-evaluable test functions (t_λ, the determinant sign and magnitude,
-  /// the crossing eigenvalue) down to locationTolerance, without the augmented-Newton
-  /// refinement or null vectors (so no branch switching there).
+  /// A speed crossover: above this N the locator builds no dense (N+1)² matrix. Special points
+  /// are bracketed on O(N) test functions (t_λ, the determinant, the crossing eigenvalue) and
+  /// refined, with their null vectors, by the O(N) minimally augmented systems of
+  /// structured_refinement.h instead of the dense augmented Newton: the same points, the same
+  /// geometry, branch switching included.
   int maxDenseLocationDimension = 400;
   /// Target |Δλ| ≤ locationTolerance·max(λ₀, |λ|) for located points and stop events (λ₀: the
   /// problem's parameter scale).

@@ -37,6 +37,15 @@ class ChainBorderedSolver final : public continuation::BorderedSolver {
   int determinantSign() const override { return sign_; }
   double logAbsDeterminant() const override { return logAbs_; }
 
+  /// General borders (the locator's fold and branch-point systems): with B = [B_q; B_r],
+  /// C = [C_q; C_r] split at the n joint rows, G = [[H, V], [Wᵀ, D_G]] with
+  /// V = [−J_hᵀ, B_q], W = [−J_hᵀ, C_q], D_G = [[0, B_r], [C_rᵀ, D]]: the same block elimination
+  /// with p = m + k ≤ kMaxBorder. F_u is symmetric, so `transposed` changes nothing.
+  int maxGeneralBorder() const override { return ChainStructure::kMaxBorder - m_; }
+  continuation::Factorization factorGeneral(continuation::ConstVectorRef u, double lambda,
+                                            continuation::ConstMatrixRef B, continuation::ConstMatrixRef C,
+                                            continuation::ConstMatrixRef D, bool transposed) override;
+
   /// The last factor() went through the dense fallback.
   bool usedDenseFallback() const { return dense_ != nullptr && usingDense_; }
 
@@ -47,6 +56,9 @@ class ChainBorderedSolver final : public continuation::BorderedSolver {
   ChainStructure ws_;
   Matrix J_, V_, W_, D_;
   Vector x_, y_;
+  Matrix Vg_, Wg_, Dg_;  // borders of the last factorGeneral()
+  Vector yg_;
+  bool general_ = false;  // solve() uses the general borders
   std::unique_ptr<continuation::DenseBorderedSolver> dense_;
   bool usingDense_ = false;
   int sign_ = 0;

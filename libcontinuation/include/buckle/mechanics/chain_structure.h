@@ -62,7 +62,9 @@ struct Inertia {
 
 /// Workspace for one chain length; T, its factorization and the border storage.
 struct ChainStructure {
-  static constexpr int kMaxBorder = 4;
+  /// Border columns of the bordered solves: m ≤ 3 held rows, the tracer's one (F_λ | c) and
+  /// one more for the locator's branch-point system (chain_solver.h).
+  static constexpr int kMaxBorder = 6;
   using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxBorder, kMaxBorder>;
   using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxBorder, 1>;
 

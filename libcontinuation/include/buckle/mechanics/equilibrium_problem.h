@@ -55,13 +55,22 @@ class EquilibriumProblem final : public continuation::Problem {
                                      continuation::ConstVectorRef du, double dlambda,
                                      continuation::MatrixRef dFu, continuation::VectorRef dFlambda) override;
 
+  /// O(n) products with F_x = [F_u, F_λ] in the joint coordinates (K_g x by prefix and suffix
+  /// sums of h, eq 27): exact to rounding, with no cancellation beyond that of the dense product.
+  /// F_u is symmetric, so F_xᵀ w = (F_u w, F_λ·w). The second derivative keeps the default
+  /// (central differences of jacobianTransposeApply, O(n)).
+  bool jacobianApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
+                     continuation::VectorRef y) override;
+  bool jacobianTransposeApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef w,
+                              continuation::VectorRef y) override;
+
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
   /// Inertia of K_q − K_g on ker J_h and its min(lowestCount, kMaxLowest) lowest eigenvalues.
   /// options.structuredStability: the inertia from two O(n) Sturm counts, the eigenvalues by
   /// isolation on those counts; for n <= 32 with eigenvalues wanted, one heap-free dense solve
   /// (faster there: benchmarks/RESULTS.md). Otherwise the dense Problem::stability().
-  static constexpr int kMaxLowest = ChainStructure::kMaxBorder;  // the isolation's fixed-size brackets
+  static constexpr int kMaxLowest = 4;  // the isolation's fixed-size brackets
   bool stability(continuation::ConstVectorRef u, double lambda, int lowestCount,
                  continuation::StabilityInfo& info) override;
 
