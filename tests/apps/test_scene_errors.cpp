@@ -16,6 +16,7 @@
 #include "scene/command.h"
 #include "scene/scene.h"
 #include "small_scene.h"
+#include "scene_run.h"
 #include "temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -32,24 +33,10 @@ std::string replaceOnce(std::string s, const std::string& from, const std::strin
   return s.replace(pos, from.size(), to);
 }
 
-struct Outcome {
-  int rc;
-  std::string err;
-  fs::path file, out;
-};
+using Outcome = buckle::test::SceneOutcome;
 
 Outcome runText(const std::string& name, const std::string& text) {
-  const fs::path dir = workDir() / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const fs::path file = dir / "scene.json";
-  std::ofstream(file) << text;
-  buckle::scene::RunCommandOptions opt;
-  opt.scene = file.string();
-  opt.out = (dir / "out").string();
-  std::ostringstream log, err;
-  const int rc = buckle::scene::runSceneCommand(opt, log, err);
-  return {rc, err.str(), file, dir / "out"};
+  return buckle::test::runSceneText("scene_errors", name, text);
 }
 
 /// Nothing but the scene file in its directory: no output, no staging directory.

@@ -12,6 +12,7 @@
 
 #include "scene/command.h"
 #include "scene/output.h"
+#include "scene_run.h"
 #include "temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -32,24 +33,10 @@ std::string scene(const std::string& twoParameter, const std::string& chain = R"
 })";
 }
 
-struct Outcome {
-  int rc;
-  std::string err;
-  fs::path file, out;
-};
+using Outcome = buckle::test::SceneOutcome;
 
 Outcome run(const std::string& name, const std::string& text) {
-  const fs::path dir = buckle::test::scratchDirectory("scene_two_parameter") / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const fs::path file = dir / "scene.json";
-  std::ofstream(file) << text;
-  buckle::scene::RunCommandOptions opt;
-  opt.scene = file.string();
-  opt.out = (dir / "out").string();
-  std::ostringstream log, err;
-  const int rc = buckle::scene::runSceneCommand(opt, log, err);
-  return {rc, err.str(), file, dir / "out"};
+  return buckle::test::runSceneText("scene_two_parameter", name, text);
 }
 
 void requireBadInput(const std::string& name, const std::string& text, const std::string& path,

@@ -148,11 +148,9 @@ TEST_CASE("switching at the branch points: U stable with dx = mu_U b q2^2, Z uns
   CHECK(zBranches == 2);
 }
 
-TEST_CASE("fold: free end, kappa < 0, lateral load (AUTO case I_up) against the extended system", "[equilibrium_branches]") {
-  // L0 = 0.5 makes κ < 0: the straight state is unstable; Fy = 0.01 selects a bent path that folds.
-  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 0.5));
-  EquilibriumProblem problem(chain, EndCondition::freeEnd(Eigen::Vector3d(0.0, 0.01, 0.0)),
-                             Eigen::Vector3d(1, 0, 0), EquilibriumOptions{false});
+namespace {
+// The AUTO case I_up (free end, κ < 0, Fy = 0.01, Fx moved): the box and range of its fold tests.
+EquilibriumBranchOptions iUpOptions() {
   EquilibriumBranchOptions o;
   o.tracer.lambdaMin = -1.0;
   o.tracer.lambdaMax = 1.0;
@@ -161,6 +159,16 @@ TEST_CASE("fold: free end, kappa < 0, lateral load (AUTO case I_up) against the 
   o.switchingDepth = 0;
   o.tracer.boxLower = Eigen::VectorXd::Constant(4, -3.0);
   o.tracer.boxUpper = Eigen::VectorXd::Constant(4, 3.0);
+  return o;
+}
+}  // namespace
+
+TEST_CASE("fold: free end, kappa < 0, lateral load (AUTO case I_up) against the extended system", "[equilibrium_branches]") {
+  // L0 = 0.5 makes κ < 0: the straight state is unstable; Fy = 0.01 selects a bent path that folds.
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 0.5));
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Eigen::Vector3d(0.0, 0.01, 0.0)),
+                             Eigen::Vector3d(1, 0, 0), EquilibriumOptions{false});
+  EquilibriumBranchOptions o = iUpOptions();
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
   CHECK(r.startUnstable);
@@ -434,14 +442,7 @@ TEST_CASE("structured and dense refinement agree on the same chain (crossover fo
     const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 0.5));
     EquilibriumProblem problem(chain, EndCondition::freeEnd(Eigen::Vector3d(0.0, 0.01, 0.0)),
                                Eigen::Vector3d(1, 0, 0));
-    EquilibriumBranchOptions o;
-    o.tracer.lambdaMin = -1.0;
-    o.tracer.lambdaMax = 1.0;
-    o.tracer.maxStep = 0.05;
-    o.tracer.maxPoints = 400;
-    o.switchingDepth = 0;
-    o.tracer.boxLower = Eigen::VectorXd::Constant(4, -3.0);
-    o.tracer.boxUpper = Eigen::VectorXd::Constant(4, 3.0);
+    EquilibriumBranchOptions o = iUpOptions();
     const EquilibriumBranches dense =
         traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
     o.tracer.maxDenseLocationDimension = 1;
