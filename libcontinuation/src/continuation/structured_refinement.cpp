@@ -105,19 +105,31 @@ bool StructuredRefinement::parameterDerivative(ConstVectorRef u, double lambda, 
   return problem_.jacobianApply(u, lambda, ex_, Fl);
 }
 
-StructuredRefinementResult StructuredRefinement::fold(Vector &u, double &lambda, ConstVectorRef tangent, Vector &v,
-                                                      double maxDistance) {
-  StructuredRefinementResult result;
-  const int n = n_;
-  const Vector u0 = u;
-  const double lambda0 = lambda;
-  auto fail = [&](const std::string &why) {
+namespace {
+// Where a refinement started: a failed refinement puts the point back, so the caller keeps the
+// point it had located; and Newton may not wander farther from it than the step.
+struct StartPoint {
+  StartPoint(const Vector &u, double lambda) : u0(u), lambda0(lambda) {}
+  double distance(const Vector &u, double lambda) const { return std::hypot((u - u0).norm(), lambda - lambda0); }
+  StructuredRefinementResult restore(Vector &u, double &lambda, StructuredRefinementResult &result,
+                                     const std::string &why) const {
     result.failure = why;
     result.converged = false;
     u = u0;
     lambda = lambda0;
     return result;
-  };
+  }
+  const Vector u0;
+  const double lambda0;
+};
+}  // namespace
+
+StructuredRefinementResult StructuredRefinement::fold(Vector &u, double &lambda, ConstVectorRef tangent, Vector &v,
+                                                      double maxDistance) {
+  StructuredRefinementResult result;
+  const int n = n_;
+  const StartPoint start(u, lambda);
+  auto fail = [&](const std::string &why) { return start.restore(u, lambda, result, why); };
   if (tangent.size() != n + 1 || !(tangent.head(n).norm() > 0.0)) return fail("no tangent to start from");
   Vector b = tangent.head(n).normalized(), c = b;
   Matrix Bm(n, 1), Cm(n, 1), Dm = Matrix::Zero(1, 1);
@@ -159,7 +171,7 @@ StructuredRefinementResult StructuredRefinement::fold(Vector &u, double &lambda,
     lambda += d[n];
     ++result.iterations;
     result.lastDLambda = step;
-    if (std::hypot((u - u0).norm(), lambda - lambda0) > maxDistance) return fail("Newton iterate left the step");
+    if (start.distance(u, lambda) > maxDistance) return fail("Newton iterate left the step");
     b = y.head(n) / wNorm;
     c = v;
     if (met) break;
@@ -218,15 +230,8 @@ StructuredRefinementResult StructuredRefinement::branchPoint(Vector &u, double &
                                                              Matrix &kernel, Vector &psi, double maxDistance) {
   StructuredRefinementResult result;
   const int n = n_;
-  const Vector u0 = u;
-  const double lambda0 = lambda;
-  auto fail = [&](const std::string &why) {
-    result.failure = why;
-    result.converged = false;
-    u = u0;
-    lambda = lambda0;
-    return result;
-  };
+  const StartPoint start(u, lambda);
+  auto fail = [&](const std::string &why) { return start.restore(u, lambda, result, why); };
   Matrix K;
   Vector psiHat;
   if (!approximateKernel(u, lambda, tangent, K, psiHat)) return fail("no approximate kernel (inverse iteration)");
@@ -283,7 +288,7 @@ StructuredRefinementResult StructuredRefinement::branchPoint(Vector &u, double &
     beta += d[n + 1];
     ++result.iterations;
     result.lastDLambda = step;
-    if (std::hypot((u - u0).norm(), lambda - lambda0) > maxDistance) return fail("Newton iterate left the step");
+    if (start.distance(u, lambda) > maxDistance) return fail("Newton iterate left the step");
     K = Knew;
     psiHat = psi;
     if (met) break;
