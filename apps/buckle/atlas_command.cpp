@@ -1,19 +1,25 @@
 #include "atlas_command.h"
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <unistd.h>
 #include <vector>
 
+#include "atlas_mpi.h"
+#include "buckle/continuation/interrupt.h"
 #include "scene/atlas.h"
 #include "scene/output.h"
 #include "scene/output_target.h"
+#include "scene/signals.h"
 
 namespace buckle::cli {
 
@@ -23,6 +29,7 @@ struct AtlasArgs {
   scene::AtlasOptions atlas;
   std::vector<double> xRange{0.05, 1.0, 20}, yRange{1.0, 3.0, 21};
   std::string out = "out/atlas";
+  double timeLimit = std::numeric_limits<double>::infinity();
   bool quiet = false;
   bool force = false;
 };
@@ -33,22 +40,47 @@ scene::AtlasAxis axis(const std::string& name, const std::vector<double>& r, con
   return scene::AtlasAxis{name, r[0], r[1], static_cast<int>(r[2])};
 }
 
+// The cells as one rank sends them to rank 0: '0' and the packed cells, or '1' and the message
+// of an error that stopped the rank (rank 0 then writes nothing and names it).
+std::string rankReport(const std::vector<scene::AtlasCell>& cells, const scene::AtlasShare& share,
+                       const std::string& fatal) {
+  return fatal.empty() ? "0" + scene::packAtlasCells(cells, share) : "1" + fatal;
+}
+
 void runAtlas(const AtlasArgs& args, Outcome& outcome) {
+  std::optional<MpiWorld> world;  // MPI only when started by mpirun; one process otherwise
+  try {
+    world.emplace();
+  } catch (const std::runtime_error& e) {
+    throw BadArgument{e.what()};
+  }
+  // Every rank reads the arguments alike; rank 0 alone checks --out (it writes there) and says
+  // what is wrong, the others leave with the same status.
   scene::AtlasOptions o = args.atlas;
-  o.x = axis(args.atlas.x.name, args.xRange, "--x-range");
-  o.y = axis(args.atlas.y.name, args.yRange, "--y-range");
-  try {
-    scene::validateAtlas(o);
-  } catch (const std::invalid_argument& e) {
-    throw BadArgument{e.what()};
-  }
   std::string target;  // args.out with symbolic links resolved: the directory that is replaced
+  std::string bad;
   try {
-    target = scene::checkOutputTarget(args.out, {}, args.force);
+    o.x = axis(args.atlas.x.name, args.xRange, "--x-range");
+    o.y = axis(args.atlas.y.name, args.yRange, "--y-range");
+    scene::validateAtlas(o);
+    if (!(args.timeLimit > 0.0)) throw BadArgument{"--time-limit must be a number of seconds > 0"};
+    if (world->root()) target = scene::checkOutputTarget(args.out, {}, args.force);
+  } catch (const BadArgument& e) {
+    bad = e.message;
+  } catch (const std::invalid_argument& e) {
+    bad = e.what();
   } catch (const scene::OutputTargetError& e) {
-    throw BadArgument{e.what()};
+    bad = e.what();
   }
-  const bool tty = ::isatty(STDOUT_FILENO) == 1 && !args.quiet;
+  if (world->broadcast(bad.empty() ? 0 : 1) != 0) {
+    if (world->root()) throw BadArgument{bad};
+    outcome.code = kBadInput;
+    return;
+  }
+  // Threads per rank: the ranks on one machine share its cores.
+  const int threads = o.threads > 0 ? o.threads
+                                    : std::max(1, int(std::thread::hardware_concurrency()) / world->ranksOnThisNode());
+  const bool tty = world->root() && ::isatty(STDOUT_FILENO) == 1 && !args.quiet;
   const auto t0 = std::chrono::steady_clock::now();
   auto progress = [tty](int done, int total) {
     if (!tty) return;
@@ -57,11 +89,61 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
               << "/" << total << std::flush;
     if (done == total) std::cout << "\n";
   };
-  const std::vector<scene::AtlasCell> cells = scene::computeAtlas(o, progress);
+  scene::SignalGuard signals;
+  continuation::Interrupt interrupt = continuation::Interrupt::after(args.timeLimit);
+  interrupt.watch(scene::SignalGuard::flag(), "interrupted by a signal (SIGINT/SIGTERM)");
+  std::vector<scene::AtlasCell> cells = scene::atlasGrid(o);
+  const scene::AtlasShare share{world->rank(), world->size()};
+  std::string fatal;
+  try {
+    scene::computeCells(cells, share, threads, interrupt, progress);
+  } catch (const std::exception& e) {
+    fatal = e.what();
+  }
+  const int signalStatus = signals.signal() != 0 ? signals.exitCode() : kSuccess;
+  if (world->distributed()) {
+    std::vector<std::string> reports;
+    try {
+      reports = world->gather(rankReport(cells, share, fatal));
+    } catch (const std::runtime_error& e) {
+      fatal = e.what();  // every rank alike
+    }
+    if (!world->root()) {
+      outcome.code = !fatal.empty() ? kComputationFailure : signalStatus;
+      return;
+    }
+    std::string failures;
+    for (size_t r = 1; r < reports.size(); ++r) {
+      if (reports[r].rfind("1", 0) == 0) {
+        failures += "\n  rank " + std::to_string(r) + ": " + reports[r].substr(1);
+        continue;
+      }
+      try {
+        scene::unpackAtlasCells(reports[r].substr(1), cells);
+      } catch (const std::runtime_error& e) {
+        failures += "\n  rank " + std::to_string(r) + ": " + e.what();
+      }
+    }
+    if (!fatal.empty()) failures = "\n  rank 0: " + fatal + failures;
+    fatal = failures;
+  }
+  if (!fatal.empty()) {
+    // distributed: one "\n  rank R: ..." line per rank that failed
+    std::cerr << "buckle atlas: stopped by an error, nothing written:" << (world->distributed() ? "" : " ") << fatal
+              << "\n";
+    outcome.code = kComputationFailure;
+    return;
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  int failed = 0;
-  for (const auto& c : cells)
+  int failed = 0, notComputed = 0;
+  std::string stopped;  // why some cells were not computed
+  for (const auto& c : cells) {
     if (c.postBuckling == "failed") ++failed;
+    if (c.postBuckling == "not computed") {
+      ++notComputed;
+      if (stopped.empty()) stopped = c.error;
+    }
+  }
   try {
     scene::StagingDirectory staging(target);
     std::string note;
@@ -75,7 +157,10 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
     summary["end"] = "clamped-pinned: y held at 0, end rotation free, Fx compression";
     summary["cells"] = cells.size();
     summary["failed_cells"] = failed;
-    summary["threads"] = o.threads > 0 ? unsigned(o.threads) : std::max(1u, std::thread::hardware_concurrency());
+    summary["not_computed_cells"] = notComputed;
+    if (notComputed > 0) summary["stopped"] = stopped;
+    summary["mpi_ranks"] = world->size();
+    summary["threads"] = threads;  // per rank
     summary["seconds"] = seconds;
     summary["plots"] = {{"gnuplot", note}, {"files", files}};
     std::ofstream file(std::string(staging.path()) + "/summary.json");
@@ -88,12 +173,21 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
     outcome.code = kComputationFailure;
     return;
   }
-  if (!args.quiet)
-    std::cout << cells.size() << " cells in " << seconds << " s; wrote " << args.out << "/atlas.csv and plots\n";
+  if (!args.quiet) {
+    std::cout << cells.size() << " cells in " << seconds << " s";
+    if (world->distributed()) std::cout << " on " << world->size() << " MPI ranks x " << threads << " threads";
+    std::cout << "; wrote " << args.out << "/atlas.csv and plots\n";
+  }
   if (failed > 0) {
     std::cerr << "buckle atlas: " << failed << " cell(s) could not be computed (post_buckling = failed in atlas.csv)\n";
     outcome.code = kComputationFailure;
   }
+  if (notComputed > 0) {
+    std::cerr << "buckle atlas: " << notComputed << " cell(s) not computed, " << stopped
+              << " (post_buckling = not computed in atlas.csv)\n";
+    outcome.code = kComputationFailure;
+  }
+  if (signalStatus != kSuccess) outcome.code = signalStatus;
 }
 
 }  // namespace
@@ -107,7 +201,8 @@ void addAtlasCommand(CLI::App& app, Outcome& outcome) {
       "compression Fx. For every cell: stability of the straight chain, first critical force (linear "
       "buckling), and whether the branch born there is stable (supercritical) or not (subcritical), by "
       "continuation and branch switching. Writes DIR/atlas.csv, DIR/summary.json and heat maps "
-      "DIR/plots/atlas_critical.png|svg, atlas_post_buckling.png|svg. Exit status: 0, 1 some cell failed, 2 bad input.");
+      "DIR/plots/atlas_critical.png|svg, atlas_post_buckling.png|svg. Under mpirun every rank computes a share of "
+      "the cells and rank 0 writes the same files. Exit status: 0, 1 some cell failed or not computed, 2 bad input.");
   cmd->add_option("--x", args->atlas.x.name, "Horizontal parameter: a, L0 or n")->capture_default_str();
   cmd->add_option("--x-range", args->xRange, "FROM TO COUNT of the horizontal parameter")->expected(3)->capture_default_str();
   cmd->add_option("--y", args->atlas.y.name, "Vertical parameter: a, L0 or n")->capture_default_str();
@@ -115,7 +210,13 @@ void addAtlasCommand(CLI::App& app, Outcome& outcome) {
   cmd->add_option("--a", args->atlas.a, "a/b when it is not an axis")->capture_default_str();
   cmd->add_option("--L0", args->atlas.L0, "L0/b when it is not an axis")->capture_default_str();
   cmd->add_option("--segments,-n", args->atlas.n, "Segment count when n is not an axis")->capture_default_str();
-  cmd->add_option("--threads,-j", args->atlas.threads, "Worker threads (0: all cores)")->capture_default_str();
+  cmd->add_option("--threads,-j", args->atlas.threads,
+                  "Worker threads (0: all cores; under mpirun, per rank: the cores shared among the ranks on a machine)")
+      ->capture_default_str();
+  cmd->add_option("--time-limit", args->timeLimit,
+                  "Seconds; past them no new cell is started, the cells computed are written and the rest marked "
+                  "\"not computed\" (exit 1). SIGINT/SIGTERM do the same")
+      ->capture_default_str();
   cmd->add_option("--out,-o", args->out,
                   "Output directory, written beside it and renamed at the end. Refused (exit 2, before computing) "
                   "when it is /, the current directory or one containing it, an existing file, or an existing "

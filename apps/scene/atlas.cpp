@@ -2,7 +2,9 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -39,7 +41,6 @@ void checkAxis(const AtlasAxis& a, const std::string& opt) {
 
 void computeCell(AtlasCell& c) {
   const mech::SegmentParameters p = mech::SegmentParameters::symmetric(c.a, 1.0, 1.0, c.L0);
-  c.kappa = c.L0 - 2.0 * (1.0 - c.a * c.a);
   try {
     const mech::FirstBuckling fb =
         mech::firstBuckling(mech::Chain::uniform(c.n, p), mech::EndCondition::clampedPinned(0.0, 0.0),
@@ -64,6 +65,45 @@ int postCode(const std::string& s) {
   if (s == "none") return 3;
   return -1;
 }
+
+// The atlas' packed cells: fixed-size fields copied byte for byte (the receiver is the same
+// program on the same kind of machine), strings as a length and their bytes.
+template <class T>
+void put(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+void putString(std::string& out, const std::string& s) {
+  put(out, std::uint64_t(s.size()));
+  out += s;
+}
+
+class Reader {
+ public:
+  explicit Reader(const std::string& bytes) : bytes_(bytes) {}
+  bool done() const { return at_ == bytes_.size(); }
+  template <class T>
+  T get() {
+    T v;
+    need(sizeof v);
+    std::memcpy(&v, bytes_.data() + at_, sizeof v);
+    at_ += sizeof v;
+    return v;
+  }
+  std::string getString() {
+    const auto n = get<std::uint64_t>();
+    need(n);
+    std::string s = bytes_.substr(at_, size_t(n));
+    at_ += size_t(n);
+    return s;
+  }
+
+ private:
+  void need(std::uint64_t n) const {
+    if (n > bytes_.size() - at_) throw std::runtime_error("atlas cells: the packed data ends early");
+  }
+  const std::string& bytes_;
+  size_t at_ = 0;
+};
 
 std::string axisLabel(const std::string& name) {
   if (name == "a") return "a/b";
@@ -91,7 +131,7 @@ void validateAtlas(const AtlasOptions& o) {
   if (o.threads < 0) throw std::invalid_argument("--threads must be >= 0");
 }
 
-std::vector<AtlasCell> computeAtlas(const AtlasOptions& o, const std::function<void(int, int)>& progress) {
+std::vector<AtlasCell> atlasGrid(const AtlasOptions& o) {
   validateAtlas(o);
   std::vector<AtlasCell> cells(size_t(o.x.count) * size_t(o.y.count));
   for (int j = 0; j < o.y.count; ++j)
@@ -107,15 +147,33 @@ std::vector<AtlasCell> computeAtlas(const AtlasOptions& o, const std::function<v
         if (axis->name == "L0") c.L0 = v;
         if (axis->name == "n") c.n = static_cast<int>(std::lround(v));
       }
+      c.kappa = c.L0 - 2.0 * (1.0 - c.a * c.a);
+      c.firstCritical = kNaN;
+      c.postBuckling = "not computed";
     }
-  const int total = static_cast<int>(cells.size());
-  unsigned threads = o.threads > 0 ? unsigned(o.threads) : std::max(1u, std::thread::hardware_concurrency());
-  threads = std::min<unsigned>(threads, unsigned(total));
+  return cells;
+}
+
+size_t computeCells(std::vector<AtlasCell>& cells, const AtlasShare& share, int threadCount,
+                    const continuation::Interrupt& interrupt, const std::function<void(int, int)>& progress) {
+  if (share.parts < 1 || share.part < 0 || share.part >= share.parts)
+    throw std::invalid_argument("atlas share " + std::to_string(share.part) + " of " + std::to_string(share.parts));
+  std::vector<size_t> mine;
+  mine.reserve(share.size(cells.size()));
+  for (size_t k = 0; k < cells.size(); ++k)
+    if (share.owns(k)) mine.push_back(k);
+  const int total = static_cast<int>(mine.size());
+  unsigned threads = threadCount > 0 ? unsigned(threadCount) : std::max(1u, std::thread::hardware_concurrency());
+  threads = std::min<unsigned>(threads, unsigned(std::max(total, 1)));
   std::atomic<int> next{0}, done{0};
   std::mutex progressMutex;
   auto worker = [&]() {
     for (int k = next++; k < total; k = next++) {
-      computeCell(cells[size_t(k)]);
+      if (interrupt.requested()) {
+        next = total;  // the other workers stop at their next cell too
+        break;
+      }
+      computeCell(cells[mine[size_t(k)]]);
       const int d = ++done;
       if (progress) {
         std::lock_guard<std::mutex> lock(progressMutex);
@@ -126,7 +184,51 @@ std::vector<AtlasCell> computeAtlas(const AtlasOptions& o, const std::function<v
   std::vector<std::thread> pool;
   for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
   for (std::thread& t : pool) t.join();
+  if (done < total) {
+    const std::string why = "stopped early: " + interrupt.describe();
+    for (size_t k : mine)
+      if (cells[k].postBuckling == "not computed") cells[k].error = why;
+  }
+  return size_t(done.load());
+}
+
+std::vector<AtlasCell> computeAtlas(const AtlasOptions& o, const std::function<void(int, int)>& progress) {
+  std::vector<AtlasCell> cells = atlasGrid(o);
+  computeCells(cells, AtlasShare{}, o.threads, continuation::Interrupt{}, progress);
   return cells;
+}
+
+std::string packAtlasCells(const std::vector<AtlasCell>& cells, const AtlasShare& share) {
+  std::string out;
+  for (size_t k = 0; k < cells.size(); ++k) {
+    if (!share.owns(k)) continue;
+    const AtlasCell& c = cells[k];
+    put(out, std::uint64_t(k));
+    put(out, std::uint8_t(c.straightStable ? 1 : 0));
+    put(out, c.firstCritical);
+    put(out, c.postSlope);
+    putString(out, c.firstShape);
+    putString(out, c.postBuckling);
+    putString(out, c.error);
+  }
+  return out;
+}
+
+void unpackAtlasCells(const std::string& bytes, std::vector<AtlasCell>& cells) {
+  Reader in(bytes);
+  while (!in.done()) {
+    const auto k = in.get<std::uint64_t>();
+    if (k >= cells.size())
+      throw std::runtime_error("atlas cells: cell " + std::to_string(k) + " is outside the grid of " +
+                               std::to_string(cells.size()));
+    AtlasCell& c = cells[size_t(k)];
+    c.straightStable = in.get<std::uint8_t>() != 0;
+    c.firstCritical = in.get<double>();
+    c.postSlope = in.get<double>();
+    c.firstShape = in.getString();
+    c.postBuckling = in.getString();
+    c.error = in.getString();
+  }
 }
 
 std::vector<std::string> writeAtlas(const AtlasOptions& o, const std::vector<AtlasCell>& cells,
@@ -153,7 +255,7 @@ std::vector<std::string> writeAtlas(const AtlasOptions& o, const std::vector<Atl
       for (int i = 0; i < o.x.count; ++i) {
         const AtlasCell& c = cells[size_t(j) * size_t(o.x.count) + size_t(i)];
         dat << num(c.x) << " " << num(c.y) << " " << (c.straightStable ? num(c.firstCritical) : "NaN") << " "
-            << postCode(c.postBuckling) << "\n";
+            << (c.postBuckling == "not computed" ? "NaN" : std::to_string(postCode(c.postBuckling))) << "\n";
       }
       dat << "\n";
     }

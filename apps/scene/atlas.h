@@ -4,9 +4,12 @@
 // character of the post-buckling branch, computed on all cores.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <string>
 #include <vector>
+
+#include "buckle/continuation/interrupt.h"
 
 namespace buckle::scene {
 
@@ -37,7 +40,7 @@ struct AtlasCell {
   std::string firstShape;           ///< shape of its mode
   /// "supercritical" (the bifurcating branch is stable under force control), "subcritical"
   /// (unstable), "unstable start" (κ <= 0), "none" (no compressive critical load),
-  /// "failed" (the branch could not be followed).
+  /// "failed" (the branch could not be followed), "not computed" (the run was stopped first).
   std::string postBuckling;
   double postSlope = 0.0;           ///< d|Fx| along the new branch over the first steps (> 0: rising)
   std::string error;
@@ -46,10 +49,36 @@ struct AtlasCell {
 /// Validates the axes; throws std::invalid_argument naming the option.
 void validateAtlas(const AtlasOptions& options);
 
-/// Computes every cell (row-major: y outer, x inner). `progress(done, total)` is called from
-/// worker threads (serialised) after each cell when given.
+/// The cells of the grid (row-major: y outer, x inner) with their parameters and κ set, not yet
+/// computed (postBuckling "not computed", firstCritical NaN).
+std::vector<AtlasCell> atlasGrid(const AtlasOptions& options);
+
+/// The part of the grid one process computes when several share it: the cells k with
+/// k mod parts = part. Interleaved rather than in blocks because the cost of a cell grows
+/// along an axis (n, or towards κ = 0), so every part gets a similar mix.
+struct AtlasShare {
+  int part = 0, parts = 1;
+  bool owns(size_t k) const { return k % size_t(parts) == size_t(part); }
+  size_t size(size_t cells) const { return cells / size_t(parts) + (size_t(part) < cells % size_t(parts) ? 1 : 0); }
+};
+
+/// Computes the cells of `share` on `threads` worker threads (0: all cores). Once `interrupt`
+/// is requested no new cell is started: those left keep "not computed", with the reason in
+/// `error`. `progress(done, total)` (total: the share's cells) is called from the workers,
+/// serialised, after each cell. Returns the number of cells computed.
+size_t computeCells(std::vector<AtlasCell>& cells, const AtlasShare& share, int threads,
+                    const continuation::Interrupt& interrupt,
+                    const std::function<void(int, int)>& progress = nullptr);
+
+/// Every cell of the grid on options.threads threads, never interrupted.
 std::vector<AtlasCell> computeAtlas(const AtlasOptions& options,
                                     const std::function<void(int, int)>& progress = nullptr);
+
+/// The computed fields of the share's cells as bytes (doubles bit for bit), to be sent to the
+/// process that writes the atlas, and back into the same grid there. unpackAtlasCells throws
+/// std::runtime_error on bytes that do not fit the grid.
+std::string packAtlasCells(const std::vector<AtlasCell>& cells, const AtlasShare& share);
+void unpackAtlasCells(const std::string& bytes, std::vector<AtlasCell>& cells);
 
 /// atlas.csv and the heat maps into an existing directory; returns the image files written
 /// (empty when gnuplot is missing) and sets `gnuplotNote`.
