@@ -54,8 +54,10 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
   } catch (const std::runtime_error& e) {
     throw BadArgument{e.what()};
   }
-  // Every rank reads the arguments alike; rank 0 alone checks --out (it writes there) and says
-  // what is wrong, the others leave with the same status.
+  // Every rank reads the arguments alike; rank 0 alone checks --out (it writes there), says what
+  // is wrong and carries the exit status. The other ranks always leave with 0 once rank 0 knows
+  // their part: mpirun ends the whole job as soon as one rank exits non-zero, which could cut
+  // rank 0 short before its message or output.
   scene::AtlasOptions o = args.atlas;
   std::string target;  // args.out with symbolic links resolved: the directory that is replaced
   std::string bad;
@@ -74,13 +76,14 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
   }
   if (world->broadcast(bad.empty() ? 0 : 1) != 0) {
     if (world->root()) throw BadArgument{bad};
-    outcome.code = kBadInput;
     return;
   }
   // Threads per rank: the ranks on one machine share its cores.
   const int threads = o.threads > 0 ? o.threads
                                     : std::max(1, int(std::thread::hardware_concurrency()) / world->ranksOnThisNode());
-  const bool tty = world->root() && ::isatty(STDOUT_FILENO) == 1 && !args.quiet;
+  // No progress bar under mpirun: a rank sees only its share, and mpirun hands the ranks a
+  // terminal even when its own output goes to a file.
+  const bool tty = !world->distributed() && ::isatty(STDOUT_FILENO) == 1 && !args.quiet;
   const auto t0 = std::chrono::steady_clock::now();
   auto progress = [tty](int done, int total) {
     if (!tty) return;
@@ -108,10 +111,7 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
     } catch (const std::runtime_error& e) {
       fatal = e.what();  // every rank alike
     }
-    if (!world->root()) {
-      outcome.code = !fatal.empty() ? kComputationFailure : signalStatus;
-      return;
-    }
+    if (!world->root()) return;  // rank 0 reports for every rank (see above)
     std::string failures;
     for (size_t r = 1; r < reports.size(); ++r) {
       if (reports[r].rfind("1", 0) == 0) {

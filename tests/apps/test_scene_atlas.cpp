@@ -1,10 +1,15 @@
 // The atlas: straight-chain stability ⇔ κ > 0, the first critical force against eq 17 for three
 // segments, supercritical post-buckling in the paper's range (docs/mechanics.md, "What the physics does"),
-// and the same answers whatever the thread count.
+// the same answers whatever the thread count, and shares computed apart (as MPI ranks do) that
+// make the whole atlas.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "scene/atlas.h"
 
@@ -69,4 +74,70 @@ TEST_CASE("atlas options are validated", "[scene][atlas]") {
   CHECK_THROWS_WITH(buckle::scene::validateAtlas(o), Catch::Contains("--y must be one of"));
   o.y = {"L0", -1.0, 1.0, 3};
   CHECK_THROWS_WITH(buckle::scene::validateAtlas(o), Catch::Contains("L0/b must be > 0"));
+}
+
+namespace {
+
+// Same cell, field by field; NaN equals NaN (a cell without a critical load).
+void checkSameCell(const AtlasCell& a, const AtlasCell& b) {
+  INFO("a = " << a.a << ", L0 = " << a.L0);
+  CHECK(a.kappa == b.kappa);
+  CHECK(a.straightStable == b.straightStable);
+  CHECK((std::isnan(a.firstCritical) ? std::isnan(b.firstCritical) : a.firstCritical == b.firstCritical));
+  CHECK(a.firstShape == b.firstShape);
+  CHECK(a.postBuckling == b.postBuckling);
+  CHECK(a.postSlope == b.postSlope);
+  CHECK(a.error == b.error);
+}
+
+}  // namespace
+
+TEST_CASE("atlas shares: computed apart, packed and unpacked, they make the whole atlas", "[scene][atlas]") {
+  AtlasOptions o;
+  o.x = {"a", 0.1, 20.0, 7};  // a/b up to 20: cells that fail, with their error message
+  o.y = {"L0", 0.1, 3.0, 4};
+  o.threads = 1;
+  const std::vector<AtlasCell> whole = buckle::scene::computeAtlas(o);
+  REQUIRE(std::count_if(whole.begin(), whole.end(), [](const AtlasCell& c) { return c.postBuckling == "failed"; }) > 0);
+  REQUIRE(std::count_if(whole.begin(), whole.end(), [](const AtlasCell& c) { return c.postBuckling == "supercritical"; }) > 0);
+  for (int parts : {2, 3}) {  // 28 cells: an even split and an uneven one
+    std::vector<AtlasCell> gathered = buckle::scene::atlasGrid(o);
+    size_t total = 0;
+    for (int part = 0; part < parts; ++part) {
+      const buckle::scene::AtlasShare share{part, parts};
+      std::vector<AtlasCell> own = buckle::scene::atlasGrid(o);
+      const size_t computed = buckle::scene::computeCells(own, share, 1, buckle::continuation::Interrupt{});
+      CHECK(computed == share.size(own.size()));
+      total += computed;
+      for (size_t k = 0; k < own.size(); ++k)
+        if (!share.owns(k)) CHECK(own[k].postBuckling == "not computed");
+      buckle::scene::unpackAtlasCells(buckle::scene::packAtlasCells(own, share), gathered);
+    }
+    CHECK(total == whole.size());
+    for (size_t k = 0; k < whole.size(); ++k) checkSameCell(gathered[k], whole[k]);
+  }
+  const buckle::scene::AtlasShare first{0, 2};
+  const std::string bytes = buckle::scene::packAtlasCells(whole, first);
+  std::vector<AtlasCell> grid = buckle::scene::atlasGrid(o);
+  CHECK_THROWS_WITH(buckle::scene::unpackAtlasCells(bytes.substr(0, bytes.size() - 1), grid),
+                    Catch::Contains("ends early"));
+  std::vector<AtlasCell> small(3);
+  CHECK_THROWS_WITH(buckle::scene::unpackAtlasCells(bytes, small), Catch::Contains("outside the grid of 3"));
+}
+
+TEST_CASE("an interrupted atlas starts no cell and says why", "[scene][atlas]") {
+  AtlasOptions o;
+  o.x = {"a", 0.5, 0.6, 3};
+  o.y = {"L0", 2.0, 2.5, 2};
+  std::atomic<bool> stop{true};
+  buckle::continuation::Interrupt interrupt;
+  interrupt.watch(&stop, "stop requested");
+  std::vector<AtlasCell> cells = buckle::scene::atlasGrid(o);
+  CHECK(buckle::scene::computeCells(cells, buckle::scene::AtlasShare{}, 2, interrupt) == 0);
+  for (const AtlasCell& c : cells) {
+    CHECK(c.postBuckling == "not computed");
+    CHECK(c.error == "stopped early: stop requested");
+    CHECK(std::isnan(c.firstCritical));
+    CHECK(c.kappa == Approx(c.L0 - 2.0 * (1.0 - c.a * c.a)));
+  }
 }
