@@ -29,11 +29,12 @@ TEST_TIMEOUT=${BUCKLE_TEST_TIMEOUT:-900}
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$ROOT}
 
 # Debian packages (names verified on bookworm). pybind11-dev, python3-dev, python3-numpy: the
-# Python module (build/python); python3-pytest: its tests. TEST_PACKAGES only for `test`:
+# Python module (build/python); python3-pytest: its tests. openmpi-bin, libopenmpi-dev:
+# `buckle atlas` under mpirun (and its test, mpirun -np 2/3). TEST_PACKAGES only for `test`:
 # chromium renders report.html in the browser test.
 readonly PACKAGES=(build-essential cmake git pkg-config ccache libeigen3-dev libsundials-dev
                    libboost-dev catch2 libcli11-dev nlohmann-json3-dev libbenchmark-dev gnuplot-nox
-                   pybind11-dev python3-dev python3-numpy python3-pytest)
+                   pybind11-dev python3-dev python3-numpy python3-pytest openmpi-bin libopenmpi-dev)
 readonly TEST_PACKAGES=(chromium)
 
 START=$SECONDS
