@@ -30,4 +30,5 @@ BUILD=$BUILD OUT=$OUT run work_precision "$HERE/work_precision.sh" --quick   # A
 run hard_cases "$BIN/hard_cases" --quick
 run critical_loads "$BIN/critical_loads" --quick
 run jump_timing "$BIN/jump_timing" --quick
+command -v mpirun > /dev/null && BUILD=$BUILD run atlas_mpi "$HERE/atlas_mpi.sh" --quick   # issue 15
 exit $status
