@@ -99,7 +99,8 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
   const scene::AtlasShare share{world->rank(), world->size()};
   std::string fatal;
   try {
-    scene::computeCells(cells, share, threads, interrupt, progress);
+    const size_t computed = scene::computeCells(cells, share, threads, interrupt, progress);
+    if (tty && computed < share.size(cells.size())) std::cout << "\n";  // end the stopped bar's line
   } catch (const std::exception& e) {
     fatal = e.what();
   }

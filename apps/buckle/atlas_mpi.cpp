@@ -6,6 +6,9 @@
 #include <stdexcept>
 
 #if BUCKLE_WITH_MPI
+// The C API only: not the C++ bindings (deprecated since MPI 2.2, removed in MPI 3).
+#define OMPI_SKIP_MPICXX 1
+#define MPICH_SKIP_MPICXX 1
 #include <mpi.h>
 #endif
 
