@@ -53,6 +53,8 @@ SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
   s.contactTorque = sp.contactTorque;
   s.lockedAfter = sp.lockedAfter.label();
   s.contactPoint = sp.contactPoint;
+  s.koiter = sp.koiter;
+  s.imperfections = sp.imperfections;
   copyLanding(sp.landing, s);
   return s;
 }

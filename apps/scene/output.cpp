@@ -179,6 +179,20 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       if (s.K.allFinite()) p["stiffness"] = {{"Kxx", number(s.K(0, 0))}, {"Kyy", number(s.K(1, 1))}, {"Kxy", number(s.K(0, 1))}};
       if (!s.note.empty()) p["note"] = s.note;
       if (s.contactPoint.allFinite()) p["contact_point"] = json::array({number(s.contactPoint.x()), number(s.contactPoint.y())});
+      if (s.koiter.valid) {  // BP: λ(ξ) = λ + aξ + bξ², ξ in rad of the unit joint-angle mode
+        p["koiter_a"] = number(s.koiter.a);
+        p["koiter_b"] = number(s.koiter.b);
+        p["post_buckling"] = mechanics::toString(s.koiter.kind);
+        json imperfections = json::array();
+        for (const mechanics::ImperfectionSensitivity& im : s.imperfections)
+          if (im.valid)
+            imperfections.push_back({{"imperfection", im.name},
+                                     {"coupling", number(im.coupling)},
+                                     {"exponent", number(im.exponent)},
+                                     {"prefactor", number(im.prefactor)},
+                                     {"sign", im.sign}});
+        p["imperfection_sensitivity"] = imperfections;
+      }
       if (s.joint >= 0)  // CT / RL
         p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", number(s.contactTorque)}, {"locked_after", s.lockedAfter}};
       if (s.jumpTried) {

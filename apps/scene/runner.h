@@ -12,6 +12,8 @@
 #include "buckle/mechanics/critical_curves.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/energy_landscape.h"
+#include "buckle/mechanics/imperfection_sensitivity.h"
+#include "buckle/mechanics/koiter.h"
 #include "buckle/mechanics/landing.h"
 #include "buckle/mechanics/linear_buckling.h"
 #include "buckle/mechanics/unloaded_shape.h"
@@ -72,6 +74,9 @@ struct SpecialRecord {
   std::vector<mechanics::JointContact> jumpContacts;  ///< joints in contact at the landing
   /// BC / SC: where the chain touches the wall or itself (NaN otherwise)
   Eigen::Vector2d contactPoint = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// BP: Koiter's coefficients and the imperfection sensitivity (SpecialPointReport)
+  mechanics::KoiterCoefficients koiter;
+  std::vector<mechanics::ImperfectionSensitivity> imperfections;
 };
 
 struct BranchRecord {

@@ -68,6 +68,21 @@ TEST_CASE("buckle show prints every special point and branch of a run", "[cli][s
   REQUIRE(start != text.end());
   CHECK(*start == "special points (" + std::to_string(sp["special_points"].size()) + ", special_points.json):");
   REQUIRE(sp["special_points"].size() >= 4);  // U and Z branch points, the folds/limits beyond them
+  // every BP carries Koiter's coefficients: the paper's chain buckles supercritically (symmetric,
+  // b·τ < 0), and an end moment couples to both modes (docs/outputs.md)
+  int bps = 0;
+  for (const json& p : sp["special_points"]) {
+    if (p["type"] != "BP") continue;
+    ++bps;
+    CHECK(p.at("koiter_a").get<double>() == 0.0);
+    CHECK(p.at("koiter_b").get<double>() < 0.0);
+    CHECK(p.at("post_buckling") == "supercritical");
+    REQUIRE(p.at("imperfection_sensitivity").size() == 3);
+    CHECK(p["imperfection_sensitivity"][2]["imperfection"] == "Me");
+    CHECK(p["imperfection_sensitivity"][2]["coupling"].get<double>() != 0.0);
+    CHECK(p["imperfection_sensitivity"][2]["exponent"].get<double>() == 0.0);  // no limit point
+  }
+  CHECK(bps == 2);
   // one row per point, in order, after the header: case, type, field, branch, parameter, Fx, Fy, Me, shape
   for (size_t i = 0; i < sp["special_points"].size(); ++i) {
     const json& p = sp["special_points"][i];

@@ -245,7 +245,16 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     s.phenomenon = cl.phenomenon;
     s.shape = cl.shape;
     switch (sp.type) {
-      case cont::SpecialPointType::BranchPoint: s.type = EventType::BranchPoint; break;
+      case cont::SpecialPointType::BranchPoint:
+        s.type = EventType::BranchPoint;
+        if (lockedAt(stretches, sp.index).empty()) {
+          s.koiter = koiterCoefficients(problem, sp);
+          if (s.koiter.valid)
+            for (int c = 0; c < 3; ++c) s.imperfections.push_back(imperfectionSensitivity(problem, sp, s.koiter, c));
+          else
+            s.note = s.koiter.error;
+        }
+        break;
       case cont::SpecialPointType::Fold: s.type = EventType::Fold; break;
       default:
         s.type = EventType::Boundary;

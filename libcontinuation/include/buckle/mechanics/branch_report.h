@@ -22,6 +22,7 @@
 #include "buckle/mechanics/classification.h"
 #include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/imperfection_sensitivity.h"
 #include "buckle/mechanics/landing.h"
 #include "buckle/mechanics/load_history.h"
 #include "buckle/mechanics/stiffness_extremum.h"
@@ -121,6 +122,13 @@ struct SpecialPointReport {
   ContactSet lockedAfter;
   /// BC / SC: where the chain touches the wall or itself (NaN otherwise).
   Eigen::Vector2d contactPoint = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// BP of free joints: Koiter's coefficients of the bifurcated branch, λ(ξ) = λ + aξ + bξ² in the
+  /// traced λ's units with ξ the unit joint-angle mode's amplitude in rad (koiter.h); invalid
+  /// (the reason in its error, also in the note) where not computed.
+  KoiterCoefficients koiter;
+  /// BP with valid koiter: the knockdown of λ by an imperfection of each end coordinate x, y, φ
+  /// (imperfection_sensitivity.h).
+  std::vector<ImperfectionSensitivity> imperfections;
 };
 
 struct BranchReport {

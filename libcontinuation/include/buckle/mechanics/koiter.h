@@ -1,0 +1,54 @@
+// Koiter's post-buckling coefficients of a branch point of the chain, on any branch (the straight
+// chain's or a bent one's, uniform or not): the generic reduction (branch_point_coefficients.h)
+// with the amplitude measured in the chain's own words. ξ = m·(q − q_p(λ)) is the amplitude of
+// the unit joint-angle mode m (|m| = 1, its largest component positive) relative to the branch
+// being traced (the parent q_p), in radians, so the bifurcated branch is
+//     λ(ξ) = λc + aξ + bξ² + O(ξ³)
+// in the traced parameter's units (a force, a torque or a coordinate, whatever λ moves).
+//
+// Which way it goes: F_u is symmetric (equilibrium_problem.h), so ψ ∝ v and the eigenvalue of
+// F_u that vanishes at λc moves like τ(λ − λc) (τ = ψᵀF_xx[e, d], ψᵀv = 1): the parent gains a
+// negative eigenvalue on the side −sign(τ). A symmetric point (a = 0 to rounding) is
+// supercritical when the bifurcated branch lies on that side (b·τ < 0: it takes over the
+// parent's stability, benign buckling), subcritical when it lies on the stable side (b·τ > 0:
+// unstable, the chain jumps). a ≠ 0 is an asymmetric (transcritical) point: one half of the
+// bifurcated branch is always on the stable side (dangerous, imperfection_sensitivity.h).
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <string>
+
+#include "buckle/continuation/branch.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+
+namespace buckle::mechanics {
+
+/// The coefficients use dense N×N matrices: above this dimension they are not computed (the
+/// tracer's own dense crossover, TracerOptions::maxDenseLocationDimension).
+constexpr int kKoiterMaxDimension = 400;
+
+enum class KoiterKind { Supercritical, Subcritical, Asymmetric };
+
+/// "supercritical", "subcritical", "asymmetric".
+const char* toString(KoiterKind kind);
+
+struct KoiterCoefficients {
+  bool valid = false;
+  double lambda = std::numeric_limits<double>::quiet_NaN();  ///< λc, the traced parameter
+  double a = std::numeric_limits<double>::quiet_NaN();       ///< dλ/dξ (λ units per rad)
+  double b = std::numeric_limits<double>::quiet_NaN();       ///< ½ d²λ/dξ² (λ units per rad²)
+  double transversality = std::numeric_limits<double>::quiet_NaN();  ///< τ (file comment)
+  KoiterKind kind = KoiterKind::Supercritical;
+  Eigen::VectorXd mode;   ///< the unit joint-angle mode m (size n)
+  Eigen::VectorXd v;      ///< null vector of F_u (size N), its joint part m
+  Eigen::VectorXd psi;    ///< left null vector, ψᵀv = 1
+  Eigen::VectorXd parentSlope;  ///< du_p/dλ of the traced branch at the point (size N)
+  std::string error;      ///< why not valid
+};
+
+/// The coefficients at the branch point bp located on a branch of `problem` (free joints: not in
+/// contact). Never throws: failures are reported in `error`.
+KoiterCoefficients koiterCoefficients(EquilibriumProblem& problem, const continuation::SpecialPoint& bp);
+
+}  // namespace buckle::mechanics

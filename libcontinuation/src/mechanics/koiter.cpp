@@ -1,0 +1,64 @@
+#include "buckle/mechanics/koiter.h"
+
+#include <cmath>
+
+#include "buckle/continuation/branch_point_coefficients.h"
+
+namespace buckle::mechanics {
+
+namespace cont = buckle::continuation;
+
+const char* toString(KoiterKind kind) {
+  switch (kind) {
+    case KoiterKind::Supercritical: return "supercritical";
+    case KoiterKind::Subcritical: return "subcritical";
+    case KoiterKind::Asymmetric: return "asymmetric";
+  }
+  return "?";
+}
+
+KoiterCoefficients koiterCoefficients(EquilibriumProblem& problem, const cont::SpecialPoint& bp) {
+  KoiterCoefficients k;
+  const int N = problem.dimension(), n = problem.segments();
+  if (N > kKoiterMaxDimension) {
+    k.error = "Koiter coefficients not computed above " + std::to_string(kKoiterMaxDimension) + " unknowns (dense)";
+    return k;
+  }
+  if (bp.type != cont::SpecialPointType::BranchPoint || bp.nullVectors.rows() != N + 1 || bp.nullVectors.cols() != 2) {
+    k.error = "Koiter coefficients: not a located simple branch point";
+    return k;
+  }
+  // the joint part of ker F_u (the λ-free combination of ker F_x), unit, largest entry positive
+  const Eigen::VectorXd t = bp.nullVectors.col(0), phi = bp.nullVectors.col(1);
+  Eigen::VectorXd m = (t[N] * phi.head(N) - phi[N] * t.head(N)).head(n);
+  if (!(m.norm() > 0.0) || !m.allFinite()) {
+    k.error = "Koiter coefficients: the null vector has no joint part";
+    return k;
+  }
+  Eigen::Index big = 0;
+  m.cwiseAbs().maxCoeff(&big);
+  m *= (m[big] < 0.0 ? -1.0 : 1.0) / m.norm();
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(N);
+  c.head(n) = m;
+  cont::BranchPointCoefficients g;
+  if (!cont::branchPointCoefficients(problem, bp, c, g, &k.error)) return k;
+  k.valid = true;
+  k.lambda = bp.lambda;
+  k.a = g.a;
+  k.b = g.b;
+  k.transversality = g.transversality;
+  k.mode = g.v.head(n) / g.v.head(n).norm();
+  k.v = g.v;
+  k.psi = g.psi;
+  k.parentSlope = g.parentSlope;
+  // a is zero by symmetry at a symmetric point; its rounding is relative to b times the
+  // amplitude's unit (1 rad) and λ's own scale
+  const double lambdaScale = std::max(problem.scales().parameter, std::abs(bp.lambda));
+  if (std::abs(k.a) > 1e-8 * std::max(lambdaScale, std::abs(k.b)))
+    k.kind = KoiterKind::Asymmetric;
+  else
+    k.kind = k.b * k.transversality < 0.0 ? KoiterKind::Supercritical : KoiterKind::Subcritical;
+  return k;
+}
+
+}  // namespace buckle::mechanics
