@@ -1,5 +1,6 @@
 #include "buckle/continuation/dense_lu.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -12,20 +13,50 @@ DenseLU::DenseLU(int size, Rounding rounding)
   if (size < 1) throw std::invalid_argument("DenseLU: size must be positive");
 }
 
-bool DenseLU::factor() { return rounding_ == Rounding::Divide ? factorImpl<false>() : factorImpl<true>(); }
+bool DenseLU::factor() { return rounding_ == Rounding::Divide ? factorDispatch<false>() : factorDispatch<true>(); }
 
 void DenseLU::solveInPlace(double *b) const {
   if (rounding_ == Rounding::Divide)
-    solveImpl<false>(b);
+    solveDispatch<false>(b);
   else
-    solveImpl<true>(b);
+    solveDispatch<true>(b);
 }
 
 template <bool reciprocal>
-bool DenseLU::factorImpl() {
-  const int n = n_;
-  double *a = lu_.data();
-  swaps_ = 0;
+bool DenseLU::factorDispatch() {
+  switch (n_) {
+    case 2: return factorImpl<2, reciprocal>();
+    case 3: return factorImpl<3, reciprocal>();
+    case 4: return factorImpl<4, reciprocal>();
+    case 5: return factorImpl<5, reciprocal>();
+    case 6: return factorImpl<6, reciprocal>();
+    case 7: return factorImpl<7, reciprocal>();
+    case 8: return factorImpl<8, reciprocal>();
+    default: return factorImpl<0, reciprocal>();
+  }
+}
+
+template <bool reciprocal>
+void DenseLU::solveDispatch(double *b) const {
+  switch (n_) {
+    case 2: return solveImpl<2, reciprocal>(b);
+    case 3: return solveImpl<3, reciprocal>(b);
+    case 4: return solveImpl<4, reciprocal>(b);
+    case 5: return solveImpl<5, reciprocal>(b);
+    case 6: return solveImpl<6, reciprocal>(b);
+    case 7: return solveImpl<7, reciprocal>(b);
+    case 8: return solveImpl<8, reciprocal>(b);
+    default: return solveImpl<0, reciprocal>(b);
+  }
+}
+
+namespace {
+
+// P A = L U of the n×n column-major `a` in place (see the header for the two roundings).
+template <int Fixed, bool reciprocal>
+bool factorKernel(double *a, int runtimeSize, int *pivots, int &swaps) {
+  const int n = Fixed > 0 ? Fixed : runtimeSize;
+  swaps = 0;
   for (int k = 0; k < n; ++k) {
     double *colK = a + static_cast<std::ptrdiff_t>(k) * n;
     // The first entry of largest magnitude (a NaN never wins a comparison, as in both libraries).
@@ -38,11 +69,11 @@ bool DenseLU::factorImpl() {
         p = i;
       }
     }
-    pivots_[std::size_t(k)] = p;
+    pivots[k] = p;
     if (largest == 0.0) return false;
     if (p != k) {
       for (int j = 0; j < n; ++j) std::swap(a[j * n + k], a[j * n + p]);
-      ++swaps_;
+      ++swaps;
     }
     const double pivot = colK[k];
     if (reciprocal) {
@@ -62,12 +93,12 @@ bool DenseLU::factorImpl() {
   return true;
 }
 
-template <bool reciprocal>
-void DenseLU::solveImpl(double *b) const {
-  const int n = n_;
-  const double *a = lu_.data();
+// b ← U⁻¹ L⁻¹ P b.
+template <int Fixed, bool reciprocal>
+void solveKernel(const double *a, int runtimeSize, const int *pivots, double *b) {
+  const int n = Fixed > 0 ? Fixed : runtimeSize;
   for (int k = 0; k < n; ++k) {
-    const int p = pivots_[std::size_t(k)];
+    const int p = pivots[k];
     if (p != k) std::swap(b[k], b[p]);
   }
   // L y = P b (unit diagonal), column by column.
@@ -84,6 +115,27 @@ void DenseLU::solveImpl(double *b) const {
     b[k] /= colK[k];
     const double bk = b[k];
     for (int i = 0; i < k; ++i) b[i] -= bk * colK[i];
+  }
+}
+
+}  // namespace
+
+template <int Fixed, bool reciprocal>
+bool DenseLU::factorImpl() {
+  return factorKernel<Fixed, reciprocal>(lu_.data(), n_, pivots_.data(), swaps_);
+}
+
+// At a compile-time size the solve runs on a local copy of b: the compiler then sees that b does
+// not overlap the factors and keeps it in registers.
+template <int Fixed, bool reciprocal>
+void DenseLU::solveImpl(double *b) const {
+  if constexpr (Fixed == 0) {
+    solveKernel<0, reciprocal>(lu_.data(), n_, pivots_.data(), b);
+  } else {
+    double x[Fixed];
+    std::copy(b, b + Fixed, x);
+    solveKernel<Fixed, reciprocal>(lu_.data(), n_, pivots_.data(), x);
+    std::copy(x, x + Fixed, b);
   }
 }
 

@@ -53,10 +53,16 @@ class DenseLU {
   int permutationSign() const { return swaps_ % 2 == 0 ? 1 : -1; }
 
  private:
-  template <bool reciprocal>
+  // Fixed > 0: the size as a compile-time constant (sizes up to kEigenIdenticalSize, loops
+  // unrolled); 0: the run-time size.
+  template <int Fixed, bool reciprocal>
   bool factorImpl();
-  template <bool reciprocal>
+  template <int Fixed, bool reciprocal>
   void solveImpl(double *b) const;
+  template <bool reciprocal>
+  bool factorDispatch();
+  template <bool reciprocal>
+  void solveDispatch(double *b) const;
 
   int n_;
   Rounding rounding_;
