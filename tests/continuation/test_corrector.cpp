@@ -2,9 +2,13 @@
 
 #include "toy_problems.h"
 
+#include <kinsol/kinsol.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -155,4 +159,113 @@ TEST_CASE("Corrector rethrows an exception thrown inside a KINSOL callback", "[c
   const CorrectorSummary summary = corrector.correct(predictor, tangent, x);
   REQUIRE(summary.converged);
   CHECK(std::abs(x[0] - 0.8) < 1e-12);
+}
+
+namespace {
+// KINSOL with its own dense matrix and linear solver (SUNLinSol_Dense) on the Keller system, with
+// the Corrector's options and the same arithmetic for G and its Jacobian: the reference the
+// Corrector's DenseLU-based linear solver must reproduce.
+struct ReferenceKeller {
+  Problem *problem;
+  Vector predictor, tangent;
+  static int system(N_Vector xv, N_Vector gv, void *self) {
+    auto &r = *static_cast<ReferenceKeller *>(self);
+    const int m = static_cast<int>(r.predictor.size()), n = m - 1;
+    Eigen::Map<const Vector> x(N_VGetArrayPointer(xv), m);
+    Eigen::Map<Vector> g(N_VGetArrayPointer(gv), m);
+    if (!r.problem->residual(x.head(n), x[n], g.head(n))) return 1;
+    g[n] = r.tangent.dot(x - r.predictor);
+    return 0;
+  }
+  static int jacobian(N_Vector xv, N_Vector, SUNMatrix J, void *self, N_Vector, N_Vector) {
+    auto &r = *static_cast<ReferenceKeller *>(self);
+    const int m = static_cast<int>(r.predictor.size()), n = m - 1;
+    Eigen::Map<const Vector> x(N_VGetArrayPointer(xv), m);
+    Eigen::Map<Matrix> A(SUNDenseMatrix_Data(J), m, m);
+    A.setZero();
+    if (!r.problem->jacobian(x.head(n), x[n], A.topLeftCorner(n, n), A.col(n).head(n))) return -1;
+    A.row(n) = r.tangent.transpose();
+    return 0;
+  }
+  // Solves from the predictor; x, iterations and ‖G‖ at the end.
+  int solve(const CorrectorOptions &options, Vector &x, long &iterations, double &fnorm) {
+    const sunindextype m = predictor.size();
+    SunContextPtr context = makeSunContext();
+    NVectorPtr xv = makeSerialVector(m, context.get()), scale = makeSerialVector(m, context.get());
+    N_VConst(1.0, scale.get());
+    SunMatrixPtr J = makeDenseMatrix(m, m, context.get());
+    SunLinearSolverPtr ls = makeDenseLinearSolver(xv.get(), J.get(), context.get());
+    KinsolMemoryPtr kinsol = makeKinsolMemory(context.get());
+    void *mem = kinsol.get();
+    KINInit(mem, &ReferenceKeller::system, xv.get());
+    KINSetUserData(mem, this);
+    KINSetLinearSolver(mem, ls.get(), J.get());
+    KINSetJacFn(mem, &ReferenceKeller::jacobian);
+    KINSetMaxSetupCalls(mem, 1);
+    KINSetFuncNormTol(mem, options.residualTolerance);
+    KINSetScaledStepTol(mem, options.stepTolerance);
+    KINSetNumMaxIters(mem, options.maxIterations);
+    KINSetMaxNewtonStep(mem, 1e100);
+    Eigen::Map<Vector>(N_VGetArrayPointer(xv.get()), m) = predictor;
+    const int flag = KINSol(mem, xv.get(), KIN_NONE, scale.get(), scale.get());
+    KINGetNumNonlinSolvIters(mem, &iterations);
+    KINGetFuncNorm(mem, &fnorm);
+    x = Eigen::Map<const Vector>(N_VGetArrayPointer(xv.get()), m);
+    return flag;
+  }
+};
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+}  // namespace
+
+TEST_CASE("Corrector's dense linear solver: the same Newton iterates as KINSOL's SUNLinSol_Dense, bit for bit",
+          "[corrector]") {
+  toys::Bratu bratu(6);
+  toys::CurvedPitchforks pitchforks(0.7);
+  toys::CubicFold cubic;
+  struct Case {
+    Problem *problem;
+    Vector predictor, tangent;
+  };
+  std::vector<Case> cases;
+  {
+    const int n = bratu.dimension();
+    Vector p = Vector::LinSpaced(n + 1, 0.2, 0.5), t = Vector::LinSpaced(n + 1, 0.1, 1.0);
+    p[n] = 2.0;
+    cases.push_back({&bratu, p, t.normalized()});
+    Vector t2 = Vector::Zero(n + 1);
+    t2[n] = 1.0;
+    cases.push_back({&bratu, p, t2});
+  }
+  for (double lambda : {0.9, 1.4}) {
+    Vector p(3), t(3);
+    p << 0.4, -0.2, lambda;
+    t << 0.3, 0.1, 1.0;
+    cases.push_back({&pitchforks, p, t.normalized()});
+  }
+  {
+    Vector p(2), t(2);
+    p << 1.2, -0.5;
+    t << 0.6, 0.8;
+    cases.push_back({&cubic, p, t});
+  }
+  int converged = 0;
+  for (const Case &c : cases) {
+    CorrectorOptions options;
+    options.residualTolerance = 1e-13;
+    Corrector corrector(*c.problem, options);
+    Vector x(c.predictor.size()), xr;
+    const CorrectorSummary summary = corrector.correct(c.predictor, c.tangent, x);
+    ReferenceKeller reference{c.problem, c.predictor, c.tangent};
+    long iterations = 0;
+    double fnorm = 0.0;
+    const int flag = reference.solve(options, xr, iterations, fnorm);
+    CHECK(summary.flag == flag);
+    CHECK(summary.iterations == iterations);
+    CHECK(sameBits(summary.residualNorm, fnorm));
+    for (Eigen::Index i = 0; i < x.size(); ++i) CHECK(sameBits(x[i], xr[i]));
+    INFO("case " << converged);
+    CHECK(summary.converged);
+    ++converged;
+  }
 }

@@ -11,7 +11,12 @@ Factorization BorderedSolver::factorGeneral(ConstVectorRef, double, ConstMatrixR
 }
 
 DenseBorderedSolver::DenseBorderedSolver(Problem &problem)
-    : problem_(problem), n_(problem.dimension()), A_(Matrix::Zero(n_ + 1, n_ + 1)), lu_(n_ + 1) {}
+    : problem_(problem),
+      n_(problem.dimension()),
+      A_(Matrix::Zero(n_ + 1, n_ + 1)),
+      small_(n_ + 1, DenseLU::Rounding::Divide),
+      useSmall_(n_ + 1 <= DenseLU::kEigenIdenticalSize),
+      lu_(useSmall_ ? 0 : n_ + 1) {}
 
 Factorization DenseBorderedSolver::factor(ConstVectorRef u, double lambda, ConstVectorRef c) {
   general_ = false;
@@ -21,22 +26,19 @@ Factorization DenseBorderedSolver::factor(ConstVectorRef u, double lambda, Const
   if (!problem_.jacobian(u, lambda, A_.topLeftCorner(n_, n_), A_.col(n_).head(n_))) return Factorization::Refused;
   A_.row(n_) = c.transpose();
   if (!A_.allFinite()) return Factorization::Refused;
-  lu_.compute(A_);
-  const auto &LU = lu_.matrixLU();
-  int sign = lu_.permutationP().determinant() > 0 ? 1 : -1;
-  // |det| as mantissa·2^exponent: one log per factorization instead of one per pivot.
-  double mantissa = 1.0;
-  long exponent = 0;
-  for (int i = 0; i <= n_; ++i) {
-    const double pivot = LU(i, i);
-    if (pivot == 0.0 || !std::isfinite(pivot)) return Factorization::Singular;
-    if (pivot < 0.0) sign = -sign;
-    int e = 0;
-    mantissa = std::frexp(mantissa * std::abs(pivot), &e);
-    exponent += e;
+  int sign = 0;
+  double logAbs = 0.0;
+  if (useSmall_) {
+    small_.matrix() = A_;
+    if (!small_.factor() || !signedLogDeterminant(small_.factors(), small_.permutationSign(), sign, logAbs))
+      return Factorization::Singular;
+  } else {
+    lu_.compute(A_);
+    if (!signedLogDeterminant(lu_.matrixLU(), lu_.permutationP().determinant() > 0 ? 1 : -1, sign, logAbs))
+      return Factorization::Singular;
   }
   sign_ = sign;
-  logAbs_ = std::log(mantissa) + static_cast<double>(exponent) * 0.6931471805599453;
+  logAbs_ = logAbs;
   return Factorization::Regular;
 }
 
@@ -74,7 +76,12 @@ bool DenseBorderedSolver::solve(ConstVectorRef b, VectorRef x) {
     x = generalLu_.solve(b);
     return x.allFinite();
   }
-  x = lu_.solve(b);
+  if (useSmall_) {
+    x = b;
+    small_.solveInPlace(x);
+  } else {
+    x = lu_.solve(b);
+  }
   return x.allFinite();
 }
 

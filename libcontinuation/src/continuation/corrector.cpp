@@ -1,7 +1,5 @@
 #include "buckle/continuation/corrector.h"
 
-#include <sunmatrix/sunmatrix_dense.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -43,13 +41,10 @@ Corrector::Corrector(Problem &problem, const CorrectorOptions &options, Bordered
   x_ = makeSerialVector(m, context_.get());
   scale_ = makeSerialVector(m, context_.get());
   N_VConst(1.0, scale_.get());
-  if (structured_) {
-    jacobian_ = makeEmptyCustomMatrix(context_.get());
-    linearSolver_ = makeCustomDirectLinearSolver(&Corrector::linearSolve, this, context_.get());
-  } else {
-    jacobian_ = makeDenseMatrix(m, m, context_.get());
-    linearSolver_ = makeDenseLinearSolver(x_.get(), jacobian_.get(), context_.get());
-  }
+  if (!structured_) dense_.emplace(static_cast<int>(m), DenseLU::Rounding::Reciprocal);
+  jacobian_ = makeEmptyCustomMatrix(context_.get());
+  linearSolver_ =
+      makeCustomDirectLinearSolver(&Corrector::linearSolve, this, context_.get(), &Corrector::linearSetup);
   kinsol_ = makeKinsolMemory(context_.get());
   void *mem = kinsol_.get();
   if (KINInit(mem, &Corrector::systemFunction, x_.get()) != KIN_SUCCESS ||
@@ -90,15 +85,23 @@ int Corrector::systemFunction(N_Vector x, N_Vector g, void *self) {
   }
 }
 
-int Corrector::jacobianFunction(N_Vector x, N_Vector, SUNMatrix J, void *self, N_Vector, N_Vector) {
+int Corrector::jacobianFunction(N_Vector x, N_Vector, SUNMatrix, void *self, N_Vector, N_Vector) {
   auto *corrector = static_cast<Corrector *>(self);
   try {
     if (corrector->structured_) return corrector->factorStructured(N_VGetArrayPointer(x));
-    return corrector->evaluateJacobian(N_VGetArrayPointer(x), SUNDenseMatrix_Data(J));
+    return corrector->evaluateJacobian(N_VGetArrayPointer(x));
   } catch (...) {
     corrector->pending_ = std::current_exception();
     return -1;
   }
+}
+
+// Dense path: the factorization of the matrix the Jacobian callback wrote. A zero pivot is
+// SUNLinSol_Dense's recoverable SUNLS_LUFACT_FAIL, so KINSOL reacts as it did with that solver.
+int Corrector::linearSetup(SUNLinearSolver solver, SUNMatrix) {
+  auto *corrector = static_cast<Corrector *>(customLinearSolverData(solver));
+  if (!corrector->dense_) return SUNLS_SUCCESS;  // structured: factored in the Jacobian callback
+  return corrector->dense_->factor() ? SUNLS_SUCCESS : SUNLS_LUFACT_FAIL;
 }
 
 int Corrector::linearSolve(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vector b, realtype) {
@@ -106,6 +109,11 @@ int Corrector::linearSolve(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vect
   const int m = corrector->n_ + 1;
   Eigen::Map<const Vector> rhs(N_VGetArrayPointer(b), m);
   Eigen::Map<Vector> solution(N_VGetArrayPointer(x), m);
+  if (corrector->dense_) {
+    solution = rhs;
+    corrector->dense_->solveInPlace(solution);
+    return SUNLS_SUCCESS;
+  }
   try {
     return corrector->structured_->solve(rhs, solution) ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_UNREC;
   } catch (...) {
@@ -141,10 +149,10 @@ int Corrector::evaluate(const double *xData, double *gData) {
   return g.allFinite() ? 0 : 1;
 }
 
-int Corrector::evaluateJacobian(const double *xData, double *jData) {
+int Corrector::evaluateJacobian(const double *xData) {
   const int m = n_ + 1;
   Eigen::Map<const Vector> x(xData, m);
-  Eigen::Map<Matrix> J(jData, m, m);  // SUNDIALS dense storage is column-major, like Eigen
+  Eigen::Map<Matrix> J = dense_->matrix();
   J.setZero();
   if (!problem_.jacobian(x.head(n_), x[n_], J.topLeftCorner(n_, n_), J.col(n_).head(n_))) return -1;
   J.row(n_) = tangent_.transpose();

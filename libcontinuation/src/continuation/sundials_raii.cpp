@@ -17,11 +17,15 @@ int customMatrixZero(SUNMatrix) { return 0; }  // nothing stored: the solver hol
 // The custom solver's content is the caller's `data`, which it does not own.
 struct CustomSolverContent {
   CustomSolveFn solve;
+  CustomSetupFn setup;
   void *data;
 };
 SUNLinearSolver_Type customSolverType(SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; }
 SUNLinearSolver_ID customSolverId(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
-int customSolverSetup(SUNLinearSolver, SUNMatrix) { return SUNLS_SUCCESS; }
+int customSolverSetup(SUNLinearSolver solver, SUNMatrix A) {
+  const auto *content = static_cast<CustomSolverContent *>(solver->content);
+  return content->setup ? content->setup(solver, A) : SUNLS_SUCCESS;
+}
 int customSolverSolve(SUNLinearSolver solver, SUNMatrix A, N_Vector x, N_Vector b, realtype tol) {
   return static_cast<CustomSolverContent *>(solver->content)->solve(solver, A, x, b, tol);
 }
@@ -82,7 +86,8 @@ SunMatrixPtr makeEmptyCustomMatrix(SUNContext context) {
   return matrix;
 }
 
-SunLinearSolverPtr makeCustomDirectLinearSolver(CustomSolveFn solve, void *data, SUNContext context) {
+SunLinearSolverPtr makeCustomDirectLinearSolver(CustomSolveFn solve, void *data, SUNContext context,
+                                                CustomSetupFn setup) {
   SunLinearSolverPtr solver(SUNLinSolNewEmpty(context));
   if (!solver) throw std::runtime_error("SUNLinSolNewEmpty failed");
   solver->ops->gettype = customSolverType;
@@ -90,7 +95,7 @@ SunLinearSolverPtr makeCustomDirectLinearSolver(CustomSolveFn solve, void *data,
   solver->ops->setup = customSolverSetup;
   solver->ops->solve = customSolverSolve;
   solver->ops->free = customSolverFree;
-  solver->content = new CustomSolverContent{solve, data};
+  solver->content = new CustomSolverContent{solve, setup, data};
   return solver;
 }
 

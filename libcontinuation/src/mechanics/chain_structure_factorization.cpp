@@ -18,7 +18,7 @@ inline double metricDiagonal(int k, int n) { return k + 1 < n ? 2.0 : 1.0; }
 
 }  // namespace
 
-void factorize(ChainStructure& ws, double sigma) {
+void factorize(ChainStructure& ws, double sigma, bool determinant) {
   const int n = ws.n;
   ws.shift = sigma;
   ws.singular = false;
@@ -27,6 +27,7 @@ void factorize(ChainStructure& ws, double sigma) {
   double mant = 1.0;
   long expo = 0;
   auto accumulate = [&](double v) {
+    if (!determinant) return;
     mant *= v;
     const double am = std::abs(mant);
     if (am > 1e150 || am < 1e-150) {
@@ -97,7 +98,8 @@ void factorize(ChainStructure& ws, double sigma) {
     }
   }
   ws.minPivotRatio = minRatio;
-  ws.logAbsDet = std::log(std::abs(mant)) + double(expo) * 0.6931471805599453;
+  ws.logAbsDet = determinant ? std::log(std::abs(mant)) + double(expo) * 0.6931471805599453
+                             : std::numeric_limits<double>::quiet_NaN();
   ws.detSign = sign;
 }
 

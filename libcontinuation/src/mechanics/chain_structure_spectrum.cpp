@@ -70,9 +70,9 @@ int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double
   return r;
 }
 
-int constrainedCountBelow(ChainStructure& ws, double sigma) {
+int constrainedCountBelow(ChainStructure& ws, double sigma, bool determinant) {
   const int r = ws.rank;
-  factorize(ws, sigma);
+  factorize(ws, sigma, determinant);
   if (r == 0) return ws.factorInertia.negative;
   ws.X.leftCols(r) = ws.B.leftCols(r);
   solveFactored(ws, ws.X, r);
@@ -92,7 +92,7 @@ int robustConstrainedCount(ChainStructure& ws, double sigma0) {
   double bestRatio = -1.0, bestFactor = 1.0;
   int bestCount = 0;
   for (double f : factors) {
-    const int c = constrainedCountBelow(ws, sigma0 * f);
+    const int c = constrainedCountBelow(ws, sigma0 * f, false);  // a count: no determinant
     if (ws.minPivotRatio >= 1e-10 && !ws.singular) return c;
     if (ws.minPivotRatio > bestRatio) {
       bestRatio = ws.minPivotRatio;

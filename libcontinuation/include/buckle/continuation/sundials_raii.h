@@ -50,11 +50,14 @@ SunLinearSolverPtr makeDenseLinearSolver(N_Vector vector, SUNMatrix matrix, SUNC
 /// An empty SUNMatrix of ID SUNMATRIX_CUSTOM: a placeholder for KINSOL's matrix-based
 /// interface when a custom linear solver holds the factorization itself.
 SunMatrixPtr makeEmptyCustomMatrix(SUNContext context);
-/// A SUNLinearSolver of type DIRECT whose solve() is `solve` (setup does nothing: the
-/// factorization happens in the Jacobian callback). `data` is returned by
-/// customLinearSolverData() and is not owned.
+/// A SUNLinearSolver of type DIRECT whose solve() is `solve` and whose setup() is `setup`
+/// (null: setup does nothing, the factorization happens in the Jacobian callback). `data` is
+/// returned by customLinearSolverData() and is not owned. Return values follow SUNDIALS: 0
+/// success, > 0 recoverable (e.g. SUNLS_LUFACT_FAIL), < 0 unrecoverable.
 using CustomSolveFn = int (*)(SUNLinearSolver, SUNMatrix, N_Vector x, N_Vector b, realtype tol);
-SunLinearSolverPtr makeCustomDirectLinearSolver(CustomSolveFn solve, void *data, SUNContext context);
+using CustomSetupFn = int (*)(SUNLinearSolver, SUNMatrix);
+SunLinearSolverPtr makeCustomDirectLinearSolver(CustomSolveFn solve, void *data, SUNContext context,
+                                                CustomSetupFn setup = nullptr);
 void *customLinearSolverData(SUNLinearSolver solver);
 /// KINSOL memory that never prints: errors go to a handler the caller installs (or nowhere).
 KinsolMemoryPtr makeKinsolMemory(SUNContext context);

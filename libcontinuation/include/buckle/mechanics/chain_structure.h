@@ -125,8 +125,9 @@ void applyHessian(const ChainStructure& ws, ConstVectorRef x, VectorRef y);
 Matrix tridiagonalMatrix(const ChainStructure& ws);
 
 // ---- factorization and counts ------------------------------------------------------------
-/// LDLᵀ of T − σM with Bunch pivoting; fills the factor fields and factorInertia.
-void factorize(ChainStructure& ws, double sigma = 0.0);
+/// LDLᵀ of T − σM with Bunch pivoting; fills the factor fields and factorInertia, and with
+/// `determinant` detSign and logAbsDet (without it logAbsDet is NaN: a count needs neither).
+void factorize(ChainStructure& ws, double sigma = 0.0, bool determinant = true);
 /// Number of eigenvalues of H below σ (Sturm count of T − σM; no factor stored).
 int countBelow(const ChainStructure& ws, double sigma);
 /// Solve (T − σM) Z = Y in place for the first `cols` columns of Y (after factorize(σ)).
@@ -143,8 +144,9 @@ Inertia hessianInertia(const ChainStructure& ws, double zeroTolerance = 1e-13);
 /// B = U⁻¹Q. Rows whose remainder falls below rankTolerance (relative to the largest row norm)
 /// are dropped, so rank-deficient C (e.g. x held on a straight chain, J_x = 0) is handled.
 int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double rankTolerance = 1e-10);
-/// Number of eigenvalues of Zᵀ H Z below σ (after setConstraints()); refactorizes at σ.
-int constrainedCountBelow(ChainStructure& ws, double sigma);
+/// Number of eigenvalues of Zᵀ H Z below σ (after setConstraints()); refactorizes at σ (with the
+/// determinant of T − σM only if `determinant`).
+int constrainedCountBelow(ChainStructure& ws, double sigma, bool determinant = true);
 /// Inertia of H on ker C (n − rank(C) eigenvalues). C may have zero rows.
 Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double zeroTolerance = 1e-13,
                            double rankTolerance = 1e-10);
