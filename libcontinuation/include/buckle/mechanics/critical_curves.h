@@ -175,8 +175,9 @@ struct CriticalCurveOptions {
   /// (MinimalFoldCurveProblem), the branch-point curve with the structured bordered solver; below
   /// it the dense systems (FoldCurveProblem, the (N+1)² LU). A speed crossover only: the same
   /// curves. tracer.linearAlgebra Dense / Structured force either path. The Koiter coefficients
-  /// (coefficients, "DP") stay dense, O(n³) per point.
-  int structuredFromDimension = 40;
+  /// (coefficients, "DP") stay dense, O(n³) per point. Measured (benchmarks/RESULTS.md): the BP
+  /// curve is faster structured from n = 10 (N = 12), the fold curve from about n = 20.
+  int structuredFromDimension = 20;
 };
 
 /// Branch-point curve of the straight chain's compressive buckling mode `mode` (0: the first)
