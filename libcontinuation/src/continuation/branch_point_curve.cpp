@@ -66,14 +66,7 @@ bool BranchPointCurveProblem::jacobian(ConstVectorRef W, double mu, MatrixRef GW
 }
 
 ProblemScales BranchPointCurveProblem::scales() const {
-  const ProblemScales s = problem_.scales();
-  ProblemScales out;
-  out.unknowns.resize(n_ + 1);
-  out.unknowns << s.unknowns, s.parameter;
-  out.residuals.resize(n_ + 1);
-  out.residuals << s.residuals, 1.0;
-  out.parameter = problem_.secondParameterScale();
-  return out;
+  return stateAndParameterScales(problem_);
 }
 
 namespace {

@@ -254,14 +254,7 @@ bool MinimalFoldCurveProblem::jacobianTransposeApply(ConstVectorRef U, double mu
 }
 
 ProblemScales MinimalFoldCurveProblem::scales() const {
-  const ProblemScales s = problem_.scales();
-  ProblemScales out;
-  out.unknowns.resize(n_ + 1);
-  out.unknowns << s.unknowns, s.parameter;
-  out.residuals.resize(n_ + 1);
-  out.residuals << s.residuals, 1.0;
-  out.parameter = problem_.secondParameterScale();
-  return out;
+  return stateAndParameterScales(problem_);
 }
 
 double MinimalFoldCurveProblem::boundary(int k, ConstVectorRef U, double mu) {

@@ -37,4 +37,19 @@ class TwoParameterProblem : public Problem {
   virtual double secondParameterScale() const { return 1.0; }
 };
 
+/// Scales of a curve problem whose unknowns are (u, λ) and whose rows are F and one normalised
+/// row (branch_point_curve.h, fold_curve.h's MinimalFoldCurveProblem): u and F in the problem's
+/// scales, λ in its parameter scale, the extra row 1, μ in secondParameterScale().
+inline ProblemScales stateAndParameterScales(const TwoParameterProblem &problem) {
+  const ProblemScales s = problem.scales();
+  const Eigen::Index n = s.unknowns.size();
+  ProblemScales out;
+  out.unknowns.resize(n + 1);
+  out.unknowns << s.unknowns, s.parameter;
+  out.residuals.resize(n + 1);
+  out.residuals << s.residuals, 1.0;
+  out.parameter = problem.secondParameterScale();
+  return out;
+}
+
 }  // namespace buckle::continuation
