@@ -3,12 +3,19 @@
 //         L0 = 0.5, clamped-pinned, eccentric end torque Me = 0.01 as μ), from its first fold,
 //         200 points in one direction (increasing Me, toward the joint limit);
 //   bp    the first branch-point curve of the straight n-segment chain (a = 0.5, L0 = 2.25) in L0,
-//         200 points in one direction, with and without the Koiter coefficients at every point.
+//         200 points in one direction, with and without the Koiter coefficients at every point
+//         (n ≤ 100: the coefficients are dense, O(n³) per point), dense and with the chain's
+//         O(n) structure (CriticalCurveOptions::structuredFromDimension, the crossover);
+//   fold  n = 1000: the fold curve of a free-end chain of slightly different paper segments
+//         (a_i = 0.5(1 + 0.05 sin 1.3i), L0 = 2.25) under an end torque λ, μ = the axial end force
+//         Fx (from −0.01), from the torque path's first fold, 200 points toward more compression
+//         (the minimally augmented system, O(n) per point); the path to the fold is not timed.
 // Best of `reps` runs.
 //
 //   critical_curves [--reps R]
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -75,17 +82,57 @@ int main(int argc, char** argv) {
     const double t = best(reps, [&] { c = foldCurve(p, fold, o); });
     std::printf("fold n=3: %zu points, %zu codim-2 points, %.2f ms\n", c.points.size(), c.special.size(), 1e3 * t);
   }
-  for (int n : {3, 10, 30, 100}) {
+  using LA = cont::TracerOptions::LinearAlgebra;
+  for (int n : {3, 10, 30, 100, 1000}) {
     for (bool coefficients : {false, true}) {
-      ChainParameterProblem p(std::vector<SegmentParameters>(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)),
-                              EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0), SecondParameter::parse("L0"));
-      CriticalCurveOptions o = twoHundred(2.25, 100.0);
-      o.coefficients = coefficients;
-      CriticalCurve c;
-      const double t = best(reps, [&] { c = branchPointCurve(p, 0, o); });
-      std::printf("bp n=%d%s: %zu points, %.2f ms\n", n, coefficients ? " with Koiter coefficients" : "", c.points.size(),
-                  1e3 * t);
+      if (coefficients && n > 100) continue;
+      for (LA la : {LA::Dense, LA::Structured}) {
+        if (la == LA::Dense && n > 100) continue;
+        ChainParameterProblem p(std::vector<SegmentParameters>(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)),
+                                EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0), SecondParameter::parse("L0"));
+        CriticalCurveOptions o = twoHundred(2.25, 100.0);
+        o.coefficients = coefficients;
+        o.tracer.linearAlgebra = la;
+        CriticalCurve c;
+        const double t = best(reps, [&] { c = branchPointCurve(p, 0, o); });
+        std::printf("bp n=%d %s%s: %zu points, %.2f ms\n", n, la == LA::Dense ? "dense" : "structured",
+                    coefficients ? " with Koiter coefficients" : "", c.points.size(), 1e3 * t);
+      }
     }
+  }
+  {
+    const int n = 1000;
+    std::vector<SegmentParameters> segs;
+    for (int i = 0; i < n; ++i)
+      segs.push_back(SegmentParameters::symmetric(0.5 * (1 + 0.05 * std::sin(1.3 * i)), 1.0, 1.0, 2.25));
+    ChainParameterProblem p(segs, EndCondition::freeEnd(Eigen::Vector3d(-0.01, 0.0, 0.0)), Eigen::Vector3d(0, 0, 1),
+                            SecondParameter::parse("x"));
+    cont::TracerOptions to;
+    to.maxStep = 0.1;
+    to.lambdaMax = 10.0;
+    to.maxPoints = 3000;
+    to.lowestEigenvalues = 0;
+    to.onStep = [](const cont::Branch& b) {
+      return b.specialPointsOfType(cont::SpecialPointType::Fold).empty() ? cont::StepAction::Continue
+                                                                          : cont::StepAction::Stop;
+    };
+    const cont::Branch path = cont::trace(p.equilibrium(), p.equilibrium().initialGuess(Eigen::VectorXd::Zero(n), 0.0),
+                                          0.0, cont::InitialDirection::increasingLambda(), to);
+    const auto folds = path.specialPointsOfType(cont::SpecialPointType::Fold);
+    if (folds.empty()) {
+      std::fprintf(stderr, "critical_curves: no fold on the torque path (n = %d)\n", n);
+      return 1;
+    }
+    const cont::SpecialPoint fold = *folds.front();
+    CriticalCurveOptions o = twoHundred(-1.0, 1.0);
+    o.tracer.maxStep = 0.05;
+    CriticalCurve c;
+    // toward more compression: the second direction of foldCurve, alone
+    o.bothDirections = true;
+    o.muMax = -0.01 + 1e-12;
+    const double t = best(reps, [&] { c = foldCurve(p, fold, o); });
+    std::printf("fold n=%d: %zu points (mu %.4g to %.4g), %zu codim-2 points, %.2f ms\n", n, c.points.size(),
+                c.points.front().mu, c.points.back().mu, c.special.size(), 1e3 * t);
   }
   return 0;
 }

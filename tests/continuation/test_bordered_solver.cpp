@@ -3,6 +3,7 @@
 #include "buckle/continuation/corrector.h"
 #include "buckle/continuation/tracer.h"
 #include "toy_problems.h"
+#include "two_parameter_toys.h"
 
 #include <catch2/catch.hpp>
 
@@ -148,4 +149,38 @@ TEST_CASE("Tracer: Automatic picks the structured solver from structuredFromDime
   const Branch none = invalid.trace(u0, 0.0, InitialDirection::increasingLambda());
   CHECK(none.stopReason == StopReason::InvalidOptions);
   CHECK(none.stopMessage.find("structured") != std::string::npos);
+}
+
+TEST_CASE("Deflated bordered solve: G through [[F_u, b], [c^T, 0]] equals the dense solve, also at singular F_u",
+          "[fold_curve]") {
+  toys::CuspToy toy;
+  for (double x : {0.8, 0.0}) {  // x = 0: F_u = [[μ, 0], [0, 1]] with μ = 0, singular
+    toy.mu = 1.5 * x * x;
+    const Vector u = (Vector(2) << x, 0.5 * x * x).finished();
+    DenseBorderedSolver base(toy);
+    DeflatedBorderedSolve deflated(base, 2);
+    Matrix B(2, 2), C(2, 2), D(2, 2);
+    B << 1.0, 0.3, -0.5, 2.0;
+    C << 0.7, -1.0, 0.2, 0.4;
+    D << 0.1, -0.2, 0.3, 0.05;
+    const Vector v = (Vector(2) << 1.0, x).finished();
+    REQUIRE(deflated.factor(u, -x * x * x, v, v, B, C, D) == Factorization::Regular);
+    Matrix G = Matrix::Zero(4, 4);
+    Vector Fl(2);
+    REQUIRE(toy.jacobian(u, -x * x * x, G.topLeftCorner(2, 2), Fl));
+    G.topRightCorner(2, 2) = B;
+    G.bottomLeftCorner(2, 2) = C.transpose();
+    G.bottomRightCorner(2, 2) = D;
+    const Vector r = (Vector(4) << 0.3, -1.1, 0.6, 0.25).finished();
+    Vector z(4);
+    REQUIRE(deflated.solve(r, z));
+    CHECK((G * z - r).norm() <= 1e-14);
+    // det of the extended matrix is ±det G = ±det M · det S (the dense base reports log|det M| = 0)
+    Matrix M = Matrix::Zero(3, 3);
+    M.topLeftCorner(2, 2) = G.topLeftCorner(2, 2);
+    M.topRightCorner(2, 1) = v;
+    M.bottomLeftCorner(1, 2) = v.transpose();
+    CHECK(std::abs(std::exp(deflated.logAbsDeterminant()) * std::abs(M.determinant()) - std::abs(G.determinant())) <=
+          1e-13 * std::abs(G.determinant()));
+  }
 }

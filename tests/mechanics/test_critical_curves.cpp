@@ -91,6 +91,12 @@ TEST_CASE("chain second-parameter derivatives match central differences for ever
       INFO(cs.kind << " segment " << cs.segment);
       CHECK(((Fp - Fm) / (2 * h) - Fmu).norm() <= 1e-7 * (1.0 + Fmu.norm()));
       CHECK(((Jp - Jm) * v / (2 * h) - FuMuV).norm() <= 1e-7 * (1.0 + FuMuV.norm()));
+      // (∂F_u/∂λ)·v, exact, against central differences of the dense Jacobian in λ
+      Vector FuLv(N);
+      REQUIRE(p.parameterJacobianApply(u, lambda, v, FuLv));
+      REQUIRE(p.jacobian(u, lambda + h, Jp, Fl));
+      REQUIRE(p.jacobian(u, lambda - h, Jm, Fl));
+      CHECK(((Jp - Jm) * v / (2 * h) - FuLv).norm() <= 1e-7 * (1.0 + FuLv.norm()));
     }
   }
 }
@@ -323,4 +329,183 @@ TEST_CASE("fold curve of the imperfect subcritical chain: pointwise folds, the c
   REQUIRE(small.size() >= 2);
   const double slope = (small.back().second - small.front().second) / (small.back().first - small.front().first);
   CHECK(std::abs(slope - 2.0 / 3.0) <= 0.05);
+}
+
+// ---- the chain's O(n) structure for long chains (structuredFromDimension) ----------------------
+
+namespace {
+// The first compressive critical load of the straight clamped-pinned chain (O(n) for long chains).
+double linearCritical(ChainParameterProblem& p, double mu) {
+  REQUIRE(p.setSecondParameter(mu));
+  LinearBucklingOptions lbo;
+  lbo.count = 2;
+  const LinearBucklingResult lb =
+      linearBuckling(p.equilibrium().chain(), Vector::Zero(p.equilibrium().segments()), EndCondition::clampedPinned(0.0), lbo);
+  for (const BucklingMode& m : lb.modes)
+    if (m.lambda < 0.0) return m.lambda;
+  FAIL("no compressive mode");
+  return 0.0;
+}
+
+CriticalCurveOptions forced(CriticalCurveOptions o, bool structured) {
+  o.tracer.linearAlgebra =
+      structured ? cont::TracerOptions::LinearAlgebra::Structured : cont::TracerOptions::LinearAlgebra::Dense;
+  return o;
+}
+}  // namespace
+
+TEST_CASE("BP curve: the structured path is the dense one (n = 40, 200) and linear buckling (n = 1000)",
+          "[critical_curves]") {
+  for (int n : {40, 200, 1000}) {
+    INFO("n = " << n);
+    ChainParameterProblem p(paperChain(n, 0.5, 1.0, 1.0, 2.25), EndCondition::clampedPinned(0.0), kAxial,
+                            SecondParameter::parse("L0"));
+    CriticalCurveOptions o = curveOptions(2.25, 4.0);
+    o.bothDirections = false;
+    o.coefficients = false;  // Koiter coefficients are dense (O(n³) per point)
+    o.tracer.maxPoints = 60;
+    const CriticalCurve s = branchPointCurve(p, 0, forced(o, true));
+    REQUIRE(s.points.size() >= 30);
+    if (n <= 200) {
+      const CriticalCurve d = branchPointCurve(p, 0, forced(o, false));
+      REQUIRE(d.points.size() == s.points.size());
+      for (size_t i = 0; i < s.points.size(); ++i) {
+        CHECK(std::abs(s.points[i].mu - d.points[i].mu) <= 1e-10 * std::abs(d.points[i].mu));
+        CHECK(std::abs(s.points[i].lambda - d.points[i].lambda) <= 1e-10 * std::abs(d.points[i].lambda));
+        CHECK((s.points[i].mode - d.points[i].mode).norm() <= 1e-8);
+      }
+    }
+    for (size_t i = 0; i < s.points.size(); i += 6) {
+      const double lc = linearCritical(p, s.points[i].mu);
+      CHECK(std::abs(s.points[i].lambda - lc) <= 1e-12 * std::abs(lc));
+    }
+    REQUIRE(p.setSecondParameter(2.25));
+    // Automatic: structured from structuredFromDimension on
+    CriticalCurveOptions a = o;
+    a.tracer.maxPoints = 3;
+    const CriticalCurve c = branchPointCurve(p, 0, a);
+    REQUIRE(c.points.size() == 3);
+    CHECK(std::abs(c.points[2].lambda - s.points[2].lambda) <= 1e-10 * std::abs(s.points[2].lambda));
+  }
+}
+
+TEST_CASE("BP curve of a long chain in scaled units (lengths x 1e-3, stiffness x 1e6) is the same curve",
+          "[critical_curves]") {
+  const double ls = 1e-3, ks = 1e6;
+  const int n = 300;
+  ChainParameterProblem p(paperChain(n, 0.5, 1.0, 1.0, 1.8), EndCondition::clampedPinned(0.0), kAxial,
+                          SecondParameter::parse("L0"));
+  ChainParameterProblem ps(paperChain(n, 0.5 * ls, ls, ks, 1.8 * ls), EndCondition::clampedPinned(0.0), kAxial,
+                           SecondParameter::parse("L0"));
+  CriticalCurveOptions o = curveOptions(1.8, 3.0), os = curveOptions(1.8 * ls, 3.0 * ls);
+  o.coefficients = os.coefficients = false;
+  o.bothDirections = os.bothDirections = false;
+  o.tracer.maxPoints = os.tracer.maxPoints = 40;
+  const CriticalCurve c = branchPointCurve(p, 0, forced(o, true));
+  const CriticalCurve cs = branchPointCurve(ps, 0, forced(os, true));
+  REQUIRE(c.points.size() == cs.points.size());
+  for (size_t i = 0; i < c.points.size(); ++i) {
+    CHECK(cs.points[i].mu == Approx(c.points[i].mu * ls).epsilon(1e-10));
+    CHECK(std::abs(cs.points[i].lambda - c.points[i].lambda * ks * ls) <= 1e-10 * std::abs(c.points[i].lambda) * ks * ls);
+  }
+}
+
+namespace {
+// A free-end chain of slightly different paper segments (a_i = 0.5(1 + 0.05 sin 1.3i), L0 = 2.25)
+// under an end torque λ with an axial end force Fx = μ: the flat triangles snap, so the torque
+// path has a fold.
+ChainParameterProblem snappingChain(int n, double Fx) {
+  std::vector<SegmentParameters> segs;
+  for (int i = 0; i < n; ++i) segs.push_back(SegmentParameters::symmetric(0.5 * (1 + 0.05 * std::sin(1.3 * i)), 1.0, 1.0, 2.25));
+  return ChainParameterProblem(segs, EndCondition::freeEnd(Eigen::Vector3d(Fx, 0.0, 0.0)), Eigen::Vector3d(0, 0, 1),
+                               SecondParameter::parse("x"));
+}
+
+// The first fold of the torque path, located by the tracer (structured above its crossover).
+cont::SpecialPoint firstFold(ChainParameterProblem& p) {
+  cont::TracerOptions to;
+  to.maxStep = 0.1;
+  to.lambdaMax = 10.0;
+  to.maxPoints = 3000;
+  to.lowestEigenvalues = 0;
+  to.onStep = [](const cont::Branch& b) {
+    return b.specialPointsOfType(cont::SpecialPointType::Fold).empty() ? cont::StepAction::Continue
+                                                                        : cont::StepAction::Stop;
+  };
+  const int n = p.equilibrium().segments();
+  const cont::Branch path = cont::trace(p.equilibrium(), p.equilibrium().initialGuess(Vector::Zero(n), 0.0), 0.0,
+                                        cont::InitialDirection::increasingLambda(), to);
+  const auto folds = path.specialPointsOfType(cont::SpecialPointType::Fold);
+  REQUIRE(!folds.empty());
+  return *folds.front();
+}
+
+// The fold near (u, λ) (null vector v) located pointwise by the tracer: an equilibrium just below
+// (or above) λ from u ± εv (off the singular point), traced toward λ until the tracer locates the fold.
+cont::SpecialPoint foldNear(ChainParameterProblem& p, const Vector& u, double lambda, const Vector& v) {
+  cont::TracerOptions to;
+  to.maxStep = 0.01;
+  to.maxPoints = 200;
+  to.lowestEigenvalues = 0;
+  to.onStep = [](const cont::Branch& b) {
+    return b.specialPointsOfType(cont::SpecialPointType::Fold).empty() ? cont::StepAction::Continue
+                                                                        : cont::StepAction::Stop;
+  };
+  const double delta = 1e-5 * std::max(1.0, std::abs(lambda));
+  for (int side : {-1, 1})
+    for (double eps : {0.0, 1e-2, -1e-2}) {
+      const cont::Branch path = cont::trace(p.equilibrium(), u + eps * v, lambda + side * delta,
+                                            side < 0 ? cont::InitialDirection::increasingLambda()
+                                                     : cont::InitialDirection::decreasingLambda(),
+                                            to);
+      const auto folds = path.specialPointsOfType(cont::SpecialPointType::Fold);
+      if (!folds.empty() && (folds.front()->u - u).norm() < 0.1) return *folds.front();
+    }
+  FAIL("no fold near the curve point");
+  return {};
+}
+}  // namespace
+
+TEST_CASE("fold curve: the structured path is the dense one (n = 40) and the pointwise folds (n = 40, 1000)",
+          "[critical_curves]") {
+  for (int n : {40, 1000}) {
+    INFO("n = " << n);
+    const double mu0 = -0.01;
+    ChainParameterProblem p = snappingChain(n, mu0);
+    const cont::SpecialPoint fold = firstFold(p);
+    REQUIRE(fold.lambda > 0.0);
+    CriticalCurveOptions o = curveOptions(-0.05, 0.05);
+    o.tracer.maxPoints = 25;
+    const CriticalCurve s = foldCurve(p, fold, forced(o, true));
+    REQUIRE(s.points.size() == 49);
+    CHECK(s.type == "LP");
+    REQUIRE(s.points[24].mu == mu0);  // the start; before it the decreasing-μ half, reversed
+    int compared = 0;
+    // more compression (μ < μ0): the fold load rises, away from the cusp where λ → 0
+    for (size_t i = 2; i < 24; i += 7) {
+      const CriticalPoint& q = s.points[i];
+      INFO("mu = " << q.mu);
+      REQUIRE(q.mu < mu0);
+      REQUIRE(q.lambda > fold.lambda);
+      ChainParameterProblem pi = snappingChain(n, q.mu);
+      const cont::SpecialPoint f = foldNear(pi, q.u, q.lambda, q.mode);
+      CHECK(std::abs(f.lambda - q.lambda) <= 1e-10 * std::abs(q.lambda));
+      CHECK((f.u - q.u).lpNorm<Eigen::Infinity>() <= 1e-6);
+      if (n <= 40) {
+        // the dense (2N+1)-system traced from the same fold down to exactly this μ
+        CriticalCurveOptions d = forced(o, false);
+        d.muMin = q.mu;
+        d.muMax = mu0 + 1e-9;
+        d.tracer.maxPoints = 2000;
+        const CriticalCurve dc = foldCurve(p, fold, d);
+        const CriticalPoint& e = dc.points.front();
+        REQUIRE(e.mu == Approx(q.mu).epsilon(1e-13));
+        CHECK(std::abs(e.lambda - q.lambda) <= 1e-10 * std::abs(q.lambda));
+        CHECK((e.u - q.u).lpNorm<Eigen::Infinity>() <= 1e-8);
+        CHECK((e.mode - q.mode).norm() <= 1e-8);
+      }
+      ++compared;
+    }
+    CHECK(compared == 4);
+  }
 }

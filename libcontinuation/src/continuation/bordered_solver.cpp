@@ -85,4 +85,71 @@ bool DenseBorderedSolver::solve(ConstVectorRef b, VectorRef x) {
   return x.allFinite();
 }
 
+DeflatedBorderedSolve::DeflatedBorderedSolve(BorderedSolver &base, int n)
+    : base_(base),
+      n_(n),
+      Bm_(n, 1),
+      Cm_(n, 1),
+      Dm_(Matrix::Zero(1, 1)),
+      rhs_(n + 1),
+      sol_(n + 1),
+      xi_(n + 1) {}
+
+Factorization DeflatedBorderedSolve::factor(ConstVectorRef u, double lambda, ConstVectorRef b, ConstVectorRef c,
+                                            ConstMatrixRef B, ConstMatrixRef C, ConstMatrixRef D) {
+  sign_ = 0;
+  logAbs_ = -std::numeric_limits<double>::infinity();
+  const int n = n_;
+  const int k = int(B.cols());
+  if (k < 1 || B.rows() != n || C.rows() != n || C.cols() != k || D.rows() != k || D.cols() != k || b.size() != n ||
+      c.size() != n)
+    return Factorization::Refused;
+  k_ = k;
+  Bm_.col(0) = b;
+  Cm_.col(0) = c;
+  const Factorization f = base_.factorGeneral(u, lambda, Bm_, Cm_, Dm_, false);
+  if (f != Factorization::Regular) return f;
+  // B', C' ((N+1)×(k+1)), X = M⁻¹B', S = D' − C'ᵀX
+  Bx_ = Matrix::Zero(n + 1, k + 1);
+  Cx_ = Matrix::Zero(n + 1, k + 1);
+  Bx_.topLeftCorner(n, k) = B;
+  Bx_(n, k) = -1.0;
+  Cx_.topLeftCorner(n, k) = C;
+  X_.resize(n + 1, k + 1);
+  for (int j = 0; j <= k; ++j) {
+    rhs_ = Bx_.col(j);
+    if (!base_.solve(rhs_, sol_)) return Factorization::Singular;
+    X_.col(j) = sol_;
+  }
+  S_ = Matrix::Zero(k + 1, k + 1);
+  S_.topLeftCorner(k, k) = D;
+  S_.noalias() -= Cx_.transpose() * X_;
+  S_.row(k) -= X_.row(n);  // the s-row: C' column k is e_{N+1}
+  if (!S_.allFinite()) return Factorization::Singular;
+  schur_.compute(S_);
+  const double detS = schur_.determinant();
+  if (!(detS != 0.0) || !std::isfinite(detS)) return Factorization::Singular;
+  sign_ = base_.determinantSign() * (detS > 0.0 ? 1 : -1);
+  logAbs_ = base_.logAbsDeterminant() + std::log(std::abs(detS));
+  return Factorization::Regular;
+}
+
+bool DeflatedBorderedSolve::solve(ConstVectorRef r, VectorRef z) {
+  if (sign_ == 0 || r.size() != n_ + k_ || z.size() != n_ + k_) return false;
+  const int n = n_, k = k_;
+  rhs_.head(n) = r.head(n);
+  rhs_[n] = 0.0;
+  if (!base_.solve(rhs_, xi_)) return false;
+  outer_.resize(k + 1);
+  outer_.head(k) = r.tail(k);
+  outer_[k] = 0.0;
+  outer_.noalias() -= Cx_.transpose() * xi_;
+  outer_[k] -= xi_[n];
+  y_ = schur_.solve(outer_);
+  xi_.noalias() -= X_ * y_;
+  z.head(n) = xi_.head(n);
+  z.tail(k) = y_.head(k);
+  return z.allFinite();
+}
+
 }  // namespace buckle::continuation

@@ -5,6 +5,7 @@
 #include "buckle/continuation/scaled_problem.h"
 
 #include <cmath>
+#include <memory>
 
 namespace buckle::continuation {
 
@@ -18,7 +19,9 @@ std::vector<CurveZero> locateCurveZeros(Problem &curve, const Branch &branch, co
   CorrectorOptions co;
   co.residualTolerance = options.residualTolerance;
   co.maxIterations = 20;
-  Corrector corrector(scaled, co);
+  // the curve's structured solver when it offers one (O(N) curve systems), else dense LU
+  const std::unique_ptr<BorderedSolver> structured = scaled.makeStructuredSolver();
+  Corrector corrector(scaled, co, structured.get());
   Vector scales(n + 1);
   for (int i = 0; i <= n; ++i) scales[i] = units.state(i);
   auto toScaled = [&](const ContinuationPoint &p) {

@@ -40,18 +40,15 @@ constexpr int kRefinementSteps = 3;
 
 }  // namespace
 
-StructuredRefinement::StructuredRefinement(Problem &problem, BorderedSolver &solver, double tolerance,
-                                           int maxIterations)
+RefinedBorderedSystem::RefinedBorderedSystem(Problem &problem, BorderedSolver &solver)
     : problem_(problem),
       solver_(solver),
-      tolerance_(tolerance),
-      maxIterations_(maxIterations),
       n_(problem.dimension()),
       ex_(Vector::Zero(problem.dimension() + 1)),
       prod_(Vector::Zero(problem.dimension() + 1)) {}
 
-bool StructuredRefinement::factor(ConstVectorRef u, double lambda, const Matrix &B, const Matrix &C, const Matrix &D,
-                                  bool transposed) {
+bool RefinedBorderedSystem::factor(ConstVectorRef u, double lambda, const Matrix &B, const Matrix &C, const Matrix &D,
+                                   bool transposed) {
   u_ = u;
   lambda_ = lambda;
   B_ = B;
@@ -61,7 +58,7 @@ bool StructuredRefinement::factor(ConstVectorRef u, double lambda, const Matrix 
   return solver_.factorGeneral(u, lambda, B, C, D, transposed) == Factorization::Regular;
 }
 
-bool StructuredRefinement::applyG(const Vector &x, Vector &y) {
+bool RefinedBorderedSystem::applyG(const Vector &x, Vector &y) {
   const int n = n_;
   const Eigen::Index k = B_.cols();
   if (transposed_) {
@@ -79,7 +76,7 @@ bool StructuredRefinement::applyG(const Vector &x, Vector &y) {
   return y.allFinite();
 }
 
-bool StructuredRefinement::refinedSolve(const Vector &b, Vector &x) {
+bool RefinedBorderedSystem::solve(const Vector &b, Vector &x) {
   x.resize(b.size());
   if (!solver_.solve(b, x)) return false;
   // Iterative refinement on the exactly evaluated residual: the solution converges to what the
@@ -87,16 +84,26 @@ bool StructuredRefinement::refinedSolve(const Vector &b, Vector &x) {
   // of steps, not "while ‖b − Gx‖ decreases": rows of very different natural size (a held end
   // position sums n lever arms) put rounding noise into the norm that hides the progress of the
   // rows that matter.
-  Vector Gx, r, dx(b.size());
+  dx_.resize(b.size());
   for (int it = 0; it < kRefinementSteps; ++it) {
-    if (!applyG(x, Gx)) return false;
-    r = b - Gx;
-    if (!solver_.solve(r, dx)) return false;
-    x += dx;
-    if (dx.norm() <= 4.0 * std::numeric_limits<double>::epsilon() * x.norm()) break;
+    if (!applyG(x, Gx_)) return false;
+    r_ = b - Gx_;
+    if (!solver_.solve(r_, dx_)) return false;
+    x += dx_;
+    if (dx_.norm() <= 4.0 * std::numeric_limits<double>::epsilon() * x.norm()) break;
   }
   return x.allFinite();
 }
+
+StructuredRefinement::StructuredRefinement(Problem &problem, BorderedSolver &solver, double tolerance,
+                                           int maxIterations)
+    : problem_(problem),
+      solver_(solver),
+      system_(problem, solver),
+      tolerance_(tolerance),
+      maxIterations_(maxIterations),
+      n_(problem.dimension()),
+      ex_(Vector::Zero(problem.dimension() + 1)) {}
 
 bool StructuredRefinement::parameterDerivative(ConstVectorRef u, double lambda, Vector &Fl) {
   ex_.setZero();

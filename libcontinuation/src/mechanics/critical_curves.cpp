@@ -3,6 +3,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -11,6 +12,8 @@
 #include "buckle/continuation/curve_zeros.h"
 #include "buckle/continuation/fold_curve.h"
 #include "buckle/continuation/root_finding.h"
+#include "buckle/continuation/structured_refinement.h"
+#include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/linear_buckling.h"
 
 namespace buckle::mechanics {
@@ -89,18 +92,95 @@ Vector nullVector(cont::Problem& problem, const Vector& u, double lambda) {
 
 // The tracer on a curve problem in both directions from W0; the second branch is reversed in
 // front of the first when joined.
-std::vector<cont::Branch> traceBoth(cont::Problem& curve, const Vector& W0, double mu0, const CriticalCurveOptions& options) {
+// Structured: the curve's O(n) solver, no fold location on the curve (its folds in μ are the
+// cusps, located by their own test function), and `restart` / `accepted` called before each
+// direction and after each accepted point (the minimally augmented system's borders).
+std::vector<cont::Branch> traceBoth(cont::Problem& curve, const Vector& W0, double mu0, const CriticalCurveOptions& options,
+                                    bool structured = false, const std::function<void()>& restart = {},
+                                    const std::function<void(const cont::ContinuationPoint&)>& accepted = {}) {
   cont::TracerOptions to = options.tracer;
   to.lambdaMin = options.muMin;
   to.lambdaMax = options.muMax;
   to.computeStability = false;
   to.detectBranchPoints = false;
+  if (structured) {
+    to.linearAlgebra = cont::TracerOptions::LinearAlgebra::Structured;
+    to.detectFolds = false;
+  }
+  if (accepted) {
+    const cont::StepCallback user = options.tracer.onStep;
+    to.onStep = [accepted, user](const cont::Branch& b) {
+      accepted(b.points.back());
+      return user ? user(b) : cont::StepAction::Continue;
+    };
+  }
   std::vector<cont::Branch> out;
   cont::Tracer tracer(curve, to);
+  if (restart) restart();
   out.push_back(tracer.trace(W0, mu0, cont::InitialDirection::increasingLambda()));
+  if (restart) restart();
   if (options.bothDirections) out.push_back(tracer.trace(W0, mu0, cont::InitialDirection::decreasingLambda()));
   return out;
 }
+
+bool useStructured(const CriticalCurveOptions& options, int N) {
+  using LA = cont::TracerOptions::LinearAlgebra;
+  if (options.tracer.linearAlgebra == LA::Dense) return false;
+  return options.tracer.linearAlgebra == LA::Structured || N >= options.structuredFromDimension;
+}
+
+// Null vector of F_u at (u, λ) near `guess` by two steps of inverse iteration with the bordered
+// matrix [[F_u, g], [gᵀ, 0]] (O(n) through the structured solver, refined on the chain's products).
+Vector structuredNullVector(cont::Problem& problem, const Vector& u, double lambda, const Vector& guess) {
+  const int N = problem.dimension();
+  const std::unique_ptr<cont::BorderedSolver> solver = problem.makeStructuredSolver();
+  if (!solver) throw std::invalid_argument("critical curve: no structured solver for this problem");
+  cont::RefinedBorderedSystem system(problem, *solver);
+  Matrix B(N, 1), D = Matrix::Zero(1, 1);
+  Vector v = guess.normalized(), rhs = Vector::Zero(N + 1), z;
+  rhs[N] = 1.0;
+  for (int it = 0; it < 2; ++it) {
+    B.col(0) = v;
+    if (!system.factor(u, lambda, B, B, D, false) || !system.solve(rhs, z))
+      throw std::invalid_argument("critical curve: singular bordered matrix at the start (not a simple critical point?)");
+    v = z.head(N).normalized();
+  }
+  return v;
+}
+
+// The chain's structured solver, recreated for the current chain after μ has changed (setting μ
+// rebuilds the EquilibriumProblem the chain solver is bound to).
+class ChainParameterSolver final : public cont::BorderedSolver {
+ public:
+  explicit ChainParameterSolver(ChainParameterProblem& problem) : problem_(problem) {}
+
+  cont::Factorization factor(cont::ConstVectorRef u, double lambda, cont::ConstVectorRef c) override {
+    return sync() ? inner_->factor(u, lambda, c) : cont::Factorization::Refused;
+  }
+  bool solve(cont::ConstVectorRef b, cont::VectorRef x) override { return inner_ && inner_->solve(b, x); }
+  int determinantSign() const override { return inner_ ? inner_->determinantSign() : 0; }
+  double logAbsDeterminant() const override {
+    return inner_ ? inner_->logAbsDeterminant() : -std::numeric_limits<double>::infinity();
+  }
+  int maxGeneralBorder() const override { return ChainStructure::kMaxBorder - problem_.equilibrium().heldCount(); }
+  cont::Factorization factorGeneral(cont::ConstVectorRef u, double lambda, cont::ConstMatrixRef B,
+                                    cont::ConstMatrixRef C, cont::ConstMatrixRef D, bool transposed) override {
+    return sync() ? inner_->factorGeneral(u, lambda, B, C, D, transposed) : cont::Factorization::Refused;
+  }
+
+ private:
+  bool sync() {
+    if (!inner_ || generation_ != problem_.generation()) {
+      inner_ = problem_.equilibrium().makeStructuredSolver();
+      generation_ = problem_.generation();
+    }
+    return inner_ != nullptr;
+  }
+
+  ChainParameterProblem& problem_;
+  std::unique_ptr<cont::BorderedSolver> inner_;
+  long generation_ = -1;
+};
 
 void addZeros(cont::Problem& curve, const cont::Branch& branch, const cont::CurveTest& g, const std::string& label,
               int n, std::vector<Codim2Point>& special) {
@@ -288,6 +368,33 @@ bool ChainParameterProblem::setSecondParameter(double mu) {
   }
   data_ = std::make_unique<ChainData>(equilibrium_->chain());
   mu_ = mu;
+  ++generation_;
+  return true;
+}
+
+std::unique_ptr<cont::BorderedSolver> ChainParameterProblem::makeStructuredSolver() {
+  return std::make_unique<ChainParameterSolver>(*this);
+}
+
+bool ChainParameterProblem::parameterJacobianApply(cont::ConstVectorRef u, double lambda, cont::ConstVectorRef v,
+                                                   cont::VectorRef FuLambdaV) {
+  const Chain& chain = equilibrium_->chain();
+  const int n = chain.size();
+  const int N = equilibrium_->dimension();
+  if (u.size() != N || v.size() != N || !u.allFinite() || !std::isfinite(lambda)) return false;
+  forwardKinematics(chain, u.head(n), *data_);
+  // F_u = [[K_q − [h_max(i,j)], −J_hᵀ], [−J_h, 0]], h = −Fx C − Fy S (eq 27): only the dead
+  // loads depend on λ (∂W/∂λ = direction on the loaded coordinates; the reactions are unknowns).
+  const Eigen::Vector3d& dir = equilibrium_->direction();
+  double dFx = 0.0, dFy = 0.0;
+  for (int c : equilibrium_->endCondition().loadedIndices()) {
+    if (c == 0) dFx = dir[0];
+    if (c == 1) dFy = dir[1];
+  }
+  dh_ = -dFx * data_->C - dFy * data_->S;
+  maxIndexProduct(dh_, v.head(n), FuLambdaV.head(n));
+  FuLambdaV.head(n) = -FuLambdaV.head(n);
+  FuLambdaV.tail(N - n).setZero();
   return true;
 }
 
@@ -396,21 +503,35 @@ CriticalCurve branchPointCurve(ChainParameterProblem& problem, int mode, const C
           "branch-point curve: the straight chain is not an equilibrium along the load path (unequal preloads, "
           "an off-axis load or a held coordinate off the axis)");
   }
+  const bool structured = useStructured(options, N);
   LinearBucklingOptions lbo;
   lbo.direction = eq.direction();
-  const LinearBucklingResult lb = linearBuckling(eq.chain(), Vector::Zero(n), eq.endCondition(), lbo);
-  std::vector<double> compressive;
-  for (const BucklingMode& b : lb.modes)
-    if (b.lambda < 0.0) compressive.push_back(b.lambda);
-  std::sort(compressive.begin(), compressive.end(), [](double x, double y) { return std::abs(x) < std::abs(y); });
+  // structured: only the lowest modes (O(n) each, linear_buckling.h), enough to hold `mode`
+  // among the compressive ones unless tensile modes come first (then all of them)
+  std::vector<const BucklingMode*> compressive;
+  LinearBucklingResult lb;
+  for (int count : {structured && mode >= 0 ? 2 * (mode + 1) : -1, -1}) {
+    lbo.count = count;
+    lb = linearBuckling(eq.chain(), Vector::Zero(n), eq.endCondition(), lbo);
+    compressive.clear();
+    for (const BucklingMode& b : lb.modes)
+      if (b.lambda < 0.0) compressive.push_back(&b);
+    if (count < 0 || mode < int(compressive.size())) break;
+  }
+  std::stable_sort(compressive.begin(), compressive.end(),
+                   [](const BucklingMode* x, const BucklingMode* y) { return std::abs(x->lambda) < std::abs(y->lambda); });
   if (mode < 0 || mode >= int(compressive.size()))
     throw std::invalid_argument("branch-point curve: the straight chain has " + std::to_string(compressive.size()) +
                                 " compressive buckling modes, mode " + std::to_string(mode) + " asked");
-  const double lambdaC = compressive[size_t(mode)];
+  const double lambdaC = compressive[size_t(mode)]->lambda;
+  Vector guess = Vector::Zero(N);
+  guess.head(n) = compressive[size_t(mode)]->mode;
+  const Vector w0 = structured ? structuredNullVector(problem, u0, lambdaC, guess) : nullVector(problem, u0, lambdaC);
   Vector c;
-  const Vector W0 = cont::BranchPointCurveProblem::start(problem, lambdaC, nullVector(problem, u0, lambdaC), c);
+  const Vector W0 = cont::BranchPointCurveProblem::start(problem, lambdaC, w0, c);
   cont::BranchPointCurveProblem curve(problem, u0, c);
-  const std::vector<cont::Branch> branches = traceBoth(curve, W0, mu0, options);
+  curve.useStructuredSolver(structured);
+  const std::vector<cont::Branch> branches = traceBoth(curve, W0, mu0, options, structured);
 
   CriticalCurve out;
   out.type = "BP";
@@ -459,6 +580,80 @@ CriticalCurve branchPointCurve(ChainParameterProblem& problem, int mode, const C
   return out;
 }
 
+namespace {
+
+// "BD": where the tracer stopped on a joint limit.
+void addLimitPoints(const cont::Branch& b, int N, std::vector<Codim2Point>& special) {
+  for (const cont::SpecialPoint& sp : b.specialPoints)
+    if (sp.type == cont::SpecialPointType::Boundary) {
+      Codim2Point bd;
+      bd.label = "BD";
+      bd.mu = sp.lambda;
+      bd.lambda = sp.u[N];
+      bd.converged = true;
+      bd.note = sp.boundaryName;
+      special.push_back(bd);
+    }
+}
+
+// The fold curve by the minimally augmented system (O(n) per point). The borders follow the
+// curve: reset to the start's before each direction and each pass over a branch, adapted at every
+// accepted or evaluated point in arclength order from there, so each bordered solve has borders
+// from a neighbouring point.
+CriticalCurve minimalFoldCurve(ChainParameterProblem& problem, const cont::SpecialPoint& fold, const Vector& v,
+                               const CriticalCurveOptions& options) {
+  const int N = problem.dimension();
+  const int n = problem.equilibrium().segments();
+  const double mu0 = problem.secondParameter();
+  cont::MinimalFoldCurveProblem curve(problem, fold.u, fold.lambda, v);
+  const Vector U0 = cont::MinimalFoldCurveProblem::start(fold.u, fold.lambda);
+  const auto restart = [&] { curve.resetBorders(); };
+  const auto accepted = [&](const cont::ContinuationPoint& p) { curve.adaptBorders(p.u, p.lambda); };
+  const std::vector<cont::Branch> branches = traceBoth(curve, U0, mu0, options, true, restart, accepted);
+
+  CriticalCurve out;
+  out.type = "LP";
+  out.parameter = problem.parameter();
+  out.stopMessage = stopText(branches);
+  // each branch from its start, in its own order; then joined as joined() does
+  std::vector<std::vector<CriticalPoint>> perBranch;
+  for (const cont::Branch& b : branches) {
+    curve.resetBorders();
+    std::vector<CriticalPoint> pts;
+    for (const cont::ContinuationPoint& p : b.points) {
+      CriticalPoint cp;
+      cp.mu = p.lambda;
+      cp.lambda = p.u[N];
+      cp.u = p.u.head(N);
+      cp.koiterA = cp.koiterB = std::numeric_limits<double>::quiet_NaN();
+      Vector vp, wp;
+      curve.adaptBorders(p.u, p.lambda);
+      if (curve.nullVectors(p.u, p.lambda, vp, wp)) cp.mode = unitMode(vp, n);
+      if (!curve.cuspTest(p.u, cp.mu, cp.cusp)) cp.cusp = std::numeric_limits<double>::quiet_NaN();
+      if (!problem.setSecondParameter(cp.mu)) continue;
+      cp.kappa = smallestStraightStiffness(problem.equilibrium().chain());
+      pts.push_back(std::move(cp));
+    }
+    perBranch.push_back(std::move(pts));
+  }
+  if (perBranch.size() > 1)
+    for (size_t i = perBranch[1].size(); i-- > 1;) out.points.push_back(perBranch[1][i]);
+  for (CriticalPoint& p : perBranch[0]) out.points.push_back(std::move(p));
+
+  const cont::CurveTest cusp = [&](cont::ConstVectorRef U, double mu, double& g) {
+    return curve.cuspTest(U, mu, g) && curve.adaptBorders(U, mu);
+  };
+  for (const cont::Branch& b : branches) {
+    curve.resetBorders();
+    addZeros(curve, b, cusp, "CP", N, out.special);
+    addLimitPoints(b, N, out.special);
+  }
+  problem.setSecondParameter(mu0);
+  return out;
+}
+
+}  // namespace
+
 CriticalCurve foldCurve(ChainParameterProblem& problem, const cont::SpecialPoint& fold,
                         const CriticalCurveOptions& options) {
   const int N = problem.dimension();
@@ -466,8 +661,14 @@ CriticalCurve foldCurve(ChainParameterProblem& problem, const cont::SpecialPoint
   const double mu0 = problem.secondParameter();
   if (fold.type != cont::SpecialPointType::Fold || fold.u.size() != N)
     throw std::invalid_argument("fold curve: the start is not a fold of this problem");
-  const Vector v = fold.nullVectors.rows() == N && fold.nullVectors.cols() >= 1 ? Vector(fold.nullVectors.col(0))
-                                                                                : nullVector(problem, fold.u, fold.lambda);
+  const bool structured = useStructured(options, N);
+  const bool haveNull = fold.nullVectors.rows() == N && fold.nullVectors.cols() >= 1;
+  if (structured && !haveNull && fold.tangent.size() != N + 1)
+    throw std::invalid_argument("fold curve: the fold has neither a null vector nor a tangent");
+  const Vector v = haveNull     ? Vector(fold.nullVectors.col(0))
+                   : structured ? structuredNullVector(problem, fold.u, fold.lambda, fold.tangent.head(N))
+                                : nullVector(problem, fold.u, fold.lambda);
+  if (structured) return minimalFoldCurve(problem, fold, v, options);
   Vector c;
   const Vector U0 = cont::FoldCurveProblem::start(problem, fold.u, fold.lambda, v, c);
   cont::FoldCurveProblem curve(problem, c);
@@ -491,16 +692,7 @@ CriticalCurve foldCurve(ChainParameterProblem& problem, const cont::SpecialPoint
   const cont::CurveTest cusp = [&](cont::ConstVectorRef U, double mu, double& g) { return curve.cuspTest(U, mu, g); };
   for (const cont::Branch& b : branches) {
     addZeros(curve, b, cusp, "CP", N, out.special);
-    for (const cont::SpecialPoint& sp : b.specialPoints)
-      if (sp.type == cont::SpecialPointType::Boundary) {
-        Codim2Point bd;
-        bd.label = "BD";
-        bd.mu = sp.lambda;
-        bd.lambda = sp.u[N];
-        bd.converged = true;
-        bd.note = sp.boundaryName;
-        out.special.push_back(bd);
-      }
+    addLimitPoints(b, N, out.special);
   }
   problem.setSecondParameter(mu0);
   return out;

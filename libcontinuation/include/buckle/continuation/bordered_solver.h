@@ -53,6 +53,41 @@ class BorderedSolver {
                                       ConstMatrixRef D, bool transposed);
 };
 
+/// G = [[F_u, B], [Cᵀ, D]] (B, C N×k, D k×k) solved through a base solver's factorization of the
+/// one-bordered M = [[F_u, b], [cᵀ, 0]], with b, c approximations of the left and right null
+/// vectors of F_u: the two-parameter curve systems (fold_curve.h, branch_point_curve.h), whose
+/// F_u is singular on the curve. Eliminating through F_u itself (the chain's block elimination)
+/// leaves a k×k Schur complement dominated by the rank-one part of F_u⁻¹ along the null vectors
+/// (numerically singular for k ≥ 2); M is well conditioned there, and G is equivalent to
+///     [[M, B'], [C'ᵀ, D']],  B' = [[B, 0], [0, −1]],  C' = [[C, 0], [0, 1]],  D' = [[D, 0], [0, 0]]
+/// with the unknowns (x, s; y, t): the extra rows force s = 0 and t = cᵀx, so the (k+1)×(k+1)
+/// Schur complement D' − C'ᵀM⁻¹B' is as well conditioned as G (block elimination on a
+/// bordered regular matrix, Govaerts 2000, ch. 3). det of the extended matrix = ±det G with a
+/// sign fixed by N and k. O(the base solver's cost) with k + 2 solves per factorization.
+class DeflatedBorderedSolve {
+ public:
+  /// `base` is not owned; it must take general borders (k = 1) at dimension n.
+  DeflatedBorderedSolve(BorderedSolver &base, int n);
+
+  Factorization factor(ConstVectorRef u, double lambda, ConstVectorRef b, ConstVectorRef c, ConstMatrixRef B,
+                       ConstMatrixRef C, ConstMatrixRef D);
+  /// z = G⁻¹ r (size N + k) after a Regular factor().
+  bool solve(ConstVectorRef r, VectorRef z);
+  int determinantSign() const { return sign_; }
+  double logAbsDeterminant() const { return logAbs_; }
+
+ private:
+  BorderedSolver &base_;
+  int n_;
+  int k_ = 0;
+  Matrix Bm_, Cm_, Dm_;          // the one-bordered M's border
+  Matrix Bx_, Cx_, X_, S_;       // B', C', M⁻¹B', the Schur complement
+  Eigen::PartialPivLU<Matrix> schur_;
+  Vector rhs_, sol_, xi_, outer_, y_;
+  int sign_ = 0;
+  double logAbs_ = 0.0;
+};
+
 /// Dense partial-pivoting LU of A(c), from Problem::jacobian(). Workspace sized once. Up to
 /// DenseLU::kEigenIdenticalSize the unblocked DenseLU (a few hundred instructions at N+1 = 4…8
 /// instead of ≈ 1.7 k for PartialPivLU<MatrixXd>'s dispatch, with bitwise the same factors,

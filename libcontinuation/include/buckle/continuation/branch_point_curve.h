@@ -8,10 +8,20 @@
 // (F_uλ w from Problem::jacobianDirectionalDerivative in the direction (w, 0); F_uμ w from
 // TwoParameterProblem). Regular where the zero eigenvalue is simple and crosses transversally
 // in λ (ψᵀF_uλ w ≠ 0).
+//
+// Structured linear algebra (useStructuredSolver): the tracer's bordered matrix of this system,
+//     [[F_u, F_uλ w, F_uμ w], [cᵀ, 0, 0], [t_wᵀ, t_λ, t_μ]],
+// is F_u bordered by two columns, so the base problem's structured solver factors it
+// (BorderedSolver::factorGeneral, O(N) for the chain) and the residual takes F_u w from
+// Problem::jacobianApply: a curve point costs O(N) instead of the (N+1)² LU. F_uλ w comes from
+// TwoParameterProblem::parameterJacobianApply, F_uμ w from secondParameterDerivatives.
 #pragma once
 
+#include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/two_parameter.h"
+
+#include <memory>
 
 namespace buckle::continuation {
 
@@ -32,12 +42,21 @@ class BranchPointCurveProblem final : public Problem {
   bool jacobian(ConstVectorRef W, double mu, MatrixRef GW, VectorRef Gmu) override;
   ProblemScales scales() const override;
 
+  /// On: the residual through Problem::jacobianApply and makeStructuredSolver() from the base
+  /// problem's structured solver (header comment). Off (the default): dense, as documented above.
+  void useStructuredSolver(bool on) { structured_ = on; }
+  /// The curve's bordered solver on the base problem's (which must take general borders with
+  /// k ≥ 1); null when off or when the base problem has none.
+  std::unique_ptr<BorderedSolver> makeStructuredSolver() override;
+
  private:
   TwoParameterProblem &problem_;
   int n_;
   Vector u0_, c_;
   Matrix Fu_, dFu_;
   Vector Flambda_, dFlambda_, Fmu_, FuMuW_;
+  Vector x_;  // (w, 0) of the structured residual
+  bool structured_ = false;
 };
 
 }  // namespace buckle::continuation

@@ -12,13 +12,18 @@
 //   cusp   the quadratic coefficient ψᵀF_uu[v, v] of the fold vanishes (ψ the left null vector):
 //          two fold curves meet, and the curve turns in μ there (a fold of the fold curve);
 //   others are the caller's test functions (curve_zeros.h), e.g. a joint limit g(u) = 0.
+//
+// For large N, MinimalFoldCurveProblem below is the same curve with O(N) linear algebra.
 #pragma once
 
+#include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/problem.h"
+#include "buckle/continuation/structured_refinement.h"
 #include "buckle/continuation/two_parameter.h"
 
 #include <Eigen/LU>
+#include <memory>
 
 namespace buckle::continuation {
 
@@ -62,6 +67,86 @@ class FoldCurveProblem final : public Problem {
   Matrix Fu_, dFu_;
   Vector Flambda_, dFlambda_, Fmu_, FuMuV_, Fv_;
   Eigen::PartialPivLU<Matrix> lu_;
+};
+
+/// The fold curve by the minimally augmented system (Govaerts 2000, §4.3; MATCONT's LP curve):
+/// unknowns U = (u, λ) (size N + 1), continuation parameter μ,
+///     F(u, λ; μ) = 0,   g(u, λ; μ) = 0,   [[F_u, b], [cᵀ, 0]] [v; g] = [0; 1],
+/// g vanishing exactly where F_u is singular (v is then its null vector), with the gradient
+///     g_x = −wᵀF_xx[(v, 0), ·]  (x = (u, λ)),   g_μ = −wᵀF_uμ v,   [[F_uᵀ, c], [bᵀ, 0]] [w; ·] = [0; 1]
+/// (Problem::secondDerivativeTransposeApply, TwoParameterProblem::secondParameterDerivatives).
+/// Every linear solve is a bordered solve on F_u by the base problem's structured solver
+/// (factorGeneral; g refined on the base problem's O(N) products, structured_refinement.h): the
+/// tracer's bordered matrix [[F_u, F_λ, F_μ], [g_uᵀ, g_λ, g_μ], [c̃ᵀ]] is F_u bordered by two
+/// columns, solved through the one-bordered [[F_u, b], [cᵀ, 0]] (DeflatedBorderedSolve: F_u is
+/// singular on the curve). So a curve point costs what the base problem's structure allows (O(N) for the
+/// chain) instead of FoldCurveProblem's (2N+2)² LU; the curve is the same set of points.
+/// The borders b, c approximate the left and right null vectors of F_u; adaptBorders() replaces
+/// them by those at a point of the curve (g changes by a positive factor near the curve, its zero
+/// set and the curve's tangent do not), which keeps the bordered matrices well conditioned as the
+/// null vectors turn along the curve. Norms are those of the problem's scaled variables.
+class MinimalFoldCurveProblem final : public Problem {
+ public:
+  /// Starts at a fold (u, λ) with (approximate) null vector v of F_u at the problem's current μ.
+  /// Throws std::invalid_argument when the base problem has no structured solver taking general
+  /// borders with k ≥ 1, or for vectors of the wrong size.
+  MinimalFoldCurveProblem(TwoParameterProblem &problem, ConstVectorRef u, double lambda, ConstVectorRef v);
+
+  int base() const { return n_; }
+  /// U = (u, λ).
+  static Vector start(ConstVectorRef u, double lambda);
+
+  int dimension() const override { return n_ + 1; }
+  bool residual(ConstVectorRef U, double mu, VectorRef G) override;
+  /// Dense [[F_u, F_λ], [g_xᵀ]] (for dense callers; the tracer uses makeStructuredSolver()).
+  bool jacobian(ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) override;
+  /// O(N) products with [[F_u, F_λ, F_μ], [g_uᵀ, g_λ, g_μ]] and its transpose.
+  bool jacobianApply(ConstVectorRef U, double mu, ConstVectorRef x, VectorRef y) override;
+  bool jacobianTransposeApply(ConstVectorRef U, double mu, ConstVectorRef w, VectorRef y) override;
+  /// u in the problem's scales, λ in its parameter scale; rows: F in the residual scales, g 1;
+  /// μ in secondParameterScale().
+  ProblemScales scales() const override;
+  std::unique_ptr<BorderedSolver> makeStructuredSolver() override;
+
+  int boundaryCount() const override { return problem_.boundaryCount(); }
+  double boundary(int k, ConstVectorRef U, double mu) override;
+  std::string boundaryName(int k) const override { return problem_.boundaryName(k); }
+
+  /// Right null vector v (cᵀv = 1) and left one w at (U, μ) (null vectors of F_u on the curve).
+  bool nullVectors(ConstVectorRef U, double mu, Vector &v, Vector &w);
+  /// Borders from the null vectors at (U, μ): c ∝ D_u⁻²v, b ∝ D_F²w, unit in the scaled variables.
+  bool adaptBorders(ConstVectorRef U, double mu);
+  /// The current borders b (≈ left null vector) and c (≈ right null vector).
+  const Vector &leftBorder() const { return b_; }
+  const Vector &rightBorder() const { return c_; }
+  /// Back to the borders of the start point (before tracing or revisiting a curve from there).
+  void resetBorders();
+  /// The cusp test of FoldCurveProblem::cuspTest, ψᵀF_uu[v, v] / (‖ψ‖ ‖v‖²) with ψ = w.
+  bool cuspTest(ConstVectorRef U, double mu, double &value);
+
+  /// g and its gradient (g_x, g_μ) at (U, μ), F_λ and F_μ there (the curve solver's borders).
+  bool gradient(ConstVectorRef U, double mu, double &g, Vector &gx, double &gmu, Vector &Flambda, Vector &Fmu);
+
+ private:
+  /// v, w, g at (U, μ) into the cache (nothing recomputed for the same U, μ and borders).
+  bool evaluate(ConstVectorRef U, double mu);
+  bool evaluateGradient(ConstVectorRef U, double mu);
+  void setBorders(const Vector &v, const Vector &w);
+
+  TwoParameterProblem &problem_;
+  int n_;
+  std::unique_ptr<BorderedSolver> solver_;  // the base problem's, for g, v, w
+  std::unique_ptr<RefinedBorderedSystem> system_;
+  Vector b_, c_;
+  Vector b0_, c0_;  // the start's
+  // Cache of evaluate() / evaluateGradient().
+  Vector cachedU_;
+  double cachedMu_ = 0.0;
+  bool cached_ = false, cachedGradient_ = false;
+  Vector v_, w_, gx_, Fmu_, FuMuV_, Flambda_, ex_;
+  double g_ = 0.0, gmu_ = 0.0;
+  Matrix Bm_, Cm_, Dm_;
+  Vector rhs_, z_, y_;
 };
 
 }  // namespace buckle::continuation

@@ -29,6 +29,34 @@
 
 namespace buckle::continuation {
 
+/// G = [[F_u, B], [Cᵀ, D]] (or [[F_uᵀ, B], [Cᵀ, D]]) at one point (u, λ), factored by a
+/// BorderedSolver (factorGeneral) and solved with iterative refinement on the residual b − G x
+/// evaluated with the problem's own O(N) products: the building block of the refinements below
+/// and of the minimally augmented curve systems (fold_curve.h).
+class RefinedBorderedSystem {
+ public:
+  /// `problem` and `solver` are not owned and must outlive the system.
+  RefinedBorderedSystem(Problem &problem, BorderedSolver &solver);
+
+  /// Factors G at (u, λ) (B, C N×k, D k×k) and remembers it for solve(). False when the solver
+  /// refuses the point or G is singular.
+  bool factor(ConstVectorRef u, double lambda, const Matrix &B, const Matrix &C, const Matrix &D, bool transposed);
+  /// x = G⁻¹ b (size N + k), refined on the exactly evaluated residual.
+  bool solve(const Vector &b, Vector &x);
+
+ private:
+  bool applyG(const Vector &x, Vector &y);
+
+  Problem &problem_;
+  BorderedSolver &solver_;
+  int n_;
+  Vector u_;
+  double lambda_ = 0.0;
+  Matrix B_, C_, D_;
+  bool transposed_ = false;
+  Vector ex_, prod_, Gx_, r_, dx_;  // workspace of applyG and solve
+};
+
 struct StructuredRefinementResult {
   bool converged = false;
   int iterations = 0;
@@ -60,23 +88,20 @@ class StructuredRefinement {
 
  private:
   /// Factors G = [[F_u (F_uᵀ), B], [Cᵀ, D]] at (u, λ) and remembers it for refinedSolve().
-  bool factor(ConstVectorRef u, double lambda, const Matrix &B, const Matrix &C, const Matrix &D, bool transposed);
+  bool factor(ConstVectorRef u, double lambda, const Matrix &B, const Matrix &C, const Matrix &D, bool transposed) {
+    return system_.factor(u, lambda, B, C, D, transposed);
+  }
   /// x = G⁻¹ b with iterative refinement on the residual b − G x from the problem's products.
-  bool refinedSolve(const Vector &b, Vector &x);
-  bool applyG(const Vector &x, Vector &y);
+  bool refinedSolve(const Vector &b, Vector &x) { return system_.solve(b, x); }
   bool parameterDerivative(ConstVectorRef u, double lambda, Vector &Fl);
 
   Problem &problem_;
   BorderedSolver &solver_;
+  RefinedBorderedSystem system_;
   double tolerance_;
   int maxIterations_;
   int n_;
-  // The factored G.
-  Vector u_;
-  double lambda_ = 0.0;
-  Matrix B_, C_, D_;
-  bool transposed_ = false;
-  Vector ex_, prod_;  // workspace of applyG
+  Vector ex_;  // workspace of parameterDerivative
 };
 
 }  // namespace buckle::continuation

@@ -49,8 +49,9 @@ struct SecondParameter {
 };
 
 /// The equilibrium problem of a chain (equilibrium_problem.h) with μ as a second parameter.
-/// Setting μ rebuilds the chain (O(n)); μ for which a segment is invalid is refused. The dense
-/// linear algebra is used (no structured solver: it would be bound to one chain).
+/// Setting μ rebuilds the chain (O(n)); μ for which a segment is invalid is refused. The O(n)
+/// products and the structured solver are the chain's (chain_solver.h), the solver following the
+/// rebuilt chain (it is recreated when μ has changed since its last factorization).
 class ChainParameterProblem final : public continuation::TwoParameterProblem {
  public:
   /// μ starts at the value the chain has (segment `segment`, or the first, for "every segment";
@@ -91,6 +92,21 @@ class ChainParameterProblem final : public continuation::TwoParameterProblem {
                  continuation::StabilityInfo& info) override {
     return equilibrium_->stability(u, lambda, lowestCount, info);
   }
+  /// Exact (∂F_u/∂λ)·v in O(n): the dead loads' λ-derivative of K_g (eq 27), −[h'_max(i,j)] v_q.
+  bool parameterJacobianApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef v,
+                              continuation::VectorRef FuLambdaV) override;
+  bool jacobianApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
+                     continuation::VectorRef y) override {
+    return equilibrium_->jacobianApply(u, lambda, x, y);
+  }
+  bool jacobianTransposeApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef w,
+                              continuation::VectorRef y) override {
+    return equilibrium_->jacobianTransposeApply(u, lambda, w, y);
+  }
+  /// The chain's O(n) bordered solver, recreated for the current chain whenever μ has changed.
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver() override;
+  /// Incremented whenever setting μ rebuilds the chain (what the structured solver follows).
+  long generation() const { return generation_; }
   continuation::ProblemScales scales() const override { return equilibrium_->scales(); }
   int boundaryCount() const override { return equilibrium_->boundaryCount(); }
   double boundary(int k, continuation::ConstVectorRef u, double lambda) override {
@@ -109,6 +125,7 @@ class ChainParameterProblem final : public continuation::TwoParameterProblem {
   SecondParameter parameter_;
   EquilibriumOptions options_;
   double mu_ = 0.0;
+  long generation_ = 0;
   std::unique_ptr<EquilibriumProblem> equilibrium_;
   std::unique_ptr<ChainData> data_;
   Vector dl_, dS_, dC_, dE1_, dE2_, dh_;
@@ -153,6 +170,14 @@ struct CriticalCurveOptions {
   continuation::TracerOptions tracer;    ///< step control of the curve (its λ range is μ's)
   bool bothDirections = true;
   bool coefficients = true;              ///< branch points: Koiter coefficients at every point
+  /// From this chain dimension N = n + m on (tracer.linearAlgebra Automatic), the curves use the
+  /// chain's O(n) structure: the fold curve by the minimally augmented system
+  /// (MinimalFoldCurveProblem), the branch-point curve with the structured bordered solver; below
+  /// it the dense systems (FoldCurveProblem, the (N+1)² LU). A speed crossover only: the same
+  /// curves. tracer.linearAlgebra Dense / Structured force either path. The Koiter coefficients
+  /// (coefficients, "DP") stay dense, O(n³) per point. Measured (benchmarks/RESULTS.md): the BP
+  /// curve is faster structured from n = 10 (N = 12), the fold curve from about n = 20.
+  int structuredFromDimension = 20;
 };
 
 /// Branch-point curve of the straight chain's compressive buckling mode `mode` (0: the first)
