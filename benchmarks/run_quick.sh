@@ -30,4 +30,5 @@ BUILD=$BUILD OUT=$OUT run work_precision "$HERE/work_precision.sh" --quick   # A
 run hard_cases "$BIN/hard_cases" --quick
 run critical_loads "$BIN/critical_loads" --quick
 run jump_timing "$BIN/jump_timing" --quick
+run long_tree "$BIN/long_tree" --quick
 exit $status
