@@ -1,18 +1,20 @@
 // long_tree: the bifurcation tree of a long straight chain (issue 13, "Done when"): the trivial
 // branch of the clamped–pinned chain under Fx through its first K branch points, every one
-// refined and switched on both sides, P points per branch, traced by the mechanics layer's one
+// refined and switched on both sides, P points per branch (the trivial branch in steps of its
+// λ range / (P − 1), the switched ones in steps of 0.2/√n), traced by the mechanics layer's one
 // entry (traceEquilibria: the core's tree driver, contact and the branch reports). Each row: wall
 // time of the tree, peak resident memory of the process so far, the branches and how many of
 // the 2K switches left the trivial branch, and the largest relative difference of the K branch
 // points from the O(n) linear buckling route (Sturm counts + Rayleigh quotient, an independent
 // computation: linear_buckling.h), and, with --dense-max ≥ n, from the dense pencil.
 //
-//   long_tree [--quick] [--n N] [--bps K] [--points P] [--dense-max N]
+//   long_tree [--quick] [--n N] [--bps K] [--points P] [--dense-max N] [--verbose]
 //     --quick        CI size: n = 100, K = 3, P = 20
 //     --n N          only this chain length (default: n = 1000 with K = 10, then n = 10000 with K = 5)
 //     --bps K        branch points switched (default 10 at n ≤ 2000, else 5)
 //     --points P     points per branch (default 50)
 //     --dense-max N  largest n also compared with the dense pencil (default 0: none; it is O(n³))
+//     --verbose      one line per switched branch: points, special points, why it stopped
 // Memory is the process's peak (getrusage), so run one n per process for a clean figure.
 #include <sys/resource.h>
 
@@ -36,7 +38,7 @@ namespace {
 
 int usage(const char* why) {
   std::fprintf(stderr,
-               "long_tree: %s\nusage: long_tree [--quick] [--n N] [--bps K] [--points P] [--dense-max N]\n", why);
+               "long_tree: %s\nusage: long_tree [--quick] [--n N] [--bps K] [--points P] [--dense-max N] [--verbose]\n", why);
   return 2;
 }
 
@@ -69,6 +71,7 @@ struct Row {
   double seconds = 0.0, megabytes = 0.0;
   int branches = 0, switched = 0, located = 0, childPoints = 0;
   double vsLinear = std::nan(""), vsDense = std::nan("");
+  std::string children;  ///< per switched branch: points, special points, stop reason (--verbose)
 };
 
 Row run(int n, int K, int P, int denseMax) {
@@ -96,7 +99,15 @@ Row run(int n, int K, int P, int denseMax) {
   opt.tracer.lambdaMin = lambdaEnd;
   opt.tracer.lambdaMax = 0.0;
   opt.tracer.lowestEigenvalues = 1;  // the smallest eigenvalue, as the scenes report it
+  // The children move along the buckling modes, in joint angles: steps of 0.2/√n (0.02, the
+  // scenes' initial step, at n = 100), so that 50 points bend the chain visibly but do not coil
+  // it (the link angles sum the joint angles: 0.02 per joint coils a 2000-segment chain into
+  // base and self contact). With the trivial branch's steps (|λ| ~ 1e−8 at n = 10 000) they would
+  // stay within 1e−7 of the straight chain, where λ(s) − λ_c ~ λ_c s² is below the rounding of
+  // the tangent's λ component and its sign, the fold test, is noise (spurious LPs).
   cont::TracerOptions child = opt.tracer;
+  child.initialStep = child.maxStep = 0.2 / std::sqrt(double(n));
+  child.minStep = 1e-6 * child.maxStep;
   child.maxPoints = P;
   child.lambdaMin = 2.0 * crit[size_t(K)];
   opt.childTracer = child;
@@ -111,6 +122,13 @@ Row run(int n, int K, int P, int denseMax) {
   for (const cont::Branch& b : branches) {
     if (b.parentId < 0) continue;
     row.childPoints = std::max(row.childPoints, int(b.points.size()));
+    row.children += "  branch " + std::to_string(b.id) + " (BP " + std::to_string(b.parentSpecialPoint) +
+                    (b.direction > 0 ? " +" : " -") + "): " + std::to_string(b.points.size()) + " points,";
+    for (const cont::SpecialPoint& sp : b.specialPoints) row.children += std::string(" ") + cont::label(sp.type);
+    row.children += std::string(", ") + cont::toString(b.stopReason) + "\n";
+    for (const SpecialPointReport& sp : tree.reports[size_t(b.id)].specialPoints)
+      if (sp.type == EventType::BaseContact || sp.type == EventType::SelfContact)
+        row.children += "    " + sp.note.substr(0, 110) + "\n";
     // off the trivial branch: the joint angles grow along the child
     if (b.stopReason != cont::StopReason::SwitchFailed && b.points.size() >= 2 &&
         b.points.back().u.head(n).norm() > 0.0)
@@ -138,12 +156,14 @@ Row run(int n, int K, int P, int denseMax) {
 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // one row at a time (long runs)
-  bool quick = false;
+  bool quick = false, verbose = false;
   int only = 0, K = 0, P = 50, denseMax = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
       quick = true;
+    } else if (a == "--verbose") {
+      verbose = true;
     } else if ((a == "--n" || a == "--bps" || a == "--points" || a == "--dense-max") && i + 1 < argc) {
       int& target = a == "--n" ? only : a == "--bps" ? K : a == "--points" ? P : denseMax;
       if (!positiveInt(argv[++i], target)) return usage((a + " needs a positive integer").c_str());
@@ -167,6 +187,7 @@ int main(int argc, char** argv) {
     const Row r = run(n, k, P, denseMax);
     std::printf("%-7d %4d %6d %10.3f %9.1f %9d %9d %9d %12.2e %12.2e\n", r.n, r.located, r.points, r.seconds,
                 r.megabytes, r.branches, r.switched, r.childPoints, r.vsLinear, r.vsDense);
+    if (verbose) std::printf("%s", r.children.c_str());
     ok = ok && r.located == k;
   }
   return ok ? 0 : 1;
