@@ -69,6 +69,10 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   br.stopMessage = report.stopMessage;
   br.points = static_cast<int>(b.points.size());
   br.finished = report.finished;
+  // a switched branch that used up its requested "child_points" ended where it was asked to
+  const bool childBudget = b.parentId >= 0 && scene_.analyses.continuation.childPoints > 0 &&
+                           b.stopReason == cont::StopReason::MaxPoints;
+  if (childBudget) br.finished = true;
   if (b.stopReason == cont::StopReason::Interrupted) {
     interrupted();  // reported once for the run, not per branch
   } else if (!br.finished) {
