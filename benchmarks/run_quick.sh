@@ -31,4 +31,5 @@ run hard_cases "$BIN/hard_cases" --quick
 run critical_loads "$BIN/critical_loads" --quick
 run jump_timing "$BIN/jump_timing" --quick
 command -v mpirun > /dev/null && BUILD=$BUILD run atlas_mpi "$HERE/atlas_mpi.sh" --quick   # issue 15
+run long_tree "$BIN/long_tree" --quick
 exit $status

@@ -71,6 +71,10 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   br.stopMessage = report.stopMessage;
   br.points = static_cast<int>(b.points.size());
   br.finished = report.finished;
+  // a switched branch that used up its requested "child_points" ended where it was asked to
+  const bool childBudget = b.parentId >= 0 && scene_.analyses.continuation.childPoints > 0 &&
+                           b.stopReason == cont::StopReason::MaxPoints;
+  if (childBudget) br.finished = true;
   if (b.stopReason == cont::StopReason::Interrupted) {
     interrupted();  // reported once for the run, not per branch
   } else if (!br.finished) {
@@ -269,9 +273,28 @@ void CaseRunner::continuation() {
   opt.tracer.lambdaMin = lambdaLo;
   opt.tracer.lambdaMax = lambdaHi;
   opt.tracer.computeStability = true;
+  // Only the smallest eigenvalue is reported (min_eig); the locator asks for the crossing
+  // eigenvalue where it needs more.
+  opt.tracer.lowestEigenvalues = 1;
   opt.switchingDepth = scene_.analyses.continuation.branchSwitching;
   opt.contact = scene_.analyses.continuation.contact;
   opt.report = reportOptions();
+  if (const int first = scene_.analyses.continuation.branchPoints; first > 0) {
+    // the first `first` simple branch points along the branch, not counting the one it starts from
+    opt.switchAt = [first](const cont::Branch& branch, const cont::SpecialPoint& bp) {
+      const double s0 = branch.points.empty() ? 0.0 : branch.points.front().arclength;
+      int before = 0;
+      for (const cont::SpecialPoint& sp : branch.specialPoints)
+        if (sp.type == cont::SpecialPointType::BranchPoint && sp.multiplicity == 1 && sp.arclength > s0 &&
+            sp.arclength < bp.arclength)
+          ++before;
+      return before < first;
+    };
+  }
+  if (const int points = scene_.analyses.continuation.childPoints; points > 0) {
+    opt.childTracer = opt.tracer;
+    opt.childTracer->maxPoints = points;
+  }
   opt.onBranch = [this](const cont::BranchTree& t, const cont::Branch&) {
     branchesSoFar_ = static_cast<int>(t.branches.size());
   };

@@ -55,6 +55,10 @@ struct PathSpec {
 struct ContinuationSpec {
   bool enabled = false;
   int branchSwitching = 0;  ///< depth of the branch tree (0: primary branch only)
+  /// Switch at the first this many simple branch points along each branch (0: all of them).
+  int branchPoints = 0;
+  /// Points per switched branch (0: the solver's max_points, as the start branches).
+  int childPoints = 0;
   /// Joints that reach a limit lock and the branch goes on under contact (mechanics/contact.h);
   /// false: the branch ends at the limit ("BD").
   bool contact = true;

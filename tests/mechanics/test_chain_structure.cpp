@@ -371,6 +371,30 @@ TEST_CASE("lowest eigenvalues (isolation + Illinois on det K_σ) match the dense
   }
 }
 
+TEST_CASE("lowest eigenvalues from a warm start: near, far and wrong guesses give the dense ones",
+          "[chain_structure]") {
+  // The warm start widens a bracket around each guessed eigenvalue from 2 % of it; guesses close
+  // to the answer, off by many eigenvalue gaps, of the wrong sign or zero must all end on the
+  // dense spectrum (the counts keep every bracket honest).
+  std::mt19937 rng(21);
+  for (int n : {40, 300}) {
+    Instance in = randomInstance(n, rng, 1.5);
+    ChainStructure ws(n);
+    assembleInstance(in, ws);
+    const double scale = std::max(1.0, in.H.norm());
+    Eigen::SelfAdjointEigenSolver<Matrix> es(in.H, Eigen::EigenvaluesOnly);
+    const Vector exact = es.eigenvalues().head(3);
+    const double gap = exact[2] - exact[0];
+    for (const Vector& guess : {Vector(exact * (1.0 + 1e-6)), Vector(exact.array() + 7.0 * gap),
+                                Vector(-exact), Vector(Vector::Zero(3)), Vector(exact.array() - 0.5 * scale)}) {
+      setConstraints(ws, Matrix(0, n));
+      Vector out(3);
+      REQUIRE(lowestEigenvalues(ws, false, 3, out, 1e-13, &guess) == 3);
+      for (int j = 0; j < 3; ++j) CHECK(std::abs(out[j] - exact[j]) <= 1e-11 * scale);
+    }
+  }
+}
+
 TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense default", "[chain_structure]") {
   std::mt19937 rng(123);
   const std::vector<EndCondition> ends = {EndCondition::freeEnd(Eigen::Vector3d(0.3, -0.2, 0.1)),

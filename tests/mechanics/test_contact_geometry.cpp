@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -177,5 +178,44 @@ TEST_CASE("base and self clearance: closed forms, crossing links, and the cut-of
       }
     const SelfClearance sc = selfClearance(chain, qr);
     if (sc.distance > 0.0) CHECK(sc.distance == Approx(all).epsilon(1e-14));
+  }
+}
+
+TEST_CASE("self clearance: the swept cut-off finds the all-pairs pair on chains that fold onto themselves",
+          "[contact_geometry]") {
+  // Spirals of 1.3 to 2.7 turns with random wiggles (n = 300): links meet and cross far along the
+  // chain, the case where a sweep could miss a pair. The independent scan: every pair, the signed
+  // distance written out (disjoint: the smallest end-point-to-segment distance; crossing: minus it).
+  auto pointSeg = [](const Eigen::Vector2d& p, const Eigen::Vector2d& s0, const Eigen::Vector2d& s1) {
+    const Eigen::Vector2d d = s1 - s0;
+    const double t = std::clamp((p - s0).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    return (p - s0 - t * d).norm();
+  };
+  auto cross2 = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) { return u.x() * v.y() - u.y() * v.x(); };
+  const int n = 300;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> wiggle(-0.02, 0.02), turns(1.3, 2.7);
+  for (int trial = 0; trial < 6; ++trial) {
+    Vector q(n);
+    const double total = 2.0 * M_PI * turns(rng);
+    for (int i = 0; i < n; ++i) q[i] = total / n * (1.0 - 0.5 * double(i) / n) + wiggle(rng);
+    const Eigen::Matrix2Xd P = jointPositions(chain, q);
+    double best = std::numeric_limits<double>::infinity();
+    int bestA = -1, bestB = -1;
+    for (int a = 0; a + 1 < P.cols(); ++a)
+      for (int b = a + 2; b + 1 < P.cols(); ++b) {
+        const Eigen::Vector2d a0 = P.col(a), a1 = P.col(a + 1), b0 = P.col(b), b1 = P.col(b + 1);
+        const double d1 = cross2(a1 - a0, b0 - a0), d2 = cross2(a1 - a0, b1 - a0);
+        const double d3 = cross2(b1 - b0, a0 - b0), d4 = cross2(b1 - b0, a1 - b0);
+        const bool crossing = d1 * d2 < 0.0 && d3 * d4 < 0.0;
+        const double m = std::min({pointSeg(a0, b0, b1), pointSeg(a1, b0, b1), pointSeg(b0, a0, a1), pointSeg(b1, a0, a1)});
+        const double d = crossing ? -m : m;
+        if (d < best) best = d, bestA = a, bestB = b;
+      }
+    const SelfClearance sc = selfClearance(chain, q);
+    CHECK(sc.distance == Approx(best).epsilon(1e-13).margin(1e-13));
+    CHECK(sc.linkA == bestA);
+    CHECK(sc.linkB == bestB);
   }
 }

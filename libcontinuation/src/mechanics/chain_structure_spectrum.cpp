@@ -176,10 +176,13 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
   };
   for (int j = 0; j < k; ++j) {
     lo[j] = std::max(lo[j], j > 0 ? out[j - 1] - tol : lo[j]);
-    // Warm start (e.g. the previous continuation point): a few counts around the guess.
+    // Warm start (e.g. the previous continuation point): counts around the guess, widening by 8
+    // from 2 % of it. (A width tied to ‖H‖ instead isolates nothing on a long or strongly loaded
+    // chain, whose lowest eigenvalues are spaced ~κ/n² ≪ 1e−3‖H‖_F, and bisection then pays
+    // ~log2(‖H‖ n²/κ) counts per eigenvalue and point.)
     if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
-      double delta = std::max(1e-3 * scale, 0.02 * std::abs((*guess)[j]));
-      for (int attempt = 0; attempt < 3 && !(int(cntLo[j]) == j && int(cntHi[j]) == j + 1); ++attempt, delta *= 8.0) {
+      double delta = std::max(1e-9 * scale, 0.02 * std::abs((*guess)[j]));
+      for (int attempt = 0; attempt < 10 && !(int(cntLo[j]) == j && int(cntHi[j]) == j + 1); ++attempt, delta *= 8.0) {
         const double a = (*guess)[j] - delta, b = (*guess)[j] + delta;
         if (a > lo[j]) record(a, evaluateShift(ws, useConstraints, a).below);
         if (b < hi[j]) record(b, evaluateShift(ws, useConstraints, b).below);

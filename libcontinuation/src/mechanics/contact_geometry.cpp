@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "buckle/continuation/root_finding.h"
 #include "buckle/mechanics/shape_name.h"
@@ -93,11 +94,49 @@ SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) {
   const int links = int(P.cols()) - 1;  // ℓ_0 … ℓ_n: link m from column m to m + 1
   SelfClearance c;
   c.distance = std::numeric_limits<double>::infinity();
+  if (links < 3) return c;
+  // Bounding circles of the links (mid-point, half length), and the links sorted by the x of
+  // their mid-points: the pairs scanned are those whose circles could beat the best so far.
+  Eigen::Matrix2Xd mid(2, links);
+  Eigen::VectorXd radius(links);
+  double rmax = 0.0, extent = 0.0;
   for (int a = 0; a < links; ++a) {
+    mid.col(a) = 0.5 * (P.col(a) + P.col(a + 1));
+    radius[a] = 0.5 * (P.col(a + 1) - P.col(a)).norm();
+    rmax = std::max(rmax, radius[a]);
+    extent = std::max(extent, mid.col(a).cwiseAbs().maxCoeff() + radius[a]);
+  }
+  std::vector<int> byX(static_cast<size_t>(links));
+  for (int a = 0; a < links; ++a) byX[size_t(a)] = a;
+  std::sort(byX.begin(), byX.end(), [&mid](int i, int j) { return mid(0, i) < mid(0, j); });
+  std::vector<double> xs(byX.size());
+  for (size_t i = 0; i < byX.size(); ++i) xs[i] = mid(0, byX[i]);
+  // A pair whose mid-points differ by more than reach in x or y has bound = |Δm| − r_a − r_b >
+  // the best so far (+ a margin far above the rounding of the bound): the all-pairs scan below
+  // would skip it too, so scanning only the others, in the same order with the same test, gives
+  // the same pair, bit for bit.
+  const double margin = 1e-9 * extent;
+  std::vector<int> candidates;
+  candidates.reserve(static_cast<size_t>(links));
+  for (int a = 0; a < links - 2; ++a) {
     const Point a0 = P.col(a), a1 = P.col(a + 1);
     const Point ma = 0.5 * (a0 + a1);
     const double ra = 0.5 * (a1 - a0).norm();
-    for (int b = a + 2; b < links; ++b) {
+    candidates.clear();
+    if (std::isfinite(c.distance)) {
+      const double reach = c.distance + ra + rmax + margin;
+      if (reach < 0.0) continue;  // every bound ≥ −r_a − r_b exceeds a crossing this deep
+      const auto lo = std::lower_bound(xs.begin(), xs.end(), mid(0, a) - reach);
+      const auto hi = std::upper_bound(xs.begin(), xs.end(), mid(0, a) + reach);
+      for (auto it = lo; it != hi; ++it) {
+        const int b = byX[size_t(it - xs.begin())];
+        if (b >= a + 2 && std::abs(mid(1, b) - mid(1, a)) <= reach) candidates.push_back(b);
+      }
+      std::sort(candidates.begin(), candidates.end());
+    } else {
+      for (int b = a + 2; b < links; ++b) candidates.push_back(b);
+    }
+    for (const int b : candidates) {
       const Point b0 = P.col(b), b1 = P.col(b + 1);
       const double rb = 0.5 * (b1 - b0).norm();
       // bounding circles: a lower bound of the pair's distance, exact evaluation only if it

@@ -15,10 +15,11 @@
 //    smallest distance of an end point to the other segment while they cross (continuous at the
 //    first touch, negative after it), and
 //        d_self(q) = min over non-adjacent pairs                            (> 0: clear).
-//    Pairs are tested all against all, O(n²), with a bounding-circle rejection (a pair whose
-//    mid-points are farther apart than half their lengths' sum is never evaluated exactly): the
-//    cut-off costs one distance per pair, nothing is missed; 200 segments take ~20 000 pairs per
-//    point. The triangles' widths are not part of the self-contact test (the centre lines meet
+//    Pairs are rejected by their bounding circles (a pair whose mid-points are farther apart
+//    than the best distance so far plus half their lengths' sum is never evaluated exactly), and
+//    only the links whose mid-points lie within that reach in x and y of a link's (a sweep over
+//    the links sorted by x) are looked at: nothing is missed, the pair found is the all-pairs
+//    scan's, and a chain that does not fold onto itself costs O(n log n) per point. The triangles' widths are not part of the self-contact test (the centre lines meet
 //    only after the bodies do: a detection, not a contact model).
 //
 // Along a traced branch (branch_report.h) a sign change of d_base or d_self between two
@@ -54,7 +55,7 @@ struct SelfClearance {
   int linkA = -1, linkB = -1;  ///< links m (0: the base link ℓ_0), linkA < linkB − 1
   Eigen::Vector2d point = Eigen::Vector2d::Zero();  ///< nearest / crossing point on link A
 };
-/// O(n²) pairs with a bounding-circle cut-off (file comment).
+/// Bounding-circle cut-off and an x sweep (file comment): O(n log n) unless the chain folds onto itself.
 SelfClearance selfClearance(const Chain& chain, ConstVectorRef q);
 
 /// Base (true) or self (false) contact located on a branch.
