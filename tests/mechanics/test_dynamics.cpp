@@ -633,9 +633,14 @@ TEST_CASE("inertial O(n) right-hand side equals the dense mass-matrix solve (n =
       Vector grad(n);
       model.potentialGradient(q, grad);
       const Vector f = -c - Eigen::Map<const Vector>(damping.data(), n).cwiseProduct(v) - grad;
-      Vector acc;
+      // The chain's M is ill-conditioned (cond grows like a power of n), so two solvers agree only
+      // to cond·ε in the forward error: check the backward error of the O(n) solution instead,
+      // M q̈ − f = J_hᵀ r with J_h q̈ = γ, to rounding relative to the terms' sizes.
+      const Vector accFast = Eigen::Map<const Vector>(dx.data() + n, n);
+      const Vector e = M * accFast - f;
+      const double size = M.cwiseAbs().rowwise().sum().maxCoeff() * accFast.cwiseAbs().maxCoeff() + f.cwiseAbs().maxCoeff();
       if (!held) {
-        acc = M.ldlt().solve(f);
+        CHECK(e.cwiseAbs().maxCoeff() < 1e-12 * size);
       } else {
         // the held row J_y = cos θ summed over the tail; γ = −J̇ q̇ − 2ω J q̇ − ω² h (h = y_end)
         const Vector& l = chain.linkLengths();
@@ -651,16 +656,11 @@ TEST_CASE("inertial O(n) right-hand side equals the dense mass-matrix solve (n =
         }
         const double w = model.baumgarteRate();
         const double gamma = ydot2 - 2.0 * w * Jy.dot(v) - w * w * y;
-        Matrix K = Matrix::Zero(n + 1, n + 1);
-        K.topLeftCorner(n, n) = M;
-        K.topRightCorner(n, 1) = -Jy;
-        K.bottomLeftCorner(1, n) = Jy.transpose();
-        Vector rhs(n + 1);
-        rhs << f, gamma;
-        acc = K.fullPivLu().solve(rhs).head(n);
+        const double r = Jy.dot(e) / Jy.squaredNorm();
+        CHECK((e - r * Jy).cwiseAbs().maxCoeff() < 1e-12 * size);
+        CHECK(std::abs(Jy.dot(accFast) - gamma) <
+              1e-12 * (Jy.cwiseAbs().dot(accFast.cwiseAbs()) + std::abs(ydot2) + 2.0 * w * Jy.cwiseAbs().dot(v.cwiseAbs()) + w * w * std::abs(y)));
       }
-      const Vector accFast = Eigen::Map<const Vector>(dx.data() + n, n);
-      CHECK((accFast - acc).cwiseAbs().maxCoeff() < 1e-9 * std::max(1.0, acc.cwiseAbs().maxCoeff()));
     }
   }
 }
