@@ -585,3 +585,82 @@ TEST_CASE("one-sided joint limit, inertial: the inelastic impact's energy is cou
     }
   }
 }
+
+TEST_CASE("inertial O(n) right-hand side equals the dense mass-matrix solve (n = 50, 200)", "[dynamics]") {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> Q(-0.8, 0.8), V(-1.0, 1.0);
+  for (int n : {50, 200}) {
+    const Chain chain = bistableChain(n);
+    const InertiaData data = unevenInertia(chain);
+    const std::vector<double> damping(size_t(n), 0.3);
+    for (int held = 0; held < 2; ++held) {
+      const EndCondition end = held ? EndCondition::clampedPinned(0.0, 0.0) : EndCondition::freeEnd();
+      InertialModel model(chain, end, data, damping, 0.0, Vector::Zero(n));
+      Vector q(n), v(n);
+      for (int i = 0; i < n; ++i) {
+        q[i] = Q(rng) / std::sqrt(double(n));
+        v[i] = V(rng);
+      }
+      Vector x(2 * n + 1), dx(2 * n + 1);
+      model.packState(q, v, x);
+      model.rhs(x.data(), dx.data());
+      // dense reference: M from massMatrix(), c from the O(n²) Lagrange sum in absolute angles
+      Matrix M(n, n);
+      model.massMatrix(q, M);
+      Vector theta(n), thetaDot(n);
+      double a = 0.0, b = 0.0;
+      for (int i = 0; i < n; ++i) {
+        theta[i] = (a += q[i]);
+        thetaDot[i] = (b += v[i]);
+      }
+      // μ_ij from M_θ = T⁻ᵀ M T⁻¹ at this q (T⁻¹ = Tinv), divided by cos(θ_i − θ_j)
+      Matrix Tinv = Matrix::Identity(n, n);
+      for (int i = 1; i < n; ++i) Tinv(i, i - 1) = -1.0;
+      const Matrix Mtheta = Tinv.transpose() * M * Tinv;
+      Vector cTheta = Vector::Zero(n);
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+          if (i != j) cTheta[i] += Mtheta(i, j) / std::cos(theta[i] - theta[j]) * std::sin(theta[i] - theta[j]) * thetaDot[j] * thetaDot[j];
+      Vector c(n);
+      for (int i = n - 1; i >= 0; --i) c[i] = cTheta[i] + (i + 1 < n ? c[i + 1] : 0.0);
+      Vector cFast(n);
+      model.velocityTerms(q, v, cFast);
+      INFO("n = " << n << " held " << held);
+      CHECK((cFast - c).cwiseAbs().maxCoeff() < 1e-9 * std::max(1.0, c.cwiseAbs().maxCoeff()));
+      // kinetic energy ½ q̇ᵀ M q̇
+      CHECK(model.kineticEnergy(x.data()) == Approx(0.5 * v.dot(M * v)).epsilon(1e-12));
+      // accelerations: KKT [[M, −J_hᵀ], [J_h, 0]] (q̈, r) = (f, γ) densely, γ from the model's rows
+      Vector grad(n);
+      model.potentialGradient(q, grad);
+      const Vector f = -c - Eigen::Map<const Vector>(damping.data(), n).cwiseProduct(v) - grad;
+      // The chain's M is ill-conditioned (cond grows like a power of n), so two solvers agree only
+      // to cond·ε in the forward error: check the backward error of the O(n) solution instead,
+      // M q̈ − f = J_hᵀ r with J_h q̈ = γ, to rounding relative to the terms' sizes.
+      const Vector accFast = Eigen::Map<const Vector>(dx.data() + n, n);
+      const Vector e = M * accFast - f;
+      const double size = M.cwiseAbs().rowwise().sum().maxCoeff() * accFast.cwiseAbs().maxCoeff() + f.cwiseAbs().maxCoeff();
+      if (!held) {
+        CHECK(e.cwiseAbs().maxCoeff() < 1e-12 * size);
+      } else {
+        // the held row J_y = cos θ summed over the tail; γ = −J̇ q̇ − 2ω J q̇ − ω² h (h = y_end)
+        const Vector& l = chain.linkLengths();
+        Vector Jy(n);
+        double s = 0.0, ydot2 = 0.0, y = 0.0;
+        for (int i = n - 1; i >= 0; --i) {
+          s += l[i + 1] * std::cos(theta[i]);
+          Jy[i] = s;
+        }
+        for (int i = 0; i < n; ++i) {
+          ydot2 += l[i + 1] * std::sin(theta[i]) * thetaDot[i] * thetaDot[i];
+          y += l[i + 1] * std::sin(theta[i]);
+        }
+        const double w = model.baumgarteRate();
+        const double gamma = ydot2 - 2.0 * w * Jy.dot(v) - w * w * y;
+        const double r = Jy.dot(e) / Jy.squaredNorm();
+        CHECK((e - r * Jy).cwiseAbs().maxCoeff() < 1e-12 * size);
+        CHECK(std::abs(Jy.dot(accFast) - gamma) <
+              1e-12 * (Jy.cwiseAbs().dot(accFast.cwiseAbs()) + std::abs(ydot2) + 2.0 * w * Jy.cwiseAbs().dot(v.cwiseAbs()) + w * w * std::abs(y)));
+      }
+    }
+  }
+}

@@ -451,3 +451,100 @@ TEST_CASE("long chain: the structured Rosenbrock method lands where dense Rosenb
   requirePotentialNonIncreasing(structured.dynamics, 1.0 + 2.0 * std::abs(structured.to[n]));
   CHECK(jumpIntegrationDefaults(kStructuredJumpFrom + 1).stepper == StepperKind::StructuredRosenbrock4);
 }
+
+namespace {
+
+// Dense reference for unstableDirection(): the stability operator H and held rows C of the
+// problem, Z from a full QR of Cᵀ, the eigen-decomposition of ZᵀHZ (O(n³); what the function did
+// for every n before the structured route).
+UnstableDirection denseUnstableDirection(EquilibriumProblem& problem, const Vector& u, double lambda) {
+  UnstableDirection d;
+  Matrix H, C;
+  REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+  const Eigen::Index n = H.rows();
+  Eigen::ColPivHouseholderQR<Matrix> qr(C.transpose());
+  const Matrix Q = qr.householderQ() * Matrix::Identity(n, n);
+  const Matrix Z = Q.rightCols(n - qr.rank());
+  Eigen::SelfAdjointEigenSolver<Matrix> es(Z.transpose() * H * Z);
+  d.eigenvalue = es.eigenvalues()[0];
+  d.direction = (Z * es.eigenvectors().col(0)).normalized();
+  d.valid = true;
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("long chains: the O(n) unstable direction and polish equal the dense ones (n = 50, 200)", "[jump]") {
+  for (int n : {50, 200}) {
+    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
+    // a slightly bent chain under a compression beyond its lowest critical loads (~κ/n²): unstable,
+    // y held (C = [J_y])
+    const double lambda = -1e-3 * (n == 50 ? 10.0 : 1.0);
+    Vector q(n);
+    for (int i = 0; i < n; ++i) q[i] = 1e-3 * std::sin(0.37 * i);
+    const Vector u = problem.initialGuess(q, lambda);
+    INFO("n = " << n);
+    REQUIRE(n > kSmallDense);  // the structured route
+    const UnstableDirection s = unstableDirection(problem, u, lambda);
+    const UnstableDirection d = denseUnstableDirection(problem, u, lambda);
+    REQUIRE(s.valid);
+    CHECK(s.eigenvalue < 0.0);
+    // the same simple eigenvalue and eigenvector (up to sign), in ker J_h
+    const double scale = 1.0;  // k̄b̄² of these segments
+    CHECK(std::abs(s.eigenvalue - d.eigenvalue) < 1e-11 * scale);
+    CHECK(std::abs(std::abs(s.direction.dot(d.direction)) - 1.0) < 1e-10);
+    Matrix H, C;
+    REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+    CHECK((C * s.direction).cwiseAbs().maxCoeff() < 1e-12 * C.norm());
+    // the eigen-equation on ker C: P(H v − μ v) = 0
+    Vector res = H * s.direction - s.eigenvalue * s.direction;
+    Eigen::ColPivHouseholderQR<Matrix> qr(C.transpose());
+    const Matrix Q = (qr.householderQ() * Matrix::Identity(n, n)).leftCols(qr.rank());
+    res -= Q * (Q.transpose() * res);
+    CHECK(res.cwiseAbs().maxCoeff() < 1e-9 * H.norm() / std::sqrt(double(n)));
+
+    // polish (structured KKT solve) from a perturbed point lands on the equilibrium that dense
+    // Newton on the full KKT system (problem.jacobian, LU) finds from the same start
+    Vector start = u;
+    for (int i = 0; i < n; ++i) start[i] += 1e-4 * std::cos(0.11 * i);
+    const PolishResult p = polishEquilibrium(problem, start.head(n), lambda);
+    REQUIRE(p.converged);
+    Vector ref = problem.initialGuess(start.head(n), lambda);
+    const int N = problem.dimension();
+    Matrix Fu(N, N);
+    Vector F(N), Fl(N);
+    for (int it = 0; it < 30; ++it) {
+      REQUIRE(problem.residual(ref, lambda, F));
+      if (F.cwiseAbs().maxCoeff() < 1e-14) break;
+      REQUIRE(problem.jacobian(ref, lambda, Fu, Fl));
+      ref -= Fu.fullPivLu().solve(F);
+    }
+    CHECK((p.u - ref).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK(p.residual <= 1e-12);
+  }
+}
+
+TEST_CASE("structured jump in scaled units: the same steps and landing angles (n = 80)", "[jump]") {
+  // lengths × 1e-3 and spring stiffnesses × 1e4: the chain's units b̄ and k̄b̄² change, the
+  // natural-unit options and the unit-weighted error norm make the integration the same
+  const int n = 80;
+  auto run = [&](double L, double k) {
+    SegmentParameters p = SegmentParameters::symmetric(0.5 * L, 1.0 * L, k, 1.2 * L);
+    const Chain chain = Chain::uniform(n, p);
+    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
+    JumpOptions options;
+    options.integration = jumpIntegrationDefaults(n);
+    options.integration.recordTrajectory = false;
+    REQUIRE(options.integration.stepper == StepperKind::StructuredRosenbrock4);
+    return simulateJump(problem, problem.initialGuess(Vector::Zero(n), 0.0), 0.0, options);
+  };
+  const JumpResult base = run(1.0, 1.0), scaled = run(1e-3, 1e4);
+  INFO(base.message << " / " << scaled.message);
+  REQUIRE(base.success);
+  REQUIRE(scaled.success);
+  CHECK(std::abs(scaled.steps - base.steps) <= base.steps / 50);
+  CHECK((scaled.to.head(n) - base.to.head(n)).cwiseAbs().maxCoeff() < 1e-10);
+  // energy in units of k̄b̄² (1e4 · 1e-6 = 1e-2)
+  CHECK(scaled.energyReleased / 1e-2 == Approx(base.energyReleased).epsilon(1e-9));
+}

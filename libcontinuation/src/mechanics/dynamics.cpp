@@ -117,6 +117,8 @@ DynamicsModel::DynamicsModel(const Chain& chain, const EndCondition& end)
       data_(chain),
       J_(3, chain.size()),
       grad_(chain.size()),
+      stiffness_(chain.size()),
+      staticsQ_(chain.size()),
       Jh_(end.heldCount(), chain.size()),
       h_(end.heldCount()),
       A_(end.heldCount(), end.heldCount()),
@@ -138,11 +140,22 @@ DynamicsModel::DynamicsModel(const Chain& chain, const EndCondition& end)
 }
 
 void DynamicsModel::evaluateStatics(ConstVectorRef q) {
+  const int n = segments();
+  if (staticsValid_ && std::equal(q.data(), q.data() + n, staticsQ_.data())) return;
+  staticsValid_ = false;
   forwardKinematics(chain_, q, data_);
   endJacobian(data_, J_);
-  // ∇Π = ∂E/∂q − J_lᵀ F_l (eq 9); loads_ is zero on held coordinates.
-  energyGradient(chain_, q, grad_);
-  grad_.noalias() -= J_.transpose() * loads_;
+  // E, ∂E/∂q and K_q from one pass of the spring model; ∇Π = ∂E/∂q − J_lᵀ F_l (eq 9, loads_
+  // zero on held coordinates; J rows (−S, C, 1)).
+  springEnergy_ = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const Jet3 e = chain_.segment(i).energyJet(q[i]);
+    springEnergy_ += e.value;
+    grad_[i] = e.d1 + loads_[0] * data_.S[i] - loads_[1] * data_.C[i] - loads_[2];
+    stiffness_[i] = e.d2;
+  }
+  staticsQ_ = q;
+  staticsValid_ = true;
   const int mh = heldCount(), m = constraintCount();
   if (m == 0) return;
   for (int k = 0; k < mh; ++k) {
@@ -165,8 +178,8 @@ void DynamicsModel::evaluateStatics(ConstVectorRef q) {
 }
 
 double DynamicsModel::potential(ConstVectorRef q) {
-  forwardKinematics(chain_, q, data_);
-  return energy(chain_, q) - loads_.dot(data_.pose);
+  evaluateStatics(q);
+  return springEnergy_ - loads_.dot(data_.pose);
 }
 
 void DynamicsModel::potentialGradient(ConstVectorRef q, VectorRef g) {
@@ -197,7 +210,7 @@ double DynamicsModel::naturalResidual(ConstVectorRef q) {
 
 double DynamicsModel::constraintViolation(ConstVectorRef q) {
   if (heldCount() == 0) return 0.0;
-  forwardKinematics(chain_, q, data_);
+  evaluateStatics(q);
   double v = 0.0;
   for (int c : held_) v = std::max(v, std::abs(data_.pose[c] - end_.value[c]));
   return v;
@@ -234,6 +247,7 @@ void DynamicsModel::setContacts(const std::vector<int>& sides) {
   for (int s : sides)
     if (s < -1 || s > 1) throw std::invalid_argument("contact sides must be -1, 0 or +1");
   sides_ = sides;
+  staticsValid_ = false;  // h_ and the rows depend on the contact set
   locked_.clear();
   for (int i = 0; i < n; ++i)
     if (sides_[size_t(i)] != 0) locked_.push_back(i);
@@ -365,12 +379,10 @@ void GradientFlowModel::jacobian(const double* x, double* jacobianRowMajor) {
   // Unconstrained: d q̇/dq = −H/c with H = K_q − K_g (eq 27), and d(c|q̇|²)/dq = −2 (H q̇)ᵀ.
   const int n = segments();
   const int N = n + 1;
-  Eigen::Map<const Vector> q(x, n);
-  velocity(x, qdot_);  // also runs the kinematics for q
+  velocity(x, qdot_);  // also runs the statics (kinematics, K_q) at q
   loadMatrix(data_, loads_, H_);
   H_ = -H_;
-  jointStiffness(chain_, q, tmpN_);
-  H_.diagonal() += tmpN_;
+  H_.diagonal() += stiffness_;
   Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Jac(jacobianRowMajor, N, N);
   Jac.setZero();
   Jac.topLeftCorner(n, n) = -H_ / c_;
@@ -396,7 +408,10 @@ bool GradientFlowModel::solveLinearized(const double* x, double a, const double*
     velocity(x, qdot_);
     Wrench total = loads_;
     for (int j = 0; j < mh; ++j) total[held_[size_t(j)]] += r_[j];
-    assemble(chain_, data_, q, total, structure_);  // H_r = U T Uᵀ
+    // H_r = U T Uᵀ from the statics velocity() evaluated (K_q and the kinematics at q)
+    loadHessianGenerator(data_, total, structure_.h);
+    structure_.kappa = stiffness_;
+    assemble(structure_.kappa, structure_.h, structure_);
     // (I − aJ̃) k = b with s = a/c: (I + s(P H_r + κ_h J_h⁺J_h − J_h⁺E)) k = b. With
     // y = s A⁻¹(J_h(κ_h − H_r) − E) k this is (I + sH_r) k + J_hᵀ y = b, A y + s (J_h(H_r − κ_h I) + E) k
     // = 0; dividing the first row by s (y' = y/s):
@@ -429,6 +444,16 @@ bool GradientFlowModel::solveLinearized(const double* x, double a, const double*
 }
 
 // ---- inertial (D2) ---------------------------------------------------------------------------
+//
+// O(n) mass matrix. In absolute angles θ = T q, M_θ(i, i) = a_i = μ_ii and, for i > j,
+// M_θ(i, j) = ℓ_j w_i cos(θ_i − θ_j) = p_iᵀ r_j with p_i = w_i (cos θ_i, sin θ_i),
+// r_j = ℓ_j (cos θ_j, sin θ_j): a diagonal-plus-semiseparable matrix of rank 2. Its LDLᵀ keeps
+// that structure, L(i, j) = p_iᵀ g_j (i > j), with 2-vectors g_j and pivots d_j from
+//     P_0 = 0,  d_j = a_j − p_jᵀ P_j p_j,  g_j = (r_j − P_j p_j) / d_j,  P_{j+1} = P_j + d_j g_j g_jᵀ
+// (equate L D Lᵀ with M_θ column by column; P_j = Σ_{k<j} d_k g_k g_kᵀ), and the solves are two
+// sweeps with 2-vector accumulators. M = Tᵀ M_θ T, so M⁻¹ f = T⁻¹ M_θ⁻¹ T⁻ᵀ f with T⁻ᵀ, T⁻¹
+// differences. The velocity terms and the kinetic energy are prefix and suffix sums of the same
+// generators. Everything the model does per right-hand side is O(n m).
 
 InertialModel::InertialModel(const Chain& chain, const EndCondition& end, const InertiaData& inertia,
                              const std::vector<double>& jointDamping, double baumgarteRate, ConstVectorRef q0)
@@ -462,23 +487,21 @@ InertialModel::InertialModel(const Chain& chain, const EndCondition& end, const 
   tailMass_ = Vector::Zero(n);
   for (int i = n - 2; i >= 0; --i) tailMass_[i] = tailMass_[i + 1] + mass_[i + 1];
   // μ_ij of the kinetic energy ½ Σ μ_ij cos(θ_i − θ_j) θ̇_i θ̇_j (see dynamics.h): link k's
-  // centre of mass moves with ℓ_p θ̇_p for every link p before it and d_k θ̇_k for itself.
-  mu_.resize(n, n);
+  // centre of mass moves with ℓ_p θ̇_p for every link p before it and d_k θ̇_k for itself, so
+  // μ_ii = I_i + m_i d_i² + ℓ_i² Σ_{k>i} m_k and μ_ij = ℓ_i w_j (i < j), w_j = m_j d_j + ℓ_j Σ_{k>j} m_k.
+  muDiag_.resize(n);
+  w_.resize(n);
+  len_ = l.tail(n);
   for (int i = 0; i < n; ++i) {
     const double li = l[i + 1];
-    mu_(i, i) = inertia_[i] + mass_[i] * com_[i] * com_[i] + li * li * tailMass_[i];
-    for (int j = i + 1; j < n; ++j) {
-      mu_(i, j) = li * (mass_[j] * com_[j] + l[j + 1] * tailMass_[j]);
-      mu_(j, i) = mu_(i, j);
-    }
+    muDiag_[i] = inertia_[i] + mass_[i] * com_[i] * com_[i] + li * li * tailMass_[i];
+    w_[i] = mass_[i] * com_[i] + li * tailMass_[i];
   }
-  Mtheta_.resize(n, n);
-  M_.resize(n, n);
   cos_.resize(n);
   sin_.resize(n);
-  // Size the factorizations once by factoring an identity (copy-assigning an LLT(size) would
-  // copy its not-yet-initialized status flag).
-  mllt_.compute(Matrix::Identity(n, n));
+  pivot_.resize(n);
+  gen_.resize(n, 2);
+  massQ_.resize(n);
   thetaDot_.resize(n);
   cTheta_.resize(n);
   f_.resize(n);
@@ -487,18 +510,23 @@ InertialModel::InertialModel(const Chain& chain, const EndCondition& end, const 
   S_.resize(m, m);
   sllt_.compute(Matrix::Identity(m, m));
 
-  double meanInertia = 0.0;
-  for (int i = 0; i < n; ++i) meanInertia += mu_(i, i) / n;
-  timeUnit_ = std::sqrt(meanInertia / torqueUnit_);
+  timeUnit_ = std::sqrt(muDiag_.mean() / torqueUnit_);
   omega_ = baumgarteRate;
   if (!(omega_ > 0.0)) {
     // Ten times the fastest uncoupled joint frequency √(|∂²Π/∂q_i²| / M_ii): the constraint
     // error then decays faster than anything the chain does, without making the ODE much stiffer.
-    Matrix H(n, n), M(n, n);
-    totalPotentialHessian(chain_, q0, loads_, H);
-    massMatrix(q0, M);
-    double w = 0.0;
-    for (int i = 0; i < n; ++i) w = std::max(w, std::sqrt(std::abs(H(i, i)) / M(i, i)));
+    // H_ii = K_q,ii − h_i (eq 27); M_ii = Σ_{k,l≥i} M_θ(k, l) by a suffix recursion.
+    evaluateStatics(q0);
+    factorMass(q0);
+    Vector h(n);
+    loadHessianGenerator(data_, loads_, h);
+    double w = 0.0, tail = 0.0, tailC = 0.0, tailS = 0.0;
+    for (int i = n - 1; i >= 0; --i) {
+      tail += muDiag_[i] + 2.0 * len_[i] * (cos_[i] * tailC + sin_[i] * tailS);
+      tailC += w_[i] * cos_[i];
+      tailS += w_[i] * sin_[i];
+      w = std::max(w, std::sqrt(std::abs(stiffness_[i] - h[i]) / tail));
+    }
     omega_ = 10.0 * (w > 0.0 ? w : 1.0);
   }
 }
@@ -507,46 +535,99 @@ InertialModel::~InertialModel() = default;
 
 long InertialModel::constructedCount() { return inertialModelsConstructed.load(); }
 
-void InertialModel::computeMassMatrix(ConstVectorRef) {
+bool InertialModel::factorMass(ConstVectorRef q) {
   const int n = segments();
+  evaluateStatics(q);
+  if (massFactored_ && std::equal(q.data(), q.data() + n, massQ_.data())) return true;
+  massFactored_ = false;
   for (int i = 0; i < n; ++i) {
     cos_[i] = std::cos(data_.theta[i]);
     sin_[i] = std::sin(data_.theta[i]);
   }
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) Mtheta_(i, j) = mu_(i, j) * (cos_[i] * cos_[j] + sin_[i] * sin_[j]);
-  // M = Tᵀ M_θ T with θ = T q, T lower-triangular ones: (M_θ T)(i, j) = Σ_{k≥j} M_θ(i, k) is a
-  // suffix sum along each row, and Tᵀ(·) a suffix sum along each column. O(n²), no temporaries.
-  M_ = Mtheta_;
-  for (int j = n - 2; j >= 0; --j) M_.col(j) += M_.col(j + 1);
-  for (int i = n - 2; i >= 0; --i) M_.row(i) += M_.row(i + 1);
-  // The two sweeps add in different orders above and below the diagonal; mirror the lower
-  // triangle so M is symmetric to the last bit (the kinetic energy sees only the symmetric part).
-  for (int j = 1; j < n; ++j)
-    for (int i = 0; i < j; ++i) M_(i, j) = M_(j, i);
+  double P00 = 0.0, P01 = 0.0, P11 = 0.0;  // P_j (symmetric 2×2)
+  bool positive = true;
+  for (int j = 0; j < n; ++j) {
+    const double p0 = w_[j] * cos_[j], p1 = w_[j] * sin_[j];
+    const double Pp0 = P00 * p0 + P01 * p1, Pp1 = P01 * p0 + P11 * p1;
+    const double d = muDiag_[j] - (p0 * Pp0 + p1 * Pp1);
+    if (!(d > 0.0)) positive = false;
+    const double g0 = (len_[j] * cos_[j] - Pp0) / d, g1 = (len_[j] * sin_[j] - Pp1) / d;
+    pivot_[j] = d;
+    gen_(j, 0) = g0;
+    gen_(j, 1) = g1;
+    P00 += d * g0 * g0;
+    P01 += d * g0 * g1;
+    P11 += d * g1 * g1;
+  }
+  massQ_ = q;
+  massFactored_ = positive;
+  return positive;
+}
+
+void InertialModel::solveMass(VectorRef f) const {
+  const int n = segments();
+  // T⁻ᵀ f (T lower-triangular ones: Tᵀ is a suffix sum, its inverse a difference)
+  for (int i = 0; i + 1 < n; ++i) f[i] -= f[i + 1];
+  // L y = f, then D, then Lᵀ x = z (L(i, j) = p_iᵀ g_j)
+  double s0 = 0.0, s1 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double y = f[i] - w_[i] * (cos_[i] * s0 + sin_[i] * s1);
+    s0 += gen_(i, 0) * y;
+    s1 += gen_(i, 1) * y;
+    f[i] = y / pivot_[i];
+  }
+  double t0 = 0.0, t1 = 0.0;
+  for (int j = n - 1; j >= 0; --j) {
+    const double x = f[j] - (gen_(j, 0) * t0 + gen_(j, 1) * t1);
+    t0 += w_[j] * cos_[j] * x;
+    t1 += w_[j] * sin_[j] * x;
+    f[j] = x;
+  }
+  // T⁻¹ α: q̈_i = α_i − α_{i−1}
+  for (int i = n - 1; i > 0; --i) f[i] -= f[i - 1];
 }
 
 void InertialModel::massMatrix(ConstVectorRef q, MatrixRef M) {
-  forwardKinematics(chain_, q, data_);
-  computeMassMatrix(q);
-  M = M_;
+  const int n = segments();
+  evaluateStatics(q);
+  // M_θ dense from its generators, then M = Tᵀ M_θ T by suffix sums along rows and columns
+  for (int j = 0; j < n; ++j) {
+    const double cj = std::cos(data_.theta[j]), sj = std::sin(data_.theta[j]);
+    M(j, j) = muDiag_[j];
+    for (int i = j + 1; i < n; ++i)
+      M(i, j) = M(j, i) = len_[j] * w_[i] * (std::cos(data_.theta[i]) * cj + std::sin(data_.theta[i]) * sj);
+  }
+  for (int j = n - 2; j >= 0; --j) M.col(j) += M.col(j + 1);
+  for (int i = n - 2; i >= 0; --i) M.row(i) += M.row(i + 1);
+  // the two sweeps add in different orders above and below the diagonal: symmetric to the last bit
+  for (int j = 1; j < n; ++j)
+    for (int i = 0; i < j; ++i) M(i, j) = M(j, i);
 }
 
 void InertialModel::velocityTerms(ConstVectorRef q, ConstVectorRef qdot, VectorRef c) {
   const int n = segments();
-  forwardKinematics(chain_, q, data_);
-  computeMassMatrix(q);
+  factorMass(q);
   double s = 0.0;
   for (int i = 0; i < n; ++i) {
     s += qdot[i];
     thetaDot_[i] = s;
   }
-  // Lagrange in absolute angles: c_θ,i = Σ_j μ_ij sin(θ_i − θ_j) θ̇_j², then c = Tᵀ c_θ.
+  // Lagrange in absolute angles: c_θ,i = Σ_j μ_ij sin(θ_i − θ_j) θ̇_j², split at j = i:
+  //   j < i: μ_ij = ℓ_j w_i → w_i (sin θ_i A_c − cos θ_i A_s), A = Σ_{j<i} ℓ_j (cos θ_j, sin θ_j) θ̇_j²
+  //   j > i: μ_ij = ℓ_i w_j → ℓ_i (sin θ_i B_c − cos θ_i B_s), B = Σ_{j>i} w_j (cos θ_j, sin θ_j) θ̇_j²
+  double ac = 0.0, as = 0.0;
   for (int i = 0; i < n; ++i) {
-    double ci = 0.0;
-    for (int j = 0; j < n; ++j)
-      ci += mu_(i, j) * (sin_[i] * cos_[j] - cos_[i] * sin_[j]) * thetaDot_[j] * thetaDot_[j];
-    cTheta_[i] = ci;
+    cTheta_[i] = w_[i] * (sin_[i] * ac - cos_[i] * as);
+    const double e = len_[i] * thetaDot_[i] * thetaDot_[i];
+    ac += e * cos_[i];
+    as += e * sin_[i];
+  }
+  double bc = 0.0, bs = 0.0;
+  for (int i = n - 1; i >= 0; --i) {
+    cTheta_[i] += len_[i] * (sin_[i] * bc - cos_[i] * bs);
+    const double e = w_[i] * thetaDot_[i] * thetaDot_[i];
+    bc += e * cos_[i];
+    bs += e * sin_[i];
   }
   double acc = 0.0;
   for (int i = n - 1; i >= 0; --i) {
@@ -581,13 +662,12 @@ double InertialModel::impact(double* x) {
   if (m == 0) return 0.0;
   Eigen::Map<const Vector> q(x, n);
   Eigen::Map<Vector> v(x + n, n);
-  const double before = kineticEnergy(x);  // also the mass matrix M_ at q
+  const double before = kineticEnergy(x);  // also the factored mass matrix at q
   evaluateStatics(q);                     // the constraint rows C = Jh_ at q
   // Inelastic impact: the admissible velocity nearest in the kinetic metric,
   // q̇⁺ = q̇⁻ − M⁻¹Cᵀ(CM⁻¹Cᵀ)⁻¹C q̇⁻ (C q̇⁺ = 0: locked joints stop, held coordinates stay held).
-  mllt_.compute(M_);
   B_ = Jh_.transpose();
-  mllt_.solveInPlace(B_);
+  for (int k = 0; k < m; ++k) solveMass(B_.col(k));
   S_.noalias() = Jh_ * B_;
   sllt_.compute(S_);
   tmpM_.noalias() = Jh_ * v;
@@ -611,9 +691,16 @@ void InertialModel::velocity(const double* x, VectorRef qdot) { qdot = Eigen::Ma
 double InertialModel::kineticEnergy(const double* x) {
   const int n = segments();
   Eigen::Map<const Vector> q(x, n), v(x + n, n);
-  forwardKinematics(chain_, q, data_);
-  computeMassMatrix(q);
-  return 0.5 * v.dot(M_ * v);
+  factorMass(q);
+  // K = ½ θ̇ᵀ M_θ θ̇ = ½ Σ a_i θ̇_i² + Σ_i w_i θ̇_i (cos θ_i, sin θ_i)·Σ_{j<i} ℓ_j θ̇_j (cos θ_j, sin θ_j)
+  double k = 0.0, omega = 0.0, ac = 0.0, as = 0.0;
+  for (int i = 0; i < n; ++i) {
+    omega += v[i];
+    k += 0.5 * muDiag_[i] * omega * omega + w_[i] * omega * (cos_[i] * ac + sin_[i] * as);
+    ac += len_[i] * omega * cos_[i];
+    as += len_[i] * omega * sin_[i];
+  }
+  return k;
 }
 
 void InertialModel::rhs(const double* x, double* dxdt) {
@@ -621,13 +708,12 @@ void InertialModel::rhs(const double* x, double* dxdt) {
   const int mh = heldCount(), m = constraintCount();
   Eigen::Map<const Vector> q(x, n), v(x + n, n);
   evaluateStatics(q);  // kinematics, ∇Π, J_h, h
-  velocityTerms(q, v, f_);  // c(q, q̇) into f_ (mass matrix and θ̇ as by-products)
+  velocityTerms(q, v, f_);  // c(q, q̇) into f_ (the factored mass matrix and θ̇ as by-products)
   // (D2) right-hand side f = −c − D q̇ − ∇Π.
   f_ = -f_;
   f_.array() -= d_.array() * v.array() + grad_.array();
-  mllt_.compute(M_);
   acc_ = f_;
-  mllt_.solveInPlace(acc_);
+  solveMass(acc_);
   if (m > 0) {
     // Index-1 form with Baumgarte stabilization: J_h q̈ = γ, γ = −J̇_h q̇ − 2ω J_h q̇ − ω² h, so
     // ḧ + 2ω ḣ + ω² h = 0 and drift decays critically damped. Schur complement of the KKT
@@ -644,7 +730,7 @@ void InertialModel::rhs(const double* x, double* dxdt) {
     }
     tmpM_.noalias() -= Jh_ * acc_;
     B_ = Jh_.transpose();
-    mllt_.solveInPlace(B_);
+    for (int k = 0; k < m; ++k) solveMass(B_.col(k));
     S_.noalias() = Jh_ * B_;
     sllt_.compute(S_);
     sllt_.solveInPlace(tmpM_);

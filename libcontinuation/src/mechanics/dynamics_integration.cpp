@@ -90,33 +90,62 @@ struct StiffJacobian {
 /// odeint::default_rosenbrock_coefficients) with the model's O(n) structured solve
 /// (DynamicsModel::solveLinearized) in place of the dense LU of (1/(γτ)) I − J: each stage
 /// (1/(γτ) − J̃) g = r is (I − γτJ̃) g = γτ r. Autonomous (∂f/∂t = 0). Step-size control as
-/// rosenbrock4_controller: factor err^{1/4}/0.9 within [1/6, 5], max-norm of the estimate over
-/// atol + rtol·max(|x|, |x⁺|).
+/// rosenbrock4_controller (Hairer & Wanner IV.8): the RMS norm of the estimate over
+/// atol·u_i + rtol·max(|x_i|, |x⁺_i|), the step factor err^{1/4}/0.9 within [1/6, 5] and, after an
+/// accepted step, Gustafsson's predictive factor. u_i is component i's unit (the model's:
+/// radians for angles, the time unit for velocities, k̄b̄² for the dissipated energy), so that the
+/// absolute tolerance means the same for the same chain in any units.
 class StructuredRosenbrock4 {
  public:
   StructuredRosenbrock4(DynamicsModel& model, double absoluteTolerance, double relativeTolerance)
       : model_(model), atol_(absoluteTolerance), rtol_(relativeTolerance) {
     for (ExplicitState* v : {&f_, &r_, &xtmp_, &err_, &xout_, &g_[0], &g_[1], &g_[2], &g_[3], &g_[4]})
       v->assign(size_t(model.stateSize()), 0.0);
+    const int n = model.segments(), N = model.stateSize();
+    unit_.assign(size_t(N), 1.0);
+    for (int i = n; i < N - 1; ++i) unit_[size_t(i)] = 1.0 / model.timeUnit();  // velocities
+    unit_[size_t(N - 1)] = model.torqueUnit();                                   // dissipated energy
   }
 
   odeint::controlled_step_result try_step(const ExplicitSystem&, ExplicitState& x, double& t, double& dt) {
     if (!step(x, dt)) {
       dt *= 0.5;
+      lastRejected_ = true;
       return odeint::fail;
     }
-    double err = 0.0;
-    for (size_t i = 0; i < x.size(); ++i)
-      err = std::max(err, std::abs(err_[i]) / (atol_ + rtol_ * std::max(std::abs(x[i]), std::abs(xout_[i]))));
-    const double fac = std::isfinite(err) ? std::max(1.0 / 6.0, std::min(5.0, std::pow(err, 0.25) / 0.9)) : 5.0;
+    double sum = 0.0;
+    for (size_t i = 0; i < x.size(); ++i) {
+      const double e = err_[i] / (atol_ * unit_[i] + rtol_ * std::max(std::abs(x[i]), std::abs(xout_[i])));
+      sum += e * e;
+    }
+    const double err = std::sqrt(sum / double(x.size()));
+    constexpr double safe = 0.9, fac1 = 5.0, fac2 = 1.0 / 6.0;
+    double fac = std::isfinite(err) ? std::max(fac2, std::min(fac1, std::pow(err, 0.25) / safe)) : fac1;
     if (!(err <= 1.0)) {
       dt /= std::max(fac, 1.0 + 1e-3);
+      lastRejected_ = true;
       return odeint::fail;
     }
+    if (haveOld_) {
+      const double pred = std::max(fac2, std::min(fac1, (dtOld_ / dt) * std::pow(err * err / errOld_, 0.25) / safe));
+      fac = std::max(fac, pred);
+    }
+    haveOld_ = true;
+    dtOld_ = dt;
+    errOld_ = std::max(0.01, err);
+    double dtNew = dt / fac;
+    if (lastRejected_) dtNew = std::min(dtNew, dt);
+    lastRejected_ = false;
     x.swap(xout_);
     t += dt;
-    dt /= fac;
+    dt = dtNew;
     return odeint::success;
+  }
+
+  /// After a rollback or an event the step history no longer applies (as odeint's reset()).
+  void reset() {
+    haveOld_ = false;
+    lastRejected_ = false;
   }
 
   /// One step of size dt from x into out, without error control (the trial steps of the event
@@ -176,6 +205,9 @@ class StructuredRosenbrock4 {
 
   DynamicsModel& model_;
   double atol_, rtol_;
+  std::vector<double> unit_;
+  bool haveOld_ = false, lastRejected_ = false;
+  double dtOld_ = 0.0, errOld_ = 1.0;
   ExplicitState f_, r_, xtmp_, err_, xout_;
   ExplicitState g_[5];
 };

@@ -1,6 +1,7 @@
 #include "buckle/mechanics/jump.h"
 
 #include "buckle/continuation/scaled_problem.h"
+#include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/contact.h"
 
 #include <Eigen/Eigenvalues>
@@ -94,6 +95,56 @@ RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn
   return rp;
 }
 
+/// unstableDirection() through the chain structure (chain_structure.h), O(n): the smallest
+/// eigenvalue μ of ZᵀHZ from the Sturm counts (lowestEigenvalues), then inverse iteration on the
+/// KKT system [[H − σI, Q], [Qᵀ, 0]] (Q the orthonormalised held rows, H − σI = U(T − σM)Uᵀ the
+/// chain structure of K_q − σI) at σ = μ − δ: its solution lies in ker J_h and each iteration
+/// shrinks the other eigen-components by δ / (μ_k − σ). δ = 1e-8 of the operator's scale: far
+/// enough from μ for the solves to stay accurate to rounding in the wanted direction, close
+/// enough for two or three iterations. (A multiple μ — the straight chain of identical bistable
+/// segments at zero load, H = κI — has no preferred eigenvector: the start vector's projection
+/// onto the eigenspace is returned, deterministically.)
+UnstableDirection structuredUnstableDirection(EquilibriumProblem& problem, const Vector& u, double lambda) {
+  UnstableDirection d;
+  const int n = problem.segments();
+  ChainStructure ws(n), shifted(n);
+  Matrix J(3, n);
+  if (!problem.assembleStructure(u, lambda, ws, J)) return d;
+  ws.typicalScale = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();
+  const std::vector<int> held = problem.endCondition().heldIndices();
+  Matrix C(held.size(), n);
+  for (size_t k = 0; k < held.size(); ++k) C.row(Eigen::Index(k)) = J.row(held[k]);
+  const int r = setConstraints(ws, C);
+  if (r >= n) return d;
+  Vector lowest(1);
+  if (lowestEigenvalues(ws, r > 0, 1, lowest) < 1 || !std::isfinite(lowest[0])) return d;
+  const double mu = lowest[0];
+  const double sigma = mu - 1e-8 * std::max({ws.typicalScale, ws.frobeniusH / std::sqrt(double(n)), std::abs(mu)});
+  Vector kappa = ws.kappa.array() - sigma;
+  assemble(kappa, ws.h, shifted);
+  const Matrix Qt = ws.Q.leftCols(r).transpose();
+  // a fixed start with every component present (no eigenvector of the chain is orthogonal to it
+  // generically)
+  Vector z(n), next(n), y(r), zeroR = Vector::Zero(r);
+  for (int i = 0; i < n; ++i) z[i] = 1.0 + 0.5 * std::sin(1.0 + 2.399963 * i);
+  if (r > 0) z -= Qt.transpose() * (Qt * z);
+  if (!(z.norm() > 0.0)) return d;
+  z.normalize();
+  for (int it = 0; it < 8; ++it) {
+    const bool ok = r > 0 ? solveKKT(shifted, Qt, z, zeroR, next, y) : solve(shifted, z, next);
+    if (!ok || !(next.norm() > 0.0)) return d;
+    next.normalize();
+    if (next.dot(z) < 0.0) next = -next;
+    const double change = (next - z).cwiseAbs().maxCoeff();
+    z = next;
+    if (change <= 1e-14) break;
+  }
+  d.eigenvalue = mu;
+  d.direction = z;
+  d.valid = z.allFinite();
+  return d;
+}
+
 std::string describeContacts(const std::vector<int>& sides, const Vector& torques) {
   std::ostringstream os;
   for (size_t i = 0; i < sides.size(); ++i)
@@ -140,7 +191,10 @@ PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, do
   // problem's scaled variables (scaled_problem.h): the tolerance is relative, in any units.
   const continuation::UnitScaling units(problem.scales());
   continuation::ScaledProblem scaled(problem, units);
-  continuation::Corrector corrector(scaled, options);
+  // Long chains: the chain's O(n) bordered solver (chain_solver.h) instead of KINSOL's dense LU.
+  const std::unique_ptr<continuation::BorderedSolver> structured =
+      problem.segments() > kSmallDense ? scaled.makeStructuredSolver() : nullptr;
+  continuation::Corrector corrector(scaled, options, structured.get());
   const Vector& D = units.scales().unknowns;
   const continuation::CorrectorSummary summary =
       corrector.solveAtFixedParameter(u0.cwiseQuotient(D), lambda / units.parameter(), result.u);
@@ -157,6 +211,8 @@ PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, do
 UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef u, double lambda) {
   UnstableDirection d;
   const Vector uFull = fullUnknowns(problem, u, lambda);
+  // long chains: O(n) through the chain structure instead of the dense O(n³) eigen-solve
+  if (problem.segments() > kSmallDense) return structuredUnstableDirection(problem, uFull, lambda);
   Matrix H, C;
   if (!problem.stabilityOperator(uFull, lambda, H, C)) return d;
   const Eigen::Index n = H.rows();

@@ -192,7 +192,10 @@ class DynamicsModel {
   int constraintCount() const { return heldCount() + lockedCount(); }
   /// The derived model's constraint-sized workspace after setContacts().
   virtual void resizeConstraints() {}
-  /// Kinematics, J, ∇Π and (with held coordinates) J_h, h, the Cholesky of J_h J_hᵀ at q.
+  /// Kinematics, J, E, ∇Π, the joint stiffnesses K_q and (with held coordinates) J_h, h, the
+  /// Cholesky of J_h J_hᵀ at q, from one pass of the spring model. Cached for the last q (bitwise;
+  /// setContacts() invalidates): a step evaluates the right-hand side at the accepted state, and
+  /// the monitor then wants Π, the residual, the speed and the constraints at that same state.
   void evaluateStatics(ConstVectorRef q);
 
   Chain chain_;
@@ -204,6 +207,10 @@ class DynamicsModel {
   ChainData data_;
   Matrix J_;      ///< 3×n end Jacobian
   Vector grad_;   ///< ∇Π
+  Vector stiffness_;     ///< K_q diagonal ∂²E/∂q_i²
+  double springEnergy_ = 0.0;  ///< E(q)
+  Vector staticsQ_;      ///< q of the cached statics
+  bool staticsValid_ = false;
   Matrix Jh_;     ///< m×n constraint rows: held coordinates, then e_iᵀ of the locked joints
   Vector h_;      ///< p_h − target, then q_i − q̄_i
   Matrix A_;      ///< J_h J_hᵀ
@@ -278,9 +285,10 @@ class InertialModel final : public DynamicsModel {
   double dissipated(const double* x) const override { return x[2 * segments()]; }
   double kineticEnergy(const double* x) override;
 
-  /// Joint-space mass matrix M(q) = Tᵀ M_θ(q) T (n×n, symmetric positive definite).
+  /// Joint-space mass matrix M(q) = Tᵀ M_θ(q) T (n×n, symmetric positive definite), dense: for
+  /// cross-checks (the model itself works on the O(n) factorization).
   void massMatrix(ConstVectorRef q, MatrixRef M);
-  /// Velocity-dependent generalized force c(q, q̇) = Tᵀ c_θ of (D2).
+  /// Velocity-dependent generalized force c(q, q̇) = Tᵀ c_θ of (D2), O(n).
   void velocityTerms(ConstVectorRef q, ConstVectorRef qdot, VectorRef c);
   /// Positions of the link centres of mass (2×n) — an independent kinematic check.
   void centresOfMass(ConstVectorRef q, Eigen::Ref<Eigen::Matrix2Xd> G) const;
@@ -293,14 +301,21 @@ class InertialModel final : public DynamicsModel {
   void resizeConstraints() override;
 
  private:
-  void computeMassMatrix(ConstVectorRef q);  // fills Mtheta_, M_ (uses theta from data_)
+  /// cos θ_i, sin θ_i and the LDLᵀ factors of M_θ at q (file comment of dynamics.cpp, "O(n)
+  /// mass matrix"); false if a pivot is not positive (M_θ not positive definite to rounding).
+  bool factorMass(ConstVectorRef q);
+  /// f ← M⁻¹ f = T⁻¹ M_θ⁻¹ T⁻ᵀ f after factorMass(), O(n).
+  void solveMass(VectorRef f) const;
 
   Vector mass_, inertia_, com_, d_;
   Vector tailMass_;  // Σ_{k>i} m_k
-  Matrix mu_;                  // μ_ij (constant)
-  Matrix Mtheta_, M_;
+  /// M_θ(i, i) = μ_ii = a_i, M_θ(i, j) = μ_ij cos(θ_i − θ_j) with μ_ij = ℓ_i w_j (i < j), constant
+  Vector muDiag_, w_, len_;
   Vector cos_, sin_;  // cos θ_i, sin θ_i
-  Eigen::LLT<Matrix> mllt_;
+  Vector pivot_;      // LDLᵀ of M_θ: the pivots d_j
+  Matrix gen_;        // n×2 generators g_j of L (L(i, j) = p_iᵀ g_j, i > j)
+  bool massFactored_ = false;
+  Vector massQ_;      // q of the factored M_θ
   Vector thetaDot_, cTheta_, f_, acc_;
   Matrix B_, S_;  // M⁻¹ J_hᵀ (n×m), J_h M⁻¹ J_hᵀ (m×m)
   Eigen::LLT<Matrix> sllt_;
