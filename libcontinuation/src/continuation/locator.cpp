@@ -209,6 +209,24 @@ std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &
   return found;
 }
 
+void Locator::locateBetween(const std::vector<StepSample> &samples, std::vector<SpecialPoint> &found) {
+  const int savedEigenvalues = evaluator_.lowestEigenvalues();
+  int needed = std::max(3, savedEigenvalues);
+  for (const StepSample &x : samples)
+    if (x.point.stability.valid()) needed = std::max(needed, x.point.stability.negative + 2);
+  evaluator_.setLowestEigenvalues(needed);
+  std::vector<StepSample> ends = samples;
+  for (StepSample &x : ends) ensureEigenvalues(problem_, x.point, needed);
+  std::vector<std::pair<StepSample, StepSample>> simple, multiple;
+  for (size_t i = 0; i + 1 < ends.size(); ++i) separateCrossings(ends[i], ends[i + 1], simple, multiple, 0);
+  for (const auto &bracket : simple) found.push_back(locateSimpleBranchPoint(bracket.first, bracket.second));
+  for (const auto &bracket : multiple) {
+    const int m = std::abs(bracket.second.point.stability.negative - bracket.first.point.stability.negative);
+    found.push_back(multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
+  }
+  evaluator_.setLowestEigenvalues(savedEigenvalues);
+}
+
 void Locator::separateCrossings(const StepSample &lo, const StepSample &hi,
                                 std::vector<std::pair<StepSample, StepSample>> &simple,
                                 std::vector<std::pair<StepSample, StepSample>> &multiple, int depth) {
