@@ -22,7 +22,10 @@ bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double 
   int first = std::max(0, nu - 1);
   int count = nu > 0 ? 2 : 1;
   Eigen::Vector2d here, there;
-  if (!eigenvaluesAt(problem, point.u, point.lambda, first, count, here)) {
+  const Vector &lowest = point.stability.lowest;  // already isolated by the point's stability()
+  if (lowest.size() >= first + count) {
+    here.head(count) = lowest.segment(first, count);
+  } else if (!eigenvaluesAt(problem, point.u, point.lambda, first, count, here)) {
     // ν is the dimension (no eigenvalue ν), or the problem offers only part of the spectrum
     if (count == 1 || !eigenvaluesAt(problem, point.u, point.lambda, first, 1, here)) return false;
     count = 1;
