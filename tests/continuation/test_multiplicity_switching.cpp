@@ -89,8 +89,8 @@ TEST_CASE("an m-fold branch point is located once, refined, and its reduced equa
         if (r > 0.5) ++k;
       }
       CHECK(std::abs(rb.directions[d][m]) <= 1e-8);  // along the trivial branch's normal: λ' = 0
-      // x = εΦβ + ε²τ·t: λ = τε² and |u|² = ε², so τ = λ/|u|² = 1 + c(k − 1)
-      CHECK(rb.curvatures[d] == Approx(1.0 + 0.4 * (k - 1)).epsilon(1e-5));
+      // x = εΦβ + ε²τ·t: |u|² = ε², u_i² = ε²/k on the k nonzero entries, so τ = λ/ε² = (1 + c(k − 1))/k
+      CHECK(rb.curvatures[d] == Approx((1.0 + 0.4 * (k - 1)) / k).epsilon(1e-5));
     }
   }
 }
@@ -108,7 +108,7 @@ TEST_CASE("traceTree switches an m-fold point along every direction: predicted =
     CHECK(bps[0]->branchesPredicted == 2 * lines);
     CHECK(bps[0]->branchesFound == 2 * lines);
     REQUIRE(int(tree.branches.size()) == 1 + 2 * lines);
-    // every child lies on its closed-form branch λ = |u|²(1 + c(k − 1))/k·k … i.e. λ = u_i²(1 + c(k − 1))
+    // every child lies on its closed-form branch λ = u_i²(1 + c(k − 1)) (u_i a nonzero entry)
     for (size_t b = 1; b < tree.branches.size(); ++b) {
       const Branch &child = tree.branches[b];
       REQUIRE(child.points.size() >= 3);

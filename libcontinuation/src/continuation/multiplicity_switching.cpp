@@ -71,7 +71,7 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
   const int n = problem.dimension();
   out = ReducedBifurcation();
   out.kernelDimension = m;
-  if (m < 1 || m >= n || bp.u.size() != n) {
+  if (m < 1 || m > n || bp.u.size() != n) {
     out.note = "multiplicity out of range";
     return false;
   }
