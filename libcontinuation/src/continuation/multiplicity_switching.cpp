@@ -293,9 +293,14 @@ std::vector<Branch> switchMultiple(Tracer &tracer, SpecialPoint &bp, const Branc
   Vector x0(n + 1);
   x0 << bp.u, bp.lambda;
   int found = 0;
+  // The first step off a multiple point is a quarter of the usual one: the other solution
+  // directions are nearby (the predictor x₀ + h·d is off the child by ~τh²), and a long first step
+  // lets the corrector fall onto a neighbouring child.
+  BranchSwitchingOptions first = options;
+  if (!(first.amplitude > 0.0)) first.amplitude = 0.25 * tracer.options().initialStep;
   for (size_t k = 0; k < rb.directions.size(); ++k) {
     for (int sign : {1, -1}) {
-      Branch child = switchBranch(tracer, bp, rb.directions[k], sign, options);
+      Branch child = switchBranch(tracer, bp, rb.directions[k], sign, first);
       if (child.stopReason != StopReason::SwitchFailed && child.points.size() >= 2) {
         Vector x1(n + 1);
         x1 << child.points[1].u, child.points[1].lambda;
