@@ -48,6 +48,9 @@ SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
   s.residual = sp.residual;
   s.K = sp.K;
   s.refined = sp.refined;
+  s.multiplicity = sp.multiplicity;
+  s.branchesPredicted = sp.branchesPredicted;
+  s.branchesFound = sp.branchesFound;
   s.note = sp.note;
   s.joint = sp.joint;
   s.contactTorque = sp.contactTorque;

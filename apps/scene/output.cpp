@@ -178,6 +178,9 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       // K_F where the report computed it (a located KMIN: the stiffness at the minimum itself)
       if (s.K.allFinite()) p["stiffness"] = {{"Kxx", number(s.K(0, 0))}, {"Kyy", number(s.K(1, 1))}, {"Kxy", number(s.K(0, 1))}};
       if (!s.note.empty()) p["note"] = s.note;
+      if (s.multiplicity > 1) p["multiplicity"] = s.multiplicity;
+      if (s.branchesPredicted >= 0)
+        p["branches"] = {{"predicted", s.branchesPredicted}, {"found", s.branchesFound}};
       if (s.contactPoint.allFinite()) p["contact_point"] = json::array({number(s.contactPoint.x()), number(s.contactPoint.y())});
       if (s.koiter.valid) {  // BP: λ(ξ) = λ + aξ + bξ², ξ in rad of the unit joint-angle mode
         p["koiter_a"] = number(s.koiter.a);

@@ -54,6 +54,9 @@ struct SpecialRecord {
   Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
   double residual = 0.0;   ///< ‖F(u, λ)‖₂ at the point
   bool refined = false;
+  int multiplicity = 1;         ///< BP: eigenvalues crossing zero together
+  /// Multiple BP: half-branches predicted by the reduced bifurcation equation / traced (−1: none)
+  int branchesPredicted = -1, branchesFound = -1;
   std::string note;
   // contact (CT / RL): the joint (0-based, −1 otherwise), its contact torque at the point, and
   // the joints locked after it (ContactSet::label)

@@ -181,14 +181,15 @@ void samePose(const json& a, const json& b, const Units& u, const std::string& w
   same(a["phi"], b["phi"], 1.0, what + " phi", tolerance);
 }
 
-// A branch point of multiplicity ≥ 2 is not refined (no regular augmented system): it is the
-// sample of the branch inside a bracket of |ds| ~ 1e-11, where the Keller system is singular
+// A branch point of multiplicity ≥ 2 has no regular augmented system (it is located by the secant
+// on its crossing eigenvalues, then only verified): it is the sample of the branch inside a
+// bracket of |ds| ~ 1e-11, where the Keller system is singular
 // to that order, so its joint angles are determined only to ~eps/|ds| ≈ 1e-5·(scale) in any unit
 // system (its λ still to rounding). Such points, and the jumps released from them (same q),
 // are compared to 1e-6 in q and position.
 bool nearMultiplePoint(const json& point, const json& all) {
   for (const json& p : all) {
-    if (p["type"] != "BP" || p["accuracy"]["refined"] == true) continue;
+    if (p["type"] != "BP") continue;
     if (!p.contains("note") || p["note"].get<std::string>().find("multiplicity") == std::string::npos) continue;
     double d = 0.0;
     for (size_t i = 0; i < p["q"].size(); ++i) d = std::max(d, std::abs(p["q"][i].get<double>() - point["q"][i].get<double>()));

@@ -149,7 +149,7 @@ TEST_CASE("Switching on a curved trivial branch follows u1 = 0.3 sin(lambda) +- 
   }
 }
 
-TEST_CASE("Multiplicity-2 points are reported but not switched", "[branch_switching]") {
+TEST_CASE("Multiplicity-2 points are switched along every direction of the reduced equation", "[branch_switching]") {
   toys::DoubleZero problem;
   TracerOptions options;
   options.initialStep = 0.05;
@@ -157,11 +157,16 @@ TEST_CASE("Multiplicity-2 points are reported but not switched", "[branch_switch
   options.lambdaMax = 0.2;
   const BranchTree tree =
       traceTree(problem, Vector::Zero(2), -0.37, InitialDirection::increasingLambda(), options, 3);
-  REQUIRE(tree.branches.size() == 1);
+  // [λu₁ − u₁³, λu₂ − u₂³]: the lines u₁ = 0, u₂ = 0, u₁ = ±u₂, both sides each (the children's own
+  // branch points are each other's, switched once)
   const auto bps = tree.branches[0].specialPointsOfType(SpecialPointType::BranchPoint);
   REQUIRE(bps.size() == 1);
   CHECK(bps[0]->multiplicity == 2);
-  CHECK_THAT(bps[0]->note, Contains("not switched"));
+  CHECK(bps[0]->branchesPredicted == 8);
+  CHECK(bps[0]->branchesFound == 8);
+  CHECK_THAT(bps[0]->note, Contains("switched"));
+  REQUIRE(tree.branches.size() >= 9);
+  for (size_t b = 1; b <= 8; ++b) CHECK(tree.branches[b].parentId == 0);
 }
 
 TEST_CASE("Switching from a point that is not a branch point is refused", "[branch_switching]") {

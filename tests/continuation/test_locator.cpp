@@ -184,13 +184,13 @@ TEST_CASE("Double zero: one branch point of multiplicity 2", "[locator]") {
   REQUIRE(bps.size() == 1);
   const SpecialPoint &bp = *bps[0];
   CHECK(bp.multiplicity == 2);
-  CHECK_FALSE(bp.refined);
+  CHECK(bp.refined);  // ker F_x is 3-dimensional at the located point
   CHECK(bp.inertiaBefore == 0);
   CHECK(bp.inertiaAfter == 2);
   CHECK(std::abs(bp.lambda) <= 1e-9 * 0.05);
   CHECK(bp.lambdaAccuracy <= 1e-9 * 0.05);
   CHECK(bp.nullVectors.cols() == 3);  // F_x = 0 at the double zero
-  CHECK_THAT(bp.note, Contains("not switched"));
+  CHECK_THAT(bp.note, Contains("kernel of F_x 3-dimensional"));
   const ContinuationPoint &p = branch.points[bp.index], &q = branch.points[bp.index + 1];
   CHECK(p.determinantSign == q.determinantSign);
 }

@@ -500,3 +500,103 @@ TEST_CASE("n = 500: the first branch point is switched on both sides above the d
   }
   CHECK(sideSign[0] * sideSign[1] < 0.0);  // the two sides of the pitchfork
 }
+
+namespace {
+
+// The κ = 0 straight chain near Fx = 0, independently of the core's reduced equation: with E even
+// and its quadratic term zero, E(q_i) = E₀ + e₄q_i⁴ + …, x = x₀ − ½qᵀGq + …, y = J_y q + …, the
+// branches leave along the critical lines of f(z) = Σz_i⁴ / (zᵀGz)² on ker J_y (the Lagrange
+// condition 4e₄z³ = μGz + ν J_yᵀ of the leading orders). G and J_y from the stability operator at
+// q = 0: with K_q = 0 it is H = −Fx·G on ker C, C = J_y.
+struct QuarticRatio {
+  Eigen::MatrixXd G, Z;  // G (n×n), Z: orthonormal basis of ker J_y (n × (n−1))
+  explicit QuarticRatio(EquilibriumProblem& problem) {
+    const int n = problem.segments();
+    Eigen::MatrixXd H, C;
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(problem.dimension());
+    REQUIRE(problem.stabilityOperator(u, 1.0, H, C));
+    G = -H;  // Fx = 1
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(C, Eigen::ComputeFullV);
+    Z = svd.matrixV().rightCols(n - 1);
+  }
+  double operator()(const Eigen::VectorXd& z) const {
+    const double g = z.dot(G * z);
+    return z.array().pow(4).sum() / (g * g);
+  }
+  // tangential gradient of f on ker J_y at z (f is homogeneous of degree 0: the gradient is tangent)
+  Eigen::VectorXd gradient(const Eigen::VectorXd& z) const {
+    const double g = z.dot(G * z);
+    const Eigen::VectorXd full = 4.0 * z.array().pow(3).matrix() / (g * g) -
+                                 4.0 * z.array().pow(4).sum() / (g * g * g) * (G * z);
+    return Z * (Z.transpose() * full);
+  }
+};
+
+EquilibriumBranches kappaZeroTree(EquilibriumProblem& problem, int n) {
+  EquilibriumBranchOptions o = pinnedOptions(-0.5, 1);
+  o.tracer.lambdaMax = 0.5;
+  o.childTracer = o.tracer;
+  o.childTracer->maxPoints = 12;
+  o.childTracer->maxStep = 0.02;
+  return traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.3, cont::InitialDirection::decreasingLambda(), o);
+}
+
+}  // namespace
+
+TEST_CASE("kappa = 0, n = 3: the double point is switched along every predicted direction", "[equilibrium_branches]") {
+  EquilibriumProblem problem(Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.5)),
+                             EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  const EquilibriumBranches r = kappaZeroTree(problem, 3);
+  const auto bps = branchPoints(r.tree.branches.at(0));
+  REQUIRE(bps.size() == 1);
+  const cont::SpecialPoint& bp = *bps[0];
+  CHECK(bp.multiplicity == 2);
+  CHECK(std::abs(bp.lambda) <= 1e-12);  // linear buckling: every critical load is 0 (degenerate)
+  CHECK(bp.refined);
+  // independent count: critical lines of the quartic ratio on the circle of ker J_y (sign changes
+  // of df/dθ over a half turn)
+  const QuarticRatio f(problem);
+  int lines = 0;
+  const int samples = 20000;
+  const double pi = std::acos(-1.0);
+  auto slope = [&](double th) {
+    const Eigen::VectorXd z = std::cos(th) * f.Z.col(0) + std::sin(th) * f.Z.col(1);
+    const Eigen::VectorXd dz = -std::sin(th) * f.Z.col(0) + std::cos(th) * f.Z.col(1);
+    return f.gradient(z).dot(dz);
+  };
+  for (int k = 0; k < samples; ++k)
+    if ((slope(pi * k / samples) > 0.0) != (slope(pi * (k + 1) / samples) > 0.0)) ++lines;
+  INFO(bp.note);
+  CHECK(bp.branchesPredicted == 2 * lines);
+  CHECK(bp.branchesFound == bp.branchesPredicted);
+  CHECK(int(r.tree.branches.size()) == 1 + bp.branchesPredicted);
+}
+
+TEST_CASE("kappa = 0, n = 4: the triple point, every direction a critical line of the quartic ratio",
+          "[equilibrium_branches]") {
+  EquilibriumProblem problem(Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.5)),
+                             EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  const EquilibriumBranches r = kappaZeroTree(problem, 4);
+  const auto bps = branchPoints(r.tree.branches.at(0));
+  REQUIRE(bps.size() == 1);
+  const cont::SpecialPoint& bp = *bps[0];
+  CHECK(bp.multiplicity == 3);
+  CHECK(std::abs(bp.lambda) <= 1e-12);
+  INFO(bp.note);
+  CHECK(bp.branchesPredicted >= 6);  // at least the three lines of a Morse function on RP²
+  CHECK(bp.branchesFound == bp.branchesPredicted);
+  REQUIRE(int(r.tree.branches.size()) == 1 + bp.branchesPredicted);
+  // each child's first point is along a critical line of f: the tangential gradient vanishes to
+  // O(amplitude²) relative
+  const QuarticRatio f(problem);
+  for (size_t b = 1; b < r.tree.branches.size(); ++b) {
+    const cont::Branch& child = r.tree.branches[b];
+    REQUIRE(child.points.size() >= 2);
+    const Eigen::VectorXd z = child.points[1].u.head(4).normalized();
+    const double amplitude = child.points[1].u.head(4).norm();
+    INFO("branch " << b << " amplitude " << amplitude);
+    const double g = z.dot(f.G * z);
+    const double scale = (4.0 * z.array().pow(3).matrix() / (g * g)).norm();  // one of the gradient's two terms
+    CHECK(f.gradient(z).norm() / scale <= 50.0 * amplitude * amplitude + 1e-6);
+  }
+}

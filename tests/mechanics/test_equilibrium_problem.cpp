@@ -361,3 +361,31 @@ TEST_CASE("EquilibriumProblem O(n) products equal the dense F_x, F_x^T and secon
     }
   }
 }
+
+TEST_CASE("stabilityEigenvalues by index: the O(n) counts and the small dense route equal a dense eigen-solve",
+          "[equilibrium]") {
+  std::mt19937 rng(4242);
+  std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
+  for (int n : {5, 40}) {  // below and above kSmallDense
+    const Chain chain = randomChain(rng, n);
+    for (const Setting& s : settings(rng)) {
+      INFO("n = " << n << ", end: " << s.name);
+      EquilibriumProblem problem(chain, s.end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
+      EquilibriumProblem dense(chain, s.end, problem.direction(), EquilibriumOptions{true, false});
+      const Vector u = randomState(rng, chain, problem.dimension());
+      const double lambda = Lam(rng);
+      Matrix H, C;
+      REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+      const int dim = n - int(C.rows());
+      const double scale = std::max(1.0, H.norm());
+      for (int first : {0, dim / 2, dim - 2}) {
+        Vector mine(2), reference(2);
+        REQUIRE(problem.stabilityEigenvalues(u, lambda, first, mine));
+        REQUIRE(dense.stabilityEigenvalues(u, lambda, first, reference));  // Problem's dense default
+        CHECK((mine - reference).cwiseAbs().maxCoeff() <= 1e-11 * scale);
+      }
+      Vector beyond(2);
+      CHECK_FALSE(problem.stabilityEigenvalues(u, lambda, dim - 1, beyond));
+    }
+  }
+}

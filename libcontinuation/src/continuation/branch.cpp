@@ -14,6 +14,7 @@ const char *label(SpecialPointType type) {
     case SpecialPointType::BranchPoint: return "BP";
     case SpecialPointType::Boundary: return "BD";
     case SpecialPointType::Endpoint: return "EP";
+    case SpecialPointType::EigenvalueTouch: return "ET";
   }
   return "??";
 }

@@ -1,5 +1,6 @@
 #include "buckle/continuation/branch_switching.h"
 
+#include "buckle/continuation/multiplicity_switching.h"
 #include "buckle/continuation/scaled_problem.h"
 #include "buckle/continuation/test_functions.h"
 
@@ -214,7 +215,6 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     for (std::size_t k = 0; k < tree.branches[i].specialPoints.size(); ++k) {
       SpecialPoint bp = tree.branches[i].specialPoints[k];
       if (bp.type != SpecialPointType::BranchPoint) continue;
-      if (bp.multiplicity > 1) continue;  // its note already says it is not switched
       if (treeOptions.switchAt && !treeOptions.switchAt(tree.branches[i], bp)) continue;
       // The BP a child starts from is the parent's; never switch back at it.
       if (!tree.branches[i].points.empty() && bp.arclength - tree.branches[i].points.front().arclength <= 1e-6 * h)
@@ -233,10 +233,17 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       }
       switchedAt.push_back(xBP);
       std::string how;
-      // after the + side, the − side only if no stop was asked for meanwhile
-      std::vector<Branch> sides = switchBothSides(switchTracer, bp, switching, &how, [&](const Branch &) {
-        return options.interrupt.requested();
-      });
+      std::vector<Branch> sides;
+      if (bp.multiplicity > 1) {
+        // every solution direction of the m-dimensional reduced equation, both sides
+        sides = switchMultiple(switchTracer, bp, switching, &how);
+        tree.branches[i].specialPoints[k].branchesPredicted = bp.branchesPredicted;
+        tree.branches[i].specialPoints[k].branchesFound = bp.branchesFound;
+      } else {
+        // after the + side, the − side only if no stop was asked for meanwhile
+        sides = switchBothSides(switchTracer, bp, switching, &how,
+                                [&](const Branch &) { return options.interrupt.requested(); });
+      }
       if (sides.empty()) {
         note += (note.empty() ? "" : "; ") + std::string("not switched: ") + how;
         continue;

@@ -209,6 +209,24 @@ std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &
   return found;
 }
 
+void Locator::locateBetween(const std::vector<StepSample> &samples, std::vector<SpecialPoint> &found) {
+  const int savedEigenvalues = evaluator_.lowestEigenvalues();
+  int needed = std::max(3, savedEigenvalues);
+  for (const StepSample &x : samples)
+    if (x.point.stability.valid()) needed = std::max(needed, x.point.stability.negative + 2);
+  evaluator_.setLowestEigenvalues(needed);
+  std::vector<StepSample> ends = samples;
+  for (StepSample &x : ends) ensureEigenvalues(problem_, x.point, needed);
+  std::vector<std::pair<StepSample, StepSample>> simple, multiple;
+  for (size_t i = 0; i + 1 < ends.size(); ++i) separateCrossings(ends[i], ends[i + 1], simple, multiple, 0);
+  for (const auto &bracket : simple) found.push_back(locateSimpleBranchPoint(bracket.first, bracket.second));
+  for (const auto &bracket : multiple) {
+    const int m = std::abs(bracket.second.point.stability.negative - bracket.first.point.stability.negative);
+    found.push_back(multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
+  }
+  evaluator_.setLowestEigenvalues(savedEigenvalues);
+}
+
 void Locator::separateCrossings(const StepSample &lo, const StepSample &hi,
                                 std::vector<std::pair<StepSample, StepSample>> &simple,
                                 std::vector<std::pair<StepSample, StepSample>> &multiple, int depth) {
@@ -606,13 +624,22 @@ SpecialPoint Locator::multipleBranchPoint(const StepSample &lo, const StepSample
   sp.inertiaBefore = lo.point.stability.negative;
   sp.inertiaAfter = hi.point.stability.negative;
   const int index = crossingIndex(lo.point, hi.point);
-  const TestFunction test = [index](const ContinuationPoint &p, double &f) { return crossingEigenvalue(p, index, f); };
+  // The mean of the m crossing eigenvalues μ_k … μ_{k+m−1}: smooth through the cluster (the
+  // eigenvalues themselves may swap order inside it) and zero where all of them vanish.
+  const TestFunction mean = [this, index, multiplicity](const ContinuationPoint &p, double &f) {
+    Vector mu(multiplicity);
+    if (!problem_.stabilityEigenvalues(p.u, p.lambda, index, mu)) return false;
+    f = mu.mean();
+    return std::isfinite(f);
+  };
+  const TestFunction single = [index](const ContinuationPoint &p, double &f) { return crossingEigenvalue(p, index, f); };
   double fLo = 0.0, fHi = 0.0;
   Root root;
   bool ok = false;
-  // The bisection bracket is already below separationFraction of the step; a last secant on
-  // the crossing eigenvalue only sharpens where inside it the point sits.
-  if (test(lo.point, fLo) && test(hi.point, fHi) && !sameSign(fLo, fHi)) ok = findRoot(lo, fLo, hi, fHi, test, root);
+  bool onMean = mean(lo.point, fLo) && mean(hi.point, fHi) && !sameSign(fLo, fHi);
+  if (onMean) ok = findRoot(lo, fLo, hi, fHi, mean, root);
+  else if (single(lo.point, fLo) && single(hi.point, fHi) && !sameSign(fLo, fHi))
+    ok = findRoot(lo, fLo, hi, fHi, single, root);
   const StepSample &at = ok ? root.at : lo;
   sp.arclength = at.point.arclength;
   sp.u = at.point.u;
@@ -623,8 +650,24 @@ SpecialPoint Locator::multipleBranchPoint(const StepSample &lo, const StepSample
   if (ok && root.evaluations > 0) sp.lambdaAccuracy = std::min(sp.lambdaAccuracy, root.lastDLambda);
   sp.locationIterations = root.evaluations;
   sp.note = format("multiplicity %.0f: crossings not separable by inertia bisection (bracket |ds| = ", multiplicity) +
-            format("%.3g); Moore refinement skipped; not switched", hi.s - lo.s);
+            format("%.3g); ", hi.s - lo.s) +
+            (onMean ? "located on the mean of the crossing eigenvalues" : "located on the lowest crossing eigenvalue");
   sp.residualNorm = residualNorm(sp.u, sp.lambda);
+  if (options_.denseAlgebra) {
+    // The point is a multiple one when ker F_x is (m+1)-dimensional there: the m + 1 smallest
+    // singular values (one is structural) vanish against the largest.
+    KernelInfo kernel;
+    if (ok && jacobianKernel(problem_, sp.u, sp.lambda, kernel) && kernel.singularValues.size() > multiplicity) {
+      // against the scaled problem's unit (F_x itself may vanish at the point, as at κ = 0)
+      const double top = std::max(kernel.singularValues.maxCoeff(), 1.0);
+      const double ratio = kernel.singularValues[multiplicity] / top;
+      sp.augmentedResidualNorm = ratio;
+      sp.refined = ratio <= 1e-8 && (kernel.singularValues.size() <= multiplicity + 1 ||
+                                     kernel.singularValues[multiplicity + 1] > 1e-8 * top);
+      sp.note += format("; kernel of F_x %.0f-dimensional", multiplicity + 1) +
+                 format(" to %.3g relative", ratio);
+    }
+  }
   fillBranchPointGeometry(sp, a_.point.tangent);
   return sp;
 }

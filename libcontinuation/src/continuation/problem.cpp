@@ -113,6 +113,16 @@ bool Problem::stability(ConstVectorRef u, double lambda, int lowestCount, Stabil
   return true;
 }
 
+bool Problem::stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values) {
+  if (!hasStabilityOperator() || first < 0) return false;
+  if (!stabilityOperator(u, lambda, stabilityH_, stabilityC_)) return false;
+  const StabilityInfo all =
+      projectedInertia(stabilityH_, stabilityC_, 1e-13, int(stabilityH_.rows()), scales().stability);
+  if (first + values.size() > all.lowest.size()) return false;
+  values = all.lowest.segment(first, values.size());
+  return true;
+}
+
 StabilityInfo projectedInertia(const Matrix& H, const Matrix& C, double zeroTolerance, int lowestCount, double scale) {
   StabilityInfo info;
   Matrix reduced;

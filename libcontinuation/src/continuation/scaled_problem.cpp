@@ -51,6 +51,10 @@ void UnitScaling::toScaled(ContinuationPoint &p) const {
   if (p.tangent.size() == n_ + 1) p.tangent = directionToScaled(p.tangent);
   p.stability.lowest /= scales_.stability;
   p.stability.smallest /= scales_.stability;
+  for (int k = 0; k < 2; ++k) {
+    p.spectrum.values[k] /= scales_.stability;
+    p.spectrum.slopes[k] /= scales_.stability;
+  }
 }
 
 void UnitScaling::toUser(ContinuationPoint &p) const {
@@ -60,6 +64,10 @@ void UnitScaling::toUser(ContinuationPoint &p) const {
   if (p.tangent.size() == n_ + 1) p.tangent = directionToUser(p.tangent);
   p.stability.lowest *= scales_.stability;
   p.stability.smallest *= scales_.stability;
+  for (int k = 0; k < 2; ++k) {
+    p.spectrum.values[k] *= scales_.stability;
+    p.spectrum.slopes[k] *= scales_.stability;
+  }
 }
 
 void UnitScaling::toScaled(SpecialPoint &p) const {
@@ -194,6 +202,12 @@ bool ScaledProblem::stability(ConstVectorRef u, double lambda, int lowestCount, 
   if (!problem_.stability(user(u), lambda * units_.parameter(), lowestCount, info)) return false;
   info.lowest /= units_.scales().stability;
   info.smallest /= units_.scales().stability;
+  return true;
+}
+
+bool ScaledProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values) {
+  if (!problem_.stabilityEigenvalues(user(u), lambda * units_.parameter(), first, values)) return false;
+  values /= units_.scales().stability;
   return true;
 }
 

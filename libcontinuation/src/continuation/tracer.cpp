@@ -72,6 +72,7 @@ bool TracerOptions::IsValid(std::string *why) const {
   if (!(locationNewtonTolerance > 0.0) || !finite(locationNewtonTolerance))
     return fail("locationNewtonTolerance must be positive and finite");
   if (maxLocationIterations < 1) return fail("maxLocationIterations must be at least 1");
+  if (!(touchTolerance > 0.0) || !finite(touchTolerance)) return fail("touchTolerance must be positive and finite");
   if (maxRefinementIterations < 1) return fail("maxRefinementIterations must be at least 1");
   if (!(separationFraction > 0.0 && separationFraction < 1.0)) return fail("separationFraction must lie in (0, 1)");
   if (lowestEigenvalues < 0) return fail("lowestEigenvalues must be >= 0");
@@ -151,6 +152,7 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   lo.detectBranchPoints = options_.detectBranchPoints;
   lo.denseAlgebra = n_ <= options_.maxDenseLocationDimension;
   lo.interrupt = options_.interrupt;
+  lo.touchTolerance = options_.touchTolerance;
   locator_ = std::make_unique<Locator>(*work_, *corrector_, *evaluator_, lo);
   stepControl_ = StepSizeControl{options_.minStep,    options_.maxStep,    options_.targetNewtonIterations,
                                  options_.stepGrowth, options_.stepShrink, options_.slowContraction};
@@ -319,7 +321,15 @@ bool Tracer::takeStep(const ContinuationPoint &a, const ContinuationPoint *previ
 
 std::vector<SpecialPoint> Tracer::locateSpecialPoints(const ContinuationPoint &a, const ContinuationPoint &b) {
   const IntervalCrossings crossings = classifyInterval(a, b, options_.detectFolds, options_.detectBranchPoints);
-  if (!crossings.fold && crossings.branchPointCrossings == 0) return {};
+  if (!crossings.fold && crossings.branchPointCrossings == 0) {
+    // Certified counting: the count saw nothing; do the eigenvalues next to zero agree?
+    if (!options_.certifiedCounting || !options_.detectBranchPoints) return {};
+    const std::vector<SuspectedCrossing> suspects =
+        suspectHiddenCrossings(a, b, a.tangent.dot(b.state() - a.state()));
+    if (suspects.empty()) return {};
+    locator_->setStep(a, b);
+    return locator_->locateHiddenCrossings(suspects);
+  }
   locator_->setStep(a, b);
   return locator_->locateSpecialPoints(crossings);
 }
@@ -394,7 +404,13 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     if (hit.event >= 0) b = std::move(hit.point);
 
     std::vector<SpecialPoint> found;
-    if (ia >= skipIntervals && (hit.event < 0 || b.arclength > a.arclength)) found = locateSpecialPoints(a, b);
+    if (ia >= skipIntervals && (hit.event < 0 || b.arclength > a.arclength)) {
+      if (options_.certifiedCounting && options_.detectBranchPoints) {
+        if (!branch.points[size_t(ia)].spectrum.valid()) measureNearZeroSpectrum(*work_, branch.points[size_t(ia)]);
+        measureNearZeroSpectrum(*work_, b);
+      }
+      found = locateSpecialPoints(a, b);
+    }
     // An interrupt during location leaves the step's special points half located: the step is
     // dropped, so every point the branch keeps is fully located, and the branch ends at a.
     if ((!found.empty() || hit.event >= 0) && options_.interrupt.requested()) {

@@ -28,6 +28,7 @@ const char* label(EventType type) {
     case EventType::Release: return "RL";
     case EventType::BaseContact: return "BC";
     case EventType::SelfContact: return "SC";
+    case EventType::EigenvalueTouch: return cont::label(cont::SpecialPointType::EigenvalueTouch);
   }
   return "?";
 }
@@ -241,6 +242,8 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     s.accuracy = sp.lambdaAccuracy;
     s.refined = sp.refined;
     s.multiplicity = sp.multiplicity;
+    s.branchesPredicted = sp.branchesPredicted;
+    s.branchesFound = sp.branchesFound;
     const Classification cl = classify(problem, sp);
     s.phenomenon = cl.phenomenon;
     s.shape = cl.shape;
@@ -256,6 +259,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
         }
         break;
       case cont::SpecialPointType::Fold: s.type = EventType::Fold; break;
+      case cont::SpecialPointType::EigenvalueTouch: s.type = EventType::EigenvalueTouch; break;
       default:
         s.type = EventType::Boundary;
         s.note = sp.boundaryName;

@@ -148,25 +148,26 @@ ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double si
 
 }  // namespace
 
-int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, VectorRef out, double tolerance,
-                      const Vector* guess) {
+int eigenvaluesFrom(ChainStructure& ws, bool useConstraints, int first, int count, VectorRef out, double tolerance,
+                    const Vector* guess) {
   const int dim = ws.n - (useConstraints ? ws.rank : 0);
-  const int k = std::max(0, std::min(count, dim));
+  if (first < 0) return 0;
+  const int k = std::max(0, std::min(count, dim - first));
   if (k == 0) return 0;
   const double scale = std::max(ws.typicalScale, ws.frobeniusH);  // as zeroThreshold: any units
   const double tol = tolerance * scale;
   // All eigenvalues lie in [−‖H‖_F, ‖H‖_F]; widen against rounding until the counts confirm it.
   double lo0 = -ws.frobeniusH * (1.0 + 1e-10) - tol, hi0 = ws.frobeniusH * (1.0 + 1e-10) + tol;
   while (evaluateShift(ws, useConstraints, lo0).below > 0) lo0 = 2.0 * lo0 - scale;
-  while (evaluateShift(ws, useConstraints, hi0).below < k) hi0 = 2.0 * hi0 + scale;
-  // Brackets: eigenvalue j lies in [lo[j], hi[j]) with count(lo[j]) ≤ j < count(hi[j]).
+  while (evaluateShift(ws, useConstraints, hi0).below < first + k) hi0 = 2.0 * hi0 + scale;
+  // Brackets: eigenvalue first + j lies in [lo[j], hi[j]) with count(lo[j]) ≤ first + j < count(hi[j]).
   ChainStructure::SmallVector lo = ChainStructure::SmallVector::Constant(k, lo0);
   ChainStructure::SmallVector hi = ChainStructure::SmallVector::Constant(k, hi0);
   ChainStructure::SmallVector cntLo = ChainStructure::SmallVector::Zero(k);
   ChainStructure::SmallVector cntHi = ChainStructure::SmallVector::Constant(k, double(dim));
   auto record = [&](double s, int c) {
     for (int j = 0; j < k; ++j) {
-      if (c > j) {
+      if (c > first + j) {
         if (s < hi[j]) { hi[j] = s; cntHi[j] = c; }
       } else if (s > lo[j]) {
         lo[j] = s;
@@ -182,19 +183,20 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
     // ~log2(‖H‖ n²/κ) counts per eigenvalue and point.)
     if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
       double delta = std::max(1e-9 * scale, 0.02 * std::abs((*guess)[j]));
-      for (int attempt = 0; attempt < 10 && !(int(cntLo[j]) == j && int(cntHi[j]) == j + 1); ++attempt, delta *= 8.0) {
+      for (int attempt = 0; attempt < 10 && !(int(cntLo[j]) == first + j && int(cntHi[j]) == first + j + 1);
+           ++attempt, delta *= 8.0) {
         const double a = (*guess)[j] - delta, b = (*guess)[j] + delta;
         if (a > lo[j]) record(a, evaluateShift(ws, useConstraints, a).below);
         if (b < hi[j]) record(b, evaluateShift(ws, useConstraints, b).below);
       }
     }
     // isolate: exactly one eigenvalue (j) in [lo, hi)
-    while (!(int(cntLo[j]) == j && int(cntHi[j]) == j + 1) && hi[j] - lo[j] > tol) {
+    while (!(int(cntLo[j]) == first + j && int(cntHi[j]) == first + j + 1) && hi[j] - lo[j] > tol) {
       const double mid = 0.5 * (lo[j] + hi[j]);
       if (mid <= lo[j] || mid >= hi[j]) break;
       record(mid, evaluateShift(ws, useConstraints, mid).below);
     }
-    if (int(cntLo[j]) == j && int(cntHi[j]) == j + 1 && hi[j] - lo[j] > tol) {
+    if (int(cntLo[j]) == first + j && int(cntHi[j]) == first + j + 1 && hi[j] - lo[j] > tol) {
       // Illinois on det, one simple root in the bracket; the counts keep the bracket honest.
       ShiftEvaluation ea = evaluateShift(ws, useConstraints, lo[j]);
       ShiftEvaluation eb = evaluateShift(ws, useConstraints, hi[j]);
@@ -209,7 +211,7 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
         const double c = std::min(std::max(br.next(), br.left + 0.25 * tol), br.right - 0.25 * tol);
         const ShiftEvaluation ec = evaluateShift(ws, useConstraints, c);
         const double fc = value(ec);
-        br.replace(ec.below > j ? 1 : -1, c, fc);  // the root is below c: c is the new right end
+        br.replace(ec.below > first + j ? 1 : -1, c, fc);  // the root is below c: c is the new right end
         if (fc == 0.0) {
           br.left = br.right = c;
           break;
@@ -221,6 +223,11 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
     out[j] = 0.5 * (lo[j] + hi[j]);
   }
   return k;
+}
+
+int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, VectorRef out, double tolerance,
+                      const Vector* guess) {
+  return eigenvaluesFrom(ws, useConstraints, 0, count, out, tolerance, guess);
 }
 
 double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance) {

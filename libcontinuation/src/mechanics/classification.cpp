@@ -70,6 +70,12 @@ Classification classify(const EquilibriumProblem& problem, const SpecialPoint& p
       c.explanation = point.boundaryName.empty() ? "boundary reached" : point.boundaryName + " reached";
       c.explanation += ": sharp change of stiffness";
       break;
+    case SpecialPointType::EigenvalueTouch:
+      // The stiffness in one mode reaches zero and recovers: the count does not change, the
+      // state stays on the same side of stability (neutral there, to the touch's accuracy).
+      c.phenomenon = Phenomenon::None;
+      c.explanation = "an eigenvalue of the stability operator touches zero without changing sign";
+      break;
     case SpecialPointType::Endpoint:
       c.phenomenon = Phenomenon::None;
       c.explanation = point.boundaryName.empty() ? "end of the branch" : point.boundaryName;

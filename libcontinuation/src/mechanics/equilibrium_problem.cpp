@@ -281,6 +281,29 @@ bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCo
   return true;
 }
 
+bool EquilibriumProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, int first,
+                                              continuation::VectorRef values) {
+  if (!options_.structuredStability) return Problem::stabilityEigenvalues(u, lambda, first, values);
+  if (first < 0 || !prepare(u)) return false;
+  assembleFromCache(u, lambda, structure_);
+  const int n = chain_.size();
+  for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
+  const int wanted = first + int(values.size());
+  if (n <= kSmallDense) {
+    // As stability(): one heap-free dense eigen-solve is cheaper than isolating on counts.
+    Eigen::Matrix<double, kSmallDense, 1> low;
+    int found = 0;
+    smallDenseInertia(structure_, heldRows_, std::min(wanted, kSmallDense), low.head(std::min(wanted, kSmallDense)),
+                      found);
+    if (found < wanted) return false;
+    values = low.segment(first, values.size());
+    return true;
+  }
+  const int rank = heldCount() > 0 ? setConstraints(structure_, heldRows_) : (structure_.rank = 0);
+  if (values.size() > ChainStructure::kMaxBorder) return false;  // the isolation's fixed-size brackets
+  return eigenvaluesFrom(structure_, rank > 0, first, int(values.size()), values) == values.size();
+}
+
 std::unique_ptr<continuation::BorderedSolver> EquilibriumProblem::makeStructuredSolver() {
   return std::make_unique<ChainBorderedSolver>(*this);
 }

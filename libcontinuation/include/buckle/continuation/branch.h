@@ -10,6 +10,17 @@
 
 namespace buckle::continuation {
 
+/// The eigenvalues of the stability operator next to zero at a point and their rates of change
+/// along the branch: what certified counting (spectral_monitor.h) compares between two points to
+/// see crossings the inertia count cannot (two in opposite directions, a touch without crossing).
+struct NearZeroSpectrum {
+  int first = -1;       ///< ascending index of values[0]: ν − 1 (ν = negative count), or 0 when ν = 0; −1: not measured
+  int count = 0;        ///< 1 or 2 tracked eigenvalues (indices first, first + 1)
+  double values[2] = {0.0, 0.0};
+  double slopes[2] = {0.0, 0.0};  ///< d/ds along the point's tangent (s: the tracer's arclength)
+  bool valid() const { return first >= 0 && count > 0; }
+};
+
 /// One accepted point x = (u, λ) with the test functions the detectors compare between points.
 struct ContinuationPoint {
   Vector u;
@@ -23,14 +34,18 @@ struct ContinuationPoint {
   double foldTest = 0.0;        ///< λ-component of the tangent: changes sign at a fold
   int determinantSign = 0;      ///< sign of det [[F_u, F_λ], [tᵀ]]: changes sign at a simple BP
   double logAbsDeterminant = 0.0;
+  NearZeroSpectrum spectrum;    ///< certified counting only (TracerOptions::certifiedCounting)
 
   /// x = (u, λ) as one vector (allocates; for tests and output, not for hot loops).
   Vector state() const;
 };
 
-enum class SpecialPointType { Fold, BranchPoint, Boundary, Endpoint };
+/// EigenvalueTouch: an eigenvalue of the stability operator reaches zero and turns back without
+/// changing sign (no inertia change, no determinant sign change; BifurcationKit issue #223), found
+/// by certified counting (spectral_monitor.h).
+enum class SpecialPointType { Fold, BranchPoint, Boundary, Endpoint, EigenvalueTouch };
 
-/// AUTO/MATCONT labels: "LP", "BP", "BD", "EP".
+/// AUTO/MATCONT labels: "LP", "BP", "BD", "EP"; "ET" for an eigenvalue touch.
 const char *label(SpecialPointType type);
 
 struct SpecialPoint {
@@ -47,6 +62,11 @@ struct SpecialPoint {
   Matrix nullVectors;
   Vector leftNullVector;        ///< branch point: ψ with ψᵀ[F_u F_λ] = 0
   int multiplicity = 1;         ///< eigenvalues crossing zero here (2: double zero)
+  /// Multiple branch points (multiplicity_switching.h): half-branches predicted by the reduced
+  /// bifurcation equation (two per solution direction) and how many of them were traced off the
+  /// point; −1 when not switched.
+  int branchesPredicted = -1;
+  int branchesFound = -1;
   int inertiaBefore = -1;       ///< negative eigenvalues of the stability operator before/after
   int inertiaAfter = -1;
   /// Achieved accuracy: |Δλ| of the last location iterate (refinement Newton step, or last
@@ -55,7 +75,8 @@ struct SpecialPoint {
   double residualNorm = 0.0;    ///< ‖F(u, λ)‖₂ at the located point
   double augmentedResidualNorm = 0.0;  ///< residual of the refinement system (fold / Moore)
   /// Test function at the located point: fold → t_λ; branch point → smallest singular value of
-  /// [F_u, F_λ]; boundary / parameter end → g (or λ_end − λ).
+  /// [F_u, F_λ]; boundary / parameter end → g (or λ_end − λ); eigenvalue touch → the touching
+  /// eigenvalue (its distance from zero is the touch's accuracy).
   double testFunctionValue = 0.0;
   int locationIterations = 0;   ///< secant/bisection evaluations + refinement Newton steps
   bool refined = false;         ///< Newton on the augmented system converged

@@ -26,6 +26,7 @@
 #include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/root_finding.h"
+#include "buckle/continuation/spectral_monitor.h"
 #include "buckle/continuation/structured_refinement.h"
 #include "buckle/continuation/test_functions.h"
 
@@ -56,6 +57,10 @@ struct LocatorOptions {
   /// algebra (structured_refinement.h: the problem's structured solver, or dense LU without one);
   /// the secant brackets on O(N) test functions (t_λ, the determinant, the crossing eigenvalue).
   bool denseAlgebra = true;
+  /// Certified counting (spectral_monitor.h): a suspected interior minimum of |μ| whose value
+  /// is at most touchTolerance·max(1, |μ_a|, |μ_b|) (scaled stability units) without a sign change
+  /// is an eigenvalue touch.
+  double touchTolerance = 1e-8;
   /// A requested interrupt makes every further sample fail: the point in hand is reported as
   /// located so far, and the tracer stops at its next step.
   Interrupt interrupt;
@@ -96,6 +101,10 @@ class Locator {
 
   /// Folds and branch points inside the current step, in arclength order (index not set).
   std::vector<SpecialPoint> locateSpecialPoints(const IntervalCrossings &crossings);
+  /// Certified counting (locator_hidden.cpp): for each suspected eigenvalue, minimise side·μ along
+  /// the step; a sign change gives the pair of branch points (each located as a simple one), a
+  /// minimum within touchTolerance of zero an EigenvalueTouch point. In arclength order.
+  std::vector<SpecialPoint> locateHiddenCrossings(const std::vector<SuspectedCrossing> &suspects);
 
   const StepSample &start() const { return a_; }
   const StepSample &end() const { return b_; }
@@ -105,6 +114,10 @@ class Locator {
   SpecialPoint locateFold(const StepSample &lo, const StepSample &hi);
   SpecialPoint locateSimpleBranchPoint(const StepSample &lo, const StepSample &hi);
   SpecialPoint multipleBranchPoint(const StepSample &lo, const StepSample &hi, int multiplicity);
+  /// Branch points between consecutive samples (the count differs between neighbours).
+  void locateBetween(const std::vector<StepSample> &samples, std::vector<SpecialPoint> &found);
+  /// The eigenvalue with ascending index `index` at a sample, times side.
+  bool sideEigenvalue(const StepSample &at, int index, int side, double &value);
   void separateCrossings(const StepSample &lo, const StepSample &hi, std::vector<std::pair<StepSample, StepSample>> &simple,
                          std::vector<std::pair<StepSample, StepSample>> &multiple, int depth);
   bool refineFold(SpecialPoint &point, const Vector &tangentRef);

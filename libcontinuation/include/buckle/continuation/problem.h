@@ -107,6 +107,12 @@ class Problem {
   /// Default: dense eigen-decomposition of Zᵀ H Z (Z a basis of ker C), which gets every
   /// eigenvalue anyway. Problems with structure override this (e.g. an O(n) Sturm count).
   virtual bool stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo& info);
+  /// Eigenvalues of H on ker C with ascending indices first … first + values.size() − 1 (the
+  /// certified counting of spectral_monitor.h follows the two next to zero, indices ν − 1 and ν).
+  /// False when the point is refused or an index is out of range. Default: dense
+  /// eigen-decomposition of Zᵀ H Z; structured problems override it (e.g. isolation on O(n)
+  /// Sturm counts of the shifted operator).
+  virtual bool stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values);
 
   // ---- optional: structured linear algebra ---------------------------------------------
   /// A solver for the bordered Jacobian [[F_u, F_λ], [cᵀ]] that exploits the problem's

@@ -83,6 +83,14 @@ struct TracerOptions {
   /// needs and is much cheaper for structured problems; the locator still asks for the
   /// crossing eigenvalue where it needs one.
   int lowestEigenvalues = 3;
+  /// Certified counting (spectral_monitor.h): record the two eigenvalues next to zero and their
+  /// rates at every point (Problem::stabilityEigenvalues, two evaluations per point) and search
+  /// the steps where one of them may reach zero unseen by the count: two opposite crossings are
+  /// located as two branch points, a touch without crossing as an EigenvalueTouch point.
+  bool certifiedCounting = true;
+  /// An interior minimum of |μ| at most this (relative to max(1, |μ| at the step's ends), in the
+  /// problem's stability scale) without a sign change is an eigenvalue touch.
+  double touchTolerance = 1e-8;
 
   // ---- linear algebra --------------------------------------------------------------------
   enum class LinearAlgebra {

@@ -43,6 +43,7 @@ enum class EventType {
   Release,           ///< "RL": a locked joint's contact torque returns to zero: it is free again
   BaseContact,       ///< "BC": the chain reaches (or leaves) the clamp's wall (contact_geometry.h)
   SelfContact,       ///< "SC": two non-adjacent links meet (or separate) (contact_geometry.h)
+  EigenvalueTouch,   ///< "ET": an eigenvalue of the stability operator touches zero without crossing
 };
 
 /// "BP", "LP", "LPF", "BD", "KMIN", "JUMP", "CT", "RL": the one spelling of the labels in every output.
@@ -110,6 +111,9 @@ struct SpecialPointReport {
   double residual = 0.0;
   bool refined = false;                ///< Newton on an augmented system converged
   int multiplicity = 1;
+  /// Multiple branch points: half-branches predicted by the reduced bifurcation equation and
+  /// traced off the point (−1: not switched; SpecialPoint::branchesPredicted / branchesFound).
+  int branchesPredicted = -1, branchesFound = -1;
   std::string note;
   /// A fold whose stable side ends there: the chain must jump (jumpFromFold, landing.h).
   bool jumps = false;

@@ -157,6 +157,11 @@ Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C
 /// values) brackets each eigenvalue with a few counts before falling back to bisection.
 int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, VectorRef out, double tolerance = 1e-13,
                       const Vector* guess = nullptr);
+/// Eigenvalues with ascending indices first … first + k − 1 (k = min(count, dimension − first)) of H
+/// or of Zᵀ H Z, as lowestEigenvalues (which is first = 0): the same isolation on the counts, so
+/// the eigenvalues next to zero of a chain with many negative ones cost O(n) each too.
+int eigenvaluesFrom(ChainStructure& ws, bool useConstraints, int first, int count, VectorRef out,
+                    double tolerance = 1e-13, const Vector* guess = nullptr);
 /// Smallest eigenvalue (lowestEigenvalues with count 1; 0 if the dimension is 0).
 double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance = 1e-13);
 

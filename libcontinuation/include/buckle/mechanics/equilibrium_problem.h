@@ -73,6 +73,10 @@ class EquilibriumProblem final : public continuation::Problem {
   static constexpr int kMaxLowest = 4;  // the isolation's fixed-size brackets
   bool stability(continuation::ConstVectorRef u, double lambda, int lowestCount,
                  continuation::StabilityInfo& info) override;
+  /// Eigenvalues by index of K_q − K_g on ker J_h, each isolated on O(n) Sturm counts of the
+  /// shifted tridiagonal T − σM (chain_structure.h, eigenvaluesFrom).
+  bool stabilityEigenvalues(continuation::ConstVectorRef u, double lambda, int first,
+                            continuation::VectorRef values) override;
 
   /// T of H = K_q − K_g(F(u, λ)) into ws (chain_structure.h) and the end Jacobian (3×n) into J,
   /// from the q-cache: what the structured stability and the structured solver linearise on.

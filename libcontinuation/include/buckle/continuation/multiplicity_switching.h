@@ -1,0 +1,51 @@
+// Branch switching at branch points of multiplicity m ≥ 2 (m eigenvalues cross zero together, e.g.
+// the unloaded straight chain with vanishing joint stiffness, κ = 0, where m = n − 1).
+//
+// At such a point x₀ the kernel of F_x = [F_u, F_λ] is (m+1)-dimensional: the parent tangent t and
+// φ₁ … φ_m; the left kernel is m-dimensional (ψ₁ … ψ_m). The branches through x₀ have tangents in
+// the kernel that solve the algebraic bifurcation equation (Lyapunov–Schmidt, Golubitsky–Schaeffer):
+//  - quadratic:  ψ_jᵀ F_xx[d, d] = 0, j = 1 … m, d = K z (K = [t φ₁ … φ_m]), |z| = 1; the parent's t
+//                is one root, the others are the children;
+//  - cubic, when the quadratic form vanishes on span φ (a symmetry q → −q makes F odd in the
+//    kernel directions): along x = x₀ + εΦβ + ε²(τ t + w₂) + O(ε³),
+//                τ (Bβ)_j + ψ_jᵀ(F_xx[Φβ, w₂] + ⅙ F_xxx[Φβ, Φβ, Φβ]) = 0,   |β| = 1,
+//    B_ji = ψ_jᵀ F_xx[φ_i, t], w₂ = −F_x⁺ ½F_xx[Φβ, Φβ] (⊥ kernel).
+// Either is a small polynomial system on the sphere, solved by Newton from many starts (a Fibonacci
+// lattice on the half-sphere; roots identified up to sign). Each root d is a solution direction:
+// two half-branches (±d), traced by switchBranch. The count predicted (two per direction) and the
+// count found (children that left the point along their own direction) go into the special point.
+// The kernel comes from a dense SVD of F_x (multiple points are rare; N² memory).
+#pragma once
+
+#include "buckle/continuation/branch.h"
+#include "buckle/continuation/branch_switching.h"
+#include "buckle/continuation/problem.h"
+#include "buckle/continuation/tracer.h"
+
+#include <string>
+#include <vector>
+
+namespace buckle::continuation {
+
+/// Solution directions of the reduced bifurcation equation at a point of multiplicity m.
+struct ReducedBifurcation {
+  int kernelDimension = 0;          ///< m: dimension of ker F_u-part (dim ker F_x − 1)
+  int order = 0;                    ///< 2 (quadratic) or 3 (cubic) equation solved
+  std::vector<Vector> directions;   ///< unit (N+1) tangents of the children (the parent excluded), problem units
+  std::vector<double> curvatures;   ///< cubic: τ along each direction (parameter offset ε²τ·t), else 0
+  std::string note;                 ///< how it was obtained, or why it failed
+};
+
+/// The m-dimensional reduced bifurcation equation at bp (u, λ, tangent set) and all its solution
+/// directions. False (with note) when the kernel is not (m+1)-dimensional to `kernelTolerance`
+/// (relative to the largest singular value) or no direction is found.
+bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
+                                  double kernelTolerance = 1e-7);
+
+/// Children of the multiple point bp, both sides of every direction, traced with `tracer`; sets
+/// bp.branchesPredicted (2 per direction) and bp.branchesFound (children that left bp along their
+/// own predicted direction, closer to it than to any other). `how` says what was done.
+std::vector<Branch> switchMultiple(Tracer &tracer, SpecialPoint &bp, const BranchSwitchingOptions &options,
+                                   std::string *how = nullptr);
+
+}  // namespace buckle::continuation

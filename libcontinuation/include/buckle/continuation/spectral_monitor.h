@@ -1,0 +1,45 @@
+// Certified counting: eigenvalue crossings between two points that the inertia count misses.
+//
+// The branch-point test compares ν, the number of negative eigenvalues of the stability operator,
+// at the two ends of a step. Two eigenvalues crossing zero in opposite directions inside one step
+// leave ν (and the determinant's sign) unchanged, and an eigenvalue that reaches zero and turns
+// back (a touch, BifurcationKit issue #223) never changes either. Both leave a trace in the two
+// eigenvalues next to zero, μ_{ν−1} < 0 ≤ μ_ν (ascending indices; on an interval with the same ν at
+// both ends they are the same two indices): one of them moves towards zero at the start of the
+// step and away from it at the end, so it has an interior extremum. The monitor records these two
+// eigenvalues and their rates dμ/ds along the tangent at every point (Problem::stabilityEigenvalues,
+// O(n) for a chain by isolation on shifted Sturm counts, and one forward difference along the
+// tangent), and flags an interval when, for one of them, the tangent lines from both ends meet on
+// the far side of zero (or within `margin` of it): the interior minimum of |μ| may reach zero.
+// The locator then minimises |μ| along the step (locator.h, locateHiddenCrossings): a sign change
+// splits the step into intervals whose counts differ (two branch points, located separately), a
+// minimum at zero within the touch tolerance is an eigenvalue touch.
+#pragma once
+
+#include "buckle/continuation/branch.h"
+#include "buckle/continuation/problem.h"
+
+#include <vector>
+
+namespace buckle::continuation {
+
+/// Fills point.spectrum: the eigenvalues with indices ν − 1 and ν (ν = point.stability.negative;
+/// only ν when ν = 0, only ν − 1 when ν is the dimension) and their slopes along point.tangent,
+/// by a forward difference with step `delta` (backward if the problem refuses the forward point).
+/// False (spectrum left invalid) without stability or when the problem refuses the eigenvalues.
+bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double delta = 1e-6);
+
+/// One eigenvalue (ascending index) whose interior extremum in a step may reach zero.
+struct SuspectedCrossing {
+  int index = -1;
+  int side = 1;                ///< sign of the eigenvalue at both ends: the search minimises side·μ
+  double predictedS = 0.0;     ///< where the tangent lines from the ends meet, in (0, stepLength)
+  double predictedValue = 0.0; ///< their value there
+};
+
+/// The tracked eigenvalues of a and b (same ν, same indices) whose tangent lines predict that
+/// side·μ falls to ≤ margin·min(|μ_a|, |μ_b|) inside the step of length stepLength.
+std::vector<SuspectedCrossing> suspectHiddenCrossings(const ContinuationPoint &a, const ContinuationPoint &b,
+                                                      double stepLength, double margin = 0.25);
+
+}  // namespace buckle::continuation

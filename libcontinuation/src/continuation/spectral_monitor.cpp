@@ -1,0 +1,80 @@
+#include "buckle/continuation/spectral_monitor.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+
+namespace buckle::continuation {
+
+namespace {
+
+bool eigenvaluesAt(Problem &problem, const Vector &u, double lambda, int first, int count, Eigen::Vector2d &out) {
+  return problem.stabilityEigenvalues(u, lambda, first, out.head(count)) && out.head(count).allFinite();
+}
+
+}  // namespace
+
+bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double delta) {
+  point.spectrum = NearZeroSpectrum();
+  const int n = problem.dimension();
+  if (!point.stability.valid() || point.tangent.size() != n + 1 || point.u.size() != n) return false;
+  const int nu = point.stability.negative;
+  int first = std::max(0, nu - 1);
+  int count = nu > 0 ? 2 : 1;
+  Eigen::Vector2d here, there;
+  const Vector &lowest = point.stability.lowest;  // already isolated by the point's stability()
+  if (lowest.size() >= first + count) {
+    here.head(count) = lowest.segment(first, count);
+  } else if (!eigenvaluesAt(problem, point.u, point.lambda, first, count, here)) {
+    // ν is the dimension (no eigenvalue ν), or the problem offers only part of the spectrum
+    if (count == 1 || !eigenvaluesAt(problem, point.u, point.lambda, first, 1, here)) return false;
+    count = 1;
+  }
+  // Rate along the tangent: dμ/ds = (μ(x + δt) − μ(x))/δ. The point x + δt is off the branch by
+  // O(δ²) only, so the slope is the branch's to O(δ) (Hellmann–Feynman needs no eigenvector).
+  double h = delta;
+  const Vector uf = point.u + h * point.tangent.head(n);
+  if (!eigenvaluesAt(problem, uf, point.lambda + h * point.tangent[n], first, count, there)) {
+    h = -delta;
+    const Vector ub = point.u + h * point.tangent.head(n);
+    if (!eigenvaluesAt(problem, ub, point.lambda + h * point.tangent[n], first, count, there)) return false;
+  }
+  point.spectrum.first = first;
+  point.spectrum.count = count;
+  for (int k = 0; k < count; ++k) {
+    point.spectrum.values[k] = here[k];
+    point.spectrum.slopes[k] = (there[k] - here[k]) / h;
+  }
+  return true;
+}
+
+std::vector<SuspectedCrossing> suspectHiddenCrossings(const ContinuationPoint &a, const ContinuationPoint &b,
+                                                      double stepLength, double margin) {
+  std::vector<SuspectedCrossing> suspects;
+  const NearZeroSpectrum &sa = a.spectrum, &sb = b.spectrum;
+  if (!sa.valid() || !sb.valid() || !(stepLength > 0.0)) return suspects;
+  if (a.stability.negative != b.stability.negative || sa.first != sb.first) return suspects;
+  const int count = std::min(sa.count, sb.count);
+  for (int k = 0; k < count; ++k) {
+    const double ma = sa.values[k], mb = sb.values[k];
+    const int side = ma > 0.0 ? 1 : -1;
+    if (ma == 0.0 || mb == 0.0 || (mb > 0.0 ? 1 : -1) != side) continue;  // a zero end is the count's business
+    const double da = side * sa.slopes[k], db = side * sb.slopes[k];   // rates of side·μ
+    if (!(da < 0.0 && db > 0.0)) continue;  // no interior minimum of side·μ
+    // Tangent lines side·μ_a + da·s and side·μ_b + db·(s − L) meet at s*.
+    const double fa = side * ma, fb = side * mb;
+    const double s = (fb - db * stepLength - fa) / (da - db);
+    if (!(s > 0.0 && s < stepLength)) continue;
+    const double value = fa + da * s;
+    if (value > margin * std::min(fa, fb)) continue;
+    SuspectedCrossing c;
+    c.index = sa.first + k;
+    c.side = side;
+    c.predictedS = s;
+    c.predictedValue = side * value;
+    suspects.push_back(c);
+  }
+  return suspects;
+}
+
+}  // namespace buckle::continuation

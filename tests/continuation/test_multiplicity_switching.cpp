@@ -1,0 +1,123 @@
+// Switching at branch points of multiplicity m ≥ 2 (multiplicity_switching.h), on gradient
+// systems whose branches are known in closed form.
+#include "buckle/continuation/multiplicity_switching.h"
+
+#include "buckle/continuation/branch_switching.h"
+#include "buckle/continuation/tracer.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace buckle::continuation;
+
+namespace {
+
+/// F = −∇V, V = −λ|u|²/2 + Σu_i⁴/4 + (c/2)Σ_{i<j} u_i²u_j², H = ∇²V: on u = 0 all m eigenvalues
+/// are −λ, an m-fold branch point at λ = 0. The branches are u = s·e with e a vector of 0, ±1
+/// entries (k nonzero ones): λ = s²(1 + c(k − 1)). Lines through 0: 2 for m = 2 per k ∈ {1, 2}
+/// (4 in all), 3 + 6 + 4 = 13 for m = 3: the cubic reduced equation has its Bézout number of roots.
+class CoupledPitchforks : public Problem {
+ public:
+  CoupledPitchforks(int m, double c) : m_(m), c_(c) {}
+  int dimension() const override { return m_; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    const double s = u.squaredNorm();
+    for (int i = 0; i < m_; ++i) F[i] = lambda * u[i] - u[i] * u[i] * u[i] - c_ * u[i] * (s - u[i] * u[i]);
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+    const double s = u.squaredNorm();
+    for (int i = 0; i < m_; ++i) {
+      for (int j = 0; j < m_; ++j) Fu(i, j) = i == j ? 0.0 : -2.0 * c_ * u[i] * u[j];
+      Fu(i, i) = lambda - 3.0 * u[i] * u[i] - c_ * (s - u[i] * u[i]);
+    }
+    Fl = u;
+    return true;
+  }
+  bool hasStabilityOperator() const override { return true; }
+  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
+    H.resize(m_, m_);
+    Vector Fl(m_);
+    jacobian(u, lambda, H, Fl);
+    H = -H;
+    C.resize(0, m_);
+    return true;
+  }
+
+ private:
+  int m_;
+  double c_;
+};
+
+TracerOptions options() {
+  TracerOptions o;
+  o.lambdaMin = -1.0;
+  o.lambdaMax = 1.0;
+  o.maxStep = 0.05;
+  o.maxPoints = 40;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("an m-fold branch point is located once, refined, and its reduced equation solved") {
+  for (int m : {2, 3}) {
+    INFO("m = " << m);
+    CoupledPitchforks problem(m, 0.4);
+    const Branch trivial = trace(problem, Vector::Zero(m), -0.37, InitialDirection::increasingLambda(), options());
+    const auto bps = trivial.specialPointsOfType(SpecialPointType::BranchPoint);
+    REQUIRE(bps.size() == 1);
+    const SpecialPoint &bp = *bps[0];
+    CHECK(bp.multiplicity == m);
+    CHECK(std::abs(bp.lambda) <= 1e-12);  // closed form: λ = 0
+    CHECK(bp.refined);
+    ReducedBifurcation rb;
+    const bool solved = reducedBifurcationDirections(problem, bp, m, rb);
+    INFO(rb.note);
+    REQUIRE(solved);
+    CHECK(rb.order == 3);  // odd in u: the quadratic part vanishes on the kernel
+    CHECK(int(rb.directions.size()) == (m == 2 ? 4 : 13));
+    // each direction is a line of 0, ±1 entries (closed form), with λ curvature τ = 1 + c(k − 1)
+    for (size_t d = 0; d < rb.directions.size(); ++d) {
+      const Vector e = rb.directions[d].head(m);
+      const double largest = e.cwiseAbs().maxCoeff();
+      int k = 0;
+      for (int i = 0; i < m; ++i) {
+        const double r = std::abs(e[i]) / largest;
+        CHECK((r <= 1e-6 || std::abs(r - 1.0) <= 1e-6));
+        if (r > 0.5) ++k;
+      }
+      CHECK(std::abs(rb.directions[d][m]) <= 1e-8);  // along the trivial branch's normal: λ' = 0
+      // x = εΦβ + ε²τ·t: |u|² = ε², u_i² = ε²/k on the k nonzero entries, so τ = λ/ε² = (1 + c(k − 1))/k
+      CHECK(rb.curvatures[d] == Approx((1.0 + 0.4 * (k - 1)) / k).epsilon(1e-5));
+    }
+  }
+}
+
+TEST_CASE("traceTree switches an m-fold point along every direction: predicted = found") {
+  for (int m : {2, 3}) {
+    INFO("m = " << m);
+    CoupledPitchforks problem(m, 0.4);
+    TracerOptions o = options();
+    o.maxPoints = 15;
+    const BranchTree tree = traceTree(problem, Vector::Zero(m), -0.37, InitialDirection::increasingLambda(), o, 1);
+    const auto bps = tree.branches.at(0).specialPointsOfType(SpecialPointType::BranchPoint);
+    REQUIRE(bps.size() == 1);
+    const int lines = m == 2 ? 4 : 13;
+    CHECK(bps[0]->branchesPredicted == 2 * lines);
+    CHECK(bps[0]->branchesFound == 2 * lines);
+    REQUIRE(int(tree.branches.size()) == 1 + 2 * lines);
+    // every child lies on its closed-form branch λ = u_i²(1 + c(k − 1)) (u_i a nonzero entry)
+    for (size_t b = 1; b < tree.branches.size(); ++b) {
+      const Branch &child = tree.branches[b];
+      REQUIRE(child.points.size() >= 3);
+      const ContinuationPoint &p = child.points.back();
+      const double largest = p.u.cwiseAbs().maxCoeff();
+      int k = 0;
+      for (int i = 0; i < m; ++i)
+        if (std::abs(p.u[i]) > 0.5 * largest) ++k;
+      CHECK(p.lambda == Approx(largest * largest * (1.0 + 0.4 * (k - 1))).epsilon(1e-8));
+    }
+  }
+}
