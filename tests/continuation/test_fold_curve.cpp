@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -38,6 +39,19 @@ void checkJacobian(Problem& curve, const Vector& U, double mu, double tolerance)
   REQUIRE(curve.residual(U, mu - h, Gm));
   CHECK(((Gp - Gm) / (2 * h) - Gmu).norm() <= tolerance * (1.0 + Gmu.norm()));
 }
+// Every point of a traced fold curve of the cusp toy on its closed form (x, x²/2, −x³) at
+// μ = 1.5x² (to 1e-10); returns the smallest x reached.
+double checkCuspFoldPoints(const Branch& branch) {
+  double xMin = 1.0;
+  for (const ContinuationPoint& p : branch.points) {
+    const double x = p.u[0];
+    xMin = std::min(xMin, x);
+    CHECK(std::abs(p.lambda - 1.5 * x * x) <= 1e-10);
+    CHECK(std::abs(p.u[2] + x * x * x) <= 1e-10);
+    CHECK(std::abs(p.u[1] - 0.5 * x * x) <= 1e-10);
+  }
+  return xMin;
+}
 }  // namespace
 
 TEST_CASE("Fold curve: the exact Jacobian against central differences of the residual", "[fold_curve]") {
@@ -64,15 +78,8 @@ TEST_CASE("Fold curve: traced through the cusp, on μ = 3x²/2, λ = −x³", "[
   options.computeStability = false;
   const Branch branch = trace(curve, U0, 0.96, InitialDirection::decreasingLambda(), options);
   REQUIRE(branch.stopReason == StopReason::LambdaRange);
-  double xMin = 1.0;
-  for (const ContinuationPoint& p : branch.points) {
-    const double x = p.u[0];
-    xMin = std::min(xMin, x);
-    CHECK(std::abs(p.lambda - 1.5 * x * x) <= 1e-10);
-    CHECK(std::abs(p.u[2] + x * x * x) <= 1e-10);
-    CHECK(std::abs(p.u[1] - 0.5 * x * x) <= 1e-10);
-    CHECK(std::abs(p.u[4] - x * p.u[3]) <= 1e-10);  // v ∥ (1, x)
-  }
+  const double xMin = checkCuspFoldPoints(branch);
+  for (const ContinuationPoint& p : branch.points) CHECK(std::abs(p.u[4] - p.u[0] * p.u[3]) <= 1e-10);  // v ∥ (1, x)
   CHECK(xMin < -0.8);  // past the cusp onto the other fold
   // the cusp is a fold of the fold curve (μ turns there)
   const auto folds = branch.specialPointsOfType(SpecialPointType::Fold);
@@ -160,14 +167,7 @@ TEST_CASE("Minimal fold curve: traced with the bordered solver through the cusp,
   const Branch branch = trace(curve, MinimalFoldCurveProblem::start(u, -0.512), 0.96,
                               InitialDirection::decreasingLambda(), options);
   REQUIRE(branch.stopReason == StopReason::LambdaRange);
-  double xMin = 1.0;
-  for (const ContinuationPoint& p : branch.points) {
-    const double x = p.u[0];
-    xMin = std::min(xMin, x);
-    CHECK(std::abs(p.lambda - 1.5 * x * x) <= 1e-10);
-    CHECK(std::abs(p.u[2] + x * x * x) <= 1e-10);
-    CHECK(std::abs(p.u[1] - 0.5 * x * x) <= 1e-10);
-  }
+  const double xMin = checkCuspFoldPoints(branch);
   CHECK(xMin < -0.8);
   // the cusp test changes sign once, at x = 0
   curve.resetBorders();

@@ -5,6 +5,8 @@
 #include "buckle/continuation/branch_switching.h"
 #include "buckle/continuation/tracer.h"
 
+#include "toy_problems.h"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -37,12 +39,7 @@ class CoupledPitchforks : public Problem {
   }
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-    H.resize(m_, m_);
-    Vector Fl(m_);
-    jacobian(u, lambda, H, Fl);
-    H = -H;
-    C.resize(0, m_);
-    return true;
+    return toys::negatedJacobian(*this, u, lambda, H, C);
   }
 
  private:

@@ -3,6 +3,8 @@
 #include "buckle/continuation/spectral_monitor.h"
 #include "buckle/continuation/tracer.h"
 
+#include "toy_problems.h"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -33,11 +35,7 @@ class OppositeCrossings : public Problem {
   }
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-    H = Matrix::Zero(2, 2);
-    H(0, 0) = 1.0 - lambda + 3.0 * u[0] * u[0];
-    H(1, 1) = lambda - c_ + 3.0 * u[1] * u[1];
-    C.resize(0, 2);
-    return true;
+    return toys::negatedJacobian(*this, u, lambda, H, C);
   }
 
  private:
@@ -63,11 +61,7 @@ class Touch : public Problem {
   }
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-    H = Matrix::Zero(2, 2);
-    H(0, 0) = (lambda - 1.0) * (lambda - 1.0) + 3.0 * u[0] * u[0];
-    H(1, 1) = 1.0;
-    C.resize(0, 2);
-    return true;
+    return toys::negatedJacobian(*this, u, lambda, H, C);
   }
 };
 

@@ -8,6 +8,17 @@
 
 namespace buckle::continuation::toys {
 
+/// The stability operator of a gradient system F = −∇V: H = −F_u, no constraints.
+inline bool negatedJacobian(Problem &problem, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) {
+  const int n = problem.dimension();
+  Vector Fl(n);
+  H = Matrix::Zero(n, n);
+  if (!problem.jacobian(u, lambda, H, Fl)) return false;
+  H = -H;
+  C.resize(0, n);
+  return true;
+}
+
 /// u² + λ² = 1: folds at λ = ±1 (u = 0).
 class Circle : public Problem {
  public:
@@ -118,12 +129,7 @@ class CurvedPitchforks : public Problem {
   }
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-    Vector Fl(2);
-    H = Matrix::Zero(2, 2);
-    jacobian(u, lambda, H, Fl);
-    H = -H;
-    C.resize(0, 2);
-    return true;
+    return negatedJacobian(*this, u, lambda, H, C);
   }
 
  private:
@@ -211,12 +217,7 @@ class Bratu : public Problem {
   }
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-    H.resize(n_, n_);
-    Vector Fl(n_);
-    jacobian(u, lambda, H, Fl);
-    H = -H;
-    C.resize(0, n_);
-    return true;
+    return negatedJacobian(*this, u, lambda, H, C);
   }
 
  private:
