@@ -205,12 +205,15 @@ struct PlacedLabel {
   Box box{0, 0, 0, 0};
   bool leader = false;             ///< drawn away from its point: a leader line joins them
   Eigen::Vector2d leaderEnd;       ///< where the leader meets the label box
+  bool shown = true;               ///< false: no free place within reach, only the marker is drawn
 };
 
 /// Places every label near its point without overlapping another label, a marker or (where it
 /// can) a curve, inside the plot area: candidate positions on rings of growing radius around
 /// the point, the cheapest taken, greedily from left to right. A label put away from its point
-/// gets a leader line.
+/// gets a leader line. A label that finds no place free of other labels inside the plot area is
+/// left out (its marker and the key still show the point): on a diagram with thousands of special
+/// points (long chains) overlapping text would hide the curves.
 void placeLabels(std::vector<PlacedLabel>& labels, const Frame& f, const Occupancy& curves) {
   const Box area{f.width * f.left, f.height * f.bottom, f.width * f.right, f.height * f.top};
   std::vector<Box> markers;
@@ -249,6 +252,10 @@ void placeLabels(std::vector<PlacedLabel>& labels, const Frame& f, const Occupan
           l.leader = r > 2.0;
         }
       }
+    }
+    if (bestCost >= 1e6) {
+      l.shown = false;
+      continue;
     }
     placed.push_back(l.box);
     // the leader ends on the box's edge nearest to the point
@@ -479,12 +486,12 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   std::vector<int> labelBlocks(cases.size(), -1);
   for (size_t o = 0; o < cases.size(); ++o) {
     bool any = false;
-    for (size_t k = 0; k < labels.size(); ++k) any = any || labelOrdinal[k] == o;
+    for (size_t k = 0; k < labels.size(); ++k) any = any || (labelOrdinal[k] == o && labels[k].shown);
     if (!any) continue;
     labelBlocks[o] = lab.begin();
     lab.text("# case " + std::to_string(cases[o]) + ": x y label_x label_y \"label\" leader_x leader_y");
     for (size_t k = 0; k < labels.size(); ++k) {
-      if (labelOrdinal[k] != o) continue;
+      if (labelOrdinal[k] != o || !labels[k].shown) continue;
       const PlacedLabel& l = labels[k];
       const Eigen::Vector2d p = f.data(l.anchor), c = f.data(l.centre), e = f.data(l.leaderEnd);
       const double nan = std::numeric_limits<double>::quiet_NaN();

@@ -219,8 +219,15 @@ void Locator::locateBetween(const std::vector<StepSample> &samples, std::vector<
   for (StepSample &x : ends) ensureEigenvalues(problem_, x.point, needed);
   std::vector<std::pair<StepSample, StepSample>> simple, multiple;
   for (size_t i = 0; i + 1 < ends.size(); ++i) separateCrossings(ends[i], ends[i + 1], simple, multiple, 0);
-  for (const auto &bracket : simple) found.push_back(locateSimpleBranchPoint(bracket.first, bracket.second));
+  // An interrupt ends the location between two branch points (below the dense crossover each
+  // refinement is O(N³) work, and a step over a cluster holds many): the tracer then drops
+  // the half-located step, so the time limit is kept within one refinement.
+  for (const auto &bracket : simple) {
+    if (options_.interrupt.requested()) break;
+    found.push_back(locateSimpleBranchPoint(bracket.first, bracket.second));
+  }
   for (const auto &bracket : multiple) {
+    if (options_.interrupt.requested()) break;
     const int m = std::abs(bracket.second.point.stability.negative - bracket.first.point.stability.negative);
     found.push_back(multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
   }
