@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <string>
 #include <sys/stat.h>
@@ -178,6 +179,13 @@ class Occupancy {
       grid_[size_t(p.y()) * size_t(w_) + size_t(p.x())] = 1;
     }
   }
+  /// Marks a rectangle (an unlabelled marker) as covered.
+  void fill(const Box& b) {
+    const int x0 = int(std::clamp(b.x0, 0.0, double(w_))), x1 = int(std::clamp(b.x1, 0.0, double(w_)));
+    const int y0 = int(std::clamp(b.y0, 0.0, double(h_))), y1 = int(std::clamp(b.y1, 0.0, double(h_)));
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) grid_[size_t(y) * size_t(w_) + size_t(x)] = 1;
+  }
   void finish() {
     sum_.assign(size_t(w_ + 1) * size_t(h_ + 1), 0);
     for (int y = 0; y < h_; ++y)
@@ -206,15 +214,24 @@ struct PlacedLabel {
   bool leader = false;             ///< drawn away from its point: a leader line joins them
   Eigen::Vector2d leaderEnd;       ///< where the leader meets the label box
   bool shown = true;               ///< false: no free place within reach, only the marker is drawn
+  int priority = 0;                ///< placed in increasing priority, then from left to right
 };
+
+/// Distances (pixels, beyond the marker) of the rings of candidate label positions.
+const std::vector<double> kLabelRings = {2.0, 18.0, 36.0, 58.0, 84.0, 116.0, 156.0};
+/// Summary mode: farther rings as well, so that every label of a crowded stretch (the branch
+/// points of a long chain's primary branch) finds a place, on a longer leader.
+const std::vector<double> kSummaryLabelRings = {2.0,   18.0,  36.0,  58.0,  84.0,  116.0, 156.0,
+                                                200.0, 250.0, 310.0, 380.0, 460.0, 560.0};
 
 /// Places every label near its point without overlapping another label, a marker or (where it
 /// can) a curve, inside the plot area: candidate positions on rings of growing radius around
-/// the point, the cheapest taken, greedily from left to right. A label put away from its point
+/// the point, the cheapest taken, greedily by priority, then from left to right. A label put away from its point
 /// gets a leader line. A label that finds no place free of other labels inside the plot area is
 /// left out (its marker and the key still show the point): on a diagram with thousands of special
 /// points (long chains) overlapping text would hide the curves.
-void placeLabels(std::vector<PlacedLabel>& labels, const Frame& f, const Occupancy& curves) {
+void placeLabels(std::vector<PlacedLabel>& labels, const Frame& f, const Occupancy& curves,
+                 const std::vector<double>& rings = kLabelRings) {
   const Box area{f.width * f.left, f.height * f.bottom, f.width * f.right, f.height * f.top};
   std::vector<Box> markers;
   for (const PlacedLabel& l : labels)
@@ -222,7 +239,9 @@ void placeLabels(std::vector<PlacedLabel>& labels, const Frame& f, const Occupan
                        l.anchor.y() + kMarkerHalf});
   std::vector<size_t> order(labels.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return labels[a].anchor.x() < labels[b].anchor.x(); });
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return std::pair(labels[a].priority, labels[a].anchor.x()) < std::pair(labels[b].priority, labels[b].anchor.x());
+  });
   std::vector<Box> placed;
   const double pi = std::acos(-1.0);
   for (size_t i : order) {
@@ -230,7 +249,7 @@ void placeLabels(std::vector<PlacedLabel>& labels, const Frame& f, const Occupan
     const double w = kLabelCharWidth * double(glyphs(l.text)) + 4.0, h = kLabelHeight;
     double bestCost = std::numeric_limits<double>::infinity();
     int rank = 0;
-    for (double r : {2.0, 18.0, 36.0, 58.0, 84.0, 116.0, 156.0}) {
+    for (double r : rings) {
       for (int k = 0; k < 16; ++k, ++rank) {
         // preferred directions first: the four diagonals, then the axes, then the rest
         static const int kOrder[16] = {2, 6, 14, 10, 0, 8, 4, 12, 1, 3, 5, 7, 9, 11, 13, 15};
@@ -294,18 +313,113 @@ struct SpecialStyle {
   const char* type;
   int point;       ///< gnuplot point type, filled; point - 1 is the open outline
   const char* key;
+  const char* color;  ///< summary mode: the type's colour (markers of all cases)
 };
-const SpecialStyle kSpecialStyles[] = {{"BP", 7, "BP branch point"},   {"LP", 9, "LP fold"},
-                                       {"LPF", 9, "LPF reaction fold"},  {"BD", 5, "BD joint limit"},
-                                       {"KMIN", 13, "KMIN Kxx minimum"}, {"JUMP", 11, "JUMP release"},
-                                       {"CT", 15, "CT contact (joint locks)"}, {"RL", 3, "RL contact released"},
-                                       {"BC", 5, "BC base contact (detected)"}, {"SC", 5, "SC self contact (detected)"}};
+const SpecialStyle kSpecialStyles[] = {{"BP", 7, "BP branch point", "#000000"},
+                                       {"LP", 9, "LP fold", "#d62728"},
+                                       {"LPF", 9, "LPF reaction fold", "#ff7f0e"},
+                                       {"BD", 5, "BD joint limit", "#8c564b"},
+                                       {"KMIN", 13, "KMIN Kxx minimum", "#9467bd"},
+                                       {"JUMP", 11, "JUMP release", "#ff7f0e"},
+                                       {"CT", 15, "CT contact (joint locks)", "#2ca02c"},
+                                       {"RL", 3, "RL contact released", "#17becf"},
+                                       {"BC", 5, "BC base contact (detected)", "#e377c2"},
+                                       {"SC", 5, "SC self contact (detected)", "#7f7f7f"}};
 
 const SpecialStyle& specialStyle(const std::string& type) {
   for (const SpecialStyle& s : kSpecialStyles)
     if (type == s.type) return s;
-  static const SpecialStyle other{"", 7, "special point"};
+  static const SpecialStyle other{"", 7, "special point", "#555555"};
   return other;
+}
+
+// ---- summary mode (long chains, large trees) -----------------------------------------------------
+
+// A bifurcation diagram of a 50-segment chain carries thousands of special points (2479 in the
+// default scene at n = 50: 882 LP, 764 CT, 352 RL, …). Like AUTO's and BifurcationKit's plots of
+// large diagrams, the summary labels only the points a reader steers by and draws the others as
+// small markers by type, counted in the key.
+
+/// `labels: auto` draws the summary above this many markers (the shipped 3-segment scenes have
+/// at most a few dozen, all labelled).
+constexpr size_t kSummaryAboveMarkers = 60;
+/// Summary labels beyond the branch points of the primary branch (which are all labelled): the
+/// jumps, then the first fold of each branch in the order the branches were traced.
+constexpr size_t kSummaryExtraLabels = 24;
+/// Summary: unlabelled markers of one case and type closer than this many pixels are drawn once.
+constexpr double kThinPixels = 4.0;
+
+/// How much a special point matters in a summary, most first.
+enum class Importance { PrimaryBranchPoint, Jump, FirstFold, Other };
+
+/// Per special record of a case (same order as `cr.specials`): the branch points of the primary
+/// branches (those with no parent: the start), the jumps (a load history's JUMP, a fold with a
+/// simulated jump), the first fold (LP, LPF) of each branch in the order the tracer reported
+/// them, the rest.
+std::vector<Importance> importance(const CaseResult& cr) {
+  std::vector<int> primary;
+  for (const BranchRecord& b : cr.branches)
+    if (b.parent < 0) primary.push_back(b.id);
+  std::vector<int> folded;
+  std::vector<Importance> out;
+  for (const SpecialRecord& r : cr.specials) {
+    Importance k = Importance::Other;
+    if (r.type == "BP" && std::find(primary.begin(), primary.end(), r.branch) != primary.end())
+      k = Importance::PrimaryBranchPoint;
+    else if (r.type == "JUMP" || r.jumpSuccess)
+      k = Importance::Jump;
+    else if ((r.type == "LP" || r.type == "LPF") && std::find(folded.begin(), folded.end(), r.branch) == folded.end()) {
+      folded.push_back(r.branch);
+      k = Importance::FirstFold;
+    }
+    out.push_back(k);
+  }
+  return out;
+}
+
+/// Indices of the points kept when points closer than `radius` are drawn once: greedy in the
+/// given order over a hash grid of cell `radius` (O(points log points)).
+std::vector<size_t> thinned(const std::vector<Eigen::Vector2d>& px, double radius) {
+  std::vector<size_t> kept;
+  std::map<std::pair<long, long>, std::vector<size_t>> grid;  // cell -> kept points in it
+  for (size_t i = 0; i < px.size(); ++i) {
+    if (!px[i].allFinite()) continue;
+    const long cx = long(std::floor(px[i].x() / radius)), cy = long(std::floor(px[i].y() / radius));
+    bool near = false;
+    for (long dx = -1; dx <= 1 && !near; ++dx)
+      for (long dy = -1; dy <= 1 && !near; ++dy) {
+        const auto it = grid.find({cx + dx, cy + dy});
+        if (it == grid.end()) continue;
+        for (size_t k : it->second) near = near || (px[k] - px[i]).norm() < radius;
+      }
+    if (near) continue;
+    grid[{cx, cy}].push_back(i);
+    kept.push_back(i);
+  }
+  return kept;
+}
+
+/// Line width and transparency of the branches (gnuplot's `#AARRGGBB`, AA = 0 opaque) such that
+/// hundreds of overlapping branches stay apart: full width up to a dozen branches, then thinner
+/// and translucent, unstable parts fainter than stable ones.
+struct BranchLook {
+  double width = 2.0;
+  int alphaStable = 0, alphaUnstable = 0;
+};
+BranchLook branchLook(size_t branches) {
+  BranchLook look;
+  if (branches <= 12) return look;
+  look.width = std::max(0.7, 2.0 * std::sqrt(12.0 / double(branches)));
+  look.alphaStable = int(std::min<size_t>(0x70, 0x20 + branches / 2));
+  look.alphaUnstable = std::min(0xB0, look.alphaStable + 0x40);
+  return look;
+}
+
+std::string withAlpha(const std::string& rgb, int alpha) {
+  if (alpha <= 0 || rgb.size() != 7 || rgb[0] != '#') return rgb;
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "%02X", alpha & 0xFF);
+  return "#" + std::string(buf) + rgb.substr(1);
 }
 
 void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
@@ -368,20 +482,50 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     std::string type;
     double x, y;
     std::string label;
+    Importance rank;
   };
   std::vector<Mark> marks;
+  std::map<std::string, size_t> records;  // special points per type over the plot's cases (the key's counts)
+  size_t branches = 0;                    // branches drawn, over the plot's cases
+  size_t markers = 0;  // one per special point and column
+  for (size_t c : cases) markers += run.cases[c].specials.size() * ny;
+  const bool summary =
+      spec.labels == PlotLabels::Summary || (spec.labels == PlotLabels::Auto && markers > kSummaryAboveMarkers);
   for (size_t o = 0; o < cases.size(); ++o) {
     const CaseResult& cr = run.cases[cases[o]];
-    for (const SpecialRecord& r : cr.specials) {
+    const std::vector<Importance> rank = importance(cr);
+    for (size_t i = 0; i < cr.specials.size(); ++i) {
+      const SpecialRecord& r = cr.specials[i];
+      ++records[r.type];
       for (size_t j = 0; j < ny; ++j) {
         const double x = specialValue(spec.x, r, cr), y = specialValue(spec.y[j], r, cr);
         if (!std::isfinite(x) || !std::isfinite(y)) continue;
         std::string label = r.type;
-        if (r.type == "BP" && !r.shape.empty() && r.shape != "other") label += " " + r.shape;
-        marks.push_back({o, r.type, x, y, label});
+        // a summary's branch points of long chains: "BP 12" for mode 12 (the key says so)
+        if (r.type == "BP" && !r.shape.empty() && r.shape != "other")
+          label += " " + (summary && r.shape.rfind("mode ", 0) == 0 ? r.shape.substr(5) : r.shape);
+        marks.push_back({o, r.type, x, y, label, rank[i]});
         extend(x, y);
       }
     }
+    std::vector<int> ids;
+    for (const PointRecord& p : cr.points)
+      if (ids.empty() || ids.back() != p.branch) ids.push_back(p.branch);
+    std::sort(ids.begin(), ids.end());
+    branches += size_t(std::unique(ids.begin(), ids.end()) - ids.begin());
+  }
+  const BranchLook look = branchLook(branches);
+  // the marks labelled: all of them, or in a summary the primary branch's branch points and then,
+  // up to a budget, the jumps and first folds (in the order the branches were traced)
+  std::vector<bool> labelled(marks.size(), !summary);
+  if (summary) {
+    std::vector<size_t> order;
+    for (size_t i = 0; i < marks.size(); ++i)
+      if (marks[i].rank != Importance::Other) order.push_back(i);
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return marks[a].rank < marks[b].rank; });
+    size_t extra = 0;
+    for (size_t i : order)
+      if (marks[i].rank == Importance::PrimaryBranchPoint || extra++ < kSummaryExtraLabels) labelled[i] = true;
   }
   // jumps: arrows from the fold to the landing point
   BlockFile jumps;
@@ -424,8 +568,10 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     if (std::find(typesPresent.begin(), typesPresent.end(), m.type) == typesPresent.end()) typesPresent.push_back(m.type);
   // the key's width: gnuplot sizes it with the main font's advance (11 pt: about 8.2 px per
   // character) over the longest title plus the sample
-  size_t keyChars = 8;
-  for (const std::string& type : typesPresent) keyChars = std::max(keyChars, glyphs(specialStyle(type).key));
+  size_t keyChars = summary ? 22 : 8;  // a summary's key title: lines of up to 22 characters
+  // a summary's key gives the count of each type: " (2479)"
+  for (const std::string& type : typesPresent)
+    keyChars = std::max(keyChars, glyphs(specialStyle(type).key) + (summary ? 3 + std::to_string(records[type]).size() : 0));
   if (multiCase || ny > 1)
     for (size_t o = 0; o < cases.size(); ++o)
       for (size_t j = 0; j < ny; ++j)
@@ -439,27 +585,51 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     for (size_t i = 0; i + 1 < line.size(); ++i)
       occupied.segment(f.pixel(line[i].x(), line[i].y()), f.pixel(line[i + 1].x(), line[i + 1].y()));
   for (const auto& [a, b] : arrows) occupied.segment(f.pixel(a.x(), a.y()), f.pixel(b.x(), b.y()));
+  // a summary's unlabelled markers, per case and type, those closer than kThinPixels drawn once;
+  // a label may cover them only where it must (like a curve)
+  std::vector<bool> drawn(marks.size(), true);
+  if (summary) {
+    for (size_t o = 0; o < cases.size(); ++o)
+      for (const std::string& type : typesPresent) {
+        std::vector<size_t> idx;
+        std::vector<Eigen::Vector2d> px;
+        for (size_t i = 0; i < marks.size(); ++i)
+          if (!labelled[i] && marks[i].ordinal == o && marks[i].type == type) {
+            idx.push_back(i);
+            px.push_back(f.pixel(marks[i].x, marks[i].y));
+            drawn[i] = false;
+          }
+        for (size_t k : thinned(px, kThinPixels)) {
+          drawn[idx[k]] = true;
+          occupied.fill({px[k].x() - 2.0, px[k].y() - 2.0, px[k].x() + 2.0, px[k].y() + 2.0});
+        }
+      }
+  }
   occupied.finish();
 
   // merge the labels of one case's points drawn at the same place
   std::vector<PlacedLabel> labels;
   std::vector<size_t> labelOrdinal;
   std::vector<std::vector<std::string>> parts;
-  for (const Mark& m : marks) {
+  for (size_t i = 0; i < marks.size(); ++i) {
+    if (!labelled[i]) continue;
+    const Mark& m = marks[i];
     const Eigen::Vector2d px = f.pixel(m.x, m.y);
     size_t k = 0;
     while (k < labels.size() && (labelOrdinal[k] != m.ordinal || (labels[k].anchor - px).norm() > 3.0)) ++k;
     if (k == labels.size()) {
       labels.emplace_back();
       labels.back().anchor = px;
+      labels.back().priority = summary ? int(m.rank) : 0;
       labelOrdinal.push_back(m.ordinal);
       parts.emplace_back();
     }
+    labels[k].priority = std::min(labels[k].priority, summary ? int(m.rank) : 0);
     if (std::find(parts[k].begin(), parts[k].end(), m.label) == parts[k].end()) parts[k].push_back(m.label);
   }
   for (size_t k = 0; k < labels.size(); ++k)
     for (size_t i = 0; i < parts[k].size(); ++i) labels[k].text += (i ? ", " : "") + parts[k][i];
-  placeLabels(labels, f, occupied);
+  placeLabels(labels, f, occupied, summary ? kSummaryLabelRings : kLabelRings);
 
   const std::string stem = spec.name;
   data.write(dir / (stem + ".dat"));
@@ -470,19 +640,27 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     int block;
     size_t ordinal;
     std::string type;
+    bool small;  ///< a summary's unlabelled markers
   };
   std::vector<SpecialBlock> specialBlocks;
   for (size_t o = 0; o < cases.size(); ++o)
-    for (const std::string& type : typesPresent) {
-      bool any = false;
-      for (const Mark& m : marks) any = any || (m.ordinal == o && m.type == type);
-      if (!any) continue;
-      const int block = sp.begin();
-      sp.text("# case " + std::to_string(cases[o]) + " (" + run.cases[cases[o]].label + "): " + type);
-      for (const Mark& m : marks)
-        if (m.ordinal == o && m.type == type) sp.point({m.x, m.y});
-      specialBlocks.push_back({block, o, type});
-    }
+    for (const std::string& type : typesPresent)
+      for (bool small : {false, true}) {
+        size_t count = 0, shown = 0;
+        for (size_t i = 0; i < marks.size(); ++i)
+          if (marks[i].ordinal == o && marks[i].type == type && labelled[i] != small) ++count, shown += drawn[i];
+        if (shown == 0) continue;
+        const int block = sp.begin();
+        std::string comment = "# case " + std::to_string(cases[o]) + " (" + run.cases[cases[o]].label + "): " + type;
+        if (small)
+          comment += " unlabelled, " + std::to_string(shown) + " of " + std::to_string(count) +
+                     " drawn (the others within " + num(kThinPixels) + " px of one drawn)";
+        sp.text(comment);
+        for (size_t i = 0; i < marks.size(); ++i)
+          if (marks[i].ordinal == o && marks[i].type == type && labelled[i] != small && drawn[i])
+            sp.point({marks[i].x, marks[i].y});
+        specialBlocks.push_back({block, o, type, small});
+      }
   std::vector<int> labelBlocks(cases.size(), -1);
   for (size_t o = 0; o < cases.size(); ++o) {
     bool any = false;
@@ -512,6 +690,9 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
                                                                    : "Bifurcation diagram: stable solid, unstable dashed")
                                : spec.title);
   s.body << "set key samplen 4\n";
+  if (summary)
+    s.body << "set key title \"labelled: branch points\\nof the primary branch\\n(BP k: mode k), jumps,\\nfirst "
+              "fold per branch;\\nkey: count per type\" left\n";
   s.body << "set xlabel " << quote(parameterColumnLabel(scene, spec.x)) << "\n";
   std::string ylabel;
   for (size_t j = 0; j < ny; ++j) ylabel += (j ? ", " : "") + columnLabel(spec.y[j]);
@@ -542,8 +723,10 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       if (multiCase) title = run.cases[cases[se.ordinal]].label;
       if (ny > 1) title += (title.empty() ? "" : " ") + spec.y[se.yIdx];
     }
-    clause(quote(stem + ".dat") + " index " + std::to_string(se.block) + " using 1:2 with lines lw 2 lc rgb " +
-           quote(seriesColor(se.ordinal, se.yIdx)) + " dt " + (se.stable ? "1" : "2") +
+    clause(quote(stem + ".dat") + " index " + std::to_string(se.block) + " using 1:2 with lines lw " +
+           num(look.width) + " lc rgb " +
+           quote(withAlpha(seriesColor(se.ordinal, se.yIdx), se.stable ? look.alphaStable : look.alphaUnstable)) +
+           " dt " + (se.stable ? "1" : "2") +
            (title.empty() ? std::string(" notitle") : " title " + quote(title) + " noenhanced"));
   }
   const std::string keyColor = perSeriesKey ? std::string("black") : seriesColor(0, 0);
@@ -558,18 +741,29 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       if (labelBlocks[o] >= 0)
         clause(quote(stem + "_labels.dat") + " index " + std::to_string(labelBlocks[o]) +
                " using 1:2:($6-$1):($7-$2) with vectors nohead lw 0.8 lc rgb '#777777' notitle");
-    for (const SpecialBlock& b : specialBlocks) {
-      const SpecialStyle& st = specialStyle(b.type);
-      const std::string fill = multiCase ? color(b.ordinal * ny) : std::string("black");
-      clause(quote(stem + "_special.dat") + " index " + std::to_string(b.block) + " using 1:2 with points pt " +
-             std::to_string(st.point) + " ps 1.4 lc rgb " + quote(fill) + " notitle");
-      clause(quote(stem + "_special.dat") + " index " + std::to_string(b.block) + " using 1:2 with points pt " +
-             std::to_string(st.point - 1) + " ps 1.4 lw 1 lc rgb 'black' notitle");
-    }
+    // a summary's small markers first, under the labelled ones
+    for (bool small : {true, false})
+      for (const SpecialBlock& b : specialBlocks) {
+        if (b.small != small) continue;
+        const SpecialStyle& st = specialStyle(b.type);
+        const std::string at = quote(stem + "_special.dat") + " index " + std::to_string(b.block) + " using 1:2";
+        if (small) {
+          clause(at + " with points pt " + std::to_string(st.point) + " ps 0.5 lc rgb " + quote(st.color) + " notitle");
+          continue;
+        }
+        const std::string fill = summary ? st.color : multiCase ? color(b.ordinal * ny) : std::string("black");
+        clause(at + " with points pt " + std::to_string(st.point) + " ps 1.4 lc rgb " + quote(fill) + " notitle");
+        clause(at + " with points pt " + std::to_string(st.point - 1) + " ps 1.4 lw 1 lc rgb 'black' notitle");
+      }
     for (const std::string& type : typesPresent) {
       const SpecialStyle& st = specialStyle(type);
-      clause("keyentry with points pt " + std::to_string(st.point) + " ps 1.4 lc rgb 'black' title " +
-             quote(*st.type ? st.key : type) + " noenhanced");
+      const std::string title = *st.type ? st.key : type;
+      if (summary)
+        clause("keyentry with points pt " + std::to_string(st.point) + " ps 1.2 lc rgb " + quote(st.color) + " title " +
+               quote(title + " (" + std::to_string(records[type]) + ")") + " noenhanced");
+      else
+        clause("keyentry with points pt " + std::to_string(st.point) + " ps 1.4 lc rgb 'black' title " + quote(title) +
+               " noenhanced");
     }
     for (size_t o = 0; o < cases.size(); ++o)
       if (labelBlocks[o] >= 0)
@@ -705,11 +899,27 @@ void energyPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
 
 // ---- chain shapes ------------------------------------------------------------------------------
 
+/// Below this many pixels per segment a chain is drawn as its centre line (base, joints, end):
+/// the triangles, springs and joint-limit arcs of a 50-segment chain across a 500-pixel panel
+/// (8 px a segment) would fill it with ink and hide the shape.
+constexpr double kDetailedSegmentPixels = 14.0;
+
+/// Whether a chain is drawn in detail in a panel of `panel` pixels (width, height) showing the
+/// data box `box` to scale (`set size ratio -1`: the scale is the smaller of the two ratios).
+bool detailedChain(const mechanics::Chain& chain, const Eigen::AlignedBox2d& box, const Eigen::Vector2d& panel) {
+  const Eigen::Vector2d extent = box.sizes();
+  const double scale = std::min(0.8 * panel.x() / extent.x(), 0.7 * panel.y() / extent.y());
+  return chain.size() == 0 || scale * chain.length() / double(chain.size()) >= kDetailedSegmentPixels;
+}
+
 // Outline of one chain at joint angles q: triangles (closed polygons), springs (zigzags),
 // joint-limit arcs; appended to the given block files. `touch`: where the chain has gone through
 // the clamp's wall or through itself (contact_geometry.h: the deepest vertex / the crossing).
+// Not `detailed` (a long chain, kDetailedSegmentPixels): `triangles` gets the centre line alone
+// and springs and limits stay empty; joints within 5 % of a limit are still marked.
 void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFile& triangles, BlockFile& springs,
-               BlockFile& limits, BlockFile& joints, BlockFile& nearLimit, BlockFile* touch = nullptr) {
+               BlockFile& limits, BlockFile& joints, BlockFile& nearLimit, BlockFile* touch = nullptr,
+               bool detailed = true) {
   if (touch) {
     const mechanics::BaseClearance base = mechanics::baseClearance(chain, q);
     if (base.distance <= 0.0) touch->point({base.point.x(), base.point.y()});
@@ -718,6 +928,20 @@ void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFil
   }
   const int n = chain.size();
   const Eigen::Matrix2Xd P = mechanics::jointPositions(chain, q);
+  // joint i within 5 % of its range from a limit
+  auto nearLimitAt = [&](int i) {
+    const double lo = chain.lowerLimits()[i], hi = chain.upperLimits()[i];
+    return std::min(hi - q[i], q[i] - lo) / (hi - lo) < 0.05;
+  };
+  if (!detailed) {
+    for (Eigen::Index j = 0; j < P.cols(); ++j) triangles.point({P(0, j), P(1, j)});
+    triangles.breakLine();
+    for (int i = 0; i < n; ++i) {
+      joints.point({P(0, i + 1), P(1, i + 1)});
+      if (nearLimitAt(i)) nearLimit.point({P(0, i + 1), P(1, i + 1)});
+    }
+    return;
+  }
   double theta = 0.0;
   auto dir = [](double t) { return Eigen::Vector2d(std::cos(t), std::sin(t)); };
   auto nrm = [](double t) { return Eigen::Vector2d(-std::sin(t), std::cos(t)); };
@@ -766,57 +990,61 @@ void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFil
       limits.breakLine();
     }
     joints.point({joint.x(), joint.y()});
-    const double margin = std::min(hi - q[i], q[i] - lo) / (hi - lo);
-    if (margin < 0.05) nearLimit.point({joint.x(), joint.y()});
+    if (nearLimitAt(i)) nearLimit.point({joint.x(), joint.y()});
     theta = after;
   }
 }
 
 /// The plot command of one chain drawn by drawChain (files BASE_{lim,tri,spr,jnt,near}.dat),
-/// the clamped base a hatched wall; `under`: a plot clause drawn first, beneath the chain.
+/// the clamped base a hatched wall; `under`: a plot clause drawn first, beneath the chain. Not
+/// `detailed`: the centre line, and only the joints near a limit marked (small red rings).
 void chainPanel(std::ostream& os, const std::string& base, double L, const std::string& under = std::string(),
-                bool touch = false) {
+                bool touch = false, bool detailed = true) {
   os << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
      << " fc rgb '#bbbbbb' fs pattern 4 border lc rgb '#555555'\n";
-  os << "plot " << (under.empty() ? std::string() : under + ", \\\n  ") << quote(base + "_lim.dat")
-     << " using 1:2 with lines lc rgb '#aaaaaa' lw 1, \\\n"
-     << "  " << quote(base + "_tri.dat")
-     << " using 1:2 with filledcurves closed fc rgb '#c6dbef' fs solid 1.0 border lc rgb '#08306b', \\\n"
-     << "  " << quote(base + "_tri.dat") << " using 1:2 with lines lc rgb '#08306b' lw 1.5, \\\n"
-     << "  " << quote(base + "_spr.dat") << " using 1:2 with lines lc rgb '#e6550d' lw 1.5, \\\n"
-     << "  " << quote(base + "_jnt.dat") << " using 1:2 with points pt 7 ps 0.9 lc rgb 'black', \\\n"
-     << "  " << quote(base + "_near.dat") << " using 1:2 with points pt 6 ps 2.5 lw 2 lc rgb 'red'"
-     << (touch ? ", \\\n  " + quote(base + "_touch.dat") + " using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'magenta'" : std::string())
-     << "\n";
+  const std::string touchClause =
+      touch ? ", \\\n  " + quote(base + "_touch.dat") + " using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'magenta'"
+            : std::string();
+  os << "plot " << (under.empty() ? std::string() : under + ", \\\n  ");
+  if (detailed)
+    os << quote(base + "_lim.dat") << " using 1:2 with lines lc rgb '#aaaaaa' lw 1, \\\n"
+       << "  " << quote(base + "_tri.dat")
+       << " using 1:2 with filledcurves closed fc rgb '#c6dbef' fs solid 1.0 border lc rgb '#08306b', \\\n"
+       << "  " << quote(base + "_tri.dat") << " using 1:2 with lines lc rgb '#08306b' lw 1.5, \\\n"
+       << "  " << quote(base + "_spr.dat") << " using 1:2 with lines lc rgb '#e6550d' lw 1.5, \\\n"
+       << "  " << quote(base + "_jnt.dat") << " using 1:2 with points pt 7 ps 0.9 lc rgb 'black', \\\n"
+       << "  " << quote(base + "_near.dat") << " using 1:2 with points pt 6 ps 2.5 lw 2 lc rgb 'red'";
+  else
+    os << quote(base + "_tri.dat") << " using 1:2 with lines lc rgb '#08306b' lw 2, \\\n"
+       << "  " << quote(base + "_near.dat") << " using 1:2 with points pt 6 ps 1 lw 1.5 lc rgb 'red'";
+  os << touchClause << "\n";
   os << "unset object 1\n";
+}
+
+/// "contact: joint 3U 5L" for a panel title; a long chain's many locked joints are counted.
+std::string lockedTitle(const std::string& locked) {
+  const size_t joints = size_t(std::count(locked.begin(), locked.end(), ' ')) + 1;
+  return joints <= 4 ? ",  contact: joint " + locked : ",  contact: " + std::to_string(joints) + " joints locked";
 }
 
 void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, size_t plotIndex, const fs::path& dir,
                 Script& s, std::vector<std::string>& notes) {
   const std::string stem = spec.name;
   const size_t nc = spec.cases.size(), na = spec.at.size();
-  s.width = std::min<int>(3200, int(520 * na));
-  s.height = std::min<int>(2400, int(330 * nc) + 60);
+  // at most five panels a row: more levels wrap onto further rows of the same case
+  const size_t cols = std::min<size_t>(na, 5), rowsPerCase = (na + cols - 1) / cols;
+  s.width = std::min<int>(3200, int(520 * cols));
+  s.height = std::min<int>(2400, int(330 * nc * rowsPerCase) + 60);
   s.body << "set encoding utf8\nset size ratio -1\nunset key\nset grid lc rgb '#eeeeee'\n";
-  s.body << "set multiplot layout " << nc << "," << na << " title "
+  s.body << "set multiplot layout " << nc * rowsPerCase << "," << cols << " title "
          << quote(spec.title.empty() ? std::string("Chain shapes to scale (units of b); grey arcs: joint limits, "
                                                    "red: joint within 5% of a limit, magenta star: through the clamp or itself")
                                      : spec.title)
          << " font ',11'\n";
 
-  // one scale for every panel: the bounding box of all chains drawn
-  Eigen::AlignedBox2d box;
-  box.extend(Eigen::Vector2d(0.0, 0.0));
-  for (size_t c : selected(spec)) {
-    const CaseResult& cr = run.cases[c];
-    box.extend(Eigen::Vector2d(cr.chain.length(), 0.0));
-    for (const PointRecord& p : cr.points) {
-      const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, p.q);
-      for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
-    }
-  }
-  const double pad = 1.2;
-  const double x0 = box.min().x() - pad, x1 = box.max().x() + pad, y0 = box.min().y() - pad, y1 = box.max().y() + pad;
+  // per case, the point drawn at each requested level (null: not drawn, `missing` says why)
+  std::vector<std::vector<const PointRecord*>> chosenOf;
+  std::vector<std::vector<std::string>> missingOf;
   for (size_t c : selected(spec)) {
     const CaseResult& cr = run.cases[c];
     const std::string& parameter = scene.cases[c].path.parameter;
@@ -829,8 +1057,8 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
         spacing = std::max(spacing, std::abs(p.parameter - cr.points[i - 1].parameter));
     }
     const double slack = 1e-9 * std::max(std::abs(lo), std::abs(hi));
-    std::vector<const PointRecord*> chosen;
-    std::vector<std::string> missing(na);
+    std::vector<const PointRecord*>& chosen = chosenOf.emplace_back();
+    std::vector<std::string>& missing = missingOf.emplace_back(na);
     for (size_t k = 0; k < na; ++k) {
       const double at = spec.at[k];
       // the stable point nearest to the requested level; among equals, the most deflected
@@ -865,8 +1093,38 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       }
       chosen.push_back(best);
     }
+  }
+
+  // one scale for every panel: the bounding box of all traced chains; long chains, drawn as their
+  // centre lines, to the box of the chains drawn (the coils of unstable branches far from any
+  // level asked for would shrink them to a few pixels)
+  auto boxOf = [&](bool drawnOnly) {
+    Eigen::AlignedBox2d box;
+    box.extend(Eigen::Vector2d(0.0, 0.0));
+    for (size_t o = 0; o < nc; ++o) {
+      const CaseResult& cr = run.cases[size_t(spec.cases[o])];
+      box.extend(Eigen::Vector2d(cr.chain.length(), 0.0));
+      for (const PointRecord& p : cr.points) {
+        if (drawnOnly && std::find(chosenOf[o].begin(), chosenOf[o].end(), &p) == chosenOf[o].end()) continue;
+        const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, p.q);
+        for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
+      }
+    }
+    return box;
+  };
+  Eigen::AlignedBox2d box = boxOf(false);
+  const Eigen::Vector2d panel(double(s.width) / double(cols), double(s.height - 60) / double(nc * rowsPerCase));
+  bool detailed = true;
+  for (size_t c : selected(spec)) detailed = detailed && detailedChain(run.cases[c].chain, box, panel);
+  if (!detailed) box = boxOf(true);
+  const double pad = 1.2;
+  const double x0 = box.min().x() - pad, x1 = box.max().x() + pad, y0 = box.min().y() - pad, y1 = box.max().y() + pad;
+  for (size_t o = 0; o < nc; ++o) {
+    const size_t c = size_t(spec.cases[o]);
+    const CaseResult& cr = run.cases[c];
+    const std::string& parameter = scene.cases[c].path.parameter;
     for (size_t k = 0; k < na; ++k) {
-      const PointRecord* p = chosen[k];
+      const PointRecord* p = chosenOf[o][k];
       BlockFile tri, spr, lim, jnt, near, touch;
       for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near, &touch}) {
         f->begin();
@@ -875,8 +1133,8 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       }
       std::ostringstream title;
       if (p) {
-        drawChain(cr.chain, p->q, tri, spr, lim, jnt, near, &touch);
-        title << (nc > 1 ? cr.label + ": " : std::string()) << scene.cases[c].path.parameter << " = "
+        drawChain(cr.chain, p->q, tri, spr, lim, jnt, near, &touch, detailed);
+        title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = "
               << num(std::round(p->parameter * 1e4) / 1e4);
         // the nearest traced point is drawn; the title says when it differs from the request
         // beyond the title's rounding
@@ -885,10 +1143,10 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
         if (p->haveStiffness && std::isfinite(p->K(0, 0)))
           title << ",  K_{xx} = " << num(std::round(p->K(0, 0) * 1e4) / 1e4) << ", K_{yy} = "
                 << num(std::round(p->K(1, 1) * 1e4) / 1e4);
-        if (!p->locked.empty()) title << ",  contact: joint " << p->locked;  // locked at a limit
+        if (!p->locked.empty()) title << lockedTitle(p->locked);  // locked at a limit
       } else {
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(spec.at[k]) << ": not drawn";
-        s.body << "set label 1 " << quote(missing[k]) << " at graph 0.5, graph 0.5 center font ',9' noenhanced\n";
+        s.body << "set label 1 " << quote(missingOf[o][k]) << " at graph 0.5, graph 0.5 center font ',9' noenhanced\n";
       }
       const std::string base = stem + "_" + std::to_string(c) + "_" + std::to_string(k);
       tri.write(dir / (base + "_tri.dat"));
@@ -901,9 +1159,11 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       s.body << "set title " << quote(title.str()) << " font ',10'\n";
       s.body << "set xrange [" << num(std::min(x0, -0.1 * L)) << ":" << num(x1) << "]\nset yrange [" << num(y0) << ":"
              << num(y1) << "]\n";
-      chainPanel(s.body, base, L, std::string(), true);
+      chainPanel(s.body, base, L, std::string(), true, detailed);
       s.body << "unset label 1\n";
     }
+    // the last row of a case that wraps is filled up, so that the next case starts a row
+    for (size_t k = na; k < cols * rowsPerCase; ++k) s.body << "set multiplot next\n";
   }
   s.body << "unset multiplot\n";
 }
@@ -974,6 +1234,7 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     }
     const double pad = 1.2, L = cr.chain.length();
     const bool ok[2] = {r.rest.size() == cr.chain.size(), r.haveStatic && r.staticShape.size() == cr.chain.size()};
+    const bool detailed = detailedChain(cr.chain, box, Eigen::Vector2d(s.width / 3.0, 420.0));
     for (int k = 0; k < 2; ++k) {
       const Eigen::VectorXd& q = k == 0 ? r.rest : r.staticShape;
       const std::string b = base + (k == 0 ? "_rest" : "_static");
@@ -983,8 +1244,9 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
         f->point({nan, nan});
         f->breakLine();
       }
-      if (ok[k]) drawChain(cr.chain, q, tri, spr, lim, jnt, near);
-      if (cr.q0.size() == cr.chain.size()) drawChain(cr.chain, cr.q0, start, startSpr, startLim, startJnt, startNear);
+      if (ok[k]) drawChain(cr.chain, q, tri, spr, lim, jnt, near, nullptr, detailed);
+      if (cr.q0.size() == cr.chain.size())
+        drawChain(cr.chain, cr.q0, start, startSpr, startLim, startJnt, startNear, nullptr, detailed);
       tri.write(dir / (b + "_tri.dat"));
       spr.write(dir / (b + "_spr.dat"));
       lim.write(dir / (b + "_lim.dat"));
@@ -1004,7 +1266,8 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       s.body << "unset key\nunset logscale x\nset format x '% h'\nunset xlabel\nunset ylabel\nset size ratio -1\n";
       s.body << "set xrange [" << num(std::min(box.min().x() - pad, -0.1 * L)) << ":" << num(box.max().x() + pad)
              << "]\nset yrange [" << num(box.min().y() - pad) << ":" << num(box.max().y() + pad) << "]\n";
-      chainPanel(s.body, b, L, quote(b + "_start.dat") + " using 1:2 with lines lc rgb '#bbbbbb' lw 1 dt 2");
+      chainPanel(s.body, b, L, quote(b + "_start.dat") + " using 1:2 with lines lc rgb '#bbbbbb' lw 1 dt 2", false,
+                 detailed);
       s.body << "set autoscale xy\n";
     }
   }

@@ -374,12 +374,20 @@ const char* const kTail = R"PAGE(</script>
       var x = [], y = [];
       for (var i = 0; i < s.joints.length; i += 2) { x.push(s.joints[i]); y.push(s.joints[i + 1]); }
       lines.push({x: x, y: y, color: s.color, dash: s.dash, width: 2.5});
-      for (var k = 0; k < x.length; ++k) marks.push({x: x[k], y: y[k], color: k === 0 || k === x.length - 1 ? '#000' : s.color, r: 3});
+      // a dot per joint while they are apart (up to 30 segments), else the base and the end only
+      for (var k = 0; k < x.length; ++k)
+        if (x.length <= 32 || k === 0 || k === x.length - 1)
+          marks.push({x: x[k], y: y[k], color: k === 0 || k === x.length - 1 ? '#000' : s.color, r: 3});
     });
     frame = frame || caseFrame(c);
-    // invisible frame line, so every shape of the case is drawn at the same scale
-    lines.push({x: [Math.min.apply(null, frame.xs), Math.max.apply(null, frame.xs)],
-                y: [Math.min.apply(null, frame.ys), Math.max.apply(null, frame.ys)], color: 'none', width: 0});
+    // invisible frame line, so every shape of the case is drawn at the same scale; bounds by a
+    // loop (Math.min.apply over a long chain's 10^5 coordinates overflows the call stack)
+    function bounds(v) {
+      var lo = Infinity, hi = -Infinity;
+      for (var i = 0; i < v.length; ++i) { if (v[i] < lo) lo = v[i]; if (v[i] > hi) hi = v[i]; }
+      return [lo, hi];
+    }
+    lines.push({x: bounds(frame.xs), y: bounds(frame.ys), color: 'none', width: 0});
     var g = chart(target, {lines: lines, marks: marks, equal: true, width: 560, height: 400, cls: 'shape',
                            xlabel: 'x (units of b)', ylabel: 'y (units of b)', title: info.title,
                            legend: info.legend});

@@ -143,6 +143,12 @@ struct SolverSpec {
 enum class PlotType { Bifurcation, Stiffness, EnergyCurves, TorqueAngle, Shapes, SuddenLoad, CriticalCurves };
 const char* toString(PlotType t);
 
+/// Which special points a bifurcation or stiffness plot labels (docs/scenes.md, `plots`): all of
+/// them, or a summary (the branch points of the primary branch, jumps, the first fold of each
+/// branch; the others small unlabelled markers counted in the key); `Auto` picks the summary
+/// above a number of markers (long chains, large trees).
+enum class PlotLabels { Auto, All, Summary };
+
 struct PlotSpec {
   PlotType type = PlotType::Bifurcation;
   std::string name;                  ///< output file stem
@@ -151,6 +157,7 @@ struct PlotSpec {
   std::vector<double> at;            ///< shapes: parameter values to draw the chain at
   std::string title;
   std::vector<int> cases;            ///< indices of the cases drawn (default: all)
+  PlotLabels labels = PlotLabels::Auto;  ///< bifurcation / stiffness: which special points are labelled
 };
 
 /// One complete run: a chain, an end condition and a path.

@@ -164,7 +164,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
   PlotSpec s;
   json obj = v;
   if (v.is_string()) obj = json{{"type", v}};
-  r.onlyKeys(obj, p, {"type", "name", "x", "y", "at", "title", "cases"});
+  r.onlyKeys(obj, p, {"type", "name", "x", "y", "at", "title", "cases", "labels"});
   if (obj.contains("cases")) {
     const json& cs = obj["cases"];
     if (!cs.is_array() || cs.empty()) r.expected(p / "cases", cs, "a non-empty array of case indices (0-based)");
@@ -212,7 +212,16 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
   if (!columns) {
     for (const char* key : {"x", "y"})
       if (obj.contains(key)) r.fail(p / key, std::string("a ") + type + " plot has fixed axes; remove this key");
+    if (obj.contains("labels"))
+      r.fail(p / "labels", "only bifurcation and stiffness plots label special points; remove this key");
   } else {
+    if (obj.contains("labels")) {
+      const std::map<std::string, PlotLabels> modes = {
+          {"auto", PlotLabels::Auto}, {"all", PlotLabels::All}, {"summary", PlotLabels::Summary}};
+      const auto mode = modes.find(r.string(obj["labels"], p / "labels"));
+      if (mode == modes.end()) r.expected(p / "labels", obj["labels"], "one of auto, all, summary");
+      s.labels = mode->second;
+    }
     const std::set<std::string> allowed = branchColumns(maxN, a.stiffness);
     std::string list;
     for (const std::string& c : allowed) list += (list.empty() ? "" : ", ") + c;

@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
-#include <chrono>
+#include <ctime>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -32,10 +32,19 @@ std::string arrayOfObjects(int n) {
   return text + "]}";
 }
 
+// CPU time of the calling thread: the time the parse itself ran, not the time other processes
+// held the cores (on a loaded machine the wall clock of one size can stretch more than the
+// other's: a ratio of 3.19 was seen for a linear parser).
+double threadSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
 double secondsToParse(const std::string& text) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const double t0 = threadSeconds();
   const nlohmann::json doc = parseJsonDocument(text, "big.json");
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double s = threadSeconds() - t0;
   REQUIRE(doc["list"].size() > 0);
   return s;
 }
@@ -66,19 +75,22 @@ constexpr bool kSanitized = false;
 }  // namespace
 
 TEST_CASE("an array of 200 000 objects parses in linear time", "[scene][json]") {
-  const std::string small = arrayOfObjects(100000), large = arrayOfObjects(200000);
+  const std::string small = arrayOfObjects(50000), large = arrayOfObjects(200000);
   const nlohmann::json doc = parseJsonDocument(large, "big.json");
   REQUIRE(doc["list"].size() == 200000);
   CHECK(doc["list"][199999]["x"] == 199999);
-  // Best of three against machine noise. The quadratic parser took 19 s for 100 000 objects
-  // (4.7 s for 50 000); the ratio would be 4, the linear one is 2.
+  // The quadratic parser took 19 s for 100 000 objects (4.7 s for 50 000). Four times the
+  // objects: a linear parser takes 4 times as long, a quadratic one 16 times; the bound is their
+  // geometric mean, a factor 2 from either (a doubling, 2 against 4, left only 1.5 and 1.33).
+  // Thread CPU time, best of five interleaved repetitions per size: a load that comes and goes
+  // slows (through shared caches) some repetitions of both sizes, not the best of each.
   double tSmall = 1e9, tLarge = 1e9;
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < 5; ++i) {
     tSmall = std::min(tSmall, secondsToParse(small));
     tLarge = std::min(tLarge, secondsToParse(large));
   }
-  INFO("100 000 objects: " << tSmall << " s, 200 000: " << tLarge << " s");
-  CHECK(tLarge / tSmall < 3.0);
+  INFO("50 000 objects: " << tSmall << " s, 200 000: " << tLarge << " s (thread CPU time)");
+  CHECK(tLarge / tSmall < 8.0);
   // the absolute target of issue 11 (Release: about 0.1 s), scaled for the sanitizers' slowdown
   CHECK(tLarge < (kSanitized ? 10.0 : 1.0));
 }

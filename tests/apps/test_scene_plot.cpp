@@ -17,6 +17,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <unistd.h>
 #include <vector>
 
@@ -170,6 +171,86 @@ bool labelLine(const std::string& line, double (&v)[6], std::string& text) {
   return true;
 }
 
+/// The bifurcation and stiffness plots of an output (those with a NAME_labels.dat).
+std::vector<std::string> labelledPlots(const fs::path& out) {
+  std::vector<std::string> stems;
+  for (const auto& e : fs::directory_iterator(out / "plots")) {
+    const std::string file = e.path().filename().string();
+    if (file.size() >= 11 && file.compare(file.size() - 11, 11, "_labels.dat") == 0)
+      stems.push_back(file.substr(0, file.size() - 11));
+  }
+  std::sort(stems.begin(), stems.end());
+  return stems;
+}
+
+/// The pixel frame of a bifurcation/stiffness plot: its fixed margins and ranges (NAME_body.gp)
+/// on the 1000×700 terminal (NAME.gp).
+struct PixelFrame {
+  double l, r, b, t, x0, x1, y0, y1;
+  static constexpr double W = 1000, H = 700;
+  explicit PixelFrame(const fs::path& plots, const std::string& stem) {
+    const std::string body = slurp(plots / (stem + "_body.gp"));
+    l = setting(body, "lmargin"), r = setting(body, "rmargin"), b = setting(body, "bmargin"), t = setting(body, "tmargin");
+    std::tie(x0, x1) = range(body, "x");
+    std::tie(y0, y1) = range(body, "y");
+    CHECK(slurp(plots / (stem + ".gp")).find("size 1000,700") != std::string::npos);
+  }
+  std::pair<double, double> px(double x, double y) const {
+    return {W * (l + (r - l) * (x - x0) / (x1 - x0)), H * (b + (t - b) * (y - y0) / (y1 - y0))};
+  }
+};
+
+struct Label {
+  double x, y;       ///< the point labelled (data)
+  std::string text;
+};
+
+/// The labels of plot STEM (NAME_labels.dat: x y label_x label_y "text" leader_x leader_y),
+/// checked to lie inside the plot area apart from one another and from every labelled marker,
+/// each leader ending on its label.
+std::vector<Label> labelsApart(const fs::path& plots, const std::string& stem) {
+  const PixelFrame f(plots, stem);
+  struct Box {
+    double x0, y0, x1, y1;
+  };
+  std::vector<Box> boxes, markers;
+  std::vector<Label> labels;
+  std::ifstream in(plots / (stem + "_labels.dat"));
+  std::string line;
+  while (std::getline(in, line)) {
+    double v[6];
+    std::string text;
+    if (!labelLine(line, v, text)) continue;
+    labels.push_back({v[0], v[1], text});
+    const auto [ax, ay] = f.px(v[0], v[1]);
+    const auto [cx, cy] = f.px(v[2], v[3]);
+    // 9 pt DejaVu Sans: at most 6.2 px per character, 11 px high
+    const double w = 6.2 * double(text.size()), h = 11.0;
+    boxes.push_back({cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2});
+    markers.push_back({ax - 5, ay - 5, ax + 5, ay + 5});
+    const Box& bx = boxes.back();
+    CHECK(bx.x0 >= f.W * f.l - 1e-6);
+    CHECK(bx.x1 <= f.W * f.r + 1e-6);
+    CHECK(bx.y0 >= f.H * f.b - 1e-6);
+    CHECK(bx.y1 <= f.H * f.t + 1e-6);
+    // a leader, when drawn, runs from the point to the label
+    if (!std::isnan(v[4])) {
+      const auto [ex, ey] = f.px(v[4], v[5]);
+      CHECK(ex >= bx.x0 - 3);
+      CHECK(ex <= bx.x1 + 3);
+      CHECK(ey >= bx.y0 - 3);
+      CHECK(ey <= bx.y1 + 3);
+    }
+  }
+  auto overlap = [](const Box& p, const Box& q) { return p.x0 < q.x1 && q.x0 < p.x1 && p.y0 < q.y1 && q.y0 < p.y1; };
+  for (size_t i = 0; i < boxes.size(); ++i)
+    for (size_t j = 0; j < boxes.size(); ++j) {
+      if (i != j) CHECK(!overlap(boxes[i], boxes[j]));
+      CHECK(!overlap(boxes[i], markers[j]));
+    }
+  return labels;
+}
+
 /// Rows of branches.csv by column name.
 struct Csv {
   std::vector<std::string> header;
@@ -301,60 +382,10 @@ TEST_CASE("special-point labels do not overlap one another, a marker or the plot
     DYNAMIC_SECTION(name) {
       const fs::path out = runShipped(name, name);
       int plots = 0;
-      for (const auto& e : fs::directory_iterator(out / "plots")) {
-        const std::string file = e.path().filename().string();
-        if (file.size() < 11 || file.compare(file.size() - 11, 11, "_labels.dat") != 0) continue;
-        const std::string stem = file.substr(0, file.size() - 11);
+      for (const std::string& stem : labelledPlots(out)) {
         INFO(stem);
         ++plots;
-        const std::string body = slurp(out / "plots" / (stem + "_body.gp"));
-        const double l = setting(body, "lmargin"), rr = setting(body, "rmargin"), b = setting(body, "bmargin"),
-                     t = setting(body, "tmargin");
-        const auto [x0, x1] = range(body, "x");
-        const auto [y0, y1] = range(body, "y");
-        const double W = 1000, H = 700;  // the terminal size of these plots (NAME.gp)
-        CHECK(slurp(out / "plots" / (stem + ".gp")).find("size 1000,700") != std::string::npos);
-        auto px = [&](double x, double y) {
-          return std::pair<double, double>{W * (l + (rr - l) * (x - x0) / (x1 - x0)), H * (b + (t - b) * (y - y0) / (y1 - y0))};
-        };
-        // labels: x y label_x label_y "text" leader_x leader_y
-        struct Box {
-          double x0, y0, x1, y1;
-        };
-        std::vector<Box> boxes, markers;
-        std::ifstream in(out / "plots" / file);
-        std::string line;
-        while (std::getline(in, line)) {
-          double v[6];
-          std::string text;
-          if (!labelLine(line, v, text)) continue;
-          const auto [ax, ay] = px(v[0], v[1]);
-          const auto [cx, cy] = px(v[2], v[3]);
-          // 9 pt DejaVu Sans: at most 6.2 px per character, 11 px high
-          const double w = 6.2 * double(text.size()), h = 11.0;
-          boxes.push_back({cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2});
-          markers.push_back({ax - 5, ay - 5, ax + 5, ay + 5});
-          const Box& bx = boxes.back();
-          CHECK(bx.x0 >= W * l - 1e-6);
-          CHECK(bx.x1 <= W * rr + 1e-6);
-          CHECK(bx.y0 >= H * b - 1e-6);
-          CHECK(bx.y1 <= H * t + 1e-6);
-          // a leader, when drawn, runs from the point to the label
-          if (!std::isnan(v[4])) {
-            const auto [ex, ey] = px(v[4], v[5]);
-            CHECK(ex >= bx.x0 - 3);
-            CHECK(ex <= bx.x1 + 3);
-            CHECK(ey >= bx.y0 - 3);
-            CHECK(ey <= bx.y1 + 3);
-          }
-        }
-        REQUIRE(!boxes.empty());
-        auto overlap = [](const Box& p, const Box& q) { return p.x0 < q.x1 && q.x0 < p.x1 && p.y0 < q.y1 && q.y0 < p.y1; };
-        for (size_t i = 0; i < boxes.size(); ++i)
-          for (size_t j = 0; j < boxes.size(); ++j) {
-            if (i != j) CHECK(!overlap(boxes[i], boxes[j]));
-            CHECK(!overlap(boxes[i], markers[j]));
-          }
+        CHECK(labelsApart(out / "plots", stem).size() > 0);
       }
       CHECK(plots >= 2);
       if (name == "hysteresis") {
@@ -562,4 +593,188 @@ TEST_CASE("load history: its stable pieces are the branches of branches.csv, in 
   CHECK(jumps == 3);
   CHECK(csv.rows.back()[csv.col("parameter")] == Approx(0.3).margin(1e-12));
   fs::remove_all(out);
+}
+
+namespace {
+
+/// Segments of the long chain whose plots are checked (default.json otherwise).
+constexpr int kLongChain = 50;
+
+/// data/scenes/default.json with `segments` segments and every bifurcation plot's `labels` set
+/// (empty: left to its default), the shapes at `at` (empty: as shipped), run into a fresh
+/// directory NAME.
+fs::path runDefault(int segments, const std::string& labels, const std::string& name,
+                    const std::vector<double>& at = {}) {
+  json scene = readJson(scenePath("default.json"));
+  scene["chain"]["segments"] = segments;
+  for (json& p : scene["plots"]) {
+    if (!labels.empty() && p["type"] == "bifurcation") p["labels"] = labels;
+    if (!at.empty() && p["type"] == "shapes") p["at"] = at;
+  }
+  const fs::path dir = freshDir(name);
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.json") << scene.dump(1);
+  const Run r = run(dir / "scene.json", dir / "out");
+  INFO(r.err);
+  REQUIRE(r.rc == 0);
+  return dir / "out";
+}
+
+/// Special points of special_points.json per type, and those of the primary branches (no parent)
+/// by type at their (Fx, q2).
+struct Specials {
+  std::map<std::string, size_t> count;
+  std::vector<std::pair<double, double>> primaryBranchPoints;
+  size_t total = 0;
+};
+
+Specials specials(const fs::path& out) {
+  Specials s;
+  std::set<int> primary;
+  for (const json& b : readJson(out / "summary.json")["cases"][0]["branches"])
+    if (int(b["parent"]) < 0) primary.insert(int(b["id"]));
+  REQUIRE(!primary.empty());
+  for (const json& p : readJson(out / "special_points.json")["special_points"]) {
+    ++s.count[p["type"]];
+    ++s.total;
+    if (p["type"] == "BP" && primary.count(int(p["branch"])))
+      s.primaryBranchPoints.emplace_back(double(p["loads"]["Fx"]), double(p["q"][1]));
+  }
+  return s;
+}
+
+/// What the summary of plot STEM (y = q2 against x = Fx) shows, checked against the run's
+/// special points: every branch point of the primary branch labelled at its place, at most
+/// `extra` other labels, one key entry per type giving its count, the unlabelled markers of one
+/// block no closer than 4 px (a thinned block drawn only where its omitted points lie within
+/// 4 px of a drawn one). Returns the number of labels.
+size_t checkSummary(const fs::path& out, const std::string& stem, size_t extra) {
+  const fs::path plots = out / "plots";
+  const Specials sp = specials(out);
+  const std::string body = slurp(plots / (stem + "_body.gp"));
+  CHECK(body.find("set key title \"labelled: ") != std::string::npos);
+  const std::vector<Label> labels = labelsApart(plots, stem);
+  // every branch point of the primary branch has a label "BP ..." at its point
+  for (const auto& [fx, q2] : sp.primaryBranchPoints) {
+    bool labelled = false;
+    for (const Label& l : labels)
+      labelled = labelled || (l.text.find("BP") != std::string::npos && std::abs(l.x - fx) <= 1e-9 * (1 + std::abs(fx)) &&
+                              std::abs(l.y - q2) <= 1e-9 * (1 + std::abs(q2)));
+    INFO("branch point at Fx = " << fx);
+    CHECK(labelled);
+  }
+  CHECK(labels.size() <= sp.primaryBranchPoints.size() + extra);
+  // the key: every type once, with the count of special_points.json
+  std::map<std::string, size_t> keyed;
+  for (const std::string& c : plotClauses(body)) {
+    if (c.rfind("keyentry with points", 0) != 0) continue;
+    const std::string title = field(c, "title");
+    const size_t open = title.rfind(" ("), close = title.rfind(')');
+    REQUIRE(open != std::string::npos);
+    REQUIRE(close == title.size() - 1);
+    keyed[title.substr(0, title.find(' '))] += std::stoul(title.substr(open + 2, close - open - 2));
+  }
+  CHECK(keyed == sp.count);
+  // unlabelled markers: blocks "TYPE unlabelled, D of N drawn"; drawn ones at least 4 px apart
+  const PixelFrame f(plots, stem);
+  size_t drawnSmall = 0, omitted = 0, labelledMarkers = 0;
+  for (const Block& b : readBlocks(plots / (stem + "_special.dat"))) {
+    REQUIRE(!b.comments.empty());
+    const size_t at = b.comments[0].find(" unlabelled, ");
+    if (at == std::string::npos) {
+      labelledMarkers += b.rows.size();
+      continue;
+    }
+    const size_t shown = std::stoul(b.comments[0].substr(at + 13)),
+                 of = std::stoul(b.comments[0].substr(b.comments[0].find(" of ", at) + 4));
+    CHECK(b.rows.size() == shown);
+    CHECK(shown <= of);
+    drawnSmall += shown;
+    omitted += of - shown;
+    for (size_t i = 0; i < b.rows.size(); ++i)
+      for (size_t j = 0; j < i; ++j) {
+        const auto [xi, yi] = f.px(b.rows[i][0], b.rows[i][1]);
+        const auto [xj, yj] = f.px(b.rows[j][0], b.rows[j][1]);
+        CHECK(std::hypot(xi - xj, yi - yj) >= 4.0 - 1e-6);
+      }
+  }
+  // every special point is a marker: labelled, drawn small, or within 4 px of one drawn small
+  INFO("unlabelled markers drawn " << drawnSmall << ", within 4 px of one drawn " << omitted);
+  CHECK(labelledMarkers + drawnSmall + omitted == sp.total);
+  CHECK(labelledMarkers >= labels.size());
+  return labels.size();
+}
+
+}  // namespace
+
+TEST_CASE("n = 3: labels auto labels every special point, as labels all does", "[scene][plot]") {
+  const fs::path autoOut = runDefault(3, "", "auto3"), allOut = runDefault(3, "all", "all3");
+  for (const std::string& stem : {std::string("bifurcation_q2"), std::string("force_deflection")}) {
+    INFO(stem);
+    // the same labels, placed the same, and the same script as with every label asked for
+    CHECK(slurp(autoOut / "plots" / (stem + "_labels.dat")) == slurp(allOut / "plots" / (stem + "_labels.dat")));
+    CHECK(slurp(autoOut / "plots" / (stem + "_body.gp")) == slurp(allOut / "plots" / (stem + "_body.gp")));
+    CHECK(slurp(autoOut / "plots" / (stem + "_body.gp")).find("set key title") == std::string::npos);
+  }
+  // every special point (Fx, q2) has a label naming its type within 3 px (the distance under which
+  // one case's labels merge, "BP, JUMP")
+  const std::vector<Label> labels = labelsApart(autoOut / "plots", "bifurcation_q2");
+  const PixelFrame f(autoOut / "plots", "bifurcation_q2");
+  size_t points = 0;
+  for (const json& p : readJson(autoOut / "special_points.json")["special_points"]) {
+    const std::string type = p["type"];
+    const auto [px, py] = f.px(double(p["loads"]["Fx"]), double(p["q"][1]));
+    bool labelled = false;
+    for (const Label& l : labels) {
+      const auto [lx, ly] = f.px(l.x, l.y);
+      const std::string text = ", " + l.text + ",";
+      labelled = labelled || (std::hypot(lx - px, ly - py) <= 3.0 &&
+                              (text.find(", " + type + ",") != std::string::npos ||
+                               text.find(", " + type + " ") != std::string::npos));
+    }
+    INFO(type << " at Fx = " << p["loads"]["Fx"]);
+    CHECK(labelled);
+    ++points;
+  }
+  CHECK(points >= 6);  // U and Z, the folds, the contacts
+  fs::remove_all(autoOut.parent_path());
+  fs::remove_all(allOut.parent_path());
+}
+
+TEST_CASE("n = 3 with labels summary: the primary branch's branch points labelled, counts in the key",
+          "[scene][plot]") {
+  const fs::path out = runDefault(3, "summary", "summary3");
+  const size_t labels = checkSummary(out, "bifurcation_q2", 24);
+  // U and Z on the straight branch, the fold with its jump, the first fold of the U branch
+  CHECK(labels >= 3);
+  fs::remove_all(out.parent_path());
+}
+
+TEST_CASE("a long chain's bifurcation diagram is a summary: bounded labels, every type counted", "[scene][plot]") {
+  // shapes on the stable part of the first buckled branch (the levels shipped for n = 3 lie beyond
+  // the stable range of a 50-segment chain, whose first critical load is -0.0030)
+  const fs::path out = runDefault(kLongChain, "", "long", {-0.0031, -0.0034});
+  const Specials sp = specials(out);
+  REQUIRE(sp.total > 60);  // above the automatic summary's threshold
+  const size_t labels = checkSummary(out, "bifurcation_q2", 24);
+  CHECK(labels < sp.total / 4);
+  CHECK(sp.primaryBranchPoints.size() >= 10);
+  // many branches: thinner, translucent lines (#AARRGGBB), the stable ones solid
+  const std::string body = slurp(out / "plots" / "bifurcation_q2_body.gp");
+  for (const std::string& c : plotClauses(body)) {
+    if (c.rfind("'bifurcation_q2.dat'", 0) != 0) continue;
+    CHECK(field(c, "rgb").size() == 9);
+    CHECK(std::stod(c.substr(c.find(" lw ") + 4)) < 2.0);
+  }
+  // shapes: the centre line alone (base, joints, end: n + 2 points) to scale, no joint dots
+  const std::string shapes = slurp(out / "plots" / "shapes_body.gp");
+  CHECK(shapes.find("set size ratio -1") != std::string::npos);
+  CHECK(shapes.find("_jnt.dat") == std::string::npos);
+  CHECK(shapes.find("_spr.dat") == std::string::npos);
+  const std::vector<Block> line = readBlocks(out / "plots" / "shapes_0_0_tri.dat");
+  REQUIRE(line.size() == 1);
+  CHECK(line[0].rows.size() == size_t(kLongChain + 2));
+  CHECK(line[0].rows.front()[0] == 0.0);
+  CHECK(line[0].rows.front()[1] == 0.0);
+  fs::remove_all(out.parent_path());
 }
