@@ -409,9 +409,9 @@ struct BranchLook {
 BranchLook branchLook(size_t branches) {
   BranchLook look;
   if (branches <= 12) return look;
-  look.width = std::max(0.7, 2.0 * std::sqrt(12.0 / double(branches)));
-  look.alphaStable = int(std::min<size_t>(0x70, 0x20 + branches / 2));
-  look.alphaUnstable = std::min(0xB0, look.alphaStable + 0x40);
+  look.width = std::max(0.8, 2.0 * std::sqrt(12.0 / double(branches)));
+  look.alphaStable = int(std::min<size_t>(0x50, 0x10 + branches / 4));
+  look.alphaUnstable = std::min(0xA0, look.alphaStable + 0x50);
   return look;
 }
 
@@ -1035,12 +1035,6 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   const size_t cols = std::min<size_t>(na, 5), rowsPerCase = (na + cols - 1) / cols;
   s.width = std::min<int>(3200, int(520 * cols));
   s.height = std::min<int>(2400, int(330 * nc * rowsPerCase) + 60);
-  s.body << "set encoding utf8\nset size ratio -1\nunset key\nset grid lc rgb '#eeeeee'\n";
-  s.body << "set multiplot layout " << nc * rowsPerCase << "," << cols << " title "
-         << quote(spec.title.empty() ? std::string("Chain shapes to scale (units of b); grey arcs: joint limits, "
-                                                   "red: joint within 5% of a limit, magenta star: through the clamp or itself")
-                                     : spec.title)
-         << " font ',11'\n";
 
   // per case, the point drawn at each requested level (null: not drawn, `missing` says why)
   std::vector<std::vector<const PointRecord*>> chosenOf;
@@ -1117,7 +1111,16 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   bool detailed = true;
   for (size_t c : selected(spec)) detailed = detailed && detailedChain(run.cases[c].chain, box, panel);
   if (!detailed) box = boxOf(true);
-  const double pad = 1.2;
+  s.body << "set encoding utf8\nset size ratio -1\nunset key\nset grid lc rgb '#eeeeee'\n";
+  s.body << "set multiplot layout " << nc * rowsPerCase << "," << cols << " title "
+         << quote(!spec.title.empty() ? spec.title
+                  : detailed ? std::string("Chain shapes to scale (units of b); grey arcs: joint limits, "
+                                           "red: joint within 5% of a limit, magenta star: through the clamp or itself")
+                             : std::string("Chain shapes to scale (units of b), centre lines (base, joints, end); red: "
+                                           "joint within 5% of a limit, magenta star: through the clamp or itself"))
+         << " font ',11'\n";
+  // a margin of 1.2 b around the chains, or 3 % of a long chain's extent
+  const double pad = std::max(1.2, 0.03 * box.sizes().maxCoeff());
   const double x0 = box.min().x() - pad, x1 = box.max().x() + pad, y0 = box.min().y() - pad, y1 = box.max().y() + pad;
   for (size_t o = 0; o < nc; ++o) {
     const size_t c = size_t(spec.cases[o]);
@@ -1134,8 +1137,9 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       std::ostringstream title;
       if (p) {
         drawChain(cr.chain, p->q, tri, spr, lim, jnt, near, &touch, detailed);
+        // four decimals, or four significant digits for the small loads of long chains
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = "
-              << num(std::round(p->parameter * 1e4) / 1e4);
+              << (std::abs(p->parameter) >= 1e-3 ? num(std::round(p->parameter * 1e4) / 1e4) : short4(p->parameter));
         // the nearest traced point is drawn; the title says when it differs from the request
         // beyond the title's rounding
         if (std::abs(p->parameter - spec.at[k]) > 1e-4 * std::max(1.0, std::abs(spec.at[k])))

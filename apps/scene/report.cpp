@@ -446,9 +446,11 @@ const char* const kTail = R"PAGE(</script>
           pick.push({x: X[i], y: Y[i], act: showPoint.bind(null, c, i)});
         }
         if (multi) legend.push({color: stableColor, label: (D.cases.length > 1 ? c.label + ' ' : '') + ycol});
+        // a long chain's thousands of special points: smaller markers, the branches stay visible
+        var radius = c.specials.length > 60 ? 2.5 : 4.5;
         c.specials.forEach(function (s) {
           if (!s.values) return;
-          marks.push({x: s.values[spec.x], y: s.values[ycol], color: TYPE_COLOR[s.type] || '#000', cls: 'special',
+          marks.push({x: s.values[spec.x], y: s.values[ycol], color: TYPE_COLOR[s.type] || '#000', cls: 'special', r: radius,
                       title: s.type + ' ' + s.field + ' at ' + c.parameter + ' = ' + fmt(s.parameter, 6),
                       act: s.joints ? showSpecial.bind(null, c, s) : null});
         });

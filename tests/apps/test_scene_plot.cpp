@@ -631,10 +631,12 @@ struct Specials {
 Specials specials(const fs::path& out) {
   Specials s;
   std::set<int> primary;
-  for (const json& b : readJson(out / "summary.json")["cases"][0]["branches"])
+  // the documents kept in variables: a range-for over a member of a temporary would dangle
+  const json summary = readJson(out / "summary.json"), points = readJson(out / "special_points.json");
+  for (const json& b : summary["cases"][0]["branches"])
     if (int(b["parent"]) < 0) primary.insert(int(b["id"]));
   REQUIRE(!primary.empty());
-  for (const json& p : readJson(out / "special_points.json")["special_points"]) {
+  for (const json& p : points["special_points"]) {
     ++s.count[p["type"]];
     ++s.total;
     if (p["type"] == "BP" && primary.count(int(p["branch"])))
@@ -721,7 +723,8 @@ TEST_CASE("n = 3: labels auto labels every special point, as labels all does", "
   const std::vector<Label> labels = labelsApart(autoOut / "plots", "bifurcation_q2");
   const PixelFrame f(autoOut / "plots", "bifurcation_q2");
   size_t points = 0;
-  for (const json& p : readJson(autoOut / "special_points.json")["special_points"]) {
+  const json specialPoints = readJson(autoOut / "special_points.json");
+  for (const json& p : specialPoints["special_points"]) {
     const std::string type = p["type"];
     const auto [px, py] = f.px(double(p["loads"]["Fx"]), double(p["q"][1]));
     bool labelled = false;
