@@ -656,12 +656,16 @@ size_t checkSummary(const fs::path& out, const std::string& stem, size_t extra) 
   const std::string body = slurp(plots / (stem + "_body.gp"));
   CHECK(body.find("set key title \"labelled: ") != std::string::npos);
   const std::vector<Label> labels = labelsApart(plots, stem);
-  // every branch point of the primary branch has a label "BP ..." at its point
+  const PixelFrame f(plots, stem);
+  // every branch point of the primary branch has a label "BP ..." at its point (within the 3 px
+  // under which neighbours share one label, "BP 3, BP 4")
   for (const auto& [fx, q2] : sp.primaryBranchPoints) {
+    const auto [bx, by] = f.px(fx, q2);
     bool labelled = false;
-    for (const Label& l : labels)
-      labelled = labelled || (l.text.find("BP") != std::string::npos && std::abs(l.x - fx) <= 1e-9 * (1 + std::abs(fx)) &&
-                              std::abs(l.y - q2) <= 1e-9 * (1 + std::abs(q2)));
+    for (const Label& l : labels) {
+      const auto [lx, ly] = f.px(l.x, l.y);
+      labelled = labelled || (l.text.find("BP") != std::string::npos && std::hypot(lx - bx, ly - by) <= 3.0);
+    }
     INFO("branch point at Fx = " << fx);
     CHECK(labelled);
   }
@@ -678,7 +682,6 @@ size_t checkSummary(const fs::path& out, const std::string& stem, size_t extra) 
   }
   CHECK(keyed == sp.count);
   // unlabelled markers: blocks "TYPE unlabelled, D of N drawn"; drawn ones at least 4 px apart
-  const PixelFrame f(plots, stem);
   size_t drawnSmall = 0, omitted = 0, labelledMarkers = 0;
   for (const Block& b : readBlocks(plots / (stem + "_special.dat"))) {
     REQUIRE(!b.comments.empty());
