@@ -348,6 +348,37 @@ constexpr size_t kSummaryAboveMarkers = 60;
 constexpr size_t kSummaryExtraLabels = 24;
 /// Summary: unlabelled markers of one case and type closer than this many pixels are drawn once.
 constexpr double kThinPixels = 4.0;
+/// Labels of one case's points closer than this many pixels are merged into one ("BP, JUMP"); a
+/// summary merges wider, the branch points of a long chain's primary branch into ranges
+/// ("BP 24-27": modes 24 to 27).
+constexpr double kMergePixels = 3.0, kSummaryMergePixels = 12.0;
+
+/// One label for the merged points' texts; a summary writes the branch points' modes as ranges
+/// ("BP 3, 4", "BP 24-27"), the other texts after them.
+std::string mergedLabel(const std::vector<std::string>& parts, bool summary) {
+  std::vector<int> modes;
+  std::vector<std::string> rest;
+  for (const std::string& p : parts) {
+    const bool mode = summary && p.size() > 3 && p.rfind("BP ", 0) == 0 &&
+                      p.find_first_not_of("0123456789", 3) == std::string::npos;
+    if (mode)
+      modes.push_back(std::stoi(p.substr(3)));
+    else
+      rest.push_back(p);
+  }
+  std::string text;
+  std::sort(modes.begin(), modes.end());
+  for (size_t i = 0; i < modes.size();) {
+    size_t j = i;
+    while (j + 1 < modes.size() && modes[j + 1] == modes[j] + 1) ++j;
+    text += (i ? ", " : "BP ") + std::to_string(modes[i]);
+    if (j == i + 1) text += ", " + std::to_string(modes[j]);
+    if (j > i + 1) text += "-" + std::to_string(modes[j]);
+    i = j + 1;
+  }
+  for (const std::string& p : rest) text += (text.empty() ? "" : ", ") + p;
+  return text;
+}
 
 /// How much a special point matters in a summary, most first.
 enum class Importance { PrimaryBranchPoint, Jump, FirstFold, Other };
@@ -616,7 +647,8 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     const Mark& m = marks[i];
     const Eigen::Vector2d px = f.pixel(m.x, m.y);
     size_t k = 0;
-    while (k < labels.size() && (labelOrdinal[k] != m.ordinal || (labels[k].anchor - px).norm() > 3.0)) ++k;
+    const double merge = summary ? kSummaryMergePixels : kMergePixels;
+    while (k < labels.size() && (labelOrdinal[k] != m.ordinal || (labels[k].anchor - px).norm() > merge)) ++k;
     if (k == labels.size()) {
       labels.emplace_back();
       labels.back().anchor = px;
@@ -627,8 +659,7 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     labels[k].priority = std::min(labels[k].priority, summary ? int(m.rank) : 0);
     if (std::find(parts[k].begin(), parts[k].end(), m.label) == parts[k].end()) parts[k].push_back(m.label);
   }
-  for (size_t k = 0; k < labels.size(); ++k)
-    for (size_t i = 0; i < parts[k].size(); ++i) labels[k].text += (i ? ", " : "") + parts[k][i];
+  for (size_t k = 0; k < labels.size(); ++k) labels[k].text = mergedLabel(parts[k], summary);
   placeLabels(labels, f, occupied, summary ? kSummaryLabelRings : kLabelRings);
 
   const std::string stem = spec.name;

@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -620,11 +621,17 @@ fs::path runDefault(int segments, const std::string& labels, const std::string& 
   return dir / "out";
 }
 
-/// Special points of special_points.json per type, and those of the primary branches (no parent)
-/// by type at their (Fx, q2).
+/// A branch point at (Fx, q2), the shape of the branch leaving it ("U", "mode 12").
+struct BranchPoint {
+  double fx, q2;
+  std::string shape;
+};
+
+/// Special points of special_points.json per type, and the branch points of the primary branches
+/// (no parent).
 struct Specials {
   std::map<std::string, size_t> count;
-  std::vector<std::pair<double, double>> primaryBranchPoints;
+  std::vector<BranchPoint> primaryBranchPoints;
   size_t total = 0;
 };
 
@@ -640,7 +647,7 @@ Specials specials(const fs::path& out) {
     ++s.count[p["type"]];
     ++s.total;
     if (p["type"] == "BP" && primary.count(int(p["branch"])))
-      s.primaryBranchPoints.emplace_back(double(p["loads"]["Fx"]), double(p["q"][1]));
+      s.primaryBranchPoints.push_back({double(p["loads"]["Fx"]), double(p["q"][1]), p["shape"]});
   }
   return s;
 }
@@ -657,16 +664,31 @@ size_t checkSummary(const fs::path& out, const std::string& stem, size_t extra) 
   CHECK(body.find("set key title \"labelled: ") != std::string::npos);
   const std::vector<Label> labels = labelsApart(plots, stem);
   const PixelFrame f(plots, stem);
-  // every branch point of the primary branch has a label "BP ..." at its point (within the 3 px
-  // under which neighbours share one label, "BP 3, BP 4")
-  for (const auto& [fx, q2] : sp.primaryBranchPoints) {
-    const auto [bx, by] = f.px(fx, q2);
+  // every branch point of the primary branch is named by a label at its point, within the 12 px
+  // under which a summary merges neighbours: "BP U", or by its mode in "BP 3, 4", "BP 24-27"
+  for (const BranchPoint& bp : sp.primaryBranchPoints) {
+    const auto [bx, by] = f.px(bp.fx, bp.q2);
     bool labelled = false;
     for (const Label& l : labels) {
       const auto [lx, ly] = f.px(l.x, l.y);
-      labelled = labelled || (l.text.find("BP") != std::string::npos && std::hypot(lx - bx, ly - by) <= 3.0);
+      if (std::hypot(lx - bx, ly - by) > 12.0 || l.text.rfind("BP ", 0) != 0) continue;
+      if (bp.shape.rfind("mode ", 0) != 0) {
+        labelled = labelled || l.text.find("BP " + bp.shape) != std::string::npos;
+        continue;
+      }
+      const int mode = std::stoi(bp.shape.substr(5));
+      // "BP a, b-c, d, LP": numbers and ranges up to the first other text
+      std::istringstream in(l.text.substr(3));
+      std::string item;
+      while (std::getline(in, item, ',')) {
+        if (item[0] == ' ') item.erase(0, 1);
+        if (item.empty() || !std::isdigit(static_cast<unsigned char>(item[0]))) break;
+        const size_t dash = item.find('-');
+        const int lo = std::stoi(item), hi = dash == std::string::npos ? lo : std::stoi(item.substr(dash + 1));
+        labelled = labelled || (lo <= mode && mode <= hi);
+      }
     }
-    INFO("branch point at Fx = " << fx);
+    INFO("branch point at Fx = " << bp.fx << ", " << bp.shape);
     CHECK(labelled);
   }
   CHECK(labels.size() <= sp.primaryBranchPoints.size() + extra);
