@@ -222,6 +222,13 @@ TEST_CASE("inconsistent scenes", "[scene][errors]") {
                   "/path/parameter", "load_limit");
   requireBadInput("plot_column", replaceOnce(kGood, "\"plots\": []", "\"plots\": [{\"type\": \"bifurcation\", \"y\": \"q7\"}]"),
                   "/plots/0/y", "a column of branches.csv");
+  requireBadInput("plot_labels",
+                  replaceOnce(kGood, "\"plots\": []", "\"plots\": [{\"type\": \"bifurcation\", \"labels\": \"some\"}]"),
+                  "/plots/0/labels", "one of auto, all, summary");
+  requireBadInput("shapes_labels",
+                  replaceOnce(kGood, "\"plots\": []",
+                              "\"plots\": [{\"type\": \"shapes\", \"at\": [0], \"labels\": \"all\"}]"),
+                  "/plots/0/labels", "only bifurcation and stiffness plots label special points");
   requireBadInput("case_override",
                   replaceOnce(kGood, "\"plots\": []", "\"plots\": [], \"cases\": [{\"label\": \"A\"}, {\"chain\": {\"a\": -1}}]"),
                   "/cases/1/chain/a", "expected a number >= 0");
