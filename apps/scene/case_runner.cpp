@@ -9,6 +9,7 @@
 #include "buckle/mechanics/jump.h"
 #include "buckle/mechanics/landing.h"
 #include "buckle/mechanics/load_history.h"
+#include "buckle/mechanics/mirror_symmetry.h"
 #include "buckle/mechanics/unloaded_shape.h"
 
 namespace buckle::scene {
@@ -119,7 +120,12 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
         opt.perturbation = scene_.analyses.jump.perturbation;
         opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
         opt.integration.recordTrajectory = false;
-        const mech::Landing landing = mech::jumpFromFold(problem, fold, opt);
+        // The fold of a mirror image branch jumps as the mirror image of its source's fold.
+        const auto source = landings_.find({b.mirrorOf, sp.source});
+        const mech::Landing landing = b.mirrorOf >= 0 && source != landings_.end()
+                                          ? mech::mirrored(source->second)
+                                          : mech::jumpFromFold(problem, fold, opt);
+        landings_[{b.id, sp.source}] = landing;
         copyLanding(landing, s);
         if (landing.interrupted) {
           interrupted();
@@ -281,6 +287,7 @@ void CaseRunner::continuation() {
   opt.tracer.lowestEigenvalues = 1;
   opt.switchingDepth = scene_.analyses.continuation.branchSwitching;
   opt.contact = scene_.analyses.continuation.contact;
+  opt.mirror = scene_.analyses.continuation.mirror;
   opt.report = reportOptions();
   if (const int first = scene_.analyses.continuation.branchPoints; first > 0) {
     // the first `first` simple branch points along the branch, not counting the one it starts from

@@ -3,12 +3,15 @@
 // to the scene runner.
 #pragma once
 
+#include <map>
 #include <string>
+#include <utility>
 
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/branch_report.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/landing.h"
 #include "scene/runner.h"
 
 namespace buckle::scene {
@@ -95,6 +98,8 @@ class CaseRunner {
   RunResult& run_;
   const RunControl& control_;
   int branchesSoFar_ = 0;  // for progress reports
+  /// The jumps simulated from (branch, special point): a mirror image's jump is their image.
+  std::map<std::pair<int, int>, mechanics::Landing> landings_;
 };
 
 }  // namespace buckle::scene

@@ -62,6 +62,9 @@ struct ContinuationSpec {
   /// Joints that reach a limit lock and the branch goes on under contact (mechanics/contact.h);
   /// false: the branch ends at the limit ("BD").
   bool contact = true;
+  /// An exactly mirror-symmetric scene (mechanics/mirror_symmetry.h) mirrors the − side child of
+  /// every symmetric pitchfork instead of tracing it; false: both traced (for checking).
+  bool mirror = true;
 };
 
 struct EnergyCurvesSpec {

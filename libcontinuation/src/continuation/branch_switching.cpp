@@ -165,12 +165,29 @@ Branch switchBranch(Tracer &tracer, const SpecialPoint &userBp, const Vector &us
 }
 
 std::vector<Branch> switchBothSides(Tracer &tracer, const SpecialPoint &bp, const BranchSwitchingOptions &options,
-                                    std::string *how, const std::function<bool(const Branch &child)> &accept) {
+                                    std::string *how, const std::function<bool(const Branch &child)> &accept,
+                                    const Reflection &symmetry) {
   std::vector<Branch> sides;
   Vector direction;
   const bool structured = tracer.problem().dimension() > tracer.options().maxDenseLocationDimension;
   if (!bifurcatingDirection(tracer.problem(), bp, direction, how, structured)) return sides;
+  // A symmetric pitchfork (symmetry.h): bp fixed by S, direction reversed by it. Compared in the
+  // tracer's scaled variables, where the tolerance is relative.
+  bool pitchfork = symmetry.enabled() && symmetry.IsValid(tracer.problem().dimension(), nullptr);
+  if (pitchfork) {
+    Vector x(bp.u.size() + 1);
+    x << bp.u, bp.lambda;
+    for (Eigen::Index j = 0; j < x.size(); ++j) x[j] /= tracer.units().state(int(j));
+    pitchfork = symmetry.maps(x, 1) && symmetry.maps(tracer.units().directionToScaled(direction), -1);
+  }
   for (int sign : {1, -1}) {
+    if (sign < 0 && pitchfork && sides.front().stopReason != StopReason::Interrupted) {
+      // the − side leaves along −d = diag(S, 1)d from the same point: the image of the + side
+      sides.push_back(reflected(symmetry, sides.front()));
+      sides.back().direction = -1;
+      sides.back().mirrorOf = 0;
+      break;
+    }
     sides.push_back(switchBranch(tracer, bp, direction, sign, options));
     if (accept && accept(sides.back())) break;
   }
@@ -201,6 +218,13 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     }
     if (treeOptions.onBranch) treeOptions.onBranch(tree, tree.branches.back());
   };
+  if (std::string why; !treeOptions.symmetry.IsValid(problem.dimension(), &why)) {
+    Branch invalid;
+    invalid.stopReason = StopReason::InvalidOptions;
+    invalid.stopMessage = "TreeOptions::symmetry: " + why;
+    add(std::move(invalid), 0);
+    return tree;
+  }
   for (const InitialDirection &direction : starts) {
     if (tree.interrupted || interrupted()) return tree;
     add(tracer.trace(u0, lambda0, direction), 0);
@@ -242,14 +266,16 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       } else {
         // after the + side, the − side only if no stop was asked for meanwhile
         sides = switchBothSides(switchTracer, bp, switching, &how,
-                                [&](const Branch &) { return options.interrupt.requested(); });
+                                [&](const Branch &) { return options.interrupt.requested(); }, treeOptions.symmetry);
       }
       if (sides.empty()) {
         note += (note.empty() ? "" : "; ") + std::string("not switched: ") + how;
         continue;
       }
       std::string children;
+      const int firstChild = static_cast<int>(tree.branches.size());
       for (Branch &child : sides) {
+        if (child.mirrorOf >= 0) child.mirrorOf += firstChild;  // an index into `sides` → a branch id
         child.parentId = static_cast<int>(i);
         child.parentSpecialPoint = static_cast<int>(k);
         children += (children.empty() ? "" : ", ") + std::to_string(tree.branches.size());

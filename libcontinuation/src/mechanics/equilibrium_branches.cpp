@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "buckle/mechanics/mirror_symmetry.h"
+
 namespace buckle::mechanics {
 
 namespace {
@@ -16,6 +18,26 @@ LockedJoint endBoundary(const continuation::Problem& problem, const continuation
   for (int k = 0; k < std::min(problem.boundaryCount(), 2 * segments); ++k)  // the joints' limits and contacts
     if (problem.boundaryName(k) == sp.boundaryName) return limitOfBoundary(k, segments);
   return {};
+}
+
+// The mirror image's share of what continueUnderContact added to its source after the source's
+// first `traced` (points, special points): the points after them and the special points from
+// the last traced one on (where the contact began; its note may have grown), and the stop.
+void appendMirroredTail(const continuation::Reflection& mirror, const continuation::Branch& source,
+                        std::pair<size_t, size_t> traced, continuation::Branch& image) {
+  if (source.points.size() == traced.first && source.specialPoints.size() == traced.second) return;
+  for (size_t i = traced.first; i < source.points.size(); ++i) {
+    image.points.push_back(source.points[i]);
+    continuation::reflect(mirror, image.points.back());
+  }
+  const size_t from = traced.second > 0 ? traced.second - 1 : 0;
+  image.specialPoints.resize(from);
+  for (size_t k = from; k < source.specialPoints.size(); ++k) {
+    image.specialPoints.push_back(source.specialPoints[k]);
+    continuation::reflect(mirror, image.specialPoints.back());
+  }
+  image.stopReason = source.stopReason;
+  image.stopMessage = mirror.mapText(source.stopMessage);
 }
 
 }  // namespace
@@ -151,14 +173,26 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
   tree.switchAt = options.switchAt;
   tree.childTracer = options.childTracer;
   tree.onBranch = options.onBranch;
+  const bool box = options.tracer.boxLower.size() || (options.childTracer && options.childTracer->boxLower.size());
+  if (options.mirror && !box) tree.symmetry = mirrorSymmetry(problem);
   result.tree = continuation::traceTree(problem, u0, lambda0, starts, options.tracer, tree);
+  // Sizes of the branches as traced, before their contact stretches: a mirror image takes the
+  // stretches of its source from there on.
+  std::vector<std::pair<size_t, size_t>> traced;
   for (continuation::Branch& branch : result.tree.branches) {
-    const continuation::TracerOptions& o =
-        branch.parentId >= 0 && options.childTracer ? *options.childTracer : options.tracer;
-    result.contact.push_back(options.contact && !result.tree.interrupted
-                                 ? continueUnderContact(problem, branch, o, options.maxContactEvents,
-                                                        options.maxContactTorque)
-                                 : std::vector<ContactStretch>{ContactStretch{}});
+    traced.emplace_back(branch.points.size(), branch.specialPoints.size());
+    if (!options.contact || result.tree.interrupted) {
+      result.contact.push_back(std::vector<ContactStretch>{ContactStretch{}});
+    } else if (branch.mirrorOf >= 0) {
+      result.contact.push_back(mirrored(result.contact[size_t(branch.mirrorOf)]));
+      appendMirroredTail(tree.symmetry, result.tree.branches[size_t(branch.mirrorOf)], traced[size_t(branch.mirrorOf)],
+                         branch);
+    } else {
+      const continuation::TracerOptions& o =
+          branch.parentId >= 0 && options.childTracer ? *options.childTracer : options.tracer;
+      result.contact.push_back(
+          continueUnderContact(problem, branch, o, options.maxContactEvents, options.maxContactTorque));
+    }
   }
   for (size_t b = 0; b < result.tree.branches.size(); ++b) {
     const continuation::Branch& branch = result.tree.branches[b];

@@ -301,7 +301,16 @@ bool EquilibriumProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, i
   }
   const int rank = heldCount() > 0 ? setConstraints(structure_, heldRows_) : (structure_.rank = 0);
   if (values.size() > ChainStructure::kMaxBorder) return false;  // the isolation's fixed-size brackets
-  return eigenvaluesFrom(structure_, rank > 0, first, int(values.size()), values) == values.size();
+  // Warm start from the previous call with the same indices: the monitor asks at a point and
+  // then a step δ = 1e−6 along its tangent, then at the next point (spectral_monitor.h), so the
+  // last values bracket the new ones within a few counts. The counts still certify the
+  // isolation; only the bisection from ±‖H‖_F is saved.
+  const Vector* guess = lastFirst_ == first && lastFrom_.size() == values.size() ? &lastFrom_ : nullptr;
+  if (eigenvaluesFrom(structure_, rank > 0, first, int(values.size()), values, 1e-13, guess) != values.size())
+    return false;
+  lastFirst_ = first;
+  lastFrom_ = values;
+  return true;
 }
 
 std::unique_ptr<continuation::BorderedSolver> EquilibriumProblem::makeStructuredSolver() {

@@ -105,6 +105,9 @@ struct Branch {
   int parentId = -1;                 ///< -1 for a root branch
   int parentSpecialPoint = -1;       ///< index into the parent's specialPoints
   int direction = 1;                 ///< +1 / −1: orientation chosen at the start
+  /// Not traced: the image of branch mirrorOf under the tree's reflection (symmetry.h,
+  /// TreeOptions::symmetry); −1 for a traced branch.
+  int mirrorOf = -1;
   std::vector<ContinuationPoint> points;
   std::vector<SpecialPoint> specialPoints;
   StopReason stopReason = StopReason::NotStarted;

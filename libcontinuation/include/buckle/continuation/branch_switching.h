@@ -12,6 +12,7 @@
 
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/problem.h"
+#include "buckle/continuation/symmetry.h"
 #include "buckle/continuation/tracer.h"
 
 #include <functional>
@@ -51,10 +52,13 @@ Branch switchBranch(Tracer &tracer, const SpecialPoint &bp, const Vector &direct
 /// (the + side: the direction's largest scaled component positive), each child traced with
 /// `tracer`. `accept(child)`, when given, ends the search at the first child it accepts (the
 /// later side is then not traced). `how` says how the direction was obtained, or why there is
-/// none (then no branch is returned).
+/// none (then no branch is returned). With a `symmetry` (symmetry.h) that fixes bp and reverses
+/// the direction (a symmetric pitchfork), the − side is not traced but the image of the + side
+/// (its mirrorOf = 0, the index in the returned vector).
 std::vector<Branch> switchBothSides(Tracer &tracer, const SpecialPoint &bp, const BranchSwitchingOptions &options,
                                     std::string *how = nullptr,
-                                    const std::function<bool(const Branch &child)> &accept = nullptr);
+                                    const std::function<bool(const Branch &child)> &accept = nullptr,
+                                    const Reflection &symmetry = Reflection());
 
 struct TreeOptions {
   int maxDepth = 0;                    ///< switching generations (0: only the start branches)
@@ -68,6 +72,11 @@ struct TreeOptions {
   /// Called when a branch is finished (traced or switched), before the next one starts: for
   /// progress reports. The tracer's own per-step callback and interrupt are in TracerOptions.
   std::function<void(const BranchTree &tree, const Branch &finished)> onBranch;
+  /// A reflection symmetry of the problem (symmetry.h; empty: none): at the simple branch points
+  /// it fixes, with a bifurcating direction it reverses, the − side child is the image of the
+  /// + side one (Branch::mirrorOf) instead of a second trace: the same tree, up to rounding, in
+  /// half the work.
+  Reflection symmetry;
 };
 
 /// The bifurcation tree from one start point, breadth first: the start branches, one per entry

@@ -43,6 +43,11 @@ struct EquilibriumBranchOptions {
   /// against its stops far harder than its springs carry (e.g. a locked mechanism at a kinematic
   /// singularity under displacement control, whose reaction grows without bound).
   double maxContactTorque = 10.0;
+  /// Mirror symmetry (mirror_symmetry.h): when the problem is exactly mirror symmetric (and the
+  /// tracers have no box on the unknowns), the − side child of every symmetric pitchfork is the
+  /// mirror image of the + side one, contact stretches included, instead of a second trace.
+  /// False: both traced (for checking).
+  bool mirror = true;
 };
 
 struct EquilibriumBranches {

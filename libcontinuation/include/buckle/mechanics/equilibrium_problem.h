@@ -129,6 +129,8 @@ class EquilibriumProblem final : public continuation::Problem {
   ChainStructure structure_;  // workspace of the structured stability()
   Matrix heldRows_;           // m×n held rows of J
   Vector lastLowest_;         // warm start of the structured eigenvalue search
+  Vector lastFrom_;           // warm start of stabilityEigenvalues: its last values ...
+  int lastFirst_ = -1;        // ... and their first index
 };
 
 }  // namespace buckle::mechanics

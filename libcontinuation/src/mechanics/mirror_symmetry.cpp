@@ -1,0 +1,69 @@
+#include "buckle/mechanics/mirror_symmetry.h"
+
+namespace buckle::mechanics {
+
+continuation::Reflection mirrorSymmetry(const EquilibriumProblem& problem) {
+  continuation::Reflection mirror;
+  const Chain& chain = problem.chain();
+  const int n = chain.size();
+  for (int i = 0; i < n; ++i) {
+    const SegmentParameters& p = chain.segment(i).parameters();
+    if (p.k1 != p.k2 || p.L1_0 != p.L2_0) return mirror;
+    if (chain.lowerLimits()[i] != -chain.upperLimits()[i]) return mirror;
+  }
+  const EndCondition& end = problem.endCondition();
+  for (int c : {1, 2})  // y and φ: zero load (or held at zero) along the whole path
+    if (end.value[c] != 0.0 || problem.direction()[c] != 0.0) return mirror;
+  mirror.signs = continuation::Vector::Constant(problem.dimension(), -1.0);
+  const std::vector<int> held = end.heldIndices();
+  for (size_t k = 0; k < held.size(); ++k)
+    if (held[k] == 0) mirror.signs[n + int(k)] = 1.0;  // the x reaction is even
+  mirror.text = mirrorText;
+  return mirror;
+}
+
+std::string mirrorText(const std::string& text) {
+  static const std::string upper = "upper", lower = "lower";
+  std::string out;
+  out.reserve(text.size());
+  for (size_t i = 0; i < text.size();) {
+    if (text.compare(i, upper.size(), upper) == 0) {
+      out += lower;
+      i += upper.size();
+    } else if (text.compare(i, lower.size(), lower) == 0) {
+      out += upper;
+      i += lower.size();
+    } else {
+      out += text[i++];
+    }
+  }
+  return out;
+}
+
+std::vector<ContactStretch> mirrored(const std::vector<ContactStretch>& stretches) {
+  std::vector<ContactStretch> image;
+  for (const ContactStretch& s : stretches) {
+    ContactStretch m{s.firstPoint, ContactSet()};
+    for (const LockedJoint& l : s.locked.joints())
+      m.locked.lock(l.joint, l.side == LimitSide::Upper ? LimitSide::Lower : LimitSide::Upper);
+    image.push_back(m);
+  }
+  return image;
+}
+
+Landing mirrored(const Landing& landing) {
+  Landing image = landing;
+  image.q = -landing.q;
+  image.F[1] = -landing.F[1];
+  image.F[2] = -landing.F[2];
+  image.pose[1] = -landing.pose[1];
+  image.pose[2] = -landing.pose[2];
+  for (JointContact& c : image.contacts) {
+    c.side = -c.side;
+    c.torque = -c.torque;
+  }
+  image.message = mirrorText(landing.message);
+  return image;
+}
+
+}  // namespace buckle::mechanics
