@@ -16,12 +16,6 @@ using continuation::ConstVectorRef;
 using continuation::MatrixRef;
 using continuation::VectorRef;
 
-namespace {
-// How far past a geometric limit points are still evaluated while the joint limits are traced
-// as boundaries (inDomain() below).
-constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step that crosses a limit
-}  // namespace
-
 EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
                                        const Eigen::Vector3d& direction, EquilibriumOptions options)
     : chain_(chain),
@@ -35,8 +29,6 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
       grad_(chain.size()),
       stiff_(chain.size()),
       cachedQ_(chain.size()),
-      domainUpper_(chain.size()),
-      domainLower_(chain.size()),
       work_(chain.size()),
       work2_(chain.size()),
       structure_(chain.size()),
@@ -47,11 +39,6 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
     requireFinite(std::string("load path direction ") + names[c], direction[c]);
   }
   structure_.typicalScale = stiffnessUnit() * lengthUnit() * lengthUnit();  // the inertia's zero floor
-  const double overshoot = options_.jointLimitsAsBoundaries ? kGeometricOvershoot : 0.0;
-  for (int i = 0; i < chain_.size(); ++i) {
-    domainUpper_[i] = chain_.segment(i).geometricUpperLimit() + overshoot;
-    domainLower_[i] = chain_.segment(i).geometricLowerLimit() - overshoot;
-  }
 }
 
 bool EquilibriumProblem::prepare(ConstVectorRef u) {
@@ -73,6 +60,13 @@ bool EquilibriumProblem::prepare(ConstVectorRef u) {
   cachedQ_ = q;
   cacheValid_ = true;
   return true;
+}
+
+Wrench EquilibriumProblem::wrench(ConstVectorRef u, double lambda) const {
+  Wrench F = prescribed(lambda);
+  const int n = chain_.size();
+  for (size_t k = 0; k < held_.size(); ++k) F[held_[k]] = u[n + int(k)];
+  return F;
 }
 
 Vector EquilibriumProblem::initialGuess(ConstVectorRef q, double lambda) const {
@@ -104,12 +98,19 @@ Vector EquilibriumProblem::initialGuess(ConstVectorRef q, double lambda) const {
 // are evaluated; the branch stops at the located limit and never reports them. Farther out, or
 // with the limits not traced as boundaries, points beyond a geometric limit are refused: there
 // the triangles would overlap and the model no longer describes the mechanism.
+namespace {
+constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step that crosses a limit
+}
 
 bool EquilibriumProblem::inDomain(ConstVectorRef u) const {
   const int n = chain_.size();
-  // Finite bounds: the negated test also refuses ±∞ and NaN.
-  for (int i = 0; i < n; ++i)
-    if (!(u[i] <= domainUpper_[i] && u[i] >= domainLower_[i])) return false;
+  const double overshoot = options_.jointLimitsAsBoundaries ? kGeometricOvershoot : 0.0;
+  for (int i = 0; i < n; ++i) {
+    const Segment& s = chain_.segment(i);
+    if (!std::isfinite(u[i]) || u[i] > s.geometricUpperLimit() + overshoot ||
+        u[i] < s.geometricLowerLimit() - overshoot)
+      return false;
+  }
   for (int k = n; k < u.size(); ++k)
     if (!std::isfinite(u[k])) return false;
   return true;

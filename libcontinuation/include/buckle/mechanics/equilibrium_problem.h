@@ -41,14 +41,8 @@ class EquilibriumProblem final : public continuation::Problem {
 
   /// Prescribed values (loads or coordinates) at λ.
   Eigen::Vector3d prescribed(double lambda) const { return end_.value + lambda * direction_; }
-  /// Total end wrench at (u, λ): given loads and the multipliers. Inline: every residual,
-  /// Jacobian and stability evaluation forms it (a call cost more than the three stores).
-  Wrench wrench(continuation::ConstVectorRef u, double lambda) const {
-    Wrench F = prescribed(lambda);
-    const int n = chain_.size();
-    for (size_t k = 0; k < held_.size(); ++k) F[held_[k]] = u[n + int(k)];
-    return F;
-  }
+  /// Total end wrench at (u, λ): given loads and the multipliers.
+  Wrench wrench(continuation::ConstVectorRef u, double lambda) const;
   /// Unknown vector for given joint angles, with the multipliers that best satisfy the
   /// equilibrium in the least-squares sense (a starting guess).
   Vector initialGuess(continuation::ConstVectorRef q, double lambda) const;
@@ -130,9 +124,6 @@ class EquilibriumProblem final : public continuation::Problem {
   Matrix J_;             // 3×n
   Vector grad_, stiff_;  // ∂E/∂q, diagonal of K_q (size n); with data_ and J_: prepare()'s cache
   Vector cachedQ_;       // q of the cache (size n)
-  // inDomain()'s bounds per joint, geometric limit ± the overshoot allowed while the limits are
-  // traced as boundaries, formed once (the same sums inDomain() formed per call; size n).
-  Vector domainUpper_, domainLower_;
   bool cacheValid_ = false;
   Vector work_, work2_;  // size n
   ChainStructure structure_;  // workspace of the structured stability()
