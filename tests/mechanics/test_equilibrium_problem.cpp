@@ -225,6 +225,53 @@ TEST_CASE("EquilibriumProblem: cached evaluations equal a fresh problem's in any
   }
 }
 
+TEST_CASE("EquilibriumProblem's domain: the geometric limits, the traced overshoot, non-finite values", "[equilibrium]") {
+  // Every joint within its geometric limits is evaluated; with the limits traced as boundaries
+  // also up to 0.05 rad beyond them (the tracer brackets a limit from its far side), otherwise
+  // nothing beyond them. NaN and ±∞ are refused in any coordinate (joint or multiplier).
+  std::mt19937 rng(77);
+  const Chain chain = randomChain(rng, 3);
+  const EndCondition end = EndCondition::clampedPinned(0.2, 0.1);
+  for (bool traced : {true, false}) {
+    EquilibriumOptions options;
+    options.jointLimitsAsBoundaries = traced;
+    EquilibriumProblem problem(chain, end, Eigen::Vector3d(1, 0, 0), options);
+    const int N = problem.dimension();
+    const Vector u0 = randomState(rng, chain, N);
+    Vector F(N);
+    REQUIRE(problem.residual(u0, 0.3, F));
+    const double overshoot = traced ? 0.05 : 0.0;
+    for (int i = 0; i < chain.size(); ++i) {
+      INFO("traced = " << traced << ", joint " << i);
+      const double upper = chain.segment(i).geometricUpperLimit(), lower = chain.segment(i).geometricLowerLimit();
+      Vector u = u0;
+      u[i] = upper + overshoot - 1e-9;
+      CHECK(problem.residual(u, 0.3, F));
+      u[i] = upper + overshoot + 1e-9;
+      CHECK_FALSE(problem.residual(u, 0.3, F));
+      u[i] = lower - overshoot + 1e-9;
+      CHECK(problem.residual(u, 0.3, F));
+      u[i] = lower - overshoot - 1e-9;
+      CHECK_FALSE(problem.residual(u, 0.3, F));
+      for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                         -std::numeric_limits<double>::infinity()}) {
+        u[i] = bad;
+        CHECK_FALSE(problem.residual(u, 0.3, F));
+      }
+      // back inside after a refusal: the same values as before it
+      Vector G(N);
+      REQUIRE(problem.residual(u0, 0.3, G));
+      Vector F0(N);
+      EquilibriumProblem fresh(chain, end, Eigen::Vector3d(1, 0, 0), options);
+      REQUIRE(fresh.residual(u0, 0.3, F0));
+      CHECK((G.array() == F0.array()).all());
+    }
+    Vector u = u0;
+    u[N - 1] = std::numeric_limits<double>::quiet_NaN();  // a multiplier
+    CHECK_FALSE(problem.residual(u, 0.3, F));
+  }
+}
+
 namespace {
 
 // The BD special point of the first branch traced from the straight chain along `direction`.

@@ -1,5 +1,7 @@
 #include "buckle/continuation/corrector.h"
 
+#include "buckle/continuation/serial_vector_ops.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -40,6 +42,9 @@ Corrector::Corrector(Problem &problem, const CorrectorOptions &options, Bordered
   context_ = makeSunContext();
   x_ = makeSerialVector(m, context_.get());
   scale_ = makeSerialVector(m, context_.get());
+  // Before KINInit, which clones its work vectors from x_ (serial_vector_ops.h).
+  useLeanSerialOperations(x_.get());
+  useLeanSerialOperations(scale_.get());
   N_VConst(1.0, scale_.get());
   if (!structured_) dense_.emplace(static_cast<int>(m), DenseLU::Rounding::Reciprocal);
   jacobian_ = makeEmptyCustomMatrix(context_.get());
@@ -75,10 +80,11 @@ void Corrector::applyOptions() {
   KINSetMaxNewtonStep(mem, options_.maxNewtonStep > 0.0 ? options_.maxNewtonStep : 1e100);
 }
 
+// NV_DATA_S in the callbacks: every vector KINSOL hands them is a serial clone of x_.
 int Corrector::systemFunction(N_Vector x, N_Vector g, void *self) {
   auto *corrector = static_cast<Corrector *>(self);
   try {
-    return corrector->evaluate(N_VGetArrayPointer(x), N_VGetArrayPointer(g));
+    return corrector->evaluate(NV_DATA_S(x), NV_DATA_S(g));
   } catch (...) {
     corrector->pending_ = std::current_exception();
     return -1;  // unrecoverable: KINSOL returns at once and correct() rethrows
@@ -88,8 +94,8 @@ int Corrector::systemFunction(N_Vector x, N_Vector g, void *self) {
 int Corrector::jacobianFunction(N_Vector x, N_Vector, SUNMatrix, void *self, N_Vector, N_Vector) {
   auto *corrector = static_cast<Corrector *>(self);
   try {
-    if (corrector->structured_) return corrector->factorStructured(N_VGetArrayPointer(x));
-    return corrector->evaluateJacobian(N_VGetArrayPointer(x));
+    if (corrector->structured_) return corrector->factorStructured(NV_DATA_S(x));
+    return corrector->evaluateJacobian(NV_DATA_S(x));
   } catch (...) {
     corrector->pending_ = std::current_exception();
     return -1;
@@ -107,8 +113,8 @@ int Corrector::linearSetup(SUNLinearSolver solver, SUNMatrix) {
 int Corrector::linearSolve(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vector b, realtype) {
   auto *corrector = static_cast<Corrector *>(customLinearSolverData(solver));
   const int m = corrector->n_ + 1;
-  Eigen::Map<const Vector> rhs(N_VGetArrayPointer(b), m);
-  Eigen::Map<Vector> solution(N_VGetArrayPointer(x), m);
+  Eigen::Map<const Vector> rhs(NV_DATA_S(b), m);
+  Eigen::Map<Vector> solution(NV_DATA_S(x), m);
   if (corrector->dense_) {
     solution = rhs;
     corrector->dense_->solveInPlace(solution);
@@ -162,7 +168,7 @@ int Corrector::evaluateJacobian(const double *xData) {
 CorrectorSummary Corrector::correct(ConstVectorRef predictor, ConstVectorRef tangent, VectorRef x) {
   predictor_ = predictor;
   tangent_ = tangent;
-  Eigen::Map<Vector>(N_VGetArrayPointer(x_.get()), n_ + 1) = predictor_;
+  Eigen::Map<Vector>(NV_DATA_S(x_.get()), n_ + 1) = predictor_;
   stepNorms_.clear();
   haveLastIterate_ = false;
   refused_ = false;
@@ -191,7 +197,7 @@ CorrectorSummary Corrector::correct(ConstVectorRef predictor, ConstVectorRef tan
   summary.converged = flag == KIN_SUCCESS || flag == KIN_INITIAL_GUESS_OK ||
                       (flag == KIN_STEP_LT_STPTOL && fnorm <= options_.stagnationFactor * options_.residualTolerance);
   if (flag < 0 && lastError_[0] != '\0') summary.message = lastError_.data();
-  x = Eigen::Map<const Vector>(N_VGetArrayPointer(x_.get()), n_ + 1);
+  x = Eigen::Map<const Vector>(NV_DATA_S(x_.get()), n_ + 1);
   return summary;
 }
 
@@ -206,7 +212,7 @@ CorrectorSummary Corrector::solveWithFixedCoordinate(ConstVectorRef predictor, i
 CorrectorSummary Corrector::solveAtFixedParameter(ConstVectorRef u0, double lambda, VectorRef u) {
   // Build the predictor in the KINSOL vector itself: correct() copies it into predictor_ and
   // starts from it, so nothing is allocated.
-  Eigen::Map<Vector> x(N_VGetArrayPointer(x_.get()), n_ + 1);
+  Eigen::Map<Vector> x(NV_DATA_S(x_.get()), n_ + 1);
   x.head(n_) = u0;
   x[n_] = lambda;
   unit_.setZero();

@@ -1,8 +1,11 @@
 #include "buckle/continuation/sundials_raii.h"
 
+#include "buckle/continuation/serial_vector_ops.h"
+
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include <cmath>
 #include <stdexcept>
 
 namespace buckle::continuation {
@@ -36,7 +39,63 @@ int customSolverFree(SUNLinearSolver solver) {
   SUNLinSolFreeEmpty(solver);
   return SUNLS_SUCCESS;
 }
+// serial_vector_ops.h: the operations of N_V*_Serial (SUNDIALS 6.4), same order of operations.
+realtype leanWL2Norm(N_Vector x, N_Vector w) {
+  const sunindextype n = NV_LENGTH_S(x);
+  const realtype *xd = NV_DATA_S(x), *wd = NV_DATA_S(w);
+  realtype sum = 0.0;
+  for (sunindextype i = 0; i < n; ++i) {
+    const realtype p = xd[i] * wd[i];
+    sum += p * p;
+  }
+  return std::sqrt(sum);
+}
+void leanProd(N_Vector x, N_Vector y, N_Vector z) {
+  const sunindextype n = NV_LENGTH_S(x);
+  const realtype *xd = NV_DATA_S(x), *yd = NV_DATA_S(y);
+  realtype *zd = NV_DATA_S(z);
+  for (sunindextype i = 0; i < n; ++i) zd[i] = xd[i] * yd[i];
+}
+realtype leanMaxNorm(N_Vector x) {
+  const sunindextype n = NV_LENGTH_S(x);
+  const realtype *xd = NV_DATA_S(x);
+  realtype max = 0.0;
+  for (sunindextype i = 0; i < n; ++i)
+    if (std::abs(xd[i]) > max) max = std::abs(xd[i]);
+  return max;
+}
+realtype leanMin(N_Vector x) {
+  const sunindextype n = NV_LENGTH_S(x);
+  const realtype *xd = NV_DATA_S(x);
+  realtype min = xd[0];
+  for (sunindextype i = 1; i < n; ++i)
+    if (xd[i] < min) min = xd[i];
+  return min;
+}
+// c·x_i: for c = 1 and c = −1 exactly the library's copy and negation.
+void leanScale(realtype c, N_Vector x, N_Vector z) {
+  const sunindextype n = NV_LENGTH_S(x);
+  const realtype *xd = NV_DATA_S(x);
+  realtype *zd = NV_DATA_S(z);
+  for (sunindextype i = 0; i < n; ++i) zd[i] = c * xd[i];
+}
+void leanConst(realtype c, N_Vector z) {
+  const sunindextype n = NV_LENGTH_S(z);
+  realtype *zd = NV_DATA_S(z);
+  for (sunindextype i = 0; i < n; ++i) zd[i] = c;
+}
 }  // namespace
+
+void useLeanSerialOperations(N_Vector v) {
+  if (N_VGetVectorID(v) != SUNDIALS_NVEC_SERIAL)
+    throw std::invalid_argument("useLeanSerialOperations: not a serial N_Vector");
+  v->ops->nvwl2norm = leanWL2Norm;
+  v->ops->nvprod = leanProd;
+  v->ops->nvmaxnorm = leanMaxNorm;
+  v->ops->nvmin = leanMin;
+  v->ops->nvscale = leanScale;
+  v->ops->nvconst = leanConst;
+}
 
 void SunContextDeleter::operator()(std::remove_pointer_t<SUNContext> *context) const noexcept {
   SUNContext handle = context;
