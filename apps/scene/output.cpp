@@ -188,12 +188,15 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
         p["post_buckling"] = mechanics::toString(s.koiter.kind);
         json imperfections = json::array();
         for (const mechanics::ImperfectionSensitivity& im : s.imperfections)
-          if (im.valid)
-            imperfections.push_back({{"imperfection", im.name},
-                                     {"coupling", number(im.coupling)},
-                                     {"exponent", number(im.exponent)},
-                                     {"prefactor", number(im.prefactor)},
-                                     {"sign", im.sign}});
+          if (im.valid) {
+            json entry = {{"imperfection", im.name},
+                          {"coupling", number(im.coupling)},
+                          {"exponent", number(im.exponent)},
+                          {"prefactor", number(im.prefactor)},
+                          {"sign", im.sign}};
+            if (im.coordinate < 0) entry["segment"] = im.segment < 0 ? json("all") : json(im.segment + 1);
+            imperfections.push_back(entry);
+          }
         p["imperfection_sensitivity"] = imperfections;
       }
       if (s.joint >= 0)  // CT / RL

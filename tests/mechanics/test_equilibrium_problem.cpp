@@ -374,7 +374,7 @@ TEST_CASE("a chain's geometric joint limit: the load equals Newton's with the jo
   CHECK((bd->u - u).norm() <= 1e-11);
 }
 
-TEST_CASE("EquilibriumProblem O(n) products equal the dense F_x, F_x^T and second derivative", "[equilibrium]") {
+TEST_CASE("EquilibriumProblem O(n) products equal the dense F_x, F_x^T and second derivatives", "[equilibrium]") {
   std::mt19937 rng(303);
   std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
   for (int n : {1, 4, 30}) {
@@ -405,6 +405,19 @@ TEST_CASE("EquilibriumProblem O(n) products equal the dense F_x, F_x^T and secon
       REQUIRE(problem.jacobianDirectionalDerivative(u, lambda, dx.head(N), dx[N], dFx.leftCols(N), dFx.col(N)));
       const Vector exact = dFx.transpose() * w;
       CHECK((y2 - exact).norm() <= 1e-7 * std::max(1.0, exact.norm()));
+      // F_xx[dx, x] in O(n) (secondDerivativeApply): the exact matrix derivative applied to x, to
+      // rounding; symmetric in its two directions; central differences of F_x x along dx
+      Vector s2(N), s2t(N), yp(N), ym(N);
+      REQUIRE(problem.secondDerivativeApply(u, lambda, dx, x, s2));
+      const Vector dense = dFx * x;
+      const double size = std::max((dFx.cwiseAbs() * x.cwiseAbs()).maxCoeff(), 1e-300);
+      CHECK((s2 - dense).lpNorm<Eigen::Infinity>() <= 1e-13 * size);
+      REQUIRE(problem.secondDerivativeApply(u, lambda, x, dx, s2t));
+      CHECK((s2 - s2t).lpNorm<Eigen::Infinity>() <= 1e-13 * size);
+      const double h = 1e-5;
+      REQUIRE(problem.jacobianApply(u + h * dx.head(N), lambda + h * dx[N], x, yp));
+      REQUIRE(problem.jacobianApply(u - h * dx.head(N), lambda - h * dx[N], x, ym));
+      CHECK((s2 - (yp - ym) / (2.0 * h)).lpNorm<Eigen::Infinity>() <= 1e-7 * std::max(size, 1.0));
     }
   }
 }

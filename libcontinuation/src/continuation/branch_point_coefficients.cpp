@@ -1,8 +1,12 @@
 #include "buckle/continuation/branch_point_coefficients.h"
 
+#include "buckle/continuation/bordered_solver.h"
+#include "buckle/continuation/structured_refinement.h"
+
 #include <Eigen/LU>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 namespace buckle::continuation {
 
@@ -12,35 +16,166 @@ bool fail(std::string *why, const std::string &reason) {
   return false;
 }
 
-/// The exact second derivatives F_xx[e, e], F_xx[e, d], F_xx[d, d] (e = (v, 0), d = (p1, 1)) at
-/// x0 + ε·w, and their derivatives along w by central differences (the third derivatives).
-class SecondDerivatives {
+/// What the reduction needs from the problem at the branch point x0 = (u0, λc): the second
+/// directional derivatives F_xx[x, z] as vectors (at x0 and at nearby points, for the third
+/// derivatives), F_λ, the left null vector system [[F_uᵀ, c], [v̂ᵀ, 0]] and the bordered
+/// [[F_u, ψ], [cᵀ, 0]] for every solve with F_u.
+class Algebra {
  public:
-  SecondDerivatives(Problem &problem, ConstVectorRef u0, double lambda, const Vector &v, const Vector &p1)
-      : problem_(problem), u0_(u0), lambda_(lambda), v_(v), p1_(p1), D_(v.size(), v.size()), Dl_(v.size()) {}
+  virtual ~Algebra() = default;
+  /// F_x at x0 (what factor and the size check need); false when the problem refuses x0.
+  virtual bool linearise(Vector &Fl) = 0;
+  /// A size of F_u (the singularity check of the left null vector).
+  virtual double jacobianSize() const = 0;
+  /// [ψ; σ] = [[F_uᵀ, c], [v̂ᵀ, 0]]⁻¹ e_{N+1}.
+  virtual bool leftNull(const Vector &c, const Vector &vHat, Vector &sol) = 0;
+  /// Factors [[F_u, ψ], [cᵀ, 0]]; solve() then gives its inverse applied to r (size N+1).
+  virtual bool factorBordered(const Vector &psi, const Vector &c) = 0;
+  virtual bool solve(const Vector &r, Vector &x) = 0;
+  /// y = F_xx[x, z] at (u, λ) (x, z size N+1).
+  virtual bool second(const Vector &u, double lambda, const Vector &x, const Vector &z, Vector &y) = 0;
+};
 
-  /// At x0 + ε(wu, wl): ee = F_xx[e, e], ed = F_xx[e, d], dd = F_xx[d, d] (dd only when asked).
-  bool at(double eps, const Vector &wu, double wl, Vector &ee, Vector &ed, Vector *dd) {
-    u_ = u0_ + eps * wu;
-    const double l = lambda_ + eps * wl;
-    if (!problem_.jacobianDirectionalDerivative(u_, l, v_, 0.0, D_, Dl_)) return false;
-    ee.noalias() = D_ * v_;
-    ed.noalias() = D_ * p1_;
-    ed += Dl_;
-    if (!dd) return true;
-    if (!problem_.jacobianDirectionalDerivative(u_, l, p1_, 1.0, D_, Dl_)) return false;
-    dd->noalias() = D_ * p1_;
-    *dd += Dl_;
+/// Dense: F_u as a matrix, partial-pivoting LU, F_xx[x, ·] the matrices of
+/// jacobianDirectionalDerivative (kept for the last x and point: most products share them).
+class DenseAlgebra final : public Algebra {
+ public:
+  DenseAlgebra(Problem &problem, ConstVectorRef u0, double lambda)
+      : problem_(problem), n_(problem.dimension()), u0_(u0), lambda_(lambda), Fu_(n_, n_), D_(n_, n_), Dl_(n_) {}
+
+  bool linearise(Vector &Fl) override {
+    Fl.resize(n_);
+    return problem_.jacobian(u0_, lambda_, Fu_, Fl);
+  }
+  double jacobianSize() const override { return Fu_.norm(); }
+  bool leftNull(const Vector &c, const Vector &vHat, Vector &sol) override {
+    Matrix A = Matrix::Zero(n_ + 1, n_ + 1);
+    A.topLeftCorner(n_, n_) = Fu_.transpose();
+    A.block(0, n_, n_, 1) = c;
+    A.block(n_, 0, 1, n_) = vHat.transpose();
+    Vector rhs = Vector::Zero(n_ + 1);
+    rhs[n_] = 1.0;
+    sol = Eigen::PartialPivLU<Matrix>(A).solve(rhs);
+    return sol.allFinite();
+  }
+  bool factorBordered(const Vector &psi, const Vector &c) override {
+    Matrix B = Matrix::Zero(n_ + 1, n_ + 1);
+    B.topLeftCorner(n_, n_) = Fu_;
+    B.block(0, n_, n_, 1) = psi;
+    B.block(n_, 0, 1, n_) = c.transpose();
+    lu_.compute(B);
+    return true;
+  }
+  bool solve(const Vector &r, Vector &x) override {
+    x = lu_.solve(r);
+    return x.allFinite();
+  }
+  bool second(const Vector &u, double lambda, const Vector &x, const Vector &z, Vector &y) override {
+    const bool same = cached_ && lambda == cachedLambda_ && x == cachedX_ && u == cachedU_;
+    if (!same) {
+      cached_ = false;
+      if (!problem_.jacobianDirectionalDerivative(u, lambda, x.head(n_), x[n_], D_, Dl_)) return false;
+      cachedU_ = u;
+      cachedLambda_ = lambda;
+      cachedX_ = x;
+      cached_ = true;
+    }
+    y.noalias() = D_ * z.head(n_);
+    if (z[n_] != 0.0) y += z[n_] * Dl_;
     return true;
   }
 
-  /// d/dε of (F_xx[e, e], F_xx[e, d], F_xx[d, d]) at ε = 0 along h·(wu, wl): central differences
+ private:
+  Problem &problem_;
+  int n_;
+  ConstVectorRef u0_;
+  double lambda_;
+  Matrix Fu_, D_;
+  Vector Dl_;
+  Eigen::PartialPivLU<Matrix> lu_;
+  bool cached_ = false;
+  Vector cachedU_, cachedX_;
+  double cachedLambda_ = 0.0;
+};
+
+/// Structured: the problem's O(N) products (jacobianApply, secondDerivativeApply) and its
+/// bordered solver's general borders (k = 1), iteratively refined on the exact residual
+/// (RefinedBorderedSystem): O(N) per solve and product for a chain.
+class StructuredAlgebra final : public Algebra {
+ public:
+  StructuredAlgebra(Problem &problem, std::unique_ptr<BorderedSolver> solver, ConstVectorRef u0, double lambda)
+      : problem_(problem),
+        n_(problem.dimension()),
+        solver_(std::move(solver)),
+        system_(problem, *solver_),
+        u0_(u0),
+        lambda_(lambda),
+        zero_(Matrix::Zero(1, 1)) {}
+
+  bool linearise(Vector &Fl) override {
+    Vector x = Vector::Zero(n_ + 1);
+    x[n_] = 1.0;
+    Fl.resize(n_);
+    if (!problem_.jacobianApply(u0_, lambda_, x, Fl)) return false;
+    // ‖F_u z‖/‖z‖ for a fixed z spread over all unknowns (in their scales): a lower bound of ‖F_u‖
+    const ProblemScales s = problem_.scales();
+    for (int i = 0; i < n_; ++i) x[i] = (std::sin(0.7 * double(i) + 0.3) + 0.5) * s.unknowns[i];
+    x[n_] = 0.0;
+    Vector y(n_);
+    if (!problem_.jacobianApply(u0_, lambda_, x, y)) return false;
+    size_ = y.norm() / x.norm();
+    return Fl.allFinite() && std::isfinite(size_);
+  }
+  double jacobianSize() const override { return size_; }
+  bool leftNull(const Vector &c, const Vector &vHat, Vector &sol) override {
+    if (!system_.factor(u0_, lambda_, c, vHat, zero_, true)) return false;
+    Vector rhs = Vector::Zero(n_ + 1);
+    rhs[n_] = 1.0;
+    return system_.solve(rhs, sol);
+  }
+  bool factorBordered(const Vector &psi, const Vector &c) override {
+    return system_.factor(u0_, lambda_, psi, c, zero_, false);
+  }
+  bool solve(const Vector &r, Vector &x) override { return system_.solve(r, x); }
+  bool second(const Vector &u, double lambda, const Vector &x, const Vector &z, Vector &y) override {
+    y.resize(n_);
+    return problem_.secondDerivativeApply(u, lambda, x, z, y);
+  }
+
+ private:
+  Problem &problem_;
+  int n_;
+  std::unique_ptr<BorderedSolver> solver_;
+  RefinedBorderedSystem system_;
+  ConstVectorRef u0_;
+  double lambda_;
+  Matrix zero_;
+  double size_ = 0.0;
+};
+
+/// The second derivatives F_xx[e, e], F_xx[e, d], F_xx[d, d] (e = (v, 0), d = (p1, 1)) at
+/// x0 + ε·w, and their derivatives along w by central differences (the third derivatives).
+class SecondDerivatives {
+ public:
+  SecondDerivatives(Algebra &algebra, ConstVectorRef u0, double lambda, const Vector &e, const Vector &d)
+      : algebra_(algebra), u0_(u0), lambda_(lambda), e_(e), d_(d) {}
+
+  /// At x0 + ε w (w size N+1): ee = F_xx[e, e], ed = F_xx[e, d], dd = F_xx[d, d] (dd only when asked).
+  bool at(double eps, const Vector &w, Vector &ee, Vector &ed, Vector *dd) {
+    const Eigen::Index n = u0_.size();
+    u_ = u0_ + eps * w.head(n);
+    const double l = lambda_ + eps * w[n];
+    if (!algebra_.second(u_, l, e_, e_, ee) || !algebra_.second(u_, l, e_, d_, ed)) return false;
+    return !dd || algebra_.second(u_, l, d_, d_, *dd);
+  }
+
+  /// d/dε of (F_xx[e, e], F_xx[e, d], F_xx[d, d]) at ε = 0 along h·w: central differences
   /// at ±h and ±h/2, one Richardson step (error O(h⁴)), divided by h.
-  bool along(double h, const Vector &wu, double wl, Vector &dee, Vector &ded, Vector *ddd) {
+  bool along(double h, const Vector &w, Vector &dee, Vector &ded, Vector *ddd) {
     const double t[4] = {h, -h, 0.5 * h, -0.5 * h};
     Vector ee[4], ed[4], dd[4];
     for (int k = 0; k < 4; ++k)
-      if (!at(t[k], wu, wl, ee[k], ed[k], ddd ? &dd[k] : nullptr)) return false;
+      if (!at(t[k], w, ee[k], ed[k], ddd ? &dd[k] : nullptr)) return false;
     auto richardson = [h](const Vector *f) -> Vector {
       return (4.0 * (f[2] - f[3]) - 0.5 * (f[0] - f[1])) / (3.0 * h);
     };
@@ -51,21 +186,23 @@ class SecondDerivatives {
   }
 
  private:
-  Problem &problem_;
+  Algebra &algebra_;
   ConstVectorRef u0_;
   double lambda_;
-  const Vector &v_, &p1_;
-  Matrix D_;
-  Vector Dl_, u_;
+  const Vector &e_, &d_;
+  Vector u_;
 };
-}  // namespace
 
-bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
-                             ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out, std::string *why) {
+/// (x, 0) and (x, 1) as (N+1)-vectors.
+Vector extended(const Vector &x, double last) {
+  Vector y(x.size() + 1);
+  y << x, last;
+  return y;
+}
+
+bool reduce(Problem &problem, Algebra &algebra, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
+            ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out, std::string *why) {
   const int n = problem.dimension();
-  if (u0.size() != n || v0.size() != n || c.size() != n || parentTangent.size() != n + 1)
-    return fail(why, "branch-point coefficients: u0, v and c must have the problem's dimension " + std::to_string(n) +
-                         ", the parent tangent " + std::to_string(n + 1));
   const double cv = c.dot(v0);
   if (!(std::abs(cv) > 0.0) || !std::isfinite(cv))
     return fail(why, "branch-point coefficients: the normalisation c is orthogonal to v");
@@ -74,56 +211,52 @@ bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC
   // the parent's slope in the scaled variables: a vertical parent (a fold) has no u_p(λ)
   if (!(std::abs(tl) / s.parameter > 1e-8 * parentTangent.head(n).cwiseQuotient(s.unknowns).norm()))
     return fail(why, "branch-point coefficients: the parent branch is vertical at the point (also a fold)");
-  Matrix Fu(n, n), D(n, n), Dd(n, n);
-  Vector Fl(n), Dl(n), Dld(n);
-  if (!problem.jacobian(u0, lambdaC, Fu, Fl))
-    return fail(why, "branch-point coefficients: the problem refused (u0, λc)");
+  Vector Fl;
+  if (!algebra.linearise(Fl)) return fail(why, "branch-point coefficients: the problem refused (u0, λc)");
 
   // ψ from [[F_uᵀ, c], [v̂ᵀ, 0]] [ψ; σ] = [0; 1]: ψᵀF_u = 0 at the branch point
+  const Vector cc = c;
   const Vector vHat = v0 / cv;
-  Matrix A = Matrix::Zero(n + 1, n + 1);
-  A.topLeftCorner(n, n) = Fu.transpose();
-  A.block(0, n, n, 1) = c;
-  A.block(n, 0, 1, n) = vHat.transpose();
-  Vector rhs = Vector::Zero(n + 1);
-  rhs[n] = 1.0;
-  const Vector sol = Eigen::PartialPivLU<Matrix>(A).solve(rhs);
+  Vector sol;
+  if (!algebra.leftNull(cc, vHat, sol) || !sol.head(n).allFinite())
+    return fail(why, "branch-point coefficients: the null space of F_u is not one-dimensional");
   Vector psi = sol.head(n);
-  if (!psi.allFinite()) return fail(why, "branch-point coefficients: the null space of F_u is not one-dimensional");
   // F_uᵀψ = −c·σ: σ is the distance from singularity (0 at the branch point)
-  if (std::abs(sol[n]) * c.norm() > 1e-6 * Fu.norm() * psi.norm())
+  if (std::abs(sol[n]) * c.norm() > 1e-6 * algebra.jacobianSize() * psi.norm())
     return fail(why, "branch-point coefficients: F_u is not singular at λc (not a branch point)");
 
   // one bordered matrix [[F_u, ψ], [cᵀ, 0]] for every solve with F_u (cᵀx = 0 fixes the null part)
-  Matrix B = Matrix::Zero(n + 1, n + 1);
-  B.topLeftCorner(n, n) = Fu;
-  B.block(0, n, n, 1) = psi;
-  B.block(n, 0, 1, n) = c.transpose();
-  const Eigen::PartialPivLU<Matrix> lu(B);
-  Vector r = Vector::Zero(n + 1);
-  auto solve = [&](const Vector &right) -> Vector {
+  if (!algebra.factorBordered(psi, cc)) return fail(why, "branch-point coefficients: singular bordered system");
+  Vector r = Vector::Zero(n + 1), x(n + 1);
+  auto solve = [&](const Vector &right, Vector &result) {
     r.head(n) = right;
     r[n] = 0.0;
-    return lu.solve(r).head(n);
+    if (!algebra.solve(r, x)) return false;
+    result = x.head(n);
+    return true;
   };
   // the null vector itself, refined: F_u v ∝ ψ-residual only, cᵀv = 1
   r.setZero();
   r[n] = 1.0;
-  const Vector v = lu.solve(r).head(n);
+  if (!algebra.solve(r, x)) return fail(why, "branch-point coefficients: singular bordered system");
+  const Vector v = x.head(n);
   psi /= psi.dot(v);
   if (!v.allFinite() || !psi.allFinite()) return fail(why, "branch-point coefficients: singular bordered system");
 
   // p1 = p1⊥ + κv: F_u p1⊥ = −F_λ (in range: ψᵀF_λ = 0 at a branch point), κ a root of the ABE
   // ψᵀF_xx[d, d] = P⊥⊥ + 2κP⊥e + κ²Pee = 0 (its two roots are the two branches' slopes)
-  const Vector p1Perp = solve(-Fl);
-  if (!problem.jacobianDirectionalDerivative(u0, lambdaC, v, 0.0, D, Dl))
-    return fail(why, "branch-point coefficients: no second derivatives at (u0, λc)");
-  const Vector Fee = D * v;
+  const std::string noSecond = "branch-point coefficients: no second derivatives at (u0, λc)";
+  const Vector uc = u0;
+  Vector p1Perp;
+  if (!solve(-Fl, p1Perp)) return fail(why, "branch-point coefficients: singular bordered system");
+  const Vector e = extended(v, 0.0), dPerp = extended(p1Perp, 1.0);
+  Vector Fee, FePerp, FperpPerp;
+  if (!algebra.second(uc, lambdaC, e, e, Fee) || !algebra.second(uc, lambdaC, e, dPerp, FePerp) ||
+      !algebra.second(uc, lambdaC, dPerp, dPerp, FperpPerp))
+    return fail(why, noSecond);
   const double Pee = psi.dot(Fee);
-  const double PperpE = psi.dot(D * p1Perp + Dl);
-  if (!problem.jacobianDirectionalDerivative(u0, lambdaC, p1Perp, 1.0, Dd, Dld))
-    return fail(why, "branch-point coefficients: no second derivatives at (u0, λc)");
-  const double PperpPerp = psi.dot(Dd * p1Perp + Dld);
+  const double PperpE = psi.dot(FePerp);
+  const double PperpPerp = psi.dot(FperpPerp);
   const double kappaGiven = c.dot(parentTangent.head(n)) / tl;
   const double disc = PperpE * PperpE - Pee * PperpPerp;
   const double q = -(PperpE + std::copysign(std::sqrt(std::max(disc, 0.0)), PperpE));
@@ -134,6 +267,7 @@ bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC
       kappa = root;
     }
   const Vector p1 = p1Perp + kappa * v;
+  const Vector dv = extended(p1, 1.0);
 
   // transversality τ = ψᵀF_xx[e, d] against its own size in the scaled variables
   const double tau = PperpE + kappa * Pee;
@@ -142,38 +276,38 @@ bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC
     return fail(why, "branch-point coefficients: the zero eigenvalue does not cross transversally (ψᵀF_xx[e, d] = 0)");
   const double a = -0.5 * Pee / tau;
 
-  // second derivatives at the point: D = F_xx[e, ·], Dd = F_xx[d, ·] (u-columns)
-  if (!problem.jacobianDirectionalDerivative(u0, lambdaC, p1, 1.0, Dd, Dld))
-    return fail(why, "branch-point coefficients: no second derivatives at (u0, λc)");
-  const Vector Fed = D * p1 + Dl;
-  const Vector Fdd = Dd * p1 + Dld;
-  const Vector u2 = solve(-(a * Fed + 0.5 * Fee));
-  const Vector p2Perp = solve(-Fdd);
-  if (!u2.allFinite() || !p2Perp.allFinite())
+  // second derivatives at the point along e and d
+  Vector Fed, Fdd;
+  if (!algebra.second(uc, lambdaC, e, dv, Fed) || !algebra.second(uc, lambdaC, dv, dv, Fdd))
+    return fail(why, noSecond);
+  Vector u2, p2Perp;
+  if (!solve(-(a * Fed + 0.5 * Fee), u2) || !solve(-Fdd, p2Perp) || !u2.allFinite() || !p2Perp.allFinite())
     return fail(why, "branch-point coefficients: singular bordered system for u2");
 
   // third derivatives D³F[e,e,e] along e; D³F[e,e,d], D³F[e,d,d], D³F[d,d,d] along d
-  SecondDerivatives second(problem, u0, lambdaC, v, p1);
+  SecondDerivatives second(algebra, u0, lambdaC, e, dv);
   const double pScaled = s.parameter * p1.cwiseQuotient(s.unknowns).norm();
   const double hu = 1e-3 / v.cwiseQuotient(s.unknowns).norm();
   const double hd = 1e-3 * std::max(s.parameter, std::abs(lambdaC)) / std::sqrt(1.0 + pScaled * pScaled);
-  const Vector zero = Vector::Zero(n);
   Vector Teee, unused, Teed, Tedd, Tddd;
-  if (!second.along(hu, v, 0.0, Teee, unused, nullptr) || !second.along(hd, p1, 1.0, Teed, Tedd, &Tddd))
+  if (!second.along(hu, e, Teee, unused, nullptr) || !second.along(hd, dv, Teed, Tedd, &Tddd))
     return fail(why, "branch-point coefficients: the problem refused a point near (u0, λc)");
 
   // p2's component along v from ψᵀ(D³F[d,d,d] + 3F_xx[d, (p2, 0)]) = 0
-  const double sigma = -(psi.dot(Tddd) + 3.0 * psi.dot(Dd * p2Perp)) / (3.0 * tau);
+  Vector Fdp2Perp, Fdu2, Feu2, Fep2;
+  if (!algebra.second(uc, lambdaC, dv, extended(p2Perp, 0.0), Fdp2Perp)) return fail(why, noSecond);
+  const double sigma = -(psi.dot(Tddd) + 3.0 * psi.dot(Fdp2Perp)) / (3.0 * tau);
   const Vector p2 = p2Perp + sigma * v;
-  const Vector third =
-      a * (Dd * u2) + D * u2 + Teee / 6.0 + 0.5 * a * Teed + 0.5 * a * a * (Tedd + D * p2);
+  const Vector u2e = extended(u2, 0.0);
+  if (!algebra.second(uc, lambdaC, dv, u2e, Fdu2) || !algebra.second(uc, lambdaC, e, u2e, Feu2) ||
+      !algebra.second(uc, lambdaC, e, extended(p2, 0.0), Fep2))
+    return fail(why, noSecond);
+  const Vector third = a * Fdu2 + Feu2 + Teee / 6.0 + 0.5 * a * Teed + 0.5 * a * a * (Tedd + Fep2);
   const double b = -psi.dot(third) / tau;
   if (!std::isfinite(a) || !std::isfinite(b)) return fail(why, "branch-point coefficients: not finite");
 
   // the ABE in the orthonormal basis t = d/|d|, φ ⊥ t of ker F_x (Euclidean in (u, λ))
-  Vector d(n + 1), e = Vector::Zero(n + 1);
-  d << p1, 1.0;
-  e.head(n) = v;
+  Vector d = dv;
   if (d.dot(parentTangent) < 0.0) d = -d;  // t along the parent's orientation
   const double nd = d.norm(), gamma = e.dot(d) / nd;
   const double nphi = (e - gamma * d / nd).norm();
@@ -196,9 +330,35 @@ bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC
   out.u2 = u2;
   return true;
 }
+}  // namespace
+
+bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
+                             ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out, std::string *why,
+                             CoefficientAlgebra algebra) {
+  const int n = problem.dimension();
+  if (u0.size() != n || v0.size() != n || c.size() != n || parentTangent.size() != n + 1)
+    return fail(why, "branch-point coefficients: u0, v and c must have the problem's dimension " + std::to_string(n) +
+                         ", the parent tangent " + std::to_string(n + 1));
+  std::unique_ptr<BorderedSolver> solver;
+  if (algebra == CoefficientAlgebra::Structured ||
+      (algebra == CoefficientAlgebra::Automatic && n > kDenseCoefficientDimension)) {
+    solver = problem.makeStructuredSolver();
+    if (solver && solver->maxGeneralBorder() < 1) solver.reset();
+    if (!solver && algebra == CoefficientAlgebra::Structured)
+      return fail(why, "branch-point coefficients: the problem has no structured solver with general borders");
+  }
+  if (!solver) {
+    DenseAlgebra dense(problem, u0, lambdaC);
+    return reduce(problem, dense, u0, lambdaC, parentTangent, v0, c, out, why);
+  }
+  StructuredAlgebra structured(problem, std::move(solver), u0, lambdaC);
+  if (reduce(problem, structured, u0, lambdaC, parentTangent, v0, c, out, why)) return true;
+  if (why) *why += " (structured algebra)";
+  return false;
+}
 
 bool branchPointCoefficients(Problem &problem, const SpecialPoint &bp, ConstVectorRef c, BranchPointCoefficients &out,
-                             std::string *why) {
+                             std::string *why, CoefficientAlgebra algebra) {
   const int n = problem.dimension();
   if (bp.type != SpecialPointType::BranchPoint || bp.u.size() != n || bp.tangent.size() != n + 1 ||
       bp.nullVectors.rows() != n + 1 || bp.nullVectors.cols() != 2)
@@ -206,7 +366,7 @@ bool branchPointCoefficients(Problem &problem, const SpecialPoint &bp, ConstVect
   // the combination of ker F_x = span{t, φ} with no λ-component is the null vector of F_u
   const Vector t = bp.nullVectors.col(0), phi = bp.nullVectors.col(1);
   const Vector v = t[n] * phi.head(n) - phi[n] * t.head(n);
-  return branchPointCoefficients(problem, bp.u, bp.lambda, bp.tangent, v, c, out, why);
+  return branchPointCoefficients(problem, bp.u, bp.lambda, bp.tangent, v, c, out, why, algebra);
 }
 
 }  // namespace buckle::continuation

@@ -102,6 +102,16 @@ bool Problem::secondDerivativeTransposeApply(ConstVectorRef u, double lambda, Co
   return y.allFinite();
 }
 
+bool Problem::secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z, VectorRef y) {
+  const int n = dimension();
+  secondFu_.resize(n, n);
+  secondFl_.resize(n);
+  if (!jacobianDirectionalDerivative(u, lambda, x.head(n), x[n], secondFu_, secondFl_)) return false;
+  y.noalias() = secondFu_ * z.head(n);
+  y += z[n] * secondFl_;
+  return y.allFinite();
+}
+
 std::unique_ptr<BorderedSolver> Problem::makeStructuredSolver() { return nullptr; }
 
 bool Problem::stabilityOperator(ConstVectorRef, double, Matrix&, Matrix&) { return false; }

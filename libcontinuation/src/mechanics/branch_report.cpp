@@ -252,9 +252,14 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
         s.type = EventType::BranchPoint;
         if (lockedAt(stretches, sp.index).empty()) {
           s.koiter = koiterCoefficients(problem, sp);
-          if (s.koiter.valid)
+          if (s.koiter.valid) {
             for (int c = 0; c < 3; ++c) s.imperfections.push_back(imperfectionSensitivity(problem, sp, s.koiter, c));
-          else
+            // preload asymmetries: of every segment at once, and of the most sensitive single one
+            s.imperfections.push_back(preloadImperfectionSensitivity(problem, sp, s.koiter, -1));
+            if (problem.segments() > 1)
+              s.imperfections.push_back(preloadImperfectionSensitivity(
+                  problem, sp, s.koiter, mostSensitivePreloadSegment(problem, sp, s.koiter)));
+          } else
             s.note = s.koiter.error;
         }
         break;

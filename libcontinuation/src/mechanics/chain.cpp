@@ -98,6 +98,20 @@ void loadHessianGenerator(const ChainData& data, const Wrench& F, VectorRef h) {
   h = -F[0] * data.C - F[1] * data.S;
 }
 
+void maxIndexProduct(ConstVectorRef h, ConstVectorRef x, VectorRef out) {
+  const Eigen::Index n = h.size();
+  double prefix = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    prefix += x[i];
+    out[i] = h[i] * prefix;
+  }
+  double suffix = 0.0;
+  for (Eigen::Index i = n - 1; i >= 0; --i) {
+    out[i] += suffix;
+    suffix += h[i] * x[i];
+  }
+}
+
 void loadMatrix(const ChainData& data, const Wrench& F, MatrixRef Kg) {
   const Eigen::Index n = data.S.size();
   for (Eigen::Index j = 0; j < n; ++j)

@@ -48,21 +48,6 @@ SegmentParameterDirection segmentDirection(Kind kind) {
   return d;
 }
 
-// (Σ_j h_max(i,j) x_j)_i in O(n): h_i Σ_{j≤i} x_j + Σ_{j>i} h_j x_j (the K_g structure, eq 27).
-void maxIndexProduct(const Vector& h, const Eigen::Ref<const Vector>& x, Eigen::Ref<Vector> out) {
-  const Eigen::Index n = h.size();
-  double prefix = 0.0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    prefix += x[i];
-    out[i] = h[i] * prefix;
-  }
-  double suffix = 0.0;
-  for (Eigen::Index i = n - 1; i >= 0; --i) {
-    out[i] += suffix;
-    suffix += h[i] * x[i];
-  }
-}
-
 double smallestStraightStiffness(const Chain& chain) {
   double kappa = std::numeric_limits<double>::infinity();
   for (int i = 0; i < chain.size(); ++i) kappa = std::min(kappa, chain.segment(i).straightStiffness());

@@ -222,6 +222,32 @@ bool EquilibriumProblem::jacobianTransposeApply(ConstVectorRef u, double lambda,
   return std::isfinite(dot);
 }
 
+bool EquilibriumProblem::secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
+                                               VectorRef y) {
+  if (!std::isfinite(lambda) || !prepare(u)) return false;
+  const int n = chain_.size();
+  const int m = heldCount();
+  const Wrench W = wrench(u, lambda);
+  Wrench dW = x[n + m] * direction_;  // the wrench along x: loads with x_λ, reactions with x_r
+  for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = x[n + k];
+  Matrix dJ(3, n);
+  endJacobianDerivative(chain_, data_, x.head(n), dJ);
+  // dh_m along x for h_m = −Fx C_m − Fy S_m, with dC = dJ_y, dS = −dJ_x (as in
+  // jacobianDirectionalDerivative)
+  const Vector dh = -dW[0] * data_.C - W[0] * dJ.row(1).transpose() - dW[1] * data_.S + W[1] * dJ.row(0).transpose();
+  maxIndexProduct(dh, z.head(n), y.head(n));
+  y.head(n) = -y.head(n);
+  jointStiffnessDerivative(chain_, u.head(n), work2_);
+  y.head(n) += work2_.cwiseProduct(x.head(n)).cwiseProduct(z.head(n));
+  for (int c : loaded_) y.head(n) -= (z[n + m] * direction_[c]) * dJ.row(c).transpose();
+  for (int k = 0; k < m; ++k) {
+    const int c = held_[size_t(k)];
+    y.head(n) -= z[n + k] * dJ.row(c).transpose();
+    y[n + k] = -dJ.row(c).dot(z.head(n));
+  }
+  return y.allFinite();
+}
+
 bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix& H, Matrix& C) {
   if (!prepare(u)) return false;
   const int n = chain_.size();

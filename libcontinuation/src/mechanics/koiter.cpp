@@ -17,13 +17,10 @@ const char* toString(KoiterKind kind) {
   return "?";
 }
 
-KoiterCoefficients koiterCoefficients(EquilibriumProblem& problem, const cont::SpecialPoint& bp) {
+KoiterCoefficients koiterCoefficients(EquilibriumProblem& problem, const cont::SpecialPoint& bp,
+                                      cont::CoefficientAlgebra algebra) {
   KoiterCoefficients k;
   const int N = problem.dimension(), n = problem.segments();
-  if (N > kKoiterMaxDimension) {
-    k.error = "Koiter coefficients not computed above " + std::to_string(kKoiterMaxDimension) + " unknowns (dense)";
-    return k;
-  }
   if (bp.type != cont::SpecialPointType::BranchPoint || bp.nullVectors.rows() != N + 1 || bp.nullVectors.cols() != 2) {
     k.error = "Koiter coefficients: not a located simple branch point";
     return k;
@@ -41,7 +38,7 @@ KoiterCoefficients koiterCoefficients(EquilibriumProblem& problem, const cont::S
   Eigen::VectorXd c = Eigen::VectorXd::Zero(N);
   c.head(n) = m;
   cont::BranchPointCoefficients g;
-  if (!cont::branchPointCoefficients(problem, bp, c, g, &k.error)) return k;
+  if (!cont::branchPointCoefficients(problem, bp, c, g, &k.error, algebra)) return k;
   k.valid = true;
   k.lambda = bp.lambda;
   k.a = g.a;

@@ -49,17 +49,28 @@ struct BranchPointCoefficients {
   Vector childTangent;           ///< unit (N+1) tangent of the child, ∝ e + a·d, along +ξ
 };
 
+/// The linear algebra of the reduction. Dense: F_u and F_xx[x, ·] as N×N matrices
+/// (jacobianDirectionalDerivative), partial-pivoting LU; O(N³). Structured: the second
+/// derivatives as vectors (Problem::secondDerivativeApply) and every solve with F_u through the
+/// problem's bordered solver with a one-column border (BorderedSolver::factorGeneral),
+/// iteratively refined on the problem's exact products (RefinedBorderedSystem); O(N) for a chain.
+/// Automatic: structured above kDenseCoefficientDimension unknowns when the problem has a
+/// structured solver that takes general borders, dense otherwise (a speed crossover only: both
+/// give the same coefficients, to ~1e-10 relative on the chain).
+enum class CoefficientAlgebra { Automatic, Dense, Structured };
+constexpr int kDenseCoefficientDimension = 60;
+
 /// The coefficients at the simple branch point (u0, λc) of the branch with tangent
 /// `parentTangent` (size N+1, any length and sign); v approximates the null vector of F_u (it is
 /// refined, then rescaled so that cᵀv = 1). False with the reason in `why` when the problem
-/// refuses a point, F_u is not singular there, the parent is vertical (a fold), or the point is
-/// not transversal. Dense: N×N matrices.
+/// refuses a point, F_u is not singular there, the parent is vertical (a fold), the point is
+/// not transversal, or (structured) the problem's solver cannot factor the bordered F_u.
 bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
                              ConstVectorRef v, ConstVectorRef c, BranchPointCoefficients &out,
-                             std::string *why = nullptr);
+                             std::string *why = nullptr, CoefficientAlgebra algebra = CoefficientAlgebra::Automatic);
 
 /// Same at a branch point located by the tracer (bp.tangent the parent's, v from bp.nullVectors).
 bool branchPointCoefficients(Problem &problem, const SpecialPoint &bp, ConstVectorRef c, BranchPointCoefficients &out,
-                             std::string *why = nullptr);
+                             std::string *why = nullptr, CoefficientAlgebra algebra = CoefficientAlgebra::Automatic);
 
 }  // namespace buckle::continuation

@@ -96,6 +96,12 @@ class Problem {
   /// y size N+1): the gradient of wᵀF_x x, i.e. y_j = wᵀF_xx[x, e_j].
   virtual bool secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
                                               VectorRef y);
+  /// y = F_xx[x, z] = d/dε F_x(z0 + εx) z at ε = 0, z0 = (u, λ) (x, z size N+1, y size N): the
+  /// second directional derivative as a vector (the post-buckling coefficients,
+  /// branch_point_coefficients.h). Default: the matrix of jacobianDirectionalDerivative() times z
+  /// (O(N²)); a structured problem overrides it with an exact O(N) product.
+  virtual bool secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
+                                     VectorRef y);
 
   // ---- optional: mechanical stability ---------------------------------------------------
   virtual bool hasStabilityOperator() const { return false; }
@@ -133,6 +139,8 @@ class Problem {
  private:
   Matrix stabilityH_, stabilityC_;  // workspace of the default stability()
   Matrix applyFu_;                   // workspace of the dense product defaults
+  Matrix secondFu_;                  // workspace of the dense secondDerivativeApply()
+  Vector secondFl_;
 };
 
 /// Inertia of the symmetric H restricted to ker C (C may have zero rows), by a dense

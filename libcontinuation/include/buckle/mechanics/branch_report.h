@@ -130,7 +130,8 @@ struct SpecialPointReport {
   /// traced λ's units with ξ the unit joint-angle mode's amplitude in rad (koiter.h); invalid
   /// (the reason in its error, also in the note) where not computed.
   KoiterCoefficients koiter;
-  /// BP with valid koiter: the knockdown of λ by an imperfection of each end coordinate x, y, φ
+  /// BP with valid koiter: the knockdown of λ by an imperfection of each end coordinate x, y, φ,
+  /// by a preload asymmetry of every segment and of the most sensitive single segment (n > 1)
   /// (imperfection_sensitivity.h).
   std::vector<ImperfectionSensitivity> imperfections;
 };

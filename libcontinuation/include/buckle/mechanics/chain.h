@@ -68,6 +68,9 @@ bool endMovesAlong(const Chain& chain, ConstVectorRef q, int c);
 
 /// h_m = −Fx·C_m − Fy·S_m: K_g(i, j) = h_max(i,j) (eq 27). The torque Me does not enter.
 void loadHessianGenerator(const ChainData& data, const Wrench& F, VectorRef h);
+/// out = K x for the matrix K(i, j) = h_max(i,j) (the K_g structure, eq 27) in O(n):
+/// out_i = h_i Σ_{j≤i} x_j + Σ_{j>i} h_j x_j (out may not alias x).
+void maxIndexProduct(ConstVectorRef h, ConstVectorRef x, VectorRef out);
 /// Dense K_g(F) = Fx ∂²x/∂q² + Fy ∂²y/∂q² (eq 26–27).
 void loadMatrix(const ChainData& data, const Wrench& F, MatrixRef Kg);
 

@@ -63,6 +63,12 @@ class EquilibriumProblem final : public continuation::Problem {
                      continuation::VectorRef y) override;
   bool jacobianTransposeApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef w,
                               continuation::VectorRef y) override;
+  /// Exact F_xx[x, z] in O(n): jacobianDirectionalDerivative() along x applied to z, i.e.
+  /// (q rows) E‴ ⊙ x_q ⊙ z_q − K_g(dh_x) z_q − dJ_h[x]ᵀ z_r − Σ_loaded dJ_c[x]ᵀ dir_c z_λ with
+  /// dh_x = d h along x (eq 27 differentiated, the wrench moving with x_r and x_λ) and dJ the
+  /// derivative of the end Jacobian (stiffness.h); (held rows) −dJ_h[x] z_q.
+  bool secondDerivativeApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
+                             continuation::ConstVectorRef z, continuation::VectorRef y) override;
 
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;

@@ -20,13 +20,10 @@
 #include <string>
 
 #include "buckle/continuation/branch.h"
+#include "buckle/continuation/branch_point_coefficients.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 
 namespace buckle::mechanics {
-
-/// The coefficients use dense N×N matrices: above this dimension they are not computed (the
-/// tracer's own dense crossover, TracerOptions::maxDenseLocationDimension).
-constexpr int kKoiterMaxDimension = 400;
 
 enum class KoiterKind { Supercritical, Subcritical, Asymmetric };
 
@@ -48,7 +45,13 @@ struct KoiterCoefficients {
 };
 
 /// The coefficients at the branch point bp located on a branch of `problem` (free joints: not in
-/// contact). Never throws: failures are reported in `error`.
-KoiterCoefficients koiterCoefficients(EquilibriumProblem& problem, const continuation::SpecialPoint& bp);
+/// contact), at any chain length: above continuation::kDenseCoefficientDimension unknowns (or
+/// with `algebra` Structured) in O(n) through the chain's exact second-derivative products and
+/// its bordered solver (branch_point_coefficients.h). The structured solver eliminates through
+/// the joint block K_q − K_g, so a chain with no held end coordinate (where that block itself is
+/// singular at its branch points) is reported with the solver's reason above the solver's dense
+/// fallback size. Never throws: failures are reported in `error`.
+KoiterCoefficients koiterCoefficients(EquilibriumProblem& problem, const continuation::SpecialPoint& bp,
+                                      continuation::CoefficientAlgebra algebra = continuation::CoefficientAlgebra::Automatic);
 
 }  // namespace buckle::mechanics
