@@ -509,3 +509,134 @@ TEST_CASE("fold curve: the structured path is the dense one (n = 40) and the poi
     CHECK(compared == 4);
   }
 }
+
+// ---- certified counting on a chain: two folds inside one step, and the touch at the cusp --------
+
+namespace {
+// The hysteresis chain (data/scenes/hysteresis.json: κ = −0.3 < 0, free end) under the end torque
+// Me = λ, with the axial tension Fx = μ as the second parameter. The Me path through the straight
+// state is Me(q) ≈ c₁q³ − c₂(μ)q near it: for μ below the straight chain's critical tension (where
+// κ + μ·g = 0) a small Z with two folds at ±Me_f, which merge at the cusp of the fold curve (μ_c,
+// Me = 0); beyond it the eigenvalue of the stability operator only touches zero at Me = 0.
+ChainParameterProblem hysteresisChain(double tension) {
+  return ChainParameterProblem(paperChain(3, 0.5, 1.0, 1.0, 1.2), EndCondition::freeEnd(Eigen::Vector3d(tension, 0, 0)),
+                               Eigen::Vector3d(0, 0, 1), SecondParameter::parse("x"));
+}
+
+// One step of the certified tracer from the path's point `a` (tangent oriented by `direction`) to
+// its mirror image (q, Me) → (−q, −Me): the step's own length lands on it.
+cont::Branch stepToMirror(ChainParameterProblem& p, const cont::ContinuationPoint& a, const Vector& direction,
+                          bool certified) {
+  cont::TracerOptions o;
+  Vector mirror(a.u.size() + 1);
+  mirror << -a.u, -a.lambda;
+  Vector t = a.tangent.dot(direction) >= 0.0 ? a.tangent : Vector(-a.tangent);
+  o.maxStep = o.initialStep = t.dot(mirror - a.state());
+  o.minStep = 1e-6 * o.maxStep;
+  o.maxPoints = 2;  // the start and the one step
+  o.lambdaMin = -1.0;
+  o.lambdaMax = 1.0;
+  o.certifiedCounting = certified;
+  return cont::trace(p, a.u, a.lambda, cont::InitialDirection::along(t), o);
+}
+
+// The Me path from the straight state at Me = 0 in small steps, towards increasing Me, stopping
+// at Me = `stop` (< 0: after the Z's fold it comes back down).
+cont::Branch finePath(ChainParameterProblem& p, double stop, int lambdaSign) {
+  cont::TracerOptions o;
+  o.maxStep = 2e-3;
+  o.initialStep = 1e-3;
+  o.lambdaMin = lambdaSign > 0 ? stop : -1.0;
+  o.lambdaMax = lambdaSign > 0 ? 1.0 : stop;
+  o.maxPoints = 2000;
+  const Vector u0 = p.equilibrium().initialGuess(Vector::Zero(3), 0.0);
+  return cont::trace(p, u0, 0.0,
+                     lambdaSign > 0 ? cont::InitialDirection::increasingLambda() : cont::InitialDirection::decreasingLambda(), o);
+}
+}  // namespace
+
+TEST_CASE("certified counting on a chain: two folds of a Z inside one step, the touch at the fold curve's cusp",
+          "[critical_curves]") {
+  // The cusp from the fold curve of the Z's fold at μ = 0.29.
+  ChainParameterProblem p = hysteresisChain(0.29);
+  const cont::Branch reference = finePath(p, -0.05, +1);
+  const auto refFolds = reference.specialPointsOfType(cont::SpecialPointType::Fold);
+  REQUIRE(!refFolds.empty());
+  const cont::SpecialPoint fold = *refFolds.front();  // the Z's upper fold, Me_f > 0 small
+  REQUIRE(fold.refined);
+  REQUIRE(fold.lambda > 0.0);
+  REQUIRE(fold.lambda < 0.01);
+  CriticalCurveOptions co = curveOptions(0.2, 0.4);
+  co.tracer.maxStep = 0.01;
+  co.tracer.maxPoints = 200;
+  const CriticalCurve curve = foldCurve(p, fold, co);
+  const Codim2Point* cusp = nullptr;
+  for (const Codim2Point& s : curve.special)
+    if (s.label == "CP" && (!cusp || std::abs(s.mu - 0.3) < std::abs(cusp->mu - 0.3))) cusp = &s;
+  REQUIRE(cusp);
+  REQUIRE(cusp->converged);
+  INFO("cusp at Fx = " << cusp->mu << ", Me = " << cusp->lambda);
+  CHECK(std::abs(cusp->lambda) <= 1e-12);  // on the straight state, by the mirror symmetry
+  // Independently: the straight chain's stability operator is singular at the cusp's tension.
+  REQUIRE(p.setSecondParameter(cusp->mu));
+  cont::StabilityInfo straight;
+  REQUIRE(p.stability(Vector::Zero(3), 0.0, 2, straight));
+  CHECK(std::abs(straight.lowest[0]) <= 1e-10 * std::abs(straight.lowest[1]));
+
+  SECTION("below the cusp: the Z's two folds in one step, counts unchanged at its ends") {
+    REQUIRE(p.setSecondParameter(0.29));
+    // From the lower arm of the Z at twice the fold's distance from the straight state, to its mirror.
+    const double sFold = fold.arclength - reference.points.front().arclength;
+    const cont::ContinuationPoint* start = nullptr;
+    for (const cont::ContinuationPoint& q : reference.points)
+      if (q.arclength - reference.points.front().arclength >= 2.0 * sFold) {
+        start = &q;
+        break;
+      }
+    REQUIRE(start);
+    const Vector back = -start->tangent;  // towards the fold and the straight state
+    const cont::Branch blind = stepToMirror(p, *start, back, false);
+    REQUIRE(blind.points.size() == 2);
+    CHECK(blind.points[0].stability.negative == blind.points[1].stability.negative);
+    CHECK(blind.points[0].foldTest * blind.points[1].foldTest > 0.0);
+    CHECK(blind.specialPointsOfType(cont::SpecialPointType::Fold).empty());  // what the count misses
+    const cont::Branch step = stepToMirror(p, *start, back, true);
+    REQUIRE(step.points.size() == 2);
+    const auto folds = step.specialPointsOfType(cont::SpecialPointType::Fold);
+    REQUIRE(folds.size() == 2);
+    CHECK(step.specialPointsOfType(cont::SpecialPointType::BranchPoint).empty());
+    for (const cont::SpecialPoint* f : folds) {
+      INFO(f->note);
+      CHECK(f->index == 0);
+      CHECK(f->refined);
+      CHECK(f->note.find("certified counting") != std::string::npos);
+      CHECK(std::abs(std::abs(f->lambda) - fold.lambda) <= 1e-12);  // the fine path's fold and its mirror
+      CHECK(std::abs(f->inertiaAfter - f->inertiaBefore) == 1);
+    }
+    CHECK(folds[0]->lambda * folds[1]->lambda < 0.0);
+  }
+
+  SECTION("at the cusp: the eigenvalue touches zero on the straight state without crossing") {
+    // μ_c by 1e−10 relative to the side without folds (exactly at μ_c the touch is a fold pair
+    // closer than the location tolerance, on either side of it by rounding).
+    const double muTouch = cusp->mu * (1.0 + 1e-10);
+    REQUIRE(p.setSecondParameter(muTouch));
+    const cont::Branch down = finePath(p, -2e-3, -1);
+    REQUIRE(down.stopReason == cont::StopReason::LambdaRange);
+    CHECK(down.specialPointsOfType(cont::SpecialPointType::Fold).empty());
+    const cont::ContinuationPoint& start = down.points.back();  // Me = −2e−3
+    Vector up = Vector::Zero(4);
+    up[3] = 1.0;
+    const cont::Branch step = stepToMirror(p, start, up, true);
+    REQUIRE(step.points.size() == 2);
+    CHECK(step.specialPointsOfType(cont::SpecialPointType::Fold).empty());
+    CHECK(step.specialPointsOfType(cont::SpecialPointType::BranchPoint).empty());
+    const auto touches = step.specialPointsOfType(cont::SpecialPointType::EigenvalueTouch);
+    REQUIRE(touches.size() == 1);
+    const cont::SpecialPoint& et = *touches.front();
+    INFO(et.note);
+    CHECK(std::abs(et.lambda - cusp->lambda) <= 1e-10);
+    CHECK(et.u.norm() <= 1e-6);  // the straight state
+    CHECK(et.inertiaBefore == et.inertiaAfter);
+  }
+}

@@ -86,10 +86,19 @@ bool MinimallyAugmentedTest::evaluate(const Matrix &A, double &psi, Vector *v) {
   return true;
 }
 
+bool foldBetween(const ContinuationPoint &a, const ContinuationPoint &b) {
+  if ((a.foldTest >= 0.0) == (b.foldTest >= 0.0)) return false;
+  if (!a.stability.valid() || !b.stability.valid() || a.determinantSign == 0 || b.determinantSign == 0) return true;
+  // sign t_λ = sign det F_u · sign det[[F_u, F_λ], [tᵀ]]: t_λ flips iff exactly one of them does.
+  const bool fuFlips = std::abs(b.stability.negative - a.stability.negative) % 2 == 1;
+  const bool borderedFlips = a.determinantSign * b.determinantSign < 0;
+  return fuFlips != borderedFlips;
+}
+
 IntervalCrossings classifyInterval(const ContinuationPoint &a, const ContinuationPoint &b, bool detectFolds,
                                    bool detectBranchPoints) {
   IntervalCrossings crossings;
-  const bool foldSignChange = (a.foldTest >= 0.0) != (b.foldTest >= 0.0);
+  const bool foldSignChange = foldBetween(a, b);
   crossings.fold = detectFolds && foldSignChange;
   if (!detectBranchPoints) return crossings;
   crossings.determinantChange = a.determinantSign * b.determinantSign < 0;
