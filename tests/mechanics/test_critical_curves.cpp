@@ -514,30 +514,35 @@ TEST_CASE("fold curve: the structured path is the dense one (n = 40) and the poi
 
 namespace {
 // The hysteresis chain (data/scenes/hysteresis.json: κ = −0.3 < 0, free end) under the end torque
-// Me = λ, with the axial tension Fx = μ as the second parameter. The Me path through the straight
-// state is Me(q) ≈ c₁q³ − c₂(μ)q near it: for μ below the straight chain's critical tension (where
-// κ + μ·g = 0) a small Z with two folds at ±Me_f, which merge at the cusp of the fold curve (μ_c,
-// Me = 0); beyond it the eigenvalue of the stability operator only touches zero at Me = 0.
+// Me = λ, with the axial tension Fx = μ as the second parameter. At Fx = 0.29 the Me path through
+// the straight state has a small Z: two folds at ±Me_f (mirror images, (q, Me) → (−q, −Me)), the
+// stretch between them one eigenvalue less stable. Its fold curve in μ has cusps (two folds meet);
+// beyond a cusp the eigenvalue only touches zero where the folds merged.
 ChainParameterProblem hysteresisChain(double tension) {
   return ChainParameterProblem(paperChain(3, 0.5, 1.0, 1.0, 1.2), EndCondition::freeEnd(Eigen::Vector3d(tension, 0, 0)),
                                Eigen::Vector3d(0, 0, 1), SecondParameter::parse("x"));
 }
 
-// One step of the certified tracer from the path's point `a` (tangent oriented by `direction`) to
-// its mirror image (q, Me) → (−q, −Me): the step's own length lands on it.
-cont::Branch stepToMirror(ChainParameterProblem& p, const cont::ContinuationPoint& a, const Vector& direction,
-                          bool certified) {
+// One step of the tracer from the path's point `a` (tangent oriented by `direction`) whose length
+// lands on the path's point `b`.
+cont::Branch stepTo(ChainParameterProblem& p, const cont::ContinuationPoint& a, const Vector& direction,
+                    const Vector& b, bool certified) {
   cont::TracerOptions o;
-  Vector mirror(a.u.size() + 1);
-  mirror << -a.u, -a.lambda;
-  Vector t = a.tangent.dot(direction) >= 0.0 ? a.tangent : Vector(-a.tangent);
-  o.maxStep = o.initialStep = t.dot(mirror - a.state());
+  const Vector t = a.tangent.dot(direction) >= 0.0 ? a.tangent : Vector(-a.tangent);
+  o.maxStep = o.initialStep = t.dot(b - a.state());
   o.minStep = 1e-6 * o.maxStep;
   o.maxPoints = 2;  // the start and the one step
   o.lambdaMin = -1.0;
   o.lambdaMax = 1.0;
   o.certifiedCounting = certified;
   return cont::trace(p, a.u, a.lambda, cont::InitialDirection::along(t), o);
+}
+
+cont::Branch stepToMirror(ChainParameterProblem& p, const cont::ContinuationPoint& a, const Vector& direction,
+                          bool certified) {
+  Vector mirror(a.u.size() + 1);
+  mirror << -a.u, -a.lambda;
+  return stepTo(p, a, direction, mirror, certified);
 }
 
 // The Me path from the straight state at Me = 0 in small steps, towards increasing Me, stopping
@@ -576,12 +581,11 @@ TEST_CASE("certified counting on a chain: two folds of a Z inside one step, the 
   REQUIRE(cusp);
   REQUIRE(cusp->converged);
   INFO("cusp at Fx = " << cusp->mu << ", Me = " << cusp->lambda);
-  CHECK(std::abs(cusp->lambda) <= 1e-12);  // on the straight state, by the mirror symmetry
-  // Independently: the straight chain's stability operator is singular at the cusp's tension.
-  REQUIRE(p.setSecondParameter(cusp->mu));
-  cont::StabilityInfo straight;
-  REQUIRE(p.stability(Vector::Zero(3), 0.0, 2, straight));
-  CHECK(std::abs(straight.lowest[0]) <= 1e-10 * std::abs(straight.lowest[1]));
+  CHECK(std::abs(cusp->lambda) <= 1e-12);  // Me = 0, by the mirror symmetry
+  // the fold curve's state closest to the cusp
+  const CriticalPoint* nearest = &curve.points.front();
+  for (const CriticalPoint& q : curve.points)
+    if (std::abs(q.mu - cusp->mu) < std::abs(nearest->mu - cusp->mu)) nearest = &q;
 
   SECTION("below the cusp: the Z's two folds in one step, counts unchanged at its ends") {
     REQUIRE(p.setSecondParameter(0.29));
@@ -621,14 +625,23 @@ TEST_CASE("certified counting on a chain: two folds of a Z inside one step, the 
     // closer than the location tolerance, on either side of it by rounding).
     const double muTouch = cusp->mu * (1.0 + 1e-10);
     REQUIRE(p.setSecondParameter(muTouch));
-    const cont::Branch down = finePath(p, -2e-3, -1);
-    REQUIRE(down.stopReason == cont::StopReason::LambdaRange);
-    CHECK(down.specialPointsOfType(cont::SpecialPointType::Fold).empty());
-    const cont::ContinuationPoint& start = down.points.back();  // Me = −2e−3
+    // Two points of the path 2e−3 below and above the cusp's Me, each polished at fixed Me from
+    // the fold curve's state next to the cusp.
+    cont::TracerOptions polish;
+    polish.maxPoints = 2;
+    const cont::Branch below = cont::trace(p, nearest->u, cusp->lambda - 2e-3, cont::InitialDirection::increasingLambda(), polish);
+    const cont::Branch above = cont::trace(p, nearest->u, cusp->lambda + 2e-3, cont::InitialDirection::increasingLambda(), polish);
+    REQUIRE(!below.points.empty());
+    REQUIRE(!above.points.empty());
+    const cont::ContinuationPoint& start = below.points.front();
     Vector up = Vector::Zero(4);
     up[3] = 1.0;
-    const cont::Branch step = stepToMirror(p, start, up, true);
+    const cont::Branch blind = stepTo(p, start, up, above.points.front().state(), false);
+    REQUIRE(blind.points.size() == 2);
+    CHECK(blind.specialPoints.size() == 2);  // the two endpoints: the count sees nothing
+    const cont::Branch step = stepTo(p, start, up, above.points.front().state(), true);
     REQUIRE(step.points.size() == 2);
+    CHECK(std::abs(step.points.back().lambda - (cusp->lambda + 2e-3)) <= 1e-12);  // the step reached it
     CHECK(step.specialPointsOfType(cont::SpecialPointType::Fold).empty());
     CHECK(step.specialPointsOfType(cont::SpecialPointType::BranchPoint).empty());
     const auto touches = step.specialPointsOfType(cont::SpecialPointType::EigenvalueTouch);
@@ -636,7 +649,8 @@ TEST_CASE("certified counting on a chain: two folds of a Z inside one step, the 
     const cont::SpecialPoint& et = *touches.front();
     INFO(et.note);
     CHECK(std::abs(et.lambda - cusp->lambda) <= 1e-10);
-    CHECK(et.u.norm() <= 1e-6);  // the straight state
+    CHECK(std::abs(et.testFunctionValue) <= 1e-8);  // the eigenvalue's minimum
+    CHECK((et.u - nearest->u).norm() <= 1e-2);     // where the fold curve ends
     CHECK(et.inertiaBefore == et.inertiaAfter);
   }
 }
