@@ -617,6 +617,25 @@ std::vector<double> firstCriticalLoads(const Chain& chain, int count) {
   std::sort(crit.begin(), crit.end(), [](double x, double y) { return x > y; });
   return crit;
 }
+
+// The straight clamped–pinned chain from Fx = 0 down to `stop` in steps `step`, above the dense
+// crossover (the O(n) refinements); with childPoints > 0 every branch point switched, its children
+// traced in the same steps.
+EquilibriumBranches tracePinnedAboveCrossover(const Chain& chain, double stop, double step, int childPoints = 0,
+                                              double childLambdaMin = 0.0) {
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(stop, childPoints > 0 ? 1 : 0);
+  REQUIRE(problem.dimension() > o.tracer.maxDenseLocationDimension);
+  o.tracer.maxStep = o.tracer.initialStep = step;
+  o.tracer.minStep = 1e-6 * step;
+  if (childPoints > 0) {
+    cont::TracerOptions children = o.tracer;
+    children.maxPoints = childPoints;
+    children.lambdaMin = childLambdaMin;
+    o.childTracer = children;
+  }
+  return traceEquilibria(problem, Eigen::VectorXd::Zero(chain.size()), 0.0, cont::InitialDirection::decreasingLambda(), o);
+}
 }  // namespace
 
 TEST_CASE("n = 1000, soft joints: one step over four critical loads 1e-7 apart finds each once, to 1e-12",
@@ -631,15 +650,9 @@ TEST_CASE("n = 1000, soft joints: one step over four critical loads 1e-7 apart f
   REQUIRE(crit.size() == 6);
   REQUIRE(crit[1] - crit[0] > -3e-7);  // the spacing this test is about
   const double stop = 0.5 * (crit[4] + crit[5]);
-  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
-  EquilibriumBranchOptions o = pinnedOptions(stop, 0);
-  REQUIRE(problem.dimension() > o.tracer.maxDenseLocationDimension);  // the O(n) refinements
   // the first step, 0.9 of the range, holds the first four critical loads
-  o.tracer.maxStep = o.tracer.initialStep = 0.9 * std::abs(stop);
-  REQUIRE(o.tracer.maxStep > std::abs(crit[3]));
-  o.tracer.minStep = 1e-6 * o.tracer.maxStep;
-  const EquilibriumBranches r =
-      traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  REQUIRE(0.9 * std::abs(stop) > std::abs(crit[3]));
+  const EquilibriumBranches r = tracePinnedAboveCrossover(chain, stop, 0.9 * std::abs(stop));
   const cont::Branch& trivial = r.tree.branches.at(0);
   const auto bps = branchPoints(trivial);
   REQUIRE(bps.size() == 5);
@@ -660,22 +673,16 @@ TEST_CASE("n = 10 000: the children of a branch point traced in steps ~1e-8 of t
           "[equilibrium_branches]") {
   // The first critical load is ~7.6e−8 k̄b̄; the children leave it with λ − λc ~ λ''s², whose
   // slope t_λ ~ λ''s is far below the rounding of the tangent's λ component: its sign, the raw
-  // fold test, is noise (RESULTS.md, "Trees of long chains": 4–11 spurious LPs per child). A
-  // real fold also moves the inertia's parity (foldBetween), which stays put on these children.
+  // fold test, is noise (RESULTS.md, "Trees of long chains": 4–11 spurious LPs per child), and so
+  // is the inertia count, which flips with it: the crossing eigenvalue stays within its rounding
+  // (foldBetween).
   const int n = 10000;
   const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   const std::vector<double> crit = firstCriticalLoads(chain, 2);
   REQUIRE(crit.size() == 2);
-  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
-  EquilibriumBranchOptions o = pinnedOptions(0.5 * (crit[0] + crit[1]), 1);
-  o.tracer.maxStep = o.tracer.initialStep = std::abs(crit[0]) / 7.3;
-  o.tracer.minStep = 1e-6 * o.tracer.maxStep;
-  cont::TracerOptions children = o.tracer;  // the trivial branch's own steps
-  children.maxPoints = 40;
-  children.lambdaMin = 2.0 * crit[1];
-  o.childTracer = children;
+  // the children in the trivial branch's own steps
   const EquilibriumBranches r =
-      traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+      tracePinnedAboveCrossover(chain, 0.5 * (crit[0] + crit[1]), std::abs(crit[0]) / 7.3, 40, 2.0 * crit[1]);
   const auto bps = branchPoints(r.tree.branches.at(0));
   REQUIRE(bps.size() == 1);
   CHECK(std::abs(bps[0]->lambda - crit[0]) <= 1e-12 * std::abs(crit[0]));
