@@ -5,11 +5,12 @@
 // sign). The free end also has the exact discrete loads
 // λ_k = −(2κ/b) sin²((2k − 1)π/(4n)) of the uniform straight chain: their largest relative error.
 //
-//   critical_loads [--quick] [--count K] [--reps R] [--dense-max N]
+//   critical_loads [--quick] [--count K] [--reps R] [--dense-max N] [--n N]
 //     --quick        CI size: n = 100 and 1000, dense up to 100, one repetition
 //     --count K      critical loads per run (default 5)
 //     --reps R       repetitions per timing, best kept (default 3)
 //     --dense-max N  largest n compared with the dense pencil (default 2000)
+//     --n N          only this chain length (repeatable; default 1000, 2000, 10 000, 100 000)
 #include <Eigen/Core>
 #include <algorithm>
 #include <chrono>
@@ -33,7 +34,7 @@ namespace {
 double seconds(std::chrono::steady_clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 int usage(const char* why) {
-  std::fprintf(stderr, "critical_loads: %s\nusage: critical_loads [--quick] [--count K] [--reps R] [--dense-max N]\n",
+  std::fprintf(stderr, "critical_loads: %s\nusage: critical_loads [--quick] [--count K] [--reps R] [--dense-max N] [--n N]\n",
                why);
   return 2;
 }
@@ -51,6 +52,7 @@ bool positiveInt(const char* s, int& out) {
 int main(int argc, char** argv) {
   bool quick = false;
   int count = 5, reps = 3, denseMax = 2000;
+  std::vector<int> only;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
@@ -58,6 +60,10 @@ int main(int argc, char** argv) {
     } else if ((a == "--count" || a == "--reps" || a == "--dense-max") && i + 1 < argc) {
       int& target = a == "--count" ? count : a == "--reps" ? reps : denseMax;
       if (!positiveInt(argv[++i], target)) return usage((a + " needs a positive integer").c_str());
+    } else if (a == "--n" && i + 1 < argc) {
+      int n = 0;
+      if (!positiveInt(argv[++i], n) || n < 2) return usage("--n needs an integer >= 2");
+      only.push_back(n);
     } else {
       return usage(("unknown argument " + a).c_str());
     }
@@ -66,7 +72,9 @@ int main(int argc, char** argv) {
     reps = 1;
     denseMax = 100;
   }
-  const std::vector<int> sizes = quick ? std::vector<int>{100, 1000} : std::vector<int>{1000, 2000, 10000, 100000};
+  const std::vector<int> sizes = !only.empty() ? only
+                                 : quick      ? std::vector<int>{100, 1000}
+                                              : std::vector<int>{1000, 2000, 10000, 100000};
   const double a = 0.5, b = 1.0, k = 1.0, L0 = 2.25;  // the paper's main segment
   std::printf("%-8s %-15s %12s %14s %14s %14s\n", "n", "end", "time [ms]", "vs dense", "mode vs dense",
               "vs exact");

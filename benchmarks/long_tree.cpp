@@ -8,12 +8,14 @@
 // points from the O(n) linear buckling route (Sturm counts + Rayleigh quotient, an independent
 // computation: linear_buckling.h), and, with --dense-max ≥ n, from the dense pencil.
 //
-//   long_tree [--quick] [--n N] [--bps K] [--points P] [--dense-max N] [--verbose]
+//   long_tree [--quick] [--n N] [--bps K] [--points P] [--dense-max N] [--child-step H] [--verbose]
 //     --quick        CI size: n = 100, K = 3, P = 20
 //     --n N          only this chain length (default: n = 1000 with K = 10, then n = 10000 with K = 5)
 //     --bps K        branch points switched (default 10 at n ≤ 2000, else 5)
 //     --points P     points per branch (default 50)
 //     --dense-max N  largest n also compared with the dense pencil (default 0: none; it is O(n³))
+//     --child-step H the switched branches' step (default 0.2/√n); the trivial branch's own step,
+//                    |λ_end|/(P − 1), reproduces the tiny-step children of issue 13 (fold test)
 //     --verbose      one line per switched branch: points, special points, why it stopped
 // Memory is the process's peak (getrusage), so run one n per process for a clean figure.
 #include <sys/resource.h>
@@ -38,7 +40,7 @@ namespace {
 
 int usage(const char* why) {
   std::fprintf(stderr,
-               "long_tree: %s\nusage: long_tree [--quick] [--n N] [--bps K] [--points P] [--dense-max N] [--verbose]\n", why);
+               "long_tree: %s\nusage: long_tree [--quick] [--n N] [--bps K] [--points P] [--dense-max N] [--child-step H] [--verbose]\n", why);
   return 2;
 }
 
@@ -74,7 +76,7 @@ struct Row {
   std::string children;  ///< per switched branch: points, special points, stop reason (--verbose)
 };
 
-Row run(int n, int K, int P, int denseMax) {
+Row run(int n, int K, int P, int denseMax, double childStep) {
   Row row;
   row.n = n;
   row.bps = K;
@@ -106,7 +108,7 @@ Row run(int n, int K, int P, int denseMax) {
   // stay within 1e−7 of the straight chain, where λ(s) − λ_c ~ λ_c s² is below the rounding of
   // the tangent's λ component and its sign, the fold test, is noise (spurious LPs).
   cont::TracerOptions child = opt.tracer;
-  child.initialStep = child.maxStep = 0.2 / std::sqrt(double(n));
+  child.initialStep = child.maxStep = childStep > 0.0 ? childStep : 0.2 / std::sqrt(double(n));
   child.minStep = 1e-6 * child.maxStep;
   child.maxPoints = P;
   child.lambdaMin = 2.0 * crit[size_t(K)];
@@ -158,12 +160,18 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // one row at a time (long runs)
   bool quick = false, verbose = false;
   int only = 0, K = 0, P = 50, denseMax = 0;
+  double childStep = 0.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
       quick = true;
     } else if (a == "--verbose") {
       verbose = true;
+    } else if (a == "--child-step" && i + 1 < argc) {
+      char* end = nullptr;
+      childStep = std::strtod(argv[++i], &end);
+      if (!end || *end != '\0' || !(childStep > 0.0) || !std::isfinite(childStep))
+        return usage("--child-step needs a positive number");
     } else if ((a == "--n" || a == "--bps" || a == "--points" || a == "--dense-max") && i + 1 < argc) {
       int& target = a == "--n" ? only : a == "--bps" ? K : a == "--points" ? P : denseMax;
       if (!positiveInt(argv[++i], target)) return usage((a + " needs a positive integer").c_str());
@@ -184,7 +192,7 @@ int main(int argc, char** argv) {
               "branches", "switched", "child pts", "vs linear", "vs dense");
   bool ok = true;
   for (const auto& [n, k] : runs) {
-    const Row r = run(n, k, P, denseMax);
+    const Row r = run(n, k, P, denseMax, childStep);
     std::printf("%-7d %4d %6d %10.3f %9.1f %9d %9d %9d %12.2e %12.2e\n", r.n, r.located, r.points, r.seconds,
                 r.megabytes, r.branches, r.switched, r.childPoints, r.vsLinear, r.vsDense);
     if (verbose) std::printf("%s", r.children.c_str());

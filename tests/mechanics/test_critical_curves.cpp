@@ -509,3 +509,148 @@ TEST_CASE("fold curve: the structured path is the dense one (n = 40) and the poi
     CHECK(compared == 4);
   }
 }
+
+// ---- certified counting on a chain: two folds inside one step, and the touch at the cusp --------
+
+namespace {
+// The hysteresis chain (data/scenes/hysteresis.json: κ = −0.3 < 0, free end) under the end torque
+// Me = λ, with the axial tension Fx = μ as the second parameter. At Fx = 0.29 the Me path through
+// the straight state has a small Z: two folds at ±Me_f (mirror images, (q, Me) → (−q, −Me)), the
+// stretch between them one eigenvalue less stable. Its fold curve in μ has cusps (two folds meet);
+// beyond a cusp the eigenvalue only touches zero where the folds merged.
+ChainParameterProblem hysteresisChain(double tension) {
+  return ChainParameterProblem(paperChain(3, 0.5, 1.0, 1.0, 1.2), EndCondition::freeEnd(Eigen::Vector3d(tension, 0, 0)),
+                               Eigen::Vector3d(0, 0, 1), SecondParameter::parse("x"));
+}
+
+// One step of the tracer from the path's point `a` (tangent oriented by `direction`) whose length
+// lands on the path's point `b`.
+cont::Branch stepTo(ChainParameterProblem& p, const cont::ContinuationPoint& a, const Vector& direction,
+                    const Vector& b, bool certified) {
+  cont::TracerOptions o;
+  const Vector t = a.tangent.dot(direction) >= 0.0 ? a.tangent : Vector(-a.tangent);
+  o.maxStep = o.initialStep = t.dot(b - a.state());
+  o.minStep = 1e-6 * o.maxStep;
+  o.maxPoints = 2;  // the start and the one step
+  o.lambdaMin = -1.0;
+  o.lambdaMax = 1.0;
+  o.certifiedCounting = certified;
+  return cont::trace(p, a.u, a.lambda, cont::InitialDirection::along(t), o);
+}
+
+cont::Branch stepToMirror(ChainParameterProblem& p, const cont::ContinuationPoint& a, const Vector& direction,
+                          bool certified) {
+  Vector mirror(a.u.size() + 1);
+  mirror << -a.u, -a.lambda;
+  return stepTo(p, a, direction, mirror, certified);
+}
+
+// The Me path from the straight state at Me = 0 in small steps, towards increasing Me, stopping
+// at Me = `stop` (< 0: after the Z's fold it comes back down).
+cont::Branch finePath(ChainParameterProblem& p, double stop, int lambdaSign) {
+  cont::TracerOptions o;
+  o.maxStep = 2e-3;
+  o.initialStep = 1e-3;
+  o.lambdaMin = lambdaSign > 0 ? stop : -1.0;
+  o.lambdaMax = lambdaSign > 0 ? 1.0 : stop;
+  o.maxPoints = 2000;
+  const Vector u0 = p.equilibrium().initialGuess(Vector::Zero(3), 0.0);
+  return cont::trace(p, u0, 0.0,
+                     lambdaSign > 0 ? cont::InitialDirection::increasingLambda() : cont::InitialDirection::decreasingLambda(), o);
+}
+}  // namespace
+
+TEST_CASE("certified counting on a chain: two folds of a Z inside one step, the touch at the fold curve's cusp",
+          "[critical_curves]") {
+  // The cusp from the fold curve of the Z's fold at μ = 0.29.
+  ChainParameterProblem p = hysteresisChain(0.29);
+  const cont::Branch reference = finePath(p, -0.05, +1);
+  const auto refFolds = reference.specialPointsOfType(cont::SpecialPointType::Fold);
+  REQUIRE(!refFolds.empty());
+  const cont::SpecialPoint fold = *refFolds.front();  // the Z's upper fold, Me_f > 0 small
+  REQUIRE(fold.refined);
+  REQUIRE(fold.lambda > 0.0);
+  REQUIRE(fold.lambda < 0.01);
+  CriticalCurveOptions co = curveOptions(0.2, 0.4);
+  co.tracer.maxStep = 0.01;
+  co.tracer.maxPoints = 200;
+  const CriticalCurve curve = foldCurve(p, fold, co);
+  const Codim2Point* cusp = nullptr;
+  for (const Codim2Point& s : curve.special)
+    if (s.label == "CP" && (!cusp || std::abs(s.mu - 0.3) < std::abs(cusp->mu - 0.3))) cusp = &s;
+  REQUIRE(cusp);
+  REQUIRE(cusp->converged);
+  INFO("cusp at Fx = " << cusp->mu << ", Me = " << cusp->lambda);
+  CHECK(std::abs(cusp->lambda) <= 1e-12);  // Me = 0, by the mirror symmetry
+  // the fold curve's state closest to the cusp
+  const CriticalPoint* nearest = &curve.points.front();
+  for (const CriticalPoint& q : curve.points)
+    if (std::abs(q.mu - cusp->mu) < std::abs(nearest->mu - cusp->mu)) nearest = &q;
+
+  SECTION("below the cusp: the Z's two folds in one step, counts unchanged at its ends") {
+    REQUIRE(p.setSecondParameter(0.29));
+    // From the lower arm of the Z at twice the fold's distance from the straight state, to its mirror.
+    const double sFold = fold.arclength - reference.points.front().arclength;
+    const cont::ContinuationPoint* start = nullptr;
+    for (const cont::ContinuationPoint& q : reference.points)
+      if (q.arclength - reference.points.front().arclength >= 2.0 * sFold) {
+        start = &q;
+        break;
+      }
+    REQUIRE(start);
+    const Vector back = -start->tangent;  // towards the fold and the straight state
+    const cont::Branch blind = stepToMirror(p, *start, back, false);
+    REQUIRE(blind.points.size() == 2);
+    CHECK(blind.points[0].stability.negative == blind.points[1].stability.negative);
+    CHECK(blind.points[0].foldTest * blind.points[1].foldTest > 0.0);
+    CHECK(blind.specialPointsOfType(cont::SpecialPointType::Fold).empty());  // what the count misses
+    const cont::Branch step = stepToMirror(p, *start, back, true);
+    REQUIRE(step.points.size() == 2);
+    const auto folds = step.specialPointsOfType(cont::SpecialPointType::Fold);
+    REQUIRE(folds.size() == 2);
+    CHECK(step.specialPointsOfType(cont::SpecialPointType::BranchPoint).empty());
+    for (const cont::SpecialPoint* f : folds) {
+      INFO(f->note);
+      CHECK(f->index == 0);
+      CHECK(f->refined);
+      CHECK(f->note.find("certified counting") != std::string::npos);
+      CHECK(std::abs(std::abs(f->lambda) - fold.lambda) <= 1e-12);  // the fine path's fold and its mirror
+      CHECK(std::abs(f->inertiaAfter - f->inertiaBefore) == 1);
+    }
+    CHECK(folds[0]->lambda * folds[1]->lambda < 0.0);
+  }
+
+  SECTION("at the cusp: the eigenvalue touches zero on the straight state without crossing") {
+    // μ_c by 1e−10 relative to the side without folds (exactly at μ_c the touch is a fold pair
+    // closer than the location tolerance, on either side of it by rounding).
+    const double muTouch = cusp->mu * (1.0 + 1e-10);
+    REQUIRE(p.setSecondParameter(muTouch));
+    // Two points of the path 2e−3 below and above the cusp's Me, each polished at fixed Me from
+    // the fold curve's state next to the cusp.
+    cont::TracerOptions polish;
+    polish.maxPoints = 2;
+    const cont::Branch below = cont::trace(p, nearest->u, cusp->lambda - 2e-3, cont::InitialDirection::increasingLambda(), polish);
+    const cont::Branch above = cont::trace(p, nearest->u, cusp->lambda + 2e-3, cont::InitialDirection::increasingLambda(), polish);
+    REQUIRE(!below.points.empty());
+    REQUIRE(!above.points.empty());
+    const cont::ContinuationPoint& start = below.points.front();
+    Vector up = Vector::Zero(4);
+    up[3] = 1.0;
+    const cont::Branch blind = stepTo(p, start, up, above.points.front().state(), false);
+    REQUIRE(blind.points.size() == 2);
+    CHECK(blind.specialPoints.size() == 2);  // the two endpoints: the count sees nothing
+    const cont::Branch step = stepTo(p, start, up, above.points.front().state(), true);
+    REQUIRE(step.points.size() == 2);
+    CHECK(std::abs(step.points.back().lambda - (cusp->lambda + 2e-3)) <= 1e-12);  // the step reached it
+    CHECK(step.specialPointsOfType(cont::SpecialPointType::Fold).empty());
+    CHECK(step.specialPointsOfType(cont::SpecialPointType::BranchPoint).empty());
+    const auto touches = step.specialPointsOfType(cont::SpecialPointType::EigenvalueTouch);
+    REQUIRE(touches.size() == 1);
+    const cont::SpecialPoint& et = *touches.front();
+    INFO(et.note);
+    CHECK(std::abs(et.lambda - cusp->lambda) <= 1e-10);
+    CHECK(std::abs(et.testFunctionValue) <= 1e-8);  // the eigenvalue's minimum
+    CHECK((et.u - nearest->u).norm() <= 0.2);      // where the fold curve ends
+    CHECK(et.inertiaBefore == et.inertiaAfter);
+  }
+}

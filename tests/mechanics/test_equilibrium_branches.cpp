@@ -600,3 +600,99 @@ TEST_CASE("kappa = 0, n = 4: the triple point, every direction a critical line o
     CHECK(f.gradient(z).norm() / scale <= 50.0 * amplitude * amplitude + 1e-6);
   }
 }
+
+// ---- many special points per step, tiny steps (issue 13: certified counting on long chains) ---
+
+namespace {
+// The first `count` compressive critical loads of the straight clamped–pinned chain, closest to 0
+// first, by the O(n) route of linear_buckling.h (Sturm counts + Rayleigh quotient).
+std::vector<double> firstCriticalLoads(const Chain& chain, int count) {
+  LinearBucklingOptions lbo;
+  lbo.count = count;
+  const LinearBucklingResult lb =
+      linearBuckling(chain, Eigen::VectorXd::Zero(chain.size()), EndCondition::clampedPinned(0.0), lbo);
+  std::vector<double> crit;
+  for (const BucklingMode& m : lb.modes)
+    if (m.lambda < 0) crit.push_back(m.lambda);
+  std::sort(crit.begin(), crit.end(), [](double x, double y) { return x > y; });
+  return crit;
+}
+
+// The straight clamped–pinned chain from Fx = 0 down to `stop` in steps `step`, above the dense
+// crossover (the O(n) refinements); with childPoints > 0 every branch point switched, its children
+// traced in the same steps.
+EquilibriumBranches tracePinnedAboveCrossover(const Chain& chain, double stop, double step, int childPoints = 0,
+                                              double childLambdaMin = 0.0) {
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(stop, childPoints > 0 ? 1 : 0);
+  REQUIRE(problem.dimension() > o.tracer.maxDenseLocationDimension);
+  o.tracer.maxStep = o.tracer.initialStep = step;
+  o.tracer.minStep = 1e-6 * step;
+  if (childPoints > 0) {
+    cont::TracerOptions children = o.tracer;
+    children.maxPoints = childPoints;
+    children.lambdaMin = childLambdaMin;
+    o.childTracer = children;
+  }
+  return traceEquilibria(problem, Eigen::VectorXd::Zero(chain.size()), 0.0, cont::InitialDirection::decreasingLambda(), o);
+}
+}  // namespace
+
+TEST_CASE("n = 1000, soft joints: one step over four critical loads 1e-7 apart finds each once, to 1e-12",
+          "[equilibrium_branches]") {
+  // κ = k(bL0 − 2(b² − a²)) = 7.5e−3: the critical loads ~κ/n² lie ~1e−7 apart in the chain's force
+  // unit k̄b̄, as those of the n = 10 000 chain with κ = 0.75 (RESULTS.md, "Trees of long chains":
+  // five in one coarse step, one reported twice and one missed). That is the size of the bracketing
+  // secant's tolerance coarseTolerance·max(1, |λ|) = 1e−7: Newton then started next to a neighbour.
+  const int n = 1000;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.5075));
+  const std::vector<double> crit = firstCriticalLoads(chain, 6);
+  REQUIRE(crit.size() == 6);
+  REQUIRE(crit[1] - crit[0] > -3e-7);  // the spacing this test is about
+  const double stop = 0.5 * (crit[4] + crit[5]);
+  // the first step, 0.9 of the range, holds the first four critical loads
+  REQUIRE(0.9 * std::abs(stop) > std::abs(crit[3]));
+  const EquilibriumBranches r = tracePinnedAboveCrossover(chain, stop, 0.9 * std::abs(stop));
+  const cont::Branch& trivial = r.tree.branches.at(0);
+  const auto bps = branchPoints(trivial);
+  REQUIRE(bps.size() == 5);
+  int inFirstStep = 0;
+  for (size_t i = 0; i < 5; ++i) {
+    const cont::SpecialPoint& bp = *bps[i];
+    INFO("critical load " << i << ": " << bp.note);
+    CHECK(bp.refined);
+    CHECK(bp.multiplicity == 1);
+    CHECK(std::abs(bp.lambda - crit[i]) <= 1e-12 * std::abs(crit[i]));
+    CHECK(bp.inertiaAfter - bp.inertiaBefore == 1);
+    if (bp.index == 0) ++inFirstStep;
+  }
+  CHECK(inFirstStep >= 3);
+}
+
+TEST_CASE("n = 10 000: the children of a branch point traced in steps ~1e-8 of the load report no fold",
+          "[equilibrium_branches]") {
+  // The first critical load is ~7.6e−8 k̄b̄; the children leave it with λ − λc ~ λ''s², whose
+  // slope t_λ ~ λ''s is far below the rounding of the tangent's λ component: its sign, the raw
+  // fold test, is noise (RESULTS.md, "Trees of long chains": 4–11 spurious LPs per child), and so
+  // is the inertia count, which flips with it: the crossing eigenvalue stays within its rounding
+  // (foldBetween).
+  const int n = 10000;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const std::vector<double> crit = firstCriticalLoads(chain, 2);
+  REQUIRE(crit.size() == 2);
+  // the children in the trivial branch's own steps
+  const EquilibriumBranches r =
+      tracePinnedAboveCrossover(chain, 0.5 * (crit[0] + crit[1]), std::abs(crit[0]) / 7.3, 40, 2.0 * crit[1]);
+  const auto bps = branchPoints(r.tree.branches.at(0));
+  REQUIRE(bps.size() == 1);
+  CHECK(std::abs(bps[0]->lambda - crit[0]) <= 1e-12 * std::abs(crit[0]));
+  REQUIRE(r.tree.branches.size() == 3);
+  for (size_t bi = 1; bi < 3; ++bi) {
+    const cont::Branch& child = r.tree.branches[bi];
+    INFO("child " << bi << ": " << child.stopMessage);
+    REQUIRE(child.points.size() == 40);
+    CHECK(child.points.back().u.head(n).norm() > 0.0);  // off the straight chain
+    CHECK(child.specialPointsOfType(cont::SpecialPointType::Fold).empty());
+    CHECK(child.specialPointsOfType(cont::SpecialPointType::BranchPoint).empty());
+  }
+}

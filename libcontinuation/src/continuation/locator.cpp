@@ -218,7 +218,12 @@ void Locator::locateBetween(const std::vector<StepSample> &samples, std::vector<
   std::vector<StepSample> ends = samples;
   for (StepSample &x : ends) ensureEigenvalues(problem_, x.point, needed);
   std::vector<std::pair<StepSample, StepSample>> simple, multiple;
-  for (size_t i = 0; i + 1 < ends.size(); ++i) separateCrossings(ends[i], ends[i + 1], simple, multiple, 0);
+  for (size_t i = 0; i + 1 < ends.size(); ++i) {
+    // Two folds close together (near a cusp of the fold curve) are a pair of opposite crossings too.
+    if (options_.detectFolds && foldBetween(ends[i].point, ends[i + 1].point))
+      found.push_back(locateFold(ends[i], ends[i + 1]));
+    if (options_.detectBranchPoints) separateCrossings(ends[i], ends[i + 1], simple, multiple, 0);
+  }
   // An interrupt ends the location between two branch points (below the dense crossover each
   // refinement is O(N³) work, and a step over a cluster holds many): the tracer then drops
   // the half-located step, so the time limit is kept within one refinement.
@@ -243,7 +248,7 @@ void Locator::separateCrossings(const StepSample &lo, const StepSample &hi,
     if (det) simple.emplace_back(lo, hi);
     return;
   }
-  const bool fold = (p.foldTest >= 0.0) != (q.foldTest >= 0.0);  // explains one crossing, reported or not
+  const bool fold = foldBetween(p, q);  // explains one crossing, reported or not
   const int inertia = std::abs(q.stability.negative - p.stability.negative);
   const int crossings = std::max(det ? 1 : 0, inertia - (fold ? 1 : 0));
   if (crossings == 0) return;
@@ -275,7 +280,7 @@ SpecialPoint Locator::locateFold(const StepSample &lo, const StepSample &hi) {
     f = p.foldTest;
     return true;
   };
-  bool ok = findRoot(lo, lo.point.foldTest, hi, hi.point.foldTest, test, root, options_.coarseTolerance);
+  bool ok = findRoot(lo, lo.point.foldTest, hi, hi.point.foldTest, test, root, bracketingTolerance(lo, hi, 1e-3));
   int evaluations = root.evaluations;
   auto adopt = [&](bool found) {
     const StepSample &at = found ? root.at : (std::abs(lo.point.foldTest) < std::abs(hi.point.foldTest) ? lo : hi);
@@ -399,6 +404,18 @@ void Locator::adoptRefinedFold(SpecialPoint &sp, const Vector &tangentRef, const
                      (Vector(n + 1) << sp.u, sp.lambda).finished() - xa_);
 }
 
+double Locator::bracketingTolerance(const StepSample &lo, const StepSample &hi, double fraction) const {
+  // findRoot's tolerance is relative to max(1, |λ|); the bracket's own width is not.
+  const double scale = std::max(1.0, std::abs(0.5 * (lo.point.lambda + hi.point.lambda)));
+  return std::min(options_.coarseTolerance, fraction * std::abs(hi.s - lo.s) / scale);
+}
+
+bool Locator::insideBracket(const SpecialPoint &sp, const StepSample &lo, const StepSample &hi) const {
+  const double s = sp.arclength - a_.point.arclength;  // the step coordinate ta·(x − xa) of the point
+  const double margin = 1e-6 * std::abs(hi.s - lo.s) + tolerance(sp.lambda);
+  return s >= std::min(lo.s, hi.s) - margin && s <= std::max(lo.s, hi.s) + margin;
+}
+
 SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSample &hi) {
   SpecialPoint sp;
   sp.type = SpecialPointType::BranchPoint;
@@ -439,7 +456,7 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
 
   Root root;
   bool ok = false;
-  if (haveTest) ok = findRoot(lo, fLo, hi, fHi, test, root, options_.coarseTolerance);
+  if (haveTest) ok = findRoot(lo, fLo, hi, fHi, test, root, bracketingTolerance(lo, hi, 1e-3));
   int evaluations = root.evaluations;
   const std::string testNote = sp.note;
   auto adopt = [&](bool found) {
@@ -456,8 +473,31 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
     else if (!root.failure.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("branch point secant: " + root.failure);
   };
   adopt(ok);
-  const bool refined = options_.denseAlgebra ? refineBranchPoint(sp, a_.point.tangent)
-                                             : refineBranchPointStructured(sp, a_.point.tangent);
+  // Several branch points in one step (a cluster at n = 10 000, or a coarse step): the bracket
+  // holds one of them, but Newton from the secant's point may still converge to a neighbour
+  // outside it, which would then be reported twice and this one missed. A refined point outside
+  // the bracket is rejected; the secant goes on inside the bracket, 1000 times tighter, and the
+  // refinement is tried again from there.
+  bool refined = false;
+  for (double fraction = 1e-3;; fraction *= 1e-3) {
+    const SpecialPoint located = sp;
+    refined = options_.denseAlgebra ? refineBranchPoint(sp, a_.point.tangent)
+                                    : refineBranchPointStructured(sp, a_.point.tangent);
+    if (!refined || insideBracket(sp, lo, hi)) break;
+    const int iterations = sp.locationIterations;
+    sp = located;
+    sp.locationIterations = iterations;
+    sp.note += (sp.note.empty() ? "" : "; ") + std::string("refinement left the bracket (to a neighbouring point)");
+    refined = false;
+    if (!(ok && root.fLeft * root.fRight < 0.0) || fraction < 1e-8) break;
+    const Root coarse = root;
+    ok = findRoot(coarse.left, coarse.fLeft, coarse.right, coarse.fRight, test, root,
+                  bracketingTolerance(lo, hi, fraction * 1e-3));
+    evaluations = sp.locationIterations + root.evaluations;
+    const std::string notes = sp.note;
+    adopt(ok);
+    sp.note = notes;
+  }
   if (!refined && ok && root.fLeft * root.fRight < 0.0) {
     finishSecant(sp, root, test, evaluations, adopt);
     if (options_.denseAlgebra) {

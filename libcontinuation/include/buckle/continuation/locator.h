@@ -6,8 +6,9 @@
 //     Keller corrector solve on the hyperplane t_aᵀ(x − x_a) = s, so every iterate is on the
 //     branch. Test functions: t_λ for folds; for branch points the minimally augmented ψ when
 //     the bordered determinant changed sign, else the eigenvalue of the stability operator that
-//     crosses zero. Before a refinement the secant only brackets (coarseTolerance): near a BP
-//     the corrector samples are ill-conditioned, the augmented systems are not;
+//     crosses zero. Before a refinement the secant only brackets (coarseTolerance, and at most
+//     1e-3 of its bracket): near a BP the corrector samples are ill-conditioned, the augmented
+//     systems are not. A refined BP outside its bracket (a neighbour's) is rejected;
 //  2. refinement: Newton on an augmented system whose regular solution IS the special point
 //       fold          (F = 0, F_u v = 0, cᵀv = 1)                 unknowns (u, λ, v)
 //       simple BP     (F(x) + βp = 0, F_xᵀp = 0, pᵀp = 1)  (Moore)  unknowns (x, β, p)
@@ -113,8 +114,14 @@ class Locator {
  private:
   SpecialPoint locateFold(const StepSample &lo, const StepSample &hi);
   SpecialPoint locateSimpleBranchPoint(const StepSample &lo, const StepSample &hi);
+  /// Relative tolerance (findRoot's) of a bracketing secant on [lo, hi]: coarseTolerance, but at
+  /// most `fraction` of the bracket's width (λ may be ≪ 1 in the problem's units, e.g. the critical
+  /// loads ~κ/n² of a long chain, and neighbouring points lie just outside the bracket).
+  double bracketingTolerance(const StepSample &lo, const StepSample &hi, double fraction) const;
+  /// A refined point lies in the bracket it was located in (its step coordinate, to rounding).
+  bool insideBracket(const SpecialPoint &sp, const StepSample &lo, const StepSample &hi) const;
   SpecialPoint multipleBranchPoint(const StepSample &lo, const StepSample &hi, int multiplicity);
-  /// Branch points between consecutive samples (the count differs between neighbours).
+  /// Folds and branch points between consecutive samples (the count differs between neighbours).
   void locateBetween(const std::vector<StepSample> &samples, std::vector<SpecialPoint> &found);
   /// The eigenvalue with ascending index `index` at a sample, times side.
   bool sideEigenvalue(const StepSample &at, int index, int side, double &value);

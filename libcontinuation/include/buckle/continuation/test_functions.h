@@ -70,11 +70,23 @@ class MinimallyAugmentedTest {
 
 /// What changed between two consecutive points.
 struct IntervalCrossings {
-  bool fold = false;               ///< t_λ changed sign
+  bool fold = false;               ///< foldBetween: t_λ changed sign, confirmed by the determinants
   bool determinantChange = false;  ///< bordered determinant changed sign
   int inertiaChange = -1;          ///< |Δ negative eigenvalues|; -1 when not known at both ends
   int branchPointCrossings = 0;    ///< eigenvalue crossings not explained by the fold
 };
+
+/// A fold between a and b: t_λ changed sign and the change is not rounding noise. By Cramer's
+/// rule t_λ = det F_u / det [[F_u, F_λ], [tᵀ]] (the bordered matrix with the point's own tangent,
+/// whose sign is determinantSign), so t_λ changes sign exactly when one of det F_u and the
+/// bordered determinant does: at a simple fold det F_u does, at a simple BP the bordered one.
+/// Where both ends carry the stability inertia ν, whose parity follows sign det F_u (for the
+/// KKT form F_u = [[H, Cᵀ], [C, 0]] of a gradient problem, or H = ±F_u), a t_λ sign change that
+/// neither the parity of Δν nor the determinant confirms is noise: on a branch traced in steps
+/// far below its λ scale (the children of a branch point at n = 10 000) t_λ ~ λ''·s lies below
+/// the rounding of the tangent's λ component, and its sign is arbitrary. Without the inertia
+/// (or with a singular end) the sign change alone decides, as before.
+bool foldBetween(const ContinuationPoint &a, const ContinuationPoint &b);
 
 IntervalCrossings classifyInterval(const ContinuationPoint &a, const ContinuationPoint &b, bool detectFolds,
                                    bool detectBranchPoints);
