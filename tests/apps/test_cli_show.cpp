@@ -77,7 +77,13 @@ TEST_CASE("buckle show prints every special point and branch of a run", "[cli][s
     CHECK(p.at("koiter_a").get<double>() == 0.0);
     CHECK(p.at("koiter_b").get<double>() < 0.0);
     CHECK(p.at("post_buckling") == "supercritical");
-    REQUIRE(p.at("imperfection_sensitivity").size() == 3);
+    // the three end coordinates, then the preload asymmetry dL0 of all segments and of the most
+    // sensitive one (docs/outputs.md)
+    REQUIRE(p.at("imperfection_sensitivity").size() == 5);
+    CHECK(p["imperfection_sensitivity"][3]["imperfection"] == "dL0");
+    CHECK(p["imperfection_sensitivity"][3]["segment"] == "all");
+    CHECK(p["imperfection_sensitivity"][4]["imperfection"] == "dL0");
+    CHECK(p["imperfection_sensitivity"][4]["segment"].is_number_integer());
     CHECK(p["imperfection_sensitivity"][2]["imperfection"] == "Me");
     CHECK(p["imperfection_sensitivity"][2]["coupling"].get<double>() != 0.0);
     CHECK(p["imperfection_sensitivity"][2]["exponent"].get<double>() == 0.0);  // no limit point

@@ -668,31 +668,3 @@ TEST_CASE("n = 1000, soft joints: one step over four critical loads 1e-7 apart f
   }
   CHECK(inFirstStep >= 3);
 }
-
-TEST_CASE("n = 10 000: the children of a branch point traced in steps ~1e-8 of the load report no fold",
-          "[equilibrium_branches]") {
-  // The first critical load is ~7.6e−8 k̄b̄; the children leave it with λ − λc ~ λ''s², whose
-  // slope t_λ ~ λ''s is far below the rounding of the tangent's λ component: its sign, the raw
-  // fold test, is noise (RESULTS.md, "Trees of long chains": 4–11 spurious LPs per child), and so
-  // is the inertia count, which flips with it: the crossing eigenvalue stays within its rounding
-  // (foldBetween).
-  const int n = 10000;
-  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  const std::vector<double> crit = firstCriticalLoads(chain, 2);
-  REQUIRE(crit.size() == 2);
-  // the children in the trivial branch's own steps
-  const EquilibriumBranches r =
-      tracePinnedAboveCrossover(chain, 0.5 * (crit[0] + crit[1]), std::abs(crit[0]) / 7.3, 40, 2.0 * crit[1]);
-  const auto bps = branchPoints(r.tree.branches.at(0));
-  REQUIRE(bps.size() == 1);
-  CHECK(std::abs(bps[0]->lambda - crit[0]) <= 1e-12 * std::abs(crit[0]));
-  REQUIRE(r.tree.branches.size() == 3);
-  for (size_t bi = 1; bi < 3; ++bi) {
-    const cont::Branch& child = r.tree.branches[bi];
-    INFO("child " << bi << ": " << child.stopMessage);
-    REQUIRE(child.points.size() == 40);
-    CHECK(child.points.back().u.head(n).norm() > 0.0);  // off the straight chain
-    CHECK(child.specialPointsOfType(cont::SpecialPointType::Fold).empty());
-    CHECK(child.specialPointsOfType(cont::SpecialPointType::BranchPoint).empty());
-  }
-}

@@ -86,44 +86,13 @@ bool MinimallyAugmentedTest::evaluate(const Matrix &A, double &psi, Vector *v) {
   return true;
 }
 
-namespace {
-
-// Below this a computed eigenvalue of the stability operator (scaled: in units of the problem's
-// typical eigenvalue, ProblemScales::stability) is not told from zero: the chain's eigenvalues
-// are isolated on Sturm counts to 1e−13·‖H‖_F, ~1e−11 at n = 10 000. Far below what a real fold
-// moves its eigenvalue over a step (|dμ/ds|·ds, dμ/ds of the order of the typical eigenvalue).
-constexpr double kEigenvalueResolution = 1e-10;
-
-// The eigenvalue with ascending index k, where the point has it (its lowest eigenvalues, or the
-// two next to zero of the certified-counting monitor).
-bool recordedEigenvalue(const ContinuationPoint &p, int k, double &value) {
-  if (k >= 0 && k < p.stability.lowest.size()) {
-    value = p.stability.lowest[k];
-    return true;
-  }
-  const NearZeroSpectrum &s = p.spectrum;
-  if (!s.valid() || k < s.first || k >= s.first + s.count) return false;
-  value = s.values[k - s.first];
-  return true;
-}
-
-}  // namespace
-
 bool foldBetween(const ContinuationPoint &a, const ContinuationPoint &b) {
   if ((a.foldTest >= 0.0) == (b.foldTest >= 0.0)) return false;
   if (!a.stability.valid() || !b.stability.valid() || a.determinantSign == 0 || b.determinantSign == 0) return true;
   // sign t_λ = sign det F_u · sign det[[F_u, F_λ], [tᵀ]]: t_λ flips iff exactly one of them does.
   const bool fuFlips = std::abs(b.stability.negative - a.stability.negative) % 2 == 1;
   const bool borderedFlips = a.determinantSign * b.determinantSign < 0;
-  if (fuFlips == borderedFlips) return false;
-  // t_λ and the count can flip together on rounding: both follow the same eigenvalue μ_k of F_u,
-  // which on those children stays ~λ''s² ≪ its rounding. Then the crossing is not resolved.
-  const int k = std::min(a.stability.negative, b.stability.negative);
-  double ma = 0.0, mb = 0.0;
-  if (recordedEigenvalue(a, k, ma) && recordedEigenvalue(b, k, mb) &&
-      std::max(std::abs(ma), std::abs(mb)) <= kEigenvalueResolution)
-    return false;
-  return true;
+  return fuFlips != borderedFlips;
 }
 
 IntervalCrossings classifyInterval(const ContinuationPoint &a, const ContinuationPoint &b, bool detectFolds,
