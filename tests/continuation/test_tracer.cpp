@@ -194,6 +194,7 @@ void forEveryStepSetting(Check check) {
       for (const double maxStep : {0.05, 0.2, 0.5, 1.0, 2.0}) {
         TracerOptions options;
         options.stepRule = rule;
+        options.foldPairGuard = true;
         options.secondOrderPredictor = secondOrder;
         options.maxStep = maxStep;
         options.initialStep = std::min(0.1, maxStep);

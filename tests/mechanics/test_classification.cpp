@@ -2,7 +2,7 @@
 // branch point of multiplicity > 1 does not depend on the arbitrary basis of its kernel.
 #include <catch2/catch.hpp>
 
-#include <Eigen/QR>
+#include <Eigen/Core>
 #include <cmath>
 
 #include "buckle/mechanics/classification.h"

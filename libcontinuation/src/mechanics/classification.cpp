@@ -47,7 +47,8 @@ Eigen::VectorXd bifurcatingMode(const SpecialPoint& point, int joints) {
       bestNorm = norm;
     }
   }
-  return (directions * directions.row(best).transpose()).head(joints);
+  const Eigen::VectorXd mode = directions * directions.row(best).transpose();
+  return mode.head(joints);
 }
 
 }  // namespace

@@ -4,7 +4,7 @@
 // the last step and to [minStep, maxStep]; after a failed step the step is halved. All steps
 // are dimensionless arclengths in the tracer's scaled variables.
 //
-// Curvature (the default): what the step taught about the branch sets the next one.
+// Curvature: what the step taught about the branch sets the next one.
 //  - Newton's contraction Θ = ‖Δx₁‖/‖Δx₀‖ ≈ ½ω‖Δx₀‖ (Deuflhard, Newton Methods for Nonlinear
 //    Problems, 2004, §5.1.3: ω the Lipschitz constant of the Jacobian's inverse times its
 //    derivative) and the first Newton step is the predictor's distance from the branch,
@@ -22,7 +22,7 @@
 // With one Newton iteration or none there is no contraction to measure: the predictor was on the
 // branch to the tolerance, and the step grows (by the angle rule at most).
 //
-// NewtonCount (AUTO-07p's rule): ds·target/iterations, and at most 0.7 when Newton contracted
+// NewtonCount (AUTO-07p's rule; the tracer's default, TracerOptions::stepRule): ds·target/iterations, and at most 0.7 when Newton contracted
 // slowly (contraction above slowContraction).
 #pragma once
 
@@ -38,7 +38,7 @@ struct StepObservation {
 
 struct StepSizeControl {
   enum class Rule { Curvature, NewtonCount };
-  Rule rule = Rule::Curvature;
+  Rule rule = Rule::NewtonCount;
   double minStep = 1e-8;
   double maxStep = 0.1;
   int targetNewtonIterations = 3;  ///< NewtonCount

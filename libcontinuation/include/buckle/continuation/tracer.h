@@ -50,7 +50,9 @@ struct TracerOptions {
   double maxStep = 0.1;
   /// How the next step follows from the last one (step_control.h): Curvature from Newton's
   /// contraction and the tangent's turning angle, or NewtonCount (AUTO-07p's iteration count).
-  StepSizeControl::Rule stepRule = StepSizeControl::Rule::Curvature;
+  /// NewtonCount by default until the curvature rule is measured against the regression
+  /// baselines and the work-precision benchmark (benchmarks/work_precision --rule curvature).
+  StepSizeControl::Rule stepRule = StepSizeControl::Rule::NewtonCount;
   double targetContraction = 0.2;   ///< Curvature: Newton contraction Θ̄ the next step aims at
   double targetAngle = 0.2;         ///< Curvature: tangent turning per step aimed at [rad]
   int targetNewtonIterations = 3;   ///< NewtonCount: ds·target/iterations
@@ -61,8 +63,8 @@ struct TracerOptions {
   /// Fold-pair guard: a step whose λ turns back and forth inside it (the cubic Hermite
   /// interpolant of λ(s) from the end values and the tangents' λ components has a derivative
   /// that changes sign twice: two folds that the sign test of t_λ at the ends cannot see) is
-  /// rejected and retried smaller.
-  bool foldPairGuard = true;
+  /// rejected and retried smaller. Off by default for the same reason as stepRule.
+  bool foldPairGuard = false;
   /// Second-order predictor x_a + ds·t_a + ½ds²·(t_a − t_p)/Δs_a (the curvature from the last
   /// two tangents) instead of x_a + ds·t_a: fewer Newton iterations per step on curved branches
   /// (benchmarks/RESULTS.md, work-precision). Off by default: it moves the points, and on the
