@@ -232,6 +232,8 @@ TEST_CASE("No step jumps over two close branch points undetected, at any step se
     const Branch branch = trace(problem, Vector::Zero(2), -3.0, InitialDirection::increasingLambda(), options);
     CHECK(branch.stopReason == StopReason::LambdaRange);
     const auto bps = branch.specialPointsOfType(SpecialPointType::BranchPoint);
+    INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " maxStep " << options.maxStep);
+    for (const SpecialPoint *bp : bps) UNSCOPED_INFO("BP at " << bp->lambda << " " << bp->note);
     REQUIRE(bps.size() == 2);
     CHECK(std::abs(bps[0]->lambda) <= 1e-12);
     CHECK(std::abs(bps[1]->lambda - c) <= 1e-12);
