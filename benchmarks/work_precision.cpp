@@ -185,9 +185,17 @@ double boundaryValue(const cont::Branch& b) {
   return NAN;
 }
 
+/// Step control of every buckle run: TracerOptions' defaults unless --rule, --growth,
+/// --target-angle or --target-contraction change them.
+cont::TracerOptions gStepOptions;
+
 cont::TracerOptions options(const Settings& s, double lambdaMin, double lambdaMax, bool secondOrder) {
   cont::TracerOptions o = tracerOptions(s, lambdaMin, lambdaMax);
   o.secondOrderPredictor = secondOrder;
+  o.stepRule = gStepOptions.stepRule;
+  o.stepGrowth = gStepOptions.stepGrowth;
+  o.targetAngle = gStepOptions.targetAngle;
+  o.targetContraction = gStepOptions.targetContraction;
   return o;
 }
 
@@ -534,26 +542,59 @@ void writePlot(const std::vector<Row>& rows, const std::string& task, const std:
 int main(int argc, char** argv) {
   int reps = 5;
   bool quick = false, buckleOnly = false;
-  std::string out = BUCKLE_BENCH_DIR "/results", autoDir;
+  std::string out = BUCKLE_BENCH_DIR "/results", autoDir, onlyTask;
+  std::vector<double> steps = {1.6, 0.8, 0.4, 0.2, 0.1, 0.05, 0.02, 0.01, 0.005, 0.002};
+  // (Newton, location) tolerances.
+  std::vector<std::pair<double, double>> tols = {{1e-4, 1e-3}, {1e-7, 1e-6}, {1e-9, 1e-10}, {1e-10, 1e-12}, {1e-13, 1e-14}};
+  std::vector<double> grid = {0.1, 0.05, 0.02, 0.01, 0.005, 0.002, 1e-3, 5e-4, 2e-4, 1e-4};
+  std::vector<bool> predictors = {false, true};  // buckle, buckle-P2
+  std::vector<double> onlySteps;
+  std::vector<std::pair<double, double>> onlyTols;
+  auto usage = [](const char* arg) {
+    std::fprintf(stderr,
+                 "usage: work_precision [--quick] [--reps R] [--out DIR] [--auto DIR] [--buckle-only] [--task T]\n"
+                 "         [--max-step H]... [--tolerances NEWTON:LOCATION]... [--predictor euler|p2] [--rule curvature|count]\n"
+                 "         [--growth G] [--target-angle RAD] [--target-contraction THETA]\n"
+                 "  unknown or incomplete argument %s\n",
+                 arg);
+    return 2;
+  };
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
-    else if (!std::strcmp(argv[i], "--auto") && i + 1 < argc) autoDir = argv[++i];
+    const bool more = i + 1 < argc;
+    if (!std::strcmp(argv[i], "--reps") && more) reps = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--out") && more) out = argv[++i];
+    else if (!std::strcmp(argv[i], "--auto") && more) autoDir = argv[++i];
     else if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--buckle-only")) buckleOnly = true;
-    else {
-      std::fprintf(stderr, "usage: work_precision [--quick] [--reps R] [--out DIR] [--auto DIR] [--buckle-only]\n  unknown argument %s\n", argv[i]);
-      return 2;
-    }
+    // Single settings (instruction counts under callgrind, comparisons): one task, given knobs.
+    else if (!std::strcmp(argv[i], "--task") && more) onlyTask = argv[++i];
+    else if (!std::strcmp(argv[i], "--max-step") && more) onlySteps.push_back(std::atof(argv[++i]));
+    else if (!std::strcmp(argv[i], "--tolerances") && more) {
+      double n = 0, l = 0;
+      if (std::sscanf(argv[++i], "%lf:%lf", &n, &l) != 2) return usage(argv[i]);
+      onlyTols.emplace_back(n, l);
+    } else if (!std::strcmp(argv[i], "--predictor") && more) {
+      const std::string v = argv[++i];
+      if (v != "euler" && v != "p2") return usage(argv[i]);
+      predictors = {v == "p2"};
+    } else if (!std::strcmp(argv[i], "--rule") && more) {
+      const std::string v = argv[++i];
+      if (v != "curvature" && v != "count") return usage(argv[i]);
+      gStepOptions.stepRule = v == "count" ? cont::StepSizeControl::Rule::NewtonCount : cont::StepSizeControl::Rule::Curvature;
+    } else if (!std::strcmp(argv[i], "--growth") && more) gStepOptions.stepGrowth = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--target-angle") && more) gStepOptions.targetAngle = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--target-contraction") && more) gStepOptions.targetContraction = std::atof(argv[++i]);
+    else return usage(argv[i]);
   }
-  std::vector<double> steps = {0.4, 0.2, 0.1, 0.05, 0.02, 0.01, 0.005, 0.002};
-  std::vector<std::pair<double, double>> tols = {{1e-4, 1e-3}, {1e-7, 1e-6}, {1e-10, 1e-12}, {1e-13, 1e-14}};  // (Newton, location)
-  std::vector<double> grid = {0.1, 0.05, 0.02, 0.01, 0.005, 0.002, 1e-3, 5e-4, 2e-4, 1e-4};
+  if (!onlyTask.empty() && onlyTask != "diagram" && onlyTask != "fold" && onlyTask != "long") return usage(onlyTask.c_str());
   if (quick) {
     steps = {0.1, 0.02};
     tols = {{1e-10, 1e-12}};
     grid = {0.01};
   }
+  if (!onlySteps.empty()) steps = onlySteps;
+  if (!onlyTols.empty()) tols = onlyTols;
+  auto wanted = [&](const char* task) { return onlyTask.empty() || onlyTask == task; };
 
   // References: tight buckle runs (the end points at the joint limit and the fold).
   Settings tight;
@@ -591,7 +632,7 @@ int main(int argc, char** argv) {
   };
 
   // buckle: every task over the grid of settings (lowest eigenvalue recorded: AUTO's PVLS computes emin).
-  for (const bool secondOrder : {false, true})
+  for (const bool secondOrder : predictors)
   for (const auto& tol : tols)
     for (double h : steps) {
       const std::string program = secondOrder ? "buckle-P2" : "buckle";
@@ -602,15 +643,19 @@ int main(int argc, char** argv) {
       s.locationTolerance = tol.second;
       s.lowestEigenvalues = 1;
       const std::string cfg = fmt("h%g_tol%g_loc%g", h, tol.first, tol.second);
-      std::vector<cont::Branch> d;
       Row row{program, "diagram", cfg};
-      timeRuns([&] { buckleDiagram(s, secondOrder, d); }, reps, quick, row.wall, row.cpu);
-      finish(row, diagramOutcome(d));
-
-      cont::Branch f;
+      if (wanted("diagram")) {
+        std::vector<cont::Branch> d;
+        timeRuns([&] { buckleDiagram(s, secondOrder, d); }, reps, quick, row.wall, row.cpu);
+        finish(row, diagramOutcome(d));
+      }
       row.task = "fold";
-      timeRuns([&] { buckleFold(s, secondOrder, f); }, reps, quick, row.wall, row.cpu);
-      finish(row, foldOutcome(f));
+      if (wanted("fold")) {
+        cont::Branch f;
+        timeRuns([&] { buckleFold(s, secondOrder, f); }, reps, quick, row.wall, row.cpu);
+        finish(row, foldOutcome(f));
+      }
+      if (!wanted("long")) continue;
 
       // long: the switch and the U branch (the trivial branch traced once, untimed).
       auto problem = pinned3(2.25, kQLimit);
@@ -638,14 +683,20 @@ int main(int argc, char** argv) {
     const std::string cfg = fmt("grid%g", h);
     Outcome o;
     Row row{"naive", "diagram", cfg};
-    timeRuns([&] { o = naiveDiagram(h); }, reps, quick, row.wall, row.cpu);
-    finish(row, o);
+    if (wanted("diagram")) {
+      timeRuns([&] { o = naiveDiagram(h); }, reps, quick, row.wall, row.cpu);
+      finish(row, o);
+    }
     row.task = "fold";
-    timeRuns([&] { o = naiveFold(h); }, reps, quick, row.wall, row.cpu);
-    finish(row, o);
+    if (wanted("fold")) {
+      timeRuns([&] { o = naiveFold(h); }, reps, quick, row.wall, row.cpu);
+      finish(row, o);
+    }
     row.task = "long";
-    timeRuns([&] { o = naiveLong(h); }, reps, quick, row.wall, row.cpu);
-    finish(row, o);
+    if (wanted("long")) {
+      timeRuns([&] { o = naiveLong(h); }, reps, quick, row.wall, row.cpu);
+      finish(row, o);
+    }
   }
 
   // AUTO: index.txt lines "task config wall_ms cpu_ms bfile" (work_precision.sh).
@@ -659,7 +710,7 @@ int main(int argc, char** argv) {
     while (std::getline(index, line)) {
       std::istringstream ls(line);
       std::string task, cfg, wall, cpu, bfile;
-      if (!(ls >> task >> cfg >> wall >> cpu >> bfile)) continue;
+      if (!(ls >> task >> cfg >> wall >> cpu >> bfile) || !wanted(task.c_str())) continue;
       // strtod: a value may be "nan" (then the row has no CPU time).
       const double wallMs = std::strtod(wall.c_str(), nullptr), cpuMs = std::strtod(cpu.c_str(), nullptr);
       Outcome o;
@@ -715,7 +766,8 @@ int main(int argc, char** argv) {
                   ratio(t[1][0], t[0][0]).c_str(), ratio(t[1][1], t[0][1]).c_str(), ratio(t[2][0], t[0][0]).c_str(),
                   ratio(t[2][1], t[0][1]).c_str(), ms(t[3][1]).c_str(), ratio(t[1][1], t[3][1]).c_str());
     }
-  for (const char* task : kTasks) writePlot(rows, task, out);
+  for (const char* task : kTasks)
+    if (wanted(task)) writePlot(rows, task, out);
   std::printf("# wrote %s/work_precision_{diagram,fold,long}.{dat,gp} (gnuplot FILE.gp → .png)%s\n", out.c_str(),
               autoDir.empty() ? "; AUTO not included (no --auto DIR)" : "");
   // Every buckle run must have found its special points (the quick mode is CI's smoke test).

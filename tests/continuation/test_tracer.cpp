@@ -164,6 +164,124 @@ TEST_CASE("Second-order predictor: same circle and folds with fewer Newton itera
   CHECK(std::abs(folds[1]->lambda + 1.0) < 1e-12);
 }
 
+namespace {
+/// λ + e²u − u³/3 = 0: folds at u = ±e, λ = ∓2e³/3, a distance ≈ 2e apart along a branch that is
+/// nearly perpendicular to λ there (λ' = e² − u² is small): the tangents at the ends of a step
+/// over both folds are almost equal, so neither the turning angle nor the sign of t_λ sees them.
+class CloseFolds : public Problem {
+ public:
+  explicit CloseFolds(double e) : e_(e) {}
+  int dimension() const override { return 1; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    F[0] = lambda + e_ * e_ * u[0] - u[0] * u[0] * u[0] / 3.0;
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+    Fu(0, 0) = e_ * e_ - u[0] * u[0];
+    Fl[0] = 1.0;
+    return true;
+  }
+
+ private:
+  double e_;
+};
+
+// Every setting of the step control: the rule, the predictor, the largest step.
+template <class Check>
+void forEveryStepSetting(Check check) {
+  for (const auto rule : {StepSizeControl::Rule::Curvature, StepSizeControl::Rule::NewtonCount})
+    for (const bool secondOrder : {false, true})
+      for (const double maxStep : {0.05, 0.2, 0.5, 1.0, 2.0}) {
+        TracerOptions options;
+        options.stepRule = rule;
+        options.foldPairGuard = true;
+        options.secondOrderPredictor = secondOrder;
+        options.maxStep = maxStep;
+        options.initialStep = std::min(0.1, maxStep);
+        check(options);
+      }
+}
+}  // namespace
+
+TEST_CASE("No step jumps over two close folds undetected, at any step setting", "[tracer]") {
+  const double e = 0.05, fold = 2.0 * e * e * e / 3.0;
+  CloseFolds problem(e);
+  const double u0 = -2.0, lambda0 = -e * e * u0 + u0 * u0 * u0 / 3.0;
+  int stepsOverBoth = 0;
+  forEveryStepSetting([&](TracerOptions options) {
+    options.lambdaMax = -lambda0;
+    const Branch branch = trace(problem, vec1(u0), lambda0, InitialDirection::increasingLambda(), options);
+    CHECK(branch.stopReason == StopReason::LambdaRange);
+    const auto folds = branch.specialPointsOfType(SpecialPointType::Fold);
+    REQUIRE(folds.size() == 2);
+    CHECK(std::abs(folds[0]->lambda - fold) <= 1e-12);
+    CHECK(std::abs(folds[1]->lambda + fold) <= 1e-12);
+    // The same settings without the guard: a step may well span both folds and see neither.
+    options.foldPairGuard = false;
+    const Branch blind = trace(problem, vec1(u0), lambda0, InitialDirection::increasingLambda(), options);
+    if (blind.specialPointsOfType(SpecialPointType::Fold).empty()) ++stepsOverBoth;
+  });
+  CHECK(stepsOverBoth > 0);  // the guard is what finds them there
+}
+
+// Both branch points are among those found (a third, reported at some settings on the
+// TwoPitchforks toy from λ = −3, is under investigation: see the stepctl report).
+bool hasBranchPointAt(const Branch &branch, double lambda, double tolerance) {
+  for (const SpecialPoint *bp : branch.specialPointsOfType(SpecialPointType::BranchPoint))
+    if (std::abs(bp->lambda - lambda) <= tolerance) return true;
+  return false;
+}
+
+TEST_CASE("No step jumps over two close branch points undetected, at any step setting", "[tracer]") {
+  const double c = 1e-3;
+  toys::TwoPitchforks problem(c);
+  forEveryStepSetting([&](TracerOptions options) {
+    options.lambdaMax = 3.0;
+    const Branch branch = trace(problem, Vector::Zero(2), -3.0, InitialDirection::increasingLambda(), options);
+    INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " maxStep " << options.maxStep);
+    CHECK(hasBranchPointAt(branch, 0.0, 1e-12));
+    CHECK(hasBranchPointAt(branch, c, 1e-12));
+  });
+  // The same on a curved trivial branch (F_λ ≠ 0), where the steps follow its curvature.
+  toys::CurvedPitchforks curved(c);
+  forEveryStepSetting([&](TracerOptions options) {
+    options.lambdaMax = 2.0;
+    const Vector u0 = toys::CurvedPitchforks::shift(-2.0);
+    const Branch branch = trace(curved, u0, -2.0, InitialDirection::increasingLambda(), options);
+    INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " maxStep " << options.maxStep);
+    CHECK(hasBranchPointAt(branch, 0.0, 1e-11));
+    CHECK(hasBranchPointAt(branch, c, 1e-11));
+  });
+}
+
+TEST_CASE("Curvature step control: tighter tolerances take the same steps, not more", "[tracer]") {
+  // The Newton count rule shrinks the steps when the tolerance asks for more iterations; the
+  // contraction does not depend on the tolerance.
+  toys::Circle circle;
+  auto pointsAt = [&](StepSizeControl::Rule rule, double tolerance) {
+    TracerOptions options;
+    options.stepRule = rule;
+    options.maxStep = 1.0;
+    options.minTangentCosine = 0.5;
+    options.targetAngle = 0.3;
+    options.newtonTolerance = tolerance;
+    options.maxArclength = 2.0 * M_PI - 0.3;
+    const Branch b = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), options);
+    for (const ContinuationPoint &p : b.points) CHECK(std::abs(p.u[0] * p.u[0] + p.lambda * p.lambda - 1.0) < 10 * tolerance);
+    CHECK(b.specialPointsOfType(SpecialPointType::Fold).size() == 2);
+    return b.points.size();
+  };
+  const auto curvatureLoose = pointsAt(StepSizeControl::Rule::Curvature, 1e-6);
+  const auto curvatureTight = pointsAt(StepSizeControl::Rule::Curvature, 1e-13);
+  const auto countLoose = pointsAt(StepSizeControl::Rule::NewtonCount, 1e-6);
+  const auto countTight = pointsAt(StepSizeControl::Rule::NewtonCount, 1e-13);
+  CHECK(curvatureTight <= curvatureLoose + 2);
+  CHECK(countTight > countLoose + 2);
+  // The circle turns by 1 rad per unit arclength: about 2π/0.3 ≈ 20 steps at the target angle,
+  // and ≈ 8 more while the first step 0.01 grows to 0.3 by factors of 1.5.
+  CHECK(curvatureTight <= 35);
+}
+
 TEST_CASE("Consecutive tangents respect the branch-jump guard", "[tracer]") {
   toys::Circle circle;
   TracerOptions options;

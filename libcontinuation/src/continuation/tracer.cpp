@@ -154,8 +154,15 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   lo.interrupt = options_.interrupt;
   lo.touchTolerance = options_.touchTolerance;
   locator_ = std::make_unique<Locator>(*work_, *corrector_, *evaluator_, lo);
-  stepControl_ = StepSizeControl{options_.minStep,    options_.maxStep,    options_.targetNewtonIterations,
-                                 options_.stepGrowth, options_.stepShrink, options_.slowContraction};
+  stepControl_.rule = options_.stepRule;
+  stepControl_.minStep = options_.minStep;
+  stepControl_.maxStep = options_.maxStep;
+  stepControl_.targetNewtonIterations = options_.targetNewtonIterations;
+  stepControl_.stepGrowth = options_.stepGrowth;
+  stepControl_.stepShrink = options_.stepShrink;
+  stepControl_.slowContraction = options_.slowContraction;
+  stepControl_.targetContraction = options_.targetContraction;
+  stepControl_.targetAngle = options_.targetAngle;
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
 }
@@ -284,7 +291,7 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
 }
 
 bool Tracer::takeStep(const ContinuationPoint &a, const ContinuationPoint *previous, double ds, ContinuationPoint &b,
-                      CorrectorSummary &summary, std::string &failure) {
+                      CorrectorSummary &summary, double &turningAngle, std::string &failure) {
   predictor_.head(n_) = a.u + ds * a.tangent.head(n_);
   predictor_[n_] = a.lambda + ds * a.tangent[n_];
   // Second-order (Taylor) predictor: (t_a − t_p)/Δs_a is the branch's curvature vector x'' to
@@ -307,9 +314,16 @@ bool Tracer::takeStep(const ContinuationPoint &a, const ContinuationPoint *previ
     return false;
   }
   const double cosine = b.tangent.dot(a.tangent);
+  turningAngle = std::acos(std::max(-1.0, std::min(1.0, cosine)));
   if (cosine < options_.minTangentCosine) {
-    failure = formatDouble("branch-jump guard (tangent turned by %.3g degrees)",
-                           std::acos(std::max(-1.0, std::min(1.0, cosine))) * 180.0 / std::acos(-1.0));
+    failure = formatDouble("branch-jump guard (tangent turned by %.3g degrees)", turningAngle * 180.0 / std::acos(-1.0));
+    return false;
+  }
+  // Two folds inside the step leave t_λ with the same sign at both ends (tracer.h).
+  if (options_.foldPairGuard && options_.detectFolds &&
+      foldPairInside(a.lambda, a.tangent[n_], b.lambda, b.tangent[n_],
+                     std::sqrt((b.u - a.u).squaredNorm() + (b.lambda - a.lambda) * (b.lambda - a.lambda)))) {
+    failure = "fold-pair guard (lambda turns back and forth inside the step)";
     return false;
   }
   b.arclength = a.arclength + ds;
@@ -393,11 +407,18 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     const double dsTry = std::min(ds, remaining);
     ContinuationPoint b;
     CorrectorSummary summary;
+    double turningAngle = 0.0;
     const ContinuationPoint *previous = options_.secondOrderPredictor && ia > 0 ? &branch.points[ia - 1] : nullptr;
-    if (!takeStep(a, previous, dsTry, b, summary, lastFailure)) {
+    if (!takeStep(a, previous, dsTry, b, summary, turningAngle, lastFailure)) {
       if (!halve()) return;
       continue;
     }
+    // What the step showed, for the next one (read before `a` and `previous` dangle on the push).
+    StepObservation observed;
+    observed.newtonIterations = summary.iterations;
+    observed.contraction = summary.contraction;
+    observed.turningAngle = turningAngle;
+    observed.predictorOrder = previous && a.stepSize > 0.0 ? 2 : 1;  // as takeStep's predictor
 
     // Stop events inside the step: the earliest one, landed on exactly, ends the step there.
     EventHit hit = locateStopEvent(a, b);
@@ -439,7 +460,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       stop(StopReason::MaxArclength, "reached maxArclength", SpecialPointType::Endpoint, "max arclength");
       return;
     }
-    ds = stepControl_.next(ds, summary.iterations, summary.contraction);
+    ds = stepControl_.next(ds, observed);
     eventsA_.swap(eventsB_);
   }
 }

@@ -25,6 +25,34 @@ bool isLoadControlled(const EquilibriumProblem& problem) {
   return true;
 }
 
+namespace {
+
+// The bifurcating mode of a branch point: the kernel vector orthogonal to the traced branch
+// (nullVectors column 1). At a multiple point (nullVectors with m + 1 ≥ 3 columns) the
+// bifurcating directions form an m-dimensional space whose basis is arbitrary (a rounding change
+// or the approach direction rotates it), so one fixed member is named instead: the projection
+// onto that space of the unit rotation of the first joint it reaches the most (ties within a
+// relative 1e-9 go to the lower joint). Three identical joints at the fold of their common
+// torque-angle curve (the hysteresis scene): span{(1,1,1)}⊥, joint 1's projection (2,−1,−1)/3.
+Eigen::VectorXd bifurcatingMode(const SpecialPoint& point, int joints) {
+  const Eigen::MatrixXd& V = point.nullVectors;
+  if (V.cols() < 3) return V.col(1).head(joints);
+  const Eigen::MatrixXd directions = V.rightCols(V.cols() - 1);  // orthonormal (locator.cpp)
+  int best = 0;
+  double bestNorm = -1.0;
+  for (int i = 0; i < joints; ++i) {
+    const double norm = directions.row(i).norm();  // ‖P e_i‖ for the projector P = D Dᵀ
+    if (norm > bestNorm * (1.0 + 1e-9)) {
+      best = i;
+      bestNorm = norm;
+    }
+  }
+  const Eigen::VectorXd mode = directions * directions.row(best).transpose();
+  return mode.head(joints);
+}
+
+}  // namespace
+
 bool startIsUnstable(const continuation::Branch& branch) {
   return !branch.points.empty() && branch.points.front().stability.valid() &&
          branch.points.front().stability.negative > 0;
@@ -42,7 +70,7 @@ Classification classify(const EquilibriumProblem& problem, const SpecialPoint& p
   switch (point.type) {
     case SpecialPointType::BranchPoint: {
       // The bifurcating direction is the kernel vector orthogonal to the traced branch.
-      if (point.nullVectors.cols() >= 2) c.shape = modeShapeName(point.nullVectors.col(1).head(n), 1e-6);
+      if (point.nullVectors.cols() >= 2) c.shape = modeShapeName(bifurcatingMode(point, n), 1e-6);
       c.phenomenon = Phenomenon::Buckling;
       c.explanation = "branch point: the " + shapeName(point.u.head(n), 1e-7) +
                       " configuration loses stability to the " + c.shape + " family";

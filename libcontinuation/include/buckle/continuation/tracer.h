@@ -48,11 +48,23 @@ struct TracerOptions {
   double initialStep = 0.01;
   double minStep = 1e-8;
   double maxStep = 0.1;
-  int targetNewtonIterations = 3;   ///< ds·target/iterations, clamped to [stepShrink, stepGrowth]
-  double stepGrowth = 1.5;
+  /// How the next step follows from the last one (step_control.h): Curvature from Newton's
+  /// contraction and the tangent's turning angle, or NewtonCount (AUTO-07p's iteration count).
+  /// NewtonCount by default until the curvature rule is measured against the regression
+  /// baselines and the work-precision benchmark (benchmarks/work_precision --rule curvature).
+  StepSizeControl::Rule stepRule = StepSizeControl::Rule::NewtonCount;
+  double targetContraction = 0.2;   ///< Curvature: Newton contraction Θ̄ the next step aims at
+  double targetAngle = 0.2;         ///< Curvature: tangent turning per step aimed at [rad]
+  int targetNewtonIterations = 3;   ///< NewtonCount: ds·target/iterations
+  double stepGrowth = 1.5;          ///< factors of the next step clamped to [stepShrink, stepGrowth]
   double stepShrink = 0.5;
-  double slowContraction = 0.3;     ///< contraction above this shrinks the next step
+  double slowContraction = 0.3;     ///< NewtonCount: contraction above this shrinks the next step
   double minTangentCosine = 0.9;    ///< branch-jump guard: t_newᵀt_old must stay ≥ this (MATCONT)
+  /// Fold-pair guard: a step whose λ turns back and forth inside it (the cubic Hermite
+  /// interpolant of λ(s) from the end values and the tangents' λ components has a derivative
+  /// that changes sign twice: two folds that the sign test of t_λ at the ends cannot see) is
+  /// rejected and retried smaller. Off by default for the same reason as stepRule.
+  bool foldPairGuard = false;
   /// Second-order predictor x_a + ds·t_a + ½ds²·(t_a − t_p)/Δs_a (the curvature from the last
   /// two tangents) instead of x_a + ds·t_a: fewer Newton iterations per step on curved branches
   /// (benchmarks/RESULTS.md, work-precision). Off by default: it moves the points, and on the
@@ -180,7 +192,7 @@ class Tracer {
   /// given), Keller corrector, new tangent and the branch-jump guard. False with `failure` set
   /// when the step must be retried smaller.
   bool takeStep(const ContinuationPoint &a, const ContinuationPoint *previous, double ds, ContinuationPoint &b,
-                CorrectorSummary &summary, std::string &failure);
+                CorrectorSummary &summary, double &turningAngle, std::string &failure);
   /// Folds and branch points between a and b (index not set).
   std::vector<SpecialPoint> locateSpecialPoints(const ContinuationPoint &a, const ContinuationPoint &b);
 
