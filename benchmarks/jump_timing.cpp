@@ -126,8 +126,8 @@ Start foldStart(int n) {
   s.tracedPoints = int(branch.points.size());
   const auto folds = branch.specialPointsOfType(cont::SpecialPointType::Fold);
   if (folds.empty()) return s;
-  s.u = folds.front().u;
-  s.lambda = folds.front().lambda;
+  s.u = folds.front()->u;
+  s.lambda = folds.front()->lambda;
   s.found = true;
   return s;
 }
@@ -161,7 +161,8 @@ int main(int argc, char** argv) {
   std::printf("%-11s %-6s %-22s %-9s %11s %7s %6s %8s %12s\n", "case", "n", "stepper", "handover", "time [ms]", "steps",
               "tests", "success", "landing diff");
   bool ok = true;
-  for (const std::string c : {"fold", "degenerate", "inertial"}) {
+  for (const char* name : {"fold", "degenerate", "inertial"}) {
+    const std::string c = name;
     if (!onlyCase.empty() && c != onlyCase) continue;
     for (int n : sizes) {
       Start s = c == "degenerate" ? degenerateStart(n) : foldStart(n);

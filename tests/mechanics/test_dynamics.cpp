@@ -672,7 +672,7 @@ TEST_CASE("inertial exact Jacobian matches central differences of the right-hand
   for (int n : {5, 30}) {
     const Chain chain = bistableChain(n);
     const InertiaData data = unevenInertia(chain);
-    std::vector<double> damping(size_t(n));
+    std::vector<double> damping(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) damping[size_t(i)] = 0.1 + 0.05 * i;
     InertialModel model(chain, EndCondition::freeEnd(Wrench(0.3, -0.2, 0.1)), data, damping, 0.0, Vector::Zero(n));
     const int N = 2 * n + 1;
