@@ -2,8 +2,11 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <memory>
 #include <string>
+#include <vector>
 
+#include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/jump.h"
 
 using namespace buckle::mechanics;
@@ -547,4 +550,188 @@ TEST_CASE("structured jump in scaled units: the same steps and landing angles (n
   CHECK((scaled.to.head(n) - base.to.head(n)).cwiseAbs().maxCoeff() < 1e-10);
   // energy in units of k̄b̄² (1e4 · 1e-6 = 1e-2)
   CHECK(scaled.energyReleased / 1e-2 == Approx(base.energyReleased).epsilon(1e-9));
+}
+
+TEST_CASE("direction rule for a multiple lowest eigenvalue: the dense and O(n) routes agree (n = 20, 50)", "[jump]") {
+  // The straight chain of identical segments at Fx = 0 with y held: H = κI and ker J_y has
+  // dimension n − 1, so the lowest eigenvalue κ is (n − 1)-fold and the rule (jump.h, step 1)
+  // gives the reference vector projected onto ker J_y in closed form: z − (cᵀz / cᵀc) c with
+  // c = J_yᵀ, c_i = x_end − x_i (eq 11).
+  for (int n : {20, 50}) {
+    INFO("n = " << n);
+    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
+    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
+    const Vector u = problem.initialGuess(Vector::Zero(n), 0.0);
+    const UnstableDirection dense = unstableDirection(problem, u, 0.0, DirectionRoute::Dense);
+    const UnstableDirection fast = unstableDirection(problem, u, 0.0, DirectionRoute::Structured);
+    REQUIRE(dense.valid);
+    REQUIRE(fast.valid);
+    const double kappa = chain.segment(0).energyJet(0.0).d2;
+    CHECK(kappa < 0.0);
+    CHECK(dense.eigenvalue == Approx(kappa).epsilon(1e-12));
+    CHECK(fast.eigenvalue == Approx(kappa).epsilon(1e-12));
+    Matrix H, C;
+    REQUIRE(problem.stabilityOperator(u, 0.0, H, C));
+    REQUIRE(C.rows() == 1);
+    CHECK((H - kappa * Matrix::Identity(n, n)).cwiseAbs().maxCoeff() < 1e-14);
+    const Vector c = C.row(0).transpose();
+    Vector expected = directionReference(n);
+    expected -= (c.dot(expected) / c.squaredNorm()) * c;
+    expected.normalize();
+    // the same vector, sign included (both are the projection of z, not −z)
+    CHECK((dense.direction - expected).cwiseAbs().maxCoeff() < 1e-10);
+    CHECK((fast.direction - expected).cwiseAbs().maxCoeff() < 1e-10);
+    // a slightly bent, compressed chain splits the eigenvalue: the simple lowest one's
+    // eigenvector on both routes
+    Vector q(n);
+    for (int i = 0; i < n; ++i) q[i] = 1e-3 * std::sin(0.37 * i);
+    const Vector ub = problem.initialGuess(q, -1e-2);
+    const UnstableDirection d2 = unstableDirection(problem, ub, -1e-2, DirectionRoute::Dense);
+    const UnstableDirection f2 = unstableDirection(problem, ub, -1e-2, DirectionRoute::Structured);
+    REQUIRE(d2.valid);
+    REQUIRE(f2.valid);
+    CHECK((d2.direction - f2.direction).cwiseAbs().maxCoeff() < 1e-8);
+  }
+}
+
+namespace {
+
+// A fold that a user meets: n bistable segments graded in L0 (1.3 at the base: the shallowest
+// well, 1.2 at the end), free end under Fy = 0.01 and an end moment M = λ, every joint in its
+// negative well at M = 0; the tracer follows M up to the first fold (the base joint's barrier).
+// As benchmarks/jump_timing.cpp, case "fold".
+struct TracedFold {
+  std::unique_ptr<EquilibriumProblem> problem;
+  buckle::continuation::SpecialPoint fold;
+};
+
+TracedFold gradedChainFold(int n, double lengthScale = 1.0, double stiffnessScale = 1.0) {
+  std::vector<SegmentParameters> segments;
+  Vector q0(n);
+  for (int i = 0; i < n; ++i) {
+    const double L0 = 1.3 - 0.1 * i / (n - 1);
+    segments.push_back(SegmentParameters::symmetric(0.5 * lengthScale, lengthScale, stiffnessScale, L0 * lengthScale));
+    q0[i] = -2.0 * std::acos(L0 / 1.5);
+  }
+  const double force = stiffnessScale * lengthScale, moment = force * lengthScale;  // k̄b̄, k̄b̄²
+  TracedFold t;
+  t.problem = std::make_unique<EquilibriumProblem>(Chain(segments), EndCondition::freeEnd(Eigen::Vector3d(0, 0.01 * force, 0)),
+                                                   Eigen::Vector3d(0, 0, moment));
+  const PolishResult start = polishEquilibrium(*t.problem, q0, 0.0);
+  REQUIRE(start.converged);
+  buckle::continuation::TracerOptions o;
+  o.maxPoints = 2000;
+  o.lambdaMax = 2.0;
+  o.detectBranchPoints = false;
+  o.lowestEigenvalues = 0;
+  buckle::continuation::Tracer tracer(*t.problem, o);
+  const auto branch = tracer.trace(start.u, 0.0, buckle::continuation::InitialDirection::increasingLambda());
+  const auto folds = branch.specialPointsOfType(buckle::continuation::SpecialPointType::Fold);
+  REQUIRE(!folds.empty());
+  t.fold = *folds.front();
+  return t;
+}
+
+JumpResult jumpWith(EquilibriumProblem& problem, const buckle::continuation::SpecialPoint& from, StepperKind stepper,
+                    Handover handover) {
+  JumpOptions options;
+  options.integration = jumpIntegrationDefaults(problem.segments());
+  options.integration.stepper = stepper;
+  options.integration.recordTrajectory = false;
+  options.handover = handover;
+  return simulateJump(problem, from.u, from.lambda, options);
+}
+
+}  // namespace
+
+TEST_CASE("jump from a traced fold of a long chain: structured with hand-over lands where dense integration to rest does (n = 50)",
+          "[jump]") {
+  const int n = 50;
+  TracedFold t = gradedChainFold(n);
+  // a simple fold: one zero eigenvalue, the base joint's mode
+  const UnstableDirection ud = unstableDirection(*t.problem, t.fold.u, t.fold.lambda);
+  REQUIRE(ud.valid);
+  const JumpResult dense = jumpWith(*t.problem, t.fold, StepperKind::Rosenbrock4, Handover::Never);
+  const JumpResult fast = jumpWith(*t.problem, t.fold, StepperKind::StructuredRosenbrock4, Handover::Always);
+  INFO(dense.message << " / " << fast.message);
+  REQUIRE(dense.success);
+  REQUIRE(fast.success);
+  CHECK(dense.stopReason == IntegrationStop::Rest);
+  CHECK(fast.stopReason == IntegrationStop::Settled);
+  CHECK(fast.basinTests >= 1);
+  // the same landing equilibrium, polished to the same tolerance
+  CHECK((fast.to - dense.to).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK(fast.stable);
+  // the base joint snapped over its barrier to the positive well; the others stayed negative
+  CHECK(fast.to[0] > 0.0);
+  for (int i = 1; i < n; ++i) CHECK(fast.to[i] < 0.0);
+}
+
+TEST_CASE("hand-over to Newton: the landing of integration to rest, in fewer steps (fold n = 200, cascade n = 80)", "[jump]") {
+  auto compare = [](EquilibriumProblem& problem, const buckle::continuation::SpecialPoint& from) {
+    const JumpResult full = jumpWith(problem, from, StepperKind::StructuredRosenbrock4, Handover::Never);
+    const JumpResult handed = jumpWith(problem, from, StepperKind::StructuredRosenbrock4, Handover::Always);
+    INFO(full.message << " / " << handed.message);
+    REQUIRE(full.success);
+    REQUIRE(handed.success);
+    CHECK(full.basinTests == 0);
+    CHECK(handed.stopReason == IntegrationStop::Settled);
+    CHECK(handed.steps < full.steps);
+    CHECK((handed.to - full.to).cwiseAbs().maxCoeff() < 1e-10);
+    CHECK(handed.energyReleased == Approx(full.energyReleased).epsilon(1e-10));
+  };
+  SECTION("fold of the graded chain, n = 200") {
+    TracedFold t = gradedChainFold(200);
+    compare(*t.problem, t.fold);
+  }
+  SECTION("degenerate straight chain, n = 80 (the cascade of the rule's direction)") {
+    const int n = 80;
+    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
+    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
+    buckle::continuation::SpecialPoint start;
+    start.u = problem.initialGuess(Vector::Zero(n), 0.0);
+    start.lambda = 0.0;
+    compare(problem, start);
+  }
+}
+
+TEST_CASE("hand-over in scaled units: the same steps, tests and landing angles (fold, n = 80)", "[jump]") {
+  const int n = 80;
+  TracedFold base = gradedChainFold(n), scaled = gradedChainFold(n, 1e-3, 1e4);
+  CHECK(scaled.fold.lambda == Approx(base.fold.lambda).epsilon(1e-8));
+  const JumpResult a = jumpWith(*base.problem, base.fold, StepperKind::StructuredRosenbrock4, Handover::Automatic);
+  const JumpResult b = jumpWith(*scaled.problem, scaled.fold, StepperKind::StructuredRosenbrock4, Handover::Automatic);
+  INFO(a.message << " / " << b.message);
+  REQUIRE(a.success);
+  REQUIRE(b.success);
+  CHECK(a.stopReason == IntegrationStop::Settled);  // Automatic: on above kStructuredJumpFrom segments
+  CHECK(b.stopReason == IntegrationStop::Settled);
+  CHECK(std::abs(a.steps - b.steps) <= a.steps / 50);
+  CHECK((a.to.head(n) - b.to.head(n)).cwiseAbs().maxCoeff() < 1e-9);
+  CHECK(b.energyReleased / 1e-2 == Approx(a.energyReleased).epsilon(1e-8));
+}
+
+TEST_CASE("inertial jump from a traced fold: the structured method on the exact Jacobian lands where dense Rosenbrock4 does (n = 24)",
+          "[jump]") {
+  const int n = 24;
+  TracedFold t = gradedChainFold(n);
+  JumpOptions options;
+  options.scene.inertia = InertiaData::uniformRods(t.problem->chain(), 1.0);
+  options.scene.jointDamping.assign(size_t(n), 1.0);
+  options.integration = jumpIntegrationDefaults(n);
+  options.integration.recordTrajectory = false;
+  options.integration.stepper = StepperKind::Rosenbrock4;
+  const JumpResult dense = simulateJump(*t.problem, t.fold.u, t.fold.lambda, options);
+  options.integration.stepper = StepperKind::StructuredRosenbrock4;
+  options.handover = Handover::Always;  // ignored by the inertial model (jump.h)
+  const JumpResult fast = simulateJump(*t.problem, t.fold.u, t.fold.lambda, options);
+  INFO(dense.message << " / " << fast.message);
+  REQUIRE(dense.success);
+  REQUIRE(fast.success);
+  CHECK(fast.stopReason == IntegrationStop::Rest);
+  CHECK(fast.basinTests == 0);
+  CHECK(fast.dynamics.kind == DynamicsKind::Inertial);
+  CHECK((fast.to - dense.to).cwiseAbs().maxCoeff() < 1e-9);
+  // the energy balance K + Π + W_d = const holds along the structured steps to the tolerance
+  CHECK(fast.dynamics.maxEnergyBalanceError < 1e-6 * std::max(1.0, std::abs(fast.energyReleased)));
 }

@@ -531,8 +531,6 @@ InertialModel::InertialModel(const Chain& chain, const EndCondition& end, const 
   }
 }
 
-InertialModel::~InertialModel() = default;
-
 long InertialModel::constructedCount() { return inertialModelsConstructed.load(); }
 
 bool InertialModel::factorMass(ConstVectorRef q) {

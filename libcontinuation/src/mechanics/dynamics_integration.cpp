@@ -44,6 +44,8 @@ bool IntegrationOptions::IsValid(std::string* why) const {
   if (!finite(residualTolerance) || !(residualTolerance > 0.0)) return fail(why, "residualTolerance must be > 0");
   if (!finite(recordInterval) || recordInterval < 0.0) return fail(why, "recordInterval must be >= 0");
   if (maxSamples < 2) return fail(why, "maxSamples must be >= 2");
+  if (!finite(settleResidual) || !(settleResidual > 0.0)) return fail(why, "settleResidual must be > 0");
+  if (settleInterval < 1) return fail(why, "settleInterval must be >= 1");
   return true;
 }
 
@@ -56,6 +58,7 @@ const char* toString(IntegrationStop reason) {
     case IntegrationStop::StepSizeUnderflow: return "step size underflow";
     case IntegrationStop::NonFinite: return "non-finite state";
     case IntegrationStop::Interrupted: return "interrupted";
+    case IntegrationStop::Settled: return "settled";
   }
   return "unknown";
 }
@@ -230,8 +233,19 @@ class Monitor {
     result_.maxEnergyBalanceError = std::max(result_.maxEnergyBalanceError, std::abs(energy(x) - result_.initialEnergy));
     record(t, x, false);
     const double speed = model_.restSpeed(x);
-    if (speed <= options_.velocityTolerance && model_.naturalResidual(q) <= options_.residualTolerance)
+    // (the residual is another sweep: only when it can end the integration)
+    const bool slow = speed <= options_.velocityTolerance;
+    const double residual = slow || options_.settled ? model_.naturalResidual(q) : 0.0;
+    if (slow && residual <= options_.residualTolerance)
       return stop(IntegrationStop::Rest, "at rest: |qdot| and the equilibrium residual are below tolerance at t = " + num(t));
+    ++sinceSettleCheck_;
+    if (options_.settled && model_.lockedCount() == 0 && residual <= options_.settleResidual &&
+        sinceSettleCheck_ >= options_.settleInterval) {
+      sinceSettleCheck_ = 0;
+      if (options_.settled(q))
+        return stop(IntegrationStop::Settled, "settled at t = " + num(t) + " (equilibrium residual " + num(residual) +
+                                                  "): handed over to the caller's certified solve");
+    }
     return false;
   }
 
@@ -303,6 +317,7 @@ class Monitor {
   DynamicsResult& result_;
   Vector qdot_;
   double lastRecorded_ = 0.0;
+  long sinceSettleCheck_ = 0;
 };
 
 // FSAL controllers keep dx/dt of the last accepted state: after a rollback it must be dropped.
@@ -577,16 +592,15 @@ DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef 
   Monitor monitor(model, natural, result);
   const std::vector<int> initialSides = model.contactSides();
 
-  // The structured Rosenbrock method needs the model's O(n) linear solve (the gradient flow has it).
-  const bool structured =
-      natural.stepper == StepperKind::StructuredRosenbrock4 && model.kind() == DynamicsKind::GradientFlow;
+  // The structured Rosenbrock method runs on the model's solveLinearized() (both models have it).
+  const bool structured = natural.stepper == StepperKind::StructuredRosenbrock4;
   if (structured) {
     ExplicitState x(x0.data(), x0.data() + N);
     StructuredRosenbrock4 controller(model, natural.absoluteTolerance, natural.relativeTolerance);
     StructuredRosenbrock4 trial(model, natural.absoluteTolerance, natural.relativeTolerance);
     auto subStep = [&](const ExplicitState& from, double, double h, ExplicitState& to) { return trial.advance(from, h, to); };
     runLoop(controller, ExplicitSystem{&model}, x, explicitData, subStep, model, natural, monitor, result);
-  } else if (natural.stepper == StepperKind::Rosenbrock4 || natural.stepper == StepperKind::StructuredRosenbrock4) {
+  } else if (natural.stepper == StepperKind::Rosenbrock4) {
     StiffState x(static_cast<size_t>(N));
     std::copy(x0.data(), x0.data() + N, x.begin());
     odeint::rosenbrock4_controller<odeint::rosenbrock4<double>> controller(natural.absoluteTolerance,

@@ -32,6 +32,13 @@ Vector fullUnknowns(EquilibriumProblem& problem, ConstVectorRef u, double lambda
                               " unknowns (got " + std::to_string(u.size()) + ")");
 }
 
+/// δ of the direction rule (jump.h, step 1): eigenvalues within δ of the lowest μ are one
+/// multiple eigenvalue. Relative to the operator's scale (the chain's k̄b̄², the RMS eigenvalue
+/// ‖H‖_F/√n, |μ|): the same δ in any units, on both routes.
+double clusterWidth(double typicalScale, double rmsEigenvalue, double mu) {
+  return 1e-8 * std::max({typicalScale, rmsEigenvalue, std::abs(mu)});
+}
+
 EndCondition frozenEnd(const EquilibriumProblem& problem, double lambda) {
   EndCondition e = problem.endCondition();
   e.value = problem.prescribed(lambda);
@@ -52,12 +59,20 @@ struct RestPoint {
   bool stable = false;
 };
 
+/// `settled`: the equilibrium the basin test certified when the integration ended Settled
+/// (no joint in contact then: the test runs only without locked joints).
 RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn, double lambda,
-                          const continuation::CorrectorOptions& options) {
+                          const continuation::CorrectorOptions& options, const PolishResult* settled = nullptr) {
   RestPoint rp;
   const int n = problem.segments();
   rp.sides = dyn.contactSides.size() == size_t(n) ? dyn.contactSides : std::vector<int>(size_t(n), 0);
   rp.torques = Vector::Zero(n);
+  if (dyn.reason == IntegrationStop::Settled && settled && !anyContact(rp.sides)) {
+    rp.polished = *settled;
+    problem.stability(rp.polished.u, lambda, 3, rp.stability);
+    rp.stable = rp.stability.valid() && rp.stability.stable();
+    return rp;
+  }
   if (dyn.reason != IntegrationStop::Rest) {
     // only a rest point is worth polishing (at a guard the state is no equilibrium)
     rp.polished.u = problem.initialGuess(dyn.q, lambda);
@@ -101,9 +116,10 @@ RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn
 /// chain structure of K_q − σI) at σ = μ − δ: its solution lies in ker J_h and each iteration
 /// shrinks the other eigen-components by δ / (μ_k − σ). δ = 1e-8 of the operator's scale: far
 /// enough from μ for the solves to stay accurate to rounding in the wanted direction, close
-/// enough for two or three iterations. (A multiple μ — the straight chain of identical bistable
-/// segments at zero load, H = κI — has no preferred eigenvector: the start vector's projection
-/// onto the eigenspace is returned, deterministically.)
+/// enough for two or three iterations. Started from the reference vector z (jump.h, step 1), the
+/// iteration keeps its components in the eigenspace of a multiple μ (the straight chain of
+/// identical bistable segments at zero load, H = κI on ker J_y) unchanged relative to each
+/// other: it returns the normalised projection of z onto that eigenspace, the rule's direction.
 UnstableDirection structuredUnstableDirection(EquilibriumProblem& problem, const Vector& u, double lambda) {
   UnstableDirection d;
   const int n = problem.segments();
@@ -119,14 +135,13 @@ UnstableDirection structuredUnstableDirection(EquilibriumProblem& problem, const
   Vector lowest(1);
   if (lowestEigenvalues(ws, r > 0, 1, lowest) < 1 || !std::isfinite(lowest[0])) return d;
   const double mu = lowest[0];
-  const double sigma = mu - 1e-8 * std::max({ws.typicalScale, ws.frobeniusH / std::sqrt(double(n)), std::abs(mu)});
+  const double sigma = mu - clusterWidth(ws.typicalScale, ws.frobeniusH / std::sqrt(double(n)), mu);
   Vector kappa = ws.kappa.array() - sigma;
   assemble(kappa, ws.h, shifted);
   const Matrix Qt = ws.Q.leftCols(r).transpose();
-  // a fixed start with every component present (no eigenvector of the chain is orthogonal to it
-  // generically)
-  Vector z(n), next(n), y(r), zeroR = Vector::Zero(r);
-  for (int i = 0; i < n; ++i) z[i] = 1.0 + 0.5 * std::sin(1.0 + 2.399963 * i);
+  // the rule's reference vector: every component present (no eigenvector of the chain is
+  // orthogonal to it generically)
+  Vector z = directionReference(n), next(n), y(r), zeroR = Vector::Zero(r);
   if (r > 0) z -= Qt.transpose() * (Qt * z);
   if (!(z.norm() > 0.0)) return d;
   z.normalize();
@@ -143,6 +158,26 @@ UnstableDirection structuredUnstableDirection(EquilibriumProblem& problem, const
   d.direction = z;
   d.valid = z.allFinite();
   return d;
+}
+
+/// The hand-over's basin test at the flow's state q (jump.h, step 2); on success `landing` is
+/// the polished equilibrium q* it certified.
+bool basinTest(EquilibriumProblem& problem, DynamicsModel& model, ConstVectorRef q, double lambda,
+               const continuation::CorrectorOptions& polish, PolishResult& landing) {
+  const int n = problem.segments();
+  // positive definite on ker J_h: O(n) Sturm counts (no eigenvalues wanted)
+  auto definite = [&](const Vector& u) {
+    continuation::StabilityInfo s;
+    return problem.stability(u, lambda, 0, s) && s.valid() && s.stable();
+  };
+  if (!definite(problem.initialGuess(q, lambda))) return false;
+  PolishResult p = polishEquilibrium(problem, q, lambda, polish);
+  if (!p.converged || !definite(p.u)) return false;
+  const Vector qStar = p.u.head(n);
+  if (!definite(problem.initialGuess(0.5 * (q + qStar), lambda))) return false;
+  if (!(model.potential(qStar) <= model.potential(q))) return false;
+  landing = std::move(p);
+  return true;
 }
 
 std::string describeContacts(const std::vector<int>& sides, const Vector& torques) {
@@ -208,11 +243,19 @@ PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, do
   return result;
 }
 
-UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef u, double lambda) {
+Vector directionReference(int n) {
+  Vector z(n);
+  for (int i = 0; i < n; ++i) z[i] = 1.0 + 0.5 * std::sin(1.0 + 2.399963 * i);
+  return z;
+}
+
+UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef u, double lambda, DirectionRoute route) {
   UnstableDirection d;
   const Vector uFull = fullUnknowns(problem, u, lambda);
   // long chains: O(n) through the chain structure instead of the dense O(n³) eigen-solve
-  if (problem.segments() > kSmallDense) return structuredUnstableDirection(problem, uFull, lambda);
+  const bool structured =
+      route == DirectionRoute::Structured || (route == DirectionRoute::Automatic && problem.segments() > kSmallDense);
+  if (structured) return structuredUnstableDirection(problem, uFull, lambda);
   Matrix H, C;
   if (!problem.stabilityOperator(uFull, lambda, H, C)) return d;
   const Eigen::Index n = H.rows();
@@ -231,7 +274,16 @@ UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef 
   Eigen::SelfAdjointEigenSolver<Matrix> es(0.5 * (reduced + reduced.transpose()));
   if (es.info() != Eigen::Success) return d;
   d.eigenvalue = es.eigenvalues()[0];
-  d.direction = Z * es.eigenvectors().col(0);
+  // The rule (jump.h, step 1): the reference vector projected onto the eigenspace of the
+  // eigenvalues within δ of the lowest (for a simple one: its eigenvector, up to sign).
+  const double scale = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();
+  const double delta = clusterWidth(scale, H.norm() / std::sqrt(double(n)), d.eigenvalue);
+  Eigen::Index k = 1;
+  while (k < es.eigenvalues().size() && es.eigenvalues()[k] - d.eigenvalue <= delta) ++k;
+  const Matrix E = Z * es.eigenvectors().leftCols(k);  // orthonormal basis of the eigenspace
+  d.direction = E * (E.transpose() * directionReference(int(n)));
+  // (a reference orthogonal to the eigenspace is not generic; then its first basis vector)
+  if (!(d.direction.norm() > 1e-8 * std::sqrt(double(n)))) d.direction = E.col(0);
   d.direction.normalize();
   d.valid = true;
   return d;
@@ -318,8 +370,19 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   }
   result.direction = v;
 
-  // 2. Release: dynamics at frozen loads / targets until rest.
-  result.dynamics = simulate(*model, qStart, Vector::Zero(n), options.integration);
+  // 2. Release: dynamics at frozen loads / targets until rest, or (gradient flow) until the
+  // basin test hands over to Newton.
+  IntegrationOptions integration = options.integration;
+  const bool handover = model->kind() == DynamicsKind::GradientFlow &&
+                        (options.handover == Handover::Always ||
+                         (options.handover == Handover::Automatic && n > kStructuredJumpFrom));
+  PolishResult certified;
+  if (handover)
+    integration.settled = [&](ConstVectorRef q) {
+      ++result.basinTests;
+      return basinTest(problem, *model, q, lambda, options.polish, certified);
+    };
+  result.dynamics = simulate(*model, qStart, Vector::Zero(n), integration);
   const DynamicsResult& dyn = result.dynamics;
   result.stopReason = dyn.reason;
   result.duration = dyn.time;
@@ -329,7 +392,7 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.restPoint = dyn.q;
 
   // 3. Polish at fixed λ (with the joints in contact fixed) and check stability.
-  const RestPoint rest = polishRestPoint(problem, dyn, lambda, options.polish);
+  const RestPoint rest = polishRestPoint(problem, dyn, lambda, options.polish, &certified);
   const PolishResult& polished = rest.polished;
   result.to = polished.u;
   result.polishConverged = polished.converged;
@@ -349,14 +412,14 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   os << "integration stopped: " << dyn.message << "; polish: " << (polished.converged ? "converged" : "not converged") << " ("
      << polished.message << ", residual " << polished.residual << "); landing " << describe(result.stabilityTo);
   if (anyContact(rest.sides)) os << " with the joints locked; in contact: " << describeContacts(rest.sides, rest.torques);
-  if (dyn.reason != IntegrationStop::Rest) {
+  const bool arrived = dyn.reason == IntegrationStop::Rest || dyn.reason == IntegrationStop::Settled;
+  if (!arrived) {
     os << "; no rest point reached";
   } else if (polished.converged && result.distance <= options.sameStateTolerance) {
     os << "; the chain came back to the start (no jump)";
   }
   result.message = os.str();
-  result.success = dyn.reason == IntegrationStop::Rest && polished.converged && result.stable &&
-                   result.distance > options.sameStateTolerance;
+  result.success = arrived && polished.converged && result.stable && result.distance > options.sameStateTolerance;
   return result;
 }
 

@@ -50,6 +50,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -297,10 +298,31 @@ class InertialModel final : public DynamicsModel {
   double timeUnit() const override { return timeUnit_; }
   double impact(double* x) override;
 
+  /// ∂(dx/dt)/∂x (row-major, (2n+1)²). Without constraints exact (dynamics_inertial_linearized.cpp:
+  /// A_q = −M⁻¹(H + C_q + G), A_v = −M⁻¹(C_v + D), the energy row 2(Dq̇)ᵀ); with held coordinates
+  /// or locked joints central differences of rhs().
+  void jacobian(const double* x, double* jacobianRowMajor) override;
+  /// (I − aJ)k = b with the exact J. Without constraints in O(n): the stage system reduces to
+  /// [M + a(C_v + D) + a²(H + C_q + G)] k_v = M b_v − a(H + C_q + G) b_q, in absolute angles a
+  /// tridiagonal plus rank-2 semiseparable matrix, solved as a banded sparse system with the
+  /// semiseparable sums as auxiliary unknowns. With constraints: a dense LU of I − aJ (O(n³)).
+  bool solveLinearized(const double* x, double a, const double* b, double* k) override;
+
  protected:
   void resizeConstraints() override;
 
  private:
+  struct Linearization;  // workspace of jacobian() / solveLinearized() (dynamics_inertial_linearized.cpp)
+  struct LinearizationDeleter {  // (defined where Linearization is complete)
+    void operator()(Linearization* p) const;
+  };
+  /// θ̇ = Tq̇, θ̈ = Tq̈, T of H = U T Uᵀ and the diagonal of the velocity terms' stiffness at x.
+  void linearizeAt(const double* x);
+  /// out_i = Σ_{j≠i} μ_ij [cos(θ_i − θ_j) β_j + sin(θ_i − θ_j) γ_j] y_j (after factorMass), O(n).
+  void applyCoupling(ConstVectorRef beta, ConstVectorRef gamma, ConstVectorRef y, VectorRef out) const;
+  /// out = K_θ y, K_θ = T + (C_q + G)_θ the stiffness in absolute angles (after linearizeAt).
+  void applyStiffnessTheta(ConstVectorRef y, VectorRef out) const;
+
   /// cos θ_i, sin θ_i and the LDLᵀ factors of M_θ at q (file comment of dynamics.cpp, "O(n)
   /// mass matrix"); false if a pivot is not positive (M_θ not positive definite to rounding).
   bool factorMass(ConstVectorRef q);
@@ -321,6 +343,7 @@ class InertialModel final : public DynamicsModel {
   Eigen::LLT<Matrix> sllt_;
   double omega_;
   double timeUnit_;
+  std::unique_ptr<Linearization, LinearizationDeleter> lin_;
 };
 
 /// The only way scenes build a model: the inertial one if and only if scene.inertia is set.
@@ -335,8 +358,8 @@ enum class StepperKind {
   CashKarp54,      ///< runge_kutta_cash_karp54, error-controlled
   Rosenbrock4,     ///< rosenbrock4 (L-stable, uses the model's Jacobian) for stiff scenes
   /// rosenbrock4's coefficients with the model's O(n) solveLinearized() instead of a dense LU
-  /// (O(n) per step instead of O(n³)): stiff long chains.
-  /// Models without a structured solve (the inertial one) are integrated with Rosenbrock4.
+  /// (O(n) per step instead of O(n³)): stiff long chains (both models; the inertial one with
+  /// constraints solves its stages densely).
   StructuredRosenbrock4,
 };
 
@@ -369,11 +392,21 @@ struct IntegrationOptions {
   /// Joint limits as one-sided constraints (file comment); false: stop at the first limit
   /// reached (IntegrationStop::JointLimit), the time bisected down to minStep.
   bool contact = true;
+  /// Hand-over test (optional; jump.h, JumpOptions::handover): consulted after an accepted step
+  /// without locked joints whose naturalResidual() is <= settleResidual, at most every
+  /// settleInterval accepted steps, with the joint angles of that step. True ends the
+  /// integration (IntegrationStop::Settled): the caller has certified where the flow goes from
+  /// there and takes over (e.g. with Newton), so the creep to rest is not integrated.
+  std::function<bool(ConstVectorRef q)> settled;
+  double settleResidual = 1e-2;
+  long settleInterval = 8;
 
   bool IsValid(std::string* why) const;
 };
 
-enum class IntegrationStop { Rest, MaxTime, MaxSteps, JointLimit, StepSizeUnderflow, NonFinite, Interrupted };
+/// Settled: stopped by IntegrationOptions::settled (not at rest; the caller's test says where
+/// the flow goes).
+enum class IntegrationStop { Rest, MaxTime, MaxSteps, JointLimit, StepSizeUnderflow, NonFinite, Interrupted, Settled };
 const char* toString(IntegrationStop reason);
 
 struct TrajectorySample {

@@ -5,11 +5,25 @@
 // Hessian K_q − K_g on ker J_h has a negative or zero eigenvalue), or from a state just past a
 // fold, the loads and held targets are frozen at their λ values and the chain is released:
 //   1. δq = ε·v, v the eigenvector of the smallest eigenvalue of Zᵀ(K_q − K_g)Z (Z a basis of
-//      ker J_h, eq 27), or the caller's direction; the sign is the one with the lower Π(q ± δq)
+//      ker J_h, eq 27), or the caller's direction. When that eigenvalue is multiple (eigenvalues
+//      within δ = 1e-8 of the operator's scale of the lowest count as one, e.g. the straight chain
+//      of identical segments, whose n − 1 eigenvalues on ker J_y coincide) v is the orthogonal
+//      projection onto its eigenspace of the fixed reference vector z_i = 1 + ½ sin(1 + 2.399963 i)
+//      (i = 0 … n−1; every component present, no symmetry of the chain), normalised: the same
+//      direction on the dense and the O(n) routes, so both land on the same equilibrium (for a
+//      simple eigenvalue this is its eigenvector). The sign is the one with the lower Π(q ± δq)
 //      (at a fold the quadratic term vanishes and the cubic one decides where the chain goes);
 //      with held coordinates the perturbed start is projected back onto them;
 //   2. the dynamics (inertial if the scene has masses, else the gradient flow, see dynamics.h)
-//      runs until rest;
+//      runs until rest — or, for the gradient flow with JumpOptions::handover, until the state
+//      passes the basin test: projected Hessian positive definite at the state q, Newton from q
+//      converges to a stable equilibrium q* with Π(q*) <= Π(q), and the Hessian is positive
+//      definite at the midpoint of q and q* too. (If the Hessian is positive definite on the ball
+//      around q* through q, the flow cannot leave it — d|q − q*|²/dt = −2(q − q*)ᵀ∇Π/c < 0 there —
+//      and ends at q*; the test samples that ball on the segment, and is consulted only once the
+//      equilibrium residual has fallen below IntegrationOptions::settleResidual.) The landing is
+//      then q* itself: the creep to rest, hundreds of steps at the integrator's tolerance, is
+//      replaced by a few Newton steps;
 //   3. the rest point is polished by Newton on the EquilibriumProblem residual at fixed λ — the
 //      continuation core's KINSOL corrector in its fixed-parameter mode — and its stability is
 //      checked with Problem::stability() (K_q − K_g positive definite on ker J_h).
@@ -57,9 +71,18 @@ struct UnstableDirection {
   bool valid = false;        ///< false: the stability operator could not be evaluated
 };
 
+/// Dense (eigen-solve of Zᵀ(K_q − K_g)Z, O(n³)) or O(n) (Sturm counts and inverse iteration on
+/// the chain structure) computation of the unstable direction; Automatic: O(n) above kSmallDense.
+enum class DirectionRoute { Automatic, Dense, Structured };
+
 /// Eigenvector of the smallest eigenvalue of the stability operator on ker J_h at (u, λ)
-/// (u = joint angles, or the full unknowns). Sign not chosen here.
-UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef u, double lambda);
+/// (u = joint angles, or the full unknowns); for a multiple smallest eigenvalue the projection
+/// of the reference vector onto its eigenspace (file comment, step 1). Sign not chosen here.
+UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef u, double lambda,
+                                    DirectionRoute route = DirectionRoute::Automatic);
+
+/// The rule's reference vector z_i = 1 + ½ sin(1 + 2.399963 i), i = 0 … n−1 (file comment).
+Vector directionReference(int n);
 
 /// Integration settings for a jump of a chain of `segments` segments. A jump starts at a fold,
 /// where the flow is slowest (critical slowing down) while the chain's other modes stay fast: a
@@ -68,10 +91,16 @@ UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef 
 /// against 15 s with dopri5, one of which did not reach rest by maxTime); below, dopri5, whose
 /// finite-difference-free steps are as fast there and which the short chains' tests pin. Above
 /// kStructuredJumpFrom segments the dense Rosenbrock method's O(n³) per step dominates: the same
-/// method on the chain structure (StepperKind::StructuredRosenbrock4, O(n) per step; the inertial
-/// model keeps Rosenbrock4).
+/// method on the chain structure (StepperKind::StructuredRosenbrock4, O(n) per step; for the
+/// inertial model too, through its exact Jacobian, dynamics.h).
 constexpr int kStructuredJumpFrom = 64;
 IntegrationOptions jumpIntegrationDefaults(int segments);
+
+/// When the gradient flow of a jump hands over to Newton in a stable basin (file comment, step
+/// 2): Automatic above kStructuredJumpFrom segments (the shorter chains' jumps, which the scenes'
+/// regression baselines pin, integrate to rest), Always, Never. The inertial model always
+/// integrates to rest (its kinetic energy can carry it out of a convex region).
+enum class Handover { Automatic, Always, Never };
 
 struct JumpOptions {
   DynamicsScene scene;                   ///< masses given → inertial dynamics, else gradient flow
@@ -84,12 +113,13 @@ struct JumpOptions {
   Vector direction;
   /// A landing closer than this (‖Δq‖∞) to the start means the chain did not jump.
   double sameStateTolerance = 1e-6;
+  Handover handover = Handover::Automatic;
 
   bool IsValid(const EquilibriumProblem& problem, std::string* why) const;
 };
 
 struct JumpResult {
-  bool success = false;      ///< rest reached, polish converged, landing stable and distinct
+  bool success = false;      ///< rest reached (or settled), polish converged, landing stable and distinct
   std::string message;       ///< why it ended (or what failed)
   IntegrationStop stopReason = IntegrationStop::MaxSteps;
   double lambda = 0.0;
@@ -101,8 +131,9 @@ struct JumpResult {
   double potentialFrom = 0.0, potentialTo = 0.0;
   double energyReleased = 0.0;       ///< ΔΠ = Π(from) − Π(to)
   double distance = 0.0;             ///< ‖q_to − q_from‖∞
-  double duration = 0.0;             ///< model time until rest
+  double duration = 0.0;             ///< model time until rest (or the hand-over)
   long steps = 0, rejectedSteps = 0;
+  int basinTests = 0;                ///< hand-over tests run (step 2), the last passed if settled
   double wallSeconds = 0.0;
   double residual = 0.0;             ///< ‖F‖∞ of the EquilibriumProblem at `to`
   bool polishConverged = false;
