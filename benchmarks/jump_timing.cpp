@@ -3,7 +3,7 @@
 //   fold        what a user meets: the first fold of a loaded, curled chain found by the tracer.
 //               n bistable segments (a = 0.5, b = 1, k = 1) graded in L0 from 1.3 at the base to
 //               1.2 at the end (the base joint's well is the shallowest), free end under a
-//               constant Fy = 0.01 (k̄b̄) and an end moment M = λ; every joint starts in its
+//               constant Fy = 0.01/n (k̄b̄) and an end moment M = λ; every joint starts in its
 //               negative well (q_i = −2 acos(L0_i / 1.5)) at M = 0, and the tracer follows M up
 //               to the first fold (a simple zero eigenvalue: the base joint's barrier).
 //   degenerate  the straight chain of identical bistable segments (L0 = 1.2), end held on the
@@ -110,7 +110,7 @@ Start foldStart(int n) {
     q0[i] = -2.0 * std::acos(L0 / 1.5);  // the well c* = b L0 / (2(b² − a²))
   }
   Start s;
-  s.problem = std::make_unique<EquilibriumProblem>(Chain(segments), EndCondition::freeEnd(Eigen::Vector3d(0.0, 0.01, 0.0)),
+  s.problem = std::make_unique<EquilibriumProblem>(Chain(segments), EndCondition::freeEnd(Eigen::Vector3d(0.0, 0.01 / n, 0.0)),
                                                    Eigen::Vector3d(0, 0, 1));
   const auto t0 = std::chrono::steady_clock::now();
   const PolishResult p = polishEquilibrium(*s.problem, q0, 0.0);

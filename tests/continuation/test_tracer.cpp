@@ -1,3 +1,4 @@
+#include <sstream>
 #include "buckle/continuation/tracer.h"
 
 #include "toy_problems.h"
@@ -249,6 +250,10 @@ TEST_CASE("No step jumps over two close branch points undetected, at any step se
     const Vector u0 = toys::CurvedPitchforks::shift(-2.0);
     const Branch branch = trace(curved, u0, -2.0, InitialDirection::increasingLambda(), options);
     INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " maxStep " << options.maxStep);
+    std::ostringstream found;
+    for (const SpecialPoint *bp : branch.specialPointsOfType(SpecialPointType::BranchPoint))
+      found << "\n  branch point at " << bp->lambda << (bp->refined ? " (refined) " : " ") << bp->note;
+    INFO("found:" << found.str());
     CHECK(hasBranchPointAt(branch, 0.0, 1e-11));
     CHECK(hasBranchPointAt(branch, c, 1e-11));
   });

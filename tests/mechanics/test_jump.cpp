@@ -597,7 +597,8 @@ TEST_CASE("direction rule for a multiple lowest eigenvalue: the dense and O(n) r
 namespace {
 
 // A fold that a user meets: n bistable segments graded in L0 (1.3 at the base: the shallowest
-// well, 1.2 at the end), free end under Fy = 0.01 and an end moment M = λ, every joint in its
+// well, 1.2 at the end), free end under Fy = 0.01/n (its moment at the base stays below the
+// wells' barriers whatever n) and an end moment M = λ, every joint in its
 // negative well at M = 0; the tracer follows M up to the first fold (the base joint's barrier).
 // As benchmarks/jump_timing.cpp, case "fold".
 struct TracedFold {
@@ -615,7 +616,7 @@ TracedFold gradedChainFold(int n, double lengthScale = 1.0, double stiffnessScal
   }
   const double force = stiffnessScale * lengthScale, moment = force * lengthScale;  // k̄b̄, k̄b̄²
   TracedFold t;
-  t.problem = std::make_unique<EquilibriumProblem>(Chain(segments), EndCondition::freeEnd(Eigen::Vector3d(0, 0.01 * force, 0)),
+  t.problem = std::make_unique<EquilibriumProblem>(Chain(segments), EndCondition::freeEnd(Eigen::Vector3d(0, 0.01 * force / n, 0)),
                                                    Eigen::Vector3d(0, 0, moment));
   const PolishResult start = polishEquilibrium(*t.problem, q0, 0.0);
   REQUIRE(start.converged);

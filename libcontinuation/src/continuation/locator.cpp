@@ -411,9 +411,14 @@ double Locator::bracketingTolerance(const StepSample &lo, const StepSample &hi, 
 }
 
 bool Locator::insideBracket(const SpecialPoint &sp, const StepSample &lo, const StepSample &hi) const {
-  const double s = sp.arclength - a_.point.arclength;  // the step coordinate ta·(x − xa) of the point
-  const double margin = 1e-6 * std::abs(hi.s - lo.s) + tolerance(sp.lambda);
-  return s >= std::min(lo.s, hi.s) - margin && s <= std::max(lo.s, hi.s) + margin;
+  // All three in the step coordinate ta·(x − xa) (the refined point's arclength is that). The
+  // samples' own s is the Hermite predictor's parameter, which on a curved branch is not.
+  auto coordinate = [&](const ContinuationPoint &p) {
+    return a_.point.tangent.head(n_).dot(p.u - xa_.head(n_)) + a_.point.tangent[n_] * (p.lambda - xa_[n_]);
+  };
+  const double s = sp.arclength - a_.point.arclength, sLo = coordinate(lo.point), sHi = coordinate(hi.point);
+  const double margin = 1e-6 * std::abs(sHi - sLo) + tolerance(sp.lambda);
+  return s >= std::min(sLo, sHi) - margin && s <= std::max(sLo, sHi) + margin;
 }
 
 SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSample &hi) {
