@@ -1,3 +1,4 @@
+#include <optional>
 #include "buckle/continuation/locator.h"
 
 #include <Eigen/SVD>
@@ -484,11 +485,13 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
   // the bracket is rejected; the secant goes on inside the bracket, 1000 times tighter, and the
   // refinement is tried again from there.
   bool refined = false;
+  std::optional<SpecialPoint> outside;  // the first refined point, outside the bracket
   for (double fraction = 1e-3;; fraction *= 1e-3) {
     const SpecialPoint located = sp;
     refined = options_.denseAlgebra ? refineBranchPoint(sp, a_.point.tangent)
                                     : refineBranchPointStructured(sp, a_.point.tangent);
     if (!refined || insideBracket(sp, lo, hi)) break;
+    if (!outside) outside = sp;
     const int iterations = sp.locationIterations;
     sp = located;
     sp.locationIterations = iterations;
@@ -502,6 +505,14 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
     const std::string notes = sp.note;
     adopt(ok);
     sp.note = notes;
+  }
+  if (!refined && outside) {
+    // No tighter bracket led Newton inside: keep the refined point rather than none (a refined
+    // branch point of the problem, if perhaps a neighbour's; the note says so).
+    const std::string notes = sp.note;
+    sp = *outside;
+    sp.note = notes + "; kept the refined point outside the bracket";
+    refined = true;
   }
   if (!refined && ok && root.fLeft * root.fRight < 0.0) {
     finishSecant(sp, root, test, evaluations, adopt);
