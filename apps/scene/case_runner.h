@@ -4,6 +4,7 @@
 #pragma once
 
 #include <map>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -64,6 +65,14 @@ class CaseRunner {
         progress->step(*branches + 1, static_cast<int>(b.points.size()), b.points.back().lambda,
                        static_cast<int>(out->specials.size() + b.specialPoints.size()));
         return continuation::StepAction::Continue;
+      };
+      // a step over a cluster of branch points can refine for seconds without a new point
+      opt.onLocated = [progress, branches](const continuation::SpecialPoint& sp) {
+        std::ostringstream what;
+        what.precision(6);
+        what << "branch " << *branches + 1 << ", located " << continuation::label(sp.type) << " at parameter "
+             << sp.lambda;
+        progress->note(what.str());
       };
     }
     return opt;

@@ -5,11 +5,13 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
 #include <limits>
 #include <string>
+#include <vector>
 
 using namespace buckle::continuation;
 using Catch::Matchers::Contains;
@@ -257,6 +259,52 @@ TEST_CASE("No step jumps over two close branch points undetected, at any step se
     CHECK(hasBranchPointAt(branch, 0.0, 1e-11));
     CHECK(hasBranchPointAt(branch, c, 1e-11));
   });
+}
+
+TEST_CASE("onLocated tells of every special point as it is located, in the problem's units", "[tracer]") {
+  // TwoPitchforks with λ scaled by 1e3 inside the tracer: the callback must convert back
+  class Scaled : public toys::TwoPitchforks {
+   public:
+    using TwoPitchforks::TwoPitchforks;
+    ProblemScales scales() const override {
+      ProblemScales s = ProblemScales::ones(2);
+      s.parameter = 1e3;
+      s.unknowns << 1e-2, 1e-2;
+      return s;
+    }
+  };
+  const double c = 1e-3;
+  for (bool scaled : {false, true}) {
+    INFO("scaled " << scaled);
+    toys::TwoPitchforks plain(c);
+    Scaled big(c);
+    Problem &problem = scaled ? static_cast<Problem &>(big) : plain;
+    TracerOptions options;
+    options.lambdaMax = 3.0;
+    options.maxStep = 2.0;  // one step over both branch points
+    std::vector<double> located;
+    std::vector<SpecialPointType> types;
+    int steps = 0;
+    options.onLocated = [&](const SpecialPoint &sp) {
+      located.push_back(sp.lambda);
+      types.push_back(sp.type);
+    };
+    options.onStep = [&](const Branch &) {
+      ++steps;
+      return StepAction::Continue;
+    };
+    const Branch branch = trace(problem, Vector::Zero(2), -3.0, InitialDirection::increasingLambda(), options);
+    const auto bps = branch.specialPointsOfType(SpecialPointType::BranchPoint);
+    REQUIRE(bps.size() == 2);
+    // every branch point of the branch was announced, with its λ to the last bit and its type
+    for (const SpecialPoint *bp : bps) {
+      const auto it = std::find(located.begin(), located.end(), bp->lambda);
+      CHECK(it != located.end());
+      if (it != located.end()) CHECK(types[size_t(it - located.begin())] == SpecialPointType::BranchPoint);
+    }
+    CHECK(located.size() >= bps.size());
+    CHECK(steps > 0);
+  }
 }
 
 TEST_CASE("Curvature step control: tighter tolerances take the same steps, not more", "[tracer]") {

@@ -55,6 +55,22 @@ double imperfectFold(const Chain& chain, const EndCondition& end, double lambdaS
   return folds.empty() ? std::numeric_limits<double>::quiet_NaN() : folds.front()->lambda;
 }
 
+/// Tall triangles, short preload: the straight chain's first (U) branch point is subcritical.
+/// The chain, its problem, that point and its Koiter coefficients (checked subcritical).
+struct SubcriticalChain {
+  Chain chain = Chain::uniform(3, SegmentParameters::symmetric(2.5, 1.0, 1.0, 0.5));
+  EquilibriumProblem p{chain, EndCondition::clampedPinned(0.0), kAxial};
+  cont::SpecialPoint bp = firstBranchPoint(p, -12.0);
+  KoiterCoefficients k = koiterCoefficients(p, bp);
+
+  SubcriticalChain() {
+    REQUIRE(k.valid);
+    REQUIRE(k.kind == KoiterKind::Subcritical);
+  }
+  SubcriticalChain(const SubcriticalChain&) = delete;
+  SubcriticalChain& operator=(const SubcriticalChain&) = delete;
+};
+
 /// The same for an imperfection ε of end coordinate c of the clamped–pinned chain.
 double imperfectFold(const Chain& chain, int c, double eps, double lambdaStart, double lambdaMin) {
   EndCondition end = EndCondition::clampedPinned(0.0);
@@ -77,13 +93,11 @@ void checkLaw(const ImperfectionSensitivity& s, const std::vector<double>& eps, 
 
 TEST_CASE("Koiter's 2/3 law: knockdown of a subcritical chain by an end moment, against the traced imperfect path",
           "[imperfection_sensitivity]") {
-  // tall triangles, short preload: the straight chain's first (U) point is subcritical
-  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(2.5, 1.0, 1.0, 0.5));
-  EquilibriumProblem p(chain, EndCondition::clampedPinned(0.0), kAxial);
-  const cont::SpecialPoint bp = firstBranchPoint(p, -12.0);
-  const KoiterCoefficients k = koiterCoefficients(p, bp);
-  REQUIRE(k.valid);
-  REQUIRE(k.kind == KoiterKind::Subcritical);
+  SubcriticalChain c;
+  const Chain& chain = c.chain;
+  EquilibriumProblem& p = c.p;
+  const cont::SpecialPoint& bp = c.bp;
+  const KoiterCoefficients& k = c.k;
   const ImperfectionSensitivity s = imperfectionSensitivity(p, bp, k, 2);  // an end moment Me = ε
   REQUIRE(s.valid);
   CHECK(s.name == "Me");
@@ -125,12 +139,11 @@ TEST_CASE("A supercritical chain has no limit point near its critical load when 
 
 TEST_CASE("Koiter's 2/3 law for a preload asymmetry (dL0), against the traced imperfect path",
           "[imperfection_sensitivity]") {
-  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(2.5, 1.0, 1.0, 0.5));
-  EquilibriumProblem p(chain, EndCondition::clampedPinned(0.0), kAxial);
-  const cont::SpecialPoint bp = firstBranchPoint(p, -12.0);
-  const KoiterCoefficients k = koiterCoefficients(p, bp);
-  REQUIRE(k.valid);
-  REQUIRE(k.kind == KoiterKind::Subcritical);
+  SubcriticalChain c;
+  const Chain& chain = c.chain;
+  EquilibriumProblem& p = c.p;
+  const cont::SpecialPoint& bp = c.bp;
+  const KoiterCoefficients& k = c.k;
   // every segment's springs apart by ε, and the middle segment's alone
   for (int segment : {-1, 1}) {
     INFO("segment " << segment);

@@ -193,15 +193,20 @@ std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &
     ensureEigenvalues(problem_, a_.point, needed);
     ensureEigenvalues(problem_, b_.point, needed);
   }
-  if (crossings.fold && options_.detectFolds) found.push_back(locateFold(a_, b_));
+  if (crossings.fold && options_.detectFolds) keep(found, locateFold(a_, b_));
   if (crossings.branchPointCrossings > 0 && options_.detectBranchPoints) {
     std::vector<std::pair<StepSample, StepSample>> simple, multiple;
     if (crossings.branchPointCrossings == 1 && crossings.determinantChange) simple.emplace_back(a_, b_);
     else separateCrossings(a_, b_, simple, multiple, 0);
-    for (const auto &bracket : simple) found.push_back(locateSimpleBranchPoint(bracket.first, bracket.second));
+    // As in locateBetween: an interrupt ends the location between two branch points.
+    for (const auto &bracket : simple) {
+      if (options_.interrupt.requested()) break;
+      keep(found, locateSimpleBranchPoint(bracket.first, bracket.second));
+    }
     for (const auto &bracket : multiple) {
+      if (options_.interrupt.requested()) break;
       const int m = std::abs(bracket.second.point.stability.negative - bracket.first.point.stability.negative);
-      found.push_back(multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
+      keep(found, multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
     }
   }
   evaluator_.setLowestEigenvalues(savedEigenvalues);
@@ -222,7 +227,7 @@ void Locator::locateBetween(const std::vector<StepSample> &samples, std::vector<
   for (size_t i = 0; i + 1 < ends.size(); ++i) {
     // Two folds close together (near a cusp of the fold curve) are a pair of opposite crossings too.
     if (options_.detectFolds && foldBetween(ends[i].point, ends[i + 1].point))
-      found.push_back(locateFold(ends[i], ends[i + 1]));
+      keep(found, locateFold(ends[i], ends[i + 1]));
     if (options_.detectBranchPoints) separateCrossings(ends[i], ends[i + 1], simple, multiple, 0);
   }
   // An interrupt ends the location between two branch points (below the dense crossover each
@@ -230,14 +235,19 @@ void Locator::locateBetween(const std::vector<StepSample> &samples, std::vector<
   // the half-located step, so the time limit is kept within one refinement.
   for (const auto &bracket : simple) {
     if (options_.interrupt.requested()) break;
-    found.push_back(locateSimpleBranchPoint(bracket.first, bracket.second));
+    keep(found, locateSimpleBranchPoint(bracket.first, bracket.second));
   }
   for (const auto &bracket : multiple) {
     if (options_.interrupt.requested()) break;
     const int m = std::abs(bracket.second.point.stability.negative - bracket.first.point.stability.negative);
-    found.push_back(multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
+    keep(found, multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
   }
   evaluator_.setLowestEigenvalues(savedEigenvalues);
+}
+
+void Locator::keep(std::vector<SpecialPoint> &found, SpecialPoint &&sp) const {
+  found.push_back(std::move(sp));
+  if (options_.onLocated) options_.onLocated(found.back());
 }
 
 void Locator::separateCrossings(const StepSample &lo, const StepSample &hi,

@@ -118,7 +118,7 @@ std::vector<SpecialPoint> Locator::locateHiddenCrossings(const std::vector<Suspe
                   "certified counting: eigenvalue %d touches zero without crossing (minimum %.3g, scaled)", c.index,
                   c.side * fx);
     sp.note = text;
-    found.push_back(std::move(sp));
+    keep(found, std::move(sp));
   }
   std::sort(found.begin(), found.end(),
             [](const SpecialPoint &p, const SpecialPoint &q) { return p.arclength < q.arclength; });

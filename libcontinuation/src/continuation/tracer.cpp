@@ -153,6 +153,13 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   lo.denseAlgebra = n_ <= options_.maxDenseLocationDimension;
   lo.interrupt = options_.interrupt;
   lo.touchTolerance = options_.touchTolerance;
+  if (options_.onLocated)
+    lo.onLocated = [this](const SpecialPoint &sp) {
+      if (units_.identity()) return options_.onLocated(sp);
+      SpecialPoint user = sp;
+      units_.toUser(user);
+      options_.onLocated(user);
+    };
   locator_ = std::make_unique<Locator>(*work_, *corrector_, *evaluator_, lo);
   stepControl_.rule = options_.stepRule;
   stepControl_.minStep = options_.minStep;

@@ -65,6 +65,8 @@ struct LocatorOptions {
   /// A requested interrupt makes every further sample fail: the point in hand is reported as
   /// located so far, and the tracer stops at its next step.
   Interrupt interrupt;
+  /// Optional: told of each point as it is located (TracerOptions::onLocated).
+  std::function<void(const SpecialPoint &)> onLocated;
 };
 
 /// A point on the current step at offset s (s = 0: its start point a).
@@ -112,6 +114,8 @@ class Locator {
   double tolerance(double lambda) const { return options_.tolerance * std::max(1.0, std::abs(lambda)); }
 
  private:
+  /// Appends `sp` to `found` and tells options_.onLocated.
+  void keep(std::vector<SpecialPoint> &found, SpecialPoint &&sp) const;
   SpecialPoint locateFold(const StepSample &lo, const StepSample &hi);
   SpecialPoint locateSimpleBranchPoint(const StepSample &lo, const StepSample &hi);
   /// Relative tolerance (findRoot's) of a bracketing secant on [lo, hi]: coarseTolerance, but at

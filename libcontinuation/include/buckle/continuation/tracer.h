@@ -43,6 +43,12 @@ enum class StepAction { Continue, Stop };
 /// converted when trace()/continueBranch() return), so read the last point only.
 using StepCallback = std::function<StepAction(const Branch &branch)>;
 
+/// Told of each special point as it is located, before its step is accepted: a step over a
+/// cluster of branch points can take seconds of refinement with no new point, and a progress
+/// report wants to say so. The point is in the problem's units. It is final only once the step
+/// is (onStep sees it in the branch): an interrupt can still drop the half-located step.
+using LocatedCallback = std::function<void(const SpecialPoint &point)>;
+
 struct TracerOptions {
   // ---- step control (dimensionless: arclength in the scaled variables, header comment) -------
   double initialStep = 0.01;
@@ -136,6 +142,7 @@ struct TracerOptions {
   /// branch with StopReason::Interrupted, keeping its points.
   Interrupt interrupt;
   StepCallback onStep;              ///< optional; see StepCallback
+  LocatedCallback onLocated;        ///< optional; see LocatedCallback
 
   bool IsValid(std::string *why) const;
 };
