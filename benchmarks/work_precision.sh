@@ -4,7 +4,12 @@
 #
 #   benchmarks/work_precision.sh             # full sweep, REPS=5; writes benchmarks/results/work_precision_*
 #   benchmarks/work_precision.sh --quick     # two AUTO settings, one repetition (CI smoke run)
-#   BUILD=build-dir AUTO_PEER=dir OUT=dir REPS=n ...
+#   BUILD=build-dir AUTO_PEER=dir OUT=dir REPS=n STEP="--rule count --growth 1.5" ...
+#
+# buckle's step control: STEP (default "--rule curvature --growth 3": TracerOptions::stepRule =
+# Curvature, stepGrowth = 3, the rule that needs the fewest points at every tolerance,
+# benchmarks/RESULTS.md section 3, "Step control from curvature"; the library's default rule is
+# the Newton-iteration count with growth 1.5, STEP="" runs that).
 #
 # AUTO (shared/peers/auto07p beside the checkout; chain.f90 compiled as in compare_auto.sh, JAC=1,
 # IID=0) sweeps its accuracy knobs: DSMAX (DS = ±min(0.01, DSMAX)) × (EPSL = EPSU, EPSS), on
@@ -27,6 +32,7 @@ PEER=$(auto_peer "$ROOT")
 BUILD=${BUILD:-$ROOT/build-bench}
 OUT=${OUT:-$HERE/results}
 REPS=${REPS:-5}
+read -r -a STEP_ARGS <<< "${STEP---rule curvature --growth 3}"
 AUTO_DIR=${AUTO_DIR:-/usr/lib/auto-07p}
 QUICK=0
 [ "${1:-}" = "--quick" ] && QUICK=1
@@ -113,10 +119,10 @@ else
   echo "AUTO-07p not installed: skipped (quick mode); buckle and the naive grid only"
 fi
 
-echo "work_precision $(date -u +%FT%TZ), git $(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo '?'), load $(cut -d' ' -f1-3 /proc/loadavg), CPUs $(grep -c ^processor /proc/cpuinfo)"
+echo "work_precision $(date -u +%FT%TZ), git $(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo '?'), load $(cut -d' ' -f1-3 /proc/loadavg), CPUs $(grep -c ^processor /proc/cpuinfo), buckle step control: ${STEP_ARGS[*]:-library defaults}"
 QARGS=()
 (( QUICK )) && QARGS=(--quick)
-"$WP" --reps "$REPS" --out "$OUT" "${AUTO_ARGS[@]}" "${QARGS[@]}"
+"$WP" --reps "$REPS" --out "$OUT" "${STEP_ARGS[@]}" "${AUTO_ARGS[@]}" "${QARGS[@]}"
 echo "load at end $(cut -d' ' -f1-3 /proc/loadavg)"
 if command -v gnuplot > /dev/null; then
   for t in diagram fold long; do gnuplot "$OUT/work_precision_$t.gp"; done

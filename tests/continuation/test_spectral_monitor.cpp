@@ -8,6 +8,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
+#include <random>
 
 using namespace buckle::continuation;
 
@@ -63,6 +65,27 @@ class Touch : public Problem {
   bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
     return toys::negatedJacobian(*this, u, lambda, H, C);
   }
+};
+
+/// OppositeCrossings with its exact rate bound: H = diag(1 − λ + 3u₁², λ − c + 3u₂²) moves by
+/// dH = diag(−dλ + 6u₁du₁, dλ + 6u₂du₂), and |dμ_i| ≤ ‖dH‖₂ = the larger |entry| (Weyl). Counts
+/// the eigenvalue evaluations.
+class BoundedOppositeCrossings : public OppositeCrossings {
+ public:
+  BoundedOppositeCrossings(double c, bool offerBound) : OppositeCrossings(c), offerBound_(offerBound) {}
+  bool stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values) override {
+    ++evaluations;
+    return Problem::stabilityEigenvalues(u, lambda, first, values);
+  }
+  bool stabilityRateBound(ConstVectorRef u, double, ConstVectorRef du, double dlambda, double &bound) override {
+    if (!offerBound_) return false;
+    bound = std::max(std::abs(-dlambda + 6.0 * u[0] * du[0]), std::abs(dlambda + 6.0 * u[1] * du[1]));
+    return true;
+  }
+  int evaluations = 0;
+
+ private:
+  bool offerBound_;
 };
 
 // Big fixed steps so that one step spans the whole event.
@@ -165,6 +188,7 @@ TEST_CASE("suspectHiddenCrossings needs an interior extremum reaching zero") {
   a.stability.negative = b.stability.negative = 0;
   a.spectrum.first = b.spectrum.first = 0;
   a.spectrum.count = b.spectrum.count = 1;
+  a.spectrum.slopesMeasured = b.spectrum.slopesMeasured = true;
   a.spectrum.values[0] = b.spectrum.values[0] = 0.04;
   a.spectrum.slopes[0] = -1.0;
   b.spectrum.slopes[0] = 1.0;
@@ -183,4 +207,83 @@ TEST_CASE("suspectHiddenCrossings needs an interior extremum reaching zero") {
   // different counts at the ends are the count's business
   b.stability.negative = 1;
   CHECK(suspectHiddenCrossings(a, b, 0.1).empty());
+}
+
+TEST_CASE("with a rate bound, the slopes are skipped only where no eigenvalue can come near zero") {
+  const double c = 1.02;
+  // Far from both crossings (λ ∈ [0, 0.6]: μ = 1 − λ ≥ 0.4 and λ − c ≤ −0.42, |dμ/ds| ≤ 1 over
+  // steps of 0.1): the bound excludes every step. The values come with the point's stability
+  // (lowestEigenvalues = 3), so the only eigenvalue evaluations are the slopes' off-branch ones:
+  // one per point without the bound, none with it.
+  BoundedOppositeCrossings measured(c, false), bounded(c, true);
+  const Branch a = trace(measured, Vector::Zero(2), 0.0, InitialDirection::increasingLambda(), bigSteps(0.6, true));
+  const Branch b = trace(bounded, Vector::Zero(2), 0.0, InitialDirection::increasingLambda(), bigSteps(0.6, true));
+  REQUIRE(a.points.size() == b.points.size());
+  REQUIRE(a.points.size() >= 6);
+  CHECK(measured.evaluations == int(a.points.size()));
+  CHECK(bounded.evaluations == 0);
+  for (size_t i = 0; i < a.points.size(); ++i) {
+    CHECK(a.points[i].lambda == b.points[i].lambda);
+    CHECK(b.points[i].spectrum.rateBound == Approx(1.0));
+    CHECK_FALSE(b.points[i].spectrum.slopesMeasured);
+  }
+
+  // Across both crossings the bound cannot exclude the step: slopes measured, both branch points found.
+  BoundedOppositeCrossings across(c, true);
+  const Branch branch = trace(across, Vector::Zero(2), 0.96, InitialDirection::increasingLambda(), bigSteps(1.3, true));
+  const auto bps = branch.specialPointsOfType(SpecialPointType::BranchPoint);
+  REQUIRE(bps.size() == 2);
+  CHECK(std::abs(bps[0]->lambda - 1.0) <= 1e-10);
+  CHECK(std::abs(bps[1]->lambda - c) <= 1e-10);
+  CHECK(branch.points[0].spectrum.slopesMeasured);
+}
+
+TEST_CASE("rateBoundsExcludeCrossing: no slopes within the bounds make suspectHiddenCrossings flag an excluded step") {
+  ContinuationPoint a, b;
+  a.stability.negative = b.stability.negative = 1;
+  for (ContinuationPoint *p : {&a, &b}) {
+    p->spectrum.first = 0;
+    p->spectrum.count = 2;
+    p->spectrum.slopesMeasured = true;
+  }
+  // The closed case: μ = 0.04 at both ends, slopes ∓1 reach −0.01 at s = 0.05 (suspected above).
+  a.spectrum.values[0] = b.spectrum.values[0] = -0.5;
+  a.spectrum.values[1] = b.spectrum.values[1] = 0.04;
+  a.spectrum.rateBound = b.spectrum.rateBound = 1.0;
+  CHECK_FALSE(rateBoundsExcludeCrossing(a, b, 0.1));
+  // With |dμ/ds| ≤ 0.1 the lines meet no lower than 0.04 − 0.005 > 0.25·0.04: excluded.
+  a.spectrum.rateBound = b.spectrum.rateBound = 0.1;
+  CHECK(rateBoundsExcludeCrossing(a, b, 0.1));
+  // No bound offered: never excluded.
+  b.spectrum.rateBound = std::numeric_limits<double>::infinity();
+  CHECK_FALSE(rateBoundsExcludeCrossing(a, b, 0.1));
+
+  // Property: random values, bounds and step lengths; whenever the step is excluded, slopes
+  // anywhere in [−D, D] (including the extremes) give no suspect.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> U(-1.0, 1.0), P(0.0, 1.0);
+  int excluded = 0, kept = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const double L = 0.5 * P(rng);
+    for (ContinuationPoint *p : {&a, &b}) {
+      p->spectrum.values[0] = -std::pow(10.0, -3.0 * P(rng));
+      p->spectrum.values[1] = std::pow(10.0, -3.0 * P(rng));
+      p->spectrum.rateBound = std::pow(10.0, 2.0 * U(rng));
+    }
+    if (!rateBoundsExcludeCrossing(a, b, L)) {
+      ++kept;
+      continue;
+    }
+    ++excluded;
+    for (int draw = 0; draw < 8; ++draw) {
+      for (int k = 0; k < 2; ++k) {
+        a.spectrum.slopes[k] = (draw < 4 ? (draw & 1 ? 1.0 : -1.0) : U(rng)) * a.spectrum.rateBound;
+        b.spectrum.slopes[k] = (draw < 4 ? (draw & 2 ? 1.0 : -1.0) : U(rng)) * b.spectrum.rateBound;
+      }
+      INFO("trial " << trial << ", draw " << draw);
+      REQUIRE(suspectHiddenCrossings(a, b, L).empty());
+    }
+  }
+  CHECK(excluded > 1000);  // both outcomes occur: the property is not vacuous
+  CHECK(kept > 1000);
 }

@@ -449,3 +449,60 @@ TEST_CASE("stabilityEigenvalues by index: the O(n) counts and the small dense ro
     }
   }
 }
+
+TEST_CASE("stabilityRateBound bounds the rate of every eigenvalue of H on ker C (central differences)",
+          "[equilibrium]") {
+  std::mt19937 rng(1717);
+  std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
+  for (int n : {3, 5, 40}) {
+    const Chain chain = randomChain(rng, n);
+    for (const Setting& s : settings(rng)) {
+      EquilibriumProblem problem(chain, s.end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
+      // every eigenvalue: Problem's dense default (the structured route isolates a few at a time)
+      EquilibriumProblem dense(chain, s.end, problem.direction(), EquilibriumOptions{true, false});
+      const int N = problem.dimension();
+      for (int trial = 0; trial < 5; ++trial) {
+        INFO("n = " << n << ", end: " << s.name << ", trial " << trial);
+        const Vector u = randomState(rng, chain, N);
+        const double lambda = Lam(rng);
+        Vector du(N);
+        for (int i = 0; i < N; ++i) du[i] = W(rng);
+        const double dlambda = W(rng);
+        double bound = -1.0;
+        REQUIRE(problem.stabilityRateBound(u, lambda, du, dlambda, bound));
+        Matrix H, C;
+        REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+        const int dim = n - int(C.rows());
+        Vector plus(dim), minus(dim);
+        const double h = 1e-6;
+        REQUIRE(dense.stabilityEigenvalues(u + h * du, lambda + h * dlambda, 0, plus));
+        REQUIRE(dense.stabilityEigenvalues(u - h * du, lambda - h * dlambda, 0, minus));
+        const double rate = ((plus - minus) / (2.0 * h)).cwiseAbs().maxCoeff();
+        // the difference quotient: O(h²) truncation, rounding ≈ ε‖H‖/h
+        CHECK(rate <= bound + 1e-7 * std::max(1.0, H.norm()));
+      }
+    }
+  }
+}
+
+TEST_CASE("stabilityRateBound of the unconstrained chain is ‖dH‖_F, by differences of the dense H", "[equilibrium]") {
+  std::mt19937 rng(2718);
+  std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
+  const Chain chain = randomChain(rng, 7);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))),
+                             Eigen::Vector3d(W(rng), W(rng), W(rng)));
+  const Vector u = randomState(rng, chain, problem.dimension());
+  Vector du(problem.dimension());
+  for (int i = 0; i < du.size(); ++i) du[i] = W(rng);
+  const double lambda = Lam(rng), dlambda = W(rng), h = 1e-6;
+  double bound = 0.0;
+  REQUIRE(problem.stabilityRateBound(u, lambda, du, dlambda, bound));
+  Matrix Hp, Hm, C;
+  REQUIRE(problem.stabilityOperator(u + h * du, lambda + h * dlambda, Hp, C));
+  REQUIRE(problem.stabilityOperator(u - h * du, lambda - h * dlambda, Hm, C));
+  CHECK(bound == Approx(((Hp - Hm) / (2.0 * h)).norm()).epsilon(1e-7));
+  // the straight chain with x held: C = J_h is rank-deficient there, no finite bound
+  EquilibriumProblem held(chain, EndCondition::heldPosition(chain.linkLengths().sum(), 0.0), Eigen::Vector3d(1, 0, 0));
+  double none = 0.0;
+  CHECK_FALSE(held.stabilityRateBound(Vector::Zero(held.dimension()), 0.0, Vector::Ones(held.dimension()), 1.0, none));
+}

@@ -55,6 +55,7 @@ void UnitScaling::toScaled(ContinuationPoint &p) const {
     p.spectrum.values[k] /= scales_.stability;
     p.spectrum.slopes[k] /= scales_.stability;
   }
+  p.spectrum.rateBound /= scales_.stability;
 }
 
 void UnitScaling::toUser(ContinuationPoint &p) const {
@@ -68,6 +69,7 @@ void UnitScaling::toUser(ContinuationPoint &p) const {
     p.spectrum.values[k] *= scales_.stability;
     p.spectrum.slopes[k] *= scales_.stability;
   }
+  p.spectrum.rateBound *= scales_.stability;
 }
 
 void UnitScaling::toScaled(SpecialPoint &p) const {
@@ -208,6 +210,15 @@ bool ScaledProblem::stability(ConstVectorRef u, double lambda, int lowestCount, 
 bool ScaledProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values) {
   if (!problem_.stabilityEigenvalues(user(u), lambda * units_.parameter(), first, values)) return false;
   values /= units_.scales().stability;
+  return true;
+}
+
+bool ScaledProblem::stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                       double &bound) {
+  du_ = du.cwiseProduct(units_.scales().unknowns);
+  if (!problem_.stabilityRateBound(user(u), lambda * units_.parameter(), du_, dlambda * units_.parameter(), bound))
+    return false;
+  bound /= units_.scales().stability;
   return true;
 }
 

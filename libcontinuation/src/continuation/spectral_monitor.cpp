@@ -14,14 +14,14 @@ bool eigenvaluesAt(Problem &problem, const Vector &u, double lambda, int first, 
 
 }  // namespace
 
-bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double delta) {
+bool measureNearZeroValues(Problem &problem, ContinuationPoint &point) {
   point.spectrum = NearZeroSpectrum();
   const int n = problem.dimension();
   if (!point.stability.valid() || point.tangent.size() != n + 1 || point.u.size() != n) return false;
   const int nu = point.stability.negative;
   int first = std::max(0, nu - 1);
   int count = nu > 0 ? 2 : 1;
-  Eigen::Vector2d here, there;
+  Eigen::Vector2d here;
   const Vector &lowest = point.stability.lowest;  // already isolated by the point's stability()
   if (lowest.size() >= first + count) {
     here.head(count) = lowest.segment(first, count);
@@ -30,20 +30,65 @@ bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double 
     if (count == 1 || !eigenvaluesAt(problem, point.u, point.lambda, first, 1, here)) return false;
     count = 1;
   }
-  // Rate along the tangent: dμ/ds = (μ(x + δt) − μ(x))/δ. The point x + δt is off the branch by
-  // O(δ²) only, so the slope is the branch's to O(δ) (Hellmann–Feynman needs no eigenvector).
-  double h = delta;
-  const Vector uf = point.u + h * point.tangent.head(n);
-  if (!eigenvaluesAt(problem, uf, point.lambda + h * point.tangent[n], first, count, there)) {
-    h = -delta;
-    const Vector ub = point.u + h * point.tangent.head(n);
-    if (!eigenvaluesAt(problem, ub, point.lambda + h * point.tangent[n], first, count, there)) return false;
-  }
   point.spectrum.first = first;
   point.spectrum.count = count;
+  for (int k = 0; k < count; ++k) point.spectrum.values[k] = here[k];
+  double bound = 0.0;
+  if (problem.stabilityRateBound(point.u, point.lambda, point.tangent.head(n), point.tangent[n], bound) &&
+      bound >= 0.0 && std::isfinite(bound))
+    point.spectrum.rateBound = bound;
+  return true;
+}
+
+bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, double delta) {
+  NearZeroSpectrum &sp = point.spectrum;
+  const int n = problem.dimension();
+  if (!sp.valid() || point.tangent.size() != n + 1 || point.u.size() != n) return false;
+  if (sp.slopesMeasured) return true;
+  // Rate along the tangent: dμ/ds = (μ(x + δt) − μ(x))/δ. The point x + δt is off the branch by
+  // O(δ²) only, so the slope is the branch's to O(δ) (Hellmann–Feynman needs no eigenvector).
+  Eigen::Vector2d there;
+  double h = delta;
+  const Vector uf = point.u + h * point.tangent.head(n);
+  if (!eigenvaluesAt(problem, uf, point.lambda + h * point.tangent[n], sp.first, sp.count, there)) {
+    h = -delta;
+    const Vector ub = point.u + h * point.tangent.head(n);
+    if (!eigenvaluesAt(problem, ub, point.lambda + h * point.tangent[n], sp.first, sp.count, there)) return false;
+  }
+  for (int k = 0; k < sp.count; ++k) sp.slopes[k] = (there[k] - sp.values[k]) / h;
+  sp.slopesMeasured = true;
+  return true;
+}
+
+bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double delta) {
+  if (!measureNearZeroValues(problem, point)) return false;
+  if (measureNearZeroSlopes(problem, point, delta)) return true;
+  point.spectrum = NearZeroSpectrum();
+  return false;
+}
+
+bool rateBoundsExcludeCrossing(const ContinuationPoint &a, const ContinuationPoint &b, double stepLength,
+                               double margin) {
+  const NearZeroSpectrum &sa = a.spectrum, &sb = b.spectrum;
+  // The cases in which suspectHiddenCrossings() flags nothing whatever the slopes.
+  if (!sa.valid() || !sb.valid() || !(stepLength > 0.0)) return true;
+  if (a.stability.negative != b.stability.negative || sa.first != sb.first) return true;
+  // The bounds hold for the derivatives at the points; the measured slopes are difference
+  // quotients over δ, i.e. derivatives at most δ away: 1 % covers their change.
+  const double Da = 1.01 * sa.rateBound, Db = 1.01 * sb.rateBound;
+  if (!std::isfinite(Da) || !std::isfinite(Db)) return false;
+  const int count = std::min(sa.count, sb.count);
   for (int k = 0; k < count; ++k) {
-    point.spectrum.values[k] = here[k];
-    point.spectrum.slopes[k] = (there[k] - here[k]) / h;
+    const double ma = sa.values[k], mb = sb.values[k];
+    const int side = ma > 0.0 ? 1 : -1;
+    if (ma == 0.0 || mb == 0.0 || (mb > 0.0 ? 1 : -1) != side) continue;  // as suspectHiddenCrossings
+    const double fa = side * ma, fb = side * mb;
+    if (Da + Db == 0.0) continue;  // no slope can be negative at a: no interior minimum
+    // Lowest meeting value of a line through (0, fa) with slope ≥ −Da and one through (L, fb) with
+    // slope ≤ Db, meeting inside (0, L): min over s of max(fa − Da·s, fb − Db·(L − s)).
+    const double s = std::clamp((fa - fb + Db * stepLength) / (Da + Db), 0.0, stepLength);
+    const double lowest = std::max(fa - Da * s, fb - Db * (stepLength - s));
+    if (!(lowest > margin * std::min(fa, fb))) return false;
   }
   return true;
 }
@@ -52,7 +97,7 @@ std::vector<SuspectedCrossing> suspectHiddenCrossings(const ContinuationPoint &a
                                                       double stepLength, double margin) {
   std::vector<SuspectedCrossing> suspects;
   const NearZeroSpectrum &sa = a.spectrum, &sb = b.spectrum;
-  if (!sa.valid() || !sb.valid() || !(stepLength > 0.0)) return suspects;
+  if (!sa.valid() || !sb.valid() || !sa.slopesMeasured || !sb.slopesMeasured || !(stepLength > 0.0)) return suspects;
   if (a.stability.negative != b.stability.negative || sa.first != sb.first) return suspects;
   const int count = std::min(sa.count, sb.count);
   for (int k = 0; k < count; ++k) {

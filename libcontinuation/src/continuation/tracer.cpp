@@ -434,8 +434,15 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     std::vector<SpecialPoint> found;
     if (ia >= skipIntervals && (hit.event < 0 || b.arclength > a.arclength)) {
       if (options_.certifiedCounting && options_.detectBranchPoints) {
-        if (!branch.points[size_t(ia)].spectrum.valid()) measureNearZeroSpectrum(*work_, branch.points[size_t(ia)]);
-        measureNearZeroSpectrum(*work_, b);
+        // The values next to zero at both ends; their slopes only where the problem's rate bound
+        // cannot exclude a hidden crossing (spectral_monitor.h): the same steps are searched.
+        ContinuationPoint &start = branch.points[size_t(ia)];
+        if (!start.spectrum.valid()) measureNearZeroValues(*work_, start);
+        measureNearZeroValues(*work_, b);
+        if (!rateBoundsExcludeCrossing(start, b, start.tangent.dot(b.state() - start.state()))) {
+          measureNearZeroSlopes(*work_, start);
+          measureNearZeroSlopes(*work_, b);
+        }
       }
       found = locateSpecialPoints(a, b);
     }

@@ -1,5 +1,6 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <cmath>
 #include <limits>
@@ -16,6 +17,12 @@ using continuation::ConstVectorRef;
 using continuation::MatrixRef;
 using continuation::VectorRef;
 
+namespace {
+// How far past a geometric limit points are still evaluated while the joint limits are traced
+// as boundaries (inDomain() below).
+constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step that crosses a limit
+}  // namespace
+
 EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
                                        const Eigen::Vector3d& direction, EquilibriumOptions options)
     : chain_(chain),
@@ -28,7 +35,10 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
       J_(3, chain.size()),
       grad_(chain.size()),
       stiff_(chain.size()),
+      stiffRate_(chain.size()),
       cachedQ_(chain.size()),
+      domainUpper_(chain.size()),
+      domainLower_(chain.size()),
       work_(chain.size()),
       work2_(chain.size()),
       structure_(chain.size()),
@@ -39,6 +49,11 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
     requireFinite(std::string("load path direction ") + names[c], direction[c]);
   }
   structure_.typicalScale = stiffnessUnit() * lengthUnit() * lengthUnit();  // the inertia's zero floor
+  const double overshoot = options_.jointLimitsAsBoundaries ? kGeometricOvershoot : 0.0;
+  for (int i = 0; i < chain_.size(); ++i) {
+    domainUpper_[i] = chain_.segment(i).geometricUpperLimit() + overshoot;
+    domainLower_[i] = chain_.segment(i).geometricLowerLimit() - overshoot;
+  }
 }
 
 bool EquilibriumProblem::prepare(ConstVectorRef u) {
@@ -56,17 +71,11 @@ bool EquilibriumProblem::prepare(ConstVectorRef u) {
     const Jet3 e = chain_.segment(i).energyJet(q[i]);
     grad_[i] = e.d1;
     stiff_[i] = e.d2;
+    stiffRate_[i] = e.d3;
   }
   cachedQ_ = q;
   cacheValid_ = true;
   return true;
-}
-
-Wrench EquilibriumProblem::wrench(ConstVectorRef u, double lambda) const {
-  Wrench F = prescribed(lambda);
-  const int n = chain_.size();
-  for (size_t k = 0; k < held_.size(); ++k) F[held_[k]] = u[n + int(k)];
-  return F;
 }
 
 Vector EquilibriumProblem::initialGuess(ConstVectorRef q, double lambda) const {
@@ -98,19 +107,12 @@ Vector EquilibriumProblem::initialGuess(ConstVectorRef q, double lambda) const {
 // are evaluated; the branch stops at the located limit and never reports them. Farther out, or
 // with the limits not traced as boundaries, points beyond a geometric limit are refused: there
 // the triangles would overlap and the model no longer describes the mechanism.
-namespace {
-constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step that crosses a limit
-}
 
 bool EquilibriumProblem::inDomain(ConstVectorRef u) const {
   const int n = chain_.size();
-  const double overshoot = options_.jointLimitsAsBoundaries ? kGeometricOvershoot : 0.0;
-  for (int i = 0; i < n; ++i) {
-    const Segment& s = chain_.segment(i);
-    if (!std::isfinite(u[i]) || u[i] > s.geometricUpperLimit() + overshoot ||
-        u[i] < s.geometricLowerLimit() - overshoot)
-      return false;
-  }
+  // Finite bounds: the negated test also refuses ±∞ and NaN.
+  for (int i = 0; i < n; ++i)
+    if (!(u[i] <= domainUpper_[i] && u[i] >= domainLower_[i])) return false;
   for (int k = n; k < u.size(); ++k)
     if (!std::isfinite(u[k])) return false;
   return true;
@@ -337,6 +339,59 @@ bool EquilibriumProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, i
   lastFirst_ = first;
   lastFrom_ = values;
   return true;
+}
+
+bool EquilibriumProblem::stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                            double& bound) {
+  if (!std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() || !prepare(u)) return false;
+  const int n = chain_.size();
+  const int m = heldCount();
+  const Wrench W = wrench(u, lambda);
+  Wrench dW = dlambda * direction_;  // loads move with λ, reactions with their unknowns
+  for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = du[n + k];
+  bool heldX = false, heldY = false;
+  for (int c : held_) {
+    heldX |= c == 0;
+    heldY |= c == 1;
+  }
+  // H = K_q − K_g with K_g(i, j) = h_max(i,j), h = −F_x C − F_y S (eq 27), so along (du, dλ)
+  // dH = diag(E‴_i du_i) − [dh_max(i,j)] with dh = −dF_x C − F_x dC − dF_y S − F_y dS, and the
+  // tail sums move with θ̇_p = Σ_{i≤p} du_i: dS_j = Σ_{p≥j} ℓ_p cos θ_p θ̇_p, dC_j = −Σ_{p≥j} ℓ_p
+  // sin θ_p θ̇_p, where ℓ_p cos θ_p = C_p − C_{p+1}, ℓ_p sin θ_p = S_p − S_{p+1} (chain.h). In the
+  // Frobenius norms the entries with max(i, j) = p appear 2p + 1 times (0-based), once on the
+  // diagonal. C = J_h has rows (−S, C, 1) of eq 11, so dC has rows (−dS, dC, 0).
+  double thetaDot = du.head(n).sum(), dS = 0.0, dC = 0.0;
+  double dH2 = 0.0, H2 = 0.0, dC2 = 0.0;
+  for (int p = n - 1; p >= 0; --p) {
+    const double cNext = p + 1 < n ? data_.C[p + 1] : 0.0, sNext = p + 1 < n ? data_.S[p + 1] : 0.0;
+    dS += (data_.C[p] - cNext) * thetaDot;
+    dC -= (data_.S[p] - sNext) * thetaDot;
+    thetaDot -= du[p];
+    const double h = -W[0] * data_.C[p] - W[1] * data_.S[p];
+    const double dh = -dW[0] * data_.C[p] - W[0] * dC - dW[1] * data_.S[p] - W[1] * dS;
+    const double dDiagonal = stiffRate_[p] * du[p] - dh, diagonal = stiff_[p] - h;
+    dH2 += dDiagonal * dDiagonal + 2.0 * p * dh * dh;
+    H2 += diagonal * diagonal + 2.0 * p * h * h;
+    if (heldX) dC2 += dS * dS;
+    if (heldY) dC2 += dC * dC;
+  }
+  bound = std::sqrt(dH2);
+  if (m == 0) return std::isfinite(bound);
+  // The eigenvector's multiplier: H v + Cᵀζ = μ v, C v = 0 give ζ = −(CCᵀ)⁻¹C H v, so
+  // ‖ζ‖ ≤ ‖H‖₂/σ_min(C); and dμ = vᵀ dH v + 2 ζᵀ dC v (differentiate and multiply by vᵀ).
+  // σ_min(C)² = the smallest eigenvalue of the Gram matrix CCᵀ (m ≤ 3; the unused diagonal is
+  // padded above every eigenvalue of the m×m block, which stays decoupled).
+  Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
+  for (int k = 0; k < m; ++k)
+    for (int l = 0; l <= k; ++l) G(k, l) = G(l, k) = J_.row(held_[size_t(k)]).dot(J_.row(held_[size_t(l)]));
+  const double trace = G.trace();
+  for (int k = m; k < 3; ++k) G(k, k) = 2.0 * trace + 1.0;
+  const double sigma2 =
+      m == 1 ? G(0, 0) : Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(G, Eigen::EigenvaluesOnly).eigenvalues()[0];
+  // Rank-deficient C (e.g. x held on the straight chain): ker C jumps, no finite bound.
+  if (!(sigma2 > 1e-12 * trace)) return false;
+  bound += 2.0 * std::sqrt(H2) * std::sqrt(dC2 / sigma2);
+  return std::isfinite(bound);
 }
 
 std::unique_ptr<continuation::BorderedSolver> EquilibriumProblem::makeStructuredSolver() {

@@ -5,6 +5,7 @@
 
 #include "buckle/continuation/problem.h"
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,10 @@ struct NearZeroSpectrum {
   int count = 0;        ///< 1 or 2 tracked eigenvalues (indices first, first + 1)
   double values[2] = {0.0, 0.0};
   double slopes[2] = {0.0, 0.0};  ///< d/ds along the point's tangent (s: the tracer's arclength)
+  bool slopesMeasured = false;    ///< slopes filled (measureNearZeroSlopes); values alone otherwise
+  /// Upper bound on |dμ_i/ds| for every eigenvalue at the point (Problem::stabilityRateBound);
+  /// +∞ when the problem offers none. Lets a step skip the slopes (spectral_monitor.h).
+  double rateBound = std::numeric_limits<double>::infinity();
   bool valid() const { return first >= 0 && count > 0; }
 };
 

@@ -119,6 +119,15 @@ class Problem {
   /// eigen-decomposition of Zᵀ H Z; structured problems override it (e.g. isolation on O(n)
   /// Sturm counts of the shifted operator).
   virtual bool stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values);
+  /// An upper bound on |dμ_i/dε| for every eigenvalue μ_i of H on ker C along
+  /// (u + ε·du, λ + ε·dlambda) at ε = 0 (Weyl: |dμ_i| ≤ ‖dH‖₂ + 2‖ζ_i‖‖dC‖₂, ζ_i the multiplier of
+  /// the eigenvector). Certified counting uses it to skip the eigenvalue slopes on steps where no
+  /// eigenvalue can come near zero (spectral_monitor.h). False (the default): no bound offered,
+  /// the slopes are measured at every point.
+  virtual bool stabilityRateBound(ConstVectorRef /*u*/, double /*lambda*/, ConstVectorRef /*du*/, double /*dlambda*/,
+                                  double & /*bound*/) {
+    return false;
+  }
 
   // ---- optional: structured linear algebra ---------------------------------------------
   /// A solver for the bordered Jacobian [[F_u, F_λ], [cᵀ]] that exploits the problem's

@@ -96,6 +96,8 @@ class ScaledProblem final : public Problem {
   /// The problem's own stability() (its inertia count must be relative to ‖H‖), eigenvalues / μ₀.
   bool stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo &info) override;
   bool stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values) override;
+  /// The problem's bound along the user direction (D_u du, λ₀ dλ), / μ₀.
+  bool stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda, double &bound) override;
   /// The problem's structured solver seen through the change of variables (still O(its cost)).
   std::unique_ptr<BorderedSolver> makeStructuredSolver() override;
   int boundaryCount() const override { return problem_.boundaryCount(); }

@@ -14,6 +14,14 @@
 // The locator then minimises |μ| along the step (locator.h, locateHiddenCrossings): a sign change
 // splits the step into intervals whose counts differ (two branch points, located separately), a
 // minimum at zero within the touch tolerance is an eigenvalue touch.
+//
+// The slopes cost a second evaluation of the problem per point (off the branch, at x + δt). They
+// are needed only where an eigenvalue could come near zero: with a bound D ≥ |dμ_i/ds| for every
+// eigenvalue (Problem::stabilityRateBound; Weyl: |dμ_i/ds| ≤ ‖dH/ds‖₂ for symmetric H), the
+// tangent lines of suspectHiddenCrossings with any slopes in [−D, D] meet no lower than the
+// lines of slopes ∓D_a, ±D_b; when that value stays above the margin, no slope the
+// measurement could return flags the step, and the tracer skips the slopes there
+// (rateBoundsExcludeCrossing). The step's outcome is the same as with the slopes measured.
 #pragma once
 
 #include "buckle/continuation/branch.h"
@@ -23,11 +31,28 @@
 
 namespace buckle::continuation {
 
+/// Default margin of suspectHiddenCrossings and rateBoundsExcludeCrossing.
+constexpr double kSuspectMargin = 0.25;
+
 /// Fills point.spectrum: the eigenvalues with indices ν − 1 and ν (ν = point.stability.negative;
 /// only ν when ν = 0, only ν − 1 when ν is the dimension) and their slopes along point.tangent,
 /// by a forward difference with step `delta` (backward if the problem refuses the forward point).
 /// False (spectrum left invalid) without stability or when the problem refuses the eigenvalues.
 bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double delta = 1e-6);
+
+/// The first half of measureNearZeroSpectrum: the values and the problem's rate bound at the
+/// point's tangent (spectrum.rateBound; +∞ without one), no slopes (spectrum.slopesMeasured false).
+bool measureNearZeroValues(Problem &problem, ContinuationPoint &point);
+/// The second half: the slopes of the values measureNearZeroValues recorded (forward difference
+/// with step `delta`, backward if refused). False (spectrum left without slopes) if refused.
+bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, double delta = 1e-6);
+
+/// True when suspectHiddenCrossings(a, b, stepLength, margin) returns no suspect for every pair
+/// of slopes within the two points' rate bounds: for each tracked eigenvalue of one sign at both
+/// ends, the lines side·μ_a − D_a·s and side·μ_b − D_b·(L − s) meet above margin·min(|μ_a|, |μ_b|).
+/// Needs the values (not the slopes) at both points, the same ν and indices, and finite bounds.
+bool rateBoundsExcludeCrossing(const ContinuationPoint &a, const ContinuationPoint &b, double stepLength,
+                               double margin = kSuspectMargin);
 
 /// One eigenvalue (ascending index) whose interior extremum in a step may reach zero.
 struct SuspectedCrossing {
@@ -40,6 +65,6 @@ struct SuspectedCrossing {
 /// The tracked eigenvalues of a and b (same ν, same indices) whose tangent lines predict that
 /// side·μ falls to ≤ margin·min(|μ_a|, |μ_b|) inside the step of length stepLength.
 std::vector<SuspectedCrossing> suspectHiddenCrossings(const ContinuationPoint &a, const ContinuationPoint &b,
-                                                      double stepLength, double margin = 0.25);
+                                                      double stepLength, double margin = kSuspectMargin);
 
 }  // namespace buckle::continuation

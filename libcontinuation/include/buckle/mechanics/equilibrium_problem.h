@@ -41,8 +41,14 @@ class EquilibriumProblem final : public continuation::Problem {
 
   /// Prescribed values (loads or coordinates) at λ.
   Eigen::Vector3d prescribed(double lambda) const { return end_.value + lambda * direction_; }
-  /// Total end wrench at (u, λ): given loads and the multipliers.
-  Wrench wrench(continuation::ConstVectorRef u, double lambda) const;
+  /// Total end wrench at (u, λ): given loads and the multipliers. Inline: every residual,
+  /// Jacobian and stability evaluation forms it (a call cost more than the three stores).
+  Wrench wrench(continuation::ConstVectorRef u, double lambda) const {
+    Wrench F = prescribed(lambda);
+    const int n = chain_.size();
+    for (size_t k = 0; k < held_.size(); ++k) F[held_[k]] = u[n + int(k)];
+    return F;
+  }
   /// Unknown vector for given joint angles, with the multipliers that best satisfy the
   /// equilibrium in the least-squares sense (a starting guess).
   Vector initialGuess(continuation::ConstVectorRef q, double lambda) const;
@@ -83,6 +89,11 @@ class EquilibriumProblem final : public continuation::Problem {
   /// shifted tridiagonal T − σM (chain_structure.h, eigenvaluesFrom).
   bool stabilityEigenvalues(continuation::ConstVectorRef u, double lambda, int first,
                             continuation::VectorRef values) override;
+  /// ‖dH‖_F + 2‖H‖_F‖dC‖_F/σ_min(C) along (du, dλ), H = K_q − K_g and C = J_h (held rows of
+  /// eq 11), in O(n) from the q-cache: an upper bound on every |dμ_i| (Problem). False when C is
+  /// rank-deficient (no finite bound) or the point is refused.
+  bool stabilityRateBound(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
+                          double dlambda, double& bound) override;
 
   /// T of H = K_q − K_g(F(u, λ)) into ws (chain_structure.h) and the end Jacobian (3×n) into J,
   /// from the q-cache: what the structured stability and the structured solver linearise on.
@@ -129,7 +140,11 @@ class EquilibriumProblem final : public continuation::Problem {
   ChainData data_;
   Matrix J_;             // 3×n
   Vector grad_, stiff_;  // ∂E/∂q, diagonal of K_q (size n); with data_ and J_: prepare()'s cache
+  Vector stiffRate_;     // d³E/dq³ per joint (size n), from the same jets: stabilityRateBound()
   Vector cachedQ_;       // q of the cache (size n)
+  // inDomain()'s bounds per joint, geometric limit ± the overshoot allowed while the limits are
+  // traced as boundaries, formed once (the same sums inDomain() formed per call; size n).
+  Vector domainUpper_, domainLower_;
   bool cacheValid_ = false;
   Vector work_, work2_;  // size n
   ChainStructure structure_;  // workspace of the structured stability()
