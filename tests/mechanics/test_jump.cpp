@@ -712,6 +712,47 @@ TEST_CASE("hand-over in scaled units: the same steps, tests and landing angles (
   CHECK(b.energyReleased / 1e-2 == Approx(a.energyReleased).epsilon(1e-8));
 }
 
+TEST_CASE("long chains' basin tolerance: the landing of the 1e-10 integration, in fewer steps (fold and cascade, n = 100)",
+          "[jump]") {
+  // jumpIntegrationDefaults above kStructuredJumpFrom segments: kLongJumpTolerance (jump.h), the
+  // shorter chains keep the IntegrationOptions default the regression baselines pin
+  const IntegrationOptions shortChain = jumpIntegrationDefaults(kStructuredJumpFrom);
+  const IntegrationOptions longChain = jumpIntegrationDefaults(kStructuredJumpFrom + 1);
+  CHECK(shortChain.absoluteTolerance == IntegrationOptions().absoluteTolerance);
+  CHECK(shortChain.relativeTolerance == IntegrationOptions().relativeTolerance);
+  CHECK(longChain.absoluteTolerance == kLongJumpTolerance);
+  CHECK(longChain.relativeTolerance == kLongJumpTolerance);
+  REQUIRE(kLongJumpTolerance > IntegrationOptions().absoluteTolerance);
+  auto compare = [](EquilibriumProblem& problem, const Vector& u, double lambda) {
+    JumpOptions options;
+    options.integration = jumpIntegrationDefaults(problem.segments());
+    options.integration.recordTrajectory = false;
+    const JumpResult basin = simulateJump(problem, u, lambda, options);
+    // the reference: the same flow to rest at the tight default tolerance
+    options.integration.absoluteTolerance = options.integration.relativeTolerance = IntegrationOptions().absoluteTolerance;
+    options.handover = Handover::Never;
+    const JumpResult tight = simulateJump(problem, u, lambda, options);
+    INFO(basin.message << " / " << tight.message);
+    REQUIRE(basin.success);
+    REQUIRE(tight.success);
+    CHECK(basin.stopReason == IntegrationStop::Settled);
+    CHECK(tight.stopReason == IntegrationStop::Rest);
+    CHECK(basin.steps < tight.steps);
+    CHECK((basin.to - tight.to).cwiseAbs().maxCoeff() < 1e-10);
+    CHECK(basin.energyReleased == Approx(tight.energyReleased).epsilon(1e-10));
+  };
+  SECTION("fold of the graded chain") {
+    TracedFold t = gradedChainFold(100);
+    compare(*t.problem, t.fold.u, t.fold.lambda);
+  }
+  SECTION("degenerate straight chain (the cascade)") {
+    const int n = 100;
+    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
+    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
+    compare(problem, problem.initialGuess(Vector::Zero(n), 0.0), 0.0);
+  }
+}
+
 TEST_CASE("inertial jump from a traced fold: the structured method on the exact Jacobian lands where dense Rosenbrock4 does (n = 24)",
           "[jump]") {
   const int n = 24;
