@@ -635,20 +635,22 @@ TEST_CASE("certified counting on a chain: two folds of a Z inside one step, belo
 }
 
 namespace {
-// The eigenvalue of the straight state's stability operator (q = 0, Me = 0: an equilibrium for
-// every Fx, by the mirror symmetry) whose eigenvector the end moment loads, i.e. with the largest
-// |vᵀ ∂φ/∂q| = |Σ v_i| (the dense 3×3 eigen-solve, not the tracer's Sturm counts). Where it
-// vanishes the straight state is a fold of the Me path whose two sides are mirror images: a cusp.
-double straightLoadedEigenvalue(ChainParameterProblem& p, double tension) {
+// The straight state (q = 0, Me = 0: an equilibrium for every Fx, by the mirror symmetry): the
+// second-lowest eigenvalue of its stability operator (the dense 3×3 eigen-solve, not the tracer's
+// Sturm counts) and its eigenvector's load by the end moment, |vᵀ ∂φ/∂q| = |Σ v_i|. Where that
+// eigenvalue vanishes with a loaded eigenvector the straight state is a fold of the Me path whose
+// two sides are mirror images: a cusp (an unloaded one would make it a branch point).
+struct StraightMode {
+  double eigenvalue = 0.0, load = 0.0;
+};
+
+StraightMode straightSecondMode(ChainParameterProblem& p, double tension) {
   REQUIRE(p.setSecondParameter(tension));
   Matrix H, C;
   REQUIRE(p.stabilityOperator(p.equilibrium().initialGuess(Vector::Zero(3), 0.0), 0.0, H, C));
   REQUIRE(C.rows() == 0);  // free end
   const Eigen::SelfAdjointEigenSolver<Matrix> es(H);
-  Eigen::Index k = 0;
-  for (Eigen::Index j = 1; j < 3; ++j)
-    if (std::abs(es.eigenvectors().col(j).sum()) > std::abs(es.eigenvectors().col(k).sum())) k = j;
-  return es.eigenvalues()[k];
+  return {es.eigenvalues()[1], std::abs(es.eigenvectors().col(1).sum())};
 }
 
 // The Me path at tension Fx = μ through the straight state: traced from the straight state at
@@ -685,19 +687,21 @@ TEST_CASE("certified counting on a chain: at the fold curve's cusp an eigenvalue
   ChainParameterProblem p = hysteresisChain(0.29);
   const ZAndCusp z = zAndCusp(p);
   const double cusp = z.cusp.mu;
-  // Independent: where the straight state's loaded eigenvalue vanishes (secant in Fx).
-  double a = 0.29, b = 0.31, fa = straightLoadedEigenvalue(p, a), fb = straightLoadedEigenvalue(p, b);
+  // Independent: where the straight state's second eigenvalue vanishes (secant in Fx; at 0.29 the
+  // Z's stretch has two negative eigenvalues, beyond the cusp one).
+  double a = 0.29, b = 0.31, fa = straightSecondMode(p, a).eigenvalue, fb = straightSecondMode(p, b).eigenvalue;
   REQUIRE(fa * fb < 0.0);
   for (int it = 0; it < 50 && fb != 0.0 && std::abs(b - a) > 1e-15 * b; ++it) {
     const double c = b - fb * (b - a) / (fb - fa);
     a = b;
     fa = fb;
     b = c;
-    fb = straightLoadedEigenvalue(p, b);
+    fb = straightSecondMode(p, b).eigenvalue;
   }
   const double marginal = b;
-  INFO("cusp Fx = " << cusp << ", the straight state's loaded eigenvalue vanishes at Fx = " << marginal);
+  INFO("cusp Fx = " << cusp << ", the straight state's second eigenvalue vanishes at Fx = " << marginal);
   CHECK(std::abs(cusp - marginal) <= 1e-10 * marginal);
+  CHECK(straightSecondMode(p, marginal).load >= 0.1);  // the end moment loads the mode: a cusp, not a branch point
 
   SECTION("at the cusp's tension: one eigenvalue touch at the straight state") {
     const cont::Branch blind = pathThroughStraight(p, cusp, false);
@@ -718,7 +722,7 @@ TEST_CASE("certified counting on a chain: at the fold curve's cusp an eigenvalue
     // moment does not load (its own zero is at a higher tension)
     CHECK(t.inertiaBefore == 1);
     CHECK(t.inertiaAfter == 1);
-    CHECK(straightLoadedEigenvalue(p, cusp) > -1e-12);
+    CHECK(std::abs(straightSecondMode(p, cusp).eigenvalue) <= 1e-12);
   }
   SECTION("the touch belongs to the cusp's tension: a dip clear of zero above it, the Z's two folds below") {
     const cont::Branch above = pathThroughStraight(p, cusp * (1.0 + 1e-4), true);
