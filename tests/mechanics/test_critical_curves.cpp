@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -558,30 +560,45 @@ cont::Branch finePath(ChainParameterProblem& p, double stop, int lambdaSign) {
   return cont::trace(p, u0, 0.0,
                      lambdaSign > 0 ? cont::InitialDirection::increasingLambda() : cont::InitialDirection::decreasingLambda(), o);
 }
-}  // namespace
+// The Z's upper fold on the fine Me path at μ = 0.29 and, from the fold curve through it, the
+// cusp nearest μ = 0.3 (where the two folds meet).
+struct ZAndCusp {
+  cont::Branch path;
+  cont::SpecialPoint fold;
+  Codim2Point cusp;
+};
 
-TEST_CASE("certified counting on a chain: two folds of a Z inside one step, below the fold curve's cusp",
-          "[critical_curves]") {
-  // The cusp from the fold curve of the Z's fold at μ = 0.29.
-  ChainParameterProblem p = hysteresisChain(0.29);
-  const cont::Branch reference = finePath(p, -0.05, +1);
-  const auto refFolds = reference.specialPointsOfType(cont::SpecialPointType::Fold);
+ZAndCusp zAndCusp(ChainParameterProblem& p) {
+  ZAndCusp z;
+  z.path = finePath(p, -0.05, +1);
+  const auto refFolds = z.path.specialPointsOfType(cont::SpecialPointType::Fold);
   REQUIRE(!refFolds.empty());
-  const cont::SpecialPoint fold = *refFolds.front();  // the Z's upper fold, Me_f > 0 small
-  REQUIRE(fold.refined);
-  REQUIRE(fold.lambda > 0.0);
-  REQUIRE(fold.lambda < 0.01);
+  z.fold = *refFolds.front();  // the Z's upper fold, Me_f > 0 small
+  REQUIRE(z.fold.refined);
+  REQUIRE(z.fold.lambda > 0.0);
+  REQUIRE(z.fold.lambda < 0.01);
   CriticalCurveOptions co = curveOptions(0.2, 0.4);
   co.tracer.maxStep = 0.01;
   co.tracer.maxPoints = 200;
-  const CriticalCurve curve = foldCurve(p, fold, co);
+  const CriticalCurve curve = foldCurve(p, z.fold, co);
   const Codim2Point* cusp = nullptr;
   for (const Codim2Point& s : curve.special)
     if (s.label == "CP" && (!cusp || std::abs(s.mu - 0.3) < std::abs(cusp->mu - 0.3))) cusp = &s;
   REQUIRE(cusp);
   REQUIRE(cusp->converged);
+  z.cusp = *cusp;
   INFO("cusp at Fx = " << cusp->mu << ", Me = " << cusp->lambda);
   CHECK(std::abs(cusp->lambda) <= 1e-12);  // Me = 0, by the mirror symmetry
+  return z;
+}
+}  // namespace
+
+TEST_CASE("certified counting on a chain: two folds of a Z inside one step, below the fold curve's cusp",
+          "[critical_curves]") {
+  ChainParameterProblem p = hysteresisChain(0.29);
+  const ZAndCusp z = zAndCusp(p);
+  const cont::Branch& reference = z.path;
+  const cont::SpecialPoint& fold = z.fold;
 
   SECTION("below the cusp: the Z's two folds in one step, counts unchanged at its ends") {
     REQUIRE(p.setSecondParameter(0.29));
@@ -614,5 +631,105 @@ TEST_CASE("certified counting on a chain: two folds of a Z inside one step, belo
       CHECK(std::abs(f->inertiaAfter - f->inertiaBefore) == 1);
     }
     CHECK(folds[0]->lambda * folds[1]->lambda < 0.0);
+  }
+}
+
+namespace {
+// The straight state (q = 0, Me = 0: an equilibrium for every Fx, by the mirror symmetry): the
+// second-lowest eigenvalue of its stability operator (the dense 3×3 eigen-solve, not the tracer's
+// Sturm counts) and its eigenvector's load by the end moment, |vᵀ ∂φ/∂q| = |Σ v_i|. Where that
+// eigenvalue vanishes with a loaded eigenvector the straight state is a fold of the Me path whose
+// two sides are mirror images: a cusp (an unloaded one would make it a branch point).
+struct StraightMode {
+  double eigenvalue = 0.0, load = 0.0;
+};
+
+StraightMode straightSecondMode(ChainParameterProblem& p, double tension) {
+  REQUIRE(p.setSecondParameter(tension));
+  Matrix H, C;
+  REQUIRE(p.stabilityOperator(p.equilibrium().initialGuess(Vector::Zero(3), 0.0), 0.0, H, C));
+  REQUIRE(C.rows() == 0);  // free end
+  const Eigen::SelfAdjointEigenSolver<Matrix> es(H);
+  return {es.eigenvalues()[1], std::abs(es.eigenvectors().col(1).sum())};
+}
+
+// The Me path at tension Fx = μ through the straight state: traced from the straight state at
+// Me = 0 (without certified counting) to |Me| = 0.0123 — at the cusp itself the straight state is
+// the path's singular point and the tangent has dMe = 0, so either side — then back through it to
+// the other side's |Me| = 0.03 in steps of up to 0.05, with or without certified counting. The
+// touch, if any, lies inside one of its steps.
+cont::Branch pathThroughStraight(ChainParameterProblem& p, double tension, bool certified) {
+  REQUIRE(p.setSecondParameter(tension));
+  cont::TracerOptions o;
+  o.maxStep = 0.05;
+  o.initialStep = 0.01;
+  o.lambdaMin = -0.0123;
+  o.lambdaMax = 0.0123;
+  o.maxPoints = 400;
+  const Vector u0 = p.equilibrium().initialGuess(Vector::Zero(3), 0.0);
+  const cont::Branch out = cont::trace(p, u0, 0.0, cont::InitialDirection::decreasingLambda(), o);
+  REQUIRE(!out.points.empty());
+  const cont::ContinuationPoint& start = out.points.back();
+  REQUIRE(std::abs(start.lambda) == Approx(0.0123).margin(1e-12));
+  o.certifiedCounting = certified;
+  o.lambdaMin = -0.03;
+  o.lambdaMax = 0.03;
+  return cont::trace(p, start.u, start.lambda,
+                     start.lambda > 0.0 ? cont::InitialDirection::decreasingLambda() : cont::InitialDirection::increasingLambda(), o);
+}
+}  // namespace
+
+TEST_CASE("certified counting on a chain: at the fold curve's cusp an eigenvalue touches zero without crossing",
+          "[critical_curves]") {
+  // At the cusp the Z's two folds merge into the straight state: along the Me path the eigenvalue
+  // of K_q − K_g that the end moment loads reaches zero there and turns back (μ ∝ s² in the cusp's normal form
+  // Π = ¼ g a⁴ − Me a), no fold, no branch point, the count 0 on both sides.
+  ChainParameterProblem p = hysteresisChain(0.29);
+  const ZAndCusp z = zAndCusp(p);
+  const double cusp = z.cusp.mu;
+  // Independent: where the straight state's second eigenvalue vanishes (secant in Fx; at 0.29 the
+  // Z's stretch has two negative eigenvalues, beyond the cusp one).
+  double a = 0.29, b = 0.31, fa = straightSecondMode(p, a).eigenvalue, fb = straightSecondMode(p, b).eigenvalue;
+  REQUIRE(fa * fb < 0.0);
+  for (int it = 0; it < 50 && fb != 0.0 && std::abs(b - a) > 1e-15 * b; ++it) {
+    const double c = b - fb * (b - a) / (fb - fa);
+    a = b;
+    fa = fb;
+    b = c;
+    fb = straightSecondMode(p, b).eigenvalue;
+  }
+  const double marginal = b;
+  INFO("cusp Fx = " << cusp << ", the straight state's second eigenvalue vanishes at Fx = " << marginal);
+  CHECK(std::abs(cusp - marginal) <= 1e-10 * marginal);
+  CHECK(straightSecondMode(p, marginal).load >= 0.1);  // the end moment loads the mode: a cusp, not a branch point
+
+  SECTION("at the cusp's tension: one eigenvalue touch at the straight state") {
+    const cont::Branch blind = pathThroughStraight(p, cusp, false);
+    CHECK(blind.specialPointsOfType(cont::SpecialPointType::EigenvalueTouch).empty());
+    CHECK(blind.specialPointsOfType(cont::SpecialPointType::Fold).empty());
+    const cont::Branch branch = pathThroughStraight(p, cusp, true);
+    const auto touches = branch.specialPointsOfType(cont::SpecialPointType::EigenvalueTouch);
+    REQUIRE(touches.size() == 1);
+    const cont::SpecialPoint& t = *touches[0];
+    INFO(t.note);
+    CHECK(branch.specialPointsOfType(cont::SpecialPointType::Fold).empty());
+    CHECK(branch.specialPointsOfType(cont::SpecialPointType::BranchPoint).empty());
+    // at the cusp: Me = 0 and the straight state, relative to the Z's fold moment at Fx = 0.29
+    CHECK(std::abs(t.lambda - z.cusp.lambda) <= 1e-6 * z.fold.lambda);
+    CHECK(t.u.cwiseAbs().maxCoeff() <= 1e-3);
+    CHECK(std::abs(t.testFunctionValue) <= 1e-8);
+    // the count is unchanged across the touch: 1, the straight state's lowest mode, which the end
+    // moment does not load (its own zero is at a higher tension)
+    CHECK(t.inertiaBefore == 1);
+    CHECK(t.inertiaAfter == 1);
+    CHECK(std::abs(straightSecondMode(p, cusp).eigenvalue) <= 1e-12);
+  }
+  SECTION("the touch belongs to the cusp's tension: a dip clear of zero above it, the Z's two folds below") {
+    const cont::Branch above = pathThroughStraight(p, cusp * (1.0 + 1e-4), true);
+    CHECK(above.specialPointsOfType(cont::SpecialPointType::EigenvalueTouch).empty());
+    CHECK(above.specialPointsOfType(cont::SpecialPointType::Fold).empty());
+    const cont::Branch below = pathThroughStraight(p, cusp * (1.0 - 1e-4), true);
+    CHECK(below.specialPointsOfType(cont::SpecialPointType::EigenvalueTouch).empty());
+    CHECK(below.specialPointsOfType(cont::SpecialPointType::Fold).size() == 2);
   }
 }

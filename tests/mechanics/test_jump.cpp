@@ -643,6 +643,16 @@ JumpResult jumpWith(EquilibriumProblem& problem, const buckle::continuation::Spe
   return simulateJump(problem, from.u, from.lambda, options);
 }
 
+// `fewer` lands on the equilibrium `reference` lands on (both polished), in fewer steps.
+void checkSameLandingFewerSteps(const JumpResult& reference, const JumpResult& fewer) {
+  INFO(reference.message << " / " << fewer.message);
+  REQUIRE(reference.success);
+  REQUIRE(fewer.success);
+  CHECK(fewer.steps < reference.steps);
+  CHECK((fewer.to - reference.to).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK(fewer.energyReleased == Approx(reference.energyReleased).epsilon(1e-10));
+}
+
 }  // namespace
 
 TEST_CASE("jump from a traced fold of a long chain: structured with hand-over lands where dense integration to rest does (n = 50)",
@@ -672,14 +682,9 @@ TEST_CASE("hand-over to Newton: the landing of integration to rest, in fewer ste
   auto compare = [](EquilibriumProblem& problem, const buckle::continuation::SpecialPoint& from) {
     const JumpResult full = jumpWith(problem, from, StepperKind::StructuredRosenbrock4, Handover::Never);
     const JumpResult handed = jumpWith(problem, from, StepperKind::StructuredRosenbrock4, Handover::Always);
-    INFO(full.message << " / " << handed.message);
-    REQUIRE(full.success);
-    REQUIRE(handed.success);
+    checkSameLandingFewerSteps(full, handed);
     CHECK(full.basinTests == 0);
     CHECK(handed.stopReason == IntegrationStop::Settled);
-    CHECK(handed.steps < full.steps);
-    CHECK((handed.to - full.to).cwiseAbs().maxCoeff() < 1e-10);
-    CHECK(handed.energyReleased == Approx(full.energyReleased).epsilon(1e-10));
   };
   SECTION("fold of the graded chain, n = 200") {
     TracedFold t = gradedChainFold(200);
@@ -710,6 +715,42 @@ TEST_CASE("hand-over in scaled units: the same steps, tests and landing angles (
   CHECK(std::abs(a.steps - b.steps) <= a.steps / 50);
   CHECK((a.to.head(n) - b.to.head(n)).cwiseAbs().maxCoeff() < 1e-9);
   CHECK(b.energyReleased / 1e-2 == Approx(a.energyReleased).epsilon(1e-8));
+}
+
+TEST_CASE("long chains' basin tolerance: the landing of the 1e-10 integration, in fewer steps (fold and cascade, n = 100)",
+          "[jump]") {
+  // jumpIntegrationDefaults above kStructuredJumpFrom segments: kLongJumpTolerance (jump.h), the
+  // shorter chains keep the IntegrationOptions default the regression baselines pin
+  const IntegrationOptions shortChain = jumpIntegrationDefaults(kStructuredJumpFrom);
+  const IntegrationOptions longChain = jumpIntegrationDefaults(kStructuredJumpFrom + 1);
+  CHECK(shortChain.absoluteTolerance == IntegrationOptions().absoluteTolerance);
+  CHECK(shortChain.relativeTolerance == IntegrationOptions().relativeTolerance);
+  CHECK(longChain.absoluteTolerance == kLongJumpTolerance);
+  CHECK(longChain.relativeTolerance == kLongJumpTolerance);
+  REQUIRE(kLongJumpTolerance > IntegrationOptions().absoluteTolerance);
+  auto compare = [](EquilibriumProblem& problem, const Vector& u, double lambda) {
+    JumpOptions options;
+    options.integration = jumpIntegrationDefaults(problem.segments());
+    options.integration.recordTrajectory = false;
+    const JumpResult basin = simulateJump(problem, u, lambda, options);
+    // the reference: the same flow to rest at the tight default tolerance
+    options.integration.absoluteTolerance = options.integration.relativeTolerance = IntegrationOptions().absoluteTolerance;
+    options.handover = Handover::Never;
+    const JumpResult tight = simulateJump(problem, u, lambda, options);
+    checkSameLandingFewerSteps(tight, basin);
+    CHECK(basin.stopReason == IntegrationStop::Settled);
+    CHECK(tight.stopReason == IntegrationStop::Rest);
+  };
+  SECTION("fold of the graded chain") {
+    TracedFold t = gradedChainFold(100);
+    compare(*t.problem, t.fold.u, t.fold.lambda);
+  }
+  SECTION("degenerate straight chain (the cascade)") {
+    const int n = 100;
+    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
+    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
+    compare(problem, problem.initialGuess(Vector::Zero(n), 0.0), 0.0);
+  }
 }
 
 TEST_CASE("inertial jump from a traced fold: the structured method on the exact Jacobian lands where dense Rosenbrock4 does (n = 24)",

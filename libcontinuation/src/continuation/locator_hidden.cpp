@@ -98,9 +98,11 @@ std::vector<SpecialPoint> Locator::locateHiddenCrossings(const std::vector<Suspe
                    std::string("certified counting: one of two opposite crossings inside one step");
         found.push_back(std::move(sp));
       }
-      continue;
+      // No count differs (the minimum's eigenvalue is zero to the count's tolerance): an exact
+      // touch whose minimum rounded to ≤ 0, as at a cusp of a fold curve. The touch test below.
+      if (!pair.empty()) continue;
     }
-    if (fx > options_.touchTolerance * std::max({1.0, fa, fb})) continue;  // a dip that stays clear of zero
+    if (std::abs(fx) > options_.touchTolerance * std::max({1.0, fa, fb})) continue;  // a dip that stays clear of zero
     SpecialPoint sp;
     sp.type = SpecialPointType::EigenvalueTouch;
     sp.arclength = best.point.arclength;

@@ -202,8 +202,12 @@ std::string describe(const continuation::StabilityInfo& s) {
 IntegrationOptions jumpIntegrationDefaults(int segments) {
   IntegrationOptions o;
   if (segments >= 10) o.stepper = StepperKind::Rosenbrock4;
-  // dense Rosenbrock4 costs O(n³) per step: long chains take the O(n) structured solve
-  if (segments > kStructuredJumpFrom) o.stepper = StepperKind::StructuredRosenbrock4;
+  // dense Rosenbrock4 costs O(n³) per step: long chains take the O(n) structured solve, and
+  // (hand-over to Newton: the integration decides the basin, jump.h) the basin's tolerance
+  if (segments > kStructuredJumpFrom) {
+    o.stepper = StepperKind::StructuredRosenbrock4;
+    o.absoluteTolerance = o.relativeTolerance = kLongJumpTolerance;
+  }
   return o;
 }
 
