@@ -64,6 +64,17 @@ Matrix rows(const Matrix& J, const std::vector<int>& idx) {
 
 const std::vector<std::vector<int>> kHeldSets = {{}, {1}, {0, 1}, {0, 1, 2}, {2}};
 
+// Zᵀ H Z on ker C (Z an orthonormal basis from a QR of Cᵀ): the dense reference of the
+// constrained spectrum; H itself without constraints.
+Matrix reducedOnKernel(const Matrix& H, const Matrix& C) {
+  if (C.rows() == 0) return H;
+  const Eigen::Index n = H.rows();
+  Eigen::ColPivHouseholderQR<Matrix> qr(C.transpose());
+  const Matrix Qf = qr.householderQ() * Matrix::Identity(n, n);
+  const Matrix Z = Qf.rightCols(n - qr.rank());
+  return Z.transpose() * H * Z;
+}
+
 }  // namespace
 
 TEST_CASE("T is congruent to H: H = U T Uᵀ, equal inertia", "[chain_structure]") {
@@ -355,13 +366,7 @@ TEST_CASE("lowest eigenvalues (isolation + Illinois on det K_σ) match the dense
     for (const auto& held : kHeldSets) {
       if (int(held.size()) >= n) continue;
       const Matrix C = rows(in.J, held);
-      Matrix reduced = in.H;
-      if (!held.empty()) {
-        Eigen::ColPivHouseholderQR<Matrix> qr(C.transpose());
-        Matrix Qf = qr.householderQ() * Matrix::Identity(n, n);
-        Matrix Z = Qf.rightCols(n - qr.rank());
-        reduced = Z.transpose() * in.H * Z;
-      }
+      const Matrix reduced = reducedOnKernel(in.H, C);
       Eigen::SelfAdjointEigenSolver<Matrix> es(reduced, Eigen::EigenvaluesOnly);
       setConstraints(ws, C);
       Vector out(3);
@@ -409,13 +414,7 @@ TEST_CASE("lowest eigenvalues from a warm start that isolates some brackets and 
     const double scale = std::max(1.0, in.H.norm());
     for (const auto& held : kHeldSets) {
       const Matrix C = rows(in.J, held);
-      Matrix reduced = in.H;
-      if (!held.empty()) {
-        Eigen::ColPivHouseholderQR<Matrix> qr(C.transpose());
-        Matrix Qf = qr.householderQ() * Matrix::Identity(n, n);
-        Matrix Z = Qf.rightCols(n - qr.rank());
-        reduced = Z.transpose() * in.H * Z;
-      }
+      const Matrix reduced = reducedOnKernel(in.H, C);
       Eigen::SelfAdjointEigenSolver<Matrix> es(reduced, Eigen::EigenvaluesOnly);
       const Vector exact = es.eigenvalues().head(3);
       const double gap = exact[2] - exact[0];
