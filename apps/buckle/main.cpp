@@ -2,6 +2,9 @@
 // Subcommands are registered here, each implemented in its own <name>_command.cpp.
 #include <CLI/CLI.hpp>
 #include <iostream>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "command.h"
 #include "critical_command.h"
@@ -11,6 +14,17 @@
 #include "show_command.h"
 
 int main(int argc, char** argv) {
+#if defined(__GLIBC__)
+  // The continuation frees and reallocates its working vectors and matrices at every point, and
+  // the outputs build strings of megabytes. With glibc's adaptive defaults the freed heap top is
+  // returned to the kernel (brk trims, TLB flushes) and faulted back in, blocks above 128 kB are
+  // mapped and unmapped each time: ~10 % of a 50-segment tree's CPU went to page faults
+  // (benchmarks/RESULTS.md, issue 13). Keep up to 64 MB of freed heap; map only blocks of 32 MB
+  // and more.
+  mallopt(M_TRIM_THRESHOLD, 64 << 20);
+  mallopt(M_TOP_PAD, 16 << 20);
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+#endif
   CLI::App app{"buckle: mechanics of compliant serial manipulators made of dual-triangle segments"};
   app.set_version_flag("--version", std::string("buckle ") + BUCKLE_VERSION);
   app.require_subcommand(1);

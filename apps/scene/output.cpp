@@ -69,13 +69,28 @@ void writeText(const fs::path& file, const std::string& text) {
   if (!out) throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
 }
 
-std::string fmt(double v) {
-  if (!std::isfinite(v)) return "nan";
-  // as printf's %.12g (the C++17 definition of to_chars), several times faster: long chains
-  // write millions of numbers, inside the run's time limit
+// Appends v as printf's %.12g (the C++17 definition of to_chars), "nan" when not finite; several
+// times faster than a stream: long chains write millions of numbers, inside the run's time limit.
+void appendNumber(std::string& out, double v) {
+  if (!std::isfinite(v)) {
+    out += "nan";
+    return;
+  }
   char buf[32];
   const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 12);
-  return std::string(buf, r.ptr);
+  out.append(buf, r.ptr);
+}
+
+void appendInteger(std::string& out, long long v) {
+  char buf[24];
+  const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+std::string fmt(double v) {
+  std::string s;
+  appendNumber(s, v);
+  return s;
 }
 
 // Joint angles of every point, rows in branches.csv's order, as a NumPy .npy file (format 1.0:
@@ -109,36 +124,69 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
   // a long chain's joint angles go to joint_angles.npy: the CSV stays a table of loads, poses and
   // stability (200 segments: 143 MB of CSV before)
   const bool sideFile = n > kBranchesCsvJointColumns;
-  std::ostringstream os;
-  os << "case,branch,point,parameter,Fx,Fy,Me,x,y,phi,dx,dy";
-  if (sideFile)
-    os << ",max_abs_q,sign_changes";
-  else
-    for (int i = 1; i <= n; ++i) os << ",q" << i;
-  os << ",stable,negative,min_eig,locked,contact_torque";
-  if (scene.analyses.stiffness) os << ",Kxx,Kyy,Kxy";
-  os << "\n";
+  // One string appended to (no stream, no string per number): tens of thousands of rows.
+  std::string os = "case,branch,point,parameter,Fx,Fy,Me,x,y,phi,dx,dy";
+  if (sideFile) {
+    os += ",max_abs_q,sign_changes";
+  } else {
+    for (int i = 1; i <= n; ++i) {
+      os += ",q";
+      appendInteger(os, i);
+    }
+  }
+  os += ",stable,negative,min_eig,locked,contact_torque";
+  if (scene.analyses.stiffness) os += ",Kxx,Kyy,Kxy";
+  os += '\n';
+  std::size_t rows = 0;
+  for (const CaseResult& cr : run.cases) rows += cr.points.size();
+  // about 19 bytes a number (%.12g with sign, point and exponent)
+  os.reserve(os.size() + rows * std::size_t(20 + 19 * (sideFile ? 13 : 11 + n)));
   for (size_t c = 0; c < run.cases.size(); ++c) {
     const CaseResult& cr = run.cases[c];
     for (const PointRecord& p : cr.points) {
-      os << c << ',' << p.branch << ',' << p.index << ',' << fmt(p.parameter);
-      for (int k = 0; k < 3; ++k) os << ',' << fmt(p.F[k]);
-      for (int k = 0; k < 3; ++k) os << ',' << fmt(p.pose[k]);
-      os << ',' << fmt(cr.pose0[0] - p.pose[0]) << ',' << fmt(p.pose[1] - cr.pose0[1]);
+      auto field = [&os](double v) {
+        os += ',';
+        appendNumber(os, v);
+      };
+      appendInteger(os, (long long)c);
+      os += ',';
+      appendInteger(os, p.branch);
+      os += ',';
+      appendInteger(os, p.index);
+      field(p.parameter);
+      for (int k = 0; k < 3; ++k) field(p.F[k]);
+      for (int k = 0; k < 3; ++k) field(p.pose[k]);
+      field(cr.pose0[0] - p.pose[0]);
+      field(p.pose[1] - cr.pose0[1]);
       if (sideFile) {
         const double qmax = p.q.size() > 0 ? p.q.cwiseAbs().maxCoeff() : 0.0;
         // sign changes of the bend, ignoring joints bent by less than 1e-9 of the largest
-        os << ',' << fmt(qmax) << ',' << mechanics::signChanges(p.q, 1e-9 * qmax);
+        field(qmax);
+        os += ',';
+        appendInteger(os, mechanics::signChanges(p.q, 1e-9 * qmax));
       } else {
-        for (int i = 0; i < n; ++i) os << ',' << (i < p.q.size() ? fmt(p.q[i]) : std::string());
+        for (int i = 0; i < n; ++i) {
+          if (i < p.q.size())
+            field(p.q[i]);
+          else
+            os += ',';
+        }
       }
-      os << ',' << (p.stable ? 1 : 0) << ',' << p.negative << ',' << fmt(p.minEigenvalue);
-      os << ',' << p.locked << ',' << fmt(p.contactTorque);
-      if (scene.analyses.stiffness) os << ',' << fmt(p.K(0, 0)) << ',' << fmt(p.K(1, 1)) << ',' << fmt(p.K(0, 1));
-      os << "\n";
+      os += p.stable ? ",1," : ",0,";
+      appendInteger(os, p.negative);
+      field(p.minEigenvalue);
+      os += ',';
+      os += p.locked;
+      field(p.contactTorque);
+      if (scene.analyses.stiffness) {
+        field(p.K(0, 0));
+        field(p.K(1, 1));
+        field(p.K(0, 1));
+      }
+      os += '\n';
     }
   }
-  writeText(dir / "branches.csv", os.str());
+  writeText(dir / "branches.csv", os);
   if (sideFile) writeJointAngles(run, n, dir / "joint_angles.npy");
 }
 

@@ -84,3 +84,48 @@ TEST_CASE("Augmented Newton reaches the exact root and reports the last update",
   CHECK_THAT(limited.failure, Contains("left the step"));
   CHECK(far[0] == 1.5);  // restored
 }
+
+TEST_CASE("Augmented Newton pivots past a zero leading entry and stops on a singular Jacobian", "[root_finding]") {
+  // z = (x, λ): λ − 1 = 0, x·λ − 3 = 0 → (3, 1). J = [[0, 1], [λ, x]]: its leading entry is zero at
+  // every iterate, so an LU without row exchanges fails at the first pivot; partial pivoting swaps.
+  const AugmentedSystem swapped = [](const Vector &z, Vector &R, Matrix *J) {
+    R.resize(2);
+    R << z[1] - 1.0, z[0] * z[1] - 3.0;
+    if (J) *J << 0.0, 1.0, z[1], z[0];
+    return true;
+  };
+  Vector z(2);
+  z << 2.0, 1.2;
+  const AugmentedNewtonResult result = augmentedNewton(swapped, z, 1, 1e-12, 20, 10.0);
+  CHECK(result.converged);
+  CHECK(std::abs(z[0] - 3.0) < 1e-13);
+  CHECK(std::abs(z[1] - 1.0) < 1e-15);
+
+  // x² − 2 = 0, λ − x² = 0 from x = 0: J = [[2x, 0], [−2x, 1]] has the zero column of x.
+  const AugmentedSystem singular = [](const Vector &w, Vector &R, Matrix *J) {
+    R.resize(2);
+    R << w[0] * w[0] - 2.0, w[1] - w[0] * w[0];
+    if (J) *J << 2.0 * w[0], 0.0, -2.0 * w[0], 1.0;
+    return true;
+  };
+  Vector s(2);
+  s << 0.0, 0.5;
+  const AugmentedNewtonResult failed = augmentedNewton(singular, s, 1, 1e-12, 20, 10.0);
+  CHECK_FALSE(failed.converged);
+  CHECK_THAT(failed.failure, Contains("singular"));
+  CHECK(s[0] == 0.0);  // restored
+  CHECK(s[1] == 0.5);
+
+  // Nearly singular in relative terms (a pivot 1e-3 eps of the largest): also refused, at any scale.
+  for (double scale : {1e-6, 1.0, 1e6}) {
+    const AugmentedSystem tiny = [scale](const Vector &w, Vector &R, Matrix *J) {
+      R.resize(2);
+      R << scale * (w[0] - 1.0), w[1] - 2.0;
+      if (J) *J << scale, 0.0, 0.0, 1e-19 * scale;
+      return true;
+    };
+    Vector t(2);
+    t << 0.0, 0.0;
+    CHECK_THAT(augmentedNewton(tiny, t, 1, 1e-12, 20, 10.0).failure, Contains("singular"));
+  }
+}

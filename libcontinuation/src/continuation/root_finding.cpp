@@ -45,8 +45,12 @@ AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, 
       result.failure = "the problem refused an iterate";
       break;
     }
-    Eigen::FullPivLU<Matrix> lu(J);
-    if (!lu.isInvertible()) {
+    // Partial pivoting (blocked, several times faster than full pivoting at the (2N+1)² fold
+    // system of a 50-segment chain); singular as FullPivLU::isInvertible judges it: a pivot below
+    // eps·m times the largest.
+    Eigen::PartialPivLU<Matrix> lu(J);
+    const auto pivots = lu.matrixLU().diagonal().cwiseAbs();
+    if (!(pivots.minCoeff() > std::numeric_limits<double>::epsilon() * double(m) * pivots.maxCoeff())) {
       result.failure = "singular augmented Jacobian";
       break;
     }

@@ -3,6 +3,8 @@
 #include "buckle/continuation/root_finding.h"
 #include "buckle/mechanics/chain_structure.h"
 
+#include <array>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -157,49 +159,72 @@ int eigenvaluesFrom(ChainStructure& ws, bool useConstraints, int first, int coun
   const double scale = std::max(ws.typicalScale, ws.frobeniusH);  // as zeroThreshold: any units
   const double tol = tolerance * scale;
   // All eigenvalues lie in [−‖H‖_F, ‖H‖_F]; widen against rounding until the counts confirm it.
+  // Confirmed only when a bracket is not isolated from the warm start alone (`outer`): an
+  // isolation by the counts at both ends of a bracket needs no outer bound.
   double lo0 = -ws.frobeniusH * (1.0 + 1e-10) - tol, hi0 = ws.frobeniusH * (1.0 + 1e-10) + tol;
-  while (evaluateShift(ws, useConstraints, lo0).below > 0) lo0 = 2.0 * lo0 - scale;
-  while (evaluateShift(ws, useConstraints, hi0).below < first + k) hi0 = 2.0 * hi0 + scale;
-  // Brackets: eigenvalue first + j lies in [lo[j], hi[j]) with count(lo[j]) ≤ first + j < count(hi[j]).
+  // Brackets: eigenvalue first + j lies in [lo[j], hi[j]) with count(lo[j]) ≤ first + j < count(hi[j]),
+  // with the evaluations at their ends (the Illinois iteration starts from them).
   ChainStructure::SmallVector lo = ChainStructure::SmallVector::Constant(k, lo0);
   ChainStructure::SmallVector hi = ChainStructure::SmallVector::Constant(k, hi0);
   ChainStructure::SmallVector cntLo = ChainStructure::SmallVector::Zero(k);
   ChainStructure::SmallVector cntHi = ChainStructure::SmallVector::Constant(k, double(dim));
-  auto record = [&](double s, int c) {
+  std::array<ShiftEvaluation, ChainStructure::kMaxBorder> evLo, evHi;
+  std::array<bool, ChainStructure::kMaxBorder> haveLo{}, haveHi{};
+  auto record = [&](double s, const ShiftEvaluation& e) {
     for (int j = 0; j < k; ++j) {
-      if (c > first + j) {
-        if (s < hi[j]) { hi[j] = s; cntHi[j] = c; }
+      if (e.below > first + j) {
+        if (s < hi[j]) { hi[j] = s; cntHi[j] = e.below; evHi[size_t(j)] = e; haveHi[size_t(j)] = true; }
       } else if (s > lo[j]) {
         lo[j] = s;
-        cntLo[j] = c;
+        cntLo[j] = e.below;
+        evLo[size_t(j)] = e;
+        haveLo[size_t(j)] = true;
       }
     }
   };
+  bool outerConfirmed = false;
+  auto outer = [&]() {
+    if (outerConfirmed) return;
+    outerConfirmed = true;
+    const double lo1 = lo0, hi1 = hi0;
+    ShiftEvaluation e;
+    while ((e = evaluateShift(ws, useConstraints, lo0)).below > 0) lo0 = 2.0 * lo0 - scale;
+    const ShiftEvaluation eLo = e;
+    while ((e = evaluateShift(ws, useConstraints, hi0)).below < first + k) hi0 = 2.0 * hi0 + scale;
+    for (int j = 0; j < k; ++j) {  // ends still at the unconfirmed bounds take the confirmed ones
+      if (lo[j] == lo1) { lo[j] = lo0; evLo[size_t(j)] = eLo; haveLo[size_t(j)] = true; }
+      if (hi[j] == hi1) { hi[j] = hi0; evHi[size_t(j)] = e; haveHi[size_t(j)] = true; }
+    }
+  };
+  auto isolated = [&](int j) { return int(cntLo[j]) == first + j && int(cntHi[j]) == first + j + 1; };
   for (int j = 0; j < k; ++j) {
-    lo[j] = std::max(lo[j], j > 0 ? out[j - 1] - tol : lo[j]);
+    if (j > 0 && out[j - 1] - tol > lo[j]) {
+      lo[j] = out[j - 1] - tol;
+      haveLo[size_t(j)] = false;
+    }
     // Warm start (e.g. the previous continuation point): counts around the guess, widening by 8
     // from 2 % of it. (A width tied to ‖H‖ instead isolates nothing on a long or strongly loaded
     // chain, whose lowest eigenvalues are spaced ~κ/n² ≪ 1e−3‖H‖_F, and bisection then pays
     // ~log2(‖H‖ n²/κ) counts per eigenvalue and point.)
     if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
       double delta = std::max(1e-9 * scale, 0.02 * std::abs((*guess)[j]));
-      for (int attempt = 0; attempt < 10 && !(int(cntLo[j]) == first + j && int(cntHi[j]) == first + j + 1);
-           ++attempt, delta *= 8.0) {
+      for (int attempt = 0; attempt < 10 && !isolated(j); ++attempt, delta *= 8.0) {
         const double a = (*guess)[j] - delta, b = (*guess)[j] + delta;
-        if (a > lo[j]) record(a, evaluateShift(ws, useConstraints, a).below);
-        if (b < hi[j]) record(b, evaluateShift(ws, useConstraints, b).below);
+        if (a > lo[j]) record(a, evaluateShift(ws, useConstraints, a));
+        if (b < hi[j]) record(b, evaluateShift(ws, useConstraints, b));
       }
     }
+    if (!isolated(j)) outer();
     // isolate: exactly one eigenvalue (j) in [lo, hi)
-    while (!(int(cntLo[j]) == first + j && int(cntHi[j]) == first + j + 1) && hi[j] - lo[j] > tol) {
+    while (!isolated(j) && hi[j] - lo[j] > tol) {
       const double mid = 0.5 * (lo[j] + hi[j]);
       if (mid <= lo[j] || mid >= hi[j]) break;
-      record(mid, evaluateShift(ws, useConstraints, mid).below);
+      record(mid, evaluateShift(ws, useConstraints, mid));
     }
-    if (int(cntLo[j]) == first + j && int(cntHi[j]) == first + j + 1 && hi[j] - lo[j] > tol) {
+    if (isolated(j) && hi[j] - lo[j] > tol) {
       // Illinois on det, one simple root in the bracket; the counts keep the bracket honest.
-      ShiftEvaluation ea = evaluateShift(ws, useConstraints, lo[j]);
-      ShiftEvaluation eb = evaluateShift(ws, useConstraints, hi[j]);
+      const ShiftEvaluation ea = haveLo[size_t(j)] ? evLo[size_t(j)] : evaluateShift(ws, useConstraints, lo[j]);
+      const ShiftEvaluation eb = haveHi[size_t(j)] ? evHi[size_t(j)] : evaluateShift(ws, useConstraints, hi[j]);
       const double ref = 0.5 * (ea.logAbsDet + eb.logAbsDet);
       auto value = [&](const ShiftEvaluation& e) {
         return e.sign * std::exp(std::max(-700.0, std::min(700.0, e.logAbsDet - ref)));
