@@ -15,8 +15,8 @@
 
 int main(int argc, char** argv) {
 #if defined(__GLIBC__)
-  // The continuation frees and reallocates its working vectors and matrices at every point, and
-  // the outputs build strings of megabytes. With glibc's adaptive defaults the freed heap top is
+  // Outside the tracer's preallocated hot loop, a tree allocates and frees large blocks again and
+  // again (dense location systems, branch reports, the outputs' strings of megabytes). With glibc's adaptive defaults the freed heap top is
   // returned to the kernel (brk trims, TLB flushes) and faulted back in, blocks above 128 kB are
   // mapped and unmapped each time: ~10 % of a 50-segment tree's CPU went to page faults
   // (benchmarks/RESULTS.md, issue 13). Keep up to 64 MB of freed heap; map only blocks of 32 MB
