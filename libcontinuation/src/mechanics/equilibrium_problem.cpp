@@ -21,6 +21,11 @@ namespace {
 // How far past a geometric limit points are still evaluated while the joint limits are traced
 // as boundaries (inDomain() below).
 constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step that crosses a limit
+// Up to this chain length stability() takes the inertia alone from smallDenseInertia (unrolled
+// for n ≤ 4) rather than two robust Sturm counts: per call with one held row, n = 2: 0.7 k
+// against 1.4 k instructions, n = 3: 1.1 k against 1.7 k, n = 4: 2.6 k against 2.0 k
+// (benchmarks/RESULTS.md, "Cheaper points, round 5").
+constexpr int kDenseInertiaUpTo = 3;
 }  // namespace
 
 EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
@@ -283,8 +288,9 @@ bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCo
   const int n = chain_.size();
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
   const int wanted = std::max(0, std::min(lowestCount, kMaxLowest));
-  if (n <= kSmallDense && wanted > 0) {
-    // Small chains: one heap-free dense eigen-solve beats the counts + eigenvalue isolation.
+  if (n <= kSmallDense && (wanted > 0 || n <= kDenseInertiaUpTo)) {
+    // Small chains: one heap-free dense eigen-solve beats the counts + eigenvalue isolation,
+    // and for n ≤ kDenseInertiaUpTo even the two Sturm counts of the inertia alone.
     Eigen::Matrix<double, kMaxLowest, 1> low;
     int found = 0;
     const Inertia in = smallDenseInertia(structure_, heldRows_, wanted, low.head(wanted), found);
