@@ -399,7 +399,7 @@ TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense defa
   std::mt19937 rng(123);
   const std::vector<EndCondition> ends = {EndCondition::freeEnd(Eigen::Vector3d(0.3, -0.2, 0.1)),
                                           EndCondition::clampedPinned(-0.5), EndCondition::heldPosition(3.0, 0.5)};
-  for (int n : {1, 3, 17, 40, 100}) {  // n >= 32 takes the O(n) path
+  for (int n : {1, 2, 3, 4, 17, 40, 100}) {  // inertia alone: dense up to n = 3, counts from 4; n >= 32 O(n)
     std::vector<SegmentParameters> segs;
     for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng, kNarrow));
     Chain chain(segs);
