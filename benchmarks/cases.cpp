@@ -1,7 +1,9 @@
 // bench_cases: buckle on the AUTO-07p comparison cases, one line per located point and a
 // timing line per case, machine-readable (key=value) for compare_auto.sh.
-//   bench_cases [--reps R] [--second-order] [CASE ...]   default: all cases, R = 5 (median time);
-//   --second-order: TracerOptions::secondOrderPredictor
+//   bench_cases [--reps R] [--second-order] [--no-certified] [CASE ...]   default: all cases, R = 5
+//   (median time); --second-order: TracerOptions::secondOrderPredictor; --no-certified:
+//   TracerOptions::certifiedCounting = false (the like-for-like A/B against AUTO, which computes no
+//   eigenvalues with IPS = 0)
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -17,9 +19,11 @@ int main(int argc, char** argv) {
   int reps = 5;
   std::vector<std::string> names;
   bool secondOrder = false;
+  bool certified = true;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--second-order")) secondOrder = true;
+    else if (!std::strcmp(argv[i], "--no-certified")) certified = false;
     else names.emplace_back(argv[i]);
   }
   if (names.empty()) names = caseNames();
@@ -28,6 +32,7 @@ int main(int argc, char** argv) {
   Settings settings;
   settings.lowestEigenvalues = 0;
   settings.secondOrderPredictor = secondOrder;
+  settings.certifiedCounting = certified;
   int failures = 0;
   for (const auto& name : names) {
     std::vector<double> times;

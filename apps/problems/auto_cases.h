@@ -50,6 +50,7 @@ struct Settings {
   /// 0 (inertia only, what the branch-point test needs; AUTO with IPS = 0 computes none).
   int lowestEigenvalues = 3;
   bool secondOrderPredictor = false;  ///< TracerOptions::secondOrderPredictor
+  bool certifiedCounting = true;      ///< TracerOptions::certifiedCounting
 };
 
 inline cont::TracerOptions tracerOptions(const Settings& s, double lambdaMin, double lambdaMax) {
@@ -63,6 +64,7 @@ inline cont::TracerOptions tracerOptions(const Settings& s, double lambdaMin, do
   o.computeStability = s.stability;
   o.lowestEigenvalues = s.lowestEigenvalues;
   o.secondOrderPredictor = s.secondOrderPredictor;
+  o.certifiedCounting = s.certifiedCounting;
   o.lambdaMin = lambdaMin;
   o.lambdaMax = lambdaMax;
   o.maxPoints = 20000;

@@ -436,7 +436,7 @@ TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense defa
   std::mt19937 rng(123);
   const std::vector<EndCondition> ends = {EndCondition::freeEnd(Eigen::Vector3d(0.3, -0.2, 0.1)),
                                           EndCondition::clampedPinned(-0.5), EndCondition::heldPosition(3.0, 0.5)};
-  for (int n : {1, 3, 17, 40, 100}) {  // n >= 32 takes the O(n) path
+  for (int n : {1, 2, 3, 4, 17, 40, 100}) {  // inertia alone: dense up to n = 3, counts from 4; n >= 32 O(n)
     std::vector<SegmentParameters> segs;
     for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng, kNarrow));
     Chain chain(segs);
@@ -478,7 +478,7 @@ TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense defa
 
 TEST_CASE("small-chain dense path: inertia and lowest eigenvalues match the dense projection", "[chain_structure]") {
   std::mt19937 rng(77);
-  for (int n : {1, 2, 3, 5, 17, 32}) {
+  for (int n : {1, 2, 3, 4, 5, 17, 32}) {  // 2, 3, 4: the unrolled sizes
     for (int trial = 0; trial < 8; ++trial) {
       Instance in = randomInstance(n, rng, 0.3 + trial);
       ChainStructure ws(n);

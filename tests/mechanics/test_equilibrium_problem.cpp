@@ -83,6 +83,28 @@ TEST_CASE("EquilibriumProblem Jacobian and its directional derivative match fini
         CHECK(err < 1e-7 * std::max(1.0, Fu.lpNorm<Eigen::Infinity>()));
         CHECK(errL < 1e-7 * std::max(1.0, Fl.lpNorm<Eigen::Infinity>()));
         CHECK((Fu - Fu.transpose()).lpNorm<Eigen::Infinity>() < 1e-14 * std::max(1.0, Fu.lpNorm<Eigen::Infinity>()));
+        // Into a block of a larger matrix (outer stride ≠ rows, as the bordered solvers pass it):
+        // the same entries, nothing written outside the block.
+        Matrix big = Matrix::Constant(N + 2, N + 3, 7.0);
+        Vector bigL = Vector::Constant(N + 1, 7.0);
+        REQUIRE(problem.jacobian(u, lambda, big.block(1, 2, N, N), bigL.head(N)));
+        CHECK(big.block(1, 2, N, N) == Fu);
+        CHECK(bigL.head(N) == Fl);
+        CHECK(bigL[N] == 7.0);
+        CHECK((big.row(0).array() == 7.0).all());
+        CHECK((big.row(N + 1).array() == 7.0).all());
+        CHECK((big.leftCols(2).array() == 7.0).all());
+        CHECK((big.rightCols(1).array() == 7.0).all());
+        // An independent assembly: the K_q − K_g block is stabilityOperator's H (totalPotentialHessian
+        // from the cache), the borders are −Cᵀ and −C, the multipliers' block is zero.
+        Matrix H, C;
+        REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+        CHECK((Fu.topLeftCorner(n, n) - H).lpNorm<Eigen::Infinity>() <= 1e-14 * std::max(1.0, H.lpNorm<Eigen::Infinity>()));
+        if (N > n) {
+          CHECK(Fu.topRightCorner(n, N - n) == -C.transpose());
+          CHECK(Fu.bottomLeftCorner(N - n, n) == -C);
+          CHECK((Fu.bottomRightCorner(N - n, N - n).array() == 0.0).all());
+        }
         // directional second derivative
         Vector du(N);
         for (int i = 0; i < N; ++i) du[i] = W(rng);

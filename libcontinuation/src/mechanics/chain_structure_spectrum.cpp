@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 
 namespace buckle::mechanics {
 
@@ -260,20 +261,29 @@ double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolera
   return lowestEigenvalues(ws, useConstraints, 1, out, tolerance, nullptr) == 1 ? out[0] : 0.0;
 }
 
-Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, int count, VectorRef lowest,
-                          int& found, double zeroTolerance, double rankTolerance) {
-  using SM = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kSmallDense, kSmallDense>;
-  const int n = ws.n;
-  if (n > kSmallDense) throw std::invalid_argument("smallDenseInertia: n > kSmallDense");
-  const int r = C.rows() > 0 ? setConstraints(ws, C, rankTolerance) : (ws.rank = 0);
+namespace {
+
+// smallDenseInertia after setConstraints (rank r, orthonormal rows in ws.Q). N > 0 is the chain
+// length at compile time: the same arithmetic in the same order (bitwise the same eigenvalues),
+// but with fixed trip counts the loops unroll. For n = 3 the generic loops' set-up and
+// vectorisation prologues cost ~1.2 k instructions per call against ~0.3 k unrolled
+// (benchmarks/RESULTS.md, "Cheaper points, round 5"); N = 0 takes n = ws.n at run time.
+template <int N>
+Inertia denseConstrainedSpectrum(ChainStructure& ws, int r, int count, VectorRef lowest, int& found,
+                                 double zeroTolerance) {
+  constexpr int kMax = N > 0 ? N : kSmallDense;
+  using SM = std::conditional_t<(N > 0), Eigen::Matrix<double, kMax, kMax>,
+                                Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMax, kMax>>;
+  using Block = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMax, kMax>;
+  const int n = N > 0 ? N : ws.n;
   SM A(n, n);
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) A(i, j) = -ws.h[std::max(i, j)];
   for (int i = 0; i < n; ++i) A(i, i) += ws.kappa[i];
   // Householder reflectors P_j map the orthonormal Q onto the first r coordinates; then
   // ker C ↔ the last d coordinates and Zᵀ H Z is the trailing d×d block of P H P.
-  SM Qw = ws.Q.topLeftCorner(n, r);
-  double v[kSmallDense];
+  Block Qw = ws.Q.topLeftCorner(n, r);
+  double v[kMax];
   for (int j = 0; j < r; ++j) {
     const int len = n - j;
     double norm2 = 0.0;
@@ -307,11 +317,11 @@ Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C,
   Inertia in;
   found = std::min(count, d);
   if (d == 0) return in;
-  SM S = A.bottomRightCorner(d, d);
-  double mu[kSmallDense];
+  Block S = A.bottomRightCorner(d, d);
+  double mu[kMax];
   if (d > 4) {
     // Larger blocks: Eigen's tridiagonal QR (Jacobi's O(d³) sweeps lose from d ≈ 5 on).
-    Eigen::SelfAdjointEigenSolver<SM> es(S, Eigen::EigenvaluesOnly);
+    Eigen::SelfAdjointEigenSolver<Block> es(S, Eigen::EigenvaluesOnly);
     for (int i = 0; i < d; ++i) mu[i] = es.eigenvalues()[i];
   } else {
     // Cyclic Jacobi: accurate and, for blocks up to 4×4, cheaper than a QR solver.
@@ -342,7 +352,8 @@ Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C,
         }
     }
     for (int i = 0; i < d; ++i) mu[i] = S(i, i);
-    std::sort(mu, mu + d);
+    for (int i = 1; i < d; ++i)  // insertion sort of d ≤ 4 values (std::sort's 16-wide pass
+      for (int j = i; j > 0 && mu[j - 1] > mu[j]; --j) std::swap(mu[j - 1], mu[j]);  // overruns mu[N])
   }
   double maxAbs = 0.0;
   for (int i = 0; i < d; ++i) maxAbs = std::max(maxAbs, std::abs(mu[i]));
@@ -354,6 +365,21 @@ Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C,
   }
   for (int i = 0; i < found; ++i) lowest[i] = mu[i];
   return in;
+}
+
+}  // namespace
+
+Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, int count, VectorRef lowest,
+                          int& found, double zeroTolerance, double rankTolerance) {
+  const int n = ws.n;
+  if (n > kSmallDense) throw std::invalid_argument("smallDenseInertia: n > kSmallDense");
+  const int r = C.rows() > 0 ? setConstraints(ws, C, rankTolerance) : (ws.rank = 0);
+  switch (n) {  // the short chains of the continuation hot path: unrolled
+    case 2: return denseConstrainedSpectrum<2>(ws, r, count, lowest, found, zeroTolerance);
+    case 3: return denseConstrainedSpectrum<3>(ws, r, count, lowest, found, zeroTolerance);
+    case 4: return denseConstrainedSpectrum<4>(ws, r, count, lowest, found, zeroTolerance);
+    default: return denseConstrainedSpectrum<0>(ws, r, count, lowest, found, zeroTolerance);
+  }
 }
 
 }  // namespace buckle::mechanics

@@ -21,6 +21,11 @@ namespace {
 // How far past a geometric limit points are still evaluated while the joint limits are traced
 // as boundaries (inDomain() below).
 constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step that crosses a limit
+// Up to this chain length stability() takes the inertia alone from smallDenseInertia (unrolled
+// for n ≤ 4) rather than two robust Sturm counts: per call with one held row, n = 2: 0.7 k
+// against 1.4 k instructions, n = 3: 1.1 k against 1.7 k, n = 4: 2.6 k against 2.0 k
+// (benchmarks/RESULTS.md, "Cheaper points, round 5").
+constexpr int kDenseInertiaUpTo = 3;
 }  // namespace
 
 EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
@@ -135,22 +140,36 @@ bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu,
   const int n = chain_.size();
   const Wrench W = wrench(u, lambda);
   loadHessianGenerator(data_, W, work_);
-  // K_q − K_g with K_g(i, j) = h_max(i,j)  (eq 27)
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) Fu(i, j) = -work_[std::max(i, j)];
-  for (int i = 0; i < n; ++i) Fu(i, i) += stiff_[i];
-  // Borders and F_λ as plain loops (n + m is tiny in the hot path; Eigen's block expressions on
-  // Refs cost more than the arithmetic there).
+  // Plain pointer loops (n + m is tiny in the hot path: Eigen's expressions on Refs, a max() per
+  // entry and the vectorised fills' alias checks cost more than the arithmetic there; the
+  // entries and their rounding are those of the textbook loops).
+  double* const a = Fu.data();
+  const Eigen::Index ld = Fu.outerStride();
+  const double* const w = work_.data();
+  const double* const kq = stiff_.data();
+  // K_q − K_g with K_g(i, j) = h_max(i,j)  (eq 27): column j is −h_j down to the diagonal, −h_i below
+  for (int j = 0; j < n; ++j) {
+    double* const col = a + j * ld;
+    const double wj = -w[j];
+    for (int i = 0; i < j; ++i) col[i] = wj;
+    col[j] = wj + kq[j];
+    for (int i = j + 1; i < n; ++i) col[i] = -w[i];
+  }
   const int m = heldCount();
+  const double* const J = J_.data();  // 3 × n, column-major
   for (int k = 0; k < m; ++k) {
     const int h = held_[size_t(k)];
-    for (int i = 0; i < n; ++i) Fu(i, n + k) = Fu(n + k, i) = -J_(h, i);
-    for (int l = 0; l < m; ++l) Fu(n + l, n + k) = 0.0;
+    double* const col = a + (n + k) * ld;
+    for (int i = 0; i < n; ++i) col[i] = a[i * ld + n + k] = -J[h + 3 * i];
+    for (int l = 0; l < m; ++l) col[n + l] = 0.0;
     Flambda[n + k] = direction_[h];
   }
-  for (int i = 0; i < n; ++i) Flambda[i] = 0.0;
-  for (int c : loaded_)
-    for (int i = 0; i < n; ++i) Flambda[i] -= J_(c, i) * direction_[c];
+  double* const fl = Flambda.data();
+  for (int i = 0; i < n; ++i) {
+    double acc = 0.0;
+    for (int c : loaded_) acc -= J[c + 3 * i] * direction_[c];
+    fl[i] = acc;
+  }
   return true;
 }
 
@@ -283,8 +302,9 @@ bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCo
   const int n = chain_.size();
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
   const int wanted = std::max(0, std::min(lowestCount, kMaxLowest));
-  if (n <= kSmallDense && wanted > 0) {
-    // Small chains: one heap-free dense eigen-solve beats the counts + eigenvalue isolation.
+  if (n <= kSmallDense && (wanted > 0 || n <= kDenseInertiaUpTo)) {
+    // Small chains: one heap-free dense eigen-solve beats the counts + eigenvalue isolation,
+    // and for n ≤ kDenseInertiaUpTo even the two Sturm counts of the inertia alone.
     Eigen::Matrix<double, kMaxLowest, 1> low;
     int found = 0;
     const Inertia in = smallDenseInertia(structure_, heldRows_, wanted, low.head(wanted), found);
