@@ -1,5 +1,7 @@
 #include "run_command.h"
 
+#include <cmath>
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -36,7 +38,15 @@ void addRunCommand(CLI::App& app, Outcome& outcome) {
   run->add_flag("--quiet,-q", options->quiet, "No progress messages (errors are still printed)");
   run->add_option("--time-limit", options->timeLimit,
                   "Seconds for the whole run (overrides the scene's /solver/time_limit); when it is reached the "
-                  "run stops within a step, writes what it computed (summary.json: \"complete\": false) and exits 1");  // checked in runSceneCommand, with a readable message
+                  "run stops within a step, writes what it computed (summary.json: \"complete\": false) and exits 1")
+      // NaN is the options' "not given": refuse it here, the rest is checked in runSceneCommand
+      ->check(CLI::Validator(
+          [](std::string& s) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(s.c_str(), &end);
+            return end != s.c_str() && std::isnan(v) ? "must be a positive number of seconds, got " + s : "";
+          },
+          "SECONDS"));
   run->callback([options, &outcome]() {
     options->handleSignals = true;
     options->progress = ::isatty(STDERR_FILENO) == 1 ? scene::Progress::Mode::Live : scene::Progress::Mode::Lines;

@@ -120,6 +120,9 @@ TEST_CASE("the command line's time limit overrides the scene's; quiet silences t
   CHECK(summaryOf(run.out)["solver"]["time_limit"] == 1.5);
   CHECK(run.log.find("buckle: [") == std::string::npos);
   CHECK(exitCode("run '" + (run.dir / "long_600.json").string() + "' --time-limit -1", run.dir / "bad.txt") == 2);
+  // NaN is no limit at all: refused, not taken as "not given"
+  CHECK(exitCode("run '" + (run.dir / "long_600.json").string() + "' --time-limit nan", run.dir / "nan.txt") == 2);
+  CHECK(slurp(run.dir / "nan.txt").find("--time-limit") != std::string::npos);
 }
 
 TEST_CASE("SIGINT and SIGTERM stop a long run with partial results and no temporary directory", "[cli][time]") {
