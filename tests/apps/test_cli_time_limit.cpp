@@ -111,7 +111,7 @@ TEST_CASE("a 100-segment default scene with time_limit 5 returns within 6 s with
   requireNoTemporaries(run.dir);
 }
 
-TEST_CASE("the command line's time limit overrides the scene's; quiet silences the progress", "[cli][time]") {
+TEST_CASE("the command line's time limit overrides the scene's, quiet silences the progress", "[cli][time]") {
   const LongRun run = runLong("override", 600.0, "--time-limit 1.5 --quiet");
   INFO(run.log);
   CHECK(run.rc == 1);

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using namespace buckle::mechanics;
 
-TEST_CASE("sudden-load scene: dynamic and quasi-static answers are equilibria; energy balance", "[scene]") {
+TEST_CASE("sudden-load scene: dynamic and quasi-static answers are equilibria, energy balance", "[scene]") {
   const fs::path out = buckle::test::absentPath("sudden", "out");
   std::ostringstream log, err;
   buckle::scene::RunCommandOptions opt;

@@ -148,7 +148,7 @@ TEST_CASE("DenseLU: determinant sign and log|det| of near-singular and badly sca
   }
 }
 
-TEST_CASE("DenseLU stops at an exactly zero pivot; the determinant refuses non-finite pivots", "[dense_lu]") {
+TEST_CASE("DenseLU stops at an exactly zero pivot, the determinant refuses non-finite pivots", "[dense_lu]") {
   std::mt19937 rng(9);
   for (auto rounding : {DenseLU::Rounding::Divide, DenseLU::Rounding::Reciprocal}) {
     Matrix A = randomMatrix(5, rng);

@@ -35,7 +35,7 @@ TEST_CASE("Slow Newton contraction caps the next step's factor at 0.7", "[step_c
   CHECK(c.next(0.1, 10, 0.5) == 0.1 * 0.4);   // already below 0.7
 }
 
-TEST_CASE("Steps stay in [minStep, maxStep]; halving below minStep reports failure", "[step_control]") {
+TEST_CASE("Steps stay in [minStep, maxStep], halving below minStep reports failure", "[step_control]") {
   const StepSizeControl c = control();
   CHECK(c.next(0.8, 1, 0.0) == 1.0);
   CHECK(c.next(2e-6, 40, 0.0) == 1e-6);

@@ -387,7 +387,7 @@ TEST_CASE("dynamics options and scenes are validated with a reason", "[dynamics]
   CHECK_FALSE(s.IsValid(chain, &why));
 }
 
-TEST_CASE("structured linearized solve equals the dense (I - a J)^-1 b; J is the flow's Jacobian (differences)",
+TEST_CASE("structured linearized solve equals the dense (I - a J)^-1 b, J is the flow's Jacobian (differences)",
           "[dynamics]") {
   const int n = 12;
   const Chain chain = bistableChain(n);

@@ -62,7 +62,7 @@ void checkLandscapeConsistency(const Chain& chain, const EnergyLandscape& L) {
 
 }  // namespace
 
-TEST_CASE("landscape: IK branches keep the end at (x, y); derivatives along the branch", "[landscape]") {
+TEST_CASE("landscape: IK branches keep the end at (x, y), derivatives along the branch", "[landscape]") {
   std::mt19937 rng(77);
   std::uniform_real_distribution<double> A(0.2, 0.9), B(0.7, 1.3), K(0.5, 3.0), L(2.2, 3.0);
   for (int trial = 0; trial < 4; ++trial) {
@@ -182,7 +182,7 @@ TEST_CASE("straight start pushed by dx > 0: U minima, Z maxima, eq 12 force, buc
   for (const LandscapeSample& s : pulled.positive) CHECK(s.status == LandscapeStatus::NoInverseKinematics);
 }
 
-TEST_CASE("non-straight start (5.5b, 0): the unloaded shape is a stable stationary point; joint limits marked",
+TEST_CASE("non-straight start (5.5b, 0): the unloaded shape is a stable stationary point, joint limits marked",
           "[landscape]") {
   const double theta = std::acos(7.0 / 8.0);
   const Eigen::Vector3d q0(theta, -2 * theta, theta);

@@ -200,7 +200,7 @@ TEST_CASE("jump from the fold itself: the cubic term picks the side", "[jump]") 
   CHECK(ri.dynamics.maxEnergyBalanceError < 1e-8);
 }
 
-TEST_CASE("AUTO's I_up fold is reproduced; the chain lands against its joint limits, confirmed independently", "[jump]") {
+TEST_CASE("AUTO's I_up fold is reproduced, the chain lands against its joint limits, confirmed independently", "[jump]") {
   const Chain chain = autoIupChain();
   Vector q(3);
   q << -1.40916, -0.508436, -0.152072;
@@ -347,7 +347,7 @@ TEST_CASE("jump with a held end coordinate keeps it held (clamped-pinned, gradie
   }
 }
 
-TEST_CASE("sudden load: gradient flow equals the quasi-static answer; inertia can overshoot into another well", "[jump]") {
+TEST_CASE("sudden load: gradient flow equals the quasi-static answer, inertia can overshoot into another well", "[jump]") {
   const Chain chain = bistableChain();
   const Vector qUnloaded = Vector::Constant(3, kWellAngle);  // each segment in its well: unloaded, stable
   const Wrench W(0.0, 0.1, 0.0);

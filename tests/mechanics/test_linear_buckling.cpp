@@ -94,7 +94,7 @@ TEST_CASE("n = 3 clamped-pinned: critical loads, mode ratios and mu match eq 15,
   CHECK(checked >= 70);
 }
 
-TEST_CASE("kappa = 0: every critical load is 0; G = 0 directions are dropped", "[buckling]") {
+TEST_CASE("kappa = 0: every critical load is 0, G = 0 directions are dropped", "[buckling]") {
   // b L0 = 2 (b² − a²) with a = 0.5, b = 1, L0 = 1.5
   const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.5));
   CHECK(std::abs(chain.segment(0).straightStiffness()) < 1e-14);
