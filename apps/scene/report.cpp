@@ -1,14 +1,18 @@
 #include "scene/report.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <stdexcept>
+#include <string>
+#include <system_error>
 
 #include "scene/output.h"
 
@@ -20,12 +24,10 @@ namespace {
 
 // The page embeds every traced point; numbers keep 6 significant digits (a hundred times finer
 // than a pixel of the diagram) and shapes 4, so a long chain's report stays a few megabytes.
-json rounded(double v, int digits = 6) {
-  if (!std::isfinite(v)) return nullptr;
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return std::strtod(buf, nullptr);
-}
+// std::to_chars with a precision prints as printf's "%.*g" and std::from_chars rounds correctly
+// as strtod does, so the value is the same double as snprintf + strtod gave (bytes of the page
+// unchanged), without the locale and stdio machinery (several times faster per number).
+json rounded(double v, int digits = 6) { return roundedForPage(v, digits); }
 
 /// Joint positions flattened as [x0, y0, x1, y1, …] (4 significant digits).
 json jointsJson(const mechanics::Chain& chain, const Eigen::VectorXd& q) {
@@ -619,6 +621,16 @@ const char* const kTail = R"PAGE(</script>
 )PAGE";
 
 }  // namespace
+
+json roundedForPage(double v, int digits) {
+  if (!std::isfinite(v)) return nullptr;
+  char buf[32];
+  const std::to_chars_result printed = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
+  double r = v;
+  // out of range (|v| rounded up past the largest double): strtod's ±HUGE_VAL, as before
+  if (std::from_chars(buf, printed.ptr, r).ec != std::errc()) r = std::strtod(std::string(buf, printed.ptr).c_str(), nullptr);
+  return r;
+}
 
 std::string reportHtml(const Scene& scene, const RunResult& run, const json& specialPoints, const json& summary) {
   json data;

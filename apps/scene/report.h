@@ -15,6 +15,10 @@
 
 namespace buckle::scene {
 
+/// v to `digits` significant digits as the page embeds it: the double nearest to printf's
+/// "%.*g" of v (null for a non-finite v: JSON has no NaN).
+nlohmann::json roundedForPage(double v, int digits);
+
 /// The complete page for a run; `specialPoints` and `summary` are the documents written as
 /// special_points.json and summary.json (output.h), shown as tables.
 std::string reportHtml(const Scene& scene, const RunResult& run, const nlohmann::json& specialPoints,

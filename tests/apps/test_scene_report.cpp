@@ -4,13 +4,19 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 #include "buckle/mechanics/chain.h"
 #include "scene/output.h"
@@ -109,4 +115,31 @@ TEST_CASE("report.html is written with the outputs and keeps the directory a buc
   CHECK(isBuckleOutput(dir.string(), &why));
   INFO(why);
   fs::remove_all(dir);
+}
+
+TEST_CASE("the page's rounded numbers are the doubles nearest to printf's %.*g (snprintf + strtod)", "[scene][report]") {
+  // The independent formulation: glibc's snprintf and strtod, which the page used before;
+  // every magnitude from subnormal to huge, both signs, ties of the decimal rounding.
+  std::mt19937_64 random(20261202);
+  std::uniform_real_distribution<double> mantissa(1.0, 10.0);
+  std::uniform_int_distribution<int> exponent(-320, 300);
+  std::vector<double> values{0.0, -0.0, 1.0, 0.5, 1.25, 2.5e-7, 123456.5, 1234565.0, 9.9999995, 999999.5, -3.0e-5,
+                             5e-324, 1.7976931348623157e308, 0.1, 1.0 / 3.0};
+  for (int k = 0; k < 20000; ++k) {
+    const double v = (k % 2 ? -1.0 : 1.0) * mantissa(random) * std::pow(10.0, exponent(random));
+    values.push_back(v);
+  }
+  for (int digits : {3, 4, 6, 10})
+    for (double v : values) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+      const double expected = std::strtod(buf, nullptr);
+      const json got = roundedForPage(v, digits);
+      REQUIRE(got.is_number_float());
+      const double g = got.get<double>();
+      INFO(buf << " digits " << digits);
+      REQUIRE(std::memcmp(&g, &expected, sizeof g) == 0);  // the same bits: the same page bytes
+    }
+  CHECK(roundedForPage(std::nan(""), 6).is_null());
+  CHECK(roundedForPage(-std::numeric_limits<double>::infinity(), 6).is_null());
 }

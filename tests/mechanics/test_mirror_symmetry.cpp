@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/mirror_symmetry.h"
@@ -176,4 +177,83 @@ TEST_CASE("mirror: no image when the scene is not symmetric", "[mirror_symmetry]
   const EquilibriumBranches r = traceEquilibria(problem, q0, 0.0, cont::InitialDirection::decreasingLambda(), o);
   REQUIRE(r.tree.branches.size() > 1);
   for (const cont::Branch& b : r.tree.branches) CHECK(b.mirrorOf == -1);
+}
+
+TEST_CASE("mirror: an image's base and self contacts, mirrored from its source, equal those located on it",
+          "[mirror_symmetry]") {
+  // traceEquilibria reports an image branch with its source's contacts mirrored
+  // (mirrored(Reflection, GeometricContact)); the independent route locates them on the image's
+  // own points (reportBranch without given contacts: Illinois on the image's distances, Newton
+  // solves with the image's locked joints).
+  const int n = GENERATE(8, 12);
+  INFO("n = " << n);
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  const EquilibriumBranchOptions o = defaultScene(true);
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  int geometric = 0, images = 0, lockedPoints = 0;
+  for (size_t b = 0; b < r.tree.branches.size(); ++b) {
+    const cont::Branch& branch = r.tree.branches[b];
+    // every point's largest compression (one residual per point) against ContactProblem's, joint by joint
+    for (const PointReport& p : r.reports[b].points) {
+      if (p.locked.empty()) continue;
+      ++lockedPoints;
+      ContactProblem contact(problem, p.locked);
+      const cont::ContinuationPoint& at = branch.points[size_t(p.index)];
+      double largest = 0.0;
+      for (const LockedJoint& l : p.locked.joints()) largest = std::max(largest, contact.compression(at.u, at.lambda, l.joint));
+      CHECK(p.contactTorque == largest);
+    }
+    if (branch.mirrorOf < 0) continue;
+    ++images;
+    INFO("branch " << b << " (image of " << branch.mirrorOf << ")");
+    GeometricContacts located;  // not given: located here on the image
+    const BranchReport own = reportBranch(problem, branch, o.report, r.contact[b], &located);
+    const BranchReport& reported = r.reports[b];
+    REQUIRE(own.specialPoints.size() == reported.specialPoints.size());
+    for (size_t k = 0; k < own.specialPoints.size(); ++k) {
+      const SpecialPointReport &x = own.specialPoints[k], &y = reported.specialPoints[k];
+      CHECK(label(x.type) == std::string(label(y.type)));
+      CHECK(x.index == y.index);
+      CHECK(x.note == y.note);
+      CHECK(x.shape == y.shape);
+      CHECK(x.stabilityBefore == y.stabilityBefore);
+      CHECK(x.stabilityAfter == y.stabilityAfter);
+      CHECK(x.refined == y.refined);
+      CHECK(std::abs(x.lambda - y.lambda) <= 1e-13 * std::max(1.0, std::abs(x.lambda)));
+      CHECK(relativeDifference(x.q, y.q) <= 1e-12);
+      CHECK(relativeDifference(x.F, y.F) <= 1e-12);
+      if (x.type == EventType::BaseContact || x.type == EventType::SelfContact) {
+        ++geometric;
+        CHECK((x.contactPoint - y.contactPoint).norm() <= 1e-12 * std::max(1.0, x.contactPoint.norm()));
+      }
+    }
+    // the mirror of the source's contacts, one by one, against those located on the image
+    GeometricContacts source;
+    reportBranch(problem, r.tree.branches[size_t(branch.mirrorOf)], o.report, r.contact[size_t(branch.mirrorOf)],
+                 &source);
+    REQUIRE(source.list.size() == located.list.size());
+    for (size_t k = 0; k < located.list.size(); ++k) {
+      const GeometricContact m = mirrored(mirrorSymmetry(problem), source.list[k]);
+      const GeometricContact& g = located.list[k];
+      CHECK(m.base == g.base);
+      CHECK(m.entering == g.entering);
+      CHECK(m.located == g.located);
+      CHECK(m.index == g.index);
+      CHECK(m.segment == g.segment);
+      CHECK(m.linkA == g.linkA);
+      CHECK(m.linkB == g.linkB);
+      CHECK(std::abs(m.lambda - g.lambda) <= 1e-13 * std::max(1.0, std::abs(g.lambda)));
+      CHECK(relativeDifference(m.u, g.u) <= 1e-12);
+      CHECK((m.point - g.point).norm() <= 1e-12 * std::max(1.0, g.point.norm()));
+      // the mirror itself: u → S u (every joint angle and the y reaction change sign), y → −y
+      CHECK(m.u.head(n) == -source.list[k].u.head(n));
+      CHECK(m.point.y() == -source.list[k].point.y());
+      CHECK_FALSE((std::signbit(m.point.y()) && m.point.y() == 0.0));  // +0 on the axis, as recomputed
+    }
+  }
+  CHECK(images == n - 1);
+  CHECK(geometric > 0);  // the children's coils reach the wall or themselves
+  CHECK(lockedPoints > 0);
 }

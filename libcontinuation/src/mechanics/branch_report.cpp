@@ -162,7 +162,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
 }
 
 BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options,
-                          const std::vector<ContactStretch>& stretches) {
+                          const std::vector<ContactStretch>& stretches, GeometricContacts* geometric) {
   const Chain& chain = problem.chain();
   const int n = chain.size();
   const int c = options.heldCoordinate;
@@ -187,6 +187,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
   // ---- points ----------------------------------------------------------------------------
   std::vector<PointReport> all;  // every point, also out of range (stability of neighbours)
   all.reserve(b.points.size());
+  Eigen::VectorXd torques(problem.dimension());
   for (size_t i = 0; i < b.points.size(); ++i) {
     const cont::ContinuationPoint& p = b.points[i];
     PointReport pr;
@@ -200,10 +201,11 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     pr.minEigenvalue = p.stability.smallest;
     pr.residual = p.residualNorm;
     pr.locked = lockedAt(stretches, int(i));
-    if (!pr.locked.empty()) {
-      ContactProblem contact(problem, pr.locked);
+    if (!pr.locked.empty() && problem.residual(p.u, p.lambda, torques)) {
+      // The compression −side·τ_c of each locked joint (ContactProblem::compression), its contact
+      // torque τ_c the free equilibrium's row: one residual for all of them.
       for (const LockedJoint& l : pr.locked.joints())
-        pr.contactTorque = std::max(pr.contactTorque, contact.compression(p.u, p.lambda, l.joint));
+        pr.contactTorque = std::max(pr.contactTorque, -double(int(l.side)) * torques[l.joint]);
     }
     if (throughReaction) {
       pr.parameter = pr.pose[c];
@@ -394,7 +396,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
       r.specialPoints.push_back(std::move(s));
     }
   }
-  reportGeometricContacts(problem, b, all, options, r);  // base / self contact (contact_geometry.h)
+  reportGeometricContacts(problem, b, all, options, r, geometric);  // base / self contact (contact_geometry.h)
   for (SpecialPointReport& s : r.specialPoints) {
     s.stabilityBefore = stabilityLabel(s.negativeBefore);
     s.stabilityAfter = stabilityLabel(s.negativeAfter);

@@ -232,11 +232,17 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
 }
 
 void reportGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
-                             const std::vector<PointReport>& all, const ReportOptions& options, BranchReport& r) {
+                             const std::vector<PointReport>& all, const ReportOptions& options, BranchReport& r,
+                             GeometricContacts* contacts) {
   const int n = problem.segments();
-  std::vector<ContactSet> locked;
-  for (const PointReport& p : all) locked.push_back(p.locked);
-  for (const GeometricContact& g : locateGeometricContacts(problem, branch, locked)) {
+  GeometricContacts local;
+  GeometricContacts& found = contacts ? *contacts : local;
+  if (!found.given) {
+    std::vector<ContactSet> locked;
+    for (const PointReport& p : all) locked.push_back(p.locked);
+    found.list = locateGeometricContacts(problem, branch, locked);
+  }
+  for (const GeometricContact& g : found.list) {
     SpecialPointReport s;
     s.type = g.base ? EventType::BaseContact : EventType::SelfContact;
     s.index = g.index;

@@ -194,12 +194,21 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
           continueUnderContact(problem, branch, o, options.maxContactEvents, options.maxContactTorque));
     }
   }
+  // A mirror image's base and self contacts are its source's mirrored (mirror_symmetry.h): the
+  // source comes first in the tree, so its located contacts are at hand.
+  std::vector<GeometricContacts> geometric(result.tree.branches.size());
   for (size_t b = 0; b < result.tree.branches.size(); ++b) {
     const continuation::Branch& branch = result.tree.branches[b];
     std::vector<Classification> names;
     for (const continuation::SpecialPoint& sp : branch.specialPoints) names.push_back(classify(problem, sp));
     result.classifications.push_back(std::move(names));
-    result.reports.push_back(reportBranch(problem, branch, options.report, result.contact[b]));
+    const int source = branch.mirrorOf;
+    if (source >= 0 && size_t(source) < b && !result.tree.interrupted) {
+      geometric[b].given = true;
+      for (const GeometricContact& g : geometric[size_t(source)].list)
+        geometric[b].list.push_back(mirrored(tree.symmetry, g));
+    }
+    result.reports.push_back(reportBranch(problem, branch, options.report, result.contact[b], &geometric[b]));
   }
   if (!result.tree.branches.empty()) result.startUnstable = startIsUnstable(result.tree.branches.front());
   return result;

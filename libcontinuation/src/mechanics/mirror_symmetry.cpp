@@ -66,4 +66,13 @@ Landing mirrored(const Landing& landing) {
   return image;
 }
 
+GeometricContact mirrored(const continuation::Reflection& mirror, const GeometricContact& contact) {
+  GeometricContact image = contact;
+  mirror.apply(image.u);
+  // 0 − y, not −y: a point on the axis (the base link's, y = +0) stays +0 as its recomputation
+  // gives it, not −0 (printed "-0" in the note)
+  image.point.y() = 0.0 - contact.point.y();
+  return image;
+}
+
 }  // namespace buckle::mechanics

@@ -29,6 +29,8 @@
 
 namespace buckle::mechanics {
 
+struct GeometricContacts;  // contact_geometry.h
+
 /// What kind of event a reported special point is. Labels (label): AUTO/MATCONT's where
 /// they exist.
 enum class EventType {
@@ -153,8 +155,10 @@ BranchReport reportBranch(EquilibriumProblem& problem, const continuation::Branc
 /// Same, for a branch continued through contact (continueUnderContact, equilibrium_branches.h):
 /// its points carry their locked joints, and a boundary where the set changes is reported as
 /// CT (a joint locks) or RL (it releases).
+/// `geometric` (contact_geometry.h): the base and self contacts given (a mirror image's) or
+/// returned as located.
 BranchReport reportBranch(EquilibriumProblem& problem, const continuation::Branch& branch, const ReportOptions& options,
-                          const std::vector<ContactStretch>& stretches);
+                          const std::vector<ContactStretch>& stretches, GeometricContacts* geometric = nullptr);
 
 /// A load history's jump (load_history.h) as a special point "JUMP" (jumping) with its landing;
 /// `parameterName` names λ in the note.

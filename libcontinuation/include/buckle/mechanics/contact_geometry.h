@@ -72,6 +72,14 @@ struct GeometricContact {
   Eigen::Vector2d point = Eigen::Vector2d::Zero();
 };
 
+/// The base and self contacts of a branch handed to or from reportBranch: `given` true, `list`
+/// holds them (a mirror image's: its source's mirrored, mirror_symmetry.h) and they are not
+/// located again; false, reportBranch locates them and leaves them in `list`.
+struct GeometricContacts {
+  bool given = false;
+  std::vector<GeometricContact> list;
+};
+
 /// The base and self contacts along `branch` traced on `problem`; `locked[i]` the joints locked
 /// at point i (empty: none anywhere). Each sign change of d_base / d_self between consecutive
 /// points is located by Illinois iteration on λ, each trial an equilibrium solved at fixed λ with
@@ -83,8 +91,10 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
 
 /// The located contacts of `branch` as special points "BC" / "SC" of its report `r` (its points
 /// `all`: every point of the branch, with their locked joints), the reported parameter as the
-/// report's (ReportOptions::heldCoordinate). Called by reportBranch.
+/// report's (ReportOptions::heldCoordinate). Called by reportBranch. `contacts`: those of
+/// locateGeometricContacts, or located here when null or empty with contacts.given false.
 void reportGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
-                             const std::vector<PointReport>& all, const ReportOptions& options, BranchReport& r);
+                             const std::vector<PointReport>& all, const ReportOptions& options, BranchReport& r,
+                             GeometricContacts* contacts = nullptr);
 
 }  // namespace buckle::mechanics

@@ -18,6 +18,7 @@
 
 #include "buckle/continuation/symmetry.h"
 #include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/contact_geometry.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/landing.h"
 
@@ -40,5 +41,13 @@ std::vector<ContactStretch> mirrored(const std::vector<ContactStretch>& stretche
 /// (x, y, φ) → (x, −y, −φ), contacts on the other side with opposite torques (the gradient flow
 /// and its side choice, the lower Π, are mirror invariant: jump.h).
 Landing mirrored(const Landing& landing);
+
+/// The mirror image of a base or self contact located on a branch (contact_geometry.h): the
+/// unknowns u → S u by `mirror`, the contact point (x, y) → (x, −y); λ, the interval, the
+/// touching segment or links, the accuracy and whether it was located kept. The wall x = 0 and
+/// the links' distances are mirror invariant (every vertex and link has a mirror twin at the same
+/// x and distance), so the image branch's contacts are these: reportBranch need not locate them
+/// again on the image (its Newton solves at fixed λ are the mirrored ones).
+GeometricContact mirrored(const continuation::Reflection& mirror, const GeometricContact& contact);
 
 }  // namespace buckle::mechanics
