@@ -2,7 +2,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <Eigen/QR>
+#include <Eigen/SVD>
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <string>
 
 using namespace buckle::continuation;
@@ -128,4 +132,69 @@ TEST_CASE("Augmented Newton pivots past a zero leading entry and stops on a sing
     t << 0.0, 0.0;
     CHECK_THAT(augmentedNewton(tiny, t, 1, 1e-12, 20, 10.0).failure, Contains("singular"));
   }
+}
+
+namespace {
+
+/// A = Q1 diag(σ) Q2ᵀ with random orthogonal Q1, Q2 (QR of random matrices) and the given σ.
+Matrix withSingularValues(const Vector& sigma, unsigned seed, Matrix& V) {
+  const Eigen::Index n = sigma.size();
+  std::srand(seed);
+  const Eigen::HouseholderQR<Matrix> q1(Matrix::Random(n, n)), q2(Matrix::Random(n, n));
+  const Matrix U = q1.householderQ() * Matrix::Identity(n, n);
+  V = q2.householderQ() * Matrix::Identity(n, n);
+  return U * sigma.asDiagonal() * V.transpose();
+}
+
+}  // namespace
+
+TEST_CASE("smallestSingularVector is the SVD's right singular vector of an isolated smallest singular value",
+          "[root_finding]") {
+  // Independent formulations: the constructed V's last column and Eigen's BDCSVD (up to sign),
+  // at n = 3 and 51, at scales 1e±6, with the smallest singular value 1e-6 … 1e-12 of the others (the pivot test may refuse 1e-4 at n = 51: the SVD then).
+  for (int n : {3, 12, 51})
+    for (double scale : {1e-6, 1.0, 1e6})
+      for (double gap : {1e-6, 1e-9, 1e-12}) {
+        INFO("n = " << n << ", scale " << scale << ", gap " << gap);
+        Vector sigma = scale * (Vector::LinSpaced(n, 2.0, 1.0));
+        sigma[n - 1] = scale * gap;
+        Matrix V;
+        const Matrix A = withSingularValues(sigma, unsigned(n * 7 + 1), V);
+        const Vector exact = V.col(n - 1);
+        // a start as the secant leaves it: the null direction and a few per cent of others
+        const Vector start = exact + 0.05 * V.col(0) - 0.03 * V.col(n / 2);
+        Vector v;
+        REQUIRE(smallestSingularVector(A, start, v));
+        const Eigen::BDCSVD<Matrix> svd(A, Eigen::ComputeFullV);
+        const Vector reference = svd.matrixV().col(n - 1);
+        const double sign = v.dot(reference) < 0.0 ? -1.0 : 1.0;
+        CHECK((sign * v - reference).norm() <= 1e-13);
+        CHECK(std::min((v - exact).norm(), (v + exact).norm()) <= 1e-12);
+        CHECK(std::abs(v.norm() - 1.0) <= 1e-15);
+      }
+}
+
+TEST_CASE("smallestSingularVector refuses two small singular values, a singular and a non-finite matrix",
+          "[root_finding]") {
+  const int n = 20;
+  Vector sigma = Vector::LinSpaced(n, 2.0, 1.0);
+  sigma[n - 1] = 1e-9;
+  sigma[n - 2] = 3e-9;  // a fold beside a crossing branch: not isolated
+  Matrix V;
+  Vector out;
+  const Matrix A = withSingularValues(sigma, 5u, V);
+  CHECK_FALSE(smallestSingularVector(A, Vector::Ones(n), out));
+  Matrix S = Matrix::Identity(n, n);
+  S(3, 3) = 0.0;  // exactly singular: the LU has a zero pivot
+  CHECK_FALSE(smallestSingularVector(S, Vector::Ones(n), out));
+  Matrix N = Matrix::Identity(n, n);
+  N(0, 1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_FALSE(smallestSingularVector(N, Vector::Ones(n), out));
+  CHECK_FALSE(smallestSingularVector(Matrix::Identity(n, n), Vector::Zero(n), out));  // no start
+  // one isolated small value, the other σ equal: accepted (only σ_n must be isolated)
+  sigma.setOnes();
+  sigma[n - 1] = 1e-7;
+  const Matrix B = withSingularValues(sigma, 9u, V);
+  REQUIRE(smallestSingularVector(B, Vector::Ones(n), out));
+  CHECK(std::min((out - V.col(n - 1)).norm(), (out + V.col(n - 1)).norm()) <= 1e-12);
 }

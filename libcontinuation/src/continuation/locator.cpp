@@ -331,8 +331,20 @@ bool Locator::refineFold(SpecialPoint &sp, const Vector &tangentRef) {
   Matrix Fu(n, n);
   Vector Fl(n);
   if (!problem_.jacobian(sp.u, sp.lambda, Fu, Fl)) return false;
-  Eigen::BDCSVD<Matrix> svd(Fu, Eigen::ComputeFullV);
-  const Vector c = svd.matrixV().col(n - 1);
+  // c: F_u's right singular vector of its smallest singular value, the normalization cᵀv = 1
+  // and the start of v. Inverse iteration from the tangent when that value is isolated (the
+  // same vector up to rounding, and its sign does not matter: (v, c) → (−v, −c) negates the
+  // Newton iterates' v exactly and leaves their (u, λ) bit for bit); the SVD otherwise (two
+  // small singular values, e.g. a fold beside a crossing branch, where a different start may
+  // leave Newton on the other point).
+  Vector c;
+  const Vector start = sp.tangent.size() == n + 1 && sp.tangent.head(n).norm() > 0.0 ? Vector(sp.tangent.head(n))
+                       : tangentRef.size() == n + 1 ? Vector(tangentRef.head(n))
+                                                    : Vector(Vector::Ones(n));
+  if (!smallestSingularVector(Fu, start, c)) {
+    Eigen::BDCSVD<Matrix> svd(Fu, Eigen::ComputeFullV);
+    c = svd.matrixV().col(n - 1);
+  }
   Vector z(2 * n + 1);
   z << sp.u, sp.lambda, c;
   Matrix dFu(n, n);

@@ -85,4 +85,40 @@ AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, 
   return result;
 }
 
+bool smallestSingularVector(const Matrix &A, ConstVectorRef start, Vector &v) {
+  const Eigen::Index n = A.rows();
+  if (n < 2 || A.cols() != n || start.size() != n || !A.allFinite()) return false;
+  const double startNorm = start.norm();
+  if (!(startNorm > 0.0) || !std::isfinite(startNorm)) return false;
+  const Eigen::PartialPivLU<Matrix> lu(A);
+  // Isolation as the pivots show it: one pivot far below all the others.
+  double smallest = std::numeric_limits<double>::infinity(), next = smallest;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double p = std::abs(lu.matrixLU()(k, k));
+    if (!std::isfinite(p)) return false;
+    if (p < smallest) {
+      next = smallest;
+      smallest = p;
+    } else if (p < next) {
+      next = p;
+    }
+  }
+  if (!(smallest > 0.0) || !(next >= 100.0 * smallest)) return false;
+  const double tolerance = 32.0 * std::numeric_limits<double>::epsilon() * std::sqrt(double(n));
+  v = start / startNorm;
+  Vector y(n), z(n);
+  for (int iteration = 0; iteration < 4; ++iteration) {
+    y = lu.transpose().solve(v);  // A⁻ᵀ v
+    z = lu.solve(y);              // (AᵀA)⁻¹ v
+    const double norm = z.norm();
+    if (!(norm > 0.0) || !std::isfinite(norm)) return false;
+    z /= norm;
+    if (z.dot(v) < 0.0) z = -z;
+    const double change = (z - v).norm();
+    v = z;
+    if (change <= tolerance) return true;
+  }
+  return false;
+}
+
 }  // namespace buckle::continuation
