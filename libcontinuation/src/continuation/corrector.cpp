@@ -199,7 +199,7 @@ double maxNorm(const Vector &v) {
 // and correct() runs KINSOL from the same predictor: those outcomes stay KINSOL's own.
 bool Corrector::leanNewton(CorrectorSummary &summary) {
   const Eigen::Index m = n_ + 1;
-  iterate_ = predictor_;
+  std::copy(predictor_.data(), predictor_.data() + m, iterate_.data());
   // KINSolInit: F at the initial guess; fmax = ‖F‖∞ against 0.01·fnormtol.
   if (evaluate(iterate_.data(), residual_.data()) != 0) return false;
   const double fnormtol = options_.residualTolerance;
@@ -226,8 +226,8 @@ bool Corrector::leanNewton(CorrectorSummary &summary) {
       if (structured_) {
         if (!structured_->solve(trial_, step_)) return false;
       } else {
-        step_ = trial_;
-        dense_->solveInPlace(step_);
+        std::copy(trial_.data(), trial_.data() + m, step_.data());
+        dense_->solveInPlace(step_.data());
       }
       // KINFullNewton: a step beyond 0.99·mxnewtstep is truncated or counted by KINSOL.
       if (l2Norm(step_) > 0.99 * maxStep) return false;
@@ -252,7 +252,7 @@ bool Corrector::leanNewton(CorrectorSummary &summary) {
       std::swap(residual_, trialResidual_);
     }
   }
-  Eigen::Map<Vector>(NV_DATA_S(x_.get()), m) = iterate_;  // KINSOL's u on return
+  std::copy(iterate_.data(), iterate_.data() + m, NV_DATA_S(x_.get()));  // KINSOL's u on return
   summary.flag = flag;
   summary.iterations = static_cast<int>(iterations);
   summary.residualNorm = fnorm;

@@ -328,7 +328,11 @@ bool Tracer::takeStep(const ContinuationPoint &a, const ContinuationPoint *previ
     return false;
   }
   const double cosine = b.tangent.dot(a.tangent);
-  turningAngle = std::acos(std::max(-1.0, std::min(1.0, cosine)));
+  // The angle itself only where something reads it: the guard's message, and the step rule that
+  // limits the turning (NewtonCount, the default, does not; an acos per point is ≈ 85 instructions).
+  turningAngle = 0.0;
+  if (cosine < options_.minTangentCosine || stepControl_.rule != StepSizeControl::Rule::NewtonCount)
+    turningAngle = std::acos(std::max(-1.0, std::min(1.0, cosine)));
   if (cosine < options_.minTangentCosine) {
     failure = formatDouble("branch-jump guard (tangent turned by %.3g degrees)", turningAngle * 180.0 / std::acos(-1.0));
     return false;

@@ -2,8 +2,10 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 
@@ -26,6 +28,19 @@ constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step t
 // against 1.4 k instructions, n = 3: 1.1 k against 1.7 k, n = 4: 2.6 k against 2.0 k
 // (benchmarks/RESULTS.md, "Cheaper points, round 5").
 constexpr int kDenseInertiaUpTo = 3;
+
+// The caches' bitwise key comparison. memcmp is a library call of ≈ 25 instructions, more than
+// comparing the 2–8 words of a short chain's key one by one (each memcpy of 8 bytes is one load).
+bool sameBits(const double* a, const double* b, size_t count) {
+  if (count > 8) return std::memcmp(a, b, sizeof(double) * count) == 0;
+  for (size_t i = 0; i < count; ++i) {
+    std::uint64_t x, y;
+    std::memcpy(&x, a + i, sizeof x);
+    std::memcpy(&y, b + i, sizeof y);
+    if (x != y) return false;
+  }
+  return true;
+}
 }  // namespace
 
 EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
@@ -68,7 +83,7 @@ bool EquilibriumProblem::prepare(ConstVectorRef u) {
     if (!std::isfinite(u[k])) return false;
   const auto q = u.head(n);
   // Bitwise: a q that merely compares equal (−0.0 vs 0.0) is evaluated afresh.
-  if (cacheValid_ && std::memcmp(q.data(), cachedQ_.data(), sizeof(double) * size_t(n)) == 0) return true;
+  if (cacheValid_ && sameBits(q.data(), cachedQ_.data(), size_t(n))) return true;
   cacheValid_ = false;
   if (!inDomain(u)) return false;
   forwardKinematics(chain_, q, data_);
@@ -301,8 +316,7 @@ bool EquilibriumProblem::smallDenseSpectrum(ConstVectorRef u, double lambda) {
   // hit needs neither the domain check nor the q-cache (which may hold another q by now, e.g.
   // the certified counting's point off the branch).
   if (spectrumSize_ >= 0 && size_t(spectrumKey_.size()) == N + 1 &&
-      std::memcmp(u.data(), spectrumKey_.data(), sizeof(double) * N) == 0 &&
-      std::memcmp(&lambda, spectrumKey_.data() + N, sizeof(double)) == 0)
+      sameBits(u.data(), spectrumKey_.data(), N) && sameBits(&lambda, spectrumKey_.data() + N, 1))
     return true;
   spectrumSize_ = -1;
   if (!prepare(u)) return false;
