@@ -9,8 +9,11 @@
 
 #include <cmath>
 #include <cstring>
+#include <map>
+#include <random>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 using namespace buckle::continuation;
 using Catch::Matchers::Contains;
@@ -268,4 +271,83 @@ TEST_CASE("Corrector's dense linear solver: the same Newton iterates as KINSOL's
     CHECK(summary.converged);
     ++converged;
   }
+}
+
+TEST_CASE("Corrector's lean Newton: KINSOL's outcome bit for bit on every path with dense and bordered solvers", "[corrector]") {
+  // CorrectorOptions::leanNewton runs KINSOL's full-Newton iteration itself where it converges
+  // plainly and hands every other outcome to KINSOL. Against KINSOL alone (leanNewton = false),
+  // from many predictors, the flag, the counts, the norms and the iterate must agree to the bit:
+  // converged runs (lean), the initial guess already a root (lean), and the paths it hands over
+  // (the iteration limit, refused points, no root, a tiny maximum step).
+  toys::Bratu bratu(5);
+  toys::CurvedPitchforks pitchforks(0.7);
+  toys::CubicFold cubic;
+  toys::Circle circle;
+  toys::LineWithDomain line(0.3);
+  std::vector<Problem *> problems{&bratu, &pitchforks, &cubic, &circle, &line};
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> W(-1.0, 1.0);
+  std::map<std::string, int> flags;
+  int lean = 0, handed = 0;
+  for (Problem *problem : problems) {
+    const int n = problem->dimension();
+    DenseBorderedSolver bordered(*problem);
+    for (int trial = 0; trial < 40; ++trial) {
+      CorrectorOptions options;
+      options.maxIterations = trial % 7 == 3 ? 1 : 10;
+      if (trial % 11 == 5) options.maxNewtonStep = 1e-3;
+      if (trial % 13 == 7) options.residualTolerance = 1e-300;  // only the step tolerance can stop it
+      const bool useBordered = trial % 2 == 1;
+      Vector predictor(n + 1), tangent(n + 1);
+      for (int i = 0; i <= n; ++i) {
+        predictor[i] = 0.5 * W(rng);
+        tangent[i] = W(rng);
+      }
+      if (problem == &circle) predictor[n] = 0.6 + 0.3 * W(rng);
+      if (problem == &bratu) predictor[n] = 1.0 + W(rng);
+      tangent.normalize();
+      Vector xLean(n + 1), xKinsol(n + 1);
+      CorrectorOptions kinsolOnly = options;
+      kinsolOnly.leanNewton = false;
+      Corrector a(*problem, options, useBordered ? &bordered : nullptr);
+      Corrector b(*problem, kinsolOnly, useBordered ? &bordered : nullptr);
+      const CorrectorSummary sa = a.correct(predictor, tangent, xLean);
+      const CorrectorSummary sb = b.correct(predictor, tangent, xKinsol);
+      INFO("trial " << trial << ", flag " << sb.flagName);
+      CHECK(sa.flag == sb.flag);
+      CHECK(std::string(sa.flagName) == sb.flagName);
+      CHECK(sa.converged == sb.converged);
+      CHECK(sa.iterations == sb.iterations);
+      CHECK(sa.residualEvaluations == sb.residualEvaluations);
+      CHECK(sa.refusedPoint == sb.refusedPoint);
+      CHECK(sa.message == sb.message);
+      CHECK(sameBits(sa.residualNorm, sb.residualNorm));
+      CHECK(sameBits(sa.lastStepNorm, sb.lastStepNorm));
+      CHECK(sameBits(sa.contraction, sb.contraction));
+      for (int i = 0; i <= n; ++i) CHECK(sameBits(xLean[i], xKinsol[i]));
+      ++flags[sb.flagName];
+      (sb.flag == KIN_SUCCESS || sb.flag == KIN_INITIAL_GUESS_OK ? lean : handed)++;
+      // The root itself as predictor: KINSOL's initial-guess exit, taken by the lean path too.
+      if (sb.flag == KIN_SUCCESS && sb.residualNorm < 1e-14) {
+        Vector again(n + 1), againKinsol(n + 1);
+        const CorrectorSummary ra = a.correct(xKinsol, tangent, again);
+        const CorrectorSummary rb = b.correct(xKinsol, tangent, againKinsol);
+        CHECK(ra.flag == rb.flag);
+        CHECK(ra.iterations == rb.iterations);
+        CHECK(sameBits(ra.residualNorm, rb.residualNorm));
+        for (int i = 0; i <= n; ++i) CHECK(sameBits(again[i], againKinsol[i]));
+        ++flags[std::string("again ") + rb.flagName];
+      }
+    }
+  }
+  std::string seen;
+  for (const auto &[name, count] : flags) seen += name + ": " + std::to_string(count) + "; ";
+  INFO(seen);
+  // Every kind of outcome occurred, so each path was compared.
+  CHECK(flags["KIN_SUCCESS"] > 20);
+  CHECK(flags["again KIN_INITIAL_GUESS_OK"] > 5);
+  CHECK(flags["KIN_MAXITER_REACHED"] > 0);
+  CHECK(flags["KIN_FIRST_SYSFUNC_ERR"] > 0);
+  CHECK(lean > 0);
+  CHECK(handed > 0);
 }

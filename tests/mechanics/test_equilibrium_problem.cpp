@@ -171,7 +171,7 @@ TEST_CASE("EquilibriumProblem: cached evaluations equal a fresh problem's in any
   // results of a problem that has never seen another point.
   std::mt19937 rng(2024);
   std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
-  std::uniform_int_distribution<int> Op(0, 5), Pick(0, 3);
+  std::uniform_int_distribution<int> Op(0, 6), Pick(0, 3);
   for (int n : {1, 3, 8}) {
     const Chain chain = randomChain(rng, n);
     for (const Setting& s : settings(rng)) {
@@ -215,6 +215,12 @@ TEST_CASE("EquilibriumProblem: cached evaluations equal a fresh problem's in any
             REQUIRE(i1.lowest.size() == i2.lowest.size());
             CHECK((i1.lowest.array() == i2.lowest.array()).all());
           }
+        } else if (op == 6) {  // the small dense spectrum, shared with stability() at its point
+          Vector v1(1), v2(1);
+          const bool ok1 = cached.stabilityEigenvalues(buffer, lambda, 0, v1);
+          const bool ok2 = fresh.stabilityEigenvalues(buffer, lambda, 0, v2);
+          REQUIRE(ok1 == ok2);
+          if (ok1) CHECK(v1[0] == v2[0]);
         } else {
           Matrix H1, C1, H2, C2;
           const bool ok1 = cached.stabilityOperator(buffer, lambda, H1, C1);
@@ -470,6 +476,71 @@ TEST_CASE("stabilityEigenvalues by index: the O(n) counts and the small dense ro
       CHECK_FALSE(problem.stabilityEigenvalues(u, lambda, dim - 1, beyond));
     }
   }
+}
+
+TEST_CASE("the small dense spectrum is shared by stability and stabilityEigenvalues at one point and recomputed on a one-ulp change",
+          "[equilibrium]") {
+  // stability() keeps the whole small dense spectrum of its point (equilibrium_problem.h), and
+  // stabilityEigenvalues() at the same (u, λ) serves it from there. Shared values must be bit for
+  // bit those of a problem that never saw the point; a change of any one component of (u, λ) by
+  // one ulp, in the same buffer, must recompute (the fresh values there differ from the cached
+  // ones in many cases, so a stale cache fails the comparison).
+  std::mt19937 rng(5151);
+  std::uniform_real_distribution<double> W(-1.5, 1.5), Lam(-0.7, 0.7);
+  int perturbed = 0, changed = 0;
+  for (int n : {2, 3, 5}) {
+    const Chain chain = randomChain(rng, n);
+    for (const Setting& s : settings(rng)) {
+      const Eigen::Vector3d dir(W(rng), W(rng), W(rng));
+      EquilibriumProblem shared(chain, s.end, dir);
+      const int N = shared.dimension();
+      const int dim = n - (N - n);  // the held rows are independent at a random state
+      // inertia only up to n = 3 (the dense route there), two values above (the route then)
+      const int asked = n <= 3 ? 0 : 2;
+      Vector x(N + 1);  // (u, λ) in one buffer, changed in place
+      x.head(N) = randomState(rng, chain, N);
+      x[N] = Lam(rng);
+      auto valuesOf = [&](EquilibriumProblem& p, Vector& out) {
+        out.resize(dim);
+        return p.stabilityEigenvalues(x.head(N), x[N], 0, out);
+      };
+      for (int component = -1; component <= N; ++component) {
+        INFO("n = " << n << ", end: " << s.name << ", component " << component);
+        Vector before(dim);
+        REQUIRE(valuesOf(shared, before));  // the cache now holds the unperturbed point
+        if (component >= 0) {
+          x[component] = std::nextafter(x[component], std::numeric_limits<double>::infinity());
+          if (dim > 0) ++perturbed;
+        }
+        buckle::continuation::StabilityInfo mine, theirs;
+        EquilibriumProblem fresh(chain, s.end, dir), fresh2(chain, s.end, dir);
+        REQUIRE(shared.stability(x.head(N), x[N], asked, mine));
+        REQUIRE(fresh.stability(x.head(N), x[N], asked, theirs));
+        CHECK(mine.negative == theirs.negative);
+        CHECK(mine.zero == theirs.zero);
+        REQUIRE(mine.lowest.size() == theirs.lowest.size());
+        CHECK((mine.lowest.array() == theirs.lowest.array()).all());
+        Vector sharedValues, freshValues;
+        REQUIRE(valuesOf(shared, sharedValues));  // from stability()'s solve
+        REQUIRE(valuesOf(fresh2, freshValues));   // a solve of its own
+        CHECK((sharedValues.array() == freshValues.array()).all());
+        if (component >= 0 && (freshValues.array() != before.array()).any()) ++changed;
+        // Indices beyond the spectrum are refused from the cache as from a solve.
+        Vector beyond(2);
+        CHECK_FALSE(shared.stabilityEigenvalues(x.head(N), x[N], dim - 1, beyond));
+        // Another point in between (the slopes' point off the branch), then back: the same values.
+        Vector off = x.head(N), elsewhere(dim), again(dim);
+        off[0] += 1e-6;
+        REQUIRE(shared.stabilityEigenvalues(off, x[N], 0, elsewhere));
+        if (dim > 0) CHECK((elsewhere.array() != freshValues.array()).any());
+        REQUIRE(valuesOf(shared, again));
+        CHECK((again.array() == freshValues.array()).all());
+      }
+    }
+  }
+  // The test can fail: many one-ulp changes move some eigenvalue's last bits (19 of 42 here), and
+  // a stale cache would return the unperturbed values there.
+  CHECK(4 * changed > perturbed);
 }
 
 TEST_CASE("stabilityRateBound bounds the rate of every eigenvalue of H on ker C (central differences)",

@@ -92,8 +92,8 @@ Tracer::EventHit Tracer::locateStopEvent(const ContinuationPoint &a, const Conti
     }
     if (e < 2 + boxEventCount() && ga != 0.0) landOnCoordinateBound(e, a, located, accuracy);
     // Keep the earliest event along the step.
-    const double s = a.tangent.dot(located.state() - a.state());
-    if (hit.event < 0 || s < a.tangent.dot(hit.point.state() - a.state())) {
+    const double s = stepAlong(a, located);
+    if (hit.event < 0 || s < stepAlong(a, hit.point)) {
       hit.event = e;
       hit.point = located;
       hit.accuracy = accuracy;
@@ -101,7 +101,7 @@ Tracer::EventHit Tracer::locateStopEvent(const ContinuationPoint &a, const Conti
     }
   }
   if (hit.event >= 0) {
-    const double s = a.tangent.dot(hit.point.state() - a.state());
+    const double s = stepAlong(a, hit.point);
     hit.point.arclength = a.arclength + s;
     hit.point.stepSize = s;
   }

@@ -2,8 +2,10 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 
@@ -26,6 +28,19 @@ constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step t
 // against 1.4 k instructions, n = 3: 1.1 k against 1.7 k, n = 4: 2.6 k against 2.0 k
 // (benchmarks/RESULTS.md, "Cheaper points, round 5").
 constexpr int kDenseInertiaUpTo = 3;
+
+// The caches' bitwise key comparison. memcmp is a library call of ≈ 25 instructions, more than
+// comparing the 2–8 words of a short chain's key one by one (each memcpy of 8 bytes is one load).
+bool sameBits(const double* a, const double* b, size_t count) {
+  if (count > 8) return std::memcmp(a, b, sizeof(double) * count) == 0;
+  for (size_t i = 0; i < count; ++i) {
+    std::uint64_t x, y;
+    std::memcpy(&x, a + i, sizeof x);
+    std::memcpy(&y, b + i, sizeof y);
+    if (x != y) return false;
+  }
+  return true;
+}
 }  // namespace
 
 EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
@@ -54,6 +69,7 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
     requireFinite(std::string("load path direction ") + names[c], direction[c]);
   }
   structure_.typicalScale = stiffnessUnit() * lengthUnit() * lengthUnit();  // the inertia's zero floor
+  spectrumKey_.resize(dimension() + 1);
   const double overshoot = options_.jointLimitsAsBoundaries ? kGeometricOvershoot : 0.0;
   for (int i = 0; i < chain_.size(); ++i) {
     domainUpper_[i] = chain_.segment(i).geometricUpperLimit() + overshoot;
@@ -67,7 +83,7 @@ bool EquilibriumProblem::prepare(ConstVectorRef u) {
     if (!std::isfinite(u[k])) return false;
   const auto q = u.head(n);
   // Bitwise: a q that merely compares equal (−0.0 vs 0.0) is evaluated afresh.
-  if (cacheValid_ && std::memcmp(q.data(), cachedQ_.data(), sizeof(double) * size_t(n)) == 0) return true;
+  if (cacheValid_ && sameBits(q.data(), cachedQ_.data(), size_t(n))) return true;
   cacheValid_ = false;
   if (!inDomain(u)) return false;
   forwardKinematics(chain_, q, data_);
@@ -294,26 +310,49 @@ bool EquilibriumProblem::assembleStructure(ConstVectorRef u, double lambda, Chai
   return true;
 }
 
-bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCount,
-                                   continuation::StabilityInfo& info) {
-  if (!options_.structuredStability) return Problem::stability(u, lambda, lowestCount, info);
+bool EquilibriumProblem::smallDenseSpectrum(ConstVectorRef u, double lambda) {
+  const size_t N = size_t(u.size());
+  // Bitwise, like prepare(): the key was stored after prepare(u) accepted these very bits, so a
+  // hit needs neither the domain check nor the q-cache (which may hold another q by now, e.g.
+  // the certified counting's point off the branch).
+  if (spectrumSize_ >= 0 && size_t(spectrumKey_.size()) == N + 1 &&
+      sameBits(u.data(), spectrumKey_.data(), N) && sameBits(&lambda, spectrumKey_.data() + N, 1))
+    return true;
+  spectrumSize_ = -1;
   if (!prepare(u)) return false;
   assembleFromCache(u, lambda, structure_);
   const int n = chain_.size();
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
+  // All n − rank values: the eigen-solve computes them anyway (`count` only limits the copy), so
+  // any later request at this point is served bit for bit as a fresh solve would serve it.
+  int found = 0;
+  spectrumInertia_ = smallDenseInertia(structure_, heldRows_, n, spectrum_.head(n), found);
+  if (size_t(spectrumKey_.size()) != N + 1) spectrumKey_.resize(Eigen::Index(N) + 1);  // sized in the constructor
+  spectrumKey_.head(Eigen::Index(N)) = u;
+  spectrumKey_[Eigen::Index(N)] = lambda;
+  spectrumSize_ = found;
+  return true;
+}
+
+bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCount,
+                                   continuation::StabilityInfo& info) {
+  if (!options_.structuredStability) return Problem::stability(u, lambda, lowestCount, info);
+  const int n = chain_.size();
   const int wanted = std::max(0, std::min(lowestCount, kMaxLowest));
   if (n <= kSmallDense && (wanted > 0 || n <= kDenseInertiaUpTo)) {
     // Small chains: one heap-free dense eigen-solve beats the counts + eigenvalue isolation,
     // and for n ≤ kDenseInertiaUpTo even the two Sturm counts of the inertia alone.
-    Eigen::Matrix<double, kMaxLowest, 1> low;
-    int found = 0;
-    const Inertia in = smallDenseInertia(structure_, heldRows_, wanted, low.head(wanted), found);
-    info.negative = in.negative;
-    info.zero = in.zero;
-    info.lowest = low.head(found);
-    info.smallest = found > 0 ? low[0] : 0.0;
+    if (!smallDenseSpectrum(u, lambda)) return false;
+    const int found = std::min(wanted, spectrumSize_);
+    info.negative = spectrumInertia_.negative;
+    info.zero = spectrumInertia_.zero;
+    info.lowest = spectrum_.head(found);
+    info.smallest = found > 0 ? spectrum_[0] : 0.0;
     return true;
   }
+  if (!prepare(u)) return false;
+  assembleFromCache(u, lambda, structure_);
+  for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
   // Inertia by two O(n) Sturm counts (Sylvester); eigenvalues only when asked for.
   const Inertia in = constrainedInertia(structure_, heldRows_);
   info.negative = in.negative;
@@ -332,21 +371,19 @@ bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCo
 bool EquilibriumProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, int first,
                                               continuation::VectorRef values) {
   if (!options_.structuredStability) return Problem::stabilityEigenvalues(u, lambda, first, values);
-  if (first < 0 || !prepare(u)) return false;
-  assembleFromCache(u, lambda, structure_);
+  if (first < 0) return false;
   const int n = chain_.size();
-  for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
   const int wanted = first + int(values.size());
   if (n <= kSmallDense) {
-    // As stability(): one heap-free dense eigen-solve is cheaper than isolating on counts.
-    Eigen::Matrix<double, kSmallDense, 1> low;
-    int found = 0;
-    smallDenseInertia(structure_, heldRows_, std::min(wanted, kSmallDense), low.head(std::min(wanted, kSmallDense)),
-                      found);
-    if (found < wanted) return false;
-    values = low.segment(first, values.size());
+    // As stability(): one heap-free dense eigen-solve is cheaper than isolating on counts, and
+    // at the point stability() was just asked about it is already done.
+    if (!smallDenseSpectrum(u, lambda) || spectrumSize_ < wanted) return false;
+    values = spectrum_.segment(first, values.size());
     return true;
   }
+  if (!prepare(u)) return false;
+  assembleFromCache(u, lambda, structure_);
+  for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
   const int rank = heldCount() > 0 ? setConstraints(structure_, heldRows_) : (structure_.rank = 0);
   if (values.size() > ChainStructure::kMaxBorder) return false;  // the isolation's fixed-size brackets
   // Warm start from the previous call with the same indices: the monitor asks at a point and

@@ -51,6 +51,10 @@ struct CorrectorOptions {
   /// A solve that stalls on the step tolerance (KIN_STEP_LT_STPTOL: rounding floor reached)
   /// still counts as converged if ‖G‖₂ ≤ stagnationFactor · residualTolerance.
   double stagnationFactor = 100.0;
+  /// Full Newton (lineSearch false) by Corrector's own reproduction of KINSOL's iteration where it
+  /// converges plainly (the same iterates, flag, counts and norms, bit for bit), KINSOL itself
+  /// otherwise; false: KINSOL always (kept for the cross-checks).
+  bool leanNewton = true;
 
   bool IsValid(std::string *why) const;
 };
@@ -104,6 +108,12 @@ class Corrector {
   int evaluateJacobian(const double *x);
   int factorStructured(const double *x);
   void applyOptions();
+  /// KINSOL's full-Newton iteration (KIN_NONE, direct linear solver, every setting of ours)
+  /// reproduced operation for operation on the corrector's own vectors, for the common outcomes
+  /// only: converged, or the initial guess already a solution. Anything else (a refused point, a
+  /// failed factorization or solve, a step at the maximum length, the step tolerance, the
+  /// iteration limit) returns false and correct() runs KINSOL itself from the same predictor.
+  bool leanNewton(CorrectorSummary &summary);
 
   Problem &problem_;
   BorderedSolver *structured_ = nullptr;
@@ -112,6 +122,7 @@ class Corrector {
   int n_;
   Vector predictor_, tangent_, lastIterate_;
   Vector unit_;  // e_k for the fixed-coordinate solves
+  Vector iterate_, residual_, step_, trial_, trialResidual_;  // leanNewton()'s uu, fval, pp, unew
   std::vector<double> stepNorms_;  // capacity fixed at construction
   bool haveLastIterate_ = false;
   bool refused_ = false;

@@ -226,6 +226,10 @@ class Tracer {
   double eventScale(int event) const;
   /// options_.onStep(branch) with the new point and the special points in the problem's units.
   StepAction notifyStep(Branch &branch);
+  /// a.tangent · (b.state() − a.state()), the arclength of the step from a to b along a's tangent,
+  /// with the difference in along_: the same subtractions and the same Eigen dot product as that
+  /// expression (bit for bit), without its two heap-allocated states per call.
+  double stepAlong(const ContinuationPoint &a, const ContinuationPoint &b);
 
   Problem &problem_;
   TracerOptions options_;
@@ -242,6 +246,7 @@ class Tracer {
   std::unique_ptr<Locator> locator_;
   StepSizeControl stepControl_;
   Vector predictor_, x_;
+  Vector along_;  // stepAlong()'s x_b − x_a (size N+1)
   std::vector<double> eventsA_, eventsB_;  // event values at the current point and the new one
 };
 

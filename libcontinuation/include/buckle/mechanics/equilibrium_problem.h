@@ -131,6 +131,10 @@ class EquilibriumProblem final : public continuation::Problem {
   bool prepare(continuation::ConstVectorRef u);
   /// T at (u, λ) into ws from the cache (after prepare(u)).
   void assembleFromCache(continuation::ConstVectorRef u, double lambda, ChainStructure& ws);
+  /// The small dense route (n ≤ kSmallDense) at (u, λ): the inertia and all eigenvalues on
+  /// ker J_h into spectrumInertia_ and spectrum_, or nothing when (u, λ) is already their key.
+  /// False (nothing cached) outside the domain.
+  bool smallDenseSpectrum(continuation::ConstVectorRef u, double lambda);
 
   Chain chain_;
   EndCondition end_;
@@ -149,6 +153,14 @@ class EquilibriumProblem final : public continuation::Problem {
   Vector work_, work2_;  // size n
   ChainStructure structure_;  // workspace of the structured stability()
   Matrix heldRows_;           // m×n held rows of J
+  // The whole small dense spectrum (n ≤ kSmallDense) of the last (u, λ) it was computed at, by
+  // stability() or stabilityEigenvalues(): the tracer asks stability() for the inertia and then the
+  // certified counting's values at the same point (spectral_monitor.h), one eigen-solve serves
+  // both. Keyed bitwise on (u, λ) like the q-cache (H depends on r and λ through the wrench).
+  Vector spectrumKey_;                             // (u, λ) of spectrum_ (size N + 1)
+  Eigen::Matrix<double, kSmallDense, 1> spectrum_; // ascending eigenvalues on ker J_h ...
+  int spectrumSize_ = -1;                          // ... their number (n − rank); −1: none cached
+  Inertia spectrumInertia_;                        // ... and the inertia that goes with them
   Vector lastLowest_;         // warm start of the structured eigenvalue search
   Vector lastFrom_;           // warm start of stabilityEigenvalues: its last values ...
   int lastFirst_ = -1;        // ... and their first index
