@@ -361,6 +361,9 @@ enum class StepperKind {
   /// (O(n) per step instead of O(n³)): stiff long chains (both models; the inertial one with
   /// constraints solves its stages densely).
   StructuredRosenbrock4,
+  /// Dormand–Prince 5(4) while the flow is not stiff, StructuredRosenbrock4 while it is
+  /// (Hairer's stiffness test on the explicit steps; dynamics_integration.cpp, SwitchingStepper).
+  StructuredSwitching,
 };
 
 /// Times (initialStep, maxStep, minStep, maxTime, recordInterval) are in the model's natural
@@ -435,6 +438,7 @@ struct DynamicsResult {
   DynamicsKind kind = DynamicsKind::GradientFlow;
   double time = 0.0;                ///< duration (model time)
   long steps = 0, rejectedSteps = 0;
+  long stiffSteps = 0;              ///< StructuredSwitching: accepted steps taken by Rosenbrock4
   Vector q, qdot;                   ///< final state
   double initialEnergy = 0.0;       ///< Π + K at t = 0
   double potential = 0.0, kinetic = 0.0, dissipated = 0.0;
