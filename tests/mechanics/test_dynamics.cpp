@@ -1,7 +1,9 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <atomic>
+#include <limits>
 #include <cmath>
 #include <random>
 #include <string>
@@ -743,4 +745,51 @@ TEST_CASE("inertial O(n) stage solve equals the dense (I - a J)^-1 b with the ex
   REQUIRE(held.solveLinearized(x.data(), 0.1, b.data(), k.data()));
   const Matrix Wh = Matrix::Identity(N, N) - 0.1 * Matrix(Jh);
   CHECK((Wh * k - b).cwiseAbs().maxCoeff() < 1e-9 * (Wh.cwiseAbs() * k.cwiseAbs() + b.cwiseAbs()).maxCoeff());
+}
+
+TEST_CASE("dynamics statics: one sincos per joint gives the chain functions' potential, gradient and end pose (n = 1000, scaled units)",
+          "[dynamics]") {
+  // The model's statics rotate each link direction from the previous one by the joint's own
+  // half-angle sincos (dynamics.cpp, evaluateStatics); the chain functions (chain.cpp) take
+  // sin θ, cos θ of every absolute angle. Both differ only by rounding: the bound is a few ulp
+  // per rotation between re-anchors (≤ 16), scaled by the sums they enter.
+  std::mt19937 rng(7);
+  for (const double L : {1.0, 1e-3, 1e3}) {
+    for (const double k : {1.0, 1e-6, 1e6}) {
+      const int n = 1000;
+      const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5 * L, 1.0 * L, k, 1.2 * L));
+      const double F = 0.3 * k * L;  // a force of the chain's own scale k̄b̄²/b̄
+      const Wrench loads(F, -0.7 * F, 0.2 * k * L * L);
+      const EndCondition end = EndCondition::freeEnd(loads);
+      GradientFlowModel model(chain, end, DynamicsScene(), Vector::Zero(n));
+      for (const double spread : {0.01, 0.5, 1.5}) {  // nearly straight … coiled many times over
+        std::uniform_real_distribution<double> angle(-spread, spread);
+        Vector q(n);
+        for (int i = 0; i < n; ++i) q[i] = std::clamp(angle(rng), chain.lowerLimits()[i] * 0.99, chain.upperLimits()[i] * 0.99);
+        // the spring model with the half-angle given is the one energyJet(q) evaluates, bit for bit
+        for (int i = 0; i < n; i += 97) {
+          const Jet3 a = chain.segment(i).energyJet(q[i]);
+          const Jet3 b = chain.segment(i).energyJet(q[i], std::sin(0.5 * q[i]), std::cos(0.5 * q[i]));
+          CHECK(a.value == b.value);
+          CHECK(a.d1 == b.d1);
+          CHECK(a.d2 == b.d2);
+          CHECK(a.d3 == b.d3);
+        }
+        Vector g(n), gRef(n);
+        model.potentialGradient(q, g);
+        totalPotentialGradient(chain, q, loads, gRef);
+        const double eps = std::numeric_limits<double>::epsilon();
+        // each S_i, C_i sums up to n link vectors of length ℓ: rounding ~ n ε ℓ per sum (both routes)
+        const double forceScale = loads.head<2>().cwiseAbs().sum() * chain.length();
+        const double torqueScale = forceScale + gRef.cwiseAbs().maxCoeff();
+        CHECK((g - gRef).cwiseAbs().maxCoeff() <= 64.0 * eps * torqueScale);
+        CHECK(model.potential(q) == Approx(totalPotential(chain, q, loads)).epsilon(0).margin(64.0 * n * eps * (k * L * L + forceScale)));
+        CHECK(std::abs(model.equilibriumResidual(q) - gRef.cwiseAbs().maxCoeff()) <= 64.0 * eps * torqueScale);
+        // the end pose: a model holding the end at the chain functions' pose sees it violated by rounding only
+        const Pose p = endPose(chain, q);
+        GradientFlowModel held(chain, EndCondition::heldPosition(p[0], p[1]), DynamicsScene(), q);
+        CHECK(held.constraintViolation(q) <= 64.0 * eps * chain.length());
+      }
+    }
+  }
 }
