@@ -134,7 +134,7 @@ TEST_CASE("gradient flow: potential never increases, Pi + dissipation is conserv
   Vector q0(3);
   q0 << 0.1, -0.05, 0.02;
   for (StepperKind stepper : {StepperKind::DormandPrince5, StepperKind::CashKarp54, StepperKind::Rosenbrock4,
-                              StepperKind::StructuredRosenbrock4}) {
+                              StepperKind::StructuredRosenbrock4, StepperKind::StructuredSwitching}) {
     IntegrationOptions options;
     options.stepper = stepper;
     const DynamicsResult r = simulate(*model, q0, Vector(), options);
@@ -183,11 +183,15 @@ TEST_CASE("all steppers agree on the landing", "[dynamics]") {
   REQUIRE(b.reason == IntegrationStop::Rest);
   options.stepper = StepperKind::StructuredRosenbrock4;
   const DynamicsResult d = simulate(*model, q0, Vector(), options);
+  options.stepper = StepperKind::StructuredSwitching;
+  const DynamicsResult e = simulate(*model, q0, Vector(), options);
   REQUIRE(c.reason == IntegrationStop::Rest);
   REQUIRE(d.reason == IntegrationStop::Rest);
+  REQUIRE(e.reason == IntegrationStop::Rest);
   CHECK((a.q - b.q).cwiseAbs().maxCoeff() < 1e-7);
   CHECK((a.q - c.q).cwiseAbs().maxCoeff() < 1e-7);
   CHECK((a.q - d.q).cwiseAbs().maxCoeff() < 1e-7);
+  CHECK((a.q - e.q).cwiseAbs().maxCoeff() < 1e-7);
   CHECK(a.steps > 0);
   CHECK(c.steps > 0);
 }
@@ -528,6 +532,16 @@ TEST_CASE("one-sided joint limit: a segment driven past its limit locks there at
   }
   t *= qbar / m / 3.0;
   CHECK(e.t == Approx(t).epsilon(1e-8));
+  // the switching stepper (explicit steps, Rosenbrock trials for the event) locates the same instant
+  IntegrationOptions switching;
+  switching.stepper = StepperKind::StructuredSwitching;
+  const DynamicsResult sw = simulate(*model, Vector::Zero(1), Vector(), switching);
+  INFO(sw.message);
+  REQUIRE(sw.reason == IntegrationStop::Rest);
+  REQUIRE(sw.contactEvents.size() == 1);
+  CHECK(sw.contactEvents[0].t == Approx(t).epsilon(1e-8));
+  CHECK(sw.q[0] == qbar);
+  CHECK(sw.maxEnergyBalanceError < 1e-8);
   // Π + W_d conserved across the event (the lock moves q by the located instant's error only)
   CHECK(r.maxEnergyBalanceError < 1e-8);
   // the model's own contact set is left as it was: a second run is identical
