@@ -16,7 +16,9 @@
 // above kStructuredJumpFrom segments kLongJumpTolerance), whether the flow hands over to Newton in
 // the stable basin (jump.h, step 2) or integrates to rest, wall time of simulateJump (best of
 // `reps`), accepted steps, basin tests, and ‖Δq‖∞ of the landing from the case's reference (dense
-// Rosenbrock4 to rest where run, else the structured method to rest at 1e-10).
+// Rosenbrock4 to rest where run, else the structured method to rest at 1e-10). Above
+// kStructuredJumpFrom segments a last row runs the default stepper, StructuredSwitching
+// (Dormand–Prince while the flow is not stiff, jump.h).
 //
 //   jump_timing [--quick] [--n N] [--reps R] [--dense-max N] [--case fold|degenerate]
 //     --quick        CI size: n = 20 and 80 (the inertial case n = 8), one repetition
@@ -194,7 +196,10 @@ int main(int argc, char** argv) {
           else diff = (t.result.to - reference).cwiseAbs().maxCoeff();
         }
         std::printf("%-11s %-6d %-22s %-6.0e %-9s %11.1f %7ld %6d %8s %12.2e\n", c.c_str(), n,
-                    stepper == StepperKind::Rosenbrock4 ? "Rosenbrock4 (dense)" : "StructuredRosenbrock4", tol,
+                    stepper == StepperKind::Rosenbrock4             ? "Rosenbrock4 (dense)"
+                    : stepper == StepperKind::StructuredSwitching ? "StructuredSwitching"
+                                                                  : "StructuredRosenbrock4",
+                    tol,
                     handover == Handover::Never ? "no" : "yes", 1e3 * t.seconds, t.result.steps, t.result.basinTests,
                     t.result.success ? "yes" : "no", diff);
         ok = ok && t.result.success && !(diff > 1e-9);
@@ -204,6 +209,10 @@ int main(int argc, char** argv) {
       if (tolerance != tight) row(StepperKind::StructuredRosenbrock4, tolerance, Handover::Never, reps);
       // (the inertial model always integrates to rest: jump.h)
       if (c != "inertial") row(StepperKind::StructuredRosenbrock4, tolerance, Handover::Always, reps);
+      // the default above kStructuredJumpFrom: Dormand–Prince while not stiff (jump.h)
+      const StepperKind chosen = jumpIntegrationDefaults(n).stepper;
+      if (chosen == StepperKind::StructuredSwitching)
+        row(chosen, tolerance, c == "inertial" ? Handover::Never : Handover::Always, reps);
     }
   }
   return ok ? 0 : 1;

@@ -1,7 +1,9 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <atomic>
+#include <limits>
 #include <cmath>
 #include <random>
 #include <string>
@@ -132,7 +134,7 @@ TEST_CASE("gradient flow: potential never increases, Pi + dissipation is conserv
   Vector q0(3);
   q0 << 0.1, -0.05, 0.02;
   for (StepperKind stepper : {StepperKind::DormandPrince5, StepperKind::CashKarp54, StepperKind::Rosenbrock4,
-                              StepperKind::StructuredRosenbrock4}) {
+                              StepperKind::StructuredRosenbrock4, StepperKind::StructuredSwitching}) {
     IntegrationOptions options;
     options.stepper = stepper;
     const DynamicsResult r = simulate(*model, q0, Vector(), options);
@@ -181,11 +183,15 @@ TEST_CASE("all steppers agree on the landing", "[dynamics]") {
   REQUIRE(b.reason == IntegrationStop::Rest);
   options.stepper = StepperKind::StructuredRosenbrock4;
   const DynamicsResult d = simulate(*model, q0, Vector(), options);
+  options.stepper = StepperKind::StructuredSwitching;
+  const DynamicsResult e = simulate(*model, q0, Vector(), options);
   REQUIRE(c.reason == IntegrationStop::Rest);
   REQUIRE(d.reason == IntegrationStop::Rest);
+  REQUIRE(e.reason == IntegrationStop::Rest);
   CHECK((a.q - b.q).cwiseAbs().maxCoeff() < 1e-7);
   CHECK((a.q - c.q).cwiseAbs().maxCoeff() < 1e-7);
   CHECK((a.q - d.q).cwiseAbs().maxCoeff() < 1e-7);
+  CHECK((a.q - e.q).cwiseAbs().maxCoeff() < 1e-7);
   CHECK(a.steps > 0);
   CHECK(c.steps > 0);
 }
@@ -526,6 +532,16 @@ TEST_CASE("one-sided joint limit: a segment driven past its limit locks there at
   }
   t *= qbar / m / 3.0;
   CHECK(e.t == Approx(t).epsilon(1e-8));
+  // the switching stepper (explicit steps, Rosenbrock trials for the event) locates the same instant
+  IntegrationOptions switching;
+  switching.stepper = StepperKind::StructuredSwitching;
+  const DynamicsResult sw = simulate(*model, Vector::Zero(1), Vector(), switching);
+  INFO(sw.message);
+  REQUIRE(sw.reason == IntegrationStop::Rest);
+  REQUIRE(sw.contactEvents.size() == 1);
+  CHECK(sw.contactEvents[0].t == Approx(t).epsilon(1e-8));
+  CHECK(sw.q[0] == qbar);
+  CHECK(sw.maxEnergyBalanceError < 1e-8);
   // Π + W_d conserved across the event (the lock moves q by the located instant's error only)
   CHECK(r.maxEnergyBalanceError < 1e-8);
   // the model's own contact set is left as it was: a second run is identical
@@ -743,4 +759,51 @@ TEST_CASE("inertial O(n) stage solve equals the dense (I - a J)^-1 b with the ex
   REQUIRE(held.solveLinearized(x.data(), 0.1, b.data(), k.data()));
   const Matrix Wh = Matrix::Identity(N, N) - 0.1 * Matrix(Jh);
   CHECK((Wh * k - b).cwiseAbs().maxCoeff() < 1e-9 * (Wh.cwiseAbs() * k.cwiseAbs() + b.cwiseAbs()).maxCoeff());
+}
+
+TEST_CASE("dynamics statics: one sincos per joint gives the chain functions' potential, gradient and end pose (n = 1000, scaled units)",
+          "[dynamics]") {
+  // The model's statics rotate each link direction from the previous one by the joint's own
+  // half-angle sincos (dynamics.cpp, evaluateStatics); the chain functions (chain.cpp) take
+  // sin θ, cos θ of every absolute angle. Both differ only by rounding: the bound is a few ulp
+  // per rotation between re-anchors (≤ 16), scaled by the sums they enter.
+  std::mt19937 rng(7);
+  for (const double L : {1.0, 1e-3, 1e3}) {
+    for (const double k : {1.0, 1e-6, 1e6}) {
+      const int n = 1000;
+      const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5 * L, 1.0 * L, k, 1.2 * L));
+      const double F = 0.3 * k * L;  // a force of the chain's own scale k̄b̄²/b̄
+      const Wrench loads(F, -0.7 * F, 0.2 * k * L * L);
+      const EndCondition end = EndCondition::freeEnd(loads);
+      GradientFlowModel model(chain, end, DynamicsScene(), Vector::Zero(n));
+      for (const double spread : {0.01, 0.5, 1.5}) {  // nearly straight … coiled many times over
+        std::uniform_real_distribution<double> angle(-spread, spread);
+        Vector q(n);
+        for (int i = 0; i < n; ++i) q[i] = std::clamp(angle(rng), chain.lowerLimits()[i] * 0.99, chain.upperLimits()[i] * 0.99);
+        // the spring model with the half-angle given is the one energyJet(q) evaluates, bit for bit
+        for (int i = 0; i < n; i += 97) {
+          const Jet3 a = chain.segment(i).energyJet(q[i]);
+          const Jet3 b = chain.segment(i).energyJet(q[i], std::sin(0.5 * q[i]), std::cos(0.5 * q[i]));
+          CHECK(a.value == b.value);
+          CHECK(a.d1 == b.d1);
+          CHECK(a.d2 == b.d2);
+          CHECK(a.d3 == b.d3);
+        }
+        Vector g(n), gRef(n);
+        model.potentialGradient(q, g);
+        totalPotentialGradient(chain, q, loads, gRef);
+        const double eps = std::numeric_limits<double>::epsilon();
+        // each S_i, C_i sums up to n link vectors of length ℓ: rounding ~ n ε ℓ per sum (both routes)
+        const double forceScale = loads.head<2>().cwiseAbs().sum() * chain.length();
+        const double torqueScale = forceScale + gRef.cwiseAbs().maxCoeff();
+        CHECK((g - gRef).cwiseAbs().maxCoeff() <= 64.0 * eps * torqueScale);
+        CHECK(model.potential(q) == Approx(totalPotential(chain, q, loads)).epsilon(0).margin(64.0 * n * eps * (k * L * L + forceScale)));
+        CHECK(std::abs(model.equilibriumResidual(q) - gRef.cwiseAbs().maxCoeff()) <= 64.0 * eps * torqueScale);
+        // the end pose: a model holding the end at the chain functions' pose sees it violated by rounding only
+        const Pose p = endPose(chain, q);
+        GradientFlowModel held(chain, EndCondition::heldPosition(p[0], p[1]), DynamicsScene(), q);
+        CHECK(held.constraintViolation(q) <= 64.0 * eps * chain.length());
+      }
+    }
+  }
 }

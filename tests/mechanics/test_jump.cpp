@@ -452,7 +452,7 @@ TEST_CASE("long chain: the structured Rosenbrock method lands where dense Rosenb
   // drift of y_end: the per-step tolerance 1e-10 on each joint angle, summed over the chain's length
   CHECK(structured.dynamics.maxConstraintViolation < 1e-9 * chain.length());
   requirePotentialNonIncreasing(structured.dynamics, 1.0 + 2.0 * std::abs(structured.to[n]));
-  CHECK(jumpIntegrationDefaults(kStructuredJumpFrom + 1).stepper == StepperKind::StructuredRosenbrock4);
+  CHECK(jumpIntegrationDefaults(kStructuredJumpFrom + 1).stepper == StepperKind::StructuredSwitching);
 }
 
 namespace {
@@ -539,7 +539,7 @@ TEST_CASE("structured jump in scaled units: the same steps and landing angles (n
     JumpOptions options;
     options.integration = jumpIntegrationDefaults(n);
     options.integration.recordTrajectory = false;
-    REQUIRE(options.integration.stepper == StepperKind::StructuredRosenbrock4);
+    REQUIRE(options.integration.stepper == StepperKind::StructuredSwitching);
     return simulateJump(problem, problem.initialGuess(Vector::Zero(n), 0.0), 0.0, options);
   };
   const JumpResult base = run(1.0, 1.0), scaled = run(1e-3, 1e4);
@@ -776,4 +776,56 @@ TEST_CASE("inertial jump from a traced fold: the structured method on the exact 
   CHECK((fast.to - dense.to).cwiseAbs().maxCoeff() < 1e-9);
   // the energy balance K + Π + W_d = const holds along the structured steps to the tolerance
   CHECK(fast.dynamics.maxEnergyBalanceError < 1e-6 * std::max(1.0, std::abs(fast.energyReleased)));
+}
+
+TEST_CASE("switching stepper: the cascade lands where the structured Rosenbrock method does, in fewer steps (n = 100)",
+          "[jump]") {
+  // the straight chain's cascade (jump_timing, case degenerate) is not stiff: Dormand–Prince's
+  // steps, limited by accuracy, are longer than Rosenbrock4's at the same tolerance
+  const int n = 100;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
+  buckle::continuation::SpecialPoint start;
+  start.u = problem.initialGuess(Vector::Zero(n), 0.0);
+  start.lambda = 0.0;
+  const JumpResult rosenbrock = jumpWith(problem, start, StepperKind::StructuredRosenbrock4, Handover::Automatic);
+  const JumpResult switching = jumpWith(problem, start, StepperKind::StructuredSwitching, Handover::Automatic);
+  checkSameLandingFewerSteps(rosenbrock, switching);
+  CHECK((switching.to - rosenbrock.to).cwiseAbs().maxCoeff() < 1e-10 * rosenbrock.to.cwiseAbs().maxCoeff());
+  CHECK(switching.stopReason == IntegrationStop::Settled);
+  CHECK(switching.stable);
+  CHECK(rosenbrock.dynamics.stiffSteps == 0);  // (counted by the switching stepper only)
+  CHECK(switching.dynamics.stiffSteps < switching.steps / 2);
+  // the flow's Lyapunov function along the explicit steps
+  JumpOptions options;
+  options.integration = jumpIntegrationDefaults(n);
+  const JumpResult recorded = simulateJump(problem, start.u, 0.0, options);
+  REQUIRE(recorded.success);
+  CHECK(recorded.steps == switching.steps);
+  requirePotentialNonIncreasing(recorded.dynamics, 1.0 + 2.0 * std::abs(recorded.to[n]));
+}
+
+TEST_CASE("switching stepper: the creep to rest is stiff, it switches to Rosenbrock4 (fold, n = 100)", "[jump]") {
+  // integrated to rest (no hand-over) at the tight tolerance: near rest the explicit steps are
+  // limited by stability (dopri5 alone: hundreds of thousands of steps, benchmarks/RESULTS.md);
+  // the stiffness test hands them to Rosenbrock4, in about its own number of steps
+  TracedFold t = gradedChainFold(100);
+  auto run = [&](StepperKind stepper) {
+    JumpOptions options;
+    options.integration = jumpIntegrationDefaults(100);
+    options.integration.stepper = stepper;
+    options.integration.absoluteTolerance = options.integration.relativeTolerance = IntegrationOptions().absoluteTolerance;
+    options.integration.recordTrajectory = false;
+    options.handover = Handover::Never;
+    return simulateJump(*t.problem, t.fold.u, t.fold.lambda, options);
+  };
+  const JumpResult rosenbrock = run(StepperKind::StructuredRosenbrock4), switching = run(StepperKind::StructuredSwitching);
+  INFO(rosenbrock.message << " / " << switching.message);
+  REQUIRE(rosenbrock.success);
+  REQUIRE(switching.success);
+  CHECK(switching.stopReason == IntegrationStop::Rest);
+  CHECK(switching.dynamics.stiffSteps > 0);
+  CHECK(switching.steps < 2 * rosenbrock.steps);
+  CHECK((switching.to - rosenbrock.to).cwiseAbs().maxCoeff() < 1e-10 * rosenbrock.to.cwiseAbs().maxCoeff());
+  CHECK(switching.energyReleased == Approx(rosenbrock.energyReleased).epsilon(1e-10));
 }

@@ -151,6 +151,12 @@ class StructuredRosenbrock4 {
     lastRejected_ = false;
   }
 
+  const std::vector<double>& units() const { return unit_; }
+  /// The last step's sixth right-hand side's argument and value (after try_step: the new state
+  /// minus the error estimate, and f there).
+  const ExplicitState& lastStageState() const { return xtmp_; }
+  const ExplicitState& lastStageRhs() const { return f_; }
+
   /// One step of size dt from x into out, without error control (the trial steps of the event
   /// location: shorter than a step the control accepted).
   bool advance(const ExplicitState& x, double dt, ExplicitState& out) {
@@ -213,6 +219,159 @@ class StructuredRosenbrock4 {
   double dtOld_ = 0.0, errOld_ = 1.0;
   ExplicitState f_, r_, xtmp_, err_, xout_;
   ExplicitState g_[5];
+};
+
+/// Dormand–Prince 5(4) while the flow is not stiff, the structured Rosenbrock4 above while it is
+/// (StepperKind::StructuredSwitching). Both control the same RMS error norm in the components'
+/// units (StructuredRosenbrock4's), so a switch does not change what a step's accuracy means.
+///
+/// Stiffness test (Hairer & Wanner I, II.10 / dopri5.f): after an accepted Dormand–Prince step,
+/// h·ρ with ρ = ‖f(x₊) − f(x₆)‖ / ‖x₊ − x₆‖ (x₆ the last stage's argument, x₊ the new state) is
+/// a Rayleigh-quotient estimate of h|λ_max|; the method's stability boundary on the negative
+/// axis is ≈ 3.3. Fifteen such steps with h·ρ > 3.25 without six consecutive ones below
+/// switch to Rosenbrock4: there the explicit step is limited by stability, not accuracy. The way
+/// back estimates ρ after an accepted Rosenbrock step the same way, between its last stage's
+/// argument and the new state (x₊ − x₆ is the step's error estimate); `backAfter` consecutive
+/// steps with h·ρ < 1 switch back, and every switch back that ends in stiffness again doubles
+/// `backAfter` (no ping-pong where the estimate is poor). Measured (benchmarks/RESULTS.md): the
+/// cascade of the straight chain's jump is accuracy-limited, and there Dormand–Prince's
+/// order-4 error estimate allows steps about twice Rosenbrock4's (whose estimate is of order 3)
+/// at a sixth of the cost per step (no factorization, no stage solves).
+class SwitchingStepper {
+ public:
+  SwitchingStepper(DynamicsModel& model, double absoluteTolerance, double relativeTolerance)
+      : model_(model), rosenbrock_(model, absoluteTolerance, relativeTolerance), atol_(absoluteTolerance),
+        rtol_(relativeTolerance) {
+    const size_t N = size_t(model.stateSize());
+    for (ExplicitState* v : {&f0_, &f6_, &f7_, &x6_, &xout_, &err_, &k_[0], &k_[1], &k_[2], &k_[3], &k_[4]}) v->assign(N, 0.0);
+    unit_ = rosenbrock_.units();
+  }
+
+  odeint::controlled_step_result try_step(const ExplicitSystem& system, ExplicitState& x, double& t, double& dt) {
+    if (stiff_) {
+      const double h = dt;
+      const odeint::controlled_step_result res = rosenbrock_.try_step(system, x, t, dt);
+      if (res == odeint::success) {
+        ++stiffSteps_;
+        // ρ between the last stage's argument and the new state (a Rayleigh quotient of J)
+        const double hrho = h * lipschitzEstimate(rosenbrock_.lastStageState(), rosenbrock_.lastStageRhs(), x);
+        nonStiffRun_ = hrho < 1.0 ? nonStiffRun_ + 1 : 0;
+        if (nonStiffRun_ >= backAfter_) {
+          stiff_ = false;
+          switchedBack_ = true;
+          stiffCount_ = nonStiffRun_ = 0;
+          haveOld_ = lastRejected_ = false;
+        }
+      }
+      return res;
+    }
+    model_.rhs(x.data(), f0_.data());  // (the statics at x are cached from the monitor)
+    dopri(x, dt);
+    double sum = 0.0;
+    for (size_t i = 0; i < x.size(); ++i) {
+      const double e = err_[i] / (atol_ * unit_[i] + rtol_ * std::max(std::abs(x[i]), std::abs(xout_[i])));
+      sum += e * e;
+    }
+    const double err = std::sqrt(sum / double(x.size()));
+    // order-4 estimate: the step factor err^{1/5} (controller as StructuredRosenbrock4's)
+    constexpr double safe = 0.9, fac1 = 5.0, fac2 = 1.0 / 6.0;
+    double fac = std::isfinite(err) ? std::max(fac2, std::min(fac1, std::pow(err, 0.2) / safe)) : fac1;
+    if (!(err <= 1.0)) {
+      dt /= std::max(fac, 1.0 + 1e-3);
+      lastRejected_ = true;
+      return odeint::fail;
+    }
+    if (haveOld_) {
+      const double pred = std::max(fac2, std::min(fac1, (dtOld_ / dt) * std::pow(err * err / errOld_, 0.2) / safe));
+      fac = std::max(fac, pred);
+    }
+    haveOld_ = true;
+    dtOld_ = dt;
+    errOld_ = std::max(0.01, err);
+    double dtNew = dt / fac;
+    if (lastRejected_) dtNew = std::min(dtNew, dt);
+    lastRejected_ = false;
+    const double hrho = dt * lipschitzEstimate(x6_, f6_, xout_);
+    x.swap(xout_);
+    t += dt;
+    dt = dtNew;
+    if (hrho > 3.25) {
+      nonStiffRun_ = 0;
+      if (++stiffCount_ >= 15) {
+        stiff_ = true;
+        if (switchedBack_) backAfter_ *= 2;
+        stiffCount_ = nonStiffRun_ = 0;
+        rosenbrock_.reset();
+      }
+    } else if (++nonStiffRun_ >= 6) {
+      stiffCount_ = 0;
+    }
+    return odeint::success;
+  }
+
+  void reset() {
+    haveOld_ = lastRejected_ = false;
+    rosenbrock_.reset();
+  }
+
+  /// Accepted steps taken by Rosenbrock4.
+  long stiffSteps() const { return stiffSteps_; }
+
+ private:
+  /// ‖f(b) − f_a‖ / ‖b − a‖ over the angles (f_a = f(a); f(b) evaluated here: the statics at b
+  /// are the monitor's next ones, cached).
+  double lipschitzEstimate(const ExplicitState& a, const ExplicitState& fa, const ExplicitState& b) {
+    model_.rhs(b.data(), f7_.data());
+    const size_t n = size_t(model_.segments());
+    double num = 0.0, den = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      num += (f7_[i] - fa[i]) * (f7_[i] - fa[i]);
+      den += (b[i] - a[i]) * (b[i] - a[i]);
+    }
+    return den > 0.0 ? std::sqrt(num / den) : 0.0;
+  }
+
+  // One Dormand–Prince 5(4) step (odeint's runge_kutta_dopri5 tableau) from x with f0_ = f(x):
+  // xout_, the error estimate err_ (uses f(xout_), into f7_), x6_ and f6_ = f(x6_).
+  void dopri(const ExplicitState& x, double h) {
+    static constexpr double b21 = 1.0 / 5, b31 = 3.0 / 40, b32 = 9.0 / 40, b41 = 44.0 / 45, b42 = -56.0 / 15,
+                            b43 = 32.0 / 9, b51 = 19372.0 / 6561, b52 = -25360.0 / 2187, b53 = 64448.0 / 6561,
+                            b54 = -212.0 / 729, b61 = 9017.0 / 3168, b62 = -355.0 / 33, b63 = 46732.0 / 5247,
+                            b64 = 49.0 / 176, b65 = -5103.0 / 18656, c1 = 35.0 / 384, c3 = 500.0 / 1113,
+                            c4 = 125.0 / 192, c5 = -2187.0 / 6784, c6 = 11.0 / 84;
+    static constexpr double dc1 = c1 - 5179.0 / 57600, dc3 = c3 - 7571.0 / 16695, dc4 = c4 - 393.0 / 640,
+                            dc5 = c5 - -92097.0 / 339200, dc6 = c6 - 187.0 / 2100, dc7 = -1.0 / 40;
+    const size_t N = x.size();
+    ExplicitState& y = x6_;  // stage arguments (the last one is x₆)
+    const ExplicitState &k1 = f0_;
+    ExplicitState &k2 = k_[0], &k3 = k_[1], &k4 = k_[2], &k5 = k_[3], &k6 = f6_;
+    for (size_t i = 0; i < N; ++i) y[i] = x[i] + h * b21 * k1[i];
+    model_.rhs(y.data(), k2.data());
+    for (size_t i = 0; i < N; ++i) y[i] = x[i] + h * (b31 * k1[i] + b32 * k2[i]);
+    model_.rhs(y.data(), k3.data());
+    for (size_t i = 0; i < N; ++i) y[i] = x[i] + h * (b41 * k1[i] + b42 * k2[i] + b43 * k3[i]);
+    model_.rhs(y.data(), k4.data());
+    for (size_t i = 0; i < N; ++i) y[i] = x[i] + h * (b51 * k1[i] + b52 * k2[i] + b53 * k3[i] + b54 * k4[i]);
+    model_.rhs(y.data(), k5.data());
+    for (size_t i = 0; i < N; ++i) y[i] = x[i] + h * (b61 * k1[i] + b62 * k2[i] + b63 * k3[i] + b64 * k4[i] + b65 * k5[i]);
+    model_.rhs(y.data(), k6.data());
+    for (size_t i = 0; i < N; ++i) xout_[i] = x[i] + h * (c1 * k1[i] + c3 * k3[i] + c4 * k4[i] + c5 * k5[i] + c6 * k6[i]);
+    model_.rhs(xout_.data(), f7_.data());
+    for (size_t i = 0; i < N; ++i)
+      err_[i] = h * (dc1 * k1[i] + dc3 * k3[i] + dc4 * k4[i] + dc5 * k5[i] + dc6 * k6[i] + dc7 * f7_[i]);
+  }
+
+  DynamicsModel& model_;
+  StructuredRosenbrock4 rosenbrock_;
+  double atol_, rtol_;
+  std::vector<double> unit_;
+  bool stiff_ = false, switchedBack_ = false;
+  int stiffCount_ = 0, nonStiffRun_ = 0, backAfter_ = 15;
+  long stiffSteps_ = 0;
+  bool haveOld_ = false, lastRejected_ = false;
+  double dtOld_ = 0.0, errOld_ = 1.0;
+  ExplicitState f0_, f6_, f7_, x6_, xout_, err_;
+  ExplicitState k_[5];
 };
 
 /// The accepted-step loop shared by all steppers: guards, monitoring, recording, rest.
@@ -594,7 +753,15 @@ DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef 
 
   // The structured Rosenbrock method runs on the model's solveLinearized() (both models have it).
   const bool structured = natural.stepper == StepperKind::StructuredRosenbrock4;
-  if (structured) {
+  if (natural.stepper == StepperKind::StructuredSwitching) {
+    ExplicitState x(x0.data(), x0.data() + N);
+    SwitchingStepper controller(model, natural.absoluteTolerance, natural.relativeTolerance);
+    // event trials: one Rosenbrock4 step (L-stable: valid whatever the stiffness)
+    StructuredRosenbrock4 trial(model, natural.absoluteTolerance, natural.relativeTolerance);
+    auto subStep = [&](const ExplicitState& from, double, double h, ExplicitState& to) { return trial.advance(from, h, to); };
+    runLoop(controller, ExplicitSystem{&model}, x, explicitData, subStep, model, natural, monitor, result);
+    result.stiffSteps = controller.stiffSteps();
+  } else if (structured) {
     ExplicitState x(x0.data(), x0.data() + N);
     StructuredRosenbrock4 controller(model, natural.absoluteTolerance, natural.relativeTolerance);
     StructuredRosenbrock4 trial(model, natural.absoluteTolerance, natural.relativeTolerance);

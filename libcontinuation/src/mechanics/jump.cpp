@@ -204,8 +204,9 @@ IntegrationOptions jumpIntegrationDefaults(int segments) {
   if (segments >= 10) o.stepper = StepperKind::Rosenbrock4;
   // dense Rosenbrock4 costs O(n³) per step: long chains take the O(n) structured solve, and
   // (hand-over to Newton: the integration decides the basin, jump.h) the basin's tolerance
+  // (and Dormand–Prince while the flow is not stiff: StructuredSwitching, jump.h)
   if (segments > kStructuredJumpFrom) {
-    o.stepper = StepperKind::StructuredRosenbrock4;
+    o.stepper = StepperKind::StructuredSwitching;
     o.absoluteTolerance = o.relativeTolerance = kLongJumpTolerance;
   }
   return o;

@@ -102,8 +102,7 @@ inline Jet3 springNearLimit(double c, double sh, double sign, double P, double d
 }
 }  // namespace
 
-void Segment::springs(double q, Jet3& L1, Jet3& L2) const {
-  const double sq = std::sin(0.5 * q), cq = std::cos(0.5 * q);  // one sincos call at -O2
+void Segment::springs(double q, double sq, double cq, Jet3& L1, Jet3& L2) const {
   const double cc = cosHalfBeta_ * cq, ss = sinHalfBeta_ * sq;
   const double sc = sinHalfBeta_ * cq, cs = cosHalfBeta_ * sq;
   const double c1 = cc - ss, c2 = cc + ss;
@@ -123,18 +122,22 @@ void Segment::springs(double q, Jet3& L1, Jet3& L2) const {
 
 Jet3 Segment::spring1(double q) const {
   Jet3 L1, L2;
-  springs(q, L1, L2);
+  springs(q, std::sin(0.5 * q), std::cos(0.5 * q), L1, L2);
   return L1;
 }
 Jet3 Segment::spring2(double q) const {
   Jet3 L1, L2;
-  springs(q, L1, L2);
+  springs(q, std::sin(0.5 * q), std::cos(0.5 * q), L1, L2);
   return L2;
 }
 
 Jet3 Segment::energyJet(double q) const {
+  return energyJet(q, std::sin(0.5 * q), std::cos(0.5 * q));  // one sincos call at -O2
+}
+
+Jet3 Segment::energyJet(double q, double sinHalf, double cosHalf) const {
   Jet3 Ls[2];
-  springs(q, Ls[0], Ls[1]);
+  springs(q, sinHalf, cosHalf, Ls[0], Ls[1]);
   const double k[2] = {p_.k1, p_.k2};
   const double L0[2] = {p_.L1_0, p_.L2_0};
   Jet3 E;

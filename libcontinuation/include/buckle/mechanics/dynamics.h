@@ -211,6 +211,7 @@ class DynamicsModel {
   Vector stiffness_;     ///< K_q diagonal ∂²E/∂q_i²
   double springEnergy_ = 0.0;  ///< E(q)
   Vector staticsQ_;      ///< q of the cached statics
+  Vector cosTheta_, sinTheta_;  ///< cos θ_m, sin θ_m of the cached statics (evaluateStatics)
   bool staticsValid_ = false;
   Matrix Jh_;     ///< m×n constraint rows: held coordinates, then e_iᵀ of the locked joints
   Vector h_;      ///< p_h − target, then q_i − q̄_i
@@ -361,6 +362,9 @@ enum class StepperKind {
   /// (O(n) per step instead of O(n³)): stiff long chains (both models; the inertial one with
   /// constraints solves its stages densely).
   StructuredRosenbrock4,
+  /// Dormand–Prince 5(4) while the flow is not stiff, StructuredRosenbrock4 while it is
+  /// (Hairer's stiffness test on the explicit steps; dynamics_integration.cpp, SwitchingStepper).
+  StructuredSwitching,
 };
 
 /// Times (initialStep, maxStep, minStep, maxTime, recordInterval) are in the model's natural
@@ -435,6 +439,7 @@ struct DynamicsResult {
   DynamicsKind kind = DynamicsKind::GradientFlow;
   double time = 0.0;                ///< duration (model time)
   long steps = 0, rejectedSteps = 0;
+  long stiffSteps = 0;              ///< StructuredSwitching: accepted steps taken by Rosenbrock4
   Vector q, qdot;                   ///< final state
   double initialEnergy = 0.0;       ///< Π + K at t = 0
   double potential = 0.0, kinetic = 0.0, dissipated = 0.0;

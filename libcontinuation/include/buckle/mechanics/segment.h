@@ -48,6 +48,10 @@ class Segment {
   double stiffness(double q) const;          ///< K_q = d²E/dq²
   /// E and its first three derivatives in one pass (hot loop).
   Jet3 energyJet(double q) const;
+  /// The same with sinHalf = sin(q/2) and cosHalf = cos(q/2) given by the caller (who needs that
+  /// sincos anyway: the dynamics share it with the kinematics, dynamics.cpp). energyJet(q) is
+  /// this with std::sin / std::cos of q/2: bit for bit the same values.
+  Jet3 energyJet(double q, double sinHalf, double cosHalf) const;
 
   /// d/dμ of energyJet(q) (E, E′, E″, E‴ at fixed q) when the parameters move along `dp`: exact
   /// (forward-mode derivative of eq 1 in the form L² = c1² + c2² + 2c1c2 cos(β12 ± q)), so away
@@ -69,7 +73,7 @@ class Segment {
 
  private:
   /// Both spring jets from one sincos of q/2 (the hot path of energyJet).
-  void springs(double q, Jet3& L1, Jet3& L2) const;
+  void springs(double q, double sinHalf, double cosHalf, Jet3& L1, Jet3& L2) const;
   SegmentParameters p_;
   double c1_, c2_, beta12_, c1c2_, sqrtP_;
   double delta_;                         ///< (c1 − c2)²
