@@ -1,9 +1,11 @@
 // bench_cases: buckle on the AUTO-07p comparison cases, one line per located point and a
 // timing line per case, machine-readable (key=value) for compare_auto.sh.
-//   bench_cases [--reps R] [--second-order] [--no-certified] [CASE ...]   default: all cases, R = 5
+//   bench_cases [--reps R] [--second-order] [--no-certified] [--lean-newton] [CASE ...]
+//   default: all cases, R = 5
 //   (median time); --second-order: TracerOptions::secondOrderPredictor; --no-certified:
 //   TracerOptions::certifiedCounting = false (the like-for-like A/B against AUTO, which computes no
-//   eigenvalues with IPS = 0)
+//   eigenvalues with IPS = 0); --lean-newton: TracerOptions::leanNewton (the corrector's own
+//   reproduction of KINSOL's full Newton where it converges plainly, KINSOL otherwise)
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -20,10 +22,12 @@ int main(int argc, char** argv) {
   std::vector<std::string> names;
   bool secondOrder = false;
   bool certified = true;
+  bool leanNewton = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--second-order")) secondOrder = true;
     else if (!std::strcmp(argv[i], "--no-certified")) certified = false;
+    else if (!std::strcmp(argv[i], "--lean-newton")) leanNewton = true;
     else names.emplace_back(argv[i]);
   }
   if (names.empty()) names = caseNames();
@@ -33,6 +37,7 @@ int main(int argc, char** argv) {
   settings.lowestEigenvalues = 0;
   settings.secondOrderPredictor = secondOrder;
   settings.certifiedCounting = certified;
+  settings.leanNewton = leanNewton;
   int failures = 0;
   for (const auto& name : names) {
     std::vector<double> times;

@@ -51,6 +51,7 @@ struct Settings {
   int lowestEigenvalues = 3;
   bool secondOrderPredictor = false;  ///< TracerOptions::secondOrderPredictor
   bool certifiedCounting = true;      ///< TracerOptions::certifiedCounting
+  bool leanNewton = false;            ///< TracerOptions::leanNewton
 };
 
 inline cont::TracerOptions tracerOptions(const Settings& s, double lambdaMin, double lambdaMax) {
@@ -65,6 +66,7 @@ inline cont::TracerOptions tracerOptions(const Settings& s, double lambdaMin, do
   o.lowestEigenvalues = s.lowestEigenvalues;
   o.secondOrderPredictor = s.secondOrderPredictor;
   o.certifiedCounting = s.certifiedCounting;
+  o.leanNewton = s.leanNewton;
   o.lambdaMin = lambdaMin;
   o.lambdaMax = lambdaMax;
   o.maxPoints = 20000;

@@ -307,6 +307,7 @@ TEST_CASE("Corrector's lean Newton: KINSOL's outcome bit for bit on every path w
       if (problem == &bratu) predictor[n] = 1.0 + W(rng);
       tangent.normalize();
       Vector xLean(n + 1), xKinsol(n + 1);
+      options.leanNewton = true;
       CorrectorOptions kinsolOnly = options;
       kinsolOnly.leanNewton = false;
       Corrector a(*problem, options, useBordered ? &bordered : nullptr);

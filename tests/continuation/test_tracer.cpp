@@ -167,6 +167,43 @@ TEST_CASE("Second-order predictor: same circle and folds with fewer Newton itera
   CHECK(std::abs(folds[1]->lambda + 1.0) < 1e-12);
 }
 
+TEST_CASE("TracerOptions::leanNewton: the same branch and special points, bit for bit, as KINSOL's Newton", "[tracer]") {
+  // The opt-in lean corrector reproduces KINSOL's full Newton; a whole branch with folds and
+  // branch points must come out identical, point by point and bit by bit.
+  auto same = [](const Branch &a, const Branch &b) {
+    REQUIRE(a.points.size() == b.points.size());
+    for (size_t i = 0; i < a.points.size(); ++i) {
+      CHECK(a.points[i].lambda == b.points[i].lambda);
+      CHECK(a.points[i].newtonIterations == b.points[i].newtonIterations);
+      CHECK((a.points[i].u.array() == b.points[i].u.array()).all());
+    }
+    REQUIRE(a.specialPoints.size() == b.specialPoints.size());
+    for (size_t i = 0; i < a.specialPoints.size(); ++i) {
+      CHECK(a.specialPoints[i].type == b.specialPoints[i].type);
+      CHECK(a.specialPoints[i].lambda == b.specialPoints[i].lambda);
+    }
+  };
+  TracerOptions options;
+  options.maxArclength = 2.0 * M_PI - 0.3;
+  toys::Circle circle;
+  const Branch kinsol = trace(circle, vec1(1.02), 0.0, InitialDirection::increasingLambda(), options);
+  options.leanNewton = true;
+  const Branch lean = trace(circle, vec1(1.02), 0.0, InitialDirection::increasingLambda(), options);
+  REQUIRE(kinsol.specialPointsOfType(SpecialPointType::Fold).size() == 2);
+  same(kinsol, lean);
+
+  toys::TwoPitchforks pitchforks(0.5);
+  TracerOptions p;
+  p.lambdaMin = -3.0;
+  p.lambdaMax = 3.0;
+  const Vector u0 = Vector::Zero(pitchforks.dimension());
+  const Branch k2 = trace(pitchforks, u0, -3.0, InitialDirection::increasingLambda(), p);
+  p.leanNewton = true;
+  const Branch l2 = trace(pitchforks, u0, -3.0, InitialDirection::increasingLambda(), p);
+  REQUIRE(!k2.specialPointsOfType(SpecialPointType::BranchPoint).empty());
+  same(k2, l2);
+}
+
 namespace {
 /// λ + e²u − u³/3 = 0: folds at u = ±e, λ = ∓2e³/3, a distance ≈ 2e apart along a branch that is
 /// nearly perpendicular to λ there (λ' = e² − u² is small): the tangents at the ends of a step

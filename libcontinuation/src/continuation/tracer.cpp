@@ -87,6 +87,7 @@ CorrectorOptions Tracer::stepCorrectorOptions() const {
   c.stepTolerance = options_.newtonStepTolerance;
   c.maxIterations = options_.maxNewtonIterations;
   c.lineSearch = options_.lineSearch;
+  c.leanNewton = options_.leanNewton;
   return c;
 }
 

@@ -51,10 +51,12 @@ struct CorrectorOptions {
   /// A solve that stalls on the step tolerance (KIN_STEP_LT_STPTOL: rounding floor reached)
   /// still counts as converged if ‖G‖₂ ≤ stagnationFactor · residualTolerance.
   double stagnationFactor = 100.0;
-  /// Full Newton (lineSearch false) by Corrector's own reproduction of KINSOL's iteration where it
-  /// converges plainly (the same iterates, flag, counts and norms, bit for bit), KINSOL itself
-  /// otherwise; false: KINSOL always (kept for the cross-checks).
-  bool leanNewton = true;
+  /// Opt-in: full Newton (lineSearch false) by Corrector's own reproduction of KINSOL's iteration
+  /// where it converges plainly (the same iterates, flag, counts and norms, bit for bit), KINSOL
+  /// itself otherwise. Off by default: the corrector is KINSOL's (the design card); on, it saves
+  /// KINSOL's per-call bookkeeping (≈ 1.8 k instructions per point at n = 3, benchmarks/RESULTS.md
+  /// "round 6") for callers that trace many tiny systems.
+  bool leanNewton = false;
 
   bool IsValid(std::string *why) const;
 };

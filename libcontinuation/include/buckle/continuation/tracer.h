@@ -90,6 +90,7 @@ struct TracerOptions {
   double newtonStepTolerance = 1e-14;
   int maxNewtonIterations = 10;
   bool lineSearch = false;
+  bool leanNewton = false;          ///< CorrectorOptions::leanNewton (opt-in; KINSOL otherwise)
 
   // ---- detection and location ------------------------------------------------------------
   bool detectFolds = true;
