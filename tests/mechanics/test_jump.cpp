@@ -18,6 +18,23 @@ namespace {
 // wells at c* = bL0 / (2(b² − a²)) = 0.8, q* = ±2 acos 0.8 ≈ ±1.287 — inside the geometric limit
 // ±2.214. A multistable chain: folds on stable branches, snap-through to other stable shapes.
 Chain bistableChain() { return Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2)); }
+// n of those segments straight, clamped–pinned with y held: a degenerate start whose lowest
+// eigenvalue is repeated n − 1 times (jump_timing's "degenerate" case; the cascade).
+struct DegenerateChain {
+  explicit DegenerateChain(int n)
+      : chain(Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2))),
+        problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0)),
+        u0(problem.initialGuess(Vector::Zero(n), 0.0)) {}
+  buckle::continuation::SpecialPoint start() const {
+    buckle::continuation::SpecialPoint s;
+    s.u = u0;
+    s.lambda = 0.0;
+    return s;
+  }
+  Chain chain;
+  EquilibriumProblem problem;
+  Vector u0;
+};
 // AUTO's I_up case (shared/peers/auto07p): L0 = 0.5, κ = −1, wells beyond the joint limits.
 Chain autoIupChain() { return Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 0.5)); }
 
@@ -431,9 +448,10 @@ TEST_CASE("jump and sudden-load options are validated with a reason", "[jump]") 
 
 TEST_CASE("long chain: the structured Rosenbrock method lands where dense Rosenbrock4 does (n = 50, y held)", "[jump]") {
   const int n = 50;
-  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));  // κ < 0
-  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
-  const Vector u0 = problem.initialGuess(Vector::Zero(n), 0.0);
+  DegenerateChain c(n);  // κ < 0
+  const Chain &chain = c.chain;
+  EquilibriumProblem &problem = c.problem;
+  const Vector &u0 = c.u0;
   JumpOptions options;
   options.integration = jumpIntegrationDefaults(n);
   REQUIRE(options.integration.stepper == StepperKind::Rosenbrock4);
@@ -559,9 +577,10 @@ TEST_CASE("direction rule for a multiple lowest eigenvalue: the dense and O(n) r
   // c = J_yᵀ, c_i = x_end − x_i (eq 11).
   for (int n : {20, 50}) {
     INFO("n = " << n);
-    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
-    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
-    const Vector u = problem.initialGuess(Vector::Zero(n), 0.0);
+    DegenerateChain straight(n);
+    const Chain &chain = straight.chain;
+    EquilibriumProblem &problem = straight.problem;
+    const Vector &u = straight.u0;
     const UnstableDirection dense = unstableDirection(problem, u, 0.0, DirectionRoute::Dense);
     const UnstableDirection fast = unstableDirection(problem, u, 0.0, DirectionRoute::Structured);
     REQUIRE(dense.valid);
@@ -691,13 +710,8 @@ TEST_CASE("hand-over to Newton: the landing of integration to rest, in fewer ste
     compare(*t.problem, t.fold);
   }
   SECTION("degenerate straight chain, n = 80 (the cascade of the rule's direction)") {
-    const int n = 80;
-    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
-    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
-    buckle::continuation::SpecialPoint start;
-    start.u = problem.initialGuess(Vector::Zero(n), 0.0);
-    start.lambda = 0.0;
-    compare(problem, start);
+    DegenerateChain c(80);
+    compare(c.problem, c.start());
   }
 }
 
@@ -746,10 +760,8 @@ TEST_CASE("long chains' basin tolerance: the landing of the 1e-10 integration, i
     compare(*t.problem, t.fold.u, t.fold.lambda);
   }
   SECTION("degenerate straight chain (the cascade)") {
-    const int n = 100;
-    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
-    EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
-    compare(problem, problem.initialGuess(Vector::Zero(n), 0.0), 0.0);
+    DegenerateChain c(100);
+    compare(c.problem, c.u0, 0.0);
   }
 }
 
@@ -783,11 +795,9 @@ TEST_CASE("switching stepper: the cascade lands where the structured Rosenbrock 
   // the straight chain's cascade (jump_timing, case degenerate) is not stiff: Dormand–Prince's
   // steps, limited by accuracy, are longer than Rosenbrock4's at the same tolerance
   const int n = 100;
-  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2));
-  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0, 0.0), Eigen::Vector3d(1, 0, 0));
-  buckle::continuation::SpecialPoint start;
-  start.u = problem.initialGuess(Vector::Zero(n), 0.0);
-  start.lambda = 0.0;
+  DegenerateChain c(n);
+  EquilibriumProblem &problem = c.problem;
+  const buckle::continuation::SpecialPoint start = c.start();
   const JumpResult rosenbrock = jumpWith(problem, start, StepperKind::StructuredRosenbrock4, Handover::Automatic);
   const JumpResult switching = jumpWith(problem, start, StepperKind::StructuredSwitching, Handover::Automatic);
   checkSameLandingFewerSteps(rosenbrock, switching);

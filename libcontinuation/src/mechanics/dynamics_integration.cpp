@@ -89,6 +89,58 @@ struct StiffJacobian {
   }
 };
 
+/// The RMS norm of an error estimate e over atol·u_i + rtol·max(|x_i|, |x⁺_i|) (Hairer & Wanner
+/// II.4, u_i the component's unit).
+double weightedErrorNorm(const ExplicitState& e, const ExplicitState& x, const ExplicitState& xNew,
+                         const std::vector<double>& unit, double atol, double rtol) {
+  double sum = 0.0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const double w = e[i] / (atol * unit[i] + rtol * std::max(std::abs(x[i]), std::abs(xNew[i])));
+    sum += w * w;
+  }
+  return std::sqrt(sum / double(x.size()));
+}
+
+/// Step-size control as odeint's rosenbrock4_controller (Hairer & Wanner IV.8): the factor
+/// err^{1/p}/0.9 within [1/6, 5] and, after an accepted step, Gustafsson's predictive factor; no
+/// growth right after a rejection. p = 4 for Rosenbrock4's order-3 estimate, 5 for Dormand–Prince.
+struct StepSizeController {
+  double exponent;  ///< 1/p
+  bool haveOld = false, lastRejected = false;
+  double dtOld = 0.0, errOld = 1.0;
+
+  /// After a rollback or an event the step history no longer applies (as odeint's reset()).
+  void reset() { haveOld = lastRejected = false; }
+  /// A step that could not be evaluated: retry at half the size.
+  void refuse(double& dt) {
+    dt *= 0.5;
+    lastRejected = true;
+  }
+  /// err: the weighted error norm of the step of size dt just tried. True: accepted, dt becomes
+  /// the next step; false: rejected, dt becomes the retry's.
+  bool accept(double err, double& dt) {
+    constexpr double safe = 0.9, fac1 = 5.0, fac2 = 1.0 / 6.0;
+    double fac = std::isfinite(err) ? std::max(fac2, std::min(fac1, std::pow(err, exponent) / safe)) : fac1;
+    if (!(err <= 1.0)) {
+      dt /= std::max(fac, 1.0 + 1e-3);
+      lastRejected = true;
+      return false;
+    }
+    if (haveOld) {
+      const double pred = std::max(fac2, std::min(fac1, (dtOld / dt) * std::pow(err * err / errOld, exponent) / safe));
+      fac = std::max(fac, pred);
+    }
+    haveOld = true;
+    dtOld = dt;
+    errOld = std::max(0.01, err);
+    double dtNew = dt / fac;
+    if (lastRejected) dtNew = std::min(dtNew, dt);
+    lastRejected = false;
+    dt = dtNew;
+    return true;
+  }
+};
+
 /// odeint's rosenbrock4 (Shampine's L-stable order-4 method with an embedded order-3 estimate,
 /// odeint::default_rosenbrock_coefficients) with the model's O(n) structured solve
 /// (DynamicsModel::solveLinearized) in place of the dense LU of (1/(γτ)) I − J: each stage
@@ -112,44 +164,18 @@ class StructuredRosenbrock4 {
 
   odeint::controlled_step_result try_step(const ExplicitSystem&, ExplicitState& x, double& t, double& dt) {
     if (!step(x, dt)) {
-      dt *= 0.5;
-      lastRejected_ = true;
+      control_.refuse(dt);
       return odeint::fail;
     }
-    double sum = 0.0;
-    for (size_t i = 0; i < x.size(); ++i) {
-      const double e = err_[i] / (atol_ * unit_[i] + rtol_ * std::max(std::abs(x[i]), std::abs(xout_[i])));
-      sum += e * e;
-    }
-    const double err = std::sqrt(sum / double(x.size()));
-    constexpr double safe = 0.9, fac1 = 5.0, fac2 = 1.0 / 6.0;
-    double fac = std::isfinite(err) ? std::max(fac2, std::min(fac1, std::pow(err, 0.25) / safe)) : fac1;
-    if (!(err <= 1.0)) {
-      dt /= std::max(fac, 1.0 + 1e-3);
-      lastRejected_ = true;
-      return odeint::fail;
-    }
-    if (haveOld_) {
-      const double pred = std::max(fac2, std::min(fac1, (dtOld_ / dt) * std::pow(err * err / errOld_, 0.25) / safe));
-      fac = std::max(fac, pred);
-    }
-    haveOld_ = true;
-    dtOld_ = dt;
-    errOld_ = std::max(0.01, err);
-    double dtNew = dt / fac;
-    if (lastRejected_) dtNew = std::min(dtNew, dt);
-    lastRejected_ = false;
+    const double h = dt;
+    if (!control_.accept(weightedErrorNorm(err_, x, xout_, unit_, atol_, rtol_), dt)) return odeint::fail;
     x.swap(xout_);
-    t += dt;
-    dt = dtNew;
+    t += h;
     return odeint::success;
   }
 
   /// After a rollback or an event the step history no longer applies (as odeint's reset()).
-  void reset() {
-    haveOld_ = false;
-    lastRejected_ = false;
-  }
+  void reset() { control_.reset(); }
 
   const std::vector<double>& units() const { return unit_; }
   /// The last step's sixth right-hand side's argument and value (after try_step: the new state
@@ -215,8 +241,7 @@ class StructuredRosenbrock4 {
   DynamicsModel& model_;
   double atol_, rtol_;
   std::vector<double> unit_;
-  bool haveOld_ = false, lastRejected_ = false;
-  double dtOld_ = 0.0, errOld_ = 1.0;
+  StepSizeController control_{0.25};
   ExplicitState f_, r_, xtmp_, err_, xout_;
   ExplicitState g_[5];
 };
@@ -260,41 +285,19 @@ class SwitchingStepper {
           stiff_ = false;
           switchedBack_ = true;
           stiffCount_ = nonStiffRun_ = 0;
-          haveOld_ = lastRejected_ = false;
+          control_.reset();
         }
       }
       return res;
     }
     model_.rhs(x.data(), f0_.data());  // (the statics at x are cached from the monitor)
     dopri(x, dt);
-    double sum = 0.0;
-    for (size_t i = 0; i < x.size(); ++i) {
-      const double e = err_[i] / (atol_ * unit_[i] + rtol_ * std::max(std::abs(x[i]), std::abs(xout_[i])));
-      sum += e * e;
-    }
-    const double err = std::sqrt(sum / double(x.size()));
-    // order-4 estimate: the step factor err^{1/5} (controller as StructuredRosenbrock4's)
-    constexpr double safe = 0.9, fac1 = 5.0, fac2 = 1.0 / 6.0;
-    double fac = std::isfinite(err) ? std::max(fac2, std::min(fac1, std::pow(err, 0.2) / safe)) : fac1;
-    if (!(err <= 1.0)) {
-      dt /= std::max(fac, 1.0 + 1e-3);
-      lastRejected_ = true;
-      return odeint::fail;
-    }
-    if (haveOld_) {
-      const double pred = std::max(fac2, std::min(fac1, (dtOld_ / dt) * std::pow(err * err / errOld_, 0.2) / safe));
-      fac = std::max(fac, pred);
-    }
-    haveOld_ = true;
-    dtOld_ = dt;
-    errOld_ = std::max(0.01, err);
-    double dtNew = dt / fac;
-    if (lastRejected_) dtNew = std::min(dtNew, dt);
-    lastRejected_ = false;
-    const double hrho = dt * lipschitzEstimate(x6_, f6_, xout_);
+    // order-4 estimate: the step factor err^{1/5}
+    const double h = dt;
+    if (!control_.accept(weightedErrorNorm(err_, x, xout_, unit_, atol_, rtol_), dt)) return odeint::fail;
+    const double hrho = h * lipschitzEstimate(x6_, f6_, xout_);
     x.swap(xout_);
-    t += dt;
-    dt = dtNew;
+    t += h;
     if (hrho > 3.25) {
       nonStiffRun_ = 0;
       if (++stiffCount_ >= 15) {
@@ -310,7 +313,7 @@ class SwitchingStepper {
   }
 
   void reset() {
-    haveOld_ = lastRejected_ = false;
+    control_.reset();
     rosenbrock_.reset();
   }
 
@@ -368,8 +371,7 @@ class SwitchingStepper {
   bool stiff_ = false, switchedBack_ = false;
   int stiffCount_ = 0, nonStiffRun_ = 0, backAfter_ = 15;
   long stiffSteps_ = 0;
-  bool haveOld_ = false, lastRejected_ = false;
-  double dtOld_ = 0.0, errOld_ = 1.0;
+  StepSizeController control_{0.2};
   ExplicitState f0_, f6_, f7_, x6_, xout_, err_;
   ExplicitState k_[5];
 };
