@@ -189,20 +189,24 @@ class CloseFolds : public Problem {
   double e_;
 };
 
-// Every setting of the step control: the rule, the predictor, the largest step.
+// Every setting of the step control: the rule, the predictor, the growth factor, the largest
+// step (0.1, 0.2, 0.3, 1, 1.5 divide the distance 3 from the start to the first branch point of
+// the pitchforks below: whole steps land on it to rounding).
 template <class Check>
 void forEveryStepSetting(Check check) {
   for (const auto rule : {StepSizeControl::Rule::Curvature, StepSizeControl::Rule::NewtonCount})
     for (const bool secondOrder : {false, true})
-      for (const double maxStep : {0.05, 0.2, 0.5, 1.0, 2.0}) {
-        TracerOptions options;
-        options.stepRule = rule;
-        options.foldPairGuard = true;
-        options.secondOrderPredictor = secondOrder;
-        options.maxStep = maxStep;
-        options.initialStep = std::min(0.1, maxStep);
-        check(options);
-      }
+      for (const double growth : {1.5, 3.0})
+        for (const double maxStep : {0.05, 0.1, 0.2, 0.3, 0.5, 1.0, 1.5, 2.0}) {
+          TracerOptions options;
+          options.stepRule = rule;
+          options.foldPairGuard = true;
+          options.secondOrderPredictor = secondOrder;
+          options.stepGrowth = growth;
+          options.maxStep = maxStep;
+          options.initialStep = std::min(0.1, maxStep);
+          check(options);
+        }
 }
 }  // namespace
 
@@ -227,37 +231,46 @@ TEST_CASE("No step jumps over two close folds undetected, at any step setting", 
   CHECK(stepsOverBoth > 0);  // the guard is what finds them there
 }
 
-// Both branch points are among those found (a third, reported at some settings on the
-// TwoPitchforks toy from λ = −3, is under investigation: see the stepctl report).
-bool hasBranchPointAt(const Branch &branch, double lambda, double tolerance) {
-  for (const SpecialPoint *bp : branch.specialPointsOfType(SpecialPointType::BranchPoint))
-    if (std::abs(bp->lambda - lambda) <= tolerance) return true;
-  return false;
+// Exactly the two branch points, at their closed-form λ (0 and c), each once.
+void checkTwoBranchPoints(const Branch &branch, double c, double tolerance) {
+  const auto bps = branch.specialPointsOfType(SpecialPointType::BranchPoint);
+  std::ostringstream found;
+  for (const SpecialPoint *bp : bps)
+    found << "\n  branch point at " << bp->lambda << " after point " << bp->index << (bp->refined ? " (refined) " : " ")
+          << bp->note;
+  INFO("found:" << found.str());
+  REQUIRE(bps.size() == 2);
+  CHECK(std::abs(bps[0]->lambda) <= tolerance);
+  CHECK(std::abs(bps[1]->lambda - c) <= tolerance);
+  CHECK(bps[0]->multiplicity == 1);
+  CHECK(bps[1]->multiplicity == 1);
 }
 
 TEST_CASE("No step jumps over two close branch points undetected, at any step setting", "[tracer]") {
-  const double c = 1e-3;
-  toys::TwoPitchforks problem(c);
-  forEveryStepSetting([&](TracerOptions options) {
-    options.lambdaMax = 3.0;
-    const Branch branch = trace(problem, Vector::Zero(2), -3.0, InitialDirection::increasingLambda(), options);
-    INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " maxStep " << options.maxStep);
-    CHECK(hasBranchPointAt(branch, 0.0, 1e-12));
-    CHECK(hasBranchPointAt(branch, c, 1e-12));
-  });
+  // Before, steps landing on λ = 0 to rounding (maxStep 0.1, 0.2, 0.3, 1, 1.5 from λ = −3) reported
+  // the first branch point twice: the step ending there from the determinant's sign change, the
+  // next from the inertia, the crossing eigenvalue being in the count's zero band at the shared
+  // point (classifyInterval). c = 0.5 as well: there the two points are in different steps.
+  for (const double c : {1e-3, 0.5}) {
+    toys::TwoPitchforks problem(c);
+    forEveryStepSetting([&](TracerOptions options) {
+      options.lambdaMax = 3.0;
+      const Branch branch = trace(problem, Vector::Zero(2), -3.0, InitialDirection::increasingLambda(), options);
+      INFO("c " << c << " rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " growth "
+                << options.stepGrowth << " maxStep " << options.maxStep);
+      CHECK(branch.stopReason == StopReason::LambdaRange);
+      checkTwoBranchPoints(branch, c, 1e-12);
+    });
+  }
   // The same on a curved trivial branch (F_λ ≠ 0), where the steps follow its curvature.
-  toys::CurvedPitchforks curved(c);
+  toys::CurvedPitchforks curved(1e-3);
   forEveryStepSetting([&](TracerOptions options) {
     options.lambdaMax = 2.0;
     const Vector u0 = toys::CurvedPitchforks::shift(-2.0);
     const Branch branch = trace(curved, u0, -2.0, InitialDirection::increasingLambda(), options);
-    INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " maxStep " << options.maxStep);
-    std::ostringstream found;
-    for (const SpecialPoint *bp : branch.specialPointsOfType(SpecialPointType::BranchPoint))
-      found << "\n  branch point at " << bp->lambda << (bp->refined ? " (refined) " : " ") << bp->note;
-    INFO("found:" << found.str());
-    CHECK(hasBranchPointAt(branch, 0.0, 1e-11));
-    CHECK(hasBranchPointAt(branch, c, 1e-11));
+    INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " growth " << options.stepGrowth
+                 << " maxStep " << options.maxStep);
+    checkTwoBranchPoints(branch, 1e-3, 1e-11);
   });
 }
 

@@ -95,6 +95,37 @@ bool foldBetween(const ContinuationPoint &a, const ContinuationPoint &b) {
   return fuFlips != borderedFlips;
 }
 
+namespace {
+
+// sign det F_u at a point, by Cramer's rule t_λ = det F_u / det [[F_u, F_λ], [tᵀ]] (0: unknown).
+int jacobianDeterminantSign(const ContinuationPoint &p) {
+  if (p.determinantSign == 0 || p.foldTest == 0.0) return 0;
+  return p.foldTest > 0.0 ? p.determinantSign : -p.determinantSign;
+}
+
+// The inertia ν of p for counting the crossings between p and `other`, with an eigenvalue in the
+// count's zero band at p (stability.zero: neither negative nor positive) put on the side that
+// det F_u takes at p. A step can end where an eigenvalue crosses (a branch point at λ = 0 reached
+// in whole steps from λ = −3 lands there to rounding): there ν does not count it as negative, but
+// the determinant may already have changed sign, so without this the step ending at p counts the
+// crossing from the determinant and the next one counts it again from ν (one branch point located
+// twice). The assignment depends on p alone, and the two steps that share p see the same one.
+// Along a branch sign det F_u = σ·(−1)^ν with a fixed σ (as in foldBetween: H = ±F_u or the KKT
+// form), so ν_p has the parity of ν_other plus one if sign det F_u differs between the two points.
+// Only a single zero-band eigenvalue at p facing a clear count at `other` is settled: with several
+// the parity does not fix the count (a double zero would be lost), and two ambiguous ends have no
+// reference.
+int settledNegative(const ContinuationPoint &p, const ContinuationPoint &other) {
+  const int nu = p.stability.negative;
+  if (p.stability.zero != 1 || other.stability.zero != 0) return nu;
+  const int sp = jacobianDeterminantSign(p), so = jacobianDeterminantSign(other);
+  if (sp == 0 || so == 0) return nu;
+  const bool parityDiffers = (nu - other.stability.negative) % 2 != 0;
+  return parityDiffers == (sp != so) ? nu : nu + 1;
+}
+
+}  // namespace
+
 IntervalCrossings classifyInterval(const ContinuationPoint &a, const ContinuationPoint &b, bool detectFolds,
                                    bool detectBranchPoints) {
   IntervalCrossings crossings;
@@ -103,7 +134,7 @@ IntervalCrossings classifyInterval(const ContinuationPoint &a, const Continuatio
   if (!detectBranchPoints) return crossings;
   crossings.determinantChange = a.determinantSign * b.determinantSign < 0;
   if (a.stability.valid() && b.stability.valid())
-    crossings.inertiaChange = std::abs(b.stability.negative - a.stability.negative);
+    crossings.inertiaChange = std::abs(settledNegative(b, a) - settledNegative(a, b));
   int count = crossings.determinantChange ? 1 : 0;
   // A fold moves one eigenvalue through zero too; only the rest are branch points.
   // (whether or not folds are being reported).
