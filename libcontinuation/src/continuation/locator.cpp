@@ -43,6 +43,7 @@ Locator::Locator(Problem &problem, Corrector &corrector, PointEvaluator &evaluat
     : problem_(problem), corrector_(corrector), evaluator_(evaluator), options_(options), n_(problem.dimension()) {
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
+  residual_ = Vector::Zero(n_);
 }
 
 void Locator::setStep(const ContinuationPoint &a, const ContinuationPoint &b) {
@@ -178,9 +179,8 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
 }
 
 double Locator::residualNorm(ConstVectorRef u, double lambda) {
-  Vector F(n_);
-  if (!problem_.residual(u, lambda, F)) return std::numeric_limits<double>::infinity();
-  return F.norm();
+  if (!problem_.residual(u, lambda, residual_)) return std::numeric_limits<double>::infinity();
+  return residual_.norm();
 }
 
 std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &crossings) {
