@@ -148,6 +148,35 @@ TEST_CASE("classifyInterval: a crossing at a shared point is counted in one of i
   CHECK(classifyInterval(a, p, true, true).branchPointCrossings + classifyInterval(p, b, true, true).branchPointCrossings == 2);
 }
 
+TEST_CASE("classifyInterval: a turning of lambda below the rounding of lambda is not a fold", "[test_functions]") {
+  // t_λ and the count flip together while λ moves by ~1e−17 over a step of 4e−9 (the children of a
+  // branch point of the n = 10 000 chain): the parity check confirms the sign change, but the
+  // step does not resolve a turning of λ. The inertia change comes with it and is no BP either.
+  ContinuationPoint a, b;
+  a.u = Vector::Zero(2);
+  b.u = (Vector(2) << 4e-9, 0.0).finished();
+  a.lambda = -7.5715230938837343e-08;
+  b.lambda = -7.5715230906755335e-08;
+  a.tangent = (Vector(3) << 1.0, 0.0, 8e-9).finished();
+  b.tangent = (Vector(3) << 1.0, 0.0, -1e-8).finished();
+  a.foldTest = a.tangent[2];
+  b.foldTest = b.tangent[2];
+  a.determinantSign = b.determinantSign = 1;
+  a.stability.negative = 1;
+  b.stability.negative = 0;
+  const IntervalCrossings noise = classifyInterval(a, b, true, true);
+  CHECK(foldBetween(a, b));  // the sign change itself is confirmed by the determinants
+  CHECK_FALSE(noise.fold);
+  CHECK(noise.branchPointCrossings == 0);
+  // The same sign change over a step of 1e−6 moves λ by ~1e−14: resolved, a fold.
+  b.u[0] = 1e-6;
+  b.tangent[2] = -1e-6;
+  b.foldTest = b.tangent[2];
+  const IntervalCrossings fold = classifyInterval(a, b, true, true);
+  CHECK(fold.fold);
+  CHECK(fold.branchPointCrossings == 0);
+}
+
 TEST_CASE("jacobianKernel: two-dimensional kernel at a pitchfork", "[test_functions]") {
   toys::TwoPitchforks problem(0.5);
   KernelInfo kernel;

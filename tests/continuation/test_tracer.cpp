@@ -540,3 +540,60 @@ TEST_CASE("Starting on a branch point along a chosen kernel direction", "[tracer
   const Branch refused = trace(problem, Vector::Zero(2), 0.0, InitialDirection::increasingLambda(), options);
   CHECK(refused.stopReason == StopReason::StartFailed);
 }
+
+TEST_CASE("Tiny steps: the fold of the cubic is still found to 1e-12, in scaled units too", "[tracer]") {
+  // The fold test's resolution (classifyInterval: a turning of λ below the rounding of the
+  // equations' λ terms is not reported) must not lose real folds at small steps: steps of 1e−6 of
+  // the problem's scale across the fold of λ/P + u/L − (u/L)³/3 = 0 at u = −L, λ = 2P/3, in units
+  // L = P = 1 and L = 1e−3, P = 1e3 (declared as the problem's scales).
+  class UnitCubic : public Problem {
+   public:
+    UnitCubic(double L, double P) : L_(L), P_(P) {}
+    int dimension() const override { return 1; }
+    bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+      const double v = u[0] / L_;
+      F[0] = lambda / P_ + v - v * v * v / 3.0;
+      return true;
+    }
+    bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+      const double v = u[0] / L_;
+      Fu(0, 0) = (1.0 - v * v) / L_;
+      Fl[0] = 1.0 / P_;
+      return true;
+    }
+    bool hasStabilityOperator() const override { return true; }
+    bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
+      return toys::negatedJacobian(*this, u, lambda, H, C);
+    }
+    ProblemScales scales() const override {
+      ProblemScales s = ProblemScales::ones(1);
+      s.unknowns << L_;
+      s.parameter = P_;
+      s.stability = 1.0 / L_;
+      return s;
+    }
+
+   private:
+    double L_, P_;
+  };
+  for (const double L : {1.0, 1e-3}) {
+    const double P = 1.0 / L;
+    INFO("L " << L << " P " << P);
+    UnitCubic problem(L, P);
+    TracerOptions options;
+    options.initialStep = options.maxStep = 1e-6;
+    options.minStep = 1e-9;
+    options.maxPoints = 400;
+    const double v0 = -1.0 - 1e-4;  // 100 steps before the fold
+    const double lambda0 = P * (-v0 + v0 * v0 * v0 / 3.0);
+    const Branch branch =
+        trace(problem, vec1(L * v0), lambda0, InitialDirection::along((Vector(2) << 1.0, 0.0).finished()), options);
+    REQUIRE(branch.points.size() == 400);
+    REQUIRE(branch.points.back().u[0] > L * (-1.0 + 1e-4));  // across the fold
+    const auto folds = branch.specialPointsOfType(SpecialPointType::Fold);
+    REQUIRE(folds.size() == 1);
+    CHECK(std::abs(folds[0]->lambda - 2.0 * P / 3.0) <= 1e-12 * P);
+    CHECK(std::abs(folds[0]->u[0] + L) <= 1e-6 * L);
+    CHECK(folds[0]->refined);
+  }
+}
