@@ -1,6 +1,7 @@
 #include "buckle/continuation/multiplicity_switching.h"
 
 #include "buckle/continuation/scaled_problem.h"
+#include "buckle/continuation/structured_refinement.h"
 
 #include <Eigen/Dense>
 #include <Eigen/SVD>
@@ -261,6 +262,99 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
 }
 
 }  // namespace
+
+namespace {
+
+// Orthonormal columns spanning those of X (modified Gram–Schmidt, twice).
+Matrix orthonormalColumns(const Matrix &X) {
+  Matrix Q = X;
+  for (Eigen::Index j = 0; j < Q.cols(); ++j) {
+    for (int pass = 0; pass < 2; ++pass)
+      for (Eigen::Index i = 0; i < j; ++i) Q.col(j) -= Q.col(i).dot(Q.col(j)) * Q.col(i);
+    Q.col(j).normalize();
+  }
+  return Q;
+}
+
+}  // namespace
+
+bool structuredMultipleKernel(Problem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda, int m,
+                              Matrix &K, Matrix &Psi, double &residual, std::string *why) {
+  const int n = problem.dimension();
+  const int k = m + 1;
+  if (m < 1 || m > n || solver.maxGeneralBorder() < k) {
+    if (why) *why = "multiplicity out of range for the solver's borders";
+    return false;
+  }
+  Vector Fl(n);
+  {
+    Vector el = Vector::Zero(n + 1);
+    el[n] = 1.0;
+    if (!problem.jacobianApply(u, lambda, el, Fl)) {
+      if (why) *why = "the problem refused the Jacobian at the point";
+      return false;
+    }
+  }
+  // Generic first borders: the deterministic sphere points of the root search, one per column.
+  const std::vector<Vector> right = sphereStarts(n + 1, k), left = sphereStarts(n, m + 7);
+  Matrix C(n + 1, k), B(n, m);
+  for (int j = 0; j < k; ++j) C.col(j) = right[size_t(j)];
+  for (int j = 0; j < m; ++j) B.col(j) = left[size_t(j + 7)];
+  RefinedBorderedSystem system(problem, solver);
+  Matrix V(n + 1, k), W(n, m);
+  for (int pass = 0; pass < 2; ++pass) {
+    // Right: [[F_u, [F_λ B]], [C_uᵀ, [C_λ 0]]] [x; (v_λ, γ)] = [0; e_i].
+    Matrix Bp(n, k), Dp = Matrix::Zero(k, k);
+    Bp.col(0) = Fl;
+    Bp.rightCols(m) = B;
+    Dp.col(0) = C.row(n).transpose();
+    const Matrix Cu = C.topRows(n);
+    if (!system.factor(u, lambda, Bp, Cu, Dp, false)) {
+      if (why) *why = "bordered kernel system singular";
+      return false;
+    }
+    Vector rhs = Vector::Zero(n + k), x(n + k);
+    for (int i = 0; i < k; ++i) {
+      rhs.setZero();
+      rhs[n + i] = 1.0;
+      if (!system.solve(rhs, x)) {
+        if (why) *why = "bordered kernel solve failed";
+        return false;
+      }
+      V.col(i).head(n) = x.head(n);
+      V(n, i) = x[n];
+    }
+    // Left: the transpose, [[F_uᵀ, C_u], [[F_λ B]ᵀ, [C_λ 0]ᵀ]] [ψ; h] = [0; (0, e_j)].
+    if (!system.factor(u, lambda, Cu, Bp, Dp.transpose(), true)) {
+      if (why) *why = "transposed bordered kernel system singular";
+      return false;
+    }
+    for (int j = 0; j < m; ++j) {
+      rhs.setZero();
+      rhs[n + 1 + j] = 1.0;
+      if (!system.solve(rhs, x)) {
+        if (why) *why = "transposed bordered kernel solve failed";
+        return false;
+      }
+      W.col(j) = x.head(n);
+    }
+    C = orthonormalColumns(V);
+    B = orthonormalColumns(W);
+  }
+  K = C;
+  Psi = B;
+  residual = 0.0;
+  Vector y(n), z(n + 1);
+  for (int i = 0; i < k; ++i) {
+    if (!problem.jacobianApply(u, lambda, K.col(i), y)) return false;
+    residual = std::max(residual, y.norm());
+  }
+  for (int j = 0; j < m; ++j) {
+    if (!problem.jacobianTransposeApply(u, lambda, Psi.col(j), z)) return false;
+    residual = std::max(residual, z.norm());
+  }
+  return true;
+}
 
 bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
                                   double kernelTolerance) {

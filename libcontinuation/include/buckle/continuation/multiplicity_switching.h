@@ -18,6 +18,7 @@
 #pragma once
 
 #include "buckle/continuation/branch.h"
+#include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch_switching.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/tracer.h"
@@ -41,6 +42,18 @@ struct ReducedBifurcation {
 /// (relative to the largest singular value) or no direction is found.
 bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
                                   double kernelTolerance = 1e-7);
+
+/// The kernel of F_x = [F_u, F_λ] at a point of multiplicity m without a dense SVD: K ((N+1)×(m+1))
+/// and Psi (N×m), orthonormal, from bordered solves with m + 1 borders through `solver`
+/// (BorderedSolver::factorGeneral, O(N) for a structured problem; needs maxGeneralBorder() ≥ m + 1):
+/// G = [[F_x, B], [Cᵀ, 0]] is regular when B spans a complement of range F_x and C is transversal to
+/// ker F_x, and then G [V; Γ] = [0; I] gives F_x V = −BΓ with Γ = 0 exactly at the point: V spans the
+/// kernel (Gᵀ likewise the left kernel). A first pass with fixed generic borders, a second with
+/// the first's kernels as borders (then G is as well conditioned as the point allows); solves
+/// refined on the problem's own products (RefinedBorderedSystem). `residual` receives
+/// max(‖F_x K‖, ‖Psiᵀ F_x‖) column-wise. False with `why` when a factorization fails.
+bool structuredMultipleKernel(Problem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda, int m,
+                              Matrix &K, Matrix &Psi, double &residual, std::string *why = nullptr);
 
 /// Children of the multiple point bp, both sides of every direction, traced with `tracer`; sets
 /// bp.branchesPredicted (2 per direction) and bp.branchesFound (children that left bp along their
