@@ -206,3 +206,61 @@ TEST_CASE("structuredMultipleKernel: where F_x vanishes (kappa = 0 type) the ker
     CHECK((Psi.transpose() * Psi - Matrix::Identity(m, m)).norm() <= 1e-14);
   }
 }
+
+TEST_CASE("reducedBifurcationDirections at n = 1000: the bordered kernels give the dense SVD's directions") {
+  // The double point of the twin chains: F odd in u, so the cubic equation; its roots are the
+  // lines (φ, 0), (0, φ) and (φ, ±φ) (the uncoupled cubics u_i³ make the diagonals roots too).
+  const int n = 1000;
+  TwinChains problem(n);
+  SpecialPoint bp;
+  bp.type = SpecialPointType::BranchPoint;
+  bp.multiplicity = 2;
+  bp.u = Vector::Zero(n);
+  bp.lambda = problem.firstBranchPoint();
+  bp.tangent = Vector::Unit(n + 1, n);
+  ReducedBifurcation bordered, dense;
+  REQUIRE(reducedBifurcationDirections(problem, bp, 2, bordered));
+  REQUIRE(reducedBifurcationDirections(problem, bp, 2, dense, 1e-7, n));  // the SVD route
+  INFO(bordered.note << " | " << dense.note);
+  CHECK(bordered.order == 3);
+  CHECK(dense.order == 3);
+  REQUIRE(bordered.directions.size() == 4);
+  REQUIRE(dense.directions.size() == bordered.directions.size());
+  for (size_t d = 0; d < bordered.directions.size(); ++d) {
+    double closest = 0.0;
+    size_t match = 0;
+    for (size_t e = 0; e < dense.directions.size(); ++e)
+      if (std::abs(bordered.directions[d].dot(dense.directions[e])) > closest) {
+        closest = std::abs(bordered.directions[d].dot(dense.directions[e]));
+        match = e;
+      }
+    CHECK(closest >= 1.0 - 1e-12);
+    // τ comes from central differences of the second derivatives (h = 1e−3) along the kernel basis,
+    // which differs between the routes (any orthonormal basis of the same kernel): O(h²) apart.
+    CHECK(bordered.curvatures[d] == Approx(dense.curvatures[match]).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("reducedBifurcationDirections where F_x vanishes: the bordered route forced gives the dense one's roots") {
+  // CoupledPitchforks' m-fold point (F_x = 0 there, the κ = 0 type): the bordered kernels with the
+  // crossover forced to 0 against the SVD route, root by root (4 and 13 lines, closed form).
+  for (int m : {2, 3}) {
+    INFO("m = " << m);
+    CoupledPitchforks problem(m, 0.4);
+    const Branch trivial = trace(problem, Vector::Zero(m), -0.37, InitialDirection::increasingLambda(), options());
+    const auto bps = trivial.specialPointsOfType(SpecialPointType::BranchPoint);
+    REQUIRE(bps.size() == 1);
+    ReducedBifurcation bordered, dense;
+    REQUIRE(reducedBifurcationDirections(problem, *bps[0], m, bordered, 1e-7, 0));
+    REQUIRE(reducedBifurcationDirections(problem, *bps[0], m, dense));
+    INFO(bordered.note << " | " << dense.note);
+    CHECK(bordered.order == dense.order);
+    REQUIRE(bordered.directions.size() == size_t(m == 2 ? 4 : 13));
+    REQUIRE(dense.directions.size() == bordered.directions.size());
+    for (const Vector &d : bordered.directions) {
+      double closest = 0.0;
+      for (const Vector &e : dense.directions) closest = std::max(closest, std::abs(d.dot(e)));
+      CHECK(closest >= 1.0 - 1e-10);
+    }
+  }
+}

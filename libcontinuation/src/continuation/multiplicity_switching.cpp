@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
+#include <memory>
 
 namespace buckle::continuation {
 
@@ -68,7 +70,8 @@ struct SecondDerivative {
   }
 };
 
-bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out, double kernelTolerance) {
+bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out, double kernelTolerance,
+                  int maxDenseDimension) {
   const int n = problem.dimension();
   out = ReducedBifurcation();
   out.kernelDimension = m;
@@ -76,27 +79,65 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
     out.note = "multiplicity out of range";
     return false;
   }
-  Matrix Fx = Matrix::Zero(n, n + 1);
-  if (!problem.jacobian(bp.u, bp.lambda, Fx.leftCols(n), Fx.col(n))) {
-    out.note = "the problem refused the Jacobian at the point";
-    return false;
+  Matrix kernel, Psi;
+  // Above the dense crossover the kernels come from bordered solves (structuredMultipleKernel, no
+  // SVD; the problem's structured solver when it takes m + 1 borders, else dense LU of the
+  // (N+m+1)² bordered matrix, e.g. for the κ = 0 chain's m = n − 1), and F_x⁺ from the bordered
+  // system [[F_x, Ψ], [Kᵀ, 0]]; at or below it the full SVD.
+  std::unique_ptr<BorderedSolver> solver;
+  std::unique_ptr<RefinedBorderedSystem> bordered;
+  Eigen::BDCSVD<Matrix> svd;
+  int r = n - m;  // rank
+  if (n > maxDenseDimension) {
+    solver = problem.makeStructuredSolver();
+    if (!solver || solver->maxGeneralBorder() < m + 1) solver = std::make_unique<DenseBorderedSolver>(problem);
+    double residual = 0.0;
+    std::string why;
+    if (!structuredMultipleKernel(problem, *solver, bp.u, bp.lambda, m, kernel, Psi, residual, &why)) {
+      out.note = "kernel of F_x is not " + std::to_string(m + 1) + "-dimensional (" + why + ")";
+      return false;
+    }
+    // the residual against the problem's unit, as the SVD's ratios below (F_x may vanish)
+    if (residual > kernelTolerance) {
+      char text[160];
+      std::snprintf(text, sizeof text, "kernel of F_x is not %d-dimensional (residual %.3g)", m + 1, residual);
+      out.note = text;
+      return false;
+    }
+    bordered = std::make_unique<RefinedBorderedSystem>(problem, *solver);
+    Vector Fl(n), el = Vector::Zero(n + 1);
+    el[n] = 1.0;
+    if (!problem.jacobianApply(bp.u, bp.lambda, el, Fl)) return false;
+    Matrix Bp(n, m + 1), Dp = Matrix::Zero(m + 1, m + 1);
+    Bp.col(0) = Fl;
+    Bp.rightCols(m) = Psi;
+    Dp.col(0) = kernel.row(n).transpose();
+    if (!bordered->factor(bp.u, bp.lambda, Bp, kernel.topRows(n), Dp, false)) {
+      out.note = "bordered system [[F_x, Psi], [K^T, 0]] singular";
+      return false;
+    }
+  } else {
+    Matrix Fx = Matrix::Zero(n, n + 1);
+    if (!problem.jacobian(bp.u, bp.lambda, Fx.leftCols(n), Fx.col(n))) {
+      out.note = "the problem refused the Jacobian at the point";
+      return false;
+    }
+    // Full SVD: σ descending (n values); ker F_x = the last m + 1 right vectors, the left kernel the
+    // last m left vectors. The kernel must be exactly (m+1)-dimensional to the tolerance.
+    svd.compute(Fx, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Vector &sigma = svd.singularValues();
+    // relative to the problem's unit (it works in scaled variables): F_x may vanish at the point
+    const double top = std::max(sigma[0], 1.0);
+    if (sigma[r] > kernelTolerance * top || (r > 0 && sigma[r - 1] <= kernelTolerance * top)) {
+      char text[160];
+      std::snprintf(text, sizeof text, "kernel of F_x is not %d-dimensional (sigma ratios %.3g, %.3g)", m + 1,
+                    sigma[r] / top, r > 0 ? sigma[r - 1] / top : 0.0);
+      out.note = text;
+      return false;
+    }
+    kernel = svd.matrixV().rightCols(m + 1);
+    Psi = svd.matrixU().rightCols(m);
   }
-  // Full SVD: σ descending (n values); ker F_x = the last m + 1 right vectors, the left kernel the
-  // last m left vectors. The kernel must be exactly (m+1)-dimensional to the tolerance.
-  Eigen::BDCSVD<Matrix> svd(Fx, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Vector &sigma = svd.singularValues();
-  // relative to the problem's unit (it works in scaled variables): F_x may vanish at the point
-  const double top = std::max(sigma[0], 1.0);
-  const int r = n - m;  // rank
-  if (sigma[r] > kernelTolerance * top || (r > 0 && sigma[r - 1] <= kernelTolerance * top)) {
-    char text[160];
-    std::snprintf(text, sizeof text, "kernel of F_x is not %d-dimensional (sigma ratios %.3g, %.3g)", m + 1,
-                  sigma[r] / top, r > 0 ? sigma[r - 1] / top : 0.0);
-    out.note = text;
-    return false;
-  }
-  const Matrix kernel = svd.matrixV().rightCols(m + 1);
-  const Matrix Psi = svd.matrixU().rightCols(m);
   // Basis [t φ₁ … φ_m]: the parent's tangent projected onto the kernel, then the complement.
   Matrix K(n + 1, m + 1);
   Vector t = bp.tangent.size() == n + 1 ? Vector(kernel * (kernel.transpose() * bp.tangent)) : Vector(kernel.col(0));
@@ -113,8 +154,16 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
     out.note = "could not complete the kernel basis";
     return false;
   }
-  // x = F_x⁺ b on the complement of the kernel (the r largest singular values).
+  // x = F_x⁺ b on the complement of the kernel: from the SVD's r largest singular values, or the
+  // bordered system [[F_x, Ψ], [Kᵀ, 0]] [x; g] = [b; 0] (x ⊥ ker F_x, F_x x = b − ΨΨᵀb).
   auto pseudoSolve = [&](const Vector &b) -> Vector {
+    if (bordered) {
+      Vector rhs = Vector::Zero(n + m + 1), x(n + m + 1);
+      rhs.head(n) = b;
+      if (!bordered->solve(rhs, x)) return Vector::Constant(n + 1, std::numeric_limits<double>::quiet_NaN());
+      return x.head(n + 1);
+    }
+    const Vector &sigma = svd.singularValues();
     Vector c = svd.matrixU().leftCols(r).transpose() * b;
     for (int i = 0; i < r; ++i) c[i] /= sigma[i];  // σ_i > kernelTolerance·top here
     return svd.matrixV().leftCols(r) * c;
@@ -357,18 +406,18 @@ bool structuredMultipleKernel(Problem &problem, BorderedSolver &solver, ConstVec
 }
 
 bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
-                                  double kernelTolerance) {
+                                  double kernelTolerance, int maxDenseDimension) {
   // In the problem's scaled variables (as bifurcatingDirection); directions back in its units.
   const int n = problem.dimension();
   const ProblemScales scales = problem.scales();
   if (!scales.identity() && scales.check(n).empty()) {
     const UnitScaling units(scales);
     ScaledProblem scaled(problem, units);
-    const bool ok = solveReduced(scaled, units.scaled(bp), multiplicity, out, kernelTolerance);
+    const bool ok = solveReduced(scaled, units.scaled(bp), multiplicity, out, kernelTolerance, maxDenseDimension);
     for (Vector &d : out.directions) d = units.directionToUser(d);
     return ok;
   }
-  return solveReduced(problem, bp, multiplicity, out, kernelTolerance);
+  return solveReduced(problem, bp, multiplicity, out, kernelTolerance, maxDenseDimension);
 }
 
 std::vector<Branch> switchMultiple(Tracer &tracer, SpecialPoint &bp, const BranchSwitchingOptions &options,

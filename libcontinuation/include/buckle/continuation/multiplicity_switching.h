@@ -14,7 +14,8 @@
 // lattice on the half-sphere; roots identified up to sign). Each root d is a solution direction:
 // two half-branches (±d), traced by switchBranch. The count predicted (two per direction) and the
 // count found (children that left the point along their own direction) go into the special point.
-// The kernel comes from a dense SVD of F_x (multiple points are rare; N² memory).
+// The kernel comes from a dense SVD of F_x up to N = 400, above from bordered solves
+// (structuredMultipleKernel). The second derivatives are still N×(N+1) matrices (N² memory).
 #pragma once
 
 #include "buckle/continuation/branch.h"
@@ -39,9 +40,12 @@ struct ReducedBifurcation {
 
 /// The m-dimensional reduced bifurcation equation at bp (u, λ, tangent set) and all its solution
 /// directions. False (with note) when the kernel is not (m+1)-dimensional to `kernelTolerance`
-/// (relative to the largest singular value) or no direction is found.
+/// (relative to the largest singular value, or to the problem's unit above the crossover) or no
+/// direction is found. Above N = maxDenseDimension (TracerOptions::maxDenseLocationDimension's
+/// default) the kernels come from structuredMultipleKernel instead of a dense SVD (through the
+/// problem's structured solver when it takes m + 1 borders, else dense LU).
 bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
-                                  double kernelTolerance = 1e-7);
+                                  double kernelTolerance = 1e-7, int maxDenseDimension = 400);
 
 /// The kernel of F_x = [F_u, F_λ] at a point of multiplicity m without a dense SVD: K ((N+1)×(m+1))
 /// and Psi (N×m), orthonormal, from bordered solves with m + 1 borders through `solver`
