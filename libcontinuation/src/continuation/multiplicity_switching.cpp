@@ -169,19 +169,38 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
     return svd.matrixV().leftCols(r) * c;
   };
 
+  // F_xx[k_a, z] at (u, λ): the matrices D_a = F_xx[k_a, ·] (N×(N+1)) at or below the crossover
+  // (as before), O(N) products (Problem::secondDerivativeApply) above it.
   const SecondDerivative D{problem, n};
-  std::vector<Matrix> Dk(size_t(m + 1));
-  for (int a = 0; a <= m; ++a)
-    if (!D(bp.u, bp.lambda, K.col(a), Dk[size_t(a)])) {
+  std::vector<Matrix> Dk(size_t(bordered ? 0 : m + 1));
+  for (size_t a = 0; a < Dk.size(); ++a)
+    if (!D(bp.u, bp.lambda, K.col(Eigen::Index(a)), Dk[a])) {
       out.note = "second derivatives unavailable";
       return false;
     }
+  bool secondOk = true;
+  auto secondAt = [&](ConstVectorRef u, double lambda, int a, const Vector &z) -> Vector {
+    Vector y(n);
+    secondOk = problem.secondDerivativeApply(u, lambda, K.col(a), z, y) && secondOk;
+    return y;
+  };
+  auto second = [&](int a, const Vector &z) -> Vector {
+    if (!bordered) return Dk[size_t(a)] * z;
+    return secondAt(bp.u, bp.lambda, a, z);
+  };
   // A_j(a, b) = ψ_jᵀ F_xx[k_a, k_b], symmetrised (the default second derivatives are differences).
   std::vector<Matrix> A(size_t(m), Matrix::Zero(m + 1, m + 1));
   double qmax = 0.0, qphi = 0.0;
+  for (int a = 0; a <= m; ++a)
+    for (int b = 0; b <= m; ++b) {
+      const Vector y = second(a, K.col(b));
+      for (int j = 0; j < m; ++j) A[size_t(j)](a, b) = Psi.col(j).dot(y);
+    }
+  if (!secondOk) {
+    out.note = "second derivatives unavailable";
+    return false;
+  }
   for (int j = 0; j < m; ++j) {
-    for (int a = 0; a <= m; ++a)
-      for (int b = 0; b <= m; ++b) A[size_t(j)](a, b) = Psi.col(j).dot(Dk[size_t(a)] * K.col(b));
     A[size_t(j)] = (0.5 * (A[size_t(j)] + A[size_t(j)].transpose())).eval();
     qmax = std::max(qmax, A[size_t(j)].cwiseAbs().maxCoeff());
     qphi = std::max(qphi, A[size_t(j)].bottomRightCorner(m, m).cwiseAbs().maxCoeff());
@@ -227,7 +246,7 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
     std::vector<Matrix> W(size_t(m * m));  // W_bc = −F_x⁺ ½F_xx[φ_b, φ_c]
     for (int b = 0; b < m; ++b)
       for (int c = 0; c < m; ++c)
-        W[size_t(b * m + c)] = -pseudoSolve(0.25 * (Dk[size_t(b + 1)] * K.col(c + 1) + Dk[size_t(c + 1)] * K.col(b + 1)));
+        W[size_t(b * m + c)] = -pseudoSolve(0.25 * (second(b + 1, K.col(c + 1)) + second(c + 1, K.col(b + 1))));
     // T[j][(a·m + b)·m + c] = ψ_jᵀ(F_xx[φ_a, W_bc] + ⅙F_xxx[φ_a, φ_b, φ_c])
     std::vector<double> T(size_t(m * m * m * m), 0.0);
     Matrix Dp, Dm;
@@ -235,16 +254,24 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
       const Vector shift = h * K.col(c + 1);
       const Vector up = bp.u + shift.head(n), um = bp.u - shift.head(n);
       for (int a = 0; a < m; ++a) {
-        if (!D(up, bp.lambda + shift[n], K.col(a + 1), Dp) || !D(um, bp.lambda - shift[n], K.col(a + 1), Dm)) {
+        if (!bordered &&
+            (!D(up, bp.lambda + shift[n], K.col(a + 1), Dp) || !D(um, bp.lambda - shift[n], K.col(a + 1), Dm))) {
           out.note = "third derivatives unavailable";
           return false;
         }
-        const Matrix D3 = (Dp - Dm) / (2.0 * h);  // F_xxx[φ_a, ·, φ_c]
         for (int b = 0; b < m; ++b) {
-          const Vector third = D3 * K.col(b + 1);
-          const Vector second = Dk[size_t(a + 1)] * W[size_t(b * m + c)];
+          // F_xxx[φ_a, φ_b, φ_c] by a central difference along φ_c
+          const Vector third = bordered ? Vector((secondAt(up, bp.lambda + shift[n], a + 1, K.col(b + 1)) -
+                                                  secondAt(um, bp.lambda - shift[n], a + 1, K.col(b + 1))) /
+                                                 (2.0 * h))
+                                        : Vector((Dp - Dm) / (2.0 * h) * K.col(b + 1));
+          const Vector secondTerm = second(a + 1, W[size_t(b * m + c)]);
           for (int j = 0; j < m; ++j)
-            T[size_t(j * m * m * m + (a * m + b) * m + c)] = Psi.col(j).dot(second + third / 6.0);
+            T[size_t(j * m * m * m + (a * m + b) * m + c)] = Psi.col(j).dot(secondTerm + third / 6.0);
+        }
+        if (!secondOk) {
+          out.note = "third derivatives unavailable";
+          return false;
         }
       }
     }

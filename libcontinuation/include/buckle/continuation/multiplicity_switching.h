@@ -15,7 +15,8 @@
 // two half-branches (±d), traced by switchBranch. The count predicted (two per direction) and the
 // count found (children that left the point along their own direction) go into the special point.
 // The kernel comes from a dense SVD of F_x up to N = 400, above from bordered solves
-// (structuredMultipleKernel). The second derivatives are still N×(N+1) matrices (N² memory).
+// (structuredMultipleKernel), and the second derivatives as O(N) products there
+// (Problem::secondDerivativeApply) instead of N×(N+1) matrices.
 #pragma once
 
 #include "buckle/continuation/branch.h"
