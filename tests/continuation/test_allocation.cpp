@@ -1,15 +1,36 @@
 // The corrector's hot loop (KINSOL iterations, residual and Jacobian callbacks on mapped
 // SUNDIALS storage) must not touch the heap once the Corrector exists (malloc_counter.h).
 #include "buckle/continuation/corrector.h"
+#include "buckle/continuation/locator.h"
+#include "buckle/continuation/spectral_monitor.h"
 
 #include "toy_problems.h"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include "../malloc_counter.h"
 
 using namespace buckle::continuation;
 using buckle::testing::mallocCalls;
+
+namespace {
+/// TwoPitchforks with its two eigenvalues in closed form (H is diagonal), sorted without the
+/// heap: the stability evaluations the certified counting asks for allocate nothing themselves,
+/// so what the tests below count is the monitor's and the locator's own work.
+class DiagonalPitchforks : public toys::TwoPitchforks {
+ public:
+  using TwoPitchforks::TwoPitchforks;
+  bool stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values) override {
+    const double a = -(lambda - 3.0 * u[0] * u[0]), b = -(lambda - c() - 3.0 * u[1] * u[1]);
+    const double sorted[2] = {std::min(a, b), std::max(a, b)};
+    if (first < 0 || first + values.size() > 2) return false;
+    for (Eigen::Index k = 0; k < values.size(); ++k) values[k] = sorted[first + k];
+    return true;
+  }
+};
+}  // namespace
 
 TEST_CASE("Corrector solves allocate nothing after construction", "[allocation]") {
 #if BUCKLE_COUNT_MALLOC
@@ -45,6 +66,50 @@ TEST_CASE("Corrector solves allocate nothing after construction", "[allocation]"
   Vector fresh(100);
   fresh.setZero();
   CHECK(mallocCalls.load() - probe >= 1);
+#else
+  SUCCEED("malloc interposition is disabled under AddressSanitizer");
+#endif
+}
+
+TEST_CASE("Certified counting's slopes and the locator's residual norm allocate nothing", "[allocation]") {
+#if BUCKLE_COUNT_MALLOC
+  DiagonalPitchforks problem(0.5);
+  // A point on the trivial branch between the two branch points (ν = 1: both eigenvalues tracked).
+  ContinuationPoint p;
+  p.u = Vector::Zero(2);
+  p.lambda = 0.2;
+  p.tangent = Vector::Unit(3, 2);
+  REQUIRE(problem.stability(p.u, p.lambda, 2, p.stability));
+  REQUIRE(p.stability.negative == 1);
+  Vector workspace(2);
+  REQUIRE(measureNearZeroValues(problem, p));
+  REQUIRE(measureNearZeroSlopes(problem, p, workspace));  // warm-up
+  // dμ/ds along e_λ: H = diag(−λ, c − λ), both slopes −1 (the difference is exact for linear μ).
+  CHECK(std::abs(p.spectrum.slopes[0] + 1.0) <= 1e-9);
+  CHECK(std::abs(p.spectrum.slopes[1] + 1.0) <= 1e-9);
+
+  Corrector corrector(problem);
+  DenseBorderedSolver solver(problem);
+  PointEvaluator evaluator(problem, solver, true);
+  Locator locator(problem, corrector, evaluator, LocatorOptions());
+  const Vector u = (Vector(2) << 0.3, -0.4).finished();
+  const double lambda = 0.7;
+  Vector F(2);
+  REQUIRE(problem.residual(u, lambda, F));
+  const double expected = F.norm();
+
+  const long before = mallocCalls.load();
+  bool measured = true, sameNorm = true;
+  for (int k = 0; k < 20; ++k) {
+    p.lambda = 0.1 + 0.01 * k;
+    REQUIRE(measureNearZeroValues(problem, p));  // resets the slopes (values alone)
+    measured = measured && measureNearZeroSlopes(problem, p, workspace) && p.spectrum.slopesMeasured;
+    sameNorm = sameNorm && locator.residualNorm(u, lambda) == expected;
+  }
+  const long after = mallocCalls.load();
+  CHECK(measured);
+  CHECK(sameNorm);
+  CHECK(after - before == 0);
 #else
   SUCCEED("malloc interposition is disabled under AddressSanitizer");
 #endif

@@ -117,6 +117,66 @@ TEST_CASE("classifyInterval separates folds, determinant changes and inertia", "
   CHECK(classifyInterval(a, b, true, false).branchPointCrossings == 0);
 }
 
+TEST_CASE("classifyInterval: a crossing at a shared point is counted in one of its two steps", "[test_functions]") {
+  // TwoPitchforks traced in whole steps from λ = −3 reaches the branch point λ = 0 to rounding:
+  // there the crossing eigenvalue lies in the count's zero band (ν = 0, one zero), and the
+  // determinant may have changed sign already (λ = +3e−16) or not yet (λ = −3e−16). The steps
+  // before (a → p) and after (p → b) must see the one crossing once between them.
+  ContinuationPoint a, p, b;
+  a.foldTest = p.foldTest = b.foldTest = 1.0;  // the trivial branch: t = e_λ
+  a.stability.negative = 0;
+  p.stability.negative = 0;
+  p.stability.zero = 1;
+  b.stability.negative = 1;
+  a.determinantSign = 1;
+  b.determinantSign = -1;
+  for (const int atPoint : {-1, 1}) {
+    INFO("determinant sign at the crossing point " << atPoint);
+    p.determinantSign = atPoint;
+    const int before = classifyInterval(a, p, true, true).branchPointCrossings;
+    const int after = classifyInterval(p, b, true, true).branchPointCrossings;
+    CHECK(before + after == 1);
+    CHECK(before == (atPoint == b.determinantSign ? 1 : 0));
+    // The same traced the other way (b → p → a: the eigenvalue leaves the negative side).
+    CHECK(classifyInterval(b, p, true, true).branchPointCrossings + classifyInterval(p, a, true, true).branchPointCrossings == 1);
+  }
+  // Two eigenvalues in the zero band (a double zero) are not settled by a parity: both kept.
+  p.stability.zero = 2;
+  b.stability.negative = 2;
+  b.determinantSign = 1;
+  p.determinantSign = 1;
+  CHECK(classifyInterval(a, p, true, true).branchPointCrossings + classifyInterval(p, b, true, true).branchPointCrossings == 2);
+}
+
+TEST_CASE("classifyInterval: a turning of lambda below the rounding of lambda is not a fold", "[test_functions]") {
+  // t_λ and the count flip together while λ moves by ~1e−17 over a step of 4e−9 (the children of a
+  // branch point of the n = 10 000 chain): the parity check confirms the sign change, but the
+  // step does not resolve a turning of λ. The inertia change comes with it and is no BP either.
+  ContinuationPoint a, b;
+  a.u = Vector::Zero(2);
+  b.u = (Vector(2) << 4e-9, 0.0).finished();
+  a.lambda = -7.5715230938837343e-08;
+  b.lambda = -7.5715230906755335e-08;
+  a.tangent = (Vector(3) << 1.0, 0.0, 8e-9).finished();
+  b.tangent = (Vector(3) << 1.0, 0.0, -1e-8).finished();
+  a.foldTest = a.tangent[2];
+  b.foldTest = b.tangent[2];
+  a.determinantSign = b.determinantSign = 1;
+  a.stability.negative = 1;
+  b.stability.negative = 0;
+  const IntervalCrossings noise = classifyInterval(a, b, true, true);
+  CHECK(foldBetween(a, b));  // the sign change itself is confirmed by the determinants
+  CHECK_FALSE(noise.fold);
+  CHECK(noise.branchPointCrossings == 0);
+  // The same sign change over a step of 1e−6 moves λ by ~1e−14: resolved, a fold.
+  b.u[0] = 1e-6;
+  b.tangent[2] = -1e-6;
+  b.foldTest = b.tangent[2];
+  const IntervalCrossings fold = classifyInterval(a, b, true, true);
+  CHECK(fold.fold);
+  CHECK(fold.branchPointCrossings == 0);
+}
+
 TEST_CASE("jacobianKernel: two-dimensional kernel at a pitchfork", "[test_functions]") {
   toys::TwoPitchforks problem(0.5);
   KernelInfo kernel;

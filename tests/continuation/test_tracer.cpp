@@ -226,20 +226,24 @@ class CloseFolds : public Problem {
   double e_;
 };
 
-// Every setting of the step control: the rule, the predictor, the largest step.
+// Every setting of the step control: the rule, the predictor, the growth factor, the largest
+// step (0.1, 0.2, 0.3, 1, 1.5 divide the distance 3 from the start to the first branch point of
+// the pitchforks below: whole steps land on it to rounding).
 template <class Check>
 void forEveryStepSetting(Check check) {
   for (const auto rule : {StepSizeControl::Rule::Curvature, StepSizeControl::Rule::NewtonCount})
     for (const bool secondOrder : {false, true})
-      for (const double maxStep : {0.05, 0.2, 0.5, 1.0, 2.0}) {
-        TracerOptions options;
-        options.stepRule = rule;
-        options.foldPairGuard = true;
-        options.secondOrderPredictor = secondOrder;
-        options.maxStep = maxStep;
-        options.initialStep = std::min(0.1, maxStep);
-        check(options);
-      }
+      for (const double growth : {1.5, 3.0})
+        for (const double maxStep : {0.05, 0.1, 0.2, 0.3, 0.5, 1.0, 1.5, 2.0}) {
+          TracerOptions options;
+          options.stepRule = rule;
+          options.foldPairGuard = true;
+          options.secondOrderPredictor = secondOrder;
+          options.stepGrowth = growth;
+          options.maxStep = maxStep;
+          options.initialStep = std::min(0.1, maxStep);
+          check(options);
+        }
 }
 }  // namespace
 
@@ -264,37 +268,46 @@ TEST_CASE("No step jumps over two close folds undetected, at any step setting", 
   CHECK(stepsOverBoth > 0);  // the guard is what finds them there
 }
 
-// Both branch points are among those found (a third, reported at some settings on the
-// TwoPitchforks toy from λ = −3, is under investigation: see the stepctl report).
-bool hasBranchPointAt(const Branch &branch, double lambda, double tolerance) {
-  for (const SpecialPoint *bp : branch.specialPointsOfType(SpecialPointType::BranchPoint))
-    if (std::abs(bp->lambda - lambda) <= tolerance) return true;
-  return false;
+// Exactly the two branch points, at their closed-form λ (0 and c), each once.
+void checkTwoBranchPoints(const Branch &branch, double c, double tolerance) {
+  const auto bps = branch.specialPointsOfType(SpecialPointType::BranchPoint);
+  std::ostringstream found;
+  for (const SpecialPoint *bp : bps)
+    found << "\n  branch point at " << bp->lambda << " after point " << bp->index << (bp->refined ? " (refined) " : " ")
+          << bp->note;
+  INFO("found:" << found.str());
+  REQUIRE(bps.size() == 2);
+  CHECK(std::abs(bps[0]->lambda) <= tolerance);
+  CHECK(std::abs(bps[1]->lambda - c) <= tolerance);
+  CHECK(bps[0]->multiplicity == 1);
+  CHECK(bps[1]->multiplicity == 1);
 }
 
 TEST_CASE("No step jumps over two close branch points undetected, at any step setting", "[tracer]") {
-  const double c = 1e-3;
-  toys::TwoPitchforks problem(c);
-  forEveryStepSetting([&](TracerOptions options) {
-    options.lambdaMax = 3.0;
-    const Branch branch = trace(problem, Vector::Zero(2), -3.0, InitialDirection::increasingLambda(), options);
-    INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " maxStep " << options.maxStep);
-    CHECK(hasBranchPointAt(branch, 0.0, 1e-12));
-    CHECK(hasBranchPointAt(branch, c, 1e-12));
-  });
+  // Before, steps landing on λ = 0 to rounding (maxStep 0.1, 0.2, 0.3, 1, 1.5 from λ = −3) reported
+  // the first branch point twice: the step ending there from the determinant's sign change, the
+  // next from the inertia, the crossing eigenvalue being in the count's zero band at the shared
+  // point (classifyInterval). c = 0.5 as well: there the two points are in different steps.
+  for (const double c : {1e-3, 0.5}) {
+    toys::TwoPitchforks problem(c);
+    forEveryStepSetting([&](TracerOptions options) {
+      options.lambdaMax = 3.0;
+      const Branch branch = trace(problem, Vector::Zero(2), -3.0, InitialDirection::increasingLambda(), options);
+      INFO("c " << c << " rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " growth "
+                << options.stepGrowth << " maxStep " << options.maxStep);
+      CHECK(branch.stopReason == StopReason::LambdaRange);
+      checkTwoBranchPoints(branch, c, 1e-12);
+    });
+  }
   // The same on a curved trivial branch (F_λ ≠ 0), where the steps follow its curvature.
-  toys::CurvedPitchforks curved(c);
+  toys::CurvedPitchforks curved(1e-3);
   forEveryStepSetting([&](TracerOptions options) {
     options.lambdaMax = 2.0;
     const Vector u0 = toys::CurvedPitchforks::shift(-2.0);
     const Branch branch = trace(curved, u0, -2.0, InitialDirection::increasingLambda(), options);
-    INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " maxStep " << options.maxStep);
-    std::ostringstream found;
-    for (const SpecialPoint *bp : branch.specialPointsOfType(SpecialPointType::BranchPoint))
-      found << "\n  branch point at " << bp->lambda << (bp->refined ? " (refined) " : " ") << bp->note;
-    INFO("found:" << found.str());
-    CHECK(hasBranchPointAt(branch, 0.0, 1e-11));
-    CHECK(hasBranchPointAt(branch, c, 1e-11));
+    INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " growth " << options.stepGrowth
+                 << " maxStep " << options.maxStep);
+    checkTwoBranchPoints(branch, 1e-3, 1e-11);
   });
 }
 
@@ -563,4 +576,61 @@ TEST_CASE("Starting on a branch point along a chosen kernel direction", "[tracer
   // Without a direction the start on the branch point is refused, not guessed.
   const Branch refused = trace(problem, Vector::Zero(2), 0.0, InitialDirection::increasingLambda(), options);
   CHECK(refused.stopReason == StopReason::StartFailed);
+}
+
+TEST_CASE("Tiny steps: the fold of the cubic is still found to 1e-12, in scaled units too", "[tracer]") {
+  // The fold test's resolution (classifyInterval: a turning of λ below the rounding of the
+  // equations' λ terms is not reported) must not lose real folds at small steps: steps of 1e−6 of
+  // the problem's scale across the fold of λ/P + u/L − (u/L)³/3 = 0 at u = −L, λ = 2P/3, in units
+  // L = P = 1 and L = 1e−3, P = 1e3 (declared as the problem's scales).
+  class UnitCubic : public Problem {
+   public:
+    UnitCubic(double L, double P) : L_(L), P_(P) {}
+    int dimension() const override { return 1; }
+    bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+      const double v = u[0] / L_;
+      F[0] = lambda / P_ + v - v * v * v / 3.0;
+      return true;
+    }
+    bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+      const double v = u[0] / L_;
+      Fu(0, 0) = (1.0 - v * v) / L_;
+      Fl[0] = 1.0 / P_;
+      return true;
+    }
+    bool hasStabilityOperator() const override { return true; }
+    bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
+      return toys::negatedJacobian(*this, u, lambda, H, C);
+    }
+    ProblemScales scales() const override {
+      ProblemScales s = ProblemScales::ones(1);
+      s.unknowns << L_;
+      s.parameter = P_;
+      s.stability = 1.0 / L_;
+      return s;
+    }
+
+   private:
+    double L_, P_;
+  };
+  for (const double L : {1.0, 1e-3}) {
+    const double P = 1.0 / L;
+    INFO("L " << L << " P " << P);
+    UnitCubic problem(L, P);
+    TracerOptions options;
+    options.initialStep = options.maxStep = 1e-6;
+    options.minStep = 1e-9;
+    options.maxPoints = 400;
+    const double v0 = -1.0 - 1e-4;  // 100 steps before the fold
+    const double lambda0 = P * (-v0 + v0 * v0 * v0 / 3.0);
+    const Branch branch =
+        trace(problem, vec1(L * v0), lambda0, InitialDirection::along((Vector(2) << 1.0, 0.0).finished()), options);
+    REQUIRE(branch.points.size() == 400);
+    REQUIRE(branch.points.back().u[0] > L * (-1.0 + 1e-4));  // across the fold
+    const auto folds = branch.specialPointsOfType(SpecialPointType::Fold);
+    REQUIRE(folds.size() == 1);
+    CHECK(std::abs(folds[0]->lambda - 2.0 * P / 3.0) <= 1e-12 * P);
+    CHECK(std::abs(folds[0]->u[0] + L) <= 1e-6 * L);
+    CHECK(folds[0]->refined);
+  }
 }

@@ -668,3 +668,42 @@ TEST_CASE("n = 1000, soft joints: one step over four critical loads 1e-7 apart f
   }
   CHECK(inFirstStep >= 3);
 }
+
+TEST_CASE("n = 10000: the children of a branch point traced in steps of 4e-9 show no folds", "[equilibrium_branches]") {
+  // The children in the trivial branch's own steps (benchmarks/RESULTS.md, "Location on long
+  // chains"): λ − λ_c ~ λ_c s² with λ_c ~ 1e−7 stays below the rounding of the equations' λ terms,
+  // t_λ and the crossing eigenvalue of F_u flip together with rounding from step to step, and the
+  // parity check of foldBetween confirmed them: 22 LPs on each child before. The turning is not
+  // resolved there (classifyInterval), and the eigenvalue crossing that came with it is the same
+  // rounding (no spurious BP either).
+  const int n = 10000;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const std::vector<double> crit = firstCriticalLoads(chain, 2);
+  REQUIRE(crit.size() == 2);
+  const double stop = 0.5 * (crit[0] + crit[1]);
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(stop, 1);
+  o.tracer.maxStep = o.tracer.initialStep = std::abs(stop) / 39.0;
+  o.tracer.minStep = 1e-6 * o.tracer.maxStep;
+  o.tracer.lambdaMax = 0.0;
+  o.tracer.maxPoints = 43;
+  o.tracer.lowestEigenvalues = 1;
+  cont::TracerOptions child = o.tracer;
+  child.initialStep = child.maxStep = 4e-9;
+  child.minStep = 1e-6 * child.maxStep;
+  child.maxPoints = 40;
+  child.lambdaMin = 2.0 * crit[1];
+  o.childTracer = child;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  const auto& branches = r.tree.branches;
+  REQUIRE(branches.size() == 3);
+  REQUIRE(branchPoints(branches[0]).size() == 1);
+  CHECK(std::abs(branchPoints(branches[0])[0]->lambda - crit[0]) <= 1e-12 * std::abs(crit[0]));
+  for (size_t k = 1; k < branches.size(); ++k) {
+    INFO("child " << k);
+    CHECK(branches[k].points.size() == 40);
+    CHECK(branches[k].specialPointsOfType(cont::SpecialPointType::Fold).empty());
+    CHECK(branchPoints(branches[k]).empty());
+  }
+}

@@ -43,6 +43,7 @@ Locator::Locator(Problem &problem, Corrector &corrector, PointEvaluator &evaluat
     : problem_(problem), corrector_(corrector), evaluator_(evaluator), options_(options), n_(problem.dimension()) {
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
+  residual_ = Vector::Zero(n_);
 }
 
 void Locator::setStep(const ContinuationPoint &a, const ContinuationPoint &b) {
@@ -178,9 +179,8 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
 }
 
 double Locator::residualNorm(ConstVectorRef u, double lambda) {
-  Vector F(n_);
-  if (!problem_.residual(u, lambda, F)) return std::numeric_limits<double>::infinity();
-  return F.norm();
+  if (!problem_.residual(u, lambda, residual_)) return std::numeric_limits<double>::infinity();
+  return residual_.norm();
 }
 
 std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &crossings) {
@@ -196,8 +196,7 @@ std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &
   if (crossings.fold && options_.detectFolds) keep(found, locateFold(a_, b_));
   if (crossings.branchPointCrossings > 0 && options_.detectBranchPoints) {
     std::vector<std::pair<StepSample, StepSample>> simple, multiple;
-    if (crossings.branchPointCrossings == 1 && crossings.determinantChange) simple.emplace_back(a_, b_);
-    else separateCrossings(a_, b_, simple, multiple, 0);
+    separateCrossings(a_, b_, simple, multiple, 0);
     // As in locateBetween: an interrupt ends the location between two branch points.
     for (const auto &bracket : simple) {
       if (options_.interrupt.requested()) break;
@@ -253,16 +252,28 @@ void Locator::keep(std::vector<SpecialPoint> &found, SpecialPoint &&sp) const {
 void Locator::separateCrossings(const StepSample &lo, const StepSample &hi,
                                 std::vector<std::pair<StepSample, StepSample>> &simple,
                                 std::vector<std::pair<StepSample, StepSample>> &multiple, int depth) {
-  const ContinuationPoint &p = lo.point, &q = hi.point;
-  const bool det = p.determinantSign * q.determinantSign < 0;
-  if (!p.stability.valid() || !q.stability.valid()) {
-    if (det) simple.emplace_back(lo, hi);
-    return;
-  }
-  const bool fold = foldBetween(p, q);  // explains one crossing, reported or not
-  const int inertia = std::abs(q.stability.negative - p.stability.negative);
-  const int crossings = std::max(det ? 1 : 0, inertia - (fold ? 1 : 0));
+  // The count of the tracer's step test (classifyInterval): the determinant's sign change, or the
+  // inertia change less one for a fold (reported or not), zero-band eigenvalues settled alike.
+  const int crossings = classifyInterval(lo.point, hi.point, true, true).branchPointCrossings;
   if (crossings == 0) return;
+  // An end in the middle of a crossing (an eigenvalue in the count's zero band: the step, or a
+  // bisection point, landed on a branch point to rounding) is a poor bracket end: the test
+  // functions vanish there too, and the secant and the refinement return that end's point, whichever
+  // crossing the bracket holds. Split the ambiguous end off by a sample at 1e-3 of the bracket from
+  // it (a few levels down to separationFraction): a crossing at the end itself is then located in
+  // its own small bracket, the bracket's other crossings away from it.
+  const bool loAmbiguous = lo.point.stability.zero > 0, hiAmbiguous = hi.point.stability.zero > 0;
+  if ((loAmbiguous || hiAmbiguous) && hi.s - lo.s > options_.separationFraction * std::abs(stepLength_) &&
+      depth <= 200) {
+    const double offset = loAmbiguous && hiAmbiguous ? 0.5 : 1e-3;
+    const double s = loAmbiguous ? lo.s + offset * (hi.s - lo.s) : hi.s - offset * (hi.s - lo.s);
+    StepSample inner;
+    if (sample(s, inner)) {
+      separateCrossings(lo, inner, simple, multiple, depth + 1);
+      separateCrossings(inner, hi, simple, multiple, depth + 1);
+      return;
+    }
+  }
   if (crossings == 1) {
     simple.emplace_back(lo, hi);
     return;

@@ -1,6 +1,7 @@
 #include "buckle/continuation/multiplicity_switching.h"
 
 #include "buckle/continuation/scaled_problem.h"
+#include "buckle/continuation/structured_refinement.h"
 
 #include <Eigen/Dense>
 #include <Eigen/SVD>
@@ -8,6 +9,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
+#include <memory>
 
 namespace buckle::continuation {
 
@@ -67,7 +70,8 @@ struct SecondDerivative {
   }
 };
 
-bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out, double kernelTolerance) {
+bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out, double kernelTolerance,
+                  int maxDenseDimension) {
   const int n = problem.dimension();
   out = ReducedBifurcation();
   out.kernelDimension = m;
@@ -75,27 +79,65 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
     out.note = "multiplicity out of range";
     return false;
   }
-  Matrix Fx = Matrix::Zero(n, n + 1);
-  if (!problem.jacobian(bp.u, bp.lambda, Fx.leftCols(n), Fx.col(n))) {
-    out.note = "the problem refused the Jacobian at the point";
-    return false;
+  Matrix kernel, Psi;
+  // Above the dense crossover the kernels come from bordered solves (structuredMultipleKernel, no
+  // SVD; the problem's structured solver when it takes m + 1 borders, else dense LU of the
+  // (N+m+1)² bordered matrix, e.g. for the κ = 0 chain's m = n − 1), and F_x⁺ from the bordered
+  // system [[F_x, Ψ], [Kᵀ, 0]]; at or below it the full SVD.
+  std::unique_ptr<BorderedSolver> solver;
+  std::unique_ptr<RefinedBorderedSystem> bordered;
+  Eigen::BDCSVD<Matrix> svd;
+  int r = n - m;  // rank
+  if (n > maxDenseDimension) {
+    solver = problem.makeStructuredSolver();
+    if (!solver || solver->maxGeneralBorder() < m + 1) solver = std::make_unique<DenseBorderedSolver>(problem);
+    double residual = 0.0;
+    std::string why;
+    if (!structuredMultipleKernel(problem, *solver, bp.u, bp.lambda, m, kernel, Psi, residual, &why)) {
+      out.note = "kernel of F_x is not " + std::to_string(m + 1) + "-dimensional (" + why + ")";
+      return false;
+    }
+    // the residual against the problem's unit, as the SVD's ratios below (F_x may vanish)
+    if (residual > kernelTolerance) {
+      char text[160];
+      std::snprintf(text, sizeof text, "kernel of F_x is not %d-dimensional (residual %.3g)", m + 1, residual);
+      out.note = text;
+      return false;
+    }
+    bordered = std::make_unique<RefinedBorderedSystem>(problem, *solver);
+    Vector Fl(n), el = Vector::Zero(n + 1);
+    el[n] = 1.0;
+    if (!problem.jacobianApply(bp.u, bp.lambda, el, Fl)) return false;
+    Matrix Bp(n, m + 1), Dp = Matrix::Zero(m + 1, m + 1);
+    Bp.col(0) = Fl;
+    Bp.rightCols(m) = Psi;
+    Dp.col(0) = kernel.row(n).transpose();
+    if (!bordered->factor(bp.u, bp.lambda, Bp, kernel.topRows(n), Dp, false)) {
+      out.note = "bordered system [[F_x, Psi], [K^T, 0]] singular";
+      return false;
+    }
+  } else {
+    Matrix Fx = Matrix::Zero(n, n + 1);
+    if (!problem.jacobian(bp.u, bp.lambda, Fx.leftCols(n), Fx.col(n))) {
+      out.note = "the problem refused the Jacobian at the point";
+      return false;
+    }
+    // Full SVD: σ descending (n values); ker F_x = the last m + 1 right vectors, the left kernel the
+    // last m left vectors. The kernel must be exactly (m+1)-dimensional to the tolerance.
+    svd.compute(Fx, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Vector &sigma = svd.singularValues();
+    // relative to the problem's unit (it works in scaled variables): F_x may vanish at the point
+    const double top = std::max(sigma[0], 1.0);
+    if (sigma[r] > kernelTolerance * top || (r > 0 && sigma[r - 1] <= kernelTolerance * top)) {
+      char text[160];
+      std::snprintf(text, sizeof text, "kernel of F_x is not %d-dimensional (sigma ratios %.3g, %.3g)", m + 1,
+                    sigma[r] / top, r > 0 ? sigma[r - 1] / top : 0.0);
+      out.note = text;
+      return false;
+    }
+    kernel = svd.matrixV().rightCols(m + 1);
+    Psi = svd.matrixU().rightCols(m);
   }
-  // Full SVD: σ descending (n values); ker F_x = the last m + 1 right vectors, the left kernel the
-  // last m left vectors. The kernel must be exactly (m+1)-dimensional to the tolerance.
-  Eigen::BDCSVD<Matrix> svd(Fx, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Vector &sigma = svd.singularValues();
-  // relative to the problem's unit (it works in scaled variables): F_x may vanish at the point
-  const double top = std::max(sigma[0], 1.0);
-  const int r = n - m;  // rank
-  if (sigma[r] > kernelTolerance * top || (r > 0 && sigma[r - 1] <= kernelTolerance * top)) {
-    char text[160];
-    std::snprintf(text, sizeof text, "kernel of F_x is not %d-dimensional (sigma ratios %.3g, %.3g)", m + 1,
-                  sigma[r] / top, r > 0 ? sigma[r - 1] / top : 0.0);
-    out.note = text;
-    return false;
-  }
-  const Matrix kernel = svd.matrixV().rightCols(m + 1);
-  const Matrix Psi = svd.matrixU().rightCols(m);
   // Basis [t φ₁ … φ_m]: the parent's tangent projected onto the kernel, then the complement.
   Matrix K(n + 1, m + 1);
   Vector t = bp.tangent.size() == n + 1 ? Vector(kernel * (kernel.transpose() * bp.tangent)) : Vector(kernel.col(0));
@@ -112,26 +154,53 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
     out.note = "could not complete the kernel basis";
     return false;
   }
-  // x = F_x⁺ b on the complement of the kernel (the r largest singular values).
+  // x = F_x⁺ b on the complement of the kernel: from the SVD's r largest singular values, or the
+  // bordered system [[F_x, Ψ], [Kᵀ, 0]] [x; g] = [b; 0] (x ⊥ ker F_x, F_x x = b − ΨΨᵀb).
   auto pseudoSolve = [&](const Vector &b) -> Vector {
+    if (bordered) {
+      Vector rhs = Vector::Zero(n + m + 1), x(n + m + 1);
+      rhs.head(n) = b;
+      if (!bordered->solve(rhs, x)) return Vector::Constant(n + 1, std::numeric_limits<double>::quiet_NaN());
+      return x.head(n + 1);
+    }
+    const Vector &sigma = svd.singularValues();
     Vector c = svd.matrixU().leftCols(r).transpose() * b;
     for (int i = 0; i < r; ++i) c[i] /= sigma[i];  // σ_i > kernelTolerance·top here
     return svd.matrixV().leftCols(r) * c;
   };
 
+  // F_xx[k_a, z] at (u, λ): the matrices D_a = F_xx[k_a, ·] (N×(N+1)) at or below the crossover
+  // (as before), O(N) products (Problem::secondDerivativeApply) above it.
   const SecondDerivative D{problem, n};
-  std::vector<Matrix> Dk(size_t(m + 1));
-  for (int a = 0; a <= m; ++a)
-    if (!D(bp.u, bp.lambda, K.col(a), Dk[size_t(a)])) {
+  std::vector<Matrix> Dk(size_t(bordered ? 0 : m + 1));
+  for (size_t a = 0; a < Dk.size(); ++a)
+    if (!D(bp.u, bp.lambda, K.col(Eigen::Index(a)), Dk[a])) {
       out.note = "second derivatives unavailable";
       return false;
     }
+  bool secondOk = true;
+  auto secondAt = [&](ConstVectorRef u, double lambda, int a, const Vector &z) -> Vector {
+    Vector y(n);
+    secondOk = problem.secondDerivativeApply(u, lambda, K.col(a), z, y) && secondOk;
+    return y;
+  };
+  auto second = [&](int a, const Vector &z) -> Vector {
+    if (!bordered) return Dk[size_t(a)] * z;
+    return secondAt(bp.u, bp.lambda, a, z);
+  };
   // A_j(a, b) = ψ_jᵀ F_xx[k_a, k_b], symmetrised (the default second derivatives are differences).
   std::vector<Matrix> A(size_t(m), Matrix::Zero(m + 1, m + 1));
   double qmax = 0.0, qphi = 0.0;
+  for (int a = 0; a <= m; ++a)
+    for (int b = 0; b <= m; ++b) {
+      const Vector y = second(a, K.col(b));
+      for (int j = 0; j < m; ++j) A[size_t(j)](a, b) = Psi.col(j).dot(y);
+    }
+  if (!secondOk) {
+    out.note = "second derivatives unavailable";
+    return false;
+  }
   for (int j = 0; j < m; ++j) {
-    for (int a = 0; a <= m; ++a)
-      for (int b = 0; b <= m; ++b) A[size_t(j)](a, b) = Psi.col(j).dot(Dk[size_t(a)] * K.col(b));
     A[size_t(j)] = (0.5 * (A[size_t(j)] + A[size_t(j)].transpose())).eval();
     qmax = std::max(qmax, A[size_t(j)].cwiseAbs().maxCoeff());
     qphi = std::max(qphi, A[size_t(j)].bottomRightCorner(m, m).cwiseAbs().maxCoeff());
@@ -177,7 +246,7 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
     std::vector<Matrix> W(size_t(m * m));  // W_bc = −F_x⁺ ½F_xx[φ_b, φ_c]
     for (int b = 0; b < m; ++b)
       for (int c = 0; c < m; ++c)
-        W[size_t(b * m + c)] = -pseudoSolve(0.25 * (Dk[size_t(b + 1)] * K.col(c + 1) + Dk[size_t(c + 1)] * K.col(b + 1)));
+        W[size_t(b * m + c)] = -pseudoSolve(0.25 * (second(b + 1, K.col(c + 1)) + second(c + 1, K.col(b + 1))));
     // T[j][(a·m + b)·m + c] = ψ_jᵀ(F_xx[φ_a, W_bc] + ⅙F_xxx[φ_a, φ_b, φ_c])
     std::vector<double> T(size_t(m * m * m * m), 0.0);
     Matrix Dp, Dm;
@@ -185,16 +254,24 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
       const Vector shift = h * K.col(c + 1);
       const Vector up = bp.u + shift.head(n), um = bp.u - shift.head(n);
       for (int a = 0; a < m; ++a) {
-        if (!D(up, bp.lambda + shift[n], K.col(a + 1), Dp) || !D(um, bp.lambda - shift[n], K.col(a + 1), Dm)) {
+        if (!bordered &&
+            (!D(up, bp.lambda + shift[n], K.col(a + 1), Dp) || !D(um, bp.lambda - shift[n], K.col(a + 1), Dm))) {
           out.note = "third derivatives unavailable";
           return false;
         }
-        const Matrix D3 = (Dp - Dm) / (2.0 * h);  // F_xxx[φ_a, ·, φ_c]
         for (int b = 0; b < m; ++b) {
-          const Vector third = D3 * K.col(b + 1);
-          const Vector second = Dk[size_t(a + 1)] * W[size_t(b * m + c)];
+          // F_xxx[φ_a, φ_b, φ_c] by a central difference along φ_c
+          const Vector third = bordered ? Vector((secondAt(up, bp.lambda + shift[n], a + 1, K.col(b + 1)) -
+                                                  secondAt(um, bp.lambda - shift[n], a + 1, K.col(b + 1))) /
+                                                 (2.0 * h))
+                                        : Vector((Dp - Dm) / (2.0 * h) * K.col(b + 1));
+          const Vector secondTerm = second(a + 1, W[size_t(b * m + c)]);
           for (int j = 0; j < m; ++j)
-            T[size_t(j * m * m * m + (a * m + b) * m + c)] = Psi.col(j).dot(second + third / 6.0);
+            T[size_t(j * m * m * m + (a * m + b) * m + c)] = Psi.col(j).dot(secondTerm + third / 6.0);
+        }
+        if (!secondOk) {
+          out.note = "third derivatives unavailable";
+          return false;
         }
       }
     }
@@ -262,19 +339,112 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
 
 }  // namespace
 
+namespace {
+
+// Orthonormal columns spanning those of X (modified Gram–Schmidt, twice).
+Matrix orthonormalColumns(const Matrix &X) {
+  Matrix Q = X;
+  for (Eigen::Index j = 0; j < Q.cols(); ++j) {
+    for (int pass = 0; pass < 2; ++pass)
+      for (Eigen::Index i = 0; i < j; ++i) Q.col(j) -= Q.col(i).dot(Q.col(j)) * Q.col(i);
+    Q.col(j).normalize();
+  }
+  return Q;
+}
+
+}  // namespace
+
+bool structuredMultipleKernel(Problem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda, int m,
+                              Matrix &K, Matrix &Psi, double &residual, std::string *why) {
+  const int n = problem.dimension();
+  const int k = m + 1;
+  if (m < 1 || m > n || solver.maxGeneralBorder() < k) {
+    if (why) *why = "multiplicity out of range for the solver's borders";
+    return false;
+  }
+  Vector Fl(n);
+  {
+    Vector el = Vector::Zero(n + 1);
+    el[n] = 1.0;
+    if (!problem.jacobianApply(u, lambda, el, Fl)) {
+      if (why) *why = "the problem refused the Jacobian at the point";
+      return false;
+    }
+  }
+  // Generic first borders: the deterministic sphere points of the root search, one per column.
+  const std::vector<Vector> right = sphereStarts(n + 1, k), left = sphereStarts(n, m + 7);
+  Matrix C(n + 1, k), B(n, m);
+  for (int j = 0; j < k; ++j) C.col(j) = right[size_t(j)];
+  for (int j = 0; j < m; ++j) B.col(j) = left[size_t(j + 7)];
+  RefinedBorderedSystem system(problem, solver);
+  Matrix V(n + 1, k), W(n, m);
+  for (int pass = 0; pass < 2; ++pass) {
+    // Right: [[F_u, [F_λ B]], [C_uᵀ, [C_λ 0]]] [x; (v_λ, γ)] = [0; e_i].
+    Matrix Bp(n, k), Dp = Matrix::Zero(k, k);
+    Bp.col(0) = Fl;
+    Bp.rightCols(m) = B;
+    Dp.col(0) = C.row(n).transpose();
+    const Matrix Cu = C.topRows(n);
+    if (!system.factor(u, lambda, Bp, Cu, Dp, false)) {
+      if (why) *why = "bordered kernel system singular";
+      return false;
+    }
+    Vector rhs = Vector::Zero(n + k), x(n + k);
+    for (int i = 0; i < k; ++i) {
+      rhs.setZero();
+      rhs[n + i] = 1.0;
+      if (!system.solve(rhs, x)) {
+        if (why) *why = "bordered kernel solve failed";
+        return false;
+      }
+      V.col(i).head(n) = x.head(n);
+      V(n, i) = x[n];
+    }
+    // Left: the transpose, [[F_uᵀ, C_u], [[F_λ B]ᵀ, [C_λ 0]ᵀ]] [ψ; h] = [0; (0, e_j)].
+    if (!system.factor(u, lambda, Cu, Bp, Dp.transpose(), true)) {
+      if (why) *why = "transposed bordered kernel system singular";
+      return false;
+    }
+    for (int j = 0; j < m; ++j) {
+      rhs.setZero();
+      rhs[n + 1 + j] = 1.0;
+      if (!system.solve(rhs, x)) {
+        if (why) *why = "transposed bordered kernel solve failed";
+        return false;
+      }
+      W.col(j) = x.head(n);
+    }
+    C = orthonormalColumns(V);
+    B = orthonormalColumns(W);
+  }
+  K = C;
+  Psi = B;
+  residual = 0.0;
+  Vector y(n), z(n + 1);
+  for (int i = 0; i < k; ++i) {
+    if (!problem.jacobianApply(u, lambda, K.col(i), y)) return false;
+    residual = std::max(residual, y.norm());
+  }
+  for (int j = 0; j < m; ++j) {
+    if (!problem.jacobianTransposeApply(u, lambda, Psi.col(j), z)) return false;
+    residual = std::max(residual, z.norm());
+  }
+  return true;
+}
+
 bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
-                                  double kernelTolerance) {
+                                  double kernelTolerance, int maxDenseDimension) {
   // In the problem's scaled variables (as bifurcatingDirection); directions back in its units.
   const int n = problem.dimension();
   const ProblemScales scales = problem.scales();
   if (!scales.identity() && scales.check(n).empty()) {
     const UnitScaling units(scales);
     ScaledProblem scaled(problem, units);
-    const bool ok = solveReduced(scaled, units.scaled(bp), multiplicity, out, kernelTolerance);
+    const bool ok = solveReduced(scaled, units.scaled(bp), multiplicity, out, kernelTolerance, maxDenseDimension);
     for (Vector &d : out.directions) d = units.directionToUser(d);
     return ok;
   }
-  return solveReduced(problem, bp, multiplicity, out, kernelTolerance);
+  return solveReduced(problem, bp, multiplicity, out, kernelTolerance, maxDenseDimension);
 }
 
 std::vector<Branch> switchMultiple(Tracer &tracer, SpecialPoint &bp, const BranchSwitchingOptions &options,

@@ -8,7 +8,7 @@ namespace buckle::continuation {
 
 namespace {
 
-bool eigenvaluesAt(Problem &problem, const Vector &u, double lambda, int first, int count, Eigen::Vector2d &out) {
+bool eigenvaluesAt(Problem &problem, ConstVectorRef u, double lambda, int first, int count, Eigen::Vector2d &out) {
   return problem.stabilityEigenvalues(u, lambda, first, out.head(count)) && out.head(count).allFinite();
 }
 
@@ -40,24 +40,33 @@ bool measureNearZeroValues(Problem &problem, ContinuationPoint &point) {
   return true;
 }
 
-bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, double delta) {
+bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, Vector &workspace, double delta) {
   NearZeroSpectrum &sp = point.spectrum;
   const int n = problem.dimension();
   if (!sp.valid() || point.tangent.size() != n + 1 || point.u.size() != n) return false;
   if (sp.slopesMeasured) return true;
+  if (workspace.size() < n) workspace.resize(n);
   // Rate along the tangent: dμ/ds = (μ(x + δt) − μ(x))/δ. The point x + δt is off the branch by
   // O(δ²) only, so the slope is the branch's to O(δ) (Hellmann–Feynman needs no eigenvector).
+  // The shifted u goes into the caller's workspace: an expression passed as ConstVectorRef
+  // would be a temporary on the heap at every call.
   Eigen::Vector2d there;
+  auto shifted = workspace.head(n);
   double h = delta;
-  const Vector uf = point.u + h * point.tangent.head(n);
-  if (!eigenvaluesAt(problem, uf, point.lambda + h * point.tangent[n], sp.first, sp.count, there)) {
+  shifted = point.u + h * point.tangent.head(n);
+  if (!eigenvaluesAt(problem, shifted, point.lambda + h * point.tangent[n], sp.first, sp.count, there)) {
     h = -delta;
-    const Vector ub = point.u + h * point.tangent.head(n);
-    if (!eigenvaluesAt(problem, ub, point.lambda + h * point.tangent[n], sp.first, sp.count, there)) return false;
+    shifted = point.u + h * point.tangent.head(n);
+    if (!eigenvaluesAt(problem, shifted, point.lambda + h * point.tangent[n], sp.first, sp.count, there)) return false;
   }
   for (int k = 0; k < sp.count; ++k) sp.slopes[k] = (there[k] - sp.values[k]) / h;
   sp.slopesMeasured = true;
   return true;
+}
+
+bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, double delta) {
+  Vector workspace;
+  return measureNearZeroSlopes(problem, point, workspace, delta);
 }
 
 bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double delta) {

@@ -452,8 +452,10 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
         if (!start.spectrum.valid()) measureNearZeroValues(*work_, start);
         measureNearZeroValues(*work_, b);
         if (!rateBoundsExcludeCrossing(start, b, stepAlong(start, b))) {
-          measureNearZeroSlopes(*work_, start);
-          measureNearZeroSlopes(*work_, b);
+          // x_ (the corrector's output, already copied into b) is free here: the shifted points'
+          // workspace, so the hot loop allocates nothing.
+          measureNearZeroSlopes(*work_, start, x_);
+          measureNearZeroSlopes(*work_, b, x_);
         }
       }
       found = locateSpecialPoints(a, b);

@@ -112,6 +112,8 @@ class Locator {
   const StepSample &start() const { return a_; }
   const StepSample &end() const { return b_; }
   double tolerance(double lambda) const { return options_.tolerance * std::max(1.0, std::abs(lambda)); }
+  /// ‖F(u, λ)‖₂ (+∞ if the problem refuses the point), into a workspace sized once: no allocation.
+  double residualNorm(ConstVectorRef u, double lambda);
 
  private:
   /// Appends `sp` to `found` and tells options_.onLocated.
@@ -146,7 +148,6 @@ class Locator {
   /// The refined fold's fields (refined, accuracy, null vector, tangent, arclength) once u, λ are set.
   void adoptRefinedFold(SpecialPoint &point, const Vector &tangentRef, const Vector &v, double lastDLambda,
                         double augmentedResidual);
-  double residualNorm(ConstVectorRef u, double lambda);
 
   Problem &problem_;
   Corrector &corrector_;
@@ -155,6 +156,7 @@ class Locator {
   int n_;
   StepSample a_, b_;
   Vector xa_, dx_, ta_, tb_, predictor_, x_;
+  Vector residual_;  // workspace of residualNorm
   double stepLength_ = 0.0;
   std::unique_ptr<BorderedSolver> refinementSolver_;  // created on first use (denseAlgebra false)
   std::unique_ptr<StructuredRefinement> structured_;

@@ -14,10 +14,13 @@
 // lattice on the half-sphere; roots identified up to sign). Each root d is a solution direction:
 // two half-branches (±d), traced by switchBranch. The count predicted (two per direction) and the
 // count found (children that left the point along their own direction) go into the special point.
-// The kernel comes from a dense SVD of F_x (multiple points are rare; N² memory).
+// The kernel comes from a dense SVD of F_x up to N = 400, above from bordered solves
+// (structuredMultipleKernel), and the second derivatives as O(N) products there
+// (Problem::secondDerivativeApply) instead of N×(N+1) matrices.
 #pragma once
 
 #include "buckle/continuation/branch.h"
+#include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch_switching.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/tracer.h"
@@ -38,9 +41,24 @@ struct ReducedBifurcation {
 
 /// The m-dimensional reduced bifurcation equation at bp (u, λ, tangent set) and all its solution
 /// directions. False (with note) when the kernel is not (m+1)-dimensional to `kernelTolerance`
-/// (relative to the largest singular value) or no direction is found.
+/// (relative to the largest singular value, or to the problem's unit above the crossover) or no
+/// direction is found. Above N = maxDenseDimension (TracerOptions::maxDenseLocationDimension's
+/// default) the kernels come from structuredMultipleKernel instead of a dense SVD (through the
+/// problem's structured solver when it takes m + 1 borders, else dense LU).
 bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
-                                  double kernelTolerance = 1e-7);
+                                  double kernelTolerance = 1e-7, int maxDenseDimension = 400);
+
+/// The kernel of F_x = [F_u, F_λ] at a point of multiplicity m without a dense SVD: K ((N+1)×(m+1))
+/// and Psi (N×m), orthonormal, from bordered solves with m + 1 borders through `solver`
+/// (BorderedSolver::factorGeneral, O(N) for a structured problem; needs maxGeneralBorder() ≥ m + 1):
+/// G = [[F_x, B], [Cᵀ, 0]] is regular when B spans a complement of range F_x and C is transversal to
+/// ker F_x, and then G [V; Γ] = [0; I] gives F_x V = −BΓ with Γ = 0 exactly at the point: V spans the
+/// kernel (Gᵀ likewise the left kernel). A first pass with fixed generic borders, a second with
+/// the first's kernels as borders (then G is as well conditioned as the point allows); solves
+/// refined on the problem's own products (RefinedBorderedSystem). `residual` receives
+/// max(‖F_x K‖, ‖Psiᵀ F_x‖) column-wise. False with `why` when a factorization fails.
+bool structuredMultipleKernel(Problem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda, int m,
+                              Matrix &K, Matrix &Psi, double &residual, std::string *why = nullptr);
 
 /// Children of the multiple point bp, both sides of every direction, traced with `tracer`; sets
 /// bp.branchesPredicted (2 per direction) and bp.branchesFound (children that left bp along their

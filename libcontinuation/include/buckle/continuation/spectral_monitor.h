@@ -45,6 +45,10 @@ bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double 
 bool measureNearZeroValues(Problem &problem, ContinuationPoint &point);
 /// The second half: the slopes of the values measureNearZeroValues recorded (forward difference
 /// with step `delta`, backward if refused). False (spectrum left without slopes) if refused.
+/// `workspace` holds the shifted point's u: once it has at least N entries the call allocates
+/// nothing itself (the tracer's hot loop; the problem's stabilityEigenvalues must not either).
+bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, Vector &workspace, double delta = 1e-6);
+/// The same with a workspace of its own (allocates: for tests and one-off use).
 bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, double delta = 1e-6);
 
 /// True when suspectHiddenCrossings(a, b, stepLength, margin) returns no suspect for every pair
