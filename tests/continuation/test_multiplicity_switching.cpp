@@ -57,16 +57,22 @@ TracerOptions options() {
   return o;
 }
 
+// The m-fold branch point of CoupledPitchforks as the tracer locates it on the trivial branch
+// (exactly one BP expected there).
+SpecialPoint locatedMultiplePoint(CoupledPitchforks &problem, int m) {
+  const Branch trivial = trace(problem, Vector::Zero(m), -0.37, InitialDirection::increasingLambda(), options());
+  const auto bps = trivial.specialPointsOfType(SpecialPointType::BranchPoint);
+  REQUIRE(bps.size() == 1);
+  return *bps[0];
+}
+
 }  // namespace
 
 TEST_CASE("an m-fold branch point is located once, refined, and its reduced equation solved") {
   for (int m : {2, 3}) {
     INFO("m = " << m);
     CoupledPitchforks problem(m, 0.4);
-    const Branch trivial = trace(problem, Vector::Zero(m), -0.37, InitialDirection::increasingLambda(), options());
-    const auto bps = trivial.specialPointsOfType(SpecialPointType::BranchPoint);
-    REQUIRE(bps.size() == 1);
-    const SpecialPoint &bp = *bps[0];
+    const SpecialPoint bp = locatedMultiplePoint(problem, m);
     CHECK(bp.multiplicity == m);
     CHECK(std::abs(bp.lambda) <= 1e-12);  // closed form: λ = 0
     CHECK(bp.refined);
@@ -247,12 +253,10 @@ TEST_CASE("reducedBifurcationDirections where F_x vanishes: the bordered route f
   for (int m : {2, 3}) {
     INFO("m = " << m);
     CoupledPitchforks problem(m, 0.4);
-    const Branch trivial = trace(problem, Vector::Zero(m), -0.37, InitialDirection::increasingLambda(), options());
-    const auto bps = trivial.specialPointsOfType(SpecialPointType::BranchPoint);
-    REQUIRE(bps.size() == 1);
+    const SpecialPoint bp = locatedMultiplePoint(problem, m);
     ReducedBifurcation bordered, dense;
-    REQUIRE(reducedBifurcationDirections(problem, *bps[0], m, bordered, 1e-7, 0));
-    REQUIRE(reducedBifurcationDirections(problem, *bps[0], m, dense));
+    REQUIRE(reducedBifurcationDirections(problem, bp, m, bordered, 1e-7, 0));
+    REQUIRE(reducedBifurcationDirections(problem, bp, m, dense));
     INFO(bordered.note << " | " << dense.note);
     CHECK(bordered.order == dense.order);
     REQUIRE(bordered.directions.size() == size_t(m == 2 ? 4 : 13));
