@@ -45,7 +45,7 @@ awk -v at="$a_total" -v ad="$a_drv" -v ao="$a_out" -v aw="$a_wr" -v ap="$apts" -
   printf "AUTO A_Ufine  : %d points; process %.1f M instructions; driver (autoae) %.1f M, of which output (stplae) %.1f M (wrline %.1f M)\n", ap, at/1e6, ad/1e6, ao/1e6, aw/1e6
   printf "                numerics alone (autoae - stplae) %.1f M = %.1f k per point\n", (ad-ao)/1e6, (ad-ao)/ap/1e3
   printf "buckle A_Ufine: %d points; process %.1f M instructions; switchBranch %.1f M = %.1f k per point\n", bp, bt/1e6, bs/1e6, bs/bp/1e3
-  printf "ratio AUTO numerics / buckle per point: %.2f (target >= 2)\n", ((ad-ao)/ap) / (bs/bp)
-  printf "buckle --second-order (TracerOptions::secondOrderPredictor): %d points; switchBranch %.1f M = %.1f k per point; ratio %.2f\n", pp, ps/1e6, ps/pp/1e3, ((ad-ao)/ap) / (ps/pp)
-  printf "buckle --no-certified (TracerOptions::certifiedCounting = false, like for like): %d points; switchBranch %.1f M = %.1f k per point; ratio %.2f\n", np, ns/1e6, ns/np/1e3, ((ad-ao)/ap) / (ns/np)
-  printf "buckle --no-certified --lean-newton (TracerOptions::leanNewton, KINSOL only where Newton does not converge plainly): %d points; switchBranch %.1f M = %.1f k per point; ratio %.2f\n", lp, ls/1e6, ls/lp/1e3, ((ad-ao)/ap) / (ls/lp) }'
+  printf "ratio AUTO numerics / buckle per point: %.3f (target >= 2)\n", ((ad-ao)/ap) / (bs/bp)
+  printf "buckle --second-order (TracerOptions::secondOrderPredictor): %d points; switchBranch %.2f M = %.2f k per point; ratio %.3f\n", pp, ps/1e6, ps/pp/1e3, ((ad-ao)/ap) / (ps/pp)
+  printf "buckle --no-certified (TracerOptions::certifiedCounting = false, like for like): %d points; switchBranch %.2f M = %.2f k per point; ratio %.3f\n", np, ns/1e6, ns/np/1e3, ((ad-ao)/ap) / (ns/np)
+  printf "buckle --no-certified --lean-newton (TracerOptions::leanNewton, KINSOL only where Newton does not converge plainly): %d points; switchBranch %.2f M = %.2f k per point; ratio %.3f\n", lp, ls/1e6, ls/lp/1e3, ((ad-ao)/ap) / (ls/lp) }'

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <utility>
 #include <random>
 #include <string>
 
@@ -102,6 +103,24 @@ TEST_CASE("the lean serial operations give bitwise the library's results, also i
         N_VScale(c, z.get(), z.get());  // in place (the library's scale-by branch)
         N_VScale_Serial(c, zp.get(), zp.get());
         CHECK(sameVector(z.get(), zp.get()));
+      }
+      // z = a x + b y: the lean a = b = 1 case and the library's others, out of place and in place
+      for (const auto& ab : {std::pair<double, double>{1.0, 1.0}, {1.0, -1.0}, {-1.0, 1.0}, {0.5, 1.0}, {W(rng), W(rng)}}) {
+        N_VLinearSum(ab.first, x.get(), ab.second, y.get(), z.get());
+        N_VLinearSum_Serial(ab.first, x.get(), ab.second, y.get(), zp.get());
+        CHECK(sameVector(z.get(), zp.get()));
+        NVectorPtr y2(N_VClone(lean.get())), yp(N_VClone(plain.get()));
+        N_VScale_Serial(1.0, y.get(), y2.get());
+        N_VScale_Serial(1.0, y.get(), yp.get());
+        N_VLinearSum(ab.first, x.get(), ab.second, y2.get(), y2.get());  // into y (axpy)
+        N_VLinearSum_Serial(ab.first, x.get(), ab.second, yp.get(), yp.get());
+        CHECK(sameVector(y2.get(), yp.get()));
+        NVectorPtr x2(N_VClone(lean.get())), xp(N_VClone(plain.get()));
+        N_VScale_Serial(1.0, x.get(), x2.get());
+        N_VScale_Serial(1.0, x.get(), xp.get());
+        N_VLinearSum(ab.first, x2.get(), ab.second, y.get(), x2.get());  // into x
+        N_VLinearSum_Serial(ab.first, xp.get(), ab.second, y.get(), xp.get());
+        CHECK(sameVector(x2.get(), xp.get()));
       }
       const double c = W(rng);
       N_VConst(c, z.get());

@@ -1,5 +1,7 @@
 #include "buckle/continuation/bordered_solver.h"
 
+#include "buckle/continuation/finite.h"
+
 #include <cmath>
 #include <limits>
 
@@ -16,23 +18,28 @@ DenseBorderedSolver::DenseBorderedSolver(Problem &problem)
       A_(Matrix::Zero(n_ + 1, n_ + 1)),
       small_(n_ + 1, DenseLU::Rounding::Divide),
       useSmall_(n_ + 1 <= DenseLU::kEigenIdenticalSize),
+      writesAll_(problem.jacobianWritesAllEntries()),
       lu_(useSmall_ ? 0 : n_ + 1) {}
 
 Factorization DenseBorderedSolver::factor(ConstVectorRef u, double lambda, ConstVectorRef c) {
   general_ = false;
   sign_ = 0;
   logAbs_ = -std::numeric_limits<double>::infinity();
-  A_.setZero();
-  if (!problem_.jacobian(u, lambda, A_.topLeftCorner(n_, n_), A_.col(n_).head(n_))) return Factorization::Refused;
-  A_.row(n_) = c.transpose();
-  if (!A_.allFinite()) return Factorization::Refused;
+  // A(c) written straight into the matrix that is factored (the small LU's own storage).
+  const auto fill = [&](auto &&A) {
+    if (!writesAll_) A.setZero();
+    if (!problem_.jacobian(u, lambda, A.topLeftCorner(n_, n_), A.col(n_).head(n_))) return false;
+    A.row(n_) = c.transpose();
+    return allFinite(A.data(), A.size());  // both contiguous: the small LU's storage, A_
+  };
   int sign = 0;
   double logAbs = 0.0;
   if (useSmall_) {
-    small_.matrix() = A_;
+    if (!fill(small_.matrix())) return Factorization::Refused;
     if (!small_.factor() || !signedLogDeterminant(small_.factors(), small_.permutationSign(), sign, logAbs))
       return Factorization::Singular;
   } else {
+    if (!fill(A_)) return Factorization::Refused;
     lu_.compute(A_);
     if (!signedLogDeterminant(lu_.matrixLU(), lu_.permutationP().determinant() > 0 ? 1 : -1, sign, logAbs))
       return Factorization::Singular;
@@ -82,7 +89,7 @@ bool DenseBorderedSolver::solve(ConstVectorRef b, VectorRef x) {
   } else {
     x = lu_.solve(b);
   }
-  return x.allFinite();
+  return allFinite(x.data(), x.size());  // a Ref with unit inner stride: contiguous
 }
 
 DeflatedBorderedSolve::DeflatedBorderedSolve(BorderedSolver &base, int n)

@@ -1,5 +1,6 @@
 #include "buckle/continuation/corrector.h"
 
+#include "buckle/continuation/finite.h"
 #include "buckle/continuation/serial_vector_ops.h"
 
 #include <algorithm>
@@ -27,7 +28,11 @@ bool CorrectorOptions::IsValid(std::string *why) const {
 }
 
 Corrector::Corrector(Problem &problem, const CorrectorOptions &options, BorderedSolver *structured)
-    : problem_(problem), structured_(structured), options_(options), n_(problem.dimension()) {
+    : problem_(problem),
+      structured_(structured),
+      options_(options),
+      n_(problem.dimension()),
+      writesAll_(problem.jacobianWritesAllEntries()) {
   std::string why;
   if (!options_.IsValid(&why)) throw std::invalid_argument("CorrectorOptions: " + why);
   if (n_ < 1) throw std::invalid_argument("Problem::dimension() must be positive");
@@ -152,22 +157,22 @@ int Corrector::evaluate(const double *xData, double *gData) {
     stepNorms_.push_back((x - lastIterate_).norm());
   lastIterate_ = x;
   haveLastIterate_ = true;
-  if (!x.allFinite() || !problem_.residual(x.head(n_), x[n_], g.head(n_))) {
+  if (!allFinite(xData, m) || !problem_.residual(x.head(n_), x[n_], g.head(n_))) {
     refused_ = true;
     return 1;  // recoverable: KINSOL halves the step
   }
   g[n_] = tangent_.dot(x - predictor_);
-  return g.allFinite() ? 0 : 1;
+  return allFinite(gData, m) ? 0 : 1;
 }
 
 int Corrector::evaluateJacobian(const double *xData) {
   const int m = n_ + 1;
   Eigen::Map<const Vector> x(xData, m);
   Eigen::Map<Matrix> J = dense_->matrix();
-  J.setZero();
+  if (!writesAll_) J.setZero();
   if (!problem_.jacobian(x.head(n_), x[n_], J.topLeftCorner(n_, n_), J.col(n_).head(n_))) return -1;
   J.row(n_) = tangent_.transpose();
-  return J.allFinite() ? 0 : -1;
+  return allFinite(J.data(), J.size()) ? 0 : -1;
 }
 
 namespace {

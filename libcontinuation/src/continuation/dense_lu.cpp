@@ -141,15 +141,35 @@ void DenseLU::solveImpl(double *b) const {
 
 bool signedLogDeterminant(const Eigen::Ref<const Matrix> &factors, int permutationSign, int &sign, double &logAbs) {
   sign = permutationSign;
-  double mantissa = 1.0;
-  long exponent = 0;
-  for (Eigen::Index i = 0; i < factors.rows(); ++i) {
+  // |det| = Π|u_ii| as one running product, split into mantissa and exponent once at the end
+  // (one frexp instead of one per pivot). While every pivot and every partial product stay well
+  // inside the normal range, scaling by a power of two is exact, so the product is the per-pivot
+  // loop's mantissa times its power of two, and the final split gives that loop's (mantissa,
+  // exponent) bit for bit; outside that range the per-pivot loop below runs instead.
+  constexpr double kLow = 0x1p-500, kHigh = 0x1p500;
+  const Eigen::Index n = factors.rows();
+  double product = 1.0;
+  bool inRange = true;
+  for (Eigen::Index i = 0; i < n; ++i) {
     const double pivot = factors(i, i);
     if (pivot == 0.0 || !std::isfinite(pivot)) return false;
     if (pivot < 0.0) sign = -sign;
+    const double magnitude = std::abs(pivot);
+    product *= magnitude;
+    inRange = inRange && magnitude >= kLow && magnitude <= kHigh && product >= kLow && product <= kHigh;
+  }
+  double mantissa = 1.0;
+  long exponent = 0;
+  if (n > 0 && inRange) {
     int e = 0;
-    mantissa = std::frexp(mantissa * std::abs(pivot), &e);
-    exponent += e;
+    mantissa = std::frexp(product, &e);
+    exponent = e;
+  } else {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      int e = 0;
+      mantissa = std::frexp(mantissa * std::abs(factors(i, i)), &e);
+      exponent += e;
+    }
   }
   logAbs = std::log(mantissa) + static_cast<double>(exponent) * 0.6931471805599453;
   return true;

@@ -114,6 +114,10 @@ bool Problem::secondDerivativeApply(ConstVectorRef u, double lambda, ConstVector
 
 std::unique_ptr<BorderedSolver> Problem::makeStructuredSolver() { return nullptr; }
 
+void Problem::boundaries(ConstVectorRef u, double lambda, VectorRef g) {
+  for (Eigen::Index k = 0; k < g.size(); ++k) g[k] = boundary(static_cast<int>(k), u, lambda);
+}
+
 bool Problem::stabilityOperator(ConstVectorRef, double, Matrix&, Matrix&) { return false; }
 
 bool Problem::stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo& info) {

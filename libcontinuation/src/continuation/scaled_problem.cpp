@@ -232,6 +232,10 @@ double ScaledProblem::boundary(int k, ConstVectorRef u, double lambda) {
   return problem_.boundary(k, user(u), lambda * units_.parameter());
 }
 
+void ScaledProblem::boundaries(ConstVectorRef u, double lambda, VectorRef g) {
+  problem_.boundaries(user(u), lambda * units_.parameter(), g);  // u scaled once, not once per k
+}
+
 ScaledBorderedSolver::ScaledBorderedSolver(std::unique_ptr<BorderedSolver> solver, const UnitScaling &units)
     : solver_(std::move(solver)), units_(units) {
   const ProblemScales &s = units_.scales();

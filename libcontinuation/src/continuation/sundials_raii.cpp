@@ -79,6 +79,20 @@ void leanScale(realtype c, N_Vector x, N_Vector z) {
   realtype *zd = NV_DATA_S(z);
   for (sunindextype i = 0; i < n; ++i) zd[i] = c * xd[i];
 }
+// z = x + y for a = b = 1 (KINSOL's full Newton step u + p): every branch of the library's
+// N_VLinearSum_Serial for a = b = 1 (its two in-place axpy cases and VSum) adds x_i and y_i, and
+// IEEE addition is commutative, so this is the library's result bit for bit; any other a, b goes to
+// the library's own function, special cases and all.
+void leanLinearSum(realtype a, N_Vector x, realtype b, N_Vector y, N_Vector z) {
+  if (a != 1.0 || b != 1.0) {
+    N_VLinearSum_Serial(a, x, b, y, z);
+    return;
+  }
+  const sunindextype n = NV_LENGTH_S(x);
+  const realtype *xd = NV_DATA_S(x), *yd = NV_DATA_S(y);
+  realtype *zd = NV_DATA_S(z);
+  for (sunindextype i = 0; i < n; ++i) zd[i] = xd[i] + yd[i];
+}
 void leanConst(realtype c, N_Vector z) {
   const sunindextype n = NV_LENGTH_S(z);
   realtype *zd = NV_DATA_S(z);
@@ -95,6 +109,7 @@ void useLeanSerialOperations(N_Vector v) {
   v->ops->nvmin = leanMin;
   v->ops->nvscale = leanScale;
   v->ops->nvconst = leanConst;
+  v->ops->nvlinearsum = leanLinearSum;
 }
 
 void SunContextDeleter::operator()(std::remove_pointer_t<SUNContext> *context) const noexcept {

@@ -384,7 +384,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
   const int events = eventCount();
   eventsA_.resize(size_t(events));
   eventsB_.resize(size_t(events));
-  for (int e = 0; e < events; ++e) eventsA_[size_t(e)] = eventValue(e, branch.points.back());
+  eventValues(branch.points.back(), eventsA_);
   double ds = options_.initialStep;
   std::string lastFailure = "no failure";
 
@@ -440,11 +440,14 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     observed.predictorOrder = previous && a.stepSize > 0.0 ? 2 : 1;  // as takeStep's predictor
 
     // Stop events inside the step: the earliest one, landed on exactly, ends the step there.
-    EventHit hit = locateStopEvent(a, b);
-    if (hit.event >= 0) b = std::move(hit.point);
+    // (Read into locals at once: the step callback below may run the tracer again.)
+    locateStopEvent(a, b, stopHit_);
+    const int hitEvent = stopHit_.event;
+    const double hitAccuracy = stopHit_.accuracy, hitValue = stopHit_.value;
+    if (hitEvent >= 0) b = std::move(stopHit_.point);
 
     std::vector<SpecialPoint> found;
-    if (ia >= skipIntervals && (hit.event < 0 || b.arclength > a.arclength)) {
+    if (ia >= skipIntervals && (hitEvent < 0 || b.arclength > a.arclength)) {
       if (options_.certifiedCounting && options_.detectBranchPoints) {
         // The values next to zero at both ends; their slopes only where the problem's rate bound
         // cannot exclude a hidden crossing (spectral_monitor.h): the same steps are searched.
@@ -462,11 +465,11 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     }
     // An interrupt during location leaves the step's special points half located: the step is
     // dropped, so every point the branch keeps is fully located, and the branch ends at a.
-    if ((!found.empty() || hit.event >= 0) && options_.interrupt.requested()) {
+    if ((!found.empty() || hitEvent >= 0) && options_.interrupt.requested()) {
       interrupted(options_.interrupt.describe());
       return;
     }
-    const bool landedOnStart = hit.event >= 0 && !(b.arclength > a.arclength);
+    const bool landedOnStart = hitEvent >= 0 && !(b.arclength > a.arclength);
     // `a` refers into branch.points: everything that reads it is done before the push.
     if (!landedOnStart) branch.points.push_back(std::move(b));
     for (SpecialPoint &sp : found) {
@@ -478,10 +481,10 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       return;
     }
 
-    if (hit.event >= 0) {
-      const std::string name = eventName(hit.event);
-      stop(eventStopReason(hit.event), "reached " + name,
-           hit.event < 2 ? SpecialPointType::Endpoint : SpecialPointType::Boundary, name, hit.accuracy, hit.value);
+    if (hitEvent >= 0) {
+      const std::string name = eventName(hitEvent);
+      stop(eventStopReason(hitEvent), "reached " + name,
+           hitEvent < 2 ? SpecialPointType::Endpoint : SpecialPointType::Boundary, name, hitAccuracy, hitValue);
       return;
     }
     if (branch.points.back().arclength >= options_.maxArclength * (1.0 - 1e-15)) {

@@ -41,6 +41,13 @@ double Tracer::eventValue(int event, const ContinuationPoint &p) {
   return work_->boundary(e, p.u, p.lambda);
 }
 
+void Tracer::eventValues(const ContinuationPoint &p, std::vector<double> &values) {
+  const int first = 2 + boxEventCount();
+  for (int e = 0; e < first; ++e) values[size_t(e)] = eventValue(e, p);
+  const int boundaries = static_cast<int>(values.size()) - first;
+  if (boundaries > 0) work_->boundaries(p.u, p.lambda, Eigen::Map<Vector>(values.data() + first, boundaries));
+}
+
 double Tracer::eventScale(int event) const {
   if (event < 2) return units_.parameter();
   const int e = event - 2;
@@ -63,11 +70,13 @@ std::string Tracer::eventName(int event) const {
   return problem_.boundaryName(e);
 }
 
-Tracer::EventHit Tracer::locateStopEvent(const ContinuationPoint &a, const ContinuationPoint &b) {
-  EventHit hit;
+void Tracer::locateStopEvent(const ContinuationPoint &a, const ContinuationPoint &b, EventHit &hit) {
+  hit.event = -1;
+  hit.accuracy = 0.0;
+  hit.value = 0.0;
   bool stepSet = false;
   const int events = eventCount();
-  for (int e = 0; e < events; ++e) eventsB_[size_t(e)] = eventValue(e, b);
+  eventValues(b, eventsB_);
   for (int e = 0; e < events; ++e) {
     const double ga = eventsA_[size_t(e)], gb = eventsB_[size_t(e)];
     if (!(ga >= 0.0 && gb < 0.0)) continue;
@@ -105,7 +114,6 @@ Tracer::EventHit Tracer::locateStopEvent(const ContinuationPoint &a, const Conti
     hit.point.arclength = a.arclength + s;
     hit.point.stepSize = s;
   }
-  return hit;
 }
 
 void Tracer::landOnCoordinateBound(int event, const ContinuationPoint &a, ContinuationPoint &located,

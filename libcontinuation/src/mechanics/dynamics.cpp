@@ -119,8 +119,8 @@ DynamicsModel::DynamicsModel(const Chain& chain, const EndCondition& end)
       grad_(chain.size()),
       stiffness_(chain.size()),
       staticsQ_(chain.size()),
-      cosTheta_(chain.size()),
-      sinTheta_(chain.size()),
+      sinHalf_(chain.size()),
+      cosHalf_(chain.size()),
       Jh_(end.heldCount(), chain.size()),
       h_(end.heldCount()),
       A_(end.heldCount(), end.heldCount()),
@@ -145,45 +145,19 @@ void DynamicsModel::evaluateStatics(ConstVectorRef q) {
   const int n = segments();
   if (staticsValid_ && std::equal(q.data(), q.data() + n, staticsQ_.data())) return;
   staticsValid_ = false;
-  // E, ∂E/∂q, K_q and the kinematics (forwardKinematics, chain.cpp) from one sincos per joint:
-  // the springs want sin, cos of q_i/2, and the link directions (cos θ_i, sin θ_i), θ_i = Σ_{k≤i} q_k,
-  // follow by rotating the previous one by q_i (cos q_i = (c − s)(c + s), sin q_i = 2sc from
-  // the half angle). Each rotation adds a few ulp; every kReanchor-th joint takes its direction
-  // from sincos(θ_i) itself, so the error stays within kReanchor rotations' rounding — the size of
-  // the rounding of the prefix sum θ_i itself (tests/mechanics/test_dynamics.cpp compares with
-  // forwardKinematics).
-  constexpr int kReanchor = 16;
-  const Vector& l = chain_.linkLengths();
+  // E, ∂E/∂q, K_q and the kinematics from one sincos per joint: the springs' half angles also
+  // give the link directions (forwardKinematics from half angles, chain.h).
   springEnergy_ = 0.0;
-  double theta = 0.0, ct = 1.0, st = 0.0;
   for (int i = 0; i < n; ++i) {
     const double sh = std::sin(0.5 * q[i]), ch = std::cos(0.5 * q[i]);  // one sincos call at -O2
+    sinHalf_[i] = sh;
+    cosHalf_[i] = ch;
     const Jet3 e = chain_.segment(i).energyJet(q[i], sh, ch);
     springEnergy_ += e.value;
     grad_[i] = e.d1;
     stiffness_[i] = e.d2;
-    theta += q[i];
-    data_.theta[i] = theta;
-    if (i % kReanchor == 0) {
-      ct = std::cos(theta);
-      st = std::sin(theta);
-    } else {
-      const double cq = (ch - sh) * (ch + sh), sq = 2.0 * sh * ch;
-      const double c = ct * cq - st * sq;
-      st = st * cq + ct * sq;
-      ct = c;
-    }
-    cosTheta_[i] = ct;
-    sinTheta_[i] = st;
   }
-  double sumS = 0.0, sumC = 0.0;  // the suffix sums of forwardKinematics (same order)
-  for (int m = n - 1; m >= 0; --m) {
-    sumS += l[m + 1] * sinTheta_[m];
-    sumC += l[m + 1] * cosTheta_[m];
-    data_.S[m] = sumS;
-    data_.C[m] = sumC;
-  }
-  data_.pose = Pose(l[0] + sumC, sumS, data_.theta[n - 1]);
+  forwardKinematics(chain_, q, sinHalf_.data(), cosHalf_.data(), data_);
   endJacobian(data_, J_);
   // ∇Π = ∂E/∂q − J_lᵀ F_l (eq 9, loads_ zero on held coordinates; J rows (−S, C, 1))
   for (int i = 0; i < n; ++i) grad_[i] = grad_[i] + loads_[0] * data_.S[i] - loads_[1] * data_.C[i] - loads_[2];

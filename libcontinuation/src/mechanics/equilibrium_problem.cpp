@@ -57,6 +57,8 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
       stiff_(chain.size()),
       stiffRate_(chain.size()),
       cachedQ_(chain.size()),
+      sinHalf_(chain.size()),
+      cosHalf_(chain.size()),
       domainUpper_(chain.size()),
       domainLower_(chain.size()),
       work_(chain.size()),
@@ -77,7 +79,7 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
   }
 }
 
-bool EquilibriumProblem::prepare(ConstVectorRef u) {
+bool EquilibriumProblem::prepare(const ConstVectorRef& u) {
   const int n = chain_.size();
   for (Eigen::Index k = n; k < u.size(); ++k)
     if (!std::isfinite(u[k])) return false;
@@ -86,14 +88,18 @@ bool EquilibriumProblem::prepare(ConstVectorRef u) {
   if (cacheValid_ && sameBits(q.data(), cachedQ_.data(), size_t(n))) return true;
   cacheValid_ = false;
   if (!inDomain(u)) return false;
-  forwardKinematics(chain_, q, data_);
-  endJacobian(data_, J_);
+  // One sincos per joint serves its springs and the link directions (chain.h).
   for (int i = 0; i < n; ++i) {
-    const Jet3 e = chain_.segment(i).energyJet(q[i]);
+    const double sh = std::sin(0.5 * q[i]), ch = std::cos(0.5 * q[i]);  // one sincos call at -O2
+    sinHalf_[i] = sh;
+    cosHalf_[i] = ch;
+    const Jet3 e = chain_.segment(i).energyJet(q[i], sh, ch);
     grad_[i] = e.d1;
     stiff_[i] = e.d2;
     stiffRate_[i] = e.d3;
   }
+  forwardKinematics(chain_, q, sinHalf_.data(), cosHalf_.data(), data_);
+  endJacobian(data_, J_);
   cachedQ_ = q;
   cacheValid_ = true;
   return true;
@@ -129,7 +135,7 @@ Vector EquilibriumProblem::initialGuess(ConstVectorRef q, double lambda) const {
 // with the limits not traced as boundaries, points beyond a geometric limit are refused: there
 // the triangles would overlap and the model no longer describes the mechanism.
 
-bool EquilibriumProblem::inDomain(ConstVectorRef u) const {
+bool EquilibriumProblem::inDomain(const ConstVectorRef& u) const {
   const int n = chain_.size();
   // Finite bounds: the negated test also refuses ±∞ and NaN.
   for (int i = 0; i < n; ++i)
@@ -180,11 +186,12 @@ bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu,
     for (int l = 0; l < m; ++l) col[n + l] = 0.0;
     Flambda[n + k] = direction_[h];
   }
+  // F_λ = −J_lᵀ d_l, summed over the loaded coordinates in their order for each i.
   double* const fl = Flambda.data();
-  for (int i = 0; i < n; ++i) {
-    double acc = 0.0;
-    for (int c : loaded_) acc -= J[c + 3 * i] * direction_[c];
-    fl[i] = acc;
+  for (int i = 0; i < n; ++i) fl[i] = 0.0;
+  for (int c : loaded_) {
+    const double d = direction_[c];
+    for (int i = 0; i < n; ++i) fl[i] -= J[c + 3 * i] * d;
   }
   return true;
 }
@@ -298,7 +305,7 @@ bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matr
   return true;
 }
 
-void EquilibriumProblem::assembleFromCache(ConstVectorRef u, double lambda, ChainStructure& ws) {
+void EquilibriumProblem::assembleFromCache(const ConstVectorRef& u, double lambda, ChainStructure& ws) {
   loadHessianGenerator(data_, wrench(u, lambda), ws.h);
   assemble(stiff_, ws.h, ws);
 }
@@ -310,7 +317,7 @@ bool EquilibriumProblem::assembleStructure(ConstVectorRef u, double lambda, Chai
   return true;
 }
 
-bool EquilibriumProblem::smallDenseSpectrum(ConstVectorRef u, double lambda) {
+bool EquilibriumProblem::smallDenseSpectrum(const ConstVectorRef& u, double lambda) {
   const size_t N = size_t(u.size());
   // Bitwise, like prepare(): the key was stored after prepare(u) accepted these very bits, so a
   // hit needs neither the domain check nor the q-cache (which may hold another q by now, e.g.
@@ -320,7 +327,10 @@ bool EquilibriumProblem::smallDenseSpectrum(ConstVectorRef u, double lambda) {
     return true;
   spectrumSize_ = -1;
   if (!prepare(u)) return false;
-  assembleFromCache(u, lambda, structure_);
+  // The dense route reads h and κ alone (smallDenseInertia), not the tridiagonal form assemble()
+  // adds for the O(n) counts (every structured route assembles for itself).
+  loadHessianGenerator(data_, wrench(u, lambda), structure_.h);
+  structure_.kappa = stiff_;
   const int n = chain_.size();
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
   // All n − rank values: the eigen-solve computes them anyway (`count` only limits the copy), so
@@ -499,6 +509,15 @@ double EquilibriumProblem::boundary(int k, ConstVectorRef u, double) {
   const int n = chain_.size();
   if (k < n) return chain_.upperLimits()[k] - u[k];
   return u[k - n] - chain_.lowerLimits()[k - n];
+}
+
+void EquilibriumProblem::boundaries(ConstVectorRef u, double, VectorRef g) {
+  const int n = chain_.size();
+  const double* const upper = chain_.upperLimits().data();
+  const double* const lower = chain_.lowerLimits().data();
+  const Eigen::Index count = g.size();
+  for (int k = 0; k < n && k < count; ++k) g[k] = upper[k] - u[k];
+  for (int k = n; k < 2 * n && k < count; ++k) g[k] = u[k - n] - lower[k - n];
 }
 
 std::string EquilibriumProblem::boundaryName(int k) const {

@@ -105,15 +105,13 @@ class DenseBorderedSolver final : public BorderedSolver {
   Factorization factorGeneral(ConstVectorRef u, double lambda, ConstMatrixRef B, ConstMatrixRef C, ConstMatrixRef D,
                               bool transposed) override;
 
-  /// A(c) of the last factor() (before factorization).
-  const Matrix &matrix() const { return A_; }
-
  private:
   Problem &problem_;
   int n_;
-  Matrix A_;
+  Matrix A_;                              // A(c) above kEigenIdenticalSize
   DenseLU small_;                         // N+1 ≤ kEigenIdenticalSize
   bool useSmall_;
+  bool writesAll_;                        // Problem::jacobianWritesAllEntries(): no zero fill
   Eigen::PartialPivLU<Matrix> lu_;        // larger N
   Matrix G_;                              // the last factorGeneral()'s matrix
   Eigen::PartialPivLU<Matrix> generalLu_;

@@ -122,6 +122,7 @@ class Corrector {
   std::optional<DenseLU> dense_;  // the Keller matrix and its factors when structured_ is null
   CorrectorOptions options_;
   int n_;
+  bool writesAll_;  // Problem::jacobianWritesAllEntries(): the Keller matrix is not cleared first
   Vector predictor_, tangent_, lastIterate_;
   Vector unit_;  // e_k for the fixed-coordinate solves
   Vector iterate_, residual_, step_, trial_, trialResidual_;  // leanNewton()'s uu, fval, pp, unew

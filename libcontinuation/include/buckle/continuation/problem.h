@@ -75,6 +75,9 @@ class Problem {
 
   /// Exact F_u (N×N, Fu may be a block of a larger matrix) and F_λ (size N).
   virtual bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) = 0;
+  /// True if jacobian() writes every entry of Fu and Flambda, zeros included. The core then does
+  /// not clear them before each call (the default, false: a problem may write its nonzeros only).
+  virtual bool jacobianWritesAllEntries() const { return false; }
 
   /// d/dε [F_u, F_λ](u + ε·du, λ + ε·dlambda) at ε = 0. Default: central
   /// differences of jacobian(); override with the exact second derivative.
@@ -138,6 +141,10 @@ class Problem {
   virtual int boundaryCount() const { return 0; }
   /// g_k(u, λ): positive inside the admissible set, zero on its boundary.
   virtual double boundary(int /*k*/, ConstVectorRef /*u*/, double /*lambda*/) { return 1.0; }
+  /// Every g_k(u, λ), k < g.size() ≤ boundaryCount(), into g: the tracer asks for all of them at
+  /// every point. The default calls boundary(k) for each; an override must give the same values
+  /// and saves the per-call overhead.
+  virtual void boundaries(ConstVectorRef u, double lambda, VectorRef g);
   virtual std::string boundaryName(int k) const { return "boundary " + std::to_string(k); }
 
   // ---- optional: units ------------------------------------------------------------------

@@ -84,6 +84,7 @@ class ScaledProblem final : public Problem {
   int dimension() const override { return n_; }
   bool residual(ConstVectorRef u, double lambda, VectorRef F) override;
   bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) override;
+  bool jacobianWritesAllEntries() const override { return problem_.jacobianWritesAllEntries(); }
   bool jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
                                      MatrixRef dFu, VectorRef dFlambda) override;
   /// The problem's own O(N) products, through the change of variables.
@@ -102,6 +103,7 @@ class ScaledProblem final : public Problem {
   std::unique_ptr<BorderedSolver> makeStructuredSolver() override;
   int boundaryCount() const override { return problem_.boundaryCount(); }
   double boundary(int k, ConstVectorRef u, double lambda) override;
+  void boundaries(ConstVectorRef u, double lambda, VectorRef g) override;
   std::string boundaryName(int k) const override { return problem_.boundaryName(k); }
 
  private:

@@ -14,7 +14,8 @@
 
 namespace buckle::continuation {
 
-/// Replaces N_VWL2Norm, N_VProd, N_VMaxNorm, N_VMin, N_VScale and N_VConst of the serial vector
+/// Replaces N_VWL2Norm, N_VProd, N_VMaxNorm, N_VMin, N_VScale, N_VConst and N_VLinearSum (its
+/// a = b = 1 case; the others stay the library's) of the serial vector
 /// v (and of its future clones) by the lean versions. v must be an NVECTOR_SERIAL.
 void useLeanSerialOperations(N_Vector v);
 

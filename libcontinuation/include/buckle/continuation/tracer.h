@@ -212,11 +212,15 @@ class Tracer {
     double accuracy = 0.0;  ///< |Δλ| of the last location update
     double value = 0.0;     ///< the event's value at the point, in the user's units
   };
-  /// Fills eventsB_ with the values at b (eventsA_ holds those at a).
-  EventHit locateStopEvent(const ContinuationPoint &a, const ContinuationPoint &b);
+  /// Fills eventsB_ with the values at b (eventsA_ holds those at a) and hit with the earliest
+  /// event crossed (hit.event = -1: none; hit.point is then left as it was). hit is the tracer's
+  /// stopHit_, reused from step to step: a point's worth of vectors is not built and freed per step.
+  void locateStopEvent(const ContinuationPoint &a, const ContinuationPoint &b, EventHit &hit);
   /// λ range and box faces are coordinates: one solve with that coordinate held at the bound.
   void landOnCoordinateBound(int event, const ContinuationPoint &a, ContinuationPoint &located, double &accuracy);
   double eventValue(int event, const ContinuationPoint &point);
+  /// Every event's value at the point into values (size eventCount()): the problem's boundaries in one call.
+  void eventValues(const ContinuationPoint &point, std::vector<double> &values);
   std::string eventName(int event) const;
   int eventCount() const;
   int boxEventCount() const;
@@ -248,6 +252,7 @@ class Tracer {
   StepSizeControl stepControl_;
   Vector predictor_, x_;
   Vector along_;  // stepAlong()'s x_b − x_a (size N+1)
+  EventHit stopHit_;                      // locateStopEvent()'s result, reused
   std::vector<double> eventsA_, eventsB_;  // event values at the current point and the new one
 };
 

@@ -52,6 +52,15 @@ struct ChainData {
 
 /// θ, the tail sums and the end pose (eq 5 generalised). O(n).
 void forwardKinematics(const Chain& chain, ConstVectorRef q, ChainData& data);
+/// The same from the joints' half-angle sines and cosines sinHalf[i] = sin(q_i/2), cosHalf[i] =
+/// cos(q_i/2), which the springs need anyway (Segment::energyJet(q, sinHalf, cosHalf)): the link
+/// directions (cos θ_m, sin θ_m) follow by rotating the previous one by q_m, cos q = (c − s)(c + s),
+/// sin q = 2sc, instead of one sincos per link. Each rotation adds a few ulp; every 16th link takes
+/// its direction from sincos(θ_m) itself, so the error stays within 16 rotations' rounding, the size
+/// of the rounding of the prefix sum θ_m itself. θ, the tail sums and the pose are summed in the
+/// same order as above.
+void forwardKinematics(const Chain& chain, ConstVectorRef q, const double* sinHalf, const double* cosHalf,
+                       ChainData& data);
 Pose endPose(const Chain& chain, ConstVectorRef q);
 /// The chain's centre line at q: column 0 the base (0, 0), column i the joint i (i = 1 … n),
 /// column n + 1 the end; 2×(n + 2). O(n). For drawing and reporting shapes. Throws

@@ -211,7 +211,7 @@ class DynamicsModel {
   Vector stiffness_;     ///< K_q diagonal ∂²E/∂q_i²
   double springEnergy_ = 0.0;  ///< E(q)
   Vector staticsQ_;      ///< q of the cached statics
-  Vector cosTheta_, sinTheta_;  ///< cos θ_m, sin θ_m of the cached statics (evaluateStatics)
+  Vector sinHalf_, cosHalf_;  ///< sin(q_i/2), cos(q_i/2) of the cached statics (evaluateStatics)
   bool staticsValid_ = false;
   Matrix Jh_;     ///< m×n constraint rows: held coordinates, then e_iᵀ of the locked joints
   Vector h_;      ///< p_h − target, then q_i − q̄_i

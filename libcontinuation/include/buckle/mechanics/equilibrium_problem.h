@@ -43,7 +43,7 @@ class EquilibriumProblem final : public continuation::Problem {
   Eigen::Vector3d prescribed(double lambda) const { return end_.value + lambda * direction_; }
   /// Total end wrench at (u, λ): given loads and the multipliers. Inline: every residual,
   /// Jacobian and stability evaluation forms it (a call cost more than the three stores).
-  Wrench wrench(continuation::ConstVectorRef u, double lambda) const {
+  Wrench wrench(const continuation::ConstVectorRef& u, double lambda) const {
     Wrench F = prescribed(lambda);
     const int n = chain_.size();
     for (size_t k = 0; k < held_.size(); ++k) F[held_[k]] = u[n + int(k)];
@@ -57,6 +57,8 @@ class EquilibriumProblem final : public continuation::Problem {
   bool residual(continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) override;
   bool jacobian(continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
                 continuation::VectorRef Flambda) override;
+  /// Every entry of F_u and F_λ, the zero block of the multipliers included.
+  bool jacobianWritesAllEntries() const override { return true; }
   bool jacobianDirectionalDerivative(continuation::ConstVectorRef u, double lambda,
                                      continuation::ConstVectorRef du, double dlambda,
                                      continuation::MatrixRef dFu, continuation::VectorRef dFlambda) override;
@@ -116,25 +118,26 @@ class EquilibriumProblem final : public continuation::Problem {
 
   int boundaryCount() const override;
   double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
+  void boundaries(continuation::ConstVectorRef u, double lambda, continuation::VectorRef g) override;
   std::string boundaryName(int k) const override;
 
  private:
   /// Inside the model's domain: finite, every joint within its geometric limits (or just past one,
   /// while the limits are traced as boundaries: equilibrium_problem.cpp).
-  bool inDomain(continuation::ConstVectorRef u) const;
+  bool inDomain(const continuation::ConstVectorRef& u) const;
   /// The q-dependent part of every evaluation at u = (q, r): kinematics (data_), the end
   /// Jacobian (J_), ∂E/∂q (grad_) and the diagonal of K_q (stiff_), from one pass of the spring
   /// model. Cached for the last q (bitwise comparison; it does not depend on r or λ): KINSOL
   /// evaluates F and then J at the same iterate, and the tracer then J and the stability at the
   /// corrected point, so each distinct q evaluates the spring model once.
   /// False (nothing cached) if u is outside the domain.
-  bool prepare(continuation::ConstVectorRef u);
+  bool prepare(const continuation::ConstVectorRef& u);
   /// T at (u, λ) into ws from the cache (after prepare(u)).
-  void assembleFromCache(continuation::ConstVectorRef u, double lambda, ChainStructure& ws);
+  void assembleFromCache(const continuation::ConstVectorRef& u, double lambda, ChainStructure& ws);
   /// The small dense route (n ≤ kSmallDense) at (u, λ): the inertia and all eigenvalues on
   /// ker J_h into spectrumInertia_ and spectrum_, or nothing when (u, λ) is already their key.
   /// False (nothing cached) outside the domain.
-  bool smallDenseSpectrum(continuation::ConstVectorRef u, double lambda);
+  bool smallDenseSpectrum(const continuation::ConstVectorRef& u, double lambda);
 
   Chain chain_;
   EndCondition end_;
@@ -146,6 +149,7 @@ class EquilibriumProblem final : public continuation::Problem {
   Vector grad_, stiff_;  // ∂E/∂q, diagonal of K_q (size n); with data_ and J_: prepare()'s cache
   Vector stiffRate_;     // d³E/dq³ per joint (size n), from the same jets: stabilityRateBound()
   Vector cachedQ_;       // q of the cache (size n)
+  Vector sinHalf_, cosHalf_;  // sin(q_i/2), cos(q_i/2) of the cache: springs and kinematics share them
   // inDomain()'s bounds per joint, geometric limit ± the overshoot allowed while the limits are
   // traced as boundaries, formed once (the same sums inDomain() formed per call; size n).
   Vector domainUpper_, domainLower_;
