@@ -637,3 +637,31 @@ TEST_CASE("EquilibriumProblem's boundaries in one call equal boundary(k) one by 
     for (int k = 0; k < K; ++k) CHECK(gs[k] == scaled.boundary(k, v, 0.3e-3));
   }
 }
+
+TEST_CASE("EquilibriumProblem's Jacobian writes every entry of F_u and F_lambda, as it declares", "[equilibrium]") {
+  // jacobianWritesAllEntries() lets the corrector and the bordered solver skip zeroing the Keller
+  // matrix: on a matrix filled with NaN the Jacobian must be the one written over zeros.
+  std::mt19937 rng(41);
+  for (const int n : {1, 3, 12}) {
+    const Chain chain = randomChain(rng, n);
+    for (const Setting& s : settings(rng)) {
+      INFO("n = " << n << ", end: " << s.name);
+      EquilibriumProblem problem(chain, s.end, Eigen::Vector3d(0.3, -1.0, 0.2));
+      REQUIRE(problem.jacobianWritesAllEntries());
+      const int N = problem.dimension();
+      const Vector u = randomState(rng, chain, N);
+      Matrix zeroFilled = Matrix::Zero(N + 2, N + 2), nanFilled(N + 2, N + 2);
+      nanFilled.setConstant(std::numeric_limits<double>::quiet_NaN());
+      Vector lz = Vector::Zero(N), ln = Vector::Constant(N, std::numeric_limits<double>::quiet_NaN());
+      // a block of a larger matrix, as the Keller matrix hands it over
+      REQUIRE(problem.jacobian(u, 0.4, zeroFilled.block(1, 1, N, N), lz));
+      REQUIRE(problem.jacobian(u, 0.4, nanFilled.block(1, 1, N, N), ln));
+      CHECK(nanFilled.block(1, 1, N, N).allFinite());
+      CHECK((nanFilled.block(1, 1, N, N).array() == zeroFilled.block(1, 1, N, N).array()).all());
+      CHECK((ln.array() == lz.array()).all());
+      // and nothing outside the block
+      CHECK(std::isnan(nanFilled(0, 0)));
+      CHECK(std::isnan(nanFilled(N + 1, N + 1)));
+    }
+  }
+}
