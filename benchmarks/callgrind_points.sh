@@ -44,7 +44,7 @@ awk -v at="$a_total" -v ad="$a_drv" -v ao="$a_out" -v aw="$a_wr" -v ap="$apts" -
     -v ps="$p_sw" -v pp="$ppts" -v ns="$n_sw" -v np="$npts" -v ls="$l_sw" -v lp="$lpts" 'BEGIN{
   printf "AUTO A_Ufine  : %d points; process %.1f M instructions; driver (autoae) %.1f M, of which output (stplae) %.1f M (wrline %.1f M)\n", ap, at/1e6, ad/1e6, ao/1e6, aw/1e6
   printf "                numerics alone (autoae - stplae) %.1f M = %.1f k per point\n", (ad-ao)/1e6, (ad-ao)/ap/1e3
-  printf "buckle A_Ufine: %d points; process %.1f M instructions; switchBranch %.1f M = %.1f k per point\n", bp, bt/1e6, bs/1e6, bs/bp/1e3
+  printf "buckle A_Ufine: %d points; process %.1f M instructions; switchBranch %.2f M = %.2f k per point\n", bp, bt/1e6, bs/1e6, bs/bp/1e3
   printf "ratio AUTO numerics / buckle per point: %.3f (target >= 2)\n", ((ad-ao)/ap) / (bs/bp)
   printf "buckle --second-order (TracerOptions::secondOrderPredictor): %d points; switchBranch %.2f M = %.2f k per point; ratio %.3f\n", pp, ps/1e6, ps/pp/1e3, ((ad-ao)/ap) / (ps/pp)
   printf "buckle --no-certified (TracerOptions::certifiedCounting = false, like for like): %d points; switchBranch %.2f M = %.2f k per point; ratio %.3f\n", np, ns/1e6, ns/np/1e3, ((ad-ao)/ap) / (ns/np)
