@@ -49,7 +49,8 @@ class Segment {
   /// E and its first three derivatives in one pass (hot loop).
   Jet3 energyJet(double q) const;
   /// The same with sinHalf = sin(q/2) and cosHalf = cos(q/2) given by the caller (who needs that
-  /// sincos anyway: the dynamics share it with the kinematics, dynamics.cpp). energyJet(q) is
+  /// sincos anyway: the equilibrium problem and the dynamics share it with the kinematics,
+  /// forwardKinematics from half angles in chain.h). energyJet(q) is
   /// this with std::sin / std::cos of q/2: bit for bit the same values.
   Jet3 energyJet(double q, double sinHalf, double cosHalf) const;
 
