@@ -515,7 +515,7 @@ void writePlot(const std::vector<Row>& rows, const std::string& task, const std:
   const int t = task == "diagram" ? 0 : task == "fold" ? 1 : 2;
   std::ofstream g(gp);
   g << "set terminal pngcairo size 1400,1000 font ',10'\nset output '" << out << "/work_precision_" << task << ".png'\n"
-    << "set logscale xy\nset format x '10^{%L}'\nset format y '10^{%L}'\nset grid\nset key bottom left\n"
+    << "set logscale xy\nset format x '10^{%L}'\nset format y '10^{%L}'\nset grid\nset key top left\n"
     << "set multiplot layout 2,2 title \"" << titles[t]
     << "\\nbuckle vs AUTO-07p vs naive load grid; buckle-P2: second-order predictor (lines: lower envelopes; errors of 0 at 1e-17)\"\n";
   const char* colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};

@@ -4,7 +4,7 @@ set logscale xy
 set format x '10^{%L}'
 set format y '10^{%L}'
 set grid
-set key bottom left
+set key top left
 set multiplot layout 2,2 title "long: U branch from BP1 to |q| = 1.5 (AUTO A-U, restarted)\nbuckle vs AUTO-07p vs naive load grid; buckle-P2: second-order predictor (lines: lower envelopes; errors of 0 at 1e-17)"
 set xlabel 'special-point error |dFx|'
 set ylabel 'wall time per run [ms]'
