@@ -3,10 +3,12 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <random>
 #include <string>
 
+#include "buckle/continuation/interrupt.h"
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/mirror_symmetry.h"
 
@@ -184,12 +186,22 @@ TEST_CASE("mirror: an image's base and self contacts, mirrored from its source, 
   // traceEquilibria reports an image branch with its source's contacts mirrored
   // (mirrored(Reflection, GeometricContact)); the independent route locates them on the image's
   // own points (reportBranch without given contacts: Illinois on the image's distances, Newton
-  // solves with the image's locked joints).
+  // solves with the image's locked joints). Also in a tree interrupted after its second image
+  // (no contact stretches then: the reports of an interrupted run).
   const int n = GENERATE(8, 12);
-  INFO("n = " << n);
+  const bool interrupt = GENERATE(false, true);
+  INFO("n = " << n << (interrupt ? ", interrupted" : ""));
   const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
-  const EquilibriumBranchOptions o = defaultScene(true);
+  EquilibriumBranchOptions o = defaultScene(true);
+  std::atomic<bool> stop{false};
+  int imagesFinished = 0;
+  if (interrupt) {
+    o.tracer.interrupt = cont::Interrupt().watch(&stop, "test stop");
+    o.onBranch = [&](const cont::BranchTree&, const cont::Branch& finished) {
+      if (finished.mirrorOf >= 0 && ++imagesFinished == 2) stop = true;
+    };
+  }
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
   int geometric = 0, images = 0, lockedPoints = 0;
@@ -253,7 +265,8 @@ TEST_CASE("mirror: an image's base and self contacts, mirrored from its source, 
       CHECK_FALSE((std::signbit(m.point.y()) && m.point.y() == 0.0));  // +0 on the axis, as recomputed
     }
   }
-  CHECK(images == n - 1);
+  CHECK(r.tree.interrupted == interrupt);
+  CHECK(images == (interrupt ? 2 : n - 1));
   CHECK(geometric > 0);  // the children's coils reach the wall or themselves
-  CHECK(lockedPoints > 0);
+  CHECK((lockedPoints > 0) == !interrupt);  // joints lock on the contact stretches only
 }

@@ -195,7 +195,10 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
     }
   }
   // A mirror image's base and self contacts are its source's mirrored (mirror_symmetry.h): the
-  // source comes first in the tree, so its located contacts are at hand.
+  // source comes first in the tree, so its located contacts are at hand. Also in an interrupted
+  // tree: an image is only made from a source that finished (branch_switching.cpp), and neither
+  // got a contact stretch, so the image's points are its source's reflected, all of them. (The
+  // reports are built after the time limit; locating the images' contacts again doubled that.)
   std::vector<GeometricContacts> geometric(result.tree.branches.size());
   for (size_t b = 0; b < result.tree.branches.size(); ++b) {
     const continuation::Branch& branch = result.tree.branches[b];
@@ -203,7 +206,7 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
     for (const continuation::SpecialPoint& sp : branch.specialPoints) names.push_back(classify(problem, sp));
     result.classifications.push_back(std::move(names));
     const int source = branch.mirrorOf;
-    if (source >= 0 && size_t(source) < b && !result.tree.interrupted) {
+    if (source >= 0 && size_t(source) < b) {
       geometric[b].given = true;
       for (const GeometricContact& g : geometric[size_t(source)].list)
         geometric[b].list.push_back(mirrored(tree.symmetry, g));
