@@ -30,7 +30,7 @@ export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$ROOT}
 
 # Debian packages (names verified on bookworm). pybind11-dev, python3-dev, python3-numpy: the
 # Python module (build/python); python3-pytest: its tests. openmpi-bin, libopenmpi-dev:
-# `buckle atlas` under mpirun (and its test, mpirun -np 2/3). TEST_PACKAGES only for `test`:
+# `buckle-mpi atlas` under mpirun (and its test, mpirun -np 2/3). TEST_PACKAGES only for `test`:
 # chromium renders report.html in the browser test.
 readonly PACKAGES=(build-essential cmake git pkg-config ccache libeigen3-dev libsundials-dev
                    libboost-dev catch2 libcli11-dev nlohmann-json3-dev libbenchmark-dev gnuplot-nox

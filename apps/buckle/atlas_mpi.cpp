@@ -33,8 +33,6 @@ bool launchedByMpi() {
   return false;
 }
 
-bool builtWithMpi() { return BUCKLE_WITH_MPI != 0; }
-
 MpiWorld::MpiWorld() {
   if (!launchedByMpi()) return;
 #if BUCKLE_WITH_MPI
@@ -51,8 +49,9 @@ MpiWorld::MpiWorld() {
 #else
   if (launcherSize() > 1)
     throw std::runtime_error("started by mpirun with " + std::to_string(launcherSize()) +
-                             " processes, but this buckle was built without MPI (install libopenmpi-dev and "
-                             "reconfigure, or run it without mpirun: it uses all cores on threads)");
+                             " processes, but `buckle` has no MPI: run `mpirun -np N buckle-mpi atlas ...` (built "
+                             "beside buckle when CMake finds MPI: libopenmpi-dev), or `buckle atlas` without mpirun: "
+                             "it uses all cores on threads");
 #endif
 }
 

@@ -1,8 +1,9 @@
 // `buckle atlas` across processes. Started by mpirun (or another MPI launcher), every rank
 // computes its share of the cells (scene::AtlasShare) on its own threads and rank 0 gathers
 // them and writes the output; started without one, MPI is never initialised and the atlas runs
-// on threads alone, as on any machine without MPI. The only unit that includes <mpi.h>: the
-// libraries and the other subcommands know nothing of MPI.
+// on threads alone, as on any machine without MPI. The only unit that includes <mpi.h>, and only
+// in `buckle-mpi` (BUCKLE_WITH_MPI=1); `buckle` compiles it without MPI, so that no command pays
+// for loading the MPI libraries. The libraries and the other subcommands know nothing of MPI.
 #pragma once
 
 #include <string>
@@ -14,15 +15,13 @@ namespace buckle::cli {
 /// PMIX_RANK, MPICH/Hydra's PMI_SIZE.
 bool launchedByMpi();
 
-/// Whether this program was built with MPI (CMake found it: BUCKLE_WITH_MPI).
-bool builtWithMpi();
-
 /// The processes of an MPI launch for the life of the object (MPI_Init ... MPI_Finalize), or a
 /// world of this one process, without MPI, when not launched by MPI.
 class MpiWorld {
  public:
-  /// Throws std::runtime_error when launched by MPI with more than one process but built
-  /// without MPI: every process would compute the whole atlas and write the same output.
+  /// Throws std::runtime_error when launched by MPI with more than one process but compiled
+  /// without MPI (`buckle`): every process would compute the whole atlas and write the same
+  /// output; the message names `buckle-mpi`.
   MpiWorld();
   ~MpiWorld();
   MpiWorld(const MpiWorld&) = delete;

@@ -1,5 +1,7 @@
 // buckle: command-line front end of the dual-triangle chain mechanics.
 // Subcommands are registered here, each implemented in its own <name>_command.cpp.
+// Compiled twice: `buckle` (every subcommand, no MPI) and, with BUCKLE_MPI_PROGRAM, `buckle-mpi`
+// (the atlas alone, for mpirun): only the program that needs MPI loads its libraries at start-up.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #if defined(__GLIBC__)
@@ -25,15 +27,24 @@ int main(int argc, char** argv) {
   mallopt(M_TOP_PAD, 16 << 20);
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
 #endif
+#if BUCKLE_MPI_PROGRAM
+  CLI::App app{"buckle-mpi: `buckle atlas` shared among the processes of mpirun (mpirun -np N buckle-mpi atlas ...)"};
+  app.set_version_flag("--version", std::string("buckle-mpi ") + BUCKLE_VERSION);
+#else
   CLI::App app{"buckle: mechanics of compliant serial manipulators made of dual-triangle segments"};
   app.set_version_flag("--version", std::string("buckle ") + BUCKLE_VERSION);
+#endif
   app.require_subcommand(1);
   buckle::cli::Outcome outcome;
+#if !BUCKLE_MPI_PROGRAM
   buckle::cli::addCriticalCommand(app, outcome);
   buckle::cli::addRunCommand(app, outcome);
+#endif
   buckle::cli::addAtlasCommand(app, outcome);
+#if !BUCKLE_MPI_PROGRAM
   buckle::cli::addRegressCommand(app, outcome);
   buckle::cli::addShowCommand(app, outcome);
+#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

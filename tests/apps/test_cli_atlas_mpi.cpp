@@ -1,7 +1,8 @@
-// `buckle atlas` under mpirun (apps/buckle/atlas_mpi.cpp): with 2 and 3 ranks (an even and an
-// uneven split of the cells) atlas.csv is the threaded run's byte for byte, order included;
-// a time limit keeps what was computed; bad input is reported once and stops every rank.
-// Built only when CMake found MPI and mpiexec (BUCKLE_MPIEXEC).
+// `buckle-mpi atlas` under mpirun (apps/buckle/atlas_mpi.cpp): with 2 and 3 ranks (an even and
+// an uneven split of the cells) atlas.csv is the threaded `buckle atlas` run's byte for byte,
+// order included; a time limit keeps what was computed; bad input is reported once and stops
+// every rank; `buckle` itself, which links no MPI, refuses more than one rank and names
+// buckle-mpi. Built only when CMake found MPI and mpiexec (BUCKLE_MPIEXEC).
 #include <catch2/catch.hpp>
 
 #ifdef BUCKLE_MPIEXEC
@@ -21,20 +22,23 @@ using buckle::test::slurp;
 
 namespace {
 
+const std::string kBuckleMpi = std::string(BUCKLE_BINARY_DIR) + "/bin/buckle-mpi";
+
 fs::path work(const std::string& name) { return buckle::test::freshDirectory("cli_atlas_mpi", name); }
 
-// `mpirun -np RANKS buckle ARGS`, output into `capture`. CI runs as root in a container:
+// `mpirun -np RANKS PROGRAM ARGS` (PROGRAM: buckle-mpi unless given), output into `capture`. CI runs as root in a container:
 // Open MPI then wants its two permissions, --oversubscribe (more ranks than cores),
 // --bind-to none, and no single-copy shared-memory transport (CMA needs ptrace rights that
 // containers often lack). Under the sanitizers, complete allocation stacks and the
 // suppressions of Open MPI's own leaks (mpi_lsan.supp); ignored in other builds.
-int mpiExitCode(int ranks, const std::string& args, const fs::path& capture) {
+int mpiExitCode(int ranks, const std::string& args, const fs::path& capture,
+                const std::string& program = kBuckleMpi) {
   const std::string cmd =
       "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none "
       "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}fast_unwind_on_malloc=0\" "
       "LSAN_OPTIONS=\"${LSAN_OPTIONS:+$LSAN_OPTIONS:}suppressions=" BUCKLE_MPI_LSAN_SUPPRESSIONS "\" '" BUCKLE_MPIEXEC
       "' --oversubscribe --bind-to none -np " +
-      std::to_string(ranks) + " '" + buckle::test::kBuckle + "' " + args + " > '" + capture.string() + "' 2>&1";
+      std::to_string(ranks) + " '" + program + "' " + args + " > '" + capture.string() + "' 2>&1";
   const int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
@@ -103,6 +107,33 @@ TEST_CASE("bad input under mpirun: one message, exit 2, nothing written, no rank
   CHECK(mpiExitCode(3, kGrid + " --out '" + (dir / "notes.txt").string() + "'", log) == 2);
   CHECK(count(slurp(log), "is an existing file") == 1);
   CHECK(slurp(dir / "notes.txt") == "mine");
+}
+
+TEST_CASE("buckle links no MPI: under mpirun with 2 ranks it names buckle-mpi and writes nothing",
+          "[cli][atlas][mpi]") {
+  const fs::path dir = work("plain");
+  const fs::path log = dir / "log.txt";
+  CHECK(mpiExitCode(2, kGrid + " --out '" + (dir / "a").string() + "'", log, buckle::test::kBuckle) == 2);
+  INFO(slurp(log));
+  CHECK(count(slurp(log), "buckle-mpi atlas") >= 1);  // each rank says so (mpirun may stop the second first)
+  CHECK(!fs::exists(dir / "a"));
+  // one rank under mpirun is a plain run on threads: the same cells as without mpirun
+  CHECK(mpiExitCode(1, kGrid + " -j 1 --out '" + (dir / "one").string() + "'", dir / "one.log", buckle::test::kBuckle) ==
+        1);
+  CHECK(exitCode(kGrid + " -j 1 --out '" + (dir / "threads").string() + "'", dir / "threads.log") == 1);
+  CHECK(slurp(dir / "one" / "atlas.csv") == slurp(dir / "threads" / "atlas.csv"));
+  const nlohmann::json summary = nlohmann::json::parse(slurp(dir / "one" / "summary.json"));
+  CHECK(summary["mpi_ranks"] == 1);
+}
+
+TEST_CASE("buckle-mpi has the atlas alone", "[cli][atlas][mpi]") {
+  const fs::path dir = work("help");
+  const std::string cmd = "'" + kBuckleMpi + "' --help > '" + (dir / "help.txt").string() + "' 2>&1";
+  CHECK(std::system(cmd.c_str()) == 0);
+  const std::string help = slurp(dir / "help.txt");
+  CHECK(count(help, "atlas") >= 1);
+  CHECK(count(help, "  run ") == 0);
+  CHECK(count(help, "  regress ") == 0);
 }
 
 #endif  // BUCKLE_MPIEXEC
