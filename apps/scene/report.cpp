@@ -29,15 +29,70 @@ namespace {
 // unchanged), without the locale and stdio machinery (several times faster per number).
 json rounded(double v, int digits = 6) { return roundedForPage(v, digits); }
 
-/// Joint positions flattened as [x0, y0, x1, y1, …] (4 significant digits).
-json jointsJson(const mechanics::Chain& chain, const Eigen::VectorXd& q) {
-  const Eigen::Matrix2Xd p = mechanics::jointPositions(chain, q);
-  json a = json::array();
-  for (Eigen::Index j = 0; j < p.cols(); ++j) {
-    a.push_back(rounded(p(0, j), 4));
-    a.push_back(rounded(p(1, j), 4));
+/// Appends rounded(v, digits) as dump() writes it: "null" when not finite, else the conversion
+/// nlohmann::json's serializer calls for a finite double (dump_float), without building a value.
+void appendRounded(std::string& out, double v, int digits = 6) {
+  const double r = std::isfinite(v) ? roundedSignificant(v, digits) : v;
+  if (!std::isfinite(r)) {
+    out += "null";
+    return;
   }
-  return a;
+  char buf[64];
+  const char* end = nlohmann::detail::to_chars(buf, buf + sizeof buf, r);
+  out.append(buf, size_t(end - buf));
+}
+
+/// Joint positions flattened as [x0, y0, x1, y1, …] (4 significant digits), as dump() writes them.
+void appendJoints(std::string& out, const mechanics::Chain& chain, const Eigen::VectorXd& q) {
+  const Eigen::Matrix2Xd p = mechanics::jointPositions(chain, q);
+  out += '[';
+  for (Eigen::Index j = 0; j < p.cols(); ++j) {
+    if (j > 0) out += ',';
+    appendRounded(out, p(0, j), 4);
+    out += ',';
+    appendRounded(out, p(1, j), 4);
+  }
+  out += ']';
+}
+
+/// The same as a JSON value (a few shapes per case: the unloaded chain, the special points).
+json jointsJson(const mechanics::Chain& chain, const Eigen::VectorXd& q) {
+  std::string text;
+  appendJoints(text, chain, q);
+  return json::parse(text);  // the same doubles: dump's numbers read back exactly
+}
+
+/// A JSON array of `count` items as dump() writes it, item(i) appending the i-th.
+template <class Item>
+void appendArray(std::string& out, size_t count, Item&& item) {
+  out += '[';
+  for (size_t i = 0; i < count; ++i) {
+    if (i > 0) out += ',';
+    item(i);
+  }
+  out += ']';
+}
+
+/// Object members as text: the key and its value as dump() writes it.
+using Members = std::vector<std::pair<std::string, std::string>>;
+
+std::string dumped(const json& v) { return v.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+/// The object with the members of `small` and the members already written as text, in the key
+/// order of nlohmann::json's std::map: the text dump() writes for the whole object, without
+/// building the large members as JSON values (a long chain's page holds millions of numbers).
+std::string objectText(const json& small, Members members) {
+  for (const auto& item : small.items()) members.emplace_back(item.key(), dumped(item.value()));
+  std::sort(members.begin(), members.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::string out = "{";
+  for (size_t i = 0; i < members.size(); ++i) {
+    if (i > 0) out += ',';
+    out += dumped(json(members[i].first));
+    out += ':';
+    out += members[i].second;
+  }
+  out += '}';
+  return out;
 }
 
 /// At most this many shape coordinates per case: beyond it every k-th point carries its shape
@@ -56,33 +111,46 @@ std::set<std::string> drawnColumns(const Scene& scene, const std::string& mainX,
   return columns;
 }
 
-json caseJson(const Scene& scene, const CaseResult& cr, size_t index, const std::set<std::string>& columns) {
+/// The per-point members of a case (branch, columns, point, shapes, stable) as text.
+Members pointMembers(const CaseResult& cr, const std::set<std::string>& columns) {
+  const std::vector<PointRecord>& pts = cr.points;
+  Members m;
+  std::string text;
+  appendArray(text, pts.size(), [&](size_t i) { text += std::to_string(pts[i].branch); });
+  m.emplace_back("branch", std::move(text));
+  Members cols;
+  for (const std::string& name : columns) {
+    std::string values;
+    appendArray(values, pts.size(), [&](size_t i) { appendRounded(values, columnValue(name, pts[i], cr.pose0)); });
+    cols.emplace_back(name, std::move(values));
+  }
+  m.emplace_back("columns", objectText(json::object(), std::move(cols)));
+  text.clear();
+  appendArray(text, pts.size(), [&](size_t i) { text += std::to_string(pts[i].index); });
+  m.emplace_back("point", std::move(text));
+  const size_t perShape = 2 * static_cast<size_t>(cr.chain.size() + 2);
+  const size_t stride = std::max<size_t>(1, (pts.size() * perShape + kShapeBudget - 1) / kShapeBudget);
+  text.clear();
+  appendArray(text, pts.size(), [&](size_t i) {
+    if (i % stride == 0 && pts[i].q.size() == cr.chain.size())
+      appendJoints(text, cr.chain, pts[i].q);
+    else
+      text += "null";
+  });
+  m.emplace_back("shapes", std::move(text));
+  text.clear();
+  appendArray(text, pts.size(), [&](size_t i) { text += pts[i].stable ? '1' : '0'; });
+  m.emplace_back("stable", std::move(text));
+  return m;
+}
+
+/// A case of the page's data as the text dump() writes for it.
+std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, const std::set<std::string>& columns) {
   json c;
   c["index"] = index;
   c["label"] = cr.label;
   c["segments"] = cr.chain.size();
   c["parameter"] = index < scene.cases.size() ? scene.cases[index].path.parameter : std::string("parameter");
-  json cols = json::object();
-  for (const std::string& name : columns) {
-    json v = json::array();
-    for (const PointRecord& p : cr.points) v.push_back(rounded(columnValue(name, p, cr.pose0)));
-    cols[name] = v;
-  }
-  c["columns"] = cols;
-  json branch = json::array(), point = json::array(), stable = json::array(), shapes = json::array();
-  const size_t perShape = 2 * static_cast<size_t>(cr.chain.size() + 2);
-  const size_t stride = std::max<size_t>(1, (cr.points.size() * perShape + kShapeBudget - 1) / kShapeBudget);
-  for (size_t i = 0; i < cr.points.size(); ++i) {
-    const PointRecord& p = cr.points[i];
-    branch.push_back(p.branch);
-    point.push_back(p.index);
-    stable.push_back(p.stable ? 1 : 0);
-    shapes.push_back(i % stride == 0 && p.q.size() == cr.chain.size() ? jointsJson(cr.chain, p.q) : json(nullptr));
-  }
-  c["branch"] = branch;
-  c["point"] = point;
-  c["stable"] = stable;
-  c["shapes"] = shapes;
   c["unloaded"] = jointsJson(cr.chain, cr.q0.size() == cr.chain.size() ? cr.q0
                                                                         : Eigen::VectorXd(Eigen::VectorXd::Zero(cr.chain.size())));
   json branches = json::array();
@@ -163,7 +231,7 @@ json caseJson(const Scene& scene, const CaseResult& cr, size_t index, const std:
       sudden["static"] = jointsJson(cr.chain, cr.sudden.staticShape);
     c["sudden"] = sudden;
   }
-  return c;
+  return objectText(c, pointMembers(cr, columns));
 }
 
 const char* const kHead = R"PAGE(<!DOCTYPE html>
@@ -622,14 +690,18 @@ const char* const kTail = R"PAGE(</script>
 
 }  // namespace
 
-json roundedForPage(double v, int digits) {
-  if (!std::isfinite(v)) return nullptr;
+double roundedSignificant(double v, int digits) {
   char buf[32];
   const std::to_chars_result printed = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
   double r = v;
   // out of range (|v| rounded up past the largest double): strtod's ±HUGE_VAL, as before
   if (std::from_chars(buf, printed.ptr, r).ec != std::errc()) r = std::strtod(std::string(buf, printed.ptr).c_str(), nullptr);
   return r;
+}
+
+json roundedForPage(double v, int digits) {
+  if (!std::isfinite(v)) return nullptr;
+  return roundedSignificant(v, digits);
 }
 
 std::string reportHtml(const Scene& scene, const RunResult& run, const json& specialPoints, const json& summary) {
@@ -649,12 +721,11 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   const std::string mainX = first ? first->x : "parameter", mainY = first ? first->y.front() : "q1";
   const std::set<std::string> columns = drawnColumns(scene, mainX, mainY);
   bool anyPoints = false;
-  json cases = json::array();
-  for (size_t c = 0; c < run.cases.size(); ++c) {
-    cases.push_back(caseJson(scene, run.cases[c], c, columns));
+  std::string cases;
+  appendArray(cases, run.cases.size(), [&](size_t c) {
+    cases += caseText(scene, run.cases[c], c, columns);
     anyPoints = anyPoints || !run.cases[c].points.empty();
-  }
-  data["cases"] = cases;
+  });
   if (anyPoints)
   {
     data["main"] = json{{"x", mainX},
@@ -674,7 +745,7 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   }
   data["plots"] = plots;
   data["critical"] = specialPoints.contains("critical_loads") ? specialPoints["critical_loads"] : json::array();
-  std::string text = data.dump(-1, ' ', false, json::error_handler_t::replace);
+  std::string text = objectText(data, {{"cases", std::move(cases)}});
   // inside <script>, "</" would end the element: JSON allows the escaped solidus
   for (size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3)) text.replace(at, 2, "<\\/");
   return kHead + text + kTail;

@@ -32,8 +32,8 @@ using nlohmann::json;
 
 namespace {
 
-/// The document embedded in the page's <script type="application/json" id="buckle-data">.
-json embedded(const std::string& page) {
+/// The text embedded in the page's <script type="application/json" id="buckle-data">.
+std::string embeddedText(const std::string& page) {
   const std::string open = "<script type=\"application/json\" id=\"buckle-data\">";
   const size_t begin = page.find(open);
   REQUIRE(begin != std::string::npos);
@@ -41,8 +41,11 @@ json embedded(const std::string& page) {
   const size_t from = begin + open.size();
   const size_t end = page.find("</script>", from);
   REQUIRE(end != std::string::npos);
-  return json::parse(page.substr(from, end - from));
+  return page.substr(from, end - from);
 }
+
+/// The document embedded in the page.
+json embedded(const std::string& page) { return json::parse(embeddedText(page)); }
 
 Scene smallScene(const std::string& description) {
   json s = {{"description", description},
@@ -98,6 +101,41 @@ TEST_CASE("the report embeds every traced point and special point of the run", "
   REQUIRE(data["plots"].size() == 2);
   CHECK(data["plots"][1]["type"] == "shapes");
   CHECK(data["critical"].size() == specials["critical_loads"].size());
+}
+
+TEST_CASE("the page's data are written as nlohmann::json dumps them, values rounded as printf's %g", "[scene][report]") {
+  // The page writes its per-point arrays as text; the independent formulation is the library's
+  // own writer: the document parsed and dumped again gives the same bytes (dump's number format,
+  // member order, escaping), and every value is the point's own, rounded as snprintf + strtod do.
+  const Scene scene = smallScene("text \"quoted\", a tab\t, an é and a </ that must be escaped");
+  const RunResult run = runScene(scene);
+  const CaseResult& cr = run.cases[0];
+  const std::string page = reportHtml(scene, run, specialPointsJson(scene, run), summaryJson(scene, run, PlotReport{}));
+  std::string text = embeddedText(page);
+  for (size_t at = text.find("<\\/"); at != std::string::npos; at = text.find("<\\/", at + 1)) text.replace(at, 3, "</");
+  const json data = json::parse(text);
+  CHECK(data.dump(-1, ' ', false, json::error_handler_t::replace) == text);
+  const auto printed = [](double v, int digits) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    return std::strtod(buf, nullptr);
+  };
+  const json& c = data["cases"][0];
+  REQUIRE(c["branch"].size() == cr.points.size());
+  for (size_t i = 0; i < cr.points.size(); ++i) {
+    const PointRecord& p = cr.points[i];
+    CHECK(c["branch"][i] == p.branch);
+    CHECK(c["point"][i] == p.index);
+    CHECK(c["columns"]["parameter"][i].get<double>() == printed(p.parameter, 6));
+    CHECK(c["columns"]["Fx"][i].get<double>() == printed(p.F[0], 6));
+    CHECK(c["columns"]["q2"][i].get<double>() == printed(p.q[1], 6));
+    const Eigen::Matrix2Xd xy = mech::jointPositions(cr.chain, p.q);
+    REQUIRE(c["shapes"][i].size() == size_t(2 * xy.cols()));
+    for (Eigen::Index j = 0; j < xy.cols(); ++j) {
+      CHECK(c["shapes"][i][size_t(2 * j)].get<double>() == printed(xy(0, j), 4));
+      CHECK(c["shapes"][i][size_t(2 * j + 1)].get<double>() == printed(xy(1, j), 4));
+    }
+  }
 }
 
 TEST_CASE("report.html is written with the outputs and keeps the directory a buckle output", "[scene][report]") {
