@@ -1,7 +1,6 @@
 #include "scene/report.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +14,7 @@
 #include <system_error>
 
 #include "scene/output.h"
+#include "scene/output_numbers.h"
 
 namespace buckle::scene {
 
@@ -24,9 +24,8 @@ namespace {
 
 // The page embeds every traced point; numbers keep 6 significant digits (a hundred times finer
 // than a pixel of the diagram) and shapes 4, so a long chain's report stays a few megabytes.
-// std::to_chars with a precision prints as printf's "%.*g" and std::from_chars rounds correctly
-// as strtod does, so the value is the same double as snprintf + strtod gave (bytes of the page
-// unchanged), without the locale and stdio machinery (several times faster per number).
+// roundedSignificant (output_numbers.h) gives the same double as snprintf + strtod (bytes of the
+// page unchanged), without the locale and stdio machinery or a conversion to text.
 json rounded(double v, int digits = 6) { return roundedForPage(v, digits); }
 
 /// Appends rounded(v, digits) as dump() writes it: "null" when not finite, else the conversion
@@ -689,15 +688,6 @@ const char* const kTail = R"PAGE(</script>
 )PAGE";
 
 }  // namespace
-
-double roundedSignificant(double v, int digits) {
-  char buf[32];
-  const std::to_chars_result printed = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
-  double r = v;
-  // out of range (|v| rounded up past the largest double): strtod's ±HUGE_VAL, as before
-  if (std::from_chars(buf, printed.ptr, r).ec != std::errc()) r = std::strtod(std::string(buf, printed.ptr).c_str(), nullptr);
-  return r;
-}
 
 json roundedForPage(double v, int digits) {
   if (!std::isfinite(v)) return nullptr;

@@ -15,10 +15,8 @@
 
 namespace buckle::scene {
 
-/// A finite v to `digits` significant digits: the double nearest to printf's "%.*g" of v.
-double roundedSignificant(double v, int digits);
-/// v to `digits` significant digits as the page embeds it: roundedSignificant (null for a
-/// non-finite v: JSON has no NaN).
+/// v to `digits` significant digits as the page embeds it: the double nearest to printf's
+/// "%.*g" of v (null for a non-finite v: JSON has no NaN).
 nlohmann::json roundedForPage(double v, int digits);
 
 /// The complete page for a run; `specialPoints` and `summary` are the documents written as

@@ -1,0 +1,22 @@
+// Numbers as the output files print them, to the byte and fast: branches.csv's printf "%.12g"
+// and report.html's values rounded to a few significant digits. A long chain's outputs hold
+// millions of numbers, and printf-style conversion with a precision (snprintf, std::to_chars with
+// a precision) costs several hundred instructions each; here the decimal digits come from one
+// scaling by an exact power of ten and a rounding to an integer, checked to be the rounding of
+// the exact value, with std::to_chars as the fallback where the check cannot tell
+// (output_numbers.cpp).
+#pragma once
+
+#include <string>
+
+namespace buckle::scene {
+
+/// Appends v as printf's "%.*g" with `precision` significant digits (1 <= precision <= 17), the
+/// same characters; "nan" when v is not finite (branches.csv's convention).
+void appendGeneral(std::string& out, double v, int precision);
+
+/// The double nearest to printf's "%.*g" of a finite v (1 <= digits <= 17): v rounded to
+/// `digits` significant decimal digits, bit for bit what snprintf + strtod give.
+double roundedSignificant(double v, int digits);
+
+}  // namespace buckle::scene
