@@ -56,6 +56,7 @@ class CaseRunner {
     opt.maxStep = scene_.solver.maxStep;
     opt.maxPoints = scene_.solver.maxPoints;
     opt.newtonTolerance = scene_.solver.tolerance;
+    opt.locationTolerance = scene_.solver.locationTolerance;
     opt.interrupt = control_.interrupt;
     if (control_.progress) {
       Progress* progress = control_.progress;

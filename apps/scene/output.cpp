@@ -227,7 +227,12 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       if (s.koiter.valid) {  // BP: λ(ξ) = λ + aξ + bξ², ξ in rad of the unit joint-angle mode
         p["koiter_a"] = number(s.koiter.a);
         p["koiter_b"] = number(s.koiter.b);
-        p["post_buckling"] = mechanics::toString(s.koiter.kind);
+        p["koiter_b_accuracy"] = number(s.koiter.bAccuracy);
+        if (s.koiter.degenerate) {  // b = 0 to its accuracy: λ = λ + c4 ξ⁴ decides
+          p["koiter_c4"] = number(s.koiter.c4);
+          p["koiter_c4_accuracy"] = number(s.koiter.c4Accuracy);
+        }
+        p["post_buckling"] = mechanics::postBucklingName(s.koiter);
         json imperfections = json::array();
         for (const mechanics::ImperfectionSensitivity& im : s.imperfections)
           if (im.valid) {
@@ -376,7 +381,8 @@ void writeCurves(const Scene& scene, const RunResult& run, const fs::path& dir) 
 
 json solverJson(const SolverSpec& s) {
   return json{{"initial_step", s.initialStep}, {"min_step", s.minStep}, {"max_step", s.maxStep},
-              {"tolerance", s.tolerance},      {"max_points", s.maxPoints}, {"time_limit", s.timeLimit}};
+              {"tolerance", s.tolerance},      {"location_tolerance", s.locationTolerance},
+              {"max_points", s.maxPoints}, {"time_limit", s.timeLimit}};
 }
 
 }  // namespace

@@ -139,6 +139,8 @@ struct SolverSpec {
   double minStep = 1e-7;
   double maxStep = 0.05;
   double tolerance = 1e-10;    ///< corrector residual tolerance
+  /// Located points: |Δλ| ≤ locationTolerance·max(λ₀, |λ|) (TracerOptions::locationTolerance).
+  double locationTolerance = 1e-12;
   int maxPoints = 4000;        ///< per branch
   double timeLimit = 120.0;    ///< seconds for the whole scene; past it the run stops (exit 1)
 };

@@ -12,13 +12,13 @@ using Catch::Matchers::Contains;
 
 namespace {
 /// F(u, λ) = A·G(u − u_p(λ), λ) with the reduced normal form G(x, y, λ) = ((1 − λ)x + αx² + xy +
-/// βx³, 2y − x²), a non-trivial parent u_p(λ) = (0.4 sin λ, 0.3λ²) and a non-symmetric A. The
-/// child is u = u_p(λ) + (ξ, ξ²/2), λ = 1 + αξ + (½ + β)ξ² exactly, ξ = (u − u_p(λ))₀: a
+/// βx³ + γx⁵, 2y − x²), a non-trivial parent u_p(λ) = (0.4 sin λ, 0.3λ²) and a non-symmetric A. The
+/// child is u = u_p(λ) + (ξ, ξ²/2), λ = 1 + αξ + (½ + β)ξ² + γξ⁴ exactly, ξ = (u − u_p(λ))₀: a
 /// transcritical point (α ≠ 0) or a pitchfork (α = 0) on a bent parent, with closed-form a = α,
 /// b = ½ + β, u2 = (0, ½), p1 = u_p'(1), p2 = u_p''(1).
 class BentNormalForm : public Problem {
  public:
-  double alpha = 0.0, beta = 0.0;
+  double alpha = 0.0, beta = 0.0, gamma = 0.0;
   Eigen::Matrix2d A = (Eigen::Matrix2d() << 2.0, 1.0, 0.5, 3.0).finished();
   static Vector up(double l) { return (Vector(2) << 0.4 * std::sin(l), 0.3 * l * l).finished(); }
   static Vector dup(double l) { return (Vector(2) << 0.4 * std::cos(l), 0.6 * l).finished(); }
@@ -27,12 +27,16 @@ class BentNormalForm : public Problem {
   bool residual(ConstVectorRef u, double l, VectorRef F) override {
     const Vector z = u - up(l);
     const double x = z[0], y = z[1];
-    F = A * (Vector(2) << (1.0 - l) * x + alpha * x * x + x * y + beta * x * x * x, 2.0 * y - x * x).finished();
+    F = A * (Vector(2) << (1.0 - l) * x + alpha * x * x + x * y + beta * x * x * x + gamma * std::pow(x, 5),
+                                  2.0 * y - x * x)
+                                     .finished();
     return true;
   }
   Eigen::Matrix2d Gz(const Vector &z, double l) const {
     const double x = z[0], y = z[1];
-    return (Eigen::Matrix2d() << 1.0 - l + 2.0 * alpha * x + y + 3.0 * beta * x * x, x, -2.0 * x, 2.0).finished();
+    return (Eigen::Matrix2d() << 1.0 - l + 2.0 * alpha * x + y + 3.0 * beta * x * x + 5.0 * gamma * std::pow(x, 4), x,
+            -2.0 * x, 2.0)
+        .finished();
   }
   bool jacobian(ConstVectorRef u, double l, MatrixRef Fu, VectorRef Fl) override {
     const Vector z = u - up(l);
@@ -44,7 +48,9 @@ class BentNormalForm : public Problem {
                                      VectorRef dFl) override {
     const Vector z = u - up(l), dz = du - dup(l) * dl;
     const Eigen::Matrix2d dGz =
-        (Eigen::Matrix2d() << -dl + 2.0 * alpha * dz[0] + dz[1] + 6.0 * beta * z[0] * dz[0], dz[0], -2.0 * dz[0], 0.0)
+        (Eigen::Matrix2d() << -dl + 2.0 * alpha * dz[0] + dz[1] + 6.0 * beta * z[0] * dz[0] +
+                                  20.0 * gamma * std::pow(z[0], 3) * dz[0],
+         dz[0], -2.0 * dz[0], 0.0)
             .finished();
     dFu = A * dGz;
     dFl = A * ((Vector(2) << -dz[0], 0.0).finished() - dGz * dup(l) - Gz(z, l) * ddup(l) * dl);
@@ -132,4 +138,111 @@ TEST_CASE("Branch-point coefficients: refused input", "[branch_point_coefficient
   fold.type = SpecialPointType::Fold;
   CHECK_FALSE(branchPointCoefficients(p, fold, c, k, &why));
   CHECK_THAT(why, Contains("not a located simple branch point"));
+}
+
+TEST_CASE("Degenerate pitchfork: b zero to its accuracy, the quartic term from the child", "[branch_point_coefficients]") {
+  BentNormalForm p;
+  const Vector c = (Vector(2) << 1.0, 0.0).finished();
+  p.beta = -0.5;  // b = ½ + β = 0: λ = 1 + γξ⁴ (closed form)
+  for (double gamma : {0.3, -0.3}) {
+    p.gamma = gamma;
+    BranchPointCoefficients k;
+    std::string why;
+    REQUIRE(branchPointCoefficients(p, BentNormalForm::up(1.0), 1.0, tangentAt(1.0), c, c, k, &why));
+    // the estimate bounds the actual error, and b = 0 lies within it
+    CHECK(std::abs(k.b) <= k.bAccuracy);
+    CHECK(k.bAccuracy > 0.0);
+    CHECK(k.bAccuracy <= 1e-10 * k.bScale);
+    ChildBranchExpansion ex;
+    REQUIRE(childBranchExpansion(p, BentNormalForm::up(1.0), 1.0, k, c, ex, &why));
+    INFO("c4 = " << ex.c4 << " +- " << ex.c4Accuracy << ", c2 = " << ex.c2);
+    // ξ here is u₀ − u_p(1)₀, not u₀ − u_p(λ)₀: they differ by O(λ − 1) = O(ξ⁴), which moves λ(ξ) at O(ξ⁷) only
+    CHECK(std::abs(ex.c4 - gamma) <= ex.c4Accuracy + 1e-9);
+    CHECK(ex.c4Accuracy <= 1e-4 * std::abs(gamma));
+    CHECK(std::abs(ex.c2) <= ex.c2Accuracy + 1e-9);
+    CHECK(std::abs(ex.c1) <= 1e-6);  // the odd part: O(ξ⁷) from the amplitude measured from u_p(1)
+  }
+}
+
+TEST_CASE("Non-degenerate pitchfork: b above its accuracy, and the child's own λ(ξ) agrees",
+          "[branch_point_coefficients]") {
+  BentNormalForm p;
+  const Vector c = (Vector(2) << 1.0, 0.0).finished();
+  p.beta = 0.2;
+  p.gamma = 0.1;
+  BranchPointCoefficients k;
+  std::string why;
+  REQUIRE(branchPointCoefficients(p, BentNormalForm::up(1.0), 1.0, tangentAt(1.0), c, c, k, &why));
+  CHECK(std::abs(k.b - 0.7) <= k.bAccuracy + 1e-9);
+  CHECK(std::abs(k.b) > 1e6 * k.bAccuracy);
+  ChildBranchExpansion ex;
+  REQUIRE(childBranchExpansion(p, BentNormalForm::up(1.0), 1.0, k, c, ex, &why));
+  // an independent formulation of b: the even part of λ at points of the child
+  CHECK(std::abs(ex.c2 - 0.7) <= ex.c2Accuracy + 1e-9);
+  CHECK(ex.c2Accuracy <= 1e-6);
+}
+
+namespace {
+/// u³ + μu − λ = 0 (exact second derivatives): folds at u = ±√(−μ/3) for μ < 0, with
+/// λ'' = ∓6√(−μ/3)·… → 0 as μ → 0, where the two folds merge in the cusp u = λ = 0.
+class CuspFamily : public Problem {
+ public:
+  double mu = 0.0;
+  int dimension() const override { return 1; }
+  bool residual(ConstVectorRef u, double l, VectorRef F) override {
+    F[0] = u[0] * u[0] * u[0] + mu * u[0] - l;
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+    Fu(0, 0) = 3.0 * u[0] * u[0] + mu;
+    Fl[0] = -1.0;
+    return true;
+  }
+  bool jacobianDirectionalDerivative(ConstVectorRef u, double, ConstVectorRef du, double, MatrixRef dFu,
+                                     VectorRef dFl) override {
+    dFu(0, 0) = 6.0 * u[0] * du[0];
+    dFl[0] = 0.0;
+    return true;
+  }
+};
+
+SpecialPoint foldAt(double u, double lambda) {
+  SpecialPoint sp;
+  sp.type = SpecialPointType::Fold;
+  sp.u = Vector::Constant(1, u);
+  sp.lambda = lambda;
+  sp.nullVectors = Matrix::Ones(1, 1);
+  return sp;
+}
+}  // namespace
+
+TEST_CASE("Fold coefficient: λ'' in closed form, and a cusp named where it vanishes", "[branch_point_coefficients]") {
+  CuspFamily p;
+  FoldCoefficient fc;
+  std::string why;
+  // μ = −3: folds at u = ±1, λ = ∓2; λ = u³ − 3u along the branch, λ'' = 6u
+  p.mu = -3.0;
+  REQUIRE(foldCoefficient(p, foldAt(1.0, -2.0), fc, &why));
+  CHECK(std::abs(fc.curvature - 6.0) <= 1e-14);
+  CHECK_FALSE(fc.cusp);
+  REQUIRE(foldCoefficient(p, foldAt(-1.0, 2.0), fc, &why));
+  CHECK(std::abs(fc.curvature + 6.0) <= 1e-14);
+  CHECK_FALSE(fc.cusp);
+  // μ = 0: the cusp, λ = u³, λ'' = 0 exactly
+  p.mu = 0.0;
+  REQUIRE(foldCoefficient(p, foldAt(0.0, 0.0), fc, &why));
+  CHECK(fc.cusp);
+  // a location error makes the accuracy grow with it: a fold 1e-6 off the cusp (λ'' = 6e-6)
+  // located to |Δλ| = 1 is not resolved, located to 1e-12 it is
+  SpecialPoint near = foldAt(1e-6, 0.0);
+  p.mu = -3e-12;
+  near.lambdaAccuracy = 1e-12;
+  REQUIRE(foldCoefficient(p, near, fc, &why));
+  CHECK(std::abs(fc.curvature - 6e-6) <= 1e-18);
+  CHECK_FALSE(fc.cusp);
+  near.lambdaAccuracy = 1.0;
+  REQUIRE(foldCoefficient(p, near, fc, &why));
+  CHECK(fc.cusp);
+  CHECK_FALSE(foldCoefficient(p, SpecialPoint(), fc, &why));
+  CHECK_THAT(why, Contains("not a located fold"));
 }

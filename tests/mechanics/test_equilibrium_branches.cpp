@@ -10,6 +10,7 @@
 
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/linear_buckling.h"
+#include "critical_loads.h"
 #include "buckle/mechanics/shape_name.h"
 
 using namespace buckle::mechanics;
@@ -38,17 +39,7 @@ const Classification& nameOf(const EquilibriumBranches& r, size_t bi, const cont
   return r.classifications[bi][size_t(sp - b.specialPoints.data())];
 }
 
-// Compressive critical loads (λ < 0) of the straight clamped–pinned chain by linear_buckling,
-// closest to 0 first.
-std::vector<double> compressiveCriticalLoads(const Chain& chain) {
-  const LinearBucklingResult lb =
-      linearBuckling(chain, Eigen::VectorXd::Zero(chain.size()), EndCondition::clampedPinned(0.0));
-  std::vector<double> crit;
-  for (const BucklingMode& m : lb.modes)
-    if (m.lambda < 0) crit.push_back(m.lambda);
-  std::sort(crit.begin(), crit.end(), [](double x, double y) { return x > y; });
-  return crit;
-}
+using buckle::mechanics::test::compressiveCriticalLoads;
 
 }  // namespace
 

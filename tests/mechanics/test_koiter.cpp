@@ -45,7 +45,7 @@ Eigen::VectorXd parentAt(EquilibriumProblem& p, const cont::SpecialPoint& bp, co
 }
 
 struct Fit {
-  double a = 0.0, b = 0.0;
+  double a = 0.0, b = 0.0, c4 = 0.0;
   int points = 0;
 };
 
@@ -82,6 +82,7 @@ Fit fitTracedChildren(EquilibriumProblem& p, const cont::BranchTree& tree, int p
   const Eigen::VectorXd c = V.colPivHouseholderQr().solve(y);
   f.a = c[0] / xiMax;
   f.b = c[1] / (xiMax * xiMax);
+  f.c4 = c[3] / std::pow(xiMax, 4);
   return f;
 }
 
@@ -342,4 +343,46 @@ TEST_CASE("Koiter coefficients of the transcritical points of a chain with unequ
       ++asymmetric;
     }
   CHECK(asymmetric >= 1);
+}
+
+TEST_CASE("A degenerate pitchfork (the design map's DP): b zero to its accuracy, the quartic term decides",
+          "[koiter]") {
+  // a/b = 2: the DP where b changes sign, located by the two-parameter analysis to 4e-13 in L0
+  const double dp = 0.6200239760986634;
+  auto pointAt = [](double L0, std::vector<double>* c4Fit) {
+    const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(2.0, 1.0, 1.0, L0));
+    EquilibriumProblem p(chain, EndCondition::clampedPinned(0.0), kAxial);
+    const EquilibriumBranches r = traceChain(p, 3, -12.0, c4Fit ? 1 : 0);
+    for (const SpecialPointReport& s : r.reports[0].specialPoints)
+      if (s.type == EventType::BranchPoint && s.koiter.valid) {
+        if (c4Fit) c4Fit->push_back(fitTracedChildren(p, r.tree, 0, s.source, s.koiter, 0.15).c4);
+        return s.koiter;
+      }
+    FAIL("no branch point with Koiter coefficients");
+    return KoiterCoefficients();
+  };
+  std::vector<double> fit;
+  const KoiterCoefficients k = pointAt(dp, &fit);
+  INFO("b = " << k.b << " +- " << k.bAccuracy << ", c4 = " << k.c4 << " +- " << k.c4Accuracy);
+  CHECK(std::abs(k.b) <= k.bAccuracy);
+  CHECK(k.degenerate);
+  REQUIRE(k.decided);
+  CHECK(std::abs(k.c4) > 100.0 * k.c4Accuracy);
+  // the same quartic term from the traced bifurcated branch (a least-squares fit of its λ(ξ),
+  // degree 5 on |ξ| ≤ 0.15: its own truncation is ~c₆ξ² of c₄, a percent)
+  REQUIRE(fit.size() == 1);
+  INFO("fit c4 = " << fit[0]);
+  CHECK(std::abs(fit[0] - k.c4) <= 2e-2 * std::abs(k.c4));
+  CHECK(postBucklingName(k) == std::string("degenerate ") + toString(k.kind));
+  CHECK(k.kind == (k.c4 * k.transversality < 0.0 ? KoiterKind::Supercritical : KoiterKind::Subcritical));
+  // either side of the DP b is well resolved, of opposite signs, and the kinds differ: b changes
+  // sign there (the two-parameter location, independent of this reduction)
+  const KoiterCoefficients below = pointAt(dp - 1e-4, nullptr), above = pointAt(dp + 1e-4, nullptr);
+  CHECK_FALSE(below.degenerate);
+  CHECK_FALSE(above.degenerate);
+  CHECK(below.b * above.b < 0.0);
+  CHECK(below.kind != above.kind);
+  // the accuracy is not a blanket: b(L0) ≈ slope·(L0 − DP) is resolved 1e-8 away from the DP
+  const double slope = (above.b - below.b) / 2e-4;
+  CHECK(k.bAccuracy <= std::abs(slope) * 1e-8);
 }

@@ -4,6 +4,7 @@
 #include "buckle/continuation/structured_refinement.h"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -200,6 +201,53 @@ Vector extended(const Vector &x, double last) {
   return y;
 }
 
+/// What the third-order solvability condition needs (reduce()'s quantities at the point).
+struct ThirdOrderInput {
+  Algebra &algebra;
+  ConstVectorRef u0;
+  double lambdaC;
+  const ProblemScales &s;
+  const Vector &e, &dv, &v, &psi, &p1, &p2Perp, &u2;
+  double a, tau;
+};
+
+struct ThirdOrder {
+  double b = 0.0;
+  double scale = 0.0;  ///< Σ|ψ_i|·|terms_i| / |τ|
+  Vector p2;           ///< the parent's curvature d²u_p/dλ²
+};
+
+/// b from the third-order condition, the third derivatives by differences at `factor` times the
+/// standard step (1e-3 in the scaled variables).
+bool thirdOrder(const ThirdOrderInput &in, double factor, ThirdOrder &out) {
+  const Vector uc = in.u0;
+  // third derivatives D³F[e,e,e] along e; D³F[e,e,d], D³F[e,d,d], D³F[d,d,d] along d
+  SecondDerivatives second(in.algebra, in.u0, in.lambdaC, in.e, in.dv);
+  const double pScaled = in.s.parameter * in.p1.cwiseQuotient(in.s.unknowns).norm();
+  const double hu = factor * 1e-3 / in.v.cwiseQuotient(in.s.unknowns).norm();
+  const double hd =
+      factor * 1e-3 * std::max(in.s.parameter, std::abs(in.lambdaC)) / std::sqrt(1.0 + pScaled * pScaled);
+  Vector Teee, unused, Teed, Tedd, Tddd;
+  if (!second.along(hu, in.e, Teee, unused, nullptr) || !second.along(hd, in.dv, Teed, Tedd, &Tddd)) return false;
+  // p2's component along v from ψᵀ(D³F[d,d,d] + 3F_xx[d, (p2, 0)]) = 0
+  Vector Fdp2Perp, Fdu2, Feu2, Fep2;
+  if (!in.algebra.second(uc, in.lambdaC, in.dv, extended(in.p2Perp, 0.0), Fdp2Perp)) return false;
+  const double sigma = -(in.psi.dot(Tddd) + 3.0 * in.psi.dot(Fdp2Perp)) / (3.0 * in.tau);
+  out.p2 = in.p2Perp + sigma * in.v;
+  const Vector u2e = extended(in.u2, 0.0);
+  if (!in.algebra.second(uc, in.lambdaC, in.dv, u2e, Fdu2) || !in.algebra.second(uc, in.lambdaC, in.e, u2e, Feu2) ||
+      !in.algebra.second(uc, in.lambdaC, in.e, extended(out.p2, 0.0), Fep2))
+    return false;
+  const double a = in.a;
+  const Vector third = a * Fdu2 + Feu2 + Teee / 6.0 + 0.5 * a * Teed + 0.5 * a * a * (Tedd + Fep2);
+  out.b = -in.psi.dot(third) / in.tau;
+  const Vector absPsi = in.psi.cwiseAbs();
+  auto size = [&](const Vector &y) { return absPsi.dot(y.cwiseAbs()); };
+  out.scale = (std::abs(a) * size(Fdu2) + size(Feu2) + size(Teee) / 6.0 + 0.5 * std::abs(a) * size(Teed) +
+               0.5 * a * a * (size(Tedd) + size(Fep2))) / std::abs(in.tau);
+  return std::isfinite(out.b);
+}
+
 bool reduce(Problem &problem, Algebra &algebra, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
             ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out, std::string *why) {
   const int n = problem.dimension();
@@ -284,27 +332,19 @@ bool reduce(Problem &problem, Algebra &algebra, ConstVectorRef u0, double lambda
   if (!solve(-(a * Fed + 0.5 * Fee), u2) || !solve(-Fdd, p2Perp) || !u2.allFinite() || !p2Perp.allFinite())
     return fail(why, "branch-point coefficients: singular bordered system for u2");
 
-  // third derivatives D³F[e,e,e] along e; D³F[e,e,d], D³F[e,d,d], D³F[d,d,d] along d
-  SecondDerivatives second(algebra, u0, lambdaC, e, dv);
-  const double pScaled = s.parameter * p1.cwiseQuotient(s.unknowns).norm();
-  const double hu = 1e-3 / v.cwiseQuotient(s.unknowns).norm();
-  const double hd = 1e-3 * std::max(s.parameter, std::abs(lambdaC)) / std::sqrt(1.0 + pScaled * pScaled);
-  Vector Teee, unused, Teed, Tedd, Tddd;
-  if (!second.along(hu, e, Teee, unused, nullptr) || !second.along(hd, dv, Teed, Tedd, &Tddd))
+  // third order: b, at the difference step h and at 2h; their difference bounds the
+  // differences' error (truncation and rounding) in any units
+  ThirdOrder third, coarse;
+  const ThirdOrderInput in{algebra, u0, lambdaC, s, e, dv, v, psi, p1, p2Perp, u2, a, tau};
+  if (!thirdOrder(in, 1.0, third) || !thirdOrder(in, 2.0, coarse))
     return fail(why, "branch-point coefficients: the problem refused a point near (u0, λc)");
-
-  // p2's component along v from ψᵀ(D³F[d,d,d] + 3F_xx[d, (p2, 0)]) = 0
-  Vector Fdp2Perp, Fdu2, Feu2, Fep2;
-  if (!algebra.second(uc, lambdaC, dv, extended(p2Perp, 0.0), Fdp2Perp)) return fail(why, noSecond);
-  const double sigma = -(psi.dot(Tddd) + 3.0 * psi.dot(Fdp2Perp)) / (3.0 * tau);
-  const Vector p2 = p2Perp + sigma * v;
-  const Vector u2e = extended(u2, 0.0);
-  if (!algebra.second(uc, lambdaC, dv, u2e, Fdu2) || !algebra.second(uc, lambdaC, e, u2e, Feu2) ||
-      !algebra.second(uc, lambdaC, e, extended(p2, 0.0), Fep2))
-    return fail(why, noSecond);
-  const Vector third = a * Fdu2 + Feu2 + Teee / 6.0 + 0.5 * a * Teed + 0.5 * a * a * (Tedd + Fep2);
-  const double b = -psi.dot(third) / tau;
+  const double b = third.b;
   if (!std::isfinite(a) || !std::isfinite(b)) return fail(why, "branch-point coefficients: not finite");
+  // b's accuracy: a b that cancels to zero keeps the rounding of its terms (64ε for the sums and
+  // the bordered solves) and the third derivatives' error, bounded by the two steps' difference
+  out.bScale = third.scale;
+  out.bAccuracy = out.bScale * 64.0 * std::numeric_limits<double>::epsilon() + std::abs(coarse.b - b);
+  const Vector &p2 = third.p2;
 
   // the ABE in the orthonormal basis t = d/|d|, φ ⊥ t of ker F_x (Euclidean in (u, λ))
   Vector d = dv;
@@ -357,6 +397,41 @@ bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC
   return false;
 }
 
+bool foldCoefficient(Problem &problem, const SpecialPoint &fold, FoldCoefficient &out, std::string *why) {
+  const int n = problem.dimension();
+  if (fold.type != SpecialPointType::Fold || fold.u.size() != n || fold.nullVectors.rows() != n ||
+      fold.nullVectors.cols() != 1)
+    return fail(why, "fold coefficient: not a located fold of this problem");
+  const Vector v = fold.nullVectors.col(0).normalized();
+  std::unique_ptr<BorderedSolver> solver;
+  if (n > kDenseCoefficientDimension) {
+    solver = problem.makeStructuredSolver();
+    if (solver && solver->maxGeneralBorder() < 1) solver.reset();
+  }
+  std::unique_ptr<Algebra> algebra;
+  if (solver) algebra = std::make_unique<StructuredAlgebra>(problem, std::move(solver), fold.u, fold.lambda);
+  else algebra = std::make_unique<DenseAlgebra>(problem, fold.u, fold.lambda);
+  Vector Fl, sol, Fvv;
+  if (!algebra->linearise(Fl)) return fail(why, "fold coefficient: the problem refused the point");
+  if (!algebra->leftNull(v, v, sol) || !sol.head(n).allFinite())
+    return fail(why, "fold coefficient: the null space of F_u is not one-dimensional");
+  const Vector psi = sol.head(n);
+  const Vector e = extended(v, 0.0);
+  if (!algebra->second(fold.u, fold.lambda, e, e, Fvv)) return fail(why, "fold coefficient: no second derivatives");
+  // λ(s) = λ0 + ½λ''s² + … with u = u0 + s v: ψᵀ(F_uu[v, v] + λ''F_λ) = 0
+  const double psiFl = psi.dot(Fl);
+  if (!(std::abs(psiFl) > 0.0)) return fail(why, "fold coefficient: ψᵀF_λ = 0 (a branch point, not a fold)");
+  out.curvature = -psi.dot(Fvv) / psiFl;
+  // the terms' rounding, and their move with the point's location error (relative to λ's scale)
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double lambdaScale = std::max(problem.scales().parameter, std::abs(fold.lambda));
+  const double located = std::isfinite(fold.lambdaAccuracy) ? fold.lambdaAccuracy / lambdaScale : 0.0;
+  out.scale = psi.cwiseAbs().dot(Fvv.cwiseAbs()) / std::abs(psiFl);
+  out.accuracy = out.scale * (64.0 * eps + located);
+  out.cusp = std::abs(out.curvature) <= out.accuracy;
+  return std::isfinite(out.curvature);
+}
+
 bool branchPointCoefficients(Problem &problem, const SpecialPoint &bp, ConstVectorRef c, BranchPointCoefficients &out,
                              std::string *why, CoefficientAlgebra algebra) {
   const int n = problem.dimension();
@@ -366,7 +441,11 @@ bool branchPointCoefficients(Problem &problem, const SpecialPoint &bp, ConstVect
   // the combination of ker F_x = span{t, φ} with no λ-component is the null vector of F_u
   const Vector t = bp.nullVectors.col(0), phi = bp.nullVectors.col(1);
   const Vector v = t[n] * phi.head(n) - phi[n] * t.head(n);
-  return branchPointCoefficients(problem, bp.u, bp.lambda, bp.tangent, v, c, out, why, algebra);
+  if (!branchPointCoefficients(problem, bp.u, bp.lambda, bp.tangent, v, c, out, why, algebra)) return false;
+  // the point's location error moves every term of b by its relative size (λ's own scale)
+  const double lambdaScale = std::max(problem.scales().parameter, std::abs(bp.lambda));
+  if (std::isfinite(bp.lambdaAccuracy)) out.bAccuracy += out.bScale * bp.lambdaAccuracy / lambdaScale;
+  return true;
 }
 
 }  // namespace buckle::continuation

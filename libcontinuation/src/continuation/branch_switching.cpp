@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 
 namespace buckle::continuation {
@@ -32,6 +33,20 @@ void orient(Vector &direction, int n) {
   Eigen::Index largest = 0;
   direction.head(n).cwiseAbs().maxCoeff(&largest);
   if (direction[largest] < 0.0) direction = -direction;
+}
+
+// Whether the scaled point x is the start of the child `b`: closer to it than a millionth of
+// the child's first step (the distance its own scale sets, in any units).
+bool startsAt(const Branch &b, const Vector &x, const UnitScaling &units) {
+  if (b.points.size() < 2) return true;
+  auto scaled = [&](const ContinuationPoint &p) {
+    Vector y(p.u.size() + 1);
+    y << p.u, p.lambda;
+    for (Eigen::Index j = 0; j < y.size(); ++j) y[j] /= units.state(int(j));
+    return y;
+  };
+  const Vector x0 = scaled(b.points[0]);
+  return (x - x0).norm() <= 1e-6 * (scaled(b.points[1]) - x0).norm();
 }
 
 }  // namespace
@@ -230,9 +245,9 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     add(tracer.trace(u0, lambda0, direction), 0);
   }
   std::vector<Vector> switchedAt;
+  std::vector<double> switchedAccuracy;  // |Δλ| of each, scaled
   const int n = problem.dimension();
   const BranchSwitchingOptions &switching = treeOptions.switching;
-  const double h = switching.amplitude > 0.0 ? switching.amplitude : options.initialStep;
 
   for (std::size_t i = 0; i < tree.branches.size(); ++i) {
     if (depth[i] >= treeOptions.maxDepth) continue;
@@ -240,22 +255,35 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       SpecialPoint bp = tree.branches[i].specialPoints[k];
       if (bp.type != SpecialPointType::BranchPoint) continue;
       if (treeOptions.switchAt && !treeOptions.switchAt(tree.branches[i], bp)) continue;
-      // The BP a child starts from is the parent's; never switch back at it.
-      if (!tree.branches[i].points.empty() && bp.arclength - tree.branches[i].points.front().arclength <= 1e-6 * h)
-        continue;
       if (tree.interrupted || interrupted()) return tree;
       Vector xBP(n + 1);
       xBP << bp.u, bp.lambda;
       for (int j = 0; j <= n; ++j) xBP[j] /= tracer.units().state(j);  // compared in the scaled variables
+      // The BP a child starts from is the parent's; never switch back at it. Only a child starts
+      // at a branch point, and the same point is the one within a millionth of the child's first
+      // step from its start: a root's branch points are switched however close to its start they
+      // lie (at κ → 0 they crowd at λ ~ κ, 1e-10 of the path's range).
+      if (tree.branches[i].parentId >= 0 && startsAt(tree.branches[i], xBP, tracer.units())) continue;
+      // The same point located from another branch: near in the state, and in λ within the two
+      // locations' accuracy or a millionth of λ itself (distinct points of a cluster at λ ~ 1e-10
+      // lie far closer than 1e-7 in the state, but their λ differ by far more than that).
+      const double accuracy = bp.lambdaAccuracy / tracer.units().parameter();
       bool seen = false;
-      for (const Vector &y : switchedAt)
-        if ((y - xBP).norm() <= 1e-7 * std::max(1.0, xBP.norm())) seen = true;
+      for (size_t j = 0; j < switchedAt.size(); ++j) {
+        const Vector &y = switchedAt[j];
+        const double dl = std::abs(y[n] - xBP[n]);
+        if ((y - xBP).norm() <= 1e-7 * std::max(1.0, xBP.norm()) &&
+            dl <= std::max({1e3 * (accuracy + switchedAccuracy[j]), 1e-6 * std::max(std::abs(y[n]), std::abs(xBP[n])),
+                            4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(xBP[n]))}))
+          seen = true;
+      }
       std::string &note = tree.branches[i].specialPoints[k].note;
       if (seen) {
         note += (note.empty() ? "" : "; ") + std::string("already switched from another branch");
         continue;
       }
       switchedAt.push_back(xBP);
+      switchedAccuracy.push_back(std::isfinite(accuracy) ? accuracy : 0.0);
       std::string how;
       std::vector<Branch> sides;
       if (bp.multiplicity > 1) {

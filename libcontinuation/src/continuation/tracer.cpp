@@ -472,10 +472,12 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     const bool landedOnStart = hitEvent >= 0 && !(b.arclength > a.arclength);
     // `a` refers into branch.points: everything that reads it is done before the push.
     if (!landedOnStart) branch.points.push_back(std::move(b));
+    const size_t firstNew = branch.specialPoints.size();
     for (SpecialPoint &sp : found) {
       sp.index = ia;
       branch.specialPoints.push_back(std::move(sp));
     }
+    if (!found.empty()) mergeCoincidentSpecialPoints(branch, firstNew);
     if (options_.onStep && !landedOnStart && notifyStep(branch) == StepAction::Stop) {
       interrupted("stopped by the step callback");
       return;

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <sstream>
 #include <vector>
 
+#include "buckle/continuation/branch_point_coefficients.h"
 #include "buckle/mechanics/contact_geometry.h"
 #include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/stiffness.h"
@@ -40,6 +42,38 @@ std::string stabilityLabel(int negative) {
 }
 
 namespace {
+
+std::string formatShort(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", x);
+  return text;
+}
+
+// A branch point of free joints: Koiter's coefficients and the imperfection sensitivities (a
+// simple point's only: a multiple one has its reduced equation).
+void addPostBuckling(EquilibriumProblem& problem, const cont::SpecialPoint& sp, SpecialPointReport& s) {
+  if (sp.multiplicity != 1) return;
+  s.koiter = koiterCoefficients(problem, sp);
+  if (!s.koiter.valid) {
+    s.note = s.koiter.error;
+    return;
+  }
+  for (int c = 0; c < 3; ++c) s.imperfections.push_back(imperfectionSensitivity(problem, sp, s.koiter, c));
+  // preload asymmetries: of every segment at once, and of the most sensitive single one
+  s.imperfections.push_back(preloadImperfectionSensitivity(problem, sp, s.koiter, -1));
+  if (problem.segments() > 1)
+    s.imperfections.push_back(
+        preloadImperfectionSensitivity(problem, sp, s.koiter, mostSensitivePreloadSegment(problem, sp, s.koiter)));
+  if (!s.koiter.error.empty()) s.note += (s.note.empty() ? "" : "; ") + s.koiter.error;
+}
+
+// A fold whose λ'' is zero to its accuracy: two folds merged, a cusp of the fold curve.
+void noteCusp(EquilibriumProblem& problem, const cont::SpecialPoint& sp, SpecialPointReport& s) {
+  cont::FoldCoefficient fc;
+  if (sp.refined && cont::foldCoefficient(problem, sp, fc) && fc.cusp)
+    s.note += (s.note.empty() ? "" : "; ") + std::string("cusp: the fold's quadratic coefficient lambda'' = ") +
+              formatShort(fc.curvature) + " is zero to its accuracy " + formatShort(fc.accuracy);
+}
 
 // Shapes of equilibria are named with a small straightness tolerance relative to the angles'
 // own unit (radians): a chain bent by less than 1e-6 rad at every joint is straight.
@@ -252,20 +286,12 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     switch (sp.type) {
       case cont::SpecialPointType::BranchPoint:
         s.type = EventType::BranchPoint;
-        if (lockedAt(stretches, sp.index).empty()) {
-          s.koiter = koiterCoefficients(problem, sp);
-          if (s.koiter.valid) {
-            for (int c = 0; c < 3; ++c) s.imperfections.push_back(imperfectionSensitivity(problem, sp, s.koiter, c));
-            // preload asymmetries: of every segment at once, and of the most sensitive single one
-            s.imperfections.push_back(preloadImperfectionSensitivity(problem, sp, s.koiter, -1));
-            if (problem.segments() > 1)
-              s.imperfections.push_back(preloadImperfectionSensitivity(
-                  problem, sp, s.koiter, mostSensitivePreloadSegment(problem, sp, s.koiter)));
-          } else
-            s.note = s.koiter.error;
-        }
+        if (lockedAt(stretches, sp.index).empty()) addPostBuckling(problem, sp, s);
         break;
-      case cont::SpecialPointType::Fold: s.type = EventType::Fold; break;
+      case cont::SpecialPointType::Fold:
+        s.type = EventType::Fold;
+        noteCusp(problem, sp, s);
+        break;
       case cont::SpecialPointType::EigenvalueTouch: s.type = EventType::EigenvalueTouch; break;
       default:
         s.type = EventType::Boundary;

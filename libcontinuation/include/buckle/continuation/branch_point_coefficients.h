@@ -40,6 +40,12 @@ struct BranchPointCoefficients {
   double a = 0.0;                ///< dλ/dξ of the child at the branch point
   double b = 0.0;                ///< ½ d²λ/dξ²
   double transversality = 0.0;   ///< τ = ψᵀF_xx[e, d]: the zero eigenvalue's crossing speed
+  /// Σ|ψ_i|·|terms_i| / |τ| over the terms of b (the size b would have without cancellation)
+  double bScale = 0.0;
+  /// What |b| may be in error by: its terms' rounding and the differences' for the third
+  /// derivatives, plus (the SpecialPoint overload) bScale times the point's relative location
+  /// error. |b| ≤ bAccuracy: b is zero to its accuracy, a degenerate pitchfork (childExpansion).
+  double bAccuracy = 0.0;
   double a11 = 0.0, a12 = 0.0, a22 = 0.0;  ///< ABE coefficients in the orthonormal basis {t, φ}
   Vector v;                      ///< null vector of F_u, cᵀv = 1
   Vector psi;                    ///< left null vector, ψᵀv = 1
@@ -72,5 +78,34 @@ bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC
 /// Same at a branch point located by the tracer (bp.tangent the parent's, v from bp.nullVectors).
 bool branchPointCoefficients(Problem &problem, const SpecialPoint &bp, ConstVectorRef c, BranchPointCoefficients &out,
                              std::string *why = nullptr, CoefficientAlgebra algebra = CoefficientAlgebra::Automatic);
+
+/// λ(s) = λ0 + ½λ''s² + … through a located fold (u = u0 + s v, |v| = 1): λ'' = −ψᵀF_uu[v, v] /
+/// ψᵀF_λ. Where λ'' is zero to its accuracy (its terms' rounding and the point's location error)
+/// the fold is a cusp of the fold curve, two folds merged (Govaerts §6.2): `cusp`.
+struct FoldCoefficient {
+  double curvature = 0.0;  ///< λ''
+  double scale = 0.0;      ///< Σ|ψ_i|·|F_uu[v, v]_i| / |ψᵀF_λ|: λ'' without cancellation
+  double accuracy = 0.0;
+  bool cusp = false;
+};
+bool foldCoefficient(Problem &problem, const SpecialPoint &fold, FoldCoefficient &out, std::string *why = nullptr);
+
+/// The child's λ(ξ) beyond b, from the child itself: at a degenerate pitchfork (|b| ≤ bAccuracy)
+/// the quartic term decides which side the branch lies on (Golubitsky & Schaeffer ch. VI: the
+/// pitchfork's unfolding is λ = bξ² + c₄ξ⁴). Points of the child at the amplitudes
+/// ξ = cᵀ(u − u0) = ±h, ±2h, ±3h (each a corrector solve on the hyperplane of that ξ from the
+/// predictor u0 + ξv + ξ²u2, λc + aξ + bξ²), then the even part ½(λ(ξ) + λ(−ξ)) − λc =
+/// c₂ξ² + c₄ξ⁴ + c₆ξ⁶ and the odd part ½(λ(ξ) − λ(−ξ)) = c₁ξ + c₃ξ³ + c₅ξ⁵ solved exactly. The
+/// fit is repeated at h/2; c₄'s accuracy is the difference of the two fits plus their
+/// rounding. h: 0.05 of the problem's scales along v (`amplitude` > 0 overrides).
+struct ChildBranchExpansion {
+  double c1 = 0.0, c2 = 0.0, c3 = 0.0, c4 = 0.0;  ///< λ = λc + c₁ξ + c₂ξ² + c₃ξ³ + c₄ξ⁴ + …
+  double c2Accuracy = 0.0, c4Accuracy = 0.0;       ///< the two fits' difference plus rounding
+  double amplitude = 0.0;                          ///< h, in the units of ξ = cᵀ(u − u0)
+};
+
+bool childBranchExpansion(Problem &problem, ConstVectorRef u0, double lambdaC, const BranchPointCoefficients &g,
+                          ConstVectorRef c, ChildBranchExpansion &out, std::string *why = nullptr,
+                          double amplitude = 0.0);
 
 }  // namespace buckle::continuation

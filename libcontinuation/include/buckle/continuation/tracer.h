@@ -256,6 +256,13 @@ class Tracer {
   std::vector<double> eventsA_, eventsB_;  // event values at the current point and the new one
 };
 
+/// One singularity, one report (tracer_coincident.cpp): a fold located at a simple branch point
+/// of the branch (within a thousandth of their steps, among the special points from `firstNew`
+/// on and those of the step before) is the tip of a bifurcated branch reached along it, which
+/// turns in λ there: the fold is dropped and the branch point keeps the stability before the
+/// first and after the last. The tracer calls it after every located step.
+void mergeCoincidentSpecialPoints(Branch &branch, size_t firstNew);
+
 /// One-shot convenience: Tracer(problem, options).trace(u0, λ0, direction).
 Branch trace(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
              const TracerOptions &options = TracerOptions());
