@@ -245,7 +245,7 @@ void bindMechanics(py::module_& m) {
             checkSize(c, q, "q");
             return Eigen::MatrixXd(mechanics::jointPositions(c, q).transpose());
           },
-          py::arg("q"), "(n+2)×2 array: the base, the n joints and the end (x, y), units of b.")
+          py::arg("q"), "(n+2)×2 array: the base, the n joints and the end (x, y), in the unit of the segments' lengths.")
       .def(
           "total_potential",
           [](const mech::Chain& c, const VectorXd& q, const VectorXd& F) {

@@ -68,7 +68,8 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
   d["branch"] = branch;
   d["point"] = point;
   std::vector<std::string> columns{"parameter", "Fx", "Fy", "Me", "x", "y", "phi", "dx", "dy", "min_eig"};
-  if (s.analyses.stiffness) columns.insert(columns.end(), {"Kxx", "Kyy", "Kxy"});
+  if (s.analyses.stiffness)
+    columns.insert(columns.end(), scene::stiffnessColumns().begin(), scene::stiffnessColumns().end());
   for (const std::string& c : columns) {
     VectorXd v(P);
     for (Eigen::Index i = 0; i < P; ++i) v[i] = scene::columnValue(c, cr.points[static_cast<size_t>(i)], cr.pose0);
@@ -168,7 +169,7 @@ void bindScene(py::module_& m) {
       "as --force). Ctrl-C raises KeyboardInterrupt.\n\n"
       "Returns a dict: `complete`, `interrupted`, `interruption`, `problems`, `computed`; `cases` (per case: "
       "`label`, `segments`, `chain` (a Chain), `q0`, `branches`: the columns of branches.csv as arrays — branch, "
-      "point, parameter, Fx, Fy, Me, x, y, phi, dx, dy, q (P×n), stable, negative, min_eig, and Kxx, Kyy, Kxy with "
+      "point, parameter, Fx, Fy, Me, x, y, phi, dx, dy, q (P×n), stable, negative, min_eig, and Kxx, Kyy, Kxy, Cxx, Cyy, Cxy, Kx_yfree, Ky_xfree, K1, K2, theta1 with "
       "stiffness); `special_points` (the dicts of special_points.json); `results` (all of special_points.json: "
       "critical_loads, energy_equilibria, ... when asked); `summary` (summary.json). Raises SceneError (a "
       "ValueError) for a bad scene.");

@@ -11,6 +11,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/linear_buckling.h"
+#include "scene/units.h"
 
 namespace buckle::cli {
 
@@ -22,7 +23,28 @@ struct CriticalOptions {
   std::string end = "pinned";
   int count = 3;
   bool json = false;
+  std::string lengthUnit, forceUnit;  ///< names for the printed units (scene/units.h); empty: k and b's units
 };
+
+// The units the numbers are printed in: the names given, else said through k and b.
+scene::UnitSystem units(const CriticalOptions& o) {
+  scene::UnitSystem u;
+  if (o.lengthUnit.empty()) return u;
+  u.kind = scene::UnitSystem::Kind::Named;
+  u.length = o.lengthUnit;
+  u.force = o.forceUnit;
+  return u;
+}
+
+std::string unitOf(const CriticalOptions& o, scene::Dimension d) {
+  if (!o.lengthUnit.empty()) return " " + units(o).unit(d);
+  switch (d) {
+    case scene::Dimension::Force: return " (in k's force unit times b's length unit: k b = 1 when k = b = 1)";
+    case scene::Dimension::Moment: return " (in k's force unit times b's length unit squared)";
+    case scene::Dimension::Length: return " (in b's length unit)";
+    default: return "";
+  }
+}
 
 std::string str(double v) {
   std::ostringstream os;
@@ -48,6 +70,14 @@ void validate(const CriticalOptions& o) {
                       " leaves the joint no range of motion (2 atan(a/b) reaches pi)"};
   if (o.count < 1) throw BadArgument{"--count must be >= 1 (got " + std::to_string(o.count) + ")"};
   if (o.end != "pinned" && o.end != "free") throw BadArgument{"--end must be pinned or free (got " + o.end + ")"};
+  if (o.lengthUnit.empty() != o.forceUnit.empty())
+    throw BadArgument{"--length-unit and --force-unit go together (got only " +
+                      std::string(o.lengthUnit.empty() ? "--force-unit" : "--length-unit") + ")"};
+  for (const auto& [name, value] : {std::pair<const char*, const std::string&>{"--length-unit", o.lengthUnit},
+                                    {"--force-unit", o.forceUnit}})
+    if (!value.empty() && !scene::validUnitName(value))
+      throw BadArgument{std::string(name) + " must be a unit name of 1 to 16 bytes (letters, digits, inner spaces, " +
+                        ". / ^ * - µ μ · ² ³), e.g. m, mm, N (got \"" + value + "\")"};
 }
 
 // The option farthest from the chain's units (b for lengths, k for stiffness) by orders of
@@ -82,6 +112,7 @@ int run(const CriticalOptions& o) {
   out["command"] = "critical";
   out["parameters"] = {{"segments", o.segments}, {"a", o.a}, {"b", o.b}, {"k", o.k},
                        {"L0", o.L0},             {"end", o.end}, {"count", o.count}};
+  out["units"] = units(o).toJson();
   try {
     // The straight uniform chain is scale-free: with lengths in units of b and stiffness in k the
     // critical loads are Fx = k b · Fx(a/b, 1, 1, L0/b), the modes and μ do not change and the
@@ -137,6 +168,11 @@ int run(const CriticalOptions& o) {
       }
       out["critical"].push_back(c);
     }
+    if (static_cast<int>(lb.modes.size()) < o.count)
+      out["note"] = "--count " + std::to_string(o.count) + " asked for " + std::to_string(o.count) +
+                    " critical loads; this chain has " + std::to_string(lb.modes.size()) +
+                    " finite compressive ones (" + std::to_string(n) + " joints" +
+                    (o.end == "pinned" ? ", one degree of freedom taken by the held y" : "") + ")";
   } catch (const std::invalid_argument& e) {
     throw BadArgument{e.what()};
   } catch (const std::exception& e) {
@@ -149,25 +185,31 @@ int run(const CriticalOptions& o) {
     return kSuccess;
   }
   std::cout << std::setprecision(10);
-  std::cout << "buckle critical: " << o.segments << " segments, a = " << o.a << ", b = " << o.b << ", k = " << o.k
-            << ", L0 = " << o.L0 << ", end " << (o.end == "pinned" ? "clamped-pinned (y held)" : "free (cantilever)")
-            << "\n";
-  std::cout << "kappa = k (b L0 - 2 (b^2 - a^2)) = " << out["kappa"].get<double>() << "\n";
+  const std::string L = o.lengthUnit.empty() ? "" : " " + o.lengthUnit;
+  std::cout << "buckle critical: " << o.segments << " segments, a = " << o.a << L << ", b = " << o.b << L
+            << ", k = " << o.k << (o.lengthUnit.empty() ? "" : " " + units(o).unit(scene::Dimension::Stiffness))
+            << ", L0 = " << o.L0 << L << ", end "
+            << (o.end == "pinned" ? "clamped-pinned (y held)" : "free (cantilever)") << "\n";
+  std::cout << "kappa = k (b L0 - 2 (b^2 - a^2)) = " << out["kappa"].get<double>()
+            << unitOf(o, scene::Dimension::Moment) << " (the straight joint stiffness, eq 4)\n";
   std::cout << "straight configuration: " << (out["straight_stable"].get<bool>() ? "stable" : "unstable")
             << " (eq 4: L0 > 2b (1 - (a/b)^2))\n";
   if (out["degenerate"].get<bool>()) std::cout << "kappa = 0: every critical load is 0\n";
   const auto& crit = out["critical"];
   if (crit.empty()) std::cout << "no finite critical load\n";
+  std::cout << "Fx < 0 compresses; forces" << unitOf(o, scene::Dimension::Force) << "\n";
   int idx = 1;
   for (const auto& c : crit) {
-    std::cout << "critical " << idx++ << ": Fx = " << c["Fx"].get<double>() << "  shape " << c["shape"].get<std::string>();
+    std::cout << "critical load " << idx++ << ": Fx = " << c["Fx"].get<double>() << "  mode shape "
+              << c["shape"].get<std::string>();
     if (c.contains("analytic_Fx"))
       std::cout << "  (eq 17: " << c["analytic_Fx"].get<double>() << ", difference " << c["error"].get<double>()
                 << "; mu = " << c["mu"].get<double>() << ", eq 18: " << c["analytic_mu"].get<double>() << ")";
-    std::cout << "\n  mode:";
+    std::cout << "\n  mode (joint angles, unit norm):";
     for (const auto& v : c["mode"]) std::cout << " " << v.get<double>();
     std::cout << "\n";
   }
+  if (out.contains("note")) std::cout << "note: " << out["note"].get<std::string>() << "\n";
   return kSuccess;
 }
 
@@ -178,14 +220,23 @@ void addCriticalCommand(CLI::App& app, Outcome& outcome) {
   CLI::App* sub = app.add_subcommand(
       "critical", "Stability of the straight chain and its critical end forces Fx (linear buckling, eq 14-18)");
   sub->add_option("--segments", options->segments, "number of segments n")->capture_default_str();
-  sub->add_option("--a", options->a, "triangle half-height a")->capture_default_str();
-  sub->add_option("--b", options->b, "triangle half-length b")->capture_default_str();
-  sub->add_option("--k", options->k, "spring stiffness k")->capture_default_str();
-  sub->add_option("--L0", options->L0, "spring free length L0 (equal preloads)")->capture_default_str();
+  sub->add_option("--a", options->a, "triangle half-height a (a length)")->capture_default_str();
+  sub->add_option("--b", options->b, "triangle half-length b (a length)")->capture_default_str();
+  sub->add_option("--k", options->k, "spring stiffness k (force per length)")->capture_default_str();
+  sub->add_option("--L0", options->L0, "spring free length L0 (equal preloads; a length)")->capture_default_str();
   sub->add_option("--end", options->end, "end condition: pinned (clamped-pinned, y held) or free (cantilever)")
       ->capture_default_str();
-  sub->add_option("--count", options->count, "number of critical loads to report")->capture_default_str();
+  sub->add_option("--count", options->count, "number of critical loads to report (fewer exist when n is small: a note says so)")->capture_default_str();
+  sub->add_option("--length-unit", options->lengthUnit, "name of the length unit of a, b, L0 (e.g. m), for the printout");
+  sub->add_option("--force-unit", options->forceUnit, "name of the force unit of k (e.g. N), for the printout");
   sub->add_flag("--json", options->json, "print one JSON object");
+  sub->footer(
+      "Printed per critical load: Fx, the compressive end force at which the straight chain buckles (Fx < 0;\n"
+      "forces in k's force unit times b's length unit, or as named by --force-unit); 'mode shape': the buckling\n"
+      "mode's name, 'mode k' when its joint angles change sign k times (U and Z for three segments); 'mode':\n"
+      "the joint angles of the mode, unit norm. For three clamped-pinned segments also eq 17's closed form and\n"
+      "mu, the end shortening per squared middle-joint angle of the mode, dx = mu b q2^2 (eq 18).\n"
+      "kappa: the straight joint stiffness k (b L0 - 2 (b^2 - a^2)), a moment (eq 4).");
   sub->callback([options, &outcome] { outcome.code = run(*options); });
 }
 

@@ -104,6 +104,15 @@ void show(const std::string& dirName, std::ostream& os) {
   const std::string description = text(field(summary, "description"));
   if (description != "-") os << "  " << description.substr(0, 200) << (description.size() > 200 ? "…" : "") << "\n";
   os << "  complete: " << text(field(summary, "complete")) << "\n";
+  // the unit names as the scene gave them (summary.json `units`, docs/outputs.md)
+  if (const json& u = field(summary, "units"); u.is_object()) {
+    const std::string system = text(field(u, "system"));
+    os << "  units: "
+       << (system == "consistent" ? "the scene's own consistent units (unnamed): "
+                                  : system == "nondimensional" ? "nondimensional: " : "")
+       << "lengths " << text(field(u, "length")) << ", forces " << text(field(u, "force")) << ", moments "
+       << text(field(u, "moment")) << ", stiffness " << text(field(u, "stiffness")) << ", angles rad\n";
+  }
   for (const json& p : list(summary, "problems")) os << "    problem: " << text(p) << "\n";
   std::string computed;
   for (const json& c : list(summary, "computed")) computed += (computed.empty() ? "" : "; ") + text(c);

@@ -101,6 +101,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
     r.minEigenvalue = p.minEigenvalue;
     r.haveStiffness = p.haveStiffness;
     r.K = p.K;
+    r.C = p.C;
     r.locked = p.locked.label();
     r.contactTorque = p.contactTorque;
     out_.points.push_back(r);

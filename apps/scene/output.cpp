@@ -70,10 +70,16 @@ void writeText(const fs::path& file, const std::string& text) {
   if (!out) throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
 }
 
-// Appends v as printf's %.12g, "nan" when not finite (output_numbers.h: the same characters at
-// a fraction of the cost of a formatting with a precision; long chains write millions of numbers,
-// inside the run's time limit).
-void appendNumber(std::string& out, double v) { appendGeneral(out, v, 12); }
+// Appends v as printf's %.12g, "nan" for NaN and "inf"/"-inf" for infinities (a rigid direction's
+// stiffness) (output_numbers.h: the same characters at a fraction of the cost of a formatting with
+// a precision; long chains write millions of numbers, inside the run's time limit).
+void appendNumber(std::string& out, double v) {
+  if (std::isinf(v)) {
+    out += v > 0.0 ? "inf" : "-inf";
+    return;
+  }
+  appendGeneral(out, v, 12);
+}
 
 void appendInteger(std::string& out, long long v) {
   char buf[24];
@@ -129,7 +135,8 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
     }
   }
   os += ",stable,negative,min_eig,locked,contact_torque";
-  if (scene.analyses.stiffness) os += ",Kxx,Kyy,Kxy";
+  if (scene.analyses.stiffness)
+    for (const std::string& column : stiffnessColumns()) os += "," + column;
   os += '\n';
   std::size_t rows = 0;
   for (const CaseResult& cr : run.cases) rows += cr.points.size();
@@ -172,11 +179,8 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
       os += ',';
       os += p.locked;
       field(p.contactTorque);
-      if (scene.analyses.stiffness) {
-        field(p.K(0, 0));
-        field(p.K(1, 1));
-        field(p.K(0, 1));
-      }
+      if (scene.analyses.stiffness)
+        for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C));
       os += '\n';
     }
   }
@@ -393,6 +397,7 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
   doc["schema"] = kOutputSchema;
   doc["scene"] = scene.file;
   doc["description"] = scene.description;
+  doc["units"] = scene.units.toJson();
   doc["complete"] = run.complete;
   // stopped early by the time limit or a signal: the results are what was computed until then
   doc["interrupted"] = run.interrupted;
@@ -469,36 +474,15 @@ double columnValue(const std::string& column, const PointRecord& p, const mechan
   const double v = commonColumn(column, p.parameter, p.F, p.pose, p.q, pose0, found);
   if (found) return v;
   if (column == "min_eig") return p.minEigenvalue;
-  if (column == "Kxx") return p.K(0, 0);
-  if (column == "Kyy") return p.K(1, 1);
-  if (column == "Kxy") return p.K(0, 1);
-  return kNaN;
+  return stiffnessColumnValue(column, p.K, p.C);
 }
 
 double columnValue(const std::string& column, const SpecialRecord& s, const mechanics::Pose& pose0) {
   bool found = false;
   const double v = commonColumn(column, s.parameter, s.F, s.pose, s.q, pose0, found);
   if (found) return v;
-  if (column == "Kxx") return s.K(0, 0);  // NaN unless the point carries its own K_F (KMIN)
-  if (column == "Kyy") return s.K(1, 1);
-  if (column == "Kxy") return s.K(0, 1);
-  return kNaN;
-}
-
-std::string columnLabel(const std::string& c) {
-  if (c == "Fx") return "F_x (units of k b)";
-  if (c == "Fy") return "F_y (units of k b)";
-  if (c == "Me") return "M_e (units of k b^2)";
-  if (c == "x" || c == "y") return c + " (units of b)";
-  if (c == "dx") return "{/Symbol d}_x = x_0 - x (units of b)";
-  if (c == "dy") return "{/Symbol d}_y = y - y_0 (units of b)";
-  if (c == "phi") return "{/Symbol f} (rad)";
-  if (c == "min_eig") return "smallest eigenvalue of the stability operator (units of k b^2)";
-  if (c == "Kxx") return "K_{xx} (units of k)";
-  if (c == "Kyy") return "K_{yy} (units of k)";
-  if (c == "Kxy") return "K_{xy} (units of k)";
-  if (c.size() >= 2 && c[0] == 'q') return "q_{" + c.substr(1) + "} (rad)";
-  return c;
+  // NaN unless the point carries its own K_F (KMIN)
+  return stiffnessColumnValue(column, s.K, Eigen::Matrix2d::Constant(kNaN));
 }
 
 StagingDirectory::StagingDirectory(const std::string& target) : target_(target) {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "scene/columns.h"
 #include "scene/runner.h"
 #include "scene/scene.h"
 
@@ -21,9 +22,6 @@ constexpr int kBranchesCsvJointColumns = 12;
 double columnValue(const std::string& column, const PointRecord& p, const mechanics::Pose& pose0);
 /// The same for a special point (stiffness columns are NaN there).
 double columnValue(const std::string& column, const SpecialRecord& s, const mechanics::Pose& pose0);
-/// Axis label with units ("F_x (units of k b)").
-std::string columnLabel(const std::string& column);
-
 /// A directory created next to `target` (same parent, hidden name), renamed onto `target` by
 /// commit(); removed by the destructor unless committed. While it exists SIGINT and SIGTERM are
 /// held back (blocked in the calling thread, then delivered when it is gone): a signal that

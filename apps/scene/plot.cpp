@@ -46,6 +46,14 @@ std::string short4(double v) {
   return buf;
 }
 
+/// Five significant digits, for titles.
+std::string short5(double v) {
+  if (!std::isfinite(v)) return "NaN";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.5g", v);
+  return buf;
+}
+
 /// gnuplot string literal (single quotes, doubled inside).
 std::string quote(const std::string& s) {
   std::string out = "'";
@@ -104,8 +112,8 @@ struct Script {
 };
 
 std::string parameterColumnLabel(const Scene& scene, const std::string& column) {
-  if (column == "parameter") return columnLabel(scene.cases.front().path.parameter);
-  return columnLabel(column);
+  if (column == "parameter") return columnLabel(scene.cases.front().path.parameter, scene.units);
+  return columnLabel(column, scene.units);
 }
 
 void header(Script& s, const std::string& title) {
@@ -120,19 +128,26 @@ void header(Script& s, const std::string& title) {
 struct Frame {
   int width = 1000, height = 700;
   double left = 0.09, right = 0.76, bottom = 0.1, top = 0.91;  ///< plot area, screen fractions
-  double xlo = 0, xhi = 1, ylo = 0, yhi = 1;
+  double xlo = 0, xhi = 1, ylo = 0, yhi = 1;  ///< with logY, ylo and yhi are decimal logarithms
+  bool logY = false;
   Eigen::Vector2d pixel(double x, double y) const {
+    const double v = logY ? std::log10(y) : y;
     return {width * (left + (right - left) * (x - xlo) / (xhi - xlo)),
-            height * (bottom + (top - bottom) * (y - ylo) / (yhi - ylo))};
+            height * (bottom + (top - bottom) * (v - ylo) / (yhi - ylo))};
   }
   Eigen::Vector2d data(const Eigen::Vector2d& px) const {
-    return {xlo + (px.x() / width - left) / (right - left) * (xhi - xlo),
-            ylo + (px.y() / height - bottom) / (top - bottom) * (yhi - ylo)};
+    const double v = ylo + (px.y() / height - bottom) / (top - bottom) * (yhi - ylo);
+    return {xlo + (px.x() / width - left) / (right - left) * (xhi - xlo), logY ? std::pow(10.0, v) : v};
   }
   void script(std::ostream& os) const {
     os << "set lmargin at screen " << num(left) << "\nset rmargin at screen " << num(right) << "\nset bmargin at screen "
        << num(bottom) << "\nset tmargin at screen " << num(top) << "\nset xrange [" << num(xlo) << ":" << num(xhi)
-       << "]\nset yrange [" << num(ylo) << ":" << num(yhi) << "]\n";
+       << "]\n";
+    if (logY)
+      os << "set logscale y\nset format y '10^{%L}'\nset yrange [" << num(std::pow(10.0, ylo)) << ":"
+         << num(std::pow(10.0, yhi)) << "]\n";
+    else
+      os << "set yrange [" << num(ylo) << ":" << num(yhi) << "]\n";
   }
 };
 
@@ -609,7 +624,13 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
         keyChars = std::max(keyChars, glyphs(run.cases[cases[o]].label) + (ny > 1 ? 1 + spec.y[j].size() : 0));
   f.right = std::clamp(1.0 - (8.2 * double(keyChars + 6) + 30.0) / f.width, 0.5, 0.8);
   std::tie(f.xlo, f.xhi) = niceRange(xlo, xhi);
-  std::tie(f.ylo, f.yhi) = niceRange(ylo, yhi);
+  // stiffness spans decades (the straight chain against a buckled one): a log axis in whole decades
+  // when every drawn value is positive and they span more than two
+  f.logY = spec.type == PlotType::Stiffness && ylo > 0.0 && std::isfinite(yhi) && yhi > 100.0 * ylo;
+  if (f.logY)
+    f.ylo = std::floor(std::log10(ylo)), f.yhi = std::ceil(std::log10(yhi));
+  else
+    std::tie(f.ylo, f.yhi) = niceRange(ylo, yhi);
 
   Occupancy occupied(f.width, f.height);
   for (const auto& line : polylines)
@@ -726,11 +747,11 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
               "fold per branch;\\nkey: count per type\" left\n";
   s.body << "set xlabel " << quote(parameterColumnLabel(scene, spec.x)) << "\n";
   std::string ylabel;
-  for (size_t j = 0; j < ny; ++j) ylabel += (j ? ", " : "") + columnLabel(spec.y[j]);
+  for (size_t j = 0; j < ny; ++j) ylabel += (j ? ", " : "") + columnLabel(spec.y[j], scene.units);
   if (ny > 1) {
     bool same = true;
     for (const std::string& y : spec.y) same = same && (y[0] == spec.y[0][0]);
-    if (same && spec.y[0][0] == 'K') ylabel = "stiffness (units of k)";
+    if (same && spec.y[0][0] == 'K') ylabel = "stiffness" + scene.units.suffix(Dimension::Stiffness);
     if (same && spec.y[0][0] == 'q') ylabel = "joint angles (rad)";
   }
   s.body << "set ylabel " << quote(ylabel) << "\n";
@@ -828,7 +849,8 @@ void torquePlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   data.write(dir / (stem + ".dat"));
   eq.write(dir / (stem + "_eq.dat"));
   header(s, spec.title.empty() ? "Torque-angle curves M(q) of one segment" : spec.title);
-  s.body << "set xlabel 'q (rad)'\nset ylabel 'M(q) = -dE/dq (units of k b^2)'\nset xzeroaxis lt -1\n";
+  s.body << "set xlabel 'q (rad)'\nset ylabel " << quote("M(q) = -dE/dq" + scene.units.suffix(Dimension::Moment))
+         << "\nset xzeroaxis lt -1\n";
   s.body << "plot \\\n";
   for (size_t c = 0; c < blocks.size(); ++c) {
     std::string title = run.cases[size_t(spec.cases[c])].label;
@@ -898,7 +920,7 @@ void energyPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     std::ostringstream title;
     title << cr.label << "  (x, y) = (" << num(cr.landscape.x) << ", " << num(cr.landscape.y) << ")";
     s.body << "set title " << quote(title.str()) << " noenhanced font ',10'\n";
-    s.body << "set xlabel 'q_1 (rad)'\nset ylabel 'E (units of k b^2)'\n";
+    s.body << "set xlabel 'q_1 (rad)'\nset ylabel " << quote("E" + scene.units.suffix(Dimension::Moment)) << "\n";
     if (torque) {
       // Me has poles where J is singular (sin q2 = 0, docs/mechanics.md erratum 7): scale the axis on the bulk
       std::vector<double> mags;
@@ -911,7 +933,7 @@ void energyPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
         std::sort(mags.begin(), mags.end());
         range = std::max(1e-6, 2.0 * mags[size_t(0.8 * double(mags.size() - 1))]);
       }
-      s.body << "set y2label 'M_e (units of k b^2)'\nset y2tics\nset ytics nomirror\nset y2zeroaxis lt 0\n"
+      s.body << "set y2label " << quote("M_e" + scene.units.suffix(Dimension::Moment)) << "\nset y2tics\nset ytics nomirror\nset y2zeroaxis lt 0\n"
              << "set y2range [" << num(-range) << ":" << num(range) << "]\n";
     }
     s.body << "plot " << quote(file) << " index 0 using 1:2 with lines lw 2 lc rgb 'blue' title 'q_3 > 0', \\\n"
@@ -1145,13 +1167,16 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   s.body << "set encoding utf8\nset size ratio -1\nunset key\nset grid lc rgb '#eeeeee'\n";
   s.body << "set multiplot layout " << nc * rowsPerCase << "," << cols << " title "
          << quote(!spec.title.empty() ? spec.title
-                  : detailed ? std::string("Chain shapes to scale (units of b); grey arcs: joint limits, "
+                  : detailed ? std::string("Chain shapes to scale" + scene.units.suffix(Dimension::Length) + "; grey arcs: joint limits, "
                                            "red: joint within 5% of a limit, magenta star: through the clamp or itself")
-                             : std::string("Chain shapes to scale (units of b), centre lines (base, joints, end); red: "
+                             : std::string("Chain shapes to scale" + scene.units.suffix(Dimension::Length) + ", centre lines (base, joints, end); red: "
                                            "joint within 5% of a limit, magenta star: through the clamp or itself"))
          << " font ',11'\n";
-  // a margin of 1.2 b around the chains, or 3 % of a long chain's extent
-  const double pad = std::max(1.2, 0.03 * box.sizes().maxCoeff());
+  // a margin of 1.2 b around the chains (b the mean half-length: a chain is 2 b n long), or 3 % of a
+  // long chain's extent
+  double bMean = 0.0;
+  for (size_t c : selected(spec)) bMean = std::max(bMean, run.cases[c].chain.length() / (2.0 * run.cases[c].chain.size()));
+  const double pad = std::max(1.2 * bMean, 0.03 * box.sizes().maxCoeff());
   const double x0 = box.min().x() - pad, x1 = box.max().x() + pad, y0 = box.min().y() - pad, y1 = box.max().y() + pad;
   for (size_t o = 0; o < nc; ++o) {
     const size_t c = size_t(spec.cases[o]);
@@ -1168,16 +1193,18 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       std::ostringstream title;
       if (p) {
         drawChain(cr.chain, p->q, tri, spr, lim, jnt, near, &touch, detailed);
-        // four decimals, or four significant digits for the small loads of long chains
-        title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = "
-              << (std::abs(p->parameter) >= 1e-3 ? num(std::round(p->parameter * 1e4) / 1e4) : short4(p->parameter));
+        // five significant digits, in the scene's unit
+        const std::string unit = scene.units.unit(columnDimension(parameter));
+        title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << short5(p->parameter)
+              << (unit.empty() ? "" : " " + unit);
         // the nearest traced point is drawn; the title says when it differs from the request
-        // beyond the title's rounding
-        if (std::abs(p->parameter - spec.at[k]) > 1e-4 * std::max(1.0, std::abs(spec.at[k])))
+        // beyond the title's rounding (relative to the path's range)
+        const PathSpec& path = scene.cases[c].path;
+        if (std::abs(p->parameter - spec.at[k]) > 1e-5 * std::max(std::abs(path.from), std::abs(path.to)))
           title << " (asked " << num(spec.at[k]) << ")";
         if (p->haveStiffness && std::isfinite(p->K(0, 0)))
-          title << ",  K_{xx} = " << num(std::round(p->K(0, 0) * 1e4) / 1e4) << ", K_{yy} = "
-                << num(std::round(p->K(1, 1) * 1e4) / 1e4);
+          title << ",  K_{xx} = " << short5(p->K(0, 0)) << ", K_{yy} = " << short5(p->K(1, 1))
+                << " " << scene.units.unit(Dimension::Stiffness);
         if (!p->locked.empty()) title << lockedTitle(p->locked);  // locked at a limit
       } else {
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(spec.at[k]) << ": not drawn";
@@ -1252,7 +1279,8 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       tEnd = std::max(tEnd, t.t);
     }
     s.body << "set key center right font ',9' opaque box\nset size noratio\nset autoscale xy\n"
-           << "set xlabel 't (units of the model time; log scale)'\nset ylabel 'energy (units of k b^2)'\n";
+           << "set xlabel 't (model time; log scale)'\nset ylabel " << quote("energy" + scene.units.suffix(Dimension::Moment))
+           << "\n";
     if (t1 > 0.0 && tEnd > t1) s.body << "set logscale x\nset xrange [" << num(t1) << ":" << num(tEnd) << "]\nset format x '10^{%L}'\n";
     s.body << "plot " << quote(base + "_energy.dat") << " using 1:2 with lines lw 2 lc rgb '#1f77b4' title 'Π (total potential)', \\\n"
            << "  '' using 1:3 with lines lw 2 lc rgb '#d62728' title 'T (kinetic)', \\\n"

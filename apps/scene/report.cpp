@@ -295,6 +295,7 @@ const char* const kTail = R"PAGE(</script>
   var PALETTE = ['#1f77b4', '#d62728', '#2ca02c', '#9467bd', '#ff7f0e', '#8c564b', '#e377c2', '#17becf'];
   var TYPE_COLOR = {BP: '#d62728', LP: '#ff7f0e', BD: '#7f7f7f', KMIN: '#9467bd', CT: '#8c564b', RL: '#17becf'};
   function ok(v) { return typeof v === 'number' && isFinite(v); }
+  function label(column) { return (D.labels && D.labels[column]) || column; }  // with the scene's unit
   function svg(tag, attrs, parent) {
     var e = document.createElementNS(NS, tag);
     for (var k in attrs) e.setAttribute(k, attrs[k]);
@@ -458,7 +459,7 @@ const char* const kTail = R"PAGE(</script>
     }
     lines.push({x: bounds(frame.xs), y: bounds(frame.ys), color: 'none', width: 0});
     var g = chart(target, {lines: lines, marks: marks, equal: true, width: 560, height: 400, cls: 'shape',
-                           xlabel: 'x (units of b)', ylabel: 'y (units of b)', title: info.title,
+                           xlabel: 'x' + D.unit_suffix.length, ylabel: 'y' + D.unit_suffix.length, title: info.title,
                            legend: info.legend});
     while (g.firstChild) target.appendChild(g.firstChild);
     target.removeChild(g);
@@ -527,7 +528,7 @@ const char* const kTail = R"PAGE(</script>
     });
     if (!multi) legend = [{color: '#1f77b4', label: 'stable'}, {color: '#d62728', dash: '6 4', label: 'unstable'}];
     return chart(parent, {id: id, lines: lines, marks: marks, pick: pick, legend: legend, title: spec.title,
-                          xlabel: spec.xlabel, ylabel: spec.y.join(', ')});
+                          xlabel: label(spec.x), ylabel: spec.y.map(label).join(', ')});
   }
 
   // ---- the page -----------------------------------------------------------------------------
@@ -628,20 +629,20 @@ const char* const kTail = R"PAGE(</script>
         c.landscape.equilibria.forEach(function (e) {
           marks.push({x: e.q1, y: e.E, color: e.stable ? '#2ca02c' : '#d62728', title: (e.stable ? 'stable ' : 'unstable ') + e.shape});
         });
-        xlabel = 'q1 (rad)'; ylabel = c.landscape.torque ? 'E (k b²), Me (k b²)' : 'E (k b²)';
+        xlabel = 'q1 (rad)'; ylabel = 'E' + D.unit_suffix.moment + (c.landscape.torque ? ', Me' + D.unit_suffix.moment : '');
       } else if (p.type === 'torque_angle' && c.torque) {
         lines.push({x: c.torque.q, y: c.torque.M, color: PALETTE[(2 * c.index) % PALETTE.length]});
         lines.push({x: c.torque.q, y: c.torque.Kq, color: PALETTE[(2 * c.index + 1) % PALETTE.length], dash: '6 4'});
         legend.push({color: PALETTE[(2 * c.index) % PALETTE.length], label: tag + 'M'});
         legend.push({color: PALETTE[(2 * c.index + 1) % PALETTE.length], dash: '6 4', label: tag + 'K_q'});
         c.torque.zeros.forEach(function (z) { marks.push({x: z.q, y: 0, color: z.stable ? '#2ca02c' : '#d62728'}); });
-        xlabel = 'q (rad)'; ylabel = 'M (k b²), K_q (k b²)';
+        xlabel = 'q (rad)'; ylabel = 'M' + D.unit_suffix.moment + ', K_q' + D.unit_suffix.rotational_stiffness;
       } else if (p.type === 'sudden_load' && c.sudden) {
         [['potential', '#1f77b4', ''], ['kinetic', '#d62728', '6 4'], ['dissipated', '#2ca02c', '3 3']].forEach(function (q) {
           lines.push({x: c.sudden.t, y: c.sudden[q[0]], color: q[1], dash: q[2]});
           legend.push({color: q[1], dash: q[2], label: tag + q[0]});
         });
-        xlabel = 't'; ylabel = 'energy (k b²)';
+        xlabel = 't (model time)'; ylabel = 'energy' + D.unit_suffix.moment;
       }
     });
     chart(panel, {lines: lines, marks: marks, legend: legend.slice(0, 8), title: p.title || p.name, xlabel: xlabel, ylabel: ylabel});
@@ -701,6 +702,15 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   json facts = summary;
   facts.erase("cases");  // per-case data are below, in the page's own layout
   data["summary"] = facts;
+  // labels with the scene's units (scene/units.h), made here so the page and the plots agree
+  json suffix = json::object();
+  for (const auto& [name, d] : {std::pair<const char*, Dimension>{"length", Dimension::Length},
+                                {"force", Dimension::Force},
+                                {"moment", Dimension::Moment},
+                                {"stiffness", Dimension::Stiffness},
+                                {"rotational_stiffness", Dimension::RotationalStiffness}})
+    suffix[name] = scene.units.suffix(d);
+  data["unit_suffix"] = suffix;
   // the main diagram: the scene's first bifurcation plot, else the path parameter against q1
   const PlotSpec* first = nullptr;
   for (const PlotSpec& p : scene.plots)
@@ -716,6 +726,18 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
     cases += caseText(scene, run.cases[c], c, columns);
     anyPoints = anyPoints || !run.cases[c].points.empty();
   });
+  json labels = json::object();
+  auto label = [&](const std::string& column) {
+    labels[column] = columnLabel(column == "parameter" ? scene.cases.front().path.parameter : column, scene.units,
+                                 LabelStyle::Plain);
+  };
+  label("parameter");
+  for (const std::string& column : columns) label(column);
+  for (const PlotSpec& p : scene.plots) {
+    if (!p.x.empty()) label(p.x);
+    for (const std::string& y : p.y) label(y);
+  }
+  data["labels"] = labels;
   if (anyPoints)
   {
     data["main"] = json{{"x", mainX},

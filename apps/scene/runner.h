@@ -35,6 +35,7 @@ struct PointRecord {
   double minEigenvalue = 0.0;
   bool haveStiffness = false;
   Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Eigen::Matrix2d C = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());  ///< C_F
   std::string locked;         ///< joints locked at their limits, "3U 5L" (ContactSet::label), "" none
   double contactTorque = 0.0; ///< largest compression of the locked joints (0: none locked)
 };

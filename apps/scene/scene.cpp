@@ -62,12 +62,25 @@ json mergePatched(const json& target, const json& patch) {
   return out;
 }
 
+// Nondimensional numbers are lengths in b and forces in k b only when b = k = 1 throughout.
+void requireUnitChain(const Reader& r, const Scene& scene) {
+  for (const CaseSpec& c : scene.cases)
+    for (size_t i = 0; i < c.chain.segments.size(); ++i) {
+      const mechanics::SegmentParameters& p = c.chain.segments[i];
+      if (p.b1 != 1.0 || p.b2 != 1.0 || p.k1 != 1.0 || p.k2 != 1.0)
+        r.fail(Pointer("/units"), "\"nondimensional\" means lengths in b and forces in k b, so b = k = 1 in every "
+                                  "segment, but " + c.label + " has b = " + show(p.b1 != 1.0 ? p.b1 : p.b2) + ", k = " +
+                                  show(p.k1 != 1.0 ? p.k1 : p.k2) + " in segment " + std::to_string(i + 1) +
+                                  ": name the units instead ({\"length\": \"m\", \"force\": \"N\"}) or remove \"units\"");
+    }
+}
+
 }  // namespace
 
 Scene parseScene(const std::string& text, const std::string& file) {
   const Reader r(file);
   const json doc = parseJsonDocument(text, file);
-  r.onlyKeys(doc, Pointer(""), {"description", "chain", "end", "path", "cases", "analyses", "solver", "plots"});
+  r.onlyKeys(doc, Pointer(""), {"description", "units", "chain", "end", "path", "cases", "analyses", "solver", "plots"});
   Scene scene;
   scene.file = file;
   if (doc.contains("description")) scene.description = r.string(doc["description"], Pointer("/description"));
@@ -110,6 +123,10 @@ Scene parseScene(const std::string& text, const std::string& file) {
   }
 
   checkAnalysesAgainstCases(r, scene);
+  if (doc.contains("units")) {
+    scene.units = parseUnits(r, doc["units"], Pointer("/units"));
+    if (scene.units.kind == UnitSystem::Kind::Nondimensional) requireUnitChain(r, scene);
+  }
   if (doc.contains("solver")) scene.solver = parseSolver(r, doc["solver"], Pointer("/solver"));
   if (doc.contains("plots")) {
     const json& plots = doc["plots"];

@@ -15,6 +15,7 @@
 #include "buckle/mechanics/stiffness_extremum.h"
 #include "buckle/mechanics/segment.h"
 #include "scene/json_reader.h"
+#include "scene/units.h"
 
 namespace buckle::scene {
 
@@ -176,6 +177,7 @@ struct CaseSpec {
 struct Scene {
   std::string file;
   std::string description;
+  UnitSystem units;             ///< what the numbers are in, for labels (scene/units.h)
   std::vector<CaseSpec> cases;  ///< at least one
   AnalysesSpec analyses;
   SolverSpec solver;

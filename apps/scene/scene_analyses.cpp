@@ -7,6 +7,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/stiffness_extremum.h"
+#include "scene/columns.h"
 
 namespace buckle::scene::detail {
 
@@ -17,7 +18,7 @@ namespace {
 std::set<std::string> branchColumns(int maxN, bool stiffness) {
   std::set<std::string> c = {"parameter", "Fx", "Fy", "Me", "x", "y", "phi", "dx", "dy", "min_eig"};
   for (int i = 1; i <= maxN; ++i) c.insert("q" + std::to_string(i));
-  if (stiffness) c.insert({"Kxx", "Kyy", "Kxy"});
+  if (stiffness) c.insert(stiffnessColumns().begin(), stiffnessColumns().end());
   return c;
 }
 

@@ -174,7 +174,7 @@ void criticalCurvesPlotBody(const Scene& scene, const RunResult& run, const Plot
                                                        : spec.title)
        << " noenhanced\n";
   body << "set xlabel " << quoteName(t.parameter) << " noenhanced\nset ylabel "
-       << quoteName(columnLabel(scene.cases.front().path.parameter)) << "\n";
+       << quoteName(columnLabel(scene.cases.front().path.parameter, scene.units)) << "\n";
   body << "set xzeroaxis lt -1 lc rgb '#888888'\n";
   body << plots.str() << (first ? "plot " : ", \\\n     ") << quoteName(file) << " index " << block
        << " using 1:2 with points pt 7 ps 1.4 lc rgb 'black' title 'codim-2 point', \\\n     "

@@ -174,3 +174,46 @@ TEST_CASE("buckle critical: the whole double range, or a refusal naming the opti
     CHECK_THAT(r.out, !Catch::Contains("unstable"));
   }
 }
+
+TEST_CASE("buckle critical says how many critical loads exist and in which units", "[cli]") {
+  // a clamped-pinned chain of n segments has n − 1 buckling modes (the held y takes one degree of
+  // freedom), a free one n: --count above that is answered with what exists and a note
+  for (int n : {2, 3, 4}) {
+    const nlohmann::json pinned = critical("--segments " + std::to_string(n) + " --count 9");
+    CHECK(pinned["critical"].size() == size_t(n - 1));
+    REQUIRE(pinned.contains("note"));
+    CHECK_THAT(pinned["note"].get<std::string>(), Catch::Contains("has " + std::to_string(n - 1)));
+    const nlohmann::json free = critical("--segments " + std::to_string(n) + " --count 9 --end free");
+    CHECK(free["critical"].size() == size_t(n));
+    CHECK_THAT(free["note"].get<std::string>(), Catch::Contains("has " + std::to_string(n)));
+    CHECK_FALSE(critical("--segments " + std::to_string(n) + " --count " + std::to_string(n - 1)).contains("note"));
+  }
+  const Run text = buckle("critical --segments 2 --count 3");
+  CHECK_THAT(text.out, Catch::Contains("note: --count 3"));
+
+  // named units: the first critical load of the SI chain of the README's example is the unit
+  // chain's times k b = 40 N, printed with N
+  const Run si = buckle("critical --segments 10 --a 0.01 --b 0.02 --k 2000 --L0 0.045 --length-unit m --force-unit N");
+  REQUIRE(si.status == 0);
+  CHECK_THAT(si.out, Catch::Contains("k = 2000 N/m"));
+  CHECK_THAT(si.out, Catch::Contains("forces N"));
+  CHECK_THAT(si.out, Catch::Contains("N·m (the straight joint stiffness"));
+  const nlohmann::json siJson =
+      critical("--segments 10 --a 0.01 --b 0.02 --k 2000 --L0 0.045 --length-unit m --force-unit N");
+  const nlohmann::json unit = critical("--segments 10");
+  CHECK(siJson["units"]["stiffness"] == "N/m");
+  CHECK(siJson["critical"][0]["Fx"].get<double>() ==
+        Approx(40.0 * unit["critical"][0]["Fx"].get<double>()).epsilon(1e-13));
+  // without names the printout says which units the numbers are in, never "units of k b"
+  const Run plain = buckle("critical --b 0.02 --k 2000 --a 0.01 --L0 0.045");
+  CHECK_THAT(plain.out, Catch::Contains("k's force unit times b's length unit"));
+  for (const char* bad : {"--length-unit m", "--length-unit 'm\"' --force-unit N", "--length-unit m --force-unit '<N>'"}) {
+    const Run r = buckle(std::string("critical ") + bad, true);
+    INFO(bad << " → " << r.out);
+    CHECK(r.status == 2);
+    CHECK_THAT(r.out, Catch::Contains("unit"));
+  }
+  // every printed column is explained by --help
+  const Run help = buckle("critical --help");
+  for (const char* word : {"mode shape", "mu", "kappa", "Fx"}) CHECK_THAT(help.out, Catch::Contains(word));
+}

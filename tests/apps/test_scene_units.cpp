@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <string>
 #include <unistd.h>
@@ -103,6 +104,7 @@ double secondParameterUnit(const json& scene, const Units& u) {
 
 /// The scene in the unit system u (the module comment); plots off (they are not compared).
 json rewrite(json scene, const Units& u) {
+  scene.erase("units");  // rescaled numbers are no longer in the units the scene named
   const json original = scene;
   const std::string parameter = parameterOf(original, json::object());
   if (scene.contains("chain")) scaleChain(scene["chain"], u);
@@ -353,4 +355,148 @@ TEST_CASE("the rewrite scales what it should", "[scene][units]") {
   CHECK(s["path"]["direction"]["Me"] == Approx(0.2 * 300.0 / 30.0));  // torque per force
   CHECK(s["path"]["direction"]["y"] == Approx(0.5 * 10.0 / 30.0));    // length per force
   CHECK(s["solver"]["initial_step"] == Approx(0.02));                  // dimensionless: as shipped
+}
+
+// ---- unit labels (scene/units.h) ----------------------------------------------------------------
+
+#include "scene/json_reader.h"
+#include "scene/scene.h"
+#include "scene/units.h"
+
+using buckle::scene::Dimension;
+using buckle::scene::UnitSystem;
+
+namespace {
+
+UnitSystem named(const std::string& length, const std::string& force) {
+  UnitSystem u;
+  u.kind = UnitSystem::Kind::Named;
+  u.length = length;
+  u.force = force;
+  return u;
+}
+
+std::string slurpFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// The value of every `set xlabel/ylabel/y2label/cblabel '…'` or "…" in a gnuplot script.
+std::vector<std::string> axisLabels(const std::string& script) {
+  std::vector<std::string> out;
+  std::istringstream in(script);
+  for (std::string line; std::getline(in, line);) {
+    for (const char* cmd : {"set xlabel ", "set ylabel ", "set y2label ", "set cblabel "})
+      if (line.rfind(cmd, 0) == 0) {
+        const std::string rest = line.substr(std::string(cmd).size());
+        const char q = rest.empty() ? '\'' : rest[0];
+        const size_t end = rest.find(q, 1);
+        out.push_back(rest.substr(1, end == std::string::npos ? std::string::npos : end - 1));
+      }
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("unit names compose into every derived unit", "[scene][units][labels]") {
+  const UnitSystem si = named("m", "N");
+  CHECK(si.unit(Dimension::Length) == "m");
+  CHECK(si.unit(Dimension::Force) == "N");
+  CHECK(si.unit(Dimension::Moment) == "N·m");
+  CHECK(si.unit(Dimension::Stiffness) == "N/m");
+  CHECK(si.unit(Dimension::Compliance) == "m/N");
+  CHECK(si.unit(Dimension::RotationalStiffness) == "N·m/rad");
+  CHECK(si.suffix(Dimension::Force) == " (N)");
+  CHECK(si.suffix(Dimension::Angle) == " (rad)");
+  CHECK(si.suffix(Dimension::None).empty());
+  // a compound name is grouped, so N/(mm) and (kg m/s^2)/mm read right
+  CHECK(named("mm", "kg m/s^2").unit(Dimension::Stiffness) == "(kg m/s^2)/mm");
+
+  UnitSystem nondim;
+  nondim.kind = UnitSystem::Kind::Nondimensional;
+  CHECK(nondim.suffix(Dimension::Force) == " (units of k b)");
+  CHECK(nondim.suffix(Dimension::Moment) == " (units of k b^2)");
+  CHECK(nondim.suffix(Dimension::Stiffness) == " (units of k)");
+
+  const UnitSystem consistent;  // no `units`: nothing claims k b
+  for (Dimension d : {Dimension::Length, Dimension::Force, Dimension::Moment, Dimension::Stiffness}) {
+    INFO(consistent.suffix(d));
+    CHECK(consistent.suffix(d).find("scene's units") != std::string::npos);
+    CHECK(consistent.suffix(d).find("k b") == std::string::npos);
+  }
+}
+
+TEST_CASE("bad units are refused at /units with what is accepted", "[scene][units][labels]") {
+  const std::string chain = R"("chain": {"segments": 3, "a": 0.01, "b": 0.02, "k": 2000, "L0": 0.045},
+      "end": {"x": {"load": 0}, "y": {"held": 0}, "phi": "free"}, "path": {"parameter": "Fx", "from": 0, "to": -1},
+      "analyses": {"continuation": true})";
+  struct Bad {
+    const char* units;
+    const char* path;
+  };
+  for (const Bad& b : {Bad{R"({"length": "m", "force": "N'\nsystem 'x"})", "/units/force"},
+                       Bad{R"({"length": "m<b>", "force": "N"})", "/units/length"},
+                       Bad{R"({"length": "mmmmmmmmmmmmmmmmm", "force": "N"})", "/units/length"},
+                       Bad{R"({"length": "", "force": "N"})", "/units/length"},
+                       Bad{R"({"length": "m"})", "/units/force"},
+                       Bad{R"({"length": "m", "force": "N", "time": "s"})", "/units/time"},
+                       Bad{R"("SI")", "/units"},
+                       Bad{R"("nondimensional")", "/units"}}) {
+    INFO(b.units);
+    try {
+      buckle::scene::parseScene(std::string("{\"units\": ") + b.units + ", " + chain + "}", "scene.json");
+      FAIL("accepted");
+    } catch (const buckle::scene::SceneError& e) {
+      CHECK(e.path() == b.path);
+      CHECK(!e.message().empty());
+    }
+  }
+  // nondimensional is accepted exactly when b = k = 1
+  const std::string unit = R"({"units": "nondimensional", "chain": {"segments": 3, "a": 0.5, "b": 1, "k": 1,
+      "L0": 2.25}, "end": {"x": {"load": 0}, "y": {"held": 0}, "phi": "free"},
+      "path": {"parameter": "Fx", "from": 0, "to": -1}, "analyses": {"continuation": true}})";
+  CHECK(buckle::scene::parseScene(unit, "scene.json").units.kind == UnitSystem::Kind::Nondimensional);
+}
+
+TEST_CASE("the SI chain says N, m and N/m in every plot, column doc and the report", "[scene][units][labels]") {
+  const fs::path dir = workDir() / "si_labels";
+  fs::remove_all(dir);
+  const json scene = readJson(sceneDir() / "si_chain.json");
+  run(scene, dir, "si");
+  const json summary = readJson(dir / "si" / "summary.json");
+  CHECK(summary["units"]["force"] == "N");
+  CHECK(summary["units"]["stiffness"] == "N/m");
+
+  // every axis label of every gnuplot script names a unit of the scene (or rad), never k b
+  size_t labelled = 0;
+  std::set<std::string> seen;
+  for (const auto& e : fs::directory_iterator(dir / "si" / "plots")) {
+    if (e.path().extension() != ".gp") continue;
+    const std::string script = slurpFile(e.path());
+    INFO(e.path().filename().string());
+    CHECK(script.find("units of") == std::string::npos);
+    for (const std::string& label : axisLabels(script)) {
+      INFO(label);
+      const bool hasUnit = label.find("(N)") != std::string::npos || label.find("(m)") != std::string::npos ||
+                           label.find("(N/m)") != std::string::npos || label.find("(N·m)") != std::string::npos ||
+                           label.find("(rad)") != std::string::npos;
+      CHECK(hasUnit);
+      seen.insert(label);
+      ++labelled;
+    }
+  }
+  CHECK(labelled >= 8);  // x and y of five plots less the shapes panels' unlabelled axes
+  CHECK(seen.count("F_x (N)") == 1);
+  CHECK(seen.count("stiffness (N/m)") == 1);
+  CHECK(seen.count("{/Symbol d}_x = x_0 - x (m)") == 1);
+  CHECK(seen.count("M(q) = -dE/dq (N·m)") == 1);
+
+  // the report: the units table the page draws its axes with, and the labels of the drawn columns
+  const std::string html = slurpFile(dir / "si" / "report.html");
+  CHECK(html.find("units of") == std::string::npos);
+  CHECK(html.find(R"x("force":" (N)")x") != std::string::npos);
+  CHECK(html.find(R"x("length":" (m)")x") != std::string::npos);
+  CHECK(html.find(R"x("Fx":"Fx (N)")x") != std::string::npos);
+  CHECK(html.find(R"x("q5":"q5 (rad)")x") != std::string::npos);
 }

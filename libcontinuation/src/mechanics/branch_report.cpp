@@ -252,7 +252,9 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     if (throughReaction && !inRange(p.parameter, options)) continue;
     PointReport pr = p;
     if (options.stiffness) {
-      pr.K = lockedLoadedStiffness(chain, pr.q, pr.F, problem.endCondition(), pr.locked).stiffness;
+      const CartesianStiffness s = lockedLoadedStiffness(chain, pr.q, pr.F, problem.endCondition(), pr.locked);
+      pr.K = s.stiffness;
+      pr.C = s.compliance;
       pr.haveStiffness = true;
     }
     r.worstResidual = std::max(r.worstResidual, pr.residual);

@@ -86,6 +86,9 @@ struct PointReport {
   double residual = 0.0;               ///< corrector residual (scaled, dimensionless)
   bool haveStiffness = false;
   Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// The compliance C_F = K_F⁻¹ of the same computation (finite where K_F is not: a rigid
+  /// direction, e.g. x at the straight chain; NaN where K_F is singular).
+  Eigen::Matrix2d C = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
   /// Joints locked at their limits at this point (contact.h); stability and K are those of the
   /// constrained chain.
   ContactSet locked;

@@ -1,0 +1,29 @@
+// The column dictionary of branches.csv and the plots: each column's label with the scene's unit
+// (scene/units.h), and the stiffness quantities derived from K_F and C_F (docs/outputs.md).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "scene/units.h"
+
+namespace buckle::scene {
+
+/// How a label is written: gnuplot's enhanced text ("K_{xx}") or plain Unicode ("Kxx").
+enum class LabelStyle { Gnuplot, Plain };
+/// Axis label of a column with the scene's unit: "F_x (N)", "F_x (units of k b)",
+/// "F_x (force, in the scene's units)"; the column's own name when it has none.
+std::string columnLabel(const std::string& column, const UnitSystem& units, LabelStyle style = LabelStyle::Gnuplot);
+
+/// The dimension of a column's values (None for counts and unknown names).
+Dimension columnDimension(const std::string& column);
+
+/// The stiffness columns of branches.csv with `stiffness` (docs/outputs.md): K_F, C_F, the
+/// directional stiffnesses with the other direction free, the principal stiffnesses K1 ≤ K2 and
+/// the direction θ1 of K1.
+const std::vector<std::string>& stiffnessColumns();
+/// One of those columns from K_F and C_F (either may be NaN: a rigid or a singular direction).
+double stiffnessColumnValue(const std::string& column, const Eigen::Matrix2d& K, const Eigen::Matrix2d& C);
+
+}  // namespace buckle::scene
