@@ -188,16 +188,20 @@ std::vector<std::string> labelledPlots(const fs::path& out) {
 /// on the 1000×700 terminal (NAME.gp).
 struct PixelFrame {
   double l, r, b, t, x0, x1, y0, y1;
+  bool logY = false;  ///< `set logscale y`: the stiffness over decades (y0, y1 then their logarithms)
   static constexpr double W = 1000, H = 700;
   explicit PixelFrame(const fs::path& plots, const std::string& stem) {
     const std::string body = slurp(plots / (stem + "_body.gp"));
     l = setting(body, "lmargin"), r = setting(body, "rmargin"), b = setting(body, "bmargin"), t = setting(body, "tmargin");
     std::tie(x0, x1) = range(body, "x");
     std::tie(y0, y1) = range(body, "y");
+    logY = body.find("set logscale y") != std::string::npos;
+    if (logY) y0 = std::log10(y0), y1 = std::log10(y1);
     CHECK(slurp(plots / (stem + ".gp")).find("size 1000,700") != std::string::npos);
   }
   std::pair<double, double> px(double x, double y) const {
-    return {W * (l + (r - l) * (x - x0) / (x1 - x0)), H * (b + (t - b) * (y - y0) / (y1 - y0))};
+    const double v = logY ? std::log10(y) : y;
+    return {W * (l + (r - l) * (x - x0) / (x1 - x0)), H * (b + (t - b) * (v - y0) / (y1 - y0))};
   }
 };
 
@@ -395,6 +399,17 @@ TEST_CASE("special-point labels do not overlap one another, a marker or the plot
         // the fold's branch point and the jump released there share one label
         const std::string labels = slurp(out / "plots" / "hysteresis_q1_labels.dat");
         CHECK(labels.find(", JUMP\"") != std::string::npos);
+      }
+      if (name == "fig9_fig10") {
+        // Kxx falls by decades into the quasi-buckling minimum and stays positive: a log axis,
+        // whose pixel positions the labels above were checked in
+        const Csv csv = readCsv(out / "branches.csv");
+        double lo = INFINITY, hi = 0.0;
+        for (const auto& row : csv.rows)
+          if (row[csv.col("case")] <= 2.0 && std::isfinite(row[csv.col("Kxx")]))
+            lo = std::min(lo, row[csv.col("Kxx")]), hi = std::max(hi, row[csv.col("Kxx")]);
+        REQUIRE(lo > 0.0);
+        CHECK(PixelFrame(out / "plots", "fig10a_Kxx").logY == (hi > 100.0 * lo));
       }
       fs::remove_all(out);
     }
