@@ -2,6 +2,7 @@
 // SUNDIALS storage) must not touch the heap once the Corrector exists (malloc_counter.h).
 #include "buckle/continuation/corrector.h"
 #include "buckle/continuation/locator.h"
+#include "buckle/continuation/numeric_diff.h"
 #include "buckle/continuation/spectral_monitor.h"
 
 #include "toy_problems.h"
@@ -109,6 +110,37 @@ TEST_CASE("Certified counting's slopes and the locator's residual norm allocate 
   const long after = mallocCalls.load();
   CHECK(measured);
   CHECK(sameNorm);
+  CHECK(after - before == 0);
+#else
+  SUCCEED("malloc interposition is disabled under AddressSanitizer");
+#endif
+}
+
+TEST_CASE("NumericDiffProblem's derivatives allocate nothing after the first call", "[allocation][numeric_diff]") {
+#if BUCKLE_COUNT_MALLOC
+  class NumericBratu : public NumericDiffProblem {
+   public:
+    int dimension() const override { return exact.dimension(); }
+    bool residual(ConstVectorRef u, double lambda, VectorRef F) override { return exact.residual(u, lambda, F); }
+    toys::Bratu exact{12};
+  } problem;
+  const int n = problem.dimension();
+  const Vector u = Vector::Constant(n, 0.3), x = Vector::Constant(n + 1, 0.2), z = Vector::Constant(n + 1, -0.1);
+  const Vector w = Vector::Constant(n, 0.5);
+  Matrix Fu(n, n), dFu(n, n);
+  Vector Fl(n), dFl(n), y(n), yt(n + 1);
+  REQUIRE(problem.jacobian(u, 1.0, Fu, Fl));  // warm-up: the scales and workspaces
+  REQUIRE(problem.secondDerivativeTransposeApply(u, 1.0, x, w, yt));
+  const long before = mallocCalls.load();
+  bool ok = true;
+  for (int k = 0; k < 5; ++k) {
+    ok = ok && problem.jacobian(u, 1.0 + 0.1 * k, Fu, Fl);
+    ok = ok && problem.jacobianDirectionalDerivative(u, 1.0, x.head(n), x[n], dFu, dFl);
+    ok = ok && problem.secondDerivativeApply(u, 1.0, x, z, y);
+    ok = ok && problem.secondDerivativeTransposeApply(u, 1.0, x, w, yt);
+  }
+  const long after = mallocCalls.load();
+  CHECK(ok);
   CHECK(after - before == 0);
 #else
   SUCCEED("malloc interposition is disabled under AddressSanitizer");

@@ -225,4 +225,47 @@ class Bratu : public Problem {
   double h_;
 };
 
+/// F = Φ·F̃(u₀/U₀, u₁/U₁, λ/Λ) with F̃ = (λ̃e^{ũ₀} + ũ₀ũ₁² − 1, λ̃²ũ₁ + ũ₁ sin ũ₀ − ũ₀³): a
+/// problem with exact first and second derivatives in units of choice (scales() says which), for
+/// checks of derivatives that must not depend on the units.
+class ScaledExponentials : public Problem {
+ public:
+  ScaledExponentials(double U0 = 1.0, double U1 = 1.0, double Lambda = 1.0, double Phi = 1.0)
+      : U0_(U0), U1_(U1), L_(Lambda), P_(Phi) {}
+  int dimension() const override { return 2; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    const double a = u[0] / U0_, b = u[1] / U1_, l = lambda / L_;
+    F[0] = P_ * (l * std::exp(a) + a * b * b - 1.0);
+    F[1] = P_ * (l * l * b + b * std::sin(a) - a * a * a);
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+    const double a = u[0] / U0_, b = u[1] / U1_, l = lambda / L_;
+    Fu << P_ / U0_ * (l * std::exp(a) + b * b), P_ / U1_ * 2.0 * a * b,
+        P_ / U0_ * (b * std::cos(a) - 3.0 * a * a), P_ / U1_ * (l * l + std::sin(a));
+    Fl << P_ / L_ * std::exp(a), P_ / L_ * 2.0 * l * b;
+    return true;
+  }
+  bool jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                     MatrixRef dFu, VectorRef dFl) override {
+    const double a = u[0] / U0_, b = u[1] / U1_, l = lambda / L_;
+    const double da = du[0] / U0_, db = du[1] / U1_, dl = dlambda / L_;
+    dFu << P_ / U0_ * ((dl + l * da) * std::exp(a) + 2.0 * b * db), P_ / U1_ * 2.0 * (da * b + a * db),
+        P_ / U0_ * (-std::sin(a) * b * da + std::cos(a) * db - 6.0 * a * da),
+        P_ / U1_ * (2.0 * l * dl + std::cos(a) * da);
+    dFl << P_ / L_ * std::exp(a) * da, P_ / L_ * 2.0 * (dl * b + l * db);
+    return true;
+  }
+  ProblemScales scales() const override {
+    ProblemScales s = ProblemScales::ones(2);
+    s.unknowns << U0_, U1_;
+    s.residuals << P_, P_;
+    s.parameter = L_;
+    return s;
+  }
+
+ private:
+  double U0_, U1_, L_, P_;
+};
+
 }  // namespace buckle::continuation::toys

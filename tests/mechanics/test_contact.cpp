@@ -5,6 +5,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -419,4 +420,94 @@ TEST_CASE("contact: the loaded stiffness with locked joints is the free joints' 
   const CartesianStiffness plain = lockedLoadedStiffness(chain, q, F, EndCondition::freeEnd(), ContactSet());
   CHECK((plain.stiffness - loadedStiffness(chain, q, F, false).stiffness).cwiseAbs().maxCoeff() == 0.0);
   CHECK_THROWS_AS(loadedStiffness(chain, q, F, false, Matrix::Zero(1, 5)), std::invalid_argument);
+}
+
+TEST_CASE("contact: a branch point on a locked stretch is switched, its children locked as the stretch",
+          "[contact][switching]") {
+  // data/scenes/locked_branch_point.json. Five segments, the second bent by its unloaded shape
+  // (q0 = 0, 0.8, 0, 0, 0), joint 1 with the lower limit −0.05, pushed by a force along the axis
+  // the links 2–5 have once joint 1 sits on that limit (θ* = −0.05 + 0.8). Before the contact the
+  // force bends joint 1 down (its line passes above joint 1); at the limit the links 2–5 are
+  // straight along it, so with joint 1 locked q* = (−0.05, 0.8, 0, 0, 0) is an equilibrium for
+  // every load (the load's moment vanishes at joints 2–5, the stop carries joint 1's), and the
+  // free part, a cantilever of four joints compressed along its axis, buckles: a branch point
+  // on the locked stretch.
+  std::vector<SegmentParameters> segs(5, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  segs[0].qMinUser = -0.05;
+  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(5);
+  q0[1] = 0.8;
+  const Chain chain(preloadsForShape(segs, q0));
+  const double theta = -0.05 + 0.8;
+  const Wrench unit(-std::cos(theta), -std::sin(theta), 0.0);  // λ = P, the compressive force
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), unit);
+  Eigen::VectorXd qStar = q0;
+  qStar[0] = -0.05;
+
+  // Independent numbers at q*: the gradient of Π is affine in P; joint 1's row vanishes at the
+  // contact load, the others at every load; K_q − K_g on joints 2–5 is singular at the loads
+  // P = eig(−B⁻¹A), H(P) = A + P·B.
+  Eigen::VectorXd g0(5), g1(5);
+  totalPotentialGradient(chain, qStar, 0.0 * unit, g0);
+  totalPotentialGradient(chain, qStar, 1.0 * unit, g1);
+  REQUIRE(g0.tail(4).cwiseAbs().maxCoeff() < 1e-12);
+  REQUIRE(g1.tail(4).cwiseAbs().maxCoeff() < 1e-12);
+  const double contactLoad = -g0[0] / (g1[0] - g0[0]);
+  Eigen::MatrixXd H0(5, 5), H1(5, 5);
+  totalPotentialHessian(chain, qStar, 0.0 * unit, H0);
+  totalPotentialHessian(chain, qStar, 1.0 * unit, H1);
+  const Eigen::MatrixXd A = H0.bottomRightCorner(4, 4), B = H1.bottomRightCorner(4, 4) - A;
+  const Eigen::VectorXcd critical = Eigen::MatrixXd(-B.fullPivLu().solve(A)).eigenvalues();
+  double firstCritical = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < critical.size(); ++i)
+    if (std::abs(critical[i].imag()) < 1e-12 && critical[i].real() > 0.0)
+      firstCritical = std::min(firstCritical, critical[i].real());
+  REQUIRE(contactLoad > 0.0);
+  REQUIRE(firstCritical > 1.5 * contactLoad);  // the stop is reached well before the free part buckles
+
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMax = 1.5 * firstCritical;
+  o.tracer.maxStep = 0.05;
+  o.tracer.maxPoints = 300;
+  o.switchingDepth = 1;
+  const EquilibriumBranches r = traceEquilibria(problem, q0, 0.0, cont::InitialDirection::increasingLambda(), o);
+  const cont::Branch& root = r.tree.branches[0];
+  const BranchReport& rep = r.reports[0];
+  REQUIRE(countType(rep, EventType::Contact) == 1);
+  const SpecialPointReport& ct = *firstOfType(rep, EventType::Contact);
+  CHECK(ct.joint == 0);
+  CHECK(ct.parameter == Approx(contactLoad).epsilon(1e-10));
+
+  // The branch point on the locked stretch, on the trivial branch q* at the first critical load.
+  int bpIndex = -1;
+  for (size_t k = 0; k < root.specialPoints.size(); ++k)
+    if (root.specialPoints[k].type == cont::SpecialPointType::BranchPoint &&
+        !lockedAt(r.contact[0], root.specialPoints[k].index + 1).empty())
+      bpIndex = int(k);
+  REQUIRE(bpIndex >= 0);
+  const cont::SpecialPoint& bp = root.specialPoints[size_t(bpIndex)];
+  INFO("BP at P = " << bp.lambda << ": " << bp.note);
+  CHECK(bp.lambda == Approx(firstCritical).epsilon(1e-9));
+  CHECK((bp.u.head(5) - qStar).cwiseAbs().maxCoeff() < 1e-10);
+
+  // Switched: both sides traced on the locked problem, leaving q* while joint 1 stays on its stop
+  // and pushes (compression > 0); every point an equilibrium of the free joints.
+  int children = 0;
+  for (size_t b = 1; b < r.tree.branches.size(); ++b) {
+    const cont::Branch& child = r.tree.branches[b];
+    if (child.parentId != 0 || child.parentSpecialPoint != bpIndex) continue;
+    ++children;
+    REQUIRE(child.points.size() > 3);
+    const ContactSet& first = r.contact[b].front().locked;
+    CHECK(first.locked(0));
+    CHECK(first.side(0) == LimitSide::Lower);
+    const cont::ContinuationPoint& p = child.points[2];
+    CHECK((p.u.head(5) - qStar).cwiseAbs().maxCoeff() > 1e-4);
+    CHECK(p.u[0] == -0.05);
+    Eigen::VectorXd g(5);
+    totalPotentialGradient(chain, p.u.head(5), p.lambda * unit, g);
+    CHECK(g.tail(4).cwiseAbs().maxCoeff() < 1e-9);
+    CHECK(g[0] > 0.0);  // the lower stop pushes joint 1 up: compression = τ_c = ∂Π/∂q1 > 0
+  }
+  CHECK(children == 2);
+  CHECK(bp.note.find("switched on the contact stretch") != std::string::npos);
 }

@@ -189,36 +189,18 @@ void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, cons
   s.note = os.str();
 }
 
-}  // namespace
 
-BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options) {
-  return reportBranch(problem, b, options, {});
-}
+// ---- reportBranch, part by part ---------------------------------------------------------------
 
-BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options,
-                          const std::vector<ContactStretch>& stretches, GeometricContacts* geometric) {
+// Every point of the branch (returned, also those out of range: the stability of neighbours);
+// those in range, with their stiffness, into r.points.
+std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options,
+                                      const std::vector<ContactStretch>& stretches, HeldStability* held,
+                                      BranchReport& r) {
   const Chain& chain = problem.chain();
   const int n = chain.size();
   const int c = options.heldCoordinate;
   const bool throughReaction = c >= 0;
-  std::unique_ptr<HeldStability> held;
-  if (throughReaction) held = std::make_unique<HeldStability>(problem, c);
-
-  BranchReport r;
-  r.stopReason = cont::toString(b.stopReason);
-  r.stopMessage = b.stopMessage;
-  r.finished = regularStop(b.stopReason);
-  int limitJoint = -1;
-  if (!r.finished && b.stopReason == cont::StopReason::StepSizeTooSmall && !b.points.empty()) {
-    limitJoint = jointAtLimit(chain, b.points.back().u.head(n));
-    if (limitJoint >= 0) {
-      r.finished = true;
-      r.stopReason = "joint limit";
-      r.stopMessage = "joint " + std::to_string(limitJoint + 1) + " reached its limit (" + b.stopMessage + ")";
-    }
-  }
-
-  // ---- points ----------------------------------------------------------------------------
   std::vector<PointReport> all;  // every point, also out of range (stability of neighbours)
   all.reserve(b.points.size());
   Eigen::VectorXd torques(problem.dimension());
@@ -260,8 +242,17 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     r.worstResidual = std::max(r.worstResidual, pr.residual);
     r.points.push_back(std::move(pr));
   }
+  return all;
+}
 
-  // ---- special points located by the tracer ------------------------------------------------
+// The special points located by the tracer, named and with their physical quantities.
+void reportLocatedPoints(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options,
+                         const std::vector<ContactStretch>& stretches, const std::vector<PointReport>& all,
+                         BranchReport& r) {
+  const Chain& chain = problem.chain();
+  const int n = chain.size();
+  const int c = options.heldCoordinate;
+  const bool throughReaction = c >= 0;
   for (size_t k = 0; k < b.specialPoints.size(); ++k) {
     const cont::SpecialPoint& sp = b.specialPoints[k];
     if (sp.type == cont::SpecialPointType::Endpoint) continue;
@@ -326,8 +317,11 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
       s.note += (s.note.empty() ? "" : "; ") + std::string("multiplicity ") + std::to_string(sp.multiplicity);
     r.specialPoints.push_back(std::move(s));
   }
+}
 
-  // ---- a joint limit where the steps collapsed ----------------------------------------------
+// A joint limit where the steps collapsed (not located: the last converged point).
+void reportCollapsedLimit(const Chain& chain, const cont::Branch& b, int limitJoint, const std::vector<PointReport>& all,
+                          BranchReport& r) {
   if (limitJoint >= 0) {
     const PointReport& p = all.back();
     SpecialPointReport s = atPoint(p, EventType::JointLimit, Phenomenon::QuasiBuckling);
@@ -342,8 +336,13 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     s.note = os.str();
     r.specialPoints.push_back(std::move(s));
   }
+}
 
-  // ---- displacement control: turning points of the held coordinate --------------------------
+// Displacement control: turning points of the held coordinate.
+void reportHeldCoordinateFolds(const cont::Branch& b, const ReportOptions& options, const std::vector<PointReport>& all,
+                               BranchReport& r) {
+  const int c = options.heldCoordinate;
+  const bool throughReaction = c >= 0;
   // Where the displacement-controlled stability changes between two points away from a branch
   // point, the held coordinate c(s) turns back (dc/ds = 0): the chain jumps there.
   if (throughReaction) {
@@ -372,8 +371,15 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
                                          [&](const SpecialPointReport& s) { return !inRange(s.parameter, options); }),
                           r.specialPoints.end());
   }
+}
 
-  // ---- quasi-buckling: a deep local minimum of the stiffness measure along a stable stretch ---
+// Quasi-buckling: a deep local minimum of the stiffness measure along a stable stretch.
+void reportStiffnessMinima(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options,
+                           BranchReport& r) {
+  const Chain& chain = problem.chain();
+  const int n = chain.size();
+  const int c = options.heldCoordinate;
+  const bool throughReaction = c >= 0;
   // Bracketed where the exact rate dm/ds along the traced tangents changes from negative to
   // positive between two consecutive stable points, then located on the branch itself
   // (stiffness_extremum.h): neither the step size nor the units move it.
@@ -424,6 +430,42 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
       r.specialPoints.push_back(std::move(s));
     }
   }
+}
+
+}  // namespace
+
+BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options) {
+  return reportBranch(problem, b, options, {});
+}
+
+BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options,
+                          const std::vector<ContactStretch>& stretches, GeometricContacts* geometric) {
+  const Chain& chain = problem.chain();
+  const int n = chain.size();
+  const int c = options.heldCoordinate;
+  const bool throughReaction = c >= 0;
+  std::unique_ptr<HeldStability> held;
+  if (throughReaction) held = std::make_unique<HeldStability>(problem, c);
+
+  BranchReport r;
+  r.stopReason = cont::toString(b.stopReason);
+  r.stopMessage = b.stopMessage;
+  r.finished = regularStop(b.stopReason);
+  int limitJoint = -1;
+  if (!r.finished && b.stopReason == cont::StopReason::StepSizeTooSmall && !b.points.empty()) {
+    limitJoint = jointAtLimit(chain, b.points.back().u.head(n));
+    if (limitJoint >= 0) {
+      r.finished = true;
+      r.stopReason = "joint limit";
+      r.stopMessage = "joint " + std::to_string(limitJoint + 1) + " reached its limit (" + b.stopMessage + ")";
+    }
+  }
+
+  const std::vector<PointReport> all = reportPoints(problem, b, options, stretches, held.get(), r);
+  reportLocatedPoints(problem, b, options, stretches, all, r);
+  reportCollapsedLimit(chain, b, limitJoint, all, r);
+  reportHeldCoordinateFolds(b, options, all, r);
+  reportStiffnessMinima(problem, b, options, r);
   reportGeometricContacts(problem, b, all, options, r, geometric);  // base / self contact (contact_geometry.h)
   for (SpecialPointReport& s : r.specialPoints) {
     s.stabilityBefore = stabilityLabel(s.negativeBefore);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "buckle/continuation/multiplicity_switching.h"
 #include "buckle/mechanics/mirror_symmetry.h"
 
 namespace buckle::mechanics {
@@ -40,14 +41,23 @@ void appendMirroredTail(const continuation::Reflection& mirror, const continuati
   image.stopMessage = mirror.mapText(source.stopMessage);
 }
 
+// The problem of a stretch with `locked` joints, its contact torques bounded by maxContactTorque
+// torque units (what continueUnderContact traces a locked stretch on).
+std::unique_ptr<ContactProblem> lockedProblem(EquilibriumProblem& problem, const ContactSet& locked,
+                                              double maxContactTorque) {
+  const double torqueUnit = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();
+  return std::make_unique<ContactProblem>(problem, locked, maxContactTorque * torqueUnit);
+}
+
 }  // namespace
 
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
                                                  const continuation::TracerOptions& options, int maxContactEvents,
-                                                 double maxContactTorque) {
+                                                 double maxContactTorque, const ContactSet& initial) {
   const int n = problem.segments();
-  std::vector<ContactStretch> stretches{ContactStretch{}};
+  std::vector<ContactStretch> stretches{ContactStretch{0, initial}};
   std::unique_ptr<ContactProblem> current;  // the problem of the last stretch (null: `problem`)
+  if (!initial.empty()) current = lockedProblem(problem, initial, maxContactTorque);
   for (int events = 0; events < maxContactEvents && !branch.points.empty(); ++events) {
     const continuation::Problem& traced = current ? static_cast<const continuation::Problem&>(*current) : problem;
     const LockedJoint hit = endBoundary(traced, branch, n);
@@ -72,8 +82,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // locked branch cannot move it); orientation only.
     continuation::Vector t = at.tangent;
     if (!release && t.size() == problem.dimension() + 1) t[hit.joint] = 0.0;
-    const double torqueUnit = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();
-    auto next = std::make_unique<ContactProblem>(problem, locked, maxContactTorque * torqueUnit);
+    auto next = lockedProblem(problem, locked, maxContactTorque);
     const std::string what = std::string(release ? "release of joint " : "contact of joint ") +
                              std::to_string(hit.joint + 1) + " " + toString(hit.side);
     auto giveUp = [&branch, &what](const std::string& why) {
@@ -162,6 +171,107 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
   return stretches;
 }
 
+namespace {
+
+// The branch points the tree never saw: traceTree switches at the branch points of the branches
+// as traced, but those of their contact-continued stretches (continueUnderContact: locked
+// stretches, and free ones after a release) are located later, on the problem of their stretch.
+// Each is switched here on that problem (a ContactProblem with the stretch's joints locked),
+// with the tree's guards — depth, switchAt, not the point a branch started from, not twice at
+// the same point — and every child is itself continued through contact from the stretch's
+// locked joints; its own branch points join the queue (breadth first, as in traceTree).
+// `traced[b]`: the sizes of branch b before its contact stretches (what traceTree switched).
+void switchOnContactStretches(EquilibriumProblem& problem, const EquilibriumBranchOptions& options,
+                              std::vector<std::pair<size_t, size_t>>& traced, EquilibriumBranches& result) {
+  continuation::BranchTree& tree = result.tree;
+  const int N = problem.dimension();
+  const continuation::ProblemScales scales = problem.scales();
+  std::vector<int> depth;
+  for (const continuation::Branch& b : tree.branches)
+    depth.push_back(b.parentId >= 0 ? depth[size_t(b.parentId)] + 1 : 0);
+  // The first special point of each branch not yet considered (0 for the children made here).
+  std::vector<size_t> first;
+  for (const auto& t : traced) first.push_back(t.second);
+  std::vector<continuation::Vector> switchedAt;  // in the scaled variables
+  const continuation::TracerOptions& childOptions = options.childTracer ? *options.childTracer : options.tracer;
+  const double h = options.switching.amplitude > 0.0 ? options.switching.amplitude : childOptions.initialStep;
+  auto addNote = [](std::string& note, const std::string& what) { note += (note.empty() ? "" : "; ") + what; };
+
+  for (size_t b = 0; b < tree.branches.size(); ++b) {
+    if (depth[b] >= options.switchingDepth) continue;
+    for (size_t k = first[b]; k < tree.branches[b].specialPoints.size(); ++k) {
+      continuation::SpecialPoint bp = tree.branches[b].specialPoints[k];
+      const continuation::Branch& branch = tree.branches[b];
+      if (bp.type != continuation::SpecialPointType::BranchPoint) continue;
+      if (options.switchAt && !options.switchAt(branch, bp)) continue;
+      if (!branch.points.empty() && bp.arclength - branch.points.front().arclength <= 1e-6 * h) continue;
+      if (options.tracer.interrupt.requested()) {
+        tree.interrupted = true;
+        tree.message = options.tracer.interrupt.describe();
+        return;
+      }
+      continuation::Vector x(N + 1);
+      x << bp.u.cwiseQuotient(scales.unknowns), bp.lambda / scales.parameter;
+      bool seen = false;
+      for (const continuation::Vector& y : switchedAt)
+        if ((y - x).norm() <= 1e-7 * std::max(1.0, x.norm())) seen = true;
+      if (seen) {
+        addNote(tree.branches[b].specialPoints[k].note, "already switched from another branch");
+        continue;
+      }
+      switchedAt.push_back(x);
+      // The interval [index, index + 1] lies in the stretch of its end point.
+      const ContactSet locked = lockedAt(result.contact[b], bp.index + 1);
+      std::unique_ptr<ContactProblem> lockedOne = locked.empty() ? nullptr
+                                                                 : lockedProblem(problem, locked, options.maxContactTorque);
+      continuation::TracerOptions o = childOptions;
+      if (lockedOne) o.certifiedCounting = false;  // as on the stretch itself (continueUnderContact)
+      continuation::Tracer tracer(lockedOne ? static_cast<continuation::Problem&>(*lockedOne) : problem, o);
+      std::string how;
+      std::vector<continuation::Branch> sides =
+          bp.multiplicity > 1
+              ? continuation::switchMultiple(tracer, bp, options.switching, &how)
+              : continuation::switchBothSides(tracer, bp, options.switching, &how,
+                                              [&](const continuation::Branch&) { return o.interrupt.requested(); });
+      continuation::SpecialPoint& at = tree.branches[b].specialPoints[k];
+      if (bp.multiplicity > 1) {
+        at.branchesPredicted = bp.branchesPredicted;
+        at.branchesFound = bp.branchesFound;
+      }
+      if (sides.empty()) {
+        addNote(at.note, "not switched: " + how);
+        continue;
+      }
+      std::string children;
+      for (continuation::Branch& child : sides) {
+        child.id = int(tree.branches.size());
+        child.parentId = int(b);
+        child.parentSpecialPoint = int(k);
+        child.mirrorOf = -1;  // no reflection is used here: both sides are traced
+        traced.emplace_back(child.points.size(), child.specialPoints.size());
+        const bool stopped = child.stopReason == continuation::StopReason::Interrupted;
+        result.contact.push_back(
+            stopped ? std::vector<ContactStretch>{ContactStretch{0, locked}}
+                    : continueUnderContact(problem, child, o, options.maxContactEvents, options.maxContactTorque, locked));
+        children += (children.empty() ? "" : ", ") + std::to_string(child.id);
+        tree.branches.push_back(std::move(child));
+        depth.push_back(depth[b] + 1);
+        first.push_back(0);
+        if (stopped) {
+          tree.interrupted = true;
+          tree.message = tree.branches.back().stopMessage;
+        }
+        if (options.onBranch) options.onBranch(tree, tree.branches.back());
+      }
+      addNote(tree.branches[b].specialPoints[k].note,
+              "switched on the contact stretch (" + how + "): branches " + children);
+      if (tree.interrupted) return;
+    }
+  }
+}
+
+}  // namespace
+
 EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::VectorXd& q0, double lambda0,
                                     const std::vector<continuation::InitialDirection>& starts,
                                     const EquilibriumBranchOptions& options) {
@@ -194,6 +304,7 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
           continueUnderContact(problem, branch, o, options.maxContactEvents, options.maxContactTorque));
     }
   }
+  if (options.contact && !result.tree.interrupted) switchOnContactStretches(problem, options, traced, result);
   // A mirror image's base and self contacts are its source's mirrored (mirror_symmetry.h): the
   // source comes first in the tree, so its located contacts are at hand. Also in an interrupted
   // tree: an image is only made from a source that finished (branch_switching.cpp), and neither

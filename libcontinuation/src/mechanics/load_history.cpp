@@ -136,6 +136,49 @@ ContactSet contactSetOf(const std::vector<int>& sides) {
   return set;
 }
 
+// Releases the chain from `from` with the load held at `at` (simulateJump; again from a saddle
+// it came to rest on) and records the jump; true when it landed.
+bool releaseChain(EquilibriumProblem& problem, const LoadHistoryOptions& options, JumpTrigger trigger,
+                  const Vector& from, double critical, double at, int fromSegment, LoadHistoryResult& result) {
+  JumpRecord rec;
+  rec.trigger = trigger;
+  rec.fromSegment = fromSegment;
+  rec.criticalLambda = critical;
+  rec.lambda = at;
+  rec.from = from;
+  JumpResult jr = simulateJump(problem, from, at, options.jump);
+  // A release along one unstable direction can come to rest on another unstable equilibrium
+  // (a saddle: e.g. the straight start with several equally weak joints, where the flow
+  // bends one joint and leaves the others exactly straight). Release again from there; each
+  // release strictly lowers Π, and at most n unstable directions can be shed.
+  for (int again = 0; !jr.success && jr.polishConverged && !jr.stable && again < problem.segments(); ++again) {
+    const Vector saddle = jr.to;
+    jr = simulateJump(problem, saddle, at, options.jump);
+  }
+  rec.success = jr.success;
+  rec.message = jr.message;
+  if (jr.to.size() == from.size()) {
+    rec.to = jr.to;
+    rec.load = problem.wrench(jr.to, at);
+    rec.energyReleased = potentialAt(problem, from, at) - potentialAt(problem, jr.to, at);
+    rec.distance = jr.distance;
+    rec.contactSides = jr.contactSides;
+    rec.contactTorques = jr.contactTorques;
+  }
+  result.jumps.push_back(rec);
+  return jr.success;
+}
+
+// A quasi-static piece of the history, traced in leg `leg`; the last jump landed on it if it has
+// no landing piece yet.
+void addSegment(LoadHistoryResult& result, cont::Branch branch, int leg, bool bifurcated) {
+  result.segments.push_back(std::move(branch));
+  result.segmentLeg.push_back(leg);
+  result.segmentBifurcated.push_back(bifurcated);
+  if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
+    result.jumps.back().toSegment = int(result.segments.size()) - 1;
+}
+
 }  // namespace
 
 LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::VectorXd& q0,
@@ -158,42 +201,13 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
   }
   Vector u = start.u;
 
-  auto release = [&](JumpTrigger trigger, const Vector& from, double critical, double at, int fromSegment) {
-    JumpRecord rec;
-    rec.trigger = trigger;
-    rec.fromSegment = fromSegment;
-    rec.criticalLambda = critical;
-    rec.lambda = at;
-    rec.from = from;
-    JumpResult jr = simulateJump(problem, from, at, options.jump);
-    // A release along one unstable direction can come to rest on another unstable equilibrium
-    // (a saddle: e.g. the straight start with several equally weak joints, where the flow
-    // bends one joint and leaves the others exactly straight). Release again from there; each
-    // release strictly lowers Π, and at most n unstable directions can be shed.
-    for (int again = 0; !jr.success && jr.polishConverged && !jr.stable && again < problem.segments(); ++again) {
-      const Vector saddle = jr.to;
-      jr = simulateJump(problem, saddle, at, options.jump);
-    }
-    rec.success = jr.success;
-    rec.message = jr.message;
-    if (jr.to.size() == from.size()) {
-      rec.to = jr.to;
-      rec.load = problem.wrench(jr.to, at);
-      rec.energyReleased = potentialAt(problem, from, at) - potentialAt(problem, jr.to, at);
-      rec.distance = jr.distance;
-      rec.contactSides = jr.contactSides;
-      rec.contactTorques = jr.contactTorques;
-    }
-    result.jumps.push_back(rec);
-    return jr.success;
-  };
   // Joints in contact with their limits (a landing against them, or a branch run into them):
   // the quasi-static pieces are traced with them locked (contact.h) until they release.
   ContactSet locked;
 
   cont::StabilityInfo info;
   if (problem.stability(u, lambda, 3, info) && info.negative > 0) {
-    if (!release(JumpTrigger::UnstableStart, u, lambda, lambda, -1)) {
+    if (!releaseChain(problem, options, JumpTrigger::UnstableStart, u, lambda, lambda, -1, result)) {
       result.message = "the unstable start did not come to a stable rest: " + result.jumps.back().message;
       return result;
     }
@@ -238,11 +252,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
           const cont::SpecialPoint& at = branch.specialPoints.back();
           const ConstrainedEquilibrium ce = solveConstrainedEquilibrium(problem, next, at.u, at.lambda);
           if (ce.converged) {
-            result.segments.push_back(branch);
-            result.segmentLeg.push_back(int(leg));
-            result.segmentBifurcated.push_back(false);
-            if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
-              result.jumps.back().toSegment = int(result.segments.size()) - 1;
+            addSegment(result, branch, int(leg), false);
             locked = next;
             u = ce.u;
             lambda = at.lambda;
@@ -260,22 +270,14 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       // goes on along the stable branch through the point that continues in the loading direction
       cont::Branch child;
       while (lost >= 0 && followBifurcated(problem, branch.specialPoints[size_t(lost)], legOptions, sign, child)) {
-        result.segments.push_back(cutAt(branch, branch.specialPoints[size_t(lost)]));
-        result.segmentLeg.push_back(int(leg));
-        result.segmentBifurcated.push_back(bifurcated);
-        if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
-          result.jumps.back().toSegment = int(result.segments.size()) - 1;
+        addSegment(result, cutAt(branch, branch.specialPoints[size_t(lost)]), int(leg), bifurcated);
         branch = std::move(child);
         bifurcated = true;
         lost = firstLeavingPoint(branch, sign, isLoss);
       }
       if (lost >= 0 && !isLoss) lost = firstLossOfStability(branch);  // a turn not followed: as before
       if (lost < 0) {
-        result.segments.push_back(branch);
-        result.segmentLeg.push_back(int(leg));
-        result.segmentBifurcated.push_back(bifurcated);
-        if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
-          result.jumps.back().toSegment = int(result.segments.size()) - 1;
+        addSegment(result, branch, int(leg), bifurcated);
         const cont::ContinuationPoint& end = branch.points.back();
         if (branch.stopReason != cont::StopReason::LambdaRange || std::abs(end.lambda - target) > 1e-9 * std::max(lambdaUnit, std::abs(target))) {
           result.message = "leg " + std::to_string(leg) + " stopped before its waypoint: " + branch.stopMessage;
@@ -286,14 +288,10 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
         break;
       }
       const cont::SpecialPoint sp = branch.specialPoints[size_t(lost)];
-      result.segments.push_back(cutAt(branch, sp));
-      result.segmentLeg.push_back(int(leg));
-      result.segmentBifurcated.push_back(bifurcated);
-      if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
-        result.jumps.back().toSegment = int(result.segments.size()) - 1;
+      addSegment(result, cutAt(branch, sp), int(leg), bifurcated);
       const double at = sp.lambda + sign * options.overshoot * std::max(lambdaUnit, std::abs(sp.lambda));
       const JumpTrigger trigger = sp.type == cont::SpecialPointType::Fold ? JumpTrigger::Fold : JumpTrigger::BranchPoint;
-      if (!release(trigger, sp.u, sp.lambda, at, int(result.segments.size()) - 1)) {
+      if (!releaseChain(problem, options, trigger, sp.u, sp.lambda, at, int(result.segments.size()) - 1, result)) {
         result.message = std::string("jump after the ") + toString(trigger) + " at lambda = " + std::to_string(sp.lambda) +
                          " failed: " + result.jumps.back().message;
         return result;

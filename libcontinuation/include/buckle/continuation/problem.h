@@ -2,7 +2,9 @@
 //
 // The core knows nothing about what the unknowns mean. A problem is a tiny
 // interface (in the spirit of Ceres' CostFunction / tiny_solver): a residual,
-// its exact Jacobian F_u and parameter derivative F_λ, and optionally
+// its exact Jacobian F_u and parameter derivative F_λ (a problem with the residual alone
+// derives from NumericDiffProblem, numeric_diff.h, which differences both; checkDerivatives,
+// derivative_check.h, checks hand-written ones), and optionally
 //   - a symmetric stability operator H with constraint rows C: the state is
 //     stable when H is positive definite on ker C (mechanics: the Hessian of the
 //     total potential, C = rows of the held end coordinates);

@@ -324,7 +324,7 @@ class InertialModel final : public DynamicsModel {
   /// out = K_θ y, K_θ = T + (C_q + G)_θ the stiffness in absolute angles (after linearizeAt).
   void applyStiffnessTheta(ConstVectorRef y, VectorRef out) const;
 
-  /// cos θ_i, sin θ_i and the LDLᵀ factors of M_θ at q (file comment of dynamics.cpp, "O(n)
+  /// cos θ_i, sin θ_i and the LDLᵀ factors of M_θ at q (dynamics_inertial.cpp, "O(n)
   /// mass matrix"); false if a pivot is not positive (M_θ not positive definite to rounding).
   bool factorMass(ConstVectorRef q);
   /// f ← M⁻¹ f = T⁻¹ M_θ⁻¹ T⁻ᵀ f after factorMass(), O(n).
@@ -363,7 +363,7 @@ enum class StepperKind {
   /// constraints solves its stages densely).
   StructuredRosenbrock4,
   /// Dormand–Prince 5(4) while the flow is not stiff, StructuredRosenbrock4 while it is
-  /// (Hairer's stiffness test on the explicit steps; dynamics_integration.cpp, SwitchingStepper).
+  /// (Hairer's stiffness test on the explicit steps; dynamics_steppers.h, SwitchingStepper).
   StructuredSwitching,
 };
 

@@ -62,13 +62,15 @@ struct EquilibriumBranches {
   std::vector<std::vector<ContactStretch>> contact;
 };
 
-/// Continues `branch`, traced on `problem`, through contact and release events (contact.h)
-/// while it ends on a located joint limit or contact release; appends the new points and
-/// special points to it and returns its stretches. `options` are the branch's tracer options
-/// (maxPoints and maxArclength count the whole branch).
+/// Continues `branch`, traced on `problem` with the joints `initial` locked (a ContactProblem
+/// with maxContactTorque; none: `problem` itself), through contact and release events
+/// (contact.h) while it ends on a located joint limit or contact release; appends the new points
+/// and special points to it and returns its stretches, the first with `initial`. `options` are
+/// the branch's tracer options (maxPoints and maxArclength count the whole branch).
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
                                                  const continuation::TracerOptions& options,
-                                                 int maxContactEvents = 50, double maxContactTorque = 10.0);
+                                                 int maxContactEvents = 50, double maxContactTorque = 10.0,
+                                                 const ContactSet& initial = ContactSet());
 
 /// Traces from joint angles q0 at λ0 (the held reactions are initialised by least squares, then
 /// polished by the tracer's fixed-parameter corrector), one start branch per entry of `starts`.

@@ -1,0 +1,137 @@
+#include "buckle/continuation/numeric_diff.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace buckle::continuation {
+
+std::string NumericDiffOptions::check() const {
+  auto inRange = [](double d) { return d > 0.0 && d <= 0.1; };
+  if (!inRange(relativeStep)) return "relativeStep must lie in (0, 0.1]";
+  if (!inRange(secondRelativeStep)) return "secondRelativeStep must lie in (0, 0.1]";
+  return "";
+}
+
+bool differenceJacobian(Problem &problem, const ProblemScales &scales, double relativeStep, ConstVectorRef u,
+                        double lambda, MatrixRef Fu, VectorRef Fl, VectorRef work, VectorRef Fplus,
+                        VectorRef Fminus) {
+  const Eigen::Index n = u.size();
+  work = u;
+  // Column j = n is F_λ. The step is the representable difference of the two abscissae, so the
+  // quotient divides by exactly the distance the residuals were taken apart.
+  for (Eigen::Index j = 0; j <= n; ++j) {
+    const double x = j < n ? u[j] : lambda;
+    const double scale = j < n ? scales.unknowns[j] : scales.parameter;
+    const double h = relativeStep * std::max(std::abs(x), scale);
+    const double xPlus = x + h, xMinus = x - h;
+    bool ok;
+    if (j < n) {
+      work[j] = xPlus;
+      ok = problem.residual(work, lambda, Fplus);
+      work[j] = xMinus;
+      ok = ok && problem.residual(work, lambda, Fminus);
+      work[j] = x;
+    } else {
+      ok = problem.residual(work, xPlus, Fplus) && problem.residual(work, xMinus, Fminus);
+    }
+    if (!ok) return false;
+    if (j < n) Fu.col(j) = (Fplus - Fminus) / (xPlus - xMinus);
+    else Fl = (Fplus - Fminus) / (xPlus - xMinus);
+  }
+  return Fu.allFinite() && Fl.allFinite();
+}
+
+NumericDiffProblem::NumericDiffProblem(const NumericDiffOptions &options) : options_(options) {}
+
+const ProblemScales &NumericDiffProblem::cachedScales() {
+  const int n = dimension();
+  if (!scalesValid_ || scales_.unknowns.size() != n) {
+    scales_ = scales();
+    if (!scales_.check(n).empty()) scales_ = ProblemScales::ones(n);
+    scalesValid_ = true;
+    work_.resize(n);
+    Fplus_.resize(n);
+    Fminus_.resize(n);
+    corner_.resize(n);
+    Jplus_.resize(n, n + 1);
+    Jminus_.resize(n, n + 1);
+  }
+  return scales_;
+}
+
+double NumericDiffProblem::directionStep(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                         double relative) {
+  const ProblemScales &s = cachedScales();
+  // In the scaled variables (where "1" is a typical size), as Problem's default second derivative.
+  const double size = std::max({1.0, u.cwiseQuotient(s.unknowns).lpNorm<Eigen::Infinity>(),
+                                std::abs(lambda) / s.parameter});
+  const double length = std::hypot(du.cwiseQuotient(s.unknowns).norm(), dlambda / s.parameter);
+  return length == 0.0 ? 0.0 : relative * size / length;
+}
+
+bool NumericDiffProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) {
+  const ProblemScales &s = cachedScales();
+  return differenceJacobian(*this, s, options_.relativeStep, u, lambda, Fu, Flambda, work_, Fplus_, Fminus_);
+}
+
+bool NumericDiffProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
+                                                       double dlambda, MatrixRef dFu, VectorRef dFlambda) {
+  const ProblemScales &s = cachedScales();
+  const double delta = options_.secondRelativeStep;
+  const double h = directionStep(u, lambda, du, dlambda, delta);
+  if (h == 0.0) {
+    dFu.setZero();
+    dFlambda.setZero();
+    return true;
+  }
+  // corner_ holds the shifted u while differenceJacobian perturbs its own copy (work_).
+  corner_ = u + h * du;
+  if (!differenceJacobian(*this, s, delta, corner_, lambda + h * dlambda, Jplus_.leftCols(dimension()),
+                          Jplus_.col(dimension()), work_, Fplus_, Fminus_))
+    return false;
+  corner_ = u - h * du;
+  if (!differenceJacobian(*this, s, delta, corner_, lambda - h * dlambda, Jminus_.leftCols(dimension()),
+                          Jminus_.col(dimension()), work_, Fplus_, Fminus_))
+    return false;
+  const int n = dimension();
+  dFu = (Jplus_.leftCols(n) - Jminus_.leftCols(n)) / (2.0 * h);
+  dFlambda = (Jplus_.col(n) - Jminus_.col(n)) / (2.0 * h);
+  return dFu.allFinite() && dFlambda.allFinite();
+}
+
+bool NumericDiffProblem::secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
+                                               VectorRef y) {
+  const int n = dimension();
+  const double delta = options_.secondRelativeStep;
+  const double h = directionStep(u, lambda, x.head(n), x[n], delta);
+  const double k = directionStep(u, lambda, z.head(n), z[n], delta);
+  if (h == 0.0 || k == 0.0) {
+    y.setZero();
+    return true;
+  }
+  // F_xx[x, z] ≈ [F(+h,+k) − F(+h,−k) − F(−h,+k) + F(−h,−k)] / (4hk), truncation O(h² + k²).
+  y.setZero();
+  for (int a = -1; a <= 1; a += 2) {
+    for (int b = -1; b <= 1; b += 2) {
+      corner_ = u + (a * h) * x.head(n) + (b * k) * z.head(n);
+      if (!residual(corner_, lambda + a * h * x[n] + b * k * z[n], Fplus_)) return false;
+      y += (a * b) * Fplus_;
+    }
+  }
+  y /= 4.0 * h * k;
+  return y.allFinite();
+}
+
+bool NumericDiffProblem::secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x,
+                                                        ConstVectorRef w, VectorRef y) {
+  const int n = dimension();
+  cachedScales();
+  // Jplus_/Jminus_ are the directional derivative's own workspaces: use a separate block.
+  Matrix &dF = second_;
+  dF.resize(n, n + 1);
+  if (!jacobianDirectionalDerivative(u, lambda, x.head(n), x[n], dF.leftCols(n), dF.col(n))) return false;
+  y.noalias() = dF.transpose() * w;
+  return y.allFinite();
+}
+
+}  // namespace buckle::continuation
