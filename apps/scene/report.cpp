@@ -14,6 +14,7 @@
 #include <string>
 #include <system_error>
 
+#include "scene/escape.h"
 #include "scene/output.h"
 
 namespace buckle::scene {
@@ -674,10 +675,7 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   }
   data["plots"] = plots;
   data["critical"] = specialPoints.contains("critical_loads") ? specialPoints["critical_loads"] : json::array();
-  std::string text = data.dump(-1, ' ', false, json::error_handler_t::replace);
-  // inside <script>, "</" would end the element: JSON allows the escaped solidus
-  for (size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3)) text.replace(at, 2, "<\\/");
-  return kHead + text + kTail;
+  return kHead + escape::jsonForHtmlScript(data) + kTail;
 }
 
 void writeReport(const Scene& scene, const RunResult& run, const json& specialPoints, const json& summary,

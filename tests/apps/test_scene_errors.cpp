@@ -303,3 +303,62 @@ TEST_CASE("the stiffness measure of KMIN is one of Kxx, Kyy, Kmin", "[scene][err
   CHECK_THROWS_WITH(buckle::scene::parseScene(base + R"({"kind": "Kxx"}}})", "s.json"),
                     Catch::Contains("/analyses/stiffness"));
 }
+
+// ---- the bad inputs of issue 27: each answered before computing, naming key, path and range ----
+
+TEST_CASE("joint limits that exclude the straight start", "[scene][errors]") {
+  requireBadInput("q_min_straight", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": 2.25, \"q_min\": 0.1"), "/chain/q_min",
+                  "expected q_min < 0: the chain starts straight (q = 0)");
+  requireBadInput("q_max_straight", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": 2.25, \"q_max\": -0.1"), "/chain/q_max",
+                  "expected q_max > 0");
+}
+
+TEST_CASE("a held end out of reach and loads beyond the chain's scale", "[scene][errors]") {
+  // three segments of length 2 b: the end reaches at most 6 b from the base
+  requireBadInput("y_held_100", replaceOnce(kGood, "\"held\": 0.0", "\"held\": 100"), "/end/y/held",
+                  "expected a position the end can reach: |y| <= 6");
+  requireBadInput("y_held_1e300", replaceOnce(kGood, "\"held\": 0.0", "\"held\": 1e300"), "/end/y/held",
+                  "expected a position the end can reach");
+  requireBadInput("Fy_1e308", replaceOnce(kGood, "\"y\": {\"held\": 0.0}", "\"y\": {\"load\": 1e308}"), "/end/y/load",
+                  "expected a load |Fy| <= 1e+12");
+  requireBadInput("path_to_1e300", replaceOnce(kGood, "\"to\": -1.0", "\"to\": -1e300"), "/path/to",
+                  "expected a load |Fx| <= 1e+12");
+}
+
+TEST_CASE("a subnormal stiffness", "[scene][errors]") {
+  requireBadInput("k_denormal", replaceOnce(kGood, "\"k\": 1.0", "\"k\": 5e-324"), "/chain/k",
+                  "expected a stiffness of at least 2.2e-308");
+  requireBadInput("k2_denormal", replaceOnce(kGood, "\"segments\": 3,", "\"segments\": [{}, {\"k2\": 1e-310}, {}],"),
+                  "/chain/segments/1/k2", "expected a stiffness of at least 2.2e-308");
+}
+
+TEST_CASE("a solver tolerance that accepts non-equilibria", "[scene][errors]") {
+  requireBadInput("tolerance_10", replaceOnce(kGood, "\"plots\": []", "\"plots\": [], \"solver\": {\"tolerance\": 10}"),
+                  "/solver/tolerance", "expected a number in (0, 1e-3]");
+}
+
+TEST_CASE("numbers JSON cannot hold are named as written", "[scene][errors]") {
+  requireBadInput("minus_infinity", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": -Infinity"), "/chain/L0",
+                  "got -Infinity (not valid JSON)");
+  const Outcome o = runText("e309", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": 1e309"));
+  INFO(o.err);
+  CHECK(o.rc == 2);
+  CHECK(o.err.find("/chain/L0: expected a finite number (at most 1.8e308 in magnitude), got 1e309") != std::string::npos);
+  CHECK(o.err.find("json.exception") == std::string::npos);  // no library internals
+}
+
+TEST_CASE("an unknown key inside an end coordinate is named", "[scene][errors]") {
+  requireBadInput("end_x_extra", replaceOnce(kGood, "\"x\": {\"load\": 0.0}", "\"x\": {\"load\": 0.0, \"lod\": 1}"),
+                  "/end/x/lod", "unknown key \"lod\" (allowed here: load, held)");
+  requireBadInput("end_x_both", replaceOnce(kGood, "\"x\": {\"load\": 0.0}", "\"x\": {\"load\": 0.0, \"held\": 1}"),
+                  "/end/x", "expected one of load, held, got both");
+}
+
+TEST_CASE("a two_parameter range far beyond the case's scale", "[scene][errors]") {
+  const std::string twoParameter =
+      "\"analyses\": {\"two_parameter\": {\"parameter\": \"k\", \"from\": -1e308, \"to\": 1e308, \"modes\": 1}},";
+  std::string text = kGood;
+  const size_t a = text.find("\"analyses\""), e = text.find("\"plots\"");
+  text.replace(a, e - a, twoParameter + "\n  ");
+  requireBadInput("two_parameter_1e308", text, "/analyses/two_parameter/from", "expected a range within 1e6 times");
+}

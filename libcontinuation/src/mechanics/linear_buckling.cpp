@@ -376,13 +376,26 @@ bool criticalLoad(StructuredPencil& p, int side, int j, double hi, std::vector<s
   return true;
 }
 
+// The chain's force unit k̄ b̄ (largest spring stiffness × largest half-length). K_q is a torque
+// per rad (k b²), the load matrix per unit load a length (b): "K_q ≈ 0 against the loads" compares
+// K_q with the load matrix times this unit, the same in every system of units.
+double forceUnit(const Chain& chain) {
+  double k = 0.0, b = 0.0;
+  for (int i = 0; i < chain.size(); ++i) {
+    const SegmentParameters& p = chain.segment(i).parameters();
+    k = std::max({k, p.k1, p.k2});
+    b = std::max({b, p.b1, p.b2});
+  }
+  return k * b;
+}
+
 // Returns false (the caller goes dense) when K_q is not definite on ker J_h.
 bool structuredModes(ConstVectorRef g, ConstVectorRef kq, const Matrix& Ch, const LinearBucklingOptions& options,
-                     std::vector<std::pair<double, Vector>>& pairs, LinearBucklingResult& out) {
+                     double force, std::vector<std::pair<double, Vector>>& pairs, LinearBucklingResult& out) {
   const int n = int(g.size());
   const double gmax = std::max(1e-300, g.cwiseAbs().maxCoeff());
   const double kmax = kq.cwiseAbs().maxCoeff();
-  if (kmax <= 1e-13 * gmax) return false;  // κ ≈ 0: every load is 0, the dense path says so
+  if (kmax <= 1e-13 * gmax * force) return false;  // κ ≈ 0: every load is 0, the dense path says so
   StructuredPencil pencil(g, kq, Ch.transpose());
   const Inertia unloaded = pencil.unloadedInertia();
   if (unloaded.zero != 0 || (unloaded.negative != 0 && unloaded.positive != 0)) return false;
@@ -454,7 +467,7 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
     std::vector<std::pair<double, Vector>> fastPairs;
     Vector gvec(n);
     loadHessianGenerator(data, Wrench(options.direction[0], options.direction[1], 0.0), gvec);
-    if (structuredModes(gvec, kq, Ch, options, fastPairs, fast)) {
+    if (structuredModes(gvec, kq, Ch, options, forceUnit(chain), fastPairs, fast)) {
       Vector Gz(n), t(n);
       for (auto& [lambda, z] : fastPairs) {
         Eigen::Index imax = 0;
@@ -524,8 +537,8 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
   const Eigen::SelfAdjointEigenSolver<Matrix> esA(A, Eigen::EigenvaluesOnly);
   const double Ascale = esA.eigenvalues().cwiseAbs().maxCoeff();
   const double Gscale = std::max(1e-300, G.cwiseAbs().maxCoeff());
-  // K_q ≈ 0 relative to the load matrix (per unit load and length): κ = 0.
-  out.degenerate = Ascale <= 1e-13 * Gscale;
+  // K_q ≈ 0 relative to the load matrix (per unit load and length) in the chain's force unit: κ = 0.
+  out.degenerate = Ascale <= 1e-13 * Gscale * forceUnit(chain);
   // κ = 0 is marginal, not stable: the sign of a rounding-level K_q must not decide it.
   out.unloadedStable = !out.degenerate && esA.eigenvalues()[0] > 0.0;
 
