@@ -13,6 +13,7 @@
 #include <unistd.h>
 #include <string>
 
+#include "scene/case_runner.h"
 #include "scene/command.h"
 #include "scene/scene.h"
 #include "small_scene.h"
@@ -361,4 +362,20 @@ TEST_CASE("a two_parameter range far beyond the case's scale", "[scene][errors]"
   const size_t a = text.find("\"analyses\""), e = text.find("\"plots\"");
   text.replace(a, e - a, twoParameter + "\n  ");
   requireBadInput("two_parameter_1e308", text, "/analyses/two_parameter/from", "expected a range within 1e6 times");
+}
+
+TEST_CASE("solver failures are explained in words, the KINSOL flag kept as detail", "[scene][errors]") {
+  using buckle::scene::solverFailureInWords;
+  const std::string start = "start point did not converge at fixed lambda (KIN_FIRST_SYSFUNC_ERR)";
+  const std::string sysfunc = solverFailureInWords(start);
+  CHECK(sysfunc.rfind("the spring model could not be evaluated", 0) == 0);
+  CHECK(sysfunc.find("; check the joint limits") != std::string::npos);
+  CHECK(sysfunc.size() > start.size());
+  CHECK(sysfunc.substr(sysfunc.size() - start.size() - 1) == start + ")");  // the flag last, as detail
+  const std::string newton = solverFailureInWords("corrector failed (KIN_LINESEARCH_NONCONV)");
+  CHECK(newton.rfind("Newton's method made no progress on the equilibrium equations", 0) == 0);
+  CHECK(newton.find("lower solver.max_step") != std::string::npos);
+  CHECK(solverFailureInWords("corrector failed (KIN_LSETUP_FAIL)").rfind("the linearised equilibrium equations", 0) == 0);
+  // messages of the mechanics already in words stay as they are
+  CHECK(solverFailureInWords("reached the end of the path range") == "reached the end of the path range");
 }
