@@ -39,7 +39,7 @@ class PythonProblem : public cont::Problem {
 
   bool residual(cont::ConstVectorRef u, double lambda, cont::VectorRef F) override {
     return call([&] {
-      const VectorXd r = vector(residual_(VectorXd(u), lambda));
+      const VectorXd r = vector(residual_(VectorXd(u), lambda), "residual(u, lam)", "an array of N numbers");
       expectSize(r.size(), n_, "residual");
       F = r;
       return r.allFinite();
@@ -48,10 +48,13 @@ class PythonProblem : public cont::Problem {
 
   bool jacobian(cont::ConstVectorRef u, double lambda, cont::MatrixRef Fu, cont::VectorRef Flambda) override {
     return call([&] {
-      const py::tuple pair = jacobian_(VectorXd(u), lambda).cast<py::tuple>();
+      const py::object returned = jacobian_(VectorXd(u), lambda);
+      if (!py::isinstance<py::tuple>(returned) && !py::isinstance<py::list>(returned))
+        throw py::type_error("jacobian(u, lam) returned " + describe(returned) + "; expected a pair (F_u, F_lambda)");
+      const auto pair = py::reinterpret_borrow<py::sequence>(returned);
       if (pair.size() != 2) throw std::invalid_argument("jacobian must return (F_u, F_lambda)");
-      const MatrixXd J = numpy().attr("atleast_2d")(pair[0]).cast<MatrixXd>();
-      const VectorXd Fl = vector(pair[1]);
+      const MatrixXd J = matrix(pair[0], "jacobian(u, lam): F_u");
+      const VectorXd Fl = vector(pair[1], "jacobian(u, lam): F_lambda", "an array of N numbers");
       if (J.rows() != n_ || J.cols() != n_)
         throw std::invalid_argument("jacobian: F_u is " + std::to_string(J.rows()) + "×" + std::to_string(J.cols()) +
                                     ", expected " + std::to_string(n_) + "×" + std::to_string(n_));
@@ -66,7 +69,7 @@ class PythonProblem : public cont::Problem {
 
   bool stabilityOperator(cont::ConstVectorRef u, double lambda, MatrixXd& H, MatrixXd& C) override {
     return call([&] {
-      H = numpy().attr("atleast_2d")(stability_(VectorXd(u), lambda)).cast<MatrixXd>();
+      H = matrix(stability_(VectorXd(u), lambda), "stability(u, lam)");
       if (H.rows() != n_ || H.cols() != n_)
         throw std::invalid_argument("stability must return an " + std::to_string(n_) + "×" + std::to_string(n_) +
                                     " symmetric matrix");
@@ -78,13 +81,38 @@ class PythonProblem : public cont::Problem {
   /// Re-raises what a callable raised (needs the GIL).
   void raiseStored() {
     if (error_) throw *error_;
+    if (!typeMessage_.empty()) throw py::type_error(typeMessage_);
     if (!message_.empty()) throw std::invalid_argument(message_);
   }
 
  private:
   // a 1-unknown problem may answer with scalars: NumPy's atleast_1d/2d make them arrays
   static py::module_ numpy() { return py::module_::import("numpy"); }
-  static VectorXd vector(const py::handle& v) { return numpy().attr("atleast_1d")(v).cast<VectorXd>(); }
+  /// "None", "the str 'abc'": what a callable returned, for a message.
+  static std::string describe(const py::handle& v) {
+    if (v.is_none()) return "None";
+    std::string r = py::repr(v).cast<std::string>();
+    if (r.size() > 60) r = r.substr(0, 57) + "...";
+    return "the " + py::type::of(v).attr("__name__").cast<std::string>() + " " + r;
+  }
+  /// The numbers `v` holds as float64 (NumPy's own conversion), or a TypeError naming the
+  /// callable `what` and what it returned.
+  static py::object numbers(const py::handle& v, const std::string& what, const std::string& expected) {
+    // None and text are refused before NumPy, which makes NaN of None and a number of "1.5"
+    if (!v.is_none() && !py::isinstance<py::str>(v) && !py::isinstance<py::bytes>(v)) {
+      try {
+        return numpy().attr("asarray")(v, py::arg("dtype") = "float64");
+      } catch (const py::error_already_set&) {  // objects NumPy cannot make numbers of
+      }
+    }
+    throw py::type_error(what + " returned " + describe(v) + "; expected " + expected);
+  }
+  static VectorXd vector(const py::handle& v, const std::string& what, const std::string& expected) {
+    return numpy().attr("atleast_1d")(numbers(v, what, expected)).cast<VectorXd>();
+  }
+  static MatrixXd matrix(const py::handle& v, const std::string& what) {
+    return numpy().attr("atleast_2d")(numbers(v, what, "an N×N array of numbers")).cast<MatrixXd>();
+  }
 
   static void expectSize(Eigen::Index got, int n, const char* what) {
     if (got != n)
@@ -100,7 +128,9 @@ class PythonProblem : public cont::Problem {
       return body();
     } catch (py::error_already_set& e) {
       error_.emplace(e);
-    } catch (const std::exception& e) {  // a cast that failed, a wrong shape
+    } catch (const py::type_error& e) {  // a callable returned no numbers
+      typeMessage_ = e.what();
+    } catch (const std::exception& e) {  // a wrong shape
       message_ = e.what();
     }
     failed_ = true;
@@ -112,7 +142,7 @@ class PythonProblem : public cont::Problem {
   py::object stability_;
   bool failed_ = false;
   std::optional<py::error_already_set> error_;
-  std::string message_;
+  std::string message_, typeMessage_;
 };
 
 py::dict specialPointDict(const cont::SpecialPoint& s) {

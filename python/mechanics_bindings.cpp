@@ -18,6 +18,7 @@
 #include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/unloaded_shape.h"
 #include "scene/report.h"
+#include "scene/scene.h"
 
 namespace buckle::python {
 
@@ -82,18 +83,20 @@ void bindMechanics(py::module_& m) {
                        std::optional<double> a2, std::optional<double> b2, std::optional<double> k1,
                        std::optional<double> k2, std::optional<double> L1_0, std::optional<double> L2_0, double qMin,
                        double qMax) {
-             mech::SegmentParameters p = mech::SegmentParameters::symmetric(a, b, k, L0);
-             p.a1 = a1.value_or(a);
-             p.b1 = b1.value_or(b);
-             p.a2 = a2.value_or(a);
-             p.b2 = b2.value_or(b);
-             p.k1 = k1.value_or(k);
-             p.k2 = k2.value_or(k);
-             p.L1_0 = L1_0.value_or(L0);
-             p.L2_0 = L2_0.value_or(L0);
-             p.qMinUser = qMin;
-             p.qMaxUser = qMax;
-             return mech::Segment(p);
+             // the keys of a scene's segment object, checked by the scene parser's own rules
+             nlohmann::json keys{{"a", a}, {"b", b}, {"k", k}, {"L0", L0}};
+             for (const auto& [key, value] : {std::pair<const char*, std::optional<double>>{"a1", a1}, {"b1", b1},
+                                              {"a2", a2}, {"b2", b2}, {"k1", k1}, {"k2", k2}, {"L1_0", L1_0},
+                                              {"L2_0", L2_0}})
+               if (value) keys[key] = *value;
+             // ±inf: no user limit; NaN is passed on to be refused
+             if (!std::isinf(qMin)) keys["q_min"] = qMin;
+             if (!std::isinf(qMax)) keys["q_max"] = qMax;
+             try {
+               return mech::Segment(scene::segmentFromKeys(keys, "Segment"));
+             } catch (const scene::SceneError& e) {
+               throw std::invalid_argument("Segment: " + e.path().substr(1) + ": " + e.message());
+             }
            }),
            py::arg("a") = 0.5, py::arg("b") = 1.0, py::arg("k") = 1.0, py::arg("L0") = 2.25, py::kw_only(),
            py::arg("a1") = py::none(), py::arg("b1") = py::none(), py::arg("a2") = py::none(),
@@ -290,6 +293,11 @@ void bindMechanics(py::module_& m) {
              mech::EndCondition e;
              e.control = {control(x, "x"), control(y, "y"), control(phi, "phi")};
              if (value.size() != 3) throw std::invalid_argument("EndCondition: value must have 3 entries");
+             for (int i = 0; i < 3; ++i)
+               if (!std::isfinite(value[i]))
+                 throw std::invalid_argument("EndCondition: value[" + std::to_string(i) +
+                                             "] must be a finite number (a load or a position), got " +
+                                             std::to_string(value[i]));
              e.value = value;
              return e;
            }),

@@ -83,7 +83,15 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
 
 scene::Scene parse(const py::object& source) {
   if (py::isinstance<py::dict>(source)) {
-    const std::string text = py::module_::import("json").attr("dumps")(source).cast<std::string>();
+    // NumPy scalars and arrays (np.int64, np.float64, ndarray) where a scene has numbers: as the
+    // Python numbers and lists they hold (.tolist()); anything else JSON cannot hold is named
+    const py::cpp_function plain([](const py::handle& v) -> py::object {
+      if (py::hasattr(v, "tolist") && py::hasattr(v, "dtype")) return v.attr("tolist")();
+      throw py::type_error("a scene dict holds numbers, strings, lists and dicts; got a value of type " +
+                           py::type::of(v).attr("__name__").cast<std::string>() + " (" +
+                           py::repr(v).cast<std::string>().substr(0, 60) + ")");
+    });
+    const std::string text = py::module_::import("json").attr("dumps")(source, py::arg("default") = plain).cast<std::string>();
     return scene::parseScene(text, "<dict>");
   }
   const py::module_ os = py::module_::import("os");

@@ -45,6 +45,19 @@ int main(int argc, char** argv) {
   buckle::cli::addRegressCommand(app, outcome);
   buckle::cli::addShowCommand(app, outcome);
 #endif
+  // CLI11 would only say "A subcommand is required" for a mistyped one: name it
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+      known = known || sub->get_name() == argv[1];
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::cerr << "error: unknown subcommand \"" << argv[1] << "\" (one of: " << names << "; see buckle --help)\n";
+      return buckle::cli::kBadInput;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -47,7 +47,10 @@ void addRunCommand(CLI::App& app, Outcome& outcome) {
             return end != s.c_str() && std::isnan(v) ? "must be a positive number of seconds, got " + s : "";
           },
           "SECONDS"));
-  run->callback([options, &outcome]() {
+  run->callback([options, run, &outcome]() {
+    // an empty --out is a mistake, not the default directory
+    if (run->count("--out") > 0 && options->out.empty())
+      throw BadArgument{"--out is empty: give the output directory (or leave --out out for out/<scene>)"};
     options->handleSignals = true;
     options->progress = ::isatty(STDERR_FILENO) == 1 ? scene::Progress::Mode::Live : scene::Progress::Mode::Lines;
     const int code = scene::runSceneCommand(*options, std::cout, std::cerr);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "scene/escape.h"
 #include "scene/output_target.h"
 
 namespace buckle::cli {
@@ -42,7 +43,8 @@ std::string number(const json& v, const char* format = "%.10g") {
 }
 
 std::string text(const json& v) {
-  if (v.is_string()) return v.get<std::string>().empty() ? "-" : v.get<std::string>();
+  // text from the scene reaches a terminal: one line, no control characters (escape sequences)
+  if (v.is_string()) return v.get<std::string>().empty() ? "-" : scene::escape::commentText(v.get<std::string>());
   if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
   if (v.is_number_integer()) return std::to_string(v.get<long long>());
   if (v.is_number()) return number(v);

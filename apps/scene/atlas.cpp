@@ -15,7 +15,9 @@
 
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/post_buckling.h"
+#include "scene/child_process.h"
 #include "scene/output.h"
+#include "scene/signals.h"
 
 namespace buckle::scene {
 
@@ -300,9 +302,10 @@ std::vector<std::string> writeAtlas(const AtlasOptions& o, const std::vector<Atl
        << "background 'white'\nset output '" << name << ".svg'\nload '" << name << "_body.gp'\nset output\n";
     gp.close();
     if (gnuplot.empty()) continue;
-    const std::string cmd = "cd '" + plots.string() + "' && '" + gnuplot + "' '" + name + ".gp' > '" + name +
-                            ".log' 2>&1";
-    if (std::system(cmd.c_str()) == 0 && fs::exists(plots / (std::string(name) + ".png"))) {
+    // no shell: an output path with quotes in it stays a path (child_process.h)
+    const ChildOutcome drawn =
+        runChild(gnuplot, {std::string(name) + ".gp"}, plots.string(), std::string(name) + ".log", stopSignalReason);
+    if (drawn.exitedZero && fs::exists(plots / (std::string(name) + ".png"))) {
       files.push_back(std::string("plots/") + name + ".png");
       files.push_back(std::string("plots/") + name + ".svg");
       std::error_code ec;

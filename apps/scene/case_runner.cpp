@@ -65,6 +65,27 @@ SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
 
 }  // namespace
 
+std::string solverFailureInWords(const std::string& solverMessage) {
+  if (solverMessage.find("KIN_") == std::string::npos) return solverMessage;
+  const auto has = [&solverMessage](const char* flag) { return solverMessage.find(flag) != std::string::npos; };
+  std::string what, change;
+  if (has("SYSFUNC")) {
+    what = "the spring model could not be evaluated at the solver's trial shapes (a spring length reaching zero "
+           "at a joint limit, or values outside the double range)";
+    change = "check the joint limits, the held coordinates and the loads, or lower solver.max_step";
+  } else if (has("LSETUP") || has("LSOLVE") || has("LINSOLV")) {
+    what = "the linearised equilibrium equations (eq 8 with the held end coordinates) are singular there";
+    change = "the chain may be at a fold or branch point of its constraints; lower solver.initial_step or "
+             "solver.max_step, or move /path/from";
+  } else {
+    what = "Newton's method made no progress on the equilibrium equations (the joint torques dE/dq balancing "
+           "J^T F, eq 8, with the held end coordinates)";
+    change = "lower solver.max_step (or initial_step), or keep the held coordinates and loads nearer the "
+             "unloaded shape";
+  }
+  return what + "; " + change + " (solver detail: " + solverMessage + ")";
+}
+
 void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report, mech::EquilibriumProblem& problem,
                         const std::string& origin) {
   BranchRecord br;
@@ -84,7 +105,8 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   } else if (!br.finished) {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\", branch " + std::to_string(b.id) + " (" + origin +
-                            ") stopped early: " + br.stopReason + (b.stopMessage.empty() ? "" : " — " + b.stopMessage));
+                            ") stopped early: " + br.stopReason +
+                            (b.stopMessage.empty() ? "" : " — " + solverFailureInWords(b.stopMessage)));
   }
   out_.branches.push_back(br);
 
@@ -330,7 +352,7 @@ void CaseRunner::continuation() {
     run_.complete = false;
     std::ostringstream os;
     os << "case \"" << spec_.label << "\": no equilibrium found at the start " << spec_.path.parameter << " = " << s0
-       << " from the unloaded shape (" << branches.front().stopMessage << ")";
+       << " from the unloaded shape: " << solverFailureInWords(branches.front().stopMessage);
     run_.problems.push_back(os.str());
     return;
   }

@@ -17,6 +17,11 @@
 
 namespace buckle::scene {
 
+/// A message of the solver in words for the user: which equations could not be solved and what
+/// to change, with the solver's own message (its KINSOL flag) kept as the detail at the end.
+/// Messages without a KINSOL flag are returned as they are.
+std::string solverFailureInWords(const std::string& solverMessage);
+
 class CaseRunner {
  public:
   CaseRunner(const Scene& scene, const CaseSpec& spec, CaseResult& out, RunResult& run, const RunControl& control)

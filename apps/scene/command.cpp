@@ -9,6 +9,7 @@
 #include <optional>
 #include <sstream>
 
+#include "scene/escape.h"
 #include "scene/output.h"
 #include "scene/output_target.h"
 #include "scene/runner.h"
@@ -70,6 +71,21 @@ std::string countsLine(const RunResult& run) {
   return os.str();
 }
 
+/// When drawing the plots must stop: at the run's time limit, counted from `started`, less a
+/// tenth of it (at most 0.5 s) for summary.json and report.html written after the plots; on a
+/// signal (with the CLI's handlers).
+continuation::Interrupt writingStop(double timeLimit, std::chrono::steady_clock::time_point started, bool signals) {
+  continuation::Interrupt stop;
+  if (timeLimit < 1e9) {
+    const double seconds = timeLimit - std::min(0.1 * timeLimit, 0.5);
+    stop.setDeadline(started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                   std::chrono::duration<double>(seconds)),
+                     timeLimit);
+  }
+  if (signals) stop.watch(SignalGuard::flag(), "interrupted by a signal (SIGINT/SIGTERM/SIGHUP)");
+  return stop;
+}
+
 }  // namespace
 
 int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::ostream& err) {
@@ -93,25 +109,31 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
     err << "buckle run: " << e.what() << "\n";
     return kBadInput;
   }
-  if (!options.quiet) {
-    log << "scene " << options.scene << ": " << scene.cases.size() << " case(s)";
-    if (!scene.description.empty()) log << " — " << scene.description.substr(0, 100) << (scene.description.size() > 100 ? "…" : "");
-    log << "\n" << std::flush;
-  }
   std::optional<SignalGuard> signals;
   if (options.handleSignals) signals.emplace();
+  // printed once the signal handlers are in place: from here on a signal stops the run cleanly
+  if (!options.quiet) {
+    const std::string description = escape::commentText(scene.description);  // one line, no control characters
+    log << "scene " << options.scene << ": " << scene.cases.size() << " case(s)";
+    size_t cut = std::min<size_t>(100, description.size());
+    while (cut < description.size() && (static_cast<unsigned char>(description[cut]) & 0xC0) == 0x80) --cut;  // whole characters
+    if (!description.empty()) log << " — " << description.substr(0, cut) << (cut < description.size() ? "…" : "");
+    log << "\n" << std::flush;
+  }
   Progress progress(err, options.quiet ? Progress::Mode::Off : options.progress);
   RunControl control;
   control.progress = &progress;
   if (!std::isnan(options.timeLimit)) {
     scene.solver.timeLimit = options.timeLimit;  // recorded as such in summary.json
   }
-  if (signals) control.interrupt.watch(SignalGuard::flag(), "interrupted by a signal (SIGINT/SIGTERM)");
+  if (signals) control.interrupt.watch(SignalGuard::flag(), "interrupted by a signal (SIGINT/SIGTERM/SIGHUP)");
   RunResult run = runScene(scene, control);
   progress.finish();
+  if (run.interrupted && signals && SignalGuard::signal() != 0) run.interruption = SignalGuard::description();
+  PlotReport plots;
   try {
     StagingDirectory staging(target);
-    const PlotReport plots = writeOutputs(scene, run, staging.path());
+    plots = writeOutputs(scene, run, staging.path(), writingStop(scene.solver.timeLimit, started, signals.has_value()));
     staging.commit();
     for (const std::string& n : plots.notes) err << "buckle run: note: " << n << "\n";
     if (!options.quiet) {
@@ -123,6 +145,9 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
       log.unsetf(std::ios::floatfield);
       if (!plots.gnuplotFound) log << "plots: " << plots.gnuplot << "\n";
       for (const std::string& f : plots.failures) log << "plot failed: " << f << "\n";
+      if (!plots.stopped.empty())
+        log << "plots not drawn (" << plots.stopped << "): " << plots.notDrawn.size() << " of " << scene.plots.size()
+            << "\n";
       log << "wrote " << out << "\n";
     }
   } catch (const std::exception& e) {
@@ -133,8 +158,11 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
     err << "buckle run: the computation did not finish (partial results written to " << out << "):\n";
     for (const std::string& p : summariseProblems(run.problems)) err << "  " << p << "\n";
   }
+  if (run.complete && !plots.stopped.empty())
+    err << "buckle run: " << plots.stopped << " while drawing the plots: " << plots.notDrawn.size()
+        << " not drawn (written to " << out << ")\n";
   if (signals && SignalGuard::signal() != 0) return SignalGuard::exitCode();
-  return run.complete ? kSuccess : kIncomplete;
+  return run.complete && plots.stopped.empty() ? kSuccess : kIncomplete;
 }
 
 }  // namespace buckle::scene

@@ -136,15 +136,17 @@ class DocumentBuilder : public json::json_sax_t {
     return true;
   }
 
-  bool parse_error(std::size_t byte, const std::string& /*token*/, const nlohmann::detail::exception& e) override {
+  bool parse_error(std::size_t byte, const std::string& token, const nlohmann::detail::exception& e) override {
     if (e.id == 406)  // a number literal outside the double range (1e999)
-      throw JsonInputError(file_, where(true).to_string(), std::string("expected a finite number (") + e.what() + ")");
+      throw JsonInputError(file_, where(true).to_string(),
+                           "expected a finite number (at most 1.8e308 in magnitude), got " + token.substr(0, 40));
     std::string what = e.what();
     const auto pos = what.find("syntax error");
     if (pos != std::string::npos) what = what.substr(pos);
     // NaN / Infinity are not JSON: say so plainly.
     const size_t at = byte > 0 ? byte - 1 : 0;
-    for (const char* bad : {"NaN", "nan", "Infinity", "-Infinity", "inf"}) {
+    // longest first: "-Infinity" also holds "Infinity"
+    for (const char* bad : {"-Infinity", "Infinity", "-NaN", "NaN", "nan", "-inf", "inf"}) {
       const size_t b = text_.rfind(bad, at);
       if (b != std::string::npos && at - b < 10)
         throw JsonInputError(file_, where(true).to_string(),

@@ -22,8 +22,10 @@
 #include <unistd.h>
 
 #include "scene/output_numbers.h"
+#include "scene/escape.h"
 #include "scene/output_target.h"
 #include "scene/report.h"
+#include "scene/signals.h"
 
 namespace buckle::scene {
 
@@ -177,7 +179,7 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
       appendInteger(os, p.negative);
       field(p.minEigenvalue);
       os += ',';
-      os += p.locked;
+      os += escape::csvField(p.locked);
       field(p.contactTorque);
       if (scene.analyses.stiffness)
         for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C));
@@ -398,10 +400,10 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
   doc["scene"] = scene.file;
   doc["description"] = scene.description;
   doc["units"] = scene.units.toJson();
-  doc["complete"] = run.complete;
+  doc["complete"] = run.complete && plots.stopped.empty();
   // stopped early by the time limit or a signal: the results are what was computed until then
-  doc["interrupted"] = run.interrupted;
-  if (run.interrupted) doc["interruption"] = run.interruption;
+  doc["interrupted"] = run.interrupted || !plots.stopped.empty();
+  if (run.interrupted || !plots.stopped.empty()) doc["interruption"] = run.interrupted ? run.interruption : plots.stopped;
   if (!run.problems.empty()) doc["problems"] = run.problems;
   doc["computed"] = run.computed;
   doc["solver"] = solverJson(scene.solver);
@@ -463,7 +465,9 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
   json p;
   p["gnuplot"] = plots.gnuplotFound ? json(plots.gnuplot) : json("not found: " + plots.gnuplot);
   p["files"] = plots.files;
+  p["written"] = plots.written;
   if (!plots.failures.empty()) p["failures"] = plots.failures;
+  if (!plots.notDrawn.empty()) p["not_drawn"] = plots.notDrawn;
   doc["plots"] = p;
   if (!plots.notes.empty()) doc["notes"] = plots.notes;
   return doc;
@@ -490,10 +494,7 @@ StagingDirectory::StagingDirectory(const std::string& target) : target_(target) 
   if (t.filename().empty()) t = t.parent_path();
   target_ = t.string();
   fs::create_directories(t.parent_path());
-  sigset_t hold;
-  sigemptyset(&hold);
-  sigaddset(&hold, SIGINT);
-  sigaddset(&hold, SIGTERM);
+  const sigset_t hold = stopSignals();
   pthread_sigmask(SIG_BLOCK, &hold, &previousMask_);
   // Not mkdtemp: it makes the directory 0700, and the renamed output would not follow the
   // umask. mkdir(0777) does; the random suffix and EEXIST retry give the same uniqueness.
@@ -540,17 +541,18 @@ void StagingDirectory::commit() {
   if (!old.empty()) fs::remove_all(old, ec);
 }
 
-PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::string& dirName) {
+PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::string& dirName,
+                        const continuation::Interrupt& stop) {
   const fs::path dir(dirName);
   // the load history's stable pieces are branches too (docs/scenes.md, `load_history`)
   if (scene.analyses.continuation.enabled || scene.analyses.loadHistory.enabled) writeBranches(scene, run, dir);
   const json specials = specialPointsJson(scene, run);
-  writeText(dir / "special_points.json", specials.dump(2) + "\n");
+  writeText(dir / "special_points.json", escape::jsonText(specials) + "\n");
   writeCurves(scene, run, dir);
   if (scene.analyses.twoParameter.enabled) writeCriticalCurvesCsv(run, dirName);
-  const PlotReport plots = drawPlots(scene, run, dirName);
+  const PlotReport plots = drawPlots(scene, run, dirName, stop);
   const json summary = summaryJson(scene, run, plots);
-  writeText(dir / "summary.json", summary.dump(2) + "\n");
+  writeText(dir / "summary.json", escape::jsonText(summary) + "\n");
   writeReport(scene, run, specials, summary, dirName);
   return plots;
 }

@@ -23,8 +23,8 @@ double columnValue(const std::string& column, const PointRecord& p, const mechan
 /// The same for a special point (stiffness columns are NaN there).
 double columnValue(const std::string& column, const SpecialRecord& s, const mechanics::Pose& pose0);
 /// A directory created next to `target` (same parent, hidden name), renamed onto `target` by
-/// commit(); removed by the destructor unless committed. While it exists SIGINT and SIGTERM are
-/// held back (blocked in the calling thread, then delivered when it is gone): a signal that
+/// commit(); removed by the destructor unless committed. While it exists SIGINT, SIGTERM and
+/// SIGHUP are held back (blocked in the calling thread, then delivered when it is gone): a signal that
 /// would end the program (a second Ctrl-C, signals.h) then ends it after the output is complete
 /// or removed, never with a half-written temporary directory left behind.
 class StagingDirectory {
@@ -47,7 +47,14 @@ struct PlotReport {
   bool gnuplotFound = false;
   std::string gnuplot;                 ///< program used, or why none
   std::vector<std::string> files;      ///< written image files, relative to the output dir
+  /// Every file in plots/ (images, scripts, data, logs), relative to the output dir: summary.json
+  /// `plots.written`, which tells a later run what it may replace (output_target.h).
+  std::vector<std::string> written;
   std::vector<std::string> failures;   ///< plots gnuplot failed to draw
+  /// Non-empty when drawing stopped early (the time limit of the run, a signal): why; the plots
+  /// not drawn are in `notDrawn` (only the one being drawn then has its data and script).
+  std::string stopped;
+  std::vector<std::string> notDrawn;
   /// What a plot could not show as asked (a shape requested where no stable point was traced):
   /// summary.json `notes`, and printed by `buckle run`.
   std::vector<std::string> notes;
@@ -69,12 +76,17 @@ void criticalCurvesPlotBody(const Scene& scene, const RunResult& run, const Plot
                             std::ostream& body);
 /// Writes every output file of the run into `dir` (which exists), report.html included;
 /// returns the plot report.
-PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::string& dir);
+/// `stop` ends the drawing of plots early (the run's time limit, a signal; output.h PlotReport).
+PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::string& dir,
+                        const continuation::Interrupt& stop = continuation::Interrupt());
 
 /// Draws the scene's plots with gnuplot into dir/plots (scripts and data files kept beside the
 /// images so a plot can be re-rendered by hand). Without gnuplot only the data and scripts are
-/// written and the report says so.
-PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string& dir);
+/// written and the report says so. gnuplot runs without a shell (child_process.h); once `stop`
+/// is requested or a stop signal is held back (signals.h) the plot being drawn is ended and the
+/// rest are not drawn (PlotReport::stopped).
+PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string& dir,
+                     const continuation::Interrupt& stop = continuation::Interrupt());
 
 /// The gnuplot executable: $BUCKLE_GNUPLOT if set (empty: none), else `gnuplot` on PATH.
 /// Returns an empty string when there is none.

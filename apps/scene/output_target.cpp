@@ -6,6 +6,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -36,6 +37,20 @@ bool sameOrAncestor(const fs::path& a, const fs::path& b) {
 }
 
 std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+
+/// summary.json `plots.written` of the output in `dir`: every file the run wrote into plots/
+/// (none when the summary has no such list).
+std::optional<std::set<std::string>> plotsWritten(const fs::path& dir) {
+  std::ifstream in(dir / "summary.json", std::ios::binary);
+  const nlohmann::json doc = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (!doc.is_object() || !doc.contains("plots") || !doc["plots"].is_object() || !doc["plots"].contains("written") ||
+      !doc["plots"]["written"].is_array())
+    return std::nullopt;
+  std::set<std::string> files;
+  for (const nlohmann::json& f : doc["plots"]["written"])
+    if (f.is_string()) files.insert(f.get<std::string>());
+  return files;
+}
 
 }  // namespace
 
@@ -72,13 +87,19 @@ bool isBuckleOutput(const std::string& dirName, std::string* why) {
   if (!fs::is_directory(dir, ec)) return no("it is not a directory");
   if (outputGenerator(dirName).empty())
     return no("it has no summary.json with the \"generator\" marker buckle writes");
+  const std::optional<std::set<std::string>> written = plotsWritten(dir);
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
     const fs::file_status st = e.symlink_status(ec);
     if (name == "plots" && fs::is_directory(st)) {
-      for (const fs::directory_entry& p : fs::directory_iterator(e.path(), ec))
-        if (!fs::is_regular_file(p.symlink_status(ec)) || !kPlotExtensions.count(p.path().extension().string()))
-          return no("it contains plots/" + p.path().filename().string() + ", which buckle does not write");
+      for (const fs::directory_entry& p : fs::directory_iterator(e.path(), ec)) {
+        const std::string file = p.path().filename().string();
+        // summary.json lists what the run wrote there; an output written before that list
+        // existed is recognised by the kinds of files buckle writes
+        const bool ours = written ? written->count("plots/" + file) > 0 : kPlotExtensions.count(p.path().extension().string()) > 0;
+        if (!fs::is_regular_file(p.symlink_status(ec)) || !ours)
+          return no("it contains plots/" + file + ", which buckle did not write");
+      }
       continue;
     }
     if (!fs::is_regular_file(st) || !kTopLevelFiles.count(name))

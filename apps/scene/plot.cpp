@@ -19,7 +19,10 @@
 
 #include "buckle/mechanics/contact_geometry.h"
 
+#include "scene/child_process.h"
+#include "scene/escape.h"
 #include "scene/output.h"
+#include "scene/signals.h"
 
 namespace buckle::scene {
 
@@ -54,15 +57,8 @@ std::string short5(double v) {
   return buf;
 }
 
-/// gnuplot string literal (single quotes, doubled inside).
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) {
-    if (c == '\'') out += "''";
-    else out += c;
-  }
-  return out + "'";
-}
+/// gnuplot string literal of any text, a scene's included (escape.h).
+std::string quote(const std::string& s) { return escape::gnuplotString(s); }
 
 /// Data file with numbered blocks (gnuplot `index`), each made of polylines separated by one
 /// blank line.
@@ -703,7 +699,8 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
           if (marks[i].ordinal == o && marks[i].type == type && labelled[i] != small) ++count, shown += drawn[i];
         if (shown == 0) continue;
         const int block = sp.begin();
-        std::string comment = "# case " + std::to_string(cases[o]) + " (" + run.cases[cases[o]].label + "): " + type;
+        std::string comment =
+            "# case " + std::to_string(cases[o]) + " (" + escape::commentText(run.cases[cases[o]].label) + "): " + type;
         if (small)
           comment += " unlabelled, " + std::to_string(shown) + " of " + std::to_string(count) +
                      " drawn (the others within " + num(kThinPixels) + " px of one drawn)";
@@ -726,7 +723,7 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
       const Eigen::Vector2d p = f.data(l.anchor), c = f.data(l.centre), e = f.data(l.leaderEnd);
       const double nan = std::numeric_limits<double>::quiet_NaN();
       std::ostringstream line;
-      line << num(p.x()) << " " << num(p.y()) << " " << num(c.x()) << " " << num(c.y()) << " \"" << l.text << "\" "
+      line << num(p.x()) << " " << num(p.y()) << " " << num(c.x()) << " " << num(c.y()) << " " << escape::datField(l.text) << " "
            << num(l.leader ? e.x() : nan) << " " << num(l.leader ? e.y() : nan);
       lab.text(line.str());
     }
@@ -1258,7 +1255,7 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
     // energies, full precision: Π + T + W_d is checked against the reported balance error
     {
       std::ostringstream os;
-      os << "# sudden load, case " << c << " (" << cr.label << "): t potential kinetic dissipated sum\n";
+      os << "# sudden load, case " << c << " (" << escape::commentText(cr.label) << "): t potential kinetic dissipated sum\n";
       char buf[160];
       for (const mechanics::TrajectorySample& t : r.trajectory) {
         std::snprintf(buf, sizeof buf, "%.17g %.17g %.17g %.17g %.17g\n", t.t, t.potential, t.kinetic, t.dissipated,
@@ -1339,15 +1336,6 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
 
 bool executable(const std::string& path) { return ::access(path.c_str(), X_OK) == 0; }
 
-std::string shellQuote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) {
-    if (c == '\'') out += "'\\''";
-    else out += c;
-  }
-  return out + "'";
-}
-
 }  // namespace
 
 std::string findGnuplot() {
@@ -1366,7 +1354,8 @@ std::string findGnuplot() {
   return std::string();
 }
 
-PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string& outDir) {
+PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string& outDir,
+                     const continuation::Interrupt& stop) {
   PlotReport report;
   if (scene.plots.empty()) {
     report.gnuplot = "no plots requested";
@@ -1379,7 +1368,13 @@ PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string
   report.gnuplot = gnuplot.empty() ? "gnuplot is not installed (no executable `gnuplot` on PATH; on Debian: apt-get "
                                      "install gnuplot-nox); the plot data and scripts are in plots/"
                                    : gnuplot;
+  const auto stopReason = [&stop]() { return stop.requested() ? stop.describe() : stopSignalReason(); };
   for (const PlotSpec& spec : scene.plots) {
+    if (report.stopped.empty()) report.stopped = stopReason();
+    if (!report.stopped.empty()) {
+      report.notDrawn.push_back(spec.name);
+      continue;
+    }
     Script s;
     s.name = spec.name;
     switch (spec.type) {
@@ -1403,10 +1398,15 @@ PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string
        << "set output " << quote(spec.name + ".svg") << "\nload " << quote(spec.name + "_body.gp") << "\nset output\n";
     std::ofstream(dir / (spec.name + ".gp")) << gp.str();
     if (gnuplot.empty()) continue;
-    const std::string cmd = "cd " + shellQuote(dir.string()) + " && " + shellQuote(gnuplot) + " " +
-                            shellQuote(spec.name + ".gp") + " > " + shellQuote(spec.name + ".log") + " 2>&1";
-    const int rc = std::system(cmd.c_str());
-    const bool ok = rc == 0 && fs::exists(dir / (spec.name + ".png")) && fs::exists(dir / (spec.name + ".svg"));
+    const ChildOutcome drawn = runChild(gnuplot, {spec.name + ".gp"}, dir.string(), spec.name + ".log", stopReason);
+    if (!drawn.stopped.empty()) {  // no half-drawn image: the script and data stay
+      report.stopped = drawn.stopped;
+      report.notDrawn.push_back(spec.name);
+      std::error_code ec;
+      for (const char* image : {".png", ".svg"}) fs::remove(dir / (spec.name + image), ec);
+      continue;
+    }
+    const bool ok = drawn.exitedZero && fs::exists(dir / (spec.name + ".png")) && fs::exists(dir / (spec.name + ".svg"));
     if (ok) {
       report.files.push_back("plots/" + spec.name + ".png");
       report.files.push_back("plots/" + spec.name + ".svg");
@@ -1416,6 +1416,8 @@ PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string
       report.failures.push_back(spec.name + " (see plots/" + spec.name + ".log)");
     }
   }
+  for (const fs::directory_entry& e : fs::directory_iterator(dir)) report.written.push_back("plots/" + e.path().filename().string());
+  std::sort(report.written.begin(), report.written.end());
   return report;
 }
 

@@ -13,6 +13,7 @@
 #include <string>
 #include <system_error>
 
+#include "scene/escape.h"
 #include "scene/output.h"
 #include "scene/output_numbers.h"
 
@@ -757,10 +758,8 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   }
   data["plots"] = plots;
   data["critical"] = specialPoints.contains("critical_loads") ? specialPoints["critical_loads"] : json::array();
-  std::string text = objectText(data, {{"cases", std::move(cases)}});
-  // inside <script>, "</" would end the element: JSON allows the escaped solidus
-  for (size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3)) text.replace(at, 2, "<\\/");
-  return kHead + text + kTail;
+  // every "<" as \u003c: nothing inside the JSON can end or change the <script> element (escape.h)
+  return kHead + escape::htmlScriptSafe(objectText(data, {{"cases", std::move(cases)}})) + kTail;
 }
 
 void writeReport(const Scene& scene, const RunResult& run, const json& specialPoints, const json& summary,

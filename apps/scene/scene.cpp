@@ -5,6 +5,7 @@
 #include <set>
 #include <sstream>
 
+#include "scene/escape.h"
 #include "scene/json_reader.h"
 #include "scene/scene_parsing.h"
 
@@ -111,7 +112,7 @@ Scene parseScene(const std::string& text, const std::string& file) {
         // point into the case when the bad value came from it
         const Pointer bad(e.path().empty() ? "" : e.path());
         if (!e.path().empty() && patch.contains(bad)) throw SceneError(file, (pi / bad).to_string(), e.message());
-        throw SceneError(file, e.path(), e.message() + " (in " + pi.to_string() + ", \"" + label + "\")");
+        throw SceneError(file, e.path(), e.message() + " (in " + pi.to_string() + ", \"" + escape::commentText(label) + "\")");
       }
       totalSegments += static_cast<int>(scene.cases.back().chain.segments.size());
       if (totalSegments > kMaxSegments)

@@ -185,6 +185,12 @@ struct Scene {
   int maxSegments() const;
 };
 
+/// One segment from the keys of a scene's segment object (a, b, k, L0, a1, b1, a2, b2, k1, k2,
+/// L1_0, L2_0, q_min, q_max; absent keys take the scene's defaults), validated exactly as in a
+/// scene: the Python Segment uses it, so both refuse the same values with the same words. Throws
+/// SceneError (file `source`, the key as path).
+mechanics::SegmentParameters segmentFromKeys(const nlohmann::json& keys, const std::string& source);
+
 /// Parses and validates a scene file. Throws SceneError on any bad input.
 Scene loadScene(const std::string& file);
 /// Same, from text (file is only used in messages).

@@ -155,7 +155,11 @@ SolverSpec parseSolver(const Reader& r, const json& s, const Pointer& p) {
   if (s.contains("initial_step")) o.initialStep = r.positive(s["initial_step"], p / "initial_step");
   if (s.contains("min_step")) o.minStep = r.positive(s["min_step"], p / "min_step");
   if (s.contains("max_step")) o.maxStep = r.positive(s["max_step"], p / "max_step");
-  if (s.contains("tolerance")) o.tolerance = r.positive(s["tolerance"], p / "tolerance");
+  if (s.contains("tolerance")) {
+    o.tolerance = r.positive(s["tolerance"], p / "tolerance");
+    // a residual norm in the chain's units: beyond 1e-3 a point is no equilibrium to plot
+    if (o.tolerance > 1e-3) r.expected(p / "tolerance", s["tolerance"], "a number in (0, 1e-3] (default 1e-10)");
+  }
   if (s.contains("location_tolerance")) {
     // relative to the parameter's scale: below 1e-15 no double resolves it, above 1e-2 it is no location
     o.locationTolerance = r.number(s["location_tolerance"], p / "location_tolerance");

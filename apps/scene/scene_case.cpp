@@ -118,6 +118,12 @@ void checkSegment(const Reader& r, const SegmentDefaults& d, const Pointer& wher
     const std::optional<Pointer> key = mostExtremeKey(d, names);
     return key ? *key : where;
   };
+  // a subnormal stiffness (5e-324) makes every stiffness product zero: a singular Jacobian
+  for (const char* key : {"k1", "k2"})
+    if (!std::isnormal(d.values.at(key)))
+      r.fail(d.source.count(key) ? d.source.at(key) : where,
+             "expected a stiffness of at least 2.2e-308 (the smallest normal double; stiffnesses in any unit), got " +
+                 show(d.values.at(key)));
   const double qMin = sp.qMinUser, qMax = sp.qMaxUser;
   sp.qMinUser = -std::numeric_limits<double>::infinity();
   sp.qMaxUser = std::numeric_limits<double>::infinity();
@@ -144,15 +150,19 @@ void checkSegment(const Reader& r, const SegmentDefaults& d, const Pointer& wher
            "shape is not a finite number (lengths are in units of b, stiffnesses in k: give values near 1)");
 }
 
+SegmentDefaults defaultSegment() {
+  SegmentDefaults d;
+  d.values = {{"a1", 0.5}, {"a2", 0.5}, {"b1", 1.0}, {"b2", 1.0}, {"k1", 1.0}, {"k2", 1.0}, {"L1_0", 2.25}, {"L2_0", 2.25}};
+  return d;
+}
+
 ChainSpec parseChain(const Reader& r, const json& chain, const Pointer& p) {
   std::set<std::string> keys = kSegmentKeys;
   keys.insert("segments");
   r.onlyKeys(chain, p, keys);
   if (!chain.contains("segments")) r.fail(p / "segments", "missing: expected the segment count (an integer >= 1) or a list of segments");
 
-  SegmentDefaults base;
-  base.values = {{"a1", 0.5}, {"a2", 0.5}, {"b1", 1.0}, {"b2", 1.0}, {"k1", 1.0},
-                 {"k2", 1.0}, {"L1_0", 2.25}, {"L2_0", 2.25}};
+  SegmentDefaults base = defaultSegment();
   json chainLevel = chain;
   chainLevel.erase("segments");
   chainLevel.erase("q0");
@@ -230,6 +240,18 @@ ChainSpec parseChain(const Reader& r, const json& chain, const Pointer& p) {
         r.fail(q0Pointers[i], e.what());
       }
       spec.preloadsFromQ0 = true;
+    } else {
+      const mechanics::Segment seg(sp);
+      if (!(seg.lowerLimit() < 0.0 && seg.upperLimit() > 0.0)) {
+        const bool minWrong = seg.lowerLimit() >= 0.0;
+        const char* key = minWrong ? "q_min" : "q_max";
+        const auto src = resolved[i].source.find(key);
+        r.fail(src != resolved[i].source.end() ? src->second : segPointers[i],
+               std::string("expected ") + (minWrong ? "q_min < 0" : "q_max > 0") +
+                   ": the chain starts straight (q = 0), which must lie strictly inside the joint limits (" +
+                   show(seg.lowerLimit()) + ", " + show(seg.upperLimit()) +
+                   ") rad; or give /chain/q0, a start shape inside them");
+      }
     }
     spec.segments.push_back(sp);
   }
@@ -252,7 +274,11 @@ EndSpec parseEnd(const Reader& r, const json& end, const Pointer& p) {
       if (v.get<std::string>() != "free") r.expected(pc, v, what);
       continue;
     }
-    if (!v.is_object() || v.size() != 1) r.expected(pc, v, what);
+    if (!v.is_object() || v.empty()) r.expected(pc, v, what);
+    for (auto it = v.begin(); it != v.end(); ++it)
+      if (it.key() != "load" && it.key() != "held")
+        r.fail(pc / it.key(), "unknown key \"" + it.key() + "\" (allowed here: load, held)");
+    if (v.size() != 1) r.fail(pc, "expected one of load, held, got both (a coordinate is either loaded or held)");
     if (v.contains("load")) {
       spec.condition.value[c] = r.number(v["load"], pc / "load");
     } else if (v.contains("held")) {
@@ -264,8 +290,6 @@ EndSpec parseEnd(const Reader& r, const json& end, const Pointer& p) {
       } else {
         spec.condition.value[c] = r.number(h, pc / "held");
       }
-    } else {
-      r.fail(pc / v.begin().key(), "unknown key \"" + v.begin().key() + "\" (allowed here: load, held)");
     }
   }
   return spec;
@@ -326,6 +350,51 @@ PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const En
   return spec;
 }
 
+// A held end coordinate the chain cannot reach, or a load beyond any the chain can carry in
+// doubles, leaves the equilibrium equations without a solution the solver could find (KINSOL
+// gives up with a code): answered here instead, before computing. The chain's own scales: its
+// length L (the farthest the end gets from the base), the force unit k b and moment unit k b².
+void checkEndAgainstChain(const Reader& r, const CaseSpec& cs) {
+  const mechanics::Chain chain(cs.chain.segments);
+  const double L = chain.length();
+  double k = 0.0, b = 0.0;
+  for (const mechanics::SegmentParameters& sp : cs.chain.segments) {
+    k = std::max({k, sp.k1, sp.k2});
+    b = std::max({b, sp.b1, sp.b2});
+  }
+  const mechanics::EndCondition& end = cs.end.condition;
+  for (int c = 0; c < 2; ++c) {
+    if (!end.isHeld(static_cast<mechanics::EndCoordinate>(c)) || cs.end.heldAtStart[size_t(c)]) continue;
+    const double v = end.value[c];
+    if (std::abs(v) > L * (1.0 + 1e-12))
+      r.fail(Pointer("/end") / kCoordinateNames[c] / "held",
+             std::string("expected a position the end can reach: |") + kCoordinateNames[c] + "| <= " + show(L) +
+                 " (the length of the straight chain), got " + show(v));
+  }
+  if (end.isHeld(mechanics::EndCoordinate::X) && end.isHeld(mechanics::EndCoordinate::Y) &&
+      !cs.end.heldAtStart[0] && !cs.end.heldAtStart[1] && std::hypot(end.value[0], end.value[1]) > L * (1.0 + 1e-12))
+    r.fail(Pointer("/end/y/held"), "expected a position the end can reach: sqrt(x^2 + y^2) <= " + show(L) +
+                                       " (the length of the straight chain), got (" + show(end.value[0]) + ", " +
+                                       show(end.value[1]) + ")");
+  // loads up to 1e12 of the chain's units: far beyond any equilibrium the springs can resist
+  const double unit[3] = {k * b, k * b, k * b * b};
+  const auto checkLoad = [&](int c, double v, const Pointer& at) {
+    const double limit = 1e12 * unit[c];
+    if (!(std::abs(v) <= limit))
+      r.fail(at, std::string("expected a load |") + kLoadNames[c] + "| <= " + show(limit) + " (1e12 times the chain's " +
+                     (c == 2 ? "moment unit k b^2" : "force unit k b") + "), got " + show(v));
+  };
+  for (int c = 0; c < 3; ++c)
+    if (!end.isHeld(static_cast<mechanics::EndCoordinate>(c)))
+      checkLoad(c, end.value[c], Pointer("/end") / kCoordinateNames[c] / "load");
+  bool isLoad = false;
+  const int c = coordinateOfParameter(cs.path.parameter, isLoad);
+  if (c >= 0 && isLoad && cs.path.from != cs.path.to) {
+    checkLoad(c, cs.path.from, Pointer("/path/from"));
+    checkLoad(c, cs.path.to, Pointer("/path/to"));
+  }
+}
+
 }  // namespace
 
 CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, bool needPath) {
@@ -340,6 +409,7 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
   for (int c = 0; c < 3; ++c)
     if (cs.end.heldAtStart[size_t(c)]) cs.end.condition.value[c] = pose0[c];
   if (!doc.contains("path")) {
+    checkEndAgainstChain(r, cs);
     if (needPath)
       r.fail(Pointer("/path"), "missing (required by /analyses/continuation and /analyses/critical_forces): the load path");
     cs.path.parameter = "Fx";
@@ -358,6 +428,7 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
     if (c >= 0) start = cs.end.condition.value[c];
   }
   cs.path = parsePath(r, path, Pointer("/path"), cs.end, start);
+  checkEndAgainstChain(r, cs);
   if (cs.path.loadLimit == 0.0 && cs.end.condition.isHeld(static_cast<mechanics::EndCoordinate>(cs.path.coordinate))) {
     if (!mechanics::endMovesAlong(chain, cs.chain.q0, cs.path.coordinate))
       r.fail(Pointer("/path/parameter"),
@@ -370,3 +441,18 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
 }
 
 }  // namespace buckle::scene::detail
+
+namespace buckle::scene {
+
+mechanics::SegmentParameters segmentFromKeys(const nlohmann::json& keys, const std::string& source) {
+  const JsonReader r(source);
+  std::set<std::string> allowed = detail::kSegmentKeys;
+  allowed.erase("q0");
+  r.onlyKeys(keys, detail::Pointer(""), allowed);
+  detail::SegmentDefaults d = detail::defaultSegment();
+  detail::applySegmentKeys(r, keys, detail::Pointer(""), d);
+  detail::checkSegment(r, d, detail::Pointer(""), 0.0);
+  return detail::toParameters(d);
+}
+
+}  // namespace buckle::scene

@@ -1,6 +1,10 @@
 // /analyses/two_parameter of a scene (docs/scenes.md): which second parameter, its range, and
 // which critical curves (mechanics/critical_curves.h).
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
+
+#include "buckle/mechanics/chain.h"
 
 #include "buckle/mechanics/critical_curves.h"
 #include "scene/scene_parsing.h"
@@ -49,6 +53,14 @@ void checkTwoParameterAgainstCases(const JsonReader& r, const Scene& scene) {
     } catch (const std::invalid_argument& e) {
       r.fail(p / "parameter", std::string("case \"") + c.label + "\": " + e.what());
     }
+    // a range far beyond the case's own scale (|μ|, or the chain's length when μ = 0) is no
+    // curve to trace: ±1e308 overflows its width
+    const double scale = std::max(std::abs(mu), mechanics::Chain(c.chain.segments).length());
+    if (!std::isfinite(t.to - t.from) || std::max(std::abs(t.from), std::abs(t.to)) > 1e6 * scale)
+      r.fail(p / (std::abs(t.from) >= std::abs(t.to) ? "from" : "to"),
+             "expected a range within 1e6 times the scale of case \"" + c.label + "\" (|from|, |to| <= " +
+                 show(1e6 * scale) + ": " + t.parameter + " = " + show(mu) + ", chain length " +
+                 show(mechanics::Chain(c.chain.segments).length()) + "), got [" + show(t.from) + ", " + show(t.to) + "]");
     if (mu < t.from || mu > t.to)
       r.fail(p / "from", "expected a range containing " + t.parameter + " = " + show(mu) + " of case \"" + c.label +
                              "\" (the curves start there)");

@@ -2,6 +2,7 @@
 
 #include <csignal>
 #include <ctime>
+#include <string>
 
 namespace buckle::scene {
 
@@ -9,7 +10,7 @@ namespace {
 
 std::atomic<bool> gReceived{false};
 volatile std::sig_atomic_t gSignal = 0;
-struct sigaction gPreviousInt, gPreviousTerm;
+struct sigaction gPreviousInt, gPreviousTerm, gPreviousHup;
 
 volatile std::sig_atomic_t gFirstSecond = 0;  // CLOCK_MONOTONIC time of the first signal (whole s)
 volatile std::sig_atomic_t gFirstMilli = 0;   // ... and its milliseconds
@@ -18,6 +19,10 @@ long long nowMilliseconds() {
   struct timespec t;
   clock_gettime(CLOCK_MONOTONIC, &t);  // async-signal-safe (POSIX)
   return static_cast<long long>(t.tv_sec) * 1000 + t.tv_nsec / 1000000;
+}
+
+const char* sigabbrev(int sig) {
+  return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "signal";
 }
 
 // Only async-signal-safe calls here. The first signal sets the flag; a later one ends the
@@ -52,11 +57,13 @@ SignalGuard::SignalGuard() {
   action.sa_flags = 0;  // a second signal: default action, from the handler
   sigaction(SIGINT, &action, &gPreviousInt);
   sigaction(SIGTERM, &action, &gPreviousTerm);
+  sigaction(SIGHUP, &action, &gPreviousHup);
 }
 
 SignalGuard::~SignalGuard() {
   sigaction(SIGINT, &gPreviousInt, nullptr);
   sigaction(SIGTERM, &gPreviousTerm, nullptr);
+  sigaction(SIGHUP, &gPreviousHup, nullptr);
 }
 
 const std::atomic<bool>* SignalGuard::flag() { return &gReceived; }
@@ -64,5 +71,25 @@ const std::atomic<bool>* SignalGuard::flag() { return &gReceived; }
 int SignalGuard::signal() { return gSignal; }
 
 int SignalGuard::exitCode() { return gSignal ? 128 + gSignal : 0; }
+
+sigset_t stopSignals() {
+  sigset_t set;
+  sigemptyset(&set);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set, sig);
+  return set;
+}
+
+std::string SignalGuard::description() {
+  return gSignal ? "interrupted by a signal (" + std::string(sigabbrev(gSignal)) + ")" : std::string();
+}
+
+std::string stopSignalReason() {
+  if (gReceived.load(std::memory_order_relaxed)) return SignalGuard::description();
+  sigset_t pending;
+  if (sigpending(&pending) != 0) return "";
+  for (int sig : {SIGINT, SIGTERM, SIGHUP})
+    if (sigismember(&pending, sig) == 1) return "interrupted by a signal (" + std::string(sigabbrev(sig)) + ")";
+  return "";
+}
 
 }  // namespace buckle::scene

@@ -13,6 +13,7 @@
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/critical_curves.h"
 #include "scene/case_runner.h"
+#include "scene/escape.h"
 #include "scene/output.h"
 
 namespace buckle::scene {
@@ -81,7 +82,7 @@ void writeCriticalCurvesCsv(const RunResult& run, const std::string& dir) {
     const auto& curves = run.cases[c].criticalCurves;
     for (size_t k = 0; k < curves.size(); ++k)
       for (const mech::CriticalPoint& p : curves[k].points)
-        os << c << ',' << k << ',' << curves[k].type << ',' << curves[k].parameter.name() << ',' << g15(p.mu) << ','
+        os << c << ',' << k << ',' << escape::csvField(curves[k].type) << ',' << escape::csvField(curves[k].parameter.name()) << ',' << g15(p.mu) << ','
            << g15(p.lambda) << ',' << g15(p.kappa) << ',' << g15(p.koiterA) << ',' << g15(p.koiterB) << ','
            << kindName(p, curves[k].type) << "\n";
   }
@@ -123,7 +124,7 @@ void criticalCurvesPlotBody(const Scene& scene, const RunResult& run, const Plot
   std::ostringstream data, plots;
   int block = 0;
   const std::string file = spec.name + "_curves.dat";
-  auto quoteName = [](const std::string& s) { return "'" + s + "'"; };
+  auto quoteName = [](const std::string& s) { return escape::gnuplotString(s); };
   bool first = true;
   for (size_t ci = 0; ci < spec.cases.size(); ++ci) {
     const int c = spec.cases[ci];
@@ -162,7 +163,7 @@ void criticalCurvesPlotBody(const Scene& scene, const RunResult& run, const Plot
   // codimension-two points: label and marker
   for (const int c : spec.cases)
     for (const mech::CriticalCurve& curve : run.cases[size_t(c)].criticalCurves)
-      for (const mech::Codim2Point& s : curve.special) data << g15(s.mu) << ' ' << g15(s.lambda) << ' ' << s.label << "\n";
+      for (const mech::Codim2Point& s : curve.special) data << g15(s.mu) << ' ' << g15(s.lambda) << ' ' << escape::datField(s.label) << "\n";
   data << "nan nan -\n";
   std::ofstream(fs::path(dir) / file) << data.str();
   const TwoParameterSpec& t = scene.analyses.twoParameter;

@@ -123,7 +123,7 @@ TEST_CASE("buckle critical: bad arguments exit with 2 and name the argument", "[
   for (const Bad& b : {Bad{"--segments 0", "--segments"}, Bad{"--b -1", "--b"}, Bad{"--k nan", "--k"},
                        Bad{"--end bogus", "--end"}, Bad{"--L0 0", "--L0"}, Bad{"--a -0.5", "--a"},
                        Bad{"--count 0", "--count"}, Bad{"--segments three", "--segments"}, Bad{"--k inf", "--k"},
-                       Bad{"--bogus 1", "--bogus"}}) {
+                       Bad{"--bogus 1", "--bogus"}, Bad{"--segments 1000000000", "--segments must be an integer in [1, 5000]"}}) {
     const Run r = buckle("critical " + b.args, true);
     INFO("buckle critical " << b.args << " → " << r.out);
     CHECK(r.status == 2);

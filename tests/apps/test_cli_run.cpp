@@ -60,3 +60,11 @@ TEST_CASE("buckle run --help and a missing scene argument", "[cli][run]") {
   CHECK(slurp(work() / "help.txt").find("Exit status") != std::string::npos);
   CHECK(exitCode("run", work() / "noarg.txt") == 2);
 }
+
+TEST_CASE("buckle run --out \"\" and an unknown subcommand exit 2 naming the mistake", "[cli][run]") {
+  const std::string scene = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/default.json";
+  CHECK(exitCode("run '" + scene + "' --out ''", work() / "empty_out.txt") == 2);
+  CHECK(slurp(work() / "empty_out.txt").find("--out is empty") != std::string::npos);
+  CHECK(exitCode("frobnicate", work() / "frobnicate.txt") == 2);
+  CHECK(slurp(work() / "frobnicate.txt").find("unknown subcommand \"frobnicate\" (one of: ") != std::string::npos);
+}

@@ -170,3 +170,24 @@ TEST_CASE("buckle show on something that is not a run's output exits 2", "[cli][
   CHECK(slurp(log).find("special_points.json: cannot be read") != std::string::npos);
   CHECK(exitCode("show", log) == 2);
 }
+
+TEST_CASE("buckle show prints a scene's text on one line, without terminal control characters", "[cli][show]") {
+  const fs::path dir = work() / "hostile";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  json scene = json::parse(slurp(std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/default.json"));
+  scene["description"] = "first line\nsecond \x1b[2J\x1b]0;title\x07 line";
+  scene["cases"] = {{{"label", "label\r\nwith \x1b[31mred"}}, {{"label", "plain"}}};  // labels shown with two cases
+  scene["plots"] = json::array();
+  std::ofstream(dir / "scene.json") << scene.dump();
+  REQUIRE(exitCode("run '" + (dir / "scene.json").string() + "' --quiet --out '" + (dir / "out").string() + "'",
+                   dir / "run.txt") == 0);
+  REQUIRE(exitCode("show '" + (dir / "out").string() + "'", dir / "show.txt") == 0);
+  const std::string shown = slurp(dir / "show.txt");
+  INFO(shown);
+  CHECK(shown.find('\x1b') == std::string::npos);
+  CHECK(shown.find('\x07') == std::string::npos);
+  CHECK(shown.find('\r') == std::string::npos);
+  CHECK(shown.find("first line second ") != std::string::npos);  // the description on one line
+  CHECK(shown.find("label with ") != std::string::npos);
+}

@@ -13,6 +13,7 @@
 #include <unistd.h>
 #include <string>
 
+#include "scene/case_runner.h"
 #include "scene/command.h"
 #include "scene/scene.h"
 #include "small_scene.h"
@@ -302,4 +303,79 @@ TEST_CASE("the stiffness measure of KMIN is one of Kxx, Kyy, Kmin", "[scene][err
                     Catch::Contains("/analyses/stiffness/measure") && Catch::Contains("Kxx, Kyy, Kmin"));
   CHECK_THROWS_WITH(buckle::scene::parseScene(base + R"({"kind": "Kxx"}}})", "s.json"),
                     Catch::Contains("/analyses/stiffness"));
+}
+
+// ---- the bad inputs of issue 27: each answered before computing, naming key, path and range ----
+
+TEST_CASE("joint limits that exclude the straight start", "[scene][errors]") {
+  requireBadInput("q_min_straight", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": 2.25, \"q_min\": 0.1"), "/chain/q_min",
+                  "expected q_min < 0: the chain starts straight (q = 0)");
+  requireBadInput("q_max_straight", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": 2.25, \"q_max\": -0.1"), "/chain/q_max",
+                  "expected q_max > 0");
+}
+
+TEST_CASE("a held end out of reach and loads beyond the chain's scale", "[scene][errors]") {
+  // three segments of length 2 b: the end reaches at most 6 b from the base
+  requireBadInput("y_held_100", replaceOnce(kGood, "\"held\": 0.0", "\"held\": 100"), "/end/y/held",
+                  "expected a position the end can reach: |y| <= 6");
+  requireBadInput("y_held_1e300", replaceOnce(kGood, "\"held\": 0.0", "\"held\": 1e300"), "/end/y/held",
+                  "expected a position the end can reach");
+  requireBadInput("Fy_1e308", replaceOnce(kGood, "\"y\": {\"held\": 0.0}", "\"y\": {\"load\": 1e308}"), "/end/y/load",
+                  "expected a load |Fy| <= 1e+12");
+  requireBadInput("path_to_1e300", replaceOnce(kGood, "\"to\": -1.0", "\"to\": -1e300"), "/path/to",
+                  "expected a load |Fx| <= 1e+12");
+}
+
+TEST_CASE("a subnormal stiffness", "[scene][errors]") {
+  requireBadInput("k_denormal", replaceOnce(kGood, "\"k\": 1.0", "\"k\": 5e-324"), "/chain/k",
+                  "expected a stiffness of at least 2.2e-308");
+  requireBadInput("k2_denormal", replaceOnce(kGood, "\"segments\": 3,", "\"segments\": [{}, {\"k2\": 1e-310}, {}],"),
+                  "/chain/segments/1/k2", "expected a stiffness of at least 2.2e-308");
+}
+
+TEST_CASE("a solver tolerance that accepts non-equilibria", "[scene][errors]") {
+  requireBadInput("tolerance_10", replaceOnce(kGood, "\"plots\": []", "\"plots\": [], \"solver\": {\"tolerance\": 10}"),
+                  "/solver/tolerance", "expected a number in (0, 1e-3]");
+}
+
+TEST_CASE("numbers JSON cannot hold are named as written", "[scene][errors]") {
+  requireBadInput("minus_infinity", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": -Infinity"), "/chain/L0",
+                  "got -Infinity (not valid JSON)");
+  const Outcome o = runText("e309", replaceOnce(kGood, "\"L0\": 2.25", "\"L0\": 1e309"));
+  INFO(o.err);
+  CHECK(o.rc == 2);
+  CHECK(o.err.find("/chain/L0: expected a finite number (at most 1.8e308 in magnitude), got 1e309") != std::string::npos);
+  CHECK(o.err.find("json.exception") == std::string::npos);  // no library internals
+}
+
+TEST_CASE("an unknown key inside an end coordinate is named", "[scene][errors]") {
+  requireBadInput("end_x_extra", replaceOnce(kGood, "\"x\": {\"load\": 0.0}", "\"x\": {\"load\": 0.0, \"lod\": 1}"),
+                  "/end/x/lod", "unknown key \"lod\" (allowed here: load, held)");
+  requireBadInput("end_x_both", replaceOnce(kGood, "\"x\": {\"load\": 0.0}", "\"x\": {\"load\": 0.0, \"held\": 1}"),
+                  "/end/x", "expected one of load, held, got both");
+}
+
+TEST_CASE("a two_parameter range far beyond the case's scale", "[scene][errors]") {
+  const std::string twoParameter =
+      "\"analyses\": {\"two_parameter\": {\"parameter\": \"k\", \"from\": -1e308, \"to\": 1e308, \"modes\": 1}},";
+  std::string text = kGood;
+  const size_t a = text.find("\"analyses\""), e = text.find("\"plots\"");
+  text.replace(a, e - a, twoParameter + "\n  ");
+  requireBadInput("two_parameter_1e308", text, "/analyses/two_parameter/from", "expected a range within 1e6 times");
+}
+
+TEST_CASE("solver failures are explained in words, the KINSOL flag kept as detail", "[scene][errors]") {
+  using buckle::scene::solverFailureInWords;
+  const std::string start = "start point did not converge at fixed lambda (KIN_FIRST_SYSFUNC_ERR)";
+  const std::string sysfunc = solverFailureInWords(start);
+  CHECK(sysfunc.rfind("the spring model could not be evaluated", 0) == 0);
+  CHECK(sysfunc.find("; check the joint limits") != std::string::npos);
+  CHECK(sysfunc.size() > start.size());
+  CHECK(sysfunc.substr(sysfunc.size() - start.size() - 1) == start + ")");  // the flag last, as detail
+  const std::string newton = solverFailureInWords("corrector failed (KIN_LINESEARCH_NONCONV)");
+  CHECK(newton.rfind("Newton's method made no progress on the equilibrium equations", 0) == 0);
+  CHECK(newton.find("lower solver.max_step") != std::string::npos);
+  CHECK(solverFailureInWords("corrector failed (KIN_LSETUP_FAIL)").rfind("the linearised equilibrium equations", 0) == 0);
+  // messages of the mechanics already in words stay as they are
+  CHECK(solverFailureInWords("reached the end of the path range") == "reached the end of the path range");
 }

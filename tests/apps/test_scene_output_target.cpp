@@ -157,6 +157,15 @@ TEST_CASE("new paths and empty directories and previous buckle outputs are accep
     CHECK(!isBuckleOutput("previous", &why));
     CHECK_THAT(why, Catch::Contains("plots/mine"));
   }
+  SECTION("a user's image in plots/ is foreign when the summary lists what the run wrote there") {
+    std::ofstream("previous/summary.json")
+        << R"({"generator": "buckle run", "schema": 1, "plots": {"written": ["plots/bifurcation.gp", "plots/bifurcation.png"]}})";
+    CHECK(isBuckleOutput("previous"));
+    std::ofstream("previous/plots/mynote.png") << "mine";
+    CHECK(!isBuckleOutput("previous", &why));
+    CHECK_THAT(why, Catch::Contains("plots/mynote.png, which buckle did not write"));
+    CHECK_THAT(refusal("previous", false), Catch::Contains("--force"));
+  }
   SECTION("a summary.json without buckle's marker is not enough") {
     std::ofstream("previous/summary.json") << "{\"generator\": \"someone else\"}";
     CHECK(!isBuckleOutput("previous", &why));

@@ -114,12 +114,17 @@ std::vector<std::string> plotClauses(const std::string& body) {
 
 // Plain string scanning, not <regex>: GCC 12 warns (-Wmaybe-uninitialized) inside <regex>
 // at -O1 with the sanitizers, and the builds are warning-free.
+// The value of `key 'text'` or `key "text"` (the scripts quote fixed texts one way, any text from
+// the scene the other, escape.h; the texts compared here hold no escapes).
 std::string field(const std::string& clause, const std::string& key) {
-  const std::string open = key + " '";
-  const size_t at = clause.find(open);
-  if (at == std::string::npos) return std::string();
-  const size_t from = at + open.size(), to = clause.find('\'', from);
-  return to == std::string::npos ? std::string() : clause.substr(from, to - from);
+  for (const char quote : {'\'', '"'}) {
+    const std::string open = key + " " + quote;
+    const size_t at = clause.find(open);
+    if (at == std::string::npos) continue;
+    const size_t from = at + open.size(), to = clause.find(quote, from);
+    return to == std::string::npos ? std::string() : clause.substr(from, to - from);
+  }
+  return std::string();
 }
 
 int indexOf(const std::string& clause) {
@@ -335,7 +340,7 @@ TEST_CASE("multi-case bifurcation plot: one colour and key entry per case, stabi
       if (c.find(" dt 2 ") != std::string::npos && field(c, "title") == "unstable") ++unstableKey;
       continue;
     }
-    if (c.rfind("'two.dat'", 0) != 0) continue;
+    if (c.rfind("\"two.dat\"", 0) != 0) continue;
     const std::string colour = field(c, "rgb"), title = field(c, "title");
     if (!title.empty()) {
       ++titled[title];
@@ -351,7 +356,7 @@ TEST_CASE("multi-case bifurcation plot: one colour and key entry per case, stabi
   // every curve clause of case k (blocks in case order: stable, unstable) uses the case colour
   int curveClauses = 0, unstableDrawn = 0;
   for (const std::string& c : clauses) {
-    if (c.rfind("'two.dat'", 0) != 0) continue;
+    if (c.rfind("\"two.dat\"", 0) != 0) continue;
     const int block = indexOf(c);
     REQUIRE(block >= 0);
     const size_t k = size_t(block) / 2;  // two blocks (stable, unstable) per case
@@ -369,7 +374,7 @@ TEST_CASE("multi-case bifurcation plot: one colour and key entry per case, stabi
   int colouredMarkers = 0;
   for (const std::string& c : clauses) {
     if (c.rfind("keyentry with points", 0) == 0) typesKeyed.insert(field(c, "title"));
-    if (c.rfind("'two_special.dat'", 0) != 0 || c.find("lw 1 lc rgb 'black'") != std::string::npos) continue;
+    if (c.rfind("\"two_special.dat\"", 0) != 0 || c.find("lw 1 lc rgb 'black'") != std::string::npos) continue;
     const Block& b = special.at(size_t(indexOf(c)));
     REQUIRE(!b.comments.empty());
     const size_t k = b.comments[0].find("# case 1") == 0 ? 1 : 0;
@@ -810,7 +815,7 @@ TEST_CASE("a long chain's bifurcation diagram is a summary: bounded labels, ever
   // many branches: thinner, translucent lines (#AARRGGBB), the stable ones solid
   const std::string body = slurp(out / "plots" / "bifurcation_q2_body.gp");
   for (const std::string& c : plotClauses(body)) {
-    if (c.rfind("'bifurcation_q2.dat'", 0) != 0) continue;
+    if (c.rfind("\"bifurcation_q2.dat\"", 0) != 0) continue;
     CHECK(field(c, "rgb").size() == 9);
     CHECK(std::stod(c.substr(c.find(" lw ") + 4)) < 2.0);
   }

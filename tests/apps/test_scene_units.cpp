@@ -500,3 +500,14 @@ TEST_CASE("the SI chain says N, m and N/m in every plot, column doc and the repo
   CHECK(html.find(R"x("Fx":"Fx (N)")x") != std::string::npos);
   CHECK(html.find(R"x("q5":"q5 (rad)")x") != std::string::npos);
 }
+
+TEST_CASE("the design map in units of 1e-4 (lengths) and 1e-8 (stiffness)", "[scene][units]") {
+  // b = 1e-4 and k = 1e-8: forces of 1e-12, torques of 1e-16, far from every threshold of 1
+  const json shipped = readJson(sceneDir() / "design_map.json");
+  const fs::path dir = workDir();
+  const json reference = run(rewrite(shipped, Units{"shipped", 1.0, 1.0}), dir, "design_map_reference");
+  REQUIRE(reference.contains("critical_curves"));
+  const Units tiny{"1e-4, 1e-8", 1e-4, 1e-8};
+  const json got = run(rewrite(shipped, tiny), dir, "design_map_tiny");
+  compare(got, reference, shipped, tiny);
+}

@@ -70,6 +70,18 @@ def test_a_callback_exception_is_raised_in_python():
         buckle.trace(bad, fold_jacobian, np.array([-1.0]), -1.0)
 
 
+def test_a_callback_returning_no_numbers_is_named():
+    for returned, shown in ((None, "None"), ("abc", "the str 'abc'")):
+        with pytest.raises(TypeError) as e:
+            buckle.trace(lambda u, lam: returned, fold_jacobian, np.array([-1.0]), -1.0)
+        assert str(e.value).startswith("residual(u, lam) returned " + shown + "; expected an array of N numbers")
+        assert "PYBIND11" not in str(e.value)
+    with pytest.raises(TypeError, match=r"jacobian\(u, lam\) returned None; expected a pair \(F_u, F_lambda\)"):
+        buckle.trace(fold_residual, lambda u, lam: None, np.array([-1.0]), -1.0)
+    with pytest.raises(TypeError, match=r"jacobian\(u, lam\): F_u returned the str 'x'"):
+        buckle.trace(fold_residual, lambda u, lam: ("x", np.array([1.0])), np.array([-1.0]), -1.0)
+
+
 def test_wrong_shapes_and_options_are_value_errors():
     with pytest.raises(ValueError, match="residual returned 2 values, expected 1"):
         buckle.trace(lambda u, lam: np.zeros(2), fold_jacobian, np.array([-1.0]), -1.0)

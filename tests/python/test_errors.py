@@ -61,7 +61,7 @@ def test_missing_scene_file(run_cli, tmp_path):
 
 
 def test_bad_segment_and_state_arguments():
-    with pytest.raises(ValueError, match="k1"):
+    with pytest.raises(ValueError, match="Segment: k: expected a number > 0"):
         buckle.Segment(k=-1.0)
     with pytest.raises(ValueError, match="3 segments"):
         buckle.Chain.uniform(3).energy(np.zeros(2))
@@ -73,3 +73,52 @@ def test_bad_segment_and_state_arguments():
         buckle.run_scene(42)
     with pytest.raises(ValueError, match="time_limit"):
         buckle.run_scene({"analyses": {}}, time_limit=-1)
+
+
+def test_segment_values_refused_like_the_cli(run_cli, tmp_path):
+    # the same rule and words as a scene's /chain/L0 (one validator)
+    scene = {"chain": {"segments": 3, "L0": 1e308}, "end": {"y": {"held": 0.0}},
+             "path": {"parameter": "Fx", "from": 0.0, "to": -1.0}, "analyses": {"continuation": True}}
+    path = tmp_path / "huge_L0.json"
+    path.write_text(json.dumps(scene))
+    cli = cli_message(run_cli, path, tmp_path)
+    rule = cli.split("/chain/L0: ", 1)[1]
+    with pytest.raises(ValueError) as e:
+        buckle.Segment(L0=1e308)
+    assert str(e.value) == "Segment: L0: " + rule
+    with pytest.raises(ValueError) as e:
+        buckle.Segment(a=1e300)
+    assert str(e.value).startswith("Segment: a: expected a smaller half-height a against the half-length b")
+    assert "qMinUser" not in str(e.value)
+    with pytest.raises(ValueError, match="Segment: q_min: expected a finite number"):
+        buckle.Segment(q_min=float("nan"))
+    with pytest.raises(ValueError, match="Segment: L1_0: "):
+        buckle.Segment(L1_0=-1.0)
+    # the defaults and per-side values still build the same segment
+    s = buckle.Segment(a=0.4, k2=2.0, q_min=-1.0)
+    assert s.parameters["a1"] == 0.4 and s.parameters["k2"] == 2.0 and s.parameters["k1"] == 1.0
+    assert s.lower_limit == -1.0
+
+
+def test_end_condition_values_must_be_finite():
+    for bad in ([float("nan"), 0, 0], [0, float("inf"), 0], [0, 0, -float("inf")]):
+        with pytest.raises(ValueError, match=r"EndCondition: value\[\d\] must be a finite number"):
+            buckle.EndCondition(value=np.array(bad, dtype=float))
+
+
+def test_numpy_numbers_in_a_scene_dict(source_dir):
+    scene = json.loads((source_dir / "data" / "scenes" / "default.json").read_text())
+    plain = buckle.run_scene(scene)
+    scene["chain"]["segments"] = np.int64(3)
+    scene["chain"]["a"] = np.float64(0.5)
+    scene["path"]["to"] = np.float32(-2.5)
+    scene["solver"]["max_step"] = np.array(0.05)
+    with_numpy = buckle.run_scene(scene)
+    assert with_numpy["summary"]["complete"] == plain["summary"]["complete"]
+    assert len(with_numpy["special_points"]) == len(plain["special_points"])
+    # an array where a list of numbers goes: the per-segment q0
+    scene["chain"]["q0"] = np.zeros(3)
+    assert buckle.run_scene(scene)["summary"]["complete"]
+    scene["chain"]["a"] = object()
+    with pytest.raises(TypeError, match="a scene dict holds numbers, strings, lists and dicts; got a value of type object"):
+        buckle.run_scene(scene)

@@ -177,6 +177,19 @@ void generalisedEigen(const Matrix& A, const Matrix& B, int wanted, std::vector<
   }
 }
 
+// The chain's force unit k̄ b̄ (largest spring stiffness × largest half-length). K_q is a torque
+// per rad (k b²), the load matrix per unit load a length (b): "K_q ≈ 0 against the loads" compares
+// K_q with the load matrix times this unit, the same in every system of units.
+double forceUnit(const Chain& chain) {
+  double k = 0.0, b = 0.0;
+  for (int i = 0; i < chain.size(); ++i) {
+    const SegmentParameters& p = chain.segment(i).parameters();
+    k = std::max({k, p.k1, p.k2});
+    b = std::max({b, p.b1, p.b2});
+  }
+  return k * b;
+}
+
 }  // namespace
 
 LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const EndCondition& end,
@@ -214,7 +227,7 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
   // Long chains and a few modes: O(n) per mode through the chain structure.
   if (n > kStructuredBucklingFrom && options.count > 0 && m <= 3) {
     LinearBucklingResult fast;
-    if (structuredBuckling(data, kq, Ch, options, fast)) return fast;
+    if (structuredBuckling(data, kq, Ch, options, forceUnit(chain), fast)) return fast;
   }
   if (n > kMaxDensePencil) {
     std::ostringstream os;
@@ -262,8 +275,8 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
   const Eigen::SelfAdjointEigenSolver<Matrix> esA(A, Eigen::EigenvaluesOnly);
   const double Ascale = esA.eigenvalues().cwiseAbs().maxCoeff();
   const double Gscale = std::max(1e-300, G.cwiseAbs().maxCoeff());
-  // K_q ≈ 0 relative to the load matrix (per unit load and length): κ = 0.
-  out.degenerate = Ascale <= 1e-13 * Gscale;
+  // K_q ≈ 0 relative to the load matrix (per unit load and length) in the chain's force unit: κ = 0.
+  out.degenerate = Ascale <= 1e-13 * Gscale * forceUnit(chain);
   // κ = 0 is marginal, not stable: the sign of a rounding-level K_q must not decide it.
   out.unloadedStable = !out.degenerate && esA.eigenvalues()[0] > 0.0;
 

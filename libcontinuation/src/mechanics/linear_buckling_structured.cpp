@@ -214,11 +214,11 @@ bool criticalLoad(StructuredPencil& p, int side, int j, double hi, std::vector<s
 
 // Returns false (the caller goes dense) when K_q is not definite on ker J_h.
 bool structuredModes(ConstVectorRef g, ConstVectorRef kq, const Matrix& Ch, const LinearBucklingOptions& options,
-                     std::vector<std::pair<double, Vector>>& pairs, LinearBucklingResult& out) {
+                     double force, std::vector<std::pair<double, Vector>>& pairs, LinearBucklingResult& out) {
   const int n = int(g.size());
   const double gmax = std::max(1e-300, g.cwiseAbs().maxCoeff());
   const double kmax = kq.cwiseAbs().maxCoeff();
-  if (kmax <= 1e-13 * gmax) return false;  // κ ≈ 0: every load is 0, the dense path says so
+  if (kmax <= 1e-13 * gmax * force) return false;  // κ ≈ 0: every load is 0, the dense path says so
   StructuredPencil pencil(g, kq, Ch.transpose());
   const Inertia unloaded = pencil.unloadedInertia();
   if (unloaded.zero != 0 || (unloaded.negative != 0 && unloaded.positive != 0)) return false;
@@ -253,12 +253,12 @@ bool structuredModes(ConstVectorRef g, ConstVectorRef kq, const Matrix& Ch, cons
 }  // namespace
 
 bool structuredBuckling(const ChainData& data, const Vector& kq, const Matrix& Ch, const LinearBucklingOptions& options,
-                        LinearBucklingResult& fast) {
+                        double force, LinearBucklingResult& fast) {
   const int n = int(kq.size());
   std::vector<std::pair<double, Vector>> fastPairs;
   Vector gvec(n);
   loadHessianGenerator(data, Wrench(options.direction[0], options.direction[1], 0.0), gvec);
-  if (!structuredModes(gvec, kq, Ch, options, fastPairs, fast)) return false;
+  if (!structuredModes(gvec, kq, Ch, options, force, fastPairs, fast)) return false;
   Vector Gz(n), t(n);
   for (auto& [lambda, z] : fastPairs) {
     Eigen::Index imax = 0;
