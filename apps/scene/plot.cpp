@@ -22,6 +22,7 @@
 #include "scene/child_process.h"
 #include "scene/escape.h"
 #include "scene/output.h"
+#include "scene/plot_range.h"
 #include "scene/signals.h"
 
 namespace buckle::scene {
@@ -146,20 +147,6 @@ struct Frame {
       os << "set yrange [" << num(ylo) << ":" << num(yhi) << "]\n";
   }
 };
-
-/// [lo, hi] widened to multiples of a round tic step (1, 2 or 5 × 10^k, about six tics), as
-/// gnuplot's autoscale would, so that fixing the range does not change the plot's look.
-std::pair<double, double> niceRange(double lo, double hi) {
-  if (!std::isfinite(lo) || !std::isfinite(hi)) return {0.0, 1.0};
-  if (!(hi > lo)) {
-    const double half = lo != 0.0 ? 0.1 * std::abs(lo) : 1.0;
-    lo -= half;
-    hi += half;
-  }
-  const double raw = (hi - lo) / 6.0, mag = std::pow(10.0, std::floor(std::log10(raw))), f = raw / mag;
-  const double step = (f < 1.5 ? 1.0 : f < 3.0 ? 2.0 : f < 7.0 ? 5.0 : 10.0) * mag;
-  return {std::floor(lo / step + 1e-9) * step, std::ceil(hi / step - 1e-9) * step};
-}
 
 /// Characters of a UTF-8 string (the width of a label in the font's average advance).
 size_t glyphs(const std::string& s) {
@@ -479,9 +466,11 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   std::vector<Series> series;
   std::vector<std::vector<Eigen::Vector2d>> polylines;  // in data coordinates, for the label placement
   double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo, ylo = xlo, yhi = -xlo;
+  std::vector<double> ys;  // a stiffness plot's values, framed without the run-up to its poles
   auto extend = [&](double x, double y) {
     if (!std::isfinite(x) || !std::isfinite(y)) return;
     xlo = std::min(xlo, x), xhi = std::max(xhi, x), ylo = std::min(ylo, y), yhi = std::max(yhi, y);
+    if (spec.type == PlotType::Stiffness) ys.push_back(y);
   };
   for (size_t o = 0; o < cases.size(); ++o) {
     const CaseResult& cr = run.cases[cases[o]];
@@ -622,6 +611,7 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
   std::tie(f.xlo, f.xhi) = niceRange(xlo, xhi);
   // stiffness spans decades (the straight chain against a buckled one): a log axis in whole decades
   // when every drawn value is positive and they span more than two
+  if (spec.type == PlotType::Stiffness && ylo <= 0.0) std::tie(ylo, yhi) = framedRange(ys);
   f.logY = spec.type == PlotType::Stiffness && ylo > 0.0 && std::isfinite(yhi) && yhi > 100.0 * ylo;
   if (f.logY)
     f.ylo = std::floor(std::log10(ylo)), f.yhi = std::ceil(std::log10(yhi));

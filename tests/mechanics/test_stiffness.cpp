@@ -237,3 +237,32 @@ TEST_CASE("singular cases: bordered solves where K_q - K_g alone is singular", "
   // beyond it the force-controlled equilibrium has one negative direction
   CHECK(loadedStiffness(chain, q, Wrench(Fs[0] * 1.01, 0.0, 0.0)).negativeDirections == 1);
 }
+
+TEST_CASE("the lateral compliance of the free chain vanishes at the clamped-pinned critical load", "[stiffness]") {
+  // The end held laterally (y) makes [[H, J_yᵀ], [J_y, 0]] singular exactly where the free chain's
+  // J_y H⁻¹ J_yᵀ = C_yy is zero (H regular there): the pinned critical loads are the zeros of C_yy
+  // and the poles of 1/C_yy, and C_F reports them as an exact 0 (the rounding left of them is
+  // below complianceAccuracy), in any units.
+  const int n = 6;
+  for (const double scale : {1.0, 1e-4, 1e4}) {
+    const double stiffnessScale = scale == 1.0 ? 1.0 : 1.0 / (scale * scale * 1e4);
+    const Chain chain =
+        Chain::uniform(n, SegmentParameters::symmetric(0.5 * scale, scale, stiffnessScale, 2.25 * scale));
+    const Vector straight = Vector::Zero(n);
+    const EndCondition pinned = EndCondition::clampedPinned(0.0);
+    const LinearBucklingResult lb = linearBuckling(chain, straight, pinned);
+    REQUIRE_FALSE(lb.modes.empty());
+    const double Fc = lb.modes[0].lambda;
+    const CartesianStiffness at = loadedStiffness(chain, straight, Wrench(Fc, 0.0, 0.0), false);
+    REQUIRE_FALSE(at.singular);
+    CHECK(at.compliance(1, 1) == 0.0);
+    CHECK(at.compliance(0, 0) == 0.0);  // the straight chain's axial rigidity
+    // either side of it C_yy is finite and of opposite signs, |C_yy| growing linearly away from it
+    const CartesianStiffness before = loadedStiffness(chain, straight, Wrench(Fc * (1 - 1e-6), 0.0, 0.0), false);
+    const CartesianStiffness after = loadedStiffness(chain, straight, Wrench(Fc * (1 + 1e-6), 0.0, 0.0), false);
+    const CartesianStiffness further = loadedStiffness(chain, straight, Wrench(Fc * (1 + 2e-6), 0.0, 0.0), false);
+    CHECK(before.compliance(1, 1) * after.compliance(1, 1) < 0.0);
+    CHECK(std::abs(before.compliance(1, 1)) > 1e3 * before.complianceAccuracy(1, 1));
+    CHECK(further.compliance(1, 1) / after.compliance(1, 1) == Approx(2.0).epsilon(1e-4));
+  }
+}

@@ -20,8 +20,10 @@ double conditioning(const Eigen::Matrix2d& A) {
   return ev.cwiseAbs().minCoeff() / big;
 }
 
-// Solves the symmetric bordered system [[H, Cᵀ], [C, 0]] X = R; false if it is singular.
-bool borderedSolve(const Matrix& H, const Matrix& C, const Matrix& R, double tolerance, Matrix& X) {
+// Solves the symmetric bordered system [[H, Cᵀ], [C, 0]] X = R; false if it is singular. `rcond`
+// (if given) receives the LU's estimate of the reciprocal condition number.
+bool borderedSolve(const Matrix& H, const Matrix& C, const Matrix& R, double tolerance, Matrix& X,
+                   double* rcond = nullptr) {
   const Eigen::Index n = H.rows(), m = C.rows();
   Matrix B = Matrix::Zero(n + m, n + m);
   B.topLeftCorner(n, n) = H;
@@ -30,6 +32,7 @@ bool borderedSolve(const Matrix& H, const Matrix& C, const Matrix& R, double tol
     B.bottomLeftCorner(m, n) = C;
   }
   const Eigen::PartialPivLU<Matrix> lu(B);
+  if (rcond) *rcond = lu.rcond();
   if (!(lu.rcond() > tolerance)) return false;
   X = lu.solve(R);
   if (!X.allFinite()) return false;
@@ -73,9 +76,19 @@ CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const W
   Matrix R = Matrix::Zero(n + Cphi.rows(), 2);
   R.topRows(n) = Jp.transpose();
   Matrix X;
-  if (borderedSolve(H, Cphi, R, options.singularTolerance, X)) {
+  double rcond = 0.0;
+  if (borderedSolve(H, Cphi, R, options.singularTolerance, X, &rcond)) {
     Eigen::Matrix2d C = Jp * X.topRows(n);
     C = 0.5 * (C + C.transpose());
+    // A backward-stable solve perturbs X by ε κ(B) |X| per column, so C_ij = J_i·X_j by
+    // ε κ |J_i| |X_j|: an entry below that is a zero of C_F (e.g. C_yy of a chain whose end is
+    // held laterally, at its critical load: the pole of the lateral stiffness), set to 0.
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        out.complianceAccuracy(i, j) = 16.0 * std::numeric_limits<double>::epsilon() / rcond *
+                                       0.5 * (Jp.row(i).norm() * X.col(j).head(n).norm() +
+                                              Jp.row(j).norm() * X.col(i).head(n).norm());
+    C = (C.cwiseAbs().array() <= out.complianceAccuracy.array()).select(0.0, C);
     out.compliance = C;
     if (conditioning(C) > options.singularTolerance) {
       out.stiffness = C.inverse();

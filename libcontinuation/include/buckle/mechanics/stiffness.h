@@ -27,6 +27,9 @@ namespace buckle::mechanics {
 struct CartesianStiffness {
   Eigen::Matrix2d stiffness = Eigen::Matrix2d::Zero();   ///< K_F: δF = K_F δp (rows/cols x, y)
   Eigen::Matrix2d compliance = Eigen::Matrix2d::Zero();  ///< C_F = K_F⁻¹ (NaN when K_F is singular)
+  /// Rounding bound of each entry of C_F (ε κ |J_i| |X_j| of the bordered solve); an entry of
+  /// C_F below its bound is reported as exactly 0 (a rigid direction, or a pole of 1/C_ii).
+  Eigen::Matrix2d complianceAccuracy = Eigen::Matrix2d::Zero();
   bool rotationHeld = false;
   /// K_F is singular: infinite compliance in some direction (C_F NaN). Set where K_q − K_g is
   /// singular on ker J_φ (force-control limit / bifurcation point); K_F is then still given.

@@ -1,0 +1,22 @@
+// Axis ranges of the plots: round tic steps, and a frame that shows a curve's bulk where a few of
+// its values run off to a pole (a stiffness 1/C through C = 0).
+#pragma once
+
+#include <utility>
+#include <vector>
+
+namespace buckle::scene {
+
+/// [lo, hi] widened to multiples of a round tic step (1, 2 or 5 × 10^k, about six tics), as
+/// gnuplot's autoscale would, so that fixing the range does not change the plot's look.
+std::pair<double, double> niceRange(double lo, double hi);
+
+/// The range of `values` (finite ones; the order is changed) that a plot frames: all of them,
+/// unless some lie further than kPoleReach interquantile spreads (the 5th to the 95th percentile)
+/// beyond those percentiles — the run-up to a pole — in which case the frame ends one spread
+/// beyond the percentile on that side, and the curve leaves the frame there.
+/// {+inf, −inf} when no value is finite.
+std::pair<double, double> framedRange(std::vector<double>& values);
+constexpr double kPoleReach = 4.0;
+
+}  // namespace buckle::scene

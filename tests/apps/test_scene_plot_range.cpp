@@ -1,0 +1,68 @@
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "scene/plot_range.h"
+
+using namespace buckle::scene;
+
+TEST_CASE("niceRange: round tic steps that contain the data", "[plot]") {
+  for (const auto& [lo, hi] : std::vector<std::pair<double, double>>{{0.3, 7.9}, {-12.0, 0.0}, {1e-9, 3e-9}, {-2e7, 5e6}}) {
+    const auto [a, b] = niceRange(lo, hi);
+    CHECK(a <= lo);
+    CHECK(b >= hi);
+    // the widening is less than one tic step (a sixth or so of the range) on either side
+    CHECK(lo - a <= 0.5 * (hi - lo));
+    CHECK(b - hi <= 0.5 * (hi - lo));
+    // both ends on a multiple of a round step 1, 2 or 5 × 10^k near a sixth of the range
+    const double mag = std::pow(10.0, std::floor(std::log10((hi - lo) / 6.0)));
+    bool round = false;
+    for (double m : {1.0, 2.0, 5.0, 10.0}) {
+      const double ka = a / (m * mag), kb = b / (m * mag);
+      round = round || (std::abs(ka - std::round(ka)) < 1e-6 && std::abs(kb - std::round(kb)) < 1e-6);
+    }
+    CHECK(round);
+  }
+  const auto [a, b] = niceRange(2.0, 2.0);  // a point: a range around it
+  CHECK(a < 2.0);
+  CHECK(b > 2.0);
+}
+
+TEST_CASE("framedRange: the whole of a smooth curve, the bulk of a curve through a pole", "[plot]") {
+  std::vector<double> smooth;
+  for (int i = 0; i <= 200; ++i) smooth.push_back(std::sin(0.05 * i) * 3.0 + 1.0);
+  const double lo = *std::min_element(smooth.begin(), smooth.end()), hi = *std::max_element(smooth.begin(), smooth.end());
+  std::vector<double> copy = smooth;
+  const auto [a, b] = framedRange(copy);
+  CHECK(a == lo);
+  CHECK(b == hi);
+
+  // K = 1/C with C through zero at x = 0.5: the samples nearest the pole reach ±1e4, the rest is O(1)
+  std::vector<double> pole;
+  for (int i = 0; i <= 200; ++i) {
+    const double x = (i + 0.5) / 201.0 - 0.5;
+    pole.push_back(1.0 / (x * (1.0 + x)) * 1e-2 + 2.0);
+  }
+  copy = pole;
+  const auto [c, d] = framedRange(copy);
+  std::vector<double> sorted = pole;
+  std::sort(sorted.begin(), sorted.end());
+  CHECK(c > sorted.front());  // clipped on both sides
+  CHECK(d < sorted.back());
+  CHECK(c <= sorted[10]);     // and the 5th to 95th percentile is inside the frame
+  CHECK(d >= sorted[190]);
+
+  // a constant with one pole value: the constant stays in view, the pole does not stretch it
+  std::vector<double> flat(100, 5.0);
+  flat.push_back(1e9);
+  const auto [e, f] = framedRange(flat);
+  CHECK(e == 5.0);
+  CHECK(f == Approx(10.0));
+
+  std::vector<double> none{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()};
+  const auto [g, h] = framedRange(none);
+  CHECK(g > h);
+}
