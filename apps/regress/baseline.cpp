@@ -71,13 +71,14 @@ CaseEntry readCase(const JsonReader& r, const json& v, const Pointer& p) {
   if (!sps.is_array()) r.expected(p / "special_points", sps, "an array");
   for (size_t i = 0; i < sps.size(); ++i) {
     const Pointer pi = p / "special_points" / i;
-    r.onlyKeys(sps[i], pi, {"branch", "type", "order", "lambda", "shape", "tolerance"});
+    r.onlyKeys(sps[i], pi, {"branch", "type", "order", "lambda", "shape", "post_buckling", "tolerance"});
     SpecialEntry s;
     s.branch = r.integer(r.required(sps[i], pi, "branch"), pi / "branch", -1, 1000000);
     s.type = r.string(r.required(sps[i], pi, "type"), pi / "type");
     s.order = r.integer(r.required(sps[i], pi, "order"), pi / "order", 0, 1000000);
     s.lambda = r.number(r.required(sps[i], pi, "lambda"), pi / "lambda");
     s.shape = r.string(r.required(sps[i], pi, "shape"), pi / "shape");
+    if (sps[i].contains("post_buckling")) s.postBuckling = r.string(sps[i]["post_buckling"], pi / "post_buckling");
     s.tolerance = readTolerance(r, r.required(sps[i], pi, "tolerance"), pi / "tolerance");
     c.specials.push_back(s);
   }
@@ -170,9 +171,12 @@ std::string formatBaseline(const Baseline& b) {
     jc["label"] = c.label;
     jc["branches"] = c.branches;
     ordered_json sps = ordered_json::array();
-    for (const SpecialEntry& s : c.specials)
-      sps.push_back(ordered_json{{"branch", s.branch}, {"type", s.type}, {"order", s.order}, {"lambda", s.lambda},
-                                 {"shape", s.shape}, {"tolerance", toJson(s.tolerance)}});
+    for (const SpecialEntry& s : c.specials) {
+      ordered_json e{{"branch", s.branch}, {"type", s.type}, {"order", s.order}, {"lambda", s.lambda}, {"shape", s.shape}};
+      if (!s.postBuckling.empty()) e["post_buckling"] = s.postBuckling;
+      e["tolerance"] = toJson(s.tolerance);
+      sps.push_back(e);
+    }
     jc["special_points"] = sps;
     ordered_json samples = ordered_json::array();
     for (const SampleEntry& s : c.samples) {
@@ -200,6 +204,7 @@ std::vector<SpecialEntry> numberSpecials(const MeasuredCase& c, const ToleranceP
     e.order = counts[{s.branch, s.type}]++;
     e.lambda = s.lambda;
     e.shape = s.shape;
+    e.postBuckling = s.postBuckling;
     e.tolerance.relative = policy.lambdaRelative;
     e.tolerance.absolute = std::max(policy.lambdaAbsolute, policy.accuracyFactor * s.accuracy);
     out.push_back(e);

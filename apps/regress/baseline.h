@@ -36,6 +36,9 @@ struct SpecialEntry {
   int order = 0;  ///< k-th point of this type on this branch
   double lambda = 0.0;
   std::string shape;
+  /// The branch point's post-buckling name; empty (and absent from the file) elsewhere, and in
+  /// baselines written before it was recorded (then not compared).
+  std::string postBuckling;
   Tolerance tolerance;
 };
 

@@ -65,6 +65,11 @@ void compareCase(const std::string& name, const std::string& prefix, const CaseE
     rows.push_back(numeric(name, q + " lambda", s.lambda, it->second.lambda, s.tolerance.allowed(s.lambda)));
     rows.push_back({name, q + " shape", s.shape, it->second.shape, s.shape == it->second.shape ? "-" : "differs", "equal",
                     s.shape == it->second.shape ? Status::Pass : Status::Fail});
+    if (!s.postBuckling.empty()) {
+      const bool same = s.postBuckling == it->second.postBuckling;
+      rows.push_back({name, q + " post_buckling", s.postBuckling, it->second.postBuckling.empty() ? "none" : it->second.postBuckling,
+                      same ? "-" : "differs", "equal", same ? Status::Pass : Status::Fail});
+    }
     now.erase(it);
   }
   for (const auto& [key, s] : now)

@@ -26,18 +26,20 @@ namespace {
 MeasuredCase fromScene(const scene::CaseResult& c) {
   MeasuredCase m;
   m.label = c.label;
-  for (const scene::SpecialRecord& s : c.specials) m.specials.push_back({s.branch, s.type, s.parameter, s.shape, s.accuracy});
+  for (const scene::SpecialRecord& s : c.specials)
+    m.specials.push_back({s.branch, s.type, s.parameter, s.shape, s.accuracy,
+                          s.koiter.valid ? mechanics::postBucklingName(s.koiter) : std::string()});
   // the located results of the analyses without branches, on pseudo-branch -1
   if (c.haveCritical)
-    for (const mechanics::BucklingMode& mode : c.critical.modes) m.specials.push_back({-1, "CRIT", mode.lambda, mode.shape, 0.0});
+    for (const mechanics::BucklingMode& mode : c.critical.modes) m.specials.push_back({-1, "CRIT", mode.lambda, mode.shape, 0.0, {}});
   if (c.haveLandscape)
     for (const mechanics::LandscapeEquilibrium& e : c.landscape.equilibria)
-      m.specials.push_back({-1, "EQ", e.q1, e.shape + (e.stable ? " stable" : " unstable"), 0.0});
+      m.specials.push_back({-1, "EQ", e.q1, e.shape + (e.stable ? " stable" : " unstable"), 0.0, {}});
   if (c.haveTorque)
-    for (const auto& [q, stable] : c.torque.equilibria) m.specials.push_back({-1, "TEQ", q, stable ? "stable" : "unstable", 0.0});
+    for (const auto& [q, stable] : c.torque.equilibria) m.specials.push_back({-1, "TEQ", q, stable ? "stable" : "unstable", 0.0, {}});
   if (c.haveSudden && c.sudden.success) {
     const std::string shape = mechanics::shapeName(c.sudden.rest, 1e-6) + (c.sudden.stable ? " stable" : " unstable");
-    for (Eigen::Index i = 0; i < c.sudden.rest.size(); ++i) m.specials.push_back({-1, "REST", c.sudden.rest[i], shape, 0.0});
+    for (Eigen::Index i = 0; i < c.sudden.rest.size(); ++i) m.specials.push_back({-1, "REST", c.sudden.rest[i], shape, 0.0, {}});
   }
   for (const scene::PointRecord& p : c.points) {
     if (m.branches.empty() || m.branches.back().id != p.branch) m.branches.push_back({p.branch, {}, {}, {}});

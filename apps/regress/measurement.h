@@ -30,6 +30,9 @@ struct MeasuredSpecial {
   double lambda = 0.0;
   std::string shape;
   double accuracy = 0.0; ///< how precisely λ is known (location accuracy or point spacing)
+  /// A branch point's post-buckling name (mechanics::postBucklingName, e.g. "degenerate
+  /// subcritical"); empty elsewhere.
+  std::string postBuckling;
 };
 
 /// One traced branch: path parameter and joint angles at each point, in tracing order.

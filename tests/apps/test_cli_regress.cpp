@@ -116,6 +116,17 @@ TEST_CASE("buckle regress reports a value shifted beyond its tolerance as FAIL, 
   std::ofstream(dir / "auto_A_U.json") << doc.dump(2);
   CHECK(exitCode(regress(dir, "--only auto_A_U"), log) == 1);
   CHECK(slurp(log).find("shape") != std::string::npos);
+
+  // so does a branch point's post-buckling classification (recorded with every BP that has one)
+  REQUIRE(exitCode(update(dir), log) == 0);
+  doc = nlohmann::ordered_json::parse(slurp(dir / "default.json"));
+  auto& bp = doc["cases"][0]["special_points"][0];
+  REQUIRE(bp["type"] == "BP");
+  REQUIRE(bp.contains("post_buckling"));
+  bp["post_buckling"] = bp["post_buckling"] == "subcritical" ? "supercritical" : "subcritical";
+  std::ofstream(dir / "default.json") << doc.dump(2);
+  CHECK(exitCode(regress(dir, "--only default"), log) == 1);
+  CHECK(slurp(log).find("b0 BP#0 post_buckling") != std::string::npos);
 }
 
 TEST_CASE("buckle regress on a malformed baseline exits 2 naming the file and the JSON path", "[cli][regress]") {

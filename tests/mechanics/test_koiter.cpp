@@ -386,3 +386,25 @@ TEST_CASE("A degenerate pitchfork (the design map's DP): b zero to its accuracy,
   const double slope = (above.b - below.b) / 2e-4;
   CHECK(k.bAccuracy <= std::abs(slope) * 1e-8);
 }
+
+TEST_CASE("The degenerate pitchfork in scaled units: b zero to its accuracy in every unit system", "[koiter]") {
+  // lengths ×L, stiffness ×K: λ and b scale with the force K·L; the reduction runs in the
+  // problem's own units, so b/(K L) and its accuracy are those of the unscaled chain
+  const double dp = 0.6200239760986634;
+  for (auto [L, K] : std::vector<std::pair<double, double>>{{1, 1}, {1e-4, 1e8}, {1, 1e8}, {1e-4, 1e4}, {2.0, 1.0}}) {
+    const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(2.0 * L, 1.0 * L, 1.0 * K, dp * L));
+    EquilibriumProblem p(chain, EndCondition::clampedPinned(0.0), kAxial);
+    const EquilibriumBranches r = traceChain(p, 3, -12.0 * K * L, 0);
+    int found = 0;
+    for (const SpecialPointReport& s : r.reports[0].specialPoints)
+      if (s.type == EventType::BranchPoint && s.koiter.valid) {
+        ++found;
+        INFO("L " << L << " K " << K << ": b/(KL) = " << s.koiter.b / (K * L) << " +- " << s.koiter.bAccuracy / (K * L));
+        CHECK(std::abs(s.koiter.b) <= s.koiter.bAccuracy);
+        CHECK(s.koiter.degenerate);
+        // b's slope in L0 is about 0.04 K (L0 in b): the accuracy resolves L0 to 1e-8 of b
+        CHECK(s.koiter.bAccuracy <= 0.04 * K * L * 1e-8);
+      }
+    CHECK(found == 1);
+  }
+}

@@ -1,6 +1,7 @@
 #include "buckle/continuation/branch_point_coefficients.h"
 
 #include "buckle/continuation/bordered_solver.h"
+#include "buckle/continuation/scaled_problem.h"
 #include "buckle/continuation/structured_refinement.h"
 
 #include <Eigen/LU>
@@ -332,18 +333,20 @@ bool reduce(Problem &problem, Algebra &algebra, ConstVectorRef u0, double lambda
   if (!solve(-(a * Fed + 0.5 * Fee), u2) || !solve(-Fdd, p2Perp) || !u2.allFinite() || !p2Perp.allFinite())
     return fail(why, "branch-point coefficients: singular bordered system for u2");
 
-  // third order: b, at the difference step h and at 2h; their difference bounds the
-  // differences' error (truncation and rounding) in any units
-  ThirdOrder third, coarse;
+  // third order: b at the difference step h, and at 2h and h/2: the spread of the three bounds
+  // the differences' error (truncation, which grows with the step, and rounding, which falls
+  // with it; one pair alone can agree by chance), in any units
+  ThirdOrder third, coarse, fine;
   const ThirdOrderInput in{algebra, u0, lambdaC, s, e, dv, v, psi, p1, p2Perp, u2, a, tau};
-  if (!thirdOrder(in, 1.0, third) || !thirdOrder(in, 2.0, coarse))
+  if (!thirdOrder(in, 1.0, third) || !thirdOrder(in, 2.0, coarse) || !thirdOrder(in, 0.5, fine))
     return fail(why, "branch-point coefficients: the problem refused a point near (u0, λc)");
   const double b = third.b;
   if (!std::isfinite(a) || !std::isfinite(b)) return fail(why, "branch-point coefficients: not finite");
   // b's accuracy: a b that cancels to zero keeps the rounding of its terms (64ε for the sums and
   // the bordered solves) and the third derivatives' error, bounded by the two steps' difference
   out.bScale = third.scale;
-  out.bAccuracy = out.bScale * 64.0 * std::numeric_limits<double>::epsilon() + std::abs(coarse.b - b);
+  out.bAccuracy = out.bScale * 64.0 * std::numeric_limits<double>::epsilon() +
+                  2.0 * std::max(std::abs(coarse.b - b), std::abs(fine.b - b));
   const Vector &p2 = third.p2;
 
   // the ABE in the orthonormal basis t = d/|d|, φ ⊥ t of ker F_x (Euclidean in (u, λ))
@@ -370,6 +373,44 @@ bool reduce(Problem &problem, Algebra &algebra, ConstVectorRef u0, double lambda
   out.u2 = u2;
   return true;
 }
+
+/// The reduction in the problem's scaled variables (scaled_problem.h), its results in the user's:
+/// with u = D_u ũ, λ = λ₀λ̃, F = D_F F̃ and ξ = cᵀ(u − u_p) = (D_u c)ᵀ(ũ − ũ_p) the same amplitude,
+///   a = λ₀ã, b = λ₀b̃, v = D_u ṽ, p1 = D_u p̃1/λ₀, p2 = D_u p̃2/λ₀², u2 = D_u ũ2,
+///   ψ = D_F⁻¹ψ̃/ν and τ = τ̃/(νλ₀) with ν = (D_F⁻¹ψ̃)ᵀv (so that ψᵀv = 1).
+/// Differences, solves and thresholds then act on O(1) quantities in every unit system: in the
+/// user's variables a chain in lengths of 1e−4 mixes rows and unknowns 1e4 apart, and the third
+/// derivatives lose four digits more than their estimate.
+bool scaledReduction(Problem &problem, const ProblemScales &s, ConstVectorRef u0, double lambdaC,
+                     ConstVectorRef parentTangent, ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out,
+                     std::string *why, CoefficientAlgebra algebra) {
+  const UnitScaling units(s);
+  ScaledProblem scaled(problem, units);
+  const Vector &Du = s.unknowns;
+  const double l0 = s.parameter;
+  BranchPointCoefficients g;
+  if (!branchPointCoefficients(scaled, u0.cwiseQuotient(Du), lambdaC / l0, units.directionToScaled(parentTangent),
+                               v0.cwiseQuotient(Du), c.cwiseProduct(Du), g, why, algebra))
+    return false;
+  out = g;
+  out.a = l0 * g.a;
+  out.b = l0 * g.b;
+  out.bScale = l0 * g.bScale;
+  out.bAccuracy = l0 * g.bAccuracy;
+  out.v = g.v.cwiseProduct(Du);
+  const Vector psi = g.psi.cwiseQuotient(s.residuals);
+  const double nu = psi.dot(out.v);
+  if (!(std::abs(nu) > 0.0) || !std::isfinite(nu))
+    return fail(why, "branch-point coefficients: the left null vector is orthogonal to v in the user's units");
+  out.psi = psi / nu;
+  out.transversality = g.transversality / (nu * l0);
+  out.parentSlope = g.parentSlope.cwiseProduct(Du) / l0;
+  out.parentCurvature = g.parentCurvature.cwiseProduct(Du) / (l0 * l0);
+  out.u2 = g.u2.cwiseProduct(Du);
+  out.childTangent = units.directionToUser(g.childTangent);
+  return true;
+}
+
 }  // namespace
 
 bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
@@ -379,6 +420,8 @@ bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC
   if (u0.size() != n || v0.size() != n || c.size() != n || parentTangent.size() != n + 1)
     return fail(why, "branch-point coefficients: u0, v and c must have the problem's dimension " + std::to_string(n) +
                          ", the parent tangent " + std::to_string(n + 1));
+  const ProblemScales s = problem.scales();
+  if (!s.identity()) return scaledReduction(problem, s, u0, lambdaC, parentTangent, v0, c, out, why, algebra);
   std::unique_ptr<BorderedSolver> solver;
   if (algebra == CoefficientAlgebra::Structured ||
       (algebra == CoefficientAlgebra::Automatic && n > kDenseCoefficientDimension)) {

@@ -194,6 +194,20 @@ bool ScaledProblem::secondDerivativeTransposeApply(ConstVectorRef u, double lamb
   return true;
 }
 
+bool ScaledProblem::secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
+                                          VectorRef y) {
+  // F̃_xx[x̃, z̃] = D_F⁻¹ F_xx[S x̃, S z̃]: the problem's own (exact, O(N)) product.
+  x_.resize(n_ + 1);
+  x_.head(n_) = x.head(n_).cwiseProduct(units_.scales().unknowns);
+  x_[n_] = x[n_] * units_.parameter();
+  z_.resize(n_ + 1);
+  z_.head(n_) = z.head(n_).cwiseProduct(units_.scales().unknowns);
+  z_[n_] = z[n_] * units_.parameter();
+  if (!problem_.secondDerivativeApply(user(u), lambda * units_.parameter(), x_, z_, y)) return false;
+  y.array() /= units_.scales().residuals.array();
+  return true;
+}
+
 bool ScaledProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) {
   if (!problem_.stabilityOperator(user(u), lambda * units_.parameter(), H, C)) return false;
   H /= units_.scales().stability;

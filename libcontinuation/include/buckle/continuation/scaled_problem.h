@@ -92,6 +92,8 @@ class ScaledProblem final : public Problem {
   bool jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) override;
   bool secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
                                       VectorRef y) override;
+  bool secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
+                             VectorRef y) override;
   bool hasStabilityOperator() const override { return problem_.hasStabilityOperator(); }
   bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override;
   /// The problem's own stability() (its inertia count must be relative to ‖H‖), eigenvalues / μ₀.
@@ -114,7 +116,7 @@ class ScaledProblem final : public Problem {
   UnitScaling units_;
   int n_;
   Vector u_, du_;
-  Vector x_, w_;  // (D_u, λ₀)·x̃ and w̃/D_F of the products
+  Vector x_, w_, z_;  // (D_u, λ₀)·x̃, w̃/D_F and (D_u, λ₀)·z̃ of the products
 };
 
 /// A problem's BorderedSolver for A(c) seen in the scaled variables:
