@@ -100,15 +100,18 @@ int update(const RegressOptions& o, std::ostream& out, std::ostream& err) {
   auto known = [&](const Source& s) {
     return std::any_of(todo.begin(), todo.end(), [&](const Baseline& b) { return b.source.kind == s.kind && b.source.name == s.name && b.source.timeLimit == s.timeLimit; });
   };
+  // the scenes and those of its galleries one folder down (hard/x.json: baseline hard_x)
   std::vector<fs::path> sceneFiles;
   std::error_code ec;
-  for (fs::directory_iterator it(scenes, ec), end; !ec && it != end; it.increment(ec))
-    if (it->path().extension() == ".json") sceneFiles.push_back(it->path());
+  for (fs::recursive_directory_iterator it(scenes, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it.depth() > 1 || it->path().extension() != ".json" || !it->is_regular_file()) continue;
+    sceneFiles.push_back(fs::relative(it->path(), scenes));
+  }
   std::sort(sceneFiles.begin(), sceneFiles.end());
   for (const fs::path& f : sceneFiles) {
     Baseline b;
-    b.source = {Source::Kind::Scene, f.filename().string()};
-    b.name = f.stem().string();
+    b.source = {Source::Kind::Scene, f.generic_string()};
+    b.name = f.has_parent_path() ? f.parent_path().generic_string() + "_" + f.stem().string() : f.stem().string();
     if (!known(b.source)) todo.push_back(b);
   }
   for (const std::string& p : problemNames()) {

@@ -35,6 +35,10 @@ MeasuredCase fromScene(const scene::CaseResult& c) {
   if (c.haveLandscape)
     for (const mechanics::LandscapeEquilibrium& e : c.landscape.equilibria)
       m.specials.push_back({-1, "EQ", e.q1, e.shape + (e.stable ? " stable" : " unstable"), 0.0, {}});
+  // codimension-two points of the two-parameter curves (value: μ, shape: the point's label)
+  for (const mechanics::CriticalCurve& curve : c.criticalCurves)
+    for (const mechanics::Codim2Point& p : curve.special)
+      if (p.converged) m.specials.push_back({-1, p.label, p.mu, p.label, p.accuracy, {}});
   if (c.haveTorque)
     for (const auto& [q, stable] : c.torque.equilibria) m.specials.push_back({-1, "TEQ", q, stable ? "stable" : "unstable", 0.0, {}});
   if (c.haveSudden && c.sudden.success) {

@@ -204,3 +204,29 @@ TEST_CASE("a time-limited baseline: stopped on time, what it computed agrees, th
   CHECK(exitCode(regress(dir, only), log) == 2);
   CHECK(slurp(log).find("/source/time_limit: a time limit applies to scenes only") != std::string::npos);
 }
+
+TEST_CASE("buckle regress --update finds a gallery one folder down and records its cusp points", "[cli][regress]") {
+  const fs::path dir = work("gallery");
+  const fs::path log = dir.parent_path() / "gallery.txt";
+  REQUIRE(exitCode("regress --update --baselines '" + dir.string() + "' --scenes '" + kScenes +
+                       "' --only hard_folds_near_cusp --repetitions 1",
+                   log) == 0);
+  INFO(slurp(log));
+  REQUIRE(fs::exists(dir / "hard_folds_near_cusp.json"));
+  const nlohmann::json doc = nlohmann::json::parse(slurp(dir / "hard_folds_near_cusp.json"));
+  CHECK(doc["source"]["scene"] == "hard/folds_near_cusp.json");
+  // the two folds at mirror loads, and the cusp of their fold curves at Fx = 0.3 = -kappa
+  int folds = 0, cusps = 0;
+  double foldSum = 0.0;
+  for (const auto& sp : doc["cases"][0]["special_points"]) {
+    if (sp["type"] == "LP") ++folds, foldSum += sp["lambda"].get<double>();
+    if (sp["type"] == "CP") {
+      ++cusps;
+      CHECK(std::abs(sp["lambda"].get<double>() - 0.3) <= 1e-12);
+    }
+  }
+  CHECK(folds == 2);
+  CHECK(std::abs(foldSum) <= 1e-15);
+  CHECK(cusps == 2);
+  CHECK(exitCode(regress(dir, "--only hard_folds_near_cusp"), log) == 0);
+}

@@ -114,20 +114,25 @@ TEST_CASE("hard case: unloading along the U branch to its tip gives one BP, stab
   }
 }
 
-TEST_CASE("hard case: kappa = 0, the triple point at the start of the path is switched like one met on the way",
+TEST_CASE("hard case: kappa = 0, the multiple point at the start of the path is switched like one met on the way",
           "[equilibrium_branches][hard]") {
-  // n = 4, L0 = 1.5: κ = 0, the unloaded straight chain's stiffness is singular and the linear
-  // analysis puts all three compressive critical loads at Fx = 0. Traced from Fx = 0 itself, both
-  // ways, the point is at the start of both roots; the same tree traced from Fx = 0.3 meets it on
-  // the way (test_equilibrium_branches.cpp checks that one's directions against the critical lines
-  // of the quartic ratio, the linear analysis at κ = 0): the same directions, all found.
-  const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.5));
-  for (const double crit : compressiveCriticalLoads(chain)) CHECK(std::abs(crit) <= 1e-12);
+  // L0 = 1.5: κ = 0, the unloaded straight chain's stiffness is singular and the linear analysis
+  // puts all n − 1 compressive critical loads at Fx = 0 (n = 3: a double point, n = 4: a triple
+  // one). Traced from Fx = 0 itself, both ways, the point is at the start of both roots; the same
+  // tree traced from Fx = 0.3 meets it on the way (test_equilibrium_branches.cpp checks that one's
+  // directions against the critical lines of the quartic ratio, the linear analysis at κ = 0): the
+  // same directions, all found; in the chain's own units and in lengths ×1e−4, stiffness ×1e8.
+  const int n = GENERATE(3, 4);
+  const double L = GENERATE(1.0, 1e-4);
+  const double K = L == 1.0 ? 1.0 : 1e8, F = K * L;
+  INFO("n = " << n << ", lengths x" << L << ", stiffness x" << K);
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5 * L, 1.0 * L, 1.0 * K, 1.5 * L));
+  for (const double crit : compressiveCriticalLoads(chain)) CHECK(std::abs(crit) <= 1e-12 * F);
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), kAxial);
   auto tree = [&](double lambda0, std::vector<cont::InitialDirection> starts) {
     EquilibriumBranchOptions o;
-    o.tracer.lambdaMin = -0.5;
-    o.tracer.lambdaMax = 0.5;
+    o.tracer.lambdaMin = -0.5 * F;
+    o.tracer.lambdaMax = 0.5 * F;
     o.tracer.maxStep = 0.05;
     o.tracer.initialStep = 0.01;
     o.switchingDepth = 1;
@@ -135,19 +140,19 @@ TEST_CASE("hard case: kappa = 0, the triple point at the start of the path is sw
     child.maxPoints = 12;
     child.maxStep = 0.02;
     o.childTracer = child;
-    return traceEquilibria(problem, Eigen::VectorXd::Zero(4), lambda0, starts, o);
+    return traceEquilibria(problem, Eigen::VectorXd::Zero(n), lambda0, starts, o);
   };
   const EquilibriumBranches atStart =
       tree(0.0, {cont::InitialDirection::decreasingLambda(), cont::InitialDirection::increasingLambda()});
-  const EquilibriumBranches onTheWay = tree(0.3, {cont::InitialDirection::decreasingLambda()});
-  auto multiple = [](const EquilibriumBranches& r, int& roots) {
+  const EquilibriumBranches onTheWay = tree(0.3 * F, {cont::InitialDirection::decreasingLambda()});
+  auto multiple = [n](const EquilibriumBranches& r, int& roots) {
     const cont::SpecialPoint* found = nullptr;
     roots = 0;
     for (const cont::Branch& b : r.tree.branches) {
       if (b.parentId >= 0) continue;
       ++roots;
       for (const cont::SpecialPoint& sp : b.specialPoints)
-        if (sp.type == cont::SpecialPointType::BranchPoint && sp.multiplicity == 3 && sp.branchesPredicted > 0)
+        if (sp.type == cont::SpecialPointType::BranchPoint && sp.multiplicity == n - 1 && sp.branchesPredicted > 0)
           found = &sp;
     }
     return found;
@@ -157,9 +162,13 @@ TEST_CASE("hard case: kappa = 0, the triple point at the start of the path is sw
   CHECK(roots == 2);
   REQUIRE(start);
   const cont::SpecialPoint* way = multiple(onTheWay, roots);
+  for (const cont::Branch& br : onTheWay.tree.branches)
+    for (const cont::SpecialPoint& sp : br.specialPoints)
+      UNSCOPED_INFO("on the way: branch " << br.id << " " << label(sp.type) << " at " << sp.lambda << " m "
+                                          << sp.multiplicity << " predicted " << sp.branchesPredicted << ": " << sp.note);
   REQUIRE(way);
   INFO(start->note);
-  CHECK(std::abs(start->lambda) <= 1e-12);
+  CHECK(std::abs(start->lambda) <= 1e-12 * F);
   CHECK(start->branchesPredicted == way->branchesPredicted);
   CHECK(start->branchesFound == start->branchesPredicted);
   // switched once, not again from the other root (the same point)
@@ -167,9 +176,9 @@ TEST_CASE("hard case: kappa = 0, the triple point at the start of the path is sw
   // the children leave along the same lines (as a set, up to sign)
   std::vector<Eigen::VectorXd> a, b;
   for (const cont::Branch& c : atStart.tree.branches)
-    if (c.parentId >= 0 && c.points.size() >= 2) a.push_back(c.points[1].u.head(4).normalized());
+    if (c.parentId >= 0 && c.points.size() >= 2) a.push_back(c.points[1].u.head(n).normalized());
   for (const cont::Branch& c : onTheWay.tree.branches)
-    if (c.parentId >= 0 && c.points.size() >= 2) b.push_back(c.points[1].u.head(4).normalized());
+    if (c.parentId >= 0 && c.points.size() >= 2) b.push_back(c.points[1].u.head(n).normalized());
   REQUIRE(a.size() == b.size());
   for (const Eigen::VectorXd& z : a) {
     double best = 0.0;

@@ -5,6 +5,10 @@
 // may report a fold (whose refinement then fails: the fold system is singular at a branch point)
 // beside the branch point. They are one point: the branch point is kept, with the stability before
 // the first and after the last, and the fold dropped.
+// Likewise a multiple branch point whose crossings rounding split over two adjacent steps (one
+// eigenvalue of the cluster a step early, by 1e-15 of λ's scale): the simple point of the first
+// step is within rounding of the multiple one, whose verified kernel holds its direction too. One
+// point of the larger multiplicity is kept, with the stability before the first and after the last.
 #include "buckle/continuation/tracer.h"
 
 #include <algorithm>
@@ -25,36 +29,51 @@ double distance(const SpecialPoint &p, const SpecialPoint &q) {
   return std::sqrt((p.u - q.u).squaredNorm() + (p.lambda - q.lambda) * (p.lambda - q.lambda));
 }
 
-}  // namespace
-
-void mergeCoincidentSpecialPoints(Branch &branch, size_t firstNew) {
+// Among the new points (from `firstNew`) and those of the step before them (a fold and a branch
+// point may fall in adjacent steps when a point lands on the tip): every point that `keeps` absorbs
+// one point that is `part` of it and closer than a thousandth of the steps that hold them (scaled
+// variables): the kept point takes the stability before the first and after the last, and `note`.
+template <class Keeps, class Part>
+void absorb(Branch &branch, size_t firstNew, Keeps keeps, Part part, const char *note) {
   std::vector<SpecialPoint> &sps = branch.specialPoints;
   if (firstNew >= sps.size()) return;
-  // the new points and those of the step before them: a fold and a branch point may fall in
-  // adjacent steps when a point lands on the tip
   const int newest = sps.back().index;
   size_t from = firstNew;
   while (from > 0 && sps[from - 1].index >= newest - 1) --from;
   for (size_t i = from; i < sps.size(); ++i) {
-    if (sps[i].type != SpecialPointType::BranchPoint || sps[i].multiplicity != 1) continue;
+    if (!keeps(sps[i])) continue;
     for (size_t j = from; j < sps.size(); ++j) {
-      const SpecialPoint &fold = sps[j];
-      if (fold.type != SpecialPointType::Fold || fold.u.size() != sps[i].u.size()) continue;
-      // the same point: closer than a thousandth of the steps that hold them (scaled variables)
-      const double step = std::max(stepLength(branch, fold.index), stepLength(branch, sps[i].index));
-      if (!(distance(fold, sps[i]) <= 1e-3 * step)) continue;
-      SpecialPoint &bp = sps[i];
-      const bool foldFirst = fold.arclength < bp.arclength;
-      if (foldFirst) bp.inertiaBefore = fold.inertiaBefore;
-      else bp.inertiaAfter = fold.inertiaAfter;
-      bp.note += (bp.note.empty() ? "" : "; ") +
-                 std::string("the traced branch turns in lambda here (the branch point reached along a bifurcated "
-                             "branch, at its tip): one point, not also a fold");
+      const SpecialPoint &other = sps[j];
+      if (j == i || other.u.size() != sps[i].u.size() || !part(other, sps[i])) continue;
+      const double step = std::max(stepLength(branch, other.index), stepLength(branch, sps[i].index));
+      if (!(distance(other, sps[i]) <= 1e-3 * step)) continue;
+      SpecialPoint &kept = sps[i];
+      if (other.arclength < kept.arclength) kept.inertiaBefore = other.inertiaBefore;
+      else kept.inertiaAfter = other.inertiaAfter;
+      kept.note += (kept.note.empty() ? "" : "; ") + std::string(note);
       sps.erase(sps.begin() + std::ptrdiff_t(j));
       if (j < i) --i;
       break;
     }
   }
+}
+
+}  // namespace
+
+void mergeCoincidentSpecialPoints(Branch &branch, size_t firstNew) {
+  auto isBranchPoint = [](const SpecialPoint &p) { return p.type == SpecialPointType::BranchPoint; };
+  absorb(
+      branch, firstNew, [&](const SpecialPoint &p) { return isBranchPoint(p) && p.multiplicity == 1; },
+      [](const SpecialPoint &p, const SpecialPoint &) { return p.type == SpecialPointType::Fold; },
+      "the traced branch turns in lambda here (the branch point reached along a bifurcated branch, at its tip): one "
+      "point, not also a fold");
+  absorb(
+      branch, std::min(firstNew, branch.specialPoints.size()),
+      [&](const SpecialPoint &p) { return isBranchPoint(p) && p.multiplicity >= 2; },
+      [&](const SpecialPoint &p, const SpecialPoint &multiple) {
+        return isBranchPoint(p) && p.multiplicity < multiple.multiplicity && std::abs(p.index - multiple.index) <= 1;
+      },
+      "one crossing of it counted in the adjacent step (within rounding): one point");
 }
 
 }  // namespace buckle::continuation

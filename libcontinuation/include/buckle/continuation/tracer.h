@@ -260,7 +260,9 @@ class Tracer {
 /// of the branch (within a thousandth of their steps, among the special points from `firstNew`
 /// on and those of the step before) is the tip of a bifurcated branch reached along it, which
 /// turns in λ there: the fold is dropped and the branch point keeps the stability before the
-/// first and after the last. The tracer calls it after every located step.
+/// first and after the last. Likewise a simple branch point in the step next to a multiple one
+/// and within rounding of it (one crossing of the cluster counted a step early) is absorbed by the
+/// multiple point. The tracer calls it after every located step.
 void mergeCoincidentSpecialPoints(Branch &branch, size_t firstNew);
 
 /// One-shot convenience: Tracer(problem, options).trace(u0, λ0, direction).
