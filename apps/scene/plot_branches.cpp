@@ -1,0 +1,549 @@
+// Bifurcation and stiffness diagrams (columns of branches.csv against the path parameter or each
+// other): branches by stability, special points marked and labelled apart, summary mode for
+// long chains and large trees.
+#include "scene/plot_internal.h"
+
+namespace buckle::scene::plot_detail {
+
+namespace {
+
+// ---- bifurcation / stiffness (columns of branches.csv) ----------------------------------------
+
+/// Column value at a special point; the columns that exist only at traced points (stiffness,
+/// smallest eigenvalue) are interpolated along the special point's branch between the two
+/// neighbouring points it lies between (exact where it is a traced point: a joint limit), unless
+/// the special point carries its own stiffness (KMIN, located between traced points).
+double specialValue(const std::string& column, const SpecialRecord& r, const CaseResult& cr) {
+  const double v = columnValue(column, r, cr.pose0);
+  if (std::isfinite(v) || r.q.size() == 0) return v;
+  double best = std::numeric_limits<double>::infinity(), value = v;
+  for (size_t i = 0; i + 1 < cr.points.size(); ++i) {
+    const PointRecord &a = cr.points[i], &b = cr.points[i + 1];
+    if (a.branch != r.branch || b.branch != r.branch || a.q.size() != r.q.size() || b.q.size() != r.q.size()) continue;
+    const Eigen::VectorXd d = b.q - a.q;
+    const double len2 = d.squaredNorm();
+    const double t = len2 > 0 ? std::clamp((r.q - a.q).dot(d) / len2, 0.0, 1.0) : 0.0;
+    const double dist = (r.q - a.q - t * d).norm();
+    // off the chord by more than half the spacing: not between these two points
+    if (dist > 0.5 * std::sqrt(len2) && dist > 0.0) continue;
+    if (dist < best) {
+      best = dist;
+      value = (1 - t) * columnValue(column, a, cr.pose0) + t * columnValue(column, b, cr.pose0);
+    }
+  }
+  return value;
+}
+
+struct SpecialStyle {
+  const char* type;
+  int point;       ///< gnuplot point type, filled; point - 1 is the open outline
+  const char* key;
+  const char* color;  ///< summary mode: the type's colour (markers of all cases)
+};
+const SpecialStyle kSpecialStyles[] = {{"BP", 7, "BP branch point", "#000000"},
+                                       {"LP", 9, "LP fold", "#d62728"},
+                                       {"LPF", 9, "LPF reaction fold", "#ff7f0e"},
+                                       {"BD", 5, "BD joint limit", "#8c564b"},
+                                       {"KMIN", 13, "KMIN Kxx minimum", "#9467bd"},
+                                       {"JUMP", 11, "JUMP release", "#ff7f0e"},
+                                       {"CT", 15, "CT contact (joint locks)", "#2ca02c"},
+                                       {"RL", 3, "RL contact released", "#17becf"},
+                                       {"BC", 5, "BC base contact (detected)", "#e377c2"},
+                                       {"SC", 5, "SC self contact (detected)", "#7f7f7f"}};
+
+const SpecialStyle& specialStyle(const std::string& type) {
+  for (const SpecialStyle& s : kSpecialStyles)
+    if (type == s.type) return s;
+  static const SpecialStyle other{"", 7, "special point", "#555555"};
+  return other;
+}
+
+// ---- summary mode (long chains, large trees) -----------------------------------------------------
+
+// A bifurcation diagram of a 50-segment chain carries thousands of special points (2479 in the
+// default scene at n = 50: 882 LP, 764 CT, 352 RL, …). Like AUTO's and BifurcationKit's plots of
+// large diagrams, the summary labels only the points a reader steers by and draws the others as
+// small markers by type, counted in the key.
+
+/// `labels: auto` draws the summary above this many markers (the shipped 3-segment scenes have
+/// at most a few dozen, all labelled).
+constexpr size_t kSummaryAboveMarkers = 60;
+/// Summary labels beyond the branch points of the primary branch (which are all labelled): the
+/// jumps, then the first fold of each branch in the order the branches were traced.
+constexpr size_t kSummaryExtraLabels = 24;
+/// Summary: unlabelled markers of one case and type closer than this many pixels are drawn once.
+constexpr double kThinPixels = 4.0;
+/// Labels of one case's points closer than this many pixels are merged into one ("BP, JUMP"); a
+/// summary merges wider, the branch points of a long chain's primary branch into ranges
+/// ("BP 24-27": modes 24 to 27).
+constexpr double kMergePixels = 3.0, kSummaryMergePixels = 12.0;
+
+/// One label for the merged points' texts; a summary writes the branch points' modes as ranges
+/// ("BP 3, 4", "BP 24-27"), the other texts after them.
+std::string mergedLabel(const std::vector<std::string>& parts, bool summary) {
+  std::vector<int> modes;
+  std::vector<std::string> rest;
+  for (const std::string& p : parts) {
+    const bool mode = summary && p.size() > 3 && p.rfind("BP ", 0) == 0 &&
+                      p.find_first_not_of("0123456789", 3) == std::string::npos;
+    if (mode)
+      modes.push_back(std::stoi(p.substr(3)));
+    else
+      rest.push_back(p);
+  }
+  std::string text;
+  std::sort(modes.begin(), modes.end());
+  for (size_t i = 0; i < modes.size();) {
+    size_t j = i;
+    while (j + 1 < modes.size() && modes[j + 1] == modes[j] + 1) ++j;
+    text += (i ? ", " : "BP ") + std::to_string(modes[i]);
+    if (j == i + 1) text += ", " + std::to_string(modes[j]);
+    if (j > i + 1) text += "-" + std::to_string(modes[j]);
+    i = j + 1;
+  }
+  for (const std::string& p : rest) text += (text.empty() ? "" : ", ") + p;
+  return text;
+}
+
+/// How much a special point matters in a summary, most first.
+enum class Importance { PrimaryBranchPoint, Jump, FirstFold, Other };
+
+/// Per special record of a case (same order as `cr.specials`): the branch points of the primary
+/// branches (those with no parent: the start), the jumps (a load history's JUMP, a fold with a
+/// simulated jump), the first fold (LP, LPF) of each branch in the order the tracer reported
+/// them, the rest.
+std::vector<Importance> importance(const CaseResult& cr) {
+  std::vector<int> primary;
+  for (const BranchRecord& b : cr.branches)
+    if (b.parent < 0) primary.push_back(b.id);
+  std::vector<int> folded;
+  std::vector<Importance> out;
+  for (const SpecialRecord& r : cr.specials) {
+    Importance k = Importance::Other;
+    if (r.type == "BP" && std::find(primary.begin(), primary.end(), r.branch) != primary.end())
+      k = Importance::PrimaryBranchPoint;
+    else if (r.type == "JUMP" || r.jumpSuccess)
+      k = Importance::Jump;
+    else if ((r.type == "LP" || r.type == "LPF") && std::find(folded.begin(), folded.end(), r.branch) == folded.end()) {
+      folded.push_back(r.branch);
+      k = Importance::FirstFold;
+    }
+    out.push_back(k);
+  }
+  return out;
+}
+
+/// Indices of the points kept when points closer than `radius` are drawn once: greedy in the
+/// given order over a hash grid of cell `radius` (O(points log points)).
+std::vector<size_t> thinned(const std::vector<Eigen::Vector2d>& px, double radius) {
+  std::vector<size_t> kept;
+  std::map<std::pair<long, long>, std::vector<size_t>> grid;  // cell -> kept points in it
+  for (size_t i = 0; i < px.size(); ++i) {
+    if (!px[i].allFinite()) continue;
+    const long cx = long(std::floor(px[i].x() / radius)), cy = long(std::floor(px[i].y() / radius));
+    bool near = false;
+    for (long dx = -1; dx <= 1 && !near; ++dx)
+      for (long dy = -1; dy <= 1 && !near; ++dy) {
+        const auto it = grid.find({cx + dx, cy + dy});
+        if (it == grid.end()) continue;
+        for (size_t k : it->second) near = near || (px[k] - px[i]).norm() < radius;
+      }
+    if (near) continue;
+    grid[{cx, cy}].push_back(i);
+    kept.push_back(i);
+  }
+  return kept;
+}
+
+/// Line width and transparency of the branches (gnuplot's `#AARRGGBB`, AA = 0 opaque) such that
+/// hundreds of overlapping branches stay apart: full width up to a dozen branches, then thinner
+/// and translucent, unstable parts fainter than stable ones.
+struct BranchLook {
+  double width = 2.0;
+  int alphaStable = 0, alphaUnstable = 0;
+};
+BranchLook branchLook(size_t branches) {
+  BranchLook look;
+  if (branches <= 12) return look;
+  look.width = std::max(0.8, 2.0 * std::sqrt(12.0 / double(branches)));
+  look.alphaStable = int(std::min<size_t>(0x50, 0x10 + branches / 4));
+  look.alphaUnstable = std::min(0xA0, look.alphaStable + 0x50);
+  return look;
+}
+
+std::string withAlpha(const std::string& rgb, int alpha) {
+  if (alpha <= 0 || rgb.size() != 7 || rgb[0] != '#') return rgb;
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "%02X", alpha & 0xFF);
+  return "#" + std::string(buf) + rgb.substr(1);
+}
+
+void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
+  BlockFile data;
+  struct Series {
+    int block;
+    size_t ordinal, yIdx;  ///< position of the case in the plot's list, column
+    bool stable;
+    bool any = false;      ///< has a drawable point
+  };
+  const std::vector<size_t> cases = selected(spec);
+  const bool multiCase = cases.size() > 1;
+  const size_t ny = spec.y.size();
+  auto seriesColor = [&](size_t ordinal, size_t j) { return color(multiCase ? ordinal * ny + j : j); };
+  std::vector<Series> series;
+  std::vector<std::vector<Eigen::Vector2d>> polylines;  // in data coordinates, for the label placement
+  double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo, ylo = xlo, yhi = -xlo;
+  std::vector<double> ys;  // a stiffness plot's values, framed without the run-up to its poles
+  auto extend = [&](double x, double y) {
+    if (!std::isfinite(x) || !std::isfinite(y)) return;
+    xlo = std::min(xlo, x), xhi = std::max(xhi, x), ylo = std::min(ylo, y), yhi = std::max(yhi, y);
+    if (spec.type == PlotType::Stiffness) ys.push_back(y);
+  };
+  for (size_t o = 0; o < cases.size(); ++o) {
+    const CaseResult& cr = run.cases[cases[o]];
+    for (size_t j = 0; j < ny; ++j) {
+      for (bool stable : {true, false}) {
+        Series se{data.begin(), o, j, stable};
+        // polylines of consecutive points with the wanted stability; a run keeps the first point
+        // of the next run so that stable and unstable parts join
+        polylines.emplace_back();
+        auto add = [&](double x, double y) {
+          data.point({x, y});
+          polylines.back().emplace_back(x, y);
+          extend(x, y);
+          se.any = true;
+        };
+        for (size_t i = 0; i < cr.points.size(); ++i) {
+          const PointRecord& p = cr.points[i];
+          const bool sameBranchNext = i + 1 < cr.points.size() && cr.points[i + 1].branch == p.branch;
+          const double x = columnValue(spec.x, p, cr.pose0), y = columnValue(spec.y[j], p, cr.pose0);
+          if (p.stable == stable && std::isfinite(x) && std::isfinite(y)) {
+            add(x, y);
+            if (sameBranchNext && cr.points[i + 1].stable != stable) {
+              const PointRecord& q = cr.points[i + 1];
+              add(columnValue(spec.x, q, cr.pose0), columnValue(spec.y[j], q, cr.pose0));
+            }
+          }
+          if (p.stable != stable || !sameBranchNext || !std::isfinite(x) || !std::isfinite(y)) {
+            data.breakLine();
+            polylines.emplace_back();
+          }
+        }
+        series.push_back(se);
+      }
+    }
+  }
+  // special points: one block per case and type; points of one case at the same place share a
+  // label ("BP, JUMP")
+  struct Mark {
+    size_t ordinal;
+    std::string type;
+    double x, y;
+    std::string label;
+    Importance rank;
+  };
+  std::vector<Mark> marks;
+  std::map<std::string, size_t> records;  // special points per type over the plot's cases (the key's counts)
+  size_t branches = 0;                    // branches drawn, over the plot's cases
+  size_t markers = 0;  // one per special point and column
+  for (size_t c : cases) markers += run.cases[c].specials.size() * ny;
+  const bool summary =
+      spec.labels == PlotLabels::Summary || (spec.labels == PlotLabels::Auto && markers > kSummaryAboveMarkers);
+  for (size_t o = 0; o < cases.size(); ++o) {
+    const CaseResult& cr = run.cases[cases[o]];
+    const std::vector<Importance> rank = importance(cr);
+    for (size_t i = 0; i < cr.specials.size(); ++i) {
+      const SpecialRecord& r = cr.specials[i];
+      ++records[r.type];
+      for (size_t j = 0; j < ny; ++j) {
+        const double x = specialValue(spec.x, r, cr), y = specialValue(spec.y[j], r, cr);
+        if (!std::isfinite(x) || !std::isfinite(y)) continue;
+        std::string label = r.type;
+        // a summary's branch points of long chains: "BP 12" for mode 12 (the key says so)
+        if (r.type == "BP" && !r.shape.empty() && r.shape != "other")
+          label += " " + (summary && r.shape.rfind("mode ", 0) == 0 ? r.shape.substr(5) : r.shape);
+        marks.push_back({o, r.type, x, y, label, rank[i]});
+        extend(x, y);
+      }
+    }
+    std::vector<int> ids;
+    for (const PointRecord& p : cr.points)
+      if (ids.empty() || ids.back() != p.branch) ids.push_back(p.branch);
+    std::sort(ids.begin(), ids.end());
+    branches += size_t(std::unique(ids.begin(), ids.end()) - ids.begin());
+  }
+  const BranchLook look = branchLook(branches);
+  // the marks labelled: all of them, or in a summary the primary branch's branch points and then,
+  // up to a budget, the jumps and first folds (in the order the branches were traced)
+  std::vector<bool> labelled(marks.size(), !summary);
+  if (summary) {
+    std::vector<size_t> order;
+    for (size_t i = 0; i < marks.size(); ++i)
+      if (marks[i].rank != Importance::Other) order.push_back(i);
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return marks[a].rank < marks[b].rank; });
+    size_t extra = 0;
+    for (size_t i : order)
+      if (marks[i].rank == Importance::PrimaryBranchPoint || extra++ < kSummaryExtraLabels) labelled[i] = true;
+  }
+  // jumps: arrows from the fold to the landing point
+  BlockFile jumps;
+  jumps.begin();
+  bool anyJump = false;
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> arrows;
+  for (size_t c : cases) {
+    const CaseResult& cr = run.cases[c];
+    for (const SpecialRecord& r : cr.specials) {
+      if (!r.jumpSuccess || r.jumpQ.size() == 0) continue;
+      SpecialRecord to = r;
+      to.q = r.jumpQ;
+      to.F = r.jumpF;
+      to.pose = r.jumpPose;
+      for (size_t j = 0; j < ny; ++j) {
+        const double x0 = columnValue(spec.x, r, cr.pose0), y0 = columnValue(spec.y[j], r, cr.pose0);
+        const double x1 = columnValue(spec.x, to, cr.pose0), y1 = columnValue(spec.y[j], to, cr.pose0);
+        if (!std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) continue;
+        jumps.point({x0, y0, x1 - x0, y1 - y0});
+        arrows.push_back({{x0, y0}, {x1, y1}});
+        extend(x0, y0);
+        extend(x1, y1);
+        anyJump = true;
+      }
+    }
+  }
+
+  // the frame: ranges from the data, margins fixed, the key in the right margin
+  Frame f;
+  f.width = s.width;
+  f.height = s.height;
+  std::vector<std::string> typesPresent;  // in the order of kSpecialStyles
+  for (const SpecialStyle& st : kSpecialStyles)
+    for (const Mark& m : marks)
+      if (m.type == st.type) {
+        typesPresent.push_back(st.type);
+        break;
+      }
+  for (const Mark& m : marks)
+    if (std::find(typesPresent.begin(), typesPresent.end(), m.type) == typesPresent.end()) typesPresent.push_back(m.type);
+  // the key's width: gnuplot sizes it with the main font's advance (11 pt: about 8.2 px per
+  // character) over the longest title plus the sample
+  size_t keyChars = summary ? 22 : 8;  // a summary's key title: lines of up to 22 characters
+  // a summary's key gives the count of each type: " (2479)"
+  for (const std::string& type : typesPresent)
+    keyChars = std::max(keyChars, glyphs(specialStyle(type).key) + (summary ? 3 + std::to_string(records[type]).size() : 0));
+  if (multiCase || ny > 1)
+    for (size_t o = 0; o < cases.size(); ++o)
+      for (size_t j = 0; j < ny; ++j)
+        keyChars = std::max(keyChars, glyphs(run.cases[cases[o]].label) + (ny > 1 ? 1 + spec.y[j].size() : 0));
+  f.right = std::clamp(1.0 - (8.2 * double(keyChars + 6) + 30.0) / f.width, 0.5, 0.8);
+  std::tie(f.xlo, f.xhi) = niceRange(xlo, xhi);
+  // stiffness spans decades (the straight chain against a buckled one): a log axis in whole decades
+  // when every drawn value is positive and they span more than two
+  if (spec.type == PlotType::Stiffness && ylo <= 0.0) std::tie(ylo, yhi) = framedRange(ys);
+  f.logY = spec.type == PlotType::Stiffness && ylo > 0.0 && std::isfinite(yhi) && yhi > 100.0 * ylo;
+  if (f.logY)
+    f.ylo = std::floor(std::log10(ylo)), f.yhi = std::ceil(std::log10(yhi));
+  else
+    std::tie(f.ylo, f.yhi) = niceRange(ylo, yhi);
+
+  Occupancy occupied(f.width, f.height);
+  for (const auto& line : polylines)
+    for (size_t i = 0; i + 1 < line.size(); ++i)
+      occupied.segment(f.pixel(line[i].x(), line[i].y()), f.pixel(line[i + 1].x(), line[i + 1].y()));
+  for (const auto& [a, b] : arrows) occupied.segment(f.pixel(a.x(), a.y()), f.pixel(b.x(), b.y()));
+  // a summary's unlabelled markers, per case and type, those closer than kThinPixels drawn once;
+  // a label may cover them only where it must (like a curve)
+  std::vector<bool> drawn(marks.size(), true);
+  if (summary) {
+    for (size_t o = 0; o < cases.size(); ++o)
+      for (const std::string& type : typesPresent) {
+        std::vector<size_t> idx;
+        std::vector<Eigen::Vector2d> px;
+        for (size_t i = 0; i < marks.size(); ++i)
+          if (!labelled[i] && marks[i].ordinal == o && marks[i].type == type) {
+            idx.push_back(i);
+            px.push_back(f.pixel(marks[i].x, marks[i].y));
+            drawn[i] = false;
+          }
+        for (size_t k : thinned(px, kThinPixels)) {
+          drawn[idx[k]] = true;
+          occupied.fill({px[k].x() - 2.0, px[k].y() - 2.0, px[k].x() + 2.0, px[k].y() + 2.0});
+        }
+      }
+  }
+  occupied.finish();
+
+  // merge the labels of one case's points drawn at the same place
+  std::vector<PlacedLabel> labels;
+  std::vector<size_t> labelOrdinal;
+  std::vector<std::vector<std::string>> parts;
+  for (size_t i = 0; i < marks.size(); ++i) {
+    if (!labelled[i]) continue;
+    const Mark& m = marks[i];
+    const Eigen::Vector2d px = f.pixel(m.x, m.y);
+    size_t k = 0;
+    const double merge = summary ? kSummaryMergePixels : kMergePixels;
+    while (k < labels.size() && (labelOrdinal[k] != m.ordinal || (labels[k].anchor - px).norm() > merge)) ++k;
+    if (k == labels.size()) {
+      labels.emplace_back();
+      labels.back().anchor = px;
+      labels.back().priority = summary ? int(m.rank) : 0;
+      labelOrdinal.push_back(m.ordinal);
+      parts.emplace_back();
+    }
+    labels[k].priority = std::min(labels[k].priority, summary ? int(m.rank) : 0);
+    if (std::find(parts[k].begin(), parts[k].end(), m.label) == parts[k].end()) parts[k].push_back(m.label);
+  }
+  for (size_t k = 0; k < labels.size(); ++k) labels[k].text = mergedLabel(parts[k], summary);
+  placeLabels(labels, f, occupied, summary ? kSummaryLabelRings : kLabelRings);
+
+  const std::string stem = spec.name;
+  data.write(dir / (stem + ".dat"));
+  // special points: blocks per (case, type); labels: one block per case with
+  //   x y label_x label_y "text" leader_x leader_y   (leader NaN when the label sits at its point)
+  BlockFile sp, lab;
+  struct SpecialBlock {
+    int block;
+    size_t ordinal;
+    std::string type;
+    bool small;  ///< a summary's unlabelled markers
+  };
+  std::vector<SpecialBlock> specialBlocks;
+  for (size_t o = 0; o < cases.size(); ++o)
+    for (const std::string& type : typesPresent)
+      for (bool small : {false, true}) {
+        size_t count = 0, shown = 0;
+        for (size_t i = 0; i < marks.size(); ++i)
+          if (marks[i].ordinal == o && marks[i].type == type && labelled[i] != small) ++count, shown += drawn[i];
+        if (shown == 0) continue;
+        const int block = sp.begin();
+        std::string comment =
+            "# case " + std::to_string(cases[o]) + " (" + escape::commentText(run.cases[cases[o]].label) + "): " + type;
+        if (small)
+          comment += " unlabelled, " + std::to_string(shown) + " of " + std::to_string(count) +
+                     " drawn (the others within " + num(kThinPixels) + " px of one drawn)";
+        sp.text(comment);
+        for (size_t i = 0; i < marks.size(); ++i)
+          if (marks[i].ordinal == o && marks[i].type == type && labelled[i] != small && drawn[i])
+            sp.point({marks[i].x, marks[i].y});
+        specialBlocks.push_back({block, o, type, small});
+      }
+  std::vector<int> labelBlocks(cases.size(), -1);
+  for (size_t o = 0; o < cases.size(); ++o) {
+    bool any = false;
+    for (size_t k = 0; k < labels.size(); ++k) any = any || (labelOrdinal[k] == o && labels[k].shown);
+    if (!any) continue;
+    labelBlocks[o] = lab.begin();
+    lab.text("# case " + std::to_string(cases[o]) + ": x y label_x label_y \"label\" leader_x leader_y");
+    for (size_t k = 0; k < labels.size(); ++k) {
+      if (labelOrdinal[k] != o || !labels[k].shown) continue;
+      const PlacedLabel& l = labels[k];
+      const Eigen::Vector2d p = f.data(l.anchor), c = f.data(l.centre), e = f.data(l.leaderEnd);
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      std::ostringstream line;
+      line << num(p.x()) << " " << num(p.y()) << " " << num(c.x()) << " " << num(c.y()) << " " << escape::datField(l.text) << " "
+           << num(l.leader ? e.x() : nan) << " " << num(l.leader ? e.y() : nan);
+      lab.text(line.str());
+    }
+  }
+  const bool anySpecial = !marks.empty();
+  if (anySpecial) {
+    sp.write(dir / (stem + "_special.dat"));
+    lab.write(dir / (stem + "_labels.dat"));
+  }
+  if (anyJump) jumps.write(dir / (stem + "_jumps.dat"));
+
+  header(s, spec.title.empty() ? (spec.type == PlotType::Stiffness ? "Loaded stiffness along the branches"
+                                                                   : "Bifurcation diagram: stable solid, unstable dashed")
+                               : spec.title);
+  s.body << "set key samplen 4\n";
+  if (summary)
+    s.body << "set key title \"labelled: branch points\\nof the primary branch\\n(BP k: mode k), jumps,\\nfirst "
+              "fold per branch;\\nkey: count per type\" left\n";
+  s.body << "set xlabel " << quote(parameterColumnLabel(scene, spec.x)) << "\n";
+  std::string ylabel;
+  for (size_t j = 0; j < ny; ++j) ylabel += (j ? ", " : "") + columnLabel(spec.y[j], scene.units);
+  if (ny > 1) {
+    bool same = true;
+    for (const std::string& y : spec.y) same = same && (y[0] == spec.y[0][0]);
+    if (same && spec.y[0][0] == 'K') ylabel = "stiffness" + scene.units.suffix(Dimension::Stiffness);
+    if (same && spec.y[0][0] == 'q') ylabel = "joint angles (rad)";
+  }
+  s.body << "set ylabel " << quote(ylabel) << "\n";
+  s.body << "# ranges and margins fixed so that the special-point labels (placed by buckle, "
+         << stem << "_labels.dat) do not overlap\n";
+  f.script(s.body);
+  s.body << "plot \\\n";
+  bool first = true;
+  auto clause = [&](const std::string& c) {
+    s.body << (first ? "  " : ", \\\n  ") << c;
+    first = false;
+  };
+  // one key entry per case (and column): its stable curve; stability itself is explained by
+  // the two entries that follow
+  const bool perSeriesKey = multiCase || ny > 1;
+  bool anyStable = false, anyUnstable = false;
+  for (const Series& se : series) {
+    (se.stable ? anyStable : anyUnstable) = (se.stable ? anyStable : anyUnstable) || se.any;
+    std::string title;
+    if (perSeriesKey && se.stable) {
+      if (multiCase) title = run.cases[cases[se.ordinal]].label;
+      if (ny > 1) title += (title.empty() ? "" : " ") + spec.y[se.yIdx];
+    }
+    clause(quote(stem + ".dat") + " index " + std::to_string(se.block) + " using 1:2 with lines lw " +
+           num(look.width) + " lc rgb " +
+           quote(withAlpha(seriesColor(se.ordinal, se.yIdx), se.stable ? look.alphaStable : look.alphaUnstable)) +
+           " dt " + (se.stable ? "1" : "2") +
+           (title.empty() ? std::string(" notitle") : " title " + quote(title) + " noenhanced"));
+  }
+  const std::string keyColor = perSeriesKey ? std::string("black") : seriesColor(0, 0);
+  if (anyStable || !anyUnstable) clause("keyentry with lines lw 2 dt 1 lc rgb " + quote(keyColor) + " title 'stable'");
+  if (anyUnstable) clause("keyentry with lines lw 2 dt 2 lc rgb " + quote(keyColor) + " title 'unstable'");
+  if (anyJump)
+    clause(quote(stem + "_jumps.dat") +
+           " using 1:2:3:4 with vectors head filled size screen 0.015,20 lw 1.5 lc rgb '#ff7f0e' title 'jump'");
+  if (anySpecial) {
+    // leader lines under the markers
+    for (size_t o = 0; o < cases.size(); ++o)
+      if (labelBlocks[o] >= 0)
+        clause(quote(stem + "_labels.dat") + " index " + std::to_string(labelBlocks[o]) +
+               " using 1:2:($6-$1):($7-$2) with vectors nohead lw 0.8 lc rgb '#777777' notitle");
+    // a summary's small markers first, under the labelled ones
+    for (bool small : {true, false})
+      for (const SpecialBlock& b : specialBlocks) {
+        if (b.small != small) continue;
+        const SpecialStyle& st = specialStyle(b.type);
+        const std::string at = quote(stem + "_special.dat") + " index " + std::to_string(b.block) + " using 1:2";
+        if (small) {
+          clause(at + " with points pt " + std::to_string(st.point) + " ps 0.5 lc rgb " + quote(st.color) + " notitle");
+          continue;
+        }
+        const std::string fill = summary ? st.color : multiCase ? color(b.ordinal * ny) : std::string("black");
+        clause(at + " with points pt " + std::to_string(st.point) + " ps 1.4 lc rgb " + quote(fill) + " notitle");
+        clause(at + " with points pt " + std::to_string(st.point - 1) + " ps 1.4 lw 1 lc rgb 'black' notitle");
+      }
+    for (const std::string& type : typesPresent) {
+      const SpecialStyle& st = specialStyle(type);
+      const std::string title = *st.type ? st.key : type;
+      if (summary)
+        clause("keyentry with points pt " + std::to_string(st.point) + " ps 1.2 lc rgb " + quote(st.color) + " title " +
+               quote(title + " (" + std::to_string(records[type]) + ")") + " noenhanced");
+      else
+        clause("keyentry with points pt " + std::to_string(st.point) + " ps 1.4 lc rgb 'black' title " + quote(title) +
+               " noenhanced");
+    }
+    for (size_t o = 0; o < cases.size(); ++o)
+      if (labelBlocks[o] >= 0)
+        clause(quote(stem + "_labels.dat") + " index " + std::to_string(labelBlocks[o]) +
+               " using 3:4:5 with labels center font ',9' tc rgb " +
+               quote(multiCase ? color(o * ny) : std::string("black")) + " noenhanced notitle");
+  }
+  s.body << "\n";
+}
+
+}  // namespace
+
+void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
+  drawBranchPlot(scene, run, spec, dir, s);
+}
+
+}  // namespace buckle::scene::plot_detail
