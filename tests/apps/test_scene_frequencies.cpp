@@ -78,7 +78,7 @@ TEST_CASE("frequencies: one free segment at rest oscillates at sqrt(K_q / (rho l
   CHECK(std::isnan(t.front().at("omega2")));  // one segment has one mode
 }
 
-TEST_CASE("frequencies: masses x4 halve every omega; the chain in mm gives omega times sqrt(1e-3 s)", "[scene]") {
+TEST_CASE("frequencies: masses x4 halve every omega, the chain in mm gives omega times sqrt(1e-3 s)", "[scene]") {
   const Table si = runTable("si", scene(4, 0.02, 2000.0, 0.5, true, R"({"length": "m", "force": "N", "mass": "kg"})"));
   const Table heavy = runTable("heavy", scene(4, 0.02, 2000.0, 2.0, true, R"({"length": "m", "force": "N", "mass": "kg"})"));
   // mm: lengths ×1e3, k in N/mm ×1e-3, ρ in kg/mm ×1e-3; time unit √(kg·mm/N) = √1e-3 s

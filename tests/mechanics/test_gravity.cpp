@@ -29,7 +29,7 @@ InertiaData unevenInertia(const Chain& chain) {
 
 }  // namespace
 
-TEST_CASE("gravity: V = -sum m g.r with the inertial model's centres of mass; gradient and Hessian by differences",
+TEST_CASE("gravity: V = -sum m g.r with the inertial model's centres of mass, gradient and Hessian by differences",
           "[gravity]") {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> U(-1.0, 1.0);

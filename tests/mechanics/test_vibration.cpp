@@ -216,7 +216,7 @@ TEST_CASE("vibration: held end coordinates and locked joints remove modes, one c
   CHECK_THROWS_AS(va.modes(Vector::Zero(n + 1), F, {}, {}, 2), std::invalid_argument);
 }
 
-TEST_CASE("vibration: masses x s divide every omega by sqrt(s); lengths x1e4 and stiffness x1e-8 scale omega^2 by k / L",
+TEST_CASE("vibration: masses x s divide every omega by sqrt(s), lengths x1e4 and stiffness x1e-8 scale omega^2 by k / L",
           "[vibration]") {
   const int n = 8;
   const Chain chain = stiffChain(n);
@@ -269,7 +269,7 @@ TEST_CASE("vibration: the period of the integrated inertial model released along
   }
 }
 
-TEST_CASE("vibration: omega_1^2 crosses zero at the located branch points and folds, with the sign of the stability "
+TEST_CASE("vibration: the crossing omega^2 is zero at the located branch points and folds, omega_1^2 has the sign of the stability "
           "operator's lowest eigenvalue at every traced point",
           "[vibration]") {
   cont::TracerOptions o;
