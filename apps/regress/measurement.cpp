@@ -1,6 +1,7 @@
 #include "regress/measurement.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "buckle/mechanics/shape_name.h"
@@ -45,6 +46,11 @@ MeasuredCase fromScene(const scene::CaseResult& c) {
     const std::string shape = mechanics::shapeName(c.sudden.rest, 1e-6) + (c.sudden.stable ? " stable" : " unstable");
     for (Eigen::Index i = 0; i < c.sudden.rest.size(); ++i) m.specials.push_back({-1, "REST", c.sudden.rest[i], shape, 0.0, {}});
   }
+  // the natural frequencies (`frequencies`) at the case's start point, on pseudo-branch -1
+  if (!c.points.empty())
+    for (Eigen::Index i = 0; i < c.points.front().omega.size(); ++i)
+      if (std::isfinite(c.points.front().omega[i]))
+        m.specials.push_back({-1, "OMEGA", c.points.front().omega[i], "mode " + std::to_string(i + 1), 0.0});
   for (const scene::PointRecord& p : c.points) {
     if (m.branches.empty() || m.branches.back().id != p.branch) m.branches.push_back({p.branch, {}, {}, {}});
     MeasuredBranch& b = m.branches.back();

@@ -126,12 +126,20 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
     r.C = p.C;
     r.locked = p.locked.label();
     r.contactTorque = p.contactTorque;
+    if (scene_.analyses.frequencies.enabled) r.omega = naturalFrequencies(p.q, p.F, p.locked, p.parameter);
     out_.points.push_back(r);
   }
   run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
 
   for (const mech::SpecialPointReport& sp : report.specialPoints) {
     SpecialRecord s = toRecord(sp, b.id);
+    // at the located point itself (plots mark it there), the joints locked as at the traced point before it
+    if (scene_.analyses.frequencies.enabled && sp.q.size() == out_.chain.size() && !report.points.empty()) {
+      const mech::PointReport* before = &report.points.front();
+      for (const mech::PointReport& p : report.points)
+        if (p.index <= sp.index) before = &p;
+      s.omega = naturalFrequencies(sp.q, sp.F, before->locked, sp.parameter);
+    }
     if (sp.source >= 0) run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
     if (scene_.analyses.jump.enabled && sp.jumps && sp.source >= 0 && !throughLoad()) {
       const cont::SpecialPoint& fold = b.specialPoints[size_t(sp.source)];

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -13,6 +14,7 @@
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/landing.h"
+#include "buckle/mechanics/vibration.h"
 #include "scene/runner.h"
 
 namespace buckle::scene {
@@ -52,6 +54,10 @@ class CaseRunner {
  private:
   void record(const continuation::Branch& b, const mechanics::BranchReport& report, mechanics::EquilibriumProblem& problem,
               const std::string& origin);
+  /// `frequencies` (case_frequencies.cpp): the signed natural frequencies at joint angles q under
+  /// the total end wrench F with the joints of `locked` locked (`parameter`: for a message).
+  Eigen::VectorXd naturalFrequencies(const Eigen::VectorXd& q, const mechanics::Wrench& F,
+                                     const mechanics::ContactSet& locked, double parameter);
   bool throughLoad() const { return spec_.path.loadLimit > 0.0; }
   /// The scene's /solver settings as tracer options (the λ range is set by each analysis).
   continuation::TracerOptions solverOptions() const {
@@ -115,6 +121,9 @@ class CaseRunner {
   int branchesSoFar_ = 0;  // for progress reports
   /// The jumps simulated from (branch, special point): a mirror image's jump is their image.
   std::map<std::pair<int, int>, mechanics::Landing> landings_;
+  /// `frequencies`: the case's chain with its rods (built at the first point)
+  std::unique_ptr<mechanics::VibrationAnalysis> vibration_;
+  bool vibrationFailed_ = false;  // a point's frequencies failed: reported once per case
 };
 
 }  // namespace buckle::scene

@@ -47,9 +47,27 @@ const Entry kColumns[] = {
 
 }  // namespace
 
+std::vector<std::string> frequencyColumns(int count) {
+  std::vector<std::string> out;
+  for (int i = 1; i <= count; ++i) out.push_back("omega" + std::to_string(i));
+  return out;
+}
+
+int frequencyIndex(const std::string& column) {
+  constexpr size_t prefix = 5;  // "omega"
+  if (column.size() <= prefix || column.size() > prefix + 3 || column.compare(0, prefix, "omega") != 0) return -1;
+  int i = 0;
+  for (size_t k = prefix; k < column.size(); ++k) {
+    if (column[k] < '0' || column[k] > '9') return -1;
+    i = 10 * i + (column[k] - '0');
+  }
+  return column[prefix] == '0' ? -1 : i - 1;
+}
+
 Dimension columnDimension(const std::string& c) {
   for (const Entry& e : kColumns)
     if (c == e.column) return e.dimension;
+  if (frequencyIndex(c) >= 0) return Dimension::AngularFrequency;
   return c.size() >= 2 && c[0] == 'q' ? Dimension::Angle : Dimension::None;
 }
 
@@ -58,6 +76,8 @@ std::string columnLabel(const std::string& c, const UnitSystem& units, LabelStyl
   for (const Entry& e : kColumns)
     if (c == e.column) return (gnuplot ? e.gnuplot : e.plain) + units.suffix(e.dimension);
   if (c.size() >= 2 && c[0] == 'q') return (gnuplot ? "q_{" + c.substr(1) + "}" : c) + units.suffix(Dimension::Angle);
+  if (frequencyIndex(c) >= 0)
+    return (gnuplot ? "{/Symbol w}_{" + c.substr(5) + "}" : "ω" + c.substr(5)) + units.suffix(Dimension::AngularFrequency);
   return c;
 }
 

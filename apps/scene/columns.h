@@ -23,6 +23,12 @@ Dimension columnDimension(const std::string& column);
 /// directional stiffnesses with the other direction free, the principal stiffnesses K1 ≤ K2 and
 /// the direction θ1 of K1.
 const std::vector<std::string>& stiffnessColumns();
+/// The natural-frequency columns of branches.csv with `frequencies` (vibration.h): omega1 …
+/// omega<count>, the signed frequencies (negative: an unstable mode, minus its growth rate).
+std::vector<std::string> frequencyColumns(int count);
+/// Index (0-based) of a frequency column "omega<i>", −1 for any other column.
+int frequencyIndex(const std::string& column);
+
 /// One of those columns from K_F and C_F (either may be NaN: a rigid or a singular direction).
 double stiffnessColumnValue(const std::string& column, const Eigen::Matrix2d& K, const Eigen::Matrix2d& C);
 

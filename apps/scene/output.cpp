@@ -139,6 +139,8 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
   os += ",stable,negative,min_eig,locked,contact_torque";
   if (scene.analyses.stiffness)
     for (const std::string& column : stiffnessColumns()) os += "," + column;
+  if (scene.analyses.frequencies.enabled)
+    for (const std::string& column : frequencyColumns(scene.analyses.frequencies.count)) os += "," + column;
   os += '\n';
   std::size_t rows = 0;
   for (const CaseResult& cr : run.cases) rows += cr.points.size();
@@ -183,6 +185,8 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
       field(p.contactTorque);
       if (scene.analyses.stiffness)
         for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C));
+      if (scene.analyses.frequencies.enabled)
+        for (int i = 0; i < scene.analyses.frequencies.count; ++i) field(i < p.omega.size() ? p.omega[i] : kNaN);
       os += '\n';
     }
   }
@@ -478,6 +482,7 @@ double columnValue(const std::string& column, const PointRecord& p, const mechan
   const double v = commonColumn(column, p.parameter, p.F, p.pose, p.q, pose0, found);
   if (found) return v;
   if (column == "min_eig") return p.minEigenvalue;
+  if (const int i = frequencyIndex(column); i >= 0) return i < p.omega.size() ? p.omega[i] : kNaN;
   return stiffnessColumnValue(column, p.K, p.C);
 }
 
@@ -485,6 +490,7 @@ double columnValue(const std::string& column, const SpecialRecord& s, const mech
   bool found = false;
   const double v = commonColumn(column, s.parameter, s.F, s.pose, s.q, pose0, found);
   if (found) return v;
+  if (const int i = frequencyIndex(column); i >= 0) return i < s.omega.size() ? s.omega[i] : kNaN;
   // NaN unless the point carries its own K_F (KMIN)
   return stiffnessColumnValue(column, s.K, Eigen::Matrix2d::Constant(kNaN));
 }

@@ -46,6 +46,9 @@ RunResult runScene(const Scene& scene, const RunControl& given) {
                                      std::to_string(a.continuation.branchSwitching) + ")"
                                : "continuation of the primary branch");
   if (a.stiffness) run.computed.push_back("loaded stiffness K_F along the branches (eq 29)");
+  if (a.frequencies.enabled)
+    run.computed.push_back("the lowest " + std::to_string(a.frequencies.count) +
+                           " natural frequencies along the branches (uniform rods, mechanics/vibration.h)");
   if (a.jump.enabled) run.computed.push_back("jumps from the folds (gradient-flow dynamics, landing polished)");
   if (a.loadHistory.enabled)
     run.computed.push_back("quasi-static load history with jumps (hysteresis), " +

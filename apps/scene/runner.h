@@ -38,6 +38,9 @@ struct PointRecord {
   Eigen::Matrix2d C = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());  ///< C_F
   std::string locked;         ///< joints locked at their limits, "3U 5L" (ContactSet::label), "" none
   double contactTorque = 0.0; ///< largest compression of the locked joints (0: none locked)
+  /// `frequencies`: the signed natural frequencies ω_i (vibration.h; negative: unstable, minus
+  /// the growth rate), NaN beyond the constrained chain's modes; empty otherwise
+  Eigen::VectorXd omega;
 };
 
 struct SpecialRecord {
@@ -81,6 +84,8 @@ struct SpecialRecord {
   /// BP: Koiter's coefficients and the imperfection sensitivity (SpecialPointReport)
   mechanics::KoiterCoefficients koiter;
   std::vector<mechanics::ImperfectionSensitivity> imperfections;
+  /// `frequencies` at the located point (PointRecord::omega), empty where not computed
+  Eigen::VectorXd omega;
 };
 
 struct BranchRecord {

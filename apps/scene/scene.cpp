@@ -127,6 +127,12 @@ Scene parseScene(const std::string& text, const std::string& file) {
   if (doc.contains("units")) {
     scene.units = parseUnits(r, doc["units"], Pointer("/units"));
     if (scene.units.kind == UnitSystem::Kind::Nondimensional) requireUnitChain(r, scene);
+    // named length and force units fix no time unit without a mass unit: the frequencies'
+    // unit √(mass·length/force) would be a guess
+    if (scene.units.kind == UnitSystem::Kind::Named && scene.units.mass.empty() && scene.analyses.frequencies.enabled)
+      r.fail(Pointer("/units/mass"),
+             "missing: the natural frequencies need the mass unit of /analyses/frequencies/mass_per_length (mass per "
+             "length); e.g. \"kg\" with length \"m\" and force \"N\" gives frequencies in rad/s");
   }
   if (doc.contains("solver")) scene.solver = parseSolver(r, doc["solver"], Pointer("/solver"));
   if (doc.contains("plots")) {

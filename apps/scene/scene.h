@@ -121,8 +121,18 @@ struct SuddenLoadSpec {
   double damping = 0.0;          ///< viscous joint damping of the inertial model
 };
 
+/// Natural frequencies of small oscillations about every traced point (mechanics/vibration.h):
+/// the lowest `count` of them, the links slender uniform rods of `massPerLength`.
+constexpr int kMaxFrequencies = 50;
+struct FrequenciesSpec {
+  bool enabled = false;
+  int count = 3;
+  double massPerLength = 0.0;  ///< > 0 (mass / length in the scene's units)
+};
+
 struct AnalysesSpec {
   ContinuationSpec continuation;
+  FrequenciesSpec frequencies;
   JumpSpec jump;
   LoadHistorySpec loadHistory;
   SuddenLoadSpec suddenLoad;

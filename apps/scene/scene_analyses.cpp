@@ -15,11 +15,31 @@ using Reader = JsonReader;
 
 namespace {
 
-std::set<std::string> branchColumns(int maxN, bool stiffness) {
+std::set<std::string> branchColumns(int maxN, const AnalysesSpec& a) {
   std::set<std::string> c = {"parameter", "Fx", "Fy", "Me", "x", "y", "phi", "dx", "dy", "min_eig"};
   for (int i = 1; i <= maxN; ++i) c.insert("q" + std::to_string(i));
-  if (stiffness) c.insert(stiffnessColumns().begin(), stiffnessColumns().end());
+  if (a.stiffness) c.insert(stiffnessColumns().begin(), stiffnessColumns().end());
+  if (a.frequencies.enabled)
+    for (const std::string& column : frequencyColumns(a.frequencies.count)) c.insert(column);
   return c;
+}
+
+// The inertial model and the frequencies divide by the rods' masses m = ρ l and inertias m l²/12:
+// both must be ordinary (normal, finite) numbers.
+void checkRodMasses(const Reader& r, const CaseSpec& c, double rho, const Pointer& p) {
+  for (const mechanics::LinkInertia& link : mechanics::InertiaData::uniformRods(mechanics::Chain(c.chain.segments), rho).links)
+    if (!std::isnormal(link.mass) || !std::isnormal(link.inertia))
+      r.fail(p, "out of the range the inertial model can compute: the rods' masses rho l or inertias rho l^3/12 "
+                "(l the link lengths of case \"" + c.label + "\") are not ordinary finite numbers; got " + show(rho));
+}
+
+FrequenciesSpec parseFrequencies(const Reader& r, const json& f, const Pointer& p) {
+  r.onlyKeys(f, p, {"count", "mass_per_length"});
+  FrequenciesSpec s;
+  s.enabled = true;
+  if (f.contains("count")) s.count = r.integer(f["count"], p / "count", 1, kMaxFrequencies);
+  s.massPerLength = r.positive(r.required(f, p, "mass_per_length"), p / "mass_per_length");
+  return s;
 }
 
 }  // namespace
@@ -27,7 +47,7 @@ std::set<std::string> branchColumns(int maxN, bool stiffness) {
 AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
   r.onlyKeys(a, p,
              {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump", "load_history",
-              "sudden_load", "two_parameter"});
+              "sudden_load", "two_parameter", "frequencies"});
   AnalysesSpec s;
   if (a.contains("continuation")) {
     const json& c = a["continuation"];
@@ -141,6 +161,12 @@ AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
     s.suddenLoad.enabled = true;
   }
   if (a.contains("two_parameter")) s.twoParameter = parseTwoParameter(r, a["two_parameter"], p / "two_parameter");
+  if (a.contains("frequencies")) {
+    s.frequencies = parseFrequencies(r, a["frequencies"], p / "frequencies");
+    if (!s.continuation.enabled && !s.loadHistory.enabled)
+      r.fail(p / "frequencies",
+             "frequencies are computed along the traced branches: it needs /analyses/continuation or load_history");
+  }
   if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled &&
       !s.loadHistory.enabled && !s.suddenLoad.enabled && !s.twoParameter.enabled)
     r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces, "
@@ -235,7 +261,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
       if (mode == modes.end()) r.expected(p / "labels", obj["labels"], "one of auto, all, summary");
       s.labels = mode->second;
     }
-    const std::set<std::string> allowed = branchColumns(maxN, a.stiffness);
+    const std::set<std::string> allowed = branchColumns(maxN, a);
     std::string list;
     for (const std::string& c : allowed) list += (list.empty() ? "" : ", ") + c;
     auto column = [&](const json& c, const Pointer& pc) {
@@ -300,16 +326,12 @@ void checkAnalysesAgainstCases(const Reader& r, const Scene& scene) {
       if (v < lo - 1e-12 || v > hi + 1e-12)
         r.fail(Pointer("/analyses/sudden_load/value"),
                "expected a value inside the path range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-      // The inertial model divides by the rods' masses m = ρ l and inertias m l²/12: both must be
-      // ordinary (normal, finite) numbers.
       const double rho = scene.analyses.suddenLoad.massPerLength;
-      if (rho > 0.0)
-        for (const mechanics::LinkInertia& link : mechanics::InertiaData::uniformRods(mechanics::Chain(c.chain.segments), rho).links)
-          if (!std::isnormal(link.mass) || !std::isnormal(link.inertia))
-            r.fail(Pointer("/analyses/sudden_load/mass_per_length"),
-                   "out of the range the inertial model can compute: the rods' masses rho l or inertias rho l^3/12 "
-                   "(l the link lengths of case \"" + c.label + "\") are not ordinary finite numbers; got " + show(rho));
+      if (rho > 0.0) checkRodMasses(r, c, rho, Pointer("/analyses/sudden_load/mass_per_length"));
     }
+  if (scene.analyses.frequencies.enabled)
+    for (const CaseSpec& c : scene.cases)
+      checkRodMasses(r, c, scene.analyses.frequencies.massPerLength, Pointer("/analyses/frequencies/mass_per_length"));
 }
 
 std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a, int nCases) {

@@ -49,6 +49,13 @@ std::string UnitSystem::unit(Dimension d) const {
     case Dimension::Angle: return "rad";
     case Dimension::Time: return kind == Kind::Nondimensional ? "model time units" : "model time";
     case Dimension::Frequency: return "1/model time";
+    case Dimension::AngularFrequency:
+      // ω² = (joint stiffness F·L) / (mass·L²): rad per √(mass·L/F)
+      if (kind == Kind::Nondimensional) return "√(k/m)";  // b = k = 1, masses in a unit m
+      if (kind == Kind::Consistent) return "rad/time";
+      if (mass.empty()) return "rad/time";
+      if (length == "m" && force == "N" && mass == "kg") return "rad/s";
+      return "rad/(" + mass + "·" + length + "/" + force + ")^1/2";
     default: break;
   }
   if (kind == Kind::Nondimensional) {
@@ -77,6 +84,7 @@ std::string UnitSystem::unit(Dimension d) const {
 std::string UnitSystem::suffix(Dimension d) const {
   if (d == Dimension::None) return "";
   if (d == Dimension::Angle || kind == Kind::Named) return " (" + unit(d) + ")";
+  if (d == Dimension::AngularFrequency && kind == Kind::Nondimensional) return " (units of √(k/m), m the mass unit)";
   if (kind == Kind::Nondimensional) return " (units of " + unit(d) + ")";
   return " (" + unit(d) + ", in the scene's units)";
 }
@@ -108,15 +116,16 @@ UnitSystem parseUnits(const JsonReader& r, const nlohmann::json& v, const JsonRe
     r.expected(p, v,
                "\"nondimensional\" (lengths in b, forces in k b), \"consistent\" (unnamed) or an object "
                "{\"length\": \"m\", \"force\": \"N\"}");
-  r.onlyKeys(v, p, {"length", "force"});
+  r.onlyKeys(v, p, {"length", "force", "mass"});
   u.kind = UnitSystem::Kind::Named;
-  for (const char* key : {"length", "force"}) {
+  for (const char* key : {"length", "force", "mass"}) {
+    if (key == std::string("mass") && !v.contains(key)) break;  // optional: only frequencies need it
     const std::string name = r.string(r.required(v, p, key), p / key);
     if (!safeUnitName(name))
       r.expected(p / key, v[key],
                  "a unit name of 1 to 16 bytes: letters, digits, inner spaces and . / ^ * - µ μ · ² ³ (e.g. \"m\", "
-                 "\"mm\", \"N\", \"kN\")");
-    (key == std::string("length") ? u.length : u.force) = name;
+                 "\"mm\", \"N\", \"kN\", \"kg\")");
+    (key == std::string("length") ? u.length : key == std::string("force") ? u.force : u.mass) = name;
   }
   return u;
 }

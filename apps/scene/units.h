@@ -22,7 +22,10 @@ enum class Dimension {
   Compliance,           ///< L/F (C_F = K_F⁻¹)
   RotationalStiffness,  ///< F·L/rad (joint stiffness K_q, the end's rotational stiffness)
   Time,                 ///< the model time of the dynamics
-  Frequency             ///< 1/time
+  Frequency,            ///< 1/time
+  /// rad per time unit of the scene's length, force and mass units, τ = √(mass·length/force)
+  /// (natural frequencies: rad/s for m, N, kg)
+  AngularFrequency
 };
 
 struct UnitSystem {
@@ -33,6 +36,9 @@ struct UnitSystem {
   };
   Kind kind = Kind::Consistent;
   std::string length, force;  ///< Named only: e.g. "m", "N"
+  /// Named only, optional: the mass unit ("kg"), which masses (mass per length in mass/length)
+  /// are in; the natural frequencies need it to have a named unit (vibration.h).
+  std::string mass;
 
   /// The unit of a quantity: "N/m", "k b^2", or (Consistent) "force/length"; "" for None.
   std::string unit(Dimension d) const;

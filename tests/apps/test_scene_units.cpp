@@ -132,6 +132,8 @@ json rewrite(json scene, const Units& u) {
     if (s.contains("mass_per_length")) s["mass_per_length"] = s["mass_per_length"].get<double>() * u.stiffness / u.length;
     if (s.contains("damping")) s["damping"] = s["damping"].get<double>() * u.torque();
   }
+  if (a.contains("frequencies"))  // the same masses per length as the sudden load: time unit unchanged
+    a["frequencies"]["mass_per_length"] = a["frequencies"]["mass_per_length"].get<double>() * u.stiffness / u.length;
   scene["plots"] = json::array();
   return scene;
 }

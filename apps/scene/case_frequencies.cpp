@@ -1,0 +1,39 @@
+// `frequencies` (docs/scenes.md): the natural frequencies of small oscillations about every
+// reported point of the traced branches, from the library's vibration analysis
+// (mechanics/vibration.h) of the constrained chain at that point: its held end coordinates and
+// the joints locked at their limits there.
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "scene/case_runner.h"
+
+namespace buckle::scene {
+
+namespace mech = buckle::mechanics;
+
+Eigen::VectorXd CaseRunner::naturalFrequencies(const Eigen::VectorXd& q, const mech::Wrench& F,
+                                               const mech::ContactSet& contacts, double parameter) {
+  const FrequenciesSpec& spec = scene_.analyses.frequencies;
+  Eigen::VectorXd omega = Eigen::VectorXd::Constant(spec.count, std::numeric_limits<double>::quiet_NaN());
+  try {
+    if (!vibration_)
+      vibration_ = std::make_unique<mech::VibrationAnalysis>(out_.chain, mech::InertiaData::uniformRods(out_.chain, spec.massPerLength));
+    std::vector<int> locked;
+    for (const mech::LockedJoint& j : contacts.joints()) locked.push_back(j.joint);
+    const mech::VibrationModes m =
+        vibration_->modes(q, F, spec_.end.condition.heldIndices(), locked, spec.count, false);
+    for (int i = 0; i < m.omegaSquared.size(); ++i) omega[i] = mech::signedFrequency(m.omegaSquared[i]);
+  } catch (const std::exception& e) {
+    if (!vibrationFailed_) {
+      vibrationFailed_ = true;
+      run_.complete = false;
+      run_.problems.push_back("case \"" + spec_.label + "\": natural frequencies at " + spec_.path.parameter + " = " +
+                              std::to_string(parameter) + " (and any later failures of this case): " + e.what());
+    }
+  }
+  return omega;
+}
+
+}  // namespace buckle::scene

@@ -1,0 +1,197 @@
+// `frequencies` (docs/scenes.md): the omega columns of branches.csv against the closed form of one
+// segment, the mass scaling law, the same chain in m and in mm, their sign against the stability
+// column, the shipped scene data/scenes/vibration.json at its branch point, the labels' units and
+// the refusals (a named-unit scene without a mass unit, no traced branches, bad keys).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "buckle/mechanics/chain.h"
+#include "rfc4180.h"
+#include "scene/columns.h"
+#include "scene/scene.h"
+#include "scene_run.h"
+
+namespace fs = std::filesystem;
+using namespace buckle::mechanics;
+
+namespace {
+
+using Table = std::vector<std::map<std::string, double>>;
+
+Table readBranches(const fs::path& out) {
+  std::ifstream in(out / "branches.csv");
+  REQUIRE(in.good());
+  std::stringstream text;
+  text << in.rdbuf();
+  const auto rows = buckle::test::readCsv(text.str());
+  REQUIRE(rows.size() >= 2);
+  Table t;
+  for (size_t r = 1; r < rows.size(); ++r) {
+    std::map<std::string, double> row;
+    for (size_t c = 0; c < rows[0].size(); ++c) row[rows[0][c]] = rows[r][c].empty() ? std::nan("") : std::stod(rows[r][c]);
+    t.push_back(row);
+  }
+  return t;
+}
+
+// A chain of `segments` (a, b, k, L0) = (0.5, 1, 1, 2.25)·(L, L, K, L), the end held in y (or
+// free) and pushed along x to −1.2·K·L, frequencies of rods of mass per length rho.
+std::string scene(int segments, double L, double K, double rho, bool heldY, const std::string& units = "",
+                  int count = 3) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "{" << (units.empty() ? "" : "\"units\": " + units + ",") << "\"chain\": {\"segments\": " << segments
+    << ", \"a\": " << 0.5 * L << ", \"b\": " << L << ", \"k\": " << K << ", \"L0\": " << 2.25 * L << "},"
+    << "\"end\": {\"x\": {\"load\": 0.0}, \"y\": " << (heldY ? "{\"held\": 0.0}" : "{\"load\": 0.0}")
+    << ", \"phi\": \"free\"}, \"path\": {\"parameter\": \"Fx\", \"from\": 0.0, \"to\": " << -1.2 * K * L << "},"
+    << "\"analyses\": {\"continuation\": true, \"frequencies\": {\"count\": " << count << ", \"mass_per_length\": " << rho
+    << "}}, \"plots\": []}";
+  return s.str();
+}
+
+Table runTable(const std::string& name, const std::string& text) {
+  const buckle::test::SceneOutcome r = buckle::test::runSceneText("scene_frequencies", name, text);
+  INFO(r.err);
+  REQUIRE(r.rc == 0);
+  return readBranches(r.out);
+}
+
+double relativeError(double x, double reference) { return std::abs(x - reference) / std::abs(reference); }
+
+}  // namespace
+
+TEST_CASE("frequencies: one free segment at rest oscillates at sqrt(K_q / (rho l^3 / 3))", "[scene]") {
+  const Table t = runTable("one", scene(1, 1.0, 1.0, 2.0, false, "", 2));
+  const Chain chain = Chain::uniform(1, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  Vector kq(1);
+  jointStiffness(chain, Vector::Zero(1), kq);
+  const double l = chain.linkLengths()[1];
+  REQUIRE(t.front().at("parameter") == 0.0);
+  CHECK(relativeError(t.front().at("omega1"), std::sqrt(kq[0] / (2.0 * l * l * l / 3.0))) <= 1e-11);
+  CHECK(std::isnan(t.front().at("omega2")));  // one segment has one mode
+}
+
+TEST_CASE("frequencies: masses x4 halve every omega, the chain in mm gives omega times sqrt(1e-3 s)", "[scene]") {
+  const Table si = runTable("si", scene(4, 0.02, 2000.0, 0.5, true, R"({"length": "m", "force": "N", "mass": "kg"})"));
+  const Table heavy = runTable("heavy", scene(4, 0.02, 2000.0, 2.0, true, R"({"length": "m", "force": "N", "mass": "kg"})"));
+  // mm: lengths ×1e3, k in N/mm ×1e-3, ρ in kg/mm ×1e-3; time unit √(kg·mm/N) = √1e-3 s
+  const Table mm = runTable("mm", scene(4, 20.0, 2.0, 5e-4, true, R"({"length": "mm", "force": "N", "mass": "kg"})"));
+  REQUIRE(si.size() == heavy.size());
+  REQUIRE(si.size() == mm.size());
+  int unstable = 0;
+  for (size_t i = 0; i < si.size(); ++i)
+    for (const char* c : {"omega1", "omega2", "omega3"}) {
+      INFO("row " << i << ", " << c);
+      CHECK(relativeError(heavy[i].at(c), 0.5 * si[i].at(c)) <= 1e-10);
+      CHECK(relativeError(mm[i].at(c), std::sqrt(1e-3) * si[i].at(c)) <= 1e-8);
+      if (std::string(c) == "omega1") {
+        // Sylvester: ω₁² has the sign of the stability operator's smallest eigenvalue
+        if (std::abs(si[i].at("min_eig")) > 1e-6 * 2000.0 * 0.02 * 0.02)
+          CHECK((si[i].at("omega1") < 0) == (si[i].at("min_eig") < 0));
+        unstable += si[i].at("omega1") < 0;
+      }
+    }
+  CHECK(unstable > 0);  // the path goes past the first branch point
+}
+
+TEST_CASE("frequencies: the shipped scene's omega1 vanishes at its branch point, the axis says rad/s", "[scene]") {
+  const fs::path file = fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes" / "vibration.json";
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  const buckle::test::SceneOutcome r = buckle::test::runSceneText("scene_frequencies", "shipped", text.str());
+  REQUIRE(r.rc == 0);
+  const Table t = readBranches(r.out);
+  // on the straight branch (branch 0) ω₁ is real before the branch point and imaginary after it,
+  // ω₁² linear in Fx through it
+  double lastStable = 0, firstUnstable = 0;
+  double wStable = 0, wUnstable = 0;
+  for (const auto& row : t) {
+    if (row.at("branch") != 0) continue;
+    if (row.at("omega1") > 0) {
+      lastStable = row.at("Fx");
+      wStable = row.at("omega1");
+    } else if (firstUnstable == 0) {
+      firstUnstable = row.at("Fx");
+      wUnstable = row.at("omega1");
+    }
+  }
+  REQUIRE(firstUnstable < lastStable);
+  // the zero of the straight line through (Fx, ±ω₁²) of the two neighbours
+  const double a = wStable * wStable, b = -wUnstable * wUnstable;
+  const double zero = lastStable + (firstUnstable - lastStable) * a / (a - b);
+  std::ifstream sp(r.out / "special_points.json");
+  const auto doc = nlohmann::json::parse(sp);
+  double bp = 0;
+  for (const auto& p : doc["special_points"])
+    if (p["type"] == "BP" && p["branch"] == 0) bp = p["parameter"];
+  REQUIRE(bp < 0);
+  CHECK(std::abs(zero - bp) <= 2e-3 * std::abs(bp));
+  std::ifstream gp(r.out / "plots" / "frequencies_body.gp");
+  std::stringstream script;
+  script << gp.rdbuf();
+  CHECK(script.str().find("{/Symbol w}_{1} (rad/s)") != std::string::npos);
+}
+
+TEST_CASE("frequencies: labels name the frequency unit each unit system implies", "[scene]") {
+  using buckle::scene::UnitSystem;
+  UnitSystem si;
+  si.kind = UnitSystem::Kind::Named;
+  si.length = "m";
+  si.force = "N";
+  si.mass = "kg";
+  CHECK(buckle::scene::columnLabel("omega2", si, buckle::scene::LabelStyle::Plain) == "ω2 (rad/s)");
+  si.length = "mm";
+  CHECK(buckle::scene::columnLabel("omega12", si, buckle::scene::LabelStyle::Plain) == "ω12 (rad/(kg·mm/N)^1/2)");
+  UnitSystem nondimensional;
+  nondimensional.kind = UnitSystem::Kind::Nondimensional;
+  CHECK(buckle::scene::columnLabel("omega1", nondimensional, buckle::scene::LabelStyle::Plain) ==
+        "ω1 (units of √(k/m), m the mass unit)");
+  CHECK(buckle::scene::columnLabel("omega1", UnitSystem(), buckle::scene::LabelStyle::Plain) ==
+        "ω1 (rad/time, in the scene's units)");
+  CHECK(buckle::scene::columnDimension("omega3") == buckle::scene::Dimension::AngularFrequency);
+  CHECK(buckle::scene::frequencyIndex("omega0") == -1);
+  CHECK(buckle::scene::frequencyIndex("omegax") == -1);
+  CHECK(buckle::scene::frequencyIndex("omega") == -1);
+}
+
+TEST_CASE("frequencies: refused with the key, the path and the accepted range", "[scene]") {
+  struct Bad {
+    std::string text, path, words;
+  };
+  const std::string base = scene(3, 1.0, 1.0, 1.0, true);
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = base;
+    const size_t at = s.find(from);
+    REQUIRE(at != std::string::npos);
+    return s.replace(at, from.size(), to);
+  };
+  const std::vector<Bad> bad = {
+      {scene(3, 0.02, 2000.0, 0.5, true, R"({"length": "m", "force": "N"})"), "/units/mass", "rad/s"},
+      {with("\"continuation\": true, ", ""), "/analyses", "continuation or load_history"},
+      {with("\"count\": 3", "\"count\": 0"), "/analyses/frequencies/count", ""},
+      {with("\"count\": 3", "\"count\": 51"), "/analyses/frequencies/count", ""},
+      {with(", \"mass_per_length\": 1", ""), "/analyses/frequencies/mass_per_length", "missing"},
+      {with("\"mass_per_length\": 1", "\"mass_per_length\": -1"), "/analyses/frequencies/mass_per_length", ""},
+      {with("\"mass_per_length\": 1", "\"mass_per_length\": 1e-320"), "/analyses/frequencies/mass_per_length",
+       "ordinary"},
+      {with("\"count\": 3", "\"count\": 3, \"modes\": true"), "/analyses/frequencies", "modes"},
+  };
+  for (const Bad& b : bad) {
+    INFO(b.text);
+    try {
+      buckle::scene::parseScene(b.text, "s.json");
+      FAIL("accepted");
+    } catch (const buckle::scene::SceneError& e) {
+      CHECK(std::string(e.path()).find(b.path) == 0);
+      CHECK(std::string(e.what()).find(b.words) != std::string::npos);
+    }
+  }
+}
