@@ -50,7 +50,7 @@ MeasuredCase fromScene(const scene::CaseResult& c) {
   if (!c.points.empty())
     for (Eigen::Index i = 0; i < c.points.front().omega.size(); ++i)
       if (std::isfinite(c.points.front().omega[i]))
-        m.specials.push_back({-1, "OMEGA", c.points.front().omega[i], "mode " + std::to_string(i + 1), 0.0});
+        m.specials.push_back({-1, "OMEGA", c.points.front().omega[i], "mode " + std::to_string(i + 1), 0.0, {}});
   for (const scene::PointRecord& p : c.points) {
     if (m.branches.empty() || m.branches.back().id != p.branch) m.branches.push_back({p.branch, {}, {}, {}});
     MeasuredBranch& b = m.branches.back();
