@@ -32,4 +32,5 @@ run critical_loads "$BIN/critical_loads" --quick
 run jump_timing "$BIN/jump_timing" --quick
 command -v mpirun > /dev/null && BUILD=$BUILD run atlas_mpi "$HERE/atlas_mpi.sh" --quick   # issue 15
 run long_tree "$BIN/long_tree" --quick
+run actuation_path "$BIN/actuation_path" --quick   # issue 29
 exit $status
