@@ -31,6 +31,7 @@ namespace {
 
 struct Row {
   double seconds = std::numeric_limits<double>::infinity();
+  double loadSeconds = std::numeric_limits<double>::infinity();  // the load path from the same start
   size_t points = 0, folds = 0;
   double lambdaEnd = 0.0;
   bool started = false;
@@ -63,6 +64,11 @@ Row run(int n, double b, double k, int reps) {
     row.points = b.points.size();
     row.folds = b.specialPointsOfType(cont::SpecialPointType::Fold).size();
     row.lambdaEnd = b.points.back().lambda;
+    // for comparison: 100 points of the load path (the payload's factor) from the same start
+    EquilibriumProblem loadPath(chain, EndCondition::freeEnd(), payload);
+    const auto t1 = std::chrono::steady_clock::now();
+    cont::trace(loadPath, loading.points.back().u, 1.0, cont::InitialDirection::increasingLambda(), o);
+    row.loadSeconds = std::min(row.loadSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
   }
   return row;
 }
@@ -76,8 +82,8 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--quick")) quick = true;
   }
-  std::printf("%-16s %6s %8s %6s %14s %12s %12s\n", "units", "n", "points", "folds", "dL0 at end (b)", "time (ms)",
-              "us/point");
+  std::printf("%-16s %6s %8s %6s %14s %12s %12s %16s\n", "units", "n", "points", "folds", "dL0 at end (b)", "time (ms)",
+              "us/point", "load path (ms)");
   const struct {
     const char* name;
     double b, k;
@@ -90,8 +96,8 @@ int main(int argc, char** argv) {
         std::printf("%-16s %6d   the payload could not be applied to the straight chain\n", u.name, n);
         continue;
       }
-      std::printf("%-16s %6d %8zu %6zu %14.6g %12.3f %12.1f\n", u.name, n, r.points, r.folds, r.lambdaEnd / u.b,
-                  1e3 * r.seconds, 1e6 * r.seconds / double(r.points));
+      std::printf("%-16s %6d %8zu %6zu %14.6g %12.3f %12.1f %16.3f\n", u.name, n, r.points, r.folds, r.lambdaEnd / u.b,
+                  1e3 * r.seconds, 1e6 * r.seconds / double(r.points), 1e3 * r.loadSeconds);
     }
   return 0;
 }
