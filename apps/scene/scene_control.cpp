@@ -24,6 +24,39 @@ std::pair<double, double> admissibleRange(const mechanics::Chain& chain, const m
   }
   return {lo, hi};
 }
+
+// The other input of the parameter's pair: (L1_0, L2_0) and (L0, dL0) each span a segment's two
+// free lengths, so moving the complement leaves the parameter's own value λ.
+std::string complementOf(const std::string& parameter) {
+  if (parameter == "L1_0") return "L2_0";
+  if (parameter == "L2_0") return "L1_0";
+  return parameter == "L0" ? "dL0" : "L0";
+}
+
+// /path/direction of a control path: the rate of the complementary input per unit of the
+// parameter, a number (every segment) or a list of one per segment, added to the named rates.
+void addDirection(const JsonReader& r, const json& d, const Pointer& pd, const std::string& parameter, int n,
+                  mechanics::ControlDirection& out) {
+  r.requireObject(d, pd);
+  const std::string allowed = complementOf(parameter);
+  for (auto it = d.begin(); it != d.end(); ++it) {
+    mechanics::ControlInput input;
+    if (it.key() != allowed || !mechanics::parseControlInput(it.key(), input))
+      r.fail(pd / it.key(), "unknown key \"" + it.key() + "\" (allowed here: " + allowed + ", the input that with " +
+                                parameter + " sets both free lengths; " + parameter + "'s own rate is 1)");
+    const Pointer pk = pd / it.key();
+    const mechanics::ControlDirection unit = mechanics::ControlDirection::named(n, input);
+    const json& v = it.value();
+    if (v.is_array()) {
+      if (int(v.size()) != n)
+        r.fail(pk, "expected a number or a list of " + std::to_string(n) + " rates (one per segment), got " +
+                       std::to_string(v.size()));
+      for (int i = 0; i < n; ++i) out.rates.row(i) += r.number(v[size_t(i)], pk / size_t(i)) * unit.rates.row(i);
+    } else {
+      out.rates += r.number(v, pk) * unit.rates;
+    }
+  }
+}
 }  // namespace
 
 bool isControlPath(const json& path) {
@@ -41,14 +74,12 @@ PathSpec parseControlPath(const JsonReader& r, const json& path, const Pointer& 
   spec.parameter = r.string(path["parameter"], p / "parameter");
   mechanics::ControlInput input = mechanics::ControlInput::dL0;
   mechanics::parseControlInput(spec.parameter, input);
-  if (path.contains("direction"))
-    r.fail(p / "direction", "a control path moves the input named by /path/parameter (of /path/segment or of every "
-                            "segment); direction is for load paths (Fx, Fy, Me, x, y, phi)");
   if (path.contains("load_limit"))
     r.fail(p / "load_limit", "only a displacement-controlled path (parameter x, y or phi) takes a load_limit");
   const int n = chain.size();
   if (path.contains("segment")) spec.segment = r.integer(path["segment"], p / "segment", 1, n) - 1;
   spec.controlDirection = mechanics::ControlDirection::named(n, input, spec.segment);
+  if (path.contains("direction")) addDirection(r, path["direction"], p / "direction", spec.parameter, n, spec.controlDirection);
   spec.start = mechanics::controlInputValue(chain, input, spec.segment);
   spec.controlDirection.origin = spec.start;
   spec.direction.setZero();

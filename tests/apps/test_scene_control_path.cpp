@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -150,7 +151,11 @@ TEST_CASE("control path scene: bad input names the key, the path and the accepte
       {"start", R"({"parameter": "L1_0", "segment": 2, "from": 2.5, "to": 3})", kContinuation, "/path/from",
        "contains the start value L1_0 of segment 2 = 2.25"},
       {"direction", R"({"parameter": "L0", "from": 2, "to": 3, "direction": {"Fy": 1}})", kContinuation,
-       "/path/direction", "direction is for load paths"},
+       "/path/direction/Fy", "allowed here: dL0"},
+      {"direction_own", R"({"parameter": "L0", "from": 2, "to": 3, "direction": {"L0": 1}})", kContinuation,
+       "/path/direction/L0", "L0's own rate is 1"},
+      {"direction_list", R"({"parameter": "dL0", "from": -1, "to": 1, "direction": {"L0": [1, 2]}})", kContinuation,
+       "/path/direction/L0", "a list of 3 rates"},
       {"critical", kPath, R"({"continuation": {}, "critical_forces": true})", "/analyses/critical_forces",
        "is a control input"},
   };
@@ -164,4 +169,57 @@ TEST_CASE("control path scene: bad input names the key, the path and the accepte
     CHECK(o.err.find(cs.expected) != std::string::npos);
     CHECK(!fs::exists(o.out));
   }
+}
+
+TEST_CASE("control path scene: a direction in control space moves both inputs, the parameter at rate 1", "[scene]") {
+  // L0 rises by λ − 2.25 while dL0 of segment 1 moves at 0.5 and of segment 3 at −0.5 per unit:
+  // the scene's path ends equal those of the library's problem with those rates.
+  const std::string path = R"({"parameter": "L0", "from": 1.5, "to": 3.0, "direction": {"dL0": [0.5, 0, -0.5]}})";
+  const buckle::test::SceneOutcome o =
+      buckle::test::runSceneText("control_path", "direction", actuationScene(1.0, 1.0, path, kContinuation));
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  const mech::Chain chain = mech::Chain::uniform(3, mech::SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  mech::ControlDirection d = mech::ControlDirection::named(3, mech::ControlInput::L0);
+  d.rates.row(0) += 0.5 * Eigen::RowVector2d(0.5, -0.5);
+  d.rates.row(2) -= 0.5 * Eigen::RowVector2d(0.5, -0.5);
+  d.origin = 2.25;
+  const json c = readJson(o.out / "summary.json")["cases"][0];
+  CHECK(double(c["start_parameter"]) == 2.25);
+  Eigen::VectorXd u(3);
+  for (int i = 0; i < 3; ++i) u[i] = c["start_q"][i];
+  mech::EquilibriumProblem actuated(chain, mech::EndCondition::freeEnd(Eigen::Vector3d(-0.3, -0.3, 0.0)),
+                                    Eigen::Vector3d::Zero(), {}, d);
+  cont::TracerOptions to;
+  to.lambdaMin = 1.5;
+  to.lambdaMax = 3.0;
+  // branches.csv rows (12 significant digits): parameter in column 3, q1..q3 in 12..14
+  std::vector<std::vector<double>> rows;
+  std::ifstream csv(o.out / "branches.csv");
+  std::string line;
+  std::getline(csv, line);
+  while (std::getline(csv, line)) {
+    std::vector<double> row;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) row.push_back(cell.empty() ? 0.0 : std::atof(cell.c_str()));
+    rows.push_back(row);
+  }
+  int ends = 0;
+  for (const cont::InitialDirection& dir : {cont::InitialDirection::increasingLambda(), cont::InitialDirection::decreasingLambda()}) {
+    const cont::Branch b = cont::trace(actuated, u, 2.25, dir, to);
+    REQUIRE(b.stopReason == cont::StopReason::LambdaRange);
+    const cont::ContinuationPoint& last = b.points.back();
+    for (const std::vector<double>& row : rows) {
+      if (row.size() < 15 || row[3] != last.lambda) continue;
+      ++ends;
+      for (int i = 0; i < 3; ++i) CHECK(row[size_t(12 + i)] == Approx(last.u[i]).margin(1e-10));
+    }
+  }
+  CHECK(ends == 2);
+  // the free lengths at λ = 3: L0 = 3 everywhere, dL0 = ±0.5·0.75 on segments 1 and 3
+  const mech::Chain end = mech::chainWithControls(chain, d, 3.0);
+  CHECK(mech::controlInputValue(end, mech::ControlInput::L0) == Approx(3.0).epsilon(1e-15));
+  CHECK(mech::controlInputValue(end, mech::ControlInput::dL0, 0) == Approx(0.375).epsilon(1e-15));
+  CHECK(mech::controlInputValue(end, mech::ControlInput::dL0, 2) == Approx(-0.375).epsilon(1e-15));
 }
