@@ -15,6 +15,9 @@
 #include "buckle/mechanics/critical_curves.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/load_history.h"
+#include "buckle/mechanics/branch_report.h"
+#include "buckle/mechanics/stiffness.h"
+#include "buckle/mechanics/stiffness_extremum.h"
 #include "buckle/mechanics/unloaded_shape.h"
 
 using namespace buckle::mechanics;
@@ -312,4 +315,41 @@ TEST_CASE("an actuation history snaps at the dL0 fold and lands on an equilibriu
         Approx(totalPotential(released, j.from.head(n), kPayload) - totalPotential(released, j.to.head(n), kPayload))
             .epsilon(1e-9));
   CHECK(j.energyReleased > 0.0);
+}
+
+TEST_CASE("stiffness along a control path: K_F of the free lengths at the point, its rate by differences",
+          "[control_path]") {
+  const int n = 3;
+  const Chain chain = defaultChain(n);
+  EquilibriumProblem actuated(chain, EndCondition::freeEnd(kPayload), Eigen::Vector3d::Zero(), {},
+                              ControlDirection::named(n, ControlInput::dL0));
+  const cont::Branch b = cont::trace(actuated, loaded(chain, kPayload), 0.0, cont::InitialDirection::increasingLambda(),
+                                     tracerOptions(-1.0, 2.0));
+  ReportOptions ro;
+  ro.stiffness = true;
+  const BranchReport r = reportBranch(actuated, b, ro);
+  REQUIRE(r.points.size() > 5);
+  for (const PointReport& p : r.points) {
+    REQUIRE(p.haveStiffness);
+    const double lambda = b.points[size_t(p.index)].lambda;
+    const Eigen::Matrix2d K = loadedStiffness(actuated.chainAt(lambda), p.q, p.F).stiffness;
+    CHECK((p.K - K).norm() <= 1e-12 * K.norm());
+  }
+  // the rate of each measure along the tangent against central differences of K_F(q, F, λ)
+  const cont::ContinuationPoint& p = b.points[b.points.size() / 2];
+  const int N = actuated.dimension();
+  for (StiffnessMeasure m : {StiffnessMeasure::Kxx, StiffnessMeasure::Kyy, StiffnessMeasure::MinEigenvalue}) {
+    INFO(toString(m));
+    const StiffnessRate sr = stiffnessRate(actuated, p.u, p.lambda, p.tangent.head(N), p.tangent[N], m);
+    REQUIRE(sr.valid);
+    const double h = 1e-5;
+    double at[2];
+    for (int s = 0; s < 2; ++s) {
+      const double sign = s == 0 ? 1.0 : -1.0;
+      const Eigen::VectorXd u = p.u + sign * h * p.tangent.head(N);
+      const double lambda = p.lambda + sign * h * p.tangent[N];
+      at[s] = stiffnessMeasure(loadedStiffness(actuated.chainAt(lambda), u.head(n), actuated.wrench(u, lambda)).stiffness, m);
+    }
+    CHECK(sr.rate == Approx((at[0] - at[1]) / (2.0 * h)).epsilon(1e-6).margin(1e-9 * std::abs(sr.value)));
+  }
 }
