@@ -10,10 +10,12 @@
 #include <limits>
 #include <vector>
 
+#include "buckle/continuation/branch_switching.h"
 #include "buckle/continuation/derivative_check.h"
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/critical_curves.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/linear_buckling.h"
 #include "buckle/mechanics/load_history.h"
 #include "buckle/mechanics/branch_report.h"
 #include "buckle/mechanics/stiffness.h"
@@ -352,4 +354,37 @@ TEST_CASE("stiffness along a control path: K_F of the free lengths at the point,
     }
     CHECK(sr.rate == Approx((at[0] - at[1]) / (2.0 * h)).epsilon(1e-6).margin(1e-9 * std::abs(sr.value)));
   }
+}
+
+TEST_CASE("the straight column under a fixed Fx buckles along an L0 path where eq 17 gives that Fx; the "
+          "buckled branch is switched to", "[control_path]") {
+  // Fx_U = λ_U κ/b with κ = k(b L0 − 2(b² − a²)) (eq 17) is affine in L0: the L0 where it equals Fx
+  const double Fx = -0.5;
+  const double f1 = analyticClampedPinned3(0.5, 1.0, 1.0, 2.0).FxU, f2 = analyticClampedPinned3(0.5, 1.0, 1.0, 2.5).FxU;
+  const double L0c = 2.0 + (Fx - f1) * 0.5 / (f2 - f1);
+  REQUIRE(analyticClampedPinned3(0.5, 1.0, 1.0, L0c).FxU == Approx(Fx).epsilon(1e-12));
+  REQUIRE(L0c < 2.25);
+  ControlDirection d = ControlDirection::named(3, ControlInput::L0);
+  d.origin = 2.25;
+  EquilibriumProblem actuated(defaultChain(3), EndCondition::clampedPinned(Fx), Eigen::Vector3d::Zero(), {}, d);
+  cont::Tracer tracer(actuated, tracerOptions(1.6, 2.25));
+  const cont::Branch straight =
+      tracer.trace(actuated.initialGuess(Eigen::VectorXd::Zero(3), 2.25), 2.25, cont::InitialDirection::decreasingLambda());
+  const auto bps = straight.specialPointsOfType(cont::SpecialPointType::BranchPoint);
+  REQUIRE(!bps.empty());
+  CHECK(std::abs(bps[0]->lambda - L0c) <= 1e-10);
+  CHECK(bps[0]->u.head(3).cwiseAbs().maxCoeff() <= 1e-12);  // on the straight branch
+  CHECK(bps[0]->inertiaBefore == 0);
+  CHECK(bps[0]->inertiaAfter == 1);
+  Eigen::VectorXd direction;
+  REQUIRE(cont::bifurcatingDirection(actuated, *bps[0], direction));
+  const cont::Branch u = cont::switchBranch(tracer, *bps[0], direction, 1);
+  REQUIRE(u.points.size() > 3);
+  // bent, and an equilibrium of the chain with its free lengths at that L0
+  const cont::ContinuationPoint& far = u.points.back();
+  CHECK(far.u.head(3).cwiseAbs().maxCoeff() > 1e-2);
+  EquilibriumProblem there(actuated.chainAt(far.lambda), EndCondition::clampedPinned(Fx), Eigen::Vector3d::Zero());
+  Eigen::VectorXd F(4);
+  REQUIRE(there.residual(far.u, 0.0, F));
+  CHECK(F.norm() <= 1e-9);
 }
