@@ -33,4 +33,5 @@ run jump_timing "$BIN/jump_timing" --quick
 command -v mpirun > /dev/null && BUILD=$BUILD run atlas_mpi "$HERE/atlas_mpi.sh" --quick   # issue 15
 run long_tree "$BIN/long_tree" --quick
 run vibration_timing "$BIN/vibration_timing" --quick
+run actuation_path "$BIN/actuation_path" --quick   # issue 29
 exit $status

@@ -183,7 +183,7 @@ void CaseRunner::loadHistory() {
   opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
   mech::LoadHistoryResult h;
   try {
-    h = mech::followLoadHistory(problem, out_.q0, scene_.analyses.loadHistory.waypoints, opt);
+    h = mech::followLoadHistory(problem, out_.qStart, scene_.analyses.loadHistory.waypoints, opt);
   } catch (const std::exception& e) {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": load history: " + e.what());
@@ -306,7 +306,7 @@ void CaseRunner::continuation() {
     lambdaHi = spec_.path.loadLimit;
   }
   end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
-  mech::EquilibriumProblem problem(out_.chain, end, direction);
+  mech::EquilibriumProblem problem(out_.chain, end, direction, {}, controlDirection());
 
   mech::EquilibriumBranchOptions opt;
   opt.tracer = solverOptions();
@@ -354,7 +354,7 @@ void CaseRunner::continuation() {
                       (throughLoad() ? std::string(c == 0 ? "Fx" : c == 1 ? "Fy" : "Me") + " (through the reaction)"
                                      : spec_.path.parameter));
   }
-  const mech::EquilibriumBranches result = mech::traceEquilibria(problem, out_.q0, s0, starts, opt);
+  const mech::EquilibriumBranches result = mech::traceEquilibria(problem, out_.qStart, s0, starts, opt);
   const auto& branches = result.tree.branches;
   if (!branches.empty() && branches.front().stopReason == cont::StopReason::StartFailed) {
     run_.complete = false;

@@ -29,6 +29,10 @@ class CaseRunner {
   CaseRunner(const Scene& scene, const CaseSpec& spec, CaseResult& out, RunResult& run, const RunControl& control)
       : scene_(scene), spec_(spec), out_(out), run_(run), control_(control) {}
 
+  /// Along a control path: the start shape qStart, the chain under /end's payload reached from the
+  /// unloaded shape by a quasi-static load history (case_runner_control.cpp). False (recorded in
+  /// the run's problems) when it cannot be reached.
+  bool actuationStart();
   void continuation();
   void loadHistory();
   void suddenLoad();
@@ -98,7 +102,11 @@ class CaseRunner {
   mechanics::EquilibriumProblem pathProblem() const {
     mechanics::EndCondition end = spec_.end.condition;
     end.value -= out_.startValue * spec_.path.direction;
-    return mechanics::EquilibriumProblem(out_.chain, end, spec_.path.direction);
+    return mechanics::EquilibriumProblem(out_.chain, end, spec_.path.direction, {}, controlDirection());
+  }
+  /// Along a control path the free lengths' direction (origin: the start value); else none.
+  mechanics::ControlDirection controlDirection() const {
+    return spec_.path.control ? spec_.path.controlDirection : mechanics::ControlDirection();
   }
   /// How the mechanics layer reports this case's branches (branch_report.h).
   mechanics::ReportOptions reportOptions() const {

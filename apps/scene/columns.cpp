@@ -30,6 +30,11 @@ const Entry kColumns[] = {
       {"dx", "{/Symbol d}_x = x_0 - x", "δx = x₀ − x", Dimension::Length},
       {"dy", "{/Symbol d}_y = y - y_0", "δy = y − y₀", Dimension::Length},
       {"phi", "{/Symbol f}", "φ", Dimension::Angle},
+      // control inputs (the path parameter of a control path, control_path.h)
+      {"L1_0", "L_1^0", "L1⁰", Dimension::Length},
+      {"L2_0", "L_2^0", "L2⁰", Dimension::Length},
+      {"L0", "L^0 = (L_1^0 + L_2^0)/2", "L⁰ = (L1⁰ + L2⁰)/2", Dimension::Length},
+      {"dL0", "{/Symbol D}L^0 = L_1^0 - L_2^0", "ΔL⁰ = L1⁰ − L2⁰", Dimension::Length},
       {"min_eig", "smallest eigenvalue of the stability operator", "smallest eigenvalue of the stability operator",
        Dimension::Moment},
       {"Kxx", "K_{xx}", "Kxx", Dimension::Stiffness},

@@ -434,6 +434,8 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
     c["q0"] = vectorJson(cr.q0);
     c["start_position"] = poseJson(cr.pose0);
     c["start_parameter"] = cr.startValue;
+    if (cr.qStart.size() == cr.q0.size() && cr.qStart != cr.q0) c["start_q"] = vectorJson(cr.qStart);
+    if (!cr.startNote.empty()) c["start_note"] = cr.startNote;
     json branches = json::array();
     for (const BranchRecord& b : cr.branches)
       branches.push_back(json{{"id", b.id}, {"parent", b.parent}, {"origin", b.origin}, {"points", b.points},

@@ -81,8 +81,10 @@ RunResult runScene(const Scene& scene, const RunControl& given) {
     out.label = spec.label;
     out.q0 = spec.chain.q0;
     out.pose0 = mech::endPose(chain, out.q0);
-    out.startValue = spec.end.condition.value[spec.path.coordinate];
+    out.startValue = spec.startValue();
+    out.qStart = out.q0;
     CaseRunner runner(scene, spec, out, run, control);
+    if (spec.path.control && !runner.actuationStart()) continue;  // recorded in run.problems
     for (size_t s = 0; s < stages.size(); ++s) {
       if (runner.interrupted()) {
         skipped.push_back(stages[s].first + (scene.cases.size() > 1 ? " (case \"" + spec.label + "\")" : ""));

@@ -124,6 +124,9 @@ struct CaseResult {
   std::string label;
   mechanics::Chain chain;
   Eigen::VectorXd q0;
+  /// The path's start shape: q0, or along a control path the chain under its payload.
+  Eigen::VectorXd qStart;
+  std::string startNote;  ///< how the start was reached, when not simply (the payload snapped the chain)
   mechanics::Pose pose0 = mechanics::Pose::Zero();
   double startValue = 0.0;
   std::vector<BranchRecord> branches;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "buckle/mechanics/control_path.h"
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/stiffness_extremum.h"
 #include "buckle/mechanics/segment.h"
@@ -51,6 +52,14 @@ struct PathSpec {
   /// coordinate's reaction as parameter, from 0 to ±loadLimit, and reported against the
   /// coordinate with displacement-control stability. 0: not used.
   double loadLimit = 0.0;
+  /// A control path (issue 29): the parameter is a control input ("L1_0", "L2_0", "L0", "dL0")
+  /// of segment `segment` or of every segment, λ moves the springs' free lengths along
+  /// `controlDirection` (origin: `start`) with the end at /end's values (the payload or the held
+  /// coordinates); `direction` is zero and `coordinate` unused.
+  bool control = false;
+  int segment = -1;     ///< 0-based; −1: every segment
+  mechanics::ControlDirection controlDirection;
+  double start = 0.0;   ///< the input's value on the scene's chain (mean over the segments for all)
 };
 
 struct ContinuationSpec {
@@ -182,6 +191,10 @@ struct CaseSpec {
   ChainSpec chain;
   EndSpec end;
   PathSpec path;
+
+  /// The path parameter's value at the start: the prescribed value of the path's coordinate, or
+  /// along a control path the inputs' value on the chain.
+  double startValue() const { return path.control ? path.start : end.condition.value[path.coordinate]; }
 };
 
 struct Scene {

@@ -296,6 +296,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
 }
 
 void checkAnalysesAgainstCases(const Reader& r, const Scene& scene) {
+  checkControlPathAnalyses(r, scene);
   checkTwoParameterAgainstCases(r, scene);
   if (scene.analyses.energyCurves.enabled)
     for (size_t i = 0; i < scene.cases.size(); ++i)
@@ -309,7 +310,7 @@ void checkAnalysesAgainstCases(const Reader& r, const Scene& scene) {
     const std::vector<double>& w = scene.analyses.loadHistory.waypoints;
     const Pointer pw = Pointer("/analyses/load_history/waypoints");
     for (const CaseSpec& c : scene.cases) {
-      const double start = c.end.condition.value[c.path.coordinate];
+      const double start = c.startValue();
       const double lo = std::min(c.path.from, c.path.to), hi = std::max(c.path.from, c.path.to);
       if (std::abs(w[0] - start) > 1e-12 * std::max(1.0, std::abs(start)))
         r.fail(pw / 0, "expected the start value " + c.path.parameter + " = " + std::to_string(start) + " of case \"" +

@@ -303,7 +303,8 @@ PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const En
   spec.parameter = r.string(path["parameter"], p / "parameter");
   bool isLoad = false;
   spec.coordinate = coordinateOfParameter(spec.parameter, isLoad);
-  if (spec.coordinate < 0) r.expected(p / "parameter", path["parameter"], "one of Fx, Fy, Me, x, y, phi");
+  if (spec.coordinate < 0)
+    r.expected(p / "parameter", path["parameter"], "one of Fx, Fy, Me, x, y, phi, or a control input L1_0, L2_0, L0, dL0");
   const bool held = end.condition.isHeld(static_cast<mechanics::EndCoordinate>(spec.coordinate));
   if (isLoad && held)
     r.fail(p / "parameter", std::string("the load ") + spec.parameter + " cannot be the parameter: /end/" +
@@ -421,6 +422,11 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
   }
   const json& path = doc["path"];
   r.requireObject(path, Pointer("/path"));
+  if (isControlPath(path)) {
+    cs.path = parseControlPath(r, path, Pointer("/path"), chain);
+    checkEndAgainstChain(r, cs);
+    return cs;
+  }
   double start = 0.0;
   if (path.contains("parameter") && path["parameter"].is_string()) {
     bool isLoad = false;

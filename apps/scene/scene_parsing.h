@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "buckle/mechanics/chain.h"
 #include "scene/json_reader.h"
 #include "scene/scene.h"
 
@@ -24,6 +25,15 @@ std::string show(double v);
 /// One case from its document (the scene's chain/end/path with the case's patch applied).
 /// needPath: an analysis needs /path (else a default Fx path of zero length is used).
 CaseSpec parseCase(const JsonReader& r, const json& doc, const std::string& label, bool needPath);
+
+/// A /path whose parameter is a control input (scene_control.cpp): true for "L1_0", "L2_0",
+/// "L0", "dL0".
+bool isControlPath(const json& path);
+/// Parses it against the chain: /path/segment (1-based, optional), the range (containing the
+/// inputs' value on the chain, every free length positive over it); /path/direction is refused.
+PathSpec parseControlPath(const JsonReader& r, const json& path, const Pointer& p, const mechanics::Chain& chain);
+/// The analyses a control path cannot run (critical forces, two-parameter, sudden load) refused.
+void checkControlPathAnalyses(const JsonReader& r, const Scene& scene);
 
 // ---- analyses, solver, plots (scene_analyses.cpp) -------------------------------------------
 

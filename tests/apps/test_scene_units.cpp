@@ -41,11 +41,12 @@ struct Units {
   double length, stiffness;
   double force() const { return stiffness * length; }
   double torque() const { return stiffness * length * length; }
-  /// Unit of a load name (Fx, Fy, Me) or an end coordinate (x, y, phi).
+  /// Unit of a load name (Fx, Fy, Me), an end coordinate (x, y, phi) or a control input (free lengths).
   double of(const std::string& key) const {
     if (key == "Fx" || key == "Fy") return force();
     if (key == "Me") return torque();
     if (key == "x" || key == "y") return length;
+    if (key == "L1_0" || key == "L2_0" || key == "L0" || key == "dL0") return length;  // control inputs
     return 1.0;  // phi
   }
   /// Unit of the reaction of a held coordinate.

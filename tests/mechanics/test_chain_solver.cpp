@@ -241,3 +241,37 @@ TEST_CASE("Corrector on the chain's structured solver allocates nothing after co
   SUCCEED("malloc interposition is disabled under AddressSanitizer");
 #endif
 }
+
+TEST_CASE("Corrector along a control path (dL0, end held) allocates nothing after construction", "[chain_solver]") {
+#if BUCKLE_COUNT_MALLOC
+  // λ moves the free lengths: every iterate re-evaluates the springs at (q, λ) (the cache's key)
+  // and the structured solver's F_λ border carries ∂²E/∂q∂λ.
+  const int n = 60;
+  EquilibriumProblem problem(uniformChain(n), EndCondition::clampedPinned(0.0, 0.5), Eigen::Vector3d::Zero(), {},
+                             ControlDirection::named(n, ControlInput::dL0));
+  const int N = problem.dimension();
+  auto solver = problem.makeStructuredSolver();
+  REQUIRE(solver != nullptr);
+  buckle::continuation::Corrector corrector(problem, {}, solver.get());
+  Vector u0 = Vector::Zero(N), u(N), x(N + 1), predictor(N + 1), tangent = Vector::Zero(N + 1);
+  REQUIRE(corrector.solveAtFixedParameter(u0, 0.02, u).converged);  // warm-up
+  tangent[N] = 1.0;
+  const long before = buckle::testing::mallocCalls.load();
+  int iterations = 0;
+  bool converged = true;
+  for (int k = 0; k < 10; ++k) {
+    predictor.head(N) = u;
+    predictor[N] = 0.02 + 0.005 * (k + 1);
+    const auto summary = corrector.correct(predictor, tangent, x);
+    converged = converged && summary.converged;
+    iterations += summary.iterations;
+    u = x.head(N);
+  }
+  const long after = buckle::testing::mallocCalls.load();
+  CHECK(converged);
+  CHECK(iterations >= 10);
+  CHECK(after - before == 0);
+#else
+  SUCCEED("malloc interposition is disabled under AddressSanitizer");
+#endif
+}

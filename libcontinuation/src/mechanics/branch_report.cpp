@@ -234,7 +234,10 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
     if (throughReaction && !inRange(p.parameter, options)) continue;
     PointReport pr = p;
     if (options.stiffness) {
-      const CartesianStiffness s = lockedLoadedStiffness(chain, pr.q, pr.F, problem.endCondition(), pr.locked);
+      // along a control path K_q is that of the free lengths at the point's λ
+      const CartesianStiffness s = lockedLoadedStiffness(
+          problem.controlled() ? problem.chainAt(b.points[size_t(pr.index)].lambda) : chain, pr.q, pr.F,
+          problem.endCondition(), pr.locked);
       pr.K = s.stiffness;
       pr.C = s.compliance;
       pr.haveStiffness = true;

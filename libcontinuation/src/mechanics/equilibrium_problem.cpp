@@ -44,7 +44,8 @@ bool sameBits(const double* a, const double* b, size_t count) {
 }  // namespace
 
 EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
-                                       const Eigen::Vector3d& direction, EquilibriumOptions options)
+                                       const Eigen::Vector3d& direction, EquilibriumOptions options,
+                                       const ControlDirection& control)
     : chain_(chain),
       end_(end),
       direction_(direction),
@@ -57,18 +58,37 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
       stiff_(chain.size()),
       stiffRate_(chain.size()),
       cachedQ_(chain.size()),
+      control_(control),
       sinHalf_(chain.size()),
       cosHalf_(chain.size()),
       domainUpper_(chain.size()),
       domainLower_(chain.size()),
       work_(chain.size()),
-      work2_(chain.size()),
       structure_(chain.size()),
       heldRows_(static_cast<Eigen::Index>(held_.size()), chain.size()) {
   static const char* names[3] = {"x", "y", "phi"};
   for (int c = 0; c < 3; ++c) {
     requireFinite(std::string("end value ") + names[c], end.value[c]);
     requireFinite(std::string("load path direction ") + names[c], direction[c]);
+  }
+  if (control_.active()) {
+    const int n = chain_.size();
+    if (control_.rates.rows() != n)
+      throw std::invalid_argument("control direction: rates for " + std::to_string(control_.rates.rows()) +
+                                  " segments, the chain has " + std::to_string(n));
+    requireFinite("control direction origin", control_.origin);
+    for (int i = 0; i < n; ++i) {
+      requireFinite("control direction rate dL1_0 of segment " + std::to_string(i + 1), control_.rates(i, 0));
+      requireFinite("control direction rate dL2_0 of segment " + std::to_string(i + 1), control_.rates(i, 1));
+    }
+    freeLength1_.resize(n);
+    freeLength2_.resize(n);
+    for (int i = 0; i < n; ++i) {
+      freeLength1_[i] = chain_.segment(i).parameters().L1_0;
+      freeLength2_[i] = chain_.segment(i).parameters().L2_0;
+    }
+    controlGrad_.resize(n);
+    controlStiff_.resize(n);
   }
   structure_.typicalScale = stiffnessUnit() * lengthUnit() * lengthUnit();  // the inertia's zero floor
   spectrumKey_.resize(dimension() + 1);
@@ -79,21 +99,37 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
   }
 }
 
-bool EquilibriumProblem::prepare(const ConstVectorRef& u) {
+bool EquilibriumProblem::prepare(const ConstVectorRef& u, double lambda) {
   const int n = chain_.size();
   for (Eigen::Index k = n; k < u.size(); ++k)
     if (!std::isfinite(u[k])) return false;
   const auto q = u.head(n);
   // Bitwise: a q that merely compares equal (−0.0 vs 0.0) is evaluated afresh.
-  if (cacheValid_ && sameBits(q.data(), cachedQ_.data(), size_t(n))) return true;
+  const bool controlled = control_.active();
+  if (cacheValid_ && sameBits(q.data(), cachedQ_.data(), size_t(n)) &&
+      (!controlled || sameBits(&lambda, &cachedLambda_, 1)))
+    return true;
   cacheValid_ = false;
   if (!inDomain(u)) return false;
   // One sincos per joint serves its springs and the link directions (chain.h).
+  const double t = lambda - control_.origin;
   for (int i = 0; i < n; ++i) {
     const double sh = std::sin(0.5 * q[i]), ch = std::cos(0.5 * q[i]);  // one sincos call at -O2
     sinHalf_[i] = sh;
     cosHalf_[i] = ch;
-    const Jet3 e = chain_.segment(i).energyJet(q[i], sh, ch);
+    Jet3 e;
+    if (controlled) {
+      // The same sums as chainWithControls(): the point at λ is bit for bit the chain at λ.
+      const double r1 = control_.rates(i, 0), r2 = control_.rates(i, 1);
+      const double L1 = freeLength1_[i] + t * r1, L2 = freeLength2_[i] + t * r2;
+      if (!(L1 > 0.0 && L2 > 0.0)) return false;  // no spring of non-positive free length (segment.cpp)
+      Jet3 rate;
+      e = chain_.segment(i).energyJet(q[i], sh, ch, L1, L2, r1, r2, rate);
+      controlGrad_[i] = rate.d1;
+      controlStiff_[i] = rate.d2;
+    } else {
+      e = chain_.segment(i).energyJet(q[i], sh, ch);
+    }
     grad_[i] = e.d1;
     stiff_[i] = e.d2;
     stiffRate_[i] = e.d3;
@@ -101,6 +137,7 @@ bool EquilibriumProblem::prepare(const ConstVectorRef& u) {
   forwardKinematics(chain_, q, sinHalf_.data(), cosHalf_.data(), data_);
   endJacobian(data_, J_);
   cachedQ_ = q;
+  cachedLambda_ = lambda;
   cacheValid_ = true;
   return true;
 }
@@ -117,7 +154,7 @@ Vector EquilibriumProblem::initialGuess(ConstVectorRef q, double lambda) const {
   endJacobian(data, J);
   // ∂E/∂q − J_lᵀ F_l = J_hᵀ r in the least-squares sense
   Vector rhs(n);
-  energyGradient(chain_, q, rhs);
+  energyGradient(controlled() ? chainAt(lambda) : chain_, q, rhs);
   const Eigen::Vector3d value = prescribed(lambda);
   for (int c : loaded_) rhs -= J.row(c).transpose() * value[c];
   Matrix Jh(n, m);
@@ -146,7 +183,7 @@ bool EquilibriumProblem::inDomain(const ConstVectorRef& u) const {
 }
 
 bool EquilibriumProblem::residual(ConstVectorRef u, double lambda, VectorRef F) {
-  if (!std::isfinite(lambda) || !prepare(u)) return false;
+  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
   const int n = chain_.size();
   const Wrench W = wrench(u, lambda);
   auto top = F.head(n);
@@ -158,7 +195,7 @@ bool EquilibriumProblem::residual(ConstVectorRef u, double lambda, VectorRef F) 
 }
 
 bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) {
-  if (!std::isfinite(lambda) || !prepare(u)) return false;
+  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
   const int n = chain_.size();
   const Wrench W = wrench(u, lambda);
   loadHessianGenerator(data_, W, work_);
@@ -193,12 +230,14 @@ bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu,
     const double d = direction_[c];
     for (int i = 0; i < n; ++i) fl[i] -= J[c + 3 * i] * d;
   }
+  if (control_.active())
+    for (int i = 0; i < n; ++i) fl[i] += controlGrad_[i];  // ∂²E/∂q∂λ of the moving free lengths
   return true;
 }
 
 bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
                                                        double dlambda, MatrixRef dFu, VectorRef dFlambda) {
-  if (!std::isfinite(lambda) || !prepare(u)) return false;
+  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
   const int n = chain_.size();
   const int m = heldCount();
   const Wrench W = wrench(u, lambda);
@@ -210,10 +249,9 @@ bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double 
   const Vector dS = -dJ.row(0).transpose(), dC = dJ.row(1).transpose();
   // dh_m for h_m = −Fx C_m − Fy S_m
   Vector dh = -dW[0] * data_.C - W[0] * dC - dW[1] * data_.S - W[1] * dS;
-  jointStiffnessDerivative(chain_, u.head(n), work2_);
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) dFu(i, j) = -dh[std::max(i, j)];
-  for (int i = 0; i < n; ++i) dFu(i, i) += work2_[i] * du[i];
+  for (int i = 0; i < n; ++i) dFu(i, i) += stiffRate_[i] * du[i];  // E‴ at (q, λ), from the cache
   for (int k = 0; k < m; ++k) {
     dFu.block(0, n + k, n, 1) = -dJ.row(held_[size_t(k)]).transpose();
     dFu.block(n + k, 0, 1, n) = -dJ.row(held_[size_t(k)]);
@@ -221,11 +259,18 @@ bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double 
   if (m > 0) dFu.bottomRightCorner(m, m).setZero();
   dFlambda.setZero();
   for (int cc : loaded_) dFlambda.head(n) -= dJ.row(cc).transpose() * direction_[cc];
+  if (control_.active()) {
+    // K_q moves with λ; F_λ's control part ∂²E/∂q∂λ moves with q_i (∂/∂λ of it is zero)
+    for (int i = 0; i < n; ++i) {
+      dFu(i, i) += controlStiff_[i] * dlambda;
+      dFlambda[i] += controlStiff_[i] * du[i];
+    }
+  }
   return true;
 }
 
 bool EquilibriumProblem::jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) {
-  if (!std::isfinite(lambda) || !prepare(u)) return false;
+  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
   const int n = chain_.size();
   const int m = heldCount();
   Vector h(n);
@@ -243,6 +288,7 @@ bool EquilibriumProblem::jacobianApply(ConstVectorRef u, double lambda, ConstVec
     y[i] += stiff_[i] * x[i] - h[i] * prefix;
   }
   for (int c : loaded_) y.head(n) -= (xl * direction_[c]) * J_.row(c).transpose();
+  if (control_.active()) y.head(n) += xl * controlGrad_;
   for (int k = 0; k < m; ++k) {
     const int c = held_[size_t(k)];
     y.head(n) -= x[n + k] * J_.row(c).transpose();
@@ -262,13 +308,14 @@ bool EquilibriumProblem::jacobianTransposeApply(ConstVectorRef u, double lambda,
   double dot = 0.0;
   for (int c : loaded_) dot -= direction_[c] * J_.row(c).dot(w.head(n));
   for (int k = 0; k < heldCount(); ++k) dot += direction_[held_[size_t(k)]] * w[n + k];
+  if (control_.active()) dot += controlGrad_.dot(w.head(n));  // jacobianApply prepared (q, λ)
   y[N] = dot;
   return std::isfinite(dot);
 }
 
 bool EquilibriumProblem::secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
                                                VectorRef y) {
-  if (!std::isfinite(lambda) || !prepare(u)) return false;
+  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
   const int n = chain_.size();
   const int m = heldCount();
   const Wrench W = wrench(u, lambda);
@@ -281,8 +328,9 @@ bool EquilibriumProblem::secondDerivativeApply(ConstVectorRef u, double lambda, 
   const Vector dh = -dW[0] * data_.C - W[0] * dJ.row(1).transpose() - dW[1] * data_.S + W[1] * dJ.row(0).transpose();
   maxIndexProduct(dh, z.head(n), y.head(n));
   y.head(n) = -y.head(n);
-  jointStiffnessDerivative(chain_, u.head(n), work2_);
-  y.head(n) += work2_.cwiseProduct(x.head(n)).cwiseProduct(z.head(n));
+  y.head(n) += stiffRate_.cwiseProduct(x.head(n)).cwiseProduct(z.head(n));  // E‴ at (q, λ)
+  if (control_.active())  // ∂K_q/∂λ (x_q z_λ + x_λ z_q); ∂²F/∂λ² = 0
+    y.head(n) += controlStiff_.cwiseProduct(z[n + m] * x.head(n) + x[n + m] * z.head(n));
   for (int c : loaded_) y.head(n) -= (z[n + m] * direction_[c]) * dJ.row(c).transpose();
   for (int k = 0; k < m; ++k) {
     const int c = held_[size_t(k)];
@@ -293,7 +341,7 @@ bool EquilibriumProblem::secondDerivativeApply(ConstVectorRef u, double lambda, 
 }
 
 bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix& H, Matrix& C) {
-  if (!prepare(u)) return false;
+  if (!prepare(u, lambda)) return false;
   const int n = chain_.size();
   H.resize(n, n);
   C.resize(heldCount(), n);
@@ -311,7 +359,7 @@ void EquilibriumProblem::assembleFromCache(const ConstVectorRef& u, double lambd
 }
 
 bool EquilibriumProblem::assembleStructure(ConstVectorRef u, double lambda, ChainStructure& ws, MatrixRef J) {
-  if (!std::isfinite(lambda) || !prepare(u)) return false;
+  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
   assembleFromCache(u, lambda, ws);
   J = J_;
   return true;
@@ -326,7 +374,7 @@ bool EquilibriumProblem::smallDenseSpectrum(const ConstVectorRef& u, double lamb
       sameBits(u.data(), spectrumKey_.data(), N) && sameBits(&lambda, spectrumKey_.data() + N, 1))
     return true;
   spectrumSize_ = -1;
-  if (!prepare(u)) return false;
+  if (!prepare(u, lambda)) return false;
   // The dense route reads h and κ alone (smallDenseInertia), not the tridiagonal form assemble()
   // adds for the O(n) counts (every structured route assembles for itself).
   loadHessianGenerator(data_, wrench(u, lambda), structure_.h);
@@ -360,7 +408,7 @@ bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCo
     info.smallest = found > 0 ? spectrum_[0] : 0.0;
     return true;
   }
-  if (!prepare(u)) return false;
+  if (!prepare(u, lambda)) return false;
   assembleFromCache(u, lambda, structure_);
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
   // Inertia by two O(n) Sturm counts (Sylvester); eigenvalues only when asked for.
@@ -391,7 +439,7 @@ bool EquilibriumProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, i
     values = spectrum_.segment(first, values.size());
     return true;
   }
-  if (!prepare(u)) return false;
+  if (!prepare(u, lambda)) return false;
   assembleFromCache(u, lambda, structure_);
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
   const int rank = heldCount() > 0 ? setConstraints(structure_, heldRows_) : (structure_.rank = 0);
@@ -410,7 +458,7 @@ bool EquilibriumProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, i
 
 bool EquilibriumProblem::stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
                                             double& bound) {
-  if (!std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() || !prepare(u)) return false;
+  if (!std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() || !prepare(u, lambda)) return false;
   const int n = chain_.size();
   const int m = heldCount();
   const Wrench W = wrench(u, lambda);
@@ -436,7 +484,8 @@ bool EquilibriumProblem::stabilityRateBound(ConstVectorRef u, double lambda, Con
     thetaDot -= du[p];
     const double h = -W[0] * data_.C[p] - W[1] * data_.S[p];
     const double dh = -dW[0] * data_.C[p] - W[0] * dC - dW[1] * data_.S[p] - W[1] * dS;
-    const double dDiagonal = stiffRate_[p] * du[p] - dh, diagonal = stiff_[p] - h;
+    const double dControl = control_.active() ? controlStiff_[p] * dlambda : 0.0;  // ∂K_q/∂λ dλ
+    const double dDiagonal = stiffRate_[p] * du[p] + dControl - dh, diagonal = stiff_[p] - h;
     dH2 += dDiagonal * dDiagonal + 2.0 * p * dh * dh;
     H2 += diagonal * diagonal + 2.0 * p * h * h;
     if (heldX) dC2 += dS * dS;
@@ -495,6 +544,11 @@ continuation::ProblemScales EquilibriumProblem::scales() const {
     const bool held = end_.isHeld(static_cast<EndCoordinate>(c));
     const double unit = held ? (c < 2 ? length : 1.0) : (c < 2 ? force : torque);
     lambda = std::min(lambda, unit / std::abs(direction_[c]));
+  }
+  // Along a control path λ moves a free length by λ·rate: its unit b̄.
+  if (control_.active()) {
+    const double rate = control_.rates.cwiseAbs().maxCoeff();
+    if (rate > 0.0) lambda = std::min(lambda, length / rate);
   }
   s.parameter = std::isfinite(lambda) && lambda > 0.0 ? lambda : force;
   s.stability = torque;  // K_q − K_g

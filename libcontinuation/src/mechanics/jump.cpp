@@ -320,7 +320,9 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   problem.stability(result.from, lambda, 3, result.stabilityFrom);
 
   const EndCondition end = frozenEnd(problem, lambda);
-  std::unique_ptr<DynamicsModel> model = makeDynamicsModel(problem.chain(), end, options.scene, qFrom);
+  // the chain with its control inputs (free lengths) where it is released
+  std::unique_ptr<DynamicsModel> model =
+      makeDynamicsModel(problem.controlled() ? problem.chainAt(lambda) : problem.chain(), end, options.scene, qFrom);
   result.potentialFrom = model->potential(qFrom);
 
   // 1. The perturbation direction: the caller's, or the softest mode of the stability operator.

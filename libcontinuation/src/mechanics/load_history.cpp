@@ -43,7 +43,9 @@ double potentialAt(EquilibriumProblem& problem, const Vector& u, double lambda) 
   const int n = problem.segments();
   // Π with the reactions as the forces of the held coordinates: the potential whose
   // stationary points on the held manifold are the equilibria.
-  return totalPotential(problem.chain(), u.head(n), problem.wrench(u, lambda));
+  // along a control path the springs' free lengths, and so E, are those at λ
+  return totalPotential(problem.controlled() ? problem.chainAt(lambda) : problem.chain(), u.head(n),
+                        problem.wrench(u, lambda));
 }
 
 // Index of the first special point past which the traced branch is no longer stable, or −1.

@@ -135,19 +135,45 @@ Jet3 Segment::energyJet(double q) const {
   return energyJet(q, std::sin(0.5 * q), std::cos(0.5 * q));  // one sincos call at -O2
 }
 
+namespace {
+// One spring's term of E = Σ ½k(L − L⁰)² (eq 7) and its q-derivatives, added to E; the stretch
+// L − L⁰ returned (both energy jets share this, so their sums are the same bit for bit).
+inline double addSpring(const Jet3& L, double k, double L0, Jet3& E) {
+  const double stretch = L.value - L0;
+  E.value += 0.5 * k * stretch * stretch;
+  E.d1 += k * stretch * L.d1;
+  E.d2 += k * (L.d1 * L.d1 + stretch * L.d2);
+  E.d3 += k * (3.0 * L.d1 * L.d2 + stretch * L.d3);
+  return stretch;
+}
+}  // namespace
+
 Jet3 Segment::energyJet(double q, double sinHalf, double cosHalf) const {
+  Jet3 L1, L2;
+  springs(q, sinHalf, cosHalf, L1, L2);
+  Jet3 E;
+  addSpring(L1, p_.k1, p_.L1_0, E);
+  addSpring(L2, p_.k2, p_.L2_0, E);
+  return E;
+}
+
+Jet3 Segment::energyJet(double q, double sinHalf, double cosHalf, double L1_0, double L2_0, double r1, double r2,
+                        Jet3& rate) const {
   Jet3 Ls[2];
   springs(q, sinHalf, cosHalf, Ls[0], Ls[1]);
   const double k[2] = {p_.k1, p_.k2};
-  const double L0[2] = {p_.L1_0, p_.L2_0};
+  const double L0[2] = {L1_0, L2_0};
+  const double r[2] = {r1, r2};
   Jet3 E;
+  rate = Jet3{};
   for (int i = 0; i < 2; ++i) {
     const Jet3& L = Ls[i];
-    const double stretch = L.value - L0[i];
-    E.value += 0.5 * k[i] * stretch * stretch;
-    E.d1 += k[i] * stretch * L.d1;
-    E.d2 += k[i] * (L.d1 * L.d1 + stretch * L.d2);
-    E.d3 += k[i] * (3.0 * L.d1 * L.d2 + stretch * L.d3);
+    const double stretch = addSpring(L, k[i], L0[i], E);
+    const double kr = k[i] * r[i];  // E = ½k(L − L⁰)²: ∂/∂L⁰ of each term is −k(·)
+    rate.value -= kr * stretch;
+    rate.d1 -= kr * L.d1;
+    rate.d2 -= kr * L.d2;
+    rate.d3 -= kr * L.d3;
   }
   return E;
 }

@@ -66,9 +66,23 @@ StiffnessRate stiffnessRate(const EquilibriumProblem& problem, cont::ConstVector
   const std::vector<int> held = problem.endCondition().heldIndices();
   for (size_t k = 0; k < held.size(); ++k) dF[held[k]] = du[n + int(k)];
   Eigen::Matrix2d dK;
-  if (!loadedStiffnessDerivative(problem.chain(), u.head(n), F, problem.endCondition().isHeld(EndCoordinate::Phi),
-                                 du.head(n), dF, r.K, dK))
-    return r;
+  const bool rotationHeld = problem.endCondition().isHeld(EndCoordinate::Phi);
+  if (!problem.controlled()) {
+    if (!loadedStiffnessDerivative(problem.chain(), u.head(n), F, rotationHeld, du.head(n), dF, r.K, dK)) return r;
+  } else {
+    // Along a control path K_q also moves with λ at fixed (q, F): that part of dK by central
+    // differences of K_F in λ (step 1e-5 of λ's unit: error ~1e-10 relative), the rest exact.
+    try {
+      if (!loadedStiffnessDerivative(problem.chainAt(lambda), u.head(n), F, rotationHeld, du.head(n), dF, r.K, dK))
+        return r;
+      const double h = 1e-5 * problem.scales().parameter;
+      const CartesianStiffness up = loadedStiffness(problem.chainAt(lambda + h), u.head(n), F, rotationHeld);
+      const CartesianStiffness down = loadedStiffness(problem.chainAt(lambda - h), u.head(n), F, rotationHeld);
+      dK += (up.stiffness - down.stiffness) * (dlambda / (2.0 * h));
+    } catch (const std::invalid_argument&) {
+      return r;  // a free length not positive within the step: no rate
+    }
+  }
   r.value = stiffnessMeasure(r.K, measure);
   r.rate = stiffnessMeasureDerivative(r.K, dK, measure);
   r.valid = std::isfinite(r.value) && std::isfinite(r.rate);

@@ -8,6 +8,10 @@
 //   −(p_c(q) − value_c(λ)) = 0         for every held coordinate c
 // so that F_u = [[K_q − K_g(F), −J_hᵀ], [−J_h, 0]] is symmetric (a KKT matrix).
 // Stability operator: K_q − K_g(F) on ker J_h.
+// With a control direction (control_path.h) λ also moves the springs' free lengths,
+// L⁰(λ) = L⁰ + (λ − origin)·rates, so E = Σ ½k(L − L⁰(λ))² depends on λ and
+//   F_λ = −J_lᵀ d_l + ∂²E/∂q∂λ,   ∂²E/∂q_i∂λ = −Σ_s k_s r_{i,s} ∂L_s/∂q_i,
+//   ∂K_q/∂λ = diag(−Σ_s k_s r_{i,s} ∂²L_s/∂q_i²),  ∂²F/∂λ² = 0 (E is quadratic in L⁰, F linear in it).
 #pragma once
 
 #include <Eigen/Core>
@@ -16,6 +20,7 @@
 #include "buckle/continuation/problem.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
+#include "buckle/mechanics/control_path.h"
 #include "buckle/mechanics/end_condition.h"
 
 namespace buckle::mechanics {
@@ -30,14 +35,26 @@ struct EquilibriumOptions {
 
 class EquilibriumProblem final : public continuation::Problem {
  public:
+  /// `control`: λ moves the free lengths as well (control_path.h; rates n×2 or empty). Throws
+  /// std::invalid_argument for non-finite input or rates of the wrong size.
   EquilibriumProblem(const Chain& chain, const EndCondition& end, const Eigen::Vector3d& direction,
-                     EquilibriumOptions options = {});
+                     EquilibriumOptions options = {}, const ControlDirection& control = {});
 
   const Chain& chain() const { return chain_; }
   const EndCondition& endCondition() const { return end_; }
   const Eigen::Vector3d& direction() const { return direction_; }
   int segments() const { return chain_.size(); }
   int heldCount() const { return static_cast<int>(held_.size()); }
+  /// The control direction (inactive: λ moves the end values alone).
+  const ControlDirection& control() const { return control_; }
+  bool controlled() const { return control_.active(); }
+  /// The chain with its free lengths at λ (chainWithControls; a copy of chain() when no control
+  /// path): what the energy, stiffness and dynamics of a point at λ are computed on. Throws
+  /// std::invalid_argument when a free length is not positive at λ.
+  Chain chainAt(double lambda) const { return chainWithControls(chain_, control_, lambda); }
+  /// ∂²E/∂q∂λ (size n) at the (q, λ) of the last evaluation (residual, jacobian,
+  /// assembleStructure …): the control part of F_λ. Empty when no control path.
+  const Vector& controlRate() const { return controlGrad_; }
 
   /// Prescribed values (loads or coordinates) at λ.
   Eigen::Vector3d prescribed(double lambda) const { return end_.value + lambda * direction_; }
@@ -131,7 +148,9 @@ class EquilibriumProblem final : public continuation::Problem {
   /// evaluates F and then J at the same iterate, and the tracer then J and the stability at the
   /// corrected point, so each distinct q evaluates the spring model once.
   /// False (nothing cached) if u is outside the domain.
-  bool prepare(const continuation::ConstVectorRef& u);
+  /// Along a control path the free lengths, and so ∂E/∂q and K_q, depend on λ: the key is then
+  /// (q, λ), bitwise, and points where a free length is not positive are refused.
+  bool prepare(const continuation::ConstVectorRef& u, double lambda);
   /// T at (u, λ) into ws from the cache (after prepare(u)).
   void assembleFromCache(const continuation::ConstVectorRef& u, double lambda, ChainStructure& ws);
   /// The small dense route (n ≤ kSmallDense) at (u, λ): the inertia and all eigenvalues on
@@ -149,12 +168,16 @@ class EquilibriumProblem final : public continuation::Problem {
   Vector grad_, stiff_;  // ∂E/∂q, diagonal of K_q (size n); with data_ and J_: prepare()'s cache
   Vector stiffRate_;     // d³E/dq³ per joint (size n), from the same jets: stabilityRateBound()
   Vector cachedQ_;       // q of the cache (size n)
+  ControlDirection control_;
+  double cachedLambda_ = 0.0;     // λ of the cache (a control path only)
+  Vector freeLength1_, freeLength2_;  // the chain's L1⁰, L2⁰ (control path only, size n)
+  Vector controlGrad_, controlStiff_; // ∂(∂E/∂q)/∂λ, ∂K_q/∂λ of the cache (control path only)
   Vector sinHalf_, cosHalf_;  // sin(q_i/2), cos(q_i/2) of the cache: springs and kinematics share them
   // inDomain()'s bounds per joint, geometric limit ± the overshoot allowed while the limits are
   // traced as boundaries, formed once (the same sums inDomain() formed per call; size n).
   Vector domainUpper_, domainLower_;
   bool cacheValid_ = false;
-  Vector work_, work2_;  // size n
+  Vector work_;  // size n
   ChainStructure structure_;  // workspace of the structured stability()
   Matrix heldRows_;           // m×n held rows of J
   // The whole small dense spectrum (n ≤ kSmallDense) of the last (u, λ) it was computed at, by

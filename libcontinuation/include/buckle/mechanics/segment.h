@@ -53,6 +53,12 @@ class Segment {
   /// forwardKinematics from half angles in chain.h). energyJet(q) is
   /// this with std::sin / std::cos of q/2: bit for bit the same values.
   Jet3 energyJet(double q, double sinHalf, double cosHalf) const;
+  /// The same with the free lengths L1⁰, L2⁰ given in place of the parameters' (the control
+  /// inputs moved along a path, control_path.h), and into `rate` its derivative when they move
+  /// at (r1, r2) per unit of the path parameter: ∂E/∂L⁰_s = −k_s(L_s − L⁰_s) and, for j ≥ 1,
+  /// ∂E^(j)/∂L⁰_s = −k_s L_s^(j) (the q-derivatives of L do not depend on L⁰).
+  Jet3 energyJet(double q, double sinHalf, double cosHalf, double L1_0, double L2_0, double r1, double r2,
+                 Jet3& rate) const;
 
   /// d/dμ of energyJet(q) (E, E′, E″, E‴ at fixed q) when the parameters move along `dp`: exact
   /// (forward-mode derivative of eq 1 in the form L² = c1² + c2² + 2c1c2 cos(β12 ± q)), so away

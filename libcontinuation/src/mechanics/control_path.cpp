@@ -1,0 +1,80 @@
+#include "buckle/mechanics/control_path.h"
+
+#include <stdexcept>
+#include <vector>
+
+namespace buckle::mechanics {
+
+namespace {
+// d(L1⁰, L2⁰)/d(input): the input's definition inverted with the other mode kept.
+Eigen::RowVector2d ratesOf(ControlInput input) {
+  switch (input) {
+    case ControlInput::L1_0: return {1.0, 0.0};
+    case ControlInput::L2_0: return {0.0, 1.0};
+    case ControlInput::L0: return {1.0, 1.0};
+    case ControlInput::dL0: return {0.5, -0.5};
+  }
+  return {0.0, 0.0};
+}
+}  // namespace
+
+ControlDirection ControlDirection::named(int n, ControlInput input, int segment) {
+  if (n < 1) throw std::invalid_argument("control direction: the chain needs at least one segment");
+  if (segment < -1 || segment >= n)
+    throw std::invalid_argument("control direction: segment " + std::to_string(segment + 1) + " out of range 1.." +
+                                std::to_string(n));
+  ControlDirection d;
+  d.rates = Eigen::MatrixX2d::Zero(n, 2);
+  for (int i = 0; i < n; ++i)
+    if (segment < 0 || segment == i) d.rates.row(i) = ratesOf(input);
+  return d;
+}
+
+std::string controlInputName(ControlInput input) {
+  switch (input) {
+    case ControlInput::L1_0: return "L1_0";
+    case ControlInput::L2_0: return "L2_0";
+    case ControlInput::L0: return "L0";
+    case ControlInput::dL0: return "dL0";
+  }
+  return "";
+}
+
+bool parseControlInput(const std::string& name, ControlInput& input) {
+  for (ControlInput c : {ControlInput::L1_0, ControlInput::L2_0, ControlInput::L0, ControlInput::dL0})
+    if (name == controlInputName(c)) {
+      input = c;
+      return true;
+    }
+  return false;
+}
+
+double controlInputValue(const Chain& chain, ControlInput input, int segment) {
+  const auto value = [input](const SegmentParameters& p) {
+    switch (input) {
+      case ControlInput::L1_0: return p.L1_0;
+      case ControlInput::L2_0: return p.L2_0;
+      case ControlInput::L0: return 0.5 * (p.L1_0 + p.L2_0);
+      case ControlInput::dL0: return p.L1_0 - p.L2_0;
+    }
+    return 0.0;
+  };
+  if (segment >= 0) return value(chain.segment(segment).parameters());
+  double sum = 0.0;
+  for (int i = 0; i < chain.size(); ++i) sum += value(chain.segment(i).parameters());
+  return sum / chain.size();
+}
+
+Chain chainWithControls(const Chain& chain, const ControlDirection& control, double lambda) {
+  std::vector<SegmentParameters> p(size_t(chain.size()));
+  const double t = lambda - control.origin;
+  for (int i = 0; i < chain.size(); ++i) {
+    p[size_t(i)] = chain.segment(i).parameters();
+    if (!control.active()) continue;
+    p[size_t(i)].L1_0 += t * control.rates(i, 0);
+    p[size_t(i)].L2_0 += t * control.rates(i, 1);
+  }
+  return Chain(p);  // validates: "segment i: L1_0 must be > 0 …"
+}
+
+}  // namespace buckle::mechanics
