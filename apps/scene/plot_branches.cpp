@@ -22,7 +22,15 @@ double specialValue(const std::string& column, const SpecialRecord& r, const Cas
     if (a.branch != r.branch || b.branch != r.branch || a.q.size() != r.q.size() || b.q.size() != r.q.size()) continue;
     const Eigen::VectorXd d = b.q - a.q;
     const double len2 = d.squaredNorm();
-    const double t = len2 > 0 ? std::clamp((r.q - a.q).dot(d) / len2, 0.0, 1.0) : 0.0;
+    double t = len2 > 0 ? std::clamp((r.q - a.q).dot(d) / len2, 0.0, 1.0) : 0.0;
+    if (!(len2 > 0)) {
+      // a branch whose shape does not change (the straight chain): between these two points in
+      // the path parameter, or not at all
+      const double dl = b.parameter - a.parameter;
+      if (!(dl != 0.0)) continue;
+      t = (r.parameter - a.parameter) / dl;
+      if (t < 0.0 || t > 1.0) continue;
+    }
     const double dist = (r.q - a.q - t * d).norm();
     // off the chord by more than half the spacing: not between these two points
     if (dist > 0.5 * std::sqrt(len2) && dist > 0.0) continue;

@@ -831,3 +831,40 @@ TEST_CASE("a long chain's bifurcation diagram is a summary: bounded labels, ever
   CHECK(line[0].rows.front()[1] == 0.0);
   fs::remove_all(out.parent_path());
 }
+
+TEST_CASE("a branch point on the straight branch is marked at the value interpolated in the path parameter",
+          "[scene][plot]") {
+  // C_yy exists only at traced points: the marker of a branch point takes the value between the two
+  // traced points around it. On the straight branch every q is 0, so the interpolation is in Fx
+  // (by the shape it would put every marker at the branch's first point).
+  const fs::path dir = freshDir("straight_marker"), out = dir / "out";
+  std::ofstream(dir.string() + ".json") << R"({
+    "chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+    "end": {"x": {"load": 0.0}, "y": {"held": 0.0}, "phi": "free"},
+    "path": {"parameter": "Fx", "from": 0.0, "to": -2.5},
+    "analyses": {"continuation": {"branch_switching": 0, "contact": false}, "stiffness": true},
+    "plots": [{"type": "stiffness", "name": "cyy", "x": "Fx", "y": ["Cyy"]}]
+  })";
+  const Run r = run(dir.string() + ".json", out);
+  INFO(r.err);
+  REQUIRE(r.rc == 0);
+  const Csv csv = readCsv(out / "branches.csv");
+  int marked = 0;
+  for (const Block& b : readBlocks(out / "plots" / "cyy_special.dat")) {
+    if (b.comments.empty() || b.comments[0].find(": BP") == std::string::npos) continue;
+    for (const std::vector<double>& row : b.rows) {
+      double below = -1e300, above = 1e300, cBelow = 0.0, cAbove = 0.0;
+      for (const auto& p : csv.rows) {
+        if (int(p[csv.col("branch")]) != 0) continue;
+        const double fx = p[csv.col("Fx")];
+        if (fx <= row[0] && fx > below) below = fx, cBelow = p[csv.col("Cyy")];
+        if (fx >= row[0] && fx < above) above = fx, cAbove = p[csv.col("Cyy")];
+      }
+      REQUIRE(above > below);
+      const double expected = cBelow + (row[0] - below) / (above - below) * (cAbove - cBelow);
+      CHECK(row[1] == Approx(expected).epsilon(1e-8));  // the data file's 10 digits
+      ++marked;
+    }
+  }
+  CHECK(marked == 2);  // the U and Z points of eq 17
+}
