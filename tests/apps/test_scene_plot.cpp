@@ -862,7 +862,7 @@ TEST_CASE("a branch point on the straight branch is marked at the value interpol
       }
       REQUIRE(above > below);
       const double expected = cBelow + (row[0] - below) / (above - below) * (cAbove - cBelow);
-      CHECK(row[1] == Approx(expected).epsilon(1e-8));  // the data file's 10 digits
+      CHECK(row[1] == Approx(expected).epsilon(1e-6));  // Fx and C_yy through 10-digit files
       ++marked;
     }
   }
