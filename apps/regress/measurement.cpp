@@ -33,6 +33,10 @@ MeasuredCase fromScene(const scene::CaseResult& c) {
   if (c.haveLandscape)
     for (const mechanics::LandscapeEquilibrium& e : c.landscape.equilibria)
       m.specials.push_back({-1, "EQ", e.q1, e.shape + (e.stable ? " stable" : " unstable"), 0.0});
+  if (c.haveEquilibria)  // every equilibrium at one state (ascending Π): Π, shape, stability and index
+    for (const mechanics::FoundEquilibrium& e : c.equilibria.equilibria)
+      m.specials.push_back({-1, "ALLEQ", e.potential,
+                            e.shape + (e.stable ? " stable" : " unstable") + ", index " + std::to_string(e.index), 0.0});
   if (c.haveTorque)
     for (const auto& [q, stable] : c.torque.equilibria) m.specials.push_back({-1, "TEQ", q, stable ? "stable" : "unstable", 0.0});
   if (c.haveSudden && c.sudden.success) {

@@ -27,7 +27,7 @@ std::set<std::string> branchColumns(int maxN, bool stiffness) {
 AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
   r.onlyKeys(a, p,
              {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump", "load_history",
-              "sudden_load", "two_parameter"});
+              "sudden_load", "two_parameter", "equilibria"});
   AnalysesSpec s;
   if (a.contains("continuation")) {
     const json& c = a["continuation"];
@@ -141,10 +141,11 @@ AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
     s.suddenLoad.enabled = true;
   }
   if (a.contains("two_parameter")) s.twoParameter = parseTwoParameter(r, a["two_parameter"], p / "two_parameter");
+  if (a.contains("equilibria")) s.equilibria = parseEquilibria(r, a["equilibria"], p / "equilibria");
   if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled &&
-      !s.loadHistory.enabled && !s.suddenLoad.enabled && !s.twoParameter.enabled)
+      !s.loadHistory.enabled && !s.suddenLoad.enabled && !s.twoParameter.enabled && !s.equilibria.enabled)
     r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces, "
-              "load_history, sudden_load, two_parameter)");
+              "load_history, sudden_load, two_parameter, equilibria)");
   return s;
 }
 
@@ -271,6 +272,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
 
 void checkAnalysesAgainstCases(const Reader& r, const Scene& scene) {
   checkTwoParameterAgainstCases(r, scene);
+  checkEquilibriaAgainstCases(r, scene);
   if (scene.analyses.energyCurves.enabled)
     for (size_t i = 0; i < scene.cases.size(); ++i)
       if (scene.cases[i].chain.segments.size() != 3)

@@ -31,6 +31,7 @@ void requireOption(bool ok, const std::string& what) {
 
 void validate(const Chain& chain, const AllEquilibriaOptions& o) {
   requireOption(o.randomStarts >= 0, "randomStarts must be >= 0");
+  requireOption(o.smoothStarts >= 0, "smoothStarts must be >= 0");
   requireOption(o.maxRootsPerStart >= 1, "maxRootsPerStart must be >= 1");
   requireOption(o.maxIterations >= 1, "maxIterations must be >= 1");
   requireOption(std::isfinite(o.deflationPower) && o.deflationPower >= 1.0, "deflationPower must be >= 1");
@@ -185,6 +186,16 @@ std::vector<Vector> startingShapes(const Chain& chain, const AllEquilibriaOption
     for (int i = 0; i < n; ++i) q[i] = amplitude * (lo[i] + (hi[i] - lo[i]) * unit(rng));
     starts.push_back(q.cwiseMax(lo).cwiseMin(hi));
   }
+  // Smooth shapes: a total turn T of up to ±2π spread over the joints with a slow cosine
+  // modulation of m half-waves. The equilibria of a long chain bend it smoothly, and a joint-by-
+  // joint random shape of n ≫ 1 joints is far from every one of them.
+  for (int k = 0; k < options.smoothStarts; ++k) {
+    const double turn = 2.0 * M_PI * (2.0 * unit(rng) - 1.0), weight = 2.0 * unit(rng) - 1.0;
+    const int halfWaves = int(4.0 * unit(rng));
+    Vector q(n);
+    for (int i = 0; i < n; ++i) q[i] = turn / n * (1.0 + weight * std::cos(M_PI * halfWaves * (i + 0.5) / n));
+    starts.push_back(q.cwiseMax(lo).cwiseMin(hi));
+  }
   return starts;
 }
 
@@ -290,6 +301,7 @@ AllEquilibria allEquilibria(const Chain& chain, const EndCondition& end, const A
   EquilibriumProblem problem(chain, end, Eigen::Vector3d::Zero(), equilibriumOptions);
   DeflatedNewton solver(problem, options);
   AllEquilibria result;
+  result.endCondition = end;
   const bool sweep = options.landscape && sweepApplies(chain, end);
   detail::SweepResult swept;
   if (sweep) swept = detail::sweepEquilibria(chain, end.value[0], end.value[1], options.landscapeSamples);

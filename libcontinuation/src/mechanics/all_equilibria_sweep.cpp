@@ -185,6 +185,11 @@ int findRoot(std::vector<int>& parent, int k) {
 // a joint limit, E decreasing outward there removes one from the count of the interior
 // critical points (1-D Morse theory with boundary): Σ(−1)^index = Σ_arcs (1 − #ends decreasing).
 void topology(const EnergyLandscape& L, const std::vector<Run>& runs, MorseCheck& morse) {
+  if (runs.empty()) {
+    morse.basis = "no feasible sample: the configuration set is empty or finer than the sweep (e.g. a single point "
+                  "with the end at full reach)";
+    return;
+  }
   for (const Run& r : runs)
     if (r.first == r.last) {
       morse.basis = "a piece of the configuration set shorter than the sweep's resolution: topology not traced";

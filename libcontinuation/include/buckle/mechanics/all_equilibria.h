@@ -26,7 +26,9 @@
 namespace buckle::mechanics {
 
 struct AllEquilibriaOptions {
-  int randomStarts = 64;            ///< random shapes a·U(q_min, q_max), a ~ U(0, 1) per start
+  int randomStarts = 64;            ///< random shapes a·U(q_min, q_max) joint by joint, a ~ U(0, 1)
+  /// Random smooth shapes: a total turn of up to ±2π spread over the joints, slowly modulated.
+  int smoothStarts = 64;
   unsigned seed = 1;                ///< of the random shapes (std::mt19937)
   std::vector<Eigen::VectorXd> starts;  ///< further starting shapes (joint angles), e.g. branch points
   bool landscapeStarts = true;      ///< n = 3 held: the sweep's equilibria as starts too
@@ -70,6 +72,7 @@ struct MorseCheck {
 };
 
 struct AllEquilibria {
+  EndCondition endCondition;        ///< the state of the controls searched
   std::vector<FoundEquilibrium> equilibria;  ///< within the joint limits, ascending Π
   std::string method;               ///< "deflated Newton" or "deflated Newton + 1-D sweep"
   std::string guarantee;            ///< what the list is guaranteed to hold
