@@ -198,6 +198,18 @@ void show(const std::string& dirName, std::ostream& os) {
     printTable(os, {"case", "ik_branch", "q1", "E", "d2E/dq1^2", "stability", "shape"}, t,
                {true, true, true, true, true, false, false});
   }
+  if (const json& all = list(sp, "equilibria"); !all.empty()) {
+    std::vector<std::vector<std::string>> t;
+    for (const json& c : all)
+      for (const json& e : list(c, "equilibria"))
+        t.push_back({text(field(c, "case")), number(field(e, "potential")), text(field(e, "index")),
+                     field(e, "stable").is_boolean() ? (field(e, "stable").get<bool>() ? "stable" : "unstable") : "-",
+                     text(field(e, "shape")), number(field(e, "accuracy"), "%.1e")});
+    os << "\nevery equilibrium at one state (" << t.size() << ", special_points.json equilibria; method, starts and "
+       << "guarantee there):\n";
+    printTable(os, {"case", "potential", "index", "stability", "shape", "accuracy"}, t,
+               {true, true, true, false, false, true});
+  }
   if (const json& zeros = list(sp, "torque_zeros"); !zeros.empty()) {
     std::vector<std::vector<std::string>> t;
     for (const json& z : zeros)

@@ -41,6 +41,8 @@ class CaseRunner {
   void twoParameter();
   void energyCurves();
   void torqueAngle();
+  /// equilibria (case_runner_equilibria.cpp)
+  void equilibria();
 
   /// True once the time limit passed or a signal came: the run is then marked incomplete,
   /// once, with the reason.

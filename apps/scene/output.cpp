@@ -21,6 +21,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "scene/output_equilibria.h"
 #include "scene/output_numbers.h"
 #include "scene/escape.h"
 #include "scene/output_target.h"
@@ -302,6 +303,7 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
   if (scene.analyses.twoParameter.enabled) doc["critical_curves"] = criticalCurvesJson(run);
   if (scene.analyses.energyCurves.enabled) doc["energy_equilibria"] = equilibria;
   if (scene.analyses.torqueAngle.enabled) doc["torque_zeros"] = torque;
+  if (scene.analyses.equilibria.enabled) doc["equilibria"] = equilibriaJson(run);
   if (scene.analyses.suddenLoad.enabled) {
     json sudden = json::array();
     for (size_t c = 0; c < run.cases.size(); ++c) {
@@ -377,6 +379,7 @@ void writeCurves(const Scene& scene, const RunResult& run, const fs::path& dir) 
     }
     writeText(dir / "energy_curves.csv", os.str());
   }
+  if (scene.analyses.equilibria.enabled) writeText(dir / "equilibria.csv", equilibriaCsv(run));
   if (scene.analyses.torqueAngle.enabled) {
     std::ostringstream os;
     os << "case,q,M,Kq\n";

@@ -11,6 +11,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/critical_curves.h"
 #include "buckle/mechanics/dynamics.h"
+#include "buckle/mechanics/all_equilibria.h"
 #include "buckle/mechanics/energy_landscape.h"
 #include "buckle/mechanics/imperfection_sensitivity.h"
 #include "buckle/mechanics/koiter.h"
@@ -143,6 +144,9 @@ struct CaseResult {
   bool haveSudden = false;
   SuddenLoadRecord sudden;
   std::vector<mechanics::CriticalCurve> criticalCurves;  ///< two_parameter: BP curves by mode, then LP curves
+  bool haveEquilibria = false;     ///< equilibria: every equilibrium at one state of the controls
+  mechanics::AllEquilibria equilibria;
+  double equilibriaAt = 0.0;       ///< ... at this path-parameter value
   explicit CaseResult(const mechanics::Chain& c) : chain(c) {}
 };
 

@@ -89,7 +89,8 @@ Scene parseScene(const std::string& text, const std::string& file) {
   if (!doc.contains("analyses")) r.fail(Pointer("/analyses"), "missing (required): what to compute");
   scene.analyses = parseAnalyses(r, doc["analyses"], Pointer("/analyses"));
   const bool needPath = scene.analyses.continuation.enabled || scene.analyses.criticalForces.enabled ||
-                        scene.analyses.twoParameter.enabled || scene.analyses.loadHistory.enabled || scene.analyses.suddenLoad.enabled;
+                        scene.analyses.twoParameter.enabled || scene.analyses.loadHistory.enabled || scene.analyses.suddenLoad.enabled ||
+                        (scene.analyses.equilibria.enabled && scene.analyses.equilibria.haveAt);
 
   // chain, end and path: what a case patches (copied key by key, not with the cases)
   json base = json::object();

@@ -139,6 +139,18 @@ struct FrequenciesSpec {
   double massPerLength = 0.0;  ///< > 0 (mass / length in the scene's units)
 };
 
+/// Every equilibrium at one state of the controls (mechanics/all_equilibria.h): the case's end
+/// condition at the path parameter `at` (default: its start value).
+struct EquilibriaSpec {
+  bool enabled = false;
+  int starts = 64;             ///< random starting shapes of the deflated Newton search
+  int smoothStarts = 64;       ///< random smooth starting shapes
+  unsigned seed = 1;           ///< of the random shapes
+  bool haveAt = false;
+  double at = 0.0;             ///< path-parameter value (haveAt)
+  int sweepPoints = 4001;      ///< q1 grid of the n = 3 sweep (end held, Me = 0)
+};
+
 struct AnalysesSpec {
   ContinuationSpec continuation;
   FrequenciesSpec frequencies;
@@ -152,6 +164,7 @@ struct AnalysesSpec {
   TorqueAngleSpec torqueAngle;
   CriticalForcesSpec criticalForces;
   TwoParameterSpec twoParameter;
+  EquilibriaSpec equilibria;
 };
 
 struct SolverSpec {

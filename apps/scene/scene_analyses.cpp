@@ -47,7 +47,7 @@ FrequenciesSpec parseFrequencies(const Reader& r, const json& f, const Pointer& 
 AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
   r.onlyKeys(a, p,
              {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump", "load_history",
-              "sudden_load", "two_parameter", "frequencies"});
+              "sudden_load", "two_parameter", "frequencies", "equilibria"});
   AnalysesSpec s;
   if (a.contains("continuation")) {
     const json& c = a["continuation"];
@@ -167,10 +167,11 @@ AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
       r.fail(p / "frequencies",
              "frequencies are computed along the traced branches: it needs /analyses/continuation or load_history");
   }
+  if (a.contains("equilibria")) s.equilibria = parseEquilibria(r, a["equilibria"], p / "equilibria");
   if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled &&
-      !s.loadHistory.enabled && !s.suddenLoad.enabled && !s.twoParameter.enabled)
+      !s.loadHistory.enabled && !s.suddenLoad.enabled && !s.twoParameter.enabled && !s.equilibria.enabled)
     r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces, "
-              "load_history, sudden_load, two_parameter)");
+              "load_history, sudden_load, two_parameter, equilibria)");
   return s;
 }
 
@@ -298,6 +299,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
 void checkAnalysesAgainstCases(const Reader& r, const Scene& scene) {
   checkControlPathAnalyses(r, scene);
   checkTwoParameterAgainstCases(r, scene);
+  checkEquilibriaAgainstCases(r, scene);
   if (scene.analyses.energyCurves.enabled)
     for (size_t i = 0; i < scene.cases.size(); ++i)
       if (scene.cases[i].chain.segments.size() != 3)

@@ -412,7 +412,8 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
   if (!doc.contains("path")) {
     checkEndAgainstChain(r, cs);
     if (needPath)
-      r.fail(Pointer("/path"), "missing (required by /analyses/continuation and /analyses/critical_forces): the load path");
+      r.fail(Pointer("/path"), "missing (required by /analyses/continuation, critical_forces, two_parameter, "
+                               "load_history, sudden_load and equilibria with \"at\"): the load path");
     cs.path.parameter = "Fx";
     cs.path.coordinate = 0;
     cs.path.direction = Eigen::Vector3d(1.0, 0.0, 0.0);

@@ -45,6 +45,10 @@ void checkTwoParameterAgainstCases(const JsonReader& r, const Scene& scene);
 /// What the analyses require of every case: 3 segments for energy curves, load-history
 /// waypoints and the sudden load inside the path range, rod masses the inertial model can use.
 void checkAnalysesAgainstCases(const JsonReader& r, const Scene& scene);
+/// /analyses/equilibria (scene_equilibria.cpp): true, false or an object of options.
+EquilibriaSpec parseEquilibria(const JsonReader& r, const json& v, const Pointer& p);
+/// Its `at` inside every case's path range.
+void checkEquilibriaAgainstCases(const JsonReader& r, const Scene& scene);
 SolverSpec parseSolver(const JsonReader& r, const json& s, const Pointer& p);
 PlotSpec parsePlot(const JsonReader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN, int nCases);
 /// The plots of a scene without "plots": one per analysis that has a plot.

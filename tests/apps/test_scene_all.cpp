@@ -86,7 +86,10 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
       if (gnuplot) {
         for (const auto& f : summary["plots"]["files"]) CHECK(fs::exists(out / f.get<std::string>()));
         // every scene draws something, except the sudden-load scene (its trajectory is data only)
-        if (!src["analyses"].contains("sudden_load")) CHECK(!summary["plots"]["files"].empty());
+        // and a scene of every equilibrium alone (a table)
+        const bool dataOnly = src["analyses"].contains("sudden_load") ||
+                              (src["analyses"].contains("equilibria") && src["analyses"].size() == 1);
+        if (!dataOnly) CHECK(!summary["plots"]["files"].empty());
         CHECK(!summary["plots"].contains("failures"));
       }
 
@@ -145,6 +148,31 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
       if (sp.contains("energy_equilibria")) {
         CHECK(!sp["energy_equilibria"].empty());
         for (const json& e : sp["energy_equilibria"]) CHECK(std::abs(e["loads"]["Me"].get<double>()) < 1e-8);
+      }
+      // every equilibrium at one state: each listed one polished to the chain's rounding, and every
+      // stationary point of the energy curves (end held, eq 6–8) among them, stability alike
+      if (sp.contains("equilibria")) {
+        REQUIRE(!sp["equilibria"].empty());
+        for (const json& c : sp["equilibria"]) {
+          CHECK(c["count"].get<size_t>() == c["equilibria"].size());
+          CHECK(c["interrupted"] == false);
+          for (const json& e : c["equilibria"]) CHECK(e["accuracy"].get<double>() <= 1e-10);
+          if (!sp.contains("energy_equilibria")) continue;
+          int onCurves = 0;
+          for (const json& l : sp["energy_equilibria"]) {
+            if (l["case"] != c["case"]) continue;
+            ++onCurves;
+            bool listed = false;
+            for (const json& e : c["equilibria"]) {
+              double d = 0.0;
+              for (size_t i = 0; i < 3; ++i)
+                d = std::max(d, std::abs(e["q"][i].get<double>() - l["q"][i].get<double>()));
+              if (d <= 1e-9 && e["stable"] == l["stable"]) listed = true;
+            }
+            CHECK(listed);
+          }
+          CHECK(onCurves == int(c["count"].get<size_t>()));
+        }
       }
       // the non-straight start q0 = (θ, −2θ, θ), cos θ = 7/8, with the end held at its unloaded
       // position (5.5, 0): q0 itself is a stable equilibrium of the energy curve, at zero load

@@ -289,6 +289,28 @@ void compare(const json& got, const json& ref, const json& scene, const Units& u
       same(g["energy"], r["energy"], u.torque(), "energy equilibrium energy");
     }
   }
+  if (ref.contains("equilibria")) {  // every equilibrium at one state: the same set, scaled
+    REQUIRE(got["equilibria"].size() == ref["equilibria"].size());
+    for (size_t i = 0; i < ref["equilibria"].size(); ++i) {
+      const json &g = got["equilibria"][i]["equilibria"], &r = ref["equilibria"][i]["equilibria"];
+      REQUIRE(g.size() == r.size());
+      for (size_t k = 0; k < r.size(); ++k) {
+        // matched by q: a mirror pair's two members have the same Π, so their order is rounding's
+        size_t match = g.size();
+        for (size_t j = 0; j < g.size() && match == g.size(); ++j) {
+          double d = 0.0;
+          for (size_t c = 0; c < r[k]["q"].size(); ++c)
+            d = std::max(d, std::abs(g[j]["q"][c].get<double>() - r[k]["q"][c].get<double>()));
+          if (d <= 1e-8) match = j;
+        }
+        INFO("equilibrium " << k << " of case " << i);
+        REQUIRE(match < g.size());
+        CHECK(g[match]["index"] == r[k]["index"]);
+        CHECK(g[match]["stable"] == r[k]["stable"]);
+        same(g[match]["potential"], r[k]["potential"], u.torque(), "equilibrium potential");
+      }
+    }
+  }
   if (ref.contains("torque_zeros")) {
     REQUIRE(got["torque_zeros"].size() == ref["torque_zeros"].size());
     for (size_t i = 0; i < ref["torque_zeros"].size(); ++i) {
@@ -328,7 +350,7 @@ TEST_CASE("every shipped scene gives the same special points in three other unit
       const json reference = run(rewrite(shipped, Units{"shipped", 1.0, 1.0}), dir, file.stem().string());
       // the comparison must have something to compare
       CHECK((!reference["special_points"].empty() || reference.contains("critical_curves") ||
-             reference.contains("energy_equilibria") ||
+             reference.contains("energy_equilibria") || reference.contains("equilibria") ||
              reference.contains("torque_zeros") || reference.contains("sudden_load")));
       for (const Units& u : kSystems) {
         INFO("unit system " << u.name << " (lengths x " << u.length << ", stiffness x " << u.stiffness << ")");

@@ -1,0 +1,117 @@
+#include "scene/output_equilibria.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace buckle::scene {
+
+namespace {
+
+using nlohmann::json;
+
+json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json vectorJson(const Eigen::VectorXd& v) {
+  json a = json::array();
+  for (int i = 0; i < v.size(); ++i) a.push_back(number(v[i]));
+  return a;
+}
+
+const char* const kCoordinate[3] = {"x", "y", "phi"};
+const char* const kLoad[3] = {"Fx", "Fy", "Me"};
+
+json equilibriumJson(const mechanics::FoundEquilibrium& e, const mechanics::EndCondition& end) {
+  json j{{"q", vectorJson(e.q)},
+         {"index", e.index},
+         {"stable", e.stable},
+         {"potential", number(e.potential)},
+         {"shape", e.shape},
+         {"loads", json{{"Fx", number(e.wrench[0])}, {"Fy", number(e.wrench[1])}, {"Me", number(e.wrench[2])}}},
+         {"pose", json{{"x", number(e.pose[0])}, {"y", number(e.pose[1])}, {"phi", number(e.pose[2])}}},
+         {"accuracy", number(e.accuracy)},
+         {"by_deflation", e.byDeflation},
+         {"by_sweep", e.bySweep}};
+  if (e.zeroEigenvalues > 0) j["zero_eigenvalues"] = e.zeroEigenvalues;
+  const std::vector<int> held = end.heldIndices();
+  if (!held.empty()) {
+    json r = json::object();
+    for (size_t k = 0; k < held.size(); ++k) r[kLoad[held[k]]] = number(e.reactions[Eigen::Index(k)]);
+    j["reactions"] = r;
+  }
+  return j;
+}
+
+}  // namespace
+
+json equilibriaJson(const RunResult& run) {
+  json out = json::array();
+  for (size_t c = 0; c < run.cases.size(); ++c) {
+    const CaseResult& cr = run.cases[c];
+    if (!cr.haveEquilibria) continue;
+    const mechanics::AllEquilibria& a = cr.equilibria;
+    json list = json::array();
+    for (const mechanics::FoundEquilibrium& e : a.equilibria) list.push_back(equilibriumJson(e, a.endCondition));
+    int stable = 0;
+    for (const mechanics::FoundEquilibrium& e : a.equilibria) stable += e.stable;
+    json held = json::array();
+    for (int k : a.endCondition.heldIndices()) held.push_back(kCoordinate[k]);
+    out.push_back(json{{"case", c},
+                       {"case_label", cr.label},
+                       {"at", number(cr.equilibriaAt)},
+                       {"held", held},
+                       {"count", a.equilibria.size()},
+                       {"stable_count", stable},
+                       {"method", a.method},
+                       {"guarantee", a.guarantee},
+                       {"starts", a.starts},
+                       {"newton_runs", a.newtonRuns},
+                       {"newton_failures", a.newtonFailures},
+                       {"duplicates", a.duplicates},
+                       {"outside_limits", a.outsideLimits},
+                       {"sweep_count", a.sweepCount},
+                       {"sweep_refined", a.sweepRefined},
+                       {"deflation_only", a.deflationOnly},
+                       {"sweep_only", a.sweepOnly},
+                       {"morse", json{{"applies", a.morse.applies},
+                                      {"sum", a.morse.sum},
+                                      {"expected", a.morse.expected},
+                                      {"holds", a.morse.holds()},
+                                      {"loops", a.morse.loops},
+                                      {"arcs", a.morse.arcs},
+                                      {"basis", a.morse.basis}}},
+                       {"interrupted", a.interrupted},
+                       {"equilibria", list}});
+  }
+  return out;
+}
+
+std::string equilibriaCsv(const RunResult& run) {
+  int maxN = 0;
+  for (const CaseResult& cr : run.cases)
+    if (cr.haveEquilibria) maxN = std::max(maxN, cr.chain.size());
+  std::ostringstream os;
+  os.precision(15);
+  os << "case,rank,potential,index,stable,shape,Fx,Fy,Me,x,y,phi,accuracy";
+  for (int i = 1; i <= maxN; ++i) os << ",q" << i;
+  os << "\n";
+  for (size_t c = 0; c < run.cases.size(); ++c) {
+    const CaseResult& cr = run.cases[c];
+    if (!cr.haveEquilibria) continue;
+    int rank = 0;
+    for (const mechanics::FoundEquilibrium& e : cr.equilibria.equilibria) {
+      os << c << ',' << ++rank << ',' << e.potential << ',' << e.index << ',' << (e.stable ? 1 : 0) << ',' << e.shape;
+      for (int k = 0; k < 3; ++k) os << ',' << e.wrench[k];
+      for (int k = 0; k < 3; ++k) os << ',' << e.pose[k];
+      os << ',' << e.accuracy;
+      for (int i = 0; i < maxN; ++i) {
+        os << ',';
+        if (i < e.q.size()) os << e.q[i];
+      }
+      os << "\n";
+    }
+  }
+  return os.str();
+}
+
+}  // namespace buckle::scene

@@ -1,0 +1,43 @@
+// /analyses/equilibria of a scene (docs/scenes.md): every equilibrium at one state of the
+// controls (mechanics/all_equilibria.h), with the search's options.
+#include <algorithm>
+#include <string>
+
+#include "scene/scene_parsing.h"
+
+namespace buckle::scene::detail {
+
+EquilibriaSpec parseEquilibria(const JsonReader& r, const json& v, const Pointer& p) {
+  EquilibriaSpec s;
+  if (v.is_boolean()) {
+    s.enabled = v.get<bool>();
+    return s;
+  }
+  if (!v.is_object())
+    r.expected(p, v, "true, false or an object {\"starts\", \"smooth_starts\", \"seed\", \"at\", \"sweep_points\"}");
+  r.onlyKeys(v, p, {"starts", "smooth_starts", "seed", "at", "sweep_points"});
+  s.enabled = true;
+  if (v.contains("starts")) s.starts = r.integer(v["starts"], p / "starts", 0, 1000000);
+  if (v.contains("smooth_starts")) s.smoothStarts = r.integer(v["smooth_starts"], p / "smooth_starts", 0, 1000000);
+  if (v.contains("seed")) s.seed = unsigned(r.integer(v["seed"], p / "seed", 0, 2147483647));
+  if (v.contains("sweep_points")) s.sweepPoints = r.integer(v["sweep_points"], p / "sweep_points", 3, 10000000);
+  if (v.contains("at")) {
+    s.haveAt = true;
+    s.at = r.number(v["at"], p / "at");
+  }
+  return s;
+}
+
+void checkEquilibriaAgainstCases(const JsonReader& r, const Scene& scene) {
+  const EquilibriaSpec& e = scene.analyses.equilibria;
+  if (!e.enabled || !e.haveAt) return;
+  for (const CaseSpec& c : scene.cases) {
+    const double lo = std::min(c.path.from, c.path.to), hi = std::max(c.path.from, c.path.to);
+    if (!(e.at >= lo && e.at <= hi))
+      r.fail(Pointer("/analyses/equilibria/at"), "expected a value of the path parameter " + c.path.parameter +
+                                                      " in [" + show(lo) + ", " + show(hi) + "] (case \"" +
+                                                      c.label + "\"), got " + show(e.at));
+  }
+}
+
+}  // namespace buckle::scene::detail

@@ -1,0 +1,98 @@
+// The equilibria analysis of a scene (docs/scenes.md): the list in special_points.json and
+// equilibria.csv equal the library's allEquilibria at the case's end condition moved to `at`;
+// bad options rejected with exit code 2, the JSON path named and nothing written.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "buckle/mechanics/all_equilibria.h"
+#include "scene_run.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::string scene(const std::string& equilibria, bool withPath = true) {
+  return std::string(R"({"units": "nondimensional",
+    "chain": {"segments": 4, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+    "end": {"x": {"load": 0.0}, "y": {"held": 0.0}, "phi": "free"},)") +
+         (withPath ? R"("path": {"parameter": "Fx", "from": -1.2, "to": 0.0},)" : "") +
+         R"("analyses": {"equilibria": )" + equilibria + "}}";
+}
+
+json readJson(const fs::path& file) {
+  std::ifstream in(file);
+  return json::parse(in);
+}
+
+int csvRows(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  int rows = -1;  // the header
+  while (std::getline(in, line)) ++rows;
+  return rows;
+}
+
+}  // namespace
+
+TEST_CASE("scene equilibria: the list at `at` is the library's, in special_points.json and the CSV",
+          "[scene][equilibria]") {
+  const buckle::test::SceneOutcome o =
+      buckle::test::runSceneText("scene_equilibria", "at", scene(R"({"starts": 24, "seed": 3, "at": -0.9})"));
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  const json sp = readJson(o.out / "special_points.json");
+  REQUIRE(sp["equilibria"].size() == 1);
+  const json& c = sp["equilibria"][0];
+  CHECK(c["at"].get<double>() == -0.9);
+  CHECK(c["held"] == json::array({"y"}));
+
+  using namespace buckle::mechanics;
+  const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  AllEquilibriaOptions options;
+  options.randomStarts = 24;
+  options.seed = 3;
+  options.starts.push_back(Eigen::VectorXd::Zero(4));
+  const AllEquilibria lib = allEquilibria(chain, EndCondition::clampedPinned(-0.9), options);
+  REQUIRE(c["count"].get<size_t>() == lib.equilibria.size());
+  CHECK(c["starts"].get<int>() == lib.starts);
+  CHECK(c["method"] == lib.method);
+  for (size_t k = 0; k < lib.equilibria.size(); ++k) {
+    const json& e = c["equilibria"][k];
+    const FoundEquilibrium& f = lib.equilibria[k];
+    CHECK(e["potential"].get<double>() == Approx(f.potential).epsilon(1e-12).margin(1e-14));
+    CHECK(e["index"].get<int>() == f.index);
+    CHECK(e["stable"].get<bool>() == f.stable);
+    CHECK(e["loads"]["Fx"].get<double>() == -0.9);  // the given load, at `at`
+    CHECK(e["reactions"]["Fy"].get<double>() == Approx(f.reactions[0]).margin(1e-12));
+    for (int i = 0; i < 4; ++i) CHECK(e["q"][size_t(i)].get<double>() == Approx(f.q[i]).margin(1e-12));
+  }
+  CHECK(csvRows(o.out / "equilibria.csv") == int(lib.equilibria.size()));
+}
+
+TEST_CASE("scene equilibria: bad options name the JSON path, exit 2, nothing written", "[scene][equilibria]") {
+  struct Bad {
+    std::string name, value, path;
+    bool withPath;
+  };
+  for (const Bad& b : std::vector<Bad>{{"starts", R"({"starts": -1})", "/analyses/equilibria/starts", true},
+                                       {"seed", R"({"seed": 1.5})", "/analyses/equilibria/seed", true},
+                                       {"key", R"({"stars": 3})", "/analyses/equilibria/stars", true},
+                                       {"type", R"("yes")", "/analyses/equilibria", true},
+                                       {"at_range", R"({"at": -2.0})", "/analyses/equilibria/at", true},
+                                       {"at_path", R"({"at": -0.5})", "/path", false}}) {
+    INFO(b.name);
+    const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_equilibria", b.name, scene(b.value, b.withPath));
+    CHECK(o.rc == 2);
+    CHECK(o.err.find(b.path) != std::string::npos);
+    CHECK(!fs::exists(o.out));
+  }
+  // no path needed without `at`: the end condition as given
+  const buckle::test::SceneOutcome ok = buckle::test::runSceneText("scene_equilibria", "no_path", scene("true", false));
+  INFO(ok.err);
+  CHECK(ok.rc == 0);
+}
