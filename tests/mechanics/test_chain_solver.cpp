@@ -209,25 +209,24 @@ TEST_CASE("Tracer on the chain: structured and dense give the same branch and br
   }
 }
 
-TEST_CASE("Corrector on the chain's structured solver allocates nothing after construction", "[chain_solver]") {
 #if BUCKLE_COUNT_MALLOC
-  // Clamped–pinned, end held off the axis: every Newton iterate factors and solves through
-  // ChainBorderedSolver inside KINSOL (custom SUNLinearSolver).
-  const int n = 60;
-  EquilibriumProblem problem(uniformChain(n), EndCondition::clampedPinned(0.0, 0.5), Eigen::Vector3d(1, 0, 0));
+namespace {
+// Ten corrector steps of λ0 + k·dλ on the problem's structured solver (inside KINSOL, custom
+// SUNLinearSolver) after one warm-up solve: the heap calls they make.
+long correctorAllocations(EquilibriumProblem& problem, double lambda0, double dlambda) {
   const int N = problem.dimension();
   auto solver = problem.makeStructuredSolver();
   REQUIRE(solver != nullptr);
   buckle::continuation::Corrector corrector(problem, {}, solver.get());
   Vector u0 = Vector::Zero(N), u(N), x(N + 1), predictor(N + 1), tangent = Vector::Zero(N + 1);
-  REQUIRE(corrector.solveAtFixedParameter(u0, 0.2, u).converged);  // warm-up
+  REQUIRE(corrector.solveAtFixedParameter(u0, lambda0, u).converged);  // warm-up
   tangent[N] = 1.0;
   const long before = buckle::testing::mallocCalls.load();
   int iterations = 0;
   bool converged = true;
   for (int k = 0; k < 10; ++k) {
     predictor.head(N) = u;
-    predictor[N] = 0.2 + 0.05 * (k + 1);
+    predictor[N] = lambda0 + dlambda * (k + 1);
     const auto summary = corrector.correct(predictor, tangent, x);
     converged = converged && summary.converged;
     iterations += summary.iterations;
@@ -236,7 +235,18 @@ TEST_CASE("Corrector on the chain's structured solver allocates nothing after co
   const long after = buckle::testing::mallocCalls.load();
   CHECK(converged);
   CHECK(iterations >= 10);
-  CHECK(after - before == 0);
+  return after - before;
+}
+}  // namespace
+#endif
+
+TEST_CASE("Corrector on the chain's structured solver allocates nothing after construction", "[chain_solver]") {
+#if BUCKLE_COUNT_MALLOC
+  // Clamped–pinned, end held off the axis: every Newton iterate factors and solves through
+  // ChainBorderedSolver inside KINSOL (custom SUNLinearSolver).
+  const int n = 60;
+  EquilibriumProblem problem(uniformChain(n), EndCondition::clampedPinned(0.0, 0.5), Eigen::Vector3d(1, 0, 0));
+  CHECK(correctorAllocations(problem, 0.2, 0.05) == 0);
 #else
   SUCCEED("malloc interposition is disabled under AddressSanitizer");
 #endif
@@ -249,28 +259,7 @@ TEST_CASE("Corrector along a control path (dL0, end held) allocates nothing afte
   const int n = 60;
   EquilibriumProblem problem(uniformChain(n), EndCondition::clampedPinned(0.0, 0.5), Eigen::Vector3d::Zero(), {},
                              ControlDirection::named(n, ControlInput::dL0));
-  const int N = problem.dimension();
-  auto solver = problem.makeStructuredSolver();
-  REQUIRE(solver != nullptr);
-  buckle::continuation::Corrector corrector(problem, {}, solver.get());
-  Vector u0 = Vector::Zero(N), u(N), x(N + 1), predictor(N + 1), tangent = Vector::Zero(N + 1);
-  REQUIRE(corrector.solveAtFixedParameter(u0, 0.02, u).converged);  // warm-up
-  tangent[N] = 1.0;
-  const long before = buckle::testing::mallocCalls.load();
-  int iterations = 0;
-  bool converged = true;
-  for (int k = 0; k < 10; ++k) {
-    predictor.head(N) = u;
-    predictor[N] = 0.02 + 0.005 * (k + 1);
-    const auto summary = corrector.correct(predictor, tangent, x);
-    converged = converged && summary.converged;
-    iterations += summary.iterations;
-    u = x.head(N);
-  }
-  const long after = buckle::testing::mallocCalls.load();
-  CHECK(converged);
-  CHECK(iterations >= 10);
-  CHECK(after - before == 0);
+  CHECK(correctorAllocations(problem, 0.02, 0.005) == 0);
 #else
   SUCCEED("malloc interposition is disabled under AddressSanitizer");
 #endif

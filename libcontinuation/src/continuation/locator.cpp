@@ -282,11 +282,7 @@ SpecialPoint Locator::locateFold(const StepSample &lo, const StepSample &hi) {
   int evaluations = root.evaluations;
   auto adopt = [&](bool found) {
     const StepSample &at = found ? root.at : (std::abs(lo.point.foldTest) < std::abs(hi.point.foldTest) ? lo : hi);
-    sp.arclength = at.point.arclength;
-    sp.u = at.point.u;
-    sp.lambda = at.point.lambda;
-    sp.tangent = at.point.tangent;
-    sp.testFunctionValue = at.point.foldTest;
+    placeAt(sp, at.point, at.point.foldTest);
     sp.lambdaAccuracy = found ? root.lastDLambda : std::abs(hi.point.lambda - lo.point.lambda);
     sp.locationIterations = evaluations;
     sp.note = root.failure.empty() ? "" : "fold secant: " + root.failure;

@@ -58,11 +58,7 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
   const std::string testNote = sp.note;
   auto adopt = [&](bool found) {
     const StepSample &at = found ? root.at : lo;
-    sp.arclength = at.point.arclength;
-    sp.u = at.point.u;
-    sp.lambda = at.point.lambda;
-    sp.tangent = at.point.tangent;
-    sp.testFunctionValue = found ? root.value : fLo;
+    placeAt(sp, at.point, found ? root.value : fLo);
     sp.lambdaAccuracy = found ? root.lastDLambda : std::abs(hi.point.lambda - lo.point.lambda);
     sp.locationIterations = evaluations;
     sp.note = testNote;
@@ -295,11 +291,7 @@ SpecialPoint Locator::multipleBranchPoint(const StepSample &lo, const StepSample
   else if (single(lo.point, fLo) && single(hi.point, fHi) && !sameSign(fLo, fHi))
     ok = findRoot(lo, fLo, hi, fHi, single, root);
   const StepSample &at = ok ? root.at : lo;
-  sp.arclength = at.point.arclength;
-  sp.u = at.point.u;
-  sp.lambda = at.point.lambda;
-  sp.tangent = at.point.tangent;
-  sp.testFunctionValue = ok ? root.value : fLo;
+  placeAt(sp, at.point, ok ? root.value : fLo);
   sp.lambdaAccuracy = std::abs(hi.point.lambda - lo.point.lambda);
   if (ok && root.evaluations > 0) sp.lambdaAccuracy = std::min(sp.lambdaAccuracy, root.lastDLambda);
   sp.locationIterations = root.evaluations;

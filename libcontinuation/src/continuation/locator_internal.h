@@ -36,4 +36,14 @@ inline std::string format(const char *pattern, double value) {
   return buffer;
 }
 
+/// A special point located at the traced point `at` (a root of its test function, or a bracket
+/// end when none was found): position, tangent and the test function's value there.
+inline void placeAt(SpecialPoint &sp, const ContinuationPoint &at, double testValue) {
+  sp.arclength = at.arclength;
+  sp.u = at.u;
+  sp.lambda = at.lambda;
+  sp.tangent = at.tangent;
+  sp.testFunctionValue = testValue;
+}
+
 }  // namespace buckle::continuation::locator_detail
