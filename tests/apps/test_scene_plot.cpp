@@ -588,6 +588,8 @@ TEST_CASE("load history: its stable pieces are the branches of branches.csv, in 
     worstEigen = std::min(worstEigen, smallest);
     stiffest = std::max(stiffest, H.norm());
     CHECK(row[csv.col("stable")] == 1.0);
+    // min_eig is the point's own (free end: H's smallest), at the folds too
+    CHECK(row[csv.col("min_eig")] == Approx(smallest).margin(1e-9 * scale));
   }
   CHECK(worstGradient < 1e-8 * scale);
   CHECK(worstEigen > -1e-9 * stiffest);

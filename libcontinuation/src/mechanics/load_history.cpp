@@ -82,8 +82,11 @@ int firstLeavingPoint(const cont::Branch& branch, double sign, bool& isLoss) {
   return isLoss ? lost : turn;
 }
 
-// Keeps the points of `branch` up to the special point `sp` and ends it there.
-cont::Branch cutAt(const cont::Branch& branch, const cont::SpecialPoint& sp) {
+// Keeps the points of `branch` up to the special point `sp` and ends it there. The last point's
+// eigenvalues are evaluated at sp itself (its lowest is zero there, not the traced point's before
+// it); its count stays the piece's (the limit from the side the piece was traced on: a stable
+// piece ends stable at its fold).
+cont::Branch cutAt(cont::Problem& problem, const cont::Branch& branch, const cont::SpecialPoint& sp) {
   cont::Branch cut = branch;
   cut.points.resize(std::min(cut.points.size(), size_t(sp.index) + 1));
   cont::ContinuationPoint last = cut.points.back();
@@ -91,6 +94,14 @@ cont::Branch cutAt(const cont::Branch& branch, const cont::SpecialPoint& sp) {
   last.lambda = sp.lambda;
   last.tangent = sp.tangent;
   last.arclength = sp.arclength;
+  last.foldTest = sp.tangent.size() > 0 ? sp.tangent[sp.tangent.size() - 1] : last.foldTest;
+  last.spectrum = {};
+  const int wanted = std::max<int>(1, int(last.stability.lowest.size()));
+  cont::StabilityInfo info;
+  if (problem.stability(sp.u, sp.lambda, wanted, info) && info.lowest.size() > 0) {
+    last.stability.lowest = info.lowest;
+    last.stability.smallest = info.smallest;
+  }
   cut.points.push_back(last);
   cut.specialPoints.erase(std::remove_if(cut.specialPoints.begin(), cut.specialPoints.end(),
                                          [&](const cont::SpecialPoint& p) { return p.arclength > sp.arclength; }),
@@ -272,7 +283,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       // goes on along the stable branch through the point that continues in the loading direction
       cont::Branch child;
       while (lost >= 0 && followBifurcated(problem, branch.specialPoints[size_t(lost)], legOptions, sign, child)) {
-        addSegment(result, cutAt(branch, branch.specialPoints[size_t(lost)]), int(leg), bifurcated);
+        addSegment(result, cutAt(problem, branch, branch.specialPoints[size_t(lost)]), int(leg), bifurcated);
         branch = std::move(child);
         bifurcated = true;
         lost = firstLeavingPoint(branch, sign, isLoss);
@@ -290,7 +301,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
         break;
       }
       const cont::SpecialPoint sp = branch.specialPoints[size_t(lost)];
-      addSegment(result, cutAt(branch, sp), int(leg), bifurcated);
+      addSegment(result, cutAt(problem, branch, sp), int(leg), bifurcated);
       const double at = sp.lambda + sign * options.overshoot * std::max(lambdaUnit, std::abs(sp.lambda));
       const JumpTrigger trigger = sp.type == cont::SpecialPointType::Fold ? JumpTrigger::Fold : JumpTrigger::BranchPoint;
       if (!releaseChain(problem, options, trigger, sp.u, sp.lambda, at, int(result.segments.size()) - 1, result)) {
