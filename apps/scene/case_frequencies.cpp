@@ -18,8 +18,12 @@ Eigen::VectorXd CaseRunner::naturalFrequencies(const Eigen::VectorXd& q, const m
   const FrequenciesSpec& spec = scene_.analyses.frequencies;
   Eigen::VectorXd omega = Eigen::VectorXd::Constant(spec.count, std::numeric_limits<double>::quiet_NaN());
   try {
-    if (!vibration_)
-      vibration_ = std::make_unique<mech::VibrationAnalysis>(out_.chain, mech::InertiaData::uniformRods(out_.chain, spec.massPerLength));
+    // along a control path the springs' free lengths are those at the point (the masses are not)
+    const mech::ControlDirection control = controlDirection();
+    if (!vibration_ || control.active())
+      vibration_ = std::make_unique<mech::VibrationAnalysis>(
+          control.active() ? mech::chainWithControls(out_.chain, control, parameter) : out_.chain,
+          mech::InertiaData::uniformRods(out_.chain, spec.massPerLength));
     std::vector<int> locked;
     for (const mech::LockedJoint& j : contacts.joints()) locked.push_back(j.joint);
     const mech::VibrationModes m =

@@ -13,6 +13,9 @@
 #include <vector>
 
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/control_path.h"
+#include "buckle/mechanics/dynamics.h"
+#include "buckle/mechanics/vibration.h"
 #include "rfc4180.h"
 #include "scene/columns.h"
 #include "scene/scene.h"
@@ -194,4 +197,36 @@ TEST_CASE("frequencies: refused with the key, the path and the accepted range", 
       CHECK(std::string(e.what()).find(b.words) != std::string::npos);
     }
   }
+}
+
+TEST_CASE("frequencies along a control path are those of the chain at the point's free lengths", "[scene]") {
+  // dL0 of every segment under a payload (the shipped actuation scene's chain): every traced point
+  // against the library's vibration analysis of the chain whose free lengths are the point's own
+  // (the scene's start has dL0 = 0, the direction's origin), with the free end.
+  const std::string text = R"({
+    "chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+    "end": {"x": {"load": -0.3}, "y": {"load": -0.3}, "phi": "free"},
+    "path": {"parameter": "dL0", "from": -1.0, "to": 1.0},
+    "analyses": {"continuation": {}, "frequencies": {"count": 3, "mass_per_length": 0.5}},
+    "solver": {"max_step": 0.05}, "plots": []
+  })";
+  const Table t = runTable("control", text);
+  const Chain base = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const ControlDirection control = ControlDirection::named(3, ControlInput::dL0);
+  int checked = 0;
+  double spread = 0.0;  // how far the free lengths moved the lowest frequency over the path
+  for (const auto& row : t) {
+    const Chain at = chainWithControls(base, control, row.at("parameter"));
+    VibrationAnalysis vib(at, InertiaData::uniformRods(base, 0.5));
+    const Vector q = (Vector(3) << row.at("q1"), row.at("q2"), row.at("q3")).finished();
+    const VibrationModes m = vib.modes(q, Wrench(row.at("Fx"), row.at("Fy"), row.at("Me")), {}, {}, 3, false);
+    for (int i = 0; i < 3; ++i) {
+      const double expected = signedFrequency(m.omegaSquared[i]);
+      CHECK(row.at("omega" + std::to_string(i + 1)) == Approx(expected).epsilon(1e-9).margin(1e-9));
+    }
+    spread = std::max(spread, std::abs(row.at("omega1") - t.front().at("omega1")));
+    ++checked;
+  }
+  CHECK(checked >= 10);
+  CHECK(spread > 1e-2 * std::abs(t.front().at("omega1")));  // the free lengths matter here
 }
