@@ -1,6 +1,6 @@
 // The equilibria analysis of a scene case (docs/scenes.md): every equilibrium at one state of the
 // controls, by mechanics/all_equilibria.h, at the case's end condition moved to the path
-// parameter `at`.
+// parameter `at` (along a control path: the chain with its free lengths at `at`).
 #include <stdexcept>
 
 #include "scene/case_runner.h"
@@ -19,8 +19,12 @@ void CaseRunner::equilibria() {
   options.landscapeSamples = e.sweepPoints;
   options.starts.push_back(out_.q0);  // the case's unloaded shape (preloads from q0)
   options.interrupt = control_.interrupt;
+  // along a control path the state is the chain with the free lengths at `at` (the loads held)
+  const mechanics::ControlDirection control = controlDirection();
+  const mechanics::Chain chain =
+      control.active() ? mechanics::chainWithControls(out_.chain, control, out_.equilibriaAt) : out_.chain;
   try {
-    out_.equilibria = mechanics::allEquilibria(out_.chain, end, options);
+    out_.equilibria = mechanics::allEquilibria(chain, end, options);
     out_.haveEquilibria = true;
   } catch (const std::invalid_argument& ex) {
     run_.complete = false;

@@ -96,3 +96,33 @@ TEST_CASE("scene equilibria: bad options name the JSON path, exit 2, nothing wri
   INFO(ok.err);
   CHECK(ok.rc == 0);
 }
+
+TEST_CASE("scene equilibria on a control path: the chain with its free lengths at `at`", "[scene][equilibria]") {
+  // dL0 of every segment as the path, the payload held: the equilibria at dL0 = 0.6 are those of
+  // the chain built with L1_0 = 2.25 + 0.3, L2_0 = 2.25 − 0.3 under the same loads (a plain scene).
+  const std::string ends = R"("end": {"x": {"load": -0.3}, "y": {"load": -0.3}, "phi": "free"},)";
+  const std::string options = R"({"starts": 24, "seed": 3, "at": 0.6})";
+  const buckle::test::SceneOutcome controlled = buckle::test::runSceneText(
+      "scene_equilibria", "control",
+      std::string(R"({"chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},)") + ends +
+          R"("path": {"parameter": "dL0", "from": -1.0, "to": 1.0}, "analyses": {"equilibria": )" + options + "}}");
+  INFO(controlled.err);
+  REQUIRE(controlled.rc == 0);
+  const buckle::test::SceneOutcome built = buckle::test::runSceneText(
+      "scene_equilibria", "built",
+      std::string(R"({"chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L1_0": 2.55, "L2_0": 1.95},)") + ends +
+          R"("analyses": {"equilibria": {"starts": 24, "seed": 3}}})");
+  INFO(built.err);
+  REQUIRE(built.rc == 0);
+  const json a = readJson(controlled.out / "special_points.json")["equilibria"][0];
+  const json b = readJson(built.out / "special_points.json")["equilibria"][0];
+  REQUIRE(a["count"].get<int>() == b["count"].get<int>());
+  REQUIRE(a["count"].get<int>() >= 1);
+  for (size_t k = 0; k < a["equilibria"].size(); ++k) {
+    const json &e = a["equilibria"][k], &f = b["equilibria"][k];
+    CHECK(e["potential"].get<double>() == Approx(f["potential"].get<double>()).epsilon(1e-10).margin(1e-12));
+    CHECK(e["index"] == f["index"]);
+    for (int i = 0; i < 3; ++i)
+      CHECK(e["q"][size_t(i)].get<double>() == Approx(f["q"][size_t(i)].get<double>()).margin(1e-10));
+  }
+}
