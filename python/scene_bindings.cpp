@@ -70,6 +70,10 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
   std::vector<std::string> columns{"parameter", "Fx", "Fy", "Me", "x", "y", "phi", "dx", "dy", "min_eig"};
   if (s.analyses.stiffness)
     columns.insert(columns.end(), scene::stiffnessColumns().begin(), scene::stiffnessColumns().end());
+  if (s.analyses.frequencies.enabled) {
+    const std::vector<std::string> omega = scene::frequencyColumns(s.analyses.frequencies.count);
+    columns.insert(columns.end(), omega.begin(), omega.end());
+  }
   for (const std::string& c : columns) {
     VectorXd v(P);
     for (Eigen::Index i = 0; i < P; ++i) v[i] = scene::columnValue(c, cr.points[static_cast<size_t>(i)], cr.pose0);

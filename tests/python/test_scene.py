@@ -81,6 +81,12 @@ def test_module_results_equal_the_command_line(name, source_dir, run_cli, tmp_pa
                 csv_q = np.array([float(row[f"q{i + 1}"]) for row in mine])
                 np.testing.assert_allclose(b["q"][:, i], csv_q, rtol=1e-11, atol=1e-11)
             np.testing.assert_array_equal(b["stable"], [row["stable"] == "1" for row in mine])
+            # the natural frequencies (`frequencies`): the same columns as the CSV's, same values
+            omega = [k for k in mine[0] if k.startswith("omega")]
+            assert sorted(k for k in b if str(k).startswith("omega")) == sorted(omega)
+            for k in omega:
+                csv_omega = np.array([float(row[k]) if row[k] not in ("", "nan") else np.nan for row in mine])
+                np.testing.assert_allclose(b[k], csv_omega, rtol=1e-11, atol=1e-11 * np.nanmax(np.abs(csv_omega)))
 
 
 def test_a_dict_runs_like_its_file(source_dir):
