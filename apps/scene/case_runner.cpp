@@ -354,6 +354,18 @@ void CaseRunner::continuation() {
                       (throughLoad() ? std::string(c == 0 ? "Fx" : c == 1 ? "Fy" : "Me") + " (through the reaction)"
                                      : spec_.path.parameter));
   }
+  // Each branch is recorded as soon as it is final (EquilibriumBranchOptions::onReport), so its
+  // traced points are released while the tree goes on; the records are put in branch order after.
+  const size_t firstBranch = out_.branches.size(), firstPoint = out_.points.size(),
+               firstSpecial = out_.specials.size();
+  opt.onReport = [&](const cont::Branch& b, mech::BranchReport&& report) {
+    if (b.stopReason == cont::StopReason::StartFailed) return;  // said below, in words
+    const std::string origin = b.parentId < 0 ? origins[size_t(b.id)]
+                                              : "BP " + std::to_string(b.parentSpecialPoint) + " of branch " +
+                                                    std::to_string(b.parentId) +
+                                                    (b.direction > 0 ? ", + side" : ", - side");
+    record(b, report, problem, origin);
+  };
   const mech::EquilibriumBranches result = mech::traceEquilibria(problem, out_.qStart, s0, starts, opt);
   const auto& branches = result.tree.branches;
   if (!branches.empty() && branches.front().stopReason == cont::StopReason::StartFailed) {
@@ -364,13 +376,11 @@ void CaseRunner::continuation() {
     run_.problems.push_back(os.str());
     return;
   }
-  for (size_t i = 0; i < branches.size(); ++i) {
-    const cont::Branch& b = branches[i];
-    std::string origin = b.parentId < 0 ? origins[size_t(b.id)]
-                                        : "BP " + std::to_string(b.parentSpecialPoint) + " of branch " +
-                                              std::to_string(b.parentId) + (b.direction > 0 ? ", + side" : ", - side");
-    record(b, result.reports[i], problem, origin);
-  }
+  const auto byBranch = [](const auto& a, const auto& b) { return a.branch < b.branch; };
+  std::stable_sort(out_.branches.begin() + long(firstBranch), out_.branches.end(),
+                   [](const BranchRecord& a, const BranchRecord& b) { return a.id < b.id; });
+  std::stable_sort(out_.points.begin() + long(firstPoint), out_.points.end(), byBranch);
+  std::stable_sort(out_.specials.begin() + long(firstSpecial), out_.specials.end(), byBranch);
   if (result.tree.interrupted) interrupted();
 }
 

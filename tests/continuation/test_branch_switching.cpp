@@ -4,7 +4,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <memory>
+#include <vector>
 #include <string>
 
 using namespace buckle::continuation;
@@ -184,4 +188,115 @@ TEST_CASE("Switching from a point that is not a branch point is refused", "[bran
   bad.minOffBranchFraction = 2.0;
   CHECK_FALSE(bad.IsValid(&why));
   CHECK_THAT(why, Contains("minOffBranchFraction"));
+}
+
+TEST_CASE("The tree's hooks: a branch extended past its trace is switched at on its own tracer; each branch final once",
+          "[branch_switching]") {
+  // TwoPitchforks: branch points at λ = 0 (u₁ = ±√λ) and λ = c (u₂ = ±√(λ − c)). The start
+  // branch is traced to λ = 0.25 only; `extend` goes on to 0.8 with a tracer of its own and
+  // appends what it finds, as contact continuation does, so the BP at λ = c exists only on the
+  // extension. The tree switches there with the tracer `switchTracer` gives (a few points only).
+  const double c = 0.5;
+  toys::TwoPitchforks problem(c);
+  TracerOptions options;
+  options.lambdaMax = 0.25;
+  options.maxStep = 0.05;
+  TracerOptions beyond = options;
+  beyond.lambdaMax = 0.8;
+  TreeOptions tree;
+  tree.maxDepth = 1;
+  tree.childTracer = beyond;
+  Tracer extension(problem, beyond);
+  int extended = 0;
+  tree.extend = [&](const BranchTree &, Branch &branch) {
+    ++extended;
+    if (branch.parentId >= 0) return;
+    Branch rest;
+    rest.points.push_back(branch.points.back());
+    const double s0 = rest.points[0].arclength;
+    rest.points[0].arclength = 0.0;
+    extension.continueBranch(rest);
+    const int base = static_cast<int>(branch.points.size()) - 1;
+    for (std::size_t i = 1; i < rest.points.size(); ++i) {
+      branch.points.push_back(rest.points[i]);
+      branch.points.back().arclength += s0;
+    }
+    for (SpecialPoint sp : rest.specialPoints) {
+      sp.index += base;
+      sp.arclength += s0;
+      branch.specialPoints.push_back(sp);
+    }
+    branch.stopReason = rest.stopReason;
+  };
+  TracerOptions few = beyond;
+  few.maxPoints = 6;
+  int ownTracers = 0;
+  tree.switchTracer = [&](const BranchTree &, std::size_t, const SpecialPoint &bp) -> std::shared_ptr<Tracer> {
+    if (std::abs(bp.lambda - c) > 1e-6) return nullptr;
+    ++ownTracers;
+    return std::make_shared<Tracer>(problem, few);
+  };
+  std::vector<std::size_t> order;
+  std::vector<bool> notesDone;
+  tree.onFinal = [&](BranchTree &t, std::size_t b) {
+    order.push_back(b);
+    bool done = true;  // a final branch's branch points all carry the switching outcome
+    if (t.branches[b].parentId < 0)
+      for (const SpecialPoint &sp : t.branches[b].specialPoints)
+        if (sp.type == SpecialPointType::BranchPoint) done = done && sp.note.find("switched") != std::string::npos;
+    notesDone.push_back(done);
+  };
+  const BranchTree result = traceTree(problem, Vector::Zero(2), -0.3, {InitialDirection::increasingLambda()},
+                                      options, tree);
+  REQUIRE(result.branches.size() == 5);
+  CHECK(extended == 5);
+  CHECK(ownTracers == 1);
+  CHECK(std::abs(result.branches[0].points.back().lambda - 0.8) <= 1e-15);
+  int fromC = 0;
+  for (std::size_t b = 1; b < result.branches.size(); ++b) {
+    const Branch &child = result.branches[b];
+    const SpecialPoint &at = result.branches[0].specialPoints[std::size_t(child.parentSpecialPoint)];
+    if (std::abs(at.lambda - c) > 1e-6) {
+      CHECK(child.points.size() > 6);  // the tree's child tracer, to λ = 0.8
+      continue;
+    }
+    ++fromC;
+    CHECK(child.points.size() <= 6);  // the hook's tracer
+    for (std::size_t i = 1; i < child.points.size(); ++i) {
+      const ContinuationPoint &p = child.points[i];
+      CHECK(std::abs(p.u[1]) * std::abs(p.u[1] * p.u[1] - (p.lambda - c)) <= 1e-10);
+      CHECK(std::abs(p.u[0]) < 1e-12);
+    }
+  }
+  CHECK(fromC == 2);
+  // every branch final exactly once, the children of each branch point before their parent
+  REQUIRE(order.size() == 5);
+  CHECK(std::vector<std::size_t>(order.begin(), order.end()) == std::vector<std::size_t>{1, 2, 3, 4, 0});
+  for (bool done : notesDone) CHECK(done);
+}
+
+TEST_CASE("An interrupted tree makes every branch final, the unfinished ones included", "[branch_switching]") {
+  toys::TwoPitchforks problem(0.5);
+  TracerOptions options;
+  options.lambdaMax = 0.8;
+  options.maxStep = 0.05;
+  TreeOptions tree;
+  tree.maxDepth = 2;
+  std::atomic<bool> stop{false};
+  options.interrupt.watch(&stop, "test");
+  std::vector<int> finals;
+  // stop as soon as the first grandchild is final: the tree has then traced part of the tree
+  tree.onFinal = [&](BranchTree &t, std::size_t b) {
+    finals.push_back(int(b));
+    if (t.branches[b].parentId > 0) stop = true;
+  };
+  const BranchTree result = traceTree(problem, Vector::Zero(2), -0.3, {InitialDirection::increasingLambda()},
+                                      options, tree);
+  CHECK(result.interrupted);
+  std::vector<int> sorted = finals;
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<int> expected(result.branches.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) expected[i] = int(i);
+  CHECK(sorted == expected);  // each once
+  CHECK(result.branches.size() < 9);
 }

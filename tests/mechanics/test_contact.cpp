@@ -509,5 +509,5 @@ TEST_CASE("contact: a branch point on a locked stretch is switched, its children
     CHECK(g[0] > 0.0);  // the lower stop pushes joint 1 up: compression = τ_c = ∂Π/∂q1 > 0
   }
   CHECK(children == 2);
-  CHECK(bp.note.find("switched on the contact stretch") != std::string::npos);
+  CHECK(bp.note.find("switched (") != std::string::npos);  // by the tree driver itself, like a traced BP
 }

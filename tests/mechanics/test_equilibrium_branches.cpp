@@ -698,3 +698,51 @@ TEST_CASE("n = 10000: the children of a branch point traced in steps of 4e-9 sho
     CHECK(branchPoints(branches[k]).empty());
   }
 }
+
+TEST_CASE("reports handed over as branches become final equal the kept ones; the traced points are released",
+          "[equilibrium_branches]") {
+  // The paper's chain to Fx = −2.5: the U branches reach joint 2's limit and go on locked
+  // (contact stretches), the − sides are mirror images. Streaming (onReport) must not change
+  // one number of any report, and must hand each branch over exactly once.
+  EquilibriumProblem problem(Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)),
+                             EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(-2.5, 1);
+  o.report.stiffness = true;
+  const EquilibriumBranches kept =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  std::vector<std::pair<int, BranchReport>> handed;
+  o.onReport = [&](const cont::Branch& b, BranchReport&& report) {
+    CHECK(!b.points.empty());  // released only after the hand-over
+    handed.emplace_back(b.id, std::move(report));
+  };
+  const EquilibriumBranches streamed =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  REQUIRE(kept.tree.branches.size() == 5);
+  REQUIRE(streamed.tree.branches.size() == kept.tree.branches.size());
+  REQUIRE(handed.size() == kept.tree.branches.size());
+  CHECK(handed.back().first == 0);  // the parent after its children
+  bool locked = false;
+  for (const auto& [id, report] : handed) {
+    const BranchReport& ref = kept.reports.at(size_t(id));
+    CHECK(streamed.tree.branches[size_t(id)].points.empty());
+    CHECK(streamed.reports[size_t(id)].points.empty());
+    CHECK(streamed.tree.branches[size_t(id)].specialPoints.size() == kept.tree.branches[size_t(id)].specialPoints.size());
+    REQUIRE(report.points.size() == ref.points.size());
+    for (size_t i = 0; i < ref.points.size(); ++i) {
+      CHECK(report.points[i].parameter == ref.points[i].parameter);
+      CHECK(report.points[i].q == ref.points[i].q);
+      CHECK(report.points[i].negative == ref.points[i].negative);
+      CHECK((report.points[i].K.array() == ref.points[i].K.array() ||
+             (report.points[i].K.array().isNaN() && ref.points[i].K.array().isNaN())).all());
+      locked = locked || !ref.points[i].locked.empty();
+    }
+    REQUIRE(report.specialPoints.size() == ref.specialPoints.size());
+    for (size_t s = 0; s < ref.specialPoints.size(); ++s) {
+      CHECK(report.specialPoints[s].type == ref.specialPoints[s].type);
+      CHECK(report.specialPoints[s].parameter == ref.specialPoints[s].parameter);
+      CHECK(report.specialPoints[s].note == ref.specialPoints[s].note);
+    }
+  }
+  CHECK(locked);  // the comparison covered contact stretches
+  CHECK(streamed.startUnstable == kept.startUnstable);
+}

@@ -215,8 +215,19 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
   Tracer tracer(problem, options);
   std::unique_ptr<Tracer> childTracer;  // only when the children have options of their own
   if (treeOptions.childTracer) childTracer = std::make_unique<Tracer>(problem, *treeOptions.childTracer);
-  Tracer &switchTracer = childTracer ? *childTracer : tracer;
+  Tracer &treeSwitchTracer = childTracer ? *childTracer : tracer;
   std::vector<int> depth;
+  std::vector<char> isFinal;
+  // A branch is final once (TreeOptions::onFinal); at the end every branch is.
+  auto finalize = [&](std::size_t i) {
+    if (isFinal[i]) return;
+    isFinal[i] = 1;
+    if (treeOptions.onFinal) treeOptions.onFinal(tree, i);
+  };
+  auto finish = [&]() -> BranchTree & {
+    for (std::size_t i = 0; i < tree.branches.size(); ++i) finalize(i);
+    return tree;
+  };
   auto interrupted = [&]() {
     if (!options.interrupt.requested()) return false;
     tree.interrupted = true;
@@ -227,6 +238,9 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     b.id = static_cast<int>(tree.branches.size());
     tree.branches.push_back(std::move(b));
     depth.push_back(generation);
+    isFinal.push_back(0);
+    if (treeOptions.extend && tree.branches.back().stopReason != StopReason::InvalidOptions)
+      treeOptions.extend(tree, tree.branches.back());
     if (tree.branches.back().stopReason == StopReason::Interrupted) {
       tree.interrupted = true;
       tree.message = tree.branches.back().stopMessage;
@@ -238,11 +252,12 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     invalid.stopReason = StopReason::InvalidOptions;
     invalid.stopMessage = "TreeOptions::symmetry: " + why;
     add(std::move(invalid), 0);
-    return tree;
+    return finish();
   }
   for (const InitialDirection &direction : starts) {
-    if (tree.interrupted || interrupted()) return tree;
+    if (tree.interrupted || interrupted()) return finish();
     add(tracer.trace(u0, lambda0, direction), 0);
+    if (treeOptions.maxDepth <= 0) finalize(tree.branches.size() - 1);
   }
   std::vector<Vector> switchedAt;
   std::vector<double> switchedAccuracy;  // |Δλ| of each, scaled
@@ -255,7 +270,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       SpecialPoint bp = tree.branches[i].specialPoints[k];
       if (bp.type != SpecialPointType::BranchPoint) continue;
       if (treeOptions.switchAt && !treeOptions.switchAt(tree.branches[i], bp)) continue;
-      if (tree.interrupted || interrupted()) return tree;
+      if (tree.interrupted || interrupted()) return finish();
       Vector xBP(n + 1);
       xBP << bp.u, bp.lambda;
       for (int j = 0; j <= n; ++j) xBP[j] /= tracer.units().state(j);  // compared in the scaled variables
@@ -284,6 +299,8 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       }
       switchedAt.push_back(xBP);
       switchedAccuracy.push_back(std::isfinite(accuracy) ? accuracy : 0.0);
+      const std::shared_ptr<Tracer> own = treeOptions.switchTracer ? treeOptions.switchTracer(tree, i, bp) : nullptr;
+      Tracer &switchTracer = own ? *own : treeSwitchTracer;
       std::string how;
       std::vector<Branch> sides;
       if (bp.multiplicity > 1) {
@@ -294,16 +311,17 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       } else {
         // after the + side, the − side only if no stop was asked for meanwhile
         sides = switchBothSides(switchTracer, bp, switching, &how,
-                                [&](const Branch &) { return options.interrupt.requested(); }, treeOptions.symmetry);
+                                [&](const Branch &) { return options.interrupt.requested(); },
+                                own ? Reflection() : treeOptions.symmetry);
       }
       if (sides.empty()) {
         note += (note.empty() ? "" : "; ") + std::string("not switched: ") + how;
         continue;
       }
       std::string children;
-      const int firstChild = static_cast<int>(tree.branches.size());
+      const std::size_t firstChild = tree.branches.size();
       for (Branch &child : sides) {
-        if (child.mirrorOf >= 0) child.mirrorOf += firstChild;  // an index into `sides` → a branch id
+        if (child.mirrorOf >= 0) child.mirrorOf += static_cast<int>(firstChild);  // an index into `sides` → a branch id
         child.parentId = static_cast<int>(i);
         child.parentSpecialPoint = static_cast<int>(k);
         children += (children.empty() ? "" : ", ") + std::to_string(tree.branches.size());
@@ -311,9 +329,13 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       }
       std::string &noteAfter = tree.branches[i].specialPoints[k].note;
       noteAfter += (noteAfter.empty() ? "" : "; ") + ("switched (" + how + "): branches " + children);
+      // the children that will not be switched at are final now, after a mirror image joined its source
+      for (std::size_t c = firstChild; c < tree.branches.size(); ++c)
+        if (depth[c] >= treeOptions.maxDepth) finalize(c);
     }
+    finalize(i);
   }
-  return tree;
+  return finish();
 }
 
 BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,

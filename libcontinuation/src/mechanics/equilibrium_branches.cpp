@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <optional>
 
 #include "buckle/continuation/multiplicity_switching.h"
 #include "buckle/mechanics/mirror_symmetry.h"
@@ -171,107 +173,11 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
   return stretches;
 }
 
-namespace {
-
-// The branch points the tree never saw: traceTree switches at the branch points of the branches
-// as traced, but those of their contact-continued stretches (continueUnderContact: locked
-// stretches, and free ones after a release) are located later, on the problem of their stretch.
-// Each is switched here on that problem (a ContactProblem with the stretch's joints locked),
-// with the tree's guards — depth, switchAt, not the point a branch started from, not twice at
-// the same point — and every child is itself continued through contact from the stretch's
-// locked joints; its own branch points join the queue (breadth first, as in traceTree).
-// `traced[b]`: the sizes of branch b before its contact stretches (what traceTree switched).
-void switchOnContactStretches(EquilibriumProblem& problem, const EquilibriumBranchOptions& options,
-                              std::vector<std::pair<size_t, size_t>>& traced, EquilibriumBranches& result) {
-  continuation::BranchTree& tree = result.tree;
-  const int N = problem.dimension();
-  const continuation::ProblemScales scales = problem.scales();
-  std::vector<int> depth;
-  for (const continuation::Branch& b : tree.branches)
-    depth.push_back(b.parentId >= 0 ? depth[size_t(b.parentId)] + 1 : 0);
-  // The first special point of each branch not yet considered (0 for the children made here).
-  std::vector<size_t> first;
-  for (const auto& t : traced) first.push_back(t.second);
-  std::vector<continuation::Vector> switchedAt;  // in the scaled variables
-  const continuation::TracerOptions& childOptions = options.childTracer ? *options.childTracer : options.tracer;
-  const double h = options.switching.amplitude > 0.0 ? options.switching.amplitude : childOptions.initialStep;
-  auto addNote = [](std::string& note, const std::string& what) { note += (note.empty() ? "" : "; ") + what; };
-
-  for (size_t b = 0; b < tree.branches.size(); ++b) {
-    if (depth[b] >= options.switchingDepth) continue;
-    for (size_t k = first[b]; k < tree.branches[b].specialPoints.size(); ++k) {
-      continuation::SpecialPoint bp = tree.branches[b].specialPoints[k];
-      const continuation::Branch& branch = tree.branches[b];
-      if (bp.type != continuation::SpecialPointType::BranchPoint) continue;
-      if (options.switchAt && !options.switchAt(branch, bp)) continue;
-      if (!branch.points.empty() && bp.arclength - branch.points.front().arclength <= 1e-6 * h) continue;
-      if (options.tracer.interrupt.requested()) {
-        tree.interrupted = true;
-        tree.message = options.tracer.interrupt.describe();
-        return;
-      }
-      continuation::Vector x(N + 1);
-      x << bp.u.cwiseQuotient(scales.unknowns), bp.lambda / scales.parameter;
-      bool seen = false;
-      for (const continuation::Vector& y : switchedAt)
-        if ((y - x).norm() <= 1e-7 * std::max(1.0, x.norm())) seen = true;
-      if (seen) {
-        addNote(tree.branches[b].specialPoints[k].note, "already switched from another branch");
-        continue;
-      }
-      switchedAt.push_back(x);
-      // The interval [index, index + 1] lies in the stretch of its end point.
-      const ContactSet locked = lockedAt(result.contact[b], bp.index + 1);
-      std::unique_ptr<ContactProblem> lockedOne = locked.empty() ? nullptr
-                                                                 : lockedProblem(problem, locked, options.maxContactTorque);
-      continuation::TracerOptions o = childOptions;
-      if (lockedOne) o.certifiedCounting = false;  // as on the stretch itself (continueUnderContact)
-      continuation::Tracer tracer(lockedOne ? static_cast<continuation::Problem&>(*lockedOne) : problem, o);
-      std::string how;
-      std::vector<continuation::Branch> sides =
-          bp.multiplicity > 1
-              ? continuation::switchMultiple(tracer, bp, options.switching, &how)
-              : continuation::switchBothSides(tracer, bp, options.switching, &how,
-                                              [&](const continuation::Branch&) { return o.interrupt.requested(); });
-      continuation::SpecialPoint& at = tree.branches[b].specialPoints[k];
-      if (bp.multiplicity > 1) {
-        at.branchesPredicted = bp.branchesPredicted;
-        at.branchesFound = bp.branchesFound;
-      }
-      if (sides.empty()) {
-        addNote(at.note, "not switched: " + how);
-        continue;
-      }
-      std::string children;
-      for (continuation::Branch& child : sides) {
-        child.id = int(tree.branches.size());
-        child.parentId = int(b);
-        child.parentSpecialPoint = int(k);
-        child.mirrorOf = -1;  // no reflection is used here: both sides are traced
-        traced.emplace_back(child.points.size(), child.specialPoints.size());
-        const bool stopped = child.stopReason == continuation::StopReason::Interrupted;
-        result.contact.push_back(
-            stopped ? std::vector<ContactStretch>{ContactStretch{0, locked}}
-                    : continueUnderContact(problem, child, o, options.maxContactEvents, options.maxContactTorque, locked));
-        children += (children.empty() ? "" : ", ") + std::to_string(child.id);
-        tree.branches.push_back(std::move(child));
-        depth.push_back(depth[b] + 1);
-        first.push_back(0);
-        if (stopped) {
-          tree.interrupted = true;
-          tree.message = tree.branches.back().stopMessage;
-        }
-        if (options.onBranch) options.onBranch(tree, tree.branches.back());
-      }
-      addNote(tree.branches[b].specialPoints[k].note,
-              "switched on the contact stretch (" + how + "): branches " + children);
-      if (tree.interrupted) return;
-    }
-  }
-}
-
-}  // namespace
-
+// One branch at a time, in the core's tree driver (continuation::traceTree): each branch as it
+// joins the tree is continued through contact (TreeOptions::extend), so the branch points of its
+// locked stretches are switched at like the traced ones, on the stretch's own problem
+// (TreeOptions::switchTracer); each branch is reported as soon as it is final (onFinal), so an
+// interrupted tree has its finished branches reported and the time limit bounds the reports too.
 EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::VectorXd& q0, double lambda0,
                                     const std::vector<continuation::InitialDirection>& starts,
                                     const EquilibriumBranchOptions& options) {
@@ -285,46 +191,84 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
   tree.onBranch = options.onBranch;
   const bool box = options.tracer.boxLower.size() || (options.childTracer && options.childTracer->boxLower.size());
   if (options.mirror && !box) tree.symmetry = mirrorSymmetry(problem);
-  result.tree = continuation::traceTree(problem, u0, lambda0, starts, options.tracer, tree);
-  // Sizes of the branches as traced, before their contact stretches: a mirror image takes the
-  // stretches of its source from there on.
+  const continuation::TracerOptions& childOptions = options.childTracer ? *options.childTracer : options.tracer;
+
+  // traced[b]: the sizes of branch b as traced, before its contact stretches (a mirror image
+  // takes its source's stretches from there on); geometric[b]: its base and self contacts.
   std::vector<std::pair<size_t, size_t>> traced;
-  for (continuation::Branch& branch : result.tree.branches) {
+  std::vector<GeometricContacts> geometric;
+  // The joints locked where a child leaves its parent: those of the parent's stretch that holds
+  // the branch point (the interval [index, index + 1] lies in the stretch of its end point).
+  auto lockedAtParent = [&result](const continuation::BranchTree& t, const continuation::Branch& b) {
+    if (b.parentId < 0) return ContactSet();
+    const continuation::SpecialPoint& bp =
+        t.branches[size_t(b.parentId)].specialPoints[size_t(b.parentSpecialPoint)];
+    return lockedAt(result.contact[size_t(b.parentId)], bp.index + 1);
+  };
+  tree.extend = [&](const continuation::BranchTree& t, continuation::Branch& branch) {
     traced.emplace_back(branch.points.size(), branch.specialPoints.size());
-    if (!options.contact || result.tree.interrupted) {
-      result.contact.push_back(std::vector<ContactStretch>{ContactStretch{}});
+    geometric.emplace_back();
+    const ContactSet locked = lockedAtParent(t, branch);
+    if (!options.contact || branch.stopReason == continuation::StopReason::Interrupted) {
+      result.contact.push_back(std::vector<ContactStretch>{ContactStretch{0, locked}});
     } else if (branch.mirrorOf >= 0) {
-      result.contact.push_back(mirrored(result.contact[size_t(branch.mirrorOf)]));
-      appendMirroredTail(tree.symmetry, result.tree.branches[size_t(branch.mirrorOf)], traced[size_t(branch.mirrorOf)],
-                         branch);
+      const size_t source = size_t(branch.mirrorOf);
+      result.contact.push_back(mirrored(result.contact[source]));
+      appendMirroredTail(tree.symmetry, t.branches[source], traced[source], branch);
     } else {
-      const continuation::TracerOptions& o =
-          branch.parentId >= 0 && options.childTracer ? *options.childTracer : options.tracer;
+      const continuation::TracerOptions& o = branch.parentId >= 0 ? childOptions : options.tracer;
       result.contact.push_back(
-          continueUnderContact(problem, branch, o, options.maxContactEvents, options.maxContactTorque));
+          continueUnderContact(problem, branch, o, options.maxContactEvents, options.maxContactTorque, locked));
     }
-  }
-  if (options.contact && !result.tree.interrupted) switchOnContactStretches(problem, options, traced, result);
-  // A mirror image's base and self contacts are its source's mirrored (mirror_symmetry.h): the
-  // source comes first in the tree, so its located contacts are at hand. Also in an interrupted
-  // tree: an image is only made from a source that finished (branch_switching.cpp), and neither
-  // got a contact stretch, so the image's points are its source's reflected, all of them. (The
-  // reports are built after the time limit; locating the images' contacts again doubled that.)
-  std::vector<GeometricContacts> geometric(result.tree.branches.size());
-  for (size_t b = 0; b < result.tree.branches.size(); ++b) {
-    const continuation::Branch& branch = result.tree.branches[b];
+  };
+  tree.switchTracer = [&](const continuation::BranchTree&, size_t b,
+                          const continuation::SpecialPoint& bp) -> std::shared_ptr<continuation::Tracer> {
+    const ContactSet locked = lockedAt(result.contact[b], bp.index + 1);
+    if (locked.empty()) return nullptr;
+    // the stretch's problem lives as long as its tracer (aliasing shared_ptr)
+    struct Owned {
+      std::unique_ptr<ContactProblem> problem;
+      std::optional<continuation::Tracer> tracer;
+    };
+    auto owned = std::make_shared<Owned>();
+    owned->problem = lockedProblem(problem, locked, options.maxContactTorque);
+    continuation::TracerOptions o = childOptions;
+    o.certifiedCounting = false;  // as on the stretch itself (continueUnderContact)
+    owned->tracer.emplace(*owned->problem, o);
+    return std::shared_ptr<continuation::Tracer>(owned, &*owned->tracer);
+  };
+  tree.onFinal = [&](continuation::BranchTree& t, size_t b) {
+    continuation::Branch& branch = t.branches[b];
+    if (b >= result.contact.size()) {  // a branch extend() never saw (invalid options)
+      result.contact.resize(b + 1, std::vector<ContactStretch>{ContactStretch{}});
+      geometric.resize(b + 1);
+    }
+    if (result.reports.size() < t.branches.size()) {
+      result.reports.resize(t.branches.size());
+      result.classifications.resize(t.branches.size());
+    }
     std::vector<Classification> names;
     for (const continuation::SpecialPoint& sp : branch.specialPoints) names.push_back(classify(problem, sp));
-    result.classifications.push_back(std::move(names));
+    result.classifications[b] = std::move(names);
+    // A mirror image's base and self contacts are its source's mirrored (mirror_symmetry.h): the
+    // source is final before its image (the + side is traced and reported first).
     const int source = branch.mirrorOf;
     if (source >= 0 && size_t(source) < b) {
       geometric[b].given = true;
       for (const GeometricContact& g : geometric[size_t(source)].list)
         geometric[b].list.push_back(mirrored(tree.symmetry, g));
     }
-    result.reports.push_back(reportBranch(problem, branch, options.report, result.contact[b], &geometric[b]));
-  }
-  if (!result.tree.branches.empty()) result.startUnstable = startIsUnstable(result.tree.branches.front());
+    BranchReport report = reportBranch(problem, branch, options.report, result.contact[b], &geometric[b]);
+    if (b == 0) result.startUnstable = startIsUnstable(branch);
+    if (!options.onReport) {
+      result.reports[b] = std::move(report);
+      return;
+    }
+    options.onReport(branch, std::move(report));
+    // handed over: the tree needs the branch's points no more (TreeOptions::onFinal)
+    std::vector<continuation::ContinuationPoint>().swap(branch.points);
+  };
+  result.tree = continuation::traceTree(problem, u0, lambda0, starts, options.tracer, tree);
   return result;
 }
 

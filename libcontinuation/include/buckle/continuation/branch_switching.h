@@ -16,6 +16,7 @@
 #include "buckle/continuation/tracer.h"
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -72,6 +73,23 @@ struct TreeOptions {
   /// Called when a branch is finished (traced or switched), before the next one starts: for
   /// progress reports. The tracer's own per-step callback and interrupt are in TracerOptions.
   std::function<void(const BranchTree &tree, const Branch &finished)> onBranch;
+  /// A branch's own continuation past the end of its trace (e.g. through contact events, with
+  /// problems of its own), called once on every branch as it joins the tree (its id, parentId,
+  /// parentSpecialPoint and mirrorOf set; a mirror image after its source), before its branch
+  /// points are looked at: the special points it appends are switched at like the traced ones.
+  std::function<void(const BranchTree &tree, Branch &branch)> extend;
+  /// The tracer to switch at `bp` of branch `branch` with, when not the tree's (e.g. a branch
+  /// point on a stretch that `extend` traced on another problem of the same dimension); null:
+  /// the tree's. The reflection `symmetry` is not used with such a tracer.
+  std::function<std::shared_ptr<Tracer>(const BranchTree &tree, std::size_t branch, const SpecialPoint &bp)>
+      switchTracer;
+  /// Called once per branch when it is final: its branch points were switched at (their notes
+  /// written) or will not be (its generation is maxDepth, or the tree was interrupted); a mirror
+  /// image's source is final only after its image joined the tree. Branches become final in
+  /// this order: the children of a branch point right after they are traced, their parent when
+  /// all its branch points are done. A consumer may report the branch here and release its
+  /// points (the tree touches a final branch's points no more).
+  std::function<void(BranchTree &tree, std::size_t branch)> onFinal;
   /// A reflection symmetry of the problem (symmetry.h; empty: none): at the simple branch points
   /// it fixes, with a bifurcating direction it reverses, the − side child is the image of the
   /// + side one (Branch::mirrorOf) instead of a second trace: the same tree, up to rounding, in

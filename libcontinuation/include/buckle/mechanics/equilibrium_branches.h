@@ -31,6 +31,12 @@ struct EquilibriumBranchOptions {
   ReportOptions report;            ///< how the branches are reported (stiffness, held coordinate)
   /// Called when a branch is finished, before the next one starts (progress reports).
   std::function<void(const continuation::BranchTree&, const continuation::Branch&)> onBranch;
+  /// Called with each branch and its report as soon as both are final (TreeOptions::onFinal:
+  /// children right after they are traced, a parent when its branch points are all switched at).
+  /// When given, the report is handed over, `reports[b]` stays empty and the branch's points are
+  /// released afterwards (its special points stay): the tree's memory then follows its largest
+  /// branch, not its size. Null: every report is kept in `reports`.
+  std::function<void(const continuation::Branch&, BranchReport&&)> onReport;
   /// Contact at the joints (contact.h): a branch that ends on a located joint limit goes on with
   /// that joint locked, in the same branch (its points appended), and with the joint free again
   /// where its contact torque returns to zero. False: the branch ends at the limit ("BD").
@@ -52,7 +58,7 @@ struct EquilibriumBranchOptions {
 
 struct EquilibriumBranches {
   continuation::BranchTree tree;
-  /// reports[b] reports tree.branches[b].
+  /// reports[b] reports tree.branches[b] (empty when EquilibriumBranchOptions::onReport took it).
   std::vector<BranchReport> reports;
   /// classifications[b][s] names tree.branches[b].specialPoints[s].
   std::vector<std::vector<Classification>> classifications;
