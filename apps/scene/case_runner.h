@@ -115,6 +115,7 @@ class CaseRunner {
     mechanics::ReportOptions o;
     o.stiffness = scene_.analyses.stiffness;
     o.stiffnessMeasure = scene_.analyses.stiffnessMeasure;
+    o.interrupt = control_.interrupt;
     if (throughLoad()) {
       o.heldCoordinate = spec_.path.coordinate;
       o.rangeLow = std::min(spec_.path.from, spec_.path.to);

@@ -4,6 +4,7 @@
 // classification table of docs/mechanics.md.
 #include <catch2/catch.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <vector>
 
@@ -146,4 +147,38 @@ TEST_CASE("KMIN: a deep local minimum of Kxx along a stable stretch, scale-free"
     }
     CHECK(kmin == 1);
   }
+}
+
+TEST_CASE("after an interrupt the report skips the post-buckling refinements and says so", "[branch_report]") {
+  // The paper's chain: two BPs on the straight branch, each with Koiter's coefficients. Reported
+  // again with an interrupt already requested, each BP keeps its location and its stability
+  // counts but has no coefficients, and its note names the reason.
+  EquilibriumProblem problem(Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)),
+                             EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMin = -1.6;
+  o.tracer.maxStep = 0.05;
+  o.switchingDepth = 0;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  const cont::Branch& straight = r.tree.branches.at(0);
+  std::atomic<bool> stop{true};
+  ReportOptions late;
+  late.interrupt.watch(&stop, "SIGTERM received");
+  const BranchReport full = reportBranch(problem, straight, ReportOptions());
+  const BranchReport cut = reportBranch(problem, straight, late);
+  REQUIRE(full.specialPoints.size() == cut.specialPoints.size());
+  int bps = 0;
+  for (size_t s = 0; s < full.specialPoints.size(); ++s) {
+    if (full.specialPoints[s].type != EventType::BranchPoint) continue;
+    ++bps;
+    CHECK(full.specialPoints[s].koiter.valid);
+    CHECK(!cut.specialPoints[s].koiter.valid);
+    CHECK(cut.specialPoints[s].imperfections.empty());
+    CHECK(cut.specialPoints[s].parameter == full.specialPoints[s].parameter);
+    CHECK(cut.specialPoints[s].negativeAfter == full.specialPoints[s].negativeAfter);
+    CHECK(cut.specialPoints[s].note.find("post-buckling coefficients not computed: SIGTERM received") !=
+          std::string::npos);
+  }
+  CHECK(bps == 2);
 }

@@ -51,8 +51,14 @@ std::string formatShort(double x) {
 
 // A branch point of free joints: Koiter's coefficients and the imperfection sensitivities (a
 // simple point's only: a multiple one has its reduced equation).
-void addPostBuckling(EquilibriumProblem& problem, const cont::SpecialPoint& sp, SpecialPointReport& s) {
+void addPostBuckling(EquilibriumProblem& problem, const cont::SpecialPoint& sp, const cont::Interrupt& interrupt,
+                     SpecialPointReport& s) {
   if (sp.multiplicity != 1) return;
+  if (interrupt.requested()) {
+    s.note += (s.note.empty() ? "" : "; ") + std::string("post-buckling coefficients not computed: ") +
+              interrupt.describe();
+    return;
+  }
   s.koiter = koiterCoefficients(problem, sp);
   if (!s.koiter.valid) {
     s.note = s.koiter.error;
@@ -282,7 +288,7 @@ void reportLocatedPoints(EquilibriumProblem& problem, const cont::Branch& b, con
     switch (sp.type) {
       case cont::SpecialPointType::BranchPoint:
         s.type = EventType::BranchPoint;
-        if (lockedAt(stretches, sp.index).empty()) addPostBuckling(problem, sp, s);
+        if (lockedAt(stretches, sp.index).empty()) addPostBuckling(problem, sp, options.interrupt, s);
         break;
       case cont::SpecialPointType::Fold:
         s.type = EventType::Fold;

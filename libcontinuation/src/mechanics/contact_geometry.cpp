@@ -157,7 +157,8 @@ SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) {
 }
 
 std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
-                                                      const std::vector<ContactSet>& locked, double tolerance) {
+                                                      const std::vector<ContactSet>& locked, double tolerance,
+                                                      const continuation::Interrupt& interrupt) {
   std::vector<GeometricContact> found;
   const Chain& chain = problem.chain();
   const int n = chain.size();
@@ -181,7 +182,7 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
       g.accuracy = std::abs(p1.lambda - p0.lambda);
       const ContactSet set = locked.empty() ? ContactSet() : locked[std::min(i, locked.size() - 1)];
       const bool sameSet = locked.empty() || (i + 1 < locked.size() && locked[i + 1] == set);
-      if (p0.lambda != p1.lambda && sameSet) {
+      if (p0.lambda != p1.lambda && sameSet && !interrupt.requested()) {
         // Illinois on λ over the interval: each trial an equilibrium at fixed λ from the
         // interpolated unknowns (the stretch's locked joints fixed)
         const bool increasing = p1.lambda > p0.lambda;
@@ -240,7 +241,7 @@ void reportGeometricContacts(EquilibriumProblem& problem, const continuation::Br
   if (!found.given) {
     std::vector<ContactSet> locked;
     for (const PointReport& p : all) locked.push_back(p.locked);
-    found.list = locateGeometricContacts(problem, branch, locked);
+    found.list = locateGeometricContacts(problem, branch, locked, 1e-12, options.interrupt);
   }
   for (const GeometricContact& g : found.list) {
     SpecialPointReport s;
@@ -266,7 +267,9 @@ void reportGeometricContacts(EquilibriumProblem& problem, const continuation::Br
     else
       os << "self contact: links " << g.linkA << " and " << g.linkB << " " << (g.entering ? "meet" : "separate")
          << " at (" << g.point.x() << ", " << g.point.y() << ")";
-    os << (g.located ? "; located on the branch (equilibria at fixed load)" : "; to the point spacing")
+    os << (g.located                      ? std::string("; located on the branch (equilibria at fixed load)")
+           : options.interrupt.requested() ? "; to the point spacing (not located: " + options.interrupt.describe() + ")"
+                                           : std::string("; to the point spacing"))
        << " — detected only: the model lets the chain pass through";
     s.note = os.str();
     s.contactPoint = g.point;

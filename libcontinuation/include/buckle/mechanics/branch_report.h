@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "buckle/continuation/branch.h"
+#include "buckle/continuation/interrupt.h"
 #include "buckle/mechanics/classification.h"
 #include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/equilibrium_problem.h"
@@ -71,6 +72,10 @@ struct ReportOptions {
   /// the branch vanishes, is "deep" (quasi-buckling) when it is below this fraction of the
   /// measure at the branch start (scale-free: a ratio of stiffnesses).
   double deepStiffnessRatio = 0.5;
+  /// Once requested (the run's time limit, a signal), the refinements of a report are skipped,
+  /// each with a note saying why: Koiter's coefficients and the imperfection sensitivities of the
+  /// branch points, and the location of base and self contacts (then to the point spacing).
+  continuation::Interrupt interrupt;
 };
 
 /// One point of a branch, in physical quantities.

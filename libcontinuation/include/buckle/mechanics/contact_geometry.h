@@ -85,9 +85,10 @@ struct GeometricContacts {
 /// points is located by Illinois iteration on λ, each trial an equilibrium solved at fixed λ with
 /// the interval's locked joints fixed (solveConstrainedEquilibrium), to |Δλ| <= tolerance·max(λ
 /// scale, |λ|). Not located (to the point spacing) across a fold inside the interval, where λ
-/// does not parametrize the branch.
+/// does not parametrize the branch, nor once `interrupt` is requested.
 std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
-                                                      const std::vector<ContactSet>& locked, double tolerance = 1e-12);
+                                                      const std::vector<ContactSet>& locked, double tolerance = 1e-12,
+                                                      const continuation::Interrupt& interrupt = {});
 
 /// The located contacts of `branch` as special points "BC" / "SC" of its report `r` (its points
 /// `all`: every point of the branch, with their locked joints), the reported parameter as the
