@@ -10,6 +10,7 @@
 #include <fstream>
 #include <set>
 #include <stdexcept>
+#include <sstream>
 #include <string>
 #include <system_error>
 
@@ -98,7 +99,37 @@ std::string objectText(const json& small, Members members) {
 
 /// At most this many shape coordinates per case: beyond it every k-th point carries its shape
 /// (the page shows the nearest one that has it).
-constexpr size_t kShapeBudget = 400000;
+constexpr size_t kShapeBudget = 200000;
+/// At most this many per-point values (columns, branch, point, stable) per case: beyond it the
+/// page keeps every k-th point of each branch and its last one, so a tree of any size gives a
+/// page of a few megabytes; the files beside it have every point.
+constexpr size_t kPointBudget = 150000;
+/// At most this many joint coordinates over a case's special points: beyond it the first ones
+/// (the start branches' come first) carry their shapes.
+constexpr size_t kSpecialShapeBudget = 100000;
+
+/// The points of a case the page shows (PageSelection).
+struct PageSelection {
+  std::vector<size_t> points;  ///< indices into CaseResult::points, in order
+  size_t stride = 1;           ///< every stride-th point of each branch (and its last)
+  size_t specialShapes = 0;    ///< the first this many special points carry their joints
+};
+
+PageSelection pageSelection(const CaseResult& cr, size_t columns) {
+  PageSelection s;
+  const std::vector<PointRecord>& pts = cr.points;
+  const size_t perPoint = columns + 3;
+  s.stride = std::max<size_t>(1, (pts.size() * perPoint + kPointBudget - 1) / kPointBudget);
+  size_t first = 0;  // the first point of the current branch
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (i > 0 && pts[i].branch != pts[i - 1].branch) first = i;
+    const bool last = i + 1 == pts.size() || pts[i + 1].branch != pts[i].branch;
+    if ((i - first) % s.stride == 0 || last) s.points.push_back(i);
+  }
+  const size_t perShape = 2 * static_cast<size_t>(cr.chain.size() + 2);
+  s.specialShapes = std::min(cr.specials.size(), kSpecialShapeBudget / perShape);
+  return s;
+}
 
 /// Columns of branches.csv the page draws: the path parameter and every axis of the scene's
 /// bifurcation and stiffness plots (and of the main diagram).
@@ -112,41 +143,44 @@ std::set<std::string> drawnColumns(const Scene& scene, const std::string& mainX,
   return columns;
 }
 
-/// The per-point members of a case (branch, columns, point, shapes, stable) as text.
-Members pointMembers(const CaseResult& cr, const std::set<std::string>& columns) {
-  const std::vector<PointRecord>& pts = cr.points;
+/// The per-point members of a case (branch, columns, point, shapes, stable) as text, for the
+/// points `shown` selects.
+Members pointMembers(const CaseResult& cr, const std::set<std::string>& columns, const PageSelection& shown) {
+  const std::vector<size_t>& keep = shown.points;
+  auto at = [&](size_t k) -> const PointRecord& { return cr.points[keep[k]]; };
   Members m;
   std::string text;
-  appendArray(text, pts.size(), [&](size_t i) { text += std::to_string(pts[i].branch); });
+  appendArray(text, keep.size(), [&](size_t k) { text += std::to_string(at(k).branch); });
   m.emplace_back("branch", std::move(text));
   Members cols;
   for (const std::string& name : columns) {
     std::string values;
-    appendArray(values, pts.size(), [&](size_t i) { appendRounded(values, columnValue(name, pts[i], cr.pose0)); });
+    appendArray(values, keep.size(), [&](size_t k) { appendRounded(values, columnValue(name, at(k), cr.pose0)); });
     cols.emplace_back(name, std::move(values));
   }
   m.emplace_back("columns", objectText(json::object(), std::move(cols)));
   text.clear();
-  appendArray(text, pts.size(), [&](size_t i) { text += std::to_string(pts[i].index); });
+  appendArray(text, keep.size(), [&](size_t k) { text += std::to_string(at(k).index); });
   m.emplace_back("point", std::move(text));
   const size_t perShape = 2 * static_cast<size_t>(cr.chain.size() + 2);
-  const size_t stride = std::max<size_t>(1, (pts.size() * perShape + kShapeBudget - 1) / kShapeBudget);
+  const size_t stride = std::max<size_t>(1, (keep.size() * perShape + kShapeBudget - 1) / kShapeBudget);
   text.clear();
-  appendArray(text, pts.size(), [&](size_t i) {
-    if (i % stride == 0 && pts[i].q.size() == cr.chain.size())
-      appendJoints(text, cr.chain, pts[i].q);
+  appendArray(text, keep.size(), [&](size_t k) {
+    if (k % stride == 0 && at(k).q.size() == cr.chain.size())
+      appendJoints(text, cr.chain, at(k).q);
     else
       text += "null";
   });
   m.emplace_back("shapes", std::move(text));
   text.clear();
-  appendArray(text, pts.size(), [&](size_t i) { text += pts[i].stable ? '1' : '0'; });
+  appendArray(text, keep.size(), [&](size_t k) { text += at(k).stable ? '1' : '0'; });
   m.emplace_back("stable", std::move(text));
   return m;
 }
 
 /// A case of the page's data as the text dump() writes for it.
-std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, const std::set<std::string>& columns) {
+std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, const std::set<std::string>& columns,
+                     const PageSelection& shown) {
   json c;
   c["index"] = index;
   c["label"] = cr.label;
@@ -160,7 +194,9 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
   c["branches"] = branches;
 
   json specials = json::array();
-  for (const SpecialRecord& s : cr.specials) {
+  for (size_t k = 0; k < cr.specials.size(); ++k) {
+    const SpecialRecord& s = cr.specials[k];
+    const bool shape = k < shown.specialShapes;
     json e{{"type", s.type},
            {"field", s.field},
            {"branch", s.branch},
@@ -178,10 +214,10 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
     json values = json::object();
     for (const std::string& name : columns) values[name] = rounded(columnValue(name, s, cr.pose0), 10);
     e["values"] = values;
-    if (s.q.size() == cr.chain.size()) e["joints"] = jointsJson(cr.chain, s.q);
+    if (shape && s.q.size() == cr.chain.size()) e["joints"] = jointsJson(cr.chain, s.q);
     if (s.jumpTried) {
       e["jump"] = s.jumpSuccess ? s.jumpLanding + (s.jumpShape.empty() ? "" : " (" + s.jumpShape + ")") : "failed: " + s.jumpMessage;
-      if (s.jumpQ.size() == cr.chain.size()) e["jump_joints"] = jointsJson(cr.chain, s.jumpQ);
+      if (shape && s.jumpQ.size() == cr.chain.size()) e["jump_joints"] = jointsJson(cr.chain, s.jumpQ);
     }
     specials.push_back(e);
   }
@@ -232,7 +268,7 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
       sudden["static"] = jointsJson(cr.chain, cr.sudden.staticShape);
     c["sudden"] = sudden;
   }
-  return objectText(c, pointMembers(cr, columns));
+  return objectText(c, pointMembers(cr, columns, shown));
 }
 
 }  // namespace
@@ -269,10 +305,31 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   const std::set<std::string> columns = drawnColumns(scene, mainX, mainY);
   bool anyPoints = false;
   std::string cases;
+  size_t points = 0, shownPoints = 0, specials = 0, shownShapes = 0, stride = 1;
   appendArray(cases, run.cases.size(), [&](size_t c) {
-    cases += caseText(scene, run.cases[c], c, columns);
-    anyPoints = anyPoints || !run.cases[c].points.empty();
+    const CaseResult& cr = run.cases[c];
+    const PageSelection shown = pageSelection(cr, columns.size());
+    cases += caseText(scene, cr, c, columns, shown);
+    anyPoints = anyPoints || !cr.points.empty();
+    points += cr.points.size();
+    shownPoints += shown.points.size();
+    specials += cr.specials.size();
+    shownShapes += shown.specialShapes;
+    stride = std::max(stride, shown.stride);
   });
+  if (shownPoints < points || shownShapes < specials) {
+    std::ostringstream os;
+    os << "This page is a summary of a large run: it draws ";
+    if (shownPoints < points)
+      os << shownPoints << " of the " << points << " traced points (every " << stride
+         << (stride == 2 ? "nd" : stride == 3 ? "rd" : "th") << " point of each branch and its last)";
+    else
+      os << "every traced point";
+    os << " and the shapes of " << shownShapes << " of the " << specials
+       << " special points. Every point is in branches.csv and joint_angles.npy, every special point in "
+          "special_points.json, beside this page.";
+    data["abridged"] = os.str();
+  }
   json labels = json::object();
   auto label = [&](const std::string& column) {
     labels[column] = columnLabel(column == "parameter" ? scene.cases.front().path.parameter : column, scene.units,

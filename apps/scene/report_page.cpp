@@ -33,6 +33,7 @@ tr.sp { cursor: pointer; } tr.sp:hover, tr.sp.on { background: #fff4cc; }
 <h1 id="title">buckle report</h1>
 <p class="desc" id="description"></p>
 <p id="status-line"></p>
+<p class="desc" id="abridged"></p>
 <pre id="errors" hidden></pre>
 <div class="row">
   <div class="panel"><div id="diagram-box"></div>
@@ -305,6 +306,7 @@ const char* const kReportTail = R"PAGE(</script>
   // ---- the page -----------------------------------------------------------------------------
   document.getElementById('title').textContent = 'buckle report: ' + D.scene;
   document.getElementById('description').textContent = D.description;
+  document.getElementById('abridged').textContent = D.abridged || '';
   document.title = 'buckle: ' + D.scene;
   var s = D.summary;
   document.getElementById('status-line').textContent =

@@ -183,3 +183,82 @@ TEST_CASE("the page's rounded numbers are the doubles nearest to printf's %.*g (
   CHECK(roundedForPage(std::nan(""), 6).is_null());
   CHECK(roundedForPage(-std::numeric_limits<double>::infinity(), 6).is_null());
 }
+
+TEST_CASE("the page of a large run stays a few megabytes and says what it left to the files", "[scene][report]") {
+  // A synthetic run far beyond the page's budgets: 60 000 points of a 400-segment chain in 12
+  // branches and 2000 special points with their shapes. The page keeps every k-th point of each
+  // branch and its last, the first special points' shapes, and says so; nothing else changes.
+  const Scene scene = smallScene("large");
+  RunResult run;
+  const int n = 400;
+  CaseResult& cr =
+      run.cases.emplace_back(mech::Chain::uniform(n, mech::SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)));
+  cr.label = "main";
+  cr.q0 = Eigen::VectorXd::Zero(n);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> angle(-0.01, 0.01);
+  const int branches = 12, perBranch = 5000;
+  for (int b = 0; b < branches; ++b) {
+    BranchRecord br;
+    br.id = b;
+    br.points = perBranch;
+    cr.branches.push_back(br);
+    for (int i = 0; i < perBranch; ++i) {
+      PointRecord p;
+      p.branch = b;
+      p.index = i;
+      p.parameter = -1e-3 * i;
+      p.q = Eigen::VectorXd::NullaryExpr(n, [&]() { return angle(rng); });
+      p.stable = (i / 100) % 2 == 0;
+      cr.points.push_back(std::move(p));
+    }
+  }
+  for (int s = 0; s < 2000; ++s) {
+    SpecialRecord sp;
+    sp.type = "BP";
+    sp.branch = s % branches;
+    sp.q = Eigen::VectorXd::Constant(n, 1e-3 * s);
+    cr.specials.push_back(std::move(sp));
+  }
+  const std::string page = reportHtml(scene, run, specialPointsJson(scene, run), summaryJson(scene, run, PlotReport{}));
+  CHECK(page.size() <= 5u * 1000 * 1000);
+  const json data = embedded(page);
+  REQUIRE(data.contains("abridged"));
+  const std::string note = data["abridged"];
+  CHECK(note.find("of the 60000 traced points") != std::string::npos);
+  CHECK(note.find("of the 2000 special points") != std::string::npos);
+  const json& c = data["cases"][0];
+  const size_t shown = c["point"].size();
+  CHECK(shown < cr.points.size());
+  CHECK(c["branch"].size() == shown);
+  CHECK(c["stable"].size() == shown);
+  CHECK(c["shapes"].size() == shown);
+  CHECK(c["columns"]["q2"].size() == shown);
+  // every branch's first and last points are there, each shown point's values are its own
+  std::vector<int> first(branches, -1), last(branches, -1);
+  for (size_t k = 0; k < shown; ++k) {
+    const int b = c["branch"][k], i = c["point"][k];
+    if (first[size_t(b)] < 0) first[size_t(b)] = i;
+    last[size_t(b)] = i;
+    const PointRecord& p = cr.points[size_t(b * perBranch + i)];
+    CHECK(c["stable"][k] == (p.stable ? 1 : 0));
+    CHECK(std::abs(c["columns"]["q2"][k].get<double>() - p.q[1]) <= 1e-5 * std::abs(p.q[1]) + 1e-300);
+  }
+  for (int b = 0; b < branches; ++b) {
+    CHECK(first[size_t(b)] == 0);
+    CHECK(last[size_t(b)] == perBranch - 1);
+  }
+  // the first special points carry their shapes, the later ones none; every one is listed
+  REQUIRE(c["specials"].size() == cr.specials.size());
+  CHECK(c["specials"][0].contains("joints"));
+  CHECK(!c["specials"][1999].contains("joints"));
+}
+
+TEST_CASE("the page of a small run is complete and says nothing about a summary", "[scene][report]") {
+  const Scene scene = smallScene("small");
+  const RunResult run = runScene(scene);
+  const json data = embedded(reportHtml(scene, run, specialPointsJson(scene, run), summaryJson(scene, run, PlotReport{})));
+  CHECK(!data.contains("abridged"));
+  CHECK(data["cases"][0]["point"].size() == run.cases[0].points.size());
+  for (const json& s : data["cases"][0]["specials"]) CHECK(s.contains("joints"));
+}
