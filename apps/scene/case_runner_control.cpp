@@ -23,7 +23,8 @@ bool CaseRunner::actuationStart() {
     direction[c] = end.value[c] - ramp.value[c];
   }
   out_.qStart = out_.q0;
-  if (direction.isZero()) return true;  // no payload: the unloaded shape
+  // exactly zero, not Eigen's isZero() (1e-12 absolute: a payload of 3e-13 N would count as none)
+  if ((direction.array() == 0.0).all()) return true;  // no payload: the unloaded shape
   mech::EquilibriumProblem problem(out_.chain, ramp, direction);
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();

@@ -5,6 +5,8 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "buckle/mechanics/unloaded_shape.h"
 
@@ -138,4 +140,32 @@ TEST_CASE("impossible preload requests are rejected naming segment and parameter
   CHECK_THAT(rejection([&] { preloadsForShape(segs, Eigen::Vector3d(0.1, 3.0, 0.1)); }),
              Catch::Contains("segment 2") && Catch::Contains("q0"));
   CHECK_THAT(rejection([&] { preloadsForShape(segs, Eigen::Vector2d(0.1, 0.1)); }), Catch::Contains("one angle per segment"));
+}
+
+TEST_CASE("a root where K_q is zero to rounding is classified by the torque either side, in any units",
+          "[unloaded]") {
+  // The borderline segment of eq 4, L0 = 2b(1 − (a/b)²): M'(0) = 0 exactly, so K_q(0) is rounding
+  // noise whose sign changes with the units. The energy is quartic there; the restoring torque
+  // M = −dE/dq either side decides, and must decide the same in every system of units.
+  const double a = 0.5, b = 1.0, k = 1.0;
+  const double L0 = 2.0 * b * (1.0 - (a / b) * (a / b));
+  bool reference = false;
+  int systems = 0;
+  for (const auto& [length, stiffness] : std::vector<std::pair<double, double>>{
+           {1.0, 1.0}, {1e-4, 1e-8}, {1e4, 1e8}, {0.02, 2000.0}, {1e3, 1e-6}, {3.0, 7.0}}) {
+    const Segment seg(SegmentParameters::symmetric(a * length, b * length, k * stiffness, L0 * length));
+    const SegmentUnloadedAngle u = unloadedAngle(seg);
+    REQUIRE(u.found);
+    CHECK(u.root.q == 0.0);
+    CHECK(std::abs(u.root.stiffness) <= 1e-12 * stiffness * length * length);
+    // independent: the signs of M a little way either side of the root
+    const bool restoring = seg.torque(-1e-2) > 0.0 && seg.torque(1e-2) < 0.0;
+    CHECK(u.root.stable == restoring);
+    if (systems++ == 0) reference = u.root.stable;
+    CHECK(u.root.stable == reference);
+    const TorqueCurve curve = torqueCurve(seg, -1.0, 1.0, 11);
+    REQUIRE(curve.equilibria.size() == 1);
+    CHECK(curve.equilibria[0].second == reference);
+  }
+  CHECK(reference);  // the quartic term of the borderline segment is positive (Fig 2's flat-topped curve)
 }

@@ -498,7 +498,9 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
     result.potentialStatic = model->potential(qStatic);
     result.maxDifference = (result.rest - qStatic).cwiseAbs().maxCoeff();
     result.differs = result.maxDifference > options.sameStateTolerance;
-    const double scale = std::max({1.0, std::abs(result.potentialDynamic), std::abs(result.potentialStatic)});
+    // the chain's energy unit k̄b̄², not 1: in any units the tie is a tie to rounding
+    const double scale =
+        std::max({model->torqueUnit(), std::abs(result.potentialDynamic), std::abs(result.potentialStatic)});
     if (std::abs(result.potentialDynamic - result.potentialStatic) <= 1e-12 * scale) result.lower = LowerPotential::Equal;
     else result.lower = result.potentialDynamic < result.potentialStatic ? LowerPotential::Dynamic : LowerPotential::Static;
     os << "; vs quasi-static: " << (result.differs ? "differs" : "same") << " (max |dq| " << result.maxDifference

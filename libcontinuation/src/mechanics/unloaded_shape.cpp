@@ -39,6 +39,16 @@ TorqueRoot makeRoot(const Segment& s, double q) {
   r.q = q;
   r.stiffness = s.stiffness(q);
   r.stable = r.stiffness > 0.0;
+  // K_q = Σ k (L'² + (L − L⁰) L'') is a sum of terms of size k b²; within their rounding it is
+  // zero (a degenerate root, e.g. the borderline M'(0) = 0 of eq 4) and its sign is noise: the
+  // restoring torque either side decides (stable: M > 0 below the root, M < 0 above).
+  const SegmentParameters& p = s.parameters();
+  const double rounding = 1e3 * std::numeric_limits<double>::epsilon() * (p.k1 * p.b1 * p.b1 + p.k2 * p.b2 * p.b2);
+  if (std::abs(r.stiffness) <= rounding) {
+    const double delta = 1e-3;  // rad
+    const double below = std::max(q - delta, 0.5 * (q + s.lowerLimit())), above = std::min(q + delta, 0.5 * (q + s.upperLimit()));
+    r.stable = s.torque(below) > 0.0 && s.torque(above) < 0.0;
+  }
   return r;
 }
 

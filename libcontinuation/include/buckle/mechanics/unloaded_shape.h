@@ -21,7 +21,7 @@ namespace buckle::mechanics {
 struct TorqueRoot {
   double q = 0.0;          ///< M(q) = 0
   double stiffness = 0.0;  ///< K_q(q) = −M'(q)
-  bool stable = false;     ///< K_q > 0
+  bool stable = false;     ///< K_q > 0 (K_q zero to rounding: M > 0 below the root and M < 0 above)
 };
 
 struct SegmentUnloadedAngle {
