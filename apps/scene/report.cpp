@@ -99,14 +99,14 @@ std::string objectText(const json& small, Members members) {
 
 /// At most this many shape coordinates per case: beyond it every k-th point carries its shape
 /// (the page shows the nearest one that has it).
-constexpr size_t kShapeBudget = 200000;
+constexpr size_t kShapeBudget = 160000;
 /// At most this many per-point values (columns, branch, point, stable) per case: beyond it the
 /// page keeps every k-th point of each branch and its last one, so a tree of any size gives a
 /// page of a few megabytes; the files beside it have every point.
-constexpr size_t kPointBudget = 150000;
+constexpr size_t kPointBudget = 120000;
 /// At most this many joint coordinates over a case's special points: beyond it the first ones
 /// (the start branches' come first) carry their shapes.
-constexpr size_t kSpecialShapeBudget = 100000;
+constexpr size_t kSpecialShapeBudget = 80000;
 
 /// The points of a case the page shows (PageSelection).
 struct PageSelection {
