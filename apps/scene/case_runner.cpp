@@ -285,29 +285,7 @@ void CaseRunner::suddenLoad() {
   }
 }
 
-void CaseRunner::continuation() {
-  double s0 = out_.startValue;
-  mech::EndCondition end = spec_.end.condition;
-  Eigen::Vector3d direction = spec_.path.direction;
-  double lambdaLo = std::min(spec_.path.from, spec_.path.to), lambdaHi = std::max(spec_.path.from, spec_.path.to);
-  std::vector<double> targets{spec_.path.to, spec_.path.from};
-  const int c = spec_.path.coordinate;
-  if (throughLoad()) {
-    // trace with the held coordinate's reaction as parameter (see PathSpec::loadLimit)
-    end.control[size_t(c)] = mech::Control::Load;
-    end.value[c] = 0.0;
-    direction = Eigen::Vector3d::Zero();
-    direction[c] = 1.0;
-    s0 = 0.0;
-    // both signs of the reaction: with an unstable start (κ < 0) the branch points lie on the
-    // tension side, and their branches still move the end into the requested range
-    targets = {-spec_.path.loadLimit, spec_.path.loadLimit};
-    lambdaLo = -spec_.path.loadLimit;
-    lambdaHi = spec_.path.loadLimit;
-  }
-  end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
-  mech::EquilibriumProblem problem(out_.chain, end, direction, {}, controlDirection());
-
+mech::EquilibriumBranchOptions CaseRunner::branchOptions(double lambdaLo, double lambdaHi) {
   mech::EquilibriumBranchOptions opt;
   opt.tracer = solverOptions();
   opt.tracer.lambdaMin = lambdaLo;
@@ -339,6 +317,33 @@ void CaseRunner::continuation() {
   opt.onBranch = [this](const cont::BranchTree& t, const cont::Branch&) {
     branchesSoFar_ = static_cast<int>(t.branches.size());
   };
+  return opt;
+}
+
+void CaseRunner::continuation() {
+  double s0 = out_.startValue;
+  mech::EndCondition end = spec_.end.condition;
+  Eigen::Vector3d direction = spec_.path.direction;
+  double lambdaLo = std::min(spec_.path.from, spec_.path.to), lambdaHi = std::max(spec_.path.from, spec_.path.to);
+  std::vector<double> targets{spec_.path.to, spec_.path.from};
+  const int c = spec_.path.coordinate;
+  if (throughLoad()) {
+    // trace with the held coordinate's reaction as parameter (see PathSpec::loadLimit)
+    end.control[size_t(c)] = mech::Control::Load;
+    end.value[c] = 0.0;
+    direction = Eigen::Vector3d::Zero();
+    direction[c] = 1.0;
+    s0 = 0.0;
+    // both signs of the reaction: with an unstable start (κ < 0) the branch points lie on the
+    // tension side, and their branches still move the end into the requested range
+    targets = {-spec_.path.loadLimit, spec_.path.loadLimit};
+    lambdaLo = -spec_.path.loadLimit;
+    lambdaHi = spec_.path.loadLimit;
+  }
+  end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
+  mech::EquilibriumProblem problem(out_.chain, end, direction, {}, controlDirection());
+
+  const mech::EquilibriumBranchOptions opt = branchOptions(lambdaLo, lambdaHi);
 
   // The start branches (one per requested direction), then branch switching breadth first, by
   // the core's tree driver (its guards: never back at the BP a branch started from, never twice
@@ -364,6 +369,7 @@ void CaseRunner::continuation() {
     run_.problems.push_back(os.str());
     return;
   }
+  if (!throughLoad()) traced_ = branches;  // the curves a disconnected branch may join
   for (size_t i = 0; i < branches.size(); ++i) {
     const cont::Branch& b = branches[i];
     std::string origin = b.parentId < 0 ? origins[size_t(b.id)]
