@@ -124,10 +124,11 @@ TEST_CASE("Tracer: the step callback's Join ends the branch as a regular end, an
   TracerOptions options;
   options.maxStep = 0.05;
   options.maxPoints = 10000;
+  bool below = false;  // the branch has been at λ < 0 (past half way round)
   options.onStep = [&](const Branch &branch) {
     const ContinuationPoint &p = branch.points.back();
-    const bool back = branch.points.size() > 10 && p.lambda >= 0.0 && p.u[0] > 0.0;
-    return back ? StepAction::Join : StepAction::Continue;
+    below = below || p.lambda < 0.0;
+    return below && p.lambda >= 0.0 && p.u[0] > 0.0 ? StepAction::Join : StepAction::Continue;
   };
   const Branch b = trace(problem, Vector::Constant(1, 1.0), 0.0, InitialDirection::increasingLambda(), options);
   REQUIRE(b.stopReason == StopReason::Joined);
