@@ -40,7 +40,8 @@ void CaseRunner::equilibria() {
 }
 
 void CaseRunner::disconnectedBranches() {
-  if (!out_.haveEquilibria || throughLoad() || traced_.empty() || interrupted()) return;
+  // with no tree (its start failed: the unloaded shape far from a held end) every equilibrium seeds
+  if (!out_.haveEquilibria || throughLoad() || interrupted()) return;
   mechanics::EquilibriumProblem problem = pathProblem();
   const double lo = std::min(spec_.path.from, spec_.path.to), hi = std::max(spec_.path.from, spec_.path.to);
   mechanics::DisconnectedBranchOptions opt;

@@ -88,9 +88,15 @@ class JoinWatch {
   cont::StepAction step(const cont::Branch& branch) {
     const cont::ContinuationPoint& p = branch.points.back();
     const Eigen::VectorXd b = scaling_.point(p), tb = scaling_.tangent(p);
-    // A new branch (or contact stretch) begins: its first point is the start, the others may
-    // still be in the tracer's scaled variables, so the watch starts from the point after it.
-    if (branch.points.size() <= 2) {
+    // A new branch (or contact stretch, or switched child that starts with points of its own)
+    // begins: the earlier points may still be in the tracer's scaled variables, so the watch
+    // starts from its newest point.
+    const bool fresh = &branch != branch_ || branch.points.size() <= std::max<size_t>(2, size_) ||
+                       branch.points.front().lambda != firstLambda_;
+    branch_ = &branch;
+    size_ = branch.points.size();
+    firstLambda_ = branch.points.front().lambda;
+    if (fresh) {
       away_.clear();
       last_ = b;
       return cont::StepAction::Continue;
@@ -111,6 +117,9 @@ class JoinWatch {
   const DisconnectedBranchOptions& options_;
   std::vector<bool> away_;
   Eigen::VectorXd last_;
+  const cont::Branch* branch_ = nullptr;  // the branch of the last step, its size and first λ
+  size_t size_ = 0;
+  double firstLambda_ = 0.0;
 };
 
 // The curve a joined branch ended on: the first one (not the branch itself) its last step meets
