@@ -131,6 +131,22 @@ void chainPanel(std::ostream& os, const std::string& base, double L, const std::
   os << "unset object 1\n";
 }
 
+/// The files chainPanel draws (BASE_{tri,spr,lim,jnt,near,touch}.dat) of the chain at q; each
+/// starts with a NaN point so that gnuplot reads an empty panel (q null) without complaint.
+void writeChainFiles(const mechanics::Chain& chain, const Eigen::VectorXd* q, const fs::path& dir,
+                     const std::string& base, bool detailed) {
+  BlockFile tri, spr, lim, jnt, near, touch;
+  for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near, &touch}) {
+    f->begin();
+    f->point({std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()});
+    f->breakLine();
+  }
+  if (q) drawChain(chain, *q, tri, spr, lim, jnt, near, &touch, detailed);
+  for (const auto& [file, suffix] : {std::pair<BlockFile*, const char*>{&tri, "_tri"}, {&spr, "_spr"}, {&lim, "_lim"},
+                                     {&jnt, "_jnt"}, {&near, "_near"}, {&touch, "_touch"}})
+    file->write(dir / (base + suffix + ".dat"));
+}
+
 /// "contact: joint 3U 5L" for a panel title; a long chain's many locked joints are counted.
 std::string lockedTitle(const std::string& locked) {
   const size_t joints = size_t(std::count(locked.begin(), locked.end(), ' ')) + 1;
@@ -241,15 +257,10 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
     const std::string& parameter = scene.cases[c].path.parameter;
     for (size_t k = 0; k < na; ++k) {
       const PointRecord* p = chosenOf[o][k];
-      BlockFile tri, spr, lim, jnt, near, touch;
-      for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near, &touch}) {
-        f->begin();
-        f->point({std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()});
-        f->breakLine();
-      }
+      const std::string base = stem + "_" + std::to_string(c) + "_" + std::to_string(k);
+      writeChainFiles(cr.chain, p ? &p->q : nullptr, dir, base, detailed);
       std::ostringstream title;
       if (p) {
-        drawChain(cr.chain, p->q, tri, spr, lim, jnt, near, &touch, detailed);
         // five significant digits, in the scene's unit
         const std::string unit = scene.units.unit(columnDimension(parameter));
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << short5(p->parameter)
@@ -267,13 +278,6 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(spec.at[k]) << ": not drawn";
         s.body << "set label 1 " << quote(missingOf[o][k]) << " at graph 0.5, graph 0.5 center font ',9' noenhanced\n";
       }
-      const std::string base = stem + "_" + std::to_string(c) + "_" + std::to_string(k);
-      tri.write(dir / (base + "_tri.dat"));
-      spr.write(dir / (base + "_spr.dat"));
-      lim.write(dir / (base + "_lim.dat"));
-      jnt.write(dir / (base + "_jnt.dat"));
-      near.write(dir / (base + "_near.dat"));
-      touch.write(dir / (base + "_touch.dat"));
       const double L = cr.chain.length();
       s.body << "set title " << quote(title.str()) << " font ',10'\n";
       s.body << "set xrange [" << num(std::min(x0, -0.1 * L)) << ":" << num(x1) << "]\nset yrange [" << num(y0) << ":"
@@ -443,20 +447,8 @@ void drawEquilibriumShapes(const Scene& scene, const RunResult& run, const PlotS
     const std::vector<mechanics::FoundEquilibrium>& list = cr.equilibria.equilibria;
     for (size_t k = 0; k < list.size(); ++k) {
       const mechanics::FoundEquilibrium& e = list[k];
-      BlockFile tri, spr, lim, jnt, near, touch;
-      for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near, &touch}) {
-        f->begin();
-        f->point({std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()});
-        f->breakLine();
-      }
-      drawChain(cr.chain, e.q, tri, spr, lim, jnt, near, &touch, detailed);
       const std::string base = spec.name + "_" + std::to_string(c) + "_" + std::to_string(k);
-      tri.write(dir / (base + "_tri.dat"));
-      spr.write(dir / (base + "_spr.dat"));
-      lim.write(dir / (base + "_lim.dat"));
-      jnt.write(dir / (base + "_jnt.dat"));
-      near.write(dir / (base + "_near.dat"));
-      touch.write(dir / (base + "_touch.dat"));
+      writeChainFiles(cr.chain, &e.q, dir, base, detailed);
       std::ostringstream title;
       title << (cases.size() > 1 ? cr.label + ", " : std::string()) << "#" << k + 1 << " " << e.shape << ": "
             << (e.stable ? "STABLE" : "unstable, index " + std::to_string(e.index)) << "\nΠ = " << short5(e.potential)

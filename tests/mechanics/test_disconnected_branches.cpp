@@ -7,13 +7,13 @@
 // at λ* by this file's Newton against the equilibrium list.
 #include <catch2/catch.hpp>
 
-#include <Eigen/LU>
 #include <cmath>
 
 #include "buckle/mechanics/all_equilibria.h"
 #include "buckle/mechanics/disconnected_branches.h"
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/unloaded_shape.h"
+#include "fixed_lambda_newton.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -61,14 +61,9 @@ std::vector<Eigen::VectorXd> crossingsAt(EquilibriumProblem& problem, const cont
   for (size_t i = 0; i + 1 < b.points.size(); ++i) {
     const double da = b.points[i].lambda - lambda, db = b.points[i + 1].lambda - lambda;
     if (da * db > 0.0 || da == db) continue;
-    Eigen::VectorXd u = b.points[i].u + (da / (da - db)) * (b.points[i + 1].u - b.points[i].u);
-    Eigen::VectorXd F(N), Fl(N);
-    Eigen::MatrixXd Fu(N, N);
-    for (int it = 0; it < 20; ++it) {
-      REQUIRE(problem.residual(u, lambda, F));
-      REQUIRE(problem.jacobian(u, lambda, Fu, Fl));
-      u -= Fu.partialPivLu().solve(F);
-    }
+    const Eigen::VectorXd u = buckle::test::polishAtFixedLambda(
+        problem, b.points[i].u + (da / (da - db)) * (b.points[i + 1].u - b.points[i].u), lambda, 20);
+    Eigen::VectorXd F(N);
     REQUIRE(problem.residual(u, lambda, F));
     REQUIRE(F.cwiseQuotient(problem.scales().residuals).lpNorm<Eigen::Infinity>() < 1e-11);
     out.push_back(u.head(problem.segments()));

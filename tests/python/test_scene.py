@@ -30,12 +30,18 @@ def close(a, b, rel=1e-9):
     return abs(a - b) <= rel * max(1.0, abs(a), abs(b))
 
 
-@pytest.mark.parametrize("name", SCENES)
-def test_module_results_equal_the_command_line(name, source_dir, run_cli, tmp_path):
+def run_shipped_scene(name, source_dir, run_cli, tmp_path):
+    """`buckle run` of data/scenes/NAME into tmp_path/out: the scene's path and the output directory."""
     scene = source_dir / "data" / "scenes" / name
     out = tmp_path / "out"
     cli = run_cli("run", scene, "--out", out, "--quiet")
     assert cli.returncode == 0, cli.stderr
+    return scene, out
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_module_results_equal_the_command_line(name, source_dir, run_cli, tmp_path):
+    scene, out = run_shipped_scene(name, source_dir, run_cli, tmp_path)
     expected = json.loads((out / "special_points.json").read_text())
     summary = json.loads((out / "summary.json").read_text())
 
@@ -95,10 +101,7 @@ EQUILIBRIA_SCENES = [name for name in SCENES if "equilibria" in json.loads(
 
 @pytest.mark.parametrize("name", EQUILIBRIA_SCENES)
 def test_module_equilibria_equal_equilibria_csv(name, source_dir, run_cli, tmp_path):
-    scene = source_dir / "data" / "scenes" / name
-    out = tmp_path / "out"
-    cli = run_cli("run", scene, "--out", out, "--quiet")
-    assert cli.returncode == 0, cli.stderr
+    scene, out = run_shipped_scene(name, source_dir, run_cli, tmp_path)
     with open(out / "equilibria.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     summary = json.loads((out / "summary.json").read_text())
