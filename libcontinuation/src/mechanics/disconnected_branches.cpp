@@ -15,6 +15,7 @@ namespace {
 // A traced curve in the scaled variables x = (u / D_u, λ / λ₀), with unit tangents there.
 struct Curve {
   int id = -1;
+  bool pending = false;  // finished in the trace under way (its id still the trace's own)
   std::vector<Eigen::VectorXd> x, t;
 };
 
@@ -74,9 +75,10 @@ Meeting meet(const Curve& c, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
   return m;
 }
 
-// The join test of the branches being traced. A branch starts on its own seed, and the second
-// direction on the first one's start: a step counts as joining one of the seed's own curves (ids
-// from groupFrom, and its seed point) only once the branch has been away from it. Any other
+// The join test of the branches being traced. A branch starts on its own seed, the second
+// direction on the first one's start, a contact stretch at its branch's end: a step counts as
+// joining one of the seed's own curves (ids from groupFrom, those of the trace under way, and its
+// seed point) only once the branch has been away from it. Any other
 // curve it joins at once: a child switched at a branch point where a traced curve crosses, and
 // that goes along it, is that curve.
 class JoinWatch {
@@ -102,7 +104,7 @@ class JoinWatch {
       return cont::StepAction::Continue;
     }
     for (size_t c = away_.size(); c < curves.size(); ++c)
-      away_.push_back(!(curves[c].id >= groupFrom || curves[c].id == seedCurve));
+      away_.push_back(!(curves[c].pending || curves[c].id >= groupFrom || curves[c].id == seedCurve));
     for (size_t c = 0; c < curves.size(); ++c) {
       const Meeting m = meet(curves[c], last_, b, tb, options_.joinFraction, options_.joinCosine);
       if (m.parallel && away_[c]) return cont::StepAction::Join;
@@ -252,6 +254,7 @@ DisconnectedBranches traceDisconnectedBranches(EquilibriumProblem& problem, cons
   o.onBranch = [&watch, &scaling, &userBranch](const cont::BranchTree& t, const cont::Branch& b) {
     if (userBranch) userBranch(t, b);
     watch.curves.push_back(curveOf(b, scaling));
+    watch.curves.back().pending = true;
   };
 
   std::vector<int> seedBranch(q.size(), -1);  // the first branch traced from each seed
@@ -290,7 +293,10 @@ DisconnectedBranches traceDisconnectedBranches(EquilibriumProblem& problem, cons
         watch.curves.resize(firstCurve);
         break;
       }
-      for (size_t c = firstCurve; c < watch.curves.size(); ++c) watch.curves[c].id += offset;
+      for (size_t c = firstCurve; c < watch.curves.size(); ++c) {
+        watch.curves[c].id += offset;
+        watch.curves[c].pending = false;
+      }
       append(std::move(t), offset, out.traced);
       bool closed = false;
       for (size_t b = size_t(offset - out.firstId); b < out.traced.tree.branches.size(); ++b) {
