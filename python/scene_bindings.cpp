@@ -85,6 +85,48 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
   return d;
 }
 
+/// The equilibria of one case (the rows of equilibria.csv) as arrays, q as an m×n matrix; with
+/// "branches", the branch through each (−1: none) and the disconnected branches' seeds.
+py::dict equilibriaArrays(const scene::CaseResult& cr) {
+  const std::vector<mechanics::FoundEquilibrium>& list = cr.equilibria.equilibria;
+  const auto m = static_cast<Eigen::Index>(list.size());
+  py::dict d;
+  Eigen::MatrixXd q(m, cr.chain.size());
+  VectorXd potential(m);
+  Eigen::VectorXi index(m), branch = Eigen::VectorXi::Constant(m, -1);
+  py::array_t<bool> stable(m);
+  auto stableView = stable.mutable_unchecked<1>();
+  std::vector<std::string> shape;
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const mechanics::FoundEquilibrium& e = list[static_cast<size_t>(k)];
+    q.row(k) = e.q.transpose();
+    potential[k] = e.potential;
+    index[k] = e.index;
+    stableView(k) = e.stable;
+    shape.push_back(e.shape);
+    if (static_cast<size_t>(k) < cr.equilibriaOnBranch.size()) branch[k] = cr.equilibriaOnBranch[static_cast<size_t>(k)];
+  }
+  d["at"] = cr.equilibriaAt;
+  d["q"] = q;
+  d["potential"] = potential;
+  d["index"] = index;
+  d["stable"] = stable;
+  d["shape"] = shape;
+  d["branch"] = branch;
+  py::list disconnected;
+  for (const scene::BranchRecord& b : cr.branches)
+    if (b.fromEquilibrium > 0) {
+      py::dict r;
+      r["id"] = b.id;
+      r["parent"] = b.parent;
+      r["from_equilibrium"] = b.fromEquilibrium;
+      r["joins"] = b.joins >= 0 ? py::object(py::int_(b.joins)) : py::object(py::none());
+      disconnected.append(r);
+    }
+  d["disconnected_branches"] = disconnected;
+  return d;
+}
+
 scene::Scene parse(const py::object& source) {
   if (py::isinstance<py::dict>(source)) {
     // NumPy scalars and arrays (np.int64, np.float64, ndarray) where a scene has numbers: as the
@@ -162,6 +204,7 @@ void bindScene(py::module_& m) {
           c["chain"] = py::cast(cr.chain);
           c["q0"] = cr.q0;
           c["branches"] = branchArrays(s, cr);
+          if (cr.haveEquilibria) c["equilibria"] = equilibriaArrays(cr);
           cases.append(c);
         }
         result["cases"] = cases;
@@ -182,7 +225,9 @@ void bindScene(py::module_& m) {
       "Returns a dict: `complete`, `interrupted`, `interruption`, `problems`, `computed`; `cases` (per case: "
       "`label`, `segments`, `chain` (a Chain), `q0`, `branches`: the columns of branches.csv as arrays — branch, "
       "point, parameter, Fx, Fy, Me, x, y, phi, dx, dy, q (P×n), stable, negative, min_eig, and Kxx, Kyy, Kxy, Cxx, Cyy, Cxy, Kx_yfree, Ky_xfree, K1, K2, theta1 with "
-      "stiffness); `special_points` (the dicts of special_points.json); `results` (all of special_points.json: "
+      "stiffness; with the equilibria analysis `equilibria`: the rows of equilibria.csv as arrays — at, q (m×n), "
+      "potential, index, stable, shape, branch (the branch through each, -1: none or not traced) — and "
+      "`disconnected_branches` (id, parent, from_equilibrium: the seed's rank, joins)); `special_points` (the dicts of special_points.json); `results` (all of special_points.json: "
       "critical_loads, energy_equilibria, ... when asked); `summary` (summary.json). Raises SceneError (a "
       "ValueError) for a bad scene.");
 }

@@ -44,6 +44,10 @@ MeasuredCase fromScene(const scene::CaseResult& c) {
     for (const mechanics::FoundEquilibrium& e : c.equilibria.equilibria)
       m.specials.push_back({-1, "ALLEQ", e.potential,
                             e.shape + (e.stable ? " stable" : " unstable") + ", index " + std::to_string(e.index), 0.0, {}});
+  // equilibria "branches": the branch through each equilibrium (value: its id, -1 none), so a
+  // disconnected branch traced from another seed, or none, is a drift
+  for (size_t i = 0; i < c.equilibriaOnBranch.size(); ++i)
+    m.specials.push_back({-1, "EQBRANCH", double(c.equilibriaOnBranch[i]), "equilibrium " + std::to_string(i + 1), 0.0, {}});
   if (c.haveTorque)
     for (const auto& [q, stable] : c.torque.equilibria) m.specials.push_back({-1, "TEQ", q, stable ? "stable" : "unstable", 0.0, {}});
   if (c.haveSudden && c.sudden.success) {

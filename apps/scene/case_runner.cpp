@@ -285,29 +285,7 @@ void CaseRunner::suddenLoad() {
   }
 }
 
-void CaseRunner::continuation() {
-  double s0 = out_.startValue;
-  mech::EndCondition end = spec_.end.condition;
-  Eigen::Vector3d direction = spec_.path.direction;
-  double lambdaLo = std::min(spec_.path.from, spec_.path.to), lambdaHi = std::max(spec_.path.from, spec_.path.to);
-  std::vector<double> targets{spec_.path.to, spec_.path.from};
-  const int c = spec_.path.coordinate;
-  if (throughLoad()) {
-    // trace with the held coordinate's reaction as parameter (see PathSpec::loadLimit)
-    end.control[size_t(c)] = mech::Control::Load;
-    end.value[c] = 0.0;
-    direction = Eigen::Vector3d::Zero();
-    direction[c] = 1.0;
-    s0 = 0.0;
-    // both signs of the reaction: with an unstable start (κ < 0) the branch points lie on the
-    // tension side, and their branches still move the end into the requested range
-    targets = {-spec_.path.loadLimit, spec_.path.loadLimit};
-    lambdaLo = -spec_.path.loadLimit;
-    lambdaHi = spec_.path.loadLimit;
-  }
-  end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
-  mech::EquilibriumProblem problem(out_.chain, end, direction, {}, controlDirection());
-
+mech::EquilibriumBranchOptions CaseRunner::branchOptions(double lambdaLo, double lambdaHi) {
   mech::EquilibriumBranchOptions opt;
   opt.tracer = solverOptions();
   opt.tracer.lambdaMin = lambdaLo;
@@ -339,6 +317,33 @@ void CaseRunner::continuation() {
   opt.onBranch = [this](const cont::BranchTree& t, const cont::Branch&) {
     branchesSoFar_ = static_cast<int>(t.branches.size());
   };
+  return opt;
+}
+
+void CaseRunner::continuation() {
+  double s0 = out_.startValue;
+  mech::EndCondition end = spec_.end.condition;
+  Eigen::Vector3d direction = spec_.path.direction;
+  double lambdaLo = std::min(spec_.path.from, spec_.path.to), lambdaHi = std::max(spec_.path.from, spec_.path.to);
+  std::vector<double> targets{spec_.path.to, spec_.path.from};
+  const int c = spec_.path.coordinate;
+  if (throughLoad()) {
+    // trace with the held coordinate's reaction as parameter (see PathSpec::loadLimit)
+    end.control[size_t(c)] = mech::Control::Load;
+    end.value[c] = 0.0;
+    direction = Eigen::Vector3d::Zero();
+    direction[c] = 1.0;
+    s0 = 0.0;
+    // both signs of the reaction: with an unstable start (κ < 0) the branch points lie on the
+    // tension side, and their branches still move the end into the requested range
+    targets = {-spec_.path.loadLimit, spec_.path.loadLimit};
+    lambdaLo = -spec_.path.loadLimit;
+    lambdaHi = spec_.path.loadLimit;
+  }
+  end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
+  mech::EquilibriumProblem problem(out_.chain, end, direction, {}, controlDirection());
+
+  mech::EquilibriumBranchOptions opt = branchOptions(lambdaLo, lambdaHi);
 
   // The start branches (one per requested direction), then branch switching breadth first, by
   // the core's tree driver (its guards: never back at the BP a branch started from, never twice
@@ -358,7 +363,13 @@ void CaseRunner::continuation() {
   // traced points are released while the tree goes on; the records are put in branch order after.
   const size_t firstBranch = out_.branches.size(), firstPoint = out_.points.size(),
                firstSpecial = out_.specials.size();
+  // the curves a disconnected branch may join (disconnectedBranches), kept before their points go
+  const bool keepCurves = scene_.analyses.equilibria.branches && !throughLoad();
   opt.onReport = [&](const cont::Branch& b, mech::BranchReport&& report) {
+    if (keepCurves) {
+      if (traced_.size() <= size_t(b.id)) traced_.resize(size_t(b.id) + 1);
+      traced_[size_t(b.id)] = b;
+    }
     if (b.stopReason == cont::StopReason::StartFailed) return;  // said below, in words
     const std::string origin = b.parentId < 0 ? origins[size_t(b.id)]
                                               : "BP " + std::to_string(b.parentSpecialPoint) + " of branch " +
@@ -369,6 +380,7 @@ void CaseRunner::continuation() {
   const mech::EquilibriumBranches result = mech::traceEquilibria(problem, out_.qStart, s0, starts, opt);
   const auto& branches = result.tree.branches;
   if (!branches.empty() && branches.front().stopReason == cont::StopReason::StartFailed) {
+    traced_.clear();  // no tree: every equilibrium seeds (disconnectedBranches)
     run_.complete = false;
     std::ostringstream os;
     os << "case \"" << spec_.label << "\": no equilibrium found at the start " << spec_.path.parameter << " = " << s0
@@ -381,6 +393,7 @@ void CaseRunner::continuation() {
                    [](const BranchRecord& a, const BranchRecord& b) { return a.id < b.id; });
   std::stable_sort(out_.points.begin() + long(firstPoint), out_.points.end(), byBranch);
   std::stable_sort(out_.specials.begin() + long(firstSpecial), out_.specials.end(), byBranch);
+  if (keepCurves) traced_.resize(branches.size());
   if (result.tree.interrupted) interrupted();
 }
 

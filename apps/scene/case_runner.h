@@ -12,6 +12,7 @@
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/branch_report.h"
 #include "buckle/mechanics/dynamics.h"
+#include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/landing.h"
 #include "buckle/mechanics/vibration.h"
@@ -43,6 +44,9 @@ class CaseRunner {
   void torqueAngle();
   /// equilibria (case_runner_equilibria.cpp)
   void equilibria();
+  /// The branches through the equilibria that the continuation's tree does not reach
+  /// (equilibria with "branches": true; case_runner_equilibria.cpp), after continuation().
+  void disconnectedBranches();
 
   /// True once the time limit passed or a signal came: the run is then marked incomplete,
   /// once, with the reason.
@@ -65,6 +69,9 @@ class CaseRunner {
   Eigen::VectorXd naturalFrequencies(const Eigen::VectorXd& q, const mechanics::Wrench& F,
                                      const mechanics::ContactSet& locked, double parameter);
   bool throughLoad() const { return spec_.path.loadLimit > 0.0; }
+  /// The continuation's tree options over the parameter range [lambdaLo, lambdaHi] (the tracer's
+  /// stability, branch switching and contact settings of /analyses/continuation).
+  mechanics::EquilibriumBranchOptions branchOptions(double lambdaLo, double lambdaHi);
   /// The scene's /solver settings as tracer options (the λ range is set by each analysis).
   continuation::TracerOptions solverOptions() const {
     continuation::TracerOptions opt;
@@ -130,6 +137,7 @@ class CaseRunner {
   RunResult& run_;
   const RunControl& control_;
   int branchesSoFar_ = 0;  // for progress reports
+  std::vector<continuation::Branch> traced_;  // the continuation's tree (not through a reaction)
   /// The jumps simulated from (branch, special point): a mirror image's jump is their image.
   std::map<std::pair<int, int>, mechanics::Landing> landings_;
   /// `frequencies`: the case's chain with its rods (built at the first point)

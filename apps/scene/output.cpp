@@ -440,9 +440,14 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
     if (cr.qStart.size() == cr.q0.size() && cr.qStart != cr.q0) c["start_q"] = vectorJson(cr.qStart);
     if (!cr.startNote.empty()) c["start_note"] = cr.startNote;
     json branches = json::array();
-    for (const BranchRecord& b : cr.branches)
+    for (const BranchRecord& b : cr.branches) {
       branches.push_back(json{{"id", b.id}, {"parent", b.parent}, {"origin", b.origin}, {"points", b.points},
                               {"stop", b.stopReason}, {"stop_message", b.stopMessage}, {"finished", b.finished}});
+      if (b.fromEquilibrium > 0) {  // disconnected: its seed (rank in equilibria.csv) and the branch it joins
+        branches.back()["from_equilibrium"] = b.fromEquilibrium;
+        branches.back()["joins"] = b.joins >= 0 ? json(b.joins) : json(nullptr);
+      }
+    }
     if (scene.analyses.continuation.enabled || scene.analyses.loadHistory.enabled) c["branches"] = branches;
     if (cr.haveCritical) {
       json crit;

@@ -51,7 +51,12 @@ json equilibriaJson(const RunResult& run) {
     if (!cr.haveEquilibria) continue;
     const mechanics::AllEquilibria& a = cr.equilibria;
     json list = json::array();
-    for (const mechanics::FoundEquilibrium& e : a.equilibria) list.push_back(equilibriumJson(e, a.endCondition));
+    for (size_t i = 0; i < a.equilibria.size(); ++i) {
+      list.push_back(equilibriumJson(a.equilibria[i], a.endCondition));
+      // the id of a branch through it (branches traced: "branches": true), null when none
+      if (!cr.equilibriaOnBranch.empty())
+        list.back()["branch"] = cr.equilibriaOnBranch[i] >= 0 ? json(cr.equilibriaOnBranch[i]) : json(nullptr);
+    }
     int stable = 0;
     for (const mechanics::FoundEquilibrium& e : a.equilibria) stable += e.stable;
     json held = json::array();
@@ -88,11 +93,15 @@ json equilibriaJson(const RunResult& run) {
 
 std::string equilibriaCsv(const RunResult& run) {
   int maxN = 0;
-  for (const CaseResult& cr : run.cases)
+  bool branches = false;  // the branches through the equilibria were traced: their ids
+  for (const CaseResult& cr : run.cases) {
     if (cr.haveEquilibria) maxN = std::max(maxN, cr.chain.size());
+    branches = branches || !cr.equilibriaOnBranch.empty();
+  }
   std::ostringstream os;
   os.precision(15);
   os << "case,rank,potential,index,stable,shape,Fx,Fy,Me,x,y,phi,accuracy";
+  if (branches) os << ",branch";
   for (int i = 1; i <= maxN; ++i) os << ",q" << i;
   os << "\n";
   for (size_t c = 0; c < run.cases.size(); ++c) {
@@ -104,6 +113,11 @@ std::string equilibriaCsv(const RunResult& run) {
       for (int k = 0; k < 3; ++k) os << ',' << e.wrench[k];
       for (int k = 0; k < 3; ++k) os << ',' << e.pose[k];
       os << ',' << e.accuracy;
+      if (branches) {
+        const size_t i = size_t(rank - 1);
+        os << ',';  // empty: no branch through it (or not traced in this case)
+        if (i < cr.equilibriaOnBranch.size() && cr.equilibriaOnBranch[i] >= 0) os << cr.equilibriaOnBranch[i];
+      }
       for (int i = 0; i < maxN; ++i) {
         os << ',';
         if (i < e.q.size()) os << e.q[i];

@@ -62,6 +62,7 @@ PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string
       case PlotType::Shapes:
         shapesPlot(scene, run, spec, size_t(&spec - scene.plots.data()), dir, s, report.notes);
         break;
+      case PlotType::EquilibriumShapes: equilibriumShapesPlot(scene, run, spec, dir, s); break;
     }
     std::ofstream(dir / (spec.name + "_body.gp")) << s.body.str();
     std::ostringstream gp;

@@ -3,6 +3,8 @@
 // long chains and large trees.
 #include "scene/plot_internal.h"
 
+#include <set>
+
 namespace buckle::scene::plot_detail {
 
 namespace {
@@ -186,6 +188,9 @@ std::string withAlpha(const std::string& rgb, int alpha) {
   return "#" + std::string(buf) + rgb.substr(1);
 }
 
+/// The colour of the branches traced from equilibria the continuation's tree does not reach.
+const std::string kDisconnectedColor = "#c51b7d";
+
 void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
   BlockFile data;
   struct Series {
@@ -193,6 +198,7 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
     size_t ordinal, yIdx;  ///< position of the case in the plot's list, column
     bool stable;
     bool any = false;      ///< has a drawable point
+    bool disconnected = false;  ///< the branches traced from equilibria the tree does not reach
   };
   const std::vector<size_t> cases = selected(spec);
   const bool multiCase = cases.size() > 1;
@@ -209,9 +215,17 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   };
   for (size_t o = 0; o < cases.size(); ++o) {
     const CaseResult& cr = run.cases[cases[o]];
+    // disconnected branches (equilibria "branches") are series of their own, in their own colour
+    std::set<int> disconnected;
+    for (const BranchRecord& b : cr.branches)
+      if (b.fromEquilibrium > 0) disconnected.insert(b.id);
+    const std::vector<bool> kinds = disconnected.empty() ? std::vector<bool>{false} : std::vector<bool>{false, true};
     for (size_t j = 0; j < ny; ++j) {
+      for (const bool disc : kinds)
       for (bool stable : {true, false}) {
         Series se{data.begin(), o, j, stable};
+        se.disconnected = disc;
+        auto wanted = [&](const PointRecord& p) { return p.stable == stable && (disconnected.count(p.branch) > 0) == disc; };
         // polylines of consecutive points with the wanted stability; a run keeps the first point
         // of the next run so that stable and unstable parts join
         polylines.emplace_back();
@@ -225,14 +239,14 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
           const PointRecord& p = cr.points[i];
           const bool sameBranchNext = i + 1 < cr.points.size() && cr.points[i + 1].branch == p.branch;
           const double x = columnValue(spec.x, p, cr.pose0), y = columnValue(spec.y[j], p, cr.pose0);
-          if (p.stable == stable && std::isfinite(x) && std::isfinite(y)) {
+          if (wanted(p) && std::isfinite(x) && std::isfinite(y)) {
             add(x, y);
             if (sameBranchNext && cr.points[i + 1].stable != stable) {
               const PointRecord& q = cr.points[i + 1];
               add(columnValue(spec.x, q, cr.pose0), columnValue(spec.y[j], q, cr.pose0));
             }
           }
-          if (p.stable != stable || !sameBranchNext || !std::isfinite(x) || !std::isfinite(y)) {
+          if (!wanted(p) || !sameBranchNext || !std::isfinite(x) || !std::isfinite(y)) {
             data.breakLine();
             polylines.emplace_back();
           }
@@ -489,23 +503,28 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   // one key entry per case (and column): its stable curve; stability itself is explained by
   // the two entries that follow
   const bool perSeriesKey = multiCase || ny > 1;
-  bool anyStable = false, anyUnstable = false;
+  bool anyStable = false, anyUnstable = false, anyDisconnected = false;
   for (const Series& se : series) {
     (se.stable ? anyStable : anyUnstable) = (se.stable ? anyStable : anyUnstable) || se.any;
+    anyDisconnected = anyDisconnected || (se.disconnected && se.any);
     std::string title;
-    if (perSeriesKey && se.stable) {
+    if (perSeriesKey && se.stable && !se.disconnected) {
       if (multiCase) title = run.cases[cases[se.ordinal]].label;
       if (ny > 1) title += (title.empty() ? "" : " ") + spec.y[se.yIdx];
     }
     clause(quote(stem + ".dat") + " index " + std::to_string(se.block) + " using 1:2 with lines lw " +
            num(look.width) + " lc rgb " +
-           quote(withAlpha(seriesColor(se.ordinal, se.yIdx), se.stable ? look.alphaStable : look.alphaUnstable)) +
+           quote(withAlpha(se.disconnected ? kDisconnectedColor : seriesColor(se.ordinal, se.yIdx),
+                           se.stable ? look.alphaStable : look.alphaUnstable)) +
            " dt " + (se.stable ? "1" : "2") +
            (title.empty() ? std::string(" notitle") : " title " + quote(title) + " noenhanced"));
   }
   const std::string keyColor = perSeriesKey ? std::string("black") : seriesColor(0, 0);
   if (anyStable || !anyUnstable) clause("keyentry with lines lw 2 dt 1 lc rgb " + quote(keyColor) + " title 'stable'");
   if (anyUnstable) clause("keyentry with lines lw 2 dt 2 lc rgb " + quote(keyColor) + " title 'unstable'");
+  if (anyDisconnected)
+    clause("keyentry with lines lw 2 dt 1 lc rgb " + quote(kDisconnectedColor) +
+           " title 'disconnected branch'");
   if (anyJump)
     clause(quote(stem + "_jumps.dat") +
            " using 1:2:3:4 with vectors head filled size screen 0.015,20 lw 1.5 lc rgb '#ff7f0e' title 'jump'");

@@ -289,6 +289,9 @@ void branchPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
 void torquePlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s);
 void energyPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s);
 void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s);
+/// `equilibrium_shapes` (plot_shapes.cpp): every equilibrium of the `equilibria` analysis, one
+/// panel each in ascending potential, stable ones marked.
+void equilibriumShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s);
 void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, size_t plotIndex, const fs::path& dir,
                 Script& s, std::vector<std::string>& notes);
 

@@ -1,5 +1,6 @@
 // The chain's shapes at chosen path values (triangles, springs, joints, limits and contacts, one
-// panel per case and value), and the sudden load's snapshots drawn the same way.
+// panel per case and value), the sudden load's snapshots and every equilibrium of the
+// `equilibria` analysis drawn the same way.
 #include "scene/plot_internal.h"
 
 namespace buckle::scene::plot_detail {
@@ -130,6 +131,22 @@ void chainPanel(std::ostream& os, const std::string& base, double L, const std::
   os << "unset object 1\n";
 }
 
+/// The files chainPanel draws (BASE_{tri,spr,lim,jnt,near,touch}.dat) of the chain at q; each
+/// starts with a NaN point so that gnuplot reads an empty panel (q null) without complaint.
+void writeChainFiles(const mechanics::Chain& chain, const Eigen::VectorXd* q, const fs::path& dir,
+                     const std::string& base, bool detailed) {
+  BlockFile tri, spr, lim, jnt, near, touch;
+  for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near, &touch}) {
+    f->begin();
+    f->point({std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()});
+    f->breakLine();
+  }
+  if (q) drawChain(chain, *q, tri, spr, lim, jnt, near, &touch, detailed);
+  for (const auto& [file, suffix] : {std::pair<BlockFile*, const char*>{&tri, "_tri"}, {&spr, "_spr"}, {&lim, "_lim"},
+                                     {&jnt, "_jnt"}, {&near, "_near"}, {&touch, "_touch"}})
+    file->write(dir / (base + suffix + ".dat"));
+}
+
 /// "contact: joint 3U 5L" for a panel title; a long chain's many locked joints are counted.
 std::string lockedTitle(const std::string& locked) {
   const size_t joints = size_t(std::count(locked.begin(), locked.end(), ' ')) + 1;
@@ -240,15 +257,10 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
     const std::string& parameter = scene.cases[c].path.parameter;
     for (size_t k = 0; k < na; ++k) {
       const PointRecord* p = chosenOf[o][k];
-      BlockFile tri, spr, lim, jnt, near, touch;
-      for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near, &touch}) {
-        f->begin();
-        f->point({std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()});
-        f->breakLine();
-      }
+      const std::string base = stem + "_" + std::to_string(c) + "_" + std::to_string(k);
+      writeChainFiles(cr.chain, p ? &p->q : nullptr, dir, base, detailed);
       std::ostringstream title;
       if (p) {
-        drawChain(cr.chain, p->q, tri, spr, lim, jnt, near, &touch, detailed);
         // five significant digits, in the scene's unit
         const std::string unit = scene.units.unit(columnDimension(parameter));
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << short5(p->parameter)
@@ -266,13 +278,6 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(spec.at[k]) << ": not drawn";
         s.body << "set label 1 " << quote(missingOf[o][k]) << " at graph 0.5, graph 0.5 center font ',9' noenhanced\n";
       }
-      const std::string base = stem + "_" + std::to_string(c) + "_" + std::to_string(k);
-      tri.write(dir / (base + "_tri.dat"));
-      spr.write(dir / (base + "_spr.dat"));
-      lim.write(dir / (base + "_lim.dat"));
-      jnt.write(dir / (base + "_jnt.dat"));
-      near.write(dir / (base + "_near.dat"));
-      touch.write(dir / (base + "_touch.dat"));
       const double L = cr.chain.length();
       s.body << "set title " << quote(title.str()) << " font ',10'\n";
       s.body << "set xrange [" << num(std::min(x0, -0.1 * L)) << ":" << num(x1) << "]\nset yrange [" << num(y0) << ":"
@@ -393,6 +398,77 @@ void drawSuddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   s.body << "unset multiplot\n";
 }
 
+// ---- every equilibrium at one state -------------------------------------------------------------
+
+// One panel per equilibrium of the `equilibria` analysis (ascending potential, as equilibria.csv
+// ranks them), all to one scale; a stable one on a green ground, its title saying so.
+void drawEquilibriumShapes(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir,
+                           Script& s) {
+  std::vector<size_t> cases;
+  size_t most = 1;
+  for (size_t c : selected(spec))
+    if (run.cases[c].haveEquilibria) {
+      cases.push_back(c);
+      most = std::max(most, run.cases[c].equilibria.equilibria.size());
+    }
+  const size_t cols = std::min<size_t>(most, 5), rowsPerCase = (most + cols - 1) / cols;
+  const size_t rows = std::max<size_t>(1, cases.size() * rowsPerCase);
+  s.width = std::min<int>(3200, int(440 * cols));
+  s.height = std::min<int>(4800, int(300 * rows) + 60);
+  Eigen::AlignedBox2d box;
+  box.extend(Eigen::Vector2d(0.0, 0.0));
+  double bMean = 0.0;
+  for (size_t c : cases) {
+    const CaseResult& cr = run.cases[c];
+    box.extend(Eigen::Vector2d(cr.chain.length(), 0.0));
+    bMean = std::max(bMean, cr.chain.length() / (2.0 * cr.chain.size()));
+    for (const mechanics::FoundEquilibrium& e : cr.equilibria.equilibria) {
+      const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, e.q);
+      for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
+    }
+  }
+  const Eigen::Vector2d panel(double(s.width) / double(cols), double(s.height - 60) / double(rows));
+  bool detailed = true;
+  for (size_t c : cases) detailed = detailed && detailedChain(run.cases[c].chain, box, panel);
+  const double pad = std::max(1.2 * bMean, 0.03 * box.sizes().maxCoeff());
+  const double x0 = box.min().x() - pad, x1 = box.max().x() + pad, y0 = box.min().y() - pad, y1 = box.max().y() + pad;
+  s.body << "set encoding utf8\nset size ratio -1\nunset key\nset grid lc rgb '#eeeeee'\n";
+  s.body << "set multiplot layout " << rows << "," << cols << " title "
+         << quote(!spec.title.empty() ? spec.title
+                                      : "Every equilibrium found, ascending total potential, to scale" +
+                                            scene.units.suffix(Dimension::Length) +
+                                            "; green ground: stable, white: unstable (index: negative eigenvalues)")
+         << " font ',11'\n";
+  if (cases.empty()) s.body << "set label 1 'no equilibria computed' at graph 0.5, graph 0.5 center\nplot NaN\n";
+  for (size_t c : cases) {
+    const CaseResult& cr = run.cases[c];
+    const std::string& parameter = scene.cases[c].path.parameter;
+    const std::string unit = scene.units.unit(columnDimension(parameter));
+    const std::vector<mechanics::FoundEquilibrium>& list = cr.equilibria.equilibria;
+    for (size_t k = 0; k < list.size(); ++k) {
+      const mechanics::FoundEquilibrium& e = list[k];
+      const std::string base = spec.name + "_" + std::to_string(c) + "_" + std::to_string(k);
+      writeChainFiles(cr.chain, &e.q, dir, base, detailed);
+      std::ostringstream title;
+      title << (cases.size() > 1 ? cr.label + ", " : std::string()) << "#" << k + 1 << " " << e.shape << ": "
+            << (e.stable ? "STABLE" : "unstable, index " + std::to_string(e.index)) << "\nΠ = " << short5(e.potential)
+            << scene.units.suffix(Dimension::Moment) << ", " << parameter << " = " << short5(cr.equilibriaAt)
+            << (unit.empty() ? "" : " " + unit);
+      if (k < cr.equilibriaOnBranch.size() && cr.equilibriaOnBranch[k] >= 0)
+        title << ", branch " << cr.equilibriaOnBranch[k];
+      const double L = cr.chain.length();
+      s.body << "set title " << quote(title.str()) << " font ',9' noenhanced\n";
+      s.body << "set xrange [" << num(std::min(x0, -0.1 * L)) << ":" << num(x1) << "]\nset yrange [" << num(y0) << ":"
+             << num(y1) << "]\n";
+      if (e.stable) s.body << "set object 2 rect from graph 0,0 to graph 1,1 behind fc rgb '#e5f5e0' fs solid 1.0 noborder\n";
+      chainPanel(s.body, base, L, std::string(), true, detailed);
+      if (e.stable) s.body << "unset object 2\n";
+    }
+    for (size_t k = list.size(); k < cols * rowsPerCase; ++k) s.body << "set multiplot next\n";
+  }
+  s.body << "unset multiplot\n";
+}
+
 }  // namespace
 
 void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, size_t plotIndex, const fs::path& dir,
@@ -402,6 +478,10 @@ void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
 
 void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
   drawSuddenPlot(scene, run, spec, dir, s);
+}
+
+void equilibriumShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s) {
+  drawEquilibriumShapes(scene, run, spec, dir, s);
 }
 
 }  // namespace buckle::scene::plot_detail

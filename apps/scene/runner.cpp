@@ -63,6 +63,8 @@ RunResult runScene(const Scene& scene, const RunControl& given) {
   if (a.energyCurves.enabled) run.computed.push_back("energy curves E(q1) with the end held (eq 6-8)");
   if (a.torqueAngle.enabled) run.computed.push_back("torque-angle curves M(q) of the first segment (eq 1)");
   if (a.equilibria.enabled) run.computed.push_back("every equilibrium at one state of the controls (deflated Newton)");
+  if (a.equilibria.enabled && a.equilibria.branches)
+    run.computed.push_back("the branches through the equilibria the continuation does not reach");
 
   std::vector<std::pair<std::string, std::function<void(CaseRunner&)>>> stages;
   if (a.torqueAngle.enabled) stages.emplace_back("torque_angle", [](CaseRunner& r) { r.torqueAngle(); });
@@ -71,6 +73,8 @@ RunResult runScene(const Scene& scene, const RunControl& given) {
   if (a.energyCurves.enabled) stages.emplace_back("energy_curves", [](CaseRunner& r) { r.energyCurves(); });
   if (a.equilibria.enabled) stages.emplace_back("equilibria", [](CaseRunner& r) { r.equilibria(); });
   if (a.continuation.enabled) stages.emplace_back("continuation", [](CaseRunner& r) { r.continuation(); });
+  if (a.equilibria.enabled && a.equilibria.branches)
+    stages.emplace_back("disconnected_branches", [](CaseRunner& r) { r.disconnectedBranches(); });
   if (a.loadHistory.enabled) stages.emplace_back("load_history", [](CaseRunner& r) { r.loadHistory(); });
   if (a.suddenLoad.enabled) stages.emplace_back("sudden_load", [](CaseRunner& r) { r.suddenLoad(); });
   std::vector<double> stageSeconds(stages.size(), 0.0);

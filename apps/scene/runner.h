@@ -97,6 +97,10 @@ struct BranchRecord {
   std::string stopMessage;
   int points = 0;
   bool finished = true;    ///< ended on a regular stop (range, boundary); false: could not go on
+  /// Traced from an equilibrium the continuation's tree does not reach (equilibria "branches"):
+  /// the rank (1-based, in equilibria.csv) of the equilibrium its tree grew from; 0: not so.
+  int fromEquilibrium = 0;
+  int joins = -1;          ///< the branch it ended on (stop "joined a traced branch"), else -1
 };
 
 using TorqueCurve = mechanics::TorqueCurve;
@@ -147,6 +151,9 @@ struct CaseResult {
   bool haveEquilibria = false;     ///< equilibria: every equilibrium at one state of the controls
   mechanics::AllEquilibria equilibria;
   double equilibriaAt = 0.0;       ///< ... at this path-parameter value
+  /// equilibria with "branches": onBranch[i] the id of a branch through equilibrium i (-1: none);
+  /// empty when the branches were not traced.
+  std::vector<int> equilibriaOnBranch;
   explicit CaseResult(const mechanics::Chain& c) : chain(c) {}
 };
 

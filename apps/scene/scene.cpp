@@ -32,6 +32,7 @@ const char* toString(PlotType t) {
     case PlotType::Shapes: return "shapes";
     case PlotType::SuddenLoad: return "sudden_load";
     case PlotType::CriticalCurves: return "critical_curves";
+    case PlotType::EquilibriumShapes: return "equilibrium_shapes";
   }
   return "?";
 }

@@ -149,6 +149,9 @@ struct EquilibriaSpec {
   bool haveAt = false;
   double at = 0.0;             ///< path-parameter value (haveAt)
   int sweepPoints = 4001;      ///< q1 grid of the n = 3 sweep (end held, Me = 0)
+  /// Trace the branches through the equilibria the continuation's tree does not reach
+  /// (mechanics/disconnected_branches.h); needs /analyses/continuation.
+  bool branches = false;
 };
 
 struct AnalysesSpec {
@@ -178,7 +181,7 @@ struct SolverSpec {
   double timeLimit = 120.0;    ///< seconds for the whole scene; past it the run stops (exit 1)
 };
 
-enum class PlotType { Bifurcation, Stiffness, EnergyCurves, TorqueAngle, Shapes, SuddenLoad, CriticalCurves };
+enum class PlotType { Bifurcation, Stiffness, EnergyCurves, TorqueAngle, Shapes, SuddenLoad, CriticalCurves, EquilibriumShapes };
 const char* toString(PlotType t);
 
 /// Which special points a bifurcation or stiffness plot labels (docs/scenes.md, `plots`): all of

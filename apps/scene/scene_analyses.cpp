@@ -221,11 +221,13 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
                                                  {"torque_angle", PlotType::TorqueAngle},
                                                  {"shapes", PlotType::Shapes},
                                                  {"sudden_load", PlotType::SuddenLoad},
-                                                 {"critical_curves", PlotType::CriticalCurves}};
+                                                 {"critical_curves", PlotType::CriticalCurves},
+                                                 {"equilibrium_shapes", PlotType::EquilibriumShapes}};
   auto it = types.find(type);
   if (it == types.end())
     r.expected(pt, obj["type"],
-               "one of bifurcation, stiffness, energy_curves, torque_angle, shapes, sudden_load, critical_curves");
+               "one of bifurcation, stiffness, energy_curves, torque_angle, shapes, sudden_load, critical_curves, "
+               "equilibrium_shapes");
   s.type = it->second;
   auto needs = [&](bool have, const char* analysis) {
     if (!have) r.fail(pt, std::string("a ") + type + " plot needs /analyses/" + analysis);
@@ -238,6 +240,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
     case PlotType::TorqueAngle: needs(a.torqueAngle.enabled, "torque_angle"); break;
     case PlotType::SuddenLoad: needs(a.suddenLoad.enabled, "sudden_load"); break;
     case PlotType::CriticalCurves: needs(a.twoParameter.enabled, "two_parameter"); break;
+    case PlotType::EquilibriumShapes: needs(a.equilibria.enabled, "equilibria"); break;
   }
   s.name = type;
   if (obj.contains("name")) {
@@ -348,6 +351,7 @@ std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a, int nCases) {
   if (a.torqueAngle.enabled) out.push_back({PlotType::TorqueAngle, "torque_angle", "", {}, {}, "", all});
   if (a.suddenLoad.enabled) out.push_back({PlotType::SuddenLoad, "sudden_load", "", {}, {}, "", all});
   if (a.twoParameter.enabled) out.push_back({PlotType::CriticalCurves, "critical_curves", "", {}, {}, "", all});
+  if (a.equilibria.enabled) out.push_back({PlotType::EquilibriumShapes, "equilibrium_shapes", "", {}, {}, "", all});
   return out;
 }
 

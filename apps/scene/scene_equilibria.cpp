@@ -14,13 +14,16 @@ EquilibriaSpec parseEquilibria(const JsonReader& r, const json& v, const Pointer
     return s;
   }
   if (!v.is_object())
-    r.expected(p, v, "true, false or an object {\"starts\", \"smooth_starts\", \"seed\", \"at\", \"sweep_points\"}");
-  r.onlyKeys(v, p, {"starts", "smooth_starts", "seed", "at", "sweep_points"});
+    r.expected(p, v,
+               "true, false or an object {\"starts\", \"smooth_starts\", \"seed\", \"at\", \"sweep_points\", "
+               "\"branches\"}");
+  r.onlyKeys(v, p, {"starts", "smooth_starts", "seed", "at", "sweep_points", "branches"});
   s.enabled = true;
   if (v.contains("starts")) s.starts = r.integer(v["starts"], p / "starts", 0, 1000000);
   if (v.contains("smooth_starts")) s.smoothStarts = r.integer(v["smooth_starts"], p / "smooth_starts", 0, 1000000);
   if (v.contains("seed")) s.seed = unsigned(r.integer(v["seed"], p / "seed", 0, 2147483647));
   if (v.contains("sweep_points")) s.sweepPoints = r.integer(v["sweep_points"], p / "sweep_points", 3, 10000000);
+  if (v.contains("branches")) s.branches = r.boolean(v["branches"], p / "branches");
   if (v.contains("at")) {
     s.haveAt = true;
     s.at = r.number(v["at"], p / "at");
@@ -30,6 +33,15 @@ EquilibriaSpec parseEquilibria(const JsonReader& r, const json& v, const Pointer
 
 void checkEquilibriaAgainstCases(const JsonReader& r, const Scene& scene) {
   const EquilibriaSpec& e = scene.analyses.equilibria;
+  if (e.enabled && e.branches && !scene.analyses.continuation.enabled)
+    r.fail(Pointer("/analyses/equilibria/branches"),
+           "the branches through the equilibria are traced as the continuation's: it needs /analyses/continuation");
+  if (e.enabled && e.branches)
+    for (const CaseSpec& c : scene.cases)
+      if (c.path.loadLimit > 0.0)
+        r.fail(Pointer("/analyses/equilibria/branches"),
+               "expected a path in a load or a held coordinate traced directly (case \"" + c.label +
+                   "\" is traced through the reaction, load_limit)");
   if (!e.enabled || !e.haveAt) return;
   for (const CaseSpec& c : scene.cases) {
     const double lo = std::min(c.path.from, c.path.to), hi = std::max(c.path.from, c.path.to);

@@ -150,6 +150,26 @@ TEST_CASE("buckle show prints the equilibria of the energy curves", "[cli][show]
   }
 }
 
+TEST_CASE("buckle show prints the branch through each equilibrium when the branches were traced", "[cli][show]") {
+  fs::path out;
+  const std::string shown = runAndShow("disconnected_branch", out);
+  INFO(shown);
+  const json eq = json::parse(slurp(out / "special_points.json"))["equilibria"][0]["equilibria"];
+  REQUIRE(eq.size() == 3);
+  const std::vector<std::string> text = lines(shown);
+  const auto header = std::find_if(text.begin(), text.end(), [](const std::string& l) {
+    const std::vector<std::string> w = words(l);
+    return !w.empty() && w[0] == "case" && w.back() == "branch";
+  });
+  REQUIRE(header != text.end());
+  // rows in the order of the list: the last word is the equilibrium's branch
+  for (size_t k = 0; k < eq.size(); ++k) {
+    const std::vector<std::string> w = words(*(header + 1 + long(k)));
+    REQUIRE(w.size() >= 7);
+    CHECK(w.back() == std::to_string(eq[k]["branch"].get<int>()));
+  }
+}
+
 TEST_CASE("buckle show on something that is not a run's output exits 2", "[cli][show]") {
   const fs::path dir = work() / "not_output";
   fs::remove_all(dir);

@@ -128,6 +128,8 @@ json rewrite(json scene, const Units& u) {
       if (a["energy_curves"].contains(key)) a["energy_curves"][key] = a["energy_curves"][key].get<double>() * u.length;
   if (a.contains("load_history"))
     for (json& w : a["load_history"]["waypoints"]) w = w.get<double>() * u.of(parameter);
+  if (a.contains("equilibria") && a["equilibria"].is_object() && a["equilibria"].contains("at"))
+    a["equilibria"]["at"] = a["equilibria"]["at"].get<double>() * u.of(parameter);
   if (a.contains("two_parameter")) {
     const double unit = secondParameterUnit(original, u);
     for (const char* key : {"from", "to"}) a["two_parameter"][key] = a["two_parameter"][key].get<double>() * unit;
@@ -372,7 +374,7 @@ TEST_CASE("the rewrite scales what it should", "[scene][units]") {
   const json scene = json::parse(R"({"chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
     "end": {"x": {"load": 0.5}, "y": {"held": 0.25}, "phi": {"load": 0.1}},
     "path": {"parameter": "Fx", "from": 0.0, "to": -2.5, "direction": {"Me": 0.2, "y": 0.5}},
-    "analyses": {"continuation": true}, "solver": {"initial_step": 0.02}})");
+    "analyses": {"continuation": true, "equilibria": {"at": -1.0}}, "solver": {"initial_step": 0.02}})");
   const Units u{"test", 10.0, 3.0};
   const json s = rewrite(scene, u);
   CHECK(s["chain"]["b"] == Approx(10.0));
@@ -385,6 +387,7 @@ TEST_CASE("the rewrite scales what it should", "[scene][units]") {
   CHECK(s["path"]["direction"]["Me"] == Approx(0.2 * 300.0 / 30.0));  // torque per force
   CHECK(s["path"]["direction"]["y"] == Approx(0.5 * 10.0 / 30.0));    // length per force
   CHECK(s["solver"]["initial_step"] == Approx(0.02));                  // dimensionless: as shipped
+  CHECK(s["analyses"]["equilibria"]["at"] == Approx(-30.0));           // a value of the path's Fx
 }
 
 // ---- unit labels (scene/units.h) ----------------------------------------------------------------

@@ -117,6 +117,49 @@ TEST_CASE("Tracer: the step callback sees every point and can stop the branch", 
   for (size_t i = 0; i < seen.size(); ++i) CHECK(seen[i] == b.points[i + 1].lambda);
 }
 
+TEST_CASE("Tracer: the step callback's Join ends the branch as a regular end, and the tree goes on", "[interrupt]") {
+  // The circle traced once round from (1, 0): the callback joins where the branch is back at its
+  // start (within its last step), as deflated continuation closes an isola.
+  toys::Circle problem;
+  TracerOptions options;
+  options.maxStep = 0.05;
+  options.maxPoints = 10000;
+  bool below = false;  // the branch has been at λ < 0 (past half way round)
+  options.onStep = [&](const Branch &branch) {
+    const ContinuationPoint &p = branch.points.back();
+    below = below || p.lambda < 0.0;
+    return below && p.lambda >= 0.0 && p.u[0] > 0.0 ? StepAction::Join : StepAction::Continue;
+  };
+  const Branch b = trace(problem, Vector::Constant(1, 1.0), 0.0, InitialDirection::increasingLambda(), options);
+  REQUIRE(b.stopReason == StopReason::Joined);
+  CHECK_THAT(b.stopMessage, Contains("joined"));
+  requireOnCircle(b);
+  // once round: the last point is past the start by at most a step, the one before short of it
+  const ContinuationPoint &last = b.points.back(), &before = b.points[b.points.size() - 2];
+  CHECK(last.lambda >= 0.0);
+  CHECK(before.lambda < 0.0);
+  CHECK(last.arclength > 2.0 * M_PI * 0.9);
+  CHECK(last.arclength < 2.0 * M_PI + 0.06);
+
+  // In a tree, a joined branch does not stop the others (an interrupted one would).
+  TracerOptions joinAtFive = options, stopAtFive = options;
+  joinAtFive.onStep = [](const Branch &branch) {
+    return branch.points.size() >= 5 ? StepAction::Join : StepAction::Continue;
+  };
+  stopAtFive.onStep = [](const Branch &branch) {
+    return branch.points.size() >= 5 ? StepAction::Stop : StepAction::Continue;
+  };
+  const std::vector<InitialDirection> both{InitialDirection::increasingLambda(), InitialDirection::decreasingLambda()};
+  const BranchTree joined = traceTree(problem, Vector::Constant(1, 1.0), 0.0, both, joinAtFive, TreeOptions());
+  CHECK_FALSE(joined.interrupted);
+  REQUIRE(joined.branches.size() == 2);
+  for (const Branch &j : joined.branches) CHECK(j.stopReason == StopReason::Joined);
+  CHECK(joined.branches[1].points.back().lambda < 0.0);
+  const BranchTree stopped = traceTree(problem, Vector::Constant(1, 1.0), 0.0, both, stopAtFive, TreeOptions());
+  CHECK(stopped.interrupted);
+  CHECK(stopped.branches.size() == 1);
+}
+
 TEST_CASE("Tracer: without an interrupt the same branch runs to its regular end", "[interrupt]") {
   // The control for the cases above: the circle traced from (1, 0) up to λ = 0.5.
   toys::Circle problem;

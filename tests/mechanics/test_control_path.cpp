@@ -21,6 +21,7 @@
 #include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/stiffness_extremum.h"
 #include "buckle/mechanics/unloaded_shape.h"
+#include "fixed_lambda_newton.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -58,16 +59,8 @@ Eigen::VectorXd loaded(const Chain& chain, const Eigen::Vector3d& load) {
 }
 
 // Newton at fixed λ on F_u (dense): the equilibrium polished to rounding.
-Eigen::VectorXd polish(EquilibriumProblem& p, Eigen::VectorXd u, double lambda) {
-  const int N = p.dimension();
-  Eigen::VectorXd F(N), Fl(N);
-  Eigen::MatrixXd Fu(N, N);
-  for (int it = 0; it < 8; ++it) {
-    REQUIRE(p.residual(u, lambda, F));
-    REQUIRE(p.jacobian(u, lambda, Fu, Fl));
-    u -= Fu.partialPivLu().solve(F);
-  }
-  return u;
+Eigen::VectorXd polish(EquilibriumProblem& p, const Eigen::VectorXd& u, double lambda) {
+  return buckle::test::polishAtFixedLambda(p, u, lambda);
 }
 
 }  // namespace

@@ -30,12 +30,18 @@ def close(a, b, rel=1e-9):
     return abs(a - b) <= rel * max(1.0, abs(a), abs(b))
 
 
-@pytest.mark.parametrize("name", SCENES)
-def test_module_results_equal_the_command_line(name, source_dir, run_cli, tmp_path):
+def run_shipped_scene(name, source_dir, run_cli, tmp_path):
+    """`buckle run` of data/scenes/NAME into tmp_path/out: the scene's path and the output directory."""
     scene = source_dir / "data" / "scenes" / name
     out = tmp_path / "out"
     cli = run_cli("run", scene, "--out", out, "--quiet")
     assert cli.returncode == 0, cli.stderr
+    return scene, out
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_module_results_equal_the_command_line(name, source_dir, run_cli, tmp_path):
+    scene, out = run_shipped_scene(name, source_dir, run_cli, tmp_path)
     expected = json.loads((out / "special_points.json").read_text())
     summary = json.loads((out / "summary.json").read_text())
 
@@ -87,6 +93,44 @@ def test_module_results_equal_the_command_line(name, source_dir, run_cli, tmp_pa
             for k in omega:
                 csv_omega = np.array([float(row[k]) if row[k] not in ("", "nan") else np.nan for row in mine])
                 np.testing.assert_allclose(b[k], csv_omega, rtol=1e-11, atol=1e-11 * np.nanmax(np.abs(csv_omega)))
+
+
+EQUILIBRIA_SCENES = [name for name in SCENES if "equilibria" in json.loads(
+    (pathlib.Path(__file__).resolve().parents[2] / "data" / "scenes" / name).read_text()).get("analyses", {})]
+
+
+@pytest.mark.parametrize("name", EQUILIBRIA_SCENES)
+def test_module_equilibria_equal_equilibria_csv(name, source_dir, run_cli, tmp_path):
+    scene, out = run_shipped_scene(name, source_dir, run_cli, tmp_path)
+    with open(out / "equilibria.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    summary = json.loads((out / "summary.json").read_text())
+    r = buckle.run_scene(str(scene))
+    assert len(rows) > 0
+    for c, case in enumerate(r["cases"]):
+        e = case["equilibria"]
+        mine = [row for row in rows if int(row["case"]) == c]
+        assert len(mine) == len(e["potential"]) == e["q"].shape[0]
+        assert [int(row["rank"]) for row in mine] == list(range(1, len(mine) + 1))
+        # equilibria.csv has 15 significant digits
+        np.testing.assert_allclose(e["potential"], [float(row["potential"]) for row in mine], rtol=1e-13)
+        for i in range(case["segments"]):
+            np.testing.assert_allclose(e["q"][:, i], [float(row[f"q{i + 1}"]) for row in mine], rtol=1e-13,
+                                       atol=1e-14)
+        np.testing.assert_array_equal(e["index"], [int(row["index"]) for row in mine])
+        np.testing.assert_array_equal(e["stable"], [row["stable"] == "1" for row in mine])
+        assert e["shape"] == [row["shape"] for row in mine]
+        # with "branches": the branch through each, and the disconnected branches as in summary.json
+        if "branch" in rows[0]:
+            np.testing.assert_array_equal(e["branch"], [int(row["branch"]) if row["branch"] else -1 for row in mine])
+        else:
+            assert (e["branch"] == -1).all()
+        seeds = {b["id"]: b["from_equilibrium"] for b in summary["cases"][c].get("branches", [])
+                 if "from_equilibrium" in b}
+        assert {b["id"]: b["from_equilibrium"] for b in e["disconnected_branches"]} == seeds
+        for b in e["disconnected_branches"]:
+            assert b["from_equilibrium"] in range(1, len(mine) + 1)
+            assert b["id"] in set(np.unique(case["branches"]["branch"]).tolist())
 
 
 def test_a_dict_runs_like_its_file(source_dir):

@@ -32,6 +32,7 @@ const char *toString(StopReason reason) {
     case StopReason::StepSizeTooSmall: return "step size below minimum";
     case StopReason::SwitchFailed: return "branch switching failed";
     case StopReason::Interrupted: return "interrupted";
+    case StopReason::Joined: return "joined a traced branch";
   }
   return "unknown";
 }

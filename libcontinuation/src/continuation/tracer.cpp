@@ -478,9 +478,16 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       branch.specialPoints.push_back(std::move(sp));
     }
     if (!found.empty()) mergeCoincidentSpecialPoints(branch, firstNew);
-    if (options_.onStep && !landedOnStart && notifyStep(branch) == StepAction::Stop) {
-      interrupted("stopped by the step callback");
-      return;
+    if (options_.onStep && !landedOnStart) {
+      const StepAction action = notifyStep(branch);
+      if (action == StepAction::Stop) {
+        interrupted("stopped by the step callback");
+        return;
+      }
+      if (action == StepAction::Join) {
+        stop(StopReason::Joined, "joined a branch already traced", SpecialPointType::Endpoint, "joined");
+        return;
+      }
     }
 
     if (hitEvent >= 0) {

@@ -57,7 +57,8 @@ class DeflatedNewton {
  public:
   DeflatedNewton(EquilibriumProblem& problem, const AllEquilibriaOptions& options)
       : problem_(problem), options_(options), n_(problem.segments()), N_(problem.dimension()),
-        scale_(problem.scales().residuals), F_(N_), trial_(N_), Fu_(N_, N_), Fl_(N_), gradLog_(n_) {}
+        scale_(problem.scales().residuals), unknownScale_(problem.scales().unknowns), F_(N_), trial_(N_), Fu_(N_, N_),
+        Fl_(N_), gradLog_(n_) {}
 
   const std::vector<Vector>& roots() const { return roots_; }
   void deflate(const Vector& q) { roots_.push_back(q); }
@@ -65,6 +66,14 @@ class DeflatedNewton {
     for (const Vector& r : roots_)
       if ((q - r).lpNorm<Eigen::Infinity>() <= options_.duplicateTolerance) return true;
     return false;
+  }
+
+  /// The Newton step −F_u⁻¹ F, solved in the problem's scaled variables (rows over their
+  /// residual scales, unknowns over theirs): torque rows ~ k b², held rows ~ b and reactions ~ k b
+  /// make F_u itself too badly scaled for a plain QR in extreme units.
+  Vector newtonStep() {
+    const Matrix scaled = scale_.cwiseInverse().asDiagonal() * Fu_ * unknownScale_.asDiagonal();
+    return -unknownScale_.cwiseProduct(scaled.colPivHouseholderQr().solve(F_.cwiseQuotient(scale_)));
   }
 
   /// ‖F(u)‖∞ with each row in the chain's unit; +∞ outside the domain.
@@ -98,7 +107,7 @@ class DeflatedNewton {
       if (!std::isfinite(norm)) return false;
       if (norm <= kHandOver) return true;
       if (!problem_.jacobian(u, 0.0, Fu_, Fl_)) return false;
-      Vector du = -Fu_.colPivHouseholderQr().solve(F_);
+      Vector du = newtonStep();
       const double m = deflation(u.head(n_));
       const double tau = 1.0 / (1.0 - gradLog_.dot(du.head(n_)));
       du *= tau;
@@ -125,7 +134,7 @@ class DeflatedNewton {
     double best = residualNorm(u, F_);
     for (int it = 0; it < kPolishIterations && std::isfinite(best) && best > 0.0; ++it) {
       if (!problem_.jacobian(u, 0.0, Fu_, Fl_)) break;
-      const Vector next = u - Fu_.colPivHouseholderQr().solve(F_);
+      const Vector next = u + newtonStep();
       const double nt = residualNorm(next, trial_);
       if (!(nt < best)) break;
       u = next;
@@ -139,7 +148,7 @@ class DeflatedNewton {
   EquilibriumProblem& problem_;
   const AllEquilibriaOptions& options_;
   int n_, N_;
-  Vector scale_, F_, trial_;
+  Vector scale_, unknownScale_, F_, trial_;
   Matrix Fu_;
   Vector Fl_, gradLog_;
   std::vector<Vector> roots_;

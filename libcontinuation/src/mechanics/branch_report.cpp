@@ -87,7 +87,7 @@ constexpr double kStraightTolerance = 1e-6;
 
 bool regularStop(cont::StopReason r) {
   return r == cont::StopReason::LambdaRange || r == cont::StopReason::Boundary || r == cont::StopReason::Box ||
-         r == cont::StopReason::MaxArclength;
+         r == cont::StopReason::MaxArclength || r == cont::StopReason::Joined;
 }
 
 /// The chain under the path's own end condition, for a branch traced through the reaction of

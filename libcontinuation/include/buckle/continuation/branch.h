@@ -101,6 +101,7 @@ enum class StopReason {
   StepSizeTooSmall,    ///< corrector failures, branch-jump rejections or singular tangents below minStep
   SwitchFailed,        ///< branch switching did not reach a point off the parent branch
   Interrupted,         ///< the Interrupt (time limit, signal) or the step callback asked to stop
+  Joined,              ///< the step callback found the branch on one already traced (StepAction::Join)
 };
 
 const char *toString(StopReason reason);

@@ -35,10 +35,12 @@
 namespace buckle::continuation {
 
 /// What a step callback tells the tracer (as Ceres' CallbackReturnType).
-enum class StepAction { Continue, Stop };
+/// Join: the branch has reached a curve already traced (deflated continuation's de-duplication):
+/// it ends there as a regular end, StopReason::Joined, not as an interruption.
+enum class StepAction { Continue, Stop, Join };
 /// Called after every accepted point, with the branch so far (its last point is the new one):
 /// progress reports, custom stop rules (BifurcationKit's finalise_solution). Stop ends the
-/// branch with StopReason::Interrupted. The new point and the special points are in the
+/// branch with StopReason::Interrupted, Join with StopReason::Joined. The new point and the special points are in the
 /// problem's units; the earlier points may still be in the tracer's scaled variables (they are
 /// converted when trace()/continueBranch() return), so read the last point only.
 using StepCallback = std::function<StepAction(const Branch &branch)>;
