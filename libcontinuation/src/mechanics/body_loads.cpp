@@ -1,5 +1,6 @@
 #include "buckle/mechanics/body_loads.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -64,6 +65,14 @@ void BodyLoads::check(const Chain& chain) const {
       requireFinite("point load rate", p.rate[c]);
     }
   }
+}
+
+void addBodyLoadHessian(const Vector& gamma, MatrixRef H) {
+  if (gamma.size() == 0) return;
+  if (gamma.size() != H.rows() || H.rows() != H.cols())
+    throw std::invalid_argument("body loads: the generator must have one entry per joint");
+  for (Eigen::Index j = 0; j < H.cols(); ++j)
+    for (Eigen::Index i = 0; i < H.rows(); ++i) H(i, j) += gamma[std::max(i, j)];
 }
 
 BodyLoadTerms::BodyLoadTerms(const Chain& chain, const BodyLoads& loads) {

@@ -19,14 +19,27 @@ void EquilibriumProblem::bodyGeneratorDerivative(const ConstVectorRef& dq, doubl
   bodyTerms_.generatorDerivative(lambda, dq, dlambda, bodyWork_);  // eq (B5)
 }
 
-bool EquilibriumProblem::bodyLoadGenerator(ConstVectorRef q, double lambda, VectorRef gamma) {
-  const int n = chain_.size();
-  if (q.size() < n || gamma.size() != n || !std::isfinite(lambda) || !prepare(q.head(n), lambda)) return false;
-  if (bodyTerms_.active())
-    bodyTerms_.generator(lambda, gamma);
-  else
-    gamma.setZero();
-  return true;
+Vector EquilibriumProblem::bodyLoadGenerator(ConstVectorRef q, double lambda) const {
+  if (!bodyTerms_.active()) return Vector();
+  BodyLoadTerms terms = bodyTerms_;
+  ChainData data(chain_);
+  forwardKinematics(chain_, q.head(chain_.size()), data);
+  terms.update(data);
+  Vector gamma(chain_.size());
+  terms.generator(lambda, gamma);
+  return gamma;
+}
+
+Vector EquilibriumProblem::bodyLoadGeneratorRate(ConstVectorRef q, double lambda, ConstVectorRef dq,
+                                                 double dlambda) const {
+  if (!bodyTerms_.active()) return Vector();
+  BodyLoadTerms terms = bodyTerms_;
+  ChainData data(chain_);
+  forwardKinematics(chain_, q.head(chain_.size()), data);
+  terms.update(data);
+  Vector dgamma(chain_.size());
+  terms.generatorDerivative(lambda, dq.head(chain_.size()), dlambda, dgamma);
+  return dgamma;
 }
 
 double EquilibriumProblem::bodyLoadPotential(ConstVectorRef q, double lambda) const {

@@ -58,6 +58,10 @@ struct BodyLoads {
   void check(const Chain& chain) const;
 };
 
+/// H += Γ with Γ(i, j) = γ_max(i,j) (eq B3): the body loads' share of a dense Hessian. An empty γ
+/// adds nothing; otherwise throws std::invalid_argument unless γ has one entry per row of H.
+void addBodyLoadHessian(const Vector& gamma, MatrixRef H);
+
 /// The terms (B2)–(B5) at one configuration: a workspace sized once for a chain, filled by
 /// update() from forwardKinematics' data (no heap allocation after construction).
 class BodyLoadTerms {

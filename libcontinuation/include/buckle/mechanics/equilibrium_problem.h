@@ -65,10 +65,12 @@ class EquilibriumProblem final : public continuation::Problem {
   /// The body loads (weight, point loads) and whether any of them is not zero.
   const BodyLoads& bodyLoads() const { return body_; }
   bool hasBodyLoads() const { return bodyTerms_.active(); }
-  /// γ(λ) of the body loads at the joint angles q (eq B3; zero without them): the Hessian of the
-  /// total potential is K_q − K_g with the generator h − γ (stiffness, vibration). False outside
-  /// the domain.
-  bool bodyLoadGenerator(continuation::ConstVectorRef q, double lambda, VectorRef gamma);
+  /// γ(λ) of the body loads at the joint angles q (eq B3; empty without them): the Hessian of the
+  /// total potential is K_q − K_g with the generator h − γ (StiffnessOptions, vibration.h). O(n).
+  Vector bodyLoadGenerator(continuation::ConstVectorRef q, double lambda) const;
+  /// dγ along (dq, dλ) at (q, λ) (eq B5; empty without body loads). O(n).
+  Vector bodyLoadGeneratorRate(continuation::ConstVectorRef q, double lambda, continuation::ConstVectorRef dq,
+                               double dlambda) const;
   /// V(q, λ) of the body loads (eq B1; 0 without them).
   double bodyLoadPotential(continuation::ConstVectorRef q, double lambda) const;
 
