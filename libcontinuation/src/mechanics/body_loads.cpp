@@ -67,6 +67,22 @@ void BodyLoads::check(const Chain& chain) const {
   }
 }
 
+InertiaData withPayload(const Chain& chain, InertiaData inertia, double mass) {
+  std::string why;
+  if (!inertia.IsValid(chain, &why)) throw std::invalid_argument(why);
+  requireNonNegative("payload mass", mass);
+  if (mass == 0.0) return inertia;
+  const int n = chain.size();
+  const double l = chain.linkLengths()[n];
+  LinkInertia& L = inertia.links[size_t(n - 1)];
+  const double d = std::isnan(L.comOffset) ? 0.5 * l : L.comOffset;
+  const double m = L.mass + mass, c = (L.mass * d + mass * l) / m;
+  L.inertia += L.mass * (d - c) * (d - c) + mass * (l - c) * (l - c);
+  L.mass = m;
+  L.comOffset = c;
+  return inertia;
+}
+
 void addBodyLoadHessian(const Vector& gamma, MatrixRef H) {
   if (gamma.size() == 0) return;
   if (gamma.size() != H.rows() || H.rows() != H.cols())

@@ -58,6 +58,11 @@ struct BodyLoads {
   void check(const Chain& chain) const;
 };
 
+/// `inertia` with a point mass `mass` ≥ 0 at the chain's end added to the end link: its mass,
+/// centre of mass and centroidal inertia (parallel axes). Throws std::invalid_argument when the
+/// inertia does not fit the chain or the mass is negative.
+InertiaData withPayload(const Chain& chain, InertiaData inertia, double mass);
+
 /// H += Γ with Γ(i, j) = γ_max(i,j) (eq B3): the body loads' share of a dense Hessian. An empty γ
 /// adds nothing; otherwise throws std::invalid_argument unless γ has one entry per row of H.
 void addBodyLoadHessian(const Vector& gamma, MatrixRef H);

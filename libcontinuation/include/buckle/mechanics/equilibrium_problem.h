@@ -71,6 +71,9 @@ class EquilibriumProblem final : public continuation::Problem {
   /// dγ along (dq, dλ) at (q, λ) (eq B5; empty without body loads). O(n).
   Vector bodyLoadGeneratorRate(continuation::ConstVectorRef q, double lambda, continuation::ConstVectorRef dq,
                                double dlambda) const;
+  /// τ' at the q of the last evaluation (eq B2: F_λ gains −τ'), for the structured solvers that
+  /// form F_λ themselves; meaningful only with hasBodyLoads().
+  const Vector& bodyRateTorques() const { return bodyTerms_.rateTorques(); }
   /// V(q, λ) of the body loads (eq B1; 0 without them).
   double bodyLoadPotential(continuation::ConstVectorRef q, double lambda) const;
 
