@@ -14,13 +14,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <limits>
 
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "common.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -72,20 +71,13 @@ Row run(int n, double b, double k, int reps) {
 int main(int argc, char** argv) {
   int reps = 3;
   bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--quick")) quick = true;
-  }
+  buckle::bench::parseRepsQuick(argc, argv, reps, quick);
   std::printf("%-16s %6s %8s %12s %12s %12s %12s %18s\n", "units", "n", "points", "g at end", "tip y/L", "time (ms)",
               "us/point", "end load us/point");
-  const struct {
-    const char* name;
-    double b, k;
-  } units[] = {{"nondimensional", 1.0, 1.0}, {"SI (b=0.02 m)", 0.02, 2000.0}};
-  for (const auto& u : units)
+  for (const buckle::bench::BenchUnits& u : buckle::bench::kBenchUnits)
     for (int n : {3, 50, 1000}) {
       if (quick && n > 50) continue;
-      const Row r = run(n, u.b, u.k, quick ? 1 : reps);
+      const Row r = run(n, u.b, u.k, reps);
       std::printf("%-16s %6d %8zu %12.6g %12.6g %12.3f %12.1f %18.1f\n", u.name, n, r.points, r.gEnd, r.tipEnd,
                   1e3 * r.seconds, 1e6 * r.seconds / double(r.points), 1e6 * r.endLoadSeconds / double(r.endLoadPoints));
     }

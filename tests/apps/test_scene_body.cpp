@@ -18,7 +18,8 @@
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/gravity.h"
 #include "buckle/mechanics/vibration.h"
-#include "rfc4180.h"
+#include "../mechanics/heavy_newton.h"
+#include "branches_table.h"
 #include "scene_run.h"
 
 namespace fs = std::filesystem;
@@ -26,23 +27,8 @@ using namespace buckle::mechanics;
 
 namespace {
 
-using Table = std::vector<std::map<std::string, double>>;
-
-Table readBranches(const fs::path& out) {
-  std::ifstream in(out / "branches.csv");
-  REQUIRE(in.good());
-  std::stringstream text;
-  text << in.rdbuf();
-  const auto rows = buckle::test::readCsv(text.str());
-  REQUIRE(rows.size() >= 2);
-  Table t;
-  for (size_t r = 1; r < rows.size(); ++r) {
-    std::map<std::string, double> row;
-    for (size_t c = 0; c < rows[0].size(); ++c) row[rows[0][c]] = rows[r][c].empty() ? std::nan("") : std::stod(rows[r][c]);
-    t.push_back(row);
-  }
-  return t;
-}
+using Table = buckle::test::BranchesTable;
+using buckle::test::readBranches;
 
 // Four segments (a, b, k, L0) = (0.5, 1, 1, 2.25), free end; `extra` goes into the top level.
 std::string scene(const std::string& extra, const std::string& path, const std::string& analyses) {
@@ -64,20 +50,10 @@ void requireBadInput(const std::string& name, const std::string& text, const std
   CHECK(!fs::exists(o.out));
 }
 
+// Newton on E + V (GravityPotential) with g raised in 30 equal steps
 Vector independentSag(const Chain& chain, const InertiaData& inertia, const Eigen::Vector2d& g) {
-  const int n = chain.size();
-  Vector q = Vector::Zero(n), grad(n), gv(n);
-  Matrix H(n, n), G(n, n);
-  for (int step = 1; step <= 30; ++step) {
-    GravityPotential V(chain, inertia, g * (step / 30.0));
-    for (int it = 0; it < 30; ++it) {
-      energyGradient(chain, q, grad);
-      V.gradient(q, gv);
-      totalPotentialHessian(chain, q, Wrench::Zero(), H);
-      V.hessian(q, G);
-      q -= (H + G).ldlt().solve(grad + gv);
-    }
-  }
+  Vector q = Vector::Zero(chain.size());
+  for (int step = 1; step <= 30; ++step) q = testing::heavyNewton(chain, inertia, g * (step / 30.0), q, 30);
   return q;
 }
 

@@ -18,6 +18,7 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/gravity.h"
 #include "buckle/mechanics/jump.h"
+#include "heavy_newton.h"
 #include "random_segments.h"
 
 using namespace buckle::mechanics;
@@ -43,37 +44,6 @@ BodyLoads randomBodyLoads(std::mt19937& rng, const Chain& chain) {
   b.gravityRate = {W(rng), W(rng)};
   for (int j = 1; j <= n + 1; j += 2) b.points.push_back({j, {W(rng), W(rng)}, {W(rng), W(rng)}});
   return b;
-}
-
-Vector randomState(std::mt19937& rng, const Chain& chain, int N) {
-  std::uniform_real_distribution<double> W(-1.5, 1.5);
-  const int n = chain.size();
-  Vector u(N);
-  for (int i = 0; i < n; ++i) {
-    std::uniform_real_distribution<double> Q(0.7 * chain.lowerLimits()[i], 0.7 * chain.upperLimits()[i]);
-    u[i] = Q(rng);
-  }
-  for (int i = n; i < N; ++i) u[i] = W(rng);
-  return u;
-}
-
-// The heavy cantilever's equilibrium by Newton on E + V with GravityPotential (absolute
-// positions; gravity.h) and the dense Hessians, from q.
-Vector independentEquilibrium(const Chain& chain, const InertiaData& inertia, const Eigen::Vector2d& g, Vector q) {
-  const int n = chain.size();
-  GravityPotential V(chain, inertia, g);
-  Vector grad(n), gv(n);
-  Matrix H(n, n), G(n, n);
-  for (int it = 0; it < 60; ++it) {
-    energyGradient(chain, q, grad);
-    V.gradient(q, gv);
-    totalPotentialHessian(chain, q, Wrench::Zero(), H);
-    V.hessian(q, G);
-    const Vector step = (H + G).ldlt().solve(grad + gv);
-    q -= step;
-    if (step.lpNorm<Eigen::Infinity>() <= 1e-15) break;
-  }
-  return q;
 }
 
 // The straight heavy column (gravity along −x, payload P at the end along −x): the dense Hessian
@@ -150,7 +120,7 @@ TEST_CASE("body loads in EquilibriumProblem: residual, Jacobian, F_lambda, secon
                                  randomBodyLoads(rng, chain));
       REQUIRE(problem.hasBodyLoads());
       const int N = problem.dimension();
-      const Vector u = randomState(rng, chain, N);
+      const Vector u = testing::randomState(rng, chain, N);
       const double lambda = Lam(rng), h = 1e-6;
       Matrix Fu(N, N), dFu(N, N), Jp(N, N), Jm(N, N);
       Vector Fl(N), dFl(N), F(N), Fp(N), Fm(N), Jlp(N), Jlm(N);
@@ -257,7 +227,7 @@ TEST_CASE("a heavy cantilever sags as an independent Newton solve, in the paper'
     REQUIRE(last.lambda == Approx(g).epsilon(1e-12));
     // independent: Newton on E + V (GravityPotential) with g raised in 40 equal steps
     Vector q = Vector::Zero(n);
-    for (int step = 1; step <= 40; ++step) q = independentEquilibrium(chain, inertia, (last.lambda * step / 40.0) * down, q);
+    for (int step = 1; step <= 40; ++step) q = testing::heavyNewton(chain, inertia, (last.lambda * step / 40.0) * down, q);
     INFO("L = " << L);
     CHECK((last.u.head(n) - q).lpNorm<Eigen::Infinity>() <= 1e-10 * q.lpNorm<Eigen::Infinity>());
     CHECK(endPose(chain, q)[1] < -0.05 * chain.length());  // a real sag, not a small one
@@ -295,7 +265,7 @@ TEST_CASE("continuation in the gravity magnitude passes through the fixed-gravit
     CHECK(b.points.size() == pointsAtUnitScale);
     for (size_t p = 0; p < b.points.size(); p += 3) {
       const double lambda = b.points[p].lambda;
-      const Vector q = independentEquilibrium(chain, inertia, lambda * down, b.points[p].u.head(n));
+      const Vector q = testing::heavyNewton(chain, inertia, lambda * down, b.points[p].u.head(n));
       CHECK((b.points[p].u.head(n) - q).lpNorm<Eigen::Infinity>() <= 1e-9 * std::max(1e-3, q.lpNorm<Eigen::Infinity>()));
     }
   }

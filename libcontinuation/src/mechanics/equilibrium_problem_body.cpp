@@ -19,26 +19,29 @@ void EquilibriumProblem::bodyGeneratorDerivative(const ConstVectorRef& dq, doubl
   bodyTerms_.generatorDerivative(lambda, dq, dlambda, bodyWork_);  // eq (B5)
 }
 
+namespace {
+// The body-load terms at q, on their own kinematics (the problem's cache is left alone).
+BodyLoadTerms termsAt(const Chain& chain, const BodyLoadTerms& terms, ConstVectorRef q) {
+  BodyLoadTerms at = terms;
+  ChainData data(chain);
+  forwardKinematics(chain, q.head(chain.size()), data);
+  at.update(data);
+  return at;
+}
+}  // namespace
+
 Vector EquilibriumProblem::bodyLoadGenerator(ConstVectorRef q, double lambda) const {
   if (!bodyTerms_.active()) return Vector();
-  BodyLoadTerms terms = bodyTerms_;
-  ChainData data(chain_);
-  forwardKinematics(chain_, q.head(chain_.size()), data);
-  terms.update(data);
   Vector gamma(chain_.size());
-  terms.generator(lambda, gamma);
+  termsAt(chain_, bodyTerms_, q).generator(lambda, gamma);
   return gamma;
 }
 
 Vector EquilibriumProblem::bodyLoadGeneratorRate(ConstVectorRef q, double lambda, ConstVectorRef dq,
                                                  double dlambda) const {
   if (!bodyTerms_.active()) return Vector();
-  BodyLoadTerms terms = bodyTerms_;
-  ChainData data(chain_);
-  forwardKinematics(chain_, q.head(chain_.size()), data);
-  terms.update(data);
   Vector dgamma(chain_.size());
-  terms.generatorDerivative(lambda, dq.head(chain_.size()), dlambda, dgamma);
+  termsAt(chain_, bodyTerms_, q).generatorDerivative(lambda, dq.head(chain_.size()), dlambda, dgamma);
   return dgamma;
 }
 
