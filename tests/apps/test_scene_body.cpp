@@ -88,10 +88,9 @@ TEST_CASE("scene gravity path: a heavy cantilever's angles and frequencies equal
   }
 }
 
-TEST_CASE("scene point loads: a force at the last joint growing along an Fx path bends the chain as the library "
-          "predicts (end of the path against a gravity-free polish)", "[scene][body_loads]") {
-  // Fy = 0.02 + 0.1·Fx at joint 4 along Fx from 0 to −0.3; the same chain's equilibrium at the end
-  // of the path, by Newton on E − F·p − f·p_4 with the dense Hessian in the test
+TEST_CASE("scene point loads: a force at the last joint growing along an Fx path: the traced end point balances the "
+          "joint torques of the end load and that force, summed here from the joint positions", "[scene][body_loads]") {
+  // Fy = 0.02 + 0.1·Fx at joint 4 along Fx from 0 to −0.3
   const std::string text = scene(R"("point_loads": [{"joint": 4, "Fy": 0.02, "rate": {"Fy": 0.1}}])",
                                  R"({"parameter": "Fx", "from": 0.0, "to": -0.3})", R"({"continuation": true})");
   const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "point_load", text);

@@ -163,6 +163,33 @@ TEST_CASE("body loads: a force at the end is the end wrench (torques J^T F, gene
   CHECK(std::abs(t.V + f.dot(data.pose.head<2>())) <= 1e-14 * scale);
 }
 
+TEST_CASE("body loads: a payload added to the end link (withPayload) weighs as the rods plus a point load m_p g at the "
+          "end", "[body_loads]") {
+  std::mt19937 rng(5);
+  const int n = 5;
+  const Chain chain = scaledChain(rng, n, 1.0, 1.0);
+  const InertiaData rods = InertiaData::uniformRods(chain, 0.8);
+  const double mp = 0.3;
+  const Eigen::Vector2d g(0.4, -2.0);
+  const InertiaData withEnd = withPayload(chain, rods, mp);
+  // the end link: total mass, centre of mass and the parallel-axis inertia about that centre
+  const double l = chain.linkLengths()[n], m = rods.links.back().mass;
+  const LinkInertia& L = withEnd.links.back();
+  CHECK(L.mass == Approx(m + mp).epsilon(1e-15));
+  CHECK(L.comOffset == Approx((m * 0.5 * l + mp * l) / (m + mp)).epsilon(1e-15));
+  CHECK(L.inertia == Approx(m * l * l / 12 + m * std::pow(0.5 * l - L.comOffset, 2) + mp * std::pow(l - L.comOffset, 2))
+                         .epsilon(1e-14));
+  BodyLoads split = BodyLoads::weight(chain, rods, g, Eigen::Vector2d::Zero());
+  split.points.push_back({n + 1, mp * g, Eigen::Vector2d::Zero()});
+  BodyLoadTerms a(chain, split), b(chain, BodyLoads::weight(chain, withEnd, g, Eigen::Vector2d::Zero()));
+  const Vector q = randomAngles(rng, chain);
+  const Terms ta = termsAt(chain, a, q, 0.0), tb = termsAt(chain, b, q, 0.0);
+  const double scale = (m * n + mp) * g.norm() * chain.length();
+  CHECK((ta.tau - tb.tau).cwiseAbs().maxCoeff() <= 1e-14 * scale);
+  CHECK((ta.gamma - tb.gamma).cwiseAbs().maxCoeff() <= 1e-14 * scale);
+  CHECK_THROWS_WITH(withPayload(chain, rods, -1.0), Catch::Contains("payload mass"));
+}
+
 TEST_CASE("body loads: bad input is refused naming the value", "[body_loads]") {
   const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   BodyLoads loads;
