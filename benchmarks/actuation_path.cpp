@@ -23,6 +23,7 @@
 
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "common.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -78,20 +79,13 @@ Row run(int n, double b, double k, int reps) {
 int main(int argc, char** argv) {
   int reps = 3;
   bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--quick")) quick = true;
-  }
+  buckle::bench::parseRepsQuick(argc, argv, reps, quick);
   std::printf("%-16s %6s %8s %6s %14s %12s %12s %16s\n", "units", "n", "points", "folds", "dL0 at end (b)", "time (ms)",
               "us/point", "load path (ms)");
-  const struct {
-    const char* name;
-    double b, k;
-  } units[] = {{"nondimensional", 1.0, 1.0}, {"SI (b=0.02 m)", 0.02, 2000.0}};
-  for (const auto& u : units)
+  for (const buckle::bench::BenchUnits& u : buckle::bench::kBenchUnits)
     for (int n : {3, 50, 1000}) {
       if (quick && n > 50) continue;
-      const Row r = run(n, u.b, u.k, quick ? 1 : reps);
+      const Row r = run(n, u.b, u.k, reps);
       if (!r.started) {
         std::printf("%-16s %6d   the payload could not be applied to the straight chain\n", u.name, n);
         continue;

@@ -3,6 +3,9 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <string>
+#include <cstdlib>
+#include <algorithm>
 
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/end_condition.h"
@@ -34,6 +37,23 @@ inline Eigen::VectorXd bentState(int n, int held) {
   for (int i = 0; i < n; ++i) u[i] = 0.3 * std::sin(6.283185307179586 * (i + 0.5) / n) + 0.05;
   for (int k = 0; k < held; ++k) u[n + k] = 0.1;
   return u;
+}
+
+/// The unit systems a benchmark repeats its rows in: nondimensional (b = k = 1) and SI
+/// (b = 0.02 m, k = 2000 N/m: the same problem in metres and newtons).
+struct BenchUnits {
+  const char* name;
+  double b, k;
+};
+inline constexpr BenchUnits kBenchUnits[] = {{"nondimensional", 1.0, 1.0}, {"SI (b=0.02 m)", 0.02, 2000.0}};
+
+/// The options `--reps R` (≥ 1) and `--quick` (n ≤ 50, one repetition) of the path benchmarks.
+inline void parseRepsQuick(int argc, char** argv, int& reps, bool& quick) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
+    else if (std::string(argv[i]) == "--quick") quick = true;
+  }
+  if (quick) reps = 1;
 }
 
 }  // namespace buckle::bench

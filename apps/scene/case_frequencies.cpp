@@ -23,11 +23,14 @@ Eigen::VectorXd CaseRunner::naturalFrequencies(const Eigen::VectorXd& q, const m
     if (!vibration_ || control.active())
       vibration_ = std::make_unique<mech::VibrationAnalysis>(
           control.active() ? mech::chainWithControls(out_.chain, control, parameter) : out_.chain,
-          mech::InertiaData::uniformRods(out_.chain, spec.massPerLength));
+          caseInertia(spec.massPerLength));
     std::vector<int> locked;
     for (const mech::LockedJoint& j : contacts.joints()) locked.push_back(j.joint);
+    // with weight or point loads the Hessian's generator h − γ (body_loads.h, eq B3)
+    if (!bodyProblem_ && spec_.body.any()) bodyProblem_ = std::make_unique<mech::EquilibriumProblem>(pathProblem());
+    const Eigen::VectorXd gamma = bodyProblem_ ? bodyProblem_->bodyLoadGenerator(q, parameter) : Eigen::VectorXd();
     const mech::VibrationModes m =
-        vibration_->modes(q, F, spec_.end.condition.heldIndices(), locked, spec.count, false);
+        vibration_->modes(q, F, spec_.end.condition.heldIndices(), locked, spec.count, false, gamma);
     for (int i = 0; i < m.omegaSquared.size(); ++i) omega[i] = mech::signedFrequency(m.omegaSquared[i]);
   } catch (const std::exception& e) {
     if (!vibrationFailed_) {

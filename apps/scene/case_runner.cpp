@@ -341,7 +341,7 @@ void CaseRunner::continuation() {
     lambdaHi = spec_.path.loadLimit;
   }
   end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
-  mech::EquilibriumProblem problem(out_.chain, end, direction, {}, controlDirection());
+  mech::EquilibriumProblem problem(out_.chain, end, direction, {}, controlDirection(), bodyLoads());
 
   mech::EquilibriumBranchOptions opt = branchOptions(lambdaLo, lambdaHi);
 

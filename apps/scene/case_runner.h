@@ -111,8 +111,13 @@ class CaseRunner {
   mechanics::EquilibriumProblem pathProblem() const {
     mechanics::EndCondition end = spec_.end.condition;
     end.value -= out_.startValue * spec_.path.direction;
-    return mechanics::EquilibriumProblem(out_.chain, end, spec_.path.direction, {}, controlDirection());
+    return mechanics::EquilibriumProblem(out_.chain, end, spec_.path.direction, {}, controlDirection(), bodyLoads());
   }
+  /// The case's weight and point loads along the path (case_body.cpp): g(λ) = λ·direction on a
+  /// gravity path, else fixed; point loads force + (λ − s0)·rate; the payload's weight at the end.
+  mechanics::BodyLoads bodyLoads() const;
+  /// The links' masses of the case (uniform rods of `massPerLength`, the payload on the end link).
+  mechanics::InertiaData caseInertia(double massPerLength) const;
   /// Along a control path the free lengths' direction (origin: the start value); else none.
   mechanics::ControlDirection controlDirection() const {
     return spec_.path.control ? spec_.path.controlDirection : mechanics::ControlDirection();
@@ -142,6 +147,8 @@ class CaseRunner {
   std::map<std::pair<int, int>, mechanics::Landing> landings_;
   /// `frequencies`: the case's chain with its rods (built at the first point)
   std::unique_ptr<mechanics::VibrationAnalysis> vibration_;
+  /// `frequencies` with body loads: the path's problem, for their γ at each point
+  std::unique_ptr<mechanics::EquilibriumProblem> bodyProblem_;
   bool vibrationFailed_ = false;  // a point's frequencies failed: reported once per case
 };
 

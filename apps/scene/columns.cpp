@@ -35,6 +35,8 @@ const Entry kColumns[] = {
       {"L2_0", "L_2^0", "L2⁰", Dimension::Length},
       {"L0", "L^0 = (L_1^0 + L_2^0)/2", "L⁰ = (L1⁰ + L2⁰)/2", Dimension::Length},
       {"dL0", "{/Symbol D}L^0 = L_1^0 - L_2^0", "ΔL⁰ = L1⁰ − L2⁰", Dimension::Length},
+      // the gravity magnitude (the path parameter of a gravity path, /gravity)
+      {"gravity", "g", "g", Dimension::Acceleration},
       {"min_eig", "smallest eigenvalue of the stability operator", "smallest eigenvalue of the stability operator",
        Dimension::Moment},
       {"Kxx", "K_{xx}", "Kxx", Dimension::Stiffness},

@@ -82,7 +82,8 @@ void requireUnitChain(const Reader& r, const Scene& scene) {
 Scene parseScene(const std::string& text, const std::string& file) {
   const Reader r(file);
   const json doc = parseJsonDocument(text, file);
-  r.onlyKeys(doc, Pointer(""), {"description", "units", "chain", "end", "path", "cases", "analyses", "solver", "plots"});
+  r.onlyKeys(doc, Pointer(""), {"description", "units", "chain", "end", "path", "gravity", "point_loads", "cases",
+                                "analyses", "solver", "plots"});
   Scene scene;
   scene.file = file;
   if (doc.contains("description")) scene.description = r.string(doc["description"], Pointer("/description"));
@@ -95,7 +96,7 @@ Scene parseScene(const std::string& text, const std::string& file) {
 
   // chain, end and path: what a case patches (copied key by key, not with the cases)
   json base = json::object();
-  for (const char* key : {"chain", "end", "path"})
+  for (const char* key : {"chain", "end", "path", "gravity", "point_loads"})
     if (doc.contains(key)) base[key] = doc[key];
   int totalSegments = 0;
   if (doc.contains("cases")) {
@@ -103,7 +104,7 @@ Scene parseScene(const std::string& text, const std::string& file) {
     if (!cases.is_array() || cases.empty()) r.expected(Pointer("/cases"), cases, "a non-empty array of case objects");
     for (size_t i = 0; i < cases.size(); ++i) {
       const Pointer pi = Pointer("/cases") / i;
-      r.onlyKeys(cases[i], pi, {"label", "chain", "end", "path"});
+      r.onlyKeys(cases[i], pi, {"label", "chain", "end", "path", "gravity", "point_loads"});
       std::string label = "case " + std::to_string(i + 1);
       if (cases[i].contains("label")) label = r.string(cases[i]["label"], pi / "label");
       json patch = cases[i];
@@ -126,6 +127,7 @@ Scene parseScene(const std::string& text, const std::string& file) {
   }
 
   checkAnalysesAgainstCases(r, scene);
+  checkBodyAnalyses(r, scene);
   if (doc.contains("units")) {
     scene.units = parseUnits(r, doc["units"], Pointer("/units"));
     if (scene.units.kind == UnitSystem::Kind::Nondimensional) requireUnitChain(r, scene);
@@ -135,6 +137,10 @@ Scene parseScene(const std::string& text, const std::string& file) {
       r.fail(Pointer("/units/mass"),
              "missing: the natural frequencies need the mass unit of /analyses/frequencies/mass_per_length (mass per "
              "length); e.g. \"kg\" with length \"m\" and force \"N\" gives frequencies in rad/s");
+    for (const CaseSpec& c : scene.cases)
+      if (scene.units.kind == UnitSystem::Kind::Named && scene.units.mass.empty() && c.body.haveGravity)
+        r.fail(Pointer("/units/mass"), "missing: /gravity's masses need a mass unit (e.g. \"kg\" with length \"m\" "
+                                       "and force \"N\": then g is in m/s^2)");
   }
   if (doc.contains("solver")) scene.solver = parseSolver(r, doc["solver"], Pointer("/solver"));
   if (doc.contains("plots")) {

@@ -27,6 +27,26 @@ using SceneError = JsonInputError;
 /// segment objects: every case is a chain to build, trace and write.
 constexpr int kMaxSegments = 100000;
 
+/// A force at a joint (/point_loads): at the path's start value and its rate along the path.
+struct PointLoadSpec {
+  int joint = 1;                                    ///< 1 … n
+  Eigen::Vector2d force = Eigen::Vector2d::Zero();  ///< (Fx, Fy) at the start value
+  Eigen::Vector2d rate = Eigen::Vector2d::Zero();   ///< d(Fx, Fy)/d(path parameter)
+};
+
+/// The loads on the chain's body (/gravity, /point_loads; mechanics/body_loads.h): the links'
+/// weight as uniform rods of `massPerLength` (the mass model of /analyses/frequencies), a payload
+/// mass at the end, point forces at joints.
+struct BodySpec {
+  bool haveGravity = false;
+  double gravity = 0.0;                                   ///< g at the start (acceleration)
+  Eigen::Vector2d direction = Eigen::Vector2d(0.0, -1.0); ///< unit vector of g
+  double massPerLength = 0.0;                             ///< ≥ 0 (mass / length)
+  double payload = 0.0;                                   ///< ≥ 0: a point mass at the end
+  std::vector<PointLoadSpec> points;
+  bool any() const { return haveGravity || !points.empty(); }
+};
+
 /// One chain variant: segment parameters (after preloads for q0 were computed) and its
 /// unloaded shape.
 struct ChainSpec {
@@ -57,6 +77,9 @@ struct PathSpec {
   /// `controlDirection` (origin: `start`) with the end at /end's values (the payload or the held
   /// coordinates); `direction` is zero and `coordinate` unused.
   bool control = false;
+  /// The path parameter is the gravity magnitude g (/gravity, "gravity"): λ = g, the
+  /// acceleration λ·/gravity/direction; the end values stay those of /end (`direction` zero).
+  bool gravity = false;
   int segment = -1;     ///< 0-based; −1: every segment
   mechanics::ControlDirection controlDirection;
   double start = 0.0;   ///< the input's value on the scene's chain (mean over the segments for all)
@@ -207,10 +230,13 @@ struct CaseSpec {
   ChainSpec chain;
   EndSpec end;
   PathSpec path;
+  BodySpec body;
 
   /// The path parameter's value at the start: the prescribed value of the path's coordinate, or
-  /// along a control path the inputs' value on the chain.
-  double startValue() const { return path.control ? path.start : end.condition.value[path.coordinate]; }
+  /// along a control path the inputs' value on the chain, or along a gravity path /gravity/value.
+  double startValue() const {
+    return path.control ? path.start : path.gravity ? body.gravity : end.condition.value[path.coordinate];
+  }
 };
 
 struct Scene {

@@ -406,6 +406,7 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
   cs.end = parseEnd(r, doc.contains("end") ? doc["end"] : json::object(), Pointer("/end"));
   // "held": "start" takes the unloaded shape's end pose
   mechanics::Chain chain(cs.chain.segments);
+  cs.body = parseBody(r, doc, chain);
   const mechanics::Pose pose0 = mechanics::endPose(chain, cs.chain.q0);
   for (int c = 0; c < 3; ++c)
     if (cs.end.heldAtStart[size_t(c)]) cs.end.condition.value[c] = pose0[c];
@@ -425,6 +426,11 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
   r.requireObject(path, Pointer("/path"));
   if (isControlPath(path)) {
     cs.path = parseControlPath(r, path, Pointer("/path"), chain);
+    checkEndAgainstChain(r, cs);
+    return cs;
+  }
+  if (path.contains("parameter") && path["parameter"] == "gravity") {
+    cs.path = parseGravityPath(r, path, Pointer("/path"), cs.body);
     checkEndAgainstChain(r, cs);
     return cs;
   }

@@ -26,6 +26,13 @@ std::string show(double v);
 /// needPath: an analysis needs /path (else a default Fx path of zero length is used).
 CaseSpec parseCase(const JsonReader& r, const json& doc, const std::string& label, bool needPath);
 
+/// /gravity and /point_loads of a case (scene_body.cpp) against its chain.
+BodySpec parseBody(const JsonReader& r, const json& doc, const mechanics::Chain& chain);
+/// A /path with parameter "gravity": the range (≥ 0, containing /gravity/value); no direction.
+PathSpec parseGravityPath(const JsonReader& r, const json& path, const Pointer& p, const BodySpec& body);
+/// The analyses that do not take body loads refused; one mass model with /analyses/frequencies.
+void checkBodyAnalyses(const JsonReader& r, const Scene& scene);
+
 /// A /path whose parameter is a control input (scene_control.cpp): true for "L1_0", "L2_0",
 /// "L0", "dL0".
 bool isControlPath(const json& path);

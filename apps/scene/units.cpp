@@ -56,6 +56,12 @@ std::string UnitSystem::unit(Dimension d) const {
       if (mass.empty()) return "rad/time";
       if (length == "m" && force == "N" && mass == "kg") return "rad/s";
       return "rad/(" + mass + "·" + length + "/" + force + ")^1/2";
+    case Dimension::Acceleration:
+      // the weight m g is a force: g in force per mass unit
+      if (kind == Kind::Nondimensional) return "k b/m";  // masses in a unit m
+      if (kind == Kind::Consistent || mass.empty()) return "force/mass";
+      if (length == "m" && force == "N" && mass == "kg") return "m/s^2";
+      return group(force) + "/" + group(mass);
     default: break;
   }
   if (kind == Kind::Nondimensional) {

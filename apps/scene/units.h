@@ -25,7 +25,9 @@ enum class Dimension {
   Frequency,            ///< 1/time
   /// rad per time unit of the scene's length, force and mass units, τ = √(mass·length/force)
   /// (natural frequencies: rad/s for m, N, kg)
-  AngularFrequency
+  AngularFrequency,
+  /// The gravitational acceleration: force per mass (m/s² = N/kg with m, N, kg)
+  Acceleration
 };
 
 struct UnitSystem {

@@ -16,7 +16,7 @@
 #include "buckle/mechanics/control_path.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/vibration.h"
-#include "rfc4180.h"
+#include "branches_table.h"
 #include "scene/columns.h"
 #include "scene/scene.h"
 #include "scene_run.h"
@@ -26,23 +26,8 @@ using namespace buckle::mechanics;
 
 namespace {
 
-using Table = std::vector<std::map<std::string, double>>;
-
-Table readBranches(const fs::path& out) {
-  std::ifstream in(out / "branches.csv");
-  REQUIRE(in.good());
-  std::stringstream text;
-  text << in.rdbuf();
-  const auto rows = buckle::test::readCsv(text.str());
-  REQUIRE(rows.size() >= 2);
-  Table t;
-  for (size_t r = 1; r < rows.size(); ++r) {
-    std::map<std::string, double> row;
-    for (size_t c = 0; c < rows[0].size(); ++c) row[rows[0][c]] = rows[r][c].empty() ? std::nan("") : std::stod(rows[r][c]);
-    t.push_back(row);
-  }
-  return t;
-}
+using Table = buckle::test::BranchesTable;
+using buckle::test::readBranches;
 
 // A chain of `segments` (a, b, k, L0) = (0.5, 1, 1, 2.25)·(L, L, K, L), the end held in y (or
 // free) and pushed along x to −1.2·K·L, frequencies of rods of mass per length rho.

@@ -47,6 +47,7 @@ struct Units {
     if (key == "Me") return torque();
     if (key == "x" || key == "y") return length;
     if (key == "L1_0" || key == "L2_0" || key == "L0" || key == "dL0") return length;  // control inputs
+    if (key == "gravity") return length;  // masses × k/L per length keep the time unit: m g × k L
     return 1.0;  // phi
   }
   /// Unit of the reaction of a held coordinate.
@@ -90,6 +91,24 @@ void scalePath(json& path, const std::string& parameter, const Units& u) {
     for (auto& [key, rate] : path["direction"].items()) rate = rate.get<double>() * u.of(key) / unit;
 }
 
+// /gravity and /point_loads: masses × k (per length × k/L), g × L, so weights scale as forces
+// and the time unit √(mass·length/force) is unchanged; point forces as forces.
+void scaleBody(json& doc, const std::string& parameter, const Units& u) {
+  if (doc.contains("gravity")) {
+    json& g = doc["gravity"];
+    if (g.contains("value")) g["value"] = g["value"].get<double>() * u.length;
+    if (g.contains("mass_per_length")) g["mass_per_length"] = g["mass_per_length"].get<double>() * u.stiffness / u.length;
+    if (g.contains("payload")) g["payload"] = g["payload"].get<double>() * u.stiffness;
+  }
+  if (doc.contains("point_loads"))
+    for (json& p : doc["point_loads"]) {
+      for (const char* key : {"Fx", "Fy"})
+        if (p.contains(key)) p[key] = p[key].get<double>() * u.force();
+      if (p.contains("rate"))
+        for (auto& [key, rate] : p["rate"].items()) rate = rate.get<double>() * u.force() / u.of(parameter);
+    }
+}
+
 std::string parameterOf(const json& scene, const json& patch) {
   if (patch.contains("path") && patch["path"].contains("parameter")) return patch["path"]["parameter"];
   if (scene.contains("path") && scene["path"].contains("parameter")) return scene["path"]["parameter"];
@@ -116,8 +135,10 @@ json rewrite(json scene, const Units& u) {
   if (scene.contains("chain")) scaleChain(scene["chain"], u);
   if (scene.contains("end")) scaleEnd(scene["end"], u);
   if (scene.contains("path")) scalePath(scene["path"], parameter, u);
+  scaleBody(scene, parameter, u);
   if (scene.contains("cases"))
     for (json& c : scene["cases"]) {
+      scaleBody(c, parameterOf(original, c), u);
       if (c.contains("chain")) scaleChain(c["chain"], u);
       if (c.contains("end")) scaleEnd(c["end"], u);
       if (c.contains("path")) scalePath(c["path"], parameterOf(original, c), u);

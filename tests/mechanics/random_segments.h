@@ -3,6 +3,9 @@
 
 #include <random>
 
+#include <Eigen/Core>
+
+#include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/segment.h"
 
 namespace buckle::mechanics::testing {
@@ -27,6 +30,19 @@ inline SegmentParameters randomSegment(std::mt19937& rng, const SegmentRanges& r
   p.L1_0 = L(rng);
   p.L2_0 = L(rng);
   return p;
+}
+
+/// u = (q, r) of size N for `chain`: joint angles within 70 % of the limits, multipliers in [−1.5, 1.5].
+inline Eigen::VectorXd randomState(std::mt19937& rng, const Chain& chain, int N) {
+  std::uniform_real_distribution<double> W(-1.5, 1.5);
+  const int n = chain.size();
+  Eigen::VectorXd u(N);
+  for (int i = 0; i < n; ++i) {
+    std::uniform_real_distribution<double> Q(0.7 * chain.lowerLimits()[i], 0.7 * chain.upperLimits()[i]);
+    u[i] = Q(rng);
+  }
+  for (int i = n; i < N; ++i) u[i] = W(rng);
+  return u;
 }
 
 }  // namespace buckle::mechanics::testing

@@ -85,6 +85,27 @@ TEST_CASE("ChainBorderedSolver equals the dense LU of the same bordered Jacobian
   }
 }
 
+TEST_CASE("ChainBorderedSolver with body loads (weight, point loads growing with lambda) equals the dense LU",
+          "[chain_solver][body_loads]") {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.4, 0.4);
+  for (int n : {3, 40}) {
+    const Chain chain = randomChain(rng, n);
+    BodyLoads body = BodyLoads::weight(chain, InertiaData::uniformRods(chain, 0.7), {W(rng), W(rng)}, {W(rng), W(rng)});
+    body.points.push_back({n / 2 + 1, {W(rng), W(rng)}, {W(rng), W(rng)}});
+    for (const EndCondition& end : {EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), 0.0)),
+                                    EndCondition::clampedPinned(W(rng), 0.1 * W(rng))}) {
+      INFO("n = " << n << ", held " << end.heldCount());
+      EquilibriumProblem problem(chain, end, Eigen::Vector3d::Zero(), {}, {}, body);
+      const int N = problem.dimension();
+      Vector u(N), c(N + 1), b(N + 1);
+      for (int i = 0; i < N; ++i) u[i] = i < n ? Q(rng) : W(rng);
+      for (int i = 0; i <= N; ++i) c[i] = W(rng), b[i] = W(rng);
+      CHECK_FALSE(agreesWithDense(problem, u, W(rng), c, b, 1e-10));
+    }
+  }
+}
+
 TEST_CASE("ChainBorderedSolver::factorGeneral equals the dense LU with the same borders (k = 1, 2, transposed)",
           "[chain_solver]") {
   std::mt19937 rng(99);

@@ -36,18 +36,7 @@ Chain randomChain(std::mt19937& rng, int n) {
   return Chain(segs);
 }
 
-/// u = (q, r) of size N: joint angles within 70 % of the limits, multipliers in [−1.5, 1.5].
-Vector randomState(std::mt19937& rng, const Chain& chain, int N) {
-  std::uniform_real_distribution<double> W(-1.5, 1.5);
-  const int n = chain.size();
-  Vector u(N);
-  for (int i = 0; i < n; ++i) {
-    std::uniform_real_distribution<double> Q(0.7 * chain.lowerLimits()[i], 0.7 * chain.upperLimits()[i]);
-    u[i] = Q(rng);
-  }
-  for (int i = n; i < N; ++i) u[i] = W(rng);
-  return u;
-}
+using testing::randomState;
 
 }  // namespace
 

@@ -12,6 +12,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/gravity.h"
+#include "heavy_newton.h"
 
 using namespace buckle::mechanics;
 
@@ -99,15 +100,8 @@ TEST_CASE("gravity: a horizontal cantilever sags as the small-deflection closed 
   const auto sag = [&](double g) {
     GravityPotential V(chain, inertia, Eigen::Vector2d(0.0, -g));
     // independent minimisation of E + V: Newton with the dense Hessian from the unloaded shape
-    Vector q = Vector::Zero(n), grad(n), gv(n);
-    Matrix H(n, n), G(n, n);
-    for (int it = 0; it < 40; ++it) {
-      energyGradient(chain, q, grad);
-      V.gradient(q, gv);
-      totalPotentialHessian(chain, q, Wrench::Zero(), H);
-      V.hessian(q, G);
-      q -= (H + G).ldlt().solve(grad + gv);
-    }
+    const Vector q = testing::heavyNewton(chain, inertia, Eigen::Vector2d(0.0, -g), Vector::Zero(n), 40);
+    Vector grad(n), gv(n);
     energyGradient(chain, q, grad);
     V.gradient(q, gv);
     REQUIRE((grad + gv).norm() <= 1e-12 * kappa.maxCoeff());

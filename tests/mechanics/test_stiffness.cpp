@@ -266,3 +266,49 @@ TEST_CASE("the lateral compliance of the free chain vanishes at the clamped-pinn
     CHECK(further.compliance(1, 1) / after.compliance(1, 1) == Approx(2.0).epsilon(1e-4));
   }
 }
+
+TEST_CASE("with the links' weight the loaded compliance is the difference quotient of the force-deflection map, and dK_F "
+          "that of K_F", "[stiffness][body_loads]") {
+  const int n = 6;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const BodyLoads weight =
+      BodyLoads::weight(chain, InertiaData::uniformRods(chain, 0.005), {0.2, -1.0}, Eigen::Vector2d::Zero());
+  const auto heavy = [&](const Eigen::Vector2d& F, const Vector& guess) {
+    EquilibriumProblem problem(chain, EndCondition::freeEnd(Eigen::Vector3d(F[0], F[1], 0.0)), Eigen::Vector3d::Zero(),
+                               {}, {}, weight);
+    const PolishResult r = polishEquilibrium(problem, guess, 0.0);
+    REQUIRE(r.converged);
+    return Vector(r.u.head(n));
+  };
+  const Eigen::Vector2d F0(0.05, 0.3);
+  const Vector q = heavy(F0, Vector::Zero(n));
+  const EndCondition end = EndCondition::freeEnd(Eigen::Vector3d(F0[0], F0[1], 0.0));
+  EquilibriumProblem problem(chain, end, Eigen::Vector3d::Zero(), {}, {}, weight);
+  StiffnessOptions so;
+  so.bodyGenerator = problem.bodyLoadGenerator(q, 0.0);
+  const CartesianStiffness s = loadedStiffness(chain, q, problem.wrench(q, 0.0), end, so);
+  INFO("singular " << s.singular << ", rigid " << s.rigid << ", C = " << s.compliance);
+  REQUIRE(s.positiveDefinite);
+  const double h = 1e-5;
+  Eigen::Matrix2d Cfd;
+  for (int c = 0; c < 2; ++c) {
+    Eigen::Vector2d e = Eigen::Vector2d::Zero();
+    e[c] = h;
+    Cfd.col(c) = (endPose(chain, heavy(F0 + e, q)) - endPose(chain, heavy(F0 - e, q))).head(2) / (2 * h);
+  }
+  CHECK((s.compliance - Cfd).lpNorm<Eigen::Infinity>() < 1e-6 * Cfd.lpNorm<Eigen::Infinity>());
+  const CartesianStiffness weightless = loadedStiffness(chain, q, problem.wrench(q, 0.0), end);
+  CHECK((weightless.compliance - Cfd).lpNorm<Eigen::Infinity>() > 1e-3 * Cfd.lpNorm<Eigen::Infinity>());
+  // dK_F along (dq, dF) with γ moving with q (eq B5) against central differences of K_F
+  const Vector dq = Vector::LinSpaced(n, 0.3, -0.5);
+  const Wrench W = problem.wrench(q, 0.0), dW(0.2, -0.1, 0.0);
+  Eigen::Matrix2d K, dK;
+  so.bodyGeneratorRate = problem.bodyLoadGeneratorRate(q, 0.0, dq, 0.0);
+  REQUIRE(loadedStiffnessDerivative(chain, q, W, false, dq, dW, K, dK, so));
+  StiffnessOptions plus, minus;
+  plus.bodyGenerator = problem.bodyLoadGenerator(q + h * dq, 0.0);
+  minus.bodyGenerator = problem.bodyLoadGenerator(q - h * dq, 0.0);
+  const Eigen::Matrix2d Kp = loadedStiffness(chain, q + h * dq, W + h * dW, false, plus).stiffness;
+  const Eigen::Matrix2d Km = loadedStiffness(chain, q - h * dq, W - h * dW, false, minus).stiffness;
+  CHECK((dK - (Kp - Km) / (2 * h)).lpNorm<Eigen::Infinity>() < 1e-6 * K.lpNorm<Eigen::Infinity>());
+}

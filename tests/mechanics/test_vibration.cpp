@@ -13,6 +13,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/gravity.h"
 #include "buckle/mechanics/vibration.h"
 
 using namespace buckle::mechanics;
@@ -51,10 +52,11 @@ struct DenseReference {
   Matrix shapes;  // n × dimension, M-orthonormal
 };
 DenseReference denseReference(VibrationAnalysis& va, const Vector& q, const Wrench& F, const std::vector<int>& held,
-                              const std::vector<int>& locked) {
+                              const std::vector<int>& locked, const Matrix* extraHessian = nullptr) {
   const int n = va.chain().size();
   Matrix H(n, n), M(n, n);
   totalPotentialHessian(va.chain(), q, F, H);
+  if (extraHessian) H += *extraHessian;
   va.massMatrix(q, M);
   const Matrix C = va.constraintRows(q, held, locked);
   Matrix Z = Matrix::Identity(n, n);
@@ -334,5 +336,35 @@ TEST_CASE("vibration: the crossing omega^2 is zero at the located branch points 
     o.lambdaMax = 3.0;
     const cont::Branch br = cont::trace(problem, Vector::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
     check(problem, br, cont::SpecialPointType::Fold, 1);
+  }
+}
+
+TEST_CASE("vibration: with the links' weight the modes are those of K_q - K_g + the weight's Hessian (GravityPotential)",
+          "[vibration][body_loads]") {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> U(-0.6, 0.6);
+  for (int n : {3, 25}) {
+    const Chain chain = stiffChain(n);
+    InertiaData inertia;
+    for (int i = 0; i < n; ++i) inertia.links.push_back({0.5 + 0.1 * (i % 5), 0.01, 0.3 * chain.linkLengths()[i + 1]});
+    VibrationAnalysis va(chain, inertia);
+    Vector q(n);
+    for (int i = 0; i < n; ++i) q[i] = U(rng) * 3.0 / n;
+    const Wrench F(-0.1, 0.05, 0.0);
+    const Eigen::Vector2d g(0.3, -2.0);
+    EquilibriumProblem problem(chain, EndCondition::freeEnd(F), Eigen::Vector3d::Zero(), {}, {},
+                               BodyLoads::weight(chain, inertia, g, Eigen::Vector2d::Zero()));
+    Matrix G(n, n);
+    GravityPotential(chain, inertia, g).hessian(q, G);  // the independent dense Hessian of V
+    for (const std::vector<int>& held : {std::vector<int>{}, {1}}) {
+      INFO("n = " << n << ", held " << held.size());
+      const VibrationModes m = va.modes(q, F, held, {}, 3, false, problem.bodyLoadGenerator(q, 0.0));
+      const DenseReference ref = denseReference(va, q, F, held, {}, &G);
+      const DenseReference without = denseReference(va, q, F, held, {});
+      const double scale = ref.values.cwiseAbs().maxCoeff();
+      REQUIRE(m.omegaSquared.size() == std::min<Eigen::Index>(3, ref.values.size()));
+      for (int j = 0; j < m.omegaSquared.size(); ++j) CHECK(std::abs(m.omegaSquared[j] - ref.values[j]) <= 1e-11 * scale);
+      CHECK(std::abs(without.values[0] - ref.values[0]) > 1e-3 * std::abs(ref.values[0]));  // the weight matters
+    }
   }
 }

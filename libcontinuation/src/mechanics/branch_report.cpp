@@ -241,9 +241,12 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
     PointReport pr = p;
     if (options.stiffness) {
       // along a control path K_q is that of the free lengths at the point's λ
-      const CartesianStiffness s = lockedLoadedStiffness(
-          problem.controlled() ? problem.chainAt(b.points[size_t(pr.index)].lambda) : chain, pr.q, pr.F,
-          problem.endCondition(), pr.locked);
+      // and with body loads the Hessian's generator h − γ (eq B3)
+      const double lambda = b.points[size_t(pr.index)].lambda;
+      StiffnessOptions so;
+      so.bodyGenerator = problem.bodyLoadGenerator(pr.q, lambda);
+      const CartesianStiffness s = lockedLoadedStiffness(problem.controlled() ? problem.chainAt(lambda) : chain, pr.q,
+                                                         pr.F, problem.endCondition(), pr.locked, so);
       pr.K = s.stiffness;
       pr.C = s.compliance;
       pr.haveStiffness = true;

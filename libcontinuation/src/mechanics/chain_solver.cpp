@@ -39,6 +39,7 @@ Factorization ChainBorderedSolver::factor(ConstVectorRef u, double lambda, Const
   V_.col(m_).setZero();
   for (int cc : loaded_) V_.col(m_) -= J_.row(cc).transpose() * dir[cc];
   if (problem_.controlled()) V_.col(m_) += problem_.controlRate();  // moving free lengths (equilibrium_problem.h)
+  if (problem_.hasBodyLoads()) V_.col(m_) -= problem_.bodyRateTorques();  // body loads growing with λ (eq B2)
   D_.setZero();
   for (int k = 0; k < m_; ++k) {
     const int h = held_[size_t(k)];

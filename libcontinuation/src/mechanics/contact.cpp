@@ -180,6 +180,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
       const int i = free_[size_t(a)];
       double fl = 0.0;
       for (int cc : loaded_) fl -= J_(cc, i) * dir[cc];
+      if (problem_.base().hasBodyLoads()) fl -= problem_.base().bodyRateTorques()[i];  // eq (B2)
       V_(a, m_) = fl;
       W_(a, m_) = c[i];
       for (int k = 0; k < m_; ++k) V_(a, k) = W_(a, k) = -J_(held_[size_t(k)], i);

@@ -45,7 +45,7 @@ bool sameBits(const double* a, const double* b, size_t count) {
 
 EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
                                        const Eigen::Vector3d& direction, EquilibriumOptions options,
-                                       const ControlDirection& control)
+                                       const ControlDirection& control, const BodyLoads& body)
     : chain_(chain),
       end_(end),
       direction_(direction),
@@ -65,7 +65,10 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
       domainLower_(chain.size()),
       work_(chain.size()),
       structure_(chain.size()),
-      heldRows_(static_cast<Eigen::Index>(held_.size()), chain.size()) {
+      heldRows_(static_cast<Eigen::Index>(held_.size()), chain.size()),
+      body_(body),
+      bodyTerms_(chain, body),
+      bodyWork_(chain.size()) {
   static const char* names[3] = {"x", "y", "phi"};
   for (int c = 0; c < 3; ++c) {
     requireFinite(std::string("end value ") + names[c], end.value[c]);
@@ -136,6 +139,7 @@ bool EquilibriumProblem::prepare(const ConstVectorRef& u, double lambda) {
   }
   forwardKinematics(chain_, q, sinHalf_.data(), cosHalf_.data(), data_);
   endJacobian(data_, J_);
+  if (bodyTerms_.active()) bodyTerms_.update(data_);
   cachedQ_ = q;
   cachedLambda_ = lambda;
   cacheValid_ = true;
@@ -157,6 +161,13 @@ Vector EquilibriumProblem::initialGuess(ConstVectorRef q, double lambda) const {
   energyGradient(controlled() ? chainAt(lambda) : chain_, q, rhs);
   const Eigen::Vector3d value = prescribed(lambda);
   for (int c : loaded_) rhs -= J.row(c).transpose() * value[c];
+  if (bodyTerms_.active()) {  // ∂V/∂q = −τ (eq B2)
+    BodyLoadTerms terms = bodyTerms_;
+    terms.update(data);
+    Vector tau(n);
+    terms.torques(lambda, tau);
+    rhs -= tau;
+  }
   Matrix Jh(n, m);
   for (int k = 0; k < m; ++k) Jh.col(k) = J.row(held_[size_t(k)]).transpose();
   u.tail(m) = Jh.colPivHouseholderQr().solve(rhs);
@@ -189,6 +200,10 @@ bool EquilibriumProblem::residual(ConstVectorRef u, double lambda, VectorRef F) 
   auto top = F.head(n);
   top = grad_;
   top.noalias() -= J_.transpose() * W;
+  if (bodyTerms_.active()) {  // + ∂V/∂q = −τ(λ) (eq B2)
+    bodyTerms_.torques(lambda, bodyWork_);
+    top -= bodyWork_;
+  }
   const Eigen::Vector3d value = prescribed(lambda);
   for (size_t k = 0; k < held_.size(); ++k) F[n + int(k)] = value[held_[k]] - data_.pose[held_[k]];
   return true;
@@ -197,8 +212,7 @@ bool EquilibriumProblem::residual(ConstVectorRef u, double lambda, VectorRef F) 
 bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) {
   if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
   const int n = chain_.size();
-  const Wrench W = wrench(u, lambda);
-  loadHessianGenerator(data_, W, work_);
+  loadGenerator(u, lambda, work_);
   // Plain pointer loops (n + m is tiny in the hot path: Eigen's expressions on Refs, a max() per
   // entry and the vectorised fills' alias checks cost more than the arithmetic there; the
   // entries and their rounding are those of the textbook loops).
@@ -232,6 +246,8 @@ bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu,
   }
   if (control_.active())
     for (int i = 0; i < n; ++i) fl[i] += controlGrad_[i];  // ∂²E/∂q∂λ of the moving free lengths
+  if (bodyTerms_.active())
+    for (int i = 0; i < n; ++i) fl[i] -= bodyTerms_.rateTorques()[i];  // ∂²V/∂q∂λ = −τ' (eq B2)
   return true;
 }
 
@@ -249,6 +265,10 @@ bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double 
   const Vector dS = -dJ.row(0).transpose(), dC = dJ.row(1).transpose();
   // dh_m for h_m = −Fx C_m − Fy S_m
   Vector dh = -dW[0] * data_.C - W[0] * dC - dW[1] * data_.S - W[1] * dS;
+  if (bodyTerms_.active()) {  // − dγ (eq B5); F_λ's −τ' moves with q by Γ' dq
+    bodyGeneratorDerivative(du.head(n), lambda, dlambda);
+    dh -= bodyWork_;
+  }
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) dFu(i, j) = -dh[std::max(i, j)];
   for (int i = 0; i < n; ++i) dFu(i, i) += stiffRate_[i] * du[i];  // E‴ at (q, λ), from the cache
@@ -259,6 +279,10 @@ bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double 
   if (m > 0) dFu.bottomRightCorner(m, m).setZero();
   dFlambda.setZero();
   for (int cc : loaded_) dFlambda.head(n) -= dJ.row(cc).transpose() * direction_[cc];
+  if (bodyTerms_.active()) {
+    maxIndexProduct(bodyTerms_.rateGenerator(), du.head(n), bodyWork_);
+    dFlambda.head(n) += bodyWork_;
+  }
   if (control_.active()) {
     // K_q moves with λ; F_λ's control part ∂²E/∂q∂λ moves with q_i (∂/∂λ of it is zero)
     for (int i = 0; i < n; ++i) {
@@ -274,7 +298,7 @@ bool EquilibriumProblem::jacobianApply(ConstVectorRef u, double lambda, ConstVec
   const int n = chain_.size();
   const int m = heldCount();
   Vector h(n);
-  loadHessianGenerator(data_, wrench(u, lambda), h);
+  loadGenerator(u, lambda, h);
   const double xl = x[n + m];  // the λ component
   // (K_g x)_i = h_i Σ_{j≤i} x_j + Σ_{j>i} h_j x_j  (K_g(i, j) = h_max(i,j), eq 27)
   double suffix = 0.0;
@@ -289,6 +313,7 @@ bool EquilibriumProblem::jacobianApply(ConstVectorRef u, double lambda, ConstVec
   }
   for (int c : loaded_) y.head(n) -= (xl * direction_[c]) * J_.row(c).transpose();
   if (control_.active()) y.head(n) += xl * controlGrad_;
+  if (bodyTerms_.active()) y.head(n) -= xl * bodyTerms_.rateTorques();
   for (int k = 0; k < m; ++k) {
     const int c = held_[size_t(k)];
     y.head(n) -= x[n + k] * J_.row(c).transpose();
@@ -309,6 +334,7 @@ bool EquilibriumProblem::jacobianTransposeApply(ConstVectorRef u, double lambda,
   for (int c : loaded_) dot -= direction_[c] * J_.row(c).dot(w.head(n));
   for (int k = 0; k < heldCount(); ++k) dot += direction_[held_[size_t(k)]] * w[n + k];
   if (control_.active()) dot += controlGrad_.dot(w.head(n));  // jacobianApply prepared (q, λ)
+  if (bodyTerms_.active()) dot -= bodyTerms_.rateTorques().dot(w.head(n));
   y[N] = dot;
   return std::isfinite(dot);
 }
@@ -325,9 +351,17 @@ bool EquilibriumProblem::secondDerivativeApply(ConstVectorRef u, double lambda, 
   endJacobianDerivative(chain_, data_, x.head(n), dJ);
   // dh_m along x for h_m = −Fx C_m − Fy S_m, with dC = dJ_y, dS = −dJ_x (as in
   // jacobianDirectionalDerivative)
-  const Vector dh = -dW[0] * data_.C - W[0] * dJ.row(1).transpose() - dW[1] * data_.S + W[1] * dJ.row(0).transpose();
+  Vector dh = -dW[0] * data_.C - W[0] * dJ.row(1).transpose() - dW[1] * data_.S + W[1] * dJ.row(0).transpose();
+  if (bodyTerms_.active()) {  // − dγ along x (eq B5, x_λ included)
+    bodyGeneratorDerivative(x.head(n), lambda, x[n + m]);
+    dh -= bodyWork_;
+  }
   maxIndexProduct(dh, z.head(n), y.head(n));
   y.head(n) = -y.head(n);
+  if (bodyTerms_.active()) {  // F_λ's −τ' along x_q, times z_λ: Γ' x_q z_λ
+    maxIndexProduct(bodyTerms_.rateGenerator(), x.head(n), bodyWork_);
+    y.head(n) += z[n + m] * bodyWork_;
+  }
   y.head(n) += stiffRate_.cwiseProduct(x.head(n)).cwiseProduct(z.head(n));  // E‴ at (q, λ)
   if (control_.active())  // ∂K_q/∂λ (x_q z_λ + x_λ z_q); ∂²F/∂λ² = 0
     y.head(n) += controlStiff_.cwiseProduct(z[n + m] * x.head(n) + x[n + m] * z.head(n));
@@ -346,15 +380,16 @@ bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matr
   H.resize(n, n);
   C.resize(heldCount(), n);
   // totalPotentialHessian() from the cached kinematics and K_q
-  loadMatrix(data_, wrench(u, lambda), H);
-  H = -H;
+  loadGenerator(u, lambda, work_);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) H(i, j) = -work_[std::max(i, j)];
   H.diagonal() += stiff_;
   for (int k = 0; k < heldCount(); ++k) C.row(k) = J_.row(held_[size_t(k)]);
   return true;
 }
 
 void EquilibriumProblem::assembleFromCache(const ConstVectorRef& u, double lambda, ChainStructure& ws) {
-  loadHessianGenerator(data_, wrench(u, lambda), ws.h);
+  loadGenerator(u, lambda, ws.h);
   assemble(stiff_, ws.h, ws);
 }
 
@@ -377,7 +412,7 @@ bool EquilibriumProblem::smallDenseSpectrum(const ConstVectorRef& u, double lamb
   if (!prepare(u, lambda)) return false;
   // The dense route reads h and κ alone (smallDenseInertia), not the tridiagonal form assemble()
   // adds for the O(n) counts (every structured route assembles for itself).
-  loadHessianGenerator(data_, wrench(u, lambda), structure_.h);
+  loadGenerator(u, lambda, structure_.h);
   structure_.kappa = stiff_;
   const int n = chain_.size();
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
@@ -456,60 +491,6 @@ bool EquilibriumProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, i
   return true;
 }
 
-bool EquilibriumProblem::stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                            double& bound) {
-  if (!std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() || !prepare(u, lambda)) return false;
-  const int n = chain_.size();
-  const int m = heldCount();
-  const Wrench W = wrench(u, lambda);
-  Wrench dW = dlambda * direction_;  // loads move with λ, reactions with their unknowns
-  for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = du[n + k];
-  bool heldX = false, heldY = false;
-  for (int c : held_) {
-    heldX |= c == 0;
-    heldY |= c == 1;
-  }
-  // H = K_q − K_g with K_g(i, j) = h_max(i,j), h = −F_x C − F_y S (eq 27), so along (du, dλ)
-  // dH = diag(E‴_i du_i) − [dh_max(i,j)] with dh = −dF_x C − F_x dC − dF_y S − F_y dS, and the
-  // tail sums move with θ̇_p = Σ_{i≤p} du_i: dS_j = Σ_{p≥j} ℓ_p cos θ_p θ̇_p, dC_j = −Σ_{p≥j} ℓ_p
-  // sin θ_p θ̇_p, where ℓ_p cos θ_p = C_p − C_{p+1}, ℓ_p sin θ_p = S_p − S_{p+1} (chain.h). In the
-  // Frobenius norms the entries with max(i, j) = p appear 2p + 1 times (0-based), once on the
-  // diagonal. C = J_h has rows (−S, C, 1) of eq 11, so dC has rows (−dS, dC, 0).
-  double thetaDot = du.head(n).sum(), dS = 0.0, dC = 0.0;
-  double dH2 = 0.0, H2 = 0.0, dC2 = 0.0;
-  for (int p = n - 1; p >= 0; --p) {
-    const double cNext = p + 1 < n ? data_.C[p + 1] : 0.0, sNext = p + 1 < n ? data_.S[p + 1] : 0.0;
-    dS += (data_.C[p] - cNext) * thetaDot;
-    dC -= (data_.S[p] - sNext) * thetaDot;
-    thetaDot -= du[p];
-    const double h = -W[0] * data_.C[p] - W[1] * data_.S[p];
-    const double dh = -dW[0] * data_.C[p] - W[0] * dC - dW[1] * data_.S[p] - W[1] * dS;
-    const double dControl = control_.active() ? controlStiff_[p] * dlambda : 0.0;  // ∂K_q/∂λ dλ
-    const double dDiagonal = stiffRate_[p] * du[p] + dControl - dh, diagonal = stiff_[p] - h;
-    dH2 += dDiagonal * dDiagonal + 2.0 * p * dh * dh;
-    H2 += diagonal * diagonal + 2.0 * p * h * h;
-    if (heldX) dC2 += dS * dS;
-    if (heldY) dC2 += dC * dC;
-  }
-  bound = std::sqrt(dH2);
-  if (m == 0) return std::isfinite(bound);
-  // The eigenvector's multiplier: H v + Cᵀζ = μ v, C v = 0 give ζ = −(CCᵀ)⁻¹C H v, so
-  // ‖ζ‖ ≤ ‖H‖₂/σ_min(C); and dμ = vᵀ dH v + 2 ζᵀ dC v (differentiate and multiply by vᵀ).
-  // σ_min(C)² = the smallest eigenvalue of the Gram matrix CCᵀ (m ≤ 3; the unused diagonal is
-  // padded above every eigenvalue of the m×m block, which stays decoupled).
-  Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
-  for (int k = 0; k < m; ++k)
-    for (int l = 0; l <= k; ++l) G(k, l) = G(l, k) = J_.row(held_[size_t(k)]).dot(J_.row(held_[size_t(l)]));
-  const double trace = G.trace();
-  for (int k = m; k < 3; ++k) G(k, k) = 2.0 * trace + 1.0;
-  const double sigma2 =
-      m == 1 ? G(0, 0) : Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(G, Eigen::EigenvaluesOnly).eigenvalues()[0];
-  // Rank-deficient C (e.g. x held on the straight chain): ker C jumps, no finite bound.
-  if (!(sigma2 > 1e-12 * trace)) return false;
-  bound += 2.0 * std::sqrt(H2) * std::sqrt(dC2 / sigma2);
-  return std::isfinite(bound);
-}
-
 std::unique_ptr<continuation::BorderedSolver> EquilibriumProblem::makeStructuredSolver() {
   return std::make_unique<ChainBorderedSolver>(*this);
 }
@@ -545,6 +526,9 @@ continuation::ProblemScales EquilibriumProblem::scales() const {
     const double unit = held ? (c < 2 ? length : 1.0) : (c < 2 ? force : torque);
     lambda = std::min(lambda, unit / std::abs(direction_[c]));
   }
+  // With body loads growing with λ (the weight along a gravity path): the λ that moves their
+  // resultants by the force unit.
+  if (bodyTerms_.active() && bodyTerms_.rateForce() > 0.0) lambda = std::min(lambda, force / bodyTerms_.rateForce());
   // Along a control path λ moves a free length by λ·rate: its unit b̄.
   if (control_.active()) {
     const double rate = control_.rates.cwiseAbs().maxCoeff();

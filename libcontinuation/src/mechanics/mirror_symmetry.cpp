@@ -6,6 +6,7 @@ continuation::Reflection mirrorSymmetry(const EquilibriumProblem& problem) {
   continuation::Reflection mirror;
   const Chain& chain = problem.chain();
   const int n = chain.size();
+  if (problem.hasBodyLoads()) return mirror;  // weight and point loads: not checked for symmetry
   for (int i = 0; i < n; ++i) {
     const SegmentParameters& p = chain.segment(i).parameters();
     if (p.k1 != p.k2 || p.L1_0 != p.L2_0) return mirror;

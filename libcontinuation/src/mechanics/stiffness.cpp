@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "buckle/continuation/problem.h"
+#include "buckle/mechanics/body_loads.h"
 
 namespace buckle::mechanics {
 
@@ -65,6 +66,7 @@ CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const W
   endJacobian(data, J);
   Matrix H(n, n);
   totalPotentialHessian(chain, q, F, H);
+  addBodyLoadHessian(options.bodyGenerator, H);
   const Matrix Jp = J.topRows(2);
   // the constraints on δq: E δq = 0 (jointConstraints), and J_φ δq = 0 when the rotation is held
   const Eigen::Index e = jointConstraints.rows();
@@ -172,6 +174,8 @@ bool loadedStiffnessDerivative(const Chain& chain, ConstVectorRef q, const Wrenc
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) dH(i, j) = -dh[std::max(i, j)];
   dH.diagonal() += dkq.cwiseProduct(dq);
+  addBodyLoadHessian(options.bodyGenerator, H);
+  addBodyLoadHessian(options.bodyGeneratorRate, dH);
 
   Matrix Cphi(rotationHeld ? 1 : 0, n);
   if (rotationHeld) Cphi.row(0) = J.row(2);

@@ -67,17 +67,24 @@ StiffnessRate stiffnessRate(const EquilibriumProblem& problem, cont::ConstVector
   for (size_t k = 0; k < held.size(); ++k) dF[held[k]] = du[n + int(k)];
   Eigen::Matrix2d dK;
   const bool rotationHeld = problem.endCondition().isHeld(EndCoordinate::Phi);
+  StiffnessOptions body;  // the body loads' γ and dγ (eq B3, B5)
+  body.bodyGenerator = problem.bodyLoadGenerator(u.head(n), lambda);
+  body.bodyGeneratorRate = problem.bodyLoadGeneratorRate(u.head(n), lambda, du.head(n), dlambda);
   if (!problem.controlled()) {
-    if (!loadedStiffnessDerivative(problem.chain(), u.head(n), F, rotationHeld, du.head(n), dF, r.K, dK)) return r;
+    if (!loadedStiffnessDerivative(problem.chain(), u.head(n), F, rotationHeld, du.head(n), dF, r.K, dK, body))
+      return r;
   } else {
     // Along a control path K_q also moves with λ at fixed (q, F): that part of dK by central
     // differences of K_F in λ (step 1e-5 of λ's unit: error ~1e-10 relative), the rest exact.
     try {
-      if (!loadedStiffnessDerivative(problem.chainAt(lambda), u.head(n), F, rotationHeld, du.head(n), dF, r.K, dK))
+      if (!loadedStiffnessDerivative(problem.chainAt(lambda), u.head(n), F, rotationHeld, du.head(n), dF, r.K, dK,
+                                     body))
         return r;
       const double h = 1e-5 * problem.scales().parameter;
-      const CartesianStiffness up = loadedStiffness(problem.chainAt(lambda + h), u.head(n), F, rotationHeld);
-      const CartesianStiffness down = loadedStiffness(problem.chainAt(lambda - h), u.head(n), F, rotationHeld);
+      StiffnessOptions fixed;  // K_q's own λ rate: γ held at its value (its rate is in dγ above)
+      fixed.bodyGenerator = body.bodyGenerator;
+      const CartesianStiffness up = loadedStiffness(problem.chainAt(lambda + h), u.head(n), F, rotationHeld, fixed);
+      const CartesianStiffness down = loadedStiffness(problem.chainAt(lambda - h), u.head(n), F, rotationHeld, fixed);
       dK += (up.stiffness - down.stiffness) * (dlambda / (2.0 * h));
     } catch (const std::invalid_argument&) {
       return r;  // a free length not positive within the step: no rate

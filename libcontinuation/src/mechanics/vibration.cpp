@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "buckle/mechanics/body_loads.h"
+
 namespace buckle::mechanics {
 
 namespace {
@@ -139,12 +141,14 @@ Matrix VibrationAnalysis::constraintRows(ConstVectorRef q, const std::vector<int
 }
 
 VibrationModes VibrationAnalysis::modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
-                                        const std::vector<int>& lockedJoints, int count, bool shapes) {
+                                        const std::vector<int>& lockedJoints, int count, bool shapes,
+                                        const Vector& bodyGenerator) {
   const int n = chain_.size();
   if (q.size() != n) throw std::invalid_argument("VibrationAnalysis::modes: q must have one angle per joint");
   if (count < 0) throw std::invalid_argument("VibrationAnalysis::modes: count must be >= 0");
   Matrix H(n, n), M(n, n);
   totalPotentialHessian(chain_, q, F, H);  // K_q − K_g(F), eq 27
+  addBodyLoadHessian(bodyGenerator, H);     // the body loads' Γ (eq B3)
   model_.massMatrix(q, M);
   const Matrix C = constraintRows(q, held, lockedJoints);
 

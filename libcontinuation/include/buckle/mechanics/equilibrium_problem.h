@@ -12,12 +12,17 @@
 // L⁰(λ) = L⁰ + (λ − origin)·rates, so E = Σ ½k(L − L⁰(λ))² depends on λ and
 //   F_λ = −J_lᵀ d_l + ∂²E/∂q∂λ,   ∂²E/∂q_i∂λ = −Σ_s k_s r_{i,s} ∂L_s/∂q_i,
 //   ∂K_q/∂λ = diag(−Σ_s k_s r_{i,s} ∂²L_s/∂q_i²),  ∂²F/∂λ² = 0 (E is quadratic in L⁰, F linear in it).
+// With body loads (body_loads.h: the links' weight and point loads at the joints, affine in λ)
+// the potential gains V(q, λ) (eq B1): the q rows gain ∂V/∂q = −τ (eq B2), the generator of
+// K_g becomes h − γ (eq B3: the same O(n) structure), F_λ gains −τ', and the second derivatives
+// dγ (eq B5). Every route below (dense, structured, stability, rate bound) includes them.
 #pragma once
 
 #include <Eigen/Core>
 #include <vector>
 
 #include "buckle/continuation/problem.h"
+#include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/control_path.h"
@@ -37,8 +42,10 @@ class EquilibriumProblem final : public continuation::Problem {
  public:
   /// `control`: λ moves the free lengths as well (control_path.h; rates n×2 or empty). Throws
   /// std::invalid_argument for non-finite input or rates of the wrong size.
+  /// `body`: the weight and point loads on the links (body_loads.h; BodyLoads::check throws).
   EquilibriumProblem(const Chain& chain, const EndCondition& end, const Eigen::Vector3d& direction,
-                     EquilibriumOptions options = {}, const ControlDirection& control = {});
+                     EquilibriumOptions options = {}, const ControlDirection& control = {},
+                     const BodyLoads& body = {});
 
   const Chain& chain() const { return chain_; }
   const EndCondition& endCondition() const { return end_; }
@@ -55,6 +62,20 @@ class EquilibriumProblem final : public continuation::Problem {
   /// ∂²E/∂q∂λ (size n) at the (q, λ) of the last evaluation (residual, jacobian,
   /// assembleStructure …): the control part of F_λ. Empty when no control path.
   const Vector& controlRate() const { return controlGrad_; }
+  /// The body loads (weight, point loads) and whether any of them is not zero.
+  const BodyLoads& bodyLoads() const { return body_; }
+  bool hasBodyLoads() const { return bodyTerms_.active(); }
+  /// γ(λ) of the body loads at the joint angles q (eq B3; empty without them): the Hessian of the
+  /// total potential is K_q − K_g with the generator h − γ (StiffnessOptions, vibration.h). O(n).
+  Vector bodyLoadGenerator(continuation::ConstVectorRef q, double lambda) const;
+  /// dγ along (dq, dλ) at (q, λ) (eq B5; empty without body loads). O(n).
+  Vector bodyLoadGeneratorRate(continuation::ConstVectorRef q, double lambda, continuation::ConstVectorRef dq,
+                               double dlambda) const;
+  /// τ' at the q of the last evaluation (eq B2: F_λ gains −τ'), for the structured solvers that
+  /// form F_λ themselves; meaningful only with hasBodyLoads().
+  const Vector& bodyRateTorques() const { return bodyTerms_.rateTorques(); }
+  /// V(q, λ) of the body loads (eq B1; 0 without them).
+  double bodyLoadPotential(continuation::ConstVectorRef q, double lambda) const;
 
   /// Prescribed values (loads or coordinates) at λ.
   Eigen::Vector3d prescribed(double lambda) const { return end_.value + lambda * direction_; }
@@ -127,7 +148,8 @@ class EquilibriumProblem final : public continuation::Problem {
   /// stiffness, angles 1, torque rows and the stability operator k̄b̄², held-position rows b̄,
   /// held-angle rows 1, force reactions k̄b̄, torque reactions k̄b̄², and λ the size that moves the
   /// first prescribed value by its unit (a force k̄b̄, a torque k̄b̄², a position b̄, an angle 1):
-  /// min over the direction's components c of unit_c / |direction_c|.
+  /// min over the direction's components c of unit_c / |direction_c| (and, with body loads that
+  /// grow with λ, k̄b̄ / Σ_i |F'_i|: body_loads.h).
   continuation::ProblemScales scales() const override;
   /// b̄ and k̄ of scales(): the mean triangle half-length and the mean spring stiffness.
   double lengthUnit() const;
@@ -157,6 +179,11 @@ class EquilibriumProblem final : public continuation::Problem {
   /// ker J_h into spectrumInertia_ and spectrum_, or nothing when (u, λ) is already their key.
   /// False (nothing cached) outside the domain.
   bool smallDenseSpectrum(const continuation::ConstVectorRef& u, double lambda);
+  /// The generator of K_q − H at (u, λ) from the cache: h(F) of eq 27 minus the body loads' γ
+  /// (equilibrium_problem_body.cpp).
+  void loadGenerator(const continuation::ConstVectorRef& u, double lambda, VectorRef h) const;
+  /// The body loads' dγ along (du_q, dλ) into bodyWork_ (zero without them).
+  void bodyGeneratorDerivative(const continuation::ConstVectorRef& dq, double lambda, double dlambda);
 
   Chain chain_;
   EndCondition end_;
@@ -188,6 +215,9 @@ class EquilibriumProblem final : public continuation::Problem {
   Eigen::Matrix<double, kSmallDense, 1> spectrum_; // ascending eigenvalues on ker J_h ...
   int spectrumSize_ = -1;                          // ... their number (n − rank); −1: none cached
   Inertia spectrumInertia_;                        // ... and the inertia that goes with them
+  BodyLoads body_;
+  BodyLoadTerms bodyTerms_;   // the body loads' τ and γ of the cache (prepare())
+  Vector bodyWork_;           // size n: dγ and other body-load scratch
   Vector lastLowest_;         // warm start of the structured eigenvalue search
   Vector lastFrom_;           // warm start of stabilityEigenvalues: its last values ...
   int lastFirst_ = -1;        // ... and their first index

@@ -28,6 +28,7 @@ namespace buckle::mechanics {
 /// unless the problem is exactly mirror symmetric: every segment with k1 = k2 and L1_0 = L2_0,
 /// joint limits q_min = −q_max (geometric and user), and the y and φ entries of the prescribed
 /// values and of the load direction zero (no transverse load, moment or offset at any λ).
+/// Body loads (weight, point loads: body_loads.h) are taken as breaking the symmetry.
 /// Exact comparisons: a scene that is symmetric only to rounding is traced in full.
 continuation::Reflection mirrorSymmetry(const EquilibriumProblem& problem);
 

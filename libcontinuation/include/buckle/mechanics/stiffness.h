@@ -52,6 +52,11 @@ struct StiffnessOptions {
   double singularTolerance = 1e-12;
   /// Also compute negativeDirections / smallestEigenvalue (a dense eigen-decomposition).
   bool computeInertia = true;
+  /// γ of the body loads at q (body_loads.h, eq B3; EquilibriumProblem::bodyLoadGenerator): the
+  /// Hessian is K_q − K_g with the generator h − γ. Empty: no body loads.
+  Vector bodyGenerator;
+  /// dγ along the direction of loadedStiffnessDerivative (eq B5). Empty: none.
+  Vector bodyGeneratorRate;
 };
 
 /// Loaded stiffness K_F at (q, F) (eq 24–29); rotation free or held.

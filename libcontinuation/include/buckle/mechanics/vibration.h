@@ -60,8 +60,11 @@ class VibrationAnalysis {
   /// `lockedJoints` (0-based) locked. `shapes`: also the mode shapes. Throws
   /// std::invalid_argument for wrong sizes or indices; std::runtime_error if M is not positive
   /// definite on ker C_h to working precision.
+  /// `bodyGenerator`: γ of the body loads at q (EquilibriumProblem::bodyLoadGenerator, eq B3),
+  /// H = K_q − K_g with the generator h − γ; empty: none.
   VibrationModes modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
-                       const std::vector<int>& lockedJoints, int count, bool shapes = true);
+                       const std::vector<int>& lockedJoints, int count, bool shapes = true,
+                       const Vector& bodyGenerator = Vector());
 
   /// Joint-space mass matrix M(q) (dense, n×n).
   void massMatrix(ConstVectorRef q, MatrixRef M);

@@ -1,0 +1,141 @@
+// /gravity, /point_loads and the gravity path (scene_body.cpp, docs/scenes.md "Weight and point
+// loads"): a heavy cantilever traced in g against an independent Newton solve of the library's
+// GravityPotential, its frequencies against the vibration analysis with that potential's Hessian,
+// a point load with a rate against the same load at the end, and bad input refused with exit 2
+// naming the JSON path, nothing written.
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/dynamics.h"
+#include "buckle/mechanics/gravity.h"
+#include "buckle/mechanics/vibration.h"
+#include "../mechanics/heavy_newton.h"
+#include "branches_table.h"
+#include "scene_run.h"
+
+namespace fs = std::filesystem;
+using namespace buckle::mechanics;
+
+namespace {
+
+using Table = buckle::test::BranchesTable;
+using buckle::test::readBranches;
+
+// Four segments (a, b, k, L0) = (0.5, 1, 1, 2.25), free end; `extra` goes into the top level.
+std::string scene(const std::string& extra, const std::string& path, const std::string& analyses) {
+  return R"({"chain": {"segments": 4, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+  "end": {"x": {"load": 0.0}, "y": {"load": 0.0}, "phi": "free"}, )" +
+         extra + R"(, "path": )" + path + R"(, "analyses": )" + analyses + R"(, "plots": []})";
+}
+
+const std::string kGravity = R"("gravity": {"value": 0.0, "direction": [0, -1], "mass_per_length": 0.01})";
+const std::string kGravityPath = R"({"parameter": "gravity", "from": 0.0, "to": 3.0})";
+
+void requireBadInput(const std::string& name, const std::string& text, const std::string& path,
+                     const std::string& expected) {
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", name, text);
+  INFO(o.err);
+  CHECK(o.rc == 2);
+  CHECK(o.err.find(": " + path + ": ") != std::string::npos);
+  CHECK(o.err.find(expected) != std::string::npos);
+  CHECK(!fs::exists(o.out));
+}
+
+// Newton on E + V (GravityPotential) with g raised in 30 equal steps
+Vector independentSag(const Chain& chain, const InertiaData& inertia, const Eigen::Vector2d& g) {
+  Vector q = Vector::Zero(chain.size());
+  for (int step = 1; step <= 30; ++step) q = testing::heavyNewton(chain, inertia, g * (step / 30.0), q, 30);
+  return q;
+}
+
+}  // namespace
+
+TEST_CASE("scene gravity path: a heavy cantilever's angles and frequencies equal the library's independent ones",
+          "[scene][body_loads]") {
+  const std::string text = scene(kGravity, kGravityPath, R"({"continuation": true, "frequencies": {"count": 2, "mass_per_length": 0.01}})");
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "cantilever", text);
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  const Table t = readBranches(o.out);
+  const std::map<std::string, double>& last = t.back();
+  CHECK(last.at("parameter") == Approx(3.0).epsilon(1e-12));
+  const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const InertiaData rods = InertiaData::uniformRods(chain, 0.01);
+  const Vector q = independentSag(chain, rods, Eigen::Vector2d(0.0, -3.0));
+  Vector traced(4);
+  for (int i = 0; i < 4; ++i) traced[i] = last.at("q" + std::to_string(i + 1));
+  CHECK((traced - q).lpNorm<Eigen::Infinity>() <= 1e-9 * q.lpNorm<Eigen::Infinity>());
+  CHECK(q.lpNorm<Eigen::Infinity>() > 1e-3);  // it sags
+  // ω from the vibration analysis with the weight's Hessian (GravityPotential's generator)
+  Vector gamma(4);
+  GravityPotential(chain, rods, Eigen::Vector2d(0.0, -3.0)).hessianGenerator(q, gamma);
+  VibrationAnalysis va(chain, rods);
+  const VibrationModes m = va.modes(q, Wrench::Zero(), {}, {}, 2, false, gamma);
+  const VibrationModes weightless = va.modes(q, Wrench::Zero(), {}, {}, 2, false);
+  for (int k = 0; k < 2; ++k) {
+    const double omega = last.at("omega" + std::to_string(k + 1));
+    CHECK(omega == Approx(signedFrequency(m.omegaSquared[k])).epsilon(1e-8));
+    CHECK(std::abs(omega - signedFrequency(weightless.omegaSquared[k])) > 1e-4 * omega);
+  }
+}
+
+TEST_CASE("scene point loads: a force at the last joint growing along an Fx path: the traced end point balances the "
+          "joint torques of the end load and that force, summed here from the joint positions", "[scene][body_loads]") {
+  // Fy = 0.02 + 0.1·Fx at joint 4 along Fx from 0 to −0.3
+  const std::string text = scene(R"("point_loads": [{"joint": 4, "Fy": 0.02, "rate": {"Fy": 0.1}}])",
+                                 R"({"parameter": "Fx", "from": 0.0, "to": -0.3})", R"({"continuation": true})");
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "point_load", text);
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  const std::map<std::string, double>& last = readBranches(o.out).back();
+  REQUIRE(last.at("parameter") == Approx(-0.3).epsilon(1e-12));
+  const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  Vector q(4);
+  for (int i = 0; i < 4; ++i) q[i] = last.at("q" + std::to_string(i + 1));
+  // residual of the equilibrium: ∂E/∂q − Jᵀ F_end − J_4ᵀ f with J_4 the Jacobian of joint 4's position
+  const Eigen::Vector2d f(0.0, 0.02 + 0.1 * -0.3);
+  Vector grad(4);
+  totalPotentialGradient(chain, q, Wrench(-0.3, 0.0, 0.0), grad);
+  const Eigen::Matrix2Xd P = jointPositions(chain, q);
+  for (int j = 0; j < 4; ++j) {
+    const Eigen::Vector2d arm = P.col(4) - P.col(j + 1);  // joint 4 about joint j+1
+    grad[j] -= arm.x() * f.y() - arm.y() * f.x();
+  }
+  CHECK(grad.lpNorm<Eigen::Infinity>() <= 1e-10);
+  CHECK(std::abs(last.at("y")) > 1e-3);
+}
+
+TEST_CASE("scene body loads: bad input names the JSON path, exit 2, nothing written", "[scene][body_loads][errors]") {
+  const std::string cont = R"({"continuation": true})";
+  requireBadInput("no_value", scene(R"("gravity": {"mass_per_length": 0.1})", kGravityPath, cont), "/gravity/value",
+                  "missing");
+  requireBadInput("negative", scene(R"("gravity": {"value": -1, "mass_per_length": 0.1})", kGravityPath, cont),
+                  "/gravity/value", ">= 0");
+  requireBadInput("zero_direction",
+                  scene(R"("gravity": {"value": 0, "direction": [0, 0], "mass_per_length": 0.1})", kGravityPath, cont),
+                  "/gravity/direction", "not zero");
+  requireBadInput("no_mass", scene(R"("gravity": {"value": 0})", kGravityPath, cont), "/gravity/mass_per_length",
+                  "needs masses");
+  requireBadInput("path_without_gravity", scene(R"("description": "x")", kGravityPath, cont), "/path/parameter",
+                  "needs /gravity");
+  requireBadInput("range", scene(kGravity, R"({"parameter": "gravity", "from": 1.0, "to": 3.0})", cont), "/path/from",
+                  "contains the start value gravity = 0");
+  requireBadInput("joint", scene(R"("point_loads": [{"joint": 5, "Fy": 1}])", kGravityPath, cont),
+                  "/point_loads/0/joint", "");
+  requireBadInput("jump", scene(kGravity, kGravityPath, R"({"continuation": true, "jump": true})"), "/analyses/jump",
+                  "do not include the weight");
+  requireBadInput("mass_model",
+                  scene(kGravity, kGravityPath, R"({"continuation": true, "frequencies": {"mass_per_length": 0.5}})"),
+                  "/analyses/frequencies/mass_per_length", "one mass model");
+  requireBadInput("mass_unit", R"({"units": {"length": "m", "force": "N"},)" + scene(kGravity, kGravityPath, cont).substr(1),
+                  "/units/mass", "mass unit");
+}
