@@ -286,6 +286,10 @@ void CaseRunner::suddenLoad() {
 }
 
 void CaseRunner::continuation() {
+  if (spec_.path.task) {
+    taskPath();
+    return;
+  }
   double s0 = out_.startValue;
   mech::EndCondition end = spec_.end.condition;
   Eigen::Vector3d direction = spec_.path.direction;
