@@ -92,8 +92,13 @@ void CaseRunner::taskPath() {
   b.stopReason = mech::toString(r.end);
   b.stopMessage = r.message;
   b.points = int(r.points.size());
-  b.finished = r.end != mech::TaskPathEvent::Failed && r.end != mech::TaskPathEvent::Interrupted;
+  b.finished = r.end != mech::TaskPathEvent::Failed && r.end != mech::TaskPathEvent::Interrupted &&
+               r.end != mech::TaskPathEvent::MaxPoints;
   out_.branches.push_back(b);
+  if (r.end == mech::TaskPathEvent::MaxPoints) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": the task path stopped at /solver/max_points: " + r.message);
+  }
   if (r.end == mech::TaskPathEvent::Failed) {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": the task path could not be followed: " +

@@ -1,9 +1,11 @@
 #include "buckle/mechanics/task_path.h"
 
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include "buckle/continuation/bordered_solver.h"
+#include "buckle/mechanics/task_path_kkt_solver.h"
 #include "buckle/mechanics/task_path_solver.h"
 
 namespace buckle::mechanics {
@@ -117,6 +119,9 @@ Chain TaskPathProblem::chainAt(ConstVectorRef p) const {
 
 bool TaskPathProblem::prepare(ConstVectorRef u) {
   if (u.size() != dim_ || !u.allFinite()) return false;
+  // the cache depends on (q, p) only; the tracer evaluates F, F_u and the boundaries at one point
+  if (cacheValid_ && std::memcmp(cachedKey_.data(), u.data(), sizeof(double) * size_t(n_ + mIn_)) == 0) return true;
+  cacheValid_ = false;
   const auto q = u.head(n_);
   const Eigen::MatrixX2d dL = freeLengthChange(u.segment(n_, mIn_));
   for (int i = 0; i < n_; ++i) {
@@ -143,6 +148,8 @@ bool TaskPathProblem::prepare(ConstVectorRef u) {
   endJacobian(data_, J_);
   loadHessianGenerator(data_, setup_.payload, h_);
   inputColumns(e1_, B_);
+  cachedKey_ = u.head(n_ + mIn_);
+  cacheValid_ = true;
   return true;
 }
 
@@ -194,31 +201,13 @@ bool TaskPathProblem::jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef
     for (int k = 0; k < m_; ++k) Fu.row(n_ + k).head(n_) = J_.row(setup_.coordinates[size_t(k)]);
     return true;
   }
-  const auto mu = u.segment(n_ + mIn_, n_);
-  const auto nu = u.segment(2 * n_ + mIn_, m_);
-  double nx = 0.0, ny = 0.0;
-  for (int k = 0; k < m_; ++k) {
-    if (setup_.coordinates[size_t(k)] == 0) nx = nu[k];
-    if (setup_.coordinates[size_t(k)] == 1) ny = nu[k];
-  }
-  // A = diag(E‴ ⊙ μ) − K_a + K_b (header): generators a_m and b_m of max-index matrices
-  const Wrench& F = setup_.payload;
-  Vector a(n_), bgen(n_);
-  double prefix = 0.0, tail = 0.0;
-  for (int m = 0; m < n_; ++m) prefix += mu[m], work_[m] = prefix;  // Σ_{j≤m} μ_j
-  for (int m = n_ - 1; m >= 0; --m) {
-    const double gamma = F[0] * data_.S[m] - F[1] * data_.C[m];
-    a[m] = gamma * work_[m] + tail;
-    tail += gamma * mu[m];
-    bgen[m] = -nx * data_.C[m] - ny * data_.S[m];
-  }
+  Vector diagA, genA;
+  Matrix D;
+  optimalityBlocks(u, diagA, genA, D);
   const int P = n_, M = n_ + mIn_, N = 2 * n_ + mIn_;
   for (int i = 0; i < n_; ++i)
-    for (int j = 0; j < n_; ++j) Fu(i, j) = bgen[std::max(i, j)] - a[std::max(i, j)];
-  Fu.topLeftCorner(n_, n_).diagonal() += third_.cwiseProduct(mu);
-  Matrix D;
-  inputColumns(e2_, D);
-  D = mu.asDiagonal() * D;
+    for (int j = 0; j < n_; ++j) Fu(i, j) = genA[std::max(i, j)];
+  Fu.topLeftCorner(n_, n_).diagonal() += diagA;
   Fu.block(0, P, n_, mIn_) = D;
   Fu.block(P, 0, mIn_, n_) = D.transpose();
   Fu.block(0, M, n_, n_) = H;
@@ -231,6 +220,43 @@ bool TaskPathProblem::jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef
     Fu.block(0, N + k, n_, 1) = row.transpose();
     Fu.block(N + k, 0, 1, n_) = row;
   }
+  return true;
+}
+
+void TaskPathProblem::optimalityBlocks(ConstVectorRef u, Vector& diagA, Vector& genA, Matrix& D) {
+  const auto mu = u.segment(n_ + mIn_, n_);
+  const auto nu = u.segment(2 * n_ + mIn_, m_);
+  double nx = 0.0, ny = 0.0;
+  for (int k = 0; k < m_; ++k) {
+    if (setup_.coordinates[size_t(k)] == 0) nx = nu[k];
+    if (setup_.coordinates[size_t(k)] == 1) ny = nu[k];
+  }
+  // A = diag(E‴ ⊙ μ) − K_a + K_b (header): one generator genA_m = b_m − a_m of a max-index matrix
+  const Wrench& F = setup_.payload;
+  genA.resize(n_);
+  double prefix = 0.0, tail = 0.0;
+  for (int m = 0; m < n_; ++m) prefix += mu[m], work_[m] = prefix;  // Σ_{j≤m} μ_j
+  for (int m = n_ - 1; m >= 0; --m) {
+    const double gamma = F[0] * data_.S[m] - F[1] * data_.C[m];
+    const double a = gamma * work_[m] + tail;
+    tail += gamma * mu[m];
+    genA[m] = -nx * data_.C[m] - ny * data_.S[m] - a;
+  }
+  diagA = third_.cwiseProduct(mu);
+  inputColumns(e2_, D);
+  D = mu.asDiagonal() * D;
+}
+
+bool TaskPathProblem::assembleOptimality(ConstVectorRef u, ChainStructure& ws, OptimalityBlocks& blocks) {
+  if (setup_.rule != TaskRule::MinimumChange || !prepare(u)) return false;
+  ws.typicalScale = structure_.typicalScale;
+  assemble(stiff_, h_, ws);
+  optimalityBlocks(u, blocks.diagA, blocks.genA, blocks.D);
+  blocks.B = B_;
+  blocks.Jc.resize(m_, n_);
+  for (int k = 0; k < m_; ++k) blocks.Jc.row(k) = J_.row(setup_.coordinates[size_t(k)]);
+  blocks.weights.resize(mIn_);
+  for (int j = 0; j < mIn_; ++j) blocks.weights[j] = setup_.inputs[size_t(j)].weight / (lengthUnit_ * lengthUnit_);
   return true;
 }
 
@@ -248,7 +274,11 @@ bool TaskPathProblem::fixedInputStability(ConstVectorRef u, Inertia& inertia, do
   if (!prepare(u)) return false;
   assemble(stiff_, h_, structure_);
   inertia = hessianInertia(structure_);
-  smallest = smallestEigenvalue(structure_, false);
+  // warm start from the last point's value (the path moves continuously)
+  Vector out(1);
+  lowestEigenvalues(structure_, false, 1, out, 1e-13, lastSmallest_.size() ? &lastSmallest_ : nullptr);
+  smallest = out[0];
+  lastSmallest_ = out;
   return true;
 }
 
@@ -300,7 +330,9 @@ std::string TaskPathProblem::boundaryName(int k) const {
 }
 
 std::unique_ptr<continuation::BorderedSolver> TaskPathProblem::makeStructuredSolver() {
-  if (setup_.rule != TaskRule::Chosen || mIn_ + 3 > ChainStructure::kMaxBorder) return nullptr;
+  if (setup_.rule == TaskRule::MinimumChange)
+    return mIn_ + m_ + 2 <= TaskPathKktSolver::kMaxSmall ? std::make_unique<TaskPathKktSolver>(*this) : nullptr;
+  if (mIn_ + 3 > ChainStructure::kMaxBorder) return nullptr;
   return std::make_unique<TaskPathBorderedSolver>(*this);
 }
 

@@ -16,6 +16,7 @@ const char* toString(TaskPathEvent event) {
     case TaskPathEvent::StabilityLoss: return "loss of stability";
     case TaskPathEvent::JointLimit: return "joint limit";
     case TaskPathEvent::InputBound: return "input bound";
+    case TaskPathEvent::MaxPoints: return "max points";
     case TaskPathEvent::Failed: return "failed";
     case TaskPathEvent::Interrupted: return "interrupted";
   }
@@ -169,6 +170,11 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
         result.message = sp.boundaryName;
         return result;
       }
+      case cont::StopReason::MaxPoints:
+        result.end = TaskPathEvent::MaxPoints;
+        result.message = "leg " + std::to_string(leg + 1) + ": the solver's point limit (" +
+                         std::to_string(opt.maxPoints) + ") reached";
+        return result;
       case cont::StopReason::Interrupted:
         result.end = TaskPathEvent::Interrupted;
         result.message = b.stopMessage;

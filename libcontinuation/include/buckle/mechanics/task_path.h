@@ -40,9 +40,8 @@
 // the continuation's regularity is that of F_u above, not of H.
 //
 // Costs: rule (a) has an O(n) bordered solver (H = U T Uᵀ bordered by the m input columns, the
-// tracer's column and the locator's, chain_structure.h); rule (b) is assembled and factorised
-// densely, O((2n + m_in + m)³) per factorisation (the block structure would allow O(n) with a
-// block-tridiagonal elimination in link angles; not done).
+// tracer's column and the locator's, task_path_solver.h); rule (b) an O(n·(m_in + m)) block
+// elimination through H (task_path_kkt_solver.h). Stability at fixed inputs is O(n).
 #pragma once
 
 #include <Eigen/Core>
@@ -146,6 +145,14 @@ class TaskPathProblem final : public continuation::Problem {
   double lengthUnit() const { return lengthUnit_; }
   double stiffnessUnit() const { return stiffnessUnit_; }
 
+  /// Rule (b): the blocks of its Jacobian (header) at u: T of H into ws, A = diag(diagA) +
+  /// [genA_max(i,k)], B, D, J_c and the weights w_j/b̄² of the p-block. False outside the domain or for rule (a).
+  struct OptimalityBlocks {
+    Vector diagA, genA, weights;
+    Matrix B, D, Jc;
+  };
+  bool assembleOptimality(continuation::ConstVectorRef u, ChainStructure& ws, OptimalityBlocks& blocks);
+
   /// T of H at (q, p) into ws, the inputs' columns B (n × m_in) and the task rows J_c (m × n):
   /// what the structured solver linearises on. False outside the domain.
   bool assembleStructure(continuation::ConstVectorRef u, ChainStructure& ws, Matrix& B, Matrix& Jc);
@@ -153,6 +160,8 @@ class TaskPathProblem final : public continuation::Problem {
  private:
   /// Spring model, kinematics and the per-segment input derivatives at u (q, p). False outside the domain.
   bool prepare(continuation::ConstVectorRef u);
+  /// Rule (b), after prepare(u): A = diag(diagA) + [genA_max(i,k)] and D (header).
+  void optimalityBlocks(continuation::ConstVectorRef u, Vector& diagA, Vector& genA, Matrix& D);
   /// Column j of B (or of D with the joint weights μ) from the per-segment derivatives e (n×2).
   void inputColumns(const Eigen::MatrixX2d& e, Matrix& out) const;
 
@@ -172,6 +181,9 @@ class TaskPathProblem final : public continuation::Problem {
   Vector h_, work_;
   Matrix B_;                     // n × m_in
   ChainStructure structure_;
+  Vector cachedKey_;          // (q, p) of the cache (bitwise)
+  bool cacheValid_ = false;
+  Vector lastSmallest_;       // warm start of the smallest eigenvalue
 };
 
 }  // namespace buckle::mechanics

@@ -20,10 +20,12 @@ enum class TaskPathEvent {
   StabilityLoss,  ///< the equilibrium at fixed inputs loses its stability
   JointLimit,
   InputBound,
+  MaxPoints,      ///< the tracer's point limit reached on a leg (TracerOptions::maxPoints)
   Failed,         ///< the continuation could not go on (its message says why)
   Interrupted,    ///< time limit or signal
 };
-/// "completed", "fold", "branch point", "loss of stability", "joint limit", "input bound", "failed", "interrupted".
+/// "completed", "fold", "branch point", "loss of stability", "joint limit", "input bound", "max points", "failed",
+/// "interrupted".
 const char* toString(TaskPathEvent event);
 
 struct TaskPathOptions {
