@@ -24,6 +24,7 @@
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/task_path_trace.h"
+#include "payload_paths.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -39,16 +40,11 @@ struct Row {
 };
 
 Row run(int n, double b, double k, TaskRule rule, int reps) {
-  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5 * b, b, k, 2.25 * b));
-  const Eigen::Vector3d payload(-0.9 / n * k * b, -0.9 / n * k * b, 0.0);
+  const Chain chain = buckle::bench::payloadChain(n, b, k);
+  const Eigen::Vector3d payload = buckle::bench::payloadOf(n, b, k);
   Row row;
-  EquilibriumProblem ramp(chain, EndCondition::freeEnd(), payload);
-  cont::TracerOptions ro;
-  ro.lambdaMin = -1.0;
-  ro.lambdaMax = 1.0;
-  ro.maxPoints = 100000;
-  const cont::Branch loading = cont::trace(ramp, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), ro);
-  if (loading.stopReason != cont::StopReason::LambdaRange) return row;
+  Eigen::VectorXd q0;
+  if (!buckle::bench::loadedStart(chain, payload, q0)) return row;
   row.started = true;
   TaskSetup setup;
   setup.payload = payload;
@@ -56,7 +52,6 @@ Row run(int n, double b, double k, TaskRule rule, int reps) {
   setup.rule = rule;
   setup.inputs = {{ControlInput::dL0, -1}, {ControlInput::L0, -1}};
   if (rule == TaskRule::MinimumChange) setup.inputs.push_back({ControlInput::dL0, 0});
-  const Eigen::VectorXd q0 = loading.points.back().u;
   const Pose pose = endPose(chain, q0);
   Eigen::VectorXd to(2);
   to << pose[0] - 0.05 * chain.length(), pose[1] + 0.1 * chain.length();
@@ -79,17 +74,10 @@ Row run(int n, double b, double k, TaskRule rule, int reps) {
 int main(int argc, char** argv) {
   int reps = 3;
   bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--quick")) quick = true;
-  }
+  buckle::bench::payloadArguments(argc, argv, reps, quick);
   std::printf("%-16s %-10s %6s %8s %12s %12s %12s  %s\n", "units", "rule", "n", "points", "s at end (b)", "time (ms)",
               "us/point", "end");
-  const struct {
-    const char* name;
-    double b, k;
-  } units[] = {{"nondimensional", 1.0, 1.0}, {"SI (b=0.02 m)", 0.02, 2000.0}};
-  for (const auto& u : units)
+  for (const auto& u : buckle::bench::kPayloadUnits)
     for (TaskRule rule : {TaskRule::Chosen, TaskRule::MinimumChange})
       for (int n : {3, 50, 1000}) {
         if (quick && n > 50) continue;

@@ -102,8 +102,10 @@ PathSpec parseTaskPath(const JsonReader& r, const json& path, const Pointer& p, 
     for (size_t k = 0; k < setup.coordinates.size(); ++k)
       if (setup.coordinates[k] < 2) r2 += spec.waypoints[i][Eigen::Index(k)] * spec.waypoints[i][Eigen::Index(k)];
     if (std::sqrt(r2) > reach * (1.0 + 1e-12)) {
-      const Pointer at = task.contains("waypoints") ? pt / "waypoints" / (task.contains("from") ? i - 1 : i)
-                                                    : pt / (i == 0 && task.contains("from") ? "from" : "to");
+      const bool from = task.contains("from");
+      const Pointer at = from && i == 0            ? pt / "from"
+                         : task.contains("waypoints") ? pt / "waypoints" / (from ? i - 1 : i)
+                                                      : pt / "to";
       r.fail(at, "expected a position the end can reach: within " + show(reach) +
                      " of the base (the length of the straight chain)");
     }

@@ -181,6 +181,8 @@ TEST_CASE("task path scene: bad input names the JSON path, exit 2, nothing writt
        "/path/task/to", "exactly one of"},
       {"reach", R"({"task": {"coordinates": ["x", "y"], "waypoints": [[0, -3], [9, 0]]}, "inputs": ["dL0", "L0"]})", cont,
        "", "/path/task/waypoints/1", "a position the end can reach"},
+      {"reach_from", R"({"task": {"coordinates": ["x", "y"], "from": [0, -9], "waypoints": [[0, -3]]}, "inputs": ["dL0", "L0"]})",
+       cont, "", "/path/task/from", "a position the end can reach"},
       {"input", R"({"task": {"coordinates": ["x"], "to": [-1]}, "inputs": ["dL1"]})", cont, "", "/path/inputs/0",
        "one of L1_0, L2_0, L0, dL0"},
       {"twice", R"({"task": {"coordinates": ["x", "y"], "to": [-1, -3]}, "inputs": ["dL0", "dL0"]})", cont, "",

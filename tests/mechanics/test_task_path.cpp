@@ -86,6 +86,33 @@ void constraintBlocks(TaskPathProblem& p, const Eigen::VectorXd& u, double s, Ei
   Jc = Fu.block(2 * n + mi, 0, m, n);
 }
 
+// A structured solver against dense LU at u: the tracer's border (factor, determinant, solve) and
+// the locator's general borders, plain and transposed.
+void compareWithDense(TaskPathProblem& p, cont::BorderedSolver& fast, const Eigen::VectorXd& u) {
+  const int N = p.dimension();
+  cont::DenseBorderedSolver dense(p);
+  const Eigen::VectorXd c = Eigen::VectorXd::LinSpaced(N + 1, 0.3, -0.7);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(N + 1, 1.0, 2.0);
+  Eigen::VectorXd x1(N + 1), x2(N + 1);
+  REQUIRE(fast.factor(u, 0.2, c) == cont::Factorization::Regular);
+  REQUIRE(dense.factor(u, 0.2, c) == cont::Factorization::Regular);
+  CHECK(fast.determinantSign() == dense.determinantSign());
+  CHECK(fast.logAbsDeterminant() == Approx(dense.logAbsDeterminant()).epsilon(1e-10));
+  REQUIRE(fast.solve(b, x1));
+  REQUIRE(dense.solve(b, x2));
+  CHECK((x1 - x2).norm() <= 1e-10 * x2.norm());
+  for (bool transposed : {false, true}) {
+    Eigen::MatrixXd Bg = Eigen::MatrixXd::Random(N, 2), Cg = Eigen::MatrixXd::Random(N, 2),
+                    Dg = Eigen::MatrixXd::Random(2, 2);
+    Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(N + 2, -1.0, 1.0), y1(N + 2), y2(N + 2);
+    REQUIRE(fast.factorGeneral(u, 0.2, Bg, Cg, Dg, transposed) == cont::Factorization::Regular);
+    REQUIRE(dense.factorGeneral(u, 0.2, Bg, Cg, Dg, transposed) == cont::Factorization::Regular);
+    REQUIRE(fast.solve(r, y1));
+    REQUIRE(dense.solve(r, y2));
+    CHECK((y1 - y2).norm() <= 1e-10 * y2.norm());
+  }
+}
+
 }  // namespace
 
 TEST_CASE("task path: derivatives of both rules against finite differences", "[task_path]") {
@@ -138,29 +165,8 @@ TEST_CASE("task path: the O(n) bordered solver agrees with dense LU", "[task_pat
   d << 0.48, 0.6, 0.64;
   p.setLeg({a, d, 0.0});
   const Eigen::VectorXd u = p.pack(q, p.startInputs() + Eigen::Vector3d(0.1, -0.2, 0.05));
-  const int N = p.dimension();
   TaskPathBorderedSolver fast(p);
-  cont::DenseBorderedSolver dense(p);
-  const Eigen::VectorXd c = Eigen::VectorXd::LinSpaced(N + 1, 0.3, -0.7);
-  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(N + 1, 1.0, 2.0);
-  Eigen::VectorXd x1(N + 1), x2(N + 1);
-  REQUIRE(fast.factor(u, 0.2, c) == cont::Factorization::Regular);
-  REQUIRE(dense.factor(u, 0.2, c) == cont::Factorization::Regular);
-  CHECK(fast.determinantSign() == dense.determinantSign());
-  CHECK(fast.logAbsDeterminant() == Approx(dense.logAbsDeterminant()).epsilon(1e-10));
-  REQUIRE(fast.solve(b, x1));
-  REQUIRE(dense.solve(b, x2));
-  CHECK((x1 - x2).norm() <= 1e-10 * x2.norm());
-  for (bool transposed : {false, true}) {
-    Eigen::MatrixXd Bg = Eigen::MatrixXd::Random(N, 2), Cg = Eigen::MatrixXd::Random(N, 2),
-                    Dg = Eigen::MatrixXd::Random(2, 2);
-    Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(N + 2, -1.0, 1.0), y1(N + 2), y2(N + 2);
-    REQUIRE(fast.factorGeneral(u, 0.2, Bg, Cg, Dg, transposed) == cont::Factorization::Regular);
-    REQUIRE(dense.factorGeneral(u, 0.2, Bg, Cg, Dg, transposed) == cont::Factorization::Regular);
-    REQUIRE(fast.solve(r, y1));
-    REQUIRE(dense.solve(r, y2));
-    CHECK((y1 - y2).norm() <= 1e-10 * y2.norm());
-  }
+  compareWithDense(p, fast, u);
 }
 
 TEST_CASE("task path: the O(n) elimination of rule (b)'s optimality system agrees with dense LU", "[task_path]") {
@@ -176,27 +182,7 @@ TEST_CASE("task path: the O(n) elimination of rule (b)'s optimality system agree
   Eigen::VectorXd u = Eigen::VectorXd::LinSpaced(N, -0.3, 0.4);
   u.segment(n, mi) = p.startInputs() + Eigen::VectorXd::LinSpaced(mi, 0.1, -0.1);
   TaskPathKktSolver fast(p);
-  cont::DenseBorderedSolver dense(p);
-  const Eigen::VectorXd c = Eigen::VectorXd::LinSpaced(N + 1, 0.3, -0.7);
-  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(N + 1, 1.0, 2.0);
-  Eigen::VectorXd x1(N + 1), x2(N + 1);
-  REQUIRE(fast.factor(u, 0.2, c) == cont::Factorization::Regular);
-  REQUIRE(dense.factor(u, 0.2, c) == cont::Factorization::Regular);
-  CHECK(fast.determinantSign() == dense.determinantSign());
-  CHECK(fast.logAbsDeterminant() == Approx(dense.logAbsDeterminant()).epsilon(1e-10));
-  REQUIRE(fast.solve(b, x1));
-  REQUIRE(dense.solve(b, x2));
-  CHECK((x1 - x2).norm() <= 1e-10 * x2.norm());
-  for (bool transposed : {false, true}) {
-    Eigen::MatrixXd Bg = Eigen::MatrixXd::Random(N, 2), Cg = Eigen::MatrixXd::Random(N, 2),
-                    Dg = Eigen::MatrixXd::Random(2, 2);
-    Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(N + 2, -1.0, 1.0), y1(N + 2), y2(N + 2);
-    REQUIRE(fast.factorGeneral(u, 0.2, Bg, Cg, Dg, transposed) == cont::Factorization::Regular);
-    REQUIRE(dense.factorGeneral(u, 0.2, Bg, Cg, Dg, transposed) == cont::Factorization::Regular);
-    REQUIRE(fast.solve(r, y1));
-    REQUIRE(dense.solve(r, y2));
-    CHECK((y1 - y2).norm() <= 1e-10 * y2.norm());
-  }
+  compareWithDense(p, fast, u);
 }
 
 TEST_CASE("task path rule (a): the task held and every point an equilibrium of the chain at its inputs", "[task_path]") {
