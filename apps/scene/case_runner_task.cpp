@@ -1,5 +1,6 @@
 // A task path (issue 29; mechanics/task_path_trace.h) as the continuation stage of a case: the
 // library's points and special points as the records the writers read.
+#include <algorithm>
 #include <memory>
 
 #include "buckle/mechanics/shape_name.h"
@@ -86,6 +87,7 @@ void CaseRunner::taskPath() {
     out_.specials.push_back(s);
     run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
   }
+  run_.worstResidual = std::max(run_.worstResidual, r.worstResidual);
   BranchRecord b;
   b.id = 0;
   b.origin = "start (task path)";

@@ -148,6 +148,7 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
       p.leg = leg;
       if (!taskPathPoint(problem, b.points[i].u, b.points[i].lambda, options.stiffness, p)) continue;
       result.points.push_back(p);
+      result.worstResidual = std::max(result.worstResidual, b.points[i].residualNorm);
     }
     if (stop) {
       const TaskPathEvent e = stop->type == cont::SpecialPointType::Fold ? TaskPathEvent::Fold : TaskPathEvent::BranchPoint;

@@ -61,6 +61,8 @@ struct TaskPathResult {
   std::string message;
   /// Waypoints as path-parameter values: 0 (the start pose) and the end of every leg.
   std::vector<double> legEnds;
+  /// The largest corrector residual over the points (ContinuationPoint::residualNorm).
+  double worstResidual = 0.0;
 };
 
 /// The metric arclength of a task-path leg: ‖Δ‖ with an angle counted as angleLength·Δφ.
