@@ -23,7 +23,7 @@
 
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/equilibrium_problem.h"
-#include "common.h"
+#include "payload_paths.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -39,17 +39,12 @@ struct Row {
 };
 
 Row run(int n, double b, double k, int reps) {
-  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5 * b, b, k, 2.25 * b));
-  const Eigen::Vector3d payload(-0.9 / n * k * b, -0.9 / n * k * b, 0.0);
+  const Chain chain = buckle::bench::payloadChain(n, b, k);
+  const Eigen::Vector3d payload = buckle::bench::payloadOf(n, b, k);
   Row row;
   // the start: the straight chain loaded to the payload (not timed)
-  EquilibriumProblem ramp(chain, EndCondition::freeEnd(), payload);
-  cont::TracerOptions ro;
-  ro.lambdaMin = -1.0;
-  ro.lambdaMax = 1.0;
-  ro.maxPoints = 100000;
-  const cont::Branch loading = cont::trace(ramp, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), ro);
-  if (loading.stopReason != cont::StopReason::LambdaRange) return row;
+  Eigen::VectorXd start;
+  if (!buckle::bench::loadedStart(chain, payload, start)) return row;
   row.started = true;
   for (int r = 0; r < reps; ++r) {
     EquilibriumProblem actuated(chain, EndCondition::freeEnd(payload), Eigen::Vector3d::Zero(), {},
@@ -59,7 +54,7 @@ Row run(int n, double b, double k, int reps) {
     o.computeStability = true;
     o.lowestEigenvalues = 1;
     const auto t0 = std::chrono::steady_clock::now();
-    const cont::Branch b = cont::trace(actuated, loading.points.back().u, 0.0, cont::InitialDirection::decreasingLambda(), o);
+    const cont::Branch b = cont::trace(actuated, start, 0.0, cont::InitialDirection::decreasingLambda(), o);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     row.seconds = std::min(row.seconds, s);
     row.points = b.points.size();
@@ -68,7 +63,7 @@ Row run(int n, double b, double k, int reps) {
     // for comparison: 100 points of the load path (the payload's factor) from the same start
     EquilibriumProblem loadPath(chain, EndCondition::freeEnd(), payload);
     const auto t1 = std::chrono::steady_clock::now();
-    cont::trace(loadPath, loading.points.back().u, 1.0, cont::InitialDirection::increasingLambda(), o);
+    cont::trace(loadPath, start, 1.0, cont::InitialDirection::increasingLambda(), o);
     row.loadSeconds = std::min(row.loadSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
   }
   return row;
@@ -82,7 +77,7 @@ int main(int argc, char** argv) {
   buckle::bench::parseRepsQuick(argc, argv, reps, quick);
   std::printf("%-16s %6s %8s %6s %14s %12s %12s %16s\n", "units", "n", "points", "folds", "dL0 at end (b)", "time (ms)",
               "us/point", "load path (ms)");
-  for (const buckle::bench::BenchUnits& u : buckle::bench::kBenchUnits)
+  for (const auto& u : buckle::bench::kBenchUnits)
     for (int n : {3, 50, 1000}) {
       if (quick && n > 50) continue;
       const Row r = run(n, u.b, u.k, reps);

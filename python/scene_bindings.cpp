@@ -74,6 +74,8 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
     const std::vector<std::string> omega = scene::frequencyColumns(s.analyses.frequencies.count);
     columns.insert(columns.end(), omega.begin(), omega.end());
   }
+  const std::vector<std::string> inputs = s.inputColumns();  // a task path's inputs
+  columns.insert(columns.end(), inputs.begin(), inputs.end());
   for (const std::string& c : columns) {
     VectorXd v(P);
     for (Eigen::Index i = 0; i < P; ++i) v[i] = scene::columnValue(c, cr.points[static_cast<size_t>(i)], cr.pose0);

@@ -321,6 +321,10 @@ mech::EquilibriumBranchOptions CaseRunner::branchOptions(double lambdaLo, double
 }
 
 void CaseRunner::continuation() {
+  if (spec_.path.task) {
+    taskPath();
+    return;
+  }
   double s0 = out_.startValue;
   mech::EndCondition end = spec_.end.condition;
   Eigen::Vector3d direction = spec_.path.direction;

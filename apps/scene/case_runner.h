@@ -35,6 +35,8 @@ class CaseRunner {
   /// the run's problems) when it cannot be reached.
   bool actuationStart();
   void continuation();
+  /// A task path (case_runner_task.cpp): the continuation stage of a case whose /path has a task.
+  void taskPath();
   void loadHistory();
   void suddenLoad();
   void criticalForces();

@@ -71,7 +71,18 @@ int frequencyIndex(const std::string& column) {
   return column[prefix] == '0' ? -1 : i - 1;
 }
 
+// A task path's input of one segment, "dL0[3]": the input's name and the segment ("" if not that form).
+static std::string segmentInput(const std::string& c, std::string& segment) {
+  const size_t open = c.find('[');
+  if (open == std::string::npos || c.empty() || c.back() != ']') return "";
+  segment = c.substr(open + 1, c.size() - open - 2);
+  return c.substr(0, open);
+}
+
 Dimension columnDimension(const std::string& c) {
+  std::string segment;
+  const std::string input = segmentInput(c, segment);
+  if (!input.empty()) return columnDimension(input);
   for (const Entry& e : kColumns)
     if (c == e.column) return e.dimension;
   if (frequencyIndex(c) >= 0) return Dimension::AngularFrequency;
@@ -80,6 +91,11 @@ Dimension columnDimension(const std::string& c) {
 
 std::string columnLabel(const std::string& c, const UnitSystem& units, LabelStyle style) {
   const bool gnuplot = style == LabelStyle::Gnuplot;
+  std::string segment;
+  if (const std::string input = segmentInput(c, segment); !input.empty())
+    for (const Entry& e : kColumns)
+      if (input == e.column)
+        return std::string(gnuplot ? e.gnuplot : e.plain) + " of segment " + segment + units.suffix(e.dimension);
   for (const Entry& e : kColumns)
     if (c == e.column) return (gnuplot ? e.gnuplot : e.plain) + units.suffix(e.dimension);
   if (c.size() >= 2 && c[0] == 'q') return (gnuplot ? "q_{" + c.substr(1) + "}" : c) + units.suffix(Dimension::Angle);

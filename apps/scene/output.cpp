@@ -57,6 +57,14 @@ double commonColumn(const std::string& c, double parameter, const mechanics::Wre
   return kNaN;
 }
 
+// A task path's input by column name (NaN for a record without it).
+double inputValue(const std::string& column, const Eigen::VectorXd& inputs, const std::vector<std::string>* names) {
+  if (!names) return kNaN;
+  for (size_t j = 0; j < names->size() && Eigen::Index(j) < inputs.size(); ++j)
+    if ((*names)[j] == column) return inputs[Eigen::Index(j)];
+  return kNaN;
+}
+
 // JSON has no NaN: write null.
 json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
@@ -142,6 +150,8 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
     for (const std::string& column : stiffnessColumns()) os += "," + column;
   if (scene.analyses.frequencies.enabled)
     for (const std::string& column : frequencyColumns(scene.analyses.frequencies.count)) os += "," + column;
+  const std::vector<std::string> inputs = scene.inputColumns();  // task paths: the inputs' values
+  for (const std::string& column : inputs) os += "," + escape::csvField(column);
   os += '\n';
   std::size_t rows = 0;
   for (const CaseResult& cr : run.cases) rows += cr.points.size();
@@ -188,6 +198,7 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
         for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C));
       if (scene.analyses.frequencies.enabled)
         for (int i = 0; i < scene.analyses.frequencies.count; ++i) field(i < p.omega.size() ? p.omega[i] : kNaN);
+      for (const std::string& column : inputs) field(inputValue(column, p.inputs, p.inputNames.get()));
       os += '\n';
     }
   }
@@ -231,6 +242,12 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       // K_F where the report computed it (a located KMIN: the stiffness at the minimum itself)
       if (s.K.allFinite()) p["stiffness"] = {{"Kxx", number(s.K(0, 0))}, {"Kyy", number(s.K(1, 1))}, {"Kxy", number(s.K(0, 1))}};
       if (!s.note.empty()) p["note"] = s.note;
+      if (s.inputNames) {  // a task path: the inputs at the point
+        json in = json::object();
+        for (size_t j = 0; j < s.inputNames->size() && Eigen::Index(j) < s.inputs.size(); ++j)
+          in[(*s.inputNames)[j]] = number(s.inputs[Eigen::Index(j)]);
+        p["inputs"] = in;
+      }
       if (s.multiplicity > 1) p["multiplicity"] = s.multiplicity;
       if (s.branchesPredicted >= 0)
         p["branches"] = {{"predicted", s.branchesPredicted}, {"found", s.branchesFound}};
@@ -493,6 +510,10 @@ double columnValue(const std::string& column, const PointRecord& p, const mechan
   if (found) return v;
   if (column == "min_eig") return p.minEigenvalue;
   if (const int i = frequencyIndex(column); i >= 0) return i < p.omega.size() ? p.omega[i] : kNaN;
+  if (p.inputNames) {
+    const double v = inputValue(column, p.inputs, p.inputNames.get());
+    if (!std::isnan(v)) return v;
+  }
   return stiffnessColumnValue(column, p.K, p.C);
 }
 
@@ -501,6 +522,10 @@ double columnValue(const std::string& column, const SpecialRecord& s, const mech
   const double v = commonColumn(column, s.parameter, s.F, s.pose, s.q, pose0, found);
   if (found) return v;
   if (const int i = frequencyIndex(column); i >= 0) return i < s.omega.size() ? s.omega[i] : kNaN;
+  if (s.inputNames) {
+    const double v = inputValue(column, s.inputs, s.inputNames.get());
+    if (!std::isnan(v)) return v;
+  }
   // NaN unless the point carries its own K_F (KMIN)
   return stiffnessColumnValue(column, s.K, Eigen::Matrix2d::Constant(kNaN));
 }

@@ -40,7 +40,11 @@ RunResult runScene(const Scene& scene, const RunControl& given) {
         start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(compute)), limit);
   }
   const AnalysesSpec& a = scene.analyses;
-  if (a.continuation.enabled)
+  const bool task = std::any_of(scene.cases.begin(), scene.cases.end(), [](const CaseSpec& c) { return c.path.task; });
+  if (task)
+    run.computed.push_back("task-space path (inverse statics): the inputs that move the end along the path, "
+                           "stability at fixed inputs");
+  else if (a.continuation.enabled)
     run.computed.push_back(a.continuation.branchSwitching > 0
                                ? "continuation with branch switching (depth " +
                                      std::to_string(a.continuation.branchSwitching) + ")"
@@ -90,7 +94,8 @@ RunResult runScene(const Scene& scene, const RunControl& given) {
     out.startValue = spec.startValue();
     out.qStart = out.q0;
     CaseRunner runner(scene, spec, out, run, control);
-    if (spec.path.control && !runner.actuationStart()) continue;  // recorded in run.problems
+    // recorded in run.problems
+    if ((spec.path.control || spec.path.task) && !runner.actuationStart()) continue;
     for (size_t s = 0; s < stages.size(); ++s) {
       if (runner.interrupted()) {
         skipped.push_back(stages[s].first + (scene.cases.size() > 1 ? " (case \"" + spec.label + "\")" : ""));

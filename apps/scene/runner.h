@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,10 @@ struct PointRecord {
   /// `frequencies`: the signed natural frequencies ω_i (vibration.h; negative: unstable, minus
   /// the growth rate), NaN beyond the constrained chain's modes; empty otherwise
   Eigen::VectorXd omega;
+  /// Along a task path: the inputs' values and their names (mechanics::taskInputName; shared by
+  /// the case's records), the columns of branches.csv beside the loads; empty otherwise
+  Eigen::VectorXd inputs;
+  std::shared_ptr<const std::vector<std::string>> inputNames;
 };
 
 struct SpecialRecord {
@@ -87,6 +92,9 @@ struct SpecialRecord {
   std::vector<mechanics::ImperfectionSensitivity> imperfections;
   /// `frequencies` at the located point (PointRecord::omega), empty where not computed
   Eigen::VectorXd omega;
+  /// Along a task path: the inputs at the point (PointRecord::inputs)
+  Eigen::VectorXd inputs;
+  std::shared_ptr<const std::vector<std::string>> inputNames;
 };
 
 struct BranchRecord {

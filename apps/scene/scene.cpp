@@ -149,7 +149,7 @@ Scene parseScene(const std::string& text, const std::string& file) {
     std::set<std::string> names;
     for (size_t i = 0; i < plots.size(); ++i) {
       PlotSpec ps = parsePlot(r, plots[i], Pointer("/plots") / i, scene.analyses, scene.maxSegments(),
-                              static_cast<int>(scene.cases.size()));
+                              static_cast<int>(scene.cases.size()), scene.inputColumns());
       if (!names.insert(ps.name).second)
         r.fail(Pointer("/plots") / i, "two plots named \"" + ps.name + "\": give one a distinct \"name\"");
       scene.plots.push_back(ps);

@@ -14,6 +14,7 @@
 #include "buckle/mechanics/control_path.h"
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/stiffness_extremum.h"
+#include "buckle/mechanics/task_path.h"
 #include "buckle/mechanics/segment.h"
 #include "scene/json_reader.h"
 #include "scene/units.h"
@@ -83,6 +84,13 @@ struct PathSpec {
   int segment = -1;     ///< 0-based; −1: every segment
   mechanics::ControlDirection controlDirection;
   double start = 0.0;   ///< the input's value on the scene's chain (mean over the segments for all)
+  /// A task-space path (issue 29; mechanics/task_path.h): the end pose on taskSetup.coordinates
+  /// follows the straight legs through `waypoints` from the start pose under /end's payload, the
+  /// inputs of taskSetup are unknowns; the parameter is the path's arclength s (from 0), `from`
+  /// and `to` its range.
+  bool task = false;
+  mechanics::TaskSetup taskSetup;
+  std::vector<Eigen::VectorXd> waypoints;  ///< each on the task coordinates
 };
 
 struct ContinuationSpec {
@@ -235,6 +243,7 @@ struct CaseSpec {
   /// The path parameter's value at the start: the prescribed value of the path's coordinate, or
   /// along a control path the inputs' value on the chain, or along a gravity path /gravity/value.
   double startValue() const {
+    if (path.task) return 0.0;
     return path.control ? path.start : path.gravity ? body.gravity : end.condition.value[path.coordinate];
   }
 };
@@ -248,6 +257,9 @@ struct Scene {
   SolverSpec solver;
   std::vector<PlotSpec> plots;
   int maxSegments() const;
+  /// The task paths' input columns of branches.csv ("dL0", "L1_0[3]": mechanics::taskInputName),
+  /// over every case in order of first appearance; empty without a task path.
+  std::vector<std::string> inputColumns() const;
 };
 
 /// One segment from the keys of a scene's segment object (a, b, k, L0, a1, b1, a2, b2, k1, k2,

@@ -200,7 +200,8 @@ SolverSpec parseSolver(const Reader& r, const json& s, const Pointer& p) {
   return o;
 }
 
-PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN, int nCases) {
+PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN, int nCases,
+                   const std::vector<std::string>& inputColumns) {
   PlotSpec s;
   json obj = v;
   if (v.is_string()) obj = json{{"type", v}};
@@ -265,7 +266,8 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
       if (mode == modes.end()) r.expected(p / "labels", obj["labels"], "one of auto, all, summary");
       s.labels = mode->second;
     }
-    const std::set<std::string> allowed = branchColumns(maxN, a);
+    std::set<std::string> allowed = branchColumns(maxN, a);
+    allowed.insert(inputColumns.begin(), inputColumns.end());
     std::string list;
     for (const std::string& c : allowed) list += (list.empty() ? "" : ", ") + c;
     auto column = [&](const json& c, const Pointer& pc) {
@@ -301,6 +303,7 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
 
 void checkAnalysesAgainstCases(const Reader& r, const Scene& scene) {
   checkControlPathAnalyses(r, scene);
+  checkTaskPathAnalyses(r, scene);
   checkTwoParameterAgainstCases(r, scene);
   checkEquilibriaAgainstCases(r, scene);
   if (scene.analyses.energyCurves.enabled)

@@ -424,6 +424,11 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
   }
   const json& path = doc["path"];
   r.requireObject(path, Pointer("/path"));
+  if (isTaskPath(path)) {
+    cs.path = parseTaskPath(r, path, Pointer("/path"), chain, cs.end);
+    checkEndAgainstChain(r, cs);
+    return cs;
+  }
   if (isControlPath(path)) {
     cs.path = parseControlPath(r, path, Pointer("/path"), chain);
     checkEndAgainstChain(r, cs);

@@ -42,6 +42,14 @@ PathSpec parseControlPath(const JsonReader& r, const json& path, const Pointer& 
 /// The analyses a control path cannot run (critical forces, two-parameter, sudden load) refused.
 void checkControlPathAnalyses(const JsonReader& r, const Scene& scene);
 
+/// A /path with a "task" (scene_task.cpp): a task-space path.
+bool isTaskPath(const json& path);
+/// Parses it against the chain and /end (every end coordinate loaded: the payload).
+PathSpec parseTaskPath(const JsonReader& r, const json& path, const Pointer& p, const mechanics::Chain& chain,
+                       const EndSpec& end);
+/// The analyses a task path cannot run refused; /analyses/continuation required.
+void checkTaskPathAnalyses(const JsonReader& r, const Scene& scene);
+
 // ---- analyses, solver, plots (scene_analyses.cpp) -------------------------------------------
 
 AnalysesSpec parseAnalyses(const JsonReader& r, const json& a, const Pointer& p);
@@ -57,7 +65,9 @@ EquilibriaSpec parseEquilibria(const JsonReader& r, const json& v, const Pointer
 /// Its `at` inside every case's path range.
 void checkEquilibriaAgainstCases(const JsonReader& r, const Scene& scene);
 SolverSpec parseSolver(const JsonReader& r, const json& s, const Pointer& p);
-PlotSpec parsePlot(const JsonReader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN, int nCases);
+/// `inputColumns`: the task paths' input columns (taskInputColumns), allowed on the axes too.
+PlotSpec parsePlot(const JsonReader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN, int nCases,
+                   const std::vector<std::string>& inputColumns = {});
 /// The plots of a scene without "plots": one per analysis that has a plot.
 std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a, int nCases);
 

@@ -197,7 +197,17 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
         const std::string before = p["stability_before"], after = p["stability_after"];
         INFO(scene.stem().string() << ": " << type << " at " << p["parameter"] << " (" << field << ", " << before
                                    << " -> " << after << ")");
-        if (type == "BP") {
+        if (field == "task path") {
+          // where a task path ends (case_runner_task.cpp): why, in words, and the inputs there
+          CHECK((type == "LP" || type == "BP" || type == "LS" || type == "BD" || type == "IB"));
+          CHECK(!p.value("note", "").empty());
+          CHECK(p.contains("inputs"));
+          if (type == "LS") {  // the path ends where the equilibrium at fixed inputs stops being stable
+            CHECK(before == "stable");
+            CHECK(after == "unstable");
+          }
+          CHECK(!p.contains("jump_to"));
+        } else if (type == "BP") {
           CHECK(field == "buckling");
         } else if (type == "LP") {
           const bool stableSide = before == "stable" || after == "stable";

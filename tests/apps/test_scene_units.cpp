@@ -48,6 +48,7 @@ struct Units {
     if (key == "x" || key == "y") return length;
     if (key == "L1_0" || key == "L2_0" || key == "L0" || key == "dL0") return length;  // control inputs
     if (key == "gravity") return length;  // masses × k/L per length keep the time unit: m g × k L
+    if (key == "s") return length;  // a task path's arclength
     return 1.0;  // phi
   }
   /// Unit of the reaction of a held coordinate.
@@ -83,6 +84,22 @@ void scaleEnd(json& end, const Units& u) {
 }
 
 void scalePath(json& path, const std::string& parameter, const Units& u) {
+  if (path.contains("task")) {  // a task path: its points on the task coordinates, the inputs' bounds
+    json& t = path["task"];
+    const json coordinates = t["coordinates"];
+    const auto scalePoint = [&](json& point) {
+      for (size_t k = 0; k < point.size(); ++k) point[k] = point[k].get<double>() * u.of(coordinates[k].get<std::string>());
+    };
+    for (const char* key : {"from", "to"})
+      if (t.contains(key)) scalePoint(t[key]);
+    if (t.contains("waypoints"))
+      for (json& w : t["waypoints"]) scalePoint(w);
+    if (path.contains("inputs"))
+      for (json& in : path["inputs"])
+        for (const char* key : {"min", "max"})
+          if (in.is_object() && in.contains(key)) in[key] = in[key].get<double>() * u.length;
+    return;
+  }
   const double unit = u.of(parameter);
   for (const char* key : {"from", "to"})
     if (path.contains(key)) path[key] = path[key].get<double>() * unit;
@@ -110,6 +127,9 @@ void scaleBody(json& doc, const std::string& parameter, const Units& u) {
 }
 
 std::string parameterOf(const json& scene, const json& patch) {
+  if (patch.contains("path") && patch["path"].contains("task")) return "s";
+  if (scene.contains("path") && scene["path"].contains("task") && !(patch.contains("path") && patch["path"].contains("parameter")))
+    return "s";
   if (patch.contains("path") && patch["path"].contains("parameter")) return patch["path"]["parameter"];
   if (scene.contains("path") && scene["path"].contains("parameter")) return scene["path"]["parameter"];
   return "";

@@ -93,6 +93,12 @@ def test_module_results_equal_the_command_line(name, source_dir, run_cli, tmp_pa
             for k in omega:
                 csv_omega = np.array([float(row[k]) if row[k] not in ("", "nan") else np.nan for row in mine])
                 np.testing.assert_allclose(b[k], csv_omega, rtol=1e-11, atol=1e-11 * np.nanmax(np.abs(csv_omega)))
+            # a task path's inputs (`path.task`): the CSV's input columns, same values
+            inputs = [k for k in mine[0] if k.split("[")[0] in ("L1_0", "L2_0", "L0", "dL0")]
+            assert sorted(k for k in b if str(k).split("[")[0] in ("L1_0", "L2_0", "L0", "dL0")) == sorted(inputs)
+            for k in inputs:
+                csv_input = np.array([float(row[k]) if row[k] not in ("", "nan") else np.nan for row in mine])
+                np.testing.assert_allclose(b[k], csv_input, rtol=1e-11, atol=1e-11)
 
 
 EQUILIBRIA_SCENES = [name for name in SCENES if "equilibria" in json.loads(

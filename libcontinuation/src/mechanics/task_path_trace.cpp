@@ -1,0 +1,196 @@
+#include "buckle/mechanics/task_path_trace.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace buckle::mechanics {
+
+namespace cont = buckle::continuation;
+
+const char* toString(TaskPathEvent event) {
+  switch (event) {
+    case TaskPathEvent::Completed: return "completed";
+    case TaskPathEvent::Fold: return "fold";
+    case TaskPathEvent::BranchPoint: return "branch point";
+    case TaskPathEvent::StabilityLoss: return "loss of stability";
+    case TaskPathEvent::JointLimit: return "joint limit";
+    case TaskPathEvent::InputBound: return "input bound";
+    case TaskPathEvent::MaxPoints: return "max points";
+    case TaskPathEvent::Failed: return "failed";
+    case TaskPathEvent::Interrupted: return "interrupted";
+  }
+  return "";
+}
+
+double taskLegLength(const TaskSetup& setup, const Vector& from, const Vector& to, double angleLength) {
+  double sum = 0.0;
+  for (size_t k = 0; k < setup.coordinates.size(); ++k) {
+    const double d = (to[Eigen::Index(k)] - from[Eigen::Index(k)]) * (setup.coordinates[k] == 2 ? angleLength : 1.0);
+    sum += d * d;
+  }
+  return std::sqrt(sum);
+}
+
+bool taskPathPoint(TaskPathProblem& problem, const Vector& u, double s, bool stiffness, TaskPathPoint& out) {
+  const int n = problem.segments();
+  out.s = s;
+  out.q = u.head(n);
+  out.inputs = u.segment(n, problem.inputCount());
+  out.pose = endPose(problem.chain(), out.q);
+  out.target = problem.target(s);
+  if (!problem.fixedInputStability(u, out.inertia, out.minEigenvalue)) return false;
+  out.stable = out.inertia.negative == 0 && out.inertia.zero == 0;
+  out.K.setConstant(std::numeric_limits<double>::quiet_NaN());
+  out.C.setConstant(std::numeric_limits<double>::quiet_NaN());
+  if (!stiffness || out.inertia.zero > 0) return true;
+  // C_F = J_p H⁻¹ J_pᵀ (eq 29, rotation free) by two O(n) solves through T (chain_structure.h)
+  ChainStructure ws(n);
+  Matrix B, Jc;
+  if (!problem.assembleStructure(u, ws, B, Jc)) return false;
+  ChainData data(problem.chain());
+  forwardKinematics(problem.chain(), out.q, data);
+  Matrix J(3, n);
+  endJacobian(data, J);
+  Matrix X(n, 2);
+  for (int c = 0; c < 2; ++c) {
+    Vector x(n);
+    if (!solve(ws, J.row(c).transpose(), x)) return true;
+    X.col(c) = x;
+  }
+  out.C = J.topRows(2) * X;
+  out.C = 0.5 * (out.C + out.C.transpose()).eval();
+  if (out.C.determinant() != 0.0) out.K = out.C.inverse();
+  return true;
+}
+
+namespace {
+
+TaskPathEvent boundaryEvent(TaskPathProblem& problem, const std::string& name) {
+  for (int k = 0; k < problem.boundaryCount(); ++k)
+    if (problem.boundaryName(k) == name) {
+      switch (problem.boundaryKind(k)) {
+        case TaskPathProblem::BoundaryKind::JointLimit: return TaskPathEvent::JointLimit;
+        case TaskPathProblem::BoundaryKind::InputBound: return TaskPathEvent::InputBound;
+        case TaskPathProblem::BoundaryKind::Stability: return TaskPathEvent::StabilityLoss;
+      }
+    }
+  return TaskPathEvent::Failed;
+}
+
+// The special point that ends a leg, from the tracer's located point.
+TaskPathSpecial special(TaskPathProblem& problem, const cont::SpecialPoint& sp, TaskPathEvent event, int leg,
+                        bool stiffness) {
+  TaskPathSpecial out;
+  out.event = event;
+  out.accuracy = sp.lambdaAccuracy;
+  taskPathPoint(problem, sp.u, sp.lambda, stiffness, out.point);
+  out.point.leg = leg;
+  switch (event) {
+    case TaskPathEvent::Fold:
+      out.why = "fold of the task map: the inputs cannot move the end further along the path (s turns back)";
+      break;
+    case TaskPathEvent::BranchPoint: out.why = "branch point of the task continuation: the path is not followed uniquely"; break;
+    default: out.why = sp.boundaryName; break;
+  }
+  return out;
+}
+
+}  // namespace
+
+TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const std::vector<Vector>& waypoints,
+                             double angleLength, const TaskPathOptions& options) {
+  TaskPathResult result;
+  const TaskSetup& setup = problem.setup();
+  const int m = problem.taskCount();
+  const Pose pose0 = endPose(problem.chain(), q0);
+  std::vector<Vector> corners{Vector(m)};
+  for (int k = 0; k < m; ++k) corners[0][k] = pose0[setup.coordinates[size_t(k)]];
+  for (const Vector& w : waypoints) corners.push_back(w);
+  Vector u = problem.pack(q0, problem.startInputs());
+  double s = 0.0;
+  result.legEnds.push_back(0.0);
+  const double tiny = 1e-12 * std::max(problem.lengthUnit(), problem.chain().length());
+  for (size_t k = 0; k + 1 < corners.size(); ++k) {
+    const double length = taskLegLength(setup, corners[k], corners[k + 1], angleLength);
+    if (!(length > tiny)) continue;
+    const int leg = int(result.legEnds.size()) - 1;
+    problem.setLeg({corners[k], (corners[k + 1] - corners[k]) / length, s});
+    cont::TracerOptions opt = options.tracer;
+    opt.lambdaMin = s - length;
+    opt.lambdaMax = s + length;
+    opt.computeStability = false;
+    opt.certifiedCounting = false;
+    opt.detectBoundaries = true;
+    const cont::StepCallback user = opt.onStep;
+    // a fold or branch point ends the path: nothing past it follows the task stably and uniquely
+    opt.onStep = [user](const cont::Branch& b) {
+      for (const cont::SpecialPoint& sp : b.specialPoints)
+        if (sp.type == cont::SpecialPointType::Fold || sp.type == cont::SpecialPointType::BranchPoint)
+          return cont::StepAction::Stop;
+      return user ? user(b) : cont::StepAction::Continue;
+    };
+    const cont::Branch b = cont::trace(problem, u, s, cont::InitialDirection::increasingLambda(), opt);
+    if (b.points.empty()) {
+      result.end = TaskPathEvent::Failed;
+      result.message = "leg " + std::to_string(leg + 1) + ": " + b.stopMessage;
+      return result;
+    }
+    const cont::SpecialPoint* stop = nullptr;
+    for (const cont::SpecialPoint& sp : b.specialPoints)
+      if (sp.type == cont::SpecialPointType::Fold || sp.type == cont::SpecialPointType::BranchPoint) {
+        stop = &sp;
+        break;
+      }
+    const size_t last = stop ? size_t(stop->index) : b.points.size() - 1;
+    for (size_t i = (k == 0 ? 0 : 1); i <= last; ++i) {
+      TaskPathPoint p;
+      p.leg = leg;
+      if (!taskPathPoint(problem, b.points[i].u, b.points[i].lambda, options.stiffness, p)) continue;
+      result.points.push_back(p);
+      result.worstResidual = std::max(result.worstResidual, b.points[i].residualNorm);
+    }
+    if (stop) {
+      const TaskPathEvent e = stop->type == cont::SpecialPointType::Fold ? TaskPathEvent::Fold : TaskPathEvent::BranchPoint;
+      result.specials.push_back(special(problem, *stop, e, leg, options.stiffness));
+      result.points.push_back(result.specials.back().point);
+      result.end = e;
+      result.message = result.specials.back().why;
+      return result;
+    }
+    switch (b.stopReason) {
+      case cont::StopReason::LambdaRange:
+        if (std::abs(b.points.back().lambda - (s + length)) <= 1e-9 * length) break;
+        result.end = TaskPathEvent::Failed;
+        result.message = "leg " + std::to_string(leg + 1) + ": the continuation turned back to the leg's start";
+        return result;
+      case cont::StopReason::Boundary: {
+        const cont::SpecialPoint& sp = b.specialPoints.back();
+        result.specials.push_back(special(problem, sp, boundaryEvent(problem, sp.boundaryName), leg, options.stiffness));
+        result.end = result.specials.back().event;
+        result.message = sp.boundaryName;
+        return result;
+      }
+      case cont::StopReason::MaxPoints:
+        result.end = TaskPathEvent::MaxPoints;
+        result.message = "leg " + std::to_string(leg + 1) + ": the solver's point limit (" +
+                         std::to_string(opt.maxPoints) + ") reached";
+        return result;
+      case cont::StopReason::Interrupted:
+        result.end = TaskPathEvent::Interrupted;
+        result.message = b.stopMessage;
+        return result;
+      default:
+        result.end = TaskPathEvent::Failed;
+        result.message = "leg " + std::to_string(leg + 1) + ": " + std::string(cont::toString(b.stopReason)) + ": " + b.stopMessage;
+        return result;
+    }
+    u = b.points.back().u;
+    s += length;
+    result.legEnds.push_back(s);
+  }
+  result.end = TaskPathEvent::Completed;
+  return result;
+}
+
+}  // namespace buckle::mechanics
