@@ -136,6 +136,13 @@ TEST_CASE("scene body loads: bad input names the JSON path, exit 2, nothing writ
   requireBadInput("mass_model",
                   scene(kGravity, kGravityPath, R"({"continuation": true, "frequencies": {"mass_per_length": 0.5}})"),
                   "/analyses/frequencies/mass_per_length", "one mass model");
+  requireBadInput("task_path",
+                  R"({"chain": {"segments": 4, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+                      "end": {"x": {"load": 0.0}, "y": {"load": -0.1}, "phi": {"load": 0.0}}, )" +
+                      kGravity +
+                      R"(, "path": {"task": {"coordinates": ["x"], "to": [3.0]}, "inputs": [{"input": "dL0"}],
+                      "rule": "chosen"}, "analyses": {"continuation": true}, "plots": []})",
+                  "/path/task", "task-space path does not take");
   requireBadInput("mass_unit", R"({"units": {"length": "m", "force": "N"},)" + scene(kGravity, kGravityPath, cont).substr(1),
                   "/units/mass", "mass unit");
 }
