@@ -5,8 +5,6 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <csignal>
-#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -14,19 +12,14 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
-#include <random>
 #include <sstream>
 #include <stdexcept>
-#include <pthread.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "scene/output_equilibria.h"
 #include "scene/output_numbers.h"
 #include "scene/escape.h"
 #include "scene/output_target.h"
 #include "scene/report.h"
-#include "scene/signals.h"
 
 namespace buckle::scene {
 
@@ -528,58 +521,6 @@ double columnValue(const std::string& column, const SpecialRecord& s, const mech
   }
   // NaN unless the point carries its own K_F (KMIN)
   return stiffnessColumnValue(column, s.K, Eigen::Matrix2d::Constant(kNaN));
-}
-
-StagingDirectory::StagingDirectory(const std::string& target) : target_(target) {
-  fs::path t = fs::absolute(fs::path(target)).lexically_normal();
-  if (t.filename().empty()) t = t.parent_path();
-  target_ = t.string();
-  fs::create_directories(t.parent_path());
-  const sigset_t hold = stopSignals();
-  pthread_sigmask(SIG_BLOCK, &hold, &previousMask_);
-  // Not mkdtemp: it makes the directory 0700, and the renamed output would not follow the
-  // umask. mkdir(0777) does; the random suffix and EEXIST retry give the same uniqueness.
-  std::random_device seed;
-  std::mt19937_64 random(seed() ^ (std::uint64_t(::getpid()) << 32));
-  const char* const alphabet = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
-  for (int attempt = 0; attempt < 100; ++attempt) {
-    std::string suffix(6, 'x');
-    for (char& ch : suffix) ch = alphabet[random() % 62];
-    const std::string candidate = (t.parent_path() / ("." + t.filename().string() + ".tmp-" + suffix)).string();
-    if (::mkdir(candidate.c_str(), 0777) == 0) {
-      path_ = candidate;
-      return;
-    }
-    if (errno != EEXIST) break;
-  }
-  const int error = errno;
-  pthread_sigmask(SIG_SETMASK, &previousMask_, nullptr);
-  throw std::runtime_error("cannot create a temporary directory next to " + target_ + ": " + std::strerror(error));
-}
-
-StagingDirectory::~StagingDirectory() {
-  if (!committed_) {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  pthread_sigmask(SIG_SETMASK, &previousMask_, nullptr);  // a held-back signal is delivered now
-}
-
-void StagingDirectory::commit() {
-  std::error_code ec;
-  std::string old;
-  if (fs::exists(target_)) {
-    old = path_ + ".old";
-    fs::rename(target_, old, ec);
-    if (ec) throw std::runtime_error("cannot move the previous " + target_ + " aside: " + ec.message());
-  }
-  fs::rename(path_, target_, ec);
-  if (ec) {
-    if (!old.empty()) fs::rename(old, target_, ec);
-    throw std::runtime_error("cannot rename " + path_ + " to " + target_ + ": " + ec.message());
-  }
-  committed_ = true;
-  if (!old.empty()) fs::remove_all(old, ec);
 }
 
 PlotReport writeOutputs(const Scene& scene, const RunResult& run, const std::string& dirName,
