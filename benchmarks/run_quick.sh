@@ -34,4 +34,6 @@ command -v mpirun > /dev/null && BUILD=$BUILD run atlas_mpi "$HERE/atlas_mpi.sh"
 run long_tree "$BIN/long_tree" --quick
 run vibration_timing "$BIN/vibration_timing" --quick
 run actuation_path "$BIN/actuation_path" --quick   # issue 29
+run task_path "$BIN/task_path" --quick   # issue 29, task-space paths
+run gravity_path "$BIN/gravity_path" --quick   # issue 31, weight
 exit $status
