@@ -127,7 +127,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
     r.locked = p.locked.label();
     r.contactTorque = p.contactTorque;
     if (scene_.analyses.frequencies.enabled) r.omega = naturalFrequencies(p.q, p.F, p.locked, p.parameter);
-    out_.points.push_back(r);
+    out_.points.push_back(std::move(r));
   }
   run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
 

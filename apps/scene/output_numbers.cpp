@@ -23,8 +23,13 @@ constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8
 /// decimal rounding, or 10^|k| not exact): the caller formats v itself.
 bool scaledDigits(double a, int digits, std::uint64_t& m, int& x) {
   if (!(a > 0.0) || digits > 15) return false;
-  x = int(std::floor(std::log10(a)));
-  for (int attempt = 0; attempt < 2; ++attempt) {
+  // The decade from the binary exponent: a = f·2^e, f in [0.5, 1), so log10(a) lies in
+  // [(e − 1)·log10(2), e·log10(2)): x is floor of the lower end or one more, and the loop below
+  // moves it up when it is one short (std::log10 was a tenth of a long chain's writing).
+  int e = 0;
+  std::frexp(a, &e);
+  x = int(std::floor((e - 1) * 0.30102999566398120));
+  for (int attempt = 0; attempt < 3; ++attempt) {
     const int k = digits - 1 - x;
     if (k < -22 || k > 22) return false;
     const double s = k >= 0 ? a * kPow10[k] : a / kPow10[-k];
