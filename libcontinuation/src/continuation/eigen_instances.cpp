@@ -6,8 +6,6 @@ template class Eigen::JacobiSVD<Eigen::MatrixXd>;
 template class Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>;
 template class Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>;
 template class Eigen::EigenSolver<Eigen::MatrixXd>;
-template class Eigen::GeneralizedEigenSolver<Eigen::MatrixXd>;
-template class Eigen::Tridiagonalization<Eigen::MatrixXd>;
 template class Eigen::FullPivLU<Eigen::MatrixXd>;
 template class Eigen::PartialPivLU<Eigen::MatrixXd>;
 template class Eigen::HouseholderQR<Eigen::MatrixXd>;

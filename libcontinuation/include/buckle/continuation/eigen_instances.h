@@ -13,8 +13,6 @@ extern template class Eigen::JacobiSVD<Eigen::MatrixXd>;
 extern template class Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>;
 extern template class Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>;
 extern template class Eigen::EigenSolver<Eigen::MatrixXd>;
-extern template class Eigen::GeneralizedEigenSolver<Eigen::MatrixXd>;
-extern template class Eigen::Tridiagonalization<Eigen::MatrixXd>;
 extern template class Eigen::FullPivLU<Eigen::MatrixXd>;
 extern template class Eigen::PartialPivLU<Eigen::MatrixXd>;
 extern template class Eigen::HouseholderQR<Eigen::MatrixXd>;
