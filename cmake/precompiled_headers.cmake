@@ -1,6 +1,6 @@
 # Precompiled headers: the heavy third-party headers (Eigen, Catch2, nlohmann::json, pybind11)
-# are parsed once per target instead of once per source file; on a fresh 2-core machine they were
-# most of the compile time (benchmarks/RESULTS.md, first build). Only headers every source of the
+# are parsed once per target instead of once per source file (benchmarks/RESULTS.md, first
+# build). Only headers every source of the
 # target may see first: no target defines a macro that changes them (EIGEN_*, CATCH_CONFIG_*).
 # BUCKLE_PCH=OFF builds without them (e.g. to check that every file includes what it uses).
 option(BUCKLE_PCH "Precompile the third-party headers of each target" ON)

@@ -20,6 +20,24 @@
 #include "run_command.h"
 #include "show_command.h"
 
+#if defined(__GLIBC__)
+namespace {
+// Each 4 kB page the heap touches first costs a page fault, and under a hypervisor a costly one
+// (a tree of a few thousand points touches thousands: benchmarks/RESULTS.md). Grow the heap by its
+// top pad now and ask for transparent huge pages on it (honoured where the kernel's THP mode is
+// `madvise` or `always`), as glibc's own tunable glibc.malloc.hugetlb=1 does.
+void adviseHugePagesForHeap() {
+  const auto low = reinterpret_cast<std::uintptr_t>(sbrk(0));
+  void* volatile grow = std::malloc(1 << 20);  // volatile: a malloc/free pair may be elided
+  std::free(grow);
+  const auto high = reinterpret_cast<std::uintptr_t>(sbrk(0));
+  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
+  const std::uintptr_t from = (low + kHuge - 1) & ~(kHuge - 1), to = high & ~(kHuge - 1);
+  if (high > low && to > from) madvise(reinterpret_cast<void*>(from), to - from, MADV_HUGEPAGE);
+}
+}  // namespace
+#endif
+
 int main(int argc, char** argv) {
 #if defined(__GLIBC__)
   // Outside the tracer's preallocated hot loop, a tree allocates and frees large blocks again and
@@ -31,20 +49,7 @@ int main(int argc, char** argv) {
   mallopt(M_TRIM_THRESHOLD, 64 << 20);
   mallopt(M_TOP_PAD, 16 << 20);
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  // Each 4 kB page the heap touches first costs a page fault, and under a hypervisor a costly one:
-  // a 30-segment tree faulted in 2300 pages, ~15 % of its CPU (benchmarks/RESULTS.md, start-up and
-  // small chains). Grow the heap by its top pad now and ask for transparent huge pages on it
-  // (honoured where the kernel's THP mode is `madvise` or `always`), as glibc's own tunable
-  // glibc.malloc.hugetlb=1 does. Short runs never reach a whole huge page and are unaffected.
-  {
-    const auto low = reinterpret_cast<std::uintptr_t>(sbrk(0));
-    void* volatile grow = std::malloc(1 << 20);  // volatile: a malloc/free pair may be elided
-    std::free(grow);
-    const auto high = reinterpret_cast<std::uintptr_t>(sbrk(0));
-    constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
-    const std::uintptr_t from = (low + kHuge - 1) & ~(kHuge - 1), to = high & ~(kHuge - 1);
-    if (high > low && to > from) madvise(reinterpret_cast<void*>(from), to - from, MADV_HUGEPAGE);
-  }
+  adviseHugePagesForHeap();
 #endif
 #if BUCKLE_MPI_PROGRAM
   CLI::App app{"buckle-mpi: `buckle atlas` shared among the processes of mpirun (mpirun -np N buckle-mpi atlas ...)"};
