@@ -21,6 +21,7 @@ inline double metricDiagonal(int k, int n) { return k + 1 < n ? 2.0 : 1.0; }
 void factorize(ChainStructure& ws, double sigma, bool determinant) {
   const int n = ws.n;
   ws.shift = sigma;
+  ++ws.factorizations;
   ws.singular = false;
   ws.factorInertia = Inertia{};
   // det as mantissa · 2^exponent, rescaled occasionally (a log per pivot would dominate the cost)
@@ -48,6 +49,10 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
   auto a = [&](int k) { return ws.diag[k] - sigma * metricDiagonal(k, n); };
   auto e = [&](int k) { return ws.off[k] + sigma; };  // M off-diagonal is −1
 
+  // With the determinant: its logarithmic derivative d log|det(T − σM)|/dσ = Σ p'/p over the
+  // pivots p (the 2×2 blocks' determinants), carried through the recurrence (dk' is the σ-derivative
+  // of the pivot candidate dk; a' = −M_kk, e' = 1): Newton on det in eigenvaluesFrom().
+  double ddk = -metricDiagonal(0, n), dLog = 0.0;
   int k = 0;
   double dk = a(0);
   while (k < n) {
@@ -67,9 +72,12 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
       }
       accumulate(dk);
       minRatio = std::min(minRatio, std::abs(dk) / scale);
+      if (determinant) dLog += ddk / dk;
       if (k + 1 < n) {
-        ws.l1[k] = ek / dk;
-        dk = a(k + 1) - ek * ws.l1[k];
+        const double l = ek / dk;
+        ws.l1[k] = l;
+        dk = a(k + 1) - ek * l;
+        if (determinant) ddk = -metricDiagonal(k + 1, n) - 2.0 * l + l * l * ddk;  // (a − e²/d)'
       }
       k += 1;
     } else {
@@ -88,10 +96,16 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
       // smallest |eigenvalue| of the block ≥ |det| / (largest |eigenvalue|)
       const double big = 0.5 * std::abs(dk + b) + std::hypot(0.5 * (dk - b), ek);
       minRatio = std::min(minRatio, std::abs(det) / (big * scale));
+      const double ddet = ddk * b - dk * metricDiagonal(k + 1, n) - 2.0 * ek;
+      if (determinant) dLog += ddet / det;
       if (k + 2 < n) {
         const double ek1 = e(k + 1);
         ws.l1[k] = -ek1 * ek / det;
         ws.l2[k] = ek1 * dk / det;
+        if (determinant) {
+          const double r = dk / det, dr = (ddk - r * ddet) / det;  // dk/det and its derivative
+          ddk = -metricDiagonal(k + 2, n) - 2.0 * ek1 * r - ek1 * ek1 * dr;
+        }
         dk = a(k + 2) - ek1 * ek1 * dk / det;
       }
       k += 2;
@@ -101,6 +115,7 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
   ws.logAbsDet = determinant ? std::log(std::abs(mant)) + double(expo) * 0.6931471805599453
                              : std::numeric_limits<double>::quiet_NaN();
   ws.detSign = sign;
+  ws.dLogAbsDet = determinant ? dLog : std::numeric_limits<double>::quiet_NaN();
 }
 
 int countBelow(const ChainStructure& ws, double sigma) {

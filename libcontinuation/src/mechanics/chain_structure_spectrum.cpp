@@ -4,8 +4,10 @@
 #include "buckle/mechanics/chain_structure.h"
 
 #include <array>
+#include <limits>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -125,11 +127,14 @@ Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C
 
 namespace {
 
-/// Count below σ and log|det|, sign of det K_σ (or of det(T − σM) without constraints).
+/// Count below σ and log|det|, sign of det K_σ (or of det(T − σM) without constraints), and the
+/// logarithmic derivative d log|det|/dσ: det K_σ = c·Π(ν_j − σ) over the eigenvalues ν_j wanted
+/// (chain_structure.h), so σ − 1/dLog is Newton's step towards the nearest of them.
 struct ShiftEvaluation {
   int below = 0;
   double logAbsDet = 0.0;
   int sign = 1;
+  double dLog = 0.0;
 };
 
 ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double sigma) {
@@ -140,13 +145,78 @@ ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double si
     ev.below = ws.factorInertia.negative;
     ev.logAbsDet = ws.logAbsDet;
     ev.sign = ws.detSign;
+    ev.dLog = ws.dLogAbsDet;
     return ev;
   }
   ev.below = constrainedCountBelow(ws, sigma);
   const double detS = ws.S.determinant();
   ev.logAbsDet = ws.logAbsDet + std::log(std::abs(detS));
   ev.sign = ws.detSign * (detS < 0.0 ? -1 : 1);
+  // det K_σ = det(T − σM)·det S, S = −BᵀX with X = (T − σM)⁻¹B: S' = −XᵀMX (M tridiagonal:
+  // diagonal 2, …, 2, 1, off-diagonal −1), and (log|det S|)' = tr(S⁻¹S').
+  const int n = ws.n;
+  ChainStructure::SmallMatrix dS(r, r);
+  for (int b = 0; b < r; ++b) {
+    const auto xb = ws.X.col(b);
+    for (int a = 0; a <= b; ++a) {
+      const auto xa = ws.X.col(a);
+      double sum = 0.0;
+      for (int i = 0; i < n; ++i) {
+        double mx = (i + 1 < n ? 2.0 : 1.0) * xb[i];
+        if (i > 0) mx -= xb[i - 1];
+        if (i + 1 < n) mx -= xb[i + 1];
+        sum += xa[i] * mx;
+      }
+      dS(a, b) = dS(b, a) = -sum;
+    }
+  }
+  ev.dLog = ws.dLogAbsDet + Eigen::PartialPivLU<ChainStructure::SmallMatrix>(ws.S).solve(dS).trace();
   return ev;
+}
+
+/// Newton on det K_σ from σ0 towards eigenvalue `index` (ascending, counted by the evaluations),
+/// every evaluation narrowing (lo, hi) by its count. True when a step fell below tol/4 and counts
+/// isolate the eigenvalue in a bracket of width < tol around the limit: `record` has then seen
+/// shifts a, b with count(a) = index, count(b) = index + 1, b − a < tol. False (the caller's
+/// isolation and Illinois polish take over from what was recorded) when an iterate leaves the
+/// bracket, a step fails to halve the one before (Newton far from the root, on the flat part
+/// of a polynomial with many roots), or after `maxSteps` evaluations.
+template <class Record>
+bool newtonFrom(ChainStructure& ws, bool useConstraints, int index, double sigma0, double tol, int maxSteps,
+                double lo, double hi, Record&& record) {
+  int countLo = -1, countHi = -1;  // counts at lo and hi once evaluated
+  auto evaluate = [&](double s) {
+    const ShiftEvaluation ev = evaluateShift(ws, useConstraints, s);
+    record(s, ev);
+    if (ev.below > index) {
+      if (s < hi) hi = s, countHi = ev.below;
+    } else if (s > lo) {
+      lo = s, countLo = ev.below;
+    }
+    return ev;
+  };
+  double c = sigma0, lastStep = std::numeric_limits<double>::infinity();
+  for (int step = 0; step < maxSteps; ++step) {
+    if (!(c > lo && c < hi)) return false;
+    const ShiftEvaluation ev = evaluate(c);
+    if (!std::isfinite(ev.dLog) || ev.dLog == 0.0) return false;
+    const double next = c - 1.0 / ev.dLog;
+    const double size = std::abs(next - c);
+    if (!std::isfinite(next) || size > 0.5 * lastStep) return false;
+    // Quadratic convergence: the error left after this step is about (size/lastStep)²·size.
+    const double predicted = std::isfinite(lastStep) ? size * (size / lastStep) * (size / lastStep) : size;
+    lastStep = size;
+    if (size <= 0.25 * tol || predicted <= 0.01 * tol) {
+      // Converged, quadratically: the root is far closer to `next` than the step. Certify by the
+      // counts at next ∓ 0.45 tol (the bracket then narrower than tol after rounding), or at
+      // lo / hi where they already lie that close.
+      const double a = next - 0.45 * tol, b = next + 0.45 * tol;
+      if (!(lo >= a && countLo == index) && !(a > lo && evaluate(a).below == index)) return false;
+      return (hi <= b && countHi == index + 1) || (b < hi && evaluate(b).below == index + 1);
+    }
+    c = next;
+  }
+  return false;
 }
 
 }  // namespace
@@ -203,10 +273,20 @@ int eigenvaluesFrom(ChainStructure& ws, bool useConstraints, int first, int coun
       lo[j] = out[j - 1] - tol;
       haveLo[size_t(j)] = false;
     }
-    // Warm start (e.g. the previous continuation point): counts around the guess, widening by 8
-    // from 2 % of it. (A width tied to ‖H‖ instead isolates nothing on a long or strongly loaded
-    // chain, whose lowest eigenvalues are spaced ~κ/n² ≪ 1e−3‖H‖_F, and bisection then pays
-    // ~log2(‖H‖ n²/κ) counts per eigenvalue and point.)
+    // Warm start: Newton on det K_σ from the guess, certified by the counts either side of its
+    // limit. A guess a step δ along the branch away (the spectral monitor's second evaluation) or
+    // one continuation step away is within Newton's quadratic range, so this costs three to five
+    // factorizations where isolation and Illinois took ten or more.
+    if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
+      if (newtonFrom(ws, useConstraints, first + j, (*guess)[j], tol, 8, lo[j], hi[j], record) && isolated(j) &&
+          hi[j] - lo[j] <= tol) {
+        out[j] = 0.5 * (lo[j] + hi[j]);
+        continue;
+      }
+    }
+    // Otherwise counts around the guess, widening by 8 from 2 % of it. (A width tied to ‖H‖
+    // instead isolates nothing on a long or strongly loaded chain, whose lowest eigenvalues are
+    // spaced ~κ/n² ≪ 1e−3‖H‖_F, and bisection then pays ~log2(‖H‖ n²/κ) counts per eigenvalue.)
     if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
       double delta = std::max(1e-9 * scale, 0.02 * std::abs((*guess)[j]));
       for (int attempt = 0; attempt < 10 && !isolated(j); ++attempt, delta *= 8.0) {
@@ -223,15 +303,24 @@ int eigenvaluesFrom(ChainStructure& ws, bool useConstraints, int first, int coun
       record(mid, evaluateShift(ws, useConstraints, mid));
     }
     if (isolated(j) && hi[j] - lo[j] > tol) {
-      // Illinois on det, one simple root in the bracket; the counts keep the bracket honest.
+      // One simple root of det in the bracket: Newton from its regula falsi point, then (if
+      // Newton leaves the bracket) Illinois; the counts keep the bracket honest.
       const ShiftEvaluation ea = haveLo[size_t(j)] ? evLo[size_t(j)] : evaluateShift(ws, useConstraints, lo[j]);
       const ShiftEvaluation eb = haveHi[size_t(j)] ? evHi[size_t(j)] : evaluateShift(ws, useConstraints, hi[j]);
       const double ref = 0.5 * (ea.logAbsDet + eb.logAbsDet);
       auto value = [&](const ShiftEvaluation& e) {
         return e.sign * std::exp(std::max(-700.0, std::min(700.0, e.logAbsDet - ref)));
       };
+      const continuation::IllinoisBracket start{lo[j], hi[j], value(ea), value(eb), 0};
+      if (newtonFrom(ws, useConstraints, first + j, start.next(), tol, 8, lo[j], hi[j], record) && isolated(j) &&
+          hi[j] - lo[j] <= tol) {
+        out[j] = 0.5 * (lo[j] + hi[j]);
+        continue;
+      }
       // Illinois on the determinant, the side of the root decided by the count (exact)
-      continuation::IllinoisBracket br{lo[j], hi[j], value(ea), value(eb), 0};
+      const ShiftEvaluation ea2 = haveLo[size_t(j)] ? evLo[size_t(j)] : evaluateShift(ws, useConstraints, lo[j]);
+      const ShiftEvaluation eb2 = haveHi[size_t(j)] ? evHi[size_t(j)] : evaluateShift(ws, useConstraints, hi[j]);
+      continuation::IllinoisBracket br{lo[j], hi[j], value(ea2), value(eb2), 0};
       for (int it = 0; it < 200 && br.width() > tol; ++it) {
         // keep progress: never closer than tol/4 to an end
         const double c = std::min(std::max(br.next(), br.left + 0.25 * tol), br.right - 0.25 * tol);

@@ -36,10 +36,13 @@
 //    (block elimination with refinement is accurate near folds where H itself is singular,
 //    Govaerts 2000, ch. 3). This covers the KKT system (V = W = Cᵀ, D = 0) and the Keller
 //    pseudo-arclength system of the corrector. Requires T − 0·M to be nonsingular.
-//  - lowestEigenvalues() / smallestEigenvalue(): each eigenvalue is isolated by bisection on the
-//    counts, then polished by Illinois regula falsi on det K_σ (constrained) or det(T − σM),
+//  - lowestEigenvalues() / smallestEigenvalue(): Newton on det K_σ (constrained) or det(T − σM),
 //    whose roots are exactly the eigenvalues wanted (det K_σ = c·Π(ν_j − σ) over the
-//    eigenvalues ν_j of ZᵀHZ): typically 10–25 O(n) factorizations per eigenvalue.
+//    eigenvalues ν_j of ZᵀHZ), its logarithmic derivative carried through the factorization;
+//    from a warm start (the previous point's values) directly, otherwise after isolating the
+//    eigenvalue by bisection on the counts, with Illinois regula falsi where Newton leaves the
+//    bracket. Every result is certified by the counts either side of it: typically 3–5 O(n)
+//    factorizations per eigenvalue from a warm start, 10–25 from none.
 //
 // The workspace is sized once; no function allocates on the heap after construction.
 #pragma once
@@ -89,6 +92,8 @@ struct ChainStructure {
   bool singular = false;     ///< an exactly zero pivot was replaced
   double logAbsDet = 0.0;    ///< log |det(T − σM)|
   int detSign = 1;           ///< sign of det(T − σM)
+  double dLogAbsDet = 0.0;   ///< d log|det(T − σM)|/dσ (with the determinant; NaN without)
+  long factorizations = 0;   ///< factorize() calls on this workspace (the eigenvalue searches' cost)
 
   // Border storage (n × kMaxBorder) and scratch.
   Matrix Q, B, X, V2, W2;
