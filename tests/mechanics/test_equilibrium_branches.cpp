@@ -364,7 +364,7 @@ TEST_CASE("hard case: top of the spectrum, n = 60: six critical loads 2e-3 apart
 
 TEST_CASE("n = 500 clamped-pinned, default options: the clustered low end to 1e-12 relative, with null vectors",
           "[equilibrium_branches]") {
-  // N = 501 > maxDenseLocationDimension = 400: located and refined by the structured path. The
+  // N = 501 > maxDenseLocationDimension = 16: located and refined by the structured path. The
   // first critical loads are ~κ/n² with gaps of the same order; a step of a third of the range
   // puts two of them in one step.
   const int n = 500;
@@ -411,6 +411,7 @@ TEST_CASE("structured and dense refinement agree on the same chain (crossover fo
     EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
     EquilibriumBranchOptions o = pinnedOptions(0.5 * (crit[2] + crit[3]), 0);
     o.tracer.maxStep = o.tracer.initialStep = std::abs(crit[0]) / 2.7;
+    o.tracer.maxDenseLocationDimension = 400;  // N = 41: dense
     const EquilibriumBranches dense =
         traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
     o.tracer.maxDenseLocationDimension = 10;

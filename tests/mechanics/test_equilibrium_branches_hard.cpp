@@ -186,3 +186,32 @@ TEST_CASE("hard case: kappa = 0, the multiple point at the start of the path is 
     CHECK(best >= 0.999);
   }
 }
+
+TEST_CASE("hard case: a multiple point above the simple points' dense crossover keeps its dense kernel check",
+          "[equilibrium_branches][hard]") {
+  // Simple points go to O(N) algebra from N = maxDenseLocationDimension on; a point of multiplicity
+  // m ≥ 2 keeps the SVD of F_x up to kMaxDenseMultiplePointDimension, which verifies that ker F_x
+  // is (m+1)-dimensional (`refined`) and gives the null vectors its switching starts from. The
+  // κ = 0 chain of 6 segments meets its quintuple point at Fx = 0 (N = 7 > 1 here).
+  const int n = 6;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.5));
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), kAxial);
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMin = -0.5;
+  o.tracer.lambdaMax = 0.5;
+  o.tracer.maxStep = 0.05;
+  o.tracer.initialStep = 0.01;
+  o.tracer.maxDenseLocationDimension = 1;
+  o.switchingDepth = 0;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.3, {cont::InitialDirection::decreasingLambda()}, o);
+  const auto bps = r.tree.branches.at(0).specialPointsOfType(cont::SpecialPointType::BranchPoint);
+  REQUIRE(bps.size() == 1);
+  const cont::SpecialPoint& bp = *bps.front();
+  INFO(bp.note);
+  CHECK(bp.multiplicity == n - 1);
+  CHECK(std::abs(bp.lambda) <= 1e-12);
+  CHECK(bp.refined);
+  CHECK(bp.augmentedResidualNorm <= 1e-8);
+  CHECK(bp.nullVectors.cols() == n);  // the (m+1)-dimensional kernel
+}

@@ -104,7 +104,7 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
   if (!refined && ok && root.fLeft * root.fRight < 0.0) {
     finishSecant(sp, root, test, evaluations, adopt);
     if (options_.denseAlgebra) {
-      fillBranchPointGeometry(sp, a_.point.tangent);
+      fillBranchPointGeometry(sp, a_.point.tangent, true);
     } else {
       Matrix K;
       Vector psi;
@@ -169,7 +169,7 @@ bool Locator::refineBranchPoint(SpecialPoint &sp, const Vector &tangentRef) {
   } else {
     sp.note += (sp.note.empty() ? "" : "; ") + std::string("Moore refinement: ") + result.failure;
   }
-  fillBranchPointGeometry(sp, tangentRef);
+  fillBranchPointGeometry(sp, tangentRef, options_.denseAlgebra);
   return result.converged;
 }
 
@@ -230,8 +230,8 @@ void Locator::setBranchPointGeometry(SpecialPoint &sp, const Vector &tangentRef,
   sp.testFunctionValue = testValue;
 }
 
-void Locator::fillBranchPointGeometry(SpecialPoint &sp, const Vector &tangentRef) {
-  if (!options_.denseAlgebra) return;  // null vectors need the dense kernel
+void Locator::fillBranchPointGeometry(SpecialPoint &sp, const Vector &tangentRef, bool dense) {
+  if (!dense) return;  // null vectors need the dense kernel
   KernelInfo kernel;
   if (!jacobianKernel(problem_, sp.u, sp.lambda, kernel)) return;
   const double scale = std::max(1.0, kernel.singularValues.maxCoeff());
@@ -299,7 +299,8 @@ SpecialPoint Locator::multipleBranchPoint(const StepSample &lo, const StepSample
             format("%.3g); ", hi.s - lo.s) +
             (onMean ? "located on the mean of the crossing eigenvalues" : "located on the lowest crossing eigenvalue");
   sp.residualNorm = residualNorm(sp.u, sp.lambda);
-  if (options_.denseAlgebra) {
+  const bool dense = options_.denseAlgebra || options_.denseMultiplePoints;
+  if (dense) {
     // The point is a multiple one when ker F_x is (m+1)-dimensional there: the m + 1 smallest
     // singular values (one is structural) vanish against the largest.
     KernelInfo kernel;
@@ -314,7 +315,7 @@ SpecialPoint Locator::multipleBranchPoint(const StepSample &lo, const StepSample
                  format(" to %.3g relative", ratio);
     }
   }
-  fillBranchPointGeometry(sp, a_.point.tangent);
+  fillBranchPointGeometry(sp, a_.point.tangent, dense);
   return sp;
 }
 

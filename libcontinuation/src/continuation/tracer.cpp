@@ -1,6 +1,7 @@
 #include "buckle/continuation/tracer.h"
 
 #include "buckle/continuation/locator.h"
+#include "buckle/continuation/multiplicity_switching.h"
 
 #include <algorithm>
 #include <cmath>
@@ -152,6 +153,7 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   lo.detectFolds = options_.detectFolds;
   lo.detectBranchPoints = options_.detectBranchPoints;
   lo.denseAlgebra = n_ <= options_.maxDenseLocationDimension;
+  lo.denseMultiplePoints = n_ <= kMaxDenseMultiplePointDimension;
   lo.interrupt = options_.interrupt;
   lo.touchTolerance = options_.touchTolerance;
   if (options_.onLocated)

@@ -58,6 +58,10 @@ struct LocatorOptions {
   /// algebra (structured_refinement.h: the problem's structured solver, or dense LU without one);
   /// the secant brackets on O(N) test functions (t_λ, the determinant, the crossing eigenvalue).
   bool denseAlgebra = true;
+  /// Dense kernel (SVD of F_x) at points of multiplicity m ≥ 2 even without denseAlgebra: their
+  /// verification (`refined`: ker F_x (m+1)-dimensional) and null vectors (multiplicity_switching.h,
+  /// kMaxDenseMultiplePointDimension).
+  bool denseMultiplePoints = true;
   /// Certified counting (spectral_monitor.h): a suspected interior minimum of |μ| whose value
   /// is at most touchTolerance·max(1, |μ_a|, |μ_b|) (scaled stability units) without a sign change
   /// is an eigenvalue touch.
@@ -137,7 +141,7 @@ class Locator {
   void finishSecant(SpecialPoint &sp, Root &root, const TestFunction &test, int &evaluations,
                     const std::function<void(bool)> &adopt);
   bool refineBranchPoint(SpecialPoint &point, const Vector &tangentRef);
-  void fillBranchPointGeometry(SpecialPoint &point, const Vector &tangentRef);
+  void fillBranchPointGeometry(SpecialPoint &point, const Vector &tangentRef, bool dense);
   // The O(N) path (denseAlgebra false).
   StructuredRefinement &structured();
   bool refineFoldStructured(SpecialPoint &point, const Vector &tangentRef);

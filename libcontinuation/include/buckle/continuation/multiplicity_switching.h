@@ -39,14 +39,21 @@ struct ReducedBifurcation {
   std::string note;                 ///< how it was obtained, or why it failed
 };
 
+/// Up to this N a point of multiplicity m ≥ 2 gets its kernel from one dense SVD of F_x (the
+/// locator's verification that ker F_x is (m+1)-dimensional, and the reduced equation below):
+/// such points are rare, and the SVD also shows the kernel's dimension. Simple points switch to
+/// O(N) algebra far earlier (TracerOptions::maxDenseLocationDimension).
+constexpr int kMaxDenseMultiplePointDimension = 400;
+
 /// The m-dimensional reduced bifurcation equation at bp (u, λ, tangent set) and all its solution
 /// directions. False (with note) when the kernel is not (m+1)-dimensional to `kernelTolerance`
 /// (relative to the largest singular value, or to the problem's unit above the crossover) or no
-/// direction is found. Above N = maxDenseDimension (TracerOptions::maxDenseLocationDimension's
-/// default) the kernels come from structuredMultipleKernel instead of a dense SVD (through the
-/// problem's structured solver when it takes m + 1 borders, else dense LU).
+/// direction is found. Above N = maxDenseDimension the kernels come from structuredMultipleKernel
+/// instead of a dense SVD (through the problem's structured solver when it takes m + 1 borders,
+/// else dense LU).
 bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
-                                  double kernelTolerance = 1e-7, int maxDenseDimension = 400);
+                                  double kernelTolerance = 1e-7,
+                                  int maxDenseDimension = kMaxDenseMultiplePointDimension);
 
 /// The kernel of F_x = [F_u, F_λ] at a point of multiplicity m without a dense SVD: K ((N+1)×(m+1))
 /// and Psi (N×m), orthonormal, from bordered solves with m + 1 borders through `solver`

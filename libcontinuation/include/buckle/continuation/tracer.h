@@ -127,8 +127,10 @@ struct TracerOptions {
   /// are bracketed on O(N) test functions (t_λ, the determinant, the crossing eigenvalue) and
   /// refined, with their null vectors, by the O(N) minimally augmented systems of
   /// structured_refinement.h instead of the dense augmented Newton: the same points, the same
-  /// geometry, branch switching included.
-  int maxDenseLocationDimension = 400;
+  /// geometry, branch switching included (points of multiplicity m ≥ 2 keep their dense kernel
+  /// up to kMaxDenseMultiplePointDimension). The O(N) refinements win from N ≈ 11 on
+  /// (benchmarks/RESULTS.md); below, the dense systems also check the kernel's dimension.
+  int maxDenseLocationDimension = 16;
   /// Target |Δλ| ≤ locationTolerance·max(λ₀, |λ|) for located points and stop events (λ₀: the
   /// problem's parameter scale).
   double locationTolerance = 1e-12;
