@@ -28,6 +28,12 @@ constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step t
 // against 1.4 k instructions, n = 3: 1.1 k against 1.7 k, n = 4: 2.6 k against 2.0 k
 // (benchmarks/RESULTS.md, "Cheaper points, round 5").
 constexpr int kDenseInertiaUpTo = 3;
+// Up to this chain length the eigenvalues (stability() with eigenvalues wanted, and the
+// certified counting's stabilityEigenvalues()) come from one dense solve of all of them rather
+// than Newton on the O(n) counts: the crossover of whole race runs lies between n = 15 and 20
+// (benchmarks/RESULTS.md). Below kSmallDense, the size of the dense route's fixed storage.
+constexpr int kDenseSpectrumUpTo = 16;
+static_assert(kDenseSpectrumUpTo <= kSmallDense);
 
 // The caches' bitwise key comparison. memcmp is a library call of ≈ 25 instructions, more than
 // comparing the 2–8 words of a short chain's key one by one (each memcpy of 8 bytes is one load).
@@ -432,7 +438,7 @@ bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCo
   if (!options_.structuredStability) return Problem::stability(u, lambda, lowestCount, info);
   const int n = chain_.size();
   const int wanted = std::max(0, std::min(lowestCount, kMaxLowest));
-  if (n <= kSmallDense && (wanted > 0 || n <= kDenseInertiaUpTo)) {
+  if (n <= kDenseSpectrumUpTo && (wanted > 0 || n <= kDenseInertiaUpTo)) {
     // Small chains: one heap-free dense eigen-solve beats the counts + eigenvalue isolation,
     // and for n ≤ kDenseInertiaUpTo even the two Sturm counts of the inertia alone.
     if (!smallDenseSpectrum(u, lambda)) return false;
@@ -467,7 +473,7 @@ bool EquilibriumProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, i
   if (first < 0) return false;
   const int n = chain_.size();
   const int wanted = first + int(values.size());
-  if (n <= kSmallDense) {
+  if (n <= kDenseSpectrumUpTo) {
     // As stability(): one heap-free dense eigen-solve is cheaper than isolating on counts, and
     // at the point stability() was just asked about it is already done.
     if (!smallDenseSpectrum(u, lambda) || spectrumSize_ < wanted) return false;

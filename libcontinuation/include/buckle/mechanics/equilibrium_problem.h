@@ -120,8 +120,9 @@ class EquilibriumProblem final : public continuation::Problem {
   bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
   /// Inertia of K_q − K_g on ker J_h and its min(lowestCount, kMaxLowest) lowest eigenvalues.
   /// options.structuredStability: the inertia from two O(n) Sturm counts, the eigenvalues by
-  /// isolation on those counts; for n <= 32 with eigenvalues wanted, one heap-free dense solve
-  /// (faster there: benchmarks/RESULTS.md). Otherwise the dense Problem::stability().
+  /// Newton on the counts' determinant (chain_structure.h); for n <= 16 with eigenvalues wanted,
+  /// one heap-free dense solve (faster there: benchmarks/RESULTS.md). Otherwise the dense
+  /// Problem::stability().
   static constexpr int kMaxLowest = 4;  // the isolation's fixed-size brackets
   bool stability(continuation::ConstVectorRef u, double lambda, int lowestCount,
                  continuation::StabilityInfo& info) override;
@@ -175,7 +176,7 @@ class EquilibriumProblem final : public continuation::Problem {
   bool prepare(const continuation::ConstVectorRef& u, double lambda);
   /// T at (u, λ) into ws from the cache (after prepare(u)).
   void assembleFromCache(const continuation::ConstVectorRef& u, double lambda, ChainStructure& ws);
-  /// The small dense route (n ≤ kSmallDense) at (u, λ): the inertia and all eigenvalues on
+  /// The small dense route (n ≤ 16, equilibrium_problem.cpp) at (u, λ): the inertia and all eigenvalues on
   /// ker J_h into spectrumInertia_ and spectrum_, or nothing when (u, λ) is already their key.
   /// False (nothing cached) outside the domain.
   bool smallDenseSpectrum(const continuation::ConstVectorRef& u, double lambda);
@@ -207,7 +208,7 @@ class EquilibriumProblem final : public continuation::Problem {
   Vector work_;  // size n
   ChainStructure structure_;  // workspace of the structured stability()
   Matrix heldRows_;           // m×n held rows of J
-  // The whole small dense spectrum (n ≤ kSmallDense) of the last (u, λ) it was computed at, by
+  // The whole small dense spectrum (n ≤ 16) of the last (u, λ) it was computed at, by
   // stability() or stabilityEigenvalues(): the tracer asks stability() for the inertia and then the
   // certified counting's values at the same point (spectral_monitor.h), one eigen-solve serves
   // both. Keyed bitwise on (u, λ) like the q-cache (H depends on r and λ through the wrench).
