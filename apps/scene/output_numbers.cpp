@@ -1,5 +1,8 @@
 #include "scene/output_numbers.h"
 
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -95,7 +98,71 @@ void appendG(std::string& out, bool negative, std::uint64_t m, int x, int precis
   out.append(buf, size_t(p - buf));
 }
 
+/// JSON's text of the double nearest ±m·10^(x − digits + 1) (m < 10^digits), as
+/// nlohmann::json's dump() writes it (dtoa's format_buffer with min_exp −4, max_exp 15): the
+/// shortest digits that read back to that double are m's without trailing zeros (two decimals
+/// of at most 15 digits never round to the same double), fixed notation for decimal exponents
+/// −4 < n ≤ 15 (an integer gets ".0"), d.ddde±XX otherwise.
+void appendJsonDigits(std::string& out, bool negative, std::uint64_t m, int x) {
+  char d[24];
+  int k = int(std::to_chars(d, d + sizeof d, m).ptr - d);
+  while (k > 1 && d[k - 1] == '0') --k;
+  const int n = x + 1;  // the value is 0.d₁d₂… · 10^n
+  char buf[48];
+  char* p = buf;
+  if (negative) *p++ = '-';
+  if (k <= n && n <= 15) {
+    p = std::copy(d, d + k, p);
+    p = std::fill_n(p, n - k, '0');
+    *p++ = '.';
+    *p++ = '0';
+  } else if (0 < n && n <= 15) {
+    p = std::copy(d, d + n, p);
+    *p++ = '.';
+    p = std::copy(d + n, d + k, p);
+  } else if (-4 < n && n <= 0) {
+    *p++ = '0';
+    *p++ = '.';
+    p = std::fill_n(p, -n, '0');
+    p = std::copy(d, d + k, p);
+  } else {
+    *p++ = d[0];
+    if (k > 1) {
+      *p++ = '.';
+      p = std::copy(d + 1, d + k, p);
+    }
+    *p++ = 'e';
+    const int e = n - 1;
+    *p++ = e < 0 ? '-' : '+';
+    const int a = std::abs(e);
+    if (a < 10) *p++ = '0';
+    p = std::to_chars(p, buf + sizeof buf, a).ptr;
+  }
+  out.append(buf, size_t(p - buf));
+}
+
 }  // namespace
+
+void appendRoundedJson(std::string& out, double v, int digits) {
+  if (!std::isfinite(v)) {
+    out += "null";
+    return;
+  }
+  std::uint64_t m = 0;
+  int x = 0;
+  if (v != 0.0 && digits <= 15 && scaledDigits(std::abs(v), digits, m, x) && x - digits + 1 >= -22 &&
+      x - digits + 1 <= 22) {
+    appendJsonDigits(out, std::signbit(v), m, x);
+    return;
+  }
+  const double r = roundedSignificant(v, digits);
+  if (!std::isfinite(r)) {
+    out += "null";
+    return;
+  }
+  char buf[64];
+  out.append(buf, size_t(nlohmann::detail::to_chars(buf, buf + sizeof buf, r) - buf));
+}
 
 void appendGeneral(std::string& out, double v, int precision) {
   if (!std::isfinite(v)) {

@@ -19,4 +19,9 @@ void appendGeneral(std::string& out, double v, int precision);
 /// `digits` significant decimal digits, bit for bit what snprintf + strtod give.
 double roundedSignificant(double v, int digits);
 
+/// Appends roundedSignificant(v, digits) as nlohmann::json's dump() writes that double (its
+/// shortest round-trip digits; "null" when v or the rounding is not finite), without the
+/// shortest-digits search: the rounding's own digits are those (1 <= digits <= 17).
+void appendRoundedJson(std::string& out, double v, int digits);
+
 }  // namespace buckle::scene

@@ -31,18 +31,8 @@ namespace {
 // page unchanged), without the locale and stdio machinery or a conversion to text.
 json rounded(double v, int digits = 6) { return roundedForPage(v, digits); }
 
-/// Appends rounded(v, digits) as dump() writes it: "null" when not finite, else the conversion
-/// nlohmann::json's serializer calls for a finite double (dump_float), without building a value.
-void appendRounded(std::string& out, double v, int digits = 6) {
-  const double r = std::isfinite(v) ? roundedSignificant(v, digits) : v;
-  if (!std::isfinite(r)) {
-    out += "null";
-    return;
-  }
-  char buf[64];
-  const char* end = nlohmann::detail::to_chars(buf, buf + sizeof buf, r);
-  out.append(buf, size_t(end - buf));
-}
+/// Appends rounded(v, digits) as dump() writes it, without building a value.
+void appendRounded(std::string& out, double v, int digits = 6) { appendRoundedJson(out, v, digits); }
 
 /// Joint positions flattened as [x0, y0, x1, y1, …] (4 significant digits), as dump() writes them.
 void appendJoints(std::string& out, const mechanics::Chain& chain, const Eigen::VectorXd& q) {
