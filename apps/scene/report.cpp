@@ -31,18 +31,15 @@ namespace {
 // page unchanged), without the locale and stdio machinery or a conversion to text.
 json rounded(double v, int digits = 6) { return roundedForPage(v, digits); }
 
-/// Appends rounded(v, digits) as dump() writes it, without building a value.
-void appendRounded(std::string& out, double v, int digits = 6) { appendRoundedJson(out, v, digits); }
-
 /// Joint positions flattened as [x0, y0, x1, y1, …] (4 significant digits), as dump() writes them.
 void appendJoints(std::string& out, const mechanics::Chain& chain, const Eigen::VectorXd& q) {
   const Eigen::Matrix2Xd p = mechanics::jointPositions(chain, q);
   out += '[';
   for (Eigen::Index j = 0; j < p.cols(); ++j) {
     if (j > 0) out += ',';
-    appendRounded(out, p(0, j), 4);
+    appendRoundedJson(out, p(0, j), 4);
     out += ',';
-    appendRounded(out, p(1, j), 4);
+    appendRoundedJson(out, p(1, j), 4);
   }
   out += ']';
 }
@@ -145,7 +142,7 @@ Members pointMembers(const CaseResult& cr, const std::set<std::string>& columns,
   Members cols;
   for (const std::string& name : columns) {
     std::string values;
-    appendArray(values, keep.size(), [&](size_t k) { appendRounded(values, columnValue(name, at(k), cr.pose0)); });
+    appendArray(values, keep.size(), [&](size_t k) { appendRoundedJson(values, columnValue(name, at(k), cr.pose0), 6); });
     cols.emplace_back(name, std::move(values));
   }
   m.emplace_back("columns", objectText(json::object(), std::move(cols)));
