@@ -94,7 +94,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   br.origin = origin;
   br.stopReason = report.stopReason;
   br.stopMessage = report.stopMessage;
-  br.points = static_cast<int>(b.points.size());
+  br.points = static_cast<int>(report.points.size());  // those reported (in the path's range)
   br.finished = report.finished;
   // a switched branch that used up its requested "child_points" ended where it was asked to
   const bool childBudget = b.parentId >= 0 && scene_.analyses.continuation.childPoints > 0 &&
@@ -124,6 +124,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
     r.haveStiffness = p.haveStiffness;
     r.K = p.K;
     r.C = p.C;
+    r.Kphi = p.rotationalStiffness;
     r.locked = p.locked.label();
     r.contactTorque = p.contactTorque;
     if (scene_.analyses.frequencies.enabled) r.omega = naturalFrequencies(p.q, p.F, p.locked, p.parameter);
@@ -294,7 +295,7 @@ mech::EquilibriumBranchOptions CaseRunner::branchOptions(double lambdaLo, double
   // Only the smallest eigenvalue is reported (min_eig); the locator asks for the crossing
   // eigenvalue where it needs more.
   opt.tracer.lowestEigenvalues = 1;
-  opt.switchingDepth = scene_.analyses.continuation.branchSwitching;
+  opt.switchingDepth = scene_.analyses.continuation.depth(throughLoad());
   opt.contact = scene_.analyses.continuation.contact;
   opt.mirror = scene_.analyses.continuation.mirror;
   opt.report = reportOptions();
@@ -331,8 +332,12 @@ void CaseRunner::continuation() {
   double lambdaLo = std::min(spec_.path.from, spec_.path.to), lambdaHi = std::max(spec_.path.from, spec_.path.to);
   std::vector<double> targets{spec_.path.to, spec_.path.from};
   const int c = spec_.path.coordinate;
+  mech::EquilibriumOptions equilibriumOptions;
   if (throughLoad()) {
-    // trace with the held coordinate's reaction as parameter (see PathSpec::loadLimit)
+    // trace with the held coordinate's reaction as parameter (PathSpec::throughReaction), each
+    // branch ending where the coordinate leaves the path's range
+    const double limit = reactionLoadLimit();
+    if (!(limit > 0.0)) return;  // said in run_.problems
     end.control[size_t(c)] = mech::Control::Load;
     end.value[c] = 0.0;
     direction = Eigen::Vector3d::Zero();
@@ -340,12 +345,13 @@ void CaseRunner::continuation() {
     s0 = 0.0;
     // both signs of the reaction: with an unstable start (κ < 0) the branch points lie on the
     // tension side, and their branches still move the end into the requested range
-    targets = {-spec_.path.loadLimit, spec_.path.loadLimit};
-    lambdaLo = -spec_.path.loadLimit;
-    lambdaHi = spec_.path.loadLimit;
+    targets = {-limit, limit};
+    lambdaLo = -limit;
+    lambdaHi = limit;
+    equilibriumOptions.heldRange = {c, std::min(spec_.path.from, spec_.path.to), std::max(spec_.path.from, spec_.path.to)};
   }
   end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
-  mech::EquilibriumProblem problem(out_.chain, end, direction, {}, controlDirection(), bodyLoads());
+  mech::EquilibriumProblem problem(out_.chain, end, direction, equilibriumOptions, controlDirection(), bodyLoads());
 
   mech::EquilibriumBranchOptions opt = branchOptions(lambdaLo, lambdaHi);
 
@@ -399,6 +405,7 @@ void CaseRunner::continuation() {
   std::stable_sort(out_.specials.begin() + long(firstSpecial), out_.specials.end(), byBranch);
   if (keepCurves) traced_.resize(branches.size());
   if (result.tree.interrupted) interrupted();
+  if (throughLoad() && !result.tree.interrupted) checkHeldCoordinateMoved(firstPoint);
 }
 
 void CaseRunner::criticalForces() {

@@ -70,7 +70,13 @@ class CaseRunner {
   /// the total end wrench F with the joints of `locked` locked (`parameter`: for a message).
   Eigen::VectorXd naturalFrequencies(const Eigen::VectorXd& q, const mechanics::Wrench& F,
                                      const mechanics::ContactSet& locked, double parameter);
-  bool throughLoad() const { return spec_.path.loadLimit > 0.0; }
+  bool throughLoad() const { return spec_.path.throughReaction; }
+  /// Through the reaction (case_runner_reaction.cpp): the load limit, the scene's or derived from
+  /// the critical reactions (into out_); 0, said in the run's problems, when none can be had.
+  double reactionLoadLimit();
+  /// Through the reaction: says in the run's problems why the end never moved, if it did not
+  /// (points from out_.points[firstPoint] on).
+  void checkHeldCoordinateMoved(size_t firstPoint);
   /// The continuation's tree options over the parameter range [lambdaLo, lambdaHi] (the tracer's
   /// stability, branch switching and contact settings of /analyses/continuation).
   mechanics::EquilibriumBranchOptions branchOptions(double lambdaLo, double lambdaHi);

@@ -50,6 +50,8 @@ const Entry kColumns[] = {
       {"K1", "K_1 (softest principal)", "K1 (softest principal)", Dimension::Stiffness},
       {"K2", "K_2 (stiffest principal)", "K2 (stiffest principal)", Dimension::Stiffness},
       {"theta1", "{/Symbol q}_1 (direction of K_1)", "θ1 (direction of K1)", Dimension::Angle},
+      {"Kphi", "K_{/Symbol f} (end rotation, forces unchanged)", "Kφ (end rotation, forces unchanged)",
+       Dimension::RotationalStiffness},
 };
 
 }  // namespace
@@ -106,11 +108,13 @@ std::string columnLabel(const std::string& c, const UnitSystem& units, LabelStyl
 
 const std::vector<std::string>& stiffnessColumns() {
   static const std::vector<std::string> kColumns = {"Kxx", "Kyy", "Kxy", "Cxx",      "Cyy",      "Cxy",
-                                                    "Kx_yfree", "Ky_xfree", "K1", "K2", "theta1"};
+                                                    "Kx_yfree", "Ky_xfree", "K1", "K2", "theta1", "Kphi"};
   return kColumns;
 }
 
-double stiffnessColumnValue(const std::string& column, const Eigen::Matrix2d& K, const Eigen::Matrix2d& C) {
+double stiffnessColumnValue(const std::string& column, const Eigen::Matrix2d& K, const Eigen::Matrix2d& C,
+                            double rotationalStiffness) {
+  if (column == "Kphi") return rotationalStiffness;
   if (column.size() == 3 && (column[0] == 'K' || column[0] == 'C') && column[1] != '1' && column[1] != '2') {
     const Eigen::Matrix2d& M = column[0] == 'K' ? K : C;
     const int i = column[1] == 'y', j = column[2] == 'y';

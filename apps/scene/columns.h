@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,7 @@ Dimension columnDimension(const std::string& column);
 
 /// The stiffness columns of branches.csv with `stiffness` (docs/outputs.md): K_F, C_F, the
 /// directional stiffnesses with the other direction free, the principal stiffnesses K1 ≤ K2 and
-/// the direction θ1 of K1.
+/// the direction θ1 of K1, and the end's rotational stiffness Kφ where φ is free.
 const std::vector<std::string>& stiffnessColumns();
 /// The natural-frequency columns of branches.csv with `frequencies` (vibration.h): omega1 …
 /// omega<count>, the signed frequencies (negative: an unstable mode, minus its growth rate).
@@ -29,7 +30,9 @@ std::vector<std::string> frequencyColumns(int count);
 /// Index (0-based) of a frequency column "omega<i>", −1 for any other column.
 int frequencyIndex(const std::string& column);
 
-/// One of those columns from K_F and C_F (either may be NaN: a rigid or a singular direction).
-double stiffnessColumnValue(const std::string& column, const Eigen::Matrix2d& K, const Eigen::Matrix2d& C);
+/// One of those columns from K_F and C_F (either may be NaN: a rigid or a singular direction)
+/// and K_φ (NaN: the rotation held, or not computed).
+double stiffnessColumnValue(const std::string& column, const Eigen::Matrix2d& K, const Eigen::Matrix2d& C,
+                            double rotationalStiffness = std::numeric_limits<double>::quiet_NaN());
 
 }  // namespace buckle::scene

@@ -188,7 +188,7 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
       os += escape::csvField(p.locked);
       field(p.contactTorque);
       if (scene.analyses.stiffness)
-        for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C));
+        for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C, p.Kphi));
       if (scene.analyses.frequencies.enabled)
         for (int i = 0; i < scene.analyses.frequencies.count; ++i) field(i < p.omega.size() ? p.omega[i] : kNaN);
       for (const std::string& column : inputs) field(inputValue(column, p.inputs, p.inputNames.get()));
@@ -449,6 +449,11 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
     c["start_parameter"] = cr.startValue;
     if (cr.qStart.size() == cr.q0.size() && cr.qStart != cr.q0) c["start_q"] = vectorJson(cr.qStart);
     if (!cr.startNote.empty()) c["start_note"] = cr.startNote;
+    if (cr.loadLimit > 0.0) {
+      c["load_limit"] = cr.loadLimit;
+      c["load_limit_derived"] = cr.loadLimitDerived;
+      if (std::isfinite(cr.firstCriticalReaction)) c["first_critical_reaction"] = cr.firstCriticalReaction;
+    }
     json branches = json::array();
     for (const BranchRecord& b : cr.branches) {
       branches.push_back(json{{"id", b.id}, {"parent", b.parent}, {"origin", b.origin}, {"points", b.points},
@@ -507,7 +512,7 @@ double columnValue(const std::string& column, const PointRecord& p, const mechan
     const double v = inputValue(column, p.inputs, p.inputNames.get());
     if (!std::isnan(v)) return v;
   }
-  return stiffnessColumnValue(column, p.K, p.C);
+  return stiffnessColumnValue(column, p.K, p.C, p.Kphi);
 }
 
 double columnValue(const std::string& column, const SpecialRecord& s, const mechanics::Pose& pose0) {

@@ -44,11 +44,13 @@ RunResult runScene(const Scene& scene, const RunControl& given) {
   if (task)
     run.computed.push_back("task-space path (inverse statics): the inputs that move the end along the path, "
                            "stability at fixed inputs");
-  else if (a.continuation.enabled)
-    run.computed.push_back(a.continuation.branchSwitching > 0
-                               ? "continuation with branch switching (depth " +
-                                     std::to_string(a.continuation.branchSwitching) + ")"
-                               : "continuation of the primary branch");
+  else if (a.continuation.enabled) {
+    const bool reaction =
+        std::any_of(scene.cases.begin(), scene.cases.end(), [](const CaseSpec& c) { return c.path.throughReaction; });
+    const int depth = a.continuation.depth(reaction);
+    run.computed.push_back(depth > 0 ? "continuation with branch switching (depth " + std::to_string(depth) + ")"
+                                     : "continuation of the primary branch");
+  }
   if (a.stiffness) run.computed.push_back("loaded stiffness K_F along the branches (eq 29)");
   if (a.frequencies.enabled)
     run.computed.push_back("the lowest " + std::to_string(a.frequencies.count) +

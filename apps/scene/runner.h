@@ -38,6 +38,7 @@ struct PointRecord {
   bool haveStiffness = false;
   Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
   Eigen::Matrix2d C = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());  ///< C_F
+  double Kphi = std::numeric_limits<double>::quiet_NaN();  ///< the end's rotational stiffness (φ free)
   std::string locked;         ///< joints locked at their limits, "3U 5L" (ContactSet::label), "" none
   double contactTorque = 0.0; ///< largest compression of the locked joints (0: none locked)
   /// `frequencies`: the signed natural frequencies ω_i (vibration.h; negative: unstable, minus
@@ -140,6 +141,11 @@ struct CaseResult {
   /// The path's start shape: q0, or along a control path the chain under its payload.
   Eigen::VectorXd qStart;
   std::string startNote;  ///< how the start was reached, when not simply (the payload snapped the chain)
+  /// Displacement control traced through the reaction (PathSpec::throughReaction): the load limit
+  /// used, whether it was derived, and the critical reaction of smallest magnitude (NaN: unknown).
+  double loadLimit = 0.0;
+  bool loadLimitDerived = false;
+  double firstCriticalReaction = std::numeric_limits<double>::quiet_NaN();
   mechanics::Pose pose0 = mechanics::Pose::Zero();
   double startValue = 0.0;
   std::vector<BranchRecord> branches;

@@ -68,10 +68,13 @@ struct PathSpec {
   int coordinate = 0;          ///< 0 = x, 1 = y, 2 = φ
   double from = 0.0, to = 0.0; ///< parameter range; contains the start value
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  ///< d(prescribed)/d(parameter)
-  /// Displacement control from a start that is singular for the held coordinate (the straight
-  /// chain cannot move its end along x to first order): the branches are traced with the
-  /// coordinate's reaction as parameter, from 0 to ±loadLimit, and reported against the
-  /// coordinate with displacement-control stability. 0: not used.
+  /// Displacement control traced through the held coordinate's reaction (mechanics/reaction_path.h):
+  /// the scene gave /path/load_limit, or the start is singular for the held coordinate (the
+  /// straight chain cannot move its end along x to first order). The branches are traced with the
+  /// reaction as parameter, from 0 to ±loadLimit, each ending where the coordinate leaves
+  /// [from, to], and reported against the coordinate with displacement-control stability.
+  bool throughReaction = false;
+  /// The scene's /path/load_limit (its force unit); 0: derived from the critical reactions.
   double loadLimit = 0.0;
   /// A control path (issue 29): the parameter is a control input ("L1_0", "L2_0", "L0", "dL0")
   /// of segment `segment` or of every segment, λ moves the springs' free lengths along
@@ -95,7 +98,11 @@ struct PathSpec {
 
 struct ContinuationSpec {
   bool enabled = false;
-  int branchSwitching = 0;  ///< depth of the branch tree (0: primary branch only)
+  /// Depth of the branch tree (0: primary branch only); −1: not given, see depth().
+  int branchSwitching = -1;
+  /// The depth used: as given, else 1 for a path traced through the reaction (only the buckled
+  /// branches move the held coordinate) and 0 otherwise.
+  int depth(bool throughReaction) const { return branchSwitching >= 0 ? branchSwitching : throughReaction ? 1 : 0; }
   /// Switch at the first this many simple branch points along each branch (0: all of them).
   int branchPoints = 0;
   /// Points per switched branch (0: the solver's max_points, as the start branches).

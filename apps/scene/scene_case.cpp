@@ -318,7 +318,9 @@ PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const En
   spec.to = r.number(path["to"], p / "to");
   if (spec.from == spec.to) r.fail(p / "to", "expected a value different from /path/from (an empty range)");
   const double lo = std::min(spec.from, spec.to), hi = std::max(spec.from, spec.to);
-  if (!(startValue >= lo - 1e-12 && startValue <= hi + 1e-12)) {
+  // rounding of a start taken from the unloaded shape's pose: relative to the values' size
+  const double slack = 1e-12 * std::max({hi - lo, std::abs(lo), std::abs(hi)});
+  if (!(startValue >= lo - slack && startValue <= hi + slack)) {
     std::ostringstream os;
     os << "expected a range [from, to] that contains the start value " << spec.parameter << " = " << startValue
        << " (set by /end/" << kCoordinateNames[spec.coordinate] << "), got [" << spec.from << ", " << spec.to << "]";
@@ -328,6 +330,7 @@ PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const En
     if (isLoad)
       r.fail(p / "load_limit", "only a displacement-controlled path (parameter x, y or phi) takes a load_limit");
     spec.loadLimit = r.positive(path["load_limit"], p / "load_limit");
+    spec.throughReaction = true;
   }
   spec.direction.setZero();
   spec.direction[spec.coordinate] = 1.0;
@@ -447,14 +450,11 @@ CaseSpec parseCase(const Reader& r, const json& doc, const std::string& label, b
   }
   cs.path = parsePath(r, path, Pointer("/path"), cs.end, start);
   checkEndAgainstChain(r, cs);
-  if (cs.path.loadLimit == 0.0 && cs.end.condition.isHeld(static_cast<mechanics::EndCoordinate>(cs.path.coordinate))) {
-    if (!mechanics::endMovesAlong(chain, cs.chain.q0, cs.path.coordinate))
-      r.fail(Pointer("/path/parameter"),
-             std::string("the unloaded shape cannot move its end along ") + kCoordinateNames[cs.path.coordinate] +
-                 " to first order (e.g. the straight chain along x): displacement control starts at a singular "
-                 "point; add /path/load_limit (the largest reaction to trace) so that the branches are traced "
-                 "through the reaction force");
-  }
+  // displacement control from a singular start (the straight chain along x): through the
+  // reaction, with the load limit derived from the critical reactions unless given
+  if (!cs.path.throughReaction && cs.end.condition.isHeld(static_cast<mechanics::EndCoordinate>(cs.path.coordinate)) &&
+      !mechanics::endMovesAlong(chain, cs.chain.q0, cs.path.coordinate))
+    cs.path.throughReaction = true;
   return cs;
 }
 

@@ -38,10 +38,10 @@ void checkEquilibriaAgainstCases(const JsonReader& r, const Scene& scene) {
            "the branches through the equilibria are traced as the continuation's: it needs /analyses/continuation");
   if (e.enabled && e.branches)
     for (const CaseSpec& c : scene.cases)
-      if (c.path.loadLimit > 0.0)
+      if (c.path.throughReaction)
         r.fail(Pointer("/analyses/equilibria/branches"),
                "expected a path in a load or a held coordinate traced directly (case \"" + c.label +
-                   "\" is traced through the reaction, load_limit)");
+                   "\" is displacement control traced through the reaction)");
   if (!e.enabled || !e.haveAt) return;
   for (const CaseSpec& c : scene.cases) {
     const double lo = std::min(c.path.from, c.path.to), hi = std::max(c.path.from, c.path.to);

@@ -138,6 +138,8 @@ TEST_CASE("the straight SI chain's lateral stiffness with x free is the closed f
   CHECK(std::abs(std::stod(start.at("Cxx"))) <= 1e-11 * Cyy);
   CHECK(start.at("Kx_yfree") == "inf");
   CHECK(std::stod(start.at("K1")) == Approx(1.0 / Cyy).epsilon(1e-11));
+  // the end's rotation under Me with the forces unchanged: n joints in series, each κ (eq 4)
+  CHECK(std::stod(start.at("Kphi")) == Approx(kappa / n).epsilon(1e-11));
   // K_F and C_F are inverses wherever both are finite
   size_t both = 0;
   for (const auto& r : rows) {

@@ -177,6 +177,18 @@ TEST_CASE("loaded compliance equals the finite difference of the equilibrium for
           Cfd.col(c) = (endPose(chain, up.head(n)) - endPose(chain, um.head(n))).head(2) / (2 * h);
         }
         CHECK((s.compliance - Cfd).lpNorm<Eigen::Infinity>() < 1e-6 * Cfd.lpNorm<Eigen::Infinity>());
+        if (rotationHeld) {
+          CHECK(std::isnan(s.rotationalStiffness));
+        } else {
+          // the end's rotational compliance: δφ/δMe with the forces unchanged, by the same differences
+          EndCondition ep = end, em = end;
+          ep.value[2] += h;
+          em.value[2] -= h;
+          const Vector up = solve(chain, ep, u.head(n)), um = solve(chain, em, u.head(n));
+          const double cpp = (endPose(chain, up.head(n))[2] - endPose(chain, um.head(n))[2]) / (2 * h);
+          CHECK(s.rotationalCompliance == Approx(cpp).epsilon(1e-6));
+          CHECK(s.rotationalStiffness == Approx(1.0 / cpp).epsilon(1e-6));
+        }
         // the load changes the stiffness (the check above is not just the unloaded one)
         const CartesianStiffness s0 = unloadedStiffness(chain, u.head(n), rotationHeld);
         CHECK((s0.compliance - Cfd).lpNorm<Eigen::Infinity>() > 1e-3 * Cfd.lpNorm<Eigen::Infinity>());

@@ -196,6 +196,20 @@ void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, cons
 }
 
 
+// Through the reaction the traced λ is the reaction: its range is the load limit, and the
+// path's own range end is the held coordinate's boundary (EquilibriumOptions::heldRange).
+void describeReactionPathStop(const EquilibriumProblem& problem, const cont::Branch& b, BranchReport& r) {
+  if (b.stopReason == cont::StopReason::LambdaRange) {
+    r.stopReason = "load limit";
+    r.stopMessage = "the reaction reached the load limit " + formatShort(b.points.empty() ? 0.0 : b.points.back().lambda) +
+                    " before the held coordinate left the path's range";
+  } else if (b.stopReason == cont::StopReason::Boundary && !b.specialPoints.empty() &&
+             problem.isRangeBoundary(b.specialPoints.back().boundaryName)) {
+    r.stopReason = cont::toString(cont::StopReason::LambdaRange);
+    r.stopMessage = b.specialPoints.back().boundaryName;
+  }
+}
+
 // ---- reportBranch, part by part ---------------------------------------------------------------
 
 // Every point of the branch (returned, also those out of range: the stability of neighbours);
@@ -249,6 +263,7 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
                                                          pr.F, problem.endCondition(), pr.locked, so);
       pr.K = s.stiffness;
       pr.C = s.compliance;
+      pr.rotationalStiffness = s.rotationalStiffness;
       pr.haveStiffness = true;
     }
     r.worstResidual = std::max(r.worstResidual, pr.residual);
@@ -268,6 +283,8 @@ void reportLocatedPoints(EquilibriumProblem& problem, const cont::Branch& b, con
   for (size_t k = 0; k < b.specialPoints.size(); ++k) {
     const cont::SpecialPoint& sp = b.specialPoints[k];
     if (sp.type == cont::SpecialPointType::Endpoint) continue;
+    // the path's range end, traced through the reaction: the branch's end, no limit of the model
+    if (sp.type == cont::SpecialPointType::Boundary && problem.isRangeBoundary(sp.boundaryName)) continue;
     PointReport at;  // the located point, as a point of the branch
     at.index = sp.index;
     at.parameter = sp.lambda;
@@ -463,6 +480,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
   r.stopReason = cont::toString(b.stopReason);
   r.stopMessage = b.stopMessage;
   r.finished = regularStop(b.stopReason);
+  if (throughReaction) describeReactionPathStop(problem, b, r);
   int limitJoint = -1;
   if (!r.finished && b.stopReason == cont::StopReason::StepSizeTooSmall && !b.points.empty()) {
     limitJoint = jointAtLimit(chain, b.points.back().u.head(n));

@@ -345,13 +345,18 @@ continuation::ProblemScales ContactProblem::scales() const {
   return s;
 }
 
+// Boundaries: the joints' 2n (a locked joint's own limit is its contact release), the base
+// problem's path range (EquilibriumOptions::heldRange), then the locked joints' torque bounds.
 int ContactProblem::boundaryCount() const {
-  return 2 * base_.segments() + (std::isfinite(maxCompression_) ? locked_.count() : 0);
+  return 2 * base_.segments() + base_.rangeBoundaryCount() + (std::isfinite(maxCompression_) ? locked_.count() : 0);
 }
 
 double ContactProblem::boundary(int k, ConstVectorRef u, double lambda) {
   const int n = base_.segments();
-  if (k >= 2 * n) return maxCompression_ - compression(u, lambda, locked_.joints()[size_t(k - 2 * n)].joint);
+  const int range = base_.rangeBoundaryCount();
+  if (k >= 2 * n + range)
+    return maxCompression_ - compression(u, lambda, locked_.joints()[size_t(k - 2 * n - range)].joint);
+  if (k >= 2 * n) return base_.boundary(base_.rangeBoundaryBegin() + k - 2 * n, u, lambda);
   const LockedJoint b = limitOfBoundary(k, base_.segments());
   if (locked_.locked(b.joint) && locked_.side(b.joint) == b.side) return compression(u, lambda, b.joint);
   return base_.boundary(k, u, lambda);
@@ -359,12 +364,14 @@ double ContactProblem::boundary(int k, ConstVectorRef u, double lambda) {
 
 std::string ContactProblem::boundaryName(int k) const {
   const int n = base_.segments();
-  if (k >= 2 * n) {
+  const int range = base_.rangeBoundaryCount();
+  if (k >= 2 * n + range) {
     std::ostringstream os;
-    os << "joint " << locked_.joints()[size_t(k - 2 * n)].joint + 1 << " contact torque reached its bound "
+    os << "joint " << locked_.joints()[size_t(k - 2 * n - range)].joint + 1 << " contact torque reached its bound "
        << maxCompression_ << " (the locked chain is pressed far beyond what its springs carry)";
     return os.str();
   }
+  if (k >= 2 * n) return base_.boundaryName(base_.rangeBoundaryBegin() + k - 2 * n);
   const LockedJoint b = limitOfBoundary(k, base_.segments());
   if (locked_.locked(b.joint) && locked_.side(b.joint) == b.side)
     return "joint " + std::to_string(b.joint + 1) + " " + toString(b.side) + " contact released (contact torque -> 0)";

@@ -137,7 +137,7 @@ LockedJoint stoppedOn(const cont::Problem& traced, const cont::Branch& branch, i
   if (branch.stopReason != cont::StopReason::Boundary || branch.specialPoints.empty()) return {};
   const cont::SpecialPoint& sp = branch.specialPoints.back();
   if (sp.type != cont::SpecialPointType::Boundary) return {};
-  for (int k = 0; k < traced.boundaryCount(); ++k)
+  for (int k = 0; k < std::min(traced.boundaryCount(), 2 * segments); ++k)  // the joints' limits
     if (traced.boundaryName(k) == sp.boundaryName) return limitOfBoundary(k, segments);
   return {};
 }

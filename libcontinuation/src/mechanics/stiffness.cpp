@@ -74,13 +74,14 @@ CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const W
   Cphi.topRows(e) = jointConstraints;
   if (rotationHeld) Cphi.row(e) = J.row(2);
 
-  // Force control: (K_q − K_g) δq = J_pᵀ δF (+ J_φᵀ δMe with J_φ δq = 0).
-  Matrix R = Matrix::Zero(n + Cphi.rows(), 2);
-  R.topRows(n) = Jp.transpose();
+  // Force control: (K_q − K_g) δq = J_pᵀ δF (+ J_φᵀ δMe with J_φ δq = 0); with the rotation free
+  // a third column J_φᵀ for the end's rotational compliance.
+  Matrix R = Matrix::Zero(n + Cphi.rows(), rotationHeld ? 2 : 3);
+  R.topRows(n) = J.topRows(R.cols()).transpose();
   Matrix X;
   double rcond = 0.0;
   if (borderedSolve(H, Cphi, R, options.singularTolerance, X, &rcond)) {
-    Eigen::Matrix2d C = Jp * X.topRows(n);
+    Eigen::Matrix2d C = Jp * X.topLeftCorner(n, 2);
     C = 0.5 * (C + C.transpose());
     // A backward-stable solve perturbs X by ε κ(B) |X| per column, so C_ij = J_i·X_j by
     // ε κ |J_i| |X_j|: an entry below that is a zero of C_F (e.g. C_yy of a chain whose end is
@@ -92,6 +93,14 @@ CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const W
                                               Jp.row(j).norm() * X.col(i).head(n).norm());
     C = (C.cwiseAbs().array() <= out.complianceAccuracy.array()).select(0.0, C);
     out.compliance = C;
+    if (!rotationHeld) {
+      const double cpp = J.row(2).dot(X.col(2).head(n));
+      out.rotationalComplianceAccuracy =
+          16.0 * std::numeric_limits<double>::epsilon() / rcond * J.row(2).norm() * X.col(2).head(n).norm();
+      out.rotationalCompliance = std::abs(cpp) <= out.rotationalComplianceAccuracy ? 0.0 : cpp;
+      out.rotationalStiffness = out.rotationalCompliance == 0.0 ? std::numeric_limits<double>::infinity()
+                                                                : 1.0 / out.rotationalCompliance;
+    }
     if (conditioning(C) > options.singularTolerance) {
       out.stiffness = C.inverse();
       out.stiffness = 0.5 * (out.stiffness + out.stiffness.transpose());

@@ -94,6 +94,9 @@ struct PointReport {
   /// The compliance C_F = K_F⁻¹ of the same computation (finite where K_F is not: a rigid
   /// direction, e.g. x at the straight chain; NaN where K_F is singular).
   Eigen::Matrix2d C = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// The end's rotational stiffness K_φ = 1/C_φφ with the end forces unchanged, where the end
+  /// rotation is free (CartesianStiffness::rotationalStiffness; NaN where φ is held).
+  double rotationalStiffness = std::numeric_limits<double>::quiet_NaN();
   /// Joints locked at their limits at this point (contact.h); stability and K are those of the
   /// constrained chain.
   ContactSet locked;

@@ -36,6 +36,15 @@ struct EquilibriumOptions {
   /// stability(): O(n) inertia and lowest eigenvalues through the chain structure
   /// (chain_structure.h); false: the dense default of Problem (kept for cross-checks).
   bool structuredStability = true;
+  /// Displacement control of end coordinate `heldRange.coordinate` traced through its reaction
+  /// (branch_report.h): the coordinate must stay in the path's range [low, high]. Two more
+  /// boundaries after the joint limits, g = pose_c − low and high − pose_c, end a branch exactly
+  /// where the end leaves the range, as the λ range ends a load path. coordinate −1: none.
+  struct CoordinateRange {
+    int coordinate = -1;  ///< 0 x, 1 y, 2 φ
+    double low = 0.0, high = 0.0;
+    bool active() const { return coordinate >= 0; }
+  } heldRange;
 };
 
 class EquilibriumProblem final : public continuation::Problem {
@@ -160,6 +169,13 @@ class EquilibriumProblem final : public continuation::Problem {
   double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
   void boundaries(continuation::ConstVectorRef u, double lambda, continuation::VectorRef g) override;
   std::string boundaryName(int k) const override;
+  /// The first of the two boundaries of EquilibriumOptions::heldRange (after the joint limits'),
+  /// and how many there are (0 or 2).
+  int rangeBoundaryBegin() const { return options_.jointLimitsAsBoundaries ? 2 * chain_.size() : 0; }
+  int rangeBoundaryCount() const { return options_.heldRange.active() ? 2 : 0; }
+  /// Whether a boundary's name (SpecialPoint::boundaryName) is one of heldRange's: the path's
+  /// range end, not a limit of the model.
+  bool isRangeBoundary(const std::string& name) const;
 
  private:
   /// Inside the model's domain: finite, every joint within its geometric limits (or just past one,

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/end_condition.h"
@@ -30,6 +31,13 @@ struct CartesianStiffness {
   /// Rounding bound of each entry of C_F (ε κ |J_i| |X_j| of the bordered solve); an entry of
   /// C_F below its bound is reported as exactly 0 (a rigid direction, or a pole of 1/C_ii).
   Eigen::Matrix2d complianceAccuracy = Eigen::Matrix2d::Zero();
+  /// Rotation free and C_F defined (NaN otherwise): the end's rotational compliance
+  /// C_φφ = J_φ (K_q − K_g)⁻¹ J_φᵀ (δφ per δMe with the end forces unchanged, on the joint
+  /// constraints), its rounding bound as complianceAccuracy's, and the end's rotational stiffness
+  /// K_φ = 1/C_φφ (inf where C_φφ is 0 to its bound: a rotation the joints cannot make).
+  double rotationalCompliance = std::numeric_limits<double>::quiet_NaN();
+  double rotationalComplianceAccuracy = std::numeric_limits<double>::quiet_NaN();
+  double rotationalStiffness = std::numeric_limits<double>::quiet_NaN();
   bool rotationHeld = false;
   /// K_F is singular: infinite compliance in some direction (C_F NaN). Set where K_q − K_g is
   /// singular on ker J_φ (force-control limit / bifurcation point); K_F is then still given.
