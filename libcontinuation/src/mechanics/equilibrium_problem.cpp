@@ -560,10 +560,13 @@ double EquilibriumProblem::boundary(int k, ConstVectorRef u, double lambda) {
   const int n = chain_.size();
   const int r = k - rangeBoundaryBegin();
   if (r >= 0) {
-    // the pose from the evaluation cache (no allocation per point); outside the domain, directly
+    // the pose from the evaluation cache (no allocation per point); outside the domain, directly.
+    // A slack of 1e-12 of the range's scale keeps a start on the range end inside: the path's
+    // start value is the same pose summed by another route (endPose), equal to a few ulp.
     const EquilibriumOptions::CoordinateRange& range = options_.heldRange;
     const double v = prepare(u, lambda) ? data_.pose[range.coordinate] : endPose(chain_, u.head(n))[range.coordinate];
-    return r == 0 ? v - range.low : range.high - v;
+    const double slack = 1e-12 * std::max({range.high - range.low, std::abs(range.low), std::abs(range.high)});
+    return r == 0 ? v - range.low + slack : range.high - v + slack;
   }
   if (k < n) return chain_.upperLimits()[k] - u[k];
   return u[k - n] - chain_.lowerLimits()[k - n];

@@ -38,8 +38,9 @@ struct EquilibriumOptions {
   bool structuredStability = true;
   /// Displacement control of end coordinate `heldRange.coordinate` traced through its reaction
   /// (branch_report.h): the coordinate must stay in the path's range [low, high]. Two more
-  /// boundaries after the joint limits, g = pose_c − low and high − pose_c, end a branch exactly
-  /// where the end leaves the range, as the λ range ends a load path. coordinate −1: none.
+  /// boundaries after the joint limits, g = pose_c − low and high − pose_c (plus 1e-12 of the
+  /// range's scale, equilibrium_problem.cpp), end a branch where the end leaves the range, as the
+  /// λ range ends a load path. coordinate −1: none.
   struct CoordinateRange {
     int coordinate = -1;  ///< 0 x, 1 y, 2 φ
     double low = 0.0, high = 0.0;
