@@ -120,7 +120,7 @@ TEST_CASE("a load limit below the first critical reaction is said, not passed as
   fc.precision(10);
   fc << std::abs(Fc);
   CHECK(problem.find(fc.str()) != std::string::npos);  // the critical reaction the limit falls short of
-  CHECK(problem.find(" N") != std::string::npos);      // in the scene's force unit
+  CHECK(problem.find(" (N)") != std::string::npos);    // in the scene's force unit
   CHECK_FALSE(summary["cases"][0]["load_limit_derived"].get<bool>());
 }
 

@@ -589,7 +589,7 @@ std::string EquilibriumProblem::boundaryName(int k) const {
     static const char* names[3] = {"x", "y", "phi"};
     const EquilibriumOptions::CoordinateRange& range = options_.heldRange;
     std::ostringstream os;
-    os.precision(17);
+    os.precision(12);
     os << "end " << names[range.coordinate] << " reached the path's range end " << (r == 0 ? range.low : range.high);
     return os.str();
   }

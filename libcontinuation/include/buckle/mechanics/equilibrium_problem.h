@@ -45,7 +45,7 @@ struct EquilibriumOptions {
     int coordinate = -1;  ///< 0 x, 1 y, 2 φ
     double low = 0.0, high = 0.0;
     bool active() const { return coordinate >= 0; }
-  } heldRange;
+  } heldRange{};
 };
 
 class EquilibriumProblem final : public continuation::Problem {
