@@ -217,10 +217,6 @@ TEST_CASE("inconsistent scenes", "[scene][errors]") {
   requireBadInput("stiffness_without_branches",
                   replaceOnce(kGood, "\"continuation\": {\"branch_switching\": 0}", "\"stiffness\": true, \"critical_forces\": true"),
                   "/analyses/stiffness", "needs /analyses/continuation");
-  requireBadInput("singular_displacement_start",
-                  replaceOnce(replaceOnce(kGood, "\"x\": {\"load\": 0.0}", "\"x\": {\"held\": \"start\"}"),
-                              "\"parameter\": \"Fx\", \"from\": 0.0, \"to\": -1.0", "\"parameter\": \"x\", \"from\": 6.0, \"to\": 5.0"),
-                  "/path/parameter", "load_limit");
   requireBadInput("plot_column", replaceOnce(kGood, "\"plots\": []", "\"plots\": [{\"type\": \"bifurcation\", \"y\": \"q7\"}]"),
                   "/plots/0/y", "a column of branches.csv");
   requireBadInput("plot_labels",
