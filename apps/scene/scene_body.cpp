@@ -119,8 +119,6 @@ void checkBodyAnalyses(const JsonReader& r, const Scene& scene) {
                                              c.label + "\" has /gravity or /point_loads (remove one of them)");
     };
     const AnalysesSpec& a = scene.analyses;
-    if (a.jump.enabled) refuse("jump", "jumps (the dynamics)");
-    if (a.loadHistory.enabled) refuse("load_history", "load histories (their jumps)");
     if (a.suddenLoad.enabled) refuse("sudden_load", "sudden loads (the dynamics)");
     if (a.criticalForces.enabled) refuse("critical_forces", "critical forces (linear buckling of the unloaded shape)");
     if (a.twoParameter.enabled) refuse("two_parameter", "two-parameter critical curves");

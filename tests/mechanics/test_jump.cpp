@@ -8,6 +8,7 @@
 
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/jump.h"
+#include "heavy_newton.h"
 
 using namespace buckle::mechanics;
 
@@ -838,4 +839,44 @@ TEST_CASE("switching stepper: the creep to rest is stiff, it switches to Rosenbr
   CHECK(switching.steps < 2 * rosenbrock.steps);
   CHECK((switching.to - rosenbrock.to).cwiseAbs().maxCoeff() < 1e-10 * rosenbrock.to.cwiseAbs().maxCoeff());
   CHECK(switching.energyReleased == Approx(rosenbrock.energyReleased).epsilon(1e-10));
+}
+
+TEST_CASE("a heavy column released past its critical weight falls to a bent stable equilibrium of that weight",
+          "[jump][body_loads]") {
+  // Gravity along −x compresses the chain standing on its clamp (λ = g): past the critical g the
+  // straight column is an unstable equilibrium. Released along its softest mode, the dynamics with
+  // the weight (dynamics.h, DynamicsScene::body) come to rest on a bent equilibrium of the same
+  // weight: checked by an independent Newton solve on E + V (GravityPotential, absolute positions).
+  for (const auto& [L, K] : {std::pair{1.0, 1.0}, std::pair{1e-4, 1e8}}) {
+    INFO("lengths x" << L << ", stiffness x" << K);
+    const int n = 4;
+    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5 * L, L, K, 2.25 * L));
+    const InertiaData rods = InertiaData::uniformRods(chain, 1.0);
+    EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d::Zero(), {}, {},
+                               BodyLoads::weight(chain, rods, Eigen::Vector2d::Zero(), Eigen::Vector2d(-1.0, 0.0)));
+    const Vector u = Vector::Zero(n);
+    // the weight where the straight column has just lost its stability (doubling from far below)
+    double g = 1e-3 * K / L;
+    buckle::continuation::StabilityInfo info;
+    for (int i = 0; i < 80; ++i, g *= 1.25) {
+      REQUIRE(problem.stability(u, g, 1, info));
+      if (info.negative > 0) break;
+    }
+    REQUIRE(info.negative == 1);
+    JumpOptions opt;
+    const JumpResult r = simulateJump(problem, u, g, opt);
+    INFO(r.message);
+    REQUIRE(r.success);
+    CHECK(r.stable);
+    CHECK(r.energyReleased > 0.0);
+    const Vector q = r.to.head(n);
+    CHECK(q.cwiseAbs().maxCoeff() > 1e-2);  // bent, not the straight column
+    // independent: Newton on E + V from the landing stays there
+    const Vector qn = buckle::mechanics::testing::heavyNewton(chain, rods, Eigen::Vector2d(-g, 0.0), q);
+    CHECK((qn - q).cwiseAbs().maxCoeff() < 1e-9);
+    // and the weight mattered: the same release without it is no jump (the straight chain is stable)
+    EquilibriumProblem weightless(chain, EndCondition::freeEnd(), Eigen::Vector3d::Zero());
+    REQUIRE(weightless.stability(u, 0.0, 1, info));
+    CHECK(info.negative == 0);
+  }
 }

@@ -38,6 +38,17 @@ bool BodyLoads::active() const {
   return any;
 }
 
+BodyLoads BodyLoads::atParameter(double lambda) const {
+  BodyLoads b = *this;
+  b.gravity += lambda * gravityRate;
+  b.gravityRate.setZero();
+  for (PointLoad& p : b.points) {
+    p.force += lambda * p.rate;
+    p.rate.setZero();
+  }
+  return b;
+}
+
 void BodyLoads::check(const Chain& chain) const {
   const int n = chain.size();
   if (mass.size() != 0 && mass.size() != n)

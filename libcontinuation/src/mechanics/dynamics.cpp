@@ -3,6 +3,8 @@
 // model (D2) in dynamics_inertial.cpp, their integration (simulate) in dynamics_integration.cpp.
 #include "buckle/mechanics/dynamics.h"
 
+#include "buckle/mechanics/body_loads.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -78,6 +80,13 @@ bool DynamicsScene::IsValid(const Chain& chain, std::string* why) const {
   if (!finite(constraintStiffness)) return fail(why, "constraintStiffness must be finite");
   if (!finite(baumgarteRate)) return fail(why, "baumgarteRate must be finite");
   if (inertia && !inertia->IsValid(chain, why)) return false;
+  if (body) {
+    try {
+      body->check(chain);
+    } catch (const std::invalid_argument& e) {
+      return fail(why, e.what());
+    }
+  }
   return true;
 }
 
@@ -139,6 +148,13 @@ void DynamicsModel::evaluateStatics(ConstVectorRef q) {
   endJacobian(data_, J_);
   // ∇Π = ∂E/∂q − J_lᵀ F_l (eq 9, loads_ zero on held coordinates; J rows (−S, C, 1))
   for (int i = 0; i < n; ++i) grad_[i] = grad_[i] + loads_[0] * data_.S[i] - loads_[1] * data_.C[i] - loads_[2];
+  bodyPotential_ = 0.0;
+  if (body_) {  // ∂V/∂q = −τ (eq B2), O(n)
+    body_->update(data_);
+    body_->torques(0.0, bodyWork_);
+    grad_ -= bodyWork_;
+    bodyPotential_ = body_->potential(data_, 0.0);
+  }
   staticsQ_ = q;
   staticsValid_ = true;
   const int mh = heldCount(), m = constraintCount();
@@ -164,7 +180,30 @@ void DynamicsModel::evaluateStatics(ConstVectorRef q) {
 
 double DynamicsModel::potential(ConstVectorRef q) {
   evaluateStatics(q);
-  return springEnergy_ - loads_.dot(data_.pose);
+  return springEnergy_ - loads_.dot(data_.pose) + bodyPotential_;
+}
+
+void DynamicsModel::setBodyLoads(const BodyLoads& body) {
+  body.check(chain_);
+  if (!body.active()) {
+    body_.reset();
+    return;
+  }
+  body_ = std::make_shared<BodyLoadTerms>(chain_, body.atParameter(0.0));
+  bodyWork_.resize(chain_.size());
+  staticsValid_ = false;
+}
+
+void DynamicsModel::subtractBodyGenerator(VectorRef h) {
+  if (!body_) return;
+  body_->generator(0.0, bodyWork_);
+  h -= bodyWork_;
+}
+
+void DynamicsModel::addBodyHessian(MatrixRef H) {
+  if (!body_) return;
+  body_->generator(0.0, bodyWork_);
+  addBodyLoadHessian(bodyWork_, H);
 }
 
 void DynamicsModel::potentialGradient(ConstVectorRef q, VectorRef g) {
@@ -293,9 +332,13 @@ std::unique_ptr<DynamicsModel> makeDynamicsModel(const Chain& chain, const EndCo
                                                  const DynamicsScene& scene, ConstVectorRef q0) {
   std::string why;
   if (!scene.IsValid(chain, &why)) throw std::invalid_argument(why);
+  std::unique_ptr<DynamicsModel> model;
   if (scene.inertia)
-    return std::make_unique<InertialModel>(chain, end, *scene.inertia, scene.jointDamping, scene.baumgarteRate, q0);
-  return std::make_unique<GradientFlowModel>(chain, end, scene, q0);
+    model = std::make_unique<InertialModel>(chain, end, *scene.inertia, scene.jointDamping, scene.baumgarteRate, q0);
+  else
+    model = std::make_unique<GradientFlowModel>(chain, end, scene, q0);
+  if (scene.body) model->setBodyLoads(*scene.body);
+  return model;
 }
 
 }  // namespace buckle::mechanics

@@ -113,6 +113,7 @@ void GradientFlowModel::jacobian(const double* x, double* jacobianRowMajor) {
   loadMatrix(data_, loads_, H_);
   H_ = -H_;
   H_.diagonal() += stiffness_;
+  addBodyHessian(H_);
   Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Jac(jacobianRowMajor, N, N);
   Jac.setZero();
   Jac.topLeftCorner(n, n) = -H_ / c_;
@@ -140,6 +141,7 @@ bool GradientFlowModel::solveLinearized(const double* x, double a, const double*
     for (int j = 0; j < mh; ++j) total[held_[size_t(j)]] += r_[j];
     // H_r = U T Uᵀ from the statics velocity() evaluated (K_q and the kinematics at q)
     loadHessianGenerator(data_, total, structure_.h);
+    subtractBodyGenerator(structure_.h);
     structure_.kappa = stiffness_;
     assemble(structure_.kappa, structure_.h, structure_);
     // (I − aJ̃) k = b with s = a/c: (I + s(P H_r + κ_h J_h⁺J_h − J_h⁺E)) k = b. With

@@ -109,6 +109,7 @@ void InertialModel::linearizeAt(const double* x) {
   L.negSquare = -L.thetaDot.cwiseProduct(L.thetaDot);
   L.twiceRate = 2.0 * L.thetaDot;
   loadHessianGenerator(data_, loads_, L.h);
+  subtractBodyGenerator(L.h);
   assemble(stiffness_, L.h, L.structure);
   // (C_q + G)_θ's diagonal is minus its off-diagonal row sums
   applyCoupling(L.negSquare, L.thetaDdot, L.ones, L.diagK);

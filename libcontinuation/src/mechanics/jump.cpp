@@ -320,9 +320,11 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   problem.stability(result.from, lambda, 3, result.stabilityFrom);
 
   const EndCondition end = frozenEnd(problem, lambda);
-  // the chain with its control inputs (free lengths) where it is released
+  // the chain with its control inputs (free lengths) and its body loads where it is released
+  DynamicsScene scene = options.scene;
+  if (problem.bodyLoads().active()) scene.body = std::make_shared<const BodyLoads>(problem.bodyLoads().atParameter(lambda));
   std::unique_ptr<DynamicsModel> model =
-      makeDynamicsModel(problem.controlled() ? problem.chainAt(lambda) : problem.chain(), end, options.scene, qFrom);
+      makeDynamicsModel(problem.controlled() ? problem.chainAt(lambda) : problem.chain(), end, scene, qFrom);
   result.potentialFrom = model->potential(qFrom);
 
   // 1. The perturbation direction: the caller's, or the softest mode of the stability operator.

@@ -53,6 +53,9 @@ struct BodyLoads {
                           const Eigen::Vector2d& gravityRate);
   /// Any force or rate not zero.
   bool active() const;
+  /// The loads at λ, as constants: g(λ) and f_a(λ), rates zero (a state at fixed λ, e.g. the
+  /// dynamics of a jump, dynamics.h).
+  BodyLoads atParameter(double lambda) const;
   /// Throws std::invalid_argument naming the bad value (sizes, finiteness, m ≥ 0, d in [0, ℓ],
   /// joints in 1 … n).
   void check(const Chain& chain) const;

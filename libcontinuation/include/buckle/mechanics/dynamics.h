@@ -64,6 +64,9 @@
 
 namespace buckle::mechanics {
 
+struct BodyLoads;      // body_loads.h (which includes this header for InertiaData)
+class BodyLoadTerms;
+
 // ---- scene data ------------------------------------------------------------------------------
 
 /// One moving link as a rigid body.
@@ -102,6 +105,9 @@ struct DynamicsScene {
   /// Inertial model: Baumgarte rate ω (1/time) of the held coordinates. <= 0: automatic,
   /// 10·max_i √(|∂²Π/∂q_i²| / M_ii) at the start (ten times the fastest joint frequency).
   double baumgarteRate = 0.0;
+  /// The links' weight and point loads at the state simulated (DynamicsModel::setBodyLoads);
+  /// null: none.
+  std::shared_ptr<const BodyLoads> body;
 
   bool IsValid(const Chain& chain, std::string* why) const;
 };
@@ -131,6 +137,11 @@ class DynamicsModel {
   int lockedCount() const { return static_cast<int>(locked_.size()); }
   /// Locked joints in increasing order.
   const std::vector<int>& lockedJoints() const { return locked_; }
+  /// The links' weight and point loads (body_loads.h) at the model's fixed state, their rates
+  /// ignored (BodyLoads::atParameter): Π gains V (eq B1), ∇Π gains −τ (eq B2) and the Hessian's
+  /// generator −γ (eq B3). Throws std::invalid_argument as BodyLoads::check. Inactive loads: none.
+  void setBodyLoads(const BodyLoads& body);
+  bool hasBodyLoads() const { return body_ != nullptr; }
   /// Sets the locked joints (size n, entries −1, 0, +1); resizes the constraint workspace.
   /// Throws std::invalid_argument for a wrong size or entry.
   void setContacts(const std::vector<int>& sides);
@@ -165,9 +176,9 @@ class DynamicsModel {
   virtual double dissipated(const double* x) const = 0;
   virtual double kineticEnergy(const double* x) = 0;
 
-  /// Π(q) = E(q) − F_l · p_l(q) (held coordinates do no work while held).
+  /// Π(q) = E(q) − F_l · p_l(q) (+ V(q) with body loads; held coordinates do no work while held).
   double potential(ConstVectorRef q);
-  /// ∂Π/∂q = ∂E/∂q − J_lᵀ F_l.
+  /// ∂Π/∂q = ∂E/∂q − J_lᵀ F_l (− τ with body loads).
   void potentialGradient(ConstVectorRef q, VectorRef g);
   /// Equilibrium residual max(‖P ∇Π‖∞, ‖h‖∞): zero exactly at an equilibrium of the scene.
   double equilibriumResidual(ConstVectorRef q);
@@ -198,6 +209,11 @@ class DynamicsModel {
   /// setContacts() invalidates): a step evaluates the right-hand side at the accepted state, and
   /// the monitor then wants Π, the residual, the speed and the constraints at that same state.
   void evaluateStatics(ConstVectorRef q);
+  /// With body loads, the Hessian generator h (eq 27's, of the end wrench) becomes h − γ at the
+  /// cached statics (eq B3); without, nothing.
+  void subtractBodyGenerator(VectorRef h);
+  /// With body loads, H += Γ, Γ(i, j) = γ_max(i,j), at the cached statics (a dense Hessian).
+  void addBodyHessian(MatrixRef H);
 
   Chain chain_;
   EndCondition end_;
@@ -220,6 +236,9 @@ class DynamicsModel {
   Vector r_, tmpM_;  // size m (r_: the multipliers of the last right-hand side)
   Vector tmpN_;      // size n
   std::vector<double> fdPlus_, fdMinus_, fdState_;  // for the finite-difference jacobian()
+  std::shared_ptr<BodyLoadTerms> body_;  ///< null: no body loads
+  Vector bodyWork_;                      ///< τ or γ of the body loads (size n)
+  double bodyPotential_ = 0.0;           ///< V at the cached statics
 };
 
 /// (D1). dx/dt = (q̇, c|q̇|²).
