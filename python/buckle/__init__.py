@@ -9,6 +9,6 @@ __doc__ = _core.__doc__
 __all__ = ["Chain", "EndCondition", "RunResult", "SceneError", "Segment", "linear_buckling", "run_scene", "trace"]
 
 # Shown as buckle.Segment, not buckle._core.Segment (reprs of the classes, help(), tracebacks)
-for _name in ("Chain", "EndCondition", "SceneError", "Segment", "linear_buckling", "run_scene", "trace"):
+for _name in ("Chain", "EndCondition", "RunResult", "SceneError", "Segment", "linear_buckling", "run_scene", "trace"):
     globals()[_name].__module__ = __name__
 del _name

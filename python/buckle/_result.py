@@ -179,8 +179,9 @@ class RunResult(dict):
         else parameter and q1). Each branch is one LineCollection (gid "case C branch B"), solid where
         stable and dashed where unstable (blue / red with one case; one colour per case otherwise);
         special points marked per type (one Line2D each, gid "special TYPE") and labelled (labels: "auto"
-        labels all up to 60 points and only the primary branch's branch points beyond, "all", "none");
-        jumps as arrows. Axis labels in the scene's units. Returns the Figure."""
+        labels all up to 60 points, beyond that only the primary branch's branch points, as ranges of
+        mode numbers, "BP 24-27"; "all"; "none"); jumps as arrows. Axis labels in the scene's units.
+        Returns the Figure."""
         spec = self.plot_spec("bifurcation") if x is None or y is None else None
         return _plot.diagram(self, x if x is not None else spec["x"], y if y is not None else spec["y"], case, ax,
                              labels, title, log=False)

@@ -210,17 +210,33 @@ for method in (r.plot, r.branches_frame):
     assert "python3-matplotlib" in lines[0] and "python3-pandas" in lines[1]
 
 
-def test_plots_of_a_long_chain_label_the_primary_branch_points_only(source_dir):
-    scene = json.loads((source_dir / "data" / "scenes" / "long_chain_jumps.json").read_text())
+def test_a_long_chains_diagram_is_a_summary(source_dir):
+    # the default scene at 50 segments: thousands of special points on about a hundred branches
+    scene = json.loads((source_dir / "data" / "scenes" / "default.json").read_text())
+    scene["chain"]["segments"] = 50
     r = buckle.run_scene(scene)
     points = r["special_points"]
-    fig = r.plot_bifurcation(x="Fx", y="q1")
+    assert len(points) > 60
+    fig = r.plot("bifurcation_q2")
     ax = fig.axes[0]
-    texts = [t for t in ax.texts if t.get_gid() != "jump"]
-    if len(points) > 60:
-        primary = r["cases"][0]["branches"]["branch"][0]
-        expected = sum(p["type"] == "BP" and p["branch"] == primary for p in points)
-        assert 0 < sum(t.get_text().count("BP") for t in texts) <= expected
-    else:
-        assert sum(t.get_text().count(",") + 1 for t in texts) == len(points)
     assert len(branch_collections(ax)) == len(r["summary"]["cases"][0]["branches"])
+    assert all(c.get_linewidth()[0] < 1 and c.get_alpha() < 1 for c in branch_collections(ax))
+    # every special point still marked, the key counting each type as special_points.json does
+    kinds = {p["type"] for p in points}
+    for kind in kinds:
+        x, _ = markers(ax, kind)
+        assert len(x) == sum(p["type"] == kind for p in points)
+    key = {t.get_text() for t in ax.get_legend().get_texts()}
+    assert {f"{kind} ({sum(p['type'] == kind for p in points)})" for kind in kinds} <= key
+    # labelled: the branch points of the primary branch, full size, as ranges of their mode numbers
+    primary = r["cases"][0]["branches"]["branch"][0]
+    modes = sorted(int(p["shape"].split()[1]) for p in points if p["type"] == "BP" and p["branch"] == primary)
+    big = [line for line in ax.lines if line.get_gid() == "labelled BP"]
+    assert len(big) == len(modes)
+    labels = [t.get_text() for t in ax.texts if t.get_gid() != "jump"]
+    assert all(t.startswith("BP ") for t in labels) and 1 < len(labels) < len(modes)
+    covered = []
+    for text in labels:
+        first, _, last = text[3:].partition("-")
+        covered += [m for m in modes if int(first) <= m <= int(last or first)]
+    assert sorted(covered) == modes  # each mode in exactly one label
