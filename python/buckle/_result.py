@@ -203,5 +203,9 @@ class RunResult(dict):
         scene's shapes plot), one panel per value and case in a grid, to the true aspect ratio, axes in
         the scene's length unit. Returns the Figure."""
         if at is None:
-            at = self.plot_spec("shapes")["at"]
+            shapes = [s for s in self["plots"] if s["type"] == "shapes"]
+            if not shapes:
+                raise ValueError("plot_shapes needs `at`, the path-parameter values to draw the chain at: the scene "
+                                 "has no shapes plot to take them from")
+            at = shapes[0]["at"]
         return _plot.shapes(self, np.atleast_1d(np.asarray(at, dtype=float)), case, title)

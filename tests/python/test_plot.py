@@ -179,13 +179,16 @@ def test_shapes_draw_the_stable_point_nearest_each_value(si_run, tmp_path):
     saved_png(fig, tmp_path / "shapes.png")
 
 
-def test_plot_errors_name_what_there_is(si_run):
+def test_plot_errors_name_what_there_is(si_run, source_dir):
     with pytest.raises(KeyError, match="no column 'Fz'.*Fx"):
         si_run.plot_bifurcation(x="Fz", y="q1")
     with pytest.raises(KeyError, match="no plot 'nothing'.*bifurcation_q5"):
         si_run.plot("nothing")
     with pytest.raises(ValueError, match="torque_angle plot is drawn by run_scene.*plots/torque_angle.png"):
         si_run.plot("torque_angle")
+    without_shapes = buckle.run_scene(source_dir / "data" / "scenes" / "fig2.json")
+    with pytest.raises(ValueError, match="plot_shapes needs `at`"):
+        without_shapes.plot_shapes()
 
 
 def test_the_package_imports_and_runs_without_matplotlib_and_pandas(source_dir):
