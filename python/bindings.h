@@ -4,6 +4,7 @@
 #include <pybind11/pybind11.h>
 
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace buckle::python {
 
@@ -14,6 +15,10 @@ void bindMechanics(pybind11::module_& m);
 void bindContinuation(pybind11::module_& m);
 /// run_scene(): a scene (dict or file) through the same runner as `buckle run`.
 void bindScene(pybind11::module_& m);
+
+/// A number as Python's repr() writes a float: the shortest digits that read back to the same
+/// double ("1e-07", "1e+308", "0.1", "-2.5e-12", "inf"), for reprs and messages. Needs the GIL.
+std::string formatNumber(double value);
 
 /// A JSON document as Python objects (dict, list, str, int, float, bool, None).
 pybind11::object toPython(const nlohmann::json& value);

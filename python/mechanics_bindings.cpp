@@ -72,6 +72,28 @@ py::object segmentFunction(const mech::Segment& s, py::object q) {
   return py::cpp_function(py::vectorize([&s](double x) { return (s.*F)(x); }))(q);
 }
 
+/// The call that builds this segment: Segment(a=…, b=…, k=…, L0=…) when both sides are equal, the
+/// per-side keywords otherwise; user joint limits when set.
+std::string segmentRepr(const mech::SegmentParameters& p) {
+  std::string r = "Segment(";
+  auto add = [&r](const char* key, double value) {
+    r += (r.back() == '(' ? "" : ", ") + std::string(key) + "=" + formatNumber(value);
+  };
+  if (p.a1 == p.a2 && p.b1 == p.b2 && p.k1 == p.k2 && p.L1_0 == p.L2_0) {
+    add("a", p.a1);
+    add("b", p.b1);
+    add("k", p.k1);
+    add("L0", p.L1_0);
+  } else {
+    for (const auto& [key, value] : {std::pair<const char*, double>{"a1", p.a1}, {"b1", p.b1}, {"a2", p.a2},
+                                     {"b2", p.b2}, {"k1", p.k1}, {"k2", p.k2}, {"L1_0", p.L1_0}, {"L2_0", p.L2_0}})
+      add(key, value);
+  }
+  if (!std::isinf(p.qMinUser)) add("q_min", p.qMinUser);
+  if (!std::isinf(p.qMaxUser)) add("q_max", p.qMaxUser);
+  return r + ")";
+}
+
 }  // namespace
 
 void bindMechanics(py::module_& m) {
@@ -127,11 +149,7 @@ void bindMechanics(py::module_& m) {
            "Spring energy E(q) = ½ Σ k (L − L⁰)²; q scalar or array (elementwise).")
       .def("torque", &segmentFunction<&mech::Segment::torque>, py::arg("q"), "Restoring torque M(q) = −dE/dq.")
       .def("stiffness", &segmentFunction<&mech::Segment::stiffness>, py::arg("q"), "Joint stiffness K_q(q) = d²E/dq².")
-      .def("__repr__", [](const mech::Segment& s) {
-        const mech::SegmentParameters& p = s.parameters();
-        return "Segment(a1=" + std::to_string(p.a1) + ", b1=" + std::to_string(p.b1) + ", k1=" + std::to_string(p.k1) +
-               ", L1_0=" + std::to_string(p.L1_0) + ", L2_0=" + std::to_string(p.L2_0) + ", ...)";
-      });
+      .def("__repr__", [](const mech::Segment& s) { return segmentRepr(s.parameters()); });
 
   py::class_<mech::Chain>(m, "Chain",
                           "An n-segment planar chain with a clamped base. Joint angles q are NumPy arrays of size n; "
@@ -297,7 +315,7 @@ void bindMechanics(py::module_& m) {
                if (!std::isfinite(value[i]))
                  throw std::invalid_argument("EndCondition: value[" + std::to_string(i) +
                                              "] must be a finite number (a load or a position), got " +
-                                             std::to_string(value[i]));
+                                             formatNumber(value[i]));
              e.value = value;
              return e;
            }),
@@ -321,7 +339,8 @@ void bindMechanics(py::module_& m) {
                              "Loads of loaded coordinates, positions of held ones.")
       .def("__repr__", [](const mech::EndCondition& e) {
         return std::string("EndCondition(x='") + controlName(e.control[0]) + "', y='" + controlName(e.control[1]) +
-               "', phi='" + controlName(e.control[2]) + "')";
+               "', phi='" + controlName(e.control[2]) + "', value=(" + formatNumber(e.value[0]) + ", " +
+               formatNumber(e.value[1]) + ", " + formatNumber(e.value[2]) + "))";
       });
 
   m.def(

@@ -1,10 +1,12 @@
 // buckle.run_scene: a scene (a dict with the schema of docs/scenes.md, or a file) through the
 // runner of `buckle run` (scene/runner.h); the special points and the summary are the documents
-// `buckle run` writes (scene/output.h), the branches the columns of branches.csv as arrays.
+// `buckle run` writes (scene/output.h), the branches the columns of branches.csv as arrays
+// (scene_arrays.h), wrapped in the package's RunResult (_result.py).
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -16,6 +18,8 @@
 #include "scene/output_target.h"
 #include "scene/runner.h"
 #include "scene/scene.h"
+#include "scene/scene_parsing.h"
+#include "scene_arrays.h"
 #include "sigint_watch.h"
 
 namespace buckle::python {
@@ -48,85 +52,52 @@ py::object toPython(const json& v) {
 
 namespace {
 
-/// The columns of branches.csv for one case (docs/outputs.md), as arrays; q as a P×n matrix.
-py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
-  const auto P = static_cast<Eigen::Index>(cr.points.size());
-  py::dict d;
-  Eigen::VectorXi branch(P), point(P), negative(P);
-  py::array_t<bool> stable(P);
-  auto stableView = stable.mutable_unchecked<1>();
-  Eigen::MatrixXd q(P, cr.chain.size());
-  for (Eigen::Index i = 0; i < P; ++i) {
-    const scene::PointRecord& p = cr.points[static_cast<size_t>(i)];
-    branch[i] = p.branch;
-    point[i] = p.index;
-    negative[i] = p.negative;
-    stableView(i) = p.stable;
-    q.row(i) = p.q.size() == cr.chain.size() ? Eigen::RowVectorXd(p.q.transpose())
-                                              : Eigen::RowVectorXd::Constant(cr.chain.size(), NAN);
+constexpr const char* kInterruption = "interrupted (KeyboardInterrupt)";
+
+/// run_scene's dict (its docstring lists the keys).
+py::dict resultDict(const scene::Scene& s, const scene::RunResult& run, const scene::PlotReport& plots) {
+  py::dict result;
+  result["complete"] = run.complete;
+  result["interrupted"] = run.interrupted;
+  result["interruption"] = run.interruption;
+  result["problems"] = run.problems;
+  result["computed"] = run.computed;
+  py::list cases;
+  int specials = 0;  // the special points of the cases before
+  int segments = 0;
+  for (const scene::CaseResult& cr : run.cases) {
+    py::dict c;
+    c["label"] = cr.label;
+    c["segments"] = cr.chain.size();
+    c["chain"] = py::cast(cr.chain);
+    c["q0"] = cr.q0;
+    c["branches"] = branchArrays(s, cr);
+    c["special_points"] = specialArrays(s, cr, specials);
+    if (cr.haveEquilibria) c["equilibria"] = equilibriaArrays(cr);
+    cases.append(c);
+    specials += static_cast<int>(cr.specials.size());
+    segments = std::max(segments, cr.chain.size());
   }
-  d["branch"] = branch;
-  d["point"] = point;
-  std::vector<std::string> columns{"parameter", "Fx", "Fy", "Me", "x", "y", "phi", "dx", "dy", "min_eig"};
-  if (s.analyses.stiffness)
-    columns.insert(columns.end(), scene::stiffnessColumns().begin(), scene::stiffnessColumns().end());
-  if (s.analyses.frequencies.enabled) {
-    const std::vector<std::string> omega = scene::frequencyColumns(s.analyses.frequencies.count);
-    columns.insert(columns.end(), omega.begin(), omega.end());
-  }
-  const std::vector<std::string> inputs = s.inputColumns();  // a task path's inputs
-  columns.insert(columns.end(), inputs.begin(), inputs.end());
-  for (const std::string& c : columns) {
-    VectorXd v(P);
-    for (Eigen::Index i = 0; i < P; ++i) v[i] = scene::columnValue(c, cr.points[static_cast<size_t>(i)], cr.pose0);
-    d[py::str(c)] = v;
-  }
-  d["q"] = q;
-  d["stable"] = stable;
-  d["negative"] = negative;
-  return d;
+  result["cases"] = cases;
+  const json specialPoints = scene::specialPointsJson(s, run);
+  result["special_points"] = toPython(specialPoints["special_points"]);
+  result["results"] = toPython(specialPoints);
+  result["summary"] = toPython(scene::summaryJson(s, run, plots));
+  result["labels"] = columnLabels(s, segments);
+  result["plots"] = plotSpecs(s.plots);
+  result["default_plots"] = plotSpecs(scene::detail::defaultPlots(s.analyses, static_cast<int>(s.cases.size())));
+  return result;
 }
 
-/// The equilibria of one case (the rows of equilibria.csv) as arrays, q as an m×n matrix; with
-/// "branches", the branch through each (−1: none) and the disconnected branches' seeds.
-py::dict equilibriaArrays(const scene::CaseResult& cr) {
-  const std::vector<mechanics::FoundEquilibrium>& list = cr.equilibria.equilibria;
-  const auto m = static_cast<Eigen::Index>(list.size());
-  py::dict d;
-  Eigen::MatrixXd q(m, cr.chain.size());
-  VectorXd potential(m);
-  Eigen::VectorXi index(m), branch = Eigen::VectorXi::Constant(m, -1);
-  py::array_t<bool> stable(m);
-  auto stableView = stable.mutable_unchecked<1>();
-  std::vector<std::string> shape;
-  for (Eigen::Index k = 0; k < m; ++k) {
-    const mechanics::FoundEquilibrium& e = list[static_cast<size_t>(k)];
-    q.row(k) = e.q.transpose();
-    potential[k] = e.potential;
-    index[k] = e.index;
-    stableView(k) = e.stable;
-    shape.push_back(e.shape);
-    if (static_cast<size_t>(k) < cr.equilibriaOnBranch.size()) branch[k] = cr.equilibriaOnBranch[static_cast<size_t>(k)];
-  }
-  d["at"] = cr.equilibriaAt;
-  d["q"] = q;
-  d["potential"] = potential;
-  d["index"] = index;
-  d["stable"] = stable;
-  d["shape"] = shape;
-  d["branch"] = branch;
-  py::list disconnected;
-  for (const scene::BranchRecord& b : cr.branches)
-    if (b.fromEquilibrium > 0) {
-      py::dict r;
-      r["id"] = b.id;
-      r["parent"] = b.parent;
-      r["from_equilibrium"] = b.fromEquilibrium;
-      r["joins"] = b.joins >= 0 ? py::object(py::int_(b.joins)) : py::object(py::none());
-      disconnected.append(r);
-    }
-  d["disconnected_branches"] = disconnected;
-  return d;
+/// KeyboardInterrupt after Ctrl-C, carrying the partial result as its `result`.
+[[noreturn]] void raiseKeyboardInterrupt(const py::object& result, const std::optional<std::string>& out) {
+  const std::string message = "run_scene interrupted (Ctrl-C)" +
+                              (out ? "; what was computed is written to " + *out : std::string()) +
+                              "; the partial result is this exception's .result";
+  py::object error = py::reinterpret_borrow<py::object>(PyExc_KeyboardInterrupt)(message);
+  error.attr("result") = result;
+  PyErr_SetObject(PyExc_KeyboardInterrupt, error.ptr());
+  throw py::error_already_set();
 }
 
 scene::Scene parse(const py::object& source) {
@@ -167,9 +138,14 @@ void bindScene(py::module_& m) {
     }
   });
 
+  // run_scene's result is a buckle.RunResult: the dict below with the methods of _result.py
+  // (DataFrames, plots); the package's own module, whatever it is imported as
+  const std::string moduleName = m.attr("__name__").cast<std::string>();
+  const std::string resultModule = moduleName.substr(0, moduleName.rfind('.') + 1) + "_result";
   m.def(
       "run_scene",
-      [](const py::object& source, std::optional<double> timeLimit, std::optional<std::string> out, bool force) {
+      [resultModule](const py::object& source, std::optional<double> timeLimit, std::optional<std::string> out,
+                     bool force) {
         if (timeLimit && !(*timeLimit > 0.0))
           throw std::invalid_argument("time_limit must be a positive number of seconds");
         scene::Scene s = parse(source);
@@ -178,60 +154,50 @@ void bindScene(py::module_& m) {
         if (out) target = scene::checkOutputTarget(*out, {s.file}, force, "out");
         SigintWatch sigint;
         scene::RunControl control;
-        control.interrupt.watch(sigint.flag(), "interrupted (KeyboardInterrupt)");
+        control.interrupt.watch(sigint.flag(), kInterruption);
         scene::RunResult run;
         scene::PlotReport plots;
         {
           py::gil_scoped_release release;
           run = scene::runScene(s, control);
-          if (out && !sigint.flag()->load()) {
+          // interrupted or not, `out` gets what was computed, as `buckle run` writes it on SIGINT:
+          // after Ctrl-C no plot is drawn (the writers' stop is the same flag)
+          if (out) {
+            continuation::Interrupt stop;
+            stop.watch(sigint.flag(), kInterruption);
             scene::StagingDirectory staging(target);
-            plots = scene::writeOutputs(s, run, staging.path());
+            plots = scene::writeOutputs(s, run, staging.path(), stop);
             staging.commit();
           }
         }
-        sigint.raiseIfInterrupted();
         if (!out) plots.gnuplot = "not drawn (run_scene without out)";
-        py::dict result;
-        result["complete"] = run.complete;
-        result["interrupted"] = run.interrupted;
-        result["interruption"] = run.interruption;
-        result["problems"] = run.problems;
-        result["computed"] = run.computed;
-        py::list cases;
-        for (const scene::CaseResult& cr : run.cases) {
-          py::dict c;
-          c["label"] = cr.label;
-          c["segments"] = cr.chain.size();
-          c["chain"] = py::cast(cr.chain);
-          c["q0"] = cr.q0;
-          c["branches"] = branchArrays(s, cr);
-          if (cr.haveEquilibria) c["equilibria"] = equilibriaArrays(cr);
-          cases.append(c);
-        }
-        result["cases"] = cases;
-        const json specials = scene::specialPointsJson(s, run);
-        result["special_points"] = toPython(specials["special_points"]);
-        result["results"] = toPython(specials);
-        result["summary"] = toPython(scene::summaryJson(s, run, plots));
+        py::object result = py::module_::import(resultModule.c_str()).attr("RunResult")(resultDict(s, run, plots));
+        if (sigint.interrupted()) raiseKeyboardInterrupt(result, out);
         return result;
       },
       py::arg("scene"), py::kw_only(), py::arg("time_limit") = py::none(), py::arg("out") = py::none(),
       py::arg("force") = false,
       "Runs a scene (a dict with the schema of docs/scenes.md, or the path of a scene file) with the runner of "
-      "`buckle run`: only the analyses it asks for.\n\n"
+      "`buckle run`: only the analyses it asks for. Returns a RunResult (a dict; docs/python.md).\n\n"
       "time_limit: seconds for the whole run (overrides /solver/time_limit); when reached the run stops within a "
       "step and returns what it computed (`complete` False, `interrupted` True). out: also write the output "
       "directory `buckle run --out` writes (CSV, JSON, plots, report.html), with the same --out rules (force: "
-      "as --force). Ctrl-C raises KeyboardInterrupt.\n\n"
-      "Returns a dict: `complete`, `interrupted`, `interruption`, `problems`, `computed`; `cases` (per case: "
-      "`label`, `segments`, `chain` (a Chain), `q0`, `branches`: the columns of branches.csv as arrays — branch, "
-      "point, parameter, Fx, Fy, Me, x, y, phi, dx, dy, q (P×n), stable, negative, min_eig, and Kxx, Kyy, Kxy, Cxx, Cyy, Cxy, Kx_yfree, Ky_xfree, K1, K2, theta1 with "
-      "stiffness; with the equilibria analysis `equilibria`: the rows of equilibria.csv as arrays — at, q (m×n), "
-      "potential, index, stable, shape, branch (the branch through each, -1: none or not traced) — and "
-      "`disconnected_branches` (id, parent, from_equilibrium: the seed's rank, joins)); `special_points` (the dicts of special_points.json); `results` (all of special_points.json: "
-      "critical_loads, energy_equilibria, ... when asked); `summary` (summary.json). Raises SceneError (a "
-      "ValueError) for a bad scene.");
+      "as --force).\n\n"
+      "Ctrl-C stops the run within a step; what was computed is written to `out` (as `buckle run` does on "
+      "SIGINT: summary.json says interrupted, no plots drawn) and KeyboardInterrupt is raised, its `result` "
+      "attribute holding the partial RunResult.\n\n"
+      "The dict: `complete`, `interrupted`, `interruption`, `problems`, `computed`; `cases` (per case: "
+      "`label`, `segments`, `chain` (a Chain), `q0`, `branches`: the columns of branches.csv as arrays, in its "
+      "order — branch, point, parameter, Fx, Fy, Me, x, y, phi, dx, dy, q (P×n), stable, negative, min_eig, locked "
+      "(str), contact_torque, and Kxx, Kyy, Kxy, Cxx, Cyy, Cxy, Kx_yfree, Ky_xfree, K1, K2, theta1 with stiffness, "
+      "omega1 … with frequencies, a task path's inputs; `special_points`: the case's special points in the same "
+      "value columns as arrays, with type, field, shape, branch and index (into the run's `special_points`); with the equilibria analysis `equilibria`: the rows of equilibria.csv as "
+      "arrays — at, q (m×n), potential, index, stable, shape, branch (the branch through each, -1: none or not "
+      "traced) — and `disconnected_branches` (id, parent, from_equilibrium: the seed's rank, joins)); "
+      "`special_points` (the dicts of special_points.json); `results` (all of special_points.json: "
+      "critical_loads, energy_equilibria, ... when asked); `summary` (summary.json, with `units`); `labels` "
+      "(column → axis label in the scene's units, as the plots write it). Raises SceneError (a ValueError) for a "
+      "bad scene.");
 }
 
 }  // namespace buckle::python

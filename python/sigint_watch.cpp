@@ -30,8 +30,10 @@ SigintWatch::~SigintWatch() {
 
 const std::atomic<bool>* SigintWatch::flag() const { return installed_ ? &gInterrupted : &never_; }
 
+bool SigintWatch::interrupted() const { return installed_ && gInterrupted.load(); }
+
 void SigintWatch::raiseIfInterrupted() const {
-  if (!installed_ || !gInterrupted.load()) return;
+  if (!interrupted()) return;
   PyErr_SetNone(PyExc_KeyboardInterrupt);
   throw py::error_already_set();
 }

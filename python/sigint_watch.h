@@ -25,6 +25,8 @@ class SigintWatch {
   /// The flag for continuation::Interrupt::watch (one that is never set when nothing is watched,
   /// so a computation in another thread is not stopped by the main thread's Ctrl-C).
   const std::atomic<bool>* flag() const;
+  /// True when SIGINT arrived while watched.
+  bool interrupted() const;
   /// Raises KeyboardInterrupt (pybind11::error_already_set) when SIGINT arrived. Needs the GIL.
   void raiseIfInterrupted() const;
 

@@ -5,7 +5,7 @@
 #                           run the main job (results in out/)
 #   scripts/setup.sh test   install missing packages (and chromium, for the browser test of
 #                           report.html), build with the tests, run ctest (pytest included)
-# Both build the Python module into build/python: PYTHONPATH=build/python python3 -c 'import buckle'
+# Both build the Python package into build/python: PYTHONPATH=build/python python3 -c 'import buckle'
 #
 # Supports Debian bookworm (also a minimal image). Installing needs root: the script uses
 # sudo when not root, and touches apt only when a package is missing (checked with
@@ -31,11 +31,13 @@ export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$ROOT}
 # Debian packages (names verified on bookworm). pybind11-dev, python3-dev, python3-numpy: the
 # Python module (build/python); python3-pytest: its tests. openmpi-bin, libopenmpi-dev:
 # `buckle-mpi atlas` under mpirun (and its test, mpirun -np 2/3). TEST_PACKAGES only for `test`:
-# chromium renders report.html in the browser test.
+# chromium renders report.html in the browser test; matplotlib and pandas, the Python package's
+# optional plots and DataFrames; pip, setuptools, wheel and venv, its `pip install .` test.
 readonly PACKAGES=(build-essential cmake git pkg-config ccache libeigen3-dev libsundials-dev
                    libboost-dev catch2 libcli11-dev nlohmann-json3-dev libbenchmark-dev gnuplot-nox
                    pybind11-dev python3-dev python3-numpy python3-pytest openmpi-bin libopenmpi-dev)
-readonly TEST_PACKAGES=(chromium)
+readonly TEST_PACKAGES=(chromium python3-matplotlib python3-pandas python3-pip python3-setuptools python3-wheel
+                        python3-venv)
 
 START=$SECONDS
 log() { printf '==> [setup %4ds] %s\n' "$((SECONDS - START))" "$*"; }

@@ -113,3 +113,37 @@ def test_end_condition_controls():
     assert e.value[0] == -0.5
     e = buckle.EndCondition(x="held", y="held", value=[2.5, 0.1, 0])
     assert e.control == ("held", "held", "load")
+
+
+# Values a fixed-point format hides (1e-7 as 0.000000), spells out (1e308 in 309 digits) or rounds
+# (0.1 and -2.5e-12 must read back to the same double).
+REPR_VALUES = [1e-7, 1e308, 0.1, -2.5e-12]
+
+
+@pytest.mark.parametrize("value", REPR_VALUES)
+def test_reprs_write_every_number_as_python_does(value):
+    # Segment: any positive stiffness keeps the geometry valid
+    k = abs(value)
+    s = buckle.Segment(a=0.5, b=1.0, k=k, L0=2.25)
+    text = repr(s)
+    assert text == f"Segment(a=0.5, b=1.0, k={k!r}, L0=2.25)"
+    assert len(text) < 120
+    again = eval(text, {"Segment": buckle.Segment})
+    assert again.parameters == s.parameters  # the digits read back to the same doubles
+    e = buckle.EndCondition("load", "held", "load", value=(value, -value, 0.0))
+    assert repr(e) == f"EndCondition(x='load', y='held', phi='load', value=({value!r}, {-value!r}, 0.0))"
+    again = eval(repr(e), {"EndCondition": buckle.EndCondition})
+    assert list(again.value) == [value, -value, 0.0] and again.control == e.control
+
+
+def test_an_asymmetric_segments_repr_names_each_side_and_the_user_limits():
+    s = buckle.Segment(a=0.5, b=1.0, k=1.0, L0=2.25, k2=1e-7, L1_0=2.3, q_min=-2.5e-12)
+    text = repr(s)
+    assert text.startswith("Segment(a1=0.5, b1=1.0, a2=0.5, b2=1.0, k1=1.0, k2=1e-07, L1_0=2.3, L2_0=2.25")
+    assert "q_min=-2.5e-12" in text and "q_max" not in text
+    assert eval(text, {"Segment": buckle.Segment}).parameters == s.parameters
+
+
+def test_a_non_finite_end_value_is_named_as_python_writes_it():
+    with pytest.raises(ValueError, match=r"value\[1\] must be a finite number .*got inf"):
+        buckle.EndCondition(value=(0.0, math.inf, 0.0))

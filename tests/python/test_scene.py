@@ -182,16 +182,49 @@ def test_time_limit_returns_what_was_computed(source_dir):
     assert r["summary"]["solver"]["time_limit"] == 0.5
 
 
-def test_keyboard_interrupt_stops_a_run(source_dir):
-    timer = threading.Timer(0.1, lambda: os.kill(os.getpid(), signal.SIGINT))
+def interrupt_after(seconds):
+    """A timer that sends this process SIGINT (Ctrl-C) after `seconds`."""
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
     timer.start()
+    return timer
+
+
+def test_keyboard_interrupt_stops_a_run(source_dir):
+    timer = interrupt_after(0.1)
     started = time.monotonic()
     try:
-        with pytest.raises(KeyboardInterrupt):
+        with pytest.raises(KeyboardInterrupt) as raised:
             buckle.run_scene(long_run(source_dir))
     finally:
         timer.cancel()
     assert time.monotonic() - started < 10
+    # the partial result rides on the exception
+    r = raised.value.result
+    assert isinstance(r, buckle.RunResult)
+    assert r["interrupted"] is True and r["complete"] is False and "KeyboardInterrupt" in r["interruption"]
+
+
+def test_keyboard_interrupt_writes_what_was_computed_to_out(source_dir, tmp_path):
+    # as `buckle run` on SIGINT: the output directory holds the partial results, marked interrupted,
+    # before KeyboardInterrupt reaches the caller
+    out = tmp_path / "partial"
+    timer = interrupt_after(1.0)
+    try:
+        with pytest.raises(KeyboardInterrupt, match="written to " + str(out)) as raised:
+            buckle.run_scene(long_run(source_dir), out=str(out))
+    finally:
+        timer.cancel()
+    r = raised.value.result
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["interrupted"] is True and summary["complete"] is False
+    assert summary["interruption"] == r["interruption"]
+    rows = read_branches_csv(out / "branches.csv")
+    assert len(rows) == len(r["cases"][0]["branches"]["parameter"]) > 0
+    np.testing.assert_allclose([float(row["Fx"]) for row in rows], r["cases"][0]["branches"]["Fx"], rtol=1e-11)
+    written = json.loads((out / "special_points.json").read_text())["special_points"]
+    assert len(written) == len(r["special_points"])
+    assert not summary["plots"]["files"]  # after Ctrl-C no plot is drawn, as on the command line
+    assert (out / "report.html").is_file()
 
 
 def test_the_gil_is_released_while_a_scene_runs(source_dir):

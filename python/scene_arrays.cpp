@@ -1,0 +1,199 @@
+#include "scene_arrays.h"
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+
+#include "scene/columns.h"
+#include "scene/output.h"
+
+namespace buckle::python {
+
+namespace py = pybind11;
+using Eigen::VectorXd;
+
+namespace {
+
+/// Columns `columns` of `rows`, each an array.
+template <class Record>
+void addValues(py::dict& d, const std::vector<std::string>& columns, const std::vector<const Record*>& rows,
+               const scene::CaseResult& cr) {
+  const auto P = static_cast<Eigen::Index>(rows.size());
+  for (const std::string& c : columns) {
+    VectorXd v(P);
+    for (Eigen::Index i = 0; i < P; ++i) v[i] = scene::columnValue(c, *rows[static_cast<size_t>(i)], cr.pose0);
+    d[py::str(c)] = v;
+  }
+}
+
+/// q of `rows` as a P×n matrix (NaN rows where a record has no angles).
+template <class Record>
+Eigen::MatrixXd angles(const std::vector<const Record*>& rows, const scene::CaseResult& cr) {
+  const auto P = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd q(P, cr.chain.size());
+  for (Eigen::Index i = 0; i < P; ++i) {
+    const Eigen::VectorXd& qi = rows[static_cast<size_t>(i)]->q;
+    q.row(i) = qi.size() == cr.chain.size() ? Eigen::RowVectorXd(qi.transpose())
+                                             : Eigen::RowVectorXd::Constant(cr.chain.size(), NAN);
+  }
+  return q;
+}
+
+/// The value columns before q in branches.csv (the rest follow stable and negative).
+const std::vector<std::string>& leadColumns() {
+  static const std::vector<std::string> kLead{"parameter", "Fx", "Fy", "Me", "x", "y", "phi", "dx", "dy"};
+  return kLead;
+}
+
+/// The value columns after q, stable, negative, min_eig, locked and contact_torque.
+std::vector<std::string> tailColumns(const scene::Scene& s) {
+  const std::vector<std::string> all = valueColumns(s);
+  return std::vector<std::string>(all.begin() + static_cast<std::ptrdiff_t>(leadColumns().size()) + 1, all.end());
+}
+
+}  // namespace
+
+std::vector<std::string> valueColumns(const scene::Scene& s) {
+  std::vector<std::string> columns{"parameter", "Fx", "Fy", "Me", "x", "y", "phi", "dx", "dy", "min_eig"};
+  if (s.analyses.stiffness)
+    columns.insert(columns.end(), scene::stiffnessColumns().begin(), scene::stiffnessColumns().end());
+  if (s.analyses.frequencies.enabled) {
+    const std::vector<std::string> omega = scene::frequencyColumns(s.analyses.frequencies.count);
+    columns.insert(columns.end(), omega.begin(), omega.end());
+  }
+  const std::vector<std::string> inputs = s.inputColumns();  // a task path's inputs
+  columns.insert(columns.end(), inputs.begin(), inputs.end());
+  return columns;
+}
+
+py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
+  const auto P = static_cast<Eigen::Index>(cr.points.size());
+  py::dict d;
+  Eigen::VectorXi branch(P), point(P), negative(P);
+  VectorXd contactTorque(P);
+  py::array_t<bool> stable(P);
+  auto stableView = stable.mutable_unchecked<1>();
+  std::vector<std::string> locked;
+  std::vector<const scene::PointRecord*> rows;
+  for (Eigen::Index i = 0; i < P; ++i) {
+    const scene::PointRecord& p = cr.points[static_cast<size_t>(i)];
+    rows.push_back(&p);
+    branch[i] = p.branch;
+    point[i] = p.index;
+    negative[i] = p.negative;
+    stableView(i) = p.stable;
+    locked.push_back(p.locked);
+    contactTorque[i] = p.contactTorque;
+  }
+  // in the order of branches.csv's columns
+  d["branch"] = branch;
+  d["point"] = point;
+  addValues(d, leadColumns(), rows, cr);
+  d["q"] = angles(rows, cr);
+  d["stable"] = stable;
+  d["negative"] = negative;
+  addValues(d, {"min_eig"}, rows, cr);
+  d["locked"] = locked;
+  d["contact_torque"] = contactTorque;
+  addValues(d, tailColumns(s), rows, cr);
+  return d;
+}
+
+py::dict specialArrays(const scene::Scene& s, const scene::CaseResult& cr, int firstIndex) {
+  const auto m = static_cast<Eigen::Index>(cr.specials.size());
+  py::dict d;
+  Eigen::VectorXi branch(m), index(m);
+  std::vector<std::string> type, field, shape;
+  std::vector<const scene::SpecialRecord*> rows;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const scene::SpecialRecord& r = cr.specials[static_cast<size_t>(i)];
+    rows.push_back(&r);
+    branch[i] = r.branch;
+    index[i] = firstIndex + static_cast<int>(i);
+    type.push_back(r.type);
+    field.push_back(r.field);
+    shape.push_back(r.shape);
+  }
+  d["index"] = index;
+  d["type"] = type;
+  d["field"] = field;
+  d["branch"] = branch;
+  addValues(d, leadColumns(), rows, cr);
+  d["q"] = angles(rows, cr);
+  addValues(d, tailColumns(s), rows, cr);
+  d["shape"] = shape;
+  return d;
+}
+
+py::dict equilibriaArrays(const scene::CaseResult& cr) {
+  const std::vector<mechanics::FoundEquilibrium>& list = cr.equilibria.equilibria;
+  const auto m = static_cast<Eigen::Index>(list.size());
+  py::dict d;
+  Eigen::MatrixXd q(m, cr.chain.size());
+  VectorXd potential(m);
+  Eigen::VectorXi index(m), branch = Eigen::VectorXi::Constant(m, -1);
+  py::array_t<bool> stable(m);
+  auto stableView = stable.mutable_unchecked<1>();
+  std::vector<std::string> shape;
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const mechanics::FoundEquilibrium& e = list[static_cast<size_t>(k)];
+    q.row(k) = e.q.transpose();
+    potential[k] = e.potential;
+    index[k] = e.index;
+    stableView(k) = e.stable;
+    shape.push_back(e.shape);
+    if (static_cast<size_t>(k) < cr.equilibriaOnBranch.size()) branch[k] = cr.equilibriaOnBranch[static_cast<size_t>(k)];
+  }
+  d["at"] = cr.equilibriaAt;
+  d["q"] = q;
+  d["potential"] = potential;
+  d["index"] = index;
+  d["stable"] = stable;
+  d["shape"] = shape;
+  d["branch"] = branch;
+  py::list disconnected;
+  for (const scene::BranchRecord& b : cr.branches)
+    if (b.fromEquilibrium > 0) {
+      py::dict r;
+      r["id"] = b.id;
+      r["parent"] = b.parent;
+      r["from_equilibrium"] = b.fromEquilibrium;
+      r["joins"] = b.joins >= 0 ? py::object(py::int_(b.joins)) : py::object(py::none());
+      disconnected.append(r);
+    }
+  d["disconnected_branches"] = disconnected;
+  return d;
+}
+
+py::dict columnLabels(const scene::Scene& s, int segments) {
+  py::dict labels;
+  auto label = [&](const std::string& column, const std::string& as) {
+    labels[py::str(column)] = scene::columnLabel(as, s.units, scene::LabelStyle::Plain);
+  };
+  // the path parameter's label, as the plots and report.html write it (plot_internal.h)
+  label("parameter", s.cases.empty() ? std::string("parameter") : s.cases.front().path.parameter);
+  for (const std::string& c : valueColumns(s))
+    if (c != "parameter") label(c, c);
+  for (int i = 1; i <= segments; ++i) label("q" + std::to_string(i), "q" + std::to_string(i));
+  return labels;
+}
+
+py::list plotSpecs(const std::vector<scene::PlotSpec>& plots) {
+  py::list out;
+  for (const scene::PlotSpec& p : plots) {
+    py::dict d;
+    d["type"] = scene::toString(p.type);
+    d["name"] = p.name;
+    d["title"] = p.title;
+    d["x"] = p.x;
+    d["y"] = p.y;
+    d["at"] = p.at;
+    d["cases"] = p.cases;
+    out.append(d);
+  }
+  return out;
+}
+
+}  // namespace buckle::python
