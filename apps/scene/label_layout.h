@@ -39,9 +39,9 @@ inline size_t glyphs(const std::string& s) {
   return size_t(std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
 }
 
-// Label metrics of the ',9' font of the plots (DejaVu Sans 9 pt at the terminals' 72 dpi):
-// measured advance about 6.1 px per character, line height 11 px; a margin on top.
-constexpr double kLabelCharWidth = 6.5, kLabelHeight = 13.0, kMarkerHalf = 7.0;
+// Label metrics of the ',9' font of the pngcairo plots: "BP mode 12" is 72 px wide (7.2 px a
+// character, digits and lower case), line height 11 px; a margin on top.
+constexpr double kLabelCharWidth = 7.3, kLabelHeight = 13.0, kMarkerHalf = 7.0;
 
 struct Box {
   double x0, y0, x1, y1;

@@ -240,8 +240,9 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
     if (p) {
       const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, p->q);
       for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
-    } else {
-      box.extend(Eigen::Vector2d(cr.chain.length(), 0.0));
+    } else {  // nothing drawn: a panel of the usual proportions for the message, not a strip
+      box.extend(Eigen::Vector2d(cr.chain.length(), 0.35 * cr.chain.length()));
+      box.extend(Eigen::Vector2d(0.0, -0.35 * cr.chain.length()));
     }
     const double pad = std::max(1.2 * cr.chain.length() / (2.0 * std::max(1, cr.chain.size())), 0.03 * box.sizes().maxCoeff());
     box.extend(Eigen::Vector2d(box.min().array() - pad));
