@@ -11,7 +11,7 @@ const char* const kReportHead = R"PAGE(<!DOCTYPE html>
 <meta name="generator" content="buckle run">
 <title>buckle report</title>
 <style>
-body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em auto; max-width: 1360px; padding: 0 1em; color: #222; }
+body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em auto; max-width: 1560px; padding: 0 1em; color: #222; }
 h1 { font-size: 1.4em; margin: 0 0 .2em; } h2 { font-size: 1.15em; margin: 1.4em 0 .4em; }
 .desc { color: #555; max-width: 70em; }
 .row { display: flex; flex-wrap: wrap; gap: 1em; align-items: flex-start; }

@@ -167,7 +167,10 @@ def check_page(html, out, specials, browser, flags, tmp, report):
             text = re.search(r'<text[^>]*class="' + axis + r'"[^>]*>([^<]*)</text>', chart)
             if text and text.group(1) and not re.search(r"\(.+\)$", text.group(1)):
                 fail(f"the axis label {text.group(1)!r} has no unit")
-    xlabel = re.search(r'class="xlabel"[^>]*>([^<]*)<', diagram).group(1)
+    xlabel = re.search(r'class="xlabel"[^>]*>([^<]*)<', diagram)
+    if not xlabel:
+        fail("the diagram has no x axis label (text.xlabel)")
+    xlabel = xlabel.group(1)
     unit = summary["units"]["force"]
     if unit not in xlabel:
         fail(f"the diagram's x label {xlabel!r} does not give the force unit {unit!r}")
@@ -190,6 +193,8 @@ def check_page(html, out, specials, browser, flags, tmp, report):
         fail(f"the key's jump entry does not match the {jumps} successful jumps")
     # labelled special points: all of them, or the summary's choice
     expected = rank_counts(specials, summary) if is_summary else len(specials)
+    if attribute(svg_open, "data-labelled-points") is None:
+        fail("the diagram does not say how many special points it labels (data-labelled-points)")
     labelled = int(attribute(svg_open, "data-labelled-points"))
     if labelled != expected:
         fail(f"{labelled} special points labelled, expected {expected}")
@@ -213,7 +218,10 @@ def check_page(html, out, specials, browser, flags, tmp, report):
     if not time or time.group(1) != "%.3g" % summary["timings_seconds"]["total"]:
         fail(f"the page's computation time {time and time.group(1)!r} is not summary.json's "
              f"{summary['timings_seconds']['total']}")
-    rows = int(re.search(r'<table id="points-table" data-rows="([0-9]+)"', html).group(1))
+    rows = re.search(r'<table id="points-table" data-rows="([0-9]+)"', html)
+    if not rows:
+        fail("no traced points table (table#points-table)")
+    rows = int(rows.group(1))
     with open(out / "branches.csv") as f:
         csv_rows = sum(1 for _ in f) - 1
     abridged = re.search(r"it draws ([0-9]+) of the ([0-9]+) traced points", html)
