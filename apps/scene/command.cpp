@@ -11,6 +11,7 @@
 
 #include "scene/escape.h"
 #include "scene/output.h"
+#include "scene/output_numbers.h"
 #include "scene/output_target.h"
 #include "scene/runner.h"
 #include "scene/scene.h"
@@ -140,9 +141,10 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
       log << "computed: ";
       for (size_t i = 0; i < run.computed.size(); ++i) log << (i ? "; " : "") << run.computed[i];
       const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-      log << "\n" << countsLine(run) << " in " << std::fixed << std::setprecision(2) << total << " s"
+      // the computation's time is summary.json's timings_seconds.total, the one report.html shows
+      log << "\n" << countsLine(run) << "; computed in " << secondsText(run.totalSeconds) << " s ("
+          << secondsText(total) << " s with the outputs written)"
           << (run.interrupted ? " (stopped early: " + run.interruption + ")" : "") << "\n";
-      log.unsetf(std::ios::floatfield);
       if (!plots.gnuplotFound) log << "plots: " << plots.gnuplot << "\n";
       for (const std::string& f : plots.failures) log << "plot failed: " << f << "\n";
       if (!plots.stopped.empty())

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <system_error>
@@ -199,6 +200,12 @@ double roundedSignificant(double v, int digits) {
   // out of range (|v| rounded up past the largest double): strtod's ±HUGE_VAL
   if (std::from_chars(buf, printed.ptr, r).ec != std::errc()) r = std::strtod(std::string(buf, printed.ptr).c_str(), nullptr);
   return r;
+}
+
+std::string secondsText(double seconds) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", seconds);
+  return buf;
 }
 
 }  // namespace buckle::scene

@@ -24,4 +24,8 @@ double roundedSignificant(double v, int digits);
 /// shortest-digits search: the rounding's own digits are those (1 <= digits <= 17).
 void appendRoundedJson(std::string& out, double v, int digits);
 
+/// A duration as the run's last line and report.html print it: printf's "%.3g" seconds, one text
+/// for the one number (summary.json's timings_seconds.total), so the two read the same.
+std::string secondsText(double seconds);
+
 }  // namespace buckle::scene

@@ -5,6 +5,17 @@
 
 namespace buckle::scene {
 
+void plot_detail::Frame::script(std::ostream& os) const {
+  os << "set lmargin at screen " << num(left) << "\nset rmargin at screen " << num(right) << "\nset bmargin at screen "
+     << num(bottom) << "\nset tmargin at screen " << num(top) << "\nset xrange [" << num(xlo) << ":" << num(xhi)
+     << "]\n";
+  if (logY)
+    os << "set logscale y\nset format y '10^{%L}'\nset yrange [" << num(std::pow(10.0, ylo)) << ":"
+       << num(std::pow(10.0, yhi)) << "]\n";
+  else
+    os << "set yrange [" << num(ylo) << ":" << num(yhi) << "]\n";
+}
+
 using namespace plot_detail;
 
 namespace {

@@ -5,6 +5,8 @@
 
 #include <set>
 
+#include "scene/special_marks.h"
+
 namespace buckle::scene::plot_detail {
 
 namespace {
@@ -44,106 +46,9 @@ double specialValue(const std::string& column, const SpecialRecord& r, const Cas
   return value;
 }
 
-struct SpecialStyle {
-  const char* type;
-  int point;       ///< gnuplot point type, filled; point - 1 is the open outline
-  const char* key;
-  const char* color;  ///< summary mode: the type's colour (markers of all cases)
-};
-const SpecialStyle kSpecialStyles[] = {{"BP", 7, "BP branch point", "#000000"},
-                                       {"LP", 9, "LP fold", "#d62728"},
-                                       {"LPF", 9, "LPF reaction fold", "#ff7f0e"},
-                                       {"BD", 5, "BD joint limit", "#8c564b"},
-                                       {"LS", 9, "LS loss of stability at fixed inputs", "#e377c2"},
-                                       {"IB", 5, "IB input bound", "#bcbd22"},
-                                       {"KMIN", 13, "KMIN Kxx minimum", "#9467bd"},
-                                       {"JUMP", 11, "JUMP release", "#ff7f0e"},
-                                       {"CT", 15, "CT contact (joint locks)", "#2ca02c"},
-                                       {"RL", 3, "RL contact released", "#17becf"},
-                                       {"BC", 5, "BC base contact (detected)", "#e377c2"},
-                                       {"SC", 5, "SC self contact (detected)", "#7f7f7f"}};
-
-const SpecialStyle& specialStyle(const std::string& type) {
-  for (const SpecialStyle& s : kSpecialStyles)
-    if (type == s.type) return s;
-  static const SpecialStyle other{"", 7, "special point", "#555555"};
-  return other;
-}
-
-// ---- summary mode (long chains, large trees) -----------------------------------------------------
-
-// A bifurcation diagram of a 50-segment chain carries thousands of special points (2479 in the
-// default scene at n = 50: 882 LP, 764 CT, 352 RL, …). Like AUTO's and BifurcationKit's plots of
-// large diagrams, the summary labels only the points a reader steers by and draws the others as
-// small markers by type, counted in the key.
-
-/// `labels: auto` draws the summary above this many markers (the shipped 3-segment scenes have
-/// at most a few dozen, all labelled).
-constexpr size_t kSummaryAboveMarkers = 60;
-/// Summary labels beyond the branch points of the primary branch (which are all labelled): the
-/// jumps, then the first fold of each branch in the order the branches were traced.
-constexpr size_t kSummaryExtraLabels = 24;
-/// Summary: unlabelled markers of one case and type closer than this many pixels are drawn once.
-constexpr double kThinPixels = 4.0;
-/// Labels of one case's points closer than this many pixels are merged into one ("BP, JUMP"); a
-/// summary merges wider, the branch points of a long chain's primary branch into ranges
-/// ("BP 24-27": modes 24 to 27).
-constexpr double kMergePixels = 3.0, kSummaryMergePixels = 12.0;
-
-/// One label for the merged points' texts; a summary writes the branch points' modes as ranges
-/// ("BP 3, 4", "BP 24-27"), the other texts after them.
-std::string mergedLabel(const std::vector<std::string>& parts, bool summary) {
-  std::vector<int> modes;
-  std::vector<std::string> rest;
-  for (const std::string& p : parts) {
-    const bool mode = summary && p.size() > 3 && p.rfind("BP ", 0) == 0 &&
-                      p.find_first_not_of("0123456789", 3) == std::string::npos;
-    if (mode)
-      modes.push_back(std::stoi(p.substr(3)));
-    else
-      rest.push_back(p);
-  }
-  std::string text;
-  std::sort(modes.begin(), modes.end());
-  for (size_t i = 0; i < modes.size();) {
-    size_t j = i;
-    while (j + 1 < modes.size() && modes[j + 1] == modes[j] + 1) ++j;
-    text += (i ? ", " : "BP ") + std::to_string(modes[i]);
-    if (j == i + 1) text += ", " + std::to_string(modes[j]);
-    if (j > i + 1) text += "-" + std::to_string(modes[j]);
-    i = j + 1;
-  }
-  for (const std::string& p : rest) text += (text.empty() ? "" : ", ") + p;
-  return text;
-}
-
-/// How much a special point matters in a summary, most first.
-enum class Importance { PrimaryBranchPoint, Jump, FirstFold, Other };
-
-/// Per special record of a case (same order as `cr.specials`): the branch points of the primary
-/// branches (those with no parent: the start), the jumps (a load history's JUMP, a fold with a
-/// simulated jump), the first fold (LP, LPF) of each branch in the order the tracer reported
-/// them, the rest.
-std::vector<Importance> importance(const CaseResult& cr) {
-  std::vector<int> primary;
-  for (const BranchRecord& b : cr.branches)
-    if (b.parent < 0) primary.push_back(b.id);
-  std::vector<int> folded;
-  std::vector<Importance> out;
-  for (const SpecialRecord& r : cr.specials) {
-    Importance k = Importance::Other;
-    if (r.type == "BP" && std::find(primary.begin(), primary.end(), r.branch) != primary.end())
-      k = Importance::PrimaryBranchPoint;
-    else if (r.type == "JUMP" || r.jumpSuccess)
-      k = Importance::Jump;
-    else if ((r.type == "LP" || r.type == "LPF") && std::find(folded.begin(), folded.end(), r.branch) == folded.end()) {
-      folded.push_back(r.branch);
-      k = Importance::FirstFold;
-    }
-    out.push_back(k);
-  }
-  return out;
-}
+/// The gnuplot point size of a full-size special-point marker and its half-width in pixels
+/// (pngcairo at the plots' size: about 4 px a unit of point size).
+constexpr double kMarkerSize = 1.4, kMarkerPixels = 5.6;
 
 /// Indices of the points kept when points closer than `radius` are drawn once: greedy in the
 /// given order over a hash grid of cell `radius` (O(points log points)).
@@ -282,11 +187,7 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
       for (size_t j = 0; j < ny; ++j) {
         const double x = specialValue(spec.x, r, cr), y = specialValue(spec.y[j], r, cr);
         if (!std::isfinite(x) || !std::isfinite(y)) continue;
-        std::string label = r.type;
-        // a summary's branch points of long chains: "BP 12" for mode 12 (the key says so)
-        if (r.type == "BP" && !r.shape.empty() && r.shape != "other")
-          label += " " + (summary && r.shape.rfind("mode ", 0) == 0 ? r.shape.substr(5) : r.shape);
-        marks.push_back({o, r.type, x, y, label, rank[i]});
+        marks.push_back({o, r.type, x, y, specialLabel(r, summary), rank[i]});
         extend(x, y);
       }
     }
@@ -310,8 +211,6 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
       if (marks[i].rank == Importance::PrimaryBranchPoint || extra++ < kSummaryExtraLabels) labelled[i] = true;
   }
   // jumps: arrows from the fold to the landing point
-  BlockFile jumps;
-  jumps.begin();
   bool anyJump = false;
   std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> arrows;
   for (size_t c : cases) {
@@ -326,7 +225,6 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
         const double x0 = columnValue(spec.x, r, cr.pose0), y0 = columnValue(spec.y[j], r, cr.pose0);
         const double x1 = columnValue(spec.x, to, cr.pose0), y1 = columnValue(spec.y[j], to, cr.pose0);
         if (!std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) continue;
-        jumps.point({x0, y0, x1 - x0, y1 - y0});
         arrows.push_back({{x0, y0}, {x1, y1}});
         extend(x0, y0);
         extend(x1, y1);
@@ -339,8 +237,8 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   Frame f;
   f.width = s.width;
   f.height = s.height;
-  std::vector<std::string> typesPresent;  // in the order of kSpecialStyles
-  for (const SpecialStyle& st : kSpecialStyles)
+  std::vector<std::string> typesPresent;  // in the order of specialStyles()
+  for (const SpecialStyle& st : specialStyles())
     for (const Mark& m : marks)
       if (m.type == st.type) {
         typesPresent.push_back(st.type);
@@ -359,7 +257,7 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
       for (size_t j = 0; j < ny; ++j)
         keyChars = std::max(keyChars, glyphs(run.cases[cases[o]].label) + (ny > 1 ? 1 + spec.y[j].size() : 0));
   f.right = std::clamp(1.0 - (8.2 * double(keyChars + 6) + 30.0) / f.width, 0.5, 0.8);
-  std::tie(f.xlo, f.xhi) = niceRange(xlo, xhi);
+  std::tie(f.xlo, f.xhi) = framedNiceRange(xlo, xhi);
   // stiffness spans decades (the straight chain against a buckled one): a log axis in whole decades
   // when every drawn value is positive and they span more than two
   if (spec.type == PlotType::Stiffness && ylo <= 0.0) std::tie(ylo, yhi) = framedRange(ys);
@@ -367,13 +265,36 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   if (f.logY)
     f.ylo = std::floor(std::log10(ylo)), f.yhi = std::ceil(std::log10(yhi));
   else
-    std::tie(f.ylo, f.yhi) = niceRange(ylo, yhi);
+    std::tie(f.ylo, f.yhi) = framedNiceRange(ylo, yhi);
 
   Occupancy occupied(f.width, f.height);
   for (const auto& line : polylines)
     for (size_t i = 0; i + 1 < line.size(); ++i)
       occupied.segment(f.pixel(line[i].x(), line[i].y()), f.pixel(line[i + 1].x(), line[i + 1].y()));
-  for (const auto& [a, b] : arrows) occupied.segment(f.pixel(a.x(), a.y()), f.pixel(b.x(), b.y()));
+  // jumps: block 0 the arrows (x y dx dy: the whole jump, or a hop's last piece with the head),
+  // block 1 the hops' bodies (label_layout.h, jumpPath: at least kJumpMinPixels long on screen)
+  occupied.finish();
+  BlockFile jumps;
+  jumps.begin();
+  std::vector<std::vector<Eigen::Vector2d>> jumpPaths;
+  for (const auto& [a, b] : arrows) {
+    jumpPaths.push_back(jumpPath(f.pixel(a.x(), a.y()), f.pixel(b.x(), b.y()), kJumpMinPixels, occupied));
+    const std::vector<Eigen::Vector2d>& path = jumpPaths.back();
+    for (size_t k = 0; k + 1 < path.size(); ++k) occupied.segment(path[k], path[k + 1]);
+  }
+  for (const std::vector<Eigen::Vector2d>& path : jumpPaths) {
+    const Eigen::Vector2d p = f.data(path[path.size() - 2]), q = f.data(path.back());
+    jumps.point({p.x(), p.y(), q.x() - p.x(), q.y() - p.y()});
+  }
+  jumps.begin();
+  for (const std::vector<Eigen::Vector2d>& path : jumpPaths) {
+    if (path.size() <= 2) continue;
+    for (size_t k = 0; k + 1 < path.size(); ++k) {
+      const Eigen::Vector2d d = f.data(path[k]);
+      jumps.point({d.x(), d.y()});
+    }
+    jumps.breakLine();
+  }
   // a summary's unlabelled markers, per case and type, those closer than kThinPixels drawn once;
   // a label may cover them only where it must (like a curve)
   std::vector<bool> drawn(marks.size(), true);
@@ -447,8 +368,14 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
                      " drawn (the others within " + num(kThinPixels) + " px of one drawn)";
         sp.text(comment);
         for (size_t i = 0; i < marks.size(); ++i)
-          if (marks[i].ordinal == o && marks[i].type == type && labelled[i] != small && drawn[i])
-            sp.point({marks[i].x, marks[i].y});
+          if (marks[i].ordinal == o && marks[i].type == type && labelled[i] != small && drawn[i]) {
+            // full-size markers of other types close by: both smaller (label_layout.h, markerRadius)
+            std::vector<Eigen::Vector2d> others;
+            for (size_t k = 0; k < marks.size() && !small; ++k)
+              if (labelled[k] && marks[k].type != type) others.push_back(f.pixel(marks[k].x, marks[k].y));
+            const double r = markerRadius(f.pixel(marks[i].x, marks[i].y), others, kMarkerPixels, 0.45 * kMarkerPixels);
+            sp.point({marks[i].x, marks[i].y, small ? 0.5 : kMarkerSize * r / kMarkerPixels});
+          }
         specialBlocks.push_back({block, o, type, small});
       }
   std::vector<int> labelBlocks(cases.size(), -1);
@@ -527,9 +454,11 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   if (anyDisconnected)
     clause("keyentry with lines lw 2 dt 1 lc rgb " + quote(kDisconnectedColor) +
            " title 'disconnected branch'");
-  if (anyJump)
+  if (anyJump) {
+    clause(quote(stem + "_jumps.dat") + " index 1 using 1:2 with lines lw 1.5 lc rgb '#ff7f0e' notitle");
     clause(quote(stem + "_jumps.dat") +
-           " using 1:2:3:4 with vectors head filled size screen 0.015,20 lw 1.5 lc rgb '#ff7f0e' title 'jump'");
+           " index 0 using 1:2:3:4 with vectors head filled size screen 0.015,20 lw 1.5 lc rgb '#ff7f0e' title 'jump'");
+  }
   if (anySpecial) {
     // leader lines under the markers
     for (size_t o = 0; o < cases.size(); ++o)
@@ -541,14 +470,14 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
       for (const SpecialBlock& b : specialBlocks) {
         if (b.small != small) continue;
         const SpecialStyle& st = specialStyle(b.type);
-        const std::string at = quote(stem + "_special.dat") + " index " + std::to_string(b.block) + " using 1:2";
+        const std::string at = quote(stem + "_special.dat") + " index " + std::to_string(b.block) + " using 1:2:3";
         if (small) {
-          clause(at + " with points pt " + std::to_string(st.point) + " ps 0.5 lc rgb " + quote(st.color) + " notitle");
+          clause(at + " with points pt " + std::to_string(st.point) + " ps variable lc rgb " + quote(st.color) + " notitle");
           continue;
         }
         const std::string fill = summary ? st.color : multiCase ? color(b.ordinal * ny) : std::string("black");
-        clause(at + " with points pt " + std::to_string(st.point) + " ps 1.4 lc rgb " + quote(fill) + " notitle");
-        clause(at + " with points pt " + std::to_string(st.point - 1) + " ps 1.4 lw 1 lc rgb 'black' notitle");
+        clause(at + " with points pt " + std::to_string(st.point) + " ps variable lc rgb " + quote(fill) + " notitle");
+        clause(at + " with points pt " + std::to_string(st.point - 1) + " ps variable lw 1 lc rgb 'black' notitle");
       }
     for (const std::string& type : typesPresent) {
       const SpecialStyle& st = specialStyle(type);

@@ -18,6 +18,15 @@ std::pair<double, double> niceRange(double lo, double hi) {
   return {std::floor(lo / step + 1e-9) * step, std::ceil(hi / step - 1e-9) * step};
 }
 
+std::pair<double, double> framedNiceRange(double lo, double hi) {
+  auto [a, b] = niceRange(lo, hi);
+  if (!std::isfinite(lo) || !std::isfinite(hi)) return {a, b};
+  const double margin = kFrameMargin * (b - a);
+  if (lo - a < margin) a = lo - margin;
+  if (b - hi < margin) b = hi + margin;
+  return {a, b};
+}
+
 std::pair<double, double> framedRange(std::vector<double>& values) {
   values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }), values.end());
   const double inf = std::numeric_limits<double>::infinity();

@@ -11,6 +11,12 @@ namespace buckle::scene {
 /// gnuplot's autoscale would, so that fixing the range does not change the plot's look.
 std::pair<double, double> niceRange(double lo, double hi);
 
+/// niceRange(lo, hi), with an end that would meet the data (an extreme within kFrameMargin of the
+/// span from it) moved out by kFrameMargin of the span: a curve at the data's extreme (the
+/// straight branch at zero deflection) is drawn apart from the axis line, not on it.
+std::pair<double, double> framedNiceRange(double lo, double hi);
+constexpr double kFrameMargin = 0.03;
+
 /// The range of `values` (finite ones; the order is changed) that a plot frames: all of them,
 /// unless some lie further than kPoleReach interquantile spreads (the 5th to the 95th percentile)
 /// beyond those percentiles — the run-up to a pole — in which case the frame ends one spread

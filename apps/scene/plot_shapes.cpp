@@ -9,6 +9,20 @@ namespace {
 
 // ---- chain shapes ------------------------------------------------------------------------------
 
+/// The pixels of one panel of the `shapes` grid.
+const Eigen::Vector2d kShapePanel(600.0, 440.0);
+
+/// Tick steps of a panel drawn to scale (`set size ratio -1`): one step on both axes, about 90
+/// pixels apart on the panel's drawn scale, so that the numbers of a long chain's panel never
+/// run into each other.
+void panelTics(std::ostream& os, const Eigen::AlignedBox2d& box, const Eigen::Vector2d& panel) {
+  const Eigen::Vector2d extent = box.sizes();
+  const double scale = std::min(0.8 * panel.x() / extent.x(), 0.7 * panel.y() / extent.y());  // pixels per unit
+  const double raw = 90.0 / scale, decade = std::pow(10.0, std::floor(std::log10(raw)));
+  const double r = raw / decade, step = decade * (r <= 1.0 ? 1.0 : r <= 2.0 ? 2.0 : r <= 5.0 ? 5.0 : 10.0);
+  os << "set xtics " << num(step) << "\nset ytics " << num(step) << "\n";
+}
+
 /// Below this many pixels per segment a chain is drawn as its centre line (base, joints, end):
 /// the triangles, springs and joint-limit arcs of a 50-segment chain across a 500-pixel panel
 /// (8 px a segment) would fill it with ink and hide the shape.
@@ -157,10 +171,11 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
                 Script& s, std::vector<std::string>& notes) {
   const std::string stem = spec.name;
   const size_t nc = spec.cases.size(), na = spec.at.size();
-  // at most five panels a row: more levels wrap onto further rows of the same case
-  const size_t cols = std::min<size_t>(na, 5), rowsPerCase = (na + cols - 1) / cols;
-  s.width = std::min<int>(3200, int(520 * cols));
-  s.height = std::min<int>(2400, int(330 * nc * rowsPerCase) + 60);
+  // a grid of panels of a readable size: up to three a row (four levels: two by two), more levels
+  // wrap onto further rows of the same case
+  const size_t cols = na <= 3 ? std::max<size_t>(na, 1) : na == 4 ? 2 : 3, rowsPerCase = (na + cols - 1) / cols;
+  s.width = int(kShapePanel.x() * double(cols));
+  s.height = std::min<int>(4800, int(kShapePanel.y() * double(nc * rowsPerCase)) + 60);
 
   // per case, the point drawn at each requested level (null: not drawn, `missing` says why)
   std::vector<std::vector<const PointRecord*>> chosenOf;
@@ -215,42 +230,38 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
     }
   }
 
-  // one scale for every panel: the bounding box of all traced chains; long chains, drawn as their
-  // centre lines, to the box of the chains drawn (the coils of unstable branches far from any
-  // level asked for would shrink them to a few pixels)
-  auto boxOf = [&](bool drawnOnly) {
+  // each panel to its own scale: the chain drawn there (and the base) fills it, true to its
+  // aspect ratio; a margin of 1.2 b around it (b the mean half-length: a chain is 2 b n long), or
+  // 3 % of a long chain's extent
+  auto boxOf = [&](size_t o, const PointRecord* p) {
+    const CaseResult& cr = run.cases[size_t(spec.cases[o])];
     Eigen::AlignedBox2d box;
     box.extend(Eigen::Vector2d(0.0, 0.0));
-    for (size_t o = 0; o < nc; ++o) {
-      const CaseResult& cr = run.cases[size_t(spec.cases[o])];
-      box.extend(Eigen::Vector2d(cr.chain.length(), 0.0));
-      for (const PointRecord& p : cr.points) {
-        if (drawnOnly && std::find(chosenOf[o].begin(), chosenOf[o].end(), &p) == chosenOf[o].end()) continue;
-        const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, p.q);
-        for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
-      }
+    if (p) {
+      const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, p->q);
+      for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
+    } else {  // nothing drawn: a panel of the usual proportions for the message, not a strip
+      box.extend(Eigen::Vector2d(cr.chain.length(), 0.35 * cr.chain.length()));
+      box.extend(Eigen::Vector2d(0.0, -0.35 * cr.chain.length()));
     }
+    const double pad = std::max(1.2 * cr.chain.length() / (2.0 * std::max(1, cr.chain.size())), 0.03 * box.sizes().maxCoeff());
+    box.extend(Eigen::Vector2d(box.min().array() - pad));
+    box.extend(Eigen::Vector2d(box.max().array() + pad));
+    box.extend(Eigen::Vector2d(-0.1 * cr.chain.length(), box.min().y()));  // the base's wall
     return box;
   };
-  Eigen::AlignedBox2d box = boxOf(false);
-  const Eigen::Vector2d panel(double(s.width) / double(cols), double(s.height - 60) / double(nc * rowsPerCase));
   bool detailed = true;
-  for (size_t c : selected(spec)) detailed = detailed && detailedChain(run.cases[c].chain, box, panel);
-  if (!detailed) box = boxOf(true);
-  s.body << "set encoding utf8\nset size ratio -1\nunset key\nset grid lc rgb '#eeeeee'\n";
+  for (size_t o = 0; o < nc; ++o)
+    for (size_t k = 0; k < na; ++k)
+      detailed = detailed && detailedChain(run.cases[size_t(spec.cases[o])].chain, boxOf(o, chosenOf[o][k]), kShapePanel);
+  s.body << "set encoding utf8\nset size ratio -1\nunset key\nset grid lc rgb '#eeeeee'\nset tics font ',9'\n";
   s.body << "set multiplot layout " << nc * rowsPerCase << "," << cols << " title "
          << quote(!spec.title.empty() ? spec.title
-                  : detailed ? std::string("Chain shapes to scale" + scene.units.suffix(Dimension::Length) + "; grey arcs: joint limits, "
-                                           "red: joint within 5% of a limit, magenta star: through the clamp or itself")
-                             : std::string("Chain shapes to scale" + scene.units.suffix(Dimension::Length) + ", centre lines (base, joints, end); red: "
-                                           "joint within 5% of a limit, magenta star: through the clamp or itself"))
+                  : detailed ? std::string("Chain shapes" + scene.units.suffix(Dimension::Length) + ", each panel to its own scale; grey arcs: "
+                                           "joint limits, red: joint within 5% of a limit, magenta star: through the clamp or itself")
+                             : std::string("Chain shapes" + scene.units.suffix(Dimension::Length) + ", each panel to its own scale, centre lines "
+                                           "(base, joints, end); red: joint within 5% of a limit, magenta star: through the clamp or itself"))
          << " font ',11'\n";
-  // a margin of 1.2 b around the chains (b the mean half-length: a chain is 2 b n long), or 3 % of a
-  // long chain's extent
-  double bMean = 0.0;
-  for (size_t c : selected(spec)) bMean = std::max(bMean, run.cases[c].chain.length() / (2.0 * run.cases[c].chain.size()));
-  const double pad = std::max(1.2 * bMean, 0.03 * box.sizes().maxCoeff());
-  const double x0 = box.min().x() - pad, x1 = box.max().x() + pad, y0 = box.min().y() - pad, y1 = box.max().y() + pad;
   for (size_t o = 0; o < nc; ++o) {
     const size_t c = size_t(spec.cases[o]);
     const CaseResult& cr = run.cases[c];
@@ -279,9 +290,11 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
         s.body << "set label 1 " << quote(missingOf[o][k]) << " at graph 0.5, graph 0.5 center font ',9' noenhanced\n";
       }
       const double L = cr.chain.length();
+      const Eigen::AlignedBox2d box = boxOf(o, p);
       s.body << "set title " << quote(title.str()) << " font ',10'\n";
-      s.body << "set xrange [" << num(std::min(x0, -0.1 * L)) << ":" << num(x1) << "]\nset yrange [" << num(y0) << ":"
-             << num(y1) << "]\n";
+      s.body << "set xrange [" << num(box.min().x()) << ":" << num(box.max().x()) << "]\nset yrange [" << num(box.min().y())
+             << ":" << num(box.max().y()) << "]\n";
+      panelTics(s.body, box, kShapePanel);
       chainPanel(s.body, base, L, std::string(), true, detailed);
       s.body << "unset label 1\n";
     }

@@ -18,6 +18,7 @@
 #include "scene/output.h"
 #include "scene/output_numbers.h"
 #include "scene/report_page.h"
+#include "scene/special_marks.h"
 
 namespace buckle::scene {
 
@@ -181,6 +182,7 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
   c["branches"] = branches;
 
   json specials = json::array();
+  const std::vector<Importance> rank = importance(cr);  // as the gnuplot diagrams rank them
   for (size_t k = 0; k < cr.specials.size(); ++k) {
     const SpecialRecord& s = cr.specials[k];
     const bool shape = k < shown.specialShapes;
@@ -201,10 +203,22 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
     json values = json::object();
     for (const std::string& name : columns) values[name] = rounded(columnValue(name, s, cr.pose0), 10);
     e["values"] = values;
+    e["label"] = specialLabel(s, false);
+    e["label_summary"] = specialLabel(s, true);
+    e["rank"] = static_cast<int>(rank[k]);
     if (shape && s.q.size() == cr.chain.size()) e["joints"] = jointsJson(cr.chain, s.q);
     if (s.jumpTried) {
       e["jump"] = s.jumpSuccess ? s.jumpLanding + (s.jumpShape.empty() ? "" : " (" + s.jumpShape + ")") : "failed: " + s.jumpMessage;
       if (shape && s.jumpQ.size() == cr.chain.size()) e["jump_joints"] = jointsJson(cr.chain, s.jumpQ);
+      if (s.jumpSuccess && s.jumpQ.size() == cr.chain.size()) {  // where the diagrams' jump arrow ends
+        SpecialRecord to = s;
+        to.q = s.jumpQ;
+        to.F = s.jumpF;
+        to.pose = s.jumpPose;
+        json landing = json::object();
+        for (const std::string& name : columns) landing[name] = rounded(columnValue(name, to, cr.pose0), 10);
+        e["landing"] = landing;
+      }
     }
     specials.push_back(e);
   }
@@ -258,6 +272,10 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
   return objectText(c, pointMembers(cr, columns, shown));
 }
 
+const char* labelsName(PlotLabels labels) {
+  return labels == PlotLabels::All ? "all" : labels == PlotLabels::Summary ? "summary" : "auto";
+}
+
 }  // namespace
 
 json roundedForPage(double v, int digits) {
@@ -280,7 +298,21 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
                                 {"stiffness", Dimension::Stiffness},
                                 {"rotational_stiffness", Dimension::RotationalStiffness}})
     suffix[name] = scene.units.suffix(d);
+  // the path parameter's unit (|Δλ| of the special points table)
+  suffix["parameter"] = scene.cases.empty() ? std::string() : scene.units.suffix(columnDimension(scene.cases.front().path.parameter));
   data["unit_suffix"] = suffix;
+  // the markers, their key and the summary's rules, as the gnuplot diagrams draw them
+  json styles = json::array();
+  for (const SpecialStyle& st : specialStyles())
+    styles.push_back(json{{"type", st.type}, {"point", st.point}, {"key", st.key}, {"color", st.color}});
+  data["marks"] = json{{"styles", styles},
+                       {"summary_above", kSummaryAboveMarkers},
+                       {"summary_extra", kSummaryExtraLabels},
+                       {"thin_px", kThinPixels},
+                       {"merge_px", kMergePixels},
+                       {"summary_merge_px", kSummaryMergePixels}};
+  // the text the run's last line prints for the computation's time (summary.json's total)
+  data["time_text"] = secondsText(run.totalSeconds);
   // the main diagram: the scene's first bifurcation plot, else the path parameter against q1
   const PlotSpec* first = nullptr;
   for (const PlotSpec& p : scene.plots)
@@ -324,6 +356,7 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   };
   label("parameter");
   for (const std::string& column : columns) label(column);
+  for (const char* load : {"Fx", "Fy", "Me"}) label(load);  // the special points table's heads
   for (const PlotSpec& p : scene.plots) {
     if (!p.x.empty()) label(p.x);
     for (const std::string& y : p.y) label(y);
@@ -336,6 +369,7 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
                         {"xlabel", mainX},
                         {"title", first && !first->title.empty() ? first->title : "Bifurcation diagram"}};
     if (first && !first->cases.empty()) data["main"]["cases"] = first->cases;
+    data["main"]["labels"] = first ? labelsName(first->labels) : "auto";
   }
   else
     data["main"] = nullptr;
@@ -344,12 +378,14 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
     json e{{"type", toString(p.type)}, {"name", p.name}, {"title", p.title}, {"x", p.x},
            {"y", p.y},                    {"at", p.at},     {"xlabel", p.x}};
     if (!p.cases.empty()) e["cases"] = p.cases;
+    e["labels"] = labelsName(p.labels);
     plots.push_back(e);
   }
   data["plots"] = plots;
   data["critical"] = specialPoints.contains("critical_loads") ? specialPoints["critical_loads"] : json::array();
   // every "<" as \u003c: nothing inside the JSON can end or change the <script> element (escape.h)
-  return kReportHead + escape::htmlScriptSafe(objectText(data, {{"cases", std::move(cases)}})) + kReportTail;
+  return kReportHead + escape::htmlScriptSafe(objectText(data, {{"cases", std::move(cases)}})) + kReportScriptStart +
+         kReportChartScript + kReportTail;
 }
 
 void writeReport(const Scene& scene, const RunResult& run, const json& specialPoints, const json& summary,

@@ -11,7 +11,7 @@ const char* const kReportHead = R"PAGE(<!DOCTYPE html>
 <meta name="generator" content="buckle run">
 <title>buckle report</title>
 <style>
-body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em auto; max-width: 1360px; padding: 0 1em; color: #222; }
+body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em auto; max-width: 1560px; padding: 0 1em; color: #222; }
 h1 { font-size: 1.4em; margin: 0 0 .2em; } h2 { font-size: 1.15em; margin: 1.4em 0 .4em; }
 .desc { color: #555; max-width: 70em; }
 .row { display: flex; flex-wrap: wrap; gap: 1em; align-items: flex-start; }
@@ -25,6 +25,9 @@ th, td { border: 1px solid #ddd; padding: 2px 6px; text-align: right; white-spac
 th { background: #f4f4f4; text-align: center; } td.t { text-align: left; }
 tr.sp { cursor: pointer; } tr.sp:hover, tr.sp.on { background: #fff4cc; }
 #shape-info { min-height: 2.8em; font-size: 13px; max-width: 560px; }
+.scroll { max-height: 32em; overflow: auto; max-width: 100%; display: inline-block; border: 1px solid #ddd; }
+.scroll thead th { position: sticky; top: 0; } td.wrap { white-space: normal; min-width: 18em; text-align: left; }
+.pager { margin: .3em 0; } .pager button { min-width: 2.2em; }
 #errors { color: #b00; background: #fee; padding: .5em; white-space: pre-wrap; }
 .note { color: #666; font-size: 12px; }
 </style>
@@ -43,13 +46,15 @@ tr.sp { cursor: pointer; } tr.sp:hover, tr.sp.on { background: #fff4cc; }
 <h2>Special points</h2>
 <div id="special-points-box"></div>
 <div id="critical-box"></div>
+<h2>Traced points</h2>
+<div id="points-box"></div>
 <h2>Views asked for by the scene</h2>
 <div class="row" id="views"></div>
 <h2>Run</h2>
 <div id="run-box"></div>
 <script type="application/json" id="buckle-data">)PAGE";
 
-const char* const kReportTail = R"PAGE(</script>
+const char* const kReportScriptStart = R"PAGE(</script>
 <script>
 (function () {
   'use strict';
@@ -63,140 +68,32 @@ const char* const kReportTail = R"PAGE(</script>
   }
   window.addEventListener('error', function (e) { fail(e.message + ' (line ' + e.lineno + ')'); });
 
-  var NS = 'http://www.w3.org/2000/svg';
-  var PALETTE = ['#1f77b4', '#d62728', '#2ca02c', '#9467bd', '#ff7f0e', '#8c564b', '#e377c2', '#17becf'];
-  var TYPE_COLOR = {BP: '#d62728', LP: '#ff7f0e', BD: '#7f7f7f', KMIN: '#9467bd', CT: '#8c564b', RL: '#17becf'};
-  function ok(v) { return typeof v === 'number' && isFinite(v); }
+)PAGE";
+
+const char* const kReportTail = R"PAGE(  var D = JSON.parse(document.getElementById('buckle-data').textContent);
   function label(column) { return (D.labels && D.labels[column]) || column; }  // with the scene's unit
-  function svg(tag, attrs, parent) {
-    var e = document.createElementNS(NS, tag);
-    for (var k in attrs) e.setAttribute(k, attrs[k]);
-    if (parent) parent.appendChild(e);
-    return e;
-  }
-  function html(tag, attrs, parent, text) {
-    var e = document.createElement(tag);
-    for (var k in attrs) e.setAttribute(k, attrs[k]);
-    if (text !== undefined) e.textContent = text;
-    if (parent) parent.appendChild(e);
-    return e;
-  }
-  function fmt(v, digits) {
-    if (!ok(v)) return '–';
-    var a = Math.abs(v);
-    if (a !== 0 && (a < 1e-3 || a >= 1e5)) return v.toExponential(2);
-    return String(+v.toPrecision(digits || 5));
-  }
-  function ticks(lo, hi, count) {
-    var raw = (hi - lo) / count, step = Math.pow(10, Math.floor(Math.log(raw) / Math.LN10)), r = raw / step;
-    step *= r >= 7.5 ? 10 : r >= 3.5 ? 5 : r >= 1.5 ? 2 : 1;
-    var out = [];
-    for (var t = Math.ceil(lo / step) * step; t <= hi + 1e-9 * step; t += step) out.push(Math.abs(t) < 1e-9 * step ? 0 : t);
-    return out;
-  }
-  function range(values) {
-    var lo = Infinity, hi = -Infinity;
-    values.forEach(function (v) { if (ok(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); } });
-    if (lo > hi) return null;
-    if (hi - lo <= 1e-12 * Math.max(1, Math.abs(lo))) { var d = Math.max(Math.abs(lo) * 0.1, 1e-3); lo -= d; hi += d; }
-    var pad = 0.04 * (hi - lo);
-    return [lo - pad, hi + pad];
-  }
-
-  // A chart: o.lines [{x, y, color, dash, width}], o.marks [{x, y, color, title, act}], o.pick
-  // [{x, y, act}] (hover/click targets), o.legend [{color, dash, label}], o.equal (same scale on both axes).
-  function chart(parent, o) {
-    var W = o.width || 640, H = o.height || 400, L = 66, R = 14, T = 26, B = 44;
-    var root = svg('svg', {viewBox: '0 0 ' + W + ' ' + H, 'class': o.cls || 'chart'}, parent);
-    if (o.id) root.setAttribute('id', o.id);
-    svg('text', {x: W / 2, y: 16, 'text-anchor': 'middle', 'class': 'title'}, root).textContent = o.title || '';
-    var xs = [], ys = [];
-    o.lines.forEach(function (l) {
-      for (var i = 0; i < l.x.length; ++i) if (ok(l.x[i]) && ok(l.y[i])) { xs.push(l.x[i]); ys.push(l.y[i]); }
+  var STYLE = {}, TYPE_COLOR = {};  // per special-point type: its marker, key entry and colour (special_marks.h)
+  D.marks.styles.forEach(function (st) { STYLE[st.type] = st; TYPE_COLOR[st.type] = st.color; });
+  function styleOf(type) { return STYLE[type] || {type: type, point: 7, key: type, color: '#555555'}; }
+  // one label for points drawn at one place: a summary writes branch points' modes as ranges
+  // ("BP 3, 4", "BP 24-27"), the other texts after them (special_marks.h, mergedLabel)
+  function mergedLabel(parts, summary) {
+    var modes = [], rest = [], text = '';
+    parts.forEach(function (p) {
+      if (summary && /^BP [0-9]+$/.test(p)) modes.push(+p.slice(3)); else rest.push(p);
     });
-    (o.marks || []).forEach(function (m) { if (ok(m.x) && ok(m.y)) { xs.push(m.x); ys.push(m.y); } });
-    var rx = range(xs), ry = range(ys);
-    if (!rx || !ry) {
-      svg('text', {x: W / 2, y: H / 2, 'text-anchor': 'middle'}, root).textContent = 'nothing to draw';
-      return root;
+    modes.sort(function (a, b) { return a - b; });
+    for (var i = 0; i < modes.length;) {
+      var j = i;
+      while (j + 1 < modes.length && modes[j + 1] === modes[j] + 1) ++j;
+      text += (i ? ', ' : 'BP ') + modes[i];
+      if (j === i + 1) text += ', ' + modes[j];
+      if (j > i + 1) text += '-' + modes[j];
+      i = j + 1;
     }
-    var pw = W - L - R, ph = H - T - B;
-    if (o.equal) {  // one unit is as long on both axes: widen the narrower range
-      var ux = (rx[1] - rx[0]) / pw, uy = (ry[1] - ry[0]) / ph, u = Math.max(ux, uy);
-      var cx = (rx[0] + rx[1]) / 2, cy = (ry[0] + ry[1]) / 2;
-      rx = [cx - u * pw / 2, cx + u * pw / 2];
-      ry = [cy - u * ph / 2, cy + u * ph / 2];
-    }
-    function sx(v) { return L + (v - rx[0]) / (rx[1] - rx[0]) * pw; }
-    function sy(v) { return T + ph - (v - ry[0]) / (ry[1] - ry[0]) * ph; }
-    ticks(rx[0], rx[1], 7).forEach(function (t) {
-      svg('line', {x1: sx(t), x2: sx(t), y1: T, y2: T + ph, 'class': 'grid'}, root);
-      svg('text', {x: sx(t), y: T + ph + 14, 'text-anchor': 'middle'}, root).textContent = fmt(t, 4);
-    });
-    ticks(ry[0], ry[1], 6).forEach(function (t) {
-      svg('line', {x1: L, x2: L + pw, y1: sy(t), y2: sy(t), 'class': 'grid'}, root);
-      svg('text', {x: L - 4, y: sy(t) + 4, 'text-anchor': 'end'}, root).textContent = fmt(t, 4);
-    });
-    svg('rect', {x: L, y: T, width: pw, height: ph, 'class': 'axis'}, root);
-    svg('text', {x: L + pw / 2, y: H - 8, 'text-anchor': 'middle'}, root).textContent = o.xlabel || '';
-    svg('text', {x: 14, y: T + ph / 2, 'text-anchor': 'middle', transform: 'rotate(-90 14 ' + (T + ph / 2) + ')'}, root)
-        .textContent = o.ylabel || '';
-    var clip = 'clip' + Math.random().toString(36).slice(2);
-    svg('rect', {x: L, y: T, width: pw, height: ph}, svg('clipPath', {id: clip}, root));
-    var body = svg('g', {'clip-path': 'url(#' + clip + ')'}, root);
-    o.lines.forEach(function (l) {
-      var d = '', pen = false;
-      for (var i = 0; i < l.x.length; ++i) {
-        if (!ok(l.x[i]) || !ok(l.y[i])) { pen = false; continue; }
-        d += (pen ? 'L' : 'M') + sx(l.x[i]).toFixed(1) + ' ' + sy(l.y[i]).toFixed(1);
-        pen = true;
-      }
-      if (d) svg('path', {d: d, fill: 'none', stroke: l.color, 'stroke-width': l.width || 1.8,
-                          'stroke-dasharray': l.dash || 'none', 'class': l.cls || 'line'}, body);
-    });
-    (o.marks || []).forEach(function (m) {
-      if (!ok(m.x) || !ok(m.y)) return;
-      var c = svg('circle', {cx: sx(m.x), cy: sy(m.y), r: m.r || 4.5, fill: m.color, stroke: '#000',
-                             'stroke-width': 0.8, 'class': m.cls || 'mark'}, body);
-      if (m.title) svg('title', {}, c).textContent = m.title;
-      if (m.act) { c.style.cursor = 'pointer'; c.addEventListener('click', m.act); }
-    });
-    (o.legend || []).forEach(function (g, k) {
-      var y = T + 12 + 15 * k;
-      svg('line', {x1: L + pw - 150, x2: L + pw - 124, y1: y, y2: y, stroke: g.color, 'stroke-width': 2,
-                   'stroke-dasharray': g.dash || 'none'}, root);
-      svg('text', {x: L + pw - 120, y: y + 4}, root).textContent = g.label;
-    });
-    if (o.pick && o.pick.length) {
-      var cursor = svg('circle', {r: 5, fill: 'none', stroke: '#000', 'stroke-width': 1.5, visibility: 'hidden'}, root);
-      var nearest = function (ev) {
-        var m = root.getScreenCTM();
-        if (!m) return null;
-        var pt = root.createSVGPoint();
-        pt.x = ev.clientX; pt.y = ev.clientY;
-        pt = pt.matrixTransform(m.inverse());
-        var best = null, bestD = 20 * 20;
-        o.pick.forEach(function (p) {
-          if (!ok(p.x) || !ok(p.y)) return;
-          var dx = sx(p.x) - pt.x, dy = sy(p.y) - pt.y, d2 = dx * dx + dy * dy;
-          if (d2 < bestD) { bestD = d2; best = p; }
-        });
-        return best;
-      };
-      var show = function (ev) {
-        var p = nearest(ev);
-        if (!p) return;
-        cursor.setAttribute('cx', sx(p.x)); cursor.setAttribute('cy', sy(p.y));
-        cursor.setAttribute('visibility', 'visible');
-        p.act();
-      };
-      root.addEventListener('mousemove', show);
-      root.addEventListener('click', show);
-    }
-    return root;
+    rest.forEach(function (p) { text += (text ? ', ' : '') + p; });
+    return text;
   }
-
-  var D = JSON.parse(document.getElementById('buckle-data').textContent);
 
   // ---- the chain's shape ----------------------------------------------------------------------
   var shapeBox = {};  // per case: a fixed frame (every shape of the case fits), so hovering does not rescale
@@ -266,11 +163,29 @@ const char* const kReportTail = R"PAGE(</script>
   }
 
   // ---- branch diagrams --------------------------------------------------------------------------
+  // Summary for large diagrams as the gnuplot ones (docs/outputs.md, Plots of long chains): above
+  // D.marks.summary_above markers only the primary branch's branch points and then, up to
+  // D.marks.summary_extra, the jumps and first folds are labelled at full size; the others are
+  // small markers thinned within D.marks.thin_px, and the key counts each type.
+  var JUMP_MIN_PX = 36;  // a jump's arrow is drawn at least this long (a hop where the jump is shorter)
   function branchChart(parent, spec, id) {
-    var lines = [], marks = [], pick = [], legend = [];
+    var lines = [], marks = [], pick = [], key = [], labels = [], arrows = [];
     var multi = D.cases.length > 1 || spec.y.length > 1;
-    D.cases.forEach(function (c) {
-      if (spec.cases && spec.cases.indexOf(c.index) < 0) return;
+    var chosen = D.cases.filter(function (c) { return !spec.cases || spec.cases.indexOf(c.index) >= 0; });
+    var markers = 0;
+    chosen.forEach(function (c) { markers += c.specials.length * spec.y.length; });
+    var summary = spec.labels === 'summary' || (spec.labels !== 'all' && markers > D.marks.summary_above);
+    var counts = {}, types = [], labelled = 0;
+    chosen.forEach(function (c) {
+      // the points labelled: all, or in a summary the primary branch points, then by importance
+      var extra = 0, ranked = c.specials.map(function (s, i) { return i; });
+      ranked.sort(function (a, b) { return c.specials[a].rank - c.specials[b].rank || a - b; });
+      var isLabelled = c.specials.map(function () { return !summary; });
+      if (summary)
+        ranked.forEach(function (i) {
+          var r = c.specials[i].rank;
+          if (r === 0 || (r < 3 && extra++ < D.marks.summary_extra)) isLabelled[i] = true;
+        });
       spec.y.forEach(function (ycol, k) {
         var X = c.columns[spec.x], Y = c.columns[ycol];
         if (!X || !Y) return;
@@ -287,20 +202,60 @@ const char* const kReportTail = R"PAGE(</script>
           }
           pick.push({x: X[i], y: Y[i], act: showPoint.bind(null, c, i)});
         }
-        if (multi) legend.push({color: stableColor, label: (D.cases.length > 1 ? c.label + ' ' : '') + ycol});
-        // a long chain's thousands of special points: smaller markers, the branches stay visible
-        var radius = c.specials.length > 60 ? 2.5 : 4.5;
-        c.specials.forEach(function (s) {
-          if (!s.values) return;
-          marks.push({x: s.values[spec.x], y: s.values[ycol], color: TYPE_COLOR[s.type] || '#000', cls: 'special', r: radius,
+        if (multi) key.push({kind: 'line', color: stableColor, label: (D.cases.length > 1 ? c.label + ' ' : '') + ycol});
+        c.specials.forEach(function (s, n) {
+          if (!s.values || !ok(s.values[spec.x]) || !ok(s.values[ycol])) return;
+          var st = styleOf(s.type), x = s.values[spec.x], y = s.values[ycol];
+          if (!counts[s.type]) { counts[s.type] = 0; types.push(s.type); }
+          ++counts[s.type];
+          var full = isLabelled[n];
+          marks.push({x: x, y: y, point: st.point, type: s.type, r: full ? 4.5 : 2.2, cls: 'special',
+                      color: summary || !multi ? st.color : PALETTE[(c.index * spec.y.length + k) % PALETTE.length],
+                      thin: full ? null : c.index + ' ' + s.type,
                       title: s.type + ' ' + s.field + ' at ' + c.parameter + ' = ' + fmt(s.parameter, 6),
                       act: s.joints ? showSpecial.bind(null, c, s) : null});
+          if (full) {
+            labels.push({x: x, y: y, text: summary ? s.label_summary : s.label, group: c.index + '/' + k, priority: summary ? s.rank : 0,
+                         color: multi ? PALETTE[(c.index * spec.y.length + k) % PALETTE.length] : null});
+            ++labelled;
+          }
+          if (s.landing && ok(s.landing[spec.x]) && ok(s.landing[ycol]))
+            arrows.push({x0: x, y0: y, x1: s.landing[spec.x], y1: s.landing[ycol], title: 'jump: ' + (s.jump || '')});
         });
       });
     });
-    if (!multi) legend = [{color: '#1f77b4', label: 'stable'}, {color: '#d62728', dash: '6 4', label: 'unstable'}];
-    return chart(parent, {id: id, lines: lines, marks: marks, pick: pick, legend: legend, title: spec.title,
-                          xlabel: label(spec.x), ylabel: spec.y.map(label).join(', ')});
+    if (!multi) key = [{kind: 'line', color: '#1f77b4', label: 'stable'}, {kind: 'line', color: '#d62728', dash: '6 4', label: 'unstable'}];
+    else key.push({kind: 'line', color: '#000', label: 'stable'}, {kind: 'line', color: '#000', dash: '6 4', label: 'unstable'});
+    if (arrows.length) key.push({kind: 'arrow', color: '#ff7f0e', label: 'jump'});
+    D.marks.styles.map(function (st) { return st.type; }).concat(types).forEach(function (t, i, all) {
+      if (!counts[t] || all.indexOf(t) !== i) return;
+      var st = styleOf(t);
+      key.push({kind: 'mark', type: t, point: st.point, color: summary || !multi ? st.color : '#000',
+                label: st.key + (summary ? ' (' + counts[t] + ')' : '')});
+    });
+    // hundreds of overlapping branches stay apart as in the gnuplot diagrams (plot_branches.cpp,
+    // branchLook): full width up to a dozen branches, then thinner and translucent, unstable fainter
+    var branches = {};
+    chosen.forEach(function (c) { c.branch.forEach(function (b) { branches[c.index + ' ' + b] = 1; }); });
+    var count = Object.keys(branches).length;
+    if (count > 12) {
+      var alpha = Math.min(0x50, 0x10 + Math.floor(count / 4)), width = Math.max(0.8, 2 * Math.sqrt(12 / count));
+      lines.forEach(function (l) {
+        l.width = width;
+        l.opacity = 1 - (l.dash ? Math.min(0xA0, alpha + 0x50) : alpha) / 255;
+      });
+    }
+    var root = chart(parent, {id: id, lines: lines, marks: marks, pick: pick, key: key, labels: labels, arrows: arrows,
+                              arrowMin: JUMP_MIN_PX, summary: summary, thinPx: D.marks.thin_px,
+                              mergePx: summary ? D.marks.summary_merge_px : D.marks.merge_px,
+                              merge: function (parts) { return mergedLabel(parts, summary); },
+                              title: spec.title, xlabel: label(spec.x), ylabel: spec.y.map(label).join(', ')});
+    root.setAttribute('data-summary', summary ? 'yes' : 'no');
+    root.setAttribute('data-labelled-points', labelled);
+    if (summary) html('p', {'class': 'note'}, parent, 'Summary of ' + markers + ' special-point markers: labelled are the branch ' +
+                      'points of the primary branch (BP k: the branch leaving it has mode k), the jumps and the first fold of ' +
+                      'each branch (up to ' + D.marks.summary_extra + '); the others are small markers, counted per type in the key.');
+    return root;
   }
 
   // ---- the page -----------------------------------------------------------------------------
@@ -322,17 +277,23 @@ const char* const kReportTail = R"PAGE(</script>
   D.cases.forEach(function (c) { c.specials.forEach(function (sp) { rows.push([c, sp]); }); });
   if (!rows.length) html('p', {id: 'special-points'}, box, 'No special points.');
   else {
-    var table = html('table', {id: 'special-points'}, box);
+    // a long chain's thousands of rows scroll inside their box, under a header that stays
+    var table = html('table', {id: 'special-points'}, html('div', {'class': 'scroll'}, box));
     var head = html('tr', {}, html('thead', {}, table));
-    ['case', 'type', 'field', 'branch', 'parameter', 'Fx', 'Fy', 'Me', 'shape', 'stability', '|Δλ|', '‖F‖', 'refined', 'jump']
-        .forEach(function (h) { html('th', {}, head, h); });
+    // a load that is the path parameter is its column (not twice)
+    var heads = ['case', 'type', 'field', 'branch', label('parameter'), label('Fx'), label('Fy'), label('Me'), 'shape', 'stability',
+                 '|Δλ|' + (D.unit_suffix.parameter || ''), '‖F‖ residual', 'refined', 'jump'];
+    var same = D.cases.every(function (c) { return c.parameter === D.cases[0].parameter; });
+    var skip = same ? ['Fx', 'Fy', 'Me'].indexOf(D.cases[0].parameter) + 5 : -1;
+    if (skip < 5) skip = -1;
+    heads.forEach(function (h, k) { if (k !== skip) html('th', {}, head, h); });
     var tbody = html('tbody', {}, table);
     rows.forEach(function (r) {
       var c = r[0], sp = r[1], tr = html('tr', {'class': 'sp'}, tbody);
       [c.label || String(c.index), sp.type, sp.field, String(sp.branch), fmt(sp.parameter, 8), fmt(sp.Fx, 6), fmt(sp.Fy, 6),
        fmt(sp.Me, 6), sp.shape, sp.before + ' → ' + sp.after, fmt(sp.accuracy, 2), fmt(sp.residual, 2),
        sp.refined ? 'yes' : 'no', sp.jump || ''].forEach(function (v, k) {
-        html('td', {'class': [0, 1, 2, 8, 9, 13].indexOf(k) >= 0 ? 't' : ''}, tr, v);
+        if (k !== skip) html('td', {'class': k === 13 ? 't wrap' : [0, 1, 2, 8, 9].indexOf(k) >= 0 ? 't' : ''}, tr, v);
       });
       if (sp.note) tr.title = sp.note;
       if (sp.joints) tr.addEventListener('click', function () {
@@ -347,13 +308,54 @@ const char* const kReportTail = R"PAGE(</script>
     html('h2', {}, cb, 'Critical loads (linear buckling of the start configuration)');
     var ct = html('table', {id: 'critical-loads'}, cb);
     var ch = html('tr', {}, ct);
-    ['case', 'load factor', 'shape', 'shortening'].forEach(function (h) { html('th', {}, ch, h); });
+    ['case', 'critical ' + label('parameter'), 'shape', 'shortening' + D.unit_suffix.length].forEach(function (h) { html('th', {}, ch, h); });
     D.critical.forEach(function (m) {
       var tr = html('tr', {}, ct);
       [m.case_label || String(m['case']), fmt(m.load_factor, 8), m.shape, fmt(m.shortening, 5)].forEach(function (v, k) {
         html('td', {'class': k === 0 || k === 2 ? 't' : ''}, tr, v);
       });
     });
+  }
+
+  // every point the page holds, paged: a long chain's tens of thousands of rows stay one page of
+  // PAGE_ROWS at a time
+  var PAGE_ROWS = 50, pbox = document.getElementById('points-box'), prow = [], pcols = [];
+  D.cases.forEach(function (c) {
+    for (var i = 0; i < c.branch.length; ++i) prow.push([c, i]);
+    Object.keys(c.columns).forEach(function (k) {
+      if (pcols.indexOf(k) < 0 && !(k === 'parameter' && c.columns[c.parameter])) pcols.push(k);
+    });
+  });
+  pcols.sort(function (a, b) { return (a !== 'parameter') - (b !== 'parameter') || (a < b ? -1 : a > b ? 1 : 0); });
+  if (!prow.length) html('p', {id: 'points-table'}, pbox, 'No traced points.');
+  else {
+    var held = D.abridged ? ' (the page holds every k-th point of a branch, see above; branches.csv has all)' : '';
+    var pager = html('div', {'class': 'pager'}, pbox), pinfo = html('span', {id: 'points-range'});
+    var ptable = html('table', {id: 'points-table', 'data-rows': prow.length}, html('div', {'class': 'scroll'}, pbox));
+    var phead = html('tr', {}, html('thead', {}, ptable));
+    (D.cases.length > 1 ? ['case'] : []).concat(['branch', 'point', 'stability']).concat(pcols.map(label))
+        .forEach(function (h) { html('th', {}, phead, h); });
+    var pbody = html('tbody', {}, ptable), first = 0;
+    var showRows = function (from) {
+      first = Math.max(0, Math.min(from, Math.floor((prow.length - 1) / PAGE_ROWS) * PAGE_ROWS));
+      while (pbody.firstChild) pbody.removeChild(pbody.firstChild);
+      prow.slice(first, first + PAGE_ROWS).forEach(function (r) {
+        var c = r[0], i = r[1], tr = html('tr', {'class': 'pt'}, pbody);
+        (D.cases.length > 1 ? [c.label] : []).concat([String(c.branch[i]), String(c.point[i]), c.stable[i] ? 'stable' : 'unstable'])
+            .concat(pcols.map(function (k) { return c.columns[k] ? fmt(c.columns[k][i], 6) : ''; }))
+            .forEach(function (v, k) { html('td', {}, tr, v); });
+        tr.addEventListener('click', function () { showPoint(c, i); });
+      });
+      pinfo.textContent = ' rows ' + (first + 1) + '–' + Math.min(prow.length, first + PAGE_ROWS) + ' of ' + prow.length + held + ' ';
+    };
+    [['«', function () { return 0; }], ['‹', function () { return first - PAGE_ROWS; }]].forEach(function (b) {
+      html('button', {type: 'button'}, pager, b[0]).addEventListener('click', function () { showRows(b[1]()); });
+    });
+    pager.appendChild(pinfo);
+    [['›', function () { return first + PAGE_ROWS; }], ['»', function () { return prow.length; }]].forEach(function (b) {
+      html('button', {type: 'button'}, pager, b[0]).addEventListener('click', function () { showRows(b[1]()); });
+    });
+    showRows(0);
   }
 
   // the scene's views
@@ -441,11 +443,13 @@ const char* const kReportTail = R"PAGE(</script>
   [['complete', String(s.complete)], ['interrupted', s.interrupted ? s.interruption : 'no'],
    ['max corrector residual', fmt(s.accuracy.max_corrector_residual, 3)],
    ['max |Δλ| of located points', fmt(s.accuracy.max_special_point_parameter_error, 3)],
-   ['total time (s)', fmt(s.timings_seconds.total, 4)]].forEach(function (f) {
+   ['computation time (s)', D.time_text, 'total-time']].forEach(function (f) {
     var tr = html('tr', {}, facts);
     html('th', {}, tr, f[0]);
-    html('td', {'class': 't'}, tr, f[1]);
+    html('td', f[2] ? {'class': 't', id: f[2]} : {'class': 't'}, tr, f[1]);
   });
+  html('p', {'class': 'note'}, rb, 'The computation time is summary.json\'s timings_seconds.total, the time the run\'s last ' +
+       'line gives as "computed in"; writing the plots and this page comes after it.');
   (s.problems || []).slice(0, 20).forEach(function (p) { html('p', {'class': 'note'}, rb, p); });
 
   // first view: the first stable point of the main diagram's first case, else the unloaded chain

@@ -174,7 +174,12 @@ void criticalCurvesPlotBody(const Scene& scene, const RunResult& run, const Plot
                                                              " (solid: supercritical, dashed: subcritical, dotted: folds)"
                                                        : spec.title)
        << " noenhanced\n";
-  body << "set xlabel " << quoteName(t.parameter) << " noenhanced\nset ylabel "
+  // the second parameter with its unit: a, b (lengths) and k (a stiffness) are segment
+  // parameters, L0, dL0, x, y and phi columns of branches.csv (columns.h)
+  const std::string second = t.parameter == "a" || t.parameter == "b" ? t.parameter + scene.units.suffix(Dimension::Length)
+                             : t.parameter == "k" ? t.parameter + scene.units.suffix(Dimension::Stiffness)
+                                                  : columnLabel(t.parameter, scene.units);
+  body << "set xlabel " << quoteName(second) << "\nset ylabel "
        << quoteName(columnLabel(scene.cases.front().path.parameter, scene.units)) << "\n";
   body << "set xzeroaxis lt -1 lc rgb '#888888'\n";
   body << plots.str() << (first ? "plot " : ", \\\n     ") << quoteName(file) << " index " << block

@@ -31,6 +31,21 @@ TEST_CASE("niceRange: round tic steps that contain the data", "[plot]") {
   CHECK(b > 2.0);
 }
 
+TEST_CASE("framedNiceRange: data at a round end are framed apart from the axis line", "[plot]") {
+  for (const auto& [lo, hi] : std::vector<std::pair<double, double>>{{-2.5, 0.0}, {0.0, 1.7}, {0.3, 7.9}, {-12.0, 0.0}}) {
+    const auto [a, b] = framedNiceRange(lo, hi);
+    const auto [na, nb] = niceRange(lo, hi);
+    // never closer than the margin to the data, and never wider than the margin beyond the round range
+    CHECK(lo - a >= kFrameMargin * (nb - na) * (1 - 1e-12));
+    CHECK(b - hi >= kFrameMargin * (nb - na) * (1 - 1e-12));
+    CHECK(a >= na - kFrameMargin * (nb - na) * (1 + 1e-12));
+    CHECK(b <= nb + kFrameMargin * (nb - na) * (1 + 1e-12));
+  }
+  // an end the round range keeps away from the data stays round: 0.3 .. 7.9 → [0, 8]
+  CHECK(framedNiceRange(0.3, 7.9).first == niceRange(0.3, 7.9).first);
+  CHECK(framedNiceRange(-2.5, 0.0).second > 0.0);  // Fx = 0 is inside, not on the frame
+}
+
 TEST_CASE("framedRange: the whole of a smooth curve, the bulk of a curve through a pole", "[plot]") {
   std::vector<double> smooth;
   for (int i = 0; i <= 200; ++i) smooth.push_back(std::sin(0.05 * i) * 3.0 + 1.0);

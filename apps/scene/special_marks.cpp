@@ -1,0 +1,83 @@
+#include "scene/special_marks.h"
+
+#include <algorithm>
+
+namespace buckle::scene {
+
+const std::vector<SpecialStyle>& specialStyles() {
+  static const std::vector<SpecialStyle> styles = {{"BP", 7, "BP branch point", "#000000"},
+                                                   {"LP", 9, "LP fold", "#d62728"},
+                                                   {"LPF", 9, "LPF reaction fold", "#ff7f0e"},
+                                                   {"BD", 5, "BD joint limit", "#8c564b"},
+                                                   {"LS", 9, "LS loss of stability at fixed inputs", "#e377c2"},
+                                                   {"IB", 5, "IB input bound", "#bcbd22"},
+                                                   {"KMIN", 13, "KMIN Kxx minimum", "#9467bd"},
+                                                   {"JUMP", 11, "JUMP release", "#ff7f0e"},
+                                                   {"CT", 15, "CT contact (joint locks)", "#2ca02c"},
+                                                   {"RL", 3, "RL contact released", "#17becf"},
+                                                   {"BC", 5, "BC base contact (detected)", "#e377c2"},
+                                                   {"SC", 5, "SC self contact (detected)", "#7f7f7f"}};
+  return styles;
+}
+
+const SpecialStyle& specialStyle(const std::string& type) {
+  for (const SpecialStyle& s : specialStyles())
+    if (type == s.type) return s;
+  static const SpecialStyle other{"", 7, "special point", "#555555"};
+  return other;
+}
+
+std::vector<Importance> importance(const CaseResult& cr) {
+  std::vector<int> primary;
+  for (const BranchRecord& b : cr.branches)
+    if (b.parent < 0) primary.push_back(b.id);
+  std::vector<int> folded;
+  std::vector<Importance> out;
+  for (const SpecialRecord& r : cr.specials) {
+    Importance k = Importance::Other;
+    if (r.type == "BP" && std::find(primary.begin(), primary.end(), r.branch) != primary.end())
+      k = Importance::PrimaryBranchPoint;
+    else if (r.type == "JUMP" || r.jumpSuccess)
+      k = Importance::Jump;
+    else if ((r.type == "LP" || r.type == "LPF") && std::find(folded.begin(), folded.end(), r.branch) == folded.end()) {
+      folded.push_back(r.branch);
+      k = Importance::FirstFold;
+    }
+    out.push_back(k);
+  }
+  return out;
+}
+
+std::string specialLabel(const SpecialRecord& r, bool summary) {
+  std::string label = r.type;
+  if (r.type == "BP" && !r.shape.empty() && r.shape != "other")
+    label += " " + (summary && r.shape.rfind("mode ", 0) == 0 ? r.shape.substr(5) : r.shape);
+  return label;
+}
+
+std::string mergedLabel(const std::vector<std::string>& parts, bool summary) {
+  std::vector<int> modes;
+  std::vector<std::string> rest;
+  for (const std::string& p : parts) {
+    const bool mode = summary && p.size() > 3 && p.rfind("BP ", 0) == 0 &&
+                      p.find_first_not_of("0123456789", 3) == std::string::npos;
+    if (mode)
+      modes.push_back(std::stoi(p.substr(3)));
+    else
+      rest.push_back(p);
+  }
+  std::string text;
+  std::sort(modes.begin(), modes.end());
+  for (size_t i = 0; i < modes.size();) {
+    size_t j = i;
+    while (j + 1 < modes.size() && modes[j + 1] == modes[j] + 1) ++j;
+    text += (i ? ", " : "BP ") + std::to_string(modes[i]);
+    if (j == i + 1) text += ", " + std::to_string(modes[j]);
+    if (j > i + 1) text += "-" + std::to_string(modes[j]);
+    i = j + 1;
+  }
+  for (const std::string& p : rest) text += (text.empty() ? "" : ", ") + p;
+  return text;
+}
+
+}  // namespace buckle::scene
