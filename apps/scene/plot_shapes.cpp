@@ -424,8 +424,12 @@ void drawEquilibriumShapes(const Scene& scene, const RunResult& run, const PlotS
       cases.push_back(c);
       most = std::max(most, run.cases[c].equilibria.equilibria.size());
     }
-  const size_t cols = std::min<size_t>(most, 5), rowsPerCase = (most + cols - 1) / cols;
-  const size_t rows = std::max<size_t>(1, cases.size() * rowsPerCase);
+  // each case on the rows its own equilibria need (no empty band under a case with fewer)
+  const size_t cols = std::min<size_t>(most, 5);
+  auto rowsOf = [&](size_t c) { return std::max<size_t>(1, (run.cases[c].equilibria.equilibria.size() + cols - 1) / cols); };
+  size_t rows = 0;
+  for (size_t c : cases) rows += rowsOf(c);
+  rows = std::max<size_t>(1, rows);
   s.width = std::min<int>(3200, int(440 * cols));
   s.height = std::min<int>(4800, int(300 * rows) + 60);
   Eigen::AlignedBox2d box;
@@ -477,7 +481,7 @@ void drawEquilibriumShapes(const Scene& scene, const RunResult& run, const PlotS
       chainPanel(s.body, base, L, std::string(), true, detailed);
       if (e.stable) s.body << "unset object 2\n";
     }
-    for (size_t k = list.size(); k < cols * rowsPerCase; ++k) s.body << "set multiplot next\n";
+    for (size_t k = list.size(); k < cols * rowsOf(c); ++k) s.body << "set multiplot next\n";
   }
   s.body << "unset multiplot\n";
 }

@@ -4,7 +4,9 @@
 #include "cli_helpers.h"
 #include "temp_dir.h"
 
+#include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -38,6 +40,17 @@ TEST_CASE("buckle run default.json writes the bifurcation diagram and exits 0", 
   const auto eq17 = summary["cases"][0]["critical_forces"]["abs_error_vs_eq17"];
   CHECK(eq17["continuation_BP_U"].get<double>() < 1e-8);
   CHECK(eq17["continuation_BP_Z"].get<double>() < 1e-8);
+  // the last line's computation time is summary.json's total, as report.html shows it ("%.3g" s)
+  const std::string log = slurp(work() / "log.txt");
+  const size_t at = log.find("; computed in ");
+  REQUIRE(at != std::string::npos);
+  const size_t from = at + std::string("; computed in ").size();
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", summary["timings_seconds"]["total"].get<double>());
+  CHECK(log.substr(from, log.find(" s (", from) - from) == text);
+  std::ifstream page(out / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(page)), std::istreambuf_iterator<char>());
+  CHECK(html.find("\"time_text\":\"" + std::string(text) + "\"") != std::string::npos);
 }
 
 TEST_CASE("buckle run on a bad scene exits 2 and writes nothing", "[cli][run]") {
