@@ -19,16 +19,21 @@ namespace buckle::scene::plot_detail {
 struct Frame {
   int width = 1000, height = 700;
   double left = 0.09, right = 0.76, bottom = 0.1, top = 0.91;  ///< plot area, screen fractions
-  double xlo = 0, xhi = 1, ylo = 0, yhi = 1;  ///< with logY, ylo and yhi are decimal logarithms
+  double xlo = 0, xhi = 1, ylo = 0, yhi = 1;  ///< with logY or symlog, ylo and yhi are transformed
   bool logY = false;
+  /// > 0: a symmetric-log y axis v = asinh(y / symlog), linear within ±symlog and logarithmic
+  /// beyond, for values of both signs over decades (a stiffness through a pole).
+  double symlog = 0.0;
+  double transformY(double y) const { return symlog > 0.0 ? std::asinh(y / symlog) : logY ? std::log10(y) : y; }
+  double inverseY(double v) const { return symlog > 0.0 ? symlog * std::sinh(v) : logY ? std::pow(10.0, v) : v; }
   Eigen::Vector2d pixel(double x, double y) const {
-    const double v = logY ? std::log10(y) : y;
+    const double v = transformY(y);
     return {width * (left + (right - left) * (x - xlo) / (xhi - xlo)),
             height * (bottom + (top - bottom) * (v - ylo) / (yhi - ylo))};
   }
   Eigen::Vector2d data(const Eigen::Vector2d& px) const {
     const double v = ylo + (px.y() / height - bottom) / (top - bottom) * (yhi - ylo);
-    return {xlo + (px.x() / width - left) / (right - left) * (xhi - xlo), logY ? std::pow(10.0, v) : v};
+    return {xlo + (px.x() / width - left) / (right - left) * (xhi - xlo), inverseY(v)};
   }
   /// The gnuplot commands that fix this frame's margins and ranges (plot.cpp).
   void script(std::ostream& os) const;

@@ -9,11 +9,30 @@ void plot_detail::Frame::script(std::ostream& os) const {
   os << "set lmargin at screen " << num(left) << "\nset rmargin at screen " << num(right) << "\nset bmargin at screen "
      << num(bottom) << "\nset tmargin at screen " << num(top) << "\nset xrange [" << num(xlo) << ":" << num(xhi)
      << "]\n";
-  if (logY)
+  if (symlog > 0.0) {
+    // gnuplot's nonlinear axis: the same asinh mapping as pixel(), so labels placed here stay
+    // on their points; tics at 0 and ±10^k from the linear threshold out
+    os << "set nonlinear y via asinh(y/" << num(symlog) << ") inverse " << num(symlog) << "*sinh(y)\nset yrange ["
+       << num(inverseY(ylo)) << ":" << num(inverseY(yhi)) << "]\nset ytics (";
+    const int k0 = int(std::lround(std::log10(symlog)));
+    const int k1 = int(std::ceil(std::log10(std::max(std::abs(inverseY(ylo)), std::abs(inverseY(yhi))))));
+    const int step = std::max(1, (k1 - k0 + 5) / 6);  // at most about six decades labelled per sign
+    os << "\"0\" 0";
+    for (int k = k0; k <= k1; k += step)
+      for (int sign : {-1, 1}) {
+        const double t = sign * std::pow(10.0, k);
+        if (!(t >= inverseY(ylo) && t <= inverseY(yhi))) continue;
+        // 0.01 … 1000 as numbers, other decades as powers of ten
+        const std::string decade = std::abs(k) <= 3 ? num(std::pow(10.0, k)) : "10^{" + std::to_string(k) + "}";
+        os << ", \"" << (sign < 0 ? "-" : "") << decade << "\" " << num(t);
+      }
+    os << ")\n";
+  } else if (logY) {
     os << "set logscale y\nset format y '10^{%L}'\nset yrange [" << num(std::pow(10.0, ylo)) << ":"
        << num(std::pow(10.0, yhi)) << "]\n";
-  else
+  } else {
     os << "set yrange [" << num(ylo) << ":" << num(yhi) << "]\n";
+  }
 }
 
 using namespace plot_detail;

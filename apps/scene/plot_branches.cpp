@@ -262,9 +262,16 @@ void drawBranchPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   // when every drawn value is positive and they span more than two
   if (spec.type == PlotType::Stiffness && ylo <= 0.0) std::tie(ylo, yhi) = framedRange(ys);
   f.logY = spec.type == PlotType::Stiffness && ylo > 0.0 && std::isfinite(yhi) && yhi > 100.0 * ylo;
-  if (f.logY)
+  // both signs over decades (a stiffness through a pole, or negative past a branch point): a
+  // symmetric-log axis, linear within the smaller magnitudes' decade
+  f.symlog = spec.type == PlotType::Stiffness && !f.logY ? symlogThreshold(ys, ylo, yhi) : 0.0;
+  if (f.logY) {
     f.ylo = std::floor(std::log10(ylo)), f.yhi = std::ceil(std::log10(yhi));
-  else
+  } else if (f.symlog > 0.0) {
+    const double lo = f.transformY(ylo), hi = f.transformY(yhi);
+    f.ylo = lo - kFrameMargin * (hi - lo);
+    f.yhi = hi + kFrameMargin * (hi - lo);
+  } else
     std::tie(f.ylo, f.yhi) = framedNiceRange(ylo, yhi);
 
   Occupancy occupied(f.width, f.height);

@@ -42,4 +42,16 @@ std::pair<double, double> framedRange(std::vector<double>& values) {
           values.back() > hi + reach ? hi + spread : values.back()};
 }
 
+double symlogThreshold(const std::vector<double>& values, double lo, double hi) {
+  if (!(lo < 0.0 && hi > 0.0) || !std::isfinite(lo) || !std::isfinite(hi)) return 0.0;
+  std::vector<double> magnitudes;
+  for (double v : values)
+    if (std::isfinite(v) && v != 0.0 && v >= lo && v <= hi) magnitudes.push_back(std::abs(v));
+  if (magnitudes.empty()) return 0.0;
+  const size_t k = magnitudes.size() / 10;
+  std::nth_element(magnitudes.begin(), magnitudes.begin() + long(k), magnitudes.end());
+  const double c = std::pow(10.0, std::floor(std::log10(magnitudes[k])));
+  return std::max(-lo, hi) > 100.0 * c ? c : 0.0;
+}
+
 }  // namespace buckle::scene

@@ -25,4 +25,10 @@ constexpr double kFrameMargin = 0.03;
 std::pair<double, double> framedRange(std::vector<double>& values);
 constexpr double kPoleReach = 4.0;
 
+/// The linear threshold c of a symmetric-log axis asinh(y / c) for the `values` drawn in
+/// [lo, hi]: where the range holds both signs and its largest magnitude is over a hundred times
+/// c = 10^floor(log10 of the 10th percentile of the nonzero magnitudes), c; otherwise 0 (a
+/// linear axis serves).
+double symlogThreshold(const std::vector<double>& values, double lo, double hi);
+
 }  // namespace buckle::scene

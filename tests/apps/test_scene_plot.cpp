@@ -870,3 +870,31 @@ TEST_CASE("a branch point on the straight branch is marked at the value interpol
   }
   CHECK(marked == 2);  // the U and Z points of eq 17
 }
+
+TEST_CASE("a stiffness plot whose curves change sign over decades has a symmetric-log axis with tics inside it",
+          "[scene][plot]") {
+  // si_chain's Kxx and Kyy run from +20 N/m through poles to −100 N/m past the branch points
+  const fs::path out = runShipped("si_chain", "si_chain_symlog");
+  std::ifstream in(out / "plots" / "stiffness_body.gp");
+  REQUIRE(in.good());
+  std::string line, nonlinear, range, tics;
+  while (std::getline(in, line)) {
+    if (line.rfind("set nonlinear y via asinh(y/", 0) == 0) nonlinear = line;
+    if (line.rfind("set yrange [", 0) == 0) range = line;
+    if (line.rfind("set ytics (", 0) == 0) tics = line;
+  }
+  REQUIRE(!nonlinear.empty());
+  REQUIRE(!range.empty());
+  const double lo = std::stod(range.substr(12)), hi = std::stod(range.substr(range.find(':') + 1));
+  CHECK(lo < 0.0);
+  CHECK(hi > 0.0);
+  // the range is that of the drawn Kxx, Kyy (framed): every tic value given lies in it
+  int count = 0;
+  for (size_t at = tics.find("\" "); at != std::string::npos; at = tics.find("\" ", at + 2)) {
+    const double t = std::stod(tics.substr(at + 2));
+    CHECK(t >= lo);
+    CHECK(t <= hi);
+    ++count;
+  }
+  CHECK(count >= 5);  // 0 and decades of both signs
+}

@@ -81,3 +81,25 @@ TEST_CASE("framedRange: the whole of a smooth curve, the bulk of a curve through
   const auto [g, h] = framedRange(none);
   CHECK(g > h);
 }
+
+TEST_CASE("symlogThreshold: a symmetric-log axis for both signs over decades, scale-free", "[plot]") {
+  for (double unit : {1.0, 1e-8, 1e8}) {
+    INFO("unit " << unit);
+    // a stiffness from 3 (unit) through a pole to −2000 (unit): both signs, three decades
+    std::vector<double> v;
+    for (int i = 0; i < 100; ++i) v.push_back(unit * (3.0 + i * 0.5));
+    for (int i = 0; i < 20; ++i) v.push_back(-unit * (10.0 + 100.0 * i));
+    const double lo = *std::min_element(v.begin(), v.end()), hi = *std::max_element(v.begin(), v.end());
+    const double c = symlogThreshold(v, lo, hi);
+    // the 10th percentile of the magnitudes is about 7.5 (unit): the linear part is one decade of unit
+    CHECK(c == Approx(unit).epsilon(1e-12));
+    // asinh(y/c) is monotone and maps the largest magnitude a few units out (logarithmic there)
+    CHECK(std::asinh(lo / c) < std::asinh(-10.0 * unit / c));
+    // one sign only: a log or linear axis serves
+    std::vector<double> positive(v.begin(), v.begin() + 100);
+    CHECK(symlogThreshold(positive, unit * 3.0, unit * 52.5) == 0.0);
+    // both signs within two decades of the threshold: linear
+    const std::vector<double> narrow{-2.0 * unit, -1.0 * unit, 1.0 * unit, 5.0 * unit};
+    CHECK(symlogThreshold(narrow, -2.0 * unit, 5.0 * unit) == 0.0);
+  }
+}
