@@ -228,18 +228,23 @@ void CaseRunner::suddenLoad() {
   out_.haveSudden = true;
   rec.value = spec.value;
   Eigen::VectorXd qStatic;
+  // the chain at rest before the load changes: the path's start shape, with weight or point loads
+  // the equilibrium under them at the start value (the quasi-static history's polished first point)
+  Eigen::VectorXd qRest = out_.qStart;
   if (spec.value != s0) {
     mech::LoadHistoryOptions opt;
     opt.tracer = solverOptions();
     opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
     try {
-      const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.q0, {s0, spec.value}, opt);
+      const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.qStart, {s0, spec.value}, opt);
       if (h.completed && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);
+      if (problem.bodyLoads().active() && !h.segments.empty() && !h.segments.front().points.empty())
+        qRest = h.segments.front().points.front().u.head(n);
     } catch (const std::exception&) {
       // no quasi-static answer: the comparison is skipped and said so below
     }
   } else {
-    qStatic = out_.q0;
+    qStatic = out_.qStart;
   }
   mech::EndCondition loaded = problem.endCondition();
   loaded.value += spec.value * problem.direction();
@@ -249,8 +254,12 @@ void CaseRunner::suddenLoad() {
     opt.scene.inertia = mech::InertiaData::uniformRods(out_.chain, spec.massPerLength);
     if (spec.damping > 0) opt.scene.jointDamping.assign(size_t(n), spec.damping);
   }
+  // with weight or point loads: from rest under them at the start value, the path's loads (on a
+  // gravity path the weight itself) at `value` at once
+  if (problem.bodyLoads().active())
+    opt.scene.body = std::make_shared<const mech::BodyLoads>(problem.bodyLoads().atParameter(spec.value));
   try {
-    const mech::SuddenLoadResult r = mech::simulateSuddenLoad(out_.chain, loaded, out_.q0, qStatic, opt);
+    const mech::SuddenLoadResult r = mech::simulateSuddenLoad(out_.chain, loaded, qRest, qStatic, opt);
     rec.success = r.success;
     rec.message = r.message;
     rec.inertial = r.inertial;

@@ -1,6 +1,7 @@
 #include "scene/report.h"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -383,6 +384,16 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   }
   data["plots"] = plots;
   data["critical"] = specialPoints.contains("critical_loads") ? specialPoints["critical_loads"] : json::array();
+  // under displacement control the critical loads are of the force that drives the held
+  // coordinate (its reaction), not of the coordinate
+  std::string criticalColumn = "parameter";
+  if (!scene.cases.empty()) {
+    const CaseSpec& c = scene.cases.front();
+    const bool load = !c.path.control && !c.path.gravity && !c.path.task;
+    if (load && c.end.condition.isHeld(static_cast<mechanics::EndCoordinate>(c.path.coordinate)))
+      criticalColumn = std::array<const char*, 3>{"Fx", "Fy", "Me"}[size_t(c.path.coordinate)];
+  }
+  data["critical_column"] = criticalColumn;
   // every "<" as \u003c: nothing inside the JSON can end or change the <script> element (escape.h)
   return kReportHead + escape::htmlScriptSafe(objectText(data, {{"cases", std::move(cases)}})) + kReportScriptStart +
          kReportChartScript + kReportTail;

@@ -308,7 +308,7 @@ const char* const kReportTail = R"PAGE(  var D = JSON.parse(document.getElementB
     html('h2', {}, cb, 'Critical loads (linear buckling of the start configuration)');
     var ct = html('table', {id: 'critical-loads'}, cb);
     var ch = html('tr', {}, ct);
-    ['case', 'critical ' + label('parameter'), 'shape', 'shortening' + D.unit_suffix.length].forEach(function (h) { html('th', {}, ch, h); });
+    ['case', 'critical ' + label(D.critical_column || 'parameter'), 'shape', 'shortening' + D.unit_suffix.length].forEach(function (h) { html('th', {}, ch, h); });
     D.critical.forEach(function (m) {
       var tr = html('tr', {}, ct);
       [m.case_label || String(m['case']), fmt(m.load_factor, 8), m.shape, fmt(m.shortening, 5)].forEach(function (v, k) {

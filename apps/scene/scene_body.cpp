@@ -119,7 +119,6 @@ void checkBodyAnalyses(const JsonReader& r, const Scene& scene) {
                                              c.label + "\" has /gravity or /point_loads (remove one of them)");
     };
     const AnalysesSpec& a = scene.analyses;
-    if (a.suddenLoad.enabled) refuse("sudden_load", "sudden loads (the dynamics)");
     if (a.criticalForces.enabled) refuse("critical_forces", "critical forces (linear buckling of the unloaded shape)");
     if (a.twoParameter.enabled) refuse("two_parameter", "two-parameter critical curves");
     if (a.equilibria.enabled) refuse("equilibria", "all equilibria");

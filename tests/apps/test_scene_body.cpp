@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/gravity.h"
@@ -122,6 +124,29 @@ TEST_CASE("scene load history under the weight: the column buckles under its own
   CHECK(bent > 0);  // past the critical weight the history is on the buckled branch
 }
 
+TEST_CASE("scene sudden weight: the cantilever released under its full weight at once comes to rest at the static "
+          "sag", "[scene][body_loads]") {
+  // g jumps from 0 to 3 (the gravity path's sudden load): the gradient flow with the weight ends at
+  // the one stable equilibrium, the sag of the independent Newton solve on E + V.
+  const std::string text = scene(kGravity, kGravityPath, R"({"sudden_load": {"value": 3.0}})");
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "sudden_weight", text);
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  std::ifstream in(o.out / "special_points.json");
+  const nlohmann::json sp = nlohmann::json::parse(in);
+  REQUIRE(sp["sudden_load"].size() == 1);
+  const nlohmann::json& e = sp["sudden_load"][0];
+  CHECK(e["success"].get<bool>());
+  CHECK(e["stable"].get<bool>());
+  const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const Vector q = independentSag(chain, InertiaData::uniformRods(chain, 0.01), Eigen::Vector2d(0.0, -3.0));
+  REQUIRE(q.lpNorm<Eigen::Infinity>() > 1e-3);  // it sags: the weight was in the dynamics
+  Vector rest(4);
+  for (int i = 0; i < 4; ++i) rest[i] = e["rest"]["q"][size_t(i)].get<double>();
+  CHECK((rest - q).lpNorm<Eigen::Infinity>() <= 1e-9 * q.lpNorm<Eigen::Infinity>());
+  CHECK_FALSE(e["quasi_static"]["differs"].get<bool>());
+}
+
 TEST_CASE("scene point loads: a force at the last joint growing along an Fx path: the traced end point balances the "
           "joint torques of the end load and that force, summed here from the joint positions", "[scene][body_loads]") {
   // Fy = 0.02 + 0.1·Fx at joint 4 along Fx from 0 to −0.3
@@ -165,8 +190,8 @@ TEST_CASE("scene body loads: bad input names the JSON path, exit 2, nothing writ
                   "contains the start value gravity = 0");
   requireBadInput("joint", scene(R"("point_loads": [{"joint": 5, "Fy": 1}])", kGravityPath, cont),
                   "/point_loads/0/joint", "");
-  requireBadInput("sudden_load", scene(kGravity, kGravityPath, R"({"continuation": true, "sudden_load": {"value": 1.0}})"),
-                  "/analyses/sudden_load", "do not include the weight");
+  requireBadInput("critical_forces", scene(kGravity, kGravityPath, R"({"continuation": true, "critical_forces": true})"),
+                  "/analyses/critical_forces", "do not include the weight");
   requireBadInput("mass_model",
                   scene(kGravity, kGravityPath, R"({"continuation": true, "frequencies": {"mass_per_length": 0.5}})"),
                   "/analyses/frequencies/mass_per_length", "one mass model");

@@ -458,7 +458,9 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
   if (qStatic.size() != 0 && qStatic.size() != n) throw std::invalid_argument("qStatic must be empty or have one entry per joint");
 
   SuddenLoadResult result;
-  EquilibriumProblem problem(chain, loaded, Eigen::Vector3d::Zero());
+  // the rest shape is an equilibrium of the loaded chain with the scene's body loads, if any
+  EquilibriumProblem problem(chain, loaded, Eigen::Vector3d::Zero(), {}, {},
+                             options.scene.body ? *options.scene.body : BodyLoads());
   std::unique_ptr<DynamicsModel> model = makeDynamicsModel(chain, loaded, options.scene, qUnloaded);
   result.inertial = model->kind() == DynamicsKind::Inertial;
   // A held coordinate whose target differs from the unloaded shape is imposed at once: the start
