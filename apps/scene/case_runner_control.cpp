@@ -1,4 +1,5 @@
-// The start of a control path (issue 29): the payload of /end applied to the unloaded shape.
+// The start of a control path (issue 29): the payload of /end, and the weight and point loads,
+// applied to the unloaded shape.
 #include <sstream>
 
 #include "buckle/mechanics/load_history.h"
@@ -23,9 +24,18 @@ bool CaseRunner::actuationStart() {
     direction[c] = end.value[c] - ramp.value[c];
   }
   out_.qStart = out_.q0;
+  // the weight and point loads grow with the payload, from none at λ = 0 to /gravity's at λ = 1
+  const mech::BodyLoads full = bodyLoads().atParameter(out_.startValue);
+  mech::BodyLoads body = full;
+  body.gravity.setZero();
+  body.gravityRate = full.gravity;
+  for (mech::PointLoad& p : body.points) {
+    p.rate = p.force;
+    p.force.setZero();
+  }
   // exactly zero, not Eigen's isZero() (1e-12 absolute: a payload of 3e-13 N would count as none)
-  if ((direction.array() == 0.0).all()) return true;  // no payload: the unloaded shape
-  mech::EquilibriumProblem problem(out_.chain, ramp, direction);
+  if ((direction.array() == 0.0).all() && !full.active()) return true;  // no payload: the unloaded shape
+  mech::EquilibriumProblem problem(out_.chain, ramp, direction, {}, {}, body);
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();
   opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(n));

@@ -123,7 +123,6 @@ void checkBodyAnalyses(const JsonReader& r, const Scene& scene) {
     if (a.twoParameter.enabled) refuse("two_parameter", "two-parameter critical curves");
     if (a.equilibria.enabled) refuse("equilibria", "all equilibria");
     if (a.energyCurves.enabled) refuse("energy_curves", "energy curves");
-    if (c.path.control) r.fail(Pointer("/path/parameter"), "a control path does not take /gravity or /point_loads yet");
     if (c.path.task) r.fail(Pointer("/path/task"), "a task-space path does not take /gravity or /point_loads yet");
     // one mass model: the frequencies' rods are the weight's rods
     if (a.frequencies.enabled && c.body.haveGravity && c.body.massPerLength != a.frequencies.massPerLength)

@@ -147,6 +147,32 @@ TEST_CASE("scene sudden weight: the cantilever released under its full weight at
   CHECK_FALSE(e["quasi_static"]["differs"].get<bool>());
 }
 
+TEST_CASE("scene control path under the weight: the free lengths move, every point balances the springs at its "
+          "free lengths against the weight", "[scene][body_loads]") {
+  // The horizontal heavy cantilever with L0 of every segment the path parameter (both springs):
+  // its start is the sag under the weight (applied with the payload), and each traced point is an
+  // equilibrium of E(q; L0 = λ) + V (GravityPotential, independent of the library's body loads).
+  const std::string text = scene(R"("gravity": {"value": 3.0, "direction": [0, -1], "mass_per_length": 0.01})",
+                                 R"({"parameter": "L0", "from": 2.0, "to": 2.5})", R"({"continuation": true})");
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "control_weight", text);
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  const Table t = readBranches(o.out);
+  REQUIRE(t.size() > 5);
+  double sag = 0.0;
+  for (const auto& row : t) {
+    const double L0 = row.at("parameter");
+    const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, L0));
+    Vector q(4), dE(4), dV(4);
+    for (int i = 0; i < 4; ++i) q[i] = row.at("q" + std::to_string(i + 1));
+    energyGradient(chain, q, dE);
+    GravityPotential(chain, InertiaData::uniformRods(chain, 0.01), Eigen::Vector2d(0.0, -3.0)).gradient(q, dV);
+    CHECK((dE + dV).lpNorm<Eigen::Infinity>() <= 1e-10);
+    sag = std::max(sag, q.lpNorm<Eigen::Infinity>());
+  }
+  CHECK(sag > 1e-3);  // the weight bends it
+}
+
 TEST_CASE("scene point loads: a force at the last joint growing along an Fx path: the traced end point balances the "
           "joint torques of the end load and that force, summed here from the joint positions", "[scene][body_loads]") {
   // Fy = 0.02 + 0.1·Fx at joint 4 along Fx from 0 to −0.3
