@@ -1,7 +1,7 @@
 #pragma once
 // Eigen's dense decompositions of Eigen::MatrixXd, instantiated once, in the library
 // (src/continuation/eigen_instances.cpp), instead of in every source file that uses one: a
-// divide-and-conquer SVD alone took ~25 s of -O3 compilation per file. Only a build-time matter:
+// divide-and-conquer SVD is among the costliest templates to compile at -O3. Only a build-time matter:
 // the precompiled headers (cmake/precompiled_headers.cmake) include this file, so every source of
 // a target linking buckle::continuation calls the library's copies; without it each file
 // instantiates its own, with the same code.

@@ -39,10 +39,10 @@
 //  - lowestEigenvalues() / smallestEigenvalue(): Newton on det K_σ (constrained) or det(T − σM),
 //    whose roots are exactly the eigenvalues wanted (det K_σ = c·Π(ν_j − σ) over the
 //    eigenvalues ν_j of ZᵀHZ), its logarithmic derivative carried through the factorization;
-//    from a warm start (the previous point's values) directly, otherwise after isolating the
-//    eigenvalue by bisection on the counts, with Illinois regula falsi where Newton leaves the
-//    bracket. Every result is certified by the counts either side of it: typically 3–5 O(n)
-//    factorizations per eigenvalue from a warm start, 10–25 from none.
+//    from a warm start (the previous point's values); without one (or where Newton leaves the
+//    counts' bracket) the eigenvalue is isolated by bisection on the counts and polished by
+//    Illinois regula falsi. Every result is certified by the counts either side of it: a few
+//    O(n) factorizations per eigenvalue from a warm start, a few tens from none.
 //
 // The workspace is sized once; no function allocates on the heap after construction.
 #pragma once
