@@ -24,6 +24,7 @@ void CaseRunner::equilibria() {
   options.landscapeSamples = e.sweepPoints;
   options.starts.push_back(out_.q0);  // the case's unloaded shape (preloads from q0)
   options.interrupt = control_.interrupt;
+  options.body = bodyLoads().atParameter(out_.equilibriaAt);  // the weight at `at` (a gravity path's g)
   // along a control path the state is the chain with the free lengths at `at` (the loads held)
   const mechanics::ControlDirection control = controlDirection();
   const mechanics::Chain chain =

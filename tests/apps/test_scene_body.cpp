@@ -173,6 +173,43 @@ TEST_CASE("scene control path under the weight: the free lengths move, every poi
   CHECK(sag > 1e-3);  // the weight bends it
 }
 
+TEST_CASE("scene equilibria under the weight: each balances the springs against the weight, the lowest is the sag",
+          "[scene][body_loads]") {
+  // Every equilibrium of the heavy horizontal cantilever at g = 3, by deflation with the body loads:
+  // each found one balances ∂E/∂q + ∂V/∂q = 0 and reports Π = E + V (V from GravityPotential, with
+  // absolute positions); the one of lowest Π is stable and is the independent static sag.
+  const std::string text = scene(kGravity, kGravityPath, R"({"equilibria": {"at": 3.0, "starts": 16, "smooth_starts": 16}})");
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "equilibria_weight", text);
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  std::ifstream in(o.out / "equilibria.csv");
+  REQUIRE(in.good());
+  std::stringstream csv;
+  csv << in.rdbuf();
+  const auto rows = buckle::test::readCsv(csv.str());
+  REQUIRE(rows.size() >= 2);
+  std::map<std::string, size_t> col;
+  for (size_t c = 0; c < rows[0].size(); ++c) col[rows[0][c]] = c;
+  const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const InertiaData rods = InertiaData::uniformRods(chain, 0.01);
+  const GravityPotential V(chain, rods, Eigen::Vector2d(0.0, -3.0));
+  for (size_t r = 1; r < rows.size(); ++r) {
+    Vector q(4), dE(4), dV(4);
+    for (int i = 0; i < 4; ++i) q[i] = std::stod(rows[r][col.at("q" + std::to_string(i + 1))]);
+    energyGradient(chain, q, dE);
+    V.gradient(q, dV);
+    CHECK((dE + dV).lpNorm<Eigen::Infinity>() <= 1e-9);
+    const double pi = energy(chain, q) + V.value(q);
+    CHECK(std::stod(rows[r][col.at("potential")]) == Approx(pi).epsilon(1e-12).margin(1e-13));
+  }
+  // rank 1, the lowest Π: stable, the sag
+  CHECK(rows[1][col.at("stable")] == "1");
+  Vector first(4);
+  for (int i = 0; i < 4; ++i) first[i] = std::stod(rows[1][col.at("q" + std::to_string(i + 1))]);
+  const Vector sag = independentSag(chain, rods, Eigen::Vector2d(0.0, -3.0));
+  CHECK((first - sag).lpNorm<Eigen::Infinity>() <= 1e-9);
+}
+
 TEST_CASE("scene point loads: a force at the last joint growing along an Fx path: the traced end point balances the "
           "joint torques of the end load and that force, summed here from the joint positions", "[scene][body_loads]") {
   // Fy = 0.02 + 0.1·Fx at joint 4 along Fx from 0 to −0.3

@@ -171,6 +171,13 @@ FoundEquilibrium describe(EquilibriumProblem& problem, const Vector& u, double a
   // Π = E − work of the given loads; a held coordinate's reaction does no work (it does not move).
   e.potential = energy(chain, e.q);
   for (int c : problem.endCondition().loadedIndices()) e.potential -= problem.endCondition().value[c] * e.pose[c];
+  if (problem.bodyLoads().active()) {  // + V (eq B1)
+    BodyLoadTerms body(chain, problem.bodyLoads());
+    ChainData data(chain);
+    forwardKinematics(chain, e.q, data);
+    body.update(data);
+    e.potential += body.potential(data, 0.0);
+  }
   e.shape = shapeName(e.q);
   e.accuracy = accuracy;
   return e;
@@ -307,11 +314,12 @@ AllEquilibria allEquilibria(const Chain& chain, const EndCondition& end, const A
   const auto begin = std::chrono::steady_clock::now();
   EquilibriumOptions equilibriumOptions;
   equilibriumOptions.jointLimitsAsBoundaries = false;  // the domain is the geometric limits exactly
-  EquilibriumProblem problem(chain, end, Eigen::Vector3d::Zero(), equilibriumOptions);
+  EquilibriumProblem problem(chain, end, Eigen::Vector3d::Zero(), equilibriumOptions, {},
+                             options.body.atParameter(0.0));
   DeflatedNewton solver(problem, options);
   AllEquilibria result;
   result.endCondition = end;
-  const bool sweep = options.landscape && sweepApplies(chain, end);
+  const bool sweep = options.landscape && sweepApplies(chain, end) && !options.body.active();
   detail::SweepResult swept;
   if (sweep) swept = detail::sweepEquilibria(chain, end.value[0], end.value[1], options.landscapeSamples);
   deflationSearch(problem, solver, startingShapes(chain, options, sweep ? &swept : nullptr), options, result);

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "buckle/continuation/interrupt.h"
+#include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/end_condition.h"
 
@@ -44,6 +45,10 @@ struct AllEquilibriaOptions {
   bool landscape = true;            ///< n = 3 held at (x, y), Me = 0: also the exact sweep
   int landscapeSamples = 4001;      ///< q1 grid of the sweep
   continuation::Interrupt interrupt;  ///< checked before every Newton run; what was found is kept
+  /// The links' weight and point loads at this state (body_loads.h; their rates are ignored:
+  /// BodyLoads::atParameter(0)): in the equations, the stability and Π (+ V, eq B1). With body
+  /// loads the n = 3 sweep (a spring-energy landscape) does not apply.
+  BodyLoads body;
 };
 
 struct FoundEquilibrium {
@@ -53,7 +58,7 @@ struct FoundEquilibrium {
   int index = -1;                   ///< negative eigenvalues of K_q − K_g on ker J_h
   int zeroEigenvalues = 0;          ///< within the stability test's tolerance (degenerate)
   bool stable = false;
-  double potential = 0.0;           ///< Π = E − Σ_loaded F_c p_c
+  double potential = 0.0;           ///< Π = E − Σ_loaded F_c p_c (+ V of the body loads)
   Pose pose = Pose::Zero();
   std::string shape;                ///< shapeName(q)
   double accuracy = 0.0;            ///< ‖F‖∞ in the chain's units after polishing
