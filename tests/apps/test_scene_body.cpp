@@ -59,6 +59,16 @@ Vector independentSag(const Chain& chain, const InertiaData& inertia, const Eige
   return q;
 }
 
+// ‖∂E/∂q + ∂V/∂q‖∞ at q: the torques of the springs and of the links' weight (uniform rods of
+// ρ = 0.01) under g, V from GravityPotential (absolute positions, eq G2), independent of the
+// library's body loads. Zero at an equilibrium of the free chain with no end load.
+double weightImbalance(const Chain& chain, const Eigen::Vector2d& g, const Vector& q) {
+  Vector dE(chain.size()), dV(chain.size());
+  energyGradient(chain, q, dE);
+  GravityPotential(chain, InertiaData::uniformRods(chain, 0.01), g).gradient(q, dV);
+  return (dE + dV).lpNorm<Eigen::Infinity>();
+}
+
 }  // namespace
 
 TEST_CASE("scene gravity path: a heavy cantilever's angles and frequencies equal the library's independent ones",
@@ -104,7 +114,6 @@ TEST_CASE("scene load history under the weight: the column buckles under its own
   REQUIRE(o.rc == 0);
   const Table t = readBranches(o.out);
   const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  const InertiaData rods = InertiaData::uniformRods(chain, 0.01);
   int bent = 0;
   for (const auto& row : t) {
     Vector q(4);
@@ -113,12 +122,8 @@ TEST_CASE("scene load history under the weight: the column buckles under its own
     // eigenvalue zero to rounding, Newton ill-conditioned there): every other point is stable
     if (std::abs(row.at("min_eig")) <= 1e-12) continue;
     CHECK(row.at("stable") == 1.0);
-    // the torques of the springs and of the weight balance (∂E/∂q + ∂V/∂q = 0, eq G2), to the
-    // CSV's 12 digits against the joint stiffness κ = 0.75
-    Vector dE(4), dV(4);
-    energyGradient(chain, q, dE);
-    GravityPotential(chain, rods, Eigen::Vector2d(-row.at("parameter"), 0.0)).gradient(q, dV);
-    CHECK((dE + dV).lpNorm<Eigen::Infinity>() <= 1e-10);
+    // the springs' and the weight's torques balance, to the CSV's 12 digits against κ = 0.75
+    CHECK(weightImbalance(chain, Eigen::Vector2d(-row.at("parameter"), 0.0), q) <= 1e-10);
     if (q.lpNorm<Eigen::Infinity>() > 1e-2) ++bent;
   }
   CHECK(bent > 0);  // past the critical weight the history is on the buckled branch
@@ -163,11 +168,9 @@ TEST_CASE("scene control path under the weight: the free lengths move, every poi
   for (const auto& row : t) {
     const double L0 = row.at("parameter");
     const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, L0));
-    Vector q(4), dE(4), dV(4);
+    Vector q(4);
     for (int i = 0; i < 4; ++i) q[i] = row.at("q" + std::to_string(i + 1));
-    energyGradient(chain, q, dE);
-    GravityPotential(chain, InertiaData::uniformRods(chain, 0.01), Eigen::Vector2d(0.0, -3.0)).gradient(q, dV);
-    CHECK((dE + dV).lpNorm<Eigen::Infinity>() <= 1e-10);
+    CHECK(weightImbalance(chain, Eigen::Vector2d(0.0, -3.0), q) <= 1e-10);
     sag = std::max(sag, q.lpNorm<Eigen::Infinity>());
   }
   CHECK(sag > 1e-3);  // the weight bends it
@@ -194,11 +197,9 @@ TEST_CASE("scene equilibria under the weight: each balances the springs against 
   const InertiaData rods = InertiaData::uniformRods(chain, 0.01);
   const GravityPotential V(chain, rods, Eigen::Vector2d(0.0, -3.0));
   for (size_t r = 1; r < rows.size(); ++r) {
-    Vector q(4), dE(4), dV(4);
+    Vector q(4);
     for (int i = 0; i < 4; ++i) q[i] = std::stod(rows[r][col.at("q" + std::to_string(i + 1))]);
-    energyGradient(chain, q, dE);
-    V.gradient(q, dV);
-    CHECK((dE + dV).lpNorm<Eigen::Infinity>() <= 1e-9);
+    CHECK(weightImbalance(chain, Eigen::Vector2d(0.0, -3.0), q) <= 1e-9);
     const double pi = energy(chain, q) + V.value(q);
     CHECK(std::stod(rows[r][col.at("potential")]) == Approx(pi).epsilon(1e-12).margin(1e-13));
   }
