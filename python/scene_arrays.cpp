@@ -128,25 +128,30 @@ py::dict specialArrays(const scene::Scene& s, const scene::CaseResult& cr, int f
 }
 
 py::dict equilibriaArrays(const scene::CaseResult& cr) {
-  const std::vector<mechanics::FoundEquilibrium>& list = cr.equilibria.equilibria;
-  const auto m = static_cast<Eigen::Index>(list.size());
+  Eigen::Index m = 0;
+  for (const scene::EquilibriumSet& set : cr.equilibriumSets) m += static_cast<Eigen::Index>(set.found.equilibria.size());
   py::dict d;
   Eigen::MatrixXd q(m, cr.chain.size());
-  VectorXd potential(m);
-  Eigen::VectorXi index(m), branch = Eigen::VectorXi::Constant(m, -1);
+  VectorXd potential(m), at(m);
+  Eigen::VectorXi index(m), rank(m), branch = Eigen::VectorXi::Constant(m, -1);
   py::array_t<bool> stable(m);
   auto stableView = stable.mutable_unchecked<1>();
   std::vector<std::string> shape;
-  for (Eigen::Index k = 0; k < m; ++k) {
-    const mechanics::FoundEquilibrium& e = list[static_cast<size_t>(k)];
-    q.row(k) = e.q.transpose();
-    potential[k] = e.potential;
-    index[k] = e.index;
-    stableView(k) = e.stable;
-    shape.push_back(e.shape);
-    if (static_cast<size_t>(k) < cr.equilibriaOnBranch.size()) branch[k] = cr.equilibriaOnBranch[static_cast<size_t>(k)];
-  }
-  d["at"] = cr.equilibriaAt;
+  Eigen::Index k = 0;
+  for (const scene::EquilibriumSet& set : cr.equilibriumSets)
+    for (size_t i = 0; i < set.found.equilibria.size(); ++i, ++k) {  // the rows of equilibria.csv
+      const mechanics::FoundEquilibrium& e = set.found.equilibria[i];
+      at[k] = set.at;
+      rank[k] = static_cast<int>(i) + 1;
+      q.row(k) = e.q.transpose();
+      potential[k] = e.potential;
+      index[k] = e.index;
+      stableView(k) = e.stable;
+      shape.push_back(e.shape);
+      if (i < set.onBranch.size()) branch[k] = set.onBranch[i];
+    }
+  d["at"] = at;
+  d["rank"] = rank;
   d["q"] = q;
   d["potential"] = potential;
   d["index"] = index;
@@ -160,6 +165,7 @@ py::dict equilibriaArrays(const scene::CaseResult& cr) {
       r["id"] = b.id;
       r["parent"] = b.parent;
       r["from_equilibrium"] = b.fromEquilibrium;
+      r["from_equilibrium_at"] = b.fromEquilibriumAt;
       r["joins"] = b.joins >= 0 ? py::object(py::int_(b.joins)) : py::object(py::none());
       disconnected.append(r);
     }

@@ -73,7 +73,7 @@ py::dict resultDict(const scene::Scene& s, const scene::RunResult& run, const sc
     c["q0"] = cr.q0;
     c["branches"] = branchArrays(s, cr);
     c["special_points"] = specialArrays(s, cr, specials);
-    if (cr.haveEquilibria) c["equilibria"] = equilibriaArrays(cr);
+    if (!cr.equilibriumSets.empty()) c["equilibria"] = equilibriaArrays(cr);
     cases.append(c);
     specials += static_cast<int>(cr.specials.size());
     segments = std::max(segments, cr.chain.size());

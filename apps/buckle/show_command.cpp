@@ -206,15 +206,15 @@ void show(const std::string& dirName, std::ostream& os) {
     std::vector<std::vector<std::string>> t;
     for (const json& c : all)
       for (const json& e : list(c, "equilibria")) {
-        t.push_back({text(field(c, "case")), number(field(e, "potential")), text(field(e, "index")),
+        t.push_back({text(field(c, "case")), number(field(c, "at")), number(field(e, "potential")), text(field(e, "index")),
                      field(e, "stable").is_boolean() ? (field(e, "stable").get<bool>() ? "stable" : "unstable") : "-",
                      text(field(e, "shape")), number(field(e, "accuracy"), "%.1e")});
         if (branches) t.back().push_back(text(field(e, "branch")));
       }
     os << "\nevery equilibrium at one state (" << t.size() << ", special_points.json equilibria; method, starts and "
        << "guarantee there):\n";
-    std::vector<std::string> header{"case", "potential", "index", "stability", "shape", "accuracy"};
-    std::vector<bool> right{true, true, true, false, false, true};
+    std::vector<std::string> header{"case", "at", "potential", "index", "stability", "shape", "accuracy"};
+    std::vector<bool> right{true, true, true, true, false, false, true};
     if (branches) {
       header.push_back("branch");
       right.push_back(true);

@@ -40,14 +40,16 @@ MeasuredCase fromScene(const scene::CaseResult& c) {
   for (const mechanics::CriticalCurve& curve : c.criticalCurves)
     for (const mechanics::Codim2Point& p : curve.special)
       if (p.converged) m.specials.push_back({-1, p.label, p.mu, p.label, p.accuracy, {}});
-  if (c.haveEquilibria)  // every equilibrium at one state (ascending Π): Π, shape, stability and index
-    for (const mechanics::FoundEquilibrium& e : c.equilibria.equilibria)
+  for (const scene::EquilibriumSet& set : c.equilibriumSets) {
+    // every equilibrium at one state (ascending Π): Π, shape, stability and index
+    for (const mechanics::FoundEquilibrium& e : set.found.equilibria)
       m.specials.push_back({-1, "ALLEQ", e.potential,
                             e.shape + (e.stable ? " stable" : " unstable") + ", index " + std::to_string(e.index), 0.0, {}});
-  // equilibria "branches": the branch through each equilibrium (value: its id, -1 none), so a
-  // disconnected branch traced from another seed, or none, is a drift
-  for (size_t i = 0; i < c.equilibriaOnBranch.size(); ++i)
-    m.specials.push_back({-1, "EQBRANCH", double(c.equilibriaOnBranch[i]), "equilibrium " + std::to_string(i + 1), 0.0, {}});
+    // equilibria "branches": the branch through each equilibrium (value: its id, -1 none), so a
+    // disconnected branch traced from another seed, or none, is a drift
+    for (size_t i = 0; i < set.onBranch.size(); ++i)
+      m.specials.push_back({-1, "EQBRANCH", double(set.onBranch[i]), "equilibrium " + std::to_string(i + 1), 0.0, {}});
+  }
   if (c.haveTorque)
     for (const auto& [q, stable] : c.torque.equilibria) m.specials.push_back({-1, "TEQ", q, stable ? "stable" : "unstable", 0.0, {}});
   if (c.haveSudden && c.sudden.success) {

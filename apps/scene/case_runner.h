@@ -64,6 +64,9 @@ class CaseRunner {
   }
 
  private:
+  /// One set of the equilibria analysis at path-parameter value `at`, and the branches through it.
+  void equilibriaAt(double at);
+  void disconnectedBranchesAt(EquilibriumSet& set);
   void record(const continuation::Branch& b, const mechanics::BranchReport& report, mechanics::EquilibriumProblem& problem,
               const std::string& origin);
   /// `frequencies` (case_frequencies.cpp): the signed natural frequencies at joint angles q under

@@ -1,8 +1,9 @@
 // The equilibria analysis of a scene case (docs/scenes.md): every equilibrium at one state of the
-// controls, by mechanics/all_equilibria.h, at the case's end condition moved to the path
-// parameter `at` (along a control path: the chain with its free lengths at `at`); with
+// controls, by mechanics/all_equilibria.h, at the case's end condition moved to each value of the
+// path parameter in `at` (along a control path: the chain with its free lengths there); with
 // "branches", the branches through those the continuation's tree does not reach, by
-// mechanics/disconnected_branches.h.
+// mechanics/disconnected_branches.h, each set seeding only what the tree and the earlier sets'
+// branches do not pass through.
 #include <algorithm>
 #include <sstream>
 #include <stdexcept>
@@ -14,9 +15,17 @@ namespace buckle::scene {
 
 void CaseRunner::equilibria() {
   const EquilibriaSpec& e = scene_.analyses.equilibria;
+  const std::vector<double> values = e.at.empty() ? std::vector<double>{out_.startValue} : e.at;
+  for (double at : values) {
+    if (interrupted()) return;  // a stop keeps the sets found so far
+    equilibriaAt(at);
+  }
+}
+
+void CaseRunner::equilibriaAt(double at) {
+  const EquilibriaSpec& e = scene_.analyses.equilibria;
   mechanics::EndCondition end = spec_.end.condition;
-  out_.equilibriaAt = e.haveAt ? e.at : out_.startValue;
-  end.value += (out_.equilibriaAt - out_.startValue) * spec_.path.direction;
+  end.value += (at - out_.startValue) * spec_.path.direction;
   mechanics::AllEquilibriaOptions options;
   options.randomStarts = e.starts;
   options.smoothStarts = e.smoothStarts;
@@ -24,25 +33,35 @@ void CaseRunner::equilibria() {
   options.landscapeSamples = e.sweepPoints;
   options.starts.push_back(out_.q0);  // the case's unloaded shape (preloads from q0)
   options.interrupt = control_.interrupt;
-  options.body = bodyLoads().atParameter(out_.equilibriaAt);  // the weight at `at` (a gravity path's g)
+  options.body = bodyLoads().atParameter(at);  // the weight at `at` (a gravity path's g)
   // along a control path the state is the chain with the free lengths at `at` (the loads held)
   const mechanics::ControlDirection control = controlDirection();
-  const mechanics::Chain chain =
-      control.active() ? mechanics::chainWithControls(out_.chain, control, out_.equilibriaAt) : out_.chain;
+  const mechanics::Chain chain = control.active() ? mechanics::chainWithControls(out_.chain, control, at) : out_.chain;
+  EquilibriumSet set;
+  set.at = at;
   try {
-    out_.equilibria = mechanics::allEquilibria(chain, end, options);
-    out_.haveEquilibria = true;
+    set.found = mechanics::allEquilibria(chain, end, options);
   } catch (const std::invalid_argument& ex) {
     run_.complete = false;
-    run_.problems.push_back("case \"" + spec_.label + "\": equilibria: " + ex.what());
+    std::ostringstream where;
+    where << "case \"" << spec_.label << "\": equilibria at " << spec_.path.parameter << " = " << at << ": ";
+    run_.problems.push_back(where.str() + ex.what());
     return;
   }
-  if (out_.equilibria.interrupted) interrupted();  // marks the run; what was found is kept
+  out_.equilibriumSets.push_back(std::move(set));
+  if (out_.equilibriumSets.back().found.interrupted) interrupted();  // marks the run; what was found is kept
 }
 
 void CaseRunner::disconnectedBranches() {
   // with no tree (its start failed: the unloaded shape far from a held end) every equilibrium seeds
-  if (!out_.haveEquilibria || throughLoad() || interrupted()) return;
+  if (throughLoad()) return;
+  for (EquilibriumSet& set : out_.equilibriumSets) {
+    if (interrupted()) return;
+    disconnectedBranchesAt(set);
+  }
+}
+
+void CaseRunner::disconnectedBranchesAt(EquilibriumSet& set) {
   mechanics::EquilibriumProblem problem = pathProblem();
   const double lo = std::min(spec_.path.from, spec_.path.to), hi = std::max(spec_.path.from, spec_.path.to);
   mechanics::DisconnectedBranchOptions opt;
@@ -53,13 +72,12 @@ void CaseRunner::disconnectedBranches() {
   };
   std::vector<Eigen::VectorXd> q;
   std::vector<bool> stable;
-  for (const mechanics::FoundEquilibrium& e : out_.equilibria.equilibria) {
+  for (const mechanics::FoundEquilibrium& e : set.found.equilibria) {
     q.push_back(e.q);
     stable.push_back(e.stable);
   }
-  const mechanics::DisconnectedBranches d =
-      mechanics::traceDisconnectedBranches(problem, q, out_.equilibriaAt, stable, traced_, opt);
-  out_.equilibriaOnBranch = d.onBranch;
+  const mechanics::DisconnectedBranches d = mechanics::traceDisconnectedBranches(problem, q, set.at, stable, traced_, opt);
+  set.onBranch = d.onBranch;
   const auto& branches = d.traced.tree.branches;
   for (size_t i = 0; i < branches.size(); ++i) {
     continuation::Branch b = branches[i];
@@ -69,7 +87,7 @@ void CaseRunner::disconnectedBranches() {
                             b.points.front().tangent[b.points.front().tangent.size() - 1] > 0.0;
     if (b.parentId < 0)
       origin << "disconnected: from equilibrium " << rank << " at " << spec_.path.parameter << " = "
-             << out_.equilibriaAt << (increasing ? ", increasing " : ", decreasing ") << spec_.path.parameter;
+             << set.at << (increasing ? ", increasing " : ", decreasing ") << spec_.path.parameter;
     else
       origin << "disconnected: BP " << b.parentSpecialPoint << " of branch " << b.parentId
              << (b.direction > 0 ? ", + side" : ", - side");
@@ -77,7 +95,9 @@ void CaseRunner::disconnectedBranches() {
     if (d.joined[i] >= 0) report.stopMessage = "joins branch " + std::to_string(d.joined[i]) + ", traced already";
     record(b, report, problem, origin.str());
     out_.branches.back().fromEquilibrium = rank;
+    out_.branches.back().fromEquilibriumAt = set.at;
     out_.branches.back().joins = d.joined[i];
+    traced_.push_back(b);  // the next set's equilibria on this branch seed nothing more
   }
   if (d.interrupted) interrupted();
 }

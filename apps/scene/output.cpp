@@ -460,6 +460,7 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
                               {"stop", b.stopReason}, {"stop_message", b.stopMessage}, {"finished", b.finished}});
       if (b.fromEquilibrium > 0) {  // disconnected: its seed (rank in equilibria.csv) and the branch it joins
         branches.back()["from_equilibrium"] = b.fromEquilibrium;
+        branches.back()["from_equilibrium_at"] = b.fromEquilibriumAt;
         branches.back()["joins"] = b.joins >= 0 ? json(b.joins) : json(nullptr);
       }
     }

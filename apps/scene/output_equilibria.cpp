@@ -46,16 +46,15 @@ json equilibriumJson(const mechanics::FoundEquilibrium& e, const mechanics::EndC
 
 json equilibriaJson(const RunResult& run) {
   json out = json::array();
-  for (size_t c = 0; c < run.cases.size(); ++c) {
+  for (size_t c = 0; c < run.cases.size(); ++c)
+    for (const EquilibriumSet& set : run.cases[c].equilibriumSets) {
     const CaseResult& cr = run.cases[c];
-    if (!cr.haveEquilibria) continue;
-    const mechanics::AllEquilibria& a = cr.equilibria;
+    const mechanics::AllEquilibria& a = set.found;
     json list = json::array();
     for (size_t i = 0; i < a.equilibria.size(); ++i) {
       list.push_back(equilibriumJson(a.equilibria[i], a.endCondition));
       // the id of a branch through it (branches traced: "branches": true), null when none
-      if (!cr.equilibriaOnBranch.empty())
-        list.back()["branch"] = cr.equilibriaOnBranch[i] >= 0 ? json(cr.equilibriaOnBranch[i]) : json(nullptr);
+      if (!set.onBranch.empty()) list.back()["branch"] = set.onBranch[i] >= 0 ? json(set.onBranch[i]) : json(nullptr);
     }
     int stable = 0;
     for (const mechanics::FoundEquilibrium& e : a.equilibria) stable += e.stable;
@@ -63,7 +62,7 @@ json equilibriaJson(const RunResult& run) {
     for (int k : a.endCondition.heldIndices()) held.push_back(kCoordinate[k]);
     out.push_back(json{{"case", c},
                        {"case_label", cr.label},
-                       {"at", number(cr.equilibriaAt)},
+                       {"at", number(set.at)},
                        {"held", held},
                        {"count", a.equilibria.size()},
                        {"stable_count", stable},
@@ -94,29 +93,29 @@ json equilibriaJson(const RunResult& run) {
 std::string equilibriaCsv(const RunResult& run) {
   int maxN = 0;
   bool branches = false;  // the branches through the equilibria were traced: their ids
-  for (const CaseResult& cr : run.cases) {
-    if (cr.haveEquilibria) maxN = std::max(maxN, cr.chain.size());
-    branches = branches || !cr.equilibriaOnBranch.empty();
-  }
+  for (const CaseResult& cr : run.cases)
+    for (const EquilibriumSet& set : cr.equilibriumSets) {
+      maxN = std::max(maxN, cr.chain.size());
+      branches = branches || !set.onBranch.empty();
+    }
   std::ostringstream os;
   os.precision(15);
-  os << "case,rank,potential,index,stable,shape,Fx,Fy,Me,x,y,phi,accuracy";
+  os << "case,at,rank,potential,index,stable,shape,Fx,Fy,Me,x,y,phi,accuracy";
   if (branches) os << ",branch";
   for (int i = 1; i <= maxN; ++i) os << ",q" << i;
   os << "\n";
-  for (size_t c = 0; c < run.cases.size(); ++c) {
-    const CaseResult& cr = run.cases[c];
-    if (!cr.haveEquilibria) continue;
+  for (size_t c = 0; c < run.cases.size(); ++c)
+    for (const EquilibriumSet& set : run.cases[c].equilibriumSets) {
     int rank = 0;
-    for (const mechanics::FoundEquilibrium& e : cr.equilibria.equilibria) {
-      os << c << ',' << ++rank << ',' << e.potential << ',' << e.index << ',' << (e.stable ? 1 : 0) << ',' << e.shape;
+    for (const mechanics::FoundEquilibrium& e : set.found.equilibria) {
+      os << c << ',' << set.at << ',' << ++rank << ',' << e.potential << ',' << e.index << ',' << (e.stable ? 1 : 0) << ',' << e.shape;
       for (int k = 0; k < 3; ++k) os << ',' << e.wrench[k];
       for (int k = 0; k < 3; ++k) os << ',' << e.pose[k];
       os << ',' << e.accuracy;
       if (branches) {
         const size_t i = size_t(rank - 1);
         os << ',';  // empty: no branch through it (or not traced in this case)
-        if (i < cr.equilibriaOnBranch.size() && cr.equilibriaOnBranch[i] >= 0) os << cr.equilibriaOnBranch[i];
+        if (i < set.onBranch.size() && set.onBranch[i] >= 0) os << set.onBranch[i];
       }
       for (int i = 0; i < maxN; ++i) {
         os << ',';

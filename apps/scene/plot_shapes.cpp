@@ -414,21 +414,28 @@ void drawSuddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
 // ---- every equilibrium at one state -------------------------------------------------------------
 
 // One panel per equilibrium of the `equilibria` analysis (ascending potential, as equilibria.csv
-// ranks them), all to one scale; a stable one on a green ground, its title saying so.
+// ranks them), a band of rows per case and value of `at`, all to one scale; a stable one on a
+// green ground, its title saying so.
 void drawEquilibriumShapes(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir,
                            Script& s) {
+  std::vector<std::pair<size_t, size_t>> sets;  // (case, set)
   std::vector<size_t> cases;
   size_t most = 1;
-  for (size_t c : selected(spec))
-    if (run.cases[c].haveEquilibria) {
-      cases.push_back(c);
-      most = std::max(most, run.cases[c].equilibria.equilibria.size());
+  for (size_t c : selected(spec)) {
+    if (!run.cases[c].equilibriumSets.empty()) cases.push_back(c);
+    for (size_t k = 0; k < run.cases[c].equilibriumSets.size(); ++k) {
+      sets.emplace_back(c, k);
+      most = std::max(most, run.cases[c].equilibriumSets[k].found.equilibria.size());
     }
-  // each case on the rows its own equilibria need (no empty band under a case with fewer)
+  }
+  auto listOf = [&](const std::pair<size_t, size_t>& cs) -> const std::vector<mechanics::FoundEquilibrium>& {
+    return run.cases[cs.first].equilibriumSets[cs.second].found.equilibria;
+  };
+  // each set on the rows its own equilibria need (no empty band under a set with fewer)
   const size_t cols = std::min<size_t>(most, 5);
-  auto rowsOf = [&](size_t c) { return std::max<size_t>(1, (run.cases[c].equilibria.equilibria.size() + cols - 1) / cols); };
+  auto rowsOf = [&](const std::pair<size_t, size_t>& cs) { return std::max<size_t>(1, (listOf(cs).size() + cols - 1) / cols); };
   size_t rows = 0;
-  for (size_t c : cases) rows += rowsOf(c);
+  for (const auto& cs : sets) rows += rowsOf(cs);
   rows = std::max<size_t>(1, rows);
   s.width = std::min<int>(3200, int(440 * cols));
   s.height = std::min<int>(4800, int(300 * rows) + 60);
@@ -439,10 +446,11 @@ void drawEquilibriumShapes(const Scene& scene, const RunResult& run, const PlotS
     const CaseResult& cr = run.cases[c];
     box.extend(Eigen::Vector2d(cr.chain.length(), 0.0));
     bMean = std::max(bMean, cr.chain.length() / (2.0 * cr.chain.size()));
-    for (const mechanics::FoundEquilibrium& e : cr.equilibria.equilibria) {
-      const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, e.q);
-      for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
-    }
+    for (const EquilibriumSet& set : cr.equilibriumSets)
+      for (const mechanics::FoundEquilibrium& e : set.found.equilibria) {
+        const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, e.q);
+        for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
+      }
   }
   const Eigen::Vector2d panel(double(s.width) / double(cols), double(s.height - 60) / double(rows));
   bool detailed = true;
@@ -456,23 +464,26 @@ void drawEquilibriumShapes(const Scene& scene, const RunResult& run, const PlotS
                                             scene.units.suffix(Dimension::Length) +
                                             "; green ground: stable, white: unstable (index: negative eigenvalues)")
          << " font ',11'\n";
-  if (cases.empty()) s.body << "set label 1 'no equilibria computed' at graph 0.5, graph 0.5 center\nplot NaN\n";
-  for (size_t c : cases) {
+  if (sets.empty()) s.body << "set label 1 'no equilibria computed' at graph 0.5, graph 0.5 center\nplot NaN\n";
+  for (const auto& cs : sets) {
+    const size_t c = cs.first;
     const CaseResult& cr = run.cases[c];
+    const EquilibriumSet& set = cr.equilibriumSets[cs.second];
     const std::string& parameter = scene.cases[c].path.parameter;
     const std::string unit = scene.units.unit(columnDimension(parameter));
-    const std::vector<mechanics::FoundEquilibrium>& list = cr.equilibria.equilibria;
+    const std::vector<mechanics::FoundEquilibrium>& list = set.found.equilibria;
     for (size_t k = 0; k < list.size(); ++k) {
       const mechanics::FoundEquilibrium& e = list[k];
-      const std::string base = spec.name + "_" + std::to_string(c) + "_" + std::to_string(k);
+      const std::string base =
+          spec.name + "_" + std::to_string(c) + (cs.second > 0 ? "_at" + std::to_string(cs.second) : "") + "_" +
+          std::to_string(k);
       writeChainFiles(cr.chain, &e.q, dir, base, detailed);
       std::ostringstream title;
       title << (cases.size() > 1 ? cr.label + ", " : std::string()) << "#" << k + 1 << " " << e.shape << ": "
             << (e.stable ? "STABLE" : "unstable, index " + std::to_string(e.index)) << "\nΠ = " << short5(e.potential)
-            << scene.units.suffix(Dimension::Moment) << ", " << parameter << " = " << short5(cr.equilibriaAt)
+            << scene.units.suffix(Dimension::Moment) << ", " << parameter << " = " << short5(set.at)
             << (unit.empty() ? "" : " " + unit);
-      if (k < cr.equilibriaOnBranch.size() && cr.equilibriaOnBranch[k] >= 0)
-        title << ", branch " << cr.equilibriaOnBranch[k];
+      if (k < set.onBranch.size() && set.onBranch[k] >= 0) title << ", branch " << set.onBranch[k];
       const double L = cr.chain.length();
       s.body << "set title " << quote(title.str()) << " font ',9' noenhanced\n";
       s.body << "set xrange [" << num(std::min(x0, -0.1 * L)) << ":" << num(x1) << "]\nset yrange [" << num(y0) << ":"
@@ -481,7 +492,7 @@ void drawEquilibriumShapes(const Scene& scene, const RunResult& run, const PlotS
       chainPanel(s.body, base, L, std::string(), true, detailed);
       if (e.stable) s.body << "unset object 2\n";
     }
-    for (size_t k = list.size(); k < cols * rowsOf(c); ++k) s.body << "set multiplot next\n";
+    for (size_t k = list.size(); k < cols * rowsOf(cs); ++k) s.body << "set multiplot next\n";
   }
   s.body << "unset multiplot\n";
 }

@@ -109,10 +109,21 @@ struct BranchRecord {
   /// Traced from an equilibrium the continuation's tree does not reach (equilibria "branches"):
   /// the rank (1-based, in equilibria.csv) of the equilibrium its tree grew from; 0: not so.
   int fromEquilibrium = 0;
+  /// ... and the path-parameter value of that equilibrium's set (equilibria `at`).
+  double fromEquilibriumAt = 0.0;
   int joins = -1;          ///< the branch it ended on (stop "joined a traced branch"), else -1
 };
 
 using TorqueCurve = mechanics::TorqueCurve;
+
+/// Every equilibrium found at one state of the controls (equilibria, one value of `at`).
+struct EquilibriumSet {
+  double at = 0.0;                 ///< the path-parameter value
+  mechanics::AllEquilibria found;
+  /// with "branches": onBranch[i] the id of a branch through equilibrium i (-1: none); empty when
+  /// the branches were not traced.
+  std::vector<int> onBranch;
+};
 
 /// The dynamic answer to a sudden load, beside the quasi-static one.
 struct SuddenLoadRecord {
@@ -162,12 +173,8 @@ struct CaseResult {
   bool haveSudden = false;
   SuddenLoadRecord sudden;
   std::vector<mechanics::CriticalCurve> criticalCurves;  ///< two_parameter: BP curves by mode, then LP curves
-  bool haveEquilibria = false;     ///< equilibria: every equilibrium at one state of the controls
-  mechanics::AllEquilibria equilibria;
-  double equilibriaAt = 0.0;       ///< ... at this path-parameter value
-  /// equilibria with "branches": onBranch[i] the id of a branch through equilibrium i (-1: none);
-  /// empty when the branches were not traced.
-  std::vector<int> equilibriaOnBranch;
+  /// equilibria: every equilibrium at each state of the controls asked (`at`), in the scene's order
+  std::vector<EquilibriumSet> equilibriumSets;
   explicit CaseResult(const mechanics::Chain& c) : chain(c) {}
 };
 

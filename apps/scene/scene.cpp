@@ -92,7 +92,7 @@ Scene parseScene(const std::string& text, const std::string& file) {
   scene.analyses = parseAnalyses(r, doc["analyses"], Pointer("/analyses"));
   const bool needPath = scene.analyses.continuation.enabled || scene.analyses.criticalForces.enabled ||
                         scene.analyses.twoParameter.enabled || scene.analyses.loadHistory.enabled || scene.analyses.suddenLoad.enabled ||
-                        (scene.analyses.equilibria.enabled && scene.analyses.equilibria.haveAt);
+                        (scene.analyses.equilibria.enabled && !scene.analyses.equilibria.at.empty());
 
   // chain, end and path: what a case patches (copied key by key, not with the cases)
   json base = json::object();

@@ -178,14 +178,16 @@ struct FrequenciesSpec {
 };
 
 /// Every equilibrium at one state of the controls (mechanics/all_equilibria.h): the case's end
-/// condition at the path parameter `at` (default: its start value).
+/// condition at each value of the path parameter in `at` (default: its start value).
 struct EquilibriaSpec {
+  /// At most this many values in `at` (each a complete search).
+  static constexpr int kMaxAt = 1000;
   bool enabled = false;
   int starts = 64;             ///< random starting shapes of the deflated Newton search
   int smoothStarts = 64;       ///< random smooth starting shapes
   unsigned seed = 1;           ///< of the random shapes
-  bool haveAt = false;
-  double at = 0.0;             ///< path-parameter value (haveAt)
+  /// Path-parameter values, in the scene's order (empty: the case's start value).
+  std::vector<double> at;
   int sweepPoints = 4001;      ///< q1 grid of the n = 3 sweep (end held, Me = 0)
   /// Trace the branches through the equilibria the continuation's tree does not reach
   /// (mechanics/disconnected_branches.h); needs /analyses/continuation.

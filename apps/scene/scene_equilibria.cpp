@@ -25,8 +25,15 @@ EquilibriaSpec parseEquilibria(const JsonReader& r, const json& v, const Pointer
   if (v.contains("sweep_points")) s.sweepPoints = r.integer(v["sweep_points"], p / "sweep_points", 3, 10000000);
   if (v.contains("branches")) s.branches = r.boolean(v["branches"], p / "branches");
   if (v.contains("at")) {
-    s.haveAt = true;
-    s.at = r.number(v["at"], p / "at");
+    const json& at = v["at"];
+    if (at.is_array()) {
+      if (at.empty() || at.size() > size_t(EquilibriaSpec::kMaxAt))
+        r.expected(p / "at", at,
+                   "a number or a list of 1 to " + std::to_string(EquilibriaSpec::kMaxAt) + " numbers");
+      for (size_t i = 0; i < at.size(); ++i) s.at.push_back(r.number(at[i], p / "at" / i));
+    } else {
+      s.at.push_back(r.number(at, p / "at"));
+    }
   }
   return s;
 }
@@ -42,14 +49,16 @@ void checkEquilibriaAgainstCases(const JsonReader& r, const Scene& scene) {
         r.fail(Pointer("/analyses/equilibria/branches"),
                "expected a path in a load or a held coordinate traced directly (case \"" + c.label +
                    "\" is displacement control traced through the reaction)");
-  if (!e.enabled || !e.haveAt) return;
-  for (const CaseSpec& c : scene.cases) {
-    const double lo = std::min(c.path.from, c.path.to), hi = std::max(c.path.from, c.path.to);
-    if (!(e.at >= lo && e.at <= hi))
-      r.fail(Pointer("/analyses/equilibria/at"), "expected a value of the path parameter " + c.path.parameter +
-                                                      " in [" + show(lo) + ", " + show(hi) + "] (case \"" +
-                                                      c.label + "\"), got " + show(e.at));
-  }
+  if (!e.enabled) return;
+  const bool list = e.at.size() > 1;
+  for (size_t i = 0; i < e.at.size(); ++i)
+    for (const CaseSpec& c : scene.cases) {
+      const double lo = std::min(c.path.from, c.path.to), hi = std::max(c.path.from, c.path.to);
+      const Pointer where = list ? Pointer("/analyses/equilibria/at") / i : Pointer("/analyses/equilibria/at");
+      if (!(e.at[i] >= lo && e.at[i] <= hi))
+        r.fail(where, "expected a value of the path parameter " + c.path.parameter + " in [" + show(lo) + ", " +
+                          show(hi) + "] (case \"" + c.label + "\"), got " + show(e.at[i]));
+    }
 }
 
 }  // namespace buckle::scene::detail

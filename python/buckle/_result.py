@@ -134,10 +134,11 @@ class RunResult(dict):
 
     def equilibria_frame(self, case=None):
         """equilibria.csv as a pandas DataFrame (the equilibria analysis): case, rank (1-based, ascending
-        potential), at, potential, index, stable, shape, branch, q1 … qn."""
+        potential within its set), at (the set's path-parameter value), potential, index, stable, shape,
+        branch, q1 … qn."""
         def extra(c, t, data):
-            data["at"] = np.full(len(t["potential"]), t["at"])
-            data["rank"] = np.arange(1, len(t["potential"]) + 1)
+            data["at"] = np.asarray(t["at"])
+            data["rank"] = np.asarray(t["rank"])
             return data
         return self._frame("equilibria_frame", "equilibria", case, extra)
 

@@ -125,6 +125,49 @@ TEST_CASE("scene disconnected branches: the branch through the missed equilibria
   CHECK(stable == 2);
 }
 
+TEST_CASE("scene disconnected branches at a list of values: a later set on an earlier set's branch seeds nothing",
+          "[scene][equilibria][disconnected]") {
+  json doc = json::parse(readText(fs::path(BUCKLE_SOURCE_DIR) / "data/scenes/disconnected_branch.json"));
+  doc["analyses"]["equilibria"]["at"] = json::array({-1.0, -1.3});
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_disconnected", "at_list", doc.dump());
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  // the same two disconnected branches as from -1 alone, both seeded by the set at -1
+  const json summary = json::parse(readText(o.out / "summary.json"));
+  std::map<int, double> seedAt;
+  for (const json& b : summary["cases"][0]["branches"])
+    if (b.contains("from_equilibrium")) seedAt[b["id"].get<int>()] = b["from_equilibrium_at"].get<double>();
+  REQUIRE(seedAt.size() == 2);
+  for (const auto& [id, value] : seedAt) CHECK(value == -1.0);
+  // every equilibrium at -1.3 lies on a branch already traced, which crosses Fx = -1.3 there
+  const json sp = json::parse(readText(o.out / "special_points.json"));
+  REQUIRE(sp["equilibria"].size() == 2);
+  const json& later = sp["equilibria"][1];
+  CHECK(later["at"].get<double>() == -1.3);
+  REQUIRE(later["count"].get<int>() == 3);
+  const auto points = rows(o.out / "branches.csv");
+  for (const json& e : later["equilibria"]) {
+    REQUIRE(e["branch"].is_number_integer());
+    const int branch = e["branch"].get<int>();
+    CHECK((branch == 0 || seedAt.count(branch) == 1));
+    double best = INFINITY;
+    for (size_t i = 0; i + 1 < points.size(); ++i) {
+      const auto &a = points[i], &b = points[i + 1];
+      if (std::stoi(a.at("branch")) != branch || std::stoi(b.at("branch")) != branch) continue;
+      const double la = num(a, "parameter") + 1.3, lb = num(b, "parameter") + 1.3;
+      if (la * lb > 0.0 || la == lb) continue;
+      const double w = la / (la - lb);
+      double d = 0.0;
+      for (int q = 0; q < 3; ++q) {
+        const std::string name = "q" + std::to_string(q + 1);
+        d = std::max(d, std::abs(num(a, name) + w * (num(b, name) - num(a, name)) - e["q"][size_t(q)].get<double>()));
+      }
+      best = std::min(best, d);
+    }
+    CHECK(best < 0.05);
+  }
+}
+
 TEST_CASE("scene disconnected branches: bad options name the JSON path, exit 2, nothing written",
           "[scene][equilibria][disconnected]") {
   const std::string chain = R"("chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},)";

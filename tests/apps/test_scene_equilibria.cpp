@@ -6,7 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "buckle/mechanics/all_equilibria.h"
 #include "scene_run.h"
@@ -74,6 +76,67 @@ TEST_CASE("scene equilibria: the list at `at` is the library's, in special_point
   CHECK(csvRows(o.out / "equilibria.csv") == int(lib.equilibria.size()));
 }
 
+TEST_CASE("scene equilibria: a list `at`, one complete set per value, each the library's at that load",
+          "[scene][equilibria]") {
+  const std::vector<double> at{-0.2, -0.9, -1.1};
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText(
+      "scene_equilibria", "at_list", scene(R"({"starts": 24, "seed": 3, "at": [-0.2, -0.9, -1.1]})"));
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  const json sp = readJson(o.out / "special_points.json");
+  REQUIRE(sp["equilibria"].size() == at.size());
+
+  using namespace buckle::mechanics;
+  const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  AllEquilibriaOptions options;
+  options.randomStarts = 24;
+  options.seed = 3;
+  options.starts.push_back(Eigen::VectorXd::Zero(4));
+  std::vector<int> straightIndex;  // the straight chain's index in each set (-1: not found)
+  size_t rows = 0;
+  for (size_t s = 0; s < at.size(); ++s) {
+    INFO("Fx = " << at[s]);
+    const json& c = sp["equilibria"][s];
+    CHECK(c["at"].get<double>() == at[s]);
+    const AllEquilibria lib = allEquilibria(chain, EndCondition::clampedPinned(at[s]), options);
+    REQUIRE(c["count"].get<size_t>() == lib.equilibria.size());
+    rows += lib.equilibria.size();
+    straightIndex.push_back(-1);
+    for (const FoundEquilibrium& f : lib.equilibria)
+      if (f.q.cwiseAbs().maxCoeff() < 1e-9) straightIndex.back() = f.index;
+    for (size_t k = 0; k < lib.equilibria.size(); ++k) {
+      const json& e = c["equilibria"][k];
+      CHECK(e["loads"]["Fx"].get<double>() == at[s]);
+      CHECK(e["index"].get<int>() == lib.equilibria[k].index);
+      for (int i = 0; i < 4; ++i)
+        CHECK(e["q"][size_t(i)].get<double>() == Approx(lib.equilibria[k].q[i]).margin(1e-12));
+    }
+  }
+  // the straight chain is in every set: stable below the first critical load, unstable past it
+  CHECK(straightIndex.front() == 0);
+  CHECK(straightIndex.back() >= 1);
+  // equilibria.csv: one row per equilibrium, the set's value in `at`, ranks from 1 in each set
+  std::ifstream in(o.out / "equilibria.csv");
+  std::string line;
+  std::getline(in, line);
+  CHECK(line.rfind("case,at,rank,", 0) == 0);
+  std::vector<int> perSet(at.size(), 0);
+  size_t read = 0;
+  while (std::getline(in, line)) {
+    ++read;
+    std::istringstream cells(line);
+    std::string cell, value, rank;
+    std::getline(cells, cell, ',');
+    std::getline(cells, value, ',');
+    std::getline(cells, rank, ',');
+    size_t s = 0;
+    while (s < at.size() && std::stod(value) != at[s]) ++s;
+    REQUIRE(s < at.size());
+    CHECK(std::stoi(rank) == ++perSet[s]);
+  }
+  CHECK(read == rows);
+}
+
 TEST_CASE("scene equilibria: bad options name the JSON path, exit 2, nothing written", "[scene][equilibria]") {
   struct Bad {
     std::string name, value, path;
@@ -84,6 +147,9 @@ TEST_CASE("scene equilibria: bad options name the JSON path, exit 2, nothing wri
                                        {"key", R"({"stars": 3})", "/analyses/equilibria/stars", true},
                                        {"type", R"("yes")", "/analyses/equilibria", true},
                                        {"at_range", R"({"at": -2.0})", "/analyses/equilibria/at", true},
+                                       {"at_empty", R"({"at": []})", "/analyses/equilibria/at", true},
+                                       {"at_list_range", R"({"at": [-0.5, -2.0]})", "/analyses/equilibria/at/1", true},
+                                       {"at_list_type", R"({"at": [-0.5, "x"]})", "/analyses/equilibria/at/1", true},
                                        {"at_path", R"({"at": -0.5})", "/path", false}}) {
     INFO(b.name);
     const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_equilibria", b.name, scene(b.value, b.withPath));

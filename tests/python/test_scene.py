@@ -117,7 +117,12 @@ def test_module_equilibria_equal_equilibria_csv(name, source_dir, run_cli, tmp_p
         e = case["equilibria"]
         mine = [row for row in rows if int(row["case"]) == c]
         assert len(mine) == len(e["potential"]) == e["q"].shape[0]
-        assert [int(row["rank"]) for row in mine] == list(range(1, len(mine) + 1))
+        np.testing.assert_array_equal(e["rank"], [int(row["rank"]) for row in mine])
+        np.testing.assert_allclose(e["at"], [float(row["at"]) for row in mine], rtol=1e-14)
+        for value in np.unique(e["at"]):  # ranked by potential within each set
+            ranks = e["rank"][e["at"] == value]
+            assert list(ranks) == list(range(1, len(ranks) + 1))
+            assert (np.diff(e["potential"][e["at"] == value]) >= 0).all()
         # equilibria.csv has 15 significant digits
         np.testing.assert_allclose(e["potential"], [float(row["potential"]) for row in mine], rtol=1e-13)
         for i in range(case["segments"]):
@@ -131,11 +136,11 @@ def test_module_equilibria_equal_equilibria_csv(name, source_dir, run_cli, tmp_p
             np.testing.assert_array_equal(e["branch"], [int(row["branch"]) if row["branch"] else -1 for row in mine])
         else:
             assert (e["branch"] == -1).all()
-        seeds = {b["id"]: b["from_equilibrium"] for b in summary["cases"][c].get("branches", [])
-                 if "from_equilibrium" in b}
-        assert {b["id"]: b["from_equilibrium"] for b in e["disconnected_branches"]} == seeds
+        seeds = {b["id"]: (b["from_equilibrium"], b["from_equilibrium_at"])
+                 for b in summary["cases"][c].get("branches", []) if "from_equilibrium" in b}
+        assert {b["id"]: (b["from_equilibrium"], b["from_equilibrium_at"]) for b in e["disconnected_branches"]} == seeds
         for b in e["disconnected_branches"]:
-            assert b["from_equilibrium"] in range(1, len(mine) + 1)
+            assert b["from_equilibrium"] in set(e["rank"][e["at"] == b["from_equilibrium_at"]].tolist())
             assert b["id"] in set(np.unique(case["branches"]["branch"]).tolist())
 
 
