@@ -167,7 +167,7 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
               double d = 0.0;
               for (size_t i = 0; i < 3; ++i)
                 d = std::max(d, std::abs(e["q"][i].get<double>() - l["q"][i].get<double>()));
-              if (d <= 1e-9 && e["stable"] == l["stable"]) listed = true;
+              if (d <= 1e-12 && e["stable"] == l["stable"]) listed = true;
             }
             CHECK(listed);
           }
