@@ -11,6 +11,8 @@ namespace buckle::python {
 /// Segment, Chain, EndCondition, the chain's energy / torque / kinematics / stiffness at a state
 /// and linear_buckling (buckle::mechanics).
 void bindMechanics(pybind11::module_& m);
+/// all_equilibria(): every equilibrium at one state of the controls (mechanics/all_equilibria.h).
+void bindEquilibria(pybind11::module_& m);
 /// trace(): the continuation core on a problem whose residual and Jacobian are Python callables.
 void bindContinuation(pybind11::module_& m);
 /// run_scene(): a scene (dict or file) through the same runner as `buckle run`.

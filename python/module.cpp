@@ -15,13 +15,14 @@ PYBIND11_MODULE(_core, m) {
       "those units, angles in radians; a scene may name them (`units`, docs/scenes.md). Sign conventions: spring energy "
       "E = 1/2 sum k (L - L0)^2, joint stiffness K_q = d2E/dq2, restoring torque M = -dE/dq, "
       "equilibrium M + J^T F = 0, compression is Fx < 0.\n\n"
-      "Mechanics: Segment, Chain, EndCondition, linear_buckling.  Scenes: run_scene (the `buckle run` "
+      "Mechanics: Segment, Chain, EndCondition, linear_buckling, all_equilibria.  Scenes: run_scene (the `buckle run` "
       "runner), returning a RunResult: a dict of NumPy arrays with DataFrames (pandas) and plots (matplotlib) "
       "when those are installed.  Continuation core: trace (a problem given by Python callables).  Bad input raises "
       "ValueError (SceneError for a scene) with the command line's message; Ctrl-C raises "
       "KeyboardInterrupt within a step (run_scene first writes what was computed to `out`). docs/python.md.";
   m.attr("__version__") = BUCKLE_VERSION;
   buckle::python::bindMechanics(m);
+  buckle::python::bindEquilibria(m);
   buckle::python::bindContinuation(m);
   buckle::python::bindScene(m);
 }

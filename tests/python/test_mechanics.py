@@ -147,3 +147,47 @@ def test_an_asymmetric_segments_repr_names_each_side_and_the_user_limits():
 def test_a_non_finite_end_value_is_named_as_python_writes_it():
     with pytest.raises(ValueError, match=r"value\[1\] must be a finite number .*got inf"):
         buckle.EndCondition(value=(0.0, math.inf, 0.0))
+
+
+def test_all_equilibria_held_end_every_one_is_an_equilibrium_with_its_index():
+    # the paper's chain with its end held at (5.5b, 0), rotation free (Fig 4): two U minima and two Z
+    # saddles; each returned q balances the springs against the reactions, sits at the held end, and
+    # its index is the count of negative eigenvalues of the Hessian on ker J_h (numpy, independently)
+    chain = buckle.Chain.uniform(3, buckle.Segment(a=0.5, b=1, k=1, L0=2.25))
+    end = buckle.EndCondition.held_position(5.5, 0.0)
+    r = buckle.all_equilibria(chain, end, starts=16, smooth_starts=16, seed=3)
+    found = r["equilibria"]
+    assert len(found) == 4
+    assert r["morse"]["applies"] and r["morse"]["holds"]
+    assert [e["stable"] for e in found].count(True) == 2
+    potentials = [e["potential"] for e in found]
+    assert potentials == sorted(potentials)
+    for e in found:
+        q, F = e["q"], e["wrench"]
+        assert np.max(np.abs(chain.total_potential_gradient(q, F))) < 1e-10
+        np.testing.assert_allclose(chain.end_pose(q)[:2], [5.5, 0.0], atol=1e-12)
+        assert F[2] == 0.0  # phi free: no end torque
+        J = chain.end_jacobian(q)[:2]
+        Z = np.linalg.svd(J)[2][2:].T  # orthonormal basis of ker J_h
+        eig = np.linalg.eigvalsh(Z.T @ chain.total_potential_hessian(q, F) @ Z)
+        assert e["index"] == int((eig < 0).sum())
+        assert e["stable"] == (e["index"] == 0)
+
+
+def test_all_equilibria_equal_the_scene_analysis_and_name_bad_options():
+    chain = buckle.Chain.uniform(4, buckle.Segment(a=0.5, b=1, k=1, L0=2.25))
+    end = buckle.EndCondition.clamped_pinned(-0.9)
+    mine = buckle.all_equilibria(chain, end, starts=24, seed=3, starts_q=[np.zeros(4)])
+    scene = {"chain": {"segments": 4, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+             "end": {"x": {"load": -0.9}, "y": {"held": 0.0}, "phi": "free"},
+             "analyses": {"equilibria": {"starts": 24, "seed": 3}}}
+    theirs = buckle.run_scene(scene)["cases"][0]["equilibria"]
+    assert len(mine["equilibria"]) == len(theirs["potential"])
+    for k, e in enumerate(mine["equilibria"]):
+        np.testing.assert_allclose(e["q"], theirs["q"][k], atol=1e-12)
+        assert e["index"] == theirs["index"][k]
+    for key, value in (("starts", -1), ("smooth_starts", -2), ("seed", -1), ("sweep_points", 2)):
+        with pytest.raises(ValueError, match=key):
+            buckle.all_equilibria(chain, end, **{key: value})
+    with pytest.raises(ValueError, match=r"starts_q\[0\]"):
+        buckle.all_equilibria(chain, end, starts_q=[np.zeros(3)])
