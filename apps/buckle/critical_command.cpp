@@ -9,6 +9,7 @@
 #include <string>
 
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/critical_loading.h"
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/linear_buckling.h"
 #include "scene/units.h"
@@ -134,7 +135,7 @@ int run(const CriticalOptions& o) {
     LinearBucklingOptions lbo;
     lbo.count = o.count;
     const LinearBucklingResult lb = linearBuckling(chain, Vector::Zero(n), end, lbo);
-    const bool analytic = n == 3 && o.end == "pinned";
+    const bool analytic = clampedPinned3Applies(chain, Vector::Zero(n), criticalLoading(end, 0, Eigen::Vector3d::UnitX()));
     const AnalyticBuckling3 an = analytic ? analyticClampedPinned3(aUnit, 1.0, 1.0, L0Unit) : AnalyticBuckling3{};
 
     // eq 4: the straight chain is stable exactly when κ > 0; a unit chain that says otherwise was

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/critical_loading.h"
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/jump.h"
 #include "buckle/mechanics/landing.h"
@@ -375,7 +376,7 @@ void CaseRunner::continuation() {
     const bool up = target > s0;
     starts.push_back(up ? cont::InitialDirection::increasingLambda() : cont::InitialDirection::decreasingLambda());
     origins.push_back(std::string("start, ") + (up ? "increasing " : "decreasing ") +
-                      (throughLoad() ? std::string(c == 0 ? "Fx" : c == 1 ? "Fy" : "Me") + " (through the reaction)"
+                      (throughLoad() ? std::string(kEndLoadNames[size_t(c)]) + " (through the reaction)"
                                      : spec_.path.parameter));
   }
   // Each branch is recorded as soon as it is final (EquilibriumBranchOptions::onReport), so its
@@ -418,39 +419,22 @@ void CaseRunner::continuation() {
 }
 
 void CaseRunner::criticalForces() {
-  mech::EndCondition end = spec_.end.condition;
+  const mech::CriticalLoading loading =
+      mech::criticalLoading(spec_.end.condition, spec_.path.coordinate, spec_.path.direction);
   mech::LinearBucklingOptions opt;
   opt.count = scene_.analyses.criticalForces.modes;
-  const int c = spec_.path.coordinate;
-  if (end.isHeld(static_cast<mech::EndCoordinate>(c))) {
-    // displacement control: the critical loads of the force that drives that coordinate
-    end.control[size_t(c)] = mech::Control::Load;
-    opt.direction = Eigen::Vector3d::Zero();
-    opt.direction[c] = 1.0;
-  } else {
-    opt.direction = spec_.path.direction;
-    for (int j = 0; j < 3; ++j)
-      if (end.isHeld(static_cast<mech::EndCoordinate>(j))) opt.direction[j] = 0.0;
-  }
+  opt.direction = loading.direction;
   try {
-    out_.critical = mech::linearBuckling(out_.chain, out_.q0, end, opt);
+    out_.critical = mech::linearBuckling(out_.chain, out_.q0, loading.end, opt);
     out_.haveCritical = true;
   } catch (const std::invalid_argument& e) {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": critical forces: " + e.what());
     return;
   }
-  // the closed forms (eq 17) apply to three identical symmetric segments, straight, clamped–pinned
-  const auto& segs = spec_.chain.segments;
-  bool symmetric = segs.size() == 3 && out_.q0.cwiseAbs().maxCoeff() == 0.0;
-  for (const auto& s : segs)
-    symmetric = symmetric && s.a1 == segs[0].a1 && s.a2 == s.a1 && s.b1 == segs[0].b1 && s.b2 == s.b1 &&
-                s.k1 == segs[0].k1 && s.k2 == s.k1 && s.L1_0 == segs[0].L1_0 && s.L2_0 == s.L1_0;
-  const bool clampedPinned = end.isHeld(mech::EndCoordinate::Y) && !end.isHeld(mech::EndCoordinate::X) &&
-                             !end.isHeld(mech::EndCoordinate::Phi) && opt.direction[0] != 0.0 &&
-                             opt.direction[1] == 0.0;
-  if (symmetric && clampedPinned) {
-    out_.analytic = mech::analyticClampedPinned3(segs[0].a1, segs[0].b1, segs[0].k1, segs[0].L1_0);
+  if (mech::clampedPinned3Applies(out_.chain, out_.q0, loading)) {
+    const mech::SegmentParameters& s = out_.chain.segment(0).parameters();
+    out_.analytic = mech::analyticClampedPinned3(s.a1, s.b1, s.k1, s.L1_0);
     out_.haveAnalytic = true;
   }
 }

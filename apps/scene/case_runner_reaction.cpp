@@ -12,11 +12,6 @@ namespace buckle::scene {
 
 namespace mech = buckle::mechanics;
 
-namespace {
-const char* const kReactionNames[3] = {"Fx", "Fy", "Me"};
-const char* const kCoordinates[3] = {"x", "y", "phi"};
-}  // namespace
-
 double CaseRunner::reactionLoadLimit() {
   const int c = spec_.path.coordinate;
   const std::string unit = scene_.units.suffix(c < 2 ? Dimension::Force : Dimension::Moment);
@@ -31,10 +26,10 @@ double CaseRunner::reactionLoadLimit() {
   } catch (const std::exception& e) {
     if (!out_.loadLimitDerived) return out_.loadLimit;  // the scene's limit stands; nothing to check it by
     run_.complete = false;
-    run_.problems.push_back("case \"" + spec_.label + "\": displacement control of " + kCoordinates[c] +
+    run_.problems.push_back("case \"" + spec_.label + "\": displacement control of " + kEndCoordinateNames[c] +
                             " from a start that cannot move it to first order is traced through the reaction " +
-                            kReactionNames[c] + ", up to a load limit that could not be derived: " + e.what() +
-                            "; give /path/load_limit, the largest |" + kReactionNames[c] + "| to trace" + unit);
+                            kEndLoadNames[c] + ", up to a load limit that could not be derived: " + e.what() +
+                            "; give /path/load_limit, the largest |" + kEndLoadNames[c] + "| to trace" + unit);
     return 0.0;
   }
   return out_.loadLimit;
@@ -54,12 +49,12 @@ void CaseRunner::checkHeldCoordinateMoved(size_t firstPoint) {
   const std::string unit = scene_.units.suffix(c < 2 ? Dimension::Force : Dimension::Moment);
   std::ostringstream os;
   os.precision(10);
-  os << "case \"" << spec_.label << "\": the end never moved along " << kCoordinates[c] << " (every equilibrium found has "
-     << kCoordinates[c] << " = " << start << "): the chain carried the reaction " << kReactionNames[c]
+  os << "case \"" << spec_.label << "\": the end never moved along " << kEndCoordinateNames[c] << " (every equilibrium found has "
+     << kEndCoordinateNames[c] << " = " << start << "): the chain carried the reaction " << kEndLoadNames[c]
      << " without buckling up to the load limit " << out_.loadLimit << unit << (out_.loadLimitDerived ? " (derived)" : "")
      << ". ";
   if (std::isfinite(out_.firstCriticalReaction) && out_.loadLimit < std::abs(out_.firstCriticalReaction))
-    os << "It buckles, and " << kCoordinates[c] << " can move, only at the critical reaction "
+    os << "It buckles, and " << kEndCoordinateNames[c] << " can move, only at the critical reaction "
        << out_.firstCriticalReaction << unit << ": raise /path/load_limit above " << std::abs(out_.firstCriticalReaction)
        << ", or leave it out to have it derived from the critical reactions";
   else if (scene_.analyses.continuation.depth(true) == 0)

@@ -18,9 +18,6 @@ json vectorJson(const Eigen::VectorXd& v) {
   return a;
 }
 
-const char* const kCoordinate[3] = {"x", "y", "phi"};
-const char* const kLoad[3] = {"Fx", "Fy", "Me"};
-
 json equilibriumJson(const mechanics::FoundEquilibrium& e, const mechanics::EndCondition& end) {
   json j{{"q", vectorJson(e.q)},
          {"index", e.index},
@@ -36,7 +33,7 @@ json equilibriumJson(const mechanics::FoundEquilibrium& e, const mechanics::EndC
   const std::vector<int> held = end.heldIndices();
   if (!held.empty()) {
     json r = json::object();
-    for (size_t k = 0; k < held.size(); ++k) r[kLoad[held[k]]] = number(e.reactions[Eigen::Index(k)]);
+    for (size_t k = 0; k < held.size(); ++k) r[kEndLoadNames[held[k]]] = number(e.reactions[Eigen::Index(k)]);
     j["reactions"] = r;
   }
   return j;
@@ -59,7 +56,7 @@ json equilibriaJson(const RunResult& run) {
     int stable = 0;
     for (const mechanics::FoundEquilibrium& e : a.equilibria) stable += e.stable;
     json held = json::array();
-    for (int k : a.endCondition.heldIndices()) held.push_back(kCoordinate[k]);
+    for (int k : a.endCondition.heldIndices()) held.push_back(kEndCoordinateNames[k]);
     out.push_back(json{{"case", c},
                        {"case_label", cr.label},
                        {"at", number(set.at)},

@@ -357,7 +357,7 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   };
   label("parameter");
   for (const std::string& column : columns) label(column);
-  for (const char* load : {"Fx", "Fy", "Me"}) label(load);  // the special points table's heads
+  for (const char* load : kEndLoadNames) label(load);  // the special points table's heads
   for (const PlotSpec& p : scene.plots) {
     if (!p.x.empty()) label(p.x);
     for (const std::string& y : p.y) label(y);
@@ -391,7 +391,7 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
     const CaseSpec& c = scene.cases.front();
     const bool load = !c.path.control && !c.path.gravity && !c.path.task;
     if (load && c.end.condition.isHeld(static_cast<mechanics::EndCoordinate>(c.path.coordinate)))
-      criticalColumn = std::array<const char*, 3>{"Fx", "Fy", "Me"}[size_t(c.path.coordinate)];
+      criticalColumn = kEndLoadNames[size_t(c.path.coordinate)];
   }
   data["critical_column"] = criticalColumn;
   // every "<" as \u003c: nothing inside the JSON can end or change the <script> element (escape.h)

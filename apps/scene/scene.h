@@ -28,6 +28,11 @@ using SceneError = JsonInputError;
 /// segment objects: every case is a chain to build, trace and write.
 constexpr int kMaxSegments = 100000;
 
+/// The end's coordinates (mechanics::EndCoordinate 0 x, 1 y, 2 φ) and the loads on them, as
+/// scenes, outputs and messages name them.
+inline constexpr std::array<const char*, 3> kEndCoordinateNames{"x", "y", "phi"};
+inline constexpr std::array<const char*, 3> kEndLoadNames{"Fx", "Fy", "Me"};
+
 /// A force at a joint (/point_loads): at the path's start value and its rate along the path.
 struct PointLoadSpec {
   int joint = 1;                                    ///< 1 … n

@@ -15,16 +15,14 @@ namespace {
 
 using Reader = JsonReader;
 
-const char* const kCoordinateNames[3] = {"x", "y", "phi"};
-const char* const kLoadNames[3] = {"Fx", "Fy", "Me"};
 
 int coordinateOfParameter(const std::string& s, bool& isLoad) {
   for (int c = 0; c < 3; ++c) {
-    if (s == kLoadNames[c]) {
+    if (s == kEndLoadNames[c]) {
       isLoad = true;
       return c;
     }
-    if (s == kCoordinateNames[c]) {
+    if (s == kEndCoordinateNames[c]) {
       isLoad = false;
       return c;
     }
@@ -266,9 +264,9 @@ EndSpec parseEnd(const Reader& r, const json& end, const Pointer& p) {
   for (int c = 0; c < 3; ++c) {
     spec.condition.control[size_t(c)] = mechanics::Control::Load;
     spec.condition.value[c] = 0.0;
-    if (!end.contains(kCoordinateNames[c])) continue;
-    const json& v = end[kCoordinateNames[c]];
-    const Pointer pc = p / kCoordinateNames[c];
+    if (!end.contains(kEndCoordinateNames[c])) continue;
+    const json& v = end[kEndCoordinateNames[c]];
+    const Pointer pc = p / kEndCoordinateNames[c];
     const std::string what = "\"free\", {\"load\": number} or {\"held\": number | \"start\"}";
     if (v.is_string()) {
       if (v.get<std::string>() != "free") r.expected(pc, v, what);
@@ -308,12 +306,12 @@ PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const En
   const bool held = end.condition.isHeld(static_cast<mechanics::EndCoordinate>(spec.coordinate));
   if (isLoad && held)
     r.fail(p / "parameter", std::string("the load ") + spec.parameter + " cannot be the parameter: /end/" +
-                                kCoordinateNames[spec.coordinate] + " is held (use \"" +
-                                kCoordinateNames[spec.coordinate] + "\" or make it loaded)");
+                                kEndCoordinateNames[spec.coordinate] + " is held (use \"" +
+                                kEndCoordinateNames[spec.coordinate] + "\" or make it loaded)");
   if (!isLoad && !held)
     r.fail(p / "parameter", std::string("the coordinate ") + spec.parameter + " cannot be the parameter: /end/" +
                                 spec.parameter + " is not held (use {\"held\": value} there, or the load " +
-                                kLoadNames[spec.coordinate] + ")");
+                                kEndLoadNames[spec.coordinate] + ")");
   spec.from = r.number(path["from"], p / "from");
   spec.to = r.number(path["to"], p / "to");
   if (spec.from == spec.to) r.fail(p / "to", "expected a value different from /path/from (an empty range)");
@@ -323,7 +321,7 @@ PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const En
   if (!(startValue >= lo - slack && startValue <= hi + slack)) {
     std::ostringstream os;
     os << "expected a range [from, to] that contains the start value " << spec.parameter << " = " << startValue
-       << " (set by /end/" << kCoordinateNames[spec.coordinate] << "), got [" << spec.from << ", " << spec.to << "]";
+       << " (set by /end/" << kEndCoordinateNames[spec.coordinate] << "), got [" << spec.from << ", " << spec.to << "]";
     r.fail(p / (std::abs(spec.from - startValue) <= std::abs(spec.to - startValue) ? "from" : "to"), os.str());
   }
   if (path.contains("load_limit")) {
@@ -346,8 +344,8 @@ PathSpec parsePath(const Reader& r, const json& path, const Pointer& p, const En
         r.fail(pd / it.key(), "the path parameter's own rate is 1 by definition; remove this key");
       const bool cHeld = end.condition.isHeld(static_cast<mechanics::EndCoordinate>(c));
       if (keyIsLoad == cHeld)
-        r.fail(pd / it.key(), std::string("expected ") + (cHeld ? kCoordinateNames[c] : kLoadNames[c]) +
-                                  ": /end/" + kCoordinateNames[c] + " is " + (cHeld ? "held" : "loaded"));
+        r.fail(pd / it.key(), std::string("expected ") + (cHeld ? kEndCoordinateNames[c] : kEndLoadNames[c]) +
+                                  ": /end/" + kEndCoordinateNames[c] + " is " + (cHeld ? "held" : "loaded"));
       spec.direction[c] = r.number(it.value(), pd / it.key());
     }
   }
@@ -371,8 +369,8 @@ void checkEndAgainstChain(const Reader& r, const CaseSpec& cs) {
     if (!end.isHeld(static_cast<mechanics::EndCoordinate>(c)) || cs.end.heldAtStart[size_t(c)]) continue;
     const double v = end.value[c];
     if (std::abs(v) > L * (1.0 + 1e-12))
-      r.fail(Pointer("/end") / kCoordinateNames[c] / "held",
-             std::string("expected a position the end can reach: |") + kCoordinateNames[c] + "| <= " + show(L) +
+      r.fail(Pointer("/end") / kEndCoordinateNames[c] / "held",
+             std::string("expected a position the end can reach: |") + kEndCoordinateNames[c] + "| <= " + show(L) +
                  " (the length of the straight chain), got " + show(v));
   }
   if (end.isHeld(mechanics::EndCoordinate::X) && end.isHeld(mechanics::EndCoordinate::Y) &&
@@ -385,12 +383,12 @@ void checkEndAgainstChain(const Reader& r, const CaseSpec& cs) {
   const auto checkLoad = [&](int c, double v, const Pointer& at) {
     const double limit = 1e12 * unit[c];
     if (!(std::abs(v) <= limit))
-      r.fail(at, std::string("expected a load |") + kLoadNames[c] + "| <= " + show(limit) + " (1e12 times the chain's " +
+      r.fail(at, std::string("expected a load |") + kEndLoadNames[c] + "| <= " + show(limit) + " (1e12 times the chain's " +
                      (c == 2 ? "moment unit k b^2" : "force unit k b") + "), got " + show(v));
   };
   for (int c = 0; c < 3; ++c)
     if (!end.isHeld(static_cast<mechanics::EndCoordinate>(c)))
-      checkLoad(c, end.value[c], Pointer("/end") / kCoordinateNames[c] / "load");
+      checkLoad(c, end.value[c], Pointer("/end") / kEndCoordinateNames[c] / "load");
   bool isLoad = false;
   const int c = coordinateOfParameter(cs.path.parameter, isLoad);
   if (c >= 0 && isLoad && cs.path.from != cs.path.to) {

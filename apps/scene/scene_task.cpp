@@ -11,13 +11,12 @@
 namespace buckle::scene::detail {
 
 namespace {
-const char* const kCoordinates[3] = {"x", "y", "phi"};
 
 // One point of the task path: as many numbers as task coordinates.
 Eigen::VectorXd taskPoint(const JsonReader& r, const json& v, const Pointer& p, const std::vector<int>& coordinates) {
   const size_t m = coordinates.size();
   std::string names;
-  for (int c : coordinates) names += std::string(names.empty() ? "" : ", ") + kCoordinates[c];
+  for (int c : coordinates) names += std::string(names.empty() ? "" : ", ") + kEndCoordinateNames[c];
   if (!v.is_array() || v.size() != m)
     r.expected(p, v, "an array of " + std::to_string(m) + " number(s): " + names + " (the task coordinates)");
   Eigen::VectorXd out(static_cast<Eigen::Index>(m));
@@ -65,8 +64,8 @@ PathSpec parseTaskPath(const JsonReader& r, const json& path, const Pointer& p, 
   r.onlyKeys(path, p, {"task", "inputs", "rule"});
   for (int c = 0; c < 3; ++c)
     if (end.condition.isHeld(static_cast<mechanics::EndCoordinate>(c)))
-      r.fail(Pointer("/end") / kCoordinates[c],
-             "a task path moves the end by its inputs under a payload: /end/" + std::string(kCoordinates[c]) +
+      r.fail(Pointer("/end") / kEndCoordinateNames[c],
+             "a task path moves the end by its inputs under a payload: /end/" + std::string(kEndCoordinateNames[c]) +
                  " must be a load, not held");
   PathSpec spec;
   spec.task = true;
@@ -82,7 +81,7 @@ PathSpec parseTaskPath(const JsonReader& r, const json& path, const Pointer& p, 
     r.expected(pt / "coordinates", coords, "an array of 1 to 3 of \"x\", \"y\", \"phi\" in that order");
   for (size_t k = 0; k < coords.size(); ++k) {
     const std::string name = r.string(coords[k], pt / "coordinates" / k);
-    const int c = int(std::find(kCoordinates, kCoordinates + 3, name) - kCoordinates);
+    const int c = int(std::find(kEndCoordinateNames.begin(), kEndCoordinateNames.end(), name) - kEndCoordinateNames.begin());
     if (c == 3 || (!setup.coordinates.empty() && c <= setup.coordinates.back()))
       r.expected(pt / "coordinates" / k, coords[k], "one of \"x\", \"y\", \"phi\", each once and in that order");
     setup.coordinates.push_back(c);

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "buckle/mechanics/critical_loading.h"
 #include "buckle/mechanics/linear_buckling.h"
 
 namespace buckle::mechanics {
@@ -14,13 +15,11 @@ ReactionLimit reactionLimit(const Chain& chain, ConstVectorRef q0, const EndCond
   if (coordinate < 0 || coordinate > 2 || !end.isHeld(static_cast<EndCoordinate>(coordinate)))
     throw std::invalid_argument("reactionLimit: the coordinate must be one the end condition holds");
   if (modes < 1) throw std::invalid_argument("reactionLimit: modes must be >= 1");
-  EndCondition released = end;
-  released.control[size_t(coordinate)] = Control::Load;
+  const CriticalLoading released = criticalLoading(end, coordinate, Eigen::Vector3d::Zero());
   LinearBucklingOptions opt;
-  opt.direction = Eigen::Vector3d::Zero();
-  opt.direction[coordinate] = 1.0;
+  opt.direction = released.direction;
   opt.count = modes;
-  const LinearBucklingResult lb = linearBuckling(chain, q0, released, opt);
+  const LinearBucklingResult lb = linearBuckling(chain, q0, released.end, opt);
   ReactionLimit out;
   if (lb.degenerate)
     throw std::invalid_argument(std::string("every critical reaction ") + loads[coordinate] +
