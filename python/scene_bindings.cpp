@@ -61,6 +61,7 @@ py::dict resultDict(const scene::Scene& s, const scene::RunResult& run, const sc
   result["interrupted"] = run.interrupted;
   result["interruption"] = run.interruption;
   result["problems"] = run.problems;
+  result["warnings"] = run.warnings;
   result["computed"] = run.computed;
   py::list cases;
   int specials = 0;  // the special points of the cases before

@@ -325,8 +325,9 @@ mech::EquilibriumBranchOptions CaseRunner::branchOptions(double lambdaLo, double
     opt.childTracer = opt.tracer;
     opt.childTracer->maxPoints = points;
   }
-  opt.onBranch = [this](const cont::BranchTree& t, const cont::Branch&) {
+  opt.onBranch = [this, depth = opt.switchingDepth](const cont::BranchTree& t, const cont::Branch& b) {
     branchesSoFar_ = static_cast<int>(t.branches.size());
+    branchAdded(b, depth);
   };
   return opt;
 }
@@ -364,6 +365,11 @@ void CaseRunner::continuation() {
   mech::EquilibriumProblem problem(out_.chain, end, direction, equilibriumOptions, controlDirection(), bodyLoads());
 
   mech::EquilibriumBranchOptions opt = branchOptions(lambdaLo, lambdaHi);
+  if (opt.switchingDepth > 0 && !spec_.path.control && !spec_.path.gravity) {
+    std::vector<double> ends;
+    for (double target : targets) ends.push_back(target - s0);
+    warnOfLargeTree(mech::criticalLoading(end, c, direction), ends, opt.switchingDepth);
+  }
 
   // The start branches (one per requested direction), then branch switching breadth first, by
   // the core's tree driver (its guards: never back at the BP a branch started from, never twice
@@ -386,6 +392,7 @@ void CaseRunner::continuation() {
   // the curves a disconnected branch may join (disconnectedBranches), kept before their points go
   const bool keepCurves = scene_.analyses.equilibria.branches && !throughLoad();
   opt.onReport = [&](const cont::Branch& b, mech::BranchReport&& report) {
+    branchSettled(b.id);
     if (keepCurves) {
       if (traced_.size() <= size_t(b.id)) traced_.resize(size_t(b.id) + 1);
       traced_[size_t(b.id)] = b;

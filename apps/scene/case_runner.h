@@ -15,6 +15,7 @@
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/landing.h"
+#include "buckle/mechanics/critical_loading.h"
 #include "buckle/mechanics/vibration.h"
 #include "scene/runner.h"
 
@@ -97,9 +98,10 @@ class CaseRunner {
       Progress* progress = control_.progress;
       const CaseResult* out = &out_;
       const int* branches = &branchesSoFar_;
-      opt.onStep = [progress, out, branches](const continuation::Branch& b) {
+      const int* queued = &ahead_.queued;
+      opt.onStep = [progress, out, branches, queued](const continuation::Branch& b) {
         progress->step(*branches + 1, static_cast<int>(b.points.size()), b.points.back().lambda,
-                       static_cast<int>(out->specials.size() + b.specialPoints.size()));
+                       static_cast<int>(out->specials.size() + b.specialPoints.size()), *queued);
         return continuation::StepAction::Continue;
       };
       // a step over a cluster of branch points can refine for seconds without a new point
@@ -153,6 +155,20 @@ class CaseRunner {
   RunResult& run_;
   const RunControl& control_;
   int branchesSoFar_ = 0;  // for progress reports
+  /// The tree's size ahead, for progress reports: per branch id its depth, the branch points on it
+  /// the tree will switch at and those it has switched at (or settled: the branch is final), and
+  /// the difference summed (branchPointsQueued_). Fed by the tree's onBranch and onReport.
+  struct TreeAhead {
+    std::vector<int> depth, found, settled;
+    int queued = 0;
+  } ahead_;
+  std::pair<int, int> tracedParent_{-1, -1};  // (parent, branch point) of the last branch added
+  void branchAdded(const continuation::Branch& b, int maxDepth);
+  void branchSettled(int id);
+  /// Warns at the start when the path's load, `ends` away from the start both ways, passes hundreds of
+  /// critical loads of the unloaded shape that a tree of this depth would switch at
+  /// (case_runner_ahead.cpp).
+  void warnOfLargeTree(const mechanics::CriticalLoading& loading, const std::vector<double>& ends, int depth);
   std::vector<continuation::Branch> traced_;  // the continuation's tree (not through a reaction)
   /// The jumps simulated from (branch, special point): a mirror image's jump is their image.
   std::map<std::pair<int, int>, mechanics::Landing> landings_;

@@ -422,6 +422,7 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
   doc["interrupted"] = run.interrupted || !plots.stopped.empty();
   if (run.interrupted || !plots.stopped.empty()) doc["interruption"] = run.interrupted ? run.interruption : plots.stopped;
   if (!run.problems.empty()) doc["problems"] = run.problems;
+  if (!run.warnings.empty()) doc["warnings"] = run.warnings;
   doc["computed"] = run.computed;
   doc["solver"] = solverJson(scene.solver);
   doc["accuracy"] = {{"max_corrector_residual", run.worstResidual},

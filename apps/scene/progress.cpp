@@ -30,7 +30,7 @@ void Progress::stage(const std::string& name, const std::string& caseLabel, int 
   report();
 }
 
-void Progress::step(int branch, int points, double parameter, int specials) {
+void Progress::step(int branch, int points, double parameter, int specials, int queued) {
   if (mode_ == Mode::Off) return;
   // Cheap exit first: the tracer calls this at every point.
   const auto now = std::chrono::steady_clock::now();
@@ -40,6 +40,7 @@ void Progress::step(int branch, int points, double parameter, int specials) {
   os.precision(6);
   os << "branch " << branch << ", " << points << " points, parameter " << parameter << ", " << specials
      << " special point" << (specials == 1 ? "" : "s");
+  if (queued > 0) os << "; " << queued << " branch point" << (queued == 1 ? "" : "s") << " queued";
   detail_ = os.str();
   report();
 }
@@ -74,6 +75,12 @@ void Progress::report() {
     out_ << "buckle: " << line << "\n" << std::flush;
   }
   anyPrinted_ = true;
+}
+
+void Progress::warn(const std::string& what) {
+  if (mode_ == Mode::Off) return;
+  if (mode_ == Mode::Live && printedLive_) out_ << "\r\033[K";  // the live line goes on below it
+  out_ << "buckle: warning: " << what << "\n" << std::flush;
 }
 
 void Progress::finish() {

@@ -22,8 +22,11 @@ class Progress {
   /// A new stage of case `caseIndex` (0-based) of `caseCount`.
   void stage(const std::string& name, const std::string& caseLabel, int caseIndex, int caseCount);
   /// The branch being traced (`branch`: 1-based count in this case, the earlier ones finished)
-  /// has `points` points and is at parameter `parameter`; `specials` special points so far.
-  void step(int branch, int points, double parameter, int specials);
+  /// has `points` points and is at parameter `parameter`; `specials` special points so far;
+  /// `queued` branch points found but not yet switched at (the tree's size ahead; < 0: none).
+  void step(int branch, int points, double parameter, int specials, int queued = -1);
+  /// A warning, printed at once as its own line (in every mode but Off).
+  void warn(const std::string& what);
   /// Anything else worth a line now and then (a jump being integrated, a located point).
   void note(const std::string& what);
   /// Clears the live line (before the final summary is printed).

@@ -183,6 +183,7 @@ struct RunResult {
   std::vector<std::string> computed;   ///< names of the analyses actually run
   bool complete = true;                ///< false: some computation could not finish (exit 1)
   std::vector<std::string> problems;   ///< why not complete
+  std::vector<std::string> warnings;   ///< what the user should know although nothing failed
   std::vector<std::pair<std::string, double>> timings;  ///< seconds per stage
   double totalSeconds = 0.0;
   double worstResidual = 0.0;          ///< max corrector residual over all branch points

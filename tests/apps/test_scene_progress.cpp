@@ -6,8 +6,13 @@
 #include <string>
 #include <vector>
 
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "buckle/mechanics/critical_loading.h"
 #include "scene/command.h"
 #include "scene/progress.h"
+#include "scene_run.h"
 
 using buckle::scene::Progress;
 using buckle::scene::summariseProblems;
@@ -37,6 +42,28 @@ TEST_CASE("Progress: plain lines name the stage, case, branch, points and parame
   CHECK_THAT(text, Contains("branch 3, 341 points, parameter -0.75, 6 special points"));
   CHECK_THAT(text, Contains("jump from the fold at -1.7"));
   CHECK(text.find('\r') == std::string::npos);  // no terminal control in logs
+}
+
+TEST_CASE("Progress: the tree's size ahead and warnings, at once and in every mode but Off", "[progress]") {
+  std::ostringstream lines, off;
+  {
+    Progress p(lines, Progress::Mode::Lines, 0.0, 0.0);
+    p.stage("continuation", "", 0, 1);
+    p.step(2, 10, -0.5, 1, 183);
+    p.step(3, 10, -0.5, 1, 1);
+    p.step(4, 10, -0.5, 1, 0);
+    Progress late(lines, Progress::Mode::Lines, 1e9, 1e9);  // a warning does not wait for the first report
+    late.warn("the path crosses 400 critical loads");
+    Progress quiet(off, Progress::Mode::Off);
+    quiet.warn("never printed");
+  }
+  const std::string text = lines.str();
+  INFO(text);
+  CHECK_THAT(text, Contains("branch 2, 10 points, parameter -0.5, 1 special point; 183 branch points queued\n"));
+  CHECK_THAT(text, Contains("branch 3, 10 points, parameter -0.5, 1 special point; 1 branch point queued\n"));
+  CHECK_THAT(text, Contains("branch 4, 10 points, parameter -0.5, 1 special point\n"));
+  CHECK_THAT(text, Contains("buckle: warning: the path crosses 400 critical loads\n"));
+  CHECK(off.str().empty());
 }
 
 TEST_CASE("Progress: a short run prints nothing, Off never prints, Live rewrites one line", "[progress]") {
@@ -78,4 +105,44 @@ TEST_CASE("summariseProblems: the first few as they are, the rest once per shape
   CHECK(lines[4] == problems.back());  // a shape seen once is shown as it is
   CHECK(summariseProblems({}, 3).empty());
   CHECK(summariseProblems({"a", "b"}, 8) == std::vector<std::string>{"a", "b"});
+}
+
+TEST_CASE("scene: a path across hundreds of critical loads is warned of at the start, on stderr and in the summary",
+          "[progress]") {
+  const auto scene = [](int n, const std::string& continuation) {
+    return R"({"units": "nondimensional", "chain": {"segments": )" + std::to_string(n) +
+           R"(, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+      "end": {"x": {"load": 0.0}, "y": {"held": 0.0}, "phi": "free"},
+      "path": {"parameter": "Fx", "from": 0.0, "to": -2.5}, "solver": {"time_limit": 0.3},
+      "analyses": {"continuation": )" + continuation + "}}";
+  };
+  const auto summary = [](const buckle::test::SceneOutcome& o) {
+    std::ifstream in(o.out / "summary.json");
+    return nlohmann::json::parse(in);
+  };
+  using namespace buckle::mechanics;
+  const int n = 150;
+  const int expected = criticalLoadCount(Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)),
+                                         Vector::Zero(n),
+                                         criticalLoading(EndCondition::clampedPinned(0.0), 0, Eigen::Vector3d::UnitX()),
+                                         -2.5);
+  REQUIRE(expected > 100);
+  const buckle::test::SceneOutcome many =
+      buckle::test::runSceneText("scene_progress", "many", scene(n, R"({"branch_switching": 1})"));
+  INFO(many.err);
+  const nlohmann::json s = summary(many);
+  REQUIRE(s.contains("warnings"));
+  REQUIRE(s["warnings"].size() == 1);
+  const std::string warning = s["warnings"][0].get<std::string>();
+  CHECK_THAT(warning, Contains("crosses " + std::to_string(expected) + " critical loads"));
+  CHECK_THAT(warning, Contains("/analyses/continuation/branch_points"));
+  CHECK_THAT(many.err, Contains("buckle: warning: " + warning.substr(0, 60)));
+  // the first few branch points on each branch only, or no switching at all: nothing to warn of
+  for (const std::string& quiet : {std::string(R"({"branch_switching": 1, "branch_points": 3})"),
+                                   std::string(R"({"branch_switching": 0})")}) {
+    const buckle::test::SceneOutcome few = buckle::test::runSceneText("scene_progress", "few", scene(n, quiet));
+    INFO(quiet);
+    CHECK(!summary(few).contains("warnings"));
+    CHECK(few.err.find("warning") == std::string::npos);
+  }
 }

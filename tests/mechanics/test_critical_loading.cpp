@@ -3,7 +3,9 @@
 // (eq 15–18) applied exactly where they hold, and there equal to the O(n) / dense solve.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "buckle/mechanics/critical_loading.h"
 #include "buckle/mechanics/linear_buckling.h"
@@ -64,5 +66,39 @@ TEST_CASE("clampedPinned3Applies: exactly the paper's symmetric straight three-s
     odd[size_t(i)].a1 = 0.45;
     odd[size_t(i)].a2 = 0.45;  // one segment unlike the others
     CHECK(!clampedPinned3Applies(Chain(odd), zero, column));
+  }
+}
+
+TEST_CASE("criticalLoadCount: the critical loads passed, against eq 17 and the eigen-solve's list, in any units",
+          "[critical_loading]") {
+  const CriticalLoading column = criticalLoading(EndCondition::clampedPinned(0.0), 0, Eigen::Vector3d::UnitX());
+  const AnalyticBuckling3 an = analyticClampedPinned3(0.5, 1.0, 1.0, 2.25);  // FxU = −0.7063, FxZ = −1.3937
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  CHECK(criticalLoadCount(paper(3), zero, column, 0.999 * an.FxU) == 0);
+  CHECK(criticalLoadCount(paper(3), zero, column, 1.001 * an.FxU) == 1);
+  CHECK(criticalLoadCount(paper(3), zero, column, 0.999 * an.FxZ) == 1);
+  CHECK(criticalLoadCount(paper(3), zero, column, 1.001 * an.FxZ) == 2);
+  CHECK(criticalLoadCount(paper(3), zero, column, 2.0) == 0);  // tension never buckles the column
+  // long chains: as many as the eigen-solve lists below the load (dense pencil up to 300, the
+  // O(n) isolation above), in the paper's units and in lengths ×1e-4, stiffness ×1e8
+  for (int n : {40, 300, 1000}) {
+    for (const double L : {1.0, 1e-4}) {
+      const double K = L == 1.0 ? 1.0 : 1e8;
+      const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5 * L, L, K, 2.25 * L));
+      LinearBucklingOptions opt;
+      opt.count = 12;
+      const LinearBucklingResult lb = linearBuckling(chain, Vector::Zero(n), column.end, opt);
+      REQUIRE(lb.modes.size() >= 12);
+      std::vector<double> compressive;
+      for (const BucklingMode& m : lb.modes)
+        if (m.lambda < 0.0) compressive.push_back(m.lambda);
+      REQUIRE(compressive.size() >= 8);
+      std::sort(compressive.begin(), compressive.end(), [](double a, double b) { return a > b; });
+      for (int k : {1, 5, 8}) {
+        INFO("n = " << n << ", L = " << L << ", between critical loads " << k << " and " << k + 1);
+        const double between = 0.5 * (compressive[size_t(k - 1)] + compressive[size_t(k)]);
+        CHECK(criticalLoadCount(chain, Vector::Zero(n), column, between) == k);
+      }
+    }
   }
 }

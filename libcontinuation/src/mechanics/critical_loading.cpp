@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "buckle/mechanics/chain_structure.h"
+
 namespace buckle::mechanics {
 
 CriticalLoading criticalLoading(const EndCondition& end, int coordinate, const Eigen::Vector3d& direction) {
@@ -31,6 +33,31 @@ bool clampedPinned3Applies(const Chain& chain, ConstVectorRef q0, const Critical
   const EndCondition& end = loading.end;
   return end.isHeld(EndCoordinate::Y) && !end.isHeld(EndCoordinate::X) && !end.isHeld(EndCoordinate::Phi) &&
          loading.direction[0] != 0.0 && loading.direction[1] == 0.0 && loading.direction[2] == 0.0;
+}
+
+int criticalLoadCount(const Chain& chain, ConstVectorRef q0, const CriticalLoading& loading, double lambda) {
+  const int n = chain.size();
+  if (q0.size() != n) throw std::invalid_argument("criticalLoadCount: q0 must have one angle per joint");
+  ChainData data(chain);
+  forwardKinematics(chain, q0, data);
+  Matrix J(3, n);
+  endJacobian(data, J);
+  const std::vector<int> held = loading.end.heldIndices();
+  Matrix C(int(held.size()), n);
+  for (size_t k = 0; k < held.size(); ++k) C.row(Eigen::Index(k)) = J.row(held[k]);
+  ChainStructure ws(n);
+  double k = 0.0, b = 0.0;  // the chain's stiffness unit k̄b̄²: the floor of the zero threshold
+  for (int i = 0; i < n; ++i) {
+    const SegmentParameters& s = chain.segment(i).parameters();
+    k += 0.5 * (s.k1 + s.k2) / n;
+    b += 0.5 * (s.b1 + s.b2) / n;
+  }
+  ws.typicalScale = k * b * b;
+  auto negative = [&](double factor) {
+    assemble(chain, data, q0, Wrench(factor * loading.direction), ws);
+    return constrainedInertia(ws, C).negative;
+  };
+  return std::abs(negative(lambda) - negative(0.0));
 }
 
 }  // namespace buckle::mechanics

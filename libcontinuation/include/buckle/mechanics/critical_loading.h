@@ -27,4 +27,13 @@ CriticalLoading criticalLoading(const EndCondition& end, int coordinate, const E
 /// along the path, φ free, and neither a transverse load nor an end moment in the direction.
 bool clampedPinned3Applies(const Chain& chain, ConstVectorRef q0, const CriticalLoading& loading);
 
+/// How many critical load factors of the linearised problem at the unloaded shape q0 lie between
+/// 0 and `lambda` (either sign): neg H(λ) − neg H(0), H(λ) = K_q(q0) − K_g(q0, λ·direction) on ker
+/// of the held rows of J (Sylvester: each eigenvalue of the pencil (K_q, K_g) passed makes one more
+/// negative eigenvalue), two O(n) Sturm counts (chain_structure.h). For a branch that stays at q0
+/// as the load grows (the straight chain under an axial load) these are the branch points it
+/// meets; otherwise an estimate. Body loads are not included. Throws std::invalid_argument for a
+/// q0 of the wrong size.
+int criticalLoadCount(const Chain& chain, ConstVectorRef q0, const CriticalLoading& loading, double lambda);
+
 }  // namespace buckle::mechanics
