@@ -39,6 +39,18 @@ int csvRows(const fs::path& file) {
   return rows;
 }
 
+// The library's list for the scene's four-segment clamped-pinned chain at Fx (the scene's options:
+// 24 random starts, seed 3; the case's unloaded shape as a start, as the case runner adds it).
+buckle::mechanics::AllEquilibria libraryEquilibria(double Fx) {
+  using namespace buckle::mechanics;
+  AllEquilibriaOptions options;
+  options.randomStarts = 24;
+  options.seed = 3;
+  options.starts.push_back(Eigen::VectorXd::Zero(4));
+  return allEquilibria(Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)),
+                       EndCondition::clampedPinned(Fx), options);
+}
+
 }  // namespace
 
 TEST_CASE("scene equilibria: the list at `at` is the library's, in special_points.json and the CSV",
@@ -54,12 +66,7 @@ TEST_CASE("scene equilibria: the list at `at` is the library's, in special_point
   CHECK(c["held"] == json::array({"y"}));
 
   using namespace buckle::mechanics;
-  const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  AllEquilibriaOptions options;
-  options.randomStarts = 24;
-  options.seed = 3;
-  options.starts.push_back(Eigen::VectorXd::Zero(4));
-  const AllEquilibria lib = allEquilibria(chain, EndCondition::clampedPinned(-0.9), options);
+  const AllEquilibria lib = libraryEquilibria(-0.9);
   REQUIRE(c["count"].get<size_t>() == lib.equilibria.size());
   CHECK(c["starts"].get<int>() == lib.starts);
   CHECK(c["method"] == lib.method);
@@ -87,18 +94,13 @@ TEST_CASE("scene equilibria: a list `at`, one complete set per value, each the l
   REQUIRE(sp["equilibria"].size() == at.size());
 
   using namespace buckle::mechanics;
-  const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  AllEquilibriaOptions options;
-  options.randomStarts = 24;
-  options.seed = 3;
-  options.starts.push_back(Eigen::VectorXd::Zero(4));
   std::vector<int> straightIndex;  // the straight chain's index in each set (-1: not found)
   size_t rows = 0;
   for (size_t s = 0; s < at.size(); ++s) {
     INFO("Fx = " << at[s]);
     const json& c = sp["equilibria"][s];
     CHECK(c["at"].get<double>() == at[s]);
-    const AllEquilibria lib = allEquilibria(chain, EndCondition::clampedPinned(at[s]), options);
+    const AllEquilibria lib = libraryEquilibria(at[s]);
     REQUIRE(c["count"].get<size_t>() == lib.equilibria.size());
     rows += lib.equilibria.size();
     straightIndex.push_back(-1);
