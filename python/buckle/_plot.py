@@ -85,12 +85,19 @@ def _landing(result, c, column, k):
     return None
 
 
-def _branch_collections(ax, xs, ys, branch, stable, stable_colour, unstable_colour, gid):
+# The branches traced from equilibria the tree does not reach (equilibria "branches"), as the
+# gnuplot diagrams draw them (plot_branches.cpp)
+DISCONNECTED_COLOUR = "#c51b7d"
+
+
+def _branch_collections(ax, xs, ys, branch, stable, stable_colour, unstable_colour, gid, disconnected=()):
     from matplotlib.collections import LineCollection
 
     ids = list(dict.fromkeys(branch.tolist()))  # branches in the order traced
     many = len(ids) > 12  # hundreds of overlapping branches stay apart thinner and translucent
     for b in ids:
+        on_colour, off_colour = (DISCONNECTED_COLOUR, DISCONNECTED_COLOUR) if b in disconnected else (
+            stable_colour, unstable_colour)
         on = np.flatnonzero(branch == b)
         pts = np.column_stack([xs[on], ys[on]])
         if len(on) == 1:
@@ -99,9 +106,9 @@ def _branch_collections(ax, xs, ys, branch, stable, stable_colour, unstable_colo
         st = stable[on]
         seg_stable = st[:-1] & st[1:] if len(on) > 1 else st[:1]
         ax.add_collection(LineCollection(
-            segments, colors=[stable_colour if s else unstable_colour for s in seg_stable],
+            segments, colors=[on_colour if s else off_colour for s in seg_stable],
             linestyles=["solid" if s else (0, (4, 3)) for s in seg_stable], linewidths=0.7 if many else 1.4,
-            alpha=0.55 if many else 1.0, gid=f"{gid} branch {b}"))
+            alpha=0.55 if many else 1.0, gid=f"{gid} branch {b}" + (" disconnected" if b in disconnected else "")))
 
 
 def _place_labels(ax, points, texts):
@@ -199,6 +206,7 @@ def diagram(result, x, ys, case, ax, labels, title, log):
     all_y = []
     marks = []  # (case, type, x, y, text) of every special point drawn
     specials_drawn = {}
+    any_disconnected = False
     for k, (c, y) in enumerate(series):
         colour = f"C{k % 10}"
         stable_colour, unstable_colour = ("tab:blue", "tab:red") if single else (colour, colour)
@@ -206,7 +214,10 @@ def diagram(result, x, ys, case, ax, labels, title, log):
         xs, yv = result.column(x, c), result.column(y, c)
         all_y.append(yv)
         gid = f"case {c}" + ("" if len(ys) == 1 else f" {y}")
-        _branch_collections(ax, xs, yv, b["branch"], b["stable"], stable_colour, unstable_colour, gid)
+        equilibria = result["cases"][c].get("equilibria") or {}
+        disconnected = {d["id"] for d in equilibria.get("disconnected_branches", [])}
+        any_disconnected = any_disconnected or bool(disconnected & set(b["branch"].tolist()))
+        _branch_collections(ax, xs, yv, b["branch"], b["stable"], stable_colour, unstable_colour, gid, disconnected)
         if not single:
             name = result["cases"][c]["label"] or f"case {c}"
             handles.append(Line2D([], [], color=colour, label=name + ("" if len(ys) == 1 else f": {y}")))
@@ -249,6 +260,8 @@ def diagram(result, x, ys, case, ax, labels, title, log):
     _place_labels(ax, points, texts)
     legend = [Line2D([], [], color="tab:blue" if single else "0.3", label="stable"),
               Line2D([], [], color="tab:red" if single else "0.3", ls=(0, (4, 3)), label="unstable")]
+    if any_disconnected:
+        legend.append(Line2D([], [], color=DISCONNECTED_COLOUR, label="disconnected branch"))
     counts = {}  # per type over the cases (each case's points once, however many y columns)
     for (t, k), line in specials_drawn.items():
         if series[k][1] == ys[0]:

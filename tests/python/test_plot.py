@@ -243,3 +243,25 @@ def test_a_long_chains_diagram_is_a_summary(source_dir):
         first, _, last = text[3:].partition("-")
         covered += [m for m in modes if int(first) <= m <= int(last or first)]
     assert sorted(covered) == modes  # each mode in exactly one label
+
+
+def test_disconnected_branches_in_their_own_colour_and_keyed(source_dir):
+    # the branches traced from equilibria the tree does not reach, as the gnuplot diagram draws them
+    r = buckle.run_scene(source_dir / "data" / "scenes" / "disconnected_branch.json")
+    ids = {d["id"] for d in r["cases"][0]["equilibria"]["disconnected_branches"]}
+    assert len(ids) == 2
+    ax = r.plot_bifurcation(x="Fx", y="q2").axes[0]
+    drawn = branch_collections(ax)
+    assert len(drawn) == len(np.unique(r["cases"][0]["branches"]["branch"]))
+    for col in drawn:
+        branch = int(col.get_gid().split()[3])
+        colours = {matplotlib.colors.to_hex(c) for c in col.get_colors()}
+        if branch in ids:
+            assert col.get_gid().endswith("disconnected")
+            assert colours == {"#c51b7d"}
+        else:
+            assert "#c51b7d" not in colours
+    assert "disconnected branch" in [t.get_text() for t in ax.get_legend().get_texts()]
+    # a run without them keys none
+    plain = buckle.run_scene(source_dir / "data" / "scenes" / "default.json").plot_bifurcation(x="Fx", y="q2")
+    assert "disconnected branch" not in [t.get_text() for t in plain.axes[0].get_legend().get_texts()]
