@@ -452,6 +452,7 @@ void CaseRunner::energyCurves() {
   opt.samples = e.points;
   opt.q1Min = std::max(e.q1From, out_.chain.lowerLimits()[0]);
   opt.q1Max = std::min(e.q1To, out_.chain.upperLimits()[0]);
+  opt.body = bodyLoads().atParameter(out_.startValue);  // E + V with the weight and point loads (eq B1)
   try {
     out_.landscape = mech::energyLandscape(out_.chain, e.x, e.y, opt);
     out_.haveLandscape = true;

@@ -211,6 +211,46 @@ TEST_CASE("scene equilibria under the weight: each balances the springs against 
   CHECK((first - sag).lpNorm<Eigen::Infinity>() <= 1e-9);
 }
 
+TEST_CASE("scene energy curves under the weight: E + V along the configuration curve, its stationary points the "
+          "equilibria deflation finds",
+          "[scene][body_loads]") {
+  // the paper's three segments as heavy rods, the end held at (5.5, 0.4): the energy curves' sweep
+  // (E + V along the inverse kinematics) and deflated Newton on the full equations are independent
+  const std::string text = R"({"chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+    "end": {"x": {"held": 5.5}, "y": {"held": 0.4}, "phi": "free"},
+    "gravity": {"value": 1.0, "direction": [0.5, -0.866], "mass_per_length": 0.05},
+    "analyses": {"energy_curves": {"x": 5.5, "y": 0.4, "points": 801},
+                 "equilibria": {"starts": 16, "smooth_starts": 16}}, "plots": []})";
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "energy_curves_weight", text);
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  std::ifstream in(o.out / "special_points.json");
+  const nlohmann::json sp = nlohmann::json::parse(in);
+  const nlohmann::json& curves = sp["energy_equilibria"];
+  const nlohmann::json& found = sp["equilibria"][0]["equilibria"];
+  REQUIRE(curves.size() >= 2);
+  REQUIRE(found.size() == curves.size());
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const Eigen::Vector2d g = Eigen::Vector2d(0.5, -0.866).normalized();
+  const GravityPotential V(chain, InertiaData::uniformRods(chain, 0.05), g);
+  for (const nlohmann::json& l : curves) {
+    CHECK(std::abs(l["loads"]["Me"].get<double>()) < 1e-9);
+    Vector q(3);
+    for (int i = 0; i < 3; ++i) q[i] = l["q"][size_t(i)].get<double>();
+    bool listed = false;
+    for (const nlohmann::json& e : found) {
+      double d = 0.0;
+      for (int i = 0; i < 3; ++i) d = std::max(d, std::abs(e["q"][size_t(i)].get<double>() - q[i]));
+      if (d > 1e-12) continue;
+      listed = true;
+      CHECK(e["stable"] == l["stable"]);
+      // Π = E + V with V from the independent potential, both in the list and on the curve
+      CHECK(e["potential"].get<double>() == Approx(energy(chain, q) + V.value(q)).epsilon(1e-12).margin(1e-13));
+    }
+    CHECK(listed);
+  }
+}
+
 TEST_CASE("scene point loads: a force at the last joint growing along an Fx path: the traced end point balances the "
           "joint torques of the end load and that force, summed here from the joint positions", "[scene][body_loads]") {
   // Fy = 0.02 + 0.1·Fx at joint 4 along Fx from 0 to −0.3

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "buckle/mechanics/all_equilibria.h"
+#include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/energy_landscape.h"
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/mirror_symmetry.h"
@@ -165,6 +166,32 @@ TEST_CASE("n = 3, end held at (5.5b, 0): the sweep's equilibria one-to-one, defl
       // non-monotonic (κ < 0): eight, four stable, the reversed Table I of erratum 8 among them
       CHECK(r.equilibria.size() == 8);
       CHECK(stable == 4);
+    }
+  }
+}
+
+TEST_CASE("n = 3, end held, with the links' weight: the sweep of E + V and deflation find the same set, Morse holds",
+          "[all_equilibria][body_loads]") {
+  // the paper's chain as uniform rods under a tilted g (docs/mechanics.md, eq B1-B3): the sweep
+  // along the configuration curve and deflated Newton on the full equations are two independent
+  // searches of the same weighted equilibria
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  for (const double weight : {0.02, 0.08}) {
+    INFO("mass per length " << weight);
+    AllEquilibriaOptions options;
+    options.landscapeStarts = false;  // deflation on its own: the sweep only compared
+    options.body = BodyLoads::weight(chain, InertiaData::uniformRods(chain, weight), {0.5, -0.866}, {0.0, 0.0});
+    const EndCondition end = EndCondition::heldPosition(5.5, 0.4);
+    const AllEquilibria r = allEquilibria(chain, end, options);
+    REQUIRE(r.sweepCount >= 2);
+    CHECK(r.sweepCount == int(r.equilibria.size()));
+    CHECK(r.deflationOnly == 0);
+    CHECK(r.sweepOnly == 0);
+    REQUIRE(r.morse.applies);
+    CHECK(r.morse.holds());
+    for (const FoundEquilibrium& f : r.equilibria) {
+      CHECK(f.byDeflation);
+      CHECK(f.bySweep);
     }
   }
 }

@@ -6,8 +6,11 @@
 #include <random>
 
 #include "buckle/continuation/problem.h"
+#include "buckle/mechanics/body_loads.h"
+#include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/energy_landscape.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/gravity.h"
 #include "buckle/mechanics/linear_buckling.h"
 #include "buckle/mechanics/unloaded_shape.h"
 
@@ -224,4 +227,61 @@ TEST_CASE("non-straight start (5.5b, 0): the unloaded shape is a stable stationa
       CHECK(e.q[i] >= limited.lowerLimits()[i]);
       CHECK(e.q[i] <= limited.upperLimits()[i]);
     }
+}
+
+TEST_CASE("landscape with the links' weight: E + V, its derivatives along the branch, equilibria of the weighted "
+          "chain by an independent potential",
+          "[landscape][body_loads]") {
+  // the paper's chain as uniform rods under g at 30° below the horizontal, heavy enough to tilt it
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const InertiaData rods = InertiaData::uniformRods(chain, 0.05);
+  const Eigen::Vector2d g(0.5, -0.866);
+  const double x = 5.5, y = 0.4;
+  LandscapeOptions opt;
+  opt.samples = 401;
+  opt.body = BodyLoads::weight(chain, rods, g, Eigen::Vector2d::Zero());
+  const EnergyLandscape heavy = energyLandscape(chain, x, y, opt);
+  const GravityPotential V(chain, rods, g);  // gravity.h: an independent formulation of V
+  BodyLoadTerms terms(chain, opt.body);
+  const double h = 1e-6;
+  int checked = 0;
+  for (int branch : {+1, -1})
+    for (const LandscapeSample& s : branchSamples(heavy, branch)) {
+      if (s.status != LandscapeStatus::Feasible || std::abs(std::sin(s.q[1])) < 0.05 || std::abs(s.q[2]) < 0.05) continue;
+      CHECK(s.energy == Approx(energy(chain, s.q) + V.value(s.q)).epsilon(1e-12).margin(1e-13));
+      const LandscapeSample p = landscapeSample(chain, x, y, s.q1 + h, branch, &terms);
+      const LandscapeSample m = landscapeSample(chain, x, y, s.q1 - h, branch, &terms);
+      CHECK(std::abs(s.dEdq1 - (p.energy - m.energy) / (2 * h)) < 1e-6 * std::max(1.0, std::abs(s.dEdq1)));
+      CHECK(std::abs(s.d2Edq1 - (p.dEdq1 - m.dEdq1) / (2 * h)) < 1e-5 * std::max(1.0, std::abs(s.d2Edq1)));
+      ++checked;
+    }
+  CHECK(checked > 40);
+  // each stationary point balances the springs, the weight and the end reaction: ∇E + ∇V = Jᵀ F with
+  // Me = 0, and its stability is that of (K_q − K_g(F) + ∇²V) on ker J_p
+  LandscapeOptions weightless;
+  weightless.samples = 401;
+  const EnergyLandscape light = energyLandscape(chain, x, y, weightless);
+  REQUIRE(!heavy.equilibria.empty());
+  double moved = 0.0;
+  for (const LandscapeEquilibrium& e : heavy.equilibria) {
+    Vector grad(3), gradV(3), q = e.q;
+    energyGradient(chain, q, grad);
+    V.gradient(q, gradV);
+    ChainData data(chain);
+    forwardKinematics(chain, q, data);
+    Matrix J(3, 3);
+    endJacobian(data, J);
+    CHECK((grad + gradV - J.transpose() * e.F).lpNorm<Eigen::Infinity>() < 1e-10);
+    CHECK(e.F[2] == 0.0);
+    Matrix H(3, 3), G(3, 3);
+    totalPotentialHessian(chain, q, e.F, H);
+    V.hessian(q, G);
+    const Eigen::HouseholderQR<Matrix> qr(J.topRows(2).transpose());
+    const Vector t = (qr.householderQ() * Matrix::Identity(3, 3)).col(2);  // ker J_p
+    CHECK(((t.transpose() * (H + G) * t)(0, 0) > 0.0) == e.stable);
+    double nearest = INFINITY;
+    for (const LandscapeEquilibrium& f : light.equilibria) nearest = std::min(nearest, (f.q - e.q).cwiseAbs().maxCoeff());
+    moved = std::max(moved, nearest);
+  }
+  CHECK(moved > 1e-3);  // the weight moved the equilibria: it is in the sums, not beside them
 }

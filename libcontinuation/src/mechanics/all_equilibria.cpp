@@ -319,9 +319,11 @@ AllEquilibria allEquilibria(const Chain& chain, const EndCondition& end, const A
   DeflatedNewton solver(problem, options);
   AllEquilibria result;
   result.endCondition = end;
-  const bool sweep = options.landscape && sweepApplies(chain, end) && !options.body.active();
+  const bool sweep = options.landscape && sweepApplies(chain, end);
   detail::SweepResult swept;
-  if (sweep) swept = detail::sweepEquilibria(chain, end.value[0], end.value[1], options.landscapeSamples);
+  if (sweep)
+    swept = detail::sweepEquilibria(chain, end.value[0], end.value[1], options.landscapeSamples,
+                                    options.body.atParameter(0.0));
   deflationSearch(problem, solver, startingShapes(chain, options, sweep ? &swept : nullptr), options, result);
   if (sweep) mergeSweep(problem, solver, swept, options, result);
   std::sort(result.equilibria.begin(), result.equilibria.end(),

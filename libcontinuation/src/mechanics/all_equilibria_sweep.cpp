@@ -23,15 +23,24 @@ bool onePiece(const LandscapeSample& a, const LandscapeSample& b) {
 
 bool opposite(double a, double b) { return (a < 0.0) != (b < 0.0); }
 
+// The configuration curve with the end held at (x, y) and what acts on the chain: its samples
+// (energy_landscape.h), E + V with the body loads.
+struct Curve {
+  const Chain& chain;
+  double x, y;
+  BodyLoadTerms* body;  // null: none (landscapeSample overwrites its last update)
+  LandscapeSample at(double q1, int branch) const { return landscapeSample(chain, x, y, q1, branch, body); }
+};
+
 // Bisection of the sign change of f (a member of the sample) on [lo, hi], f(lo) of sign `fLo`.
 // Bisection alone: the refined cells are those where Newton's derivative changes sign.
 template <class Value>
-bool bisect(const Chain& chain, double x, double y, int branch, double lo, double hi, double fLo, Value value,
+bool bisect(const Curve& c, int branch, double lo, double hi, double fLo, Value value,
             LandscapeSample& out) {
   for (int it = 0; it < 200 && hi - lo > 4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(lo));
        ++it) {
     const double mid = 0.5 * (lo + hi);
-    const LandscapeSample s = landscapeSample(chain, x, y, mid, branch);
+    const LandscapeSample s = c.at(mid, branch);
     if (!usable(s) || !std::isfinite(value(s))) return false;
     if (opposite(value(s), fLo) || value(s) == 0.0) {
       hi = mid;
@@ -39,13 +48,13 @@ bool bisect(const Chain& chain, double x, double y, int branch, double lo, doubl
       lo = mid;
     }
   }
-  out = landscapeSample(chain, x, y, 0.5 * (lo + hi), branch);
+  out = c.at(0.5 * (lo + hi), branch);
   return usable(out);
 }
 
 // A cell where dE/dq1 keeps its sign but d²E/dq1² changes it holds an extremum of dE/dq1: where
 // that extremum crosses zero, two roots share the cell and the sign test missed both.
-void refineCells(const Chain& chain, double x, double y, const std::vector<LandscapeSample>& s, int branch,
+void refineCells(const Curve& c, const std::vector<LandscapeSample>& s, int branch,
                  std::vector<SweepPoint>& out) {
   auto d1 = [](const LandscapeSample& p) { return p.dEdq1; };
   auto d2 = [](const LandscapeSample& p) { return p.d2Edq1; };
@@ -55,10 +64,10 @@ void refineCells(const Chain& chain, double x, double y, const std::vector<Lands
     if (a.dEdq1 == 0.0 || b.dEdq1 == 0.0 || opposite(a.dEdq1, b.dEdq1)) continue;
     if (!std::isfinite(a.d2Edq1) || !std::isfinite(b.d2Edq1) || !opposite(a.d2Edq1, b.d2Edq1)) continue;
     LandscapeSample m;
-    if (!bisect(chain, x, y, branch, a.q1, b.q1, a.d2Edq1, d2, m) || !opposite(m.dEdq1, a.dEdq1)) continue;
+    if (!bisect(c, branch, a.q1, b.q1, a.d2Edq1, d2, m) || !opposite(m.dEdq1, a.dEdq1)) continue;
     LandscapeSample r;
-    if (bisect(chain, x, y, branch, a.q1, m.q1, a.dEdq1, d1, r)) out.push_back({r.q, r.d2Edq1 > 0.0, true});
-    if (bisect(chain, x, y, branch, m.q1, b.q1, m.dEdq1, d1, r)) out.push_back({r.q, r.d2Edq1 > 0.0, true});
+    if (bisect(c, branch, a.q1, m.q1, a.dEdq1, d1, r)) out.push_back({r.q, r.d2Edq1 > 0.0, true});
+    if (bisect(c, branch, m.q1, b.q1, m.dEdq1, d1, r)) out.push_back({r.q, r.d2Edq1 > 0.0, true});
   }
 }
 
@@ -79,22 +88,22 @@ const std::vector<LandscapeSample>& samplesOf(const EnergyLandscape& L, int bran
 // The last feasible point between a feasible q1 and an infeasible one, by bisection, moved back
 // towards the feasible side until dE/dq1 is defined (it is not at a junction itself, where the
 // q1-parametrisation turns).
-LandscapeSample boundarySample(const Chain& chain, double x, double y, int branch, double inside, double out) {
+LandscapeSample boundarySample(const Curve& c, int branch, double inside, double out) {
   double in = inside;
   for (int it = 0; it < 60; ++it) {
     const double mid = 0.5 * (in + out);
-    (feasible(landscapeSample(chain, x, y, mid, branch)) ? in : out) = mid;
+    (feasible(c.at(mid, branch)) ? in : out) = mid;
   }
   for (double fraction = 1e-9; fraction < 1.0; fraction *= 4.0) {
-    const LandscapeSample s = landscapeSample(chain, x, y, in + fraction * (inside - in), branch);
+    const LandscapeSample s = c.at(in + fraction * (inside - in), branch);
     if (usable(s)) return s;
   }
-  return landscapeSample(chain, x, y, inside, branch);
+  return c.at(inside, branch);
 }
 
 // The runs of both branches with their ends' boundary points; false (with the reason) when the
 // curve jumps between two samples.
-bool findRuns(const Chain& chain, const EnergyLandscape& L, std::vector<Run>& runs, std::string& why) {
+bool findRuns(const Curve& c, const EnergyLandscape& L, std::vector<Run>& runs, std::string& why) {
   for (int branch : {+1, -1}) {
     const std::vector<LandscapeSample>& s = samplesOf(L, branch);
     const int N = int(s.size());
@@ -119,7 +128,7 @@ bool findRuns(const Chain& chain, const EnergyLandscape& L, std::vector<Run>& ru
         r.boundary[side] = s[size_t(end)];
         if (next < 0 || next >= N) continue;  // joint 1's own limit: the sample is on it
         r.junction[side] = s[size_t(next)].status == LandscapeStatus::NoInverseKinematics;
-        r.boundary[side] = boundarySample(chain, L.x, L.y, branch, s[size_t(end)].q1, s[size_t(next)].q1);
+        r.boundary[side] = boundarySample(c, branch, s[size_t(end)].q1, s[size_t(next)].q1);
       }
       runs.push_back(r);
     }
@@ -137,7 +146,7 @@ bool findRuns(const Chain& chain, const EnergyLandscape& L, std::vector<Run>& ru
 // boundary point, and on the short piece through a junction, where q1 turns back and the curve
 // passes onto the other branch (E's rate along the curve is +dE/dq1 outward on one branch and
 // −dE/dq1 coming back on the other: a root lies between when both dE/dq1 have one sign).
-void refineEnds(const Chain& chain, const EnergyLandscape& L, const std::vector<Run>& runs,
+void refineEnds(const Curve& c, const EnergyLandscape& L, const std::vector<Run>& runs,
                 std::vector<SweepPoint>& out) {
   auto d1 = [](const LandscapeSample& p) { return p.dEdq1; };
   for (const Run& r : runs)
@@ -148,7 +157,7 @@ void refineEnds(const Chain& chain, const EnergyLandscape& L, const std::vector<
       const LandscapeSample& lo = e.q1 < B.q1 ? e : B;
       const double hi = e.q1 < B.q1 ? B.q1 : e.q1;
       LandscapeSample root;
-      if (bisect(chain, L.x, L.y, r.branch, lo.q1, hi, lo.dEdq1, d1, root))
+      if (bisect(c, r.branch, lo.q1, hi, lo.dEdq1, d1, root))
         out.push_back({root.q, root.d2Edq1 > 0.0, true});
     }
   for (const Run& a : runs)
@@ -237,17 +246,20 @@ void topology(const EnergyLandscape& L, const std::vector<Run>& runs, MorseCheck
 
 }  // namespace
 
-SweepResult sweepEquilibria(const Chain& chain, double x, double y, int samples) {
+SweepResult sweepEquilibria(const Chain& chain, double x, double y, int samples, const BodyLoads& body) {
   LandscapeOptions options;
   options.samples = samples;
+  options.body = body;
   const EnergyLandscape L = energyLandscape(chain, x, y, options);
+  BodyLoadTerms terms(chain, body.atParameter(0.0));
+  const Curve c{chain, x, y, terms.active() ? &terms : nullptr};
   SweepResult result;
   for (const LandscapeEquilibrium& e : L.equilibria) result.equilibria.push_back({e.q, e.stable, false});
-  refineCells(chain, x, y, L.positive, +1, result.equilibria);
-  refineCells(chain, x, y, L.negative, -1, result.equilibria);
+  refineCells(c, L.positive, +1, result.equilibria);
+  refineCells(c, L.negative, -1, result.equilibria);
   std::vector<Run> runs;
-  if (findRuns(chain, L, runs, result.morse.basis)) {
-    refineEnds(chain, L, runs, result.equilibria);
+  if (findRuns(c, L, runs, result.morse.basis)) {
+    refineEnds(c, L, runs, result.equilibria);
     topology(L, runs, result.morse);
   }
   return result;

@@ -23,7 +23,8 @@ struct SweepResult {
   MorseCheck morse;  ///< applies, expected, loops, arcs, basis (sum is left to the caller)
 };
 
-/// Throws std::invalid_argument unless the chain has 3 segments and samples >= 2.
-SweepResult sweepEquilibria(const Chain& chain, double x, double y, int samples);
+/// Throws std::invalid_argument unless the chain has 3 segments and samples >= 2. `body`: the
+/// weight and point loads (the curve's function is then E + V, eq B1).
+SweepResult sweepEquilibria(const Chain& chain, double x, double y, int samples, const BodyLoads& body = BodyLoads());
 
 }  // namespace buckle::mechanics::detail

@@ -26,20 +26,28 @@ struct BranchDerivatives {
   double dE = std::numeric_limits<double>::quiet_NaN();
   double d2E = std::numeric_limits<double>::quiet_NaN();
   double Me = std::numeric_limits<double>::quiet_NaN();
-  Eigen::Vector3d grad = Eigen::Vector3d::Zero();
+  double V = 0.0;  ///< the body loads' potential (eq B1)
+  Eigen::Vector3d grad = Eigen::Vector3d::Zero();  ///< ∇(E + V)
   Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
 };
 
-BranchDerivatives branchDerivatives(const Chain& chain, const Eigen::Vector3d& q) {
+BranchDerivatives branchDerivatives(const Chain& chain, const Eigen::Vector3d& q, BodyLoadTerms* body) {
   BranchDerivatives d;
   ChainData data(chain);
   forwardKinematics(chain, q, data);
   Matrix J(3, 3);
   endJacobian(data, J);
   d.J = J;
-  Vector g(3), kq(3);
+  Vector g(3), kq(3), tau = Vector::Zero(3), gamma = Vector::Zero(3);
   energyGradient(chain, q, g);
   jointStiffness(chain, q, kq);
+  if (body && body->active()) {
+    body->update(data);
+    body->torques(0.0, tau);
+    body->generator(0.0, gamma);
+    d.V = body->potential(data, 0.0);
+    g -= tau;  // ∇V = −τ (eq B2)
+  }
   d.grad = g;
   // Tangent of the IK curve: J_p t = 0 with t1 = 1.
   Eigen::Matrix2d A;
@@ -61,7 +69,10 @@ BranchDerivatives branchDerivatives(const Chain& chain, const Eigen::Vector3d& q
       }
     const Eigen::Vector2d s23 = A.lu().solve(Eigen::Vector2d(-txx, -tyy));
     double quad = 0.0;
-    for (int i = 0; i < 3; ++i) quad += kq[i] * d.t[i] * d.t[i];
+    for (int i = 0; i < 3; ++i) {
+      quad += kq[i] * d.t[i] * d.t[i];
+      for (int j = 0; j < 3; ++j) quad += gamma[std::max(i, j)] * d.t[i] * d.t[j];  // ∇²V (eq B3)
+    }
     d.d2E = quad + g[1] * s23[0] + g[2] * s23[1];
   }
   // Me from ∇E = Jᵀ F (eq 12), where the 3×3 J is regular (sin q2 ≠ 0, docs/mechanics.md erratum 7).
@@ -87,7 +98,7 @@ bool landscapeInverseKinematics(const Chain& chain, double x, double y, double q
   return true;
 }
 
-LandscapeSample landscapeSample(const Chain& chain, double x, double y, double q1, int branch) {
+LandscapeSample landscapeSample(const Chain& chain, double x, double y, double q1, int branch, BodyLoadTerms* body) {
   LandscapeSample s;
   s.q1 = q1;
   Eigen::Vector3d q;
@@ -101,7 +112,8 @@ LandscapeSample landscapeSample(const Chain& chain, double x, double y, double q
       s.violatedJoint = i + 1;
       break;
     }
-  const BranchDerivatives d = branchDerivatives(chain, q);
+  const BranchDerivatives d = branchDerivatives(chain, q, body);
+  s.energy += d.V;
   s.dEdq1 = d.dE;
   s.d2Edq1 = d.d2E;
   s.endTorque = d.Me;
@@ -110,7 +122,7 @@ LandscapeSample landscapeSample(const Chain& chain, double x, double y, double q
 
 namespace {
 
-LandscapeEquilibrium makeEquilibrium(const Chain& chain, const LandscapeSample& s, int branch) {
+LandscapeEquilibrium makeEquilibrium(const Chain& chain, const LandscapeSample& s, int branch, BodyLoadTerms* body) {
   LandscapeEquilibrium e;
   e.branch = branch;
   e.q1 = s.q1;
@@ -118,7 +130,7 @@ LandscapeEquilibrium makeEquilibrium(const Chain& chain, const LandscapeSample& 
   e.energy = s.energy;
   e.d2Edq1 = s.d2Edq1;
   e.stable = s.d2Edq1 > 0.0;
-  const BranchDerivatives d = branchDerivatives(chain, s.q);
+  const BranchDerivatives d = branchDerivatives(chain, s.q, body);
   // ∇E = J_pᵀ F_p with Me = 0 (least squares; exact at an equilibrium).
   const Eigen::Matrix<double, 3, 2> Jpt = d.J.topRows(2).transpose();
   const Eigen::Vector2d Fp = Jpt.colPivHouseholderQr().solve(d.grad);
@@ -129,7 +141,7 @@ LandscapeEquilibrium makeEquilibrium(const Chain& chain, const LandscapeSample& 
 }
 
 void locateEquilibria(const Chain& chain, double x, double y, const std::vector<LandscapeSample>& samples, int branch,
-                      std::vector<LandscapeEquilibrium>& out) {
+                      BodyLoadTerms* body, std::vector<LandscapeEquilibrium>& out) {
   auto usable = [](const LandscapeSample& s) {
     return s.status == LandscapeStatus::Feasible && std::isfinite(s.dEdq1);
   };
@@ -138,13 +150,13 @@ void locateEquilibria(const Chain& chain, double x, double y, const std::vector<
     if (!usable(a) || !usable(b)) continue;
     if (std::abs(wrapAngle(b.q[1] - a.q[1])) > 0.5 || std::abs(b.q[2] - a.q[2]) > 0.5) continue;  // not one piece
     if (a.dEdq1 == 0.0) {
-      out.push_back(makeEquilibrium(chain, a, branch));
+      out.push_back(makeEquilibrium(chain, a, branch, body));
       continue;
     }
     if (b.dEdq1 == 0.0 || (a.dEdq1 < 0) == (b.dEdq1 < 0)) continue;
     // Safeguarded Newton (derivative d²E/dq1²) inside the bracket.
     double lo = a.q1, hi = b.q1, glo = a.dEdq1;
-    LandscapeSample cur = landscapeSample(chain, x, y, 0.5 * (lo + hi), branch);
+    LandscapeSample cur = landscapeSample(chain, x, y, 0.5 * (lo + hi), branch, body);
     bool ok = usable(cur);
     for (int it = 0; ok && it < 200; ++it) {
       const double g = cur.dEdq1;
@@ -158,11 +170,11 @@ void locateEquilibria(const Chain& chain, double x, double y, const std::vector<
       double next = (std::isfinite(cur.d2Edq1) && cur.d2Edq1 != 0.0) ? cur.q1 - g / cur.d2Edq1 : 0.5 * (lo + hi);
       if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
       const double step = std::abs(next - cur.q1);
-      cur = landscapeSample(chain, x, y, next, branch);
+      cur = landscapeSample(chain, x, y, next, branch, body);
       ok = usable(cur);
       if (step <= 1e-15 * std::max(1.0, std::abs(next)) || hi - lo <= 1e-15) break;
     }
-    if (ok) out.push_back(makeEquilibrium(chain, cur, branch));
+    if (ok) out.push_back(makeEquilibrium(chain, cur, branch, body));
   }
 }
 
@@ -181,13 +193,15 @@ EnergyLandscape energyLandscape(const Chain& chain, double x, double y, const La
   requireFinite("q1Min", lo);
   requireFinite("q1Max", hi);
   if (!(lo < hi)) throw std::invalid_argument("q1Min must be < q1Max");
+  BodyLoadTerms terms(chain, options.body.atParameter(0.0));  // throws as BodyLoads::check
+  BodyLoadTerms* body = terms.active() ? &terms : nullptr;
   for (int i = 0; i < options.samples; ++i) {
     const double q1 = lo + (hi - lo) * i / (options.samples - 1);
-    L.positive.push_back(landscapeSample(chain, x, y, q1, +1));
-    L.negative.push_back(landscapeSample(chain, x, y, q1, -1));
+    L.positive.push_back(landscapeSample(chain, x, y, q1, +1, body));
+    L.negative.push_back(landscapeSample(chain, x, y, q1, -1, body));
   }
-  locateEquilibria(chain, x, y, L.positive, +1, L.equilibria);
-  locateEquilibria(chain, x, y, L.negative, -1, L.equilibria);
+  locateEquilibria(chain, x, y, L.positive, +1, body, L.equilibria);
+  locateEquilibria(chain, x, y, L.negative, -1, body, L.equilibria);
   std::sort(L.equilibria.begin(), L.equilibria.end(),
             [](const LandscapeEquilibrium& a, const LandscapeEquilibrium& b) { return a.q1 < b.q1; });
   return L;

@@ -46,8 +46,8 @@ struct AllEquilibriaOptions {
   int landscapeSamples = 4001;      ///< q1 grid of the sweep
   continuation::Interrupt interrupt;  ///< checked before every Newton run; what was found is kept
   /// The links' weight and point loads at this state (body_loads.h; their rates are ignored:
-  /// BodyLoads::atParameter(0)): in the equations, the stability and Π (+ V, eq B1). With body
-  /// loads the n = 3 sweep (a spring-energy landscape) does not apply.
+  /// BodyLoads::atParameter(0)): in the equations, the stability, Π (+ V, eq B1) and the n = 3
+  /// sweep (of E + V along the configuration curve).
   BodyLoads body;
 };
 

@@ -11,6 +11,8 @@
 // needed to hold the configuration; it vanishes at the equilibria with Me = 0),
 //   d²E/dq1² = tᵀ ∇²E t + ∇E·q''  — at an equilibrium tᵀ (K_q − K_g(F)) t, the Hessian of the
 // total potential projected on ker J_p: > 0 stable, < 0 unstable.
+// With body loads (the links' weight, point loads at joints: body_loads.h) E is E + V (eq B1)
+// throughout: ∇V = −τ (eq B2), ∇²V(i, j) = γ_max(i,j) (eq B3), and the end torque balances both.
 #pragma once
 
 #include <Eigen/Core>
@@ -18,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain.h"
 
 namespace buckle::mechanics {
@@ -59,13 +62,17 @@ struct LandscapeOptions {
   /// q1 range; default (NaN) the first joint's limits.
   double q1Min = std::numeric_limits<double>::quiet_NaN();
   double q1Max = std::numeric_limits<double>::quiet_NaN();
+  /// The weight and point loads (their rates ignored: BodyLoads::atParameter(0)); none by default.
+  BodyLoads body;
 };
 
 /// Joint angles on one IK branch for a given q1; false when the end is out of reach.
 bool landscapeInverseKinematics(const Chain& chain, double x, double y, double q1, int branch, Eigen::Vector3d& q);
 
-/// Evaluate one point of the landscape.
-LandscapeSample landscapeSample(const Chain& chain, double x, double y, double q1, int branch);
+/// Evaluate one point of the landscape; `body` (optional, its last update() is overwritten): the
+/// body loads' terms, E + V.
+LandscapeSample landscapeSample(const Chain& chain, double x, double y, double q1, int branch,
+                                BodyLoadTerms* body = nullptr);
 
 /// Throws std::invalid_argument if the chain does not have 3 segments or x, y are not finite.
 EnergyLandscape energyLandscape(const Chain& chain, double x, double y, const LandscapeOptions& options = {});
