@@ -182,6 +182,60 @@ TEST_CASE("vibration structured: omega^2 crosses zero at the located branch poin
   }
 }
 
+TEST_CASE("vibration structured: a heavy tip (M_theta nearly of rank one): every omega^2, far above the pencil's diagonal "
+          "scale, as the dense route, also from the previous call's values",
+          "[vibration][vibration_structured]") {
+  const int n = 70;
+  const Chain chain = stiffChain(n);
+  InertiaData inertia;
+  for (int i = 0; i < n; ++i) {  // light rods and a heavy last link with its mass at the tip
+    const double l = chain.linkLengths()[i + 1], m = i + 1 == n ? 1.0 : 0.03;
+    inertia.links.push_back({m, i + 1 == n ? 0.0 : m * l * l / 12.0, i + 1 == n ? l : 0.5 * l});
+  }
+  VibrationAnalysis va(chain, inertia);
+  const Vector q = Vector::LinSpaced(n, 0.01, -0.02);
+  const Wrench F(-0.02, 0.001, 0.0);
+  va.setRoute(VibrationRoute::Dense);
+  const VibrationModes d = va.modes(q, F, {1}, {}, n, false);
+  va.setRoute(VibrationRoute::Structured);
+  const double scale = d.omegaSquared.cwiseAbs().maxCoeff();
+  for (int call = 0; call < 2; ++call) {  // cold, then warm
+    const VibrationModes s = va.modes(q, F, {1}, {}, n, false);
+    REQUIRE(s.omegaSquared.size() == d.omegaSquared.size());
+    // (M is ill-conditioned here: both routes are good to ~ε cond(M) of the spectrum, 4e-10 seen)
+    CHECK((s.omegaSquared - d.omegaSquared).cwiseAbs().maxCoeff() <= 3e-9 * scale);
+  }
+}
+
+TEST_CASE("vibration structured: omega^2 crosses zero at the located fold of a 100-segment chain (free end, lateral force)",
+          "[vibration][vibration_structured]") {
+  const int n = 100;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 0.5));
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Eigen::Vector3d(0, 0.001, 0)), Eigen::Vector3d(1, 0, 0));
+  cont::TracerOptions o;
+  o.maxPoints = 20000;
+  o.lambdaMin = -0.3;
+  o.lambdaMax = 0.3;
+  o.initialStep = 0.003;
+  o.maxStep = 0.015;
+  o.minStep = 3e-7;
+  const cont::Branch br = cont::trace(problem, Vector::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const auto folds = br.specialPointsOfType(cont::SpecialPointType::Fold);
+  REQUIRE(folds.size() == 1);
+  const cont::SpecialPoint& sp = *folds[0];
+  VibrationAnalysis va(chain, InertiaData::uniformRods(chain, 1.0));
+  const int index = std::min(sp.inertiaBefore, sp.inertiaAfter);
+  INFO("fold at lambda = " << sp.lambda << ", inertia " << sp.inertiaBefore << " -> " << sp.inertiaAfter);
+  const VibrationModes m = va.modes(sp.u.head(n), problem.wrench(sp.u, sp.lambda), {}, {}, n, false);
+  REQUIRE(m.route == VibrationRoute::Structured);
+  REQUIRE(index < n);
+  const double scale = m.omegaSquared.cwiseAbs().maxCoeff();
+  CHECK(std::abs(m.omegaSquared[index]) <= 1e-10 * scale);
+  // the neighbours are not zero: the crossing one is isolated
+  if (index > 0) CHECK(std::abs(m.omegaSquared[index - 1]) > 1e3 * std::abs(m.omegaSquared[index]));
+  if (index + 1 < n) CHECK(std::abs(m.omegaSquared[index + 1]) > 1e3 * std::abs(m.omegaSquared[index]));
+}
+
 TEST_CASE("vibration structured: the automatic route is dense below kStructuredFrom joints and structured from it",
           "[vibration][vibration_structured]") {
   for (int n : {VibrationAnalysis::kStructuredFrom - 1, VibrationAnalysis::kStructuredFrom}) {

@@ -357,6 +357,8 @@ int pencilEigenvalues(PencilStructure& ws, int first, int count, VectorRef out, 
   double bound = 4.0 * ws.scale;
   while (pencilCountBelow(ws, -bound, false) > 0) bound *= 4.0;
   while (pencilCountBelow(ws, bound, false) < dim) bound *= 4.0;
+  // the tolerance's unit: the spectrum's size (bound/4 < max |ω²| when the bound had to grow)
+  const double unit = std::max(ws.scale, 0.25 * bound);
   Vector part;  // the guesses of one chunk (a chunk's search is at most kMaxSearch wide)
   int done = 0;
   while (done < k) {
@@ -366,7 +368,7 @@ int pencilEigenvalues(PencilStructure& ws, int first, int count, VectorRef out, 
       part = guess->segment(done, std::min<Eigen::Index>(m, guess->size() - done));
       chunkGuess = &part;
     }
-    done += search::searchEigenvalues([&](double s) { return evaluatePencil(ws, s); }, dim, ws.scale, bound,
+    done += search::searchEigenvalues([&](double s) { return evaluatePencil(ws, s); }, dim, unit, bound,
                                       first + done, m, out.segment(done, m), tolerance, chunkGuess);
   }
   return k;

@@ -5,7 +5,7 @@
 // tridiagonal (chain_structure.h) and M = U M_θ Uᵀ with M_θ(i, i) = a_i and M_θ(i, j) = p_iᵀ r_j
 // for i > j (dynamics_inertial.cpp, "O(n) mass matrix"). So H − σM = U G_σ Uᵀ with
 //     G_σ = T − σ M_θ,   G_σ(i, j) = −σ p_iᵀ r_j + [i = j + 1] e_j   (i > j, e_j = T(j + 1, j)),
-// a quasiseparable matrix. Its LDLᵀ (no pivoting) keeps the structure,
+// a quasiseparable matrix. Its LDLᵀ keeps the structure (with 1×1 pivots; 2×2 ones below),
 //     L(i, j) = −σ p_iᵀ g_j + [i = j + 1] e_j / d_j      (i > j),
 // with 2-vectors g_j and pivots d_j from the recursion (P_0 = 0, P_j = Σ_{k<j} d_k g_k g_kᵀ)
 //     z_j = −σ P_j p_j + e_{j−1} g_{j−1},
@@ -28,8 +28,8 @@
 // Pivoting. Unpivoted, a tiny pivot d_j (σ near an eigenvalue of a leading block) makes P_{j+1}
 // huge, and the next steps cancel it again in rounding: the state, unlike the tridiagonal Sturm
 // recurrence's, does not recover. So, as chain_structure.h's tridiagonal LDLᵀ, 2×2 pivots by Bunch's
-// test on the coupling c = S(j + 1, j) to the next row (|d_j|·scale < α c²: D = [[d_j, c], [c, b]],
-// det D < 0, one eigenvalue of each sign); the recursion then takes the two rows at once,
+// test on the coupling c = S(j + 1, j) to the next row (|d_j|·max(scale, |b|) < α c² with
+// b = S(j + 1, j + 1): D = [[d_j, c], [c, b]], det D < 0, one eigenvalue of each sign); the recursion then takes the two rows at once,
 // P += [ρ_j ρ_{j+1}] D⁻¹ [ρ_j ρ_{j+1}]ᵀ with ρ_k = r_k − z_k, and the tridiagonal channel into row j + 2
 // is e_{j+1}(D⁻¹)_{1,:}. An exactly zero 1×1 pivot left (c = 0 too) is replaced by −pivmin (LAPACK
 // dstebz): the count is then that just above σ. The determinant's derivative is carried while every
@@ -109,7 +109,8 @@ int setPencilConstraints(PencilStructure& ws, const Eigen::Ref<const Matrix>& C,
 /// Number of eigenvalues of the pencil on ker C below σ (refactorizes at σ; X and S at σ after).
 int pencilCountBelow(PencilStructure& ws, double sigma, bool determinant = true);
 /// Eigenvalues first … first + k − 1 (ascending; k = min(count, n − rank − first)) of the pencil on
-/// ker C to absolute accuracy tolerance · scale, by the certified search of chain_structure.h;
+/// ker C to absolute accuracy tolerance · max(scale, max |ω²|) (the latter within a factor 4, from
+/// counts that confirm the search's outer bound), by the certified search of chain_structure.h;
 /// `guess` (e.g. the previous point's values, indexed from `first`) starts Newton. Returns k.
 int pencilEigenvalues(PencilStructure& ws, int first, int count, VectorRef out, double tolerance = 1e-13,
                       const Vector* guess = nullptr);

@@ -22,7 +22,7 @@
 //    the free joints, the links between two free joints one rigid body), held end rows by
 //    bordering (r ≤ 3); each ω² isolated by the pencil's counts and polished on its determinant
 //    (warm-started by the previous call's values), each shape by inverse iteration with the same
-//    O(n) solves at a shift just below ω², moved while the unpivoted LDLᵀ meets a tiny pivot.
+//    O(n) solves at a shift just below ω², moved while the LDLᵀ meets a tiny pivot.
 // The route is chosen by size (structured from kStructuredFrom joints; below, dense is faster:
 // benchmarks/RESULTS.md) unless set by setRoute(); VibrationModes::route names the one used.
 #pragma once
