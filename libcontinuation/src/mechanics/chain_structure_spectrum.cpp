@@ -2,6 +2,7 @@
 // on the chain structure (chain_structure.h, "factorization and counts"); the small dense route.
 #include "buckle/mechanics/chain_structure.h"
 #include "eigenvalue_search.h"
+#include "structure_kernels.h"
 
 #include <array>
 #include <limits>
@@ -55,22 +56,7 @@ int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double
   const int n = ws.n;
   if (C.rows() > 3 || (C.rows() > 0 && C.cols() != n))
     throw std::invalid_argument("setConstraints: C must be m×n with m <= 3");
-  double maxNorm = 0.0;
-  for (Eigen::Index i = 0; i < C.rows(); ++i) maxNorm = std::max(maxNorm, C.row(i).norm());
-  int r = 0;
-  if (maxNorm > 0.0) {
-    for (Eigen::Index i = 0; i < C.rows(); ++i) {
-      auto qr = ws.Q.col(r);
-      qr = C.row(i).transpose();
-      for (int pass = 0; pass < 2; ++pass)
-        for (int j = 0; j < r; ++j) qr -= ws.Q.col(j).dot(qr) * ws.Q.col(j);
-      const double nrm = qr.norm();
-      if (nrm <= rankTolerance * maxNorm) continue;
-      qr /= nrm;
-      applyUInverse(qr, ws.B.col(r));
-      ++r;
-    }
-  }
+  const int r = structure::orthonormaliseRows(C, ws.Q, ws.B, rankTolerance);
   ws.rank = r;
   return r;
 }

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "eigenvalue_search.h"
+#include "structure_kernels.h"
 
 namespace buckle::mechanics {
 
@@ -77,18 +78,9 @@ void factorizePencil(PencilStructure& ws, double sigma, bool determinant) {
   if (scale == 0.0) scale = 1.0;
   const double pivmin = kTinyPivot * scale;
   double minRatio = std::numeric_limits<double>::infinity();
-  double mant = 1.0, dLog = 0.0;  // det as mantissa · 2^exponent (a log per pivot would dominate)
-  long expo = 0;
+  structure::ScaledProduct det;
+  double dLog = 0.0;
   int sign = 1;
-  auto accumulate = [&](double v) {
-    mant *= v;
-    const double am = std::abs(mant);
-    if (am > 1e150 || am < 1e-150) {
-      int e2 = 0;
-      mant = std::frexp(mant, &e2);
-      expo += e2;
-    }
-  };
   // State after the pivots before j: P_j; the last pivot block's generator column and (D⁻¹)_last,last
   // (gPrev, invPrev: the tridiagonal channel into row j through ePrev); their σ-derivatives while
   // every pivot is 1×1 (dLog is carried only then: NaN after a 2×2 block, the search's counts take over).
@@ -144,7 +136,7 @@ void factorizePencil(PencilStructure& ws, double sigma, bool determinant) {
       P00 += rho0 * g0;
       P01 += rho0 * g1;
       P11 += rho1 * g1;
-      if (determinant) accumulate(dj);
+      if (determinant) det.multiply(dj);
       if (derivative) {
         dLog += ddj / dj;
         const double dg0 = (-dz0 - g0 * ddj) / dj, dg1 = (-dz1 - g1 * ddj) / dj;
@@ -167,8 +159,8 @@ void factorizePencil(PencilStructure& ws, double sigma, bool determinant) {
     derivative = false;
     ++ws.twoByTwo;
     const double sig0 = ws.r(j + 1, 0) + sigma * Pq0, sig1 = ws.r(j + 1, 1) + sigma * Pq1;  // ρ of row j + 1
-    const double det = dj * b - c * c;
-    const double i00 = b / det, i01 = -c / det, i11 = dj / det;  // D⁻¹
+    const double detD = dj * b - c * c;
+    const double i00 = b / detD, i01 = -c / detD, i11 = dj / detD;  // D⁻¹
     ws.block[size_t(j)] = 2;
     ws.block[size_t(j) + 1] = 0;
     ws.d[j] = i00;  // a 2×2 block stores D⁻¹: (d[j], dOff[j]; dOff[j], d[j + 1])
@@ -177,8 +169,8 @@ void factorizePencil(PencilStructure& ws, double sigma, bool determinant) {
     ++ws.negative;
     sign = -sign;
     const double big = 0.5 * std::abs(dj + b) + std::hypot(0.5 * (dj - b), c);
-    minRatio = std::min(minRatio, std::abs(det) / (big * scale));
-    if (determinant) accumulate(det);
+    minRatio = std::min(minRatio, std::abs(detD) / (big * scale));
+    if (determinant) det.multiply(detD);
     // generators [g_j g_{j+1}] = [ρ_j ρ_{j+1}] D⁻¹; P += [ρ_j ρ_{j+1}] D⁻¹ [ρ_j ρ_{j+1}]ᵀ
     const double ga0 = rho0 * i00 + sig0 * i01, ga1 = rho1 * i00 + sig1 * i01;
     const double gb0 = rho0 * i01 + sig0 * i11, gb1 = rho1 * i01 + sig1 * i11;
@@ -200,8 +192,7 @@ void factorizePencil(PencilStructure& ws, double sigma, bool determinant) {
   }
   ws.minPivotRatio = minRatio;
   ws.detSign = sign;
-  ws.logAbsDet = determinant ? std::log(std::abs(mant)) + double(expo) * 0.6931471805599453
-                             : std::numeric_limits<double>::quiet_NaN();
+  ws.logAbsDet = determinant ? det.logAbs() : std::numeric_limits<double>::quiet_NaN();
   ws.dLogAbsDet = derivative ? dLog : std::numeric_limits<double>::quiet_NaN();
 }
 
@@ -286,20 +277,7 @@ int setPencilConstraints(PencilStructure& ws, const Eigen::Ref<const Matrix>& C,
   const int n = ws.n;
   if (C.rows() > 3 || (C.rows() > 0 && C.cols() != n))
     throw std::invalid_argument("setPencilConstraints: C must be m×n with m <= 3");
-  double maxNorm = 0.0;
-  for (Eigen::Index i = 0; i < C.rows(); ++i) maxNorm = std::max(maxNorm, C.row(i).norm());
-  int rank = 0;
-  for (Eigen::Index i = 0; i < C.rows() && maxNorm > 0.0; ++i) {
-    auto q = ws.Q.col(rank).head(n);
-    q = C.row(i).transpose();
-    for (int pass = 0; pass < 2; ++pass)  // modified Gram–Schmidt, twice
-      for (int j = 0; j < rank; ++j) q -= ws.Q.col(j).head(n).dot(q) * ws.Q.col(j).head(n);
-    const double norm = q.norm();
-    if (norm <= rankTolerance * maxNorm) continue;
-    q /= norm;
-    applyUInverse(q, ws.B.col(rank).head(n));
-    ++rank;
-  }
+  const int rank = structure::orthonormaliseRows(C, ws.Q.topRows(n), ws.B.topRows(n), rankTolerance);
   ws.rank = rank;
   return rank;
 }
