@@ -61,7 +61,8 @@ PencilStructure::PencilStructure(int cap)
       Q(Matrix::Zero(cap, 3)),
       B(Matrix::Zero(cap, 3)),
       X(Matrix::Zero(cap, 3)),
-      work(Vector::Zero(cap)) {
+      work(Vector::Zero(cap)),
+      guessChunk(Vector::Zero(0)) {
   if (cap < 1) throw std::invalid_argument("PencilStructure: capacity must be >= 1");
 }
 
@@ -337,14 +338,15 @@ int pencilEigenvalues(PencilStructure& ws, int first, int count, VectorRef out, 
   while (pencilCountBelow(ws, bound, false) < dim) bound *= 4.0;
   // the tolerance's unit: the spectrum's size (bound/4 < max |ω²| when the bound had to grow)
   const double unit = std::max(ws.scale, 0.25 * bound);
-  Vector part;  // the guesses of one chunk (a chunk's search is at most kMaxSearch wide)
   int done = 0;
   while (done < k) {
     const int m = std::min(search::kMaxSearch, k - done);
     const Vector* chunkGuess = nullptr;
     if (guess && guess->size() > done) {
-      part = guess->segment(done, std::min<Eigen::Index>(m, guess->size() - done));
-      chunkGuess = &part;
+      // the guesses of one chunk (a chunk's search is at most kMaxSearch wide)
+      ws.guessChunk.resize(std::min<Eigen::Index>(m, guess->size() - done));
+      ws.guessChunk = guess->segment(done, ws.guessChunk.size());
+      chunkGuess = &ws.guessChunk;
     }
     done += search::searchEigenvalues([&](double s) { return evaluatePencil(ws, s); }, dim, unit, bound,
                                       first + done, m, out.segment(done, m), tolerance, chunkGuess);

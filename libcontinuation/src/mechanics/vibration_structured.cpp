@@ -58,7 +58,7 @@ struct VibrationAnalysis::Structured {
   std::vector<int> freeJoints;
   // the previous call's constraints and values: the warm start of the eigenvalue search
   std::vector<int> lastHeld, lastLocked;
-  Vector lastValues;
+  Vector lastValues, values;
   // inverse iteration: the current iterate, the next and its mass product; the modes' M ξ
   Vector xi, z, Mz;
   Matrix modesTheta, massModes;
@@ -231,7 +231,8 @@ VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench
   // the next ω² too when shapes are wanted: the last shape's shift is placed by its gap
   const int want = shapes ? std::min(k + 1, p) : k;
   const bool warm = held == s.lastHeld && lockedJoints == s.lastLocked && s.lastValues.size() > 0;
-  Vector values(want);
+  Vector& values = s.values;  // (workspace: sized once, resized only when `want` changes)
+  values.resize(want);
   pencilEigenvalues(ws, 0, want, values, kSearchTolerance * kSearchUnit, warm ? &s.lastValues : nullptr);
   s.lastHeld = held;
   s.lastLocked = lockedJoints;

@@ -93,6 +93,7 @@ struct PencilStructure {
   int rank = 0;
   SmallMatrix S;
   Vector work;  ///< scratch (mass products)
+  Vector guessChunk;  ///< the warm start of one chunk of the eigenvalue search (resized only when the chunk size changes)
 };
 
 /// LDLᵀ of G_σ by the recursion above; with `determinant` also log|det|, its sign and derivative.
