@@ -331,8 +331,9 @@ int pencilEigenvalues(PencilStructure& ws, int first, int count, VectorRef out, 
   const int dim = ws.n - ws.rank;
   const int k = std::max(0, std::min(count, dim - first));
   if (k <= 0) return 0;
-  // The search takes [−bound, bound] for granted where a warm start isolates the last eigenvalue
-  // (there is no cheap norm bound of the pencil, ‖T‖/λ_min(M_θ)): confirm it by two counts.
+  // The spectrum's size for the tolerance's unit and the search's outer bound: no cheap norm bound
+  // of the pencil (‖T‖/λ_min(M_θ)) is at hand, and the diagonal scale can be 1e5 below max |ω²|
+  // (a heavy tip), so grow it until the counts confirm it.
   double bound = 4.0 * ws.scale;
   while (pencilCountBelow(ws, -bound, false) > 0) bound *= 4.0;
   while (pencilCountBelow(ws, bound, false) < dim) bound *= 4.0;
