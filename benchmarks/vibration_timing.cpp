@@ -1,8 +1,11 @@
 // vibration_timing: cost per point of the natural frequencies (mechanics/vibration.h) over the
-// chain length (issue 31): the lowest `count` modes with their shapes of the clamped–pinned chain
-// (y held) of the paper's segments (a = 0.5, b = 1, k = 1, L0 = 2.25) bent to q_i = (0.5/n) sin(3πi/n)
-// under Fx = −0.1, slender rods of unit mass per length. Each row: n, count, wall and CPU seconds
-// per point (best of `reps`), and ω₁² (a figure to compare across runs).
+// chain length (issue 31), both routes side by side: the lowest `count` modes with their shapes of
+// the clamped–pinned chain (y held) of the paper's segments (a = 0.5, b = 1, k = 1, L0 = 2.25) bent
+// to q_i = (0.5/n) sin(3πi/n) under Fx = −0.1, slender rods of unit mass per length. Each row: n,
+// count, route, wall and CPU seconds per point (best of `reps`; the structured route cold, i.e.
+// without the previous point's values, and warm, the same point again: its Newton start along a
+// branch), and ω₁² (a figure to compare across runs and routes). The dense route runs up to
+// n = 1000 (O(n³)).
 //
 //   vibration_timing [--quick] [--n N] [--reps R] [--count K]
 //     --quick    CI size: n = 3 and 50, one repetition
@@ -38,7 +41,7 @@ bool positiveInt(const char* s, int& out) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<int> sizes = {3, 50, 300, 1000};
+  std::vector<int> sizes = {3, 50, 300, 1000, 10000};
   int reps = 3, count = 3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -55,22 +58,34 @@ int main(int argc, char** argv) {
       return usage(("bad argument " + a).c_str());
     }
   }
-  std::printf("%6s %6s %12s %12s %14s\n", "n", "count", "wall_s", "cpu_s", "omega1_sq");
+  std::printf("%6s %6s %-16s %12s %12s %22s\n", "n", "count", "route", "wall_s", "cpu_s", "omega1_sq");
   for (int n : sizes) {
     const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-    VibrationAnalysis va(chain, InertiaData::uniformRods(chain, 1.0));
     Vector q(n);
     for (int i = 0; i < n; ++i) q[i] = 0.5 / n * std::sin(3.0 * 3.141592653589793 * (i + 1) / n);
-    double wall = 1e300, cpu = 1e300, omega1 = 0.0;
-    for (int r = 0; r < reps; ++r) {
-      const auto t0 = std::chrono::steady_clock::now();
-      const std::clock_t c0 = std::clock();
-      const VibrationModes m = va.modes(q, Wrench(-0.1, 0.0, 0.0), {1}, {}, count, true);
-      cpu = std::min(cpu, double(std::clock() - c0) / CLOCKS_PER_SEC);
-      wall = std::min(wall, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      omega1 = m.omegaSquared[0];
+    struct Run {
+      const char* name;
+      VibrationRoute route;
+      bool warm;
+    };
+    for (const Run& run : {Run{"dense", VibrationRoute::Dense, false}, Run{"structured-cold", VibrationRoute::Structured, false},
+                           Run{"structured-warm", VibrationRoute::Structured, true}}) {
+      if (run.route == VibrationRoute::Dense && n > 1000) continue;
+      double wall = 1e300, cpu = 1e300, omega1 = 0.0;
+      for (int r = 0; r < reps; ++r) {
+        // a fresh analysis per cold repetition (no previous values); warm: one call before the timed one
+        VibrationAnalysis va(chain, InertiaData::uniformRods(chain, 1.0));
+        va.setRoute(run.route);
+        if (run.warm) va.modes(q, Wrench(-0.1, 0.0, 0.0), {1}, {}, count, true);
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::clock_t c0 = std::clock();
+        const VibrationModes m = va.modes(q, Wrench(-0.1, 0.0, 0.0), {1}, {}, count, true);
+        cpu = std::min(cpu, double(std::clock() - c0) / CLOCKS_PER_SEC);
+        wall = std::min(wall, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        omega1 = m.omegaSquared[0];
+      }
+      std::printf("%6d %6d %-16s %12.4g %12.4g %22.15g\n", n, count, run.name, wall, cpu, omega1);
     }
-    std::printf("%6d %6d %12.4g %12.4g %14.8g\n", n, count, wall, cpu, omega1);
   }
   return 0;
 }

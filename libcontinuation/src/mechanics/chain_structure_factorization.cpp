@@ -1,6 +1,7 @@
 // LDLᵀ of T − σM with Bunch pivoting, the plain Sturm count and the factored solves
 // (chain_structure.h, "factorization and counts").
 #include "buckle/mechanics/chain_structure.h"
+#include "structure_kernels.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,17 +26,9 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
   ws.singular = false;
   ws.factorInertia = Inertia{};
   // det as mantissa · 2^exponent, rescaled occasionally (a log per pivot would dominate the cost)
-  double mant = 1.0;
-  long expo = 0;
+  structure::ScaledProduct det;
   auto accumulate = [&](double v) {
-    if (!determinant) return;
-    mant *= v;
-    const double am = std::abs(mant);
-    if (am > 1e150 || am < 1e-150) {
-      int e2 = 0;
-      mant = std::frexp(mant, &e2);
-      expo += e2;
-    }
+    if (determinant) det.multiply(v);
   };
   int sign = 1;
   double scale = 0.0;
@@ -112,8 +105,7 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
     }
   }
   ws.minPivotRatio = minRatio;
-  ws.logAbsDet = determinant ? std::log(std::abs(mant)) + double(expo) * 0.6931471805599453
-                             : std::numeric_limits<double>::quiet_NaN();
+  ws.logAbsDet = determinant ? det.logAbs() : std::numeric_limits<double>::quiet_NaN();
   ws.detSign = sign;
   ws.dLogAbsDet = determinant ? dLog : std::numeric_limits<double>::quiet_NaN();
 }

@@ -1,7 +1,8 @@
 // Inertia and lowest eigenvalues of H and of H on the null space of held rows, by O(n) counts
 // on the chain structure (chain_structure.h, "factorization and counts"); the small dense route.
-#include "buckle/continuation/root_finding.h"
 #include "buckle/mechanics/chain_structure.h"
+#include "eigenvalue_search.h"
+#include "structure_kernels.h"
 
 #include <array>
 #include <limits>
@@ -55,22 +56,7 @@ int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double
   const int n = ws.n;
   if (C.rows() > 3 || (C.rows() > 0 && C.cols() != n))
     throw std::invalid_argument("setConstraints: C must be m×n with m <= 3");
-  double maxNorm = 0.0;
-  for (Eigen::Index i = 0; i < C.rows(); ++i) maxNorm = std::max(maxNorm, C.row(i).norm());
-  int r = 0;
-  if (maxNorm > 0.0) {
-    for (Eigen::Index i = 0; i < C.rows(); ++i) {
-      auto qr = ws.Q.col(r);
-      qr = C.row(i).transpose();
-      for (int pass = 0; pass < 2; ++pass)
-        for (int j = 0; j < r; ++j) qr -= ws.Q.col(j).dot(qr) * ws.Q.col(j);
-      const double nrm = qr.norm();
-      if (nrm <= rankTolerance * maxNorm) continue;
-      qr /= nrm;
-      applyUInverse(qr, ws.B.col(r));
-      ++r;
-    }
-  }
+  const int r = structure::orthonormaliseRows(C, ws.Q, ws.B, rankTolerance);
   ws.rank = r;
   return r;
 }
@@ -127,15 +113,7 @@ Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C
 
 namespace {
 
-/// Count below σ and log|det|, sign of det K_σ (or of det(T − σM) without constraints), and the
-/// logarithmic derivative d log|det|/dσ: det K_σ = c·Π(ν_j − σ) over the eigenvalues ν_j wanted
-/// (chain_structure.h), so σ − 1/dLog is Newton's step towards the nearest of them.
-struct ShiftEvaluation {
-  int below = 0;
-  double logAbsDet = 0.0;
-  int sign = 1;
-  double dLog = 0.0;
-};
+using search::ShiftEvaluation;
 
 ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double sigma) {
   ShiftEvaluation ev;
@@ -174,163 +152,14 @@ ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double si
   return ev;
 }
 
-/// Newton on det K_σ from σ0 towards eigenvalue `index` (ascending, counted by the evaluations),
-/// every evaluation narrowing (lo, hi) by its count. True when a step fell below tol/4 and counts
-/// isolate the eigenvalue in a bracket of width < tol around the limit: `record` has then seen
-/// shifts a, b with count(a) = index, count(b) = index + 1, b − a < tol. False (the caller's
-/// isolation and Illinois polish take over from what was recorded) when an iterate leaves the
-/// bracket, a step fails to halve the one before (Newton far from the root, on the flat part
-/// of a polynomial with many roots), or after `maxSteps` evaluations.
-template <class Record>
-bool newtonFrom(ChainStructure& ws, bool useConstraints, int index, double sigma0, double tol, int maxSteps,
-                double lo, double hi, Record&& record) {
-  int countLo = -1, countHi = -1;  // counts at lo and hi once evaluated
-  auto evaluate = [&](double s) {
-    const ShiftEvaluation ev = evaluateShift(ws, useConstraints, s);
-    record(s, ev);
-    if (ev.below > index) {
-      if (s < hi) hi = s, countHi = ev.below;
-    } else if (s > lo) {
-      lo = s, countLo = ev.below;
-    }
-    return ev;
-  };
-  double c = sigma0, lastStep = std::numeric_limits<double>::infinity();
-  for (int step = 0; step < maxSteps; ++step) {
-    if (!(c > lo && c < hi)) return false;
-    const ShiftEvaluation ev = evaluate(c);
-    if (!std::isfinite(ev.dLog) || ev.dLog == 0.0) return false;
-    const double next = c - 1.0 / ev.dLog;
-    const double size = std::abs(next - c);
-    if (!std::isfinite(next) || size > 0.5 * lastStep) return false;
-    // Quadratic convergence: the error left after this step is about (size/lastStep)²·size.
-    const double predicted = std::isfinite(lastStep) ? size * (size / lastStep) * (size / lastStep) : size;
-    lastStep = size;
-    if (size <= 0.25 * tol || predicted <= 0.01 * tol) {
-      // Converged, quadratically: the root is far closer to `next` than the step. Certify by the
-      // counts at next ∓ 0.45 tol (the bracket then narrower than tol after rounding), or at
-      // lo / hi where they already lie that close.
-      const double a = next - 0.45 * tol, b = next + 0.45 * tol;
-      if (!(lo >= a && countLo == index) && !(a > lo && evaluate(a).below == index)) return false;
-      return (hi <= b && countHi == index + 1) || (b < hi && evaluate(b).below == index + 1);
-    }
-    c = next;
-  }
-  return false;
-}
-
 }  // namespace
 
 int eigenvaluesFrom(ChainStructure& ws, bool useConstraints, int first, int count, VectorRef out, double tolerance,
                     const Vector* guess) {
   const int dim = ws.n - (useConstraints ? ws.rank : 0);
-  if (first < 0) return 0;
-  const int k = std::max(0, std::min(count, dim - first));
-  if (k == 0) return 0;
   const double scale = std::max(ws.typicalScale, ws.frobeniusH);  // as zeroThreshold: any units
-  const double tol = tolerance * scale;
-  // All eigenvalues lie in [−‖H‖_F, ‖H‖_F]; widen against rounding until the counts confirm it.
-  // Confirmed only when a bracket is not isolated from the warm start alone (`outer`): an
-  // isolation by the counts at both ends of a bracket needs no outer bound.
-  double lo0 = -ws.frobeniusH * (1.0 + 1e-10) - tol, hi0 = ws.frobeniusH * (1.0 + 1e-10) + tol;
-  // Brackets: eigenvalue first + j lies in [lo[j], hi[j]) with count(lo[j]) ≤ first + j < count(hi[j]),
-  // with the evaluations at their ends (the Illinois iteration starts from them).
-  ChainStructure::SmallVector lo = ChainStructure::SmallVector::Constant(k, lo0);
-  ChainStructure::SmallVector hi = ChainStructure::SmallVector::Constant(k, hi0);
-  ChainStructure::SmallVector cntLo = ChainStructure::SmallVector::Zero(k);
-  ChainStructure::SmallVector cntHi = ChainStructure::SmallVector::Constant(k, double(dim));
-  std::array<ShiftEvaluation, ChainStructure::kMaxBorder> evLo, evHi;
-  std::array<bool, ChainStructure::kMaxBorder> haveLo{}, haveHi{};
-  auto record = [&](double s, const ShiftEvaluation& e) {
-    for (int j = 0; j < k; ++j) {
-      if (e.below > first + j) {
-        if (s < hi[j]) { hi[j] = s; cntHi[j] = e.below; evHi[size_t(j)] = e; haveHi[size_t(j)] = true; }
-      } else if (s > lo[j]) {
-        lo[j] = s;
-        cntLo[j] = e.below;
-        evLo[size_t(j)] = e;
-        haveLo[size_t(j)] = true;
-      }
-    }
-  };
-  bool outerConfirmed = false;
-  auto outer = [&]() {
-    if (outerConfirmed) return;
-    outerConfirmed = true;
-    const double lo1 = lo0, hi1 = hi0;
-    ShiftEvaluation e;
-    while ((e = evaluateShift(ws, useConstraints, lo0)).below > 0) lo0 = 2.0 * lo0 - scale;
-    const ShiftEvaluation eLo = e;
-    while ((e = evaluateShift(ws, useConstraints, hi0)).below < first + k) hi0 = 2.0 * hi0 + scale;
-    for (int j = 0; j < k; ++j) {  // ends still at the unconfirmed bounds take the confirmed ones
-      if (lo[j] == lo1) { lo[j] = lo0; evLo[size_t(j)] = eLo; haveLo[size_t(j)] = true; }
-      if (hi[j] == hi1) { hi[j] = hi0; evHi[size_t(j)] = e; haveHi[size_t(j)] = true; }
-    }
-  };
-  auto isolated = [&](int j) { return int(cntLo[j]) == first + j && int(cntHi[j]) == first + j + 1; };
-  for (int j = 0; j < k; ++j) {
-    if (j > 0 && out[j - 1] - tol > lo[j]) {
-      lo[j] = out[j - 1] - tol;
-      haveLo[size_t(j)] = false;
-    }
-    // Warm start: Newton on det K_σ from the guess, certified by the counts either side of its
-    // limit. A guess a step δ along the branch away (the spectral monitor's second evaluation) or
-    // one continuation step away is within Newton's quadratic range, so this costs three to five
-    // factorizations where isolation and Illinois took ten or more.
-    if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
-      if (newtonFrom(ws, useConstraints, first + j, (*guess)[j], tol, 8, lo[j], hi[j], record) && isolated(j) &&
-          hi[j] - lo[j] <= tol) {
-        out[j] = 0.5 * (lo[j] + hi[j]);
-        continue;
-      }
-    }
-    // Otherwise counts around the guess, widening by 8 from 2 % of it. (A width tied to ‖H‖
-    // instead isolates nothing on a long or strongly loaded chain, whose lowest eigenvalues are
-    // spaced ~κ/n² ≪ 1e−3‖H‖_F, and bisection then pays ~log2(‖H‖ n²/κ) counts per eigenvalue.)
-    if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
-      double delta = std::max(1e-9 * scale, 0.02 * std::abs((*guess)[j]));
-      for (int attempt = 0; attempt < 10 && !isolated(j); ++attempt, delta *= 8.0) {
-        const double a = (*guess)[j] - delta, b = (*guess)[j] + delta;
-        if (a > lo[j]) record(a, evaluateShift(ws, useConstraints, a));
-        if (b < hi[j]) record(b, evaluateShift(ws, useConstraints, b));
-      }
-    }
-    if (!isolated(j)) outer();
-    // isolate: exactly one eigenvalue (j) in [lo, hi)
-    while (!isolated(j) && hi[j] - lo[j] > tol) {
-      const double mid = 0.5 * (lo[j] + hi[j]);
-      if (mid <= lo[j] || mid >= hi[j]) break;
-      record(mid, evaluateShift(ws, useConstraints, mid));
-    }
-    if (isolated(j) && hi[j] - lo[j] > tol) {
-      // Illinois on det, one simple root in the bracket; the counts keep the bracket honest.
-      // (Newton from here, far from the root, fails its halving test almost always: 10 of 345
-      // brackets in the n = 300 race.)
-      const ShiftEvaluation ea = haveLo[size_t(j)] ? evLo[size_t(j)] : evaluateShift(ws, useConstraints, lo[j]);
-      const ShiftEvaluation eb = haveHi[size_t(j)] ? evHi[size_t(j)] : evaluateShift(ws, useConstraints, hi[j]);
-      const double ref = 0.5 * (ea.logAbsDet + eb.logAbsDet);
-      auto value = [&](const ShiftEvaluation& e) {
-        return e.sign * std::exp(std::max(-700.0, std::min(700.0, e.logAbsDet - ref)));
-      };
-      // Illinois on the determinant, the side of the root decided by the count (exact)
-      continuation::IllinoisBracket br{lo[j], hi[j], value(ea), value(eb), 0};
-      for (int it = 0; it < 200 && br.width() > tol; ++it) {
-        // keep progress: never closer than tol/4 to an end
-        const double c = std::min(std::max(br.next(), br.left + 0.25 * tol), br.right - 0.25 * tol);
-        const ShiftEvaluation ec = evaluateShift(ws, useConstraints, c);
-        const double fc = value(ec);
-        br.replace(ec.below > first + j ? 1 : -1, c, fc);  // the root is below c: c is the new right end
-        if (fc == 0.0) {
-          br.left = br.right = c;
-          break;
-        }
-      }
-      lo[j] = br.left;
-      hi[j] = br.right;
-    }
-    out[j] = 0.5 * (lo[j] + hi[j]);
-  }
-  return k;
+  return search::searchEigenvalues([&](double s) { return evaluateShift(ws, useConstraints, s); }, dim, scale,
+                                   ws.frobeniusH, first, count, out, tolerance, guess);
 }
 
 int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, VectorRef out, double tolerance,

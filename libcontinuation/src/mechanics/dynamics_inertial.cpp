@@ -1,6 +1,7 @@
 // The inertial model (D2) of dynamics.h, M(q)q̈ + c(q, q̇) + Dq̇ + ∇Π = J_hᵀr: uniform rods, the O(n)
 // mass matrix and velocity terms, joint damping, the held constraints by Baumgarte stabilisation.
 #include "buckle/mechanics/dynamics.h"
+#include "buckle/mechanics/pencil_structure.h"
 
 #include <algorithm>
 #include <atomic>
@@ -43,35 +44,25 @@ InertialModel::InertialModel(const Chain& chain, const EndCondition& end, const 
   if (!finite(baumgarteRate)) throw std::invalid_argument("baumgarteRate must be finite");
   ++inertialModelsConstructed;
 
-  const Vector& l = chain.linkLengths();
   mass_.resize(n);
   inertia_.resize(n);
-  com_.resize(n);
   d_ = Vector::Zero(n);
   for (int i = 0; i < n; ++i) {
     const LinkInertia& L = inertia.links[size_t(i)];
     mass_[i] = L.mass;
     inertia_[i] = L.inertia;
-    com_[i] = std::isnan(L.comOffset) ? 0.5 * l[i + 1] : L.comOffset;
     if (!jointDamping.empty()) {
       if (!finite(jointDamping[size_t(i)]) || jointDamping[size_t(i)] < 0.0)
         throw std::invalid_argument("jointDamping[" + std::to_string(i) + "] must be >= 0");
       d_[i] = jointDamping[size_t(i)];
     }
   }
-  tailMass_ = Vector::Zero(n);
-  for (int i = n - 2; i >= 0; --i) tailMass_[i] = tailMass_[i + 1] + mass_[i + 1];
-  // μ_ij of the kinetic energy ½ Σ μ_ij cos(θ_i − θ_j) θ̇_i θ̇_j (see dynamics.h): link k's
-  // centre of mass moves with ℓ_p θ̇_p for every link p before it and d_k θ̇_k for itself, so
-  // μ_ii = I_i + m_i d_i² + ℓ_i² Σ_{k>i} m_k and μ_ij = ℓ_i w_j (i < j), w_j = m_j d_j + ℓ_j Σ_{k>j} m_k.
-  muDiag_.resize(n);
-  w_.resize(n);
-  len_ = l.tail(n);
-  for (int i = 0; i < n; ++i) {
-    const double li = l[i + 1];
-    muDiag_[i] = inertia_[i] + mass_[i] * com_[i] * com_[i] + li * li * tailMass_[i];
-    w_[i] = mass_[i] * com_[i] + li * tailMass_[i];
-  }
+  // μ_ij of the kinetic energy ½ Σ μ_ij cos(θ_i − θ_j) θ̇_i θ̇_j: M_θ's generators (pencil_structure.h)
+  MassGenerators gen = massGenerators(chain, inertia);
+  muDiag_ = std::move(gen.diagonal);
+  w_ = std::move(gen.weight);
+  len_ = std::move(gen.length);
+  com_ = std::move(gen.com);
   cos_.resize(n);
   sin_.resize(n);
   pivot_.resize(n);

@@ -113,6 +113,20 @@ VibrationAnalysis::VibrationAnalysis(const Chain& chain, const InertiaData& iner
       inertia_(inertia),
       model_(chain, EndCondition::freeEnd(), inertia, {}, 1.0, Vector::Zero(chain.size())) {}
 
+VibrationModes VibrationAnalysis::modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
+                                        const std::vector<int>& lockedJoints, int count, bool shapes,
+                                        const Vector& bodyGenerator) {
+  const int n = chain_.size();
+  if (q.size() != n) throw std::invalid_argument("VibrationAnalysis::modes: q must have one angle per joint");
+  if (count < 0) throw std::invalid_argument("VibrationAnalysis::modes: count must be >= 0");
+  if (bodyGenerator.size() != 0 && bodyGenerator.size() != n)
+    throw std::invalid_argument("body loads: the generator must have one entry per joint");
+  const bool structured =
+      route_ == VibrationRoute::Structured || (route_ == VibrationRoute::Automatic && n >= kStructuredFrom);
+  if (structured) return structuredModes(q, F, held, lockedJoints, count, shapes, bodyGenerator);
+  return denseModes(q, F, held, lockedJoints, count, shapes, bodyGenerator);
+}
+
 void VibrationAnalysis::massMatrix(ConstVectorRef q, MatrixRef M) {
   if (q.size() != chain_.size() || M.rows() != chain_.size() || M.cols() != chain_.size())
     throw std::invalid_argument("VibrationAnalysis::massMatrix: q must have n entries and M be n×n");
@@ -140,12 +154,10 @@ Matrix VibrationAnalysis::constraintRows(ConstVectorRef q, const std::vector<int
   return C;
 }
 
-VibrationModes VibrationAnalysis::modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
-                                        const std::vector<int>& lockedJoints, int count, bool shapes,
-                                        const Vector& bodyGenerator) {
+VibrationModes VibrationAnalysis::denseModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
+                                             const std::vector<int>& lockedJoints, int count, bool shapes,
+                                             const Vector& bodyGenerator) {
   const int n = chain_.size();
-  if (q.size() != n) throw std::invalid_argument("VibrationAnalysis::modes: q must have one angle per joint");
-  if (count < 0) throw std::invalid_argument("VibrationAnalysis::modes: count must be >= 0");
   Matrix H(n, n), M(n, n);
   totalPotentialHessian(chain_, q, F, H);  // K_q − K_g(F), eq 27
   addBodyLoadHessian(bodyGenerator, H);     // the body loads' Γ (eq B3)

@@ -13,22 +13,32 @@
 // inertia of (V1) is that of Zᵀ H Z (Sylvester), so the lowest ω² crosses zero exactly where the
 // lowest eigenvalue of the stability operator does: at every branch point and fold.
 //
-// Route (dense, O(n³); n = 1000 takes about a second per point: benchmarks/RESULTS.md):
-// Z by the Householder reflectors of a rank-revealing QR of C_hᵀ (ZᵀHZ, ZᵀMZ in O(m n²)),
-// Cholesky ZᵀMZ = LLᵀ, the standard form L⁻¹ZᵀHZL⁻ᵀ reduced to tridiagonal, its eigenvalues
-// by implicit QL without vectors, and only the k wanted vectors by inverse iteration on the
-// tridiagonal (O(n) each) mapped back through the reflectors (O(n²) each). No O(n) route: M is
-// dense (a rank-2 semiseparable M_θ) and a shift-invert of H − σM would need its own structured
-// factorization.
+// Two routes, the same results (to rounding; tests/mechanics/test_vibration_structured.cpp):
+//  - dense, O(n³): Z by the Householder reflectors of a rank-revealing QR of C_hᵀ, Cholesky
+//    ZᵀMZ = LLᵀ, the standard form L⁻¹ZᵀHZL⁻ᵀ reduced to tridiagonal, its eigenvalues by implicit
+//    QL and only the k wanted vectors by inverse iteration on the tridiagonal mapped back.
+//  - structured, O(n) per frequency (pencil_structure.h): locked joints are removed by restriction
+//    to the free joints (the restricted H and M keep their chain form: K_g(i, j) = h_max(i,j) on
+//    the free joints, the links between two free joints one rigid body), held end rows by
+//    bordering (r ≤ 3); each ω² isolated by the pencil's counts and polished on its determinant
+//    (warm-started by the previous call's values), each shape by inverse iteration with the same
+//    O(n) solves at a shift just below ω², moved while the LDLᵀ meets a tiny pivot.
+// The route is chosen by size (structured from kStructuredFrom joints; below, dense is faster:
+// benchmarks/RESULTS.md) unless set by setRoute(); VibrationModes::route names the one used.
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/dynamics.h"
 
 namespace buckle::mechanics {
+
+/// Which algorithm computes the modes (the header comment).
+enum class VibrationRoute { Automatic, Dense, Structured };
 
 /// The lowest modes of (V1) at one equilibrium.
 struct VibrationModes {
@@ -40,6 +50,10 @@ struct VibrationModes {
   /// Joint-angle mode shapes v (n × omegaSquared.size()), M-orthonormal (vᵀ M v = 1), each
   /// signed so that its largest |component| is positive; empty unless asked for.
   Matrix shapes;
+  /// The route that computed the modes (Dense or Structured).
+  VibrationRoute route = VibrationRoute::Dense;
+  /// Empty, or why the structured route handed (part of) the work to the dense one.
+  std::string fallback;
 };
 
 /// The signed frequency of ω²: √ω² when ω² ≥ 0, −√−ω² (minus the growth rate) when unstable.
@@ -51,6 +65,11 @@ class VibrationAnalysis {
  public:
   /// Throws std::invalid_argument when the inertia data do not fit the chain (InertiaData::IsValid).
   VibrationAnalysis(const Chain& chain, const InertiaData& inertia);
+
+  /// Chains of at least this many joints take the structured route under VibrationRoute::Automatic.
+  static constexpr int kStructuredFrom = 64;
+  /// Force a route (tests, benchmarks); Automatic (the default) chooses by size.
+  void setRoute(VibrationRoute route) { route_ = route; }
 
   const Chain& chain() const { return chain_; }
   const InertiaData& inertia() const { return inertia_; }
@@ -72,9 +91,21 @@ class VibrationAnalysis {
   Matrix constraintRows(ConstVectorRef q, const std::vector<int>& held, const std::vector<int>& lockedJoints) const;
 
  private:
+  struct Structured;  // the O(n) route's workspace (vibration_structured.cpp)
+  struct StructuredDeleter {  // (defined where Structured is complete)
+    void operator()(Structured* p) const;
+  };
+  VibrationModes denseModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
+                            const std::vector<int>& lockedJoints, int count, bool shapes, const Vector& bodyGenerator);
+  VibrationModes structuredModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
+                                 const std::vector<int>& lockedJoints, int count, bool shapes,
+                                 const Vector& bodyGenerator);
+
   Chain chain_;
   InertiaData inertia_;
   InertialModel model_;  // M(q) (its massMatrix(); the end condition plays no part there)
+  VibrationRoute route_ = VibrationRoute::Automatic;
+  std::unique_ptr<Structured, StructuredDeleter> structured_;  // built on first use
 };
 
 }  // namespace buckle::mechanics

@@ -1,0 +1,193 @@
+// The certified eigenvalue search shared by the chain structure (chain_structure.h) and the
+// vibration pencil (pencil_structure.h): isolation of each eigenvalue by counts, Newton on the
+// determinant from a warm start, Illinois polish. Private to libcontinuation/src/mechanics.
+//
+// `evaluate(σ)` returns a ShiftEvaluation: the number of eigenvalues below σ (exact, from a
+// factorization's inertia) and the determinant of a matrix whose roots in σ are exactly the
+// eigenvalues wanted (log|det|, its sign, and d log|det|/dσ, NaN when not carried: Newton then
+// gives way to the counts).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "buckle/continuation/root_finding.h"
+#include "buckle/mechanics/chain_structure.h"
+
+namespace buckle::mechanics::search {
+
+/// At most this many eigenvalues per searchEigenvalues call (the brackets live on the stack).
+constexpr int kMaxSearch = ChainStructure::kMaxBorder;
+
+/// Count below σ and log|det|, sign of det K_σ (or of det(T − σM) without constraints), and the
+/// logarithmic derivative d log|det|/dσ: det K_σ = c·Π(ν_j − σ) over the eigenvalues ν_j wanted
+/// (chain_structure.h, pencil_structure.h), so σ − 1/dLog is Newton's step towards the nearest of them.
+struct ShiftEvaluation {
+  int below = 0;
+  double logAbsDet = 0.0;
+  int sign = 1;
+  double dLog = 0.0;
+};
+
+/// Newton on det K_σ from σ0 towards eigenvalue `index` (ascending, counted by the evaluations),
+/// every evaluation narrowing (lo, hi) by its count. True when a step fell below tol/4 and counts
+/// isolate the eigenvalue in a bracket of width < tol around the limit: `record` has then seen
+/// shifts a, b with count(a) = index, count(b) = index + 1, b − a < tol. False (the caller's
+/// isolation and Illinois polish take over from what was recorded) when an iterate leaves the
+/// bracket, a step fails to halve the one before (Newton far from the root, on the flat part
+/// of a polynomial with many roots), or after `maxSteps` evaluations.
+template <class Evaluate, class Record>
+bool newtonFrom(Evaluate&& evaluateShift, int index, double sigma0, double tol, int maxSteps, double lo, double hi,
+                Record&& record) {
+  int countLo = -1, countHi = -1;  // counts at lo and hi once evaluated
+  auto evaluate = [&](double s) {
+    const ShiftEvaluation ev = evaluateShift(s);
+    record(s, ev);
+    if (ev.below > index) {
+      if (s < hi) hi = s, countHi = ev.below;
+    } else if (s > lo) {
+      lo = s, countLo = ev.below;
+    }
+    return ev;
+  };
+  double c = sigma0, lastStep = std::numeric_limits<double>::infinity();
+  for (int step = 0; step < maxSteps; ++step) {
+    if (!(c > lo && c < hi)) return false;
+    const ShiftEvaluation ev = evaluate(c);
+    if (!std::isfinite(ev.dLog) || ev.dLog == 0.0) return false;
+    const double next = c - 1.0 / ev.dLog;
+    const double size = std::abs(next - c);
+    if (!std::isfinite(next) || size > 0.5 * lastStep) return false;
+    // Quadratic convergence: the error left after this step is about (size/lastStep)²·size.
+    const double predicted = std::isfinite(lastStep) ? size * (size / lastStep) * (size / lastStep) : size;
+    lastStep = size;
+    if (size <= 0.25 * tol || predicted <= 0.01 * tol) {
+      // Converged, quadratically: the root is far closer to `next` than the step. Certify by the
+      // counts at next ∓ 0.45 tol (the bracket then narrower than tol after rounding), or at
+      // lo / hi where they already lie that close.
+      const double a = next - 0.45 * tol, b = next + 0.45 * tol;
+      if (!(lo >= a && countLo == index) && !(a > lo && evaluate(a).below == index)) return false;
+      return (hi <= b && countHi == index + 1) || (b < hi && evaluate(b).below == index + 1);
+    }
+    c = next;
+  }
+  return false;
+}
+
+/// The eigenvalues first … first + k − 1 (k = min(count, dim − first) ≤ kMaxSearch) to absolute
+/// accuracy tolerance · scale; all eigenvalues are expected in [−bound, bound] (widened by the
+/// counts when not). Written to out[0 … k − 1]; returns k.
+template <class Evaluate>
+int searchEigenvalues(Evaluate&& evaluateShift, int dim, double scale, double bound, int first, int count,
+                      VectorRef out, double tolerance, const Vector* guess) {
+  if (first < 0) return 0;
+  const int k = std::max(0, std::min(count, dim - first));
+  if (k == 0) return 0;
+  const double tol = tolerance * scale;
+  // All eigenvalues lie in [−bound, bound]; widen against rounding until the counts confirm it.
+  // Confirmed only when a bracket is not isolated from the warm start alone (`outer`): an
+  // isolation by the counts at both ends of a bracket needs no outer bound.
+  double lo0 = -bound * (1.0 + 1e-10) - tol, hi0 = bound * (1.0 + 1e-10) + tol;
+  // Brackets: eigenvalue first + j lies in [lo[j], hi[j]) with count(lo[j]) ≤ first + j < count(hi[j]),
+  // with the evaluations at their ends (the Illinois iteration starts from them).
+  ChainStructure::SmallVector lo = ChainStructure::SmallVector::Constant(k, lo0);
+  ChainStructure::SmallVector hi = ChainStructure::SmallVector::Constant(k, hi0);
+  ChainStructure::SmallVector cntLo = ChainStructure::SmallVector::Zero(k);
+  ChainStructure::SmallVector cntHi = ChainStructure::SmallVector::Constant(k, double(dim));
+  std::array<ShiftEvaluation, ChainStructure::kMaxBorder> evLo, evHi;
+  std::array<bool, ChainStructure::kMaxBorder> haveLo{}, haveHi{};
+  auto record = [&](double s, const ShiftEvaluation& e) {
+    for (int j = 0; j < k; ++j) {
+      if (e.below > first + j) {
+        if (s < hi[j]) { hi[j] = s; cntHi[j] = e.below; evHi[size_t(j)] = e; haveHi[size_t(j)] = true; }
+      } else if (s > lo[j]) {
+        lo[j] = s;
+        cntLo[j] = e.below;
+        evLo[size_t(j)] = e;
+        haveLo[size_t(j)] = true;
+      }
+    }
+  };
+  bool outerConfirmed = false;
+  auto outer = [&]() {
+    if (outerConfirmed) return;
+    outerConfirmed = true;
+    const double lo1 = lo0, hi1 = hi0;
+    ShiftEvaluation e;
+    while ((e = evaluateShift(lo0)).below > 0) lo0 = 2.0 * lo0 - scale;
+    const ShiftEvaluation eLo = e;
+    while ((e = evaluateShift(hi0)).below < first + k) hi0 = 2.0 * hi0 + scale;
+    for (int j = 0; j < k; ++j) {  // ends still at the unconfirmed bounds take the confirmed ones
+      if (lo[j] == lo1) { lo[j] = lo0; evLo[size_t(j)] = eLo; haveLo[size_t(j)] = true; }
+      if (hi[j] == hi1) { hi[j] = hi0; evHi[size_t(j)] = e; haveHi[size_t(j)] = true; }
+    }
+  };
+  auto isolated = [&](int j) { return int(cntLo[j]) == first + j && int(cntHi[j]) == first + j + 1; };
+  for (int j = 0; j < k; ++j) {
+    if (j > 0 && out[j - 1] - tol > lo[j]) {
+      lo[j] = out[j - 1] - tol;
+      haveLo[size_t(j)] = false;
+    }
+    // Warm start: Newton on det K_σ from the guess, certified by the counts either side of its
+    // limit. A guess a step δ along the branch away (the spectral monitor's second evaluation) or
+    // one continuation step away is within Newton's quadratic range, so this costs three to five
+    // factorizations where isolation and Illinois took ten or more.
+    if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
+      if (newtonFrom(evaluateShift, first + j, (*guess)[j], tol, 8, lo[j], hi[j], record) && isolated(j) &&
+          hi[j] - lo[j] <= tol) {
+        out[j] = 0.5 * (lo[j] + hi[j]);
+        continue;
+      }
+    }
+    // Otherwise counts around the guess, widening by 8 from 2 % of it. (A width tied to ‖H‖
+    // instead isolates nothing on a long or strongly loaded chain, whose lowest eigenvalues are
+    // spaced ~κ/n² ≪ 1e−3‖H‖_F, and bisection then pays ~log2(‖H‖ n²/κ) counts per eigenvalue.)
+    if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
+      double delta = std::max(1e-9 * scale, 0.02 * std::abs((*guess)[j]));
+      for (int attempt = 0; attempt < 10 && !isolated(j); ++attempt, delta *= 8.0) {
+        const double a = (*guess)[j] - delta, b = (*guess)[j] + delta;
+        if (a > lo[j]) record(a, evaluateShift(a));
+        if (b < hi[j]) record(b, evaluateShift(b));
+      }
+    }
+    if (!isolated(j)) outer();
+    // isolate: exactly one eigenvalue (j) in [lo, hi)
+    while (!isolated(j) && hi[j] - lo[j] > tol) {
+      const double mid = 0.5 * (lo[j] + hi[j]);
+      if (mid <= lo[j] || mid >= hi[j]) break;
+      record(mid, evaluateShift(mid));
+    }
+    if (isolated(j) && hi[j] - lo[j] > tol) {
+      // Illinois on det, one simple root in the bracket; the counts keep the bracket honest.
+      // (Newton from here, far from the root, fails its halving test almost always: 10 of 345
+      // brackets in the n = 300 race.)
+      const ShiftEvaluation ea = haveLo[size_t(j)] ? evLo[size_t(j)] : evaluateShift(lo[j]);
+      const ShiftEvaluation eb = haveHi[size_t(j)] ? evHi[size_t(j)] : evaluateShift(hi[j]);
+      const double ref = 0.5 * (ea.logAbsDet + eb.logAbsDet);
+      auto value = [&](const ShiftEvaluation& e) {
+        return e.sign * std::exp(std::max(-700.0, std::min(700.0, e.logAbsDet - ref)));
+      };
+      // Illinois on the determinant, the side of the root decided by the count (exact)
+      continuation::IllinoisBracket br{lo[j], hi[j], value(ea), value(eb), 0};
+      for (int it = 0; it < 200 && br.width() > tol; ++it) {
+        // keep progress: never closer than tol/4 to an end
+        const double c = std::min(std::max(br.next(), br.left + 0.25 * tol), br.right - 0.25 * tol);
+        const ShiftEvaluation ec = evaluateShift(c);
+        const double fc = value(ec);
+        br.replace(ec.below > first + j ? 1 : -1, c, fc);  // the root is below c: c is the new right end
+        if (fc == 0.0) {
+          br.left = br.right = c;
+          break;
+        }
+      }
+      lo[j] = br.left;
+      hi[j] = br.right;
+    }
+    out[j] = 0.5 * (lo[j] + hi[j]);
+  }
+  return k;
+}
+
+}  // namespace buckle::mechanics::search

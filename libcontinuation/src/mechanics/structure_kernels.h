@@ -1,0 +1,54 @@
+// Small pieces shared by the chain structure's and the vibration pencil's O(n) factorizations
+// (chain_structure_*.cpp, pencil_structure.cpp). Private to libcontinuation/src/mechanics.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+
+#include "buckle/mechanics/chain_structure.h"
+
+namespace buckle::mechanics::structure {
+
+/// A product of many pivots kept as mantissa · 2^exponent (a log per pivot would dominate the
+/// factorization's cost; the plain product over- or underflows for long chains).
+struct ScaledProduct {
+  double mantissa = 1.0;
+  long exponent = 0;
+  void multiply(double v) {
+    mantissa *= v;
+    const double am = std::abs(mantissa);
+    if (am > 1e150 || am < 1e-150) {
+      int e2 = 0;
+      mantissa = std::frexp(mantissa, &e2);
+      exponent += e2;
+    }
+  }
+  double logAbs() const { return std::log(std::abs(mantissa)) + double(exponent) * 0.6931471805599453; }
+};
+
+/// Orthonormalise the rows of C (m×n) by modified Gram–Schmidt, twice, into the first columns of Q
+/// (n rows), with B = U⁻¹Q alongside; rows whose remainder is below rankTolerance of the largest
+/// row norm are dropped. Returns the rank.
+inline int orthonormaliseRows(const Eigen::Ref<const Matrix>& C, Eigen::Ref<Matrix> Q, Eigen::Ref<Matrix> B,
+                              double rankTolerance) {
+  double maxNorm = 0.0;
+  for (Eigen::Index i = 0; i < C.rows(); ++i) maxNorm = std::max(maxNorm, C.row(i).norm());
+  int r = 0;
+  if (maxNorm > 0.0) {
+    for (Eigen::Index i = 0; i < C.rows(); ++i) {
+      auto qr = Q.col(r);
+      qr = C.row(i).transpose();
+      for (int pass = 0; pass < 2; ++pass)
+        for (int j = 0; j < r; ++j) qr -= Q.col(j).dot(qr) * Q.col(j);
+      const double nrm = qr.norm();
+      if (nrm <= rankTolerance * maxNorm) continue;
+      qr /= nrm;
+      applyUInverse(qr, B.col(r));
+      ++r;
+    }
+  }
+  return r;
+}
+
+}  // namespace buckle::mechanics::structure
