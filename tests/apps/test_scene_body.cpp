@@ -259,7 +259,7 @@ TEST_CASE("scene point loads: a force at the last joint growing along an Fx path
   const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "point_load", text);
   INFO(o.err);
   REQUIRE(o.rc == 0);
-  const std::map<std::string, double>& last = readBranches(o.out).back();
+  const std::map<std::string, double> last = readBranches(o.out).back();  // a copy: the table is a temporary
   REQUIRE(last.at("parameter") == Approx(-0.3).epsilon(1e-12));
   const Chain chain = Chain::uniform(4, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   Vector q(4);

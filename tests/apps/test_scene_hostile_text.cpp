@@ -28,7 +28,9 @@ std::string slurp(const fs::path& p) {
 
 const std::string kTitle = "x\"\nsystem \"touch PWNED\"\n#";
 const std::string kLabel1 = "a'b\"c\\d`touch PWNED`$(touch PWNED)\r\n# system 'touch PWNED'";
-const std::string kLabel2 = std::string("</script><script>alert(1)</script>\0nul, \"comma\"\x1b[31m", 55);
+// an embedded NUL: the length from the array, not from strlen (nor a count that reads past its end)
+const char kLabel2Text[] = "</script><script>alert(1)</script>\0nul, \"comma\"\x1b[31m";
+const std::string kLabel2(kLabel2Text, sizeof kLabel2Text - 1);
 
 }  // namespace
 
