@@ -8,6 +8,7 @@
 
 #include "scene/columns.h"
 #include "scene/output.h"
+#include "scene/special_marks.h"
 
 namespace buckle::python {
 
@@ -23,7 +24,7 @@ void addValues(py::dict& d, const std::vector<std::string>& columns, const std::
   const auto P = static_cast<Eigen::Index>(rows.size());
   for (const std::string& c : columns) {
     VectorXd v(P);
-    for (Eigen::Index i = 0; i < P; ++i) v[i] = scene::columnValue(c, *rows[static_cast<size_t>(i)], cr.pose0);
+    for (Eigen::Index i = 0; i < P; ++i) v[i] = scene::columnValue(c, *rows[static_cast<size_t>(i)], cr);
     d[py::str(c)] = v;
   }
 }
@@ -76,15 +77,15 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
   py::array_t<bool> stable(P);
   auto stableView = stable.mutable_unchecked<1>();
   std::vector<std::string> locked;
-  std::vector<const scene::PointRecord*> rows;
+  std::vector<const mechanics::PointReport*> rows;
   for (Eigen::Index i = 0; i < P; ++i) {
-    const scene::PointRecord& p = cr.points[static_cast<size_t>(i)];
+    const mechanics::PointReport& p = cr.points[static_cast<size_t>(i)];
     rows.push_back(&p);
     branch[i] = p.branch;
     point[i] = p.index;
     negative[i] = p.negative;
     stableView(i) = p.stable;
-    locked.push_back(p.locked);
+    locked.push_back(p.locked.label());
     contactTorque[i] = p.contactTorque;
   }
   // in the order of branches.csv's columns
@@ -106,14 +107,14 @@ py::dict specialArrays(const scene::Scene& s, const scene::CaseResult& cr, int f
   py::dict d;
   Eigen::VectorXi branch(m), index(m);
   std::vector<std::string> type, field, shape;
-  std::vector<const scene::SpecialRecord*> rows;
+  std::vector<const scene::SpecialPointResult*> rows;
   for (Eigen::Index i = 0; i < m; ++i) {
-    const scene::SpecialRecord& r = cr.specials[static_cast<size_t>(i)];
+    const scene::SpecialPointResult& r = cr.specials[static_cast<size_t>(i)];
     rows.push_back(&r);
     branch[i] = r.branch;
     index[i] = firstIndex + static_cast<int>(i);
-    type.push_back(r.type);
-    field.push_back(r.field);
+    type.push_back(mechanics::label(r.type));
+    field.push_back(scene::fieldName(cr, r));
     shape.push_back(r.shape);
   }
   d["index"] = index;

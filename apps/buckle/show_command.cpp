@@ -88,20 +88,8 @@ void printTable(std::ostream& os, const std::vector<std::string>& header, const 
   for (const auto& r : rows) line(r);
 }
 
-void show(const std::string& dirName, std::ostream& os) {
-  const fs::path dir(dirName);
-  std::error_code ec;
-  if (!fs::exists(dir, ec)) throw NotAnOutput{dirName + " does not exist"};
-  if (!fs::is_directory(dir, ec)) throw NotAnOutput{dirName + " is not a directory (give the output directory of buckle run)"};
-  const std::string generator = scene::outputGenerator(dirName);
-  if (generator.empty())
-    throw NotAnOutput{dirName + " is not a buckle output: it has no summary.json written by buckle run"};
-  if (generator != scene::kRunGenerator)
-    throw NotAnOutput{dirName + " is a `" + generator + "` output, not a `buckle run` one; its table is " +
-                      (dir / "atlas.csv").string() + " (columns: docs/outputs.md)"};
-  const json summary = readJson(dir / "summary.json");
-  const json sp = readJson(dir / "special_points.json");
-
+/// The run's scene, completeness, units, problems, what it computed, its accuracy and cases.
+void showHeader(const std::string& dirName, const json& summary, std::ostream& os) {
   os << dirName << ": buckle run of " << text(field(summary, "scene")) << "\n";
   const std::string description = text(field(summary, "description"));
   if (description != "-") os << "  " << description.substr(0, 200) << (description.size() > 200 ? "…" : "") << "\n";
@@ -129,7 +117,10 @@ void show(const std::string& dirName, std::ostream& os) {
     for (size_t c = 0; c < cases.size(); ++c) os << (c ? ";" : "") << " " << c << " = " << text(field(cases[c], "label"));
     os << "\n";
   }
+}
 
+/// special_points.json's points as a table.
+void showSpecialPoints(const json& sp, std::ostream& os) {
   const json& points = list(sp, "special_points");
   if (points.empty()) {
     os << "\nspecial points: none\n";
@@ -165,21 +156,11 @@ void show(const std::string& dirName, std::ostream& os) {
     }
     printTable(os, header, rows, right);
   }
+}
 
-  std::vector<std::vector<std::string>> rows;
-  for (size_t c = 0; c < cases.size(); ++c)
-    for (const json& b : list(cases[c], "branches"))
-      rows.push_back({std::to_string(c), text(field(b, "id")), text(field(b, "parent")), text(field(b, "origin")),
-                      text(field(b, "points")), text(field(b, "stop")), text(field(b, "finished")),
-                      text(field(b, "stop_message"))});
-  if (rows.empty()) {
-    os << "\nbranches: none\n";
-  } else {
-    os << "\nbranches (" << rows.size() << ", summary.json; points in branches.csv):\n";
-    printTable(os, {"case", "id", "parent", "origin", "points", "stop", "finished", "message"}, rows,
-               {true, true, true, false, true, false, false, false});
-  }
-
+/// The analyses' results other than branches: critical loads, energy-curve equilibria, every
+/// equilibrium at one state, torque zeros, sudden load.
+void showAnalyses(const json& sp, std::ostream& os) {
   if (const json& critical = list(sp, "critical_loads"); !critical.empty()) {
     std::vector<std::vector<std::string>> crit;
     for (const json& m : critical)
@@ -242,6 +223,41 @@ void show(const std::string& dirName, std::ostream& os) {
     printTable(os, {"case", "value", "model", "at rest", "stable", "differs from quasi-static", "lower in Π", "message"},
                t, {true, true, false, false, false, false, false, false});
   }
+}
+
+void show(const std::string& dirName, std::ostream& os) {
+  const fs::path dir(dirName);
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) throw NotAnOutput{dirName + " does not exist"};
+  if (!fs::is_directory(dir, ec)) throw NotAnOutput{dirName + " is not a directory (give the output directory of buckle run)"};
+  const std::string generator = scene::outputGenerator(dirName);
+  if (generator.empty())
+    throw NotAnOutput{dirName + " is not a buckle output: it has no summary.json written by buckle run"};
+  if (generator != scene::kRunGenerator)
+    throw NotAnOutput{dirName + " is a `" + generator + "` output, not a `buckle run` one; its table is " +
+                      (dir / "atlas.csv").string() + " (columns: docs/outputs.md)"};
+  const json summary = readJson(dir / "summary.json");
+  const json sp = readJson(dir / "special_points.json");
+
+  showHeader(dirName, summary, os);
+  showSpecialPoints(sp, os);
+
+  const json& cases = list(summary, "cases");
+  std::vector<std::vector<std::string>> rows;
+  for (size_t c = 0; c < cases.size(); ++c)
+    for (const json& b : list(cases[c], "branches"))
+      rows.push_back({std::to_string(c), text(field(b, "id")), text(field(b, "parent")), text(field(b, "origin")),
+                      text(field(b, "points")), text(field(b, "stop")), text(field(b, "finished")),
+                      text(field(b, "stop_message"))});
+  if (rows.empty()) {
+    os << "\nbranches: none\n";
+  } else {
+    os << "\nbranches (" << rows.size() << ", summary.json; points in branches.csv):\n";
+    printTable(os, {"case", "id", "parent", "origin", "points", "stop", "finished", "message"}, rows,
+               {true, true, true, false, true, false, false, false});
+  }
+
+  showAnalyses(sp, os);
   std::vector<std::string> csv;
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
     if (e.path().extension() == ".csv") csv.push_back(e.path().filename().string());

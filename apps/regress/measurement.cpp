@@ -27,8 +27,8 @@ namespace {
 MeasuredCase fromScene(const scene::CaseResult& c) {
   MeasuredCase m;
   m.label = c.label;
-  for (const scene::SpecialRecord& s : c.specials)
-    m.specials.push_back({s.branch, s.type, s.parameter, s.shape, s.accuracy,
+  for (const scene::SpecialPointResult& s : c.specials)
+    m.specials.push_back({s.branch, mechanics::label(s.type), s.parameter, s.shape, s.accuracy,
                           s.koiter.valid ? mechanics::postBucklingName(s.koiter) : std::string()});
   // the located results of the analyses without branches, on pseudo-branch -1
   if (c.haveCritical)
@@ -61,7 +61,7 @@ MeasuredCase fromScene(const scene::CaseResult& c) {
     for (Eigen::Index i = 0; i < c.points.front().omega.size(); ++i)
       if (std::isfinite(c.points.front().omega[i]))
         m.specials.push_back({-1, "OMEGA", c.points.front().omega[i], "mode " + std::to_string(i + 1), 0.0, {}});
-  for (const scene::PointRecord& p : c.points) {
+  for (const mechanics::PointReport& p : c.points) {
     if (m.branches.empty() || m.branches.back().id != p.branch) m.branches.push_back({p.branch, {}, {}, {}});
     MeasuredBranch& b = m.branches.back();
     b.index.push_back(p.index);

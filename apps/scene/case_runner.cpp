@@ -18,54 +18,6 @@ namespace buckle::scene {
 namespace cont = buckle::continuation;
 namespace mech = buckle::mechanics;
 
-namespace {
-
-void copyLanding(const mech::Landing& l, SpecialRecord& s) {
-  s.jumpTried = l.tried;
-  s.jumpSuccess = l.success;
-  s.jumpLanding = l.kind;
-  s.jumpMessage = l.message;
-  s.jumpQ = l.q;
-  s.jumpF = l.F;
-  s.jumpPose = l.pose;
-  s.jumpShape = l.shape;
-  s.energyReleased = l.energyReleased;
-  s.jumpDistance = l.distance;
-  s.jumpContacts = l.contacts;
-}
-
-SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
-  SpecialRecord s;
-  s.type = mech::label(sp.type);
-  s.field = mech::toString(sp.phenomenon);
-  s.branch = branch;
-  s.parameter = sp.parameter;
-  s.F = sp.F;
-  s.pose = sp.pose;
-  s.q = sp.q;
-  s.shape = sp.shape;
-  s.stabilityBefore = sp.stabilityBefore;
-  s.stabilityAfter = sp.stabilityAfter;
-  s.accuracy = sp.accuracy;
-  s.residual = sp.residual;
-  s.K = sp.K;
-  s.refined = sp.refined;
-  s.multiplicity = sp.multiplicity;
-  s.branchesPredicted = sp.branchesPredicted;
-  s.branchesFound = sp.branchesFound;
-  s.note = sp.note;
-  s.joint = sp.joint;
-  s.contactTorque = sp.contactTorque;
-  s.lockedAfter = sp.lockedAfter.label();
-  s.contactPoint = sp.contactPoint;
-  s.koiter = sp.koiter;
-  s.imperfections = sp.imperfections;
-  copyLanding(sp.landing, s);
-  return s;
-}
-
-}  // namespace
-
 std::string solverFailureInWords(const std::string& solverMessage) {
   if (solverMessage.find("KIN_") == std::string::npos) return solverMessage;
   const auto has = [&solverMessage](const char* flag) { return solverMessage.find(flag) != std::string::npos; };
@@ -111,67 +63,57 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   }
   out_.branches.push_back(br);
 
+  const bool frequencies = scene_.analyses.frequencies.enabled;
   for (const mech::PointReport& p : report.points) {
-    PointRecord r;
+    mech::PointReport& r = out_.points.emplace_back(p);
     r.branch = b.id;
-    r.index = p.index;
-    r.parameter = p.parameter;
-    r.q = p.q;
-    r.F = p.F;
-    r.pose = p.pose;
-    r.negative = p.negative;
-    r.stable = p.stable;
-    r.minEigenvalue = p.minEigenvalue;
-    r.haveStiffness = p.haveStiffness;
-    r.K = p.K;
-    r.C = p.C;
-    r.Kphi = p.rotationalStiffness;
-    r.locked = p.locked.label();
-    r.contactTorque = p.contactTorque;
-    if (scene_.analyses.frequencies.enabled) r.omega = naturalFrequencies(p.q, p.F, p.locked, p.parameter);
-    out_.points.push_back(std::move(r));
+    if (frequencies) r.omega = naturalFrequencies(p.q, p.F, p.locked, p.parameter);
   }
   run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
 
   for (const mech::SpecialPointReport& sp : report.specialPoints) {
-    SpecialRecord s = toRecord(sp, b.id);
+    SpecialPointResult s{sp, {}};
+    s.branch = b.id;
     // at the located point itself (plots mark it there), the joints locked as at the traced point before it
-    if (scene_.analyses.frequencies.enabled && sp.q.size() == out_.chain.size() && !report.points.empty()) {
+    if (frequencies && sp.q.size() == out_.chain.size() && !report.points.empty()) {
       const mech::PointReport* before = &report.points.front();
       for (const mech::PointReport& p : report.points)
         if (p.index <= sp.index) before = &p;
       s.omega = naturalFrequencies(sp.q, sp.F, before->locked, sp.parameter);
     }
     if (sp.source >= 0) run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
-    if (scene_.analyses.jump.enabled && sp.jumps && sp.source >= 0 && !throughLoad()) {
-      const cont::SpecialPoint& fold = b.specialPoints[size_t(sp.source)];
-      if (interrupted()) {
-        s.jumpMessage = "not simulated: " + run_.interruption;
-      } else {
-        if (control_.progress) control_.progress->note("jump from the fold at " + std::to_string(fold.lambda));
-        mech::JumpOptions opt;
-        opt.perturbation = scene_.analyses.jump.perturbation;
-        opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
-        opt.integration.recordTrajectory = false;
-        // The fold of a mirror image branch jumps as the mirror image of its source's fold.
-        const auto source = landings_.find({b.mirrorOf, sp.source});
-        const mech::Landing landing = b.mirrorOf >= 0 && source != landings_.end()
-                                          ? mech::mirrored(source->second)
-                                          : mech::jumpFromFold(problem, fold, opt);
-        landings_[{b.id, sp.source}] = landing;
-        copyLanding(landing, s);
-        if (landing.interrupted) {
-          interrupted();
-        } else if (!landing.success) {
-          run_.complete = false;
-          run_.problems.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter +
-                                  " = " + std::to_string(fold.lambda) +
-                                  " did not land on a stable equilibrium: " + landing.message);
-        }
-      }
-    }
-    out_.specials.push_back(s);
+    if (scene_.analyses.jump.enabled && sp.jumps && sp.source >= 0 && !throughLoad()) s.landing = jumpFrom(b, sp, problem);
+    out_.specials.push_back(std::move(s));
   }
+}
+
+// The jump from the fold `sp` of branch b (the jump analysis): where the chain lands.
+mech::Landing CaseRunner::jumpFrom(const cont::Branch& b, const mech::SpecialPointReport& sp,
+                                   mech::EquilibriumProblem& problem) {
+  const cont::SpecialPoint& fold = b.specialPoints[size_t(sp.source)];
+  if (interrupted()) {
+    mech::Landing none;
+    none.message = "not simulated: " + run_.interruption;
+    return none;
+  }
+  if (control_.progress) control_.progress->note("jump from the fold at " + std::to_string(fold.lambda));
+  mech::JumpOptions opt;
+  opt.perturbation = scene_.analyses.jump.perturbation;
+  opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
+  opt.integration.recordTrajectory = false;
+  // The fold of a mirror image branch jumps as the mirror image of its source's fold.
+  const auto source = landings_.find({b.mirrorOf, sp.source});
+  const mech::Landing landing = b.mirrorOf >= 0 && source != landings_.end() ? mech::mirrored(source->second)
+                                                                             : mech::jumpFromFold(problem, fold, opt);
+  landings_[{b.id, sp.source}] = landing;
+  if (landing.interrupted) {
+    interrupted();
+  } else if (!landing.success) {
+    run_.complete = false;
+    run_.problems.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter + " = " +
+                            std::to_string(fold.lambda) + " did not land on a stable equilibrium: " + landing.message);
+  }
+  return landing;
 }
 
 // The load history of the scene: stable quasi-static pieces joined by jumps. Each piece is a
@@ -208,9 +150,12 @@ void CaseRunner::loadHistory() {
            << (h.segmentBifurcated[k] ? ", on the stable branch born at the branch point" : "");
     record(b, mech::reportBranch(problem, b, reportOptions()), problem, origin.str());
   }
-  for (const mech::JumpRecord& j : h.jumps)
-    out_.specials.push_back(
-        toRecord(mech::reportJump(problem, j, spec_.path.parameter), j.fromSegment >= 0 ? base + j.fromSegment : base));
+  for (const mech::JumpRecord& j : h.jumps) {
+    SpecialPointResult& s = out_.specials.emplace_back();
+    static_cast<mech::SpecialPointReport&>(s) = mech::reportJump(problem, j, spec_.path.parameter);
+    s.branch = j.fromSegment >= 0 ? base + j.fromSegment : base;
+    s.landing = mech::landingOf(problem, j);
+  }
   if (!h.completed && !interrupted()) {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": load history stopped: " + h.message);

@@ -1,6 +1,5 @@
-// One case of a scene, stage by stage: what each analysis asks of the library, and the
-// conversion of the library's reports into the records the writers read (runner.h). Internal
-// to the scene runner.
+// One case of a scene, stage by stage: what each analysis asks of the library, and its reports
+// collected into the case's result (runner.h). Internal to the scene runner.
 #pragma once
 
 #include <map>
@@ -70,6 +69,10 @@ class CaseRunner {
   void disconnectedBranchesAt(EquilibriumSet& set);
   void record(const continuation::Branch& b, const mechanics::BranchReport& report, mechanics::EquilibriumProblem& problem,
               const std::string& origin);
+  /// The `jump` analysis at the fold `sp` of branch b: where the chain lands (a mirror image
+  /// branch's fold: the image of its source's landing).
+  mechanics::Landing jumpFrom(const continuation::Branch& b, const mechanics::SpecialPointReport& sp,
+                              mechanics::EquilibriumProblem& problem);
   /// `frequencies` (case_frequencies.cpp): the signed natural frequencies at joint angles q under
   /// the total end wrench F with the joints of `locked` locked (`parameter`: for a message).
   Eigen::VectorXd naturalFrequencies(const Eigen::VectorXd& q, const mechanics::Wrench& F,

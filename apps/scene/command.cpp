@@ -53,10 +53,11 @@ std::string countsLine(const RunResult& run) {
     points += c.points.size();
     branches += c.branches.size();
     specials += c.specials.size();
-    for (const SpecialRecord& s : c.specials) {
-      auto it = std::find_if(byType.begin(), byType.end(), [&](const auto& t) { return t.first == s.type; });
+    for (const SpecialPointResult& s : c.specials) {
+      const std::string type = mechanics::label(s.type);
+      auto it = std::find_if(byType.begin(), byType.end(), [&](const auto& t) { return t.first == type; });
       if (it == byType.end())
-        byType.emplace_back(s.type, 1);
+        byType.emplace_back(type, 1);
       else
         ++it->second;
     }

@@ -20,6 +20,7 @@
 #include "scene/escape.h"
 #include "scene/output_target.h"
 #include "scene/report.h"
+#include "scene/special_marks.h"
 
 namespace buckle::scene {
 
@@ -116,7 +117,7 @@ void writeJointAngles(const RunResult& run, int n, const fs::path& file) {
   std::vector<double> row(static_cast<std::size_t>(n));
   bytes.reserve(bytes.size() + rows * row.size() * sizeof(double));
   for (const CaseResult& cr : run.cases)
-    for (const PointRecord& p : cr.points) {
+    for (const mechanics::PointReport& p : cr.points) {
       for (int i = 0; i < n; ++i) row[std::size_t(i)] = i < p.q.size() ? p.q[i] : std::numeric_limits<double>::quiet_NaN();
       bytes.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(double));  // x86-64/ARM: little-endian
     }
@@ -152,7 +153,7 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
   os.reserve(os.size() + rows * std::size_t(20 + 19 * (sideFile ? 13 : 11 + n)));
   for (size_t c = 0; c < run.cases.size(); ++c) {
     const CaseResult& cr = run.cases[c];
-    for (const PointRecord& p : cr.points) {
+    for (const mechanics::PointReport& p : cr.points) {
       auto field = [&os](double v) {
         os += ',';
         appendNumber(os, v);
@@ -185,13 +186,13 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
       appendInteger(os, p.negative);
       field(p.minEigenvalue);
       os += ',';
-      os += escape::csvField(p.locked);
+      os += escape::csvField(p.locked.label());
       field(p.contactTorque);
       if (scene.analyses.stiffness)
-        for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C, p.Kphi));
+        for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C, p.rotationalStiffness));
       if (scene.analyses.frequencies.enabled)
         for (int i = 0; i < scene.analyses.frequencies.count; ++i) field(i < p.omega.size() ? p.omega[i] : kNaN);
-      for (const std::string& column : inputs) field(inputValue(column, p.inputs, p.inputNames.get()));
+      for (const std::string& column : inputs) field(inputValue(column, p.inputs, &cr.inputNames));
       os += '\n';
     }
   }
@@ -217,12 +218,12 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
   json points = json::array(), critical = json::array(), equilibria = json::array(), torque = json::array();
   for (size_t c = 0; c < run.cases.size(); ++c) {
     const CaseResult& cr = run.cases[c];
-    for (const SpecialRecord& s : cr.specials) {
+    for (const SpecialPointResult& s : cr.specials) {
       json p;
       p["case"] = c;
       p["case_label"] = cr.label;
-      p["type"] = s.type;
-      p["field"] = s.field;
+      p["type"] = mechanics::label(s.type);
+      p["field"] = fieldName(cr, s);
       p["branch"] = s.branch;
       p["parameter"] = number(s.parameter);
       p["loads"] = wrenchJson(s.F);
@@ -235,10 +236,10 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       // K_F where the report computed it (a located KMIN: the stiffness at the minimum itself)
       if (s.K.allFinite()) p["stiffness"] = {{"Kxx", number(s.K(0, 0))}, {"Kyy", number(s.K(1, 1))}, {"Kxy", number(s.K(0, 1))}};
       if (!s.note.empty()) p["note"] = s.note;
-      if (s.inputNames) {  // a task path: the inputs at the point
+      if (!cr.inputNames.empty()) {  // a task path: the inputs at the point
         json in = json::object();
-        for (size_t j = 0; j < s.inputNames->size() && Eigen::Index(j) < s.inputs.size(); ++j)
-          in[(*s.inputNames)[j]] = number(s.inputs[Eigen::Index(j)]);
+        for (size_t j = 0; j < cr.inputNames.size() && Eigen::Index(j) < s.inputs.size(); ++j)
+          in[cr.inputNames[j]] = number(s.inputs[Eigen::Index(j)]);
         p["inputs"] = in;
       }
       if (s.multiplicity > 1) p["multiplicity"] = s.multiplicity;
@@ -268,21 +269,21 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
         p["imperfection_sensitivity"] = imperfections;
       }
       if (s.joint >= 0)  // CT / RL
-        p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", number(s.contactTorque)}, {"locked_after", s.lockedAfter}};
-      if (s.jumpTried) {
+        p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", number(s.contactTorque)}, {"locked_after", s.lockedAfter.label()}};
+      if (const mechanics::Landing& l = s.landing; l.tried) {
         json j;
-        j["success"] = s.jumpSuccess;
-        j["landing"] = s.jumpLanding;
-        j["message"] = s.jumpMessage;
-        if (s.jumpQ.size() > 0) {
-          j["q"] = vectorJson(s.jumpQ);
-          j["loads"] = wrenchJson(s.jumpF);
-          j["position"] = poseJson(s.jumpPose);
-          j["shape"] = s.jumpShape;
+        j["success"] = l.success;
+        j["landing"] = l.kind;
+        j["message"] = l.message;
+        if (l.q.size() > 0) {
+          j["q"] = vectorJson(l.q);
+          j["loads"] = wrenchJson(l.F);
+          j["position"] = poseJson(l.pose);
+          j["shape"] = l.shape;
         }
-        j["energy_released"] = number(s.energyReleased);
-        j["distance"] = number(s.jumpDistance);
-        j["contacts"] = contactsJson(s.jumpContacts);
+        j["energy_released"] = number(l.energyReleased);
+        j["distance"] = number(l.distance);
+        j["contacts"] = contactsJson(l.contacts);
         p["jump_to"] = j;
       }
       points.push_back(p);
@@ -479,8 +480,8 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
         json errors = json::object();
         for (const auto& [name, exact] : {std::pair<std::string, double>{"U", a.FxU}, {"Z", a.FxZ}}) {
           double best = std::numeric_limits<double>::infinity();
-          for (const SpecialRecord& s : cr.specials)
-            if (s.type == "BP") best = std::min(best, std::abs(s.F[0] - exact));
+          for (const SpecialPointResult& s : cr.specials)
+            if (s.type == mechanics::EventType::BranchPoint) best = std::min(best, std::abs(s.F[0] - exact));
           if (std::isfinite(best)) errors["continuation_BP_" + name] = best;
           double lin = std::numeric_limits<double>::infinity();
           for (const auto& m : cr.critical.modes) lin = std::min(lin, std::abs(m.lambda - exact));
@@ -504,26 +505,26 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
   return doc;
 }
 
-double columnValue(const std::string& column, const PointRecord& p, const mechanics::Pose& pose0) {
+double columnValue(const std::string& column, const mechanics::PointReport& p, const CaseResult& cr) {
   bool found = false;
-  const double v = commonColumn(column, p.parameter, p.F, p.pose, p.q, pose0, found);
+  const double v = commonColumn(column, p.parameter, p.F, p.pose, p.q, cr.pose0, found);
   if (found) return v;
   if (column == "min_eig") return p.minEigenvalue;
   if (const int i = frequencyIndex(column); i >= 0) return i < p.omega.size() ? p.omega[i] : kNaN;
-  if (p.inputNames) {
-    const double v = inputValue(column, p.inputs, p.inputNames.get());
+  if (!cr.inputNames.empty()) {
+    const double v = inputValue(column, p.inputs, &cr.inputNames);
     if (!std::isnan(v)) return v;
   }
-  return stiffnessColumnValue(column, p.K, p.C, p.Kphi);
+  return stiffnessColumnValue(column, p.K, p.C, p.rotationalStiffness);
 }
 
-double columnValue(const std::string& column, const SpecialRecord& s, const mechanics::Pose& pose0) {
+double columnValue(const std::string& column, const mechanics::SpecialPointReport& s, const CaseResult& cr) {
   bool found = false;
-  const double v = commonColumn(column, s.parameter, s.F, s.pose, s.q, pose0, found);
+  const double v = commonColumn(column, s.parameter, s.F, s.pose, s.q, cr.pose0, found);
   if (found) return v;
   if (const int i = frequencyIndex(column); i >= 0) return i < s.omega.size() ? s.omega[i] : kNaN;
-  if (s.inputNames) {
-    const double v = inputValue(column, s.inputs, s.inputNames.get());
+  if (!cr.inputNames.empty()) {
+    const double v = inputValue(column, s.inputs, &cr.inputNames);
     if (!std::isnan(v)) return v;
   }
   // NaN unless the point carries its own K_F (KMIN)

@@ -178,7 +178,7 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   s.height = std::min<int>(4800, int(kShapePanel.y() * double(nc * rowsPerCase)) + 60);
 
   // per case, the point drawn at each requested level (null: not drawn, `missing` says why)
-  std::vector<std::vector<const PointRecord*>> chosenOf;
+  std::vector<std::vector<const mechanics::PointReport*>> chosenOf;
   std::vector<std::vector<std::string>> missingOf;
   for (size_t c : selected(spec)) {
     const CaseResult& cr = run.cases[c];
@@ -186,20 +186,20 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
     // the traced stable range, and the sampling of the parameter along the branches
     double lo = std::numeric_limits<double>::infinity(), hi = -lo, spacing = 0.0;
     for (size_t i = 0; i < cr.points.size(); ++i) {
-      const PointRecord& p = cr.points[i];
+      const mechanics::PointReport& p = cr.points[i];
       if (p.stable) lo = std::min(lo, p.parameter), hi = std::max(hi, p.parameter);
       if (i > 0 && cr.points[i - 1].branch == p.branch)
         spacing = std::max(spacing, std::abs(p.parameter - cr.points[i - 1].parameter));
     }
     const double slack = 1e-9 * std::max(std::abs(lo), std::abs(hi));
-    std::vector<const PointRecord*>& chosen = chosenOf.emplace_back();
+    std::vector<const mechanics::PointReport*>& chosen = chosenOf.emplace_back();
     std::vector<std::string>& missing = missingOf.emplace_back(na);
     for (size_t k = 0; k < na; ++k) {
       const double at = spec.at[k];
       // the stable point nearest to the requested level; among equals, the most deflected
-      const PointRecord* best = nullptr;
+      const mechanics::PointReport* best = nullptr;
       double bestD = std::numeric_limits<double>::infinity();
-      for (const PointRecord& p : cr.points) {
+      for (const mechanics::PointReport& p : cr.points) {
         if (!p.stable) continue;
         const double d = std::abs(p.parameter - at) - 1e-9 * p.q.cwiseAbs().sum();
         if (d < bestD) {
@@ -233,7 +233,7 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   // each panel to its own scale: the chain drawn there (and the base) fills it, true to its
   // aspect ratio; a margin of 1.2 b around it (b the mean half-length: a chain is 2 b n long), or
   // 3 % of a long chain's extent
-  auto boxOf = [&](size_t o, const PointRecord* p) {
+  auto boxOf = [&](size_t o, const mechanics::PointReport* p) {
     const CaseResult& cr = run.cases[size_t(spec.cases[o])];
     Eigen::AlignedBox2d box;
     box.extend(Eigen::Vector2d(0.0, 0.0));
@@ -267,7 +267,7 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
     const CaseResult& cr = run.cases[c];
     const std::string& parameter = scene.cases[c].path.parameter;
     for (size_t k = 0; k < na; ++k) {
-      const PointRecord* p = chosenOf[o][k];
+      const mechanics::PointReport* p = chosenOf[o][k];
       const std::string base = stem + "_" + std::to_string(c) + "_" + std::to_string(k);
       writeChainFiles(cr.chain, p ? &p->q : nullptr, dir, base, detailed);
       std::ostringstream title;
@@ -284,7 +284,7 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
         if (p->haveStiffness && std::isfinite(p->K(0, 0)))
           title << ",  K_{xx} = " << short5(p->K(0, 0)) << ", K_{yy} = " << short5(p->K(1, 1))
                 << " " << scene.units.unit(Dimension::Stiffness);
-        if (!p->locked.empty()) title << lockedTitle(p->locked);  // locked at a limit
+        if (!p->locked.empty()) title << lockedTitle(p->locked.label());  // locked at a limit
       } else {
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(spec.at[k]) << ": not drawn";
         s.body << "set label 1 " << quote(missingOf[o][k]) << " at graph 0.5, graph 0.5 center font ',9' noenhanced\n";

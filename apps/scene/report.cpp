@@ -106,7 +106,7 @@ struct PageSelection {
 
 PageSelection pageSelection(const CaseResult& cr, size_t columns) {
   PageSelection s;
-  const std::vector<PointRecord>& pts = cr.points;
+  const std::vector<mechanics::PointReport>& pts = cr.points;
   const size_t perPoint = columns + 3;
   s.stride = std::max<size_t>(1, (pts.size() * perPoint + kPointBudget - 1) / kPointBudget);
   size_t first = 0;  // the first point of the current branch
@@ -136,7 +136,7 @@ std::set<std::string> drawnColumns(const Scene& scene, const std::string& mainX,
 /// points `shown` selects.
 Members pointMembers(const CaseResult& cr, const std::set<std::string>& columns, const PageSelection& shown) {
   const std::vector<size_t>& keep = shown.points;
-  auto at = [&](size_t k) -> const PointRecord& { return cr.points[keep[k]]; };
+  auto at = [&](size_t k) -> const mechanics::PointReport& { return cr.points[keep[k]]; };
   Members m;
   std::string text;
   appendArray(text, keep.size(), [&](size_t k) { text += std::to_string(at(k).branch); });
@@ -144,7 +144,7 @@ Members pointMembers(const CaseResult& cr, const std::set<std::string>& columns,
   Members cols;
   for (const std::string& name : columns) {
     std::string values;
-    appendArray(values, keep.size(), [&](size_t k) { appendRoundedJson(values, columnValue(name, at(k), cr.pose0), 6); });
+    appendArray(values, keep.size(), [&](size_t k) { appendRoundedJson(values, columnValue(name, at(k), cr), 6); });
     cols.emplace_back(name, std::move(values));
   }
   m.emplace_back("columns", objectText(json::object(), std::move(cols)));
@@ -185,10 +185,10 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
   json specials = json::array();
   const std::vector<Importance> rank = importance(cr);  // as the gnuplot diagrams rank them
   for (size_t k = 0; k < cr.specials.size(); ++k) {
-    const SpecialRecord& s = cr.specials[k];
+    const SpecialPointResult& s = cr.specials[k];
     const bool shape = k < shown.specialShapes;
-    json e{{"type", s.type},
-           {"field", s.field},
+    json e{{"type", mechanics::label(s.type)},
+           {"field", fieldName(cr, s)},
            {"branch", s.branch},
            {"parameter", rounded(s.parameter, 10)},
            {"Fx", rounded(s.F[0], 10)},
@@ -202,22 +202,22 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
            {"refined", s.refined},
            {"note", s.note}};
     json values = json::object();
-    for (const std::string& name : columns) values[name] = rounded(columnValue(name, s, cr.pose0), 10);
+    for (const std::string& name : columns) values[name] = rounded(columnValue(name, s, cr), 10);
     e["values"] = values;
     e["label"] = specialLabel(s, false);
     e["label_summary"] = specialLabel(s, true);
     e["rank"] = static_cast<int>(rank[k]);
     if (shape && s.q.size() == cr.chain.size()) e["joints"] = jointsJson(cr.chain, s.q);
-    if (s.jumpTried) {
-      e["jump"] = s.jumpSuccess ? s.jumpLanding + (s.jumpShape.empty() ? "" : " (" + s.jumpShape + ")") : "failed: " + s.jumpMessage;
-      if (shape && s.jumpQ.size() == cr.chain.size()) e["jump_joints"] = jointsJson(cr.chain, s.jumpQ);
-      if (s.jumpSuccess && s.jumpQ.size() == cr.chain.size()) {  // where the diagrams' jump arrow ends
-        SpecialRecord to = s;
-        to.q = s.jumpQ;
-        to.F = s.jumpF;
-        to.pose = s.jumpPose;
+    if (const mechanics::Landing& l = s.landing; l.tried) {
+      e["jump"] = l.success ? l.kind + (l.shape.empty() ? "" : " (" + l.shape + ")") : "failed: " + l.message;
+      if (shape && l.q.size() == cr.chain.size()) e["jump_joints"] = jointsJson(cr.chain, l.q);
+      if (l.success && l.q.size() == cr.chain.size()) {  // where the diagrams' jump arrow ends
+        mechanics::SpecialPointReport to = s;
+        to.q = l.q;
+        to.F = l.F;
+        to.pose = l.pose;
         json landing = json::object();
-        for (const std::string& name : columns) landing[name] = rounded(columnValue(name, to, cr.pose0), 10);
+        for (const std::string& name : columns) landing[name] = rounded(columnValue(name, to, cr), 10);
         e["landing"] = landing;
       }
     }

@@ -13,6 +13,7 @@
 #include "buckle/mechanics/critical_curves.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/all_equilibria.h"
+#include "buckle/mechanics/branch_report.h"
 #include "buckle/mechanics/energy_landscape.h"
 #include "buckle/mechanics/imperfection_sensitivity.h"
 #include "buckle/mechanics/koiter.h"
@@ -24,78 +25,11 @@
 
 namespace buckle::scene {
 
-/// One point of a traced branch, in physical quantities.
-struct PointRecord {
-  int branch = 0;
-  int index = 0;
-  double parameter = 0.0;
-  mechanics::Wrench F = mechanics::Wrench::Zero();  ///< total end wrench (loads and reactions)
-  mechanics::Pose pose = mechanics::Pose::Zero();
-  Eigen::VectorXd q;
-  bool stable = false;
-  int negative = -1;       ///< negative eigenvalues of the stability operator
-  double minEigenvalue = 0.0;
-  bool haveStiffness = false;
-  Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
-  Eigen::Matrix2d C = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());  ///< C_F
-  double Kphi = std::numeric_limits<double>::quiet_NaN();  ///< the end's rotational stiffness (φ free)
-  std::string locked;         ///< joints locked at their limits, "3U 5L" (ContactSet::label), "" none
-  double contactTorque = 0.0; ///< largest compression of the locked joints (0: none locked)
-  /// `frequencies`: the signed natural frequencies ω_i (vibration.h; negative: unstable, minus
-  /// the growth rate), NaN beyond the constrained chain's modes; empty otherwise
-  Eigen::VectorXd omega;
-  /// Along a task path: the inputs' values and their names (mechanics::taskInputName; shared by
-  /// the case's records), the columns of branches.csv beside the loads; empty otherwise
-  Eigen::VectorXd inputs;
-  std::shared_ptr<const std::vector<std::string>> inputNames;
-};
-
-struct SpecialRecord {
-  std::string type;        ///< "BP" branch point, "LP" fold, "BD" joint limit, "KMIN" stiffness minimum
-  std::string field;       ///< "buckling", "quasi-buckling", "jumping"
-  int branch = 0;
-  double parameter = 0.0;
-  mechanics::Wrench F = mechanics::Wrench::Zero();
-  mechanics::Pose pose = mechanics::Pose::Zero();
-  Eigen::VectorXd q;
-  std::string shape;       ///< shapeName of the branch leaving a BP / of q elsewhere
-  std::string stabilityBefore, stabilityAfter;
-  double accuracy = 0.0;   ///< |Δλ| of the last location iterate
-  /// K_F at the point where the report computed it (KMIN, located between traced points), else NaN
-  Eigen::Matrix2d K = Eigen::Matrix2d::Constant(std::numeric_limits<double>::quiet_NaN());
-  double residual = 0.0;   ///< ‖F(u, λ)‖₂ at the point
-  bool refined = false;
-  int multiplicity = 1;         ///< BP: eigenvalues crossing zero together
-  /// Multiple BP: half-branches predicted by the reduced bifurcation equation / traced (−1: none)
-  int branchesPredicted = -1, branchesFound = -1;
-  std::string note;
-  // contact (CT / RL): the joint (0-based, −1 otherwise), its contact torque at the point, and
-  // the joints locked after it (ContactSet::label)
-  int joint = -1;
-  double contactTorque = std::numeric_limits<double>::quiet_NaN();
-  std::string lockedAfter;
-  // jump analysis (folds only): where the chain lands when released there
-  bool jumpTried = false;
-  bool jumpSuccess = false;
-  std::string jumpLanding;   ///< "stable equilibrium" or "joint limit"
-  std::string jumpMessage;
-  Eigen::VectorXd jumpQ;
-  mechanics::Wrench jumpF = mechanics::Wrench::Zero();
-  mechanics::Pose jumpPose = mechanics::Pose::Zero();
-  std::string jumpShape;
-  double energyReleased = 0.0;
-  double jumpDistance = 0.0;
-  std::vector<mechanics::JointContact> jumpContacts;  ///< joints in contact at the landing
-  /// BC / SC: where the chain touches the wall or itself (NaN otherwise)
-  Eigen::Vector2d contactPoint = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
-  /// BP: Koiter's coefficients and the imperfection sensitivity (SpecialPointReport)
-  mechanics::KoiterCoefficients koiter;
-  std::vector<mechanics::ImperfectionSensitivity> imperfections;
-  /// `frequencies` at the located point (PointRecord::omega), empty where not computed
-  Eigen::VectorXd omega;
-  /// Along a task path: the inputs at the point (PointRecord::inputs)
-  Eigen::VectorXd inputs;
-  std::shared_ptr<const std::vector<std::string>> inputNames;
+/// A special point of a case: the library's report, and beside it where the chain lands when it
+/// jumps there (a fold's jump simulated by the `jump` analysis, a load history's JUMP; `tried`
+/// false elsewhere). Statics do not depend on dynamics, so the landing is not inside the report.
+struct SpecialPointResult : mechanics::SpecialPointReport {
+  mechanics::Landing landing;
 };
 
 struct BranchRecord {
@@ -160,8 +94,11 @@ struct CaseResult {
   mechanics::Pose pose0 = mechanics::Pose::Zero();
   double startValue = 0.0;
   std::vector<BranchRecord> branches;
-  std::vector<PointRecord> points;
-  std::vector<SpecialRecord> specials;
+  /// Every reported point of every branch, in the order the branches were reported.
+  std::vector<mechanics::PointReport> points;
+  std::vector<SpecialPointResult> specials;
+  /// Along a task path: the names of PointReport::inputs (mechanics::taskInputName), else empty.
+  std::vector<std::string> inputNames;
   bool haveCritical = false;
   mechanics::LinearBucklingResult critical;
   bool haveAnalytic = false;       ///< the case is the paper's symmetric clamped–pinned 3-chain

@@ -1,30 +1,40 @@
 #include "scene/special_marks.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace buckle::scene {
 
+namespace mech = buckle::mechanics;
+using mech::EventType;
+
 const std::vector<SpecialStyle>& specialStyles() {
-  static const std::vector<SpecialStyle> styles = {{"BP", 7, "BP branch point", "#000000"},
-                                                   {"LP", 9, "LP fold", "#d62728"},
-                                                   {"LPF", 9, "LPF reaction fold", "#ff7f0e"},
-                                                   {"BD", 5, "BD joint limit", "#8c564b"},
-                                                   {"LS", 9, "LS loss of stability at fixed inputs", "#e377c2"},
-                                                   {"IB", 5, "IB input bound", "#bcbd22"},
-                                                   {"KMIN", 13, "KMIN Kxx minimum", "#9467bd"},
-                                                   {"JUMP", 11, "JUMP release", "#ff7f0e"},
-                                                   {"CT", 15, "CT contact (joint locks)", "#2ca02c"},
-                                                   {"RL", 3, "RL contact released", "#17becf"},
-                                                   {"BC", 5, "BC base contact (detected)", "#e377c2"},
-                                                   {"SC", 5, "SC self contact (detected)", "#7f7f7f"}};
+  static const std::vector<SpecialStyle> styles = {
+      {EventType::BranchPoint, 7, "BP branch point", "#000000"},
+      {EventType::Fold, 9, "LP fold", "#d62728"},
+      {EventType::ReactionFold, 9, "LPF reaction fold", "#ff7f0e"},
+      {EventType::Boundary, 5, "BD joint limit", "#8c564b"},
+      {EventType::StabilityLoss, 9, "LS loss of stability at fixed inputs", "#e377c2"},
+      {EventType::InputBound, 5, "IB input bound", "#bcbd22"},
+      {EventType::StiffnessMinimum, 13, "KMIN Kxx minimum", "#9467bd"},
+      {EventType::Jump, 11, "JUMP release", "#ff7f0e"},
+      {EventType::Contact, 15, "CT contact (joint locks)", "#2ca02c"},
+      {EventType::Release, 3, "RL contact released", "#17becf"},
+      {EventType::BaseContact, 5, "BC base contact (detected)", "#e377c2"},
+      {EventType::SelfContact, 5, "SC self contact (detected)", "#7f7f7f"},
+      {EventType::EigenvalueTouch, 7, "ET eigenvalue touches zero", "#555555"}};
   return styles;
 }
 
-const SpecialStyle& specialStyle(const std::string& type) {
+const SpecialStyle& specialStyle(EventType type) {
+  if (type == EventType::JointLimit) type = EventType::Boundary;
   for (const SpecialStyle& s : specialStyles())
     if (type == s.type) return s;
-  static const SpecialStyle other{"", 7, "special point", "#555555"};
-  return other;
+  throw std::logic_error(std::string("no marker style for special points ") + mech::label(type));
+}
+
+const char* fieldName(const CaseResult& cr, const mech::SpecialPointReport& s) {
+  return cr.inputNames.empty() ? mech::toString(s.phenomenon) : "task path";
 }
 
 std::vector<Importance> importance(const CaseResult& cr) {
@@ -33,13 +43,14 @@ std::vector<Importance> importance(const CaseResult& cr) {
     if (b.parent < 0) primary.push_back(b.id);
   std::vector<int> folded;
   std::vector<Importance> out;
-  for (const SpecialRecord& r : cr.specials) {
+  for (const SpecialPointResult& r : cr.specials) {
     Importance k = Importance::Other;
-    if (r.type == "BP" && std::find(primary.begin(), primary.end(), r.branch) != primary.end())
+    if (r.type == EventType::BranchPoint && std::find(primary.begin(), primary.end(), r.branch) != primary.end())
       k = Importance::PrimaryBranchPoint;
-    else if (r.type == "JUMP" || r.jumpSuccess)
+    else if (r.type == EventType::Jump || r.landing.success)
       k = Importance::Jump;
-    else if ((r.type == "LP" || r.type == "LPF") && std::find(folded.begin(), folded.end(), r.branch) == folded.end()) {
+    else if ((r.type == EventType::Fold || r.type == EventType::ReactionFold) &&
+             std::find(folded.begin(), folded.end(), r.branch) == folded.end()) {
       folded.push_back(r.branch);
       k = Importance::FirstFold;
     }
@@ -48,9 +59,9 @@ std::vector<Importance> importance(const CaseResult& cr) {
   return out;
 }
 
-std::string specialLabel(const SpecialRecord& r, bool summary) {
-  std::string label = r.type;
-  if (r.type == "BP" && !r.shape.empty() && r.shape != "other")
+std::string specialLabel(const mech::SpecialPointReport& r, bool summary) {
+  std::string label = mech::label(r.type);
+  if (r.type == EventType::BranchPoint && !r.shape.empty() && r.shape != "other")
     label += " " + (summary && r.shape.rfind("mode ", 0) == 0 ? r.shape.substr(5) : r.shape);
   return label;
 }

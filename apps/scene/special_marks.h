@@ -13,16 +13,21 @@ namespace buckle::scene {
 
 /// The marker of a special-point type.
 struct SpecialStyle {
-  const char* type;
+  mechanics::EventType type;
   int point;          ///< gnuplot point type, filled; point - 1 is the open outline
   const char* key;    ///< the key's entry
   const char* color;  ///< the type's colour (summary markers, the report's markers)
+  const char* label() const { return mechanics::label(type); }
 };
 
-/// Every type in the key's order.
+/// Every type in the key's order (BD once: a located boundary and a collapsed joint limit share it).
 const std::vector<SpecialStyle>& specialStyles();
-/// The style of `type` (a neutral one for a type the table does not know).
-const SpecialStyle& specialStyle(const std::string& type);
+/// The style of `type`.
+const SpecialStyle& specialStyle(mechanics::EventType type);
+
+/// The field's words for a special point (special_points.json's `field`): its phenomenon
+/// ("buckling", "quasi-buckling", "jumping", "none"), or "task path" along a task path.
+const char* fieldName(const CaseResult& cr, const mechanics::SpecialPointReport& s);
 
 // A bifurcation diagram of a 50-segment chain carries thousands of special points (2479 in the
 // default scene at n = 50: 882 LP, 764 CT, 352 RL, …). Like AUTO's and BifurcationKit's plots of
@@ -49,7 +54,7 @@ constexpr double kJumpMinPixels = 36.0;
 /// How much a special point matters in a summary, most first.
 enum class Importance { PrimaryBranchPoint, Jump, FirstFold, Other };
 
-/// Per special record of a case (same order as `cr.specials`): the branch points of the primary
+/// Per special point of a case (same order as `cr.specials`): the branch points of the primary
 /// branches (those with no parent: the start), the jumps (a load history's JUMP, a fold with a
 /// simulated jump), the first fold (LP, LPF) of each branch in the order the tracer reported
 /// them, the rest.
@@ -57,7 +62,7 @@ std::vector<Importance> importance(const CaseResult& cr);
 
 /// The label of a special point: its type, and a branch point's mode or shape ("BP U"; a
 /// summary writes "BP 12" for "mode 12", the key says so).
-std::string specialLabel(const SpecialRecord& r, bool summary);
+std::string specialLabel(const mechanics::SpecialPointReport& r, bool summary);
 
 /// One label for the texts of points drawn at one place; a summary writes the branch points'
 /// modes as ranges ("BP 3, 4", "BP 24-27"), the other texts after them.

@@ -79,9 +79,9 @@ TEST_CASE("the report embeds every traced point and special point of the run", "
   CHECK(c["shapes"].size() == cr.points.size());
   REQUIRE(c["specials"].size() == cr.specials.size());
   for (size_t i = 0; i < cr.specials.size(); ++i) {
-    const SpecialRecord& s = cr.specials[i];
+    const SpecialPointResult& s = cr.specials[i];
     const json& e = c["specials"][i];
-    CHECK(e["type"] == s.type);
+    CHECK(e["type"] == mech::label(s.type));
     CHECK(e["branch"] == s.branch);
     // 10 significant digits in the table
     CHECK(std::abs(e["parameter"].get<double>() - s.parameter) <= 1e-9 * std::max(1.0, std::abs(s.parameter)));
@@ -125,7 +125,7 @@ TEST_CASE("the page's data are written as nlohmann::json dumps them, values roun
   const json& c = data["cases"][0];
   REQUIRE(c["branch"].size() == cr.points.size());
   for (size_t i = 0; i < cr.points.size(); ++i) {
-    const PointRecord& p = cr.points[i];
+    const mech::PointReport& p = cr.points[i];
     CHECK(c["branch"][i] == p.branch);
     CHECK(c["point"][i] == p.index);
     CHECK(c["columns"]["parameter"][i].get<double>() == printed(p.parameter, 6));
@@ -204,7 +204,7 @@ TEST_CASE("the page of a large run stays a few megabytes and says what it left t
     br.points = perBranch;
     cr.branches.push_back(br);
     for (int i = 0; i < perBranch; ++i) {
-      PointRecord p;
+      mech::PointReport p;
       p.branch = b;
       p.index = i;
       p.parameter = -1e-3 * i;
@@ -214,8 +214,8 @@ TEST_CASE("the page of a large run stays a few megabytes and says what it left t
     }
   }
   for (int s = 0; s < 2000; ++s) {
-    SpecialRecord sp;
-    sp.type = "BP";
+    SpecialPointResult sp;
+    sp.type = mech::EventType::BranchPoint;
     sp.branch = s % branches;
     sp.q = Eigen::VectorXd::Constant(n, 1e-3 * s);
     cr.specials.push_back(std::move(sp));
@@ -240,7 +240,7 @@ TEST_CASE("the page of a large run stays a few megabytes and says what it left t
     const int b = c["branch"][k], i = c["point"][k];
     if (first[size_t(b)] < 0) first[size_t(b)] = i;
     last[size_t(b)] = i;
-    const PointRecord& p = cr.points[size_t(b * perBranch + i)];
+    const mech::PointReport& p = cr.points[size_t(b * perBranch + i)];
     CHECK(c["stable"][k] == (p.stable ? 1 : 0));
     CHECK(std::abs(c["columns"]["q2"][k].get<double>() - p.q[1]) <= 1e-5 * std::abs(p.q[1]) + 1e-300);
   }

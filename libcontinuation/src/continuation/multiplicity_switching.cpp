@@ -70,218 +70,235 @@ struct SecondDerivative {
   }
 };
 
-bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out, double kernelTolerance,
-                  int maxDenseDimension) {
-  const int n = problem.dimension();
-  out = ReducedBifurcation();
-  out.kernelDimension = m;
-  if (m < 1 || m > n || bp.u.size() != n) {
-    out.note = "multiplicity out of range";
+// The reduced bifurcation equation of a multiple branch point (Lyapunov–Schmidt on ker F_x), in
+// stages that share the kernels: the kernels ker F_x and ker F_xᵀ, the basis [t φ₁ … φ_m] with the
+// parent's tangent first, the quadratic coefficients A_j = ψ_jᵀ F_xx[k_a, k_b], and the roots of
+// the quadratic equation on the sphere or, where it vanishes on span φ, of the cubic one.
+class ReducedEquation {
+ public:
+  ReducedEquation(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out)
+      : problem_(problem), bp_(bp), n_(problem.dimension()), m_(m), r_(n_ - m), D_{problem, n_}, out_(out) {}
+
+  bool solve(double kernelTolerance, int maxDenseDimension) {
+    out_ = ReducedBifurcation();
+    out_.kernelDimension = m_;
+    if (m_ < 1 || m_ > n_ || bp_.u.size() != n_) return fail("multiplicity out of range");
+    const bool kernels = n_ > maxDenseDimension ? structuredKernels(kernelTolerance) : denseKernels(kernelTolerance);
+    if (!kernels || !basis() || !quadraticCoefficients()) return false;
+    if (qphi_ > 1e-6 * qmax_) {
+      solveQuadratic();
+    } else if (!solveCubic()) {
+      return false;
+    }
+    if (out_.directions.empty())
+      return fail(out_.order == 2 ? "quadratic bifurcation equation: no real root besides the parent"
+                                  : "cubic bifurcation equation: no real root");
+    out_.note = std::string(out_.order == 2 ? "quadratic" : "cubic") + " reduced bifurcation equation, m = " +
+                std::to_string(m_) + ": " + std::to_string(out_.directions.size()) + " solution directions";
+    return true;
+  }
+
+ private:
+  bool fail(const std::string &why) {
+    out_.note = why;
     return false;
   }
-  Matrix kernel, Psi;
+
   // Above the dense crossover the kernels come from bordered solves (structuredMultipleKernel, no
   // SVD; the problem's structured solver when it takes m + 1 borders, else dense LU of the
   // (N+m+1)² bordered matrix, e.g. for the κ = 0 chain's m = n − 1), and F_x⁺ from the bordered
-  // system [[F_x, Ψ], [Kᵀ, 0]]; at or below it the full SVD.
-  std::unique_ptr<BorderedSolver> solver;
-  std::unique_ptr<RefinedBorderedSystem> bordered;
-  Eigen::BDCSVD<Matrix> svd;
-  int r = n - m;  // rank
-  if (n > maxDenseDimension) {
-    solver = problem.makeStructuredSolver();
-    if (!solver || solver->maxGeneralBorder() < m + 1) solver = std::make_unique<DenseBorderedSolver>(problem);
+  // system [[F_x, Ψ], [Kᵀ, 0]].
+  bool structuredKernels(double kernelTolerance) {
+    const int n = n_, m = m_;
+    solver_ = problem_.makeStructuredSolver();
+    if (!solver_ || solver_->maxGeneralBorder() < m + 1) solver_ = std::make_unique<DenseBorderedSolver>(problem_);
     double residual = 0.0;
     std::string why;
-    if (!structuredMultipleKernel(problem, *solver, bp.u, bp.lambda, m, kernel, Psi, residual, &why)) {
-      out.note = "kernel of F_x is not " + std::to_string(m + 1) + "-dimensional (" + why + ")";
-      return false;
-    }
-    // the residual against the problem's unit, as the SVD's ratios below (F_x may vanish)
+    if (!structuredMultipleKernel(problem_, *solver_, bp_.u, bp_.lambda, m, kernel_, Psi_, residual, &why))
+      return fail("kernel of F_x is not " + std::to_string(m + 1) + "-dimensional (" + why + ")");
+    // the residual against the problem's unit, as the SVD's ratios (F_x may vanish)
     if (residual > kernelTolerance) {
       char text[160];
       std::snprintf(text, sizeof text, "kernel of F_x is not %d-dimensional (residual %.3g)", m + 1, residual);
-      out.note = text;
-      return false;
+      return fail(text);
     }
-    bordered = std::make_unique<RefinedBorderedSystem>(problem, *solver);
+    bordered_ = std::make_unique<RefinedBorderedSystem>(problem_, *solver_);
     Vector Fl(n), el = Vector::Zero(n + 1);
     el[n] = 1.0;
-    if (!problem.jacobianApply(bp.u, bp.lambda, el, Fl)) return false;
+    if (!problem_.jacobianApply(bp_.u, bp_.lambda, el, Fl)) return false;
     Matrix Bp(n, m + 1), Dp = Matrix::Zero(m + 1, m + 1);
     Bp.col(0) = Fl;
-    Bp.rightCols(m) = Psi;
-    Dp.col(0) = kernel.row(n).transpose();
-    if (!bordered->factor(bp.u, bp.lambda, Bp, kernel.topRows(n), Dp, false)) {
-      out.note = "bordered system [[F_x, Psi], [K^T, 0]] singular";
-      return false;
-    }
-  } else {
-    Matrix Fx = Matrix::Zero(n, n + 1);
-    if (!problem.jacobian(bp.u, bp.lambda, Fx.leftCols(n), Fx.col(n))) {
-      out.note = "the problem refused the Jacobian at the point";
-      return false;
-    }
-    // Full SVD: σ descending (n values); ker F_x = the last m + 1 right vectors, the left kernel the
-    // last m left vectors. The kernel must be exactly (m+1)-dimensional to the tolerance.
-    svd.compute(Fx, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    const Vector &sigma = svd.singularValues();
+    Bp.rightCols(m) = Psi_;
+    Dp.col(0) = kernel_.row(n).transpose();
+    if (!bordered_->factor(bp_.u, bp_.lambda, Bp, kernel_.topRows(n), Dp, false))
+      return fail("bordered system [[F_x, Psi], [K^T, 0]] singular");
+    return true;
+  }
+
+  // At or below the crossover: the full SVD, σ descending (n values); ker F_x = the last m + 1
+  // right vectors, the left kernel the last m left vectors. The kernel must be exactly
+  // (m+1)-dimensional to the tolerance.
+  bool denseKernels(double kernelTolerance) {
+    Matrix Fx = Matrix::Zero(n_, n_ + 1);
+    if (!problem_.jacobian(bp_.u, bp_.lambda, Fx.leftCols(n_), Fx.col(n_)))
+      return fail("the problem refused the Jacobian at the point");
+    svd_.compute(Fx, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Vector &sigma = svd_.singularValues();
     // relative to the problem's unit (it works in scaled variables): F_x may vanish at the point
     const double top = std::max(sigma[0], 1.0);
-    if (sigma[r] > kernelTolerance * top || (r > 0 && sigma[r - 1] <= kernelTolerance * top)) {
+    if (sigma[r_] > kernelTolerance * top || (r_ > 0 && sigma[r_ - 1] <= kernelTolerance * top)) {
       char text[160];
-      std::snprintf(text, sizeof text, "kernel of F_x is not %d-dimensional (sigma ratios %.3g, %.3g)", m + 1,
-                    sigma[r] / top, r > 0 ? sigma[r - 1] / top : 0.0);
-      out.note = text;
-      return false;
+      std::snprintf(text, sizeof text, "kernel of F_x is not %d-dimensional (sigma ratios %.3g, %.3g)", m_ + 1,
+                    sigma[r_] / top, r_ > 0 ? sigma[r_ - 1] / top : 0.0);
+      return fail(text);
     }
-    kernel = svd.matrixV().rightCols(m + 1);
-    Psi = svd.matrixU().rightCols(m);
+    kernel_ = svd_.matrixV().rightCols(m_ + 1);
+    Psi_ = svd_.matrixU().rightCols(m_);
+    return true;
   }
+
   // Basis [t φ₁ … φ_m]: the parent's tangent projected onto the kernel, then the complement.
-  Matrix K(n + 1, m + 1);
-  Vector t = bp.tangent.size() == n + 1 ? Vector(kernel * (kernel.transpose() * bp.tangent)) : Vector(kernel.col(0));
-  if (t.norm() < 1e-8) t = kernel.col(0);
-  K.col(0) = t.normalized();
-  int filled = 1;
-  for (int k = 0; k <= m && filled <= m; ++k) {
-    Vector w = kernel.col(k);
-    for (int pass = 0; pass < 2; ++pass)
-      for (int j = 0; j < filled; ++j) w -= K.col(j).dot(w) * K.col(j);
-    if (w.norm() > 1e-6) K.col(filled++) = w.normalized();
+  bool basis() {
+    const int n = n_, m = m_;
+    K_.resize(n + 1, m + 1);
+    Vector t = bp_.tangent.size() == n + 1 ? Vector(kernel_ * (kernel_.transpose() * bp_.tangent)) : Vector(kernel_.col(0));
+    if (t.norm() < 1e-8) t = kernel_.col(0);
+    K_.col(0) = t.normalized();
+    int filled = 1;
+    for (int k = 0; k <= m && filled <= m; ++k) {
+      Vector w = kernel_.col(k);
+      for (int pass = 0; pass < 2; ++pass)
+        for (int j = 0; j < filled; ++j) w -= K_.col(j).dot(w) * K_.col(j);
+      if (w.norm() > 1e-6) K_.col(filled++) = w.normalized();
+    }
+    if (filled != m + 1) return fail("could not complete the kernel basis");
+    return true;
   }
-  if (filled != m + 1) {
-    out.note = "could not complete the kernel basis";
-    return false;
-  }
+
   // x = F_x⁺ b on the complement of the kernel: from the SVD's r largest singular values, or the
   // bordered system [[F_x, Ψ], [Kᵀ, 0]] [x; g] = [b; 0] (x ⊥ ker F_x, F_x x = b − ΨΨᵀb).
-  auto pseudoSolve = [&](const Vector &b) -> Vector {
-    if (bordered) {
-      Vector rhs = Vector::Zero(n + m + 1), x(n + m + 1);
-      rhs.head(n) = b;
-      if (!bordered->solve(rhs, x)) return Vector::Constant(n + 1, std::numeric_limits<double>::quiet_NaN());
-      return x.head(n + 1);
+  Vector pseudoSolve(const Vector &b) const {
+    if (bordered_) {
+      Vector rhs = Vector::Zero(n_ + m_ + 1), x(n_ + m_ + 1);
+      rhs.head(n_) = b;
+      if (!bordered_->solve(rhs, x)) return Vector::Constant(n_ + 1, std::numeric_limits<double>::quiet_NaN());
+      return x.head(n_ + 1);
     }
-    const Vector &sigma = svd.singularValues();
-    Vector c = svd.matrixU().leftCols(r).transpose() * b;
-    for (int i = 0; i < r; ++i) c[i] /= sigma[i];  // σ_i > kernelTolerance·top here
-    return svd.matrixV().leftCols(r) * c;
-  };
+    const Vector &sigma = svd_.singularValues();
+    Vector c = svd_.matrixU().leftCols(r_).transpose() * b;
+    for (int i = 0; i < r_; ++i) c[i] /= sigma[i];  // σ_i > kernelTolerance·top here
+    return svd_.matrixV().leftCols(r_) * c;
+  }
 
-  // F_xx[k_a, z] at (u, λ): the matrices D_a = F_xx[k_a, ·] (N×(N+1)) at or below the crossover
-  // (as before), O(N) products (Problem::secondDerivativeApply) above it.
-  const SecondDerivative D{problem, n};
-  std::vector<Matrix> Dk(size_t(bordered ? 0 : m + 1));
-  for (size_t a = 0; a < Dk.size(); ++a)
-    if (!D(bp.u, bp.lambda, K.col(Eigen::Index(a)), Dk[a])) {
-      out.note = "second derivatives unavailable";
-      return false;
-    }
-  bool secondOk = true;
-  auto secondAt = [&](ConstVectorRef u, double lambda, int a, const Vector &z) -> Vector {
-    Vector y(n);
-    secondOk = problem.secondDerivativeApply(u, lambda, K.col(a), z, y) && secondOk;
+  // F_xx[k_a, z] at (u, λ): the matrices D_a = F_xx[k_a, ·] (N×(N+1)) at or below the crossover,
+  // O(N) products (Problem::secondDerivativeApply) above it.
+  Vector secondAt(ConstVectorRef u, double lambda, int a, const Vector &z) {
+    Vector y(n_);
+    secondOk_ = problem_.secondDerivativeApply(u, lambda, K_.col(a), z, y) && secondOk_;
     return y;
-  };
-  auto second = [&](int a, const Vector &z) -> Vector {
-    if (!bordered) return Dk[size_t(a)] * z;
-    return secondAt(bp.u, bp.lambda, a, z);
-  };
+  }
+  Vector second(int a, const Vector &z) {
+    if (!bordered_) return Dk_[size_t(a)] * z;
+    return secondAt(bp_.u, bp_.lambda, a, z);
+  }
+
   // A_j(a, b) = ψ_jᵀ F_xx[k_a, k_b], symmetrised (the default second derivatives are differences).
-  std::vector<Matrix> A(size_t(m), Matrix::Zero(m + 1, m + 1));
-  double qmax = 0.0, qphi = 0.0;
-  for (int a = 0; a <= m; ++a)
-    for (int b = 0; b <= m; ++b) {
-      const Vector y = second(a, K.col(b));
-      for (int j = 0; j < m; ++j) A[size_t(j)](a, b) = Psi.col(j).dot(y);
+  bool quadraticCoefficients() {
+    const int m = m_;
+    Dk_.resize(size_t(bordered_ ? 0 : m + 1));
+    for (size_t a = 0; a < Dk_.size(); ++a)
+      if (!D_(bp_.u, bp_.lambda, K_.col(Eigen::Index(a)), Dk_[a])) return fail("second derivatives unavailable");
+    A_.assign(size_t(m), Matrix::Zero(m + 1, m + 1));
+    for (int a = 0; a <= m; ++a)
+      for (int b = 0; b <= m; ++b) {
+        const Vector y = second(a, K_.col(b));
+        for (int j = 0; j < m; ++j) A_[size_t(j)](a, b) = Psi_.col(j).dot(y);
+      }
+    if (!secondOk_) return fail("second derivatives unavailable");
+    for (int j = 0; j < m; ++j) {
+      A_[size_t(j)] = (0.5 * (A_[size_t(j)] + A_[size_t(j)].transpose())).eval();
+      qmax_ = std::max(qmax_, A_[size_t(j)].cwiseAbs().maxCoeff());
+      qphi_ = std::max(qphi_, A_[size_t(j)].bottomRightCorner(m, m).cwiseAbs().maxCoeff());
     }
-  if (!secondOk) {
-    out.note = "second derivatives unavailable";
-    return false;
+    if (!(qmax_ > 0.0)) return fail("degenerate bifurcation equation (vanishing second derivatives)");
+    return true;
   }
-  for (int j = 0; j < m; ++j) {
-    A[size_t(j)] = (0.5 * (A[size_t(j)] + A[size_t(j)].transpose())).eval();
-    qmax = std::max(qmax, A[size_t(j)].cwiseAbs().maxCoeff());
-    qphi = std::max(qphi, A[size_t(j)].bottomRightCorner(m, m).cwiseAbs().maxCoeff());
-  }
-  if (!(qmax > 0.0)) {
-    out.note = "degenerate bifurcation equation (vanishing second derivatives)";
-    return false;
-  }
-  std::vector<Vector> roots;
-  if (qphi > 1e-6 * qmax) {
-    // Quadratic equation on the sphere S^m: zᵀA_j z = 0, |z|² = 1.
-    out.order = 2;
+
+  // Quadratic equation on the sphere S^m: zᵀA_j z = 0, |z|² = 1.
+  void solveQuadratic() {
+    const int m = m_;
+    out_.order = 2;
     const auto system = [&](const Vector &z, Vector &R, Matrix &J) {
       R.resize(m + 1);
       J.resize(m + 1, m + 1);
       for (int j = 0; j < m; ++j) {
-        R[j] = z.dot(A[size_t(j)] * z) / qmax;
-        J.row(j) = 2.0 * (A[size_t(j)] * z).transpose() / qmax;
+        R[j] = z.dot(A_[size_t(j)] * z) / qmax_;
+        J.row(j) = 2.0 * (A_[size_t(j)] * z).transpose() / qmax_;
       }
       R[m] = z.squaredNorm() - 1.0;
       J.row(m) = 2.0 * z.transpose();
     };
+    std::vector<Vector> roots;
     for (Vector z : sphereStarts(m + 1, 64 * (m + 1))) {
       if (!newton(system, z, 1e-12)) continue;
       z.normalize();
       if (std::abs(z[0]) >= 1.0 - 1e-6) continue;  // the parent branch
       if (addUpToSign(roots, z)) {
-        out.directions.push_back(K * z);
-        out.curvatures.push_back(0.0);
+        out_.directions.push_back(K_ * z);
+        out_.curvatures.push_back(0.0);
       }
     }
-  } else {
-    // Cubic: the quadratic form vanishes on span φ. Tensor of the cubic term, from the
-    // bilinear correction w₂ and a central difference of the second derivative along φ_c.
-    out.order = 3;
-    const Matrix B = [&] {
-      Matrix b(m, m);
-      for (int j = 0; j < m; ++j)
-        for (int i = 0; i < m; ++i) b(j, i) = A[size_t(j)](i + 1, 0);
-      return b;
-    }();
+  }
+
+  // The cubic term's tensor T[j][(a·m + b)·m + c] = ψ_jᵀ(F_xx[φ_a, W_bc] + ⅙F_xxx[φ_a, φ_b, φ_c]),
+  // from the bilinear correction W_bc = −F_x⁺ ½F_xx[φ_b, φ_c] and a central difference of the
+  // second derivative along φ_c.
+  bool cubicTensor(std::vector<double> &T) {
+    const int n = n_, m = m_;
     const double h = 1e-3;
-    std::vector<Matrix> W(size_t(m * m));  // W_bc = −F_x⁺ ½F_xx[φ_b, φ_c]
+    std::vector<Matrix> W(size_t(m * m));
     for (int b = 0; b < m; ++b)
       for (int c = 0; c < m; ++c)
-        W[size_t(b * m + c)] = -pseudoSolve(0.25 * (second(b + 1, K.col(c + 1)) + second(c + 1, K.col(b + 1))));
-    // T[j][(a·m + b)·m + c] = ψ_jᵀ(F_xx[φ_a, W_bc] + ⅙F_xxx[φ_a, φ_b, φ_c])
-    std::vector<double> T(size_t(m * m * m * m), 0.0);
+        W[size_t(b * m + c)] = -pseudoSolve(0.25 * (second(b + 1, K_.col(c + 1)) + second(c + 1, K_.col(b + 1))));
+    T.assign(size_t(m * m * m * m), 0.0);
     Matrix Dp, Dm;
     for (int c = 0; c < m; ++c) {
-      const Vector shift = h * K.col(c + 1);
-      const Vector up = bp.u + shift.head(n), um = bp.u - shift.head(n);
+      const Vector shift = h * K_.col(c + 1);
+      const Vector up = bp_.u + shift.head(n), um = bp_.u - shift.head(n);
       for (int a = 0; a < m; ++a) {
-        if (!bordered &&
-            (!D(up, bp.lambda + shift[n], K.col(a + 1), Dp) || !D(um, bp.lambda - shift[n], K.col(a + 1), Dm))) {
-          out.note = "third derivatives unavailable";
-          return false;
-        }
+        if (!bordered_ &&
+            (!D_(up, bp_.lambda + shift[n], K_.col(a + 1), Dp) || !D_(um, bp_.lambda - shift[n], K_.col(a + 1), Dm)))
+          return fail("third derivatives unavailable");
         for (int b = 0; b < m; ++b) {
           // F_xxx[φ_a, φ_b, φ_c] by a central difference along φ_c
-          const Vector third = bordered ? Vector((secondAt(up, bp.lambda + shift[n], a + 1, K.col(b + 1)) -
-                                                  secondAt(um, bp.lambda - shift[n], a + 1, K.col(b + 1))) /
-                                                 (2.0 * h))
-                                        : Vector((Dp - Dm) / (2.0 * h) * K.col(b + 1));
+          const Vector third = bordered_ ? Vector((secondAt(up, bp_.lambda + shift[n], a + 1, K_.col(b + 1)) -
+                                                   secondAt(um, bp_.lambda - shift[n], a + 1, K_.col(b + 1))) /
+                                                  (2.0 * h))
+                                         : Vector((Dp - Dm) / (2.0 * h) * K_.col(b + 1));
           const Vector secondTerm = second(a + 1, W[size_t(b * m + c)]);
           for (int j = 0; j < m; ++j)
-            T[size_t(j * m * m * m + (a * m + b) * m + c)] = Psi.col(j).dot(secondTerm + third / 6.0);
+            T[size_t(j * m * m * m + (a * m + b) * m + c)] = Psi_.col(j).dot(secondTerm + third / 6.0);
         }
-        if (!secondOk) {
-          out.note = "third derivatives unavailable";
-          return false;
-        }
+        if (!secondOk_) return fail("third derivatives unavailable");
       }
     }
+    return true;
+  }
+
+  // Cubic: the quadratic form vanishes on span φ. Unknowns y = (β, τ): τBβ + g(β) = 0, |β|² = 1
+  // (rows scaled by the cubic's size), B_ji = A_j(i + 1, 0).
+  bool solveCubic() {
+    const int m = m_;
+    out_.order = 3;
+    Matrix B(m, m);
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i) B(j, i) = A_[size_t(j)](i + 1, 0);
+    std::vector<double> T;
+    if (!cubicTensor(T)) return false;
     double cscale = 0.0;
     for (double v : T) cscale = std::max(cscale, std::abs(v));
     const double bscale = B.cwiseAbs().maxCoeff();
-    if (!(cscale > 0.0) || !(bscale > 0.0)) {
-      out.note = "degenerate cubic bifurcation equation";
-      return false;
-    }
+    if (!(cscale > 0.0) || !(bscale > 0.0)) return fail("degenerate cubic bifurcation equation");
     auto cubic = [&](const Vector &beta, Vector &g, Matrix &dg) {
       g = Vector::Zero(m);
       dg = Matrix::Zero(m, m);
@@ -296,7 +313,6 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
               dg(j, c) += t * beta[a] * beta[b];
             }
     };
-    // Unknowns y = (β, τ): τBβ + g(β) = 0, |β|² = 1 (rows scaled by the cubic's size).
     const auto system = [&](const Vector &y, Vector &R, Matrix &J) {
       const Vector beta = y.head(m);
       const double tau = y[m];
@@ -312,6 +328,7 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
       J.row(m).head(m) = 2.0 * beta.transpose();
       J(m, m) = 0.0;
     };
+    std::vector<Vector> roots;
     for (const Vector &beta0 : sphereStarts(m, 64 * m)) {
       Vector g;
       Matrix dg;
@@ -322,19 +339,31 @@ bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurc
       if (!newton(system, y, 1e-12)) continue;
       const Vector beta = y.head(m).normalized();
       if (addUpToSign(roots, beta)) {
-        out.directions.push_back((K.rightCols(m) * beta).normalized());
-        out.curvatures.push_back(y[m]);
+        out_.directions.push_back((K_.rightCols(m) * beta).normalized());
+        out_.curvatures.push_back(y[m]);
       }
     }
+    return true;
   }
-  if (out.directions.empty()) {
-    out.note = out.order == 2 ? "quadratic bifurcation equation: no real root besides the parent"
-                              : "cubic bifurcation equation: no real root";
-    return false;
-  }
-  out.note = std::string(out.order == 2 ? "quadratic" : "cubic") + " reduced bifurcation equation, m = " +
-             std::to_string(m) + ": " + std::to_string(out.directions.size()) + " solution directions";
-  return true;
+
+  Problem &problem_;
+  const SpecialPoint &bp_;
+  const int n_, m_, r_;  // dimension, multiplicity, rank of F_x
+  const SecondDerivative D_;
+  ReducedBifurcation &out_;
+  Matrix kernel_, Psi_, K_;  // ker F_x, ker F_xᵀ, the basis [t φ₁ … φ_m]
+  std::unique_ptr<BorderedSolver> solver_;
+  std::unique_ptr<RefinedBorderedSystem> bordered_;
+  Eigen::BDCSVD<Matrix> svd_;
+  std::vector<Matrix> Dk_;
+  std::vector<Matrix> A_;
+  double qmax_ = 0.0, qphi_ = 0.0;
+  bool secondOk_ = true;
+};
+
+bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out, double kernelTolerance,
+                  int maxDenseDimension) {
+  return ReducedEquation(problem, bp, m, out).solve(kernelTolerance, maxDenseDimension);
 }
 
 }  // namespace

@@ -31,6 +31,8 @@ const char* label(EventType type) {
     case EventType::BaseContact: return "BC";
     case EventType::SelfContact: return "SC";
     case EventType::EigenvalueTouch: return cont::label(cont::SpecialPointType::EigenvalueTouch);
+    case EventType::StabilityLoss: return "LS";
+    case EventType::InputBound: return "IB";
   }
   return "?";
 }
@@ -497,32 +499,13 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
   reportHeldCoordinateFolds(b, options, all, r);
   reportStiffnessMinima(problem, b, options, r);
   reportGeometricContacts(problem, b, all, options, r, geometric);  // base / self contact (contact_geometry.h)
+  for (PointReport& p : r.points) p.branch = b.id;
   for (SpecialPointReport& s : r.specialPoints) {
+    s.branch = b.id;
     s.stabilityBefore = stabilityLabel(s.negativeBefore);
     s.stabilityAfter = stabilityLabel(s.negativeAfter);
   }
   return r;
-}
-
-SpecialPointReport reportJump(const EquilibriumProblem& problem, const JumpRecord& j, const std::string& parameterName) {
-  const int n = problem.segments();
-  SpecialPointReport s;
-  s.type = EventType::Jump;
-  s.phenomenon = Phenomenon::Jumping;
-  s.parameter = s.lambda = j.lambda;
-  s.q = j.from.head(n);
-  s.F = problem.wrench(j.from, j.lambda);
-  s.pose = endPose(problem.chain(), s.q);
-  s.shape = shapeName(s.q, kStraightTolerance);
-  s.stabilityBefore = j.trigger == JumpTrigger::UnstableStart ? "unstable" : "critical";
-  s.stabilityAfter = j.success ? "stable" : "unknown";
-  std::ostringstream note;
-  note << "trigger: " << toString(j.trigger) << " at " << parameterName << " = " << j.criticalLambda
-       << "; released at " << j.lambda;
-  s.note = note.str();
-  s.jumps = true;
-  s.landing = landingOf(problem, j);
-  return s;
 }
 
 }  // namespace buckle::mechanics

@@ -1,5 +1,6 @@
 #include "buckle/mechanics/landing.h"
 
+#include <sstream>
 #include <stdexcept>
 
 #include "buckle/mechanics/shape_name.h"
@@ -66,6 +67,26 @@ Landing landingOf(const EquilibriumProblem& problem, const JumpRecord& j) {
   l.energyReleased = j.energyReleased;
   l.distance = j.distance;
   return l;
+}
+
+SpecialPointReport reportJump(const EquilibriumProblem& problem, const JumpRecord& j, const std::string& parameterName) {
+  const int n = problem.segments();
+  SpecialPointReport s;
+  s.type = EventType::Jump;
+  s.phenomenon = Phenomenon::Jumping;
+  s.parameter = s.lambda = j.lambda;
+  s.q = j.from.head(n);
+  s.F = problem.wrench(j.from, j.lambda);
+  s.pose = endPose(problem.chain(), s.q);
+  s.shape = shapeName(s.q, kStraightTolerance);
+  s.stabilityBefore = j.trigger == JumpTrigger::UnstableStart ? "unstable" : "critical";
+  s.stabilityAfter = j.success ? "stable" : "unknown";
+  std::ostringstream note;
+  note << "trigger: " << toString(j.trigger) << " at " << parameterName << " = " << j.criticalLambda
+       << "; released at " << j.lambda;
+  s.note = note.str();
+  s.jumps = true;
+  return s;
 }
 
 }  // namespace buckle::mechanics

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "buckle/mechanics/shape_name.h"
+
 namespace buckle::mechanics {
 
 namespace cont = buckle::continuation;
@@ -191,6 +193,70 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
   }
   result.end = TaskPathEvent::Completed;
   return result;
+}
+
+namespace {
+
+EventType eventType(TaskPathEvent e) {
+  switch (e) {
+    case TaskPathEvent::Fold: return EventType::Fold;
+    case TaskPathEvent::BranchPoint: return EventType::BranchPoint;
+    case TaskPathEvent::StabilityLoss: return EventType::StabilityLoss;
+    case TaskPathEvent::InputBound: return EventType::InputBound;
+    default: return EventType::Boundary;  // a joint limit (the path's specials are these five)
+  }
+}
+
+const char* stabilityOf(const TaskPathPoint& p) {
+  return p.stable ? "stable" : (p.inertia.negative > 0 ? "unstable" : "critical");
+}
+
+}  // namespace
+
+BranchReport reportTaskPath(const TaskPathResult& path, const Wrench& payload, bool stiffness, int id) {
+  BranchReport r;
+  for (size_t i = 0; i < path.points.size(); ++i) {
+    const TaskPathPoint& p = path.points[i];
+    PointReport& o = r.points.emplace_back();
+    o.branch = id;
+    o.index = int(i);
+    o.parameter = p.s;
+    o.F = payload;
+    o.pose = p.pose;
+    o.q = p.q;
+    o.stable = p.stable;
+    o.negative = p.inertia.negative;
+    o.minEigenvalue = p.minEigenvalue;
+    o.haveStiffness = stiffness;
+    o.K = p.K;
+    o.C = p.C;
+    o.inputs = p.inputs;
+  }
+  for (const TaskPathSpecial& sp : path.specials) {
+    SpecialPointReport& s = r.specialPoints.emplace_back();
+    s.branch = id;
+    s.type = eventType(sp.event);
+    s.index = std::max(0, int(path.points.size()) - 2);
+    s.parameter = s.lambda = sp.point.s;
+    s.F = payload;
+    s.pose = sp.point.pose;
+    s.q = sp.point.q;
+    s.shape = shapeName(sp.point.q);
+    // stability at fixed inputs on the path before the point, and at the point itself
+    s.stabilityBefore = path.points.size() > 1 ? stabilityOf(path.points[path.points.size() - 2]) : stabilityOf(sp.point);
+    s.stabilityAfter = sp.event == TaskPathEvent::StabilityLoss ? "unstable" : stabilityOf(sp.point);
+    s.accuracy = sp.accuracy;
+    s.K = sp.point.K;
+    s.refined = true;
+    s.note = sp.why;
+    s.inputs = sp.point.inputs;
+  }
+  r.finished = path.end != TaskPathEvent::Failed && path.end != TaskPathEvent::Interrupted &&
+               path.end != TaskPathEvent::MaxPoints;
+  r.stopReason = toString(path.end);
+  r.stopMessage = path.message;
+  r.worstResidual = path.worstResidual;
+  return r;
 }
 
 }  // namespace buckle::mechanics

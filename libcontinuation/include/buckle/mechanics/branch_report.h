@@ -24,8 +24,6 @@
 #include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/imperfection_sensitivity.h"
-#include "buckle/mechanics/landing.h"
-#include "buckle/mechanics/load_history.h"
 #include "buckle/mechanics/stiffness_extremum.h"
 
 namespace buckle::mechanics {
@@ -47,9 +45,12 @@ enum class EventType {
   BaseContact,       ///< "BC": the chain reaches (or leaves) the clamp's wall (contact_geometry.h)
   SelfContact,       ///< "SC": two non-adjacent links meet (or separate) (contact_geometry.h)
   EigenvalueTouch,   ///< "ET": an eigenvalue of the stability operator touches zero without crossing
+  StabilityLoss,     ///< "LS": along a task path, the equilibrium at fixed inputs loses its stability
+  InputBound,        ///< "IB": along a task path, a control input reaches its bound (task_path.h)
 };
 
-/// "BP", "LP", "LPF", "BD", "KMIN", "JUMP", "CT", "RL": the one spelling of the labels in every output.
+/// "BP", "LP", "LPF", "BD", "KMIN", "JUMP", "CT", "RL", "BC", "SC", "ET", "LS", "IB": the one spelling
+/// of the labels in every output.
 const char* label(EventType type);
 
 /// "stable", "unstable (k negative)", or "unknown" for a count that was not computed (< 0).
@@ -80,6 +81,7 @@ struct ReportOptions {
 
 /// One point of a branch, in physical quantities.
 struct PointReport {
+  int branch = -1;                     ///< the traced branch's id (continuation::Branch::id)
   int index = 0;                       ///< index of the point in the traced branch
   double parameter = 0.0;              ///< the traced λ, or the held coordinate (ReportOptions)
   Wrench F = Wrench::Zero();           ///< total end wrench (loads and reactions)
@@ -102,10 +104,16 @@ struct PointReport {
   ContactSet locked;
   /// Largest compression −side·τ_c over the locked joints (0 when none is locked).
   double contactTorque = 0.0;
+  /// The signed natural frequencies ω_i at the point (vibration.h: negative is unstable, minus the
+  /// growth rate; NaN beyond the constrained chain's modes) where the caller computed them, else empty.
+  Eigen::VectorXd omega;
+  /// Along a task path: the control inputs' values at the point (task_path.h), else empty.
+  Eigen::VectorXd inputs;
 };
 
 /// One special point of a branch, named in the field's words.
 struct SpecialPointReport {
+  int branch = -1;                     ///< the traced branch's id (continuation::Branch::id)
   EventType type = EventType::BranchPoint;
   Phenomenon phenomenon = Phenomenon::None;
   int source = -1;                     ///< index into the traced branch's specialPoints (−1: found here)
@@ -128,9 +136,9 @@ struct SpecialPointReport {
   /// traced off the point (−1: not switched; SpecialPoint::branchesPredicted / branchesFound).
   int branchesPredicted = -1, branchesFound = -1;
   std::string note;
-  /// A fold whose stable side ends there: the chain must jump (jumpFromFold, landing.h).
+  /// A fold whose stable side ends there: the chain must jump (jumpFromFold, landing.h, simulates
+  /// where it lands; statics do not depend on dynamics, so the landing is kept beside the report).
   bool jumps = false;
-  Landing landing;                     ///< filled by whoever simulates the jump
   /// CT / RL: the joint (0-based) that locks or releases, and its contact torque τ_c at the point
   /// (≈ 0 there: the free and the locked equilibria meet); NaN / −1 for other events.
   int joint = -1;
@@ -147,6 +155,9 @@ struct SpecialPointReport {
   /// by a preload asymmetry of every segment and of the most sensitive single segment (n > 1)
   /// (imperfection_sensitivity.h).
   std::vector<ImperfectionSensitivity> imperfections;
+  /// As PointReport::omega and PointReport::inputs, at the located point.
+  Eigen::VectorXd omega;
+  Eigen::VectorXd inputs;
 };
 
 struct BranchReport {
@@ -170,10 +181,5 @@ BranchReport reportBranch(EquilibriumProblem& problem, const continuation::Branc
 /// returned as located.
 BranchReport reportBranch(EquilibriumProblem& problem, const continuation::Branch& branch, const ReportOptions& options,
                           const std::vector<ContactStretch>& stretches, GeometricContacts* geometric = nullptr);
-
-/// A load history's jump (load_history.h) as a special point "JUMP" (jumping) with its landing;
-/// `parameterName` names λ in the note.
-SpecialPointReport reportJump(const EquilibriumProblem& problem, const JumpRecord& jump,
-                              const std::string& parameterName);
 
 }  // namespace buckle::mechanics

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "buckle/continuation/branch.h"
+#include "buckle/mechanics/branch_report.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/jump.h"
 #include "buckle/mechanics/load_history.h"
@@ -46,5 +47,10 @@ Landing jumpFromFold(EquilibriumProblem& problem, const continuation::SpecialPoi
 
 /// The landing of a load history's jump.
 Landing landingOf(const EquilibriumProblem& problem, const JumpRecord& jump);
+
+/// A load history's jump (load_history.h) as a special point "JUMP" (jumping); its landing is
+/// landingOf(problem, jump). `parameterName` names λ in the note.
+SpecialPointReport reportJump(const EquilibriumProblem& problem, const JumpRecord& jump,
+                              const std::string& parameterName);
 
 }  // namespace buckle::mechanics

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/branch_report.h"
 #include "buckle/mechanics/task_path.h"
 
 namespace buckle::mechanics {
@@ -75,6 +76,12 @@ double taskLegLength(const TaskSetup& setup, const Vector& from, const Vector& t
 /// Never throws for numerical failures (end = Failed, message).
 TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const std::vector<Vector>& waypoints,
                              double angleLength, const TaskPathOptions& options = {});
+
+/// The task path as branch `id`'s report (branch_report.h) under the end wrench `payload`: its
+/// points with their inputs, and each special point typed (LP, BP, LS, BD, IB) with the stability
+/// at fixed inputs before it and at it, its location's accuracy, why the path ends there in the
+/// note. Stiffness columns where `stiffness` (TaskPathOptions::stiffness) computed them.
+BranchReport reportTaskPath(const TaskPathResult& path, const Wrench& payload, bool stiffness, int id = 0);
 
 /// A point's record from u (stability and, with `stiffness`, K_F, C_F at fixed inputs). False outside the domain.
 bool taskPathPoint(TaskPathProblem& problem, const Vector& u, double s, bool stiffness, TaskPathPoint& out);
