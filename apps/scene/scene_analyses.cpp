@@ -7,6 +7,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/stiffness_extremum.h"
+#include "scene/analyses.h"
 #include "scene/columns.h"
 
 namespace buckle::scene::detail {
@@ -44,134 +45,143 @@ FrequenciesSpec parseFrequencies(const Reader& r, const json& f, const Pointer& 
 
 }  // namespace
 
+void parseContinuation(const Reader& r, const json& c, const Pointer& pc, AnalysesSpec& s) {
+  if (c.is_boolean()) {
+    s.continuation.enabled = c.get<bool>();
+  } else {
+    r.onlyKeys(c, pc, {"branch_switching", "contact", "branch_points", "child_points", "mirror"});
+    s.continuation.enabled = true;
+    if (c.contains("branch_switching"))
+      s.continuation.branchSwitching = r.integer(c["branch_switching"], pc / "branch_switching", 0, 4);
+    if (c.contains("contact")) s.continuation.contact = r.boolean(c["contact"], pc / "contact");
+    if (c.contains("mirror")) s.continuation.mirror = r.boolean(c["mirror"], pc / "mirror");
+    if (c.contains("branch_points"))
+      s.continuation.branchPoints = r.integer(c["branch_points"], pc / "branch_points", 1, 10000000);
+    if (c.contains("child_points"))
+      s.continuation.childPoints = r.integer(c["child_points"], pc / "child_points", 2, 10000000);
+  }
+}
+
+void parseStiffness(const Reader& r, const json& k, const Pointer& pk, AnalysesSpec& s) {
+  if (k.is_object()) {
+    // {"measure": M}: the stiffness measure whose deep minima are quasi-buckling (KMIN)
+    r.onlyKeys(k, pk, {"measure"});
+    s.stiffness = true;
+    if (k.contains("measure")) {
+      const std::string m = r.string(k["measure"], pk / "measure");
+      if (!mechanics::parseStiffnessMeasure(m, s.stiffnessMeasure))
+        r.expected(pk / "measure", k["measure"], "one of Kxx, Kyy, Kmin (the smallest eigenvalue of K_F)");
+    }
+  } else {
+    s.stiffness = r.boolean(k, pk);
+  }
+  if (s.stiffness && !s.continuation.enabled)
+    r.fail(pk, "stiffness is computed along the traced branches: it needs /analyses/continuation");
+}
+
+void parseEnergyCurves(const Reader& r, const json& e, const Pointer& pe, AnalysesSpec& s) {
+  r.onlyKeys(e, pe, {"x", "y", "q1_from", "q1_to", "points", "torque"});
+  s.energyCurves.enabled = true;
+  if (!e.contains("x") || !e.contains("y")) r.fail(pe / (e.contains("x") ? "y" : "x"), "missing (required): the held end position");
+  s.energyCurves.x = r.number(e["x"], pe / "x");
+  s.energyCurves.y = r.number(e["y"], pe / "y");
+  if (e.contains("q1_from")) s.energyCurves.q1From = r.number(e["q1_from"], pe / "q1_from");
+  if (e.contains("q1_to")) s.energyCurves.q1To = r.number(e["q1_to"], pe / "q1_to");
+  if (!(s.energyCurves.q1From < s.energyCurves.q1To)) r.fail(pe / "q1_to", "expected q1_to > q1_from");
+  if (e.contains("points")) s.energyCurves.points = r.integer(e["points"], pe / "points", 3, 1000000);
+  if (e.contains("torque")) s.energyCurves.torque = r.boolean(e["torque"], pe / "torque");
+}
+
+void parseTorqueAngle(const Reader& r, const json& t, const Pointer& pt, AnalysesSpec& s) {
+  if (t.is_boolean()) {
+    s.torqueAngle.enabled = t.get<bool>();
+  } else {
+    r.onlyKeys(t, pt, {"q_from", "q_to", "points"});
+    s.torqueAngle.enabled = true;
+    if (t.contains("q_from")) s.torqueAngle.qFrom = r.number(t["q_from"], pt / "q_from");
+    if (t.contains("q_to")) s.torqueAngle.qTo = r.number(t["q_to"], pt / "q_to");
+    if (!(s.torqueAngle.qFrom < s.torqueAngle.qTo)) r.fail(pt / "q_to", "expected q_to > q_from");
+    if (t.contains("points")) s.torqueAngle.points = r.integer(t["points"], pt / "points", 3, 1000000);
+  }
+}
+
+void parseCriticalForces(const Reader& r, const json& c, const Pointer& pc, AnalysesSpec& s) {
+  if (c.is_boolean()) {
+    s.criticalForces.enabled = c.get<bool>();
+  } else {
+    r.onlyKeys(c, pc, {"modes"});
+    s.criticalForces.enabled = true;
+    if (c.contains("modes")) s.criticalForces.modes = r.integer(c["modes"], pc / "modes", 1, 100000);
+  }
+}
+
+void parseJump(const Reader& r, const json& j, const Pointer& pj, AnalysesSpec& s) {
+  if (j.is_boolean()) {
+    s.jump.enabled = j.get<bool>();
+  } else {
+    r.onlyKeys(j, pj, {"perturbation"});
+    s.jump.enabled = true;
+    if (j.contains("perturbation")) s.jump.perturbation = r.positive(j["perturbation"], pj / "perturbation");
+  }
+  if (s.jump.enabled && !s.continuation.enabled)
+    r.fail(pj, "jumps are simulated from the folds of the traced branches: it needs /analyses/continuation");
+}
+
+void parseLoadHistory(const Reader& r, const json& h, const Pointer& ph, AnalysesSpec& s) {
+  r.onlyKeys(h, ph, {"waypoints", "perturbation"});
+  if (!h.contains("waypoints")) r.fail(ph / "waypoints", "missing (required): the path-parameter values to visit");
+  const json& w = h["waypoints"];
+  if (!w.is_array() || w.size() < 2) r.expected(ph / "waypoints", w, "an array of at least two numbers");
+  for (size_t i = 0; i < w.size(); ++i) s.loadHistory.waypoints.push_back(r.number(w[i], ph / "waypoints" / i));
+  if (h.contains("perturbation")) s.loadHistory.perturbation = r.positive(h["perturbation"], ph / "perturbation");
+  s.loadHistory.enabled = true;
+}
+
+void parseSuddenLoad(const Reader& r, const json& d, const Pointer& pd, AnalysesSpec& s) {
+  r.onlyKeys(d, pd, {"value", "mass_per_length", "damping"});
+  if (!d.contains("value")) r.fail(pd / "value", "missing (required): the path-parameter value applied at once");
+  s.suddenLoad.value = r.number(d["value"], pd / "value");
+  if (d.contains("mass_per_length")) s.suddenLoad.massPerLength = r.positive(d["mass_per_length"], pd / "mass_per_length");
+  if (d.contains("damping")) s.suddenLoad.damping = r.nonNegative(d["damping"], pd / "damping");
+  if (d.contains("damping") && !d.contains("mass_per_length"))
+    r.fail(pd / "damping", "joint damping belongs to the inertial model: give mass_per_length too");
+  s.suddenLoad.enabled = true;
+}
+
+void parseFrequenciesBlock(const Reader& r, const json& f, const Pointer& p, AnalysesSpec& s) {
+  s.frequencies = parseFrequencies(r, f, p);
+  if (!s.continuation.enabled && !s.loadHistory.enabled)
+    r.fail(p, "frequencies are computed along the traced branches: it needs /analyses/continuation or load_history");
+}
+
+void parseTwoParameterBlock(const Reader& r, const json& v, const Pointer& p, AnalysesSpec& s) {
+  s.twoParameter = parseTwoParameter(r, v, p);
+}
+
+void parseEquilibriaBlock(const Reader& r, const json& v, const Pointer& p, AnalysesSpec& s) {
+  s.equilibria = parseEquilibria(r, v, p);
+}
+
 AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
-  r.onlyKeys(a, p,
-             {"continuation", "stiffness", "energy_curves", "critical_forces", "torque_angle", "jump", "load_history",
-              "sudden_load", "two_parameter", "frequencies", "equilibria"});
+  std::set<std::string> keys;
+  std::vector<std::string> standalone;
+  for (const Analysis& x : analyses())
+    if (x.key) {
+      keys.insert(x.key);
+      if (x.standalone) standalone.push_back(x.key);
+    }
+  r.onlyKeys(a, p, keys);
   AnalysesSpec s;
-  if (a.contains("continuation")) {
-    const json& c = a["continuation"];
-    const Pointer pc = p / "continuation";
-    if (c.is_boolean()) {
-      s.continuation.enabled = c.get<bool>();
-    } else {
-      r.onlyKeys(c, pc, {"branch_switching", "contact", "branch_points", "child_points", "mirror"});
-      s.continuation.enabled = true;
-      if (c.contains("branch_switching"))
-        s.continuation.branchSwitching = r.integer(c["branch_switching"], pc / "branch_switching", 0, 4);
-      if (c.contains("contact")) s.continuation.contact = r.boolean(c["contact"], pc / "contact");
-      if (c.contains("mirror")) s.continuation.mirror = r.boolean(c["mirror"], pc / "mirror");
-      if (c.contains("branch_points"))
-        s.continuation.branchPoints = r.integer(c["branch_points"], pc / "branch_points", 1, 10000000);
-      if (c.contains("child_points"))
-        s.continuation.childPoints = r.integer(c["child_points"], pc / "child_points", 2, 10000000);
-    }
+  // in the registry's order: an analysis that needs another one's branches comes after it
+  for (const Analysis& x : analyses())
+    if (x.key && a.contains(x.key)) x.parse(r, a[x.key], p / x.key, s);
+  bool any = false;
+  for (const Analysis& x : analyses()) any = any || (x.standalone && x.asked(s));
+  if (!any) {
+    std::string list;
+    for (const std::string& k : standalone) list += (list.empty() ? "" : ", ") + k;
+    r.fail(p, "expected at least one analysis (" + list + ")");
   }
-  if (a.contains("stiffness")) {
-    const json& k = a["stiffness"];
-    const Pointer pk = p / "stiffness";
-    if (k.is_object()) {
-      // {"measure": M}: the stiffness measure whose deep minima are quasi-buckling (KMIN)
-      r.onlyKeys(k, pk, {"measure"});
-      s.stiffness = true;
-      if (k.contains("measure")) {
-        const std::string m = r.string(k["measure"], pk / "measure");
-        if (!mechanics::parseStiffnessMeasure(m, s.stiffnessMeasure))
-          r.expected(pk / "measure", k["measure"], "one of Kxx, Kyy, Kmin (the smallest eigenvalue of K_F)");
-      }
-    } else {
-      s.stiffness = r.boolean(k, pk);
-    }
-    if (s.stiffness && !s.continuation.enabled)
-      r.fail(p / "stiffness", "stiffness is computed along the traced branches: it needs /analyses/continuation");
-  }
-  if (a.contains("energy_curves")) {
-    const json& e = a["energy_curves"];
-    const Pointer pe = p / "energy_curves";
-    r.onlyKeys(e, pe, {"x", "y", "q1_from", "q1_to", "points", "torque"});
-    s.energyCurves.enabled = true;
-    if (!e.contains("x") || !e.contains("y")) r.fail(pe / (e.contains("x") ? "y" : "x"), "missing (required): the held end position");
-    s.energyCurves.x = r.number(e["x"], pe / "x");
-    s.energyCurves.y = r.number(e["y"], pe / "y");
-    if (e.contains("q1_from")) s.energyCurves.q1From = r.number(e["q1_from"], pe / "q1_from");
-    if (e.contains("q1_to")) s.energyCurves.q1To = r.number(e["q1_to"], pe / "q1_to");
-    if (!(s.energyCurves.q1From < s.energyCurves.q1To)) r.fail(pe / "q1_to", "expected q1_to > q1_from");
-    if (e.contains("points")) s.energyCurves.points = r.integer(e["points"], pe / "points", 3, 1000000);
-    if (e.contains("torque")) s.energyCurves.torque = r.boolean(e["torque"], pe / "torque");
-  }
-  if (a.contains("torque_angle")) {
-    const json& t = a["torque_angle"];
-    const Pointer pt = p / "torque_angle";
-    if (t.is_boolean()) {
-      s.torqueAngle.enabled = t.get<bool>();
-    } else {
-      r.onlyKeys(t, pt, {"q_from", "q_to", "points"});
-      s.torqueAngle.enabled = true;
-      if (t.contains("q_from")) s.torqueAngle.qFrom = r.number(t["q_from"], pt / "q_from");
-      if (t.contains("q_to")) s.torqueAngle.qTo = r.number(t["q_to"], pt / "q_to");
-      if (!(s.torqueAngle.qFrom < s.torqueAngle.qTo)) r.fail(pt / "q_to", "expected q_to > q_from");
-      if (t.contains("points")) s.torqueAngle.points = r.integer(t["points"], pt / "points", 3, 1000000);
-    }
-  }
-  if (a.contains("critical_forces")) {
-    const json& c = a["critical_forces"];
-    const Pointer pc = p / "critical_forces";
-    if (c.is_boolean()) {
-      s.criticalForces.enabled = c.get<bool>();
-    } else {
-      r.onlyKeys(c, pc, {"modes"});
-      s.criticalForces.enabled = true;
-      if (c.contains("modes")) s.criticalForces.modes = r.integer(c["modes"], pc / "modes", 1, 100000);
-    }
-  }
-  if (a.contains("jump")) {
-    const json& j = a["jump"];
-    const Pointer pj = p / "jump";
-    if (j.is_boolean()) {
-      s.jump.enabled = j.get<bool>();
-    } else {
-      r.onlyKeys(j, pj, {"perturbation"});
-      s.jump.enabled = true;
-      if (j.contains("perturbation")) s.jump.perturbation = r.positive(j["perturbation"], pj / "perturbation");
-    }
-    if (s.jump.enabled && !s.continuation.enabled)
-      r.fail(pj, "jumps are simulated from the folds of the traced branches: it needs /analyses/continuation");
-  }
-  if (a.contains("load_history")) {
-    const json& h = a["load_history"];
-    const Pointer ph = p / "load_history";
-    r.onlyKeys(h, ph, {"waypoints", "perturbation"});
-    if (!h.contains("waypoints")) r.fail(ph / "waypoints", "missing (required): the path-parameter values to visit");
-    const json& w = h["waypoints"];
-    if (!w.is_array() || w.size() < 2) r.expected(ph / "waypoints", w, "an array of at least two numbers");
-    for (size_t i = 0; i < w.size(); ++i) s.loadHistory.waypoints.push_back(r.number(w[i], ph / "waypoints" / i));
-    if (h.contains("perturbation")) s.loadHistory.perturbation = r.positive(h["perturbation"], ph / "perturbation");
-    s.loadHistory.enabled = true;
-  }
-  if (a.contains("sudden_load")) {
-    const json& d = a["sudden_load"];
-    const Pointer pd = p / "sudden_load";
-    r.onlyKeys(d, pd, {"value", "mass_per_length", "damping"});
-    if (!d.contains("value")) r.fail(pd / "value", "missing (required): the path-parameter value applied at once");
-    s.suddenLoad.value = r.number(d["value"], pd / "value");
-    if (d.contains("mass_per_length")) s.suddenLoad.massPerLength = r.positive(d["mass_per_length"], pd / "mass_per_length");
-    if (d.contains("damping")) s.suddenLoad.damping = r.nonNegative(d["damping"], pd / "damping");
-    if (d.contains("damping") && !d.contains("mass_per_length"))
-      r.fail(pd / "damping", "joint damping belongs to the inertial model: give mass_per_length too");
-    s.suddenLoad.enabled = true;
-  }
-  if (a.contains("two_parameter")) s.twoParameter = parseTwoParameter(r, a["two_parameter"], p / "two_parameter");
-  if (a.contains("frequencies")) {
-    s.frequencies = parseFrequencies(r, a["frequencies"], p / "frequencies");
-    if (!s.continuation.enabled && !s.loadHistory.enabled)
-      r.fail(p / "frequencies",
-             "frequencies are computed along the traced branches: it needs /analyses/continuation or load_history");
-  }
-  if (a.contains("equilibria")) s.equilibria = parseEquilibria(r, a["equilibria"], p / "equilibria");
-  if (!s.continuation.enabled && !s.energyCurves.enabled && !s.torqueAngle.enabled && !s.criticalForces.enabled &&
-      !s.loadHistory.enabled && !s.suddenLoad.enabled && !s.twoParameter.enabled && !s.equilibria.enabled)
-    r.fail(p, "expected at least one analysis (continuation, energy_curves, torque_angle, critical_forces, "
-              "load_history, sudden_load, two_parameter, equilibria)");
   return s;
 }
 

@@ -52,7 +52,20 @@ void checkTaskPathAnalyses(const JsonReader& r, const Scene& scene);
 
 // ---- analyses, solver, plots (scene_analyses.cpp) -------------------------------------------
 
+/// /analyses: every block through the registry (analyses.h), in its order.
 AnalysesSpec parseAnalyses(const JsonReader& r, const json& a, const Pointer& p);
+/// The blocks of the analyses under /analyses (registered in analyses.cpp), each read into `s`.
+void parseContinuation(const JsonReader& r, const json& c, const Pointer& p, AnalysesSpec& s);
+void parseStiffness(const JsonReader& r, const json& k, const Pointer& p, AnalysesSpec& s);
+void parseEnergyCurves(const JsonReader& r, const json& e, const Pointer& p, AnalysesSpec& s);
+void parseTorqueAngle(const JsonReader& r, const json& t, const Pointer& p, AnalysesSpec& s);
+void parseCriticalForces(const JsonReader& r, const json& c, const Pointer& p, AnalysesSpec& s);
+void parseJump(const JsonReader& r, const json& j, const Pointer& p, AnalysesSpec& s);
+void parseLoadHistory(const JsonReader& r, const json& h, const Pointer& p, AnalysesSpec& s);
+void parseSuddenLoad(const JsonReader& r, const json& d, const Pointer& p, AnalysesSpec& s);
+void parseFrequenciesBlock(const JsonReader& r, const json& f, const Pointer& p, AnalysesSpec& s);
+void parseTwoParameterBlock(const JsonReader& r, const json& v, const Pointer& p, AnalysesSpec& s);
+void parseEquilibriaBlock(const JsonReader& r, const json& v, const Pointer& p, AnalysesSpec& s);
 /// /analyses/two_parameter (scene_two_parameter.cpp).
 TwoParameterSpec parseTwoParameter(const JsonReader& r, const json& v, const Pointer& p);
 /// Its segment exists and its range contains every case's value of the parameter.
