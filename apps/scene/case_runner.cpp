@@ -192,8 +192,7 @@ void CaseRunner::suddenLoad() {
   } else {
     qStatic = out_.qStart;
   }
-  mech::EndCondition loaded = problem.endCondition();
-  loaded.value += spec.value * problem.direction();
+  const mech::EndCondition loaded = loadPath().at(spec.value);
   mech::SuddenLoadOptions opt;
   opt.integration = integrationOptions();
   if (spec.massPerLength > 0) {
@@ -282,9 +281,7 @@ void CaseRunner::continuation() {
     taskPath();
     return;
   }
-  double s0 = out_.startValue;
-  mech::EndCondition end = spec_.end.condition;
-  Eigen::Vector3d direction = spec_.path.direction;
+  mech::LoadPath path = loadPath();
   double lambdaLo = std::min(spec_.path.from, spec_.path.to), lambdaHi = std::max(spec_.path.from, spec_.path.to);
   std::vector<double> targets{spec_.path.to, spec_.path.from};
   const int c = spec_.path.coordinate;
@@ -294,11 +291,7 @@ void CaseRunner::continuation() {
     // branch ending where the coordinate leaves the path's range
     const double limit = reactionLoadLimit();
     if (!(limit > 0.0)) return;  // said in run_.problems
-    end.control[size_t(c)] = mech::Control::Load;
-    end.value[c] = 0.0;
-    direction = Eigen::Vector3d::Zero();
-    direction[c] = 1.0;
-    s0 = 0.0;
+    path = path.throughReaction(c);
     // both signs of the reaction: with an unstable start (κ < 0) the branch points lie on the
     // tension side, and their branches still move the end into the requested range
     targets = {-limit, limit};
@@ -306,14 +299,15 @@ void CaseRunner::continuation() {
     lambdaHi = limit;
     equilibriumOptions.heldRange = {c, std::min(spec_.path.from, spec_.path.to), std::max(spec_.path.from, spec_.path.to)};
   }
-  end.value -= s0 * direction;  // prescribed(λ) = start values + (λ − s0)·direction
-  mech::EquilibriumProblem problem(out_.chain, end, direction, equilibriumOptions, controlDirection(), bodyLoads());
+  const double s0 = path.startValue;
+  const mech::EndCondition end = path.problemEnd();
+  mech::EquilibriumProblem problem(out_.chain, end, path.direction, equilibriumOptions, controlDirection(), bodyLoads());
 
   mech::EquilibriumBranchOptions opt = branchOptions(lambdaLo, lambdaHi);
   if (opt.switchingDepth > 0 && !spec_.path.control && !spec_.path.gravity) {
     std::vector<double> ends;
     for (double target : targets) ends.push_back(target - s0);
-    warnOfLargeTree(mech::criticalLoading(end, c, direction), ends, opt.switchingDepth);
+    warnOfLargeTree(mech::criticalLoading(end, c, path.direction), ends, opt.switchingDepth);
   }
 
   // The start branches (one per requested direction), then branch switching breadth first, by

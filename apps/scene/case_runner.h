@@ -123,11 +123,12 @@ class CaseRunner {
     opt.interrupt = control_.interrupt;
     return opt;
   }
-  /// The path as an EquilibriumProblem: prescribed(λ) = start values + (λ − s0)·direction.
+  /// The scene's path of the end condition: prescribed(λ) = start values + (λ − s0)·direction.
+  mechanics::LoadPath loadPath() const { return {spec_.end.condition, spec_.path.direction, out_.startValue}; }
+  /// The path as an EquilibriumProblem.
   mechanics::EquilibriumProblem pathProblem() const {
-    mechanics::EndCondition end = spec_.end.condition;
-    end.value -= out_.startValue * spec_.path.direction;
-    return mechanics::EquilibriumProblem(out_.chain, end, spec_.path.direction, {}, controlDirection(), bodyLoads());
+    return mechanics::EquilibriumProblem(out_.chain, loadPath().problemEnd(), spec_.path.direction, {},
+                                         controlDirection(), bodyLoads());
   }
   /// The case's weight and point loads along the path (case_body.cpp): g(λ) = λ·direction on a
   /// gravity path, else fixed; point loads force + (λ − s0)·rate; the payload's weight at the end.

@@ -24,8 +24,7 @@ void CaseRunner::equilibria() {
 
 void CaseRunner::equilibriaAt(double at) {
   const EquilibriaSpec& e = scene_.analyses.equilibria;
-  mechanics::EndCondition end = spec_.end.condition;
-  end.value += (at - out_.startValue) * spec_.path.direction;
+  const mechanics::EndCondition end = loadPath().at(at);
   mechanics::AllEquilibriaOptions options;
   options.randomStarts = e.starts;
   options.smoothStarts = e.smoothStarts;

@@ -44,8 +44,7 @@ const char* kindName(const mech::CriticalPoint& p, const std::string& type) {
 
 void CaseRunner::twoParameter() {
   const TwoParameterSpec& t = scene_.analyses.twoParameter;
-  mech::EndCondition end = spec_.end.condition;
-  end.value -= out_.startValue * spec_.path.direction;  // λ is the path parameter (pathProblem())
+  const mech::EndCondition end = loadPath().problemEnd();  // λ is the path parameter (pathProblem())
   const std::string where = "case \"" + spec_.label + "\": two_parameter: ";
   try {
     mech::ChainParameterProblem problem(spec_.chain.segments, end, spec_.path.direction,

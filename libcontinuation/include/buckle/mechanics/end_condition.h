@@ -1,7 +1,7 @@
 // What is prescribed at the end effector: each of x, y, φ is either load-controlled (a given
 // force / torque) or displacement-controlled (a given coordinate, whose reaction becomes an
 // unknown Lagrange multiplier). A LoadPath moves all prescribed values along a straight line
-// in load / displacement space: value(λ) = value + λ·direction.
+// in load / displacement space with the path parameter λ.
 #pragma once
 
 #include <Eigen/Core>
@@ -31,6 +31,24 @@ struct EndCondition {
   std::vector<int> heldIndices() const;
   std::vector<int> loadedIndices() const;
   int heldCount() const { return static_cast<int>(heldIndices().size()); }
+};
+
+/// A straight path of the prescribed values: at path parameter λ they are
+///   prescribed(λ) = start.value + (λ − startValue)·direction.
+struct LoadPath {
+  EndCondition start;                                   ///< the end condition at λ = startValue
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  ///< d prescribed / dλ
+  double startValue = 0.0;
+
+  /// The end condition EquilibriumProblem takes with `direction` (its prescribed(λ) = value +
+  /// λ·direction): the start's values moved back to λ = 0.
+  EndCondition problemEnd() const;
+  /// The end condition with the prescribed values at path parameter λ.
+  EndCondition at(double lambda) const;
+  /// The same path traced through the reaction of its held coordinate c (reaction_path.h): c
+  /// released and loaded along itself from zero (λ = F_c, startValue 0), the other prescribed
+  /// values fixed at their start values.
+  LoadPath throughReaction(int c) const;
 };
 
 }  // namespace buckle::mechanics
