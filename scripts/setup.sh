@@ -33,12 +33,13 @@ export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$ROOT}
 # `buckle-mpi atlas` under mpirun (and its test, mpirun -np 2/3). TEST_PACKAGES only for `test`:
 # chromium renders report.html in the browser test; matplotlib and pandas, the Python package's
 # optional plots and DataFrames; pip, setuptools, wheel and venv, its `pip install .` test;
-# universal-ctags, the size test's function lengths (scripts/check_sizes.sh --functions).
+# universal-ctags, the size test's function lengths (scripts/check_sizes.sh --functions); nodejs,
+# the syntax check of report.html's script (apps/scene/report/report.js).
 readonly PACKAGES=(build-essential cmake git pkg-config ccache libeigen3-dev libsundials-dev
                    libboost-dev catch2 libcli11-dev nlohmann-json3-dev libbenchmark-dev gnuplot-nox
                    pybind11-dev python3-dev python3-numpy python3-pytest openmpi-bin libopenmpi-dev)
 readonly TEST_PACKAGES=(chromium python3-matplotlib python3-pandas python3-pip python3-setuptools python3-wheel
-                        python3-venv universal-ctags)
+                        python3-venv universal-ctags nodejs)
 
 START=$SECONDS
 log() { printf '==> [setup %4ds] %s\n' "$((SECONDS - START))" "$*"; }

@@ -1,6 +1,6 @@
 // Labels placed apart on a plot whose pixel geometry is fixed before it is drawn: the special
 // points of the gnuplot diagrams (plot_branches.cpp); report.html's script follows the same rules
-// (report_chart.cpp). Candidate positions on rings around each point, the cheapest free one.
+// (apps/scene/report/report.js). Candidate positions on rings around each point, the cheapest free one.
 #pragma once
 
 #include <Eigen/Core>
@@ -124,7 +124,7 @@ void placeLabels(std::vector<PlacedLabel>& labels, const Frame& f, const Occupan
 /// The drawn path of a jump from `a` to `b` (pixels): the straight segment when it is at least
 /// `minPixels` long; else a hop, a quadratic arc from a to b about `minPixels` long, bulging to
 /// the side with fewer curve pixels, so that a jump of a few pixels is still seen to leave and
-/// land (report.html's script draws the same, report_chart.cpp). 13 points along a hop.
+/// land (report.html's script draws the same, apps/scene/report/report.js). 13 points along a hop.
 std::vector<Eigen::Vector2d> jumpPath(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double minPixels,
                                       const Occupancy& curves);
 

@@ -395,8 +395,8 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   }
   data["critical_column"] = criticalColumn;
   // every "<" as \u003c: nothing inside the JSON can end or change the <script> element (escape.h)
-  return kReportHead + escape::htmlScriptSafe(objectText(data, {{"cases", std::move(cases)}})) + kReportScriptStart +
-         kReportChartScript + kReportTail;
+  return kReportHead + escape::htmlScriptSafe(objectText(data, {{"cases", std::move(cases)}})) + kReportMiddle +
+         kReportScript + kReportEnd;
 }
 
 void writeReport(const Scene& scene, const RunResult& run, const json& specialPoints, const json& summary,
