@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "scene/column_values.h"
 #include "scene/columns.h"
 #include "scene/runner.h"
 #include "scene/scene.h"
@@ -18,10 +19,6 @@ namespace buckle::scene {
 /// angles, which go to joint_angles.npy (docs/outputs.md).
 constexpr int kBranchesCsvJointColumns = 12;
 
-/// Value of a branches.csv column at a point of case `cr` (NaN when it does not apply).
-double columnValue(const std::string& column, const mechanics::PointReport& p, const CaseResult& cr);
-/// The same for a special point (stiffness columns are NaN there unless it carries its own K_F).
-double columnValue(const std::string& column, const mechanics::SpecialPointReport& s, const CaseResult& cr);
 /// A directory created next to `target` (same parent, hidden name), renamed onto `target` by
 /// commit(); removed by the destructor unless committed. While it exists SIGINT, SIGTERM and
 /// SIGHUP are held back (blocked in the calling thread, then delivered when it is gone): a signal that
