@@ -68,8 +68,8 @@ const std::vector<Analysis>& analyses() {
        },
        nullptr, nullptr, false},
       {"jump", detail::parseJump, [](A a) { return a.jump.enabled; },
-       [](S) -> std::string { return "jumps from the folds (gradient-flow dynamics, landing polished)"; }, nullptr,
-       nullptr, false},
+       [](S) -> std::string { return "jumps from the folds (gradient-flow dynamics, landing polished)"; }, "jump",
+       [](CaseRunner& r) { r.jumps(); }, false},
   };
   return table;
 }

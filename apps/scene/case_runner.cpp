@@ -39,8 +39,7 @@ std::string solverFailureInWords(const std::string& solverMessage) {
   return what + "; " + change + " (solver detail: " + solverMessage + ")";
 }
 
-void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report, mech::EquilibriumProblem& problem,
-                        const std::string& origin) {
+void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report, const std::string& origin) {
   BranchRecord br;
   br.id = b.id;
   br.parent = b.parentId;
@@ -49,6 +48,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   br.stopMessage = report.stopMessage;
   br.points = static_cast<int>(report.points.size());  // those reported (in the path's range)
   br.finished = report.finished;
+  br.mirrorOf = b.mirrorOf;
   // a switched branch that used up its requested "child_points" ended where it was asked to
   const bool childBudget = b.parentId >= 0 && scene_.analyses.continuation.childPoints > 0 &&
                            b.stopReason == cont::StopReason::MaxPoints;
@@ -82,38 +82,53 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
       s.omega = naturalFrequencies(sp.q, sp.F, before->locked, sp.parameter);
     }
     if (sp.source >= 0) run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
-    if (scene_.analyses.jump.enabled && sp.jumps && sp.source >= 0 && !throughLoad()) s.landing = jumpFrom(b, sp, problem);
     out_.specials.push_back(std::move(s));
   }
 }
 
-// The jump from the fold `sp` of branch b (the jump analysis): where the chain lands.
-mech::Landing CaseRunner::jumpFrom(const cont::Branch& b, const mech::SpecialPointReport& sp,
-                                   mech::EquilibriumProblem& problem) {
-  const cont::SpecialPoint& fold = b.specialPoints[size_t(sp.source)];
-  if (interrupted()) {
-    mech::Landing none;
-    none.message = "not simulated: " + run_.interruption;
-    return none;
+// The `jump` analysis, a stage of its own once the branches are traced: from every fold whose
+// stable side ends there, the chain released with the loads frozen (jumpFromFold) — the fold of
+// a mirror image branch lands as the mirror image of its source's landing.
+void CaseRunner::jumps() {
+  if (throughLoad()) return;  // no jump under displacement control traced through the reaction
+  mech::EquilibriumProblem problem = pathProblem();
+  const std::vector<int> held = problem.endCondition().heldIndices();
+  std::map<int, int> mirrorOf;  // branch id → the id of its mirror source
+  for (const BranchRecord& b : out_.branches) mirrorOf[b.id] = b.mirrorOf;
+  std::map<std::pair<int, int>, mech::Landing> landings;  // (branch, special point of its trace)
+  for (SpecialPointResult& s : out_.specials) {
+    if (!s.jumps || s.source < 0 || s.landing.tried || s.q.size() != out_.chain.size()) continue;
+    if (interrupted()) {
+      s.landing.message = "not simulated: " + run_.interruption;
+      continue;
+    }
+    // the fold's unknowns u = (q, reactions of the held coordinates: the wrench's components there)
+    cont::SpecialPoint fold;
+    fold.lambda = s.lambda;
+    fold.u.resize(problem.dimension());
+    fold.u.head(s.q.size()) = s.q;
+    for (size_t k = 0; k < held.size(); ++k) fold.u[s.q.size() + Eigen::Index(k)] = s.F[held[k]];
+    if (control_.progress) control_.progress->note("jump from the fold at " + std::to_string(fold.lambda));
+    const int source = mirrorOf.count(s.branch) ? mirrorOf[s.branch] : -1;
+    const auto image = landings.find({source, s.source});
+    if (source >= 0 && image != landings.end()) {
+      s.landing = mech::mirrored(image->second);
+    } else {
+      mech::JumpOptions opt;
+      opt.perturbation = scene_.analyses.jump.perturbation;
+      opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
+      opt.integration.recordTrajectory = false;
+      s.landing = mech::jumpFromFold(problem, fold, opt);
+    }
+    landings[{s.branch, s.source}] = s.landing;
+    if (s.landing.interrupted) {
+      interrupted();
+    } else if (!s.landing.success) {
+      run_.complete = false;
+      run_.problems.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter + " = " +
+                              std::to_string(fold.lambda) + " did not land on a stable equilibrium: " + s.landing.message);
+    }
   }
-  if (control_.progress) control_.progress->note("jump from the fold at " + std::to_string(fold.lambda));
-  mech::JumpOptions opt;
-  opt.perturbation = scene_.analyses.jump.perturbation;
-  opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
-  opt.integration.recordTrajectory = false;
-  // The fold of a mirror image branch jumps as the mirror image of its source's fold.
-  const auto source = landings_.find({b.mirrorOf, sp.source});
-  const mech::Landing landing = b.mirrorOf >= 0 && source != landings_.end() ? mech::mirrored(source->second)
-                                                                             : mech::jumpFromFold(problem, fold, opt);
-  landings_[{b.id, sp.source}] = landing;
-  if (landing.interrupted) {
-    interrupted();
-  } else if (!landing.success) {
-    run_.complete = false;
-    run_.problems.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter + " = " +
-                            std::to_string(fold.lambda) + " did not land on a stable equilibrium: " + landing.message);
-  }
-  return landing;
 }
 
 // The load history of the scene: stable quasi-static pieces joined by jumps. Each piece is a
@@ -148,7 +163,7 @@ void CaseRunner::loadHistory() {
     origin << "load history, leg " << h.segmentLeg[k] << " (" << spec_.path.parameter << " -> "
            << scene_.analyses.loadHistory.waypoints[size_t(h.segmentLeg[k])] << ")"
            << (h.segmentBifurcated[k] ? ", on the stable branch born at the branch point" : "");
-    record(b, mech::reportBranch(problem, b, reportOptions()), problem, origin.str());
+    record(b, mech::reportBranch(problem, b, reportOptions()), origin.str());
   }
   for (const mech::JumpRecord& j : h.jumps) {
     SpecialPointResult& s = out_.specials.emplace_back();
@@ -341,7 +356,7 @@ void CaseRunner::continuation() {
                                               : "BP " + std::to_string(b.parentSpecialPoint) + " of branch " +
                                                     std::to_string(b.parentId) +
                                                     (b.direction > 0 ? ", + side" : ", - side");
-    record(b, report, problem, origin);
+    record(b, report, origin);
   };
   const mech::EquilibriumBranches result = mech::traceEquilibria(problem, out_.qStart, s0, starts, opt);
   const auto& branches = result.tree.branches;

@@ -46,6 +46,8 @@ class CaseRunner {
   void torqueAngle();
   /// equilibria (case_runner_equilibria.cpp)
   void equilibria();
+  /// `jump` (after the branches are traced): where the chain lands from every fold of them.
+  void jumps();
   /// The branches through the equilibria that the continuation's tree does not reach
   /// (equilibria with "branches": true; case_runner_equilibria.cpp), after continuation().
   void disconnectedBranches();
@@ -67,12 +69,8 @@ class CaseRunner {
   /// One set of the equilibria analysis at path-parameter value `at`, and the branches through it.
   void equilibriaAt(double at);
   void disconnectedBranchesAt(EquilibriumSet& set);
-  void record(const continuation::Branch& b, const mechanics::BranchReport& report, mechanics::EquilibriumProblem& problem,
-              const std::string& origin);
-  /// The `jump` analysis at the fold `sp` of branch b: where the chain lands (a mirror image
-  /// branch's fold: the image of its source's landing).
-  mechanics::Landing jumpFrom(const continuation::Branch& b, const mechanics::SpecialPointReport& sp,
-                              mechanics::EquilibriumProblem& problem);
+  void record(const continuation::Branch& b, const mechanics::BranchReport& report, const std::string& origin);
+
   /// `frequencies` (case_frequencies.cpp): the signed natural frequencies at joint angles q under
   /// the total end wrench F with the joints of `locked` locked (`parameter`: for a message).
   Eigen::VectorXd naturalFrequencies(const Eigen::VectorXd& q, const mechanics::Wrench& F,
@@ -174,8 +172,6 @@ class CaseRunner {
   /// (case_runner_ahead.cpp).
   void warnOfLargeTree(const mechanics::CriticalLoading& loading, const std::vector<double>& ends, int depth);
   std::vector<continuation::Branch> traced_;  // the continuation's tree (not through a reaction)
-  /// The jumps simulated from (branch, special point): a mirror image's jump is their image.
-  std::map<std::pair<int, int>, mechanics::Landing> landings_;
   /// `frequencies`: the case's chain with its rods (built at the first point)
   std::unique_ptr<mechanics::VibrationAnalysis> vibration_;
   /// `frequencies` with body loads: the path's problem, for their γ at each point

@@ -46,6 +46,7 @@ struct BranchRecord {
   /// ... and the path-parameter value of that equilibrium's set (equilibria `at`).
   double fromEquilibriumAt = 0.0;
   int joins = -1;          ///< the branch it ended on (stop "joined a traced branch"), else -1
+  int mirrorOf = -1;       ///< the branch it is the mirror image of (continuation::Branch::mirrorOf), else -1
 };
 
 using TorqueCurve = mechanics::TorqueCurve;
