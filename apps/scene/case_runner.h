@@ -160,6 +160,7 @@ class CaseRunner {
   /// the difference summed (branchPointsQueued_). Fed by the tree's onBranch and onReport.
   struct TreeAhead {
     std::vector<int> depth, found, settled;
+    std::vector<char> paused;  // a root traced up to a branch point only: reported again when traced further
     int queued = 0;
   } ahead_;
   std::pair<int, int> tracedParent_{-1, -1};  // (parent, branch point) of the last branch added

@@ -224,8 +224,24 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     isFinal[i] = 1;
     if (treeOptions.onFinal) treeOptions.onFinal(tree, i);
   };
+  // A branch joins the tree (add) and is extended once its trace has ended (settle): a root
+  // paused at a branch point (Tracer::pauseAtBranchPoints) is settled when it ends.
+  auto settle = [&](std::size_t i) {
+    Branch &b = tree.branches[i];
+    if (treeOptions.extend && b.stopReason != StopReason::InvalidOptions) treeOptions.extend(tree, b);
+    if (tree.branches[i].stopReason == StopReason::Interrupted) {
+      tree.interrupted = true;
+      tree.message = tree.branches[i].stopMessage;
+    }
+  };
   auto finish = [&]() -> BranchTree & {
-    for (std::size_t i = 0; i < tree.branches.size(); ++i) finalize(i);
+    for (std::size_t i = 0; i < tree.branches.size(); ++i) {
+      if (tree.branches[i].stopReason == StopReason::Paused) {  // stopped early: the tree is interrupted
+        Tracer::endPaused(tree.branches[i], tree.message.empty() ? "interrupted" : tree.message);
+        settle(i);
+      }
+      finalize(i);
+    }
     return tree;
   };
   auto interrupted = [&]() {
@@ -239,13 +255,23 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     tree.branches.push_back(std::move(b));
     depth.push_back(generation);
     isFinal.push_back(0);
-    if (treeOptions.extend && tree.branches.back().stopReason != StopReason::InvalidOptions)
-      treeOptions.extend(tree, tree.branches.back());
-    if (tree.branches.back().stopReason == StopReason::Interrupted) {
-      tree.interrupted = true;
-      tree.message = tree.branches.back().stopMessage;
-    }
+    if (tree.branches.back().stopReason != StopReason::Paused) settle(tree.branches.size() - 1);
     if (treeOptions.onBranch) treeOptions.onBranch(tree, tree.branches.back());
+  };
+  // A root traced only up to its latest branch point goes on (one more branch point, or to its
+  // end); an interrupt ends it where it stands. False when it was not paused.
+  auto resume = [&](std::size_t i) {
+    if (tree.branches[i].stopReason != StopReason::Paused) return false;
+    if (tree.interrupted || interrupted()) {
+      Tracer::endPaused(tree.branches[i], tree.message);
+    } else {
+      tracer.pauseAtBranchPoints(true);
+      tracer.continueBranch(tree.branches[i]);
+      tracer.pauseAtBranchPoints(false);
+    }
+    if (tree.branches[i].stopReason != StopReason::Paused) settle(i);
+    if (treeOptions.onBranch) treeOptions.onBranch(tree, tree.branches[i]);
+    return true;
   };
   if (std::string why; !treeOptions.symmetry.IsValid(problem.dimension(), &why)) {
     Branch invalid;
@@ -254,9 +280,17 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     add(std::move(invalid), 0);
     return finish();
   }
+  // With switching, each root is traced up to its first branch point only, and further as its
+  // branch points are switched at (below): under a time limit or an interruption the tree holds
+  // the branches of a long root's first (along a load path: weakest) branch points, not a
+  // root whose hundreds of branch points were all located before any was switched at. The
+  // branches and their ids are those of tracing every root whole first.
   for (const InitialDirection &direction : starts) {
     if (tree.interrupted || interrupted()) return finish();
-    add(tracer.trace(u0, lambda0, direction), 0);
+    tracer.pauseAtBranchPoints(treeOptions.maxDepth > 0);
+    Branch root = tracer.trace(u0, lambda0, direction);
+    tracer.pauseAtBranchPoints(false);
+    add(std::move(root), 0);
     if (treeOptions.maxDepth <= 0) finalize(tree.branches.size() - 1);
   }
   std::vector<Vector> switchedAt;
@@ -266,7 +300,10 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
 
   for (std::size_t i = 0; i < tree.branches.size(); ++i) {
     if (depth[i] >= treeOptions.maxDepth) continue;
-    for (std::size_t k = 0; k < tree.branches[i].specialPoints.size(); ++k) {
+    for (std::size_t k = 0;; ++k) {
+      // past the last special point: a paused root goes on (and gains a branch point or its end)
+      if (k >= tree.branches[i].specialPoints.size() && !(resume(i) && k < tree.branches[i].specialPoints.size()))
+        break;
       SpecialPoint bp = tree.branches[i].specialPoints[k];
       if (bp.type != SpecialPointType::BranchPoint) continue;
       if (treeOptions.switchAt && !treeOptions.switchAt(tree.branches[i], bp)) continue;

@@ -388,7 +388,13 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
   eventsB_.resize(size_t(events));
   eventValues(branch.points.back(), eventsA_);
   double ds = options_.initialStep;
+  if (branch.stopReason == StopReason::Paused) {  // the step the tracer would have taken next
+    ds = branch.resumeStep;
+    branch.stopReason = StopReason::NotStarted;
+    branch.resumeStep = 0.0;
+  }
   std::string lastFailure = "no failure";
+  bool pause = false;  // a branch point was located in the last step (pauseAtBranchPoints)
 
   // Ends the branch at its last point.
   auto stop = [&branch](StopReason reason, const std::string &message, SpecialPointType type, const std::string &name,
@@ -411,6 +417,12 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
   for (;;) {
     if (options_.interrupt.requested()) {
       interrupted(options_.interrupt.describe());
+      return;
+    }
+    if (pause) {
+      branch.stopReason = StopReason::Paused;
+      branch.stopMessage.clear();
+      branch.resumeStep = ds;
       return;
     }
     if (static_cast<int>(branch.points.size()) >= options_.maxPoints) {
@@ -480,6 +492,9 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       branch.specialPoints.push_back(std::move(sp));
     }
     if (!found.empty()) mergeCoincidentSpecialPoints(branch, firstNew);
+    if (pauseAtBranchPoints_)
+      for (size_t k = firstNew; k < branch.specialPoints.size(); ++k)
+        if (branch.specialPoints[k].type == SpecialPointType::BranchPoint) pause = true;
     if (options_.onStep && !landedOnStart) {
       const StepAction action = notifyStep(branch);
       if (action == StepAction::Stop) {
@@ -505,6 +520,14 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     ds = stepControl_.next(ds, observed);
     eventsA_.swap(eventsB_);
   }
+}
+
+void Tracer::endPaused(Branch &branch, const std::string &message) {
+  if (branch.stopReason != StopReason::Paused || branch.points.empty()) return;
+  branch.stopReason = StopReason::Interrupted;
+  branch.stopMessage = message;
+  branch.resumeStep = 0.0;
+  appendEndpoint(branch, SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
 }
 
 Branch trace(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
