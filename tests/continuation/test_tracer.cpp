@@ -711,3 +711,28 @@ TEST_CASE("A paused branch ended where it stands is interrupted there, with its 
   Tracer::endPaused(branch, "again");
   CHECK(branch.stopMessage == "time limit");
 }
+
+TEST_CASE("A paused trace steps over at most kPausedCrossings branch points at a time", "[tracer]") {
+  // 40 branch points 0.001 apart: the first step of 0.02 alone would cross 20 of them
+  toys::ManyPitchforks problem(40, 0.001);
+  TracerOptions options;
+  options.lambdaMax = 0.05;
+  options.initialStep = 0.02;
+  options.maxStep = 0.05;
+  Tracer tracer(problem, options);
+  tracer.pauseAtBranchPoints(true);
+  Branch branch = tracer.trace(Vector::Zero(40), -0.0005, InitialDirection::increasingLambda());
+  std::size_t before = 0;
+  int pauses = 0;
+  while (branch.stopReason == StopReason::Paused) {
+    ++pauses;
+    const std::size_t found = branch.specialPointsOfType(SpecialPointType::BranchPoint).size();
+    CHECK(found > before);
+    CHECK(found - before <= std::size_t(Tracer::kPausedCrossings));
+    before = found;
+    tracer.continueBranch(branch);
+  }
+  CHECK(branch.stopReason == StopReason::LambdaRange);
+  CHECK(branch.specialPointsOfType(SpecialPointType::BranchPoint).size() == 40);  // each once
+  CHECK(pauses >= 5);
+}

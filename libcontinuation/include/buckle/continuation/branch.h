@@ -104,7 +104,8 @@ enum class StopReason {
   Joined,              ///< the step callback found the branch on one already traced (StepAction::Join)
   /// Not ended: the tracer returned after a step that located a branch point, as asked
   /// (Tracer::pauseAtBranchPoints); Tracer::continueBranch goes on from its last point with
-  /// the step it would have taken (Branch::resumeStep), the same points as without the pause.
+  /// the step it would have taken (Branch::resumeStep): the same points as without the pause,
+  /// unless a step crossed more than Tracer::kPausedCrossings branch points (then retried shorter).
   Paused,
 };
 

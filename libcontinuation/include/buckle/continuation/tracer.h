@@ -188,7 +188,10 @@ class Tracer {
   /// While set, trace() and continueBranch() return after the first step that located a branch
   /// point, with StopReason::Paused (no endpoint appended): the tree driver switches at the
   /// weakest branch points of a long branch before tracing it further (branch_switching.h).
+  /// A step over more than kPausedCrossings branch points (the count's change) is then retried
+  /// shorter.
   void pauseAtBranchPoints(bool pause) { pauseAtBranchPoints_ = pause; }
+  static constexpr int kPausedCrossings = 8;
   /// Ends a paused branch where it stands, as an interrupt would (StopReason::Interrupted,
   /// an endpoint "interrupted" with `message`).
   static void endPaused(Branch &branch, const std::string &message);
