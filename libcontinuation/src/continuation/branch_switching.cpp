@@ -49,6 +49,21 @@ bool startsAt(const Branch &b, const Vector &x, const UnitScaling &units) {
   return (x - x0).norm() <= 1e-6 * (scaled(b.points[1]) - x0).norm();
 }
 
+// Whether the scaled point x (λ accuracy `accuracy`) is one of those switched at already.
+bool switchedBefore(const std::vector<Vector> &switchedAt, const std::vector<double> &switchedAccuracy, const Vector &x,
+                    double accuracy) {
+  const Eigen::Index n = x.size() - 1;
+  for (size_t j = 0; j < switchedAt.size(); ++j) {
+    const Vector &y = switchedAt[j];
+    const double dl = std::abs(y[n] - x[n]);
+    if ((y - x).norm() <= 1e-7 * std::max(1.0, x.norm()) &&
+        dl <= std::max({1e3 * (accuracy + switchedAccuracy[j]), 1e-6 * std::max(std::abs(y[n]), std::abs(x[n])),
+                        4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(x[n]))}))
+      return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note,
@@ -224,8 +239,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     isFinal[i] = 1;
     if (treeOptions.onFinal) treeOptions.onFinal(tree, i);
   };
-  // A branch joins the tree (add) and is extended once its trace has ended (settle): a root
-  // paused at a branch point (Tracer::pauseAtBranchPoints) is settled when it ends.
+  // A branch joins the tree (add) and is extended once its trace has ended (settle).
   auto settle = [&](std::size_t i) {
     Branch &b = tree.branches[i];
     if (treeOptions.extend && b.stopReason != StopReason::InvalidOptions) treeOptions.extend(tree, b);
@@ -258,8 +272,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     if (tree.branches.back().stopReason != StopReason::Paused) settle(tree.branches.size() - 1);
     if (treeOptions.onBranch) treeOptions.onBranch(tree, tree.branches.back());
   };
-  // A root traced only up to its latest branch point goes on (one more branch point, or to its
-  // end); an interrupt ends it where it stands. False when it was not paused.
+  // A paused root goes on to its next branch point or end; an interrupt ends it where it stands.
   auto resume = [&](std::size_t i) {
     if (tree.branches[i].stopReason != StopReason::Paused) return false;
     if (tree.interrupted || interrupted()) {
@@ -280,19 +293,14 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     add(std::move(invalid), 0);
     return finish();
   }
-  // With switching, each root is traced up to its first branch point only, and further as its
-  // branch points are switched at (below): under a time limit or an interruption the tree holds
-  // the branches of a long root's first (along a load path: weakest) branch points, not a
-  // root whose hundreds of branch points were all located before any was switched at. The
-  // branches and their ids are those of tracing every root whole first.
+  // With switching the roots are traced lazily (header): here up to their first branch point.
+  tracer.pauseAtBranchPoints(treeOptions.maxDepth > 0);
   for (const InitialDirection &direction : starts) {
     if (tree.interrupted || interrupted()) return finish();
-    tracer.pauseAtBranchPoints(treeOptions.maxDepth > 0);
-    Branch root = tracer.trace(u0, lambda0, direction);
-    tracer.pauseAtBranchPoints(false);
-    add(std::move(root), 0);
+    add(tracer.trace(u0, lambda0, direction), 0);
     if (treeOptions.maxDepth <= 0) finalize(tree.branches.size() - 1);
   }
+  tracer.pauseAtBranchPoints(false);
   std::vector<Vector> switchedAt;
   std::vector<double> switchedAccuracy;  // |Δλ| of each, scaled
   const int n = problem.dimension();
@@ -320,15 +328,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       // locations' accuracy or a millionth of λ itself (distinct points of a cluster at λ ~ 1e-10
       // lie far closer than 1e-7 in the state, but their λ differ by far more than that).
       const double accuracy = bp.lambdaAccuracy / tracer.units().parameter();
-      bool seen = false;
-      for (size_t j = 0; j < switchedAt.size(); ++j) {
-        const Vector &y = switchedAt[j];
-        const double dl = std::abs(y[n] - xBP[n]);
-        if ((y - xBP).norm() <= 1e-7 * std::max(1.0, xBP.norm()) &&
-            dl <= std::max({1e3 * (accuracy + switchedAccuracy[j]), 1e-6 * std::max(std::abs(y[n]), std::abs(xBP[n])),
-                            4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(xBP[n]))}))
-          seen = true;
-      }
+      const bool seen = switchedBefore(switchedAt, switchedAccuracy, xBP, accuracy);
       std::string &note = tree.branches[i].specialPoints[k].note;
       if (seen) {
         note += (note.empty() ? "" : "; ") + std::string("already switched from another branch");
