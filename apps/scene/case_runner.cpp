@@ -69,6 +69,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
     r.branch = b.id;
     if (frequencies) r.omega = naturalFrequencies(p.q, p.F, p.locked, p.parameter);
   }
+  keepTimeForWriting(report.points.size());
   run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
 
   for (const mech::SpecialPointReport& sp : report.specialPoints) {
@@ -253,6 +254,21 @@ void CaseRunner::suddenLoad() {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": sudden load: " + e.what());
   }
+}
+
+void CaseRunner::keepTimeForWriting(size_t points) {
+  // Writing a point costs in proportion to its values (its n joint angles, its columns of
+  // branches.csv and its share of the special points and the report); kSecondsPerValue is a loaded machine's cost with
+  // a margin (benchmarks/RESULTS.md, the issue 27 rows). The computation stops that much earlier
+  // than the fixed reserve (runner.cpp) allows, so that a fast tree's many points are written
+  // within the limit too. At most half the limit.
+  constexpr double kSecondsPerValue = 1.5e-7;
+  constexpr int kValuesPerPoint = 200;  // a point's columns, special points and report share
+  storedValues_ += double(points) * double(out_.chain.size() + kValuesPerPoint);
+  const double limit = std::min(scene_.solver.timeLimit, 1e9);
+  const double reserved = std::min(0.2 * limit, 1.0);  // runner.cpp's
+  const double needed = std::min(storedValues_ * kSecondsPerValue, 0.5 * limit);
+  if (needed > reserved) control_.interrupt.keepBeforeDeadline(needed - reserved);
 }
 
 mech::EquilibriumBranchOptions CaseRunner::branchOptions(double lambdaLo, double lambdaHi) {

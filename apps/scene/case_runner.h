@@ -162,11 +162,16 @@ class CaseRunner {
   /// the difference summed (branchPointsQueued_). Fed by the tree's onBranch and onReport.
   struct TreeAhead {
     std::vector<int> depth, found, settled;
+    std::vector<char> paused;  // a root traced up to a branch point only: reported again when traced further
     int queued = 0;
   } ahead_;
   std::pair<int, int> tracedParent_{-1, -1};  // (parent, branch point) of the last branch added
   void branchAdded(const continuation::Branch& b, int maxDepth);
   void branchSettled(int id);
+  /// Moves the computation's deadline earlier by the time writing the points recorded so far
+  /// will take beyond the runner's fixed reserve (case_runner.cpp).
+  void keepTimeForWriting(size_t points);
+  double storedValues_ = 0.0;  // values of the points this case recorded so far
   /// Warns at the start when the path's load, `ends` away from the start both ways, passes hundreds of
   /// critical loads of the unloaded shape that a tree of this depth would switch at
   /// (case_runner_ahead.cpp).

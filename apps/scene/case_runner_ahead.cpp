@@ -21,12 +21,15 @@ constexpr int kManyBranchPoints = 100;
 void CaseRunner::branchAdded(const cont::Branch& b, int maxDepth) {
   if (b.id < 0) return;
   const size_t id = size_t(b.id);
-  if (id == 0) ahead_ = TreeAhead();  // a new tree
+  const bool again = id < ahead_.paused.size() && ahead_.paused[id];  // a paused root traced further
+  if (id == 0 && !again) ahead_ = TreeAhead();  // a new tree
   if (ahead_.depth.size() <= id) {
     ahead_.depth.resize(id + 1, 0);
     ahead_.found.resize(id + 1, 0);
     ahead_.settled.resize(id + 1, 0);
+    ahead_.paused.resize(id + 1, 0);
   }
+  ahead_.paused[id] = b.stopReason == cont::StopReason::Paused;
   const bool child = b.parentId >= 0 && size_t(b.parentId) < id;
   ahead_.depth[id] = child ? ahead_.depth[size_t(b.parentId)] + 1 : 0;
   if (ahead_.depth[id] < maxDepth) {
@@ -36,8 +39,8 @@ void CaseRunner::branchAdded(const cont::Branch& b, int maxDepth) {
     for (const cont::SpecialPoint& sp : b.specialPoints)
       if (sp.type == cont::SpecialPointType::BranchPoint && (!child || sp.arclength > s0)) ++found;
     if (const int first = scene_.analyses.continuation.branchPoints; first > 0) found = std::min(found, first);
+    ahead_.queued += found - ahead_.found[id];  // the branch points found since it was last reported
     ahead_.found[id] = found;
-    ahead_.queued += found;
   }
   // a child is the first of its branch point's (its other side comes next): one more switched at
   if (child && (id == 0 || b.parentId != tracedParent_.first || b.parentSpecialPoint != tracedParent_.second)) {

@@ -300,3 +300,77 @@ TEST_CASE("An interrupted tree makes every branch final, the unfinished ones inc
   CHECK(sorted == expected);  // each once
   CHECK(result.branches.size() < 9);
 }
+
+TEST_CASE("A root is traced lazily: the tree's root is the branch traced whole, its children in branch-point order",
+          "[branch_switching]") {
+  toys::ManyPitchforks problem(5, 0.1);  // branch points at λ = 0, 0.1, …, 0.4 on u = 0
+  TracerOptions options;
+  options.lambdaMax = 0.6;
+  options.maxStep = 0.05;
+  Tracer whole(problem, options);
+  const Branch reference = whole.trace(Vector::Zero(5), -0.2, InitialDirection::increasingLambda());
+  REQUIRE(reference.specialPointsOfType(SpecialPointType::BranchPoint).size() == 5);
+  TreeOptions tree;
+  tree.maxDepth = 1;
+  std::vector<std::pair<int, StopReason>> reports;  // onBranch: (id, stop reason)
+  std::vector<int> extended;
+  tree.onBranch = [&](const BranchTree &, const Branch &b) { reports.emplace_back(b.id, b.stopReason); };
+  tree.extend = [&](const BranchTree &, Branch &b) {
+    CHECK(b.stopReason != StopReason::Paused);  // only a trace that has ended is extended
+    extended.push_back(b.id);
+  };
+  const BranchTree result =
+      traceTree(problem, Vector::Zero(5), -0.2, {InitialDirection::increasingLambda()}, options, tree);
+  REQUIRE(result.branches.size() == 11);
+  const Branch &root = result.branches[0];
+  CHECK(root.stopReason == StopReason::LambdaRange);
+  REQUIRE(root.points.size() == reference.points.size());
+  for (std::size_t i = 0; i < root.points.size(); ++i) {
+    CHECK(root.points[i].u == reference.points[i].u);
+    CHECK(root.points[i].lambda == reference.points[i].lambda);
+  }
+  // children 2k + 1, 2k + 2 from the k-th branch point, in order, all finished
+  int lastParentPoint = -1;
+  for (std::size_t b = 1; b < result.branches.size(); ++b) {
+    const Branch &child = result.branches[b];
+    CHECK(child.parentId == 0);
+    CHECK(child.stopReason == StopReason::LambdaRange);
+    CHECK(child.parentSpecialPoint >= lastParentPoint);
+    lastParentPoint = child.parentSpecialPoint;
+  }
+  // the root reported as it went on (paused), its last report the ended trace; extended once, last
+  int rootReports = 0;
+  for (const auto &r : reports)
+    if (r.first == 0) ++rootReports;
+  CHECK(rootReports == 6);  // paused at each of its 5 branch points, then ended (after the last children)
+  CHECK(reports.back().first == 0);
+  CHECK(reports.back().second == StopReason::LambdaRange);
+  CHECK(std::find(extended.begin(), extended.end(), 0) == extended.end() - 1);
+  CHECK(extended.size() == 11);
+}
+
+TEST_CASE("Under an interrupt the tree holds the branches of the root's first branch points, not a whole root",
+          "[branch_switching]") {
+  toys::ManyPitchforks problem(5, 0.1);
+  TracerOptions options;
+  options.lambdaMax = 0.6;
+  options.maxStep = 0.05;
+  TreeOptions tree;
+  tree.maxDepth = 1;
+  std::atomic<bool> stop{false};
+  options.interrupt.watch(&stop, "test stop");
+  int finalChildren = 0;
+  tree.onFinal = [&](BranchTree &t, std::size_t b) {
+    if (t.branches[b].parentId >= 0 && ++finalChildren == 4) stop = true;  // both sides of two branch points
+  };
+  const BranchTree result =
+      traceTree(problem, Vector::Zero(5), -0.2, {InitialDirection::increasingLambda()}, options, tree);
+  CHECK(result.interrupted);
+  REQUIRE(result.branches.size() == 5);
+  const Branch &root = result.branches[0];
+  CHECK(root.stopReason == StopReason::Interrupted);
+  CHECK(root.stopMessage == "test stop");
+  CHECK(root.specialPointsOfType(SpecialPointType::BranchPoint).size() == 2);  // λ = 0 and 0.1 only
+  CHECK(root.points.back().lambda < 0.2);
+  for (std::size_t b = 1; b < 5; ++b) CHECK(result.branches[b].stopReason == StopReason::LambdaRange);
+}

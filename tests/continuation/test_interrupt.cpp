@@ -11,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <set>
 #include <thread>
 
 using namespace buckle::continuation;
@@ -62,6 +63,32 @@ TEST_CASE("Interrupt: never, a deadline, a flag, and copies share the flag", "[i
   CHECK(b.requested());
   CHECK(b.reason() == Interrupt::Reason::Flag);
   CHECK(b.describe() == "SIGINT received");
+}
+
+TEST_CASE("Interrupt: time kept before the deadline moves it for every copy, never later again", "[interrupt]") {
+  const Interrupt original = Interrupt::after(3600.0);
+  const Interrupt copy = original;
+  CHECK_FALSE(copy.requested());
+  CHECK(copy.secondsLeft() > 3599.0);
+  original.keepBeforeDeadline(600.0);
+  CHECK(copy.secondsLeft() < 3000.1);
+  CHECK(copy.secondsLeft() > 2999.0);
+  CHECK_FALSE(copy.requested());
+  original.keepBeforeDeadline(10.0);  // less than kept already: no change
+  CHECK(copy.secondsLeft() < 3000.1);
+  copy.keepBeforeDeadline(3600.0 - 0.001);  // from a copy too: now within a millisecond
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  CHECK(original.requested());
+  CHECK(original.reason() == Interrupt::Reason::TimeLimit);
+  // a new deadline starts afresh, for itself and its copies only
+  Interrupt fresh = copy;
+  fresh.setDeadline(Interrupt::Clock::now() + std::chrono::hours(1), 3600.0);
+  CHECK_FALSE(fresh.requested());
+  CHECK(copy.requested());
+  // without a deadline nothing is kept
+  const Interrupt never;
+  never.keepBeforeDeadline(1.0);
+  CHECK_FALSE(never.requested());
 }
 
 TEST_CASE("Tracer: a requested interrupt stops the branch at once and keeps the start", "[interrupt]") {
@@ -178,24 +205,29 @@ TEST_CASE("traceTree: both start directions, and an interrupt stops the tree wit
   options.maxStep = 0.05;
   TreeOptions treeOptions;
   treeOptions.maxDepth = 1;
-  int finished = 0;
+  std::set<int> finished;
   treeOptions.onBranch = [&](const BranchTree &tree, const Branch &b) {
-    ++finished;
-    CHECK(b.id == static_cast<int>(tree.branches.size()) - 1);
+    // a branch as it joins the tree; a root again each time it went on (traced lazily)
+    if (finished.insert(b.id).second) {
+      CHECK(b.id == static_cast<int>(tree.branches.size()) - 1);
+    } else {
+      CHECK(b.parentId < 0);
+    }
   };
   const std::vector<InitialDirection> both{InitialDirection::increasingLambda(), InitialDirection::decreasingLambda()};
   const BranchTree full = traceTree(problem, Vector::Zero(2), 0.2, both, options, treeOptions);
   // Roots in the order asked: up (through the BP at λ = 0.5) and down (through λ = 0).
   REQUIRE(full.branches.size() == 6);
   CHECK_FALSE(full.interrupted);
-  CHECK(finished == 6);
+  CHECK(finished.size() == 6);
   CHECK(full.branches[0].direction == 1);
   CHECK(full.branches[1].direction == -1);
   CHECK(full.branches[0].points.back().lambda == Approx(0.8));
   CHECK(full.branches[1].points.back().lambda == Approx(-0.3));
   for (size_t i = 2; i < full.branches.size(); ++i) CHECK(full.branches[i].parentId >= 0);
 
-  // Stop after the first root: the second root and every switch are not traced.
+  // Stop after the first root joined (traced up to its branch point at λ = 0.5): the second root
+  // and every switch are not traced, the first root ends where it stood, a prefix of the full one.
   std::atomic<bool> flag{false};
   options.interrupt.watch(&flag, "enough");
   treeOptions.onBranch = [&](const BranchTree &, const Branch &) { flag = true; };
@@ -203,5 +235,9 @@ TEST_CASE("traceTree: both start directions, and an interrupt stops the tree wit
   REQUIRE(partial.branches.size() == 1);
   CHECK(partial.interrupted);
   CHECK(partial.message == "enough");
-  CHECK(partial.branches[0].points.size() == full.branches[0].points.size());
+  const Branch &root = partial.branches[0];
+  CHECK(root.stopReason == StopReason::Interrupted);
+  REQUIRE(root.points.size() < full.branches[0].points.size());
+  CHECK(root.points.back().lambda > 0.5);  // just past its branch point
+  for (size_t i = 0; i < root.points.size(); ++i) CHECK(root.points[i].u == full.branches[0].points[i].u);
 }

@@ -634,3 +634,105 @@ TEST_CASE("Tiny steps: the fold of the cubic is still found to 1e-12, in scaled 
     CHECK(folds[0]->refined);
   }
 }
+
+namespace {
+
+// Bitwise equality of two branches' points and special points (the pause must change nothing).
+void requireSameBranch(const Branch &a, const Branch &b) {
+  REQUIRE(a.points.size() == b.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    INFO("point " << i);
+    const ContinuationPoint &p = a.points[i], &q = b.points[i];
+    CHECK(p.u == q.u);
+    CHECK(p.lambda == q.lambda);
+    CHECK(p.tangent == q.tangent);
+    CHECK(p.arclength == q.arclength);
+    CHECK(p.stepSize == q.stepSize);
+    CHECK(p.stability.negative == q.stability.negative);
+  }
+  REQUIRE(a.specialPoints.size() == b.specialPoints.size());
+  for (std::size_t k = 0; k < a.specialPoints.size(); ++k) {
+    INFO("special point " << k);
+    CHECK(a.specialPoints[k].type == b.specialPoints[k].type);
+    CHECK(a.specialPoints[k].lambda == b.specialPoints[k].lambda);
+    CHECK(a.specialPoints[k].u == b.specialPoints[k].u);
+    CHECK(a.specialPoints[k].index == b.specialPoints[k].index);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("A branch paused at each branch point and continued is the branch traced whole, bit for bit", "[tracer]") {
+  toys::ManyPitchforks problem(6, 0.1);  // branch points at λ = 0, 0.1, …, 0.5
+  TracerOptions options;
+  options.lambdaMax = 0.75;
+  options.maxStep = 0.05;
+  Tracer whole(problem, options);
+  const Branch reference = whole.trace(Vector::Zero(6), -0.2, InitialDirection::increasingLambda());
+  REQUIRE(reference.stopReason == StopReason::LambdaRange);
+  REQUIRE(reference.specialPointsOfType(SpecialPointType::BranchPoint).size() == 6);
+
+  Tracer tracer(problem, options);
+  tracer.pauseAtBranchPoints(true);
+  Branch branch = tracer.trace(Vector::Zero(6), -0.2, InitialDirection::increasingLambda());
+  int pauses = 0;
+  while (branch.stopReason == StopReason::Paused) {
+    ++pauses;
+    // paused right after the step that located the next branch point, with the step to take next
+    CHECK(branch.specialPointsOfType(SpecialPointType::BranchPoint).size() == std::size_t(pauses));
+    CHECK(branch.specialPoints.back().type == SpecialPointType::BranchPoint);
+    CHECK(branch.resumeStep > 0.0);
+    tracer.continueBranch(branch);
+  }
+  CHECK(pauses == 6);
+  CHECK(branch.stopReason == StopReason::LambdaRange);
+  requireSameBranch(branch, reference);
+}
+
+TEST_CASE("A paused branch ended where it stands is interrupted there, with its endpoint", "[tracer]") {
+  toys::ManyPitchforks problem(3, 0.1);
+  TracerOptions options;
+  options.lambdaMax = 0.5;
+  options.maxStep = 0.05;
+  Tracer tracer(problem, options);
+  tracer.pauseAtBranchPoints(true);
+  Branch branch = tracer.trace(Vector::Zero(3), -0.2, InitialDirection::increasingLambda());
+  REQUIRE(branch.stopReason == StopReason::Paused);
+  const std::size_t points = branch.points.size();
+  Tracer::endPaused(branch, "time limit");
+  CHECK(branch.stopReason == StopReason::Interrupted);
+  CHECK(branch.stopMessage == "time limit");
+  CHECK(branch.points.size() == points);
+  REQUIRE(branch.specialPoints.back().type == SpecialPointType::Endpoint);
+  CHECK(branch.specialPoints.back().boundaryName == "interrupted");
+  CHECK(branch.specialPoints.back().lambda == branch.points.back().lambda);
+  CHECK(branch.specialPoints.back().lambda < 0.1);  // only the first branch point (λ = 0) was reached
+  // only a paused branch is ended so
+  Tracer::endPaused(branch, "again");
+  CHECK(branch.stopMessage == "time limit");
+}
+
+TEST_CASE("A paused trace steps over at most kPausedCrossings branch points at a time", "[tracer]") {
+  // 40 branch points 0.001 apart: the first step of 0.02 alone would cross 20 of them
+  toys::ManyPitchforks problem(40, 0.001);
+  TracerOptions options;
+  options.lambdaMax = 0.05;
+  options.initialStep = 0.02;
+  options.maxStep = 0.05;
+  Tracer tracer(problem, options);
+  tracer.pauseAtBranchPoints(true);
+  Branch branch = tracer.trace(Vector::Zero(40), -0.0005, InitialDirection::increasingLambda());
+  std::size_t before = 0;
+  int pauses = 0;
+  while (branch.stopReason == StopReason::Paused) {
+    ++pauses;
+    const std::size_t found = branch.specialPointsOfType(SpecialPointType::BranchPoint).size();
+    CHECK(found > before);
+    CHECK(found - before <= std::size_t(Tracer::kPausedCrossings));
+    before = found;
+    tracer.continueBranch(branch);
+  }
+  CHECK(branch.stopReason == StopReason::LambdaRange);
+  CHECK(branch.specialPointsOfType(SpecialPointType::BranchPoint).size() == 40);  // each once
+  CHECK(pauses >= 5);
+}

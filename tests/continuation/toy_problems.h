@@ -103,6 +103,34 @@ class TwoPitchforks : public Problem {
   double c_;
 };
 
+/// m decoupled symmetric pitchforks (λ − c_j)u_j − u_j³, c_j = j·spacing, H = −F_u: m branch
+/// points on u = 0 at λ = c_j, one per step of a long trivial branch (the tree's lazy roots).
+class ManyPitchforks : public Problem {
+ public:
+  ManyPitchforks(int m, double spacing) : m_(m), spacing_(spacing) {}
+  int dimension() const override { return m_; }
+  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    for (int j = 0; j < m_; ++j) F[j] = (lambda - j * spacing_) * u[j] - u[j] * u[j] * u[j];
+    return true;
+  }
+  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+    Fu.setZero();
+    for (int j = 0; j < m_; ++j) {
+      Fu(j, j) = lambda - j * spacing_ - 3.0 * u[j] * u[j];
+      Fl[j] = u[j];
+    }
+    return true;
+  }
+  bool hasStabilityOperator() const override { return true; }
+  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
+    return negatedJacobian(*this, u, lambda, H, C);
+  }
+
+ private:
+  int m_;
+  double spacing_;
+};
+
 /// TwoPitchforks in v = u − g(λ), g(λ) = (0.3 sin λ, 0.2 λ²): the same branch points at λ = 0
 /// and λ = c, but on a curved trivial branch u = g(λ) with F_λ ≠ 0, so the location and Moore
 /// systems see non-trivial geometry. Bifurcated branch: u₁ = 0.3 sin λ ± √λ, u₂ = 0.2 λ².

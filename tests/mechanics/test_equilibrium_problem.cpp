@@ -472,6 +472,107 @@ TEST_CASE("stabilityEigenvalues by index: the O(n) counts and the small dense ro
   }
 }
 
+TEST_CASE("along a load path past many critical loads: the inertia and the values next to zero equal a dense eigen-solve, "
+          "in a few factorizations each where nu changes from point to point",
+          "[equilibrium]") {
+  // The monitor's calls (spectral_monitor.h) at points of a compressed chain, ν rising by
+  // several per step: the indices asked for change at every point, so only the eigenvalues found
+  // lately by index (eigenvalue_memory.h) can warm-start the searches. Held ends, body loads and
+  // lengths ×1e±4, stiffnesses ×1e±8: every value against the dense route.
+  struct Case {
+    int n;
+    double L, K;
+  };
+  std::mt19937 rng(2718);
+  std::uniform_real_distribution<double> W(-1.0, 1.0);
+  for (const Case& c : {Case{10, 1.0, 1.0}, Case{60, 1e-4, 1e8}, Case{60, 1e4, 1e-8}, Case{300, 1.0, 1.0},
+                        Case{300, 1e4, 1e8}, Case{300, 1e-4, 1e-8}}) {
+    std::vector<SegmentParameters> segs;
+    for (int i = 0; i < c.n; ++i) {
+      SegmentParameters p = testing::randomSegment(rng);
+      p.a1 *= c.L, p.a2 *= c.L, p.b1 *= c.L, p.b2 *= c.L, p.L1_0 *= c.L, p.L2_0 *= c.L;
+      p.k1 *= c.K, p.k2 *= c.K;
+      segs.push_back(p);
+    }
+    const Chain chain(segs);
+    const double force = c.K * c.L;  // the force unit k b
+    BodyLoads body;
+    body.mass = Vector::Constant(c.n, 1e-3 * force);  // a light weight across the path
+    body.centre = 0.5 * chain.linkLengths().tail(c.n);
+    body.gravityRate = Eigen::Vector2d(0.0, -1.0);
+    struct End {
+      std::string name;
+      EndCondition end;
+      BodyLoads body;
+    };
+    for (const End& e : {End{"clamped-pinned", EndCondition::clampedPinned(0.0, 0.0), BodyLoads()},
+                         End{"held position", EndCondition::heldPosition(0.0, 0.0), BodyLoads()},
+                         End{"free end, weight", EndCondition::freeEnd(Eigen::Vector3d::Zero()), body}}) {
+      INFO("n = " << c.n << ", lengths x" << c.L << ", stiffness x" << c.K << ", " << e.name);
+      const bool held = e.name == "held position";
+      // λ compresses the chain along x: the load Fx (free x) or, with x held, the reaction in u
+      EquilibriumProblem problem(chain, e.end, Eigen::Vector3d(held ? 0.0 : -force, 0.0, 0.0), {}, {}, e.body);
+      EquilibriumProblem dense(chain, e.end, problem.direction(), EquilibriumOptions{true, false}, {}, e.body);
+      const int N = problem.dimension();
+      Vector u0 = Vector::Zero(N), du(N);
+      for (int i = 0; i < c.n; ++i) u0[i] = 1e-3 * W(rng);  // near the straight chain, not on it
+      for (int i = 0; i < N; ++i) du[i] = W(rng) * (i < c.n ? 1.0 : force);
+      auto at = [&](double t) {
+        Vector u = u0;
+        if (held) u[c.n] = -t * force;  // the x reaction: the compressive force
+        return u;
+      };
+      // the load at which a third of the spectrum (at most 40 values) is negative
+      const int target = std::min(c.n / 3, 40);
+      double tMax = 1e-3;
+      buckle::continuation::StabilityInfo ref;
+      for (;; tMax *= 2.0) {
+        REQUIRE(tMax < 1e12);
+        REQUIRE(dense.stability(at(tMax), held ? 0.0 : tMax, 0, ref));
+        if (ref.negative >= target) break;
+      }
+      const int points = 30;
+      int changes = 0, lastNu = 0, values = 0;
+      const long before = problem.structuredFactorizations();
+      for (int j = 1; j <= points; ++j) {
+        const double t = tMax * double(j * j) / double(points * points);
+        const Vector u = at(t);
+        const double lambda = held ? 0.0 : t;
+        Matrix H, C;
+        REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+        const double scale = std::max(c.K * c.L * c.L, H.norm());
+        buckle::continuation::StabilityInfo mine, theirs;
+        REQUIRE(problem.stability(u, lambda, 1, mine));
+        REQUIRE(dense.stability(u, lambda, 1, theirs));
+        CHECK(mine.negative == theirs.negative);
+        CHECK(mine.zero == theirs.zero);
+        REQUIRE(mine.lowest.size() == 1);
+        CHECK(std::abs(mine.lowest[0] - theirs.lowest[0]) <= 1e-11 * scale);
+        const int nu = mine.negative;
+        changes += nu != lastNu ? 1 : 0;
+        lastNu = nu;
+        // as the monitor: ν − 1 and ν at the point, then a step δ along a direction
+        const int first = std::max(0, nu - 1);
+        Vector here(2), reference(2);
+        REQUIRE(problem.stabilityEigenvalues(u, lambda, first, here));
+        REQUIRE(dense.stabilityEigenvalues(u, lambda, first, reference));
+        CHECK((here - reference).cwiseAbs().maxCoeff() <= 1e-11 * scale);
+        const Vector shifted = u + 1e-6 * du;
+        REQUIRE(problem.stabilityEigenvalues(shifted, lambda, first, here));
+        REQUIRE(dense.stabilityEigenvalues(shifted, lambda, first, reference));
+        CHECK((here - reference).cwiseAbs().maxCoeff() <= 1e-11 * scale);
+        values += 5;
+      }
+      if (c.n > 16) {  // the structured route (n ≤ 16: one small dense solve per point)
+        CHECK(changes >= 4);  // the indices asked for moved along the path
+        const double perValue = double(problem.structuredFactorizations() - before) / double(values);
+        INFO("factorizations per value " << perValue);
+        CHECK(perValue <= 13.0);  // a bisection from ±‖H‖_F takes about 50, Newton from the last index's value 15 to 22
+      }
+    }
+  }
+}
+
 TEST_CASE("the small dense spectrum is shared by stability and stabilityEigenvalues at one point and recomputed on a one-ulp change",
           "[equilibrium]") {
   // stability() keeps the whole small dense spectrum of its point (equilibrium_problem.h), and

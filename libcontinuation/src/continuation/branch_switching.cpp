@@ -49,6 +49,21 @@ bool startsAt(const Branch &b, const Vector &x, const UnitScaling &units) {
   return (x - x0).norm() <= 1e-6 * (scaled(b.points[1]) - x0).norm();
 }
 
+// Whether the scaled point x (λ accuracy `accuracy`) is one of those switched at already.
+bool switchedBefore(const std::vector<Vector> &switchedAt, const std::vector<double> &switchedAccuracy, const Vector &x,
+                    double accuracy) {
+  const Eigen::Index n = x.size() - 1;
+  for (size_t j = 0; j < switchedAt.size(); ++j) {
+    const Vector &y = switchedAt[j];
+    const double dl = std::abs(y[n] - x[n]);
+    if ((y - x).norm() <= 1e-7 * std::max(1.0, x.norm()) &&
+        dl <= std::max({1e3 * (accuracy + switchedAccuracy[j]), 1e-6 * std::max(std::abs(y[n]), std::abs(x[n])),
+                        4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(x[n]))}))
+      return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note,
@@ -224,8 +239,23 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     isFinal[i] = 1;
     if (treeOptions.onFinal) treeOptions.onFinal(tree, i);
   };
+  // A branch joins the tree (add) and is extended once its trace has ended (settle).
+  auto settle = [&](std::size_t i) {
+    Branch &b = tree.branches[i];
+    if (treeOptions.extend && b.stopReason != StopReason::InvalidOptions) treeOptions.extend(tree, b);
+    if (tree.branches[i].stopReason == StopReason::Interrupted) {
+      tree.interrupted = true;
+      tree.message = tree.branches[i].stopMessage;
+    }
+  };
   auto finish = [&]() -> BranchTree & {
-    for (std::size_t i = 0; i < tree.branches.size(); ++i) finalize(i);
+    for (std::size_t i = 0; i < tree.branches.size(); ++i) {
+      if (tree.branches[i].stopReason == StopReason::Paused) {  // stopped early: the tree is interrupted
+        Tracer::endPaused(tree.branches[i], tree.message.empty() ? "interrupted" : tree.message);
+        settle(i);
+      }
+      finalize(i);
+    }
     return tree;
   };
   auto interrupted = [&]() {
@@ -239,13 +269,22 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     tree.branches.push_back(std::move(b));
     depth.push_back(generation);
     isFinal.push_back(0);
-    if (treeOptions.extend && tree.branches.back().stopReason != StopReason::InvalidOptions)
-      treeOptions.extend(tree, tree.branches.back());
-    if (tree.branches.back().stopReason == StopReason::Interrupted) {
-      tree.interrupted = true;
-      tree.message = tree.branches.back().stopMessage;
-    }
+    if (tree.branches.back().stopReason != StopReason::Paused) settle(tree.branches.size() - 1);
     if (treeOptions.onBranch) treeOptions.onBranch(tree, tree.branches.back());
+  };
+  // A paused root goes on to its next branch point or end; an interrupt ends it where it stands.
+  auto resume = [&](std::size_t i) {
+    if (tree.branches[i].stopReason != StopReason::Paused) return false;
+    if (tree.interrupted || interrupted()) {
+      Tracer::endPaused(tree.branches[i], tree.message);
+    } else {
+      tracer.pauseAtBranchPoints(true);
+      tracer.continueBranch(tree.branches[i]);
+      tracer.pauseAtBranchPoints(false);
+    }
+    if (tree.branches[i].stopReason != StopReason::Paused) settle(i);
+    if (treeOptions.onBranch) treeOptions.onBranch(tree, tree.branches[i]);
+    return true;
   };
   if (std::string why; !treeOptions.symmetry.IsValid(problem.dimension(), &why)) {
     Branch invalid;
@@ -254,11 +293,14 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     add(std::move(invalid), 0);
     return finish();
   }
+  // With switching the roots are traced lazily (header): here up to their first branch point.
+  tracer.pauseAtBranchPoints(treeOptions.maxDepth > 0);
   for (const InitialDirection &direction : starts) {
     if (tree.interrupted || interrupted()) return finish();
     add(tracer.trace(u0, lambda0, direction), 0);
     if (treeOptions.maxDepth <= 0) finalize(tree.branches.size() - 1);
   }
+  tracer.pauseAtBranchPoints(false);
   std::vector<Vector> switchedAt;
   std::vector<double> switchedAccuracy;  // |Δλ| of each, scaled
   const int n = problem.dimension();
@@ -266,7 +308,10 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
 
   for (std::size_t i = 0; i < tree.branches.size(); ++i) {
     if (depth[i] >= treeOptions.maxDepth) continue;
-    for (std::size_t k = 0; k < tree.branches[i].specialPoints.size(); ++k) {
+    for (std::size_t k = 0;; ++k) {
+      // past the last special point: a paused root goes on (and gains a branch point or its end)
+      if (k >= tree.branches[i].specialPoints.size() && !(resume(i) && k < tree.branches[i].specialPoints.size()))
+        break;
       SpecialPoint bp = tree.branches[i].specialPoints[k];
       if (bp.type != SpecialPointType::BranchPoint) continue;
       if (treeOptions.switchAt && !treeOptions.switchAt(tree.branches[i], bp)) continue;
@@ -283,15 +328,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       // locations' accuracy or a millionth of λ itself (distinct points of a cluster at λ ~ 1e-10
       // lie far closer than 1e-7 in the state, but their λ differ by far more than that).
       const double accuracy = bp.lambdaAccuracy / tracer.units().parameter();
-      bool seen = false;
-      for (size_t j = 0; j < switchedAt.size(); ++j) {
-        const Vector &y = switchedAt[j];
-        const double dl = std::abs(y[n] - xBP[n]);
-        if ((y - xBP).norm() <= 1e-7 * std::max(1.0, xBP.norm()) &&
-            dl <= std::max({1e3 * (accuracy + switchedAccuracy[j]), 1e-6 * std::max(std::abs(y[n]), std::abs(xBP[n])),
-                            4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(xBP[n]))}))
-          seen = true;
-      }
+      const bool seen = switchedBefore(switchedAt, switchedAccuracy, xBP, accuracy);
       std::string &note = tree.branches[i].specialPoints[k].note;
       if (seen) {
         note += (note.empty() ? "" : "; ") + std::string("already switched from another branch");

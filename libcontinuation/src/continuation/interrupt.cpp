@@ -22,7 +22,17 @@ Interrupt &Interrupt::setDeadline(Clock::time_point deadline, double seconds) {
   hasDeadline_ = true;
   deadline_ = deadline;
   seconds_ = seconds;
+  kept_ = std::make_shared<std::atomic<Clock::rep>>(0);  // a new deadline: its own copies
   return *this;
+}
+
+void Interrupt::keepBeforeDeadline(double seconds) const {
+  if (!hasDeadline_ || !(seconds > 0.0)) return;
+  const Clock::rep ticks =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(std::min(seconds, 1e9))).count();
+  Clock::rep now = kept_->load(std::memory_order_relaxed);
+  while (ticks > now && !kept_->compare_exchange_weak(now, ticks, std::memory_order_relaxed)) {
+  }
 }
 
 Interrupt &Interrupt::watch(const std::atomic<bool> *flag, std::string what) {
@@ -46,7 +56,9 @@ std::string Interrupt::describe() const {
 
 double Interrupt::secondsLeft() const {
   if (!hasDeadline_) return std::numeric_limits<double>::infinity();
-  return std::chrono::duration<double>(deadline_ - Clock::now()).count();
+  return std::chrono::duration<double>(deadline_ - Clock::duration(kept_->load(std::memory_order_relaxed)) -
+                                       Clock::now())
+      .count();
 }
 
 }  // namespace buckle::continuation

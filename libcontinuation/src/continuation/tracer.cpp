@@ -38,6 +38,20 @@ void appendEndpoint(Branch &branch, SpecialPointType type, const std::string &na
   branch.specialPoints.push_back(sp);
 }
 
+// Pausing at branch points (the tree switches at each before the branch goes on): a step a → b
+// of length dsTry over more than Tracer::kPausedCrossings of them is retried shorter (true, ds
+// that step), so the pause comes after a few and not after the thousands one first step of a
+// long chain crosses (n = 10 000: about 1600 in the first 0.02 of the default path, its critical
+// loads ∝ k²).
+bool retryShorter(const ContinuationPoint &a, const ContinuationPoint &b, double dsTry, double minStep, double &ds) {
+  if (!a.stability.valid() || !b.stability.valid()) return false;
+  const int crossed = std::abs(b.stability.negative - a.stability.negative);
+  const double shorter = dsTry * std::max(0.02, 0.5 * double(Tracer::kPausedCrossings) / double(crossed));
+  if (crossed <= Tracer::kPausedCrossings || shorter < minStep) return false;
+  ds = shorter;
+  return true;
+}
+
 }  // namespace
 
 bool TracerOptions::IsValid(std::string *why) const {
@@ -387,8 +401,10 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
   eventsA_.resize(size_t(events));
   eventsB_.resize(size_t(events));
   eventValues(branch.points.back(), eventsA_);
-  double ds = options_.initialStep;
+  double ds = branch.stopReason == StopReason::Paused ? branch.resumeStep : options_.initialStep;
+  if (branch.stopReason == StopReason::Paused) branch.stopReason = StopReason::NotStarted;
   std::string lastFailure = "no failure";
+  bool pause = false;  // a branch point was located in the last step (pauseAtBranchPoints)
 
   // Ends the branch at its last point.
   auto stop = [&branch](StopReason reason, const std::string &message, SpecialPointType type, const std::string &name,
@@ -413,6 +429,12 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       interrupted(options_.interrupt.describe());
       return;
     }
+    if (pause) {
+      branch.stopReason = StopReason::Paused;
+      branch.stopMessage.clear();
+      branch.resumeStep = ds;
+      return;
+    }
     if (static_cast<int>(branch.points.size()) >= options_.maxPoints) {
       stop(StopReason::MaxPoints, "reached maxPoints = " + std::to_string(options_.maxPoints),
            SpecialPointType::Endpoint, "max points");
@@ -434,6 +456,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       if (!halve()) return;
       continue;
     }
+    if (pauseAtBranchPoints_ && ia >= skipIntervals && retryShorter(a, b, dsTry, options_.minStep, ds)) continue;
     // What the step showed, for the next one (read before `a` and `previous` dangle on the push).
     StepObservation observed;
     observed.newtonIterations = summary.iterations;
@@ -480,6 +503,8 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       branch.specialPoints.push_back(std::move(sp));
     }
     if (!found.empty()) mergeCoincidentSpecialPoints(branch, firstNew);
+    for (size_t k = firstNew; pauseAtBranchPoints_ && k < branch.specialPoints.size(); ++k)
+      pause = pause || branch.specialPoints[k].type == SpecialPointType::BranchPoint;
     if (options_.onStep && !landedOnStart) {
       const StepAction action = notifyStep(branch);
       if (action == StepAction::Stop) {
@@ -505,6 +530,14 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     ds = stepControl_.next(ds, observed);
     eventsA_.swap(eventsB_);
   }
+}
+
+void Tracer::endPaused(Branch &branch, const std::string &message) {
+  if (branch.stopReason != StopReason::Paused || branch.points.empty()) return;
+  branch.stopReason = StopReason::Interrupted;
+  branch.stopMessage = message;
+  branch.resumeStep = 0.0;
+  appendEndpoint(branch, SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
 }
 
 Branch trace(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,

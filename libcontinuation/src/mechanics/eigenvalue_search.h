@@ -35,12 +35,20 @@ struct ShiftEvaluation {
 /// every evaluation narrowing (lo, hi) by its count. True when a step fell below tol/4 and counts
 /// isolate the eigenvalue in a bracket of width < tol around the limit: `record` has then seen
 /// shifts a, b with count(a) = index, count(b) = index + 1, b − a < tol. False (the caller's
-/// isolation and Illinois polish take over from what was recorded) when an iterate leaves the
-/// bracket, a step fails to halve the one before (Newton far from the root, on the flat part
-/// of a polynomial with many roots), or after `maxSteps` evaluations.
+/// isolation and Illinois polish take over from what was recorded, around `last`, the latest
+/// iterate, with `lastStep` its step) when an iterate leaves the bracket, a step fails to halve
+/// the one before, or after `maxSteps` evaluations.
+///
+/// From the second evaluation in the same gap between eigenvalues on, the step is that of the
+/// model d log|det|/dσ = 1/(σ − ν) + R fitted to the last two evaluations (ν the eigenvalue
+/// wanted, R the other eigenvalues' Σ 1/(σ − ν_j), nearly constant near ν: the secular-equation
+/// solvers' one-pole model, Bunch, Nielsen & Sorensen 1978). Plain Newton takes R = 0, and where
+/// many eigenvalues lie on one side (the lowest of a chain with hundreds below zero) R dominates
+/// and Newton creeps towards ν linearly, as on a root of high multiplicity; the model's step
+/// lands within a few per cent at once.
 template <class Evaluate, class Record>
 bool newtonFrom(Evaluate&& evaluateShift, int index, double sigma0, double tol, int maxSteps, double lo, double hi,
-                Record&& record) {
+                Record&& record, double& last, double& lastStepOut) {
   int countLo = -1, countHi = -1;  // counts at lo and hi once evaluated
   auto evaluate = [&](double s) {
     const ShiftEvaluation ev = evaluateShift(s);
@@ -53,13 +61,46 @@ bool newtonFrom(Evaluate&& evaluateShift, int index, double sigma0, double tol, 
     return ev;
   };
   double c = sigma0, lastStep = std::numeric_limits<double>::infinity();
+  double previous = 0.0, previousDLog = 0.0;  // the evaluation before, for the model
+  int previousBelow = -1;
+  last = c;
+  lastStepOut = std::numeric_limits<double>::infinity();
   for (int step = 0; step < maxSteps; ++step) {
     if (!(c > lo && c < hi)) return false;
     const ShiftEvaluation ev = evaluate(c);
+    last = c;
     if (!std::isfinite(ev.dLog) || ev.dLog == 0.0) return false;
-    const double next = c - 1.0 / ev.dLog;
+    double next = c - 1.0 / ev.dLog;  // Newton: the model with R = 0
+    // The count says on which side of c the eigenvalue lies; Newton may point the other way
+    // (R dominating) and then steps as far towards it instead: a second evaluation in the same
+    // gap, for the model.
+    const bool below = ev.below > index;
+    const auto towards = [&](double x) { return below ? x < c : x > c; };
+    if (!towards(next)) next = 2.0 * c - next;
+    const bool model = previousBelow == ev.below && c != previous;
+    if (model) {
+      // 1/(σp − ν) − 1/(c − ν) = dp − d with x = c − ν, h = c − σp:  (dp − d)·x² − (dp − d)·h·x − h = 0
+      const double h = c - previous, dd = previousDLog - ev.dLog;
+      const double disc = dd * dd * h * h + 4.0 * dd * h;
+      if (dd != 0.0 && disc >= 0.0) {
+        const double root = std::sqrt(disc);
+        const double nu1 = c - (dd * h + root) / (2.0 * dd), nu2 = c - (dd * h - root) / (2.0 * dd);
+        // of the two roots those towards the eigenvalue inside the bracket, the nearer to c
+        const bool ok1 = std::isfinite(nu1) && towards(nu1) && nu1 > lo && nu1 < hi;
+        const bool ok2 = std::isfinite(nu2) && towards(nu2) && nu2 > lo && nu2 < hi;
+        if (ok1 && (!ok2 || std::abs(nu1 - c) <= std::abs(nu2 - c))) next = nu1;
+        else if (ok2) next = nu2;
+      }
+    }
+    previous = c;
+    previousDLog = ev.dLog;
+    previousBelow = ev.below;
+    if (std::isfinite(next) && next > lo && next < hi) last = next;  // the best estimate so far
     const double size = std::abs(next - c);
-    if (!std::isfinite(next) || size > 0.5 * lastStep) return false;
+    // The halving test from the model's second step on: its first step corrects Newton's
+    // underestimate (it may be the longer), after that the steps shrink superlinearly.
+    if (!std::isfinite(next) || (size > 0.5 * lastStep && !(model && step == 1))) return false;
+    lastStepOut = size;
     // Quadratic convergence: the error left after this step is about (size/lastStep)²·size.
     const double predicted = std::isfinite(lastStep) ? size * (size / lastStep) * (size / lastStep) : size;
     lastStep = size;
@@ -134,20 +175,23 @@ int searchEigenvalues(Evaluate&& evaluateShift, int dim, double scale, double bo
     // limit. A guess a step δ along the branch away (the spectral monitor's second evaluation) or
     // one continuation step away is within Newton's quadratic range, so this costs three to five
     // factorizations where isolation and Illinois took ten or more.
+    double centre = std::numeric_limits<double>::quiet_NaN(), width = std::numeric_limits<double>::infinity();
     if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
-      if (newtonFrom(evaluateShift, first + j, (*guess)[j], tol, 8, lo[j], hi[j], record) && isolated(j) &&
-          hi[j] - lo[j] <= tol) {
+      centre = (*guess)[j];
+      if (newtonFrom(evaluateShift, first + j, (*guess)[j], tol, 8, lo[j], hi[j], record, centre, width) &&
+          isolated(j) && hi[j] - lo[j] <= tol) {
         out[j] = 0.5 * (lo[j] + hi[j]);
         continue;
       }
     }
-    // Otherwise counts around the guess, widening by 8 from 2 % of it. (A width tied to ‖H‖
-    // instead isolates nothing on a long or strongly loaded chain, whose lowest eigenvalues are
-    // spaced ~κ/n² ≪ 1e−3‖H‖_F, and bisection then pays ~log2(‖H‖ n²/κ) counts per eigenvalue.)
-    if (guess && j < guess->size() && std::isfinite((*guess)[j]) && (*guess)[j] > lo[j] && (*guess)[j] < hi[j]) {
-      double delta = std::max(1e-9 * scale, 0.02 * std::abs((*guess)[j]));
-      for (int attempt = 0; attempt < 10 && !isolated(j); ++attempt, delta *= 8.0) {
-        const double a = (*guess)[j] - delta, b = (*guess)[j] + delta;
+    // Otherwise counts around the guess (or Newton's latest iterate, nearer), widening by 8 from
+    // twice its last step or 2 % of it. (A width tied to ‖H‖ instead isolates nothing on a long or
+    // strongly loaded chain, whose lowest eigenvalues are spaced ~κ/n² ≪ 1e−3‖H‖_F, and bisection
+    // then pays ~log2(‖H‖ n²/κ) counts per eigenvalue.)
+    if (std::isfinite(centre) && centre > lo[j] && centre < hi[j]) {
+      double delta = std::max(1e-9 * scale, std::min(0.02 * std::abs(centre), 2.0 * width));
+      for (int attempt = 0; attempt < 12 && !isolated(j); ++attempt, delta *= 8.0) {
+        const double a = centre - delta, b = centre + delta;
         if (a > lo[j]) record(a, evaluateShift(a));
         if (b < hi[j]) record(b, evaluateShift(b));
       }
@@ -158,6 +202,15 @@ int searchEigenvalues(Evaluate&& evaluateShift, int dim, double scale, double bo
       const double mid = 0.5 * (lo[j] + hi[j]);
       if (mid <= lo[j] || mid >= hi[j]) break;
       record(mid, evaluateShift(mid));
+    }
+    // Isolated: the model iteration from the bracket's middle (a failed try has at least halved
+    // the bracket by its first count), a few times, before Illinois.
+    for (int attempt = 0; attempt < 4 && isolated(j) && hi[j] - lo[j] > tol; ++attempt) {
+      double at = 0.0, step = 0.0;
+      const double mid = 0.5 * (lo[j] + hi[j]);
+      if (newtonFrom(evaluateShift, first + j, mid, tol, 8, lo[j], hi[j], record, at, step) && isolated(j) &&
+          hi[j] - lo[j] <= tol)
+        break;
     }
     if (isolated(j) && hi[j] - lo[j] > tol) {
       // Illinois on det, one simple root in the bracket; the counts keep the bracket honest.

@@ -195,34 +195,46 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
 
   // traced[b]: the sizes of branch b as traced, before its contact stretches (a mirror image
   // takes its source's stretches from there on); geometric[b]: its base and self contacts.
+  // All three indexed by branch id: a root is extended when its trace ends, after the branches
+  // of its first branch points (continuation::traceTree), so extend() does not see the ids in order.
   std::vector<std::pair<size_t, size_t>> traced;
   std::vector<GeometricContacts> geometric;
+  auto slot = [&](size_t id) {
+    if (result.contact.size() > id) return;
+    // a branch not (yet) extended: one stretch from its first point, no joint locked
+    result.contact.resize(id + 1, std::vector<ContactStretch>{ContactStretch{}});
+    traced.resize(id + 1);
+    geometric.resize(id + 1);
+  };
   // The joints locked where a child leaves its parent: those of the parent's stretch that holds
   // the branch point (the interval [index, index + 1] lies in the stretch of its end point).
-  auto lockedAtParent = [&result](const continuation::BranchTree& t, const continuation::Branch& b) {
+  auto lockedAtParent = [&](const continuation::BranchTree& t, const continuation::Branch& b) {
     if (b.parentId < 0) return ContactSet();
+    slot(size_t(b.parentId));
     const continuation::SpecialPoint& bp =
         t.branches[size_t(b.parentId)].specialPoints[size_t(b.parentSpecialPoint)];
     return lockedAt(result.contact[size_t(b.parentId)], bp.index + 1);
   };
   tree.extend = [&](const continuation::BranchTree& t, continuation::Branch& branch) {
-    traced.emplace_back(branch.points.size(), branch.specialPoints.size());
-    geometric.emplace_back();
+    const size_t id = size_t(branch.id);
+    slot(id);
+    traced[id] = {branch.points.size(), branch.specialPoints.size()};
     const ContactSet locked = lockedAtParent(t, branch);
     if (!options.contact || branch.stopReason == continuation::StopReason::Interrupted) {
-      result.contact.push_back(std::vector<ContactStretch>{ContactStretch{0, locked}});
+      result.contact[id] = std::vector<ContactStretch>{ContactStretch{0, locked}};
     } else if (branch.mirrorOf >= 0) {
       const size_t source = size_t(branch.mirrorOf);
-      result.contact.push_back(mirrored(result.contact[source]));
+      result.contact[id] = mirrored(result.contact[source]);
       appendMirroredTail(tree.symmetry, t.branches[source], traced[source], branch);
     } else {
       const continuation::TracerOptions& o = branch.parentId >= 0 ? childOptions : options.tracer;
-      result.contact.push_back(
-          continueUnderContact(problem, branch, o, options.maxContactEvents, options.maxContactTorque, locked));
+      result.contact[id] =
+          continueUnderContact(problem, branch, o, options.maxContactEvents, options.maxContactTorque, locked);
     }
   };
   tree.switchTracer = [&](const continuation::BranchTree&, size_t b,
                           const continuation::SpecialPoint& bp) -> std::shared_ptr<continuation::Tracer> {
+    slot(b);
     const ContactSet locked = lockedAt(result.contact[b], bp.index + 1);
     if (locked.empty()) return nullptr;
     // the stretch's problem lives as long as its tracer (aliasing shared_ptr)
@@ -239,10 +251,7 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
   };
   tree.onFinal = [&](continuation::BranchTree& t, size_t b) {
     continuation::Branch& branch = t.branches[b];
-    if (b >= result.contact.size()) {  // a branch extend() never saw (invalid options)
-      result.contact.resize(b + 1, std::vector<ContactStretch>{ContactStretch{}});
-      geometric.resize(b + 1);
-    }
+    slot(b);  // a branch extend() never saw (invalid options)
     if (result.reports.size() < t.branches.size()) {
       result.reports.resize(t.branches.size());
       result.classifications.resize(t.branches.size());

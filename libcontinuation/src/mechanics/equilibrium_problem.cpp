@@ -465,9 +465,11 @@ bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCo
   const int dim = in.size();
   info.lowest.resize(std::min(wanted, dim));
   if (info.lowest.size() > 0) {
+    if (guess_.size() != ChainStructure::kMaxBorder) guess_.resize(ChainStructure::kMaxBorder);
+    const bool guessed = found_.guesses(0, guess_.head(info.lowest.size()));
     lowestEigenvalues(structure_, structure_.rank > 0, int(info.lowest.size()), info.lowest, 1e-13,
-                      lastLowest_.size() == info.lowest.size() ? &lastLowest_ : nullptr);
-    lastLowest_ = info.lowest;
+                      guessed ? &guess_ : nullptr);
+    found_.remember(0, info.lowest);
   }
   info.smallest = info.lowest.size() > 0 ? info.lowest[0] : 0.0;
   return true;
@@ -491,15 +493,17 @@ bool EquilibriumProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, i
   for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
   const int rank = heldCount() > 0 ? setConstraints(structure_, heldRows_) : (structure_.rank = 0);
   if (values.size() > ChainStructure::kMaxBorder) return false;  // the isolation's fixed-size brackets
-  // Warm start from the previous call with the same indices: the monitor asks at a point and
-  // then a step δ = 1e−6 along its tangent, then at the next point (spectral_monitor.h), so the
-  // last values bracket the new ones within a few counts. The counts still certify the
+  // Warm start from the values found lately (eigenvalue_memory.h): the monitor asks at a point
+  // and then a step δ = 1e−6 along its tangent, then at the next point (spectral_monitor.h), the
+  // locator at its samples, so the values found bracket the new ones within a few counts, also
+  // where ν, and with it the indices asked for, changed. The counts still certify the
   // isolation; only the bisection from ±‖H‖_F is saved.
-  const Vector* guess = lastFirst_ == first && lastFrom_.size() == values.size() ? &lastFrom_ : nullptr;
-  if (eigenvaluesFrom(structure_, rank > 0, first, int(values.size()), values, 1e-13, guess) != values.size())
+  if (guess_.size() != ChainStructure::kMaxBorder) guess_.resize(ChainStructure::kMaxBorder);
+  const bool guessed = found_.guesses(first, guess_.head(values.size()));
+  if (eigenvaluesFrom(structure_, rank > 0, first, int(values.size()), values, 1e-13, guessed ? &guess_ : nullptr) !=
+      values.size())
     return false;
-  lastFirst_ = first;
-  lastFrom_ = values;
+  found_.remember(first, values);
   return true;
 }
 

@@ -102,6 +102,11 @@ enum class StopReason {
   SwitchFailed,        ///< branch switching did not reach a point off the parent branch
   Interrupted,         ///< the Interrupt (time limit, signal) or the step callback asked to stop
   Joined,              ///< the step callback found the branch on one already traced (StepAction::Join)
+  /// Not ended: the tracer returned after a step that located a branch point, as asked
+  /// (Tracer::pauseAtBranchPoints); Tracer::continueBranch goes on from its last point with
+  /// the step it would have taken (Branch::resumeStep): the same points as without the pause,
+  /// unless a step crossed more than Tracer::kPausedCrossings branch points (then retried shorter).
+  Paused,
 };
 
 const char *toString(StopReason reason);
@@ -118,6 +123,7 @@ struct Branch {
   std::vector<SpecialPoint> specialPoints;
   StopReason stopReason = StopReason::NotStarted;
   std::string stopMessage;
+  double resumeStep = 0.0;  ///< StopReason::Paused: the step (scaled arclength) continueBranch takes next
 
   /// Special points of one type, in arclength order.
   std::vector<const SpecialPoint *> specialPointsOfType(SpecialPointType type) const;

@@ -71,12 +71,16 @@ struct TreeOptions {
   /// few points only.
   std::optional<TracerOptions> childTracer;
   /// Called when a branch is finished (traced or switched), before the next one starts: for
-  /// progress reports. The tracer's own per-step callback and interrupt are in TracerOptions.
+  /// progress reports; again for a root each time it was traced further (its id the same, its
+  /// points and special points more: StopReason::Paused while it is not yet ended). The
+  /// tracer's own per-step callback and interrupt are in TracerOptions.
   std::function<void(const BranchTree &tree, const Branch &finished)> onBranch;
   /// A branch's own continuation past the end of its trace (e.g. through contact events, with
-  /// problems of its own), called once on every branch as it joins the tree (its id, parentId,
-  /// parentSpecialPoint and mirrorOf set; a mirror image after its source), before its branch
-  /// points are looked at: the special points it appends are switched at like the traced ones.
+  /// problems of its own), called once on every branch when its trace has ended (its id,
+  /// parentId, parentSpecialPoint and mirrorOf set; a mirror image after its source): a child as
+  /// it joins the tree, a root when its trace ends, after the branches of the branch points
+  /// before (traceTree), so not in the order of the ids. The special points it appends are
+  /// switched at like the traced ones.
   std::function<void(const BranchTree &tree, Branch &branch)> extend;
   /// The tracer to switch at `bp` of branch `branch` with, when not the tree's (e.g. a branch
   /// point on a stretch that `extend` traced on another problem of the same dimension); null:
@@ -103,7 +107,11 @@ struct TreeOptions {
 /// started from and was not already switched from another branch (the guards are noted on the
 /// branch point). Multiple points (multiplicity ≥ 2) are reported but not switched. A requested
 /// TracerOptions::interrupt stops the branch in progress and every later one; the tree then
-/// says so (`interrupted`, `message`).
+/// says so (`interrupted`, `message`). With maxDepth > 0 a root is traced lazily, up to the
+/// next branch point the loop is about to switch at (Tracer::pauseAtBranchPoints): the ids,
+/// branches and points are those of tracing it whole first, but an interrupted tree holds the
+/// branches of a root's first branch points (the weakest, along a load path from zero) however
+/// many it has further on.
 BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
                      const TracerOptions &options, const TreeOptions &tree);
 

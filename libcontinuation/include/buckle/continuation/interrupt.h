@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <string>
 
 namespace buckle::continuation {
@@ -24,6 +25,10 @@ class Interrupt {
 
   /// Requested from `deadline` on; `seconds` is the limit as the user gave it (for messages).
   Interrupt &setDeadline(Clock::time_point deadline, double seconds);
+  /// Moves the deadline of this Interrupt and of every copy made since setDeadline() to
+  /// `seconds` before the one set (never later than an earlier call moved it): room kept for
+  /// writing what was computed, which grows with it. No effect without a deadline.
+  void keepBeforeDeadline(double seconds) const;
   /// Requested while *flag is true; `what` names the source in messages ("SIGINT received").
   /// The flag must outlive every copy of this Interrupt.
   Interrupt &watch(const std::atomic<bool> *flag, std::string what = "interrupted");
@@ -32,7 +37,8 @@ class Interrupt {
   /// every step of every loop.
   Reason reason() const {
     if (flag_ && flag_->load(std::memory_order_relaxed)) return Reason::Flag;
-    if (hasDeadline_ && Clock::now() >= deadline_) return Reason::TimeLimit;
+    if (hasDeadline_ && Clock::now() >= deadline_ - Clock::duration(kept_->load(std::memory_order_relaxed)))
+      return Reason::TimeLimit;
     return Reason::None;
   }
   bool requested() const { return reason() != Reason::None; }
@@ -46,6 +52,8 @@ class Interrupt {
  private:
   bool hasDeadline_ = false;
   Clock::time_point deadline_{};
+  /// keepBeforeDeadline(), in clock ticks, shared by the copies
+  std::shared_ptr<std::atomic<Clock::rep>> kept_ = std::make_shared<std::atomic<Clock::rep>>(0);
   double seconds_ = 0.0;
   const std::atomic<bool> *flag_ = nullptr;
   std::string flagWhat_;

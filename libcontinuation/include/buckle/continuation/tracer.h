@@ -182,7 +182,19 @@ class Tracer {
   /// Continues `branch`, whose points are complete (tangent set); the last point is the
   /// current one. Special points are not searched in the first `skipIntervals` intervals
   /// (a branch that starts at a branch point). A branch without points: InvalidOptions.
+  /// A StopReason::Paused branch goes on with the step it was paused before (resumeStep).
   void continueBranch(Branch &branch, int skipIntervals = 0);
+
+  /// While set, trace() and continueBranch() return after the first step that located a branch
+  /// point, with StopReason::Paused (no endpoint appended): the tree driver switches at the
+  /// weakest branch points of a long branch before tracing it further (branch_switching.h).
+  /// A step over more than kPausedCrossings branch points (the count's change) is then retried
+  /// shorter.
+  void pauseAtBranchPoints(bool pause) { pauseAtBranchPoints_ = pause; }
+  static constexpr int kPausedCrossings = 8;
+  /// Ends a paused branch where it stands, as an interrupt would (StopReason::Interrupted,
+  /// an endpoint "interrupted" with `message`).
+  static void endPaused(Branch &branch, const std::string &message);
 
   /// Fills tangent, test functions and stability of a point from its u, λ. In the scaled
   /// variables (units()), like corrector().
@@ -199,6 +211,7 @@ class Tracer {
   bool structured() const { return structuredSolver_ != nullptr; }
 
  private:
+  bool pauseAtBranchPoints_ = false;
   // ---- one step (tracer.cpp) -------------------------------------------------------------
   /// Predictor x_a + ds·t_a (+ ½ds²·(t_a − t_p)/Δs_a when the point `previous` before a is
   /// given), Keller corrector, new tangent and the branch-jump guard. False with `failure` set

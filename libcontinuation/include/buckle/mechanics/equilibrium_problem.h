@@ -26,6 +26,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/control_path.h"
+#include "buckle/mechanics/eigenvalue_memory.h"
 #include "buckle/mechanics/end_condition.h"
 
 namespace buckle::mechanics {
@@ -140,6 +141,9 @@ class EquilibriumProblem final : public continuation::Problem {
   /// shifted tridiagonal T − σM (chain_structure.h, eigenvaluesFrom).
   bool stabilityEigenvalues(continuation::ConstVectorRef u, double lambda, int first,
                             continuation::VectorRef values) override;
+  /// O(n) factorizations the structured stability() and stabilityEigenvalues() have taken so
+  /// far (their cost; eigenvalue_memory.h).
+  long structuredFactorizations() const { return structure_.factorizations; }
   /// ‖dH‖_F + 2‖H‖_F‖dC‖_F/σ_min(C) along (du, dλ), H = K_q − K_g and C = J_h (held rows of
   /// eq 11), in O(n) from the q-cache: an upper bound on every |dμ_i| (Problem). False when C is
   /// rank-deficient (no finite bound) or the point is refused.
@@ -236,9 +240,8 @@ class EquilibriumProblem final : public continuation::Problem {
   BodyLoads body_;
   BodyLoadTerms bodyTerms_;   // the body loads' τ and γ of the cache (prepare())
   Vector bodyWork_;           // size n: dγ and other body-load scratch
-  Vector lastLowest_;         // warm start of the structured eigenvalue search
-  Vector lastFrom_;           // warm start of stabilityEigenvalues: its last values ...
-  int lastFirst_ = -1;        // ... and their first index
+  EigenvalueMemory found_;    // warm starts of the structured eigenvalue searches (by index)
+  Vector guess_;              // their guesses (size kMaxBorder once used: no allocation per call)
 };
 
 }  // namespace buckle::mechanics
