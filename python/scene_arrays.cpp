@@ -72,10 +72,10 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
   const auto P = static_cast<Eigen::Index>(cr.points.size());
   py::dict d;
   Eigen::VectorXi branch(P), point(P), negative(P);
-  VectorXd contactTorque(P);
+  VectorXd contactTorque(P), wallForce(P);
   py::array_t<bool> stable(P);
   auto stableView = stable.mutable_unchecked<1>();
-  std::vector<std::string> locked;
+  std::vector<std::string> locked, wall;
   std::vector<const scene::PointRecord*> rows;
   for (Eigen::Index i = 0; i < P; ++i) {
     const scene::PointRecord& p = cr.points[static_cast<size_t>(i)];
@@ -86,6 +86,8 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
     stableView(i) = p.stable;
     locked.push_back(p.locked);
     contactTorque[i] = p.contactTorque;
+    wall.push_back(p.wall);
+    wallForce[i] = p.wallForce;
   }
   // in the order of branches.csv's columns
   d["branch"] = branch;
@@ -97,6 +99,8 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
   addValues(d, {"min_eig"}, rows, cr);
   d["locked"] = locked;
   d["contact_torque"] = contactTorque;
+  d["wall"] = wall;
+  d["wall_force"] = wallForce;
   addValues(d, tailColumns(s), rows, cr);
   return d;
 }

@@ -57,6 +57,11 @@ SpecialRecord toRecord(const mech::SpecialPointReport& sp, int branch) {
   s.joint = sp.joint;
   s.contactTorque = sp.contactTorque;
   s.lockedAfter = sp.lockedAfter.label();
+  if (sp.vertex.segment >= 0) {
+    s.vertex = sp.vertex.label();
+    s.contactForce = sp.contactForce;
+    s.wallAfter = sp.lockedAfter.wallLabel();
+  }
   s.contactPoint = sp.contactPoint;
   s.koiter = sp.koiter;
   s.imperfections = sp.imperfections;
@@ -128,6 +133,8 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
     r.Kphi = p.rotationalStiffness;
     r.locked = p.locked.label();
     r.contactTorque = p.contactTorque;
+    r.wall = p.locked.wallLabel();
+    r.wallForce = p.wallForces.sum();
     if (scene_.analyses.frequencies.enabled) r.omega = naturalFrequencies(p.q, p.F, p.locked, p.parameter);
     out_.points.push_back(std::move(r));
   }

@@ -138,7 +138,7 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
       appendInteger(os, i);
     }
   }
-  os += ",stable,negative,min_eig,locked,contact_torque";
+  os += ",stable,negative,min_eig,locked,contact_torque,wall,wall_force";
   if (scene.analyses.stiffness)
     for (const std::string& column : stiffnessColumns()) os += "," + column;
   if (scene.analyses.frequencies.enabled)
@@ -187,6 +187,9 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
       os += ',';
       os += escape::csvField(p.locked);
       field(p.contactTorque);
+      os += ',';
+      os += escape::csvField(p.wall);
+      field(p.wallForce);
       if (scene.analyses.stiffness)
         for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C, p.Kphi));
       if (scene.analyses.frequencies.enabled)
@@ -269,6 +272,8 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       }
       if (s.joint >= 0)  // CT / RL
         p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", number(s.contactTorque)}, {"locked_after", s.lockedAfter}};
+      if (!s.vertex.empty())  // WC / WR
+        p["wall_contact"] = {{"vertex", s.vertex}, {"contact_force", number(s.contactForce)}, {"wall_after", s.wallAfter}};
       if (s.jumpTried) {
         json j;
         j["success"] = s.jumpSuccess;

@@ -41,6 +41,8 @@ struct PointRecord {
   double Kphi = std::numeric_limits<double>::quiet_NaN();  ///< the end's rotational stiffness (φ free)
   std::string locked;         ///< joints locked at their limits, "3U 5L" (ContactSet::label), "" none
   double contactTorque = 0.0; ///< largest compression of the locked joints (0: none locked)
+  std::string wall;           ///< vertices held on the base wall, "5d-" (ContactSet::wallLabel), "" none
+  double wallForce = 0.0;     ///< the wall's total push Σ μ_v along +x on the chain (0: none on it)
   /// `frequencies`: the signed natural frequencies ω_i (vibration.h; negative: unstable, minus
   /// the growth rate), NaN beyond the constrained chain's modes; empty otherwise
   Eigen::VectorXd omega;
@@ -74,6 +76,11 @@ struct SpecialRecord {
   int joint = -1;
   double contactTorque = std::numeric_limits<double>::quiet_NaN();
   std::string lockedAfter;
+  // wall contact (WC / WR): the vertex (WallVertex::label, "" otherwise), its wall force at the
+  // point, and the vertices on the wall after it (ContactSet::wallLabel)
+  std::string vertex;
+  double contactForce = std::numeric_limits<double>::quiet_NaN();
+  std::string wallAfter;
   // jump analysis (folds only): where the chain lands when released there
   bool jumpTried = false;
   bool jumpSuccess = false;

@@ -15,6 +15,8 @@ const std::vector<SpecialStyle>& specialStyles() {
                                                    {"JUMP", 11, "JUMP release", "#ff7f0e"},
                                                    {"CT", 15, "CT contact (joint locks)", "#2ca02c"},
                                                    {"RL", 3, "RL contact released", "#17becf"},
+                                                   {"WC", 15, "WC vertex on the wall", "#006d2c"},
+                                                   {"WR", 3, "WR vertex leaves the wall", "#08519c"},
                                                    {"BC", 5, "BC base contact (detected)", "#e377c2"},
                                                    {"SC", 5, "SC self contact (detected)", "#7f7f7f"}};
   return styles;

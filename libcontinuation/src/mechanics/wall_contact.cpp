@@ -67,7 +67,11 @@ WallApproach nearestWallVertex(const Chain& chain, ConstVectorRef q, const std::
   for (int i = 0; i < n; ++i) {
     const SegmentParameters& p = chain.segment(i).parameters();
     const double before = theta, after = theta + q[i];
-    for (int corner = i > 0 ? 0 : 3; corner <= 4; ++corner) {  // segment 1's proximal triangle is clamped
+    // segment 1's proximal triangle is clamped; a proximal corner on the previous segment's distal
+    // one (equal half-heights: the link's two triangles share their base) is that vertex
+    const bool shared = i > 0 && p.a1 == chain.segment(i - 1).parameters().a2;
+    for (int corner = i > 0 ? 0 : 3; corner <= 4; ++corner) {
+      if (shared && (corner == 1 || corner == 2)) continue;
       const WallVertex v{i, corner};
       if (std::find(exclude.begin(), exclude.end(), v) != exclude.end()) continue;
       const Point x = vertexAt(p, P.col(i + 1), before, after, corner);

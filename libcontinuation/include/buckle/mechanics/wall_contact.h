@@ -59,7 +59,9 @@ void wallVertexDerivatives(const Eigen::Matrix2Xd& P, const Eigen::Vector2d& poi
                            VectorRef gradient, VectorRef generator);
 
 /// The moving vertex nearest to the wall, i.e. of smallest x, leaving out `exclude` (the vertices
-/// already held on it). distance +inf when none is left.
+/// already held on it). distance +inf when none is left. A link's two triangles share their base
+/// (ℓ_m = b_m2 + b_(m+1)1): where the half-heights are equal (a_(i+1)1 = a_i2) the proximal
+/// corners of segment i + 1 are the distal corners of segment i and only the latter are named.
 struct WallApproach {
   double distance = 0.0;
   WallVertex vertex;
