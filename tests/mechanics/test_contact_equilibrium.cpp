@@ -14,6 +14,8 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/unloaded_shape.h"
 
+#include "curled_chain.h"
+
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
 
@@ -57,36 +59,13 @@ double moment(const Eigen::Vector2d& r, const Eigen::Vector2d& c, const Eigen::V
   return d.x() * f.y() - d.y() * f.x();
 }
 
-// The contact_release chain (data/scenes/contact_release.json) without its joint stop, lengths
-// scaled by sL and spring stiffnesses by sK: five segments curled by their unloaded shape, the
-// end behind the root, so a growing Fy swings segment 5's distal triangle onto the wall.
-Chain curledChain(double sL = 1.0, double sK = 1.0) {
-  std::vector<SegmentParameters> segs(5, SegmentParameters::symmetric(0.5 * sL, 1.0 * sL, 1.0 * sK, 2.25 * sL));
-  Eigen::VectorXd q0(5);
-  q0 << 0.2, 1.3, 1.3, 1.3, 1.3;
-  return Chain(preloadsForShape(segs, q0));
-}
-
-Eigen::VectorXd curledShape() {
-  Eigen::VectorXd q0(5);
-  q0 << 0.2, 1.3, 1.3, 1.3, 1.3;
-  return q0;
-}
-
-EquilibriumOptions withWall() {
-  EquilibriumOptions o;
-  o.wallAsBoundary = true;
-  return o;
-}
+// The contact_release chain without its joint stop, lengths scaled by sL, stiffnesses by sK.
+Chain curledChain(double sL = 1.0, double sK = 1.0) { return testing::curledChain(false, sL, sK); }
 
 // Fy from 0 to `to` (in force units k b of the scaled chain) with the wall as a constraint.
 EquilibriumBranches traceCurled(EquilibriumProblem& problem, double to) {
-  EquilibriumBranchOptions o;
-  o.tracer.lambdaMax = to;
-  o.tracer.initialStep = 0.01;  // in the problem's own units (ProblemScales): unit-free
-  o.tracer.maxStep = 0.02;
-  o.switchingDepth = 0;
-  return traceEquilibria(problem, curledShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
+  return traceEquilibria(problem, testing::curledShape(), 0.0, cont::InitialDirection::increasingLambda(),
+                         testing::curledTrace(to));
 }
 
 const SpecialPointReport* firstOf(const BranchReport& r, EventType t) {
@@ -100,7 +79,7 @@ const SpecialPointReport* firstOf(const BranchReport& r, EventType t) {
 TEST_CASE("wall: a segment pressed against the wall holds its vertex there with the force of a moment balance",
           "[contact][wall]") {
   const Chain chain = curledChain();
-  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), withWall());
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), testing::withWall());
   const EquilibriumBranches r = traceCurled(problem, 0.14);
   const BranchReport& rep = r.reports[0];
   const SpecialPointReport* wc = firstOf(rep, EventType::WallContact);
@@ -139,7 +118,7 @@ TEST_CASE("wall: a segment pressed against the wall holds its vertex there with 
 
 TEST_CASE("wall: scaled units give the same angles and the force scaled by the force unit k b", "[contact][wall]") {
   const Chain chain1 = curledChain();
-  EquilibriumProblem p1(chain1, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), withWall());
+  EquilibriumProblem p1(chain1, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), testing::withWall());
   const EquilibriumBranches ref = traceCurled(p1, 0.14);
   REQUIRE(firstOf(ref.reports[0], EventType::WallContact) != nullptr);
   const SpecialPointReport& wc0 = *firstOf(ref.reports[0], EventType::WallContact);
@@ -147,7 +126,7 @@ TEST_CASE("wall: scaled units give the same angles and the force scaled by the f
     INFO("lengths x" << sL << ", stiffness x" << sK);
     const double force = sL * sK;  // k b
     const Chain chain = curledChain(sL, sK);
-    EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), withWall());
+    EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), testing::withWall());
     const EquilibriumBranches r = traceCurled(problem, 0.14 * force);
     const SpecialPointReport* wc = firstOf(r.reports[0], EventType::WallContact);
     REQUIRE(wc != nullptr);

@@ -14,6 +14,7 @@
 #include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/unloaded_shape.h"
 #include "buckle/mechanics/wall_contact.h"
+#include "curled_chain.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -750,39 +751,17 @@ TEST_CASE("reports handed over as branches become final equal the kept ones; the
   CHECK(streamed.startUnstable == kept.startUnstable);
 }
 
-namespace {
-
-// data/scenes/contact_release.json: five paper segments curled by their unloaded shape
-// q0 = (0.2, 1.3, 1.3, 1.3, 1.3), joint 1 stopped at q_min = 0.1 (none when `stop` is false), the
-// free end pulled up by Fy = λ.
-Chain contactReleaseChain(bool stop) {
-  std::vector<SegmentParameters> segs(5, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  if (stop) segs[0].qMinUser = 0.1;
-  Eigen::VectorXd q0(5);
-  q0 << 0.2, 1.3, 1.3, 1.3, 1.3;
-  return Chain(preloadsForShape(segs, q0));
-}
-
-Eigen::VectorXd contactReleaseShape() {
-  Eigen::VectorXd q0(5);
-  q0 << 0.2, 1.3, 1.3, 1.3, 1.3;
-  return q0;
-}
-
-}  // namespace
+using testing::curledChain;
+using testing::curledShape;
+using testing::curledTrace;
+using testing::withWall;
 
 TEST_CASE("wall: contact_release no longer passes through the wall, holding segment 5 on it between WC and WR",
           "[equilibrium][wall]") {
-  const Chain chain = contactReleaseChain(true);
-  EquilibriumOptions eo;
-  eo.wallAsBoundary = true;
-  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), eo);
-  EquilibriumBranchOptions o;
-  o.tracer.lambdaMax = 1.0;
-  o.tracer.initialStep = 0.01;
-  o.tracer.maxStep = 0.02;
-  o.switchingDepth = 0;
-  const EquilibriumBranches r = traceEquilibria(problem, contactReleaseShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const Chain chain = curledChain(true);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), withWall());
+  const EquilibriumBranchOptions o = curledTrace(1.0);
+  const EquilibriumBranches r = traceEquilibria(problem, curledShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
   const BranchReport& rep = r.reports[0];
   std::vector<std::string> events;
   for (const SpecialPointReport& sp : rep.specialPoints)
@@ -833,7 +812,7 @@ TEST_CASE("wall: contact_release no longer passes through the wall, holding segm
   CHECK(held >= 3);
   // without the wall the same chain passes through it there
   EquilibriumProblem ghost(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));
-  const EquilibriumBranches g = traceEquilibria(ghost, contactReleaseShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const EquilibriumBranches g = traceEquilibria(ghost, curledShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
   double ghostDeepest = 0.0;
   for (const cont::ContinuationPoint& p : g.tree.branches[0].points) ghostDeepest = std::min(ghostDeepest, smallestX(p.u.head(5)));
   CHECK(ghostDeepest < -1e-2);
@@ -842,16 +821,10 @@ TEST_CASE("wall: contact_release no longer passes through the wall, holding segm
 TEST_CASE("wall: a vertex pressed on the wall releases where the reversed load brings its force back to zero",
           "[equilibrium][wall]") {
   // Leg 1: Fy grows to 0.13, segment 5's distal corner is pressed on the wall (WC near 0.1104).
-  const Chain chain = contactReleaseChain(false);
-  EquilibriumOptions eo;
-  eo.wallAsBoundary = true;
-  EquilibriumProblem up(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), eo);
-  EquilibriumBranchOptions o;
-  o.tracer.lambdaMax = 0.13;
-  o.tracer.initialStep = 0.01;
-  o.tracer.maxStep = 0.02;
-  o.switchingDepth = 0;
-  const EquilibriumBranches r = traceEquilibria(up, contactReleaseShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const Chain chain = curledChain(false);
+  EquilibriumProblem up(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), withWall());
+  const EquilibriumBranchOptions o = curledTrace(0.13);
+  const EquilibriumBranches r = traceEquilibria(up, curledShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
   const cont::Branch& leg1 = r.tree.branches[0];
   const ContactSet set = r.contact[0].back().locked;
   REQUIRE(set.wallCount() == 1);
@@ -860,7 +833,7 @@ TEST_CASE("wall: a vertex pressed on the wall releases where the reversed load b
     if (sp.type == EventType::WallContact) contactFy = sp.parameter;
   REQUIRE(contactFy > 0.1);
   // Leg 2: from the pressed state at Fy = 0.13 the load decreases (Fy = 0.13 − λ).
-  EquilibriumProblem down(chain, EndCondition::freeEnd(Eigen::Vector3d(0, 0.13, 0)), Eigen::Vector3d(0, -1, 0), eo);
+  EquilibriumProblem down(chain, EndCondition::freeEnd(Eigen::Vector3d(0, 0.13, 0)), Eigen::Vector3d(0, -1, 0), withWall());
   ContactProblem pressed(down, set);
   const Eigen::VectorXd start = pressed.withWallForces(leg1.points.back().u, 0.0);
   REQUIRE(start[start.size() - 1] > 1e-3);  // pushed

@@ -323,6 +323,9 @@ bool ContactProblem::stability(ConstVectorRef u, double lambda, int lowestCount,
     info.negative = 0;
     return true;
   }
+  // the chain structure's counts take at most 3 constraint rows (setConstraints): with more held
+  // coordinates and wall vertices together, the dense route of the core (O(n³))
+  if (heldRows_.rows() > 3) return Problem::stability(u, lambda, lowestCount, info);
   if (!assembleReduced(u, lambda, reduced_, Jf_)) return false;
   for (size_t k = 0; k < held_.size(); ++k) heldRows_.row(Eigen::Index(k)) = Jf_.row(held_[k]);
   for (int k = 0; k < locked_.wallCount(); ++k)  // the wall rows ∇x_vᵀ on the free joints
