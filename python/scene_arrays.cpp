@@ -73,10 +73,10 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
   const auto P = static_cast<Eigen::Index>(cr.points.size());
   py::dict d;
   Eigen::VectorXi branch(P), point(P), negative(P);
-  VectorXd contactTorque(P);
+  VectorXd contactTorque(P), wallForce(P);
   py::array_t<bool> stable(P);
   auto stableView = stable.mutable_unchecked<1>();
-  std::vector<std::string> locked;
+  std::vector<std::string> locked, wall;
   std::vector<const mechanics::PointReport*> rows;
   for (Eigen::Index i = 0; i < P; ++i) {
     const mechanics::PointReport& p = cr.points[static_cast<size_t>(i)];
@@ -87,6 +87,8 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
     stableView(i) = p.stable;
     locked.push_back(p.locked.label());
     contactTorque[i] = p.contactTorque;
+    wall.push_back(p.locked.wallLabel());
+    wallForce[i] = p.wallForces.sum();
   }
   // in the order of branches.csv's columns
   d["branch"] = branch;
@@ -98,6 +100,8 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
   addValues(d, {"min_eig"}, rows, cr);
   d["locked"] = locked;
   d["contact_torque"] = contactTorque;
+  d["wall"] = wall;
+  d["wall_force"] = wallForce;
   addValues(d, tailColumns(s), rows, cr);
   return d;
 }

@@ -190,7 +190,7 @@ void bindScene(py::module_& m) {
       "The dict: `complete`, `interrupted`, `interruption`, `problems`, `computed`; `cases` (per case: "
       "`label`, `segments`, `chain` (a Chain), `q0`, `branches`: the columns of branches.csv as arrays, in its "
       "order — branch, point, parameter, Fx, Fy, Me, x, y, phi, dx, dy, q (P×n), stable, negative, min_eig, locked "
-      "(str), contact_torque, and Kxx, Kyy, Kxy, Cxx, Cyy, Cxy, Kx_yfree, Ky_xfree, K1, K2, theta1, Kphi with stiffness, "
+      "(str), contact_torque, wall (str), wall_force, and Kxx, Kyy, Kxy, Cxx, Cyy, Cxy, Kx_yfree, Ky_xfree, K1, K2, theta1, Kphi with stiffness, "
       "omega1 … with frequencies, a task path's inputs; `special_points`: the case's special points in the same "
       "value columns as arrays, with type, field, shape, branch and index (into the run's `special_points`); with the equilibria analysis `equilibria`: the rows of equilibria.csv as "
       "arrays — at, q (m×n), potential, index, stable, shape, branch (the branch through each, -1: none or not "

@@ -24,6 +24,8 @@ Eigen::VectorXd CaseRunner::naturalFrequencies(const Eigen::VectorXd& q, const m
       vibration_ = std::make_unique<mech::VibrationAnalysis>(
           control.active() ? mech::chainWithControls(out_.chain, control, parameter) : out_.chain,
           caseInertia(spec.massPerLength));
+    // vertices held on the wall: their rows ∇x_v are no joint locks; not computed there (NaN)
+    if (contacts.wallCount() > 0) return omega;
     std::vector<int> locked;
     for (const mech::LockedJoint& j : contacts.joints()) locked.push_back(j.joint);
     // with weight or point loads the Hessian's generator h − γ (body_loads.h, eq B3)

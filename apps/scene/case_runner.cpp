@@ -317,6 +317,8 @@ void CaseRunner::continuation() {
   std::vector<double> targets{spec_.path.to, spec_.path.from};
   const int c = spec_.path.coordinate;
   mech::EquilibriumOptions equilibriumOptions;
+  // with contact and the wall, the base wall is a unilateral constraint like the joint stops (contact.h)
+  equilibriumOptions.wallAsBoundary = scene_.analyses.continuation.contact && scene_.analyses.continuation.wall;
   if (throughLoad()) {
     // trace with the held coordinate's reaction as parameter (PathSpec::throughReaction), each
     // branch ending where the coordinate leaves the path's range

@@ -111,7 +111,7 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
       appendInteger(os, i);
     }
   }
-  os += ",stable,negative,min_eig,locked,contact_torque";
+  os += ",stable,negative,min_eig,locked,contact_torque,wall,wall_force";
   if (scene.analyses.stiffness)
     for (const std::string& column : stiffnessColumns()) os += "," + column;
   if (scene.analyses.frequencies.enabled)
@@ -160,6 +160,9 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
       os += ',';
       os += escape::csvField(p.locked.label());
       field(p.contactTorque);
+      os += ',';
+      os += escape::csvField(p.locked.wallLabel());
+      field(p.wallForces.sum());
       if (scene.analyses.stiffness)
         for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C, p.rotationalStiffness));
       if (scene.analyses.frequencies.enabled)
@@ -242,6 +245,9 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       }
       if (s.joint >= 0)  // CT / RL
         p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", number(s.contactTorque)}, {"locked_after", s.lockedAfter.label()}};
+      if (s.vertex.segment >= 0)  // WC / WR
+        p["wall_contact"] = {{"vertex", s.vertex.label()}, {"contact_force", number(s.contactForce)},
+                             {"wall_after", s.lockedAfter.wallLabel()}};
       if (const mechanics::Landing& l = s.landing; l.tried) {
         json j;
         j["success"] = l.success;

@@ -43,12 +43,23 @@ bool detailedChain(const mechanics::Chain& chain, const Eigen::AlignedBox2d& box
 // and springs and limits stay empty; joints within 5 % of a limit are still marked.
 void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFile& triangles, BlockFile& springs,
                BlockFile& limits, BlockFile& joints, BlockFile& nearLimit, BlockFile* touch = nullptr,
-               bool detailed = true) {
+               bool detailed = true, BlockFile* wall = nullptr) {
+  // a vertex within 1e-9 of the chain's length of x = 0 rests on the wall (held there by the
+  // contact, wall_contact.h); deeper is through it
+  const double onWall = 1e-9 * chain.length();
   if (touch) {
     const mechanics::BaseClearance base = mechanics::baseClearance(chain, q);
-    if (base.distance <= 0.0) touch->point({base.point.x(), base.point.y()});
+    if (base.distance < -onWall) touch->point({base.point.x(), base.point.y()});
     const mechanics::SelfClearance self = mechanics::selfClearance(chain, q);
     if (self.distance <= 0.0) touch->point({self.point.x(), self.point.y()});
+  }
+  if (wall) {
+    std::vector<mechanics::WallVertex> on;
+    for (mechanics::WallApproach a = mechanics::nearestWallVertex(chain, q); std::abs(a.distance) <= onWall;
+         a = mechanics::nearestWallVertex(chain, q, on)) {
+      wall->point({a.point.x(), a.point.y()});
+      on.push_back(a.vertex);
+    }
   }
   const int n = chain.size();
   const Eigen::Matrix2Xd P = mechanics::jointPositions(chain, q);
@@ -127,7 +138,8 @@ void chainPanel(std::ostream& os, const std::string& base, double L, const std::
   os << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
      << " fc rgb '#bbbbbb' fs pattern 4 border lc rgb '#555555'\n";
   const std::string touchClause =
-      touch ? ", \\\n  " + quote(base + "_touch.dat") + " using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'magenta'"
+      touch ? ", \\\n  " + quote(base + "_touch.dat") + " using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'magenta'" +
+                  ", \\\n  " + quote(base + "_wall.dat") + " using 1:2 with points pt 9 ps 2.5 lc rgb '#2ca02c'"
             : std::string();
   os << "plot " << (under.empty() ? std::string() : under + ", \\\n  ");
   if (detailed)
@@ -145,19 +157,19 @@ void chainPanel(std::ostream& os, const std::string& base, double L, const std::
   os << "unset object 1\n";
 }
 
-/// The files chainPanel draws (BASE_{tri,spr,lim,jnt,near,touch}.dat) of the chain at q; each
+/// The files chainPanel draws (BASE_{tri,spr,lim,jnt,near,touch,wall}.dat) of the chain at q; each
 /// starts with a NaN point so that gnuplot reads an empty panel (q null) without complaint.
 void writeChainFiles(const mechanics::Chain& chain, const Eigen::VectorXd* q, const fs::path& dir,
                      const std::string& base, bool detailed) {
-  BlockFile tri, spr, lim, jnt, near, touch;
-  for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near, &touch}) {
+  BlockFile tri, spr, lim, jnt, near, touch, wall;
+  for (BlockFile* f : {&tri, &spr, &lim, &jnt, &near, &touch, &wall}) {
     f->begin();
     f->point({std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()});
     f->breakLine();
   }
-  if (q) drawChain(chain, *q, tri, spr, lim, jnt, near, &touch, detailed);
+  if (q) drawChain(chain, *q, tri, spr, lim, jnt, near, &touch, detailed, &wall);
   for (const auto& [file, suffix] : {std::pair<BlockFile*, const char*>{&tri, "_tri"}, {&spr, "_spr"}, {&lim, "_lim"},
-                                     {&jnt, "_jnt"}, {&near, "_near"}, {&touch, "_touch"}})
+                                     {&jnt, "_jnt"}, {&near, "_near"}, {&touch, "_touch"}, {&wall, "_wall"}})
     file->write(dir / (base + suffix + ".dat"));
 }
 
@@ -258,9 +270,9 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   s.body << "set multiplot layout " << nc * rowsPerCase << "," << cols << " title "
          << quote(!spec.title.empty() ? spec.title
                   : detailed ? std::string("Chain shapes" + scene.units.suffix(Dimension::Length) + ", each panel to its own scale; grey arcs: "
-                                           "joint limits, red: joint within 5% of a limit, magenta star: through the clamp or itself")
+                                           "joint limits, red: joint within 5% of a limit, green: vertex held on the wall, magenta star: through the clamp or itself")
                              : std::string("Chain shapes" + scene.units.suffix(Dimension::Length) + ", each panel to its own scale, centre lines "
-                                           "(base, joints, end); red: joint within 5% of a limit, magenta star: through the clamp or itself"))
+                                           "(base, joints, end); red: joint within 5% of a limit, green: vertex held on the wall, magenta star: through the clamp or itself"))
          << " font ',11'\n";
   for (size_t o = 0; o < nc; ++o) {
     const size_t c = size_t(spec.cases[o]);
@@ -285,6 +297,7 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
           title << ",  K_{xx} = " << short5(p->K(0, 0)) << ", K_{yy} = " << short5(p->K(1, 1))
                 << " " << scene.units.unit(Dimension::Stiffness);
         if (!p->locked.empty()) title << lockedTitle(p->locked.label());  // locked at a limit
+        if (!p->locked.wallLabel().empty()) title << ",  on the wall: " << p->locked.wallLabel();  // vertices held on the wall
       } else {
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(spec.at[k]) << ": not drawn";
         s.body << "set label 1 " << quote(missingOf[o][k]) << " at graph 0.5, graph 0.5 center font ',9' noenhanced\n";

@@ -115,6 +115,9 @@ struct ContinuationSpec {
   /// Joints that reach a limit lock and the branch goes on under contact (mechanics/contact.h);
   /// false: the branch ends at the limit ("BD").
   bool contact = true;
+  /// With contact: the base wall x = 0 holds the vertices that reach it (mechanics/contact.h,
+  /// wall_contact.h: WC / WR); false: the chain passes through it, detected only (BC).
+  bool wall = false;
   /// An exactly mirror-symmetric scene (mechanics/mirror_symmetry.h) mirrors the − side child of
   /// every symmetric pitchfork instead of tracing it; false: both traced (for checking).
   bool mirror = true;

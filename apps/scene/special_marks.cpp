@@ -20,6 +20,8 @@ const std::vector<SpecialStyle>& specialStyles() {
       {EventType::Jump, 11, "JUMP release", "#ff7f0e"},
       {EventType::Contact, 15, "CT contact (joint locks)", "#2ca02c"},
       {EventType::Release, 3, "RL contact released", "#17becf"},
+      {EventType::WallContact, 15, "WC vertex on the wall", "#006d2c"},
+      {EventType::WallRelease, 3, "WR vertex leaves the wall", "#08519c"},
       {EventType::BaseContact, 5, "BC base contact (detected)", "#e377c2"},
       {EventType::SelfContact, 5, "SC self contact (detected)", "#7f7f7f"},
       {EventType::EigenvalueTouch, 7, "ET eigenvalue touches zero", "#555555"}};

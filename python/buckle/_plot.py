@@ -8,9 +8,10 @@ import numpy as np
 
 # Marker and colour per special-point type (docs/outputs.md lists the types)
 MARKERS = {"BP": "o", "LP": "s", "LPF": "D", "BD": "^", "KMIN": "v", "JUMP": "*", "CT": "P", "RL": "X",
-           "BC": "h", "SC": "p", "LS": "<", "IB": ">"}
+           "WC": "P", "WR": "X", "BC": "h", "SC": "p", "LS": "<", "IB": ">"}
 COLOURS = {"BP": "tab:red", "LP": "tab:green", "LPF": "tab:olive", "BD": "black", "KMIN": "tab:purple",
-           "JUMP": "tab:orange", "CT": "tab:brown", "RL": "tab:pink", "BC": "tab:gray", "SC": "tab:cyan"}
+           "JUMP": "tab:orange", "CT": "tab:brown", "RL": "tab:pink", "WC": "darkgreen", "WR": "navy",
+           "BC": "tab:gray", "SC": "tab:cyan"}
 # Above this many special points "auto" labels only the primary branch's branch points (as the
 # command line's summary plots, docs/scenes.md `labels`)
 AUTO_LABEL_LIMIT = 60

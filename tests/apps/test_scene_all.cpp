@@ -235,6 +235,17 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
           CHECK(!p.contains("jump_to"));
           REQUIRE(p.contains("contact"));
           CHECK(std::abs(p["contact"]["contact_torque"].get<double>()) <= 1e-9);
+        } else if (type == "WC" || type == "WR") {
+          // a vertex reaches or leaves the wall (mechanics/contact.h): the free and the held
+          // equilibria meet there, so the wall force is zero to the location's accuracy and the
+          // vertex lies on x = 0
+          CHECK(field == "none");
+          CHECK(!p.contains("jump_to"));
+          REQUIRE(p.contains("wall_contact"));
+          CHECK(!p["wall_contact"]["vertex"].get<std::string>().empty());
+          CHECK(std::abs(p["wall_contact"]["contact_force"].get<double>()) <= 1e-9);
+          REQUIRE(p.contains("contact_point"));
+          CHECK(std::abs(p["contact_point"][0].get<double>()) <= 1e-9 * std::max(1.0, std::abs(p["position"]["x"].get<double>())));
         } else if (type == "BC" || type == "SC") {
           // base / self contact (mechanics/contact_geometry.h): detected, no phenomenon, the
           // touching point on the wall x = 0 for BC

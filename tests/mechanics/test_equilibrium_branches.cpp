@@ -12,6 +12,9 @@
 #include "buckle/mechanics/linear_buckling.h"
 #include "critical_loads.h"
 #include "buckle/mechanics/shape_name.h"
+#include "buckle/mechanics/unloaded_shape.h"
+#include "buckle/mechanics/wall_contact.h"
+#include "curled_chain.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -746,4 +749,119 @@ TEST_CASE("reports handed over as branches become final equal the kept ones; the
   }
   CHECK(locked);  // the comparison covered contact stretches
   CHECK(streamed.startUnstable == kept.startUnstable);
+}
+
+using testing::curledChain;
+using testing::curledShape;
+using testing::curledTrace;
+using testing::withWall;
+
+TEST_CASE("wall: contact_release no longer passes through the wall, holding segment 5 on it between WC and WR",
+          "[equilibrium][wall]") {
+  const Chain chain = curledChain(true);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), withWall());
+  const EquilibriumBranchOptions o = curledTrace(1.0);
+  const EquilibriumBranches r = traceEquilibria(problem, curledShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const BranchReport& rep = r.reports[0];
+  std::vector<std::string> events;
+  for (const SpecialPointReport& sp : rep.specialPoints)
+    if (sp.type != EventType::StiffnessMinimum) events.push_back(label(sp.type));
+  CHECK(events == std::vector<std::string>{"WC", "WR", "CT", "RL"});
+  CHECK(r.tree.branches[0].stopReason == cont::StopReason::LambdaRange);
+  // every traced point, and every point of the free chain's own trace (wall off) in between,
+  // against the test's own vertices: the moving triangles' corners and joints
+  auto smallestX = [&chain](const Eigen::VectorXd& q) {
+    const Eigen::Matrix2Xd P = jointPositions(chain, q);
+    double x = std::numeric_limits<double>::infinity(), theta = 0.0;
+    for (int i = 0; i < chain.size(); ++i) {
+      const SegmentParameters& p = chain.segment(i).parameters();
+      const double before = theta, after = theta + q[i];
+      const Eigen::Vector2d j = P.col(i + 1);
+      for (double s : {1.0, -1.0}) {
+        if (i > 0) x = std::min({x, j.x(), j.x() - p.b1 * std::cos(before) - s * p.a1 * std::sin(before)});
+        x = std::min(x, j.x() + p.b2 * std::cos(after) - s * p.a2 * std::sin(after));
+      }
+      theta = after;
+    }
+    return x;
+  };
+  double deepest = 0.0;
+  for (const cont::ContinuationPoint& p : r.tree.branches[0].points) deepest = std::min(deepest, smallestX(p.u.head(5)));
+  CHECK(deepest >= -1e-12);
+  // the wall stretch: vertex 5d- held, pushed (μ ≥ 0); the wall forces 0 at both ends
+  const SpecialPointReport* wc = nullptr;
+  const SpecialPointReport* wr = nullptr;
+  for (const SpecialPointReport& sp : rep.specialPoints) {
+    if (sp.type == EventType::WallContact) wc = &sp;
+    if (sp.type == EventType::WallRelease) wr = &sp;
+  }
+  REQUIRE(wc);
+  REQUIRE(wr);
+  CHECK(wc->vertex == WallVertex{4, 4});
+  CHECK(wr->vertex == WallVertex{4, 4});
+  CHECK(std::abs(wc->contactForce) <= 1e-12);
+  CHECK(std::abs(wr->contactForce) <= 1e-12);
+  int held = 0;
+  for (const PointReport& pt : rep.points) {
+    if (pt.locked.wallCount() == 0) continue;
+    ++held;
+    CHECK(pt.parameter >= wc->parameter - 1e-12);
+    CHECK(pt.parameter <= wr->parameter + 1e-12);
+    CHECK(pt.wallForces[0] >= -1e-12);
+  }
+  CHECK(held >= 3);
+  // without the wall the same chain passes through it there
+  EquilibriumProblem ghost(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));
+  const EquilibriumBranches g = traceEquilibria(ghost, curledShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
+  double ghostDeepest = 0.0;
+  for (const cont::ContinuationPoint& p : g.tree.branches[0].points) ghostDeepest = std::min(ghostDeepest, smallestX(p.u.head(5)));
+  CHECK(ghostDeepest < -1e-2);
+}
+
+TEST_CASE("wall: a vertex pressed on the wall releases where the reversed load brings its force back to zero",
+          "[equilibrium][wall]") {
+  // Leg 1: Fy grows to 0.13, segment 5's distal corner is pressed on the wall (WC near 0.1104).
+  const Chain chain = curledChain(false);
+  EquilibriumProblem up(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), withWall());
+  const EquilibriumBranchOptions o = curledTrace(0.13);
+  const EquilibriumBranches r = traceEquilibria(up, curledShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const cont::Branch& leg1 = r.tree.branches[0];
+  const ContactSet set = r.contact[0].back().locked;
+  REQUIRE(set.wallCount() == 1);
+  double contactFy = 0.0;
+  for (const SpecialPointReport& sp : r.reports[0].specialPoints)
+    if (sp.type == EventType::WallContact) contactFy = sp.parameter;
+  REQUIRE(contactFy > 0.1);
+  // Leg 2: from the pressed state at Fy = 0.13 the load decreases (Fy = 0.13 − λ).
+  EquilibriumProblem down(chain, EndCondition::freeEnd(Eigen::Vector3d(0, 0.13, 0)), Eigen::Vector3d(0, -1, 0), withWall());
+  ContactProblem pressed(down, set);
+  const Eigen::VectorXd start = pressed.withWallForces(leg1.points.back().u, 0.0);
+  REQUIRE(start[start.size() - 1] > 1e-3);  // pushed
+  cont::TracerOptions to = o.tracer;
+  to.lambdaMax = 0.13;
+  cont::Branch leg2 = cont::trace(pressed, start, 0.0, cont::InitialDirection::increasingLambda(), to);
+  REQUIRE(leg2.stopReason == cont::StopReason::Boundary);
+  CHECK(leg2.specialPoints.back().boundaryName == wallReleaseName(set.wall()[0]));
+  const std::vector<ContactStretch> stretches = continueUnderContact(down, leg2, to, 50, 10.0, set);
+  REQUIRE(stretches.size() == 2);
+  CHECK(stretches[1].locked.empty());
+  CHECK(leg2.stopReason == cont::StopReason::LambdaRange);
+  // the release: the wall force's zero, located; the same load as the contact of leg 1 (both are
+  // where the free and the pressed equilibria meet with μ = 0)
+  const auto found = std::find_if(leg2.specialPoints.begin(), leg2.specialPoints.end(), [&set](const cont::SpecialPoint& sp) {
+    return sp.boundaryName == wallReleaseName(set.wall()[0]);
+  });
+  REQUIRE(found != leg2.specialPoints.end());
+  const cont::SpecialPoint& release = *found;
+  ContactProblem at(down, set);
+  CHECK(std::abs(at.wallForces(release.u, release.lambda)[0]) <= 1e-10);
+  CHECK(0.13 - release.lambda == Approx(contactFy).epsilon(1e-9));
+  // the free branch resumes: clear of the wall, equilibria of the free chain, down to Fy = 0
+  Eigen::VectorXd F(down.dimension());
+  for (size_t i = size_t(stretches[1].firstPoint); i < leg2.points.size(); ++i) {
+    CHECK(nearestWallVertex(chain, leg2.points[i].u.head(5)).distance > 0.0);
+    REQUIRE(down.residual(leg2.points[i].u, leg2.points[i].lambda, F));
+    CHECK(F.cwiseAbs().maxCoeff() <= 1e-9);
+  }
+  CHECK(leg2.points.back().lambda == Approx(0.13));
 }

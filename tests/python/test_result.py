@@ -96,7 +96,7 @@ def test_branches_frame_is_branches_csv(name, source_dir, run_cli, tmp_path, pan
     header = [c for c in rows[0] if c not in ("max_abs_q", "sign_changes")]
     assert [c for c in frame.columns if c in header] == header
     for column in header:
-        if column == "locked":
+        if column in ("locked", "wall"):
             assert frame[column].tolist() == [row[column] for row in rows]
             continue
         csv_values = np.array([number(row[column]) for row in rows])

@@ -30,6 +30,8 @@ const char* label(EventType type) {
     case EventType::Release: return "RL";
     case EventType::BaseContact: return "BC";
     case EventType::SelfContact: return "SC";
+    case EventType::WallContact: return "WC";
+    case EventType::WallRelease: return "WR";
     case EventType::EigenvalueTouch: return cont::label(cont::SpecialPointType::EigenvalueTouch);
     case EventType::StabilityLoss: return "LS";
     case EventType::InputBound: return "IB";
@@ -159,6 +161,42 @@ int jointAtLimit(const Chain& chain, const Eigen::VectorXd& q) {
   return joint;
 }
 
+/// A boundary after which the branch's vertices on the wall change (continueUnderContact): WC when
+/// a vertex reaches the wall, WR when one leaves it.
+void reportWallEvent(EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
+                     const ContactSet& before, const ContactSet& after, const std::vector<PointReport>& all,
+                     SpecialPointReport& s) {
+  WallVertex vertex{-1, 0};
+  for (const WallVertex& v : after.wall())
+    if (!before.touching(v)) vertex = v;
+  const bool contact = vertex.segment >= 0;
+  if (!contact)
+    for (const WallVertex& v : before.wall())
+      if (!after.touching(v)) vertex = v;
+  if (vertex.segment < 0) return;
+  const ContactSet& set = contact ? after : before;
+  ContactProblem held(problem, set);
+  const Vector mu = held.wallForces(sp.u, sp.lambda);
+  const auto k = std::lower_bound(set.wall().begin(), set.wall().end(), vertex) - set.wall().begin();
+  const int n = problem.segments();
+  const Eigen::Matrix2Xd P = jointPositions(problem.chain(), sp.u.head(n));
+  s.type = contact ? EventType::WallContact : EventType::WallRelease;
+  s.phenomenon = Phenomenon::None;  // a change of the constraints, none of the paper's three phenomena
+  s.vertex = vertex;
+  s.contactForce = mu[k];
+  s.contactPoint = wallVertexPoint(problem.chain(), sp.u.head(n), P, vertex);
+  s.lockedAfter = after;
+  if (size_t(sp.index + 1) < all.size()) s.negativeAfter = all[size_t(sp.index + 1)].negative;
+  if (sp.index < int(b.points.size())) s.negativeBefore = all[size_t(sp.index)].negative;
+  std::ostringstream os;
+  os.precision(6);
+  os << "vertex " << vertex.label() << " at (" << s.contactPoint.x() << ", " << s.contactPoint.y() << "): "
+     << (contact ? "reaches the base wall and is held on it" : "wall force returns to zero: leaves the wall")
+     << "; wall force = " << s.contactForce
+     << "; on the wall after: " << (after.wall().empty() ? std::string("none") : after.wallLabel());
+  s.note = os.str();
+}
+
 /// A boundary after which the branch's locked joints change (continueUnderContact): CT when a
 /// joint locks, RL when one releases; s is left a plain boundary otherwise.
 void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
@@ -177,7 +215,10 @@ void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, cons
   if (!contact)
     for (const LockedJoint& l : before.joints())
       if (!after.locked(l.joint)) joint = l.joint;
-  if (joint < 0) return;
+  if (joint < 0) {
+    reportWallEvent(problem, b, sp, before, after, all, s);
+    return;
+  }
   const LimitSide side = contact ? after.side(joint) : before.side(joint);
   ContactProblem locked(problem, contact ? after : before);
   s.type = contact ? EventType::Contact : EventType::Release;
@@ -239,7 +280,14 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
     pr.minEigenvalue = p.stability.smallest;
     pr.residual = p.residualNorm;
     pr.locked = lockedAt(stretches, int(i));
-    if (!pr.locked.empty() && problem.residual(p.u, p.lambda, torques)) {
+    if (pr.locked.wallCount() > 0) {
+      // the wall forces close the free rows (ContactProblem::wallForces); the joints' contact
+      // torques include their terms
+      ContactProblem held(problem, pr.locked);
+      pr.wallForces = held.wallForces(p.u, p.lambda);
+      for (const LockedJoint& l : pr.locked.joints())
+        pr.contactTorque = std::max(pr.contactTorque, held.compression(p.u, p.lambda, l.joint));
+    } else if (!pr.locked.empty() && problem.residual(p.u, p.lambda, torques)) {
       // The compression −side·τ_c of each locked joint (ContactProblem::compression), its contact
       // torque τ_c the free equilibrium's row: one residual for all of them.
       for (const LockedJoint& l : pr.locked.joints())
@@ -262,7 +310,7 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
       StiffnessOptions so;
       so.bodyGenerator = problem.bodyLoadGenerator(pr.q, lambda);
       const CartesianStiffness s = lockedLoadedStiffness(problem.controlled() ? problem.chainAt(lambda) : chain, pr.q,
-                                                         pr.F, problem.endCondition(), pr.locked, so);
+                                                         pr.F, problem.endCondition(), pr.locked, so, pr.wallForces);
       pr.K = s.stiffness;
       pr.C = s.compliance;
       pr.rotationalStiffness = s.rotationalStiffness;

@@ -9,6 +9,7 @@
 
 #include "buckle/continuation/root_finding.h"
 #include "buckle/mechanics/shape_name.h"
+#include "buckle/mechanics/wall_contact.h"
 
 namespace buckle::mechanics {
 
@@ -16,8 +17,6 @@ namespace {
 
 using Point = Eigen::Vector2d;
 
-Point dir(double t) { return Point(std::cos(t), std::sin(t)); }
-Point nrm(double t) { return Point(-std::sin(t), std::cos(t)); }
 
 double pointSegment(const Point& p, const Point& a, const Point& b, Point* nearest = nullptr) {
   const Point d = b - a;
@@ -60,32 +59,12 @@ double distanceAt(const Chain& chain, ConstVectorRef q, bool base) {
 }  // namespace
 
 BaseClearance baseClearance(const Chain& chain, ConstVectorRef q) {
-  const int n = chain.size();
-  const Eigen::Matrix2Xd P = jointPositions(chain, q);  // checks the size
+  const WallApproach a = nearestWallVertex(chain, q);  // the vertices of wall_contact.h
   BaseClearance c;
-  c.distance = std::numeric_limits<double>::infinity();
-  auto consider = [&](const Point& v, int segment, bool distal) {
-    if (v.x() < c.distance) {
-      c.distance = v.x();
-      c.segment = segment;
-      c.distal = distal;
-      c.point = v;
-    }
-  };
-  double theta = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const SegmentParameters& p = chain.segment(i).parameters();
-    const Point joint = P.col(i + 1);
-    const double before = theta, after = theta + q[i];
-    if (i > 0) {  // segment 1's proximal triangle is clamped to the wall
-      consider(joint, i, false);
-      consider(joint - p.b1 * dir(before) + p.a1 * nrm(before), i, false);
-      consider(joint - p.b1 * dir(before) - p.a1 * nrm(before), i, false);
-    }
-    consider(joint + p.b2 * dir(after) + p.a2 * nrm(after), i, true);
-    consider(joint + p.b2 * dir(after) - p.a2 * nrm(after), i, true);
-    theta = after;
-  }
+  c.distance = a.distance;
+  c.segment = a.vertex.segment;
+  c.distal = a.vertex.distal();
+  c.point = a.point;
   return c;
 }
 
@@ -166,6 +145,7 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
   if (count < 2) return found;
   const double lambdaScale = problem.scales().parameter;
   for (bool base : {true, false}) {
+    if (base && problem.wallIsBoundary()) continue;  // the wall is a constraint: WC / WR (contact.h)
     std::vector<double> d(count);
     for (size_t i = 0; i < count; ++i) d[i] = distanceAt(chain, branch.points[i].u.head(n), base);
     for (size_t i = 0; i + 1 < count; ++i) {

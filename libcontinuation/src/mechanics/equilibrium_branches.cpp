@@ -12,15 +12,63 @@ namespace buckle::mechanics {
 
 namespace {
 
-// The boundary (joint, side) a branch's last special point stopped on, found by its name among
-// the problem's boundaries; joint −1 when the branch did not end on one.
-LockedJoint endBoundary(const continuation::Problem& problem, const continuation::Branch& branch, int segments) {
-  if (branch.stopReason != continuation::StopReason::Boundary || branch.specialPoints.empty()) return {};
+// What a branch's last special point stopped on: a joint limit or a joint's release (joint ≥ 0),
+// the wall reached by a vertex or a vertex's release from it (vertex.segment ≥ 0), or nothing.
+struct BoundaryEvent {
+  LockedJoint joint;
+  WallVertex vertex;
+  bool wallRelease = false;
+  bool any() const { return joint.joint >= 0 || vertex.segment >= 0; }
+};
+
+// The event found by the boundary's name among the problem's boundaries (the joints' limits and
+// contacts, the wall's clearance and releases); `wall` the vertices on the wall before it.
+BoundaryEvent endEvent(const EquilibriumProblem& base, const continuation::Problem& problem,
+                      const continuation::Branch& branch, const std::vector<WallVertex>& wall) {
+  BoundaryEvent e;
+  const int segments = base.segments();
+  if (branch.stopReason != continuation::StopReason::Boundary || branch.specialPoints.empty()) return e;
   const continuation::SpecialPoint& sp = branch.specialPoints.back();
-  if (sp.type != continuation::SpecialPointType::Boundary) return {};
-  for (int k = 0; k < std::min(problem.boundaryCount(), 2 * segments); ++k)  // the joints' limits and contacts
-    if (problem.boundaryName(k) == sp.boundaryName) return limitOfBoundary(k, segments);
-  return {};
+  if (sp.type != continuation::SpecialPointType::Boundary) return e;
+  for (int k = 0; k < std::min(problem.boundaryCount(), 2 * segments); ++k)
+    if (problem.boundaryName(k) == sp.boundaryName) {
+      e.joint = limitOfBoundary(k, segments);
+      return e;
+    }
+  if (base.wallIsBoundary() && sp.boundaryName == EquilibriumProblem::wallBoundaryName()) {
+    e.vertex = nearestWallVertex(base.chain(), sp.u.head(segments), wall).vertex;
+    return e;
+  }
+  for (const WallVertex& v : wall)
+    if (sp.boundaryName == wallReleaseName(v)) {
+      e.vertex = v;
+      e.wallRelease = true;
+    }
+  return e;
+}
+
+// A stretch's point or special point in the branch's unknowns (q, r): the wall forces μ, which
+// the stretch's problem carries after them (contact.h), are dropped (wallForces recovers them).
+void toBaseUnknowns(continuation::Vector& u, continuation::Vector& tangent, int N) {
+  if (u.size() > N) u.conservativeResize(N);
+  if (tangent.size() > N + 1) {
+    const double tl = tangent[tangent.size() - 1];
+    tangent.conservativeResize(N + 1);
+    tangent[N] = tl;
+  }
+}
+void toBaseUnknowns(continuation::SpecialPoint& sp, int N) {
+  const Eigen::Index D = sp.u.size();
+  toBaseUnknowns(sp.u, sp.tangent, N);
+  if (sp.leftNullVector.size() > N) sp.leftNullVector.conservativeResize(N);
+  if (sp.nullVectors.rows() == D + 1 && D > N) {  // branch point: (D + 1)×2, λ last
+    continuation::Matrix v(N + 1, sp.nullVectors.cols());
+    v.topRows(N) = sp.nullVectors.topRows(N);
+    v.row(N) = sp.nullVectors.row(D);
+    sp.nullVectors = v;
+  } else if (sp.nullVectors.rows() == D && D > N) {  // fold: D×1
+    sp.nullVectors.conservativeResize(N, sp.nullVectors.cols());
+  }
 }
 
 // The mirror image's share of what continueUnderContact added to its source after the source's
@@ -51,6 +99,31 @@ std::unique_ptr<ContactProblem> lockedProblem(EquilibriumProblem& problem, const
   return std::make_unique<ContactProblem>(problem, locked, maxContactTorque * torqueUnit);
 }
 
+// dg/ds at the start p0 of a stretch (on its problem's unknowns (q, r, μ), λ) for the changed
+// contact's boundary g: a released joint's g = side·(q̄ − q) moves with −side·t_q; a joint contact's
+// compression −side·τ_c with −side·(F_u,i t_u + F_λ,i t_λ) (row i of the stretch before, exact); a
+// vertex's wall force μ_v with its own component of the tangent; a released vertex's x_v with
+// ∇x_v·t_q.
+double contactRate(EquilibriumProblem& problem, const ContactSet& before, const BoundaryEvent& hit, bool release,
+                   int wallIndex, const continuation::ContinuationPoint& p0) {
+  const int n = problem.segments(), D = int(p0.u.size());
+  if (hit.joint.joint >= 0) {
+    const int i = hit.joint.joint;
+    const double sideSign = hit.joint.side == LimitSide::Upper ? 1.0 : -1.0;
+    if (release) return -sideSign * p0.tangent[i];
+    ContactProblem prior(problem, before);  // the same wall vertices: the same unknowns
+    continuation::Matrix Fu(D, D);
+    continuation::Vector Fl(D);
+    if (!prior.jacobian(p0.u, p0.lambda, Fu, Fl)) return 0.0;
+    return -sideSign * (Fu.row(i).dot(p0.tangent.head(D)) + Fl[i] * p0.tangent[D]);
+  }
+  if (!release) return p0.tangent[D - before.wallCount() - 1 + wallIndex];
+  const Eigen::Matrix2Xd P = jointPositions(problem.chain(), p0.u.head(n));
+  continuation::Vector grad(n), gen(n);
+  wallVertexDerivatives(P, wallVertexPoint(problem.chain(), p0.u.head(n), P, hit.vertex), hit.vertex, grad, gen);
+  return grad.dot(p0.tangent.head(n));
+}
+
 }  // namespace
 
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
@@ -60,16 +133,26 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
   std::vector<ContactStretch> stretches{ContactStretch{0, initial}};
   std::unique_ptr<ContactProblem> current;  // the problem of the last stretch (null: `problem`)
   if (!initial.empty()) current = lockedProblem(problem, initial, maxContactTorque);
+  if (initial.wallCount() > 0) {  // traced with the wall forces among the unknowns: keep (q, r)
+    for (continuation::ContinuationPoint& p : branch.points) toBaseUnknowns(p.u, p.tangent, problem.dimension());
+    for (continuation::SpecialPoint& sp : branch.specialPoints) toBaseUnknowns(sp, problem.dimension());
+  }
   for (int events = 0; events < maxContactEvents && !branch.points.empty(); ++events) {
     const continuation::Problem& traced = current ? static_cast<const continuation::Problem&>(*current) : problem;
-    const LockedJoint hit = endBoundary(traced, branch, n);
-    if (hit.joint < 0) break;
+    const BoundaryEvent hit = endEvent(problem, traced, branch, stretches.back().locked.wall());
+    if (!hit.any()) break;
     ContactSet locked = stretches.back().locked;
-    const bool release = locked.locked(hit.joint) && locked.side(hit.joint) == hit.side;
-    if (release)
-      locked.release(hit.joint);
+    const bool onJoint = hit.joint.joint >= 0;
+    const bool release = onJoint ? locked.locked(hit.joint.joint) && locked.side(hit.joint.joint) == hit.joint.side
+                                 : hit.wallRelease;
+    if (onJoint && release)
+      locked.release(hit.joint.joint);
+    else if (onJoint)
+      locked.lock(hit.joint.joint, hit.joint.side);
+    else if (release)
+      locked.leave(hit.vertex);
     else
-      locked.lock(hit.joint, hit.side);
+      locked.touch(hit.vertex);
     const continuation::SpecialPoint& at = branch.specialPoints.back();
     // The budget of points and arclength is the whole branch's.
     continuation::TracerOptions o = options;
@@ -80,19 +163,17 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // the inertia count and the determinant, without the hidden-crossing monitor.
     o.certifiedCounting = false;
     if (o.maxPoints < 2 || !(o.maxArclength > 0.0)) break;
-    // Leave along the branch's tangent with the newly locked joint's component removed (the
-    // locked branch cannot move it); orientation only.
-    continuation::Vector t = at.tangent;
-    if (!release && t.size() == problem.dimension() + 1) t[hit.joint] = 0.0;
     auto next = lockedProblem(problem, locked, maxContactTorque);
-    const std::string what = std::string(release ? "release of joint " : "contact of joint ") +
-                             std::to_string(hit.joint + 1) + " " + toString(hit.side);
+    const std::string what =
+        onJoint ? std::string(release ? "release of joint " : "contact of joint ") + std::to_string(hit.joint.joint + 1) +
+                      " " + toString(hit.joint.side)
+                : std::string(release ? "release of vertex " : "wall contact of vertex ") + hit.vertex.label();
     auto giveUp = [&branch, &what](const std::string& why) {
       std::string& note = branch.specialPoints.back().note;
       note += (note.empty() ? "" : "; ") + what + ": " + why;
     };
-    // The start: the located point polished with the new set of locked joints. It lies on the
-    // changed joint's boundary (g = 0 to the location's accuracy, either sign), so it is started
+    // The start: the located point polished with the new set of contacts. It lies on the
+    // changed contact's boundary (g = 0 to the location's accuracy, either sign), so it is started
     // by continueBranch, which only looks for crossings from g ≥ 0, not by trace(), which refuses a
     // start with g < 0.
     const ConstrainedEquilibrium start =
@@ -102,40 +183,44 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       break;
     }
     continuation::Tracer tracer(*next, o);
-    // The stretch leaves the point to the admissible side of the changed joint's boundary g
-    // (compression of a new contact, distance to the limit of a released joint): dg/ds > 0 along
-    // its tangent. The parent's direction decides only when that is ambiguous: on an unstable
-    // branch a joint can reach its limit with the locked branch turning back in λ (a corner).
-    const int changed = hit.side == LimitSide::Upper ? hit.joint : hit.joint + n;
-    const int N = problem.dimension();
+    // The stretch leaves the point to the admissible side of the changed contact's boundary g
+    // (compression of a new contact, distance to the limit of a released joint or to the wall of a
+    // released vertex): dg/ds > 0 along its tangent. The parent's direction decides only when that
+    // is ambiguous: on an unstable branch a joint can reach its limit with the locked branch
+    // turning back in λ (a corner).
+    const int N = problem.dimension(), D = next->dimension();
+    const int wallIndex = onJoint ? -1
+                                  : int(std::lower_bound(locked.wall().begin(), locked.wall().end(), hit.vertex) -
+                                        locked.wall().begin());
+    const int changed = onJoint ? (hit.joint.side == LimitSide::Upper ? hit.joint.joint : hit.joint.joint + n)
+                        : release ? next->wallClearanceBoundary()
+                                  : next->wallReleaseBoundary(wallIndex);
     auto startPoint = [&](const continuation::Vector& direction, continuation::ContinuationPoint& p) {
       p = continuation::ContinuationPoint();
-      p.u = start.u;
+      p.u.resize(D);
+      p.u.head(N) = start.u;
+      p.u.tail(D - N) = start.wallForces;
       p.lambda = at.lambda;
       tracer.units().toScaled(p);
       if (!tracer.completePoint(p, tracer.units().directionToScaled(direction))) return false;
       tracer.units().toUser(p);
       return true;
     };
-    continuation::Vector direction =
-        t.size() == N + 1 && t.norm() > 0.0 ? t : continuation::Vector(continuation::Vector::Unit(N + 1, N));
+    // Leave along the branch's tangent (q, r, λ; the wall forces' rates 0) with the newly locked
+    // joint's component removed (the locked branch cannot move it); orientation only.
+    continuation::Vector direction = continuation::Vector::Unit(D + 1, D);
+    if (at.tangent.size() == N + 1 && at.tangent.norm() > 0.0) {
+      direction.setZero();
+      direction.head(N) = at.tangent.head(N);
+      direction[D] = at.tangent[N];
+      if (onJoint && !release) direction[hit.joint.joint] = 0.0;
+    }
     continuation::ContinuationPoint p0;
     if (!startPoint(direction, p0)) {
       giveUp("no unique tangent at the point");
       break;
     }
-    // dg/ds: a released joint's g = side·(q̄ − q) moves with −side·t_q; a contact's compression
-    // −side·τ_c with −side·(F_u,i t_u + F_λ,i t_λ) (the free equilibrium's row i, exact).
-    double rate = 0.0;
-    const double sideSign = hit.side == LimitSide::Upper ? 1.0 : -1.0;
-    if (release) {
-      rate = -sideSign * p0.tangent[hit.joint];
-    } else {
-      continuation::Matrix Fu(N, N);
-      continuation::Vector Fl(N);
-      if (problem.jacobian(p0.u, p0.lambda, Fu, Fl))
-        rate = -sideSign * (Fu.row(hit.joint).dot(p0.tangent.head(N)) + Fl[hit.joint] * p0.tangent[N]);
-    }
+    const double rate = contactRate(problem, stretches.back().locked, hit, release, wallIndex, p0);
     if (rate < 0.0 && !startPoint(-p0.tangent, p0)) {
       giveUp("no unique tangent at the point");
       break;
@@ -145,24 +230,28 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     stretch.points.push_back(p0);
     tracer.continueBranch(stretch);
     // A stretch that does not leave its start, or leaves it to the wrong side (a contact that
-    // pulls at once, or a released joint that goes on past its limit), would chatter: stop.
+    // pulls at once, or a released joint or vertex that goes on past its limit or the wall),
+    // would chatter: stop.
     if (stretch.points.size() < 2 || !(stretch.points.back().arclength > options.minStep)) {
       giveUp("the branch does not leave the point (" + stretch.stopMessage + ")");
       break;
     }
     if (next->boundary(changed, stretch.points[1].u, stretch.points[1].lambda) < 0.0) {
-      giveUp(release ? "the free joint would go past its limit" : "the contact would pull (tension)");
+      giveUp(release ? (onJoint ? "the free joint would go past its limit" : "the vertex would go through the wall")
+                     : "the contact would pull (tension)");
       break;
     }
     const int base = int(branch.points.size()) - 1;  // the stretch's point 0 is the branch's last point
     const double s0 = branch.points.back().arclength;
     for (size_t i = 1; i < stretch.points.size(); ++i) {
       stretch.points[i].arclength += s0;
+      toBaseUnknowns(stretch.points[i].u, stretch.points[i].tangent, N);
       branch.points.push_back(std::move(stretch.points[i]));
     }
     for (continuation::SpecialPoint& sp : stretch.specialPoints) {
       sp.index += base;
       sp.arclength += s0;
+      toBaseUnknowns(sp, N);
       branch.specialPoints.push_back(std::move(sp));
     }
     branch.stopReason = stretch.stopReason;
@@ -186,7 +275,13 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
   continuation::TreeOptions tree;
   tree.maxDepth = options.switchingDepth;
   tree.switching = options.switching;
-  tree.switchAt = options.switchAt;
+  // Not at a branch point on a stretch with vertices on the wall: its problem's unknowns carry
+  // the wall forces, which the branch does not store (continueUnderContact); the point is reported.
+  tree.switchAt = [&result, &options](const continuation::Branch& b, const continuation::SpecialPoint& bp) {
+    if (size_t(b.id) < result.contact.size() && lockedAt(result.contact[size_t(b.id)], bp.index + 1).wallCount() > 0)
+      return false;
+    return !options.switchAt || options.switchAt(b, bp);
+  };
   tree.childTracer = options.childTracer;
   tree.onBranch = options.onBranch;
   const bool box = options.tracer.boxLower.size() || (options.childTracer && options.childTracer->boxLower.size());

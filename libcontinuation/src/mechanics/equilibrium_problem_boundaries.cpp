@@ -1,24 +1,27 @@
 // The boundaries of the equilibrium problem (Problem::boundary): the joint limits, where the
 // tracer stops or contact begins (contact.h), and the held coordinate's path range of a
-// displacement path traced through its reaction (EquilibriumOptions::heldRange).
+// displacement path traced through its reaction (EquilibriumOptions::heldRange), and the base
+// wall (EquilibriumOptions::wallAsBoundary), where a wall contact begins.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/wall_contact.h"
 
 namespace buckle::mechanics {
 
 using continuation::ConstVectorRef;
 using continuation::VectorRef;
 
-int EquilibriumProblem::boundaryCount() const { return rangeBoundaryBegin() + rangeBoundaryCount(); }
+int EquilibriumProblem::boundaryCount() const { return wallBoundaryIndex() + (options_.wallAsBoundary ? 1 : 0); }
 
 // A joint limit is the joint angle at the limit itself, geometric (the closing spring's length
 // is zero, or |c1 − c2|) or the user's: the spring model is regular there (inDomain,
 // equilibrium_problem.cpp).
 double EquilibriumProblem::boundary(int k, ConstVectorRef u, double lambda) {
   const int n = chain_.size();
+  if (options_.wallAsBoundary && k == wallBoundaryIndex()) return nearestWallVertex(chain_, u.head(n)).distance;
   const int r = k - rangeBoundaryBegin();
   if (r >= 0) {
     // the pose from the evaluation cache (no allocation per point); outside the domain, directly.
@@ -46,6 +49,7 @@ void EquilibriumProblem::boundaries(ConstVectorRef u, double lambda, VectorRef g
 
 std::string EquilibriumProblem::boundaryName(int k) const {
   const int n = chain_.size();
+  if (options_.wallAsBoundary && k == wallBoundaryIndex()) return wallBoundaryName();
   if (const int r = k - rangeBoundaryBegin(); r >= 0) {
     static const char* names[3] = {"x", "y", "phi"};
     const EquilibriumOptions::CoordinateRange& range = options_.heldRange;

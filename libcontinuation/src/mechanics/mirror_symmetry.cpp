@@ -1,5 +1,7 @@
 #include "buckle/mechanics/mirror_symmetry.h"
 
+#include <cctype>
+
 namespace buckle::mechanics {
 
 continuation::Reflection mirrorSymmetry(const EquilibriumProblem& problem) {
@@ -34,6 +36,11 @@ std::string mirrorText(const std::string& text) {
     } else if (text.compare(i, lower.size(), lower) == 0) {
       out += upper;
       i += lower.size();
+    } else if (i > 0 && std::isdigit(static_cast<unsigned char>(text[i - 1])) && i + 1 < text.size() &&
+               (text[i] == 'p' || text[i] == 'd') && (text[i + 1] == '+' || text[i + 1] == '-')) {
+      out += text[i];  // a wall vertex's label, "3d+" (wall_contact.h): its corner across the link
+      out += text[i + 1] == '+' ? '-' : '+';
+      i += 2;
     } else {
       out += text[i++];
     }
@@ -47,6 +54,8 @@ std::vector<ContactStretch> mirrored(const std::vector<ContactStretch>& stretche
     ContactStretch m{s.firstPoint, ContactSet()};
     for (const LockedJoint& l : s.locked.joints())
       m.locked.lock(l.joint, l.side == LimitSide::Upper ? LimitSide::Lower : LimitSide::Upper);
+    for (const WallVertex& v : s.locked.wall())  // +a and −a corners trade places (wall_contact.h)
+      m.locked.touch(WallVertex{v.segment, v.corner == 0 ? 0 : v.corner % 2 == 1 ? v.corner + 1 : v.corner - 1});
     image.push_back(m);
   }
   return image;

@@ -47,6 +47,8 @@ enum class EventType {
   EigenvalueTouch,   ///< "ET": an eigenvalue of the stability operator touches zero without crossing
   StabilityLoss,     ///< "LS": along a task path, the equilibrium at fixed inputs loses its stability
   InputBound,        ///< "IB": along a task path, a control input reaches its bound (task_path.h)
+  WallContact,       ///< "WC": a vertex reaches the base wall and is held on it (contact.h, wall_contact.h)
+  WallRelease,       ///< "WR": a vertex's wall force returns to zero: it leaves the wall
 };
 
 /// "BP", "LP", "LPF", "BD", "KMIN", "JUMP", "CT", "RL", "BC", "SC", "ET", "LS", "IB": the one spelling
@@ -109,6 +111,8 @@ struct PointReport {
   Eigen::VectorXd omega;
   /// Along a task path: the control inputs' values at the point (task_path.h), else empty.
   Eigen::VectorXd inputs;
+  /// The wall forces μ_v (a force along +x on the chain), one per vertex of locked.wall().
+  Eigen::VectorXd wallForces;
 };
 
 /// One special point of a branch, named in the field's words.
@@ -143,9 +147,13 @@ struct SpecialPointReport {
   /// (≈ 0 there: the free and the locked equilibria meet); NaN / −1 for other events.
   int joint = -1;
   double contactTorque = std::numeric_limits<double>::quiet_NaN();
-  /// The locked joints after the point (CT, RL).
+  /// The locked joints and the vertices on the wall after the point (CT, RL, WC, WR).
   ContactSet lockedAfter;
-  /// BC / SC: where the chain touches the wall or itself (NaN otherwise).
+  /// WC / WR: the vertex that reaches or leaves the wall (segment −1 otherwise) and its wall force
+  /// at the point (≈ 0 there; NaN otherwise).
+  WallVertex vertex{-1, 0};
+  double contactForce = std::numeric_limits<double>::quiet_NaN();
+  /// BC / SC / WC / WR: where the chain touches the wall or itself (NaN otherwise).
   Eigen::Vector2d contactPoint = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
   /// BP of free joints: Koiter's coefficients of the bifurcated branch, λ(ξ) = λ + aξ + bξ² in the
   /// traced λ's units with ξ the unit joint-angle mode's amplitude in rad (koiter.h); invalid

@@ -17,6 +17,12 @@
 // equilibrium holds there) and the contact releases where it returns to 0: that is a boundary
 // g = c_i ≥ 0 of ContactProblem, located by the tracer like a joint limit.
 //
+// Vertices held on the base wall (wall_contact.h) are bordered, not eliminated: each adds its
+// force μ_v to the unknowns, u = (q, r, μ), and its row −x_v(q) = 0; the q rows gain −μ_v ∇x_v
+// and K_q − K_g's generator −μ_v (x_v − x_Pm) (the same generator form). A branch stores (q, r)
+// only: μ is recovered at any equilibrium by least squares on the free rows, which it closes
+// exactly (wallForces), as a locked joint's torque is read off its row.
+//
 // Structure (O(n)): with the locked rows eliminated, F_u restricted to the free joints is
 // K_q − K_g on the free indices F, whose entries are κ_a δ_ab − h_max(a,b) (eq 27): the same
 // generator form, so the free block is U T Uᵀ of a chain structure of size |F| (chain_structure.h)
@@ -37,6 +43,7 @@
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/stiffness.h"
+#include "buckle/mechanics/wall_contact.h"
 
 namespace buckle::mechanics {
 
@@ -53,7 +60,8 @@ struct LockedJoint {
   bool operator==(const LockedJoint& o) const { return joint == o.joint && side == o.side; }
 };
 
-/// The joints locked at their limits, sorted by joint, at most one side per joint.
+/// The joints locked at their limits, sorted by joint, at most one side per joint, and the
+/// vertices held on the base wall (wall_contact.h), sorted.
 class ContactSet {
  public:
   ContactSet() = default;
@@ -65,18 +73,31 @@ class ContactSet {
   bool locked(int joint) const;
   /// Side of a locked joint (Upper for a free one: check locked() first).
   LimitSide side(int joint) const;
+  /// Number of locked joints.
   int count() const { return int(joints_.size()); }
-  bool empty() const { return joints_.empty(); }
+  /// No joint locked and no vertex on the wall: the free chain.
+  bool empty() const { return joints_.empty() && wall_.empty(); }
   const std::vector<LockedJoint>& joints() const { return joints_; }
-  /// 1-based joint numbers with their side, "3U 5L" ("" when empty): the `locked` column.
+  /// 1-based joint numbers with their side, "3U 5L" ("" when none): the `locked` column.
   std::string label() const;
-  /// Throws std::invalid_argument naming the problem when a joint is outside [0, segments).
+  /// Holds `vertex` on the wall (no-op when it is already held).
+  void touch(const WallVertex& vertex);
+  /// Lets `vertex` leave the wall (no-op when it is not held).
+  void leave(const WallVertex& vertex);
+  bool touching(const WallVertex& vertex) const;
+  int wallCount() const { return int(wall_.size()); }
+  const std::vector<WallVertex>& wall() const { return wall_; }
+  /// The vertices on the wall, "3d+ 4j" ("" when none): the `wall` column.
+  std::string wallLabel() const;
+  /// Throws std::invalid_argument naming the problem when a joint is outside [0, segments) or a
+  /// vertex is not a moving one (checkWallVertex).
   void check(int segments) const;
-  bool operator==(const ContactSet& o) const { return joints_ == o.joints_; }
+  bool operator==(const ContactSet& o) const { return joints_ == o.joints_ && wall_ == o.wall_; }
   bool operator!=(const ContactSet& o) const { return !(*this == o); }
 
  private:
   std::vector<LockedJoint> joints_;
+  std::vector<WallVertex> wall_;
 };
 
 /// The limit angle q̄ of joint i on `side` (the chain's limits: geometric or the scene's).
@@ -88,7 +109,9 @@ double limitAngle(const Chain& chain, int joint, LimitSide side);
 /// of joint k − n; for a free joint the joint limit g = q_max − q / q − q_min, for a joint locked
 /// on that side its compression c ≥ 0 (release), for the other side of a locked joint the
 /// (positive) distance to that limit. With a finite `maxCompression` (a torque, the problem's
-/// units) one more boundary per locked joint, 2n + k for the k-th: maxCompression − c ≥ 0.
+/// units) one more boundary per locked joint, 2n + k for the k-th: maxCompression − c ≥ 0. Then,
+/// when `base` traces the wall (EquilibriumOptions::wallAsBoundary), the smallest x over the
+/// vertices not on the wall; then one per vertex on the wall, its force μ_v ≥ 0 (release).
 class ContactProblem final : public continuation::Problem {
  public:
   /// Throws std::invalid_argument if a locked joint is outside the chain or maxCompression is
@@ -101,13 +124,20 @@ class ContactProblem final : public continuation::Problem {
   /// Free joints in increasing order.
   const std::vector<int>& freeJoints() const { return free_; }
 
-  /// Contact torque τ_c,i = ∂E/∂q_i − (JᵀF)_i of joint i at (u, λ) (any joint; ~0 for a free
-  /// one at an equilibrium). NaN outside the domain.
+  /// Contact torque τ_c,i = ∂E/∂q_i − (JᵀF)_i − Σ_v μ_v ∂x_v/∂q_i of joint i at (u, λ) (any
+  /// joint; ~0 for a free one at an equilibrium); u is (q, r, μ) or (q, r) (μ then from
+  /// wallForces). NaN outside the domain.
   double contactTorque(continuation::ConstVectorRef u, double lambda, int joint);
   /// Compression −side·τ_c,i of a locked joint (≥ 0 while the contact holds).
   double compression(continuation::ConstVectorRef u, double lambda, int joint);
+  /// The wall forces μ (one per vertex of contacts().wall(), a force along +x on the chain) that
+  /// close the free joints' rows of the base problem at (q, r) = u.head(base dimension) in the
+  /// least-squares sense: exact at a constrained equilibrium. NaN outside the domain.
+  Vector wallForces(continuation::ConstVectorRef u, double lambda);
+  /// (q, r) extended to this problem's unknowns (q, r, μ) with μ = wallForces.
+  Vector withWallForces(continuation::ConstVectorRef u, double lambda);
 
-  int dimension() const override { return base_.dimension(); }
+  int dimension() const override { return base_.dimension() + locked_.wallCount(); }
   bool residual(continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) override;
   bool jacobian(continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
                 continuation::VectorRef Flambda) override;
@@ -116,7 +146,8 @@ class ContactProblem final : public continuation::Problem {
                                      continuation::MatrixRef dFu, continuation::VectorRef dFlambda) override;
 
   bool hasStabilityOperator() const override { return true; }
-  /// H = K_q − K_g (n×n), C = the held rows J_h and one row e_iᵀ per locked joint.
+  /// H = K_q − K_g − Σ μ_v ∂²x_v (n×n), C = the held rows J_h, one row e_iᵀ per locked joint and
+  /// one row ∇x_vᵀ per vertex on the wall.
   bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
   /// Inertia and lowest eigenvalues of K_q − K_g on the free joints and ker J_h,F, O(n) through
   /// the reduced chain structure (file comment).
@@ -129,15 +160,32 @@ class ContactProblem final : public continuation::Problem {
   continuation::ProblemScales scales() const override;
 
   int boundaryCount() const override;
+  /// The first torque bound (file comment), the wall's boundaries: the clearance of the vertices
+  /// not on the wall (−1 when the base does not trace the wall), the release of wall vertex k.
+  int torqueBoundBegin() const;
+  int wallClearanceBoundary() const;
+  int wallReleaseBoundary(int k) const;
   double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
   std::string boundaryName(int k) const override;
 
-  /// T of K_q − K_g on the free joints into ws (size freeJoints().size()) and the end Jacobian's
-  /// free columns into Jf (3×|F|); false outside the domain or when every joint is locked.
+  /// T of K_q − K_g (with the wall forces' terms) on the free joints into ws (size
+  /// freeJoints().size()) and the end Jacobian's free columns into Jf (3×|F|); u = (q, r, μ).
+  /// False outside the domain or when every joint is locked.
   bool assembleReduced(continuation::ConstVectorRef u, double lambda, ChainStructure& ws,
                        continuation::MatrixRef Jf);
+  /// The full structure (every joint) of K_q − K_g with the wall forces' terms in its generator,
+  /// and the end Jacobian (3×n), at u = (q, r, μ): what the reduced structure is cut from.
+  bool assembleFull(continuation::ConstVectorRef u, double lambda, ChainStructure& full, continuation::MatrixRef J);
+  /// The wall vertices' ∇x_v (columns of wallGradients(), n×w) and generators of −∂²x_v (columns
+  /// of wallGenerators(), wall_contact.h) at q; false when q is not finite.
+  bool wallKinematics(continuation::ConstVectorRef q);
+  const Matrix& wallGradients() const { return wallGrad_; }
+  const Matrix& wallGenerators() const { return wallGen_; }
 
  private:
+  // The base problem's rows at (q, r) with the wall forces' terms −Σ μ_v ∇x_v added to the q rows.
+  bool baseRowsWithWall(continuation::ConstVectorRef u, double lambda, VectorRef F);
+
   EquilibriumProblem& base_;
   ContactSet locked_;
   double maxCompression_;
@@ -148,7 +196,17 @@ class ContactProblem final : public continuation::Problem {
   Vector kf_, hf_;       // κ_F, h_F of the reduced structure
   Vector residual_;      // the free equilibrium's rows (contact torques), size N
   Vector lastLowest_;
+  Matrix wallGrad_, wallGen_;  // n×w: ∇x_v and the generators of −∂²x_v (wallKinematics)
+  Vector wallX_;               // x_v of the wall vertices
 };
+
+/// K_q − K_g on the joints `free` (increasing) of `full`: the generator form κ_a δ_ab − h_max(a,b)
+/// (eq 27) with κ_F, h_F (scratch kf, hf of size |F|) assembled into `reduced`. O(n).
+void reduceToFreeJoints(const ChainStructure& full, const std::vector<int>& free, VectorRef kf, VectorRef hf,
+                        ChainStructure& reduced);
+
+/// The name of ContactProblem's release boundary of a vertex on the wall.
+std::string wallReleaseName(const WallVertex& v);
 
 /// A stretch of a traced branch with one set of locked joints: points [firstPoint, the next
 /// stretch's firstPoint) of the branch (equilibrium_branches.h). The point where a contact
@@ -164,17 +222,20 @@ const ContactSet& lockedAt(const std::vector<ContactStretch>& stretches, int ind
 /// Boundary k of ContactProblem / EquilibriumProblem as (joint, side).
 LockedJoint limitOfBoundary(int k, int segments);
 
-/// An equilibrium at fixed λ with the joints of `locked` held at their limits: Newton on the
-/// ContactProblem's rows with its O(n) solver from u0 (q of locked joints set to their limits
-/// first). `tolerance` bounds the scaled residual (rows over ProblemScales::residuals).
+/// An equilibrium at fixed λ with the joints of `locked` held at their limits and its wall
+/// vertices on the wall: Newton on the ContactProblem's rows with its O(n) solver from u0 = (q, r)
+/// (q of locked joints set to their limits first, the wall forces from least squares); `u` of the
+/// result is (q, r). `tolerance` bounds the scaled residual (rows over ProblemScales::residuals).
 struct ConstrainedEquilibrium {
   bool converged = false;
   continuation::Vector u;          ///< (q, r)
   double residual = 0.0;           ///< max scaled |F_i| at u
   int iterations = 0;
   continuation::Vector torques;    ///< contact torque τ_c,i of every joint (0 at free ones)
-  /// Smallest compression among the locked joints (+inf when none): < 0 means the contact
-  /// would pull, so that joint should be released.
+  /// The wall forces μ_v, one per vertex of locked.wall() (a force along +x on the chain).
+  continuation::Vector wallForces;
+  /// Smallest compression among the locked joints and the wall forces (+inf when none): < 0
+  /// means the contact would pull, so that joint or vertex should be released.
   double minCompression = 0.0;
   std::string message;             ///< why it did not converge
 };
@@ -191,9 +252,12 @@ continuation::StabilityInfo constrainedStability(EquilibriumProblem& base, const
 ContactSet jointsAtLimits(const Chain& chain, continuation::ConstVectorRef q, double tolerance);
 
 /// Loaded stiffness K_F (eq 29) with the locked joints rigid (δq_i = 0): C_F = J_p P J_pᵀ, P the
-/// inverse of K_q − K_g on ker [E_L; J_φ if the rotation is held], E_L the locked rows.
+/// inverse of K_q − K_g on ker [E_L; J_φ if the rotation is held], E_L the locked rows. With
+/// vertices on the wall, their rows ∇x_vᵀ join E_L and their forces `wallForces` (one per vertex
+/// of locked.wall()) add −Σ μ_v ∂²x_v to the Hessian (wall_contact.h).
 CartesianStiffness lockedLoadedStiffness(const Chain& chain, continuation::ConstVectorRef q, const Wrench& F,
                                          const EndCondition& end, const ContactSet& locked,
-                                         const StiffnessOptions& options = {});
+                                         const StiffnessOptions& options = {},
+                                         continuation::ConstVectorRef wallForces = continuation::Vector());
 
 }  // namespace buckle::mechanics

@@ -72,7 +72,10 @@ struct EquilibriumBranches {
 /// with maxContactTorque; none: `problem` itself), through contact and release events
 /// (contact.h) while it ends on a located joint limit or contact release; appends the new points
 /// and special points to it and returns its stretches, the first with `initial`. `options` are
-/// the branch's tracer options (maxPoints and maxArclength count the whole branch).
+/// the branch's tracer options (maxPoints and maxArclength count the whole branch). The branch
+/// keeps (q, r) per point: the wall forces of stretches with vertices on the wall (contact.h),
+/// also those of a branch traced with `initial` vertices on the wall, are dropped
+/// (ContactProblem::wallForces recovers them), and its branch points are not switched at.
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
                                                  const continuation::TracerOptions& options,
                                                  int maxContactEvents = 50, double maxContactTorque = 10.0,

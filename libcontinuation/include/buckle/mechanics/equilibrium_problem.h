@@ -47,6 +47,10 @@ struct EquilibriumOptions {
     double low = 0.0, high = 0.0;
     bool active() const { return coordinate >= 0; }
   } heldRange{};
+  /// The base wall as a boundary (wall_contact.h): one more after heldRange's, g = d_base, the
+  /// smallest x over the moving vertices, so the tracer stops where a vertex reaches x = 0 (where
+  /// the wall contact begins, contact.h).
+  bool wallAsBoundary = false;
 };
 
 class EquilibriumProblem final : public continuation::Problem {
@@ -181,6 +185,12 @@ class EquilibriumProblem final : public continuation::Problem {
   /// Whether a boundary's name (SpecialPoint::boundaryName) is one of heldRange's: the path's
   /// range end, not a limit of the model.
   bool isRangeBoundary(const std::string& name) const;
+  /// The wall boundary (EquilibriumOptions::wallAsBoundary): its index (after heldRange's) and
+  /// whether there is one.
+  int wallBoundaryIndex() const { return rangeBoundaryBegin() + rangeBoundaryCount(); }
+  bool wallIsBoundary() const { return options_.wallAsBoundary; }
+  /// Its name (SpecialPoint::boundaryName where the tracer stopped on it).
+  static const char* wallBoundaryName() { return "a vertex reaches the base wall x = 0"; }
 
  private:
   /// Inside the model's domain: finite, every joint within its geometric limits (or just past one,

@@ -32,7 +32,8 @@ namespace buckle::mechanics {
 /// Exact comparisons: a scene that is symmetric only to rounding is traced in full.
 continuation::Reflection mirrorSymmetry(const EquilibriumProblem& problem);
 
-/// The mirror image of a text: the words "upper" and "lower" (a joint's limits) exchanged.
+/// The mirror image of a text: the words "upper" and "lower" (a joint's limits) exchanged, and
+/// the ± corner of a wall vertex's label ("3d+" ↔ "3d-", wall_contact.h).
 std::string mirrorText(const std::string& text);
 
 /// The mirror image of a branch's contact stretches: the same joints locked on the other side.

@@ -1,0 +1,118 @@
+// Constrained equilibria, stability and stiffness of the chain with joints locked at their
+// limits and vertices held on the base wall (contact.h).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include "buckle/continuation/bordered_solver.h"
+#include "buckle/mechanics/contact.h"
+
+namespace buckle::mechanics {
+
+using continuation::ConstVectorRef;
+using continuation::Factorization;
+
+ConstrainedEquilibrium solveConstrainedEquilibrium(EquilibriumProblem& base, const ContactSet& locked,
+                                                   ConstVectorRef u0, double lambda, double tolerance,
+                                                   int maxIterations) {
+  ConstrainedEquilibrium out;
+  const int N = base.dimension();
+  if (u0.size() != N)
+    throw std::invalid_argument("solveConstrainedEquilibrium: u0 must have " + std::to_string(N) + " entries, got " +
+                                std::to_string(u0.size()));
+  if (!std::isfinite(lambda)) throw std::invalid_argument("solveConstrainedEquilibrium: lambda must be finite");
+  ContactProblem problem(base, locked);
+  const continuation::ProblemScales s = problem.scales();
+  const std::unique_ptr<continuation::BorderedSolver> solver = problem.makeStructuredSolver();
+  const int D = problem.dimension();  // N + the wall forces
+  Vector start = u0;
+  for (const LockedJoint& l : locked.joints()) start[l.joint] = limitAngle(base.chain(), l.joint, l.side);
+  Vector u = problem.withWallForces(start, lambda), F(D), trial(D), b = Vector::Zero(D + 1), dx(D + 1),
+         c = Vector::Zero(D + 1);
+  c[D] = 1.0;  // fixed λ: the border row e_λ
+  if (!u.allFinite()) u.tail(D - N).setZero();  // no free row to read the forces from: start at 0
+  auto scaledNorm = [&](const Vector& r) { return r.cwiseQuotient(s.residuals).cwiseAbs().maxCoeff(); };
+  if (!problem.residual(u, lambda, F)) {
+    out.message = "the start is outside the model's domain";
+    out.u = u.head(N);
+    return out;
+  }
+  double norm = scaledNorm(F);
+  for (out.iterations = 0; out.iterations < maxIterations && !(norm <= tolerance); ++out.iterations) {
+    if (solver->factor(u, lambda, c) != Factorization::Regular) {
+      out.message = "singular constrained Jacobian";
+      break;
+    }
+    b.head(D) = F;
+    if (!solver->solve(b, dx)) {
+      out.message = "singular constrained Jacobian";
+      break;
+    }
+    // Newton step, halved while it leaves the domain or increases the residual.
+    double t = 1.0, trialNorm = std::numeric_limits<double>::infinity();
+    for (int h = 0; h < 30; ++h, t *= 0.5) {
+      trial = u - t * dx.head(D);
+      if (problem.residual(trial, lambda, F) && (trialNorm = scaledNorm(F)) < std::max(norm, tolerance) * 2.0) break;
+      trialNorm = std::numeric_limits<double>::infinity();
+    }
+    if (!std::isfinite(trialNorm)) {
+      out.message = "the Newton step leaves the model's domain";
+      break;
+    }
+    u = trial;
+    norm = trialNorm;
+  }
+  if (!problem.residual(u, lambda, F)) norm = std::numeric_limits<double>::infinity();
+  out.u = u.head(N);
+  out.residual = norm;
+  out.converged = norm <= tolerance;
+  if (!out.converged && out.message.empty()) out.message = "no convergence in " + std::to_string(maxIterations) + " iterations";
+  out.torques = Vector::Zero(base.segments());
+  out.wallForces = u.tail(D - N);
+  out.minCompression = out.wallForces.size() > 0 ? out.wallForces.minCoeff() : std::numeric_limits<double>::infinity();
+  for (const LockedJoint& l : locked.joints()) {
+    out.torques[l.joint] = problem.contactTorque(u, lambda, l.joint);
+    out.minCompression = std::min(out.minCompression, -double(int(l.side)) * out.torques[l.joint]);
+  }
+  return out;
+}
+
+continuation::StabilityInfo constrainedStability(EquilibriumProblem& base, const ContactSet& locked, ConstVectorRef u,
+                                                 double lambda, int lowestCount) {
+  ContactProblem problem(base, locked);
+  continuation::StabilityInfo info;
+  const Vector full = u.size() == problem.dimension() ? Vector(u) : problem.withWallForces(u, lambda);
+  if (!problem.stability(full, lambda, lowestCount, info)) info.negative = -1;
+  return info;
+}
+
+CartesianStiffness lockedLoadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, const EndCondition& end,
+                                         const ContactSet& locked, const StiffnessOptions& options,
+                                         ConstVectorRef wallForces) {
+  if (locked.empty()) return loadedStiffness(chain, q, F, end, options);
+  locked.check(chain.size());
+  const int n = chain.size(), w = locked.wallCount();
+  if (wallForces.size() != w)
+    throw std::invalid_argument("lockedLoadedStiffness: one wall force per vertex on the wall (" + std::to_string(w) +
+                                "), got " + std::to_string(wallForces.size()));
+  Matrix E = Matrix::Zero(locked.count() + w, n);  // δq_i = 0 at the locked joints, δx_v = 0 on the wall
+  for (int k = 0; k < locked.count(); ++k) E(k, locked.joints()[size_t(k)].joint) = 1.0;
+  if (w == 0) return loadedStiffness(chain, q, F, end.isHeld(EndCoordinate::Phi), E, options);
+  // The wall forces' −Σ μ_v ∂²x_v enters as a body-load generator γ (the Hessian's generator is
+  // h − γ, stiffness.h): γ += μ_v g_v (wall_contact.h).
+  StiffnessOptions o = options;
+  if (o.bodyGenerator.size() == 0) o.bodyGenerator = Vector::Zero(n);
+  const Eigen::Matrix2Xd P = jointPositions(chain, q);
+  Vector grad(n), gen(n);
+  for (int k = 0; k < w; ++k) {
+    const WallVertex& v = locked.wall()[size_t(k)];
+    wallVertexDerivatives(P, wallVertexPoint(chain, q, P, v), v, grad, gen);
+    E.row(locked.count() + k) = grad.transpose();
+    o.bodyGenerator += wallForces[k] * gen;
+  }
+  return loadedStiffness(chain, q, F, end.isHeld(EndCoordinate::Phi), E, o);
+}
+
+}  // namespace buckle::mechanics

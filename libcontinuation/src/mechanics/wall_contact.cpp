@@ -1,0 +1,89 @@
+#include "buckle/mechanics/wall_contact.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace buckle::mechanics {
+
+namespace {
+
+using Point = Eigen::Vector2d;
+
+Point dir(double t) { return Point(std::cos(t), std::sin(t)); }
+Point nrm(double t) { return Point(-std::sin(t), std::cos(t)); }
+
+// The vertex from its joint (P column segment + 1) and the angles of the links on either side
+// of the joint: the same sums as the shape plots and baseClearance.
+Point vertexAt(const SegmentParameters& p, const Point& joint, double before, double after, int corner) {
+  switch (corner) {
+    case 0: return joint;
+    case 1: return joint - p.b1 * dir(before) + p.a1 * nrm(before);
+    case 2: return joint - p.b1 * dir(before) - p.a1 * nrm(before);
+    case 3: return joint + p.b2 * dir(after) + p.a2 * nrm(after);
+    default: return joint + p.b2 * dir(after) - p.a2 * nrm(after);
+  }
+}
+
+}  // namespace
+
+std::string WallVertex::label() const {
+  static const char* const names[] = {"j", "p+", "p-", "d+", "d-"};
+  return std::to_string(segment + 1) + names[std::clamp(corner, 0, 4)];
+}
+
+void checkWallVertex(const WallVertex& v, int segments) {
+  if (v.segment < 0 || v.segment >= segments || v.corner < 0 || v.corner > 4 || (v.segment == 0 && v.corner < 3))
+    throw std::invalid_argument("wall contact: vertex (segment " + std::to_string(v.segment + 1) + ", corner " +
+                                std::to_string(v.corner) + ") is not a moving vertex of the chain of " +
+                                std::to_string(segments) +
+                                " segments (segments 1.." + std::to_string(segments) +
+                                ", corners 0..4; segment 1 has only its distal corners 3, 4)");
+}
+
+Eigen::Vector2d wallVertexPoint(const Chain& chain, ConstVectorRef q, const Eigen::Matrix2Xd& P, const WallVertex& v) {
+  double before = 0.0;
+  for (int j = 0; j < v.segment; ++j) before += q[j];
+  return vertexAt(chain.segment(v.segment).parameters(), P.col(v.segment + 1), before, before + q[v.segment], v.corner);
+}
+
+void wallVertexDerivatives(const Eigen::Matrix2Xd& P, const Eigen::Vector2d& point, const WallVertex& v,
+                           VectorRef gradient, VectorRef generator) {
+  gradient.setZero();
+  generator.setZero();
+  for (int j = 0; j <= v.lastJoint(); ++j) {  // joint j sits at P column j + 1
+    gradient[j] = -(point.y() - P(1, j + 1));
+    generator[j] = point.x() - P(0, j + 1);
+  }
+}
+
+WallApproach nearestWallVertex(const Chain& chain, ConstVectorRef q, const std::vector<WallVertex>& exclude) {
+  const int n = chain.size();
+  const Eigen::Matrix2Xd P = jointPositions(chain, q);  // checks the size
+  WallApproach c;
+  c.distance = std::numeric_limits<double>::infinity();
+  double theta = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const SegmentParameters& p = chain.segment(i).parameters();
+    const double before = theta, after = theta + q[i];
+    // segment 1's proximal triangle is clamped; a proximal corner on the previous segment's distal
+    // one (equal half-heights: the link's two triangles share their base) is that vertex
+    const bool shared = i > 0 && p.a1 == chain.segment(i - 1).parameters().a2;
+    for (int corner = i > 0 ? 0 : 3; corner <= 4; ++corner) {
+      if (shared && (corner == 1 || corner == 2)) continue;
+      const WallVertex v{i, corner};
+      if (std::find(exclude.begin(), exclude.end(), v) != exclude.end()) continue;
+      const Point x = vertexAt(p, P.col(i + 1), before, after, corner);
+      if (x.x() < c.distance) {
+        c.distance = x.x();
+        c.vertex = v;
+        c.point = x;
+      }
+    }
+    theta = after;
+  }
+  return c;
+}
+
+}  // namespace buckle::mechanics

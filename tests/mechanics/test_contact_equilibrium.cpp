@@ -1,0 +1,274 @@
+// Vertices held on the base wall (contact.h, wall_contact.h): the constrained equilibria, their
+// forces, stability and units, against computations of the test's own.
+#include <catch2/catch.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "buckle/continuation/bordered_solver.h"
+#include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/equilibrium_branches.h"
+#include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/unloaded_shape.h"
+
+#include "curled_chain.h"
+
+using namespace buckle::mechanics;
+namespace cont = buckle::continuation;
+
+namespace {
+
+Eigen::Vector2d along(double t) { return {std::cos(t), std::sin(t)}; }
+Eigen::Vector2d across(double t) { return {-std::sin(t), std::cos(t)}; }
+
+// The test's own geometry: joints P_j (0-based joint j at column j), the end, the absolute link
+// angles θ_m, from the link lengths b_11, b_i2 + b_(i+1)1, b_n2.
+struct Geometry {
+  Eigen::Matrix2Xd P;
+  Eigen::Vector2d end;
+  Eigen::VectorXd theta;  // θ_m of link m (m = 0 … n)
+};
+Geometry geometry(const Chain& chain, const Eigen::VectorXd& q) {
+  const int n = chain.size();
+  Geometry g;
+  g.P.resize(2, n);
+  g.theta = Eigen::VectorXd::Zero(n + 1);
+  Eigen::Vector2d at(chain.segment(0).parameters().b1, 0.0);
+  for (int j = 0; j < n; ++j) {
+    g.P.col(j) = at;
+    g.theta[j + 1] = g.theta[j] + q[j];
+    const double link = chain.segment(j).parameters().b2 + (j + 1 < n ? chain.segment(j + 1).parameters().b1 : 0.0);
+    at += link * along(g.theta[j + 1]);
+  }
+  g.end = at;
+  return g;
+}
+
+// Distal base corner −a of segment i: its joint + b2 along θ_(i+1) − a2 across it.
+Eigen::Vector2d distalMinus(const Chain& chain, const Geometry& g, int i) {
+  const SegmentParameters& p = chain.segment(i).parameters();
+  return g.P.col(i) + p.b2 * along(g.theta[i + 1]) - p.a2 * across(g.theta[i + 1]);
+}
+
+// Moment about point c of a force f at r.
+double moment(const Eigen::Vector2d& r, const Eigen::Vector2d& c, const Eigen::Vector2d& f) {
+  const Eigen::Vector2d d = r - c;
+  return d.x() * f.y() - d.y() * f.x();
+}
+
+// The contact_release chain without its joint stop, lengths scaled by sL, stiffnesses by sK.
+Chain curledChain(double sL = 1.0, double sK = 1.0) { return testing::curledChain(false, sL, sK); }
+
+// Fy from 0 to `to` (in force units k b of the scaled chain) with the wall as a constraint.
+EquilibriumBranches traceCurled(EquilibriumProblem& problem, double to) {
+  return traceEquilibria(problem, testing::curledShape(), 0.0, cont::InitialDirection::increasingLambda(),
+                         testing::curledTrace(to));
+}
+
+const SpecialPointReport* firstOf(const BranchReport& r, EventType t) {
+  for (const SpecialPointReport& s : r.specialPoints)
+    if (s.type == t) return &s;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST_CASE("wall: a segment pressed against the wall holds its vertex there with the force of a moment balance",
+          "[contact][wall]") {
+  const Chain chain = curledChain();
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), testing::withWall());
+  const EquilibriumBranches r = traceCurled(problem, 0.14);
+  const BranchReport& rep = r.reports[0];
+  const SpecialPointReport* wc = firstOf(rep, EventType::WallContact);
+  for (const SpecialPointReport& sp : rep.specialPoints) INFO(label(sp.type) << " " << sp.parameter << " " << sp.note);
+  INFO(rep.stopReason << ": " << rep.stopMessage);
+  REQUIRE(wc != nullptr);
+  CHECK(wc->vertex == WallVertex{4, 4});  // segment 5's distal corner −a
+  CHECK(std::abs(wc->contactPoint.x()) <= 1e-12);
+  CHECK(std::abs(wc->contactForce) <= 1e-12);
+  int pressed = 0;
+  for (const PointReport& pt : rep.points) {
+    if (pt.locked.wallCount() == 0) continue;
+    REQUIRE(pt.locked.wall() == std::vector<WallVertex>{WallVertex{4, 4}});
+    ++pressed;
+    const Geometry g = geometry(chain, pt.q);
+    const Eigen::Vector2d v = distalMinus(chain, g, 4);
+    CHECK(std::abs(v.x()) <= 1e-12);  // on the wall
+    // Moment balance of the part beyond each joint j: the springs' ∂E/∂q_j carries the moments
+    // of the end force and of the wall's push μ (along +x, at v) about P_j. Joint 5's row gives μ;
+    // the four others must then balance with it.
+    Eigen::VectorXd dE(5);
+    for (int j = 0; j < 5; ++j) dE[j] = -chain.segment(j).torque(pt.q[j]);
+    const Eigen::Vector2d F(pt.F[0], pt.F[1]);
+    const double mu = (dE[4] - moment(g.end, g.P.col(4), F)) / moment(v, g.P.col(4), Eigen::Vector2d(1.0, 0.0));
+    for (int j = 0; j < 5; ++j)
+      CHECK(std::abs(dE[j] - moment(g.end, g.P.col(j), F) - mu * moment(v, g.P.col(j), {1.0, 0.0})) <= 1e-12);
+    REQUIRE(pt.wallForces.size() == 1);
+    CHECK(pt.wallForces[0] == Approx(mu).epsilon(1e-10).margin(1e-13));
+    CHECK(mu >= -1e-13);  // the wall pushes
+  }
+  CHECK(pressed >= 5);
+  // the force grows from zero at the contact
+  CHECK(rep.points.back().wallForces.size() == 1);
+  CHECK(rep.points.back().wallForces[0] > 1e-3);
+}
+
+TEST_CASE("wall: scaled units give the same angles and the force scaled by the force unit k b", "[contact][wall]") {
+  const Chain chain1 = curledChain();
+  EquilibriumProblem p1(chain1, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), testing::withWall());
+  const EquilibriumBranches ref = traceCurled(p1, 0.14);
+  REQUIRE(firstOf(ref.reports[0], EventType::WallContact) != nullptr);
+  const SpecialPointReport& wc0 = *firstOf(ref.reports[0], EventType::WallContact);
+  for (const auto& [sL, sK] : {std::pair{1e4, 1e8}, std::pair{1e-4, 1e-8}, std::pair{1e4, 1e-8}}) {
+    INFO("lengths x" << sL << ", stiffness x" << sK);
+    const double force = sL * sK;  // k b
+    const Chain chain = curledChain(sL, sK);
+    EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), testing::withWall());
+    const EquilibriumBranches r = traceCurled(problem, 0.14 * force);
+    const SpecialPointReport* wc = firstOf(r.reports[0], EventType::WallContact);
+    REQUIRE(wc != nullptr);
+    CHECK(wc->vertex == wc0.vertex);
+    CHECK(wc->parameter / force == Approx(wc0.parameter).epsilon(1e-9));
+    CHECK((wc->q - wc0.q).cwiseAbs().maxCoeff() <= 1e-9);
+    // the pressed state at the same scaled load: same angles, force scaled by k b
+    ContactSet set;
+    set.touch(wc0.vertex);
+    const double f = 0.13;
+    const Eigen::VectorXd u0 = wc0.q;
+    const ConstrainedEquilibrium e1 = solveConstrainedEquilibrium(p1, set, u0, f);
+    const ConstrainedEquilibrium es = solveConstrainedEquilibrium(problem, set, u0, f * force);
+    REQUIRE(e1.converged);
+    REQUIRE(es.converged);
+    CHECK((es.u - e1.u).cwiseAbs().maxCoeff() <= 1e-9);
+    CHECK(es.wallForces[0] / force == Approx(e1.wallForces[0]).epsilon(1e-9));
+    CHECK(e1.wallForces[0] > 0.0);
+  }
+}
+
+TEST_CASE("wall: the constrained stability equals a dense eigen-solve on the kernel of the constraint gradients",
+          "[contact][wall]") {
+  // Any (q, r, μ) will do (the operator is defined off equilibrium too): a 40-segment chain
+  // (the O(n) Sturm route) and a 6-segment one (the small dense route), y held, one or two
+  // vertices on the wall, one joint locked.
+  for (const int n : {6, 40}) {
+    INFO("n = " << n);
+    std::vector<SegmentParameters> segs(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+    for (int i = 0; i < n; ++i) segs[size_t(i)].L1_0 = 2.25 + 0.02 * std::sin(1.0 + i), segs[size_t(i)].L2_0 = 2.25;
+    const Chain chain(segs);
+    EquilibriumProblem problem(chain, EndCondition::clampedPinned(-0.3), Eigen::Vector3d(1, 0, 0));
+    Eigen::VectorXd q(n);
+    for (int i = 0; i < n; ++i) q[i] = 0.4 * std::sin(0.7 * i + 0.3);
+    ContactSet set;
+    set.touch(WallVertex{n / 2, 3});
+    set.touch(WallVertex{n - 1, 0});
+    set.lock(1, LimitSide::Upper);
+    ContactProblem cp(problem, set);
+    const int N = problem.dimension();
+    Eigen::VectorXd u(cp.dimension());
+    u.head(n) = q;
+    u[n] = 0.2;                // the held y's reaction Fy
+    u[N] = 0.7;                // μ of vertex (n/2 + 1)d+
+    u[N + 1] = 0.35;           // μ of joint n's vertex
+    const double lambda = -0.4;
+    cont::StabilityInfo info;
+    REQUIRE(cp.stability(u, lambda, 3, info));
+    // Dense: Π's Hessian from the library's total potential (end wrench) plus the wall forces'
+    // −Σ μ ∂²x_v, on ker [J_y; e_2; ∇x_v]. ∂x_v by central differences of the test's own vertex
+    // x; ∂²x_v = −(x_v − x_P,max(j,l)) (a rotation about joint max(j, l) moves v by R90 (v − P)),
+    // checked against central differences.
+    Eigen::MatrixXd H(n, n);
+    totalPotentialHessian(chain, q, Wrench(-0.3 + lambda, 0.2, 0.0), H);
+    auto vertexAt = [&](const Eigen::VectorXd& qq, const WallVertex& v) -> Eigen::Vector2d {
+      const Geometry g = geometry(chain, qq);
+      const SegmentParameters& p = chain.segment(v.segment).parameters();
+      if (v.corner == 0) return g.P.col(v.segment);
+      const double t = g.theta[v.segment + 1];
+      return g.P.col(v.segment) + p.b2 * along(t) + (v.corner == 3 ? 1.0 : -1.0) * p.a2 * across(t);
+    };
+    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(4, n);
+    const Geometry g = geometry(chain, q);
+    for (int j = 0; j < n; ++j) C(0, j) = g.end.x() - g.P(0, j);  // ∂y/∂q_j
+    C(1, 1) = 1.0;
+    for (int k = 0; k < 2; ++k) {
+      const WallVertex& v = set.wall()[size_t(k)];
+      const Eigen::Vector2d x = vertexAt(q, v);
+      const int last = v.corner == 0 ? v.segment - 1 : v.segment;
+      for (int j = 0; j < n; ++j) {
+        Eigen::VectorXd a = q, b = q;
+        a[j] += 1e-6;
+        b[j] -= 1e-6;
+        C(2 + k, j) = (vertexAt(a, v).x() - vertexAt(b, v).x()) / 2e-6;
+        for (int l = 0; l < n; ++l) {
+          const double d2 = j <= last && l <= last ? -(x.x() - g.P(0, std::max(j, l))) : 0.0;
+          if (j % 7 == 0 && l % 5 == 0) {  // spot checks of the closed form
+            Eigen::VectorXd pp = q, pm = q, mp = q, mm = q;
+            const double h = 1e-4;
+            pp[j] += h, pp[l] += h, pm[j] += h, pm[l] -= h, mp[j] -= h, mp[l] += h, mm[j] -= h, mm[l] -= h;
+            const double fd = (vertexAt(pp, v).x() - vertexAt(pm, v).x() - vertexAt(mp, v).x() + vertexAt(mm, v).x()) /
+                              (4 * h * h);
+            CHECK(std::abs(fd - d2) <= 1e-5 * std::max(1.0, std::abs(d2)));
+          }
+          H(j, l) -= u[N + k] * d2;
+        }
+      }
+    }
+    H = 0.5 * (H + H.transpose()).eval();
+    const Eigen::MatrixXd Z = C.transpose().fullPivHouseholderQr().matrixQ().rightCols(n - 4);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Z.transpose() * H * Z);
+    const Eigen::VectorXd ev = es.eigenvalues();
+    int negative = 0;
+    for (int i = 0; i < ev.size(); ++i) negative += ev[i] < 0.0;
+    CHECK(info.negative == negative);
+    const int wanted = std::min(3, int(ev.size()));  // n = 6: a kernel of 2 (5 free joints, 3 rows)
+    REQUIRE(info.lowest.size() == wanted);
+    for (int i = 0; i < wanted; ++i) CHECK(info.lowest[i] == Approx(ev[i]).margin(1e-8));
+    // the same operator from stabilityOperator() (the dense route of the core)
+    Eigen::MatrixXd Hs, Cs;
+    REQUIRE(cp.stabilityOperator(u, lambda, Hs, Cs));
+    CHECK((Hs - H).cwiseAbs().maxCoeff() <= 1e-11 * std::max(1.0, H.cwiseAbs().maxCoeff()));
+    CHECK((Cs - C).cwiseAbs().maxCoeff() <= 1e-8);
+  }
+}
+
+TEST_CASE("wall: the O(n) bordered solver of the wall-constrained chain equals a dense solve", "[contact][wall]") {
+  const int n = 30;
+  std::vector<SegmentParameters> segs(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const Chain chain(segs);
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(-0.3), Eigen::Vector3d(1, 0, 0));
+  ContactSet set;
+  set.touch(WallVertex{7, 1});
+  set.touch(WallVertex{20, 4});
+  set.lock(3, LimitSide::Lower);
+  ContactProblem cp(problem, set);
+  const int D = cp.dimension();
+  Eigen::VectorXd u(D);
+  for (int i = 0; i < n; ++i) u[i] = 0.3 * std::cos(0.9 * i);
+  u.tail(D - n) << 0.1, 0.5, 0.25;
+  const double lambda = -0.2;
+  Eigen::VectorXd c = Eigen::VectorXd::LinSpaced(D + 1, 0.3, -0.5), b = Eigen::VectorXd::LinSpaced(D + 1, 1.0, 2.0);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(D + 1, D + 1);
+  Eigen::VectorXd Fl(D);
+  REQUIRE(cp.jacobian(u, lambda, A.topLeftCorner(D, D), Fl));
+  A.topRightCorner(D, 1) = Fl;
+  A.row(D) = c.transpose();
+  const Eigen::VectorXd dense = A.fullPivLu().solve(b);
+  auto solver = cp.makeStructuredSolver();
+  REQUIRE(solver->factor(u, lambda, c) == cont::Factorization::Regular);
+  Eigen::VectorXd x(D + 1);
+  REQUIRE(solver->solve(b, x));
+  CHECK((x - dense).cwiseAbs().maxCoeff() <= 1e-10 * dense.cwiseAbs().maxCoeff());
+  CHECK(solver->determinantSign() == (A.determinant() > 0 ? 1 : -1));
+  // the Jacobian itself against central differences of the residual
+  Eigen::VectorXd Fp(D), Fm(D);
+  for (int j = 0; j < D; ++j) {
+    Eigen::VectorXd up = u, um = u;
+    up[j] += 1e-6;
+    um[j] -= 1e-6;
+    REQUIRE(cp.residual(up, lambda, Fp));
+    REQUIRE(cp.residual(um, lambda, Fm));
+    CHECK(((Fp - Fm) / 2e-6 - A.col(j).head(D)).cwiseAbs().maxCoeff() <= 1e-7);
+  }
+}
