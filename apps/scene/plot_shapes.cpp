@@ -296,7 +296,7 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
         if (p->haveStiffness && std::isfinite(p->K(0, 0)))
           title << ",  K_{xx} = " << short5(p->K(0, 0)) << ", K_{yy} = " << short5(p->K(1, 1))
                 << " " << scene.units.unit(Dimension::Stiffness);
-        if (!p->locked.empty()) title << lockedTitle(p->locked.label());  // locked at a limit
+        if (!p->locked.label().empty()) title << lockedTitle(p->locked.label());  // joints locked at a limit
         if (!p->locked.wallLabel().empty()) title << ",  on the wall: " << p->locked.wallLabel();  // vertices held on the wall
       } else {
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(spec.at[k]) << ": not drawn";
