@@ -51,8 +51,8 @@ Row run(int n, double b, double k, int reps) {
                                 ControlDirection::named(n, ControlInput::dL0));
     cont::TracerOptions o;
     o.maxPoints = 100;
-    o.computeStability = true;
-    o.lowestEigenvalues = 1;
+    o.detection.stability = true;
+    o.detection.lowestEigenvalues = 1;
     const auto t0 = std::chrono::steady_clock::now();
     const cont::Branch b = cont::trace(actuated, start, 0.0, cont::InitialDirection::decreasingLambda(), o);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -48,7 +48,7 @@ CriticalCurveOptions twoHundred(double muMin, double muMax) {
   o.muMax = muMax;
   o.bothDirections = false;
   o.tracer.maxPoints = 200;
-  o.tracer.maxStep = 0.01;
+  o.tracer.step.maxStep = 0.01;
   return o;
 }
 }  // namespace
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
     ChainParameterProblem p(std::vector<SegmentParameters>(3, SegmentParameters::symmetric(2.5, 1.0, 1.0, 0.5)), end,
                             Eigen::Vector3d(1, 0, 0), SecondParameter::parse("phi"));
     cont::TracerOptions to;
-    to.maxStep = 0.05;
+    to.step.maxStep = 0.05;
     to.lambdaMin = -20;
     const cont::Branch path = cont::trace(p, p.equilibrium().initialGuess(Eigen::VectorXd::Zero(3), 0.0), 0.0,
                                           cont::InitialDirection::decreasingLambda(), to);
@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
     const cont::SpecialPoint fold = *folds.front();
     CriticalCurve c;
     CriticalCurveOptions o = twoHundred(-1.0, 1.0);
-    o.tracer.initialStep = o.tracer.maxStep = 0.004;  // 200 points before the joint limit (BD at Me ≈ 0.22)
+    o.tracer.step.initialStep = o.tracer.step.maxStep = 0.004;  // 200 points before the joint limit (BD at Me ≈ 0.22)
     const double t = best(reps, [&] { c = foldCurve(p, fold, o); });
     std::printf("fold n=3: %zu points, %zu codim-2 points, %.2f ms\n", c.points.size(), c.special.size(), 1e3 * t);
   }
@@ -108,13 +108,14 @@ int main(int argc, char** argv) {
     ChainParameterProblem p(segs, EndCondition::freeEnd(Eigen::Vector3d(-0.01, 0.0, 0.0)), Eigen::Vector3d(0, 0, 1),
                             SecondParameter::parse("x"));
     cont::TracerOptions to;
-    to.maxStep = 0.1;
+    to.step.maxStep = 0.1;
     to.lambdaMax = 10.0;
     to.maxPoints = 3000;
-    to.lowestEigenvalues = 0;
-    to.onStep = [](const cont::Branch& b) {
-      return b.specialPointsOfType(cont::SpecialPointType::Fold).empty() ? cont::StepAction::Continue
-                                                                          : cont::StepAction::Stop;
+    to.detection.lowestEigenvalues = 0;
+    to.onStep = [](const cont::StepInfo& step) {
+      for (const cont::SpecialPoint& sp : step.specialPoints)
+        if (sp.type == cont::SpecialPointType::Fold) return cont::StepAction::Stop;
+      return cont::StepAction::Continue;
     };
     const cont::Branch path = cont::trace(p.equilibrium(), p.equilibrium().initialGuess(Eigen::VectorXd::Zero(n), 0.0),
                                           0.0, cont::InitialDirection::increasingLambda(), to);
@@ -125,7 +126,7 @@ int main(int argc, char** argv) {
     }
     const cont::SpecialPoint fold = *folds.front();
     CriticalCurveOptions o = twoHundred(-1.0, 1.0);
-    o.tracer.maxStep = 0.05;
+    o.tracer.step.maxStep = 0.05;
     CriticalCurve c;
     // toward more compression: the second direction of foldCurve, alone
     o.bothDirections = true;

@@ -46,8 +46,8 @@ Row run(int n, double b, double k, int reps) {
   body.points.push_back({n + 1, Eigen::Vector2d::Zero(), Eigen::Vector2d(0.0, -payload)});
   cont::TracerOptions o;
   o.maxPoints = 100;
-  o.computeStability = true;
-  o.lowestEigenvalues = 1;
+  o.detection.stability = true;
+  o.detection.lowestEigenvalues = 1;
   Row row;
   for (int r = 0; r < reps; ++r) {
     EquilibriumProblem heavy(chain, EndCondition::freeEnd(), Eigen::Vector3d::Zero(), {}, {}, body);

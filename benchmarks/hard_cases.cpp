@@ -238,7 +238,7 @@ Row clustered(const std::string& id, int n, bool top, int count, bool relativeLo
   s.maxStep = s.initialStep = std::abs(lambdaEnd - lambda0) / 3;
   s.minStep = 1e-6 * s.maxStep;
   cont::TracerOptions o = tracerOptions(s, lambdaEnd, lambda0);
-  if (relativeLocation) o.locationTolerance = 1e-12 * std::min(1.0, std::abs(crit[first]));
+  if (relativeLocation) o.location.tolerance = 1e-12 * std::min(1.0, std::abs(crit[first]));
   cont::Tracer tracer(problem, o);
   const cont::Branch br = tracer.trace(Eigen::VectorXd::Zero(n + 1), lambda0, cont::InitialDirection::decreasingLambda());
   row.ms = timer.ms();
@@ -280,7 +280,7 @@ Row switched(int n) {
   s.minStep = 1e-6 * s.maxStep;
   const cont::TracerOptions o = tracerOptions(s, 0.5 * (crit[0] + crit[1]), 0.0);
   cont::TreeOptions tree;
-  tree.maxDepth = 1;
+  tree.branchSwitching = 1;
   cont::TracerOptions children = o;
   children.maxPoints = 20;
   children.lambdaMin = 2.0 * crit[1];

@@ -122,8 +122,8 @@ Start foldStart(int n) {
   cont::TracerOptions o;
   o.maxPoints = 2000;
   o.lambdaMax = 2.0;
-  o.detectBranchPoints = false;
-  o.lowestEigenvalues = 0;
+  o.detection.branchPoints = false;
+  o.detection.lowestEigenvalues = 0;
   cont::Tracer tracer(*s.problem, o);
   const cont::Branch branch = tracer.trace(p.u, 0.0, cont::InitialDirection::increasingLambda());
   s.traceSeconds = seconds(t0);

@@ -220,11 +220,11 @@ void BM_TracerStep(benchmark::State& state) {
                        Eigen::Vector3d(1, 0, 0));
   continuation::TracerOptions o;
   o.maxPoints = 41;
-  o.initialStep = step;
-  o.maxStep = step;
-  o.minStep = step / 1024;
+  o.step.initialStep = step;
+  o.step.maxStep = step;
+  o.step.minStep = step / 1024;
   o.lambdaMax = 1000.0;
-  o.lowestEigenvalues = 0;
+  o.detection.lowestEigenvalues = 0;
   o.linearAlgebra = structured ? continuation::TracerOptions::LinearAlgebra::Structured
                                : continuation::TracerOptions::LinearAlgebra::Dense;
   continuation::Tracer tracer(p, o);

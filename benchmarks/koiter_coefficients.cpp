@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
                                 : std::numeric_limits<double>::quiet_NaN();
     const double ts = timeCoefficients(p, bp, cont::CoefficientAlgebra::Structured, reps, fast);
     if (!fast.valid) {
-      std::fprintf(stderr, "n = %d: %s\n", n, fast.error.c_str());
+      std::fprintf(stderr, "n = %d: %s\n", n, fast.message.c_str());
       return 1;
     }
     std::printf("%6d %14.8e %14.8e %14.6g %12.6g %.2e\n", n, lambda, fast.b, td, ts,

@@ -95,12 +95,12 @@ Row run(int n, int K, int P, int denseMax, double childStep) {
   // of range/(P − 1) in the chain's force unit k̄b̄ = 1); the switched branches P points each.
   const double lambdaEnd = 0.5 * (crit[size_t(K) - 1] + crit[size_t(K)]);
   EquilibriumBranchOptions opt;
-  opt.tracer.maxStep = opt.tracer.initialStep = std::abs(lambdaEnd) / (P - 1);
-  opt.tracer.minStep = 1e-6 * opt.tracer.maxStep;
+  opt.tracer.step.maxStep = opt.tracer.step.initialStep = std::abs(lambdaEnd) / (P - 1);
+  opt.tracer.step.minStep = 1e-6 * opt.tracer.step.maxStep;
   opt.tracer.maxPoints = P + 2 * K + 1;  // the located branch points are points of the branch too
   opt.tracer.lambdaMin = lambdaEnd;
   opt.tracer.lambdaMax = 0.0;
-  opt.tracer.lowestEigenvalues = 1;  // the smallest eigenvalue, as the scenes report it
+  opt.tracer.detection.lowestEigenvalues = 1;  // the smallest eigenvalue, as the scenes report it
   // The children move along the buckling modes, in joint angles: steps of 0.2/√n (0.02, the
   // scenes' initial step, at n = 100), so that 50 points bend the chain visibly but do not coil
   // it (the link angles sum the joint angles: 0.02 per joint coils a 2000-segment chain into
@@ -108,12 +108,12 @@ Row run(int n, int K, int P, int denseMax, double childStep) {
   // stay within 1e−7 of the straight chain, where λ(s) − λ_c ~ λ_c s² is below the rounding of
   // the tangent's λ component and its sign, the fold test, is noise (spurious LPs).
   cont::TracerOptions child = opt.tracer;
-  child.initialStep = child.maxStep = childStep > 0.0 ? childStep : 0.2 / std::sqrt(double(n));
-  child.minStep = 1e-6 * child.maxStep;
+  child.step.initialStep = child.step.maxStep = childStep > 0.0 ? childStep : 0.2 / std::sqrt(double(n));
+  child.step.minStep = 1e-6 * child.step.maxStep;
   child.maxPoints = P;
   child.lambdaMin = 2.0 * crit[size_t(K)];
-  opt.childTracer = child;
-  opt.switchingDepth = 1;
+  opt.tree.childTracer = child;
+  opt.tree.branchSwitching = 1;
   const auto t0 = std::chrono::steady_clock::now();
   const EquilibriumBranches tree =
       traceEquilibria(problem, q0, 0.0, cont::InitialDirection::decreasingLambda(), opt);

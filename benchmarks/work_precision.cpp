@@ -160,7 +160,7 @@ class Projector {
  private:
   static cont::CorrectorOptions options() {
     cont::CorrectorOptions co;
-    co.residualTolerance = 1e-14;
+    co.tolerance = 1e-14;
     co.maxIterations = 30;
     return co;
   }
@@ -191,11 +191,11 @@ cont::TracerOptions gStepOptions;
 
 cont::TracerOptions options(const Settings& s, double lambdaMin, double lambdaMax, bool secondOrder) {
   cont::TracerOptions o = tracerOptions(s, lambdaMin, lambdaMax);
-  o.secondOrderPredictor = secondOrder;
-  o.stepRule = gStepOptions.stepRule;
-  o.stepGrowth = gStepOptions.stepGrowth;
-  o.targetAngle = gStepOptions.targetAngle;
-  o.targetContraction = gStepOptions.targetContraction;
+  o.step.secondOrderPredictor = secondOrder;
+  o.step.rule = gStepOptions.step.rule;
+  o.step.stepGrowth = gStepOptions.step.stepGrowth;
+  o.step.targetAngle = gStepOptions.step.targetAngle;
+  o.step.targetContraction = gStepOptions.step.targetContraction;
   return o;
 }
 
@@ -580,10 +580,10 @@ int main(int argc, char** argv) {
     } else if (!std::strcmp(argv[i], "--rule") && more) {
       const std::string v = argv[++i];
       if (v != "curvature" && v != "count") return usage(argv[i]);
-      gStepOptions.stepRule = v == "count" ? cont::StepSizeControl::Rule::NewtonCount : cont::StepSizeControl::Rule::Curvature;
-    } else if (!std::strcmp(argv[i], "--growth") && more) gStepOptions.stepGrowth = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--target-angle") && more) gStepOptions.targetAngle = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--target-contraction") && more) gStepOptions.targetContraction = std::atof(argv[++i]);
+      gStepOptions.step.rule = v == "count" ? cont::StepOptions::Rule::NewtonCount : cont::StepOptions::Rule::Curvature;
+    } else if (!std::strcmp(argv[i], "--growth") && more) gStepOptions.step.stepGrowth = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--target-angle") && more) gStepOptions.step.targetAngle = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--target-contraction") && more) gStepOptions.step.targetContraction = std::atof(argv[++i]);
     else return usage(argv[i]);
   }
   if (!onlyTask.empty() && onlyTask != "diagram" && onlyTask != "fold" && onlyTask != "long") return usage(onlyTask.c_str());

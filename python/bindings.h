@@ -13,10 +13,15 @@ namespace buckle::python {
 void bindMechanics(pybind11::module_& m);
 /// all_equilibria(): every equilibrium at one state of the controls (mechanics/all_equilibria.h).
 void bindEquilibria(pybind11::module_& m);
+/// TracerOptions and its groups: the continuation core's settings, with the library's defaults.
+void bindTracerOptions(pybind11::module_& m);
 /// trace(): the continuation core on a problem whose residual and Jacobian are Python callables.
 void bindContinuation(pybind11::module_& m);
 /// run_scene(): a scene (dict or file) through the same runner as `buckle run`.
 void bindScene(pybind11::module_& m);
+
+/// "step.maxStep must ..." as Python names the field: "step.max_step must ...".
+std::string snakeCase(const std::string& text);
 
 /// A number as Python's repr() writes a float: the shortest digits that read back to the same
 /// double ("1e-07", "1e+308", "0.1", "-2.5e-12", "inf"), for reprs and messages. Needs the GIL.

@@ -197,27 +197,31 @@ py::dict branchDict(const cont::Branch& b, int n) {
 void bindContinuation(py::module_& m) {
   m.def(
       "trace",
-      [](py::function residual, py::function jacobian, const VectorXd& u0, double lambda0, int direction,
-         double lambdaMin, double lambdaMax, int maxPoints, double initialStep, double minStep, double maxStep,
-         double tolerance, double locationTolerance, int branchSwitching, py::object stability,
+      [](py::function residual, py::function jacobian, const VectorXd& u0, double lambda0,
+         const cont::TracerOptions& given, int direction, std::optional<double> lambdaMin,
+         std::optional<double> lambdaMax, std::optional<int> maxPoints, std::optional<double> initialStep,
+         std::optional<double> minStep, std::optional<double> maxStep, std::optional<double> tolerance,
+         std::optional<double> locationTolerance, int branchSwitching, py::object stability,
          std::optional<double> timeLimit) {
         if (u0.size() < 1) throw std::invalid_argument("u0 must have at least one unknown");
         if (direction != 1 && direction != -1) throw std::invalid_argument("direction must be +1 or -1");
         if (branchSwitching < 0) throw std::invalid_argument("branch_switching must be >= 0");
         if (timeLimit && !(*timeLimit > 0.0))
           throw std::invalid_argument("time_limit must be a positive number of seconds");
-        cont::TracerOptions options;
-        options.lambdaMin = lambdaMin;
-        options.lambdaMax = lambdaMax;
-        options.maxPoints = maxPoints;
-        options.initialStep = initialStep;
-        options.minStep = minStep;
-        options.maxStep = maxStep;
-        options.newtonTolerance = tolerance;
-        options.locationTolerance = locationTolerance;
-        options.computeStability = !stability.is_none();
-        std::string why;
-        if (!options.IsValid(&why)) throw std::invalid_argument("invalid continuation options: " + why);
+        // the keywords are short forms of the options' fields (one name each: max_step is
+        // options.step.max_step); what they do not name keeps the given options' value
+        cont::TracerOptions options = given;
+        if (lambdaMin) options.lambdaMin = *lambdaMin;
+        if (lambdaMax) options.lambdaMax = *lambdaMax;
+        if (maxPoints) options.maxPoints = *maxPoints;
+        if (initialStep) options.step.initialStep = *initialStep;
+        if (minStep) options.step.minStep = *minStep;
+        if (maxStep) options.step.maxStep = *maxStep;
+        if (tolerance) options.corrector.tolerance = *tolerance;
+        if (locationTolerance) options.location.tolerance = *locationTolerance;
+        options.detection.stability = !stability.is_none();
+        const std::string why = options.validate();
+        if (!why.empty()) throw std::invalid_argument("invalid continuation options: " + snakeCase(why));
         PythonProblem problem(static_cast<int>(u0.size()), std::move(residual), std::move(jacobian), stability);
         SigintWatch sigint;
         if (timeLimit) options.interrupt = cont::Interrupt::after(*timeLimit);
@@ -226,7 +230,7 @@ void bindContinuation(py::module_& m) {
         {
           py::gil_scoped_release release;
           cont::TreeOptions treeOptions;
-          treeOptions.maxDepth = branchSwitching;
+          treeOptions.branchSwitching = branchSwitching;
           tree = cont::traceTree(problem, u0, lambda0,
                                  {direction > 0 ? cont::InitialDirection::increasingLambda()
                                                 : cont::InitialDirection::decreasingLambda()},
@@ -243,17 +247,19 @@ void bindContinuation(py::module_& m) {
         return out;
       },
       py::arg("residual"), py::arg("jacobian"), py::arg("u0"), py::arg("lambda0"), py::kw_only(),
-      py::arg("direction") = 1, py::arg("lambda_min") = -std::numeric_limits<double>::infinity(),
-      py::arg("lambda_max") = std::numeric_limits<double>::infinity(), py::arg("max_points") = 500,
-      py::arg("initial_step") = 0.01, py::arg("min_step") = 1e-8, py::arg("max_step") = 0.1,
-      py::arg("tolerance") = 1e-10, py::arg("location_tolerance") = 1e-12, py::arg("branch_switching") = 0,
+      py::arg("options") = cont::TracerOptions(), py::arg("direction") = 1, py::arg("lambda_min") = py::none(),
+      py::arg("lambda_max") = py::none(), py::arg("max_points") = py::none(), py::arg("initial_step") = py::none(),
+      py::arg("min_step") = py::none(), py::arg("max_step") = py::none(), py::arg("tolerance") = py::none(),
+      py::arg("location_tolerance") = py::none(), py::arg("branch_switching") = 0,
       py::arg("stability") = py::none(), py::arg("time_limit") = py::none(),
       "Traces the solution branches of F(u, λ) = 0 from (u0, λ0) by pseudo-arclength continuation, locating folds "
       "(LP) and branch points (BP) and, with branch_switching = d > 0, switching at branch points down to d "
       "generations.\n\n"
       "residual(u, lam) -> F (array of N); jacobian(u, lam) -> (F_u (N×N), F_lambda (N)), exact; optional "
       "stability(u, lam) -> symmetric N×N H (a state is stable where H is positive definite). direction: sign of "
-      "dλ/ds at the start. Step sizes and tolerances are those of continuation::TracerOptions (docs/continuation.md). "
+      "dλ/ds at the start. options: a TracerOptions (its defaults are the library's); the keywords lambda_min, "
+      "lambda_max, max_points, initial_step, min_step, max_step, tolerance and location_tolerance are short forms of "
+      "its fields (options.step.max_step, options.corrector.tolerance, options.location.tolerance, ...). "
       "time_limit (s) stops the trace within a step, keeping what it computed (`interrupted`).\n\n"
       "Returns {'branches': [...], 'interrupted', 'message'}; each branch a dict with u (P×N), lambda, arclength, "
       "negative (negative eigenvalues of H, -1 without stability), special_points (dicts: type 'LP'/'BP'/'BD'/'EP', "

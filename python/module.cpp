@@ -17,12 +17,13 @@ PYBIND11_MODULE(_core, m) {
       "equilibrium M + J^T F = 0, compression is Fx < 0.\n\n"
       "Mechanics: Segment, Chain, EndCondition, linear_buckling, all_equilibria.  Scenes: run_scene (the `buckle run` "
       "runner), returning a RunResult: a dict of NumPy arrays with DataFrames (pandas) and plots (matplotlib) "
-      "when those are installed.  Continuation core: trace (a problem given by Python callables).  Bad input raises "
+      "when those are installed.  Continuation core: trace (a problem given by Python callables) with TracerOptions.  Bad input raises "
       "ValueError (SceneError for a scene) with the command line's message; Ctrl-C raises "
       "KeyboardInterrupt within a step (run_scene first writes what was computed to `out`). docs/python.md.";
   m.attr("__version__") = BUCKLE_VERSION;
   buckle::python::bindMechanics(m);
   buckle::python::bindEquilibria(m);
+  buckle::python::bindTracerOptions(m);
   buckle::python::bindContinuation(m);
   buckle::python::bindScene(m);
 }

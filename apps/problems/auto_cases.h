@@ -56,17 +56,17 @@ struct Settings {
 
 inline cont::TracerOptions tracerOptions(const Settings& s, double lambdaMin, double lambdaMax) {
   cont::TracerOptions o;
-  o.initialStep = s.initialStep;
-  o.maxStep = s.maxStep;
-  o.minStep = std::min(s.minStep, s.initialStep);
-  o.newtonTolerance = s.newtonTolerance;
-  o.locationTolerance = s.locationTolerance;
-  o.locationNewtonTolerance = std::min(1e-13, s.newtonTolerance);
-  o.computeStability = s.stability;
-  o.lowestEigenvalues = s.lowestEigenvalues;
-  o.secondOrderPredictor = s.secondOrderPredictor;
-  o.certifiedCounting = s.certifiedCounting;
-  o.leanNewton = s.leanNewton;
+  o.step.initialStep = s.initialStep;
+  o.step.maxStep = s.maxStep;
+  o.step.minStep = std::min(s.minStep, s.initialStep);
+  o.corrector.tolerance = s.newtonTolerance;
+  o.location.tolerance = s.locationTolerance;
+  o.location.newtonTolerance = std::min(1e-13, s.newtonTolerance);
+  o.detection.stability = s.stability;
+  o.detection.lowestEigenvalues = s.lowestEigenvalues;
+  o.step.secondOrderPredictor = s.secondOrderPredictor;
+  o.detection.certifiedCounting = s.certifiedCounting;
+  o.corrector.leanNewton = s.leanNewton;
   o.lambdaMin = lambdaMin;
   o.lambdaMax = lambdaMax;
   o.maxPoints = 20000;

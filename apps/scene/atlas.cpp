@@ -52,7 +52,7 @@ void computeCell(AtlasCell& c) {
     c.firstShape = fb.shape;
     c.postBuckling = mech::toString(fb.kind);
     c.postSlope = fb.slope;
-    c.error = fb.error;
+    c.error = fb.message;
   } catch (const std::exception& e) {  // an invalid segment (e.g. a/b too large) names itself
     c.firstCritical = kNaN;
     c.postBuckling = "failed";

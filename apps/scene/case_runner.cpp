@@ -172,7 +172,7 @@ void CaseRunner::loadHistory() {
     s.branch = j.fromSegment >= 0 ? base + j.fromSegment : base;
     s.landing = mech::landingOf(problem, j);
   }
-  if (!h.completed && !interrupted()) {
+  if (!h.success && !interrupted()) {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": load history stopped: " + h.message);
   }
@@ -199,7 +199,7 @@ void CaseRunner::suddenLoad() {
     opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
     try {
       const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.qStart, {s0, spec.value}, opt);
-      if (h.completed && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);
+      if (h.success && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);
       if (problem.bodyLoads().active() && !h.segments.empty() && !h.segments.front().points.empty())
         qRest = h.segments.front().points.front().u.head(n);
     } catch (const std::exception&) {
@@ -276,17 +276,17 @@ mech::EquilibriumBranchOptions CaseRunner::branchOptions(double lambdaLo, double
   opt.tracer = solverOptions();
   opt.tracer.lambdaMin = lambdaLo;
   opt.tracer.lambdaMax = lambdaHi;
-  opt.tracer.computeStability = true;
+  opt.tracer.detection.stability = true;
   // Only the smallest eigenvalue is reported (min_eig); the locator asks for the crossing
   // eigenvalue where it needs more.
-  opt.tracer.lowestEigenvalues = 1;
-  opt.switchingDepth = scene_.analyses.continuation.depth(throughLoad());
+  opt.tracer.detection.lowestEigenvalues = 1;
+  opt.tree.branchSwitching = scene_.analyses.continuation.depth(throughLoad());
   opt.contact = scene_.analyses.continuation.contact;
   opt.mirror = scene_.analyses.continuation.mirror;
   opt.report = reportOptions();
   if (const int first = scene_.analyses.continuation.branchPoints; first > 0) {
     // the first `first` simple branch points along the branch, not counting the one it starts from
-    opt.switchAt = [first](const cont::Branch& branch, const cont::SpecialPoint& bp) {
+    opt.tree.switchAt = [first](const cont::Branch& branch, const cont::SpecialPoint& bp) {
       const double s0 = branch.points.empty() ? 0.0 : branch.points.front().arclength;
       int before = 0;
       for (const cont::SpecialPoint& sp : branch.specialPoints)
@@ -297,10 +297,10 @@ mech::EquilibriumBranchOptions CaseRunner::branchOptions(double lambdaLo, double
     };
   }
   if (const int points = scene_.analyses.continuation.childPoints; points > 0) {
-    opt.childTracer = opt.tracer;
-    opt.childTracer->maxPoints = points;
+    opt.tree.childTracer = opt.tracer;
+    opt.tree.childTracer->maxPoints = points;
   }
-  opt.onBranch = [this, depth = opt.switchingDepth](const cont::BranchTree& t, const cont::Branch& b) {
+  opt.tree.onBranch = [this, depth = opt.tree.branchSwitching](const cont::BranchTree& t, const cont::Branch& b) {
     branchesSoFar_ = static_cast<int>(t.branches.size());
     branchAdded(b, depth);
   };
@@ -337,10 +337,10 @@ void CaseRunner::continuation() {
   mech::EquilibriumProblem problem(out_.chain, end, path.direction, equilibriumOptions, controlDirection(), bodyLoads());
 
   mech::EquilibriumBranchOptions opt = branchOptions(lambdaLo, lambdaHi);
-  if (opt.switchingDepth > 0 && !spec_.path.control && !spec_.path.gravity) {
+  if (opt.tree.branchSwitching > 0 && !spec_.path.control && !spec_.path.gravity) {
     std::vector<double> ends;
     for (double target : targets) ends.push_back(target - s0);
-    warnOfLargeTree(mech::criticalLoading(end, c, path.direction), ends, opt.switchingDepth);
+    warnOfLargeTree(mech::criticalLoading(end, c, path.direction), ends, opt.tree.branchSwitching);
   }
 
   // The start branches (one per requested direction), then branch switching breadth first, by

@@ -87,22 +87,16 @@ class CaseRunner {
   mechanics::EquilibriumBranchOptions branchOptions(double lambdaLo, double lambdaHi);
   /// The scene's /solver settings as tracer options (the λ range is set by each analysis).
   continuation::TracerOptions solverOptions() const {
-    continuation::TracerOptions opt;
-    opt.initialStep = scene_.solver.initialStep;
-    opt.minStep = scene_.solver.minStep;
-    opt.maxStep = scene_.solver.maxStep;
-    opt.maxPoints = scene_.solver.maxPoints;
-    opt.newtonTolerance = scene_.solver.tolerance;
-    opt.locationTolerance = scene_.solver.locationTolerance;
+    continuation::TracerOptions opt = scene_.solver.tracer;
     opt.interrupt = control_.interrupt;
     if (control_.progress) {
       Progress* progress = control_.progress;
       const CaseResult* out = &out_;
       const int* branches = &branchesSoFar_;
       const int* queued = &ahead_.queued;
-      opt.onStep = [progress, out, branches, queued](const continuation::Branch& b) {
-        progress->step(*branches + 1, static_cast<int>(b.points.size()), b.points.back().lambda,
-                       static_cast<int>(out->specials.size() + b.specialPoints.size()), *queued);
+      opt.onStep = [progress, out, branches, queued](const continuation::StepInfo& step) {
+        progress->step(*branches + 1, step.pointCount, step.point.lambda,
+                       static_cast<int>(out->specials.size()) + step.specialPointCount, *queued);
         return continuation::StepAction::Continue;
       };
       // a step over a cluster of branch points can refine for seconds without a new point

@@ -45,7 +45,7 @@ bool CaseRunner::actuationStart() {
   } catch (const std::exception& e) {
     h.message = e.what();
   }
-  if (!h.completed || h.segments.empty() || h.segments.back().points.empty()) {
+  if (!h.success || h.segments.empty() || h.segments.back().points.empty()) {
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": the payload of /end could not be applied to the unloaded "
                             "shape (the start of the control path): " + h.message);

@@ -66,7 +66,7 @@ void CaseRunner::disconnectedBranchesAt(EquilibriumSet& set) {
   mechanics::DisconnectedBranchOptions opt;
   opt.branches = branchOptions(lo, hi);
   const int before = int(traced_.size());
-  opt.branches.onBranch = [this, before](const continuation::BranchTree& t, const continuation::Branch&) {
+  opt.branches.tree.onBranch = [this, before](const continuation::BranchTree& t, const continuation::Branch&) {
     branchesSoFar_ = before + static_cast<int>(t.branches.size());
   };
   std::vector<Eigen::VectorXd> q;

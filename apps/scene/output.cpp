@@ -20,6 +20,7 @@
 #include "scene/escape.h"
 #include "scene/output_target.h"
 #include "scene/report.h"
+#include "scene/solver_settings.h"
 #include "scene/special_marks.h"
 
 namespace buckle::scene {
@@ -379,12 +380,6 @@ void writeCurves(const Scene& scene, const RunResult& run, const fs::path& dir) 
     }
     writeText(dir / "torque_angle.csv", os.str());
   }
-}
-
-json solverJson(const SolverSpec& s) {
-  return json{{"initial_step", s.initialStep}, {"min_step", s.minStep}, {"max_step", s.maxStep},
-              {"tolerance", s.tolerance},      {"location_tolerance", s.locationTolerance},
-              {"max_points", s.maxPoints}, {"time_limit", s.timeLimit}};
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "scene/escape.h"
 #include "scene/json_reader.h"
 #include "scene/scene_parsing.h"
+#include "scene/solver_settings.h"
 
 namespace buckle::scene {
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "buckle/mechanics/chain_tracer_options.h"
 #include "buckle/mechanics/control_path.h"
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/stiffness_extremum.h"
@@ -218,14 +219,10 @@ struct AnalysesSpec {
   EquilibriaSpec equilibria;
 };
 
+/// /solver: the tracer settings of every analysis (the library's mechanics::chainTracerOptions(),
+/// with what the scene names changed; each analysis sets its own λ range) and the run's limit.
 struct SolverSpec {
-  double initialStep = 0.02;
-  double minStep = 1e-7;
-  double maxStep = 0.05;
-  double tolerance = 1e-10;    ///< corrector residual tolerance
-  /// Located points: |Δλ| ≤ locationTolerance·max(λ₀, |λ|) (TracerOptions::locationTolerance).
-  double locationTolerance = 1e-12;
-  int maxPoints = 4000;        ///< per branch
+  continuation::TracerOptions tracer = mechanics::chainTracerOptions();
   double timeLimit = 120.0;    ///< seconds for the whole scene; past it the run stops (exit 1)
 };
 

@@ -186,31 +186,6 @@ AnalysesSpec parseAnalyses(const Reader& r, const json& a, const Pointer& p) {
   return s;
 }
 
-SolverSpec parseSolver(const Reader& r, const json& s, const Pointer& p) {
-  r.onlyKeys(s, p, {"initial_step", "min_step", "max_step", "tolerance", "location_tolerance", "max_points",
-                      "time_limit"});
-  SolverSpec o;
-  if (s.contains("initial_step")) o.initialStep = r.positive(s["initial_step"], p / "initial_step");
-  if (s.contains("min_step")) o.minStep = r.positive(s["min_step"], p / "min_step");
-  if (s.contains("max_step")) o.maxStep = r.positive(s["max_step"], p / "max_step");
-  if (s.contains("tolerance")) {
-    o.tolerance = r.positive(s["tolerance"], p / "tolerance");
-    // a residual norm in the chain's units: beyond 1e-3 a point is no equilibrium to plot
-    if (o.tolerance > 1e-3) r.expected(p / "tolerance", s["tolerance"], "a number in (0, 1e-3] (default 1e-10)");
-  }
-  if (s.contains("location_tolerance")) {
-    // relative to the parameter's scale: below 1e-15 no double resolves it, above 1e-2 it is no location
-    o.locationTolerance = r.number(s["location_tolerance"], p / "location_tolerance");
-    if (!(o.locationTolerance >= 1e-15 && o.locationTolerance <= 1e-2))
-      r.expected(p / "location_tolerance", s["location_tolerance"], "a relative tolerance in [1e-15, 1e-2]");
-  }
-  if (s.contains("max_points")) o.maxPoints = r.integer(s["max_points"], p / "max_points", 2, 10000000);
-  if (s.contains("time_limit")) o.timeLimit = r.positive(s["time_limit"], p / "time_limit");
-  if (!(o.minStep <= o.initialStep)) r.fail(p / "min_step", "expected min_step <= initial_step");
-  if (!(o.initialStep <= o.maxStep)) r.fail(p / "max_step", "expected max_step >= initial_step");
-  return o;
-}
-
 PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN, int nCases,
                    const std::vector<std::string>& inputColumns) {
   PlotSpec s;

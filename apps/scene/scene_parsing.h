@@ -77,7 +77,6 @@ void checkAnalysesAgainstCases(const JsonReader& r, const Scene& scene);
 EquilibriaSpec parseEquilibria(const JsonReader& r, const json& v, const Pointer& p);
 /// Its `at` inside every case's path range.
 void checkEquilibriaAgainstCases(const JsonReader& r, const Scene& scene);
-SolverSpec parseSolver(const JsonReader& r, const json& s, const Pointer& p);
 /// `inputColumns`: the task paths' input columns (taskInputColumns), allowed on the axes too.
 PlotSpec parsePlot(const JsonReader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN, int nCases,
                    const std::vector<std::string>& inputColumns = {});

@@ -71,7 +71,7 @@ TEST_CASE("control path scene: the start under the payload and the folds of the 
   cont::TracerOptions to;
   to.lambdaMin = -1.0;
   to.lambdaMax = 1.0;
-  to.computeStability = true;
+  to.detection.stability = true;
   const cont::Branch loading =
       cont::trace(ramp, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), to);
   REQUIRE(loading.stopReason == cont::StopReason::LambdaRange);

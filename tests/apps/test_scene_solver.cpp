@@ -53,7 +53,7 @@ TEST_CASE("solver.location_tolerance: a looser one is honoured, a tighter one ac
     const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_solver", "tol" + std::to_string(k), withSolver(text));
     INFO(o.err);
     REQUIRE(o.rc == 0);
-    CHECK(readJson(o.out / "summary.json")["solver"]["location_tolerance"].get<double>() == tolerances[k]);
+    CHECK(readJson(o.out / "summary.json")["solver"]["location"]["tolerance"].get<double>() == tolerances[k]);
     at[k] = firstBranchPoint(o.out);
     // |Δλ| ≤ tol·max(λ₀, |λ|), λ₀ = 1 in the chain's force unit k̄/b̄ = 1 here
     const double scale = std::max(1.0, std::abs(at[k].lambda));

@@ -53,7 +53,7 @@ TEST_CASE("Accuracy report", "[.][report]") {
   {
     toys::TwoPitchforks pitchfork(1e-3);
     TracerOptions o = options;
-    o.initialStep = o.maxStep = 0.05;
+    o.step.initialStep = o.step.maxStep = 0.05;
     o.lambdaMax = 0.2;
     const double exact[] = {0.0, 1e-3};
     print("pitchforks c=1e-3 (1 step)", trace(pitchfork, Vector::Zero(2), -0.37, InitialDirection::increasingLambda(), o),
@@ -62,7 +62,7 @@ TEST_CASE("Accuracy report", "[.][report]") {
   {
     toys::DoubleZero dz;
     TracerOptions o = options;
-    o.initialStep = o.maxStep = 0.05;
+    o.step.initialStep = o.step.maxStep = 0.05;
     o.lambdaMax = 0.2;
     const double exact[] = {0.0};
     print("double zero", trace(dz, Vector::Zero(2), -0.37, InitialDirection::increasingLambda(), o), exact, 1);
@@ -82,7 +82,7 @@ TEST_CASE("Accuracy report", "[.][report]") {
   {
     toys::Bratu bratu(20);
     TracerOptions o = options;
-    o.maxStep = 0.5;
+    o.step.maxStep = 0.5;
     o.maxPoints = 60;
     o.lambdaMax = 5.0;
     const Branch b = trace(bratu, Vector::Zero(20), 0.0, InitialDirection::increasingLambda(), o);

@@ -110,7 +110,7 @@ TEST_CASE("Tracer: Automatic picks the structured solver from structuredFromDime
           "[bordered_solver]") {
   TracerOptions options;
   options.maxPoints = 60;
-  options.maxStep = 0.2;
+  options.step.maxStep = 0.2;
   options.structuredFromDimension = 5;
   StructuredBratu big(9), small(4);
   Tracer structuredTracer(big, options);

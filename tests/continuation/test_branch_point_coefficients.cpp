@@ -109,7 +109,7 @@ TEST_CASE("Branch-point coefficients at the branch point the tracer located on t
   p.alpha = 0.7;
   p.beta = -1.3;
   TracerOptions options;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   options.lambdaMax = 1.5;
   const Branch b = trace(p, BentNormalForm::up(0.5), 0.5, InitialDirection::increasingLambda(), options);
   const auto bps = b.specialPointsOfType(SpecialPointType::BranchPoint);

@@ -18,8 +18,8 @@ TEST_CASE("Branch-point curve: the lower eigenvalue of A(μ), λ = 3/2 − √(1
   options.lambdaMin = -2.0;
   options.lambdaMax = 2.0;
   options.maxPoints = 400;
-  options.computeStability = false;
-  options.newtonTolerance = 1e-13;
+  options.detection.stability = false;
+  options.corrector.tolerance = 1e-13;
   for (const InitialDirection& d : {InitialDirection::increasingLambda(), InitialDirection::decreasingLambda()}) {
     const Branch branch = trace(curve, W0, 0.0, d, options);
     REQUIRE(branch.stopReason == StopReason::LambdaRange);

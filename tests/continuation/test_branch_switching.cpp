@@ -23,7 +23,7 @@ TEST_CASE("Pitchfork: both bifurcating directions, closed-form branch and its st
   toys::TwoPitchforks problem(c);
   TracerOptions options;
   options.lambdaMax = 0.4;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   const BranchTree tree =
       traceTree(problem, Vector::Zero(2), -0.3, InitialDirection::increasingLambda(), options, 1);
   REQUIRE(tree.branches.size() == 3);
@@ -74,7 +74,7 @@ TEST_CASE("Two levels of switching on the double pitchfork", "[branch_switching]
   toys::TwoPitchforks problem(c);
   TracerOptions options;
   options.lambdaMax = 0.8;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   const BranchTree tree =
       traceTree(problem, Vector::Zero(2), -0.3, InitialDirection::increasingLambda(), options, 2);
   // trivial; 2 from λ=0 (u₁ = ±√λ); 2 from λ=c (u₂ = ±√(λ−c)); 2×2 from λ=c on the u₁ branches.
@@ -156,8 +156,8 @@ TEST_CASE("Switching on a curved trivial branch follows u1 = 0.3 sin(lambda) +- 
 TEST_CASE("Multiplicity-2 points are switched along every direction of the reduced equation", "[branch_switching]") {
   toys::DoubleZero problem;
   TracerOptions options;
-  options.initialStep = 0.05;
-  options.maxStep = 0.05;
+  options.step.initialStep = 0.05;
+  options.step.maxStep = 0.05;
   options.lambdaMax = 0.2;
   const BranchTree tree =
       traceTree(problem, Vector::Zero(2), -0.37, InitialDirection::increasingLambda(), options, 3);
@@ -200,11 +200,11 @@ TEST_CASE("The tree's hooks: a branch extended past its trace is switched at on 
   toys::TwoPitchforks problem(c);
   TracerOptions options;
   options.lambdaMax = 0.25;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   TracerOptions beyond = options;
   beyond.lambdaMax = 0.8;
   TreeOptions tree;
-  tree.maxDepth = 1;
+  tree.branchSwitching = 1;
   tree.childTracer = beyond;
   Tracer extension(problem, beyond);
   int extended = 0;
@@ -279,9 +279,9 @@ TEST_CASE("An interrupted tree makes every branch final, the unfinished ones inc
   toys::TwoPitchforks problem(0.5);
   TracerOptions options;
   options.lambdaMax = 0.8;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   TreeOptions tree;
-  tree.maxDepth = 2;
+  tree.branchSwitching = 2;
   std::atomic<bool> stop{false};
   options.interrupt.watch(&stop, "test");
   std::vector<int> finals;
@@ -306,12 +306,12 @@ TEST_CASE("A root is traced lazily: the tree's root is the branch traced whole, 
   toys::ManyPitchforks problem(5, 0.1);  // branch points at λ = 0, 0.1, …, 0.4 on u = 0
   TracerOptions options;
   options.lambdaMax = 0.6;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   Tracer whole(problem, options);
   const Branch reference = whole.trace(Vector::Zero(5), -0.2, InitialDirection::increasingLambda());
   REQUIRE(reference.specialPointsOfType(SpecialPointType::BranchPoint).size() == 5);
   TreeOptions tree;
-  tree.maxDepth = 1;
+  tree.branchSwitching = 1;
   std::vector<std::pair<int, StopReason>> reports;  // onBranch: (id, stop reason)
   std::vector<int> extended;
   tree.onBranch = [&](const BranchTree &, const Branch &b) { reports.emplace_back(b.id, b.stopReason); };
@@ -354,9 +354,9 @@ TEST_CASE("Under an interrupt the tree holds the branches of the root's first br
   toys::ManyPitchforks problem(5, 0.1);
   TracerOptions options;
   options.lambdaMax = 0.6;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   TreeOptions tree;
-  tree.maxDepth = 1;
+  tree.branchSwitching = 1;
   std::atomic<bool> stop{false};
   options.interrupt.watch(&stop, "test stop");
   int finalChildren = 0;

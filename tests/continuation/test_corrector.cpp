@@ -49,7 +49,7 @@ TEST_CASE("Corrector at fixed lambda polishes a root", "[corrector]") {
   CHECK(std::abs(u[0] - 0.8) < 1e-12);
   // Reuse of the same KINSOL instance: many solves, each independent of the previous one.
   CorrectorOptions tight;
-  tight.residualTolerance = 1e-13;
+  tight.tolerance = 1e-13;
   corrector.setOptions(tight);
   for (int k = 1; k <= 50; ++k) {
     const double lambda = 0.9 * std::sin(0.1 * k);
@@ -125,9 +125,9 @@ TEST_CASE("CorrectorOptions::IsValid names the bad option", "[corrector]") {
   std::string why;
   CorrectorOptions options;
   CHECK(options.IsValid(&why));
-  options.residualTolerance = -1.0;
+  options.tolerance = -1.0;
   CHECK_FALSE(options.IsValid(&why));
-  CHECK_THAT(why, Contains("residualTolerance"));
+  CHECK_THAT(why, Contains("corrector.tolerance"));
   options = CorrectorOptions();
   options.maxIterations = 0;
   CHECK_FALSE(options.IsValid(&why));
@@ -205,7 +205,7 @@ struct ReferenceKeller {
     KINSetLinearSolver(mem, ls.get(), J.get());
     KINSetJacFn(mem, &ReferenceKeller::jacobian);
     KINSetMaxSetupCalls(mem, 1);
-    KINSetFuncNormTol(mem, options.residualTolerance);
+    KINSetFuncNormTol(mem, options.tolerance);
     KINSetScaledStepTol(mem, options.stepTolerance);
     KINSetNumMaxIters(mem, options.maxIterations);
     KINSetMaxNewtonStep(mem, 1e100);
@@ -255,7 +255,7 @@ TEST_CASE("Corrector's dense linear solver: the same Newton iterates as KINSOL's
   int converged = 0;
   for (const Case &c : cases) {
     CorrectorOptions options;
-    options.residualTolerance = 1e-13;
+    options.tolerance = 1e-13;
     Corrector corrector(*c.problem, options);
     Vector x(c.predictor.size()), xr;
     const CorrectorSummary summary = corrector.correct(c.predictor, c.tangent, x);
@@ -296,7 +296,7 @@ TEST_CASE("Corrector's lean Newton: KINSOL's outcome bit for bit on every path w
       CorrectorOptions options;
       options.maxIterations = trial % 7 == 3 ? 1 : 10;
       if (trial % 11 == 5) options.maxNewtonStep = 1e-3;
-      if (trial % 13 == 7) options.residualTolerance = 1e-300;  // only the step tolerance can stop it
+      if (trial % 13 == 7) options.tolerance = 1e-300;  // only the step tolerance can stop it
       const bool useBordered = trial % 2 == 1;
       Vector predictor(n + 1), tangent(n + 1);
       for (int i = 0; i <= n; ++i) {

@@ -19,7 +19,7 @@ TEST_CASE("Curve zeros: the branch-point curve crosses λ = 0 at μ = ±√2", "
   TracerOptions options;
   options.lambdaMin = -3.0;
   options.lambdaMax = 3.0;
-  options.computeStability = false;
+  options.detection.stability = false;
   const CurveTest zeroLoad = [](ConstVectorRef W, double, double& g) {
     g = W[2];
     return true;
@@ -47,7 +47,7 @@ TEST_CASE("Curve zeros: the cusp located on a fold curve, where μ turns", "[cur
   FoldCurveProblem curve(toy, c);
   TracerOptions options;
   options.lambdaMax = 2.0;
-  options.computeStability = false;
+  options.detection.stability = false;
   const Branch branch = trace(curve, U0, 1.5, InitialDirection::decreasingLambda(), options);
   const CurveTest cusp = [&](ConstVectorRef U, double mu, double& g) { return curve.cuspTest(U, mu, g); };
   const auto zeros = locateCurveZeros(curve, branch, cusp);
@@ -65,7 +65,7 @@ TEST_CASE("Curve zeros: none without a sign change, none on a one-point branch",
   BranchPointCurveProblem curve(toy, Vector::Zero(2), c);
   TracerOptions options;
   options.lambdaMax = 1.0;
-  options.computeStability = false;
+  options.detection.stability = false;
   const Branch branch = trace(curve, W0, 0.0, InitialDirection::increasingLambda(), options);
   const CurveTest positive = [](ConstVectorRef, double mu, double& g) {
     g = 1.0 + mu * mu;

@@ -65,7 +65,7 @@ TEST_CASE("checkDerivatives passes right derivatives in any units", "[derivative
     const DerivativeCheck check =
         checkDerivatives(problem, kPoint.cwiseProduct(s.unknowns), 1.2 * s.parameter);
     INFO(check.message);
-    CHECK(check.ok);
+    CHECK(check.success);
     CHECK(check.maxRelativeError < 1e-7);
     // Every derivative the core uses was compared.
     for (const char *name : {"F_u", "F_lambda", "jacobianApply", "jacobianTransposeApply",
@@ -79,14 +79,14 @@ TEST_CASE("checkDerivatives passes right derivatives in any units", "[derivative
   toys::Bratu bratu(20);
   const DerivativeCheck check = checkDerivatives(bratu, Vector::Constant(20, 0.4), 2.0);
   INFO(check.message);
-  CHECK(check.ok);
+  CHECK(check.success);
   CHECK(check.maxRelativeError < 1e-7);
 }
 
 TEST_CASE("checkDerivatives names the wrong entry of F_u and F_lambda", "[derivative_check]") {
   WrongBratu wrongFu(20, 7, 7, false);
   const DerivativeCheck fu = checkDerivatives(wrongFu, Vector::Constant(20, 0.4), 2.0);
-  CHECK_FALSE(fu.ok);
+  CHECK_FALSE(fu.success);
   const DerivativeComparison *c = fu.find("F_u");
   REQUIRE(c != nullptr);
   CHECK(c->row == 7);
@@ -100,7 +100,7 @@ TEST_CASE("checkDerivatives names the wrong entry of F_u and F_lambda", "[deriva
 
   WrongBratu wrongFl(20, 3, 0, true);
   const DerivativeCheck fl = checkDerivatives(wrongFl, Vector::Constant(20, 0.4), 2.0);
-  CHECK_FALSE(fl.ok);
+  CHECK_FALSE(fl.success);
   CHECK(fl.find("F_lambda")->row == 3);
   CHECK(fl.find("F_lambda")->column == 20);
   CHECK(fl.find("F_u")->maxRelativeError < 1e-7);
@@ -112,7 +112,7 @@ TEST_CASE("checkDerivatives catches a wrong second derivative and a wrong produc
     const ProblemScales s = second.scales();
     const DerivativeCheck check = checkDerivatives(second, kPoint.cwiseProduct(s.unknowns), 1.2 * s.parameter);
     INFO(check.message);
-    CHECK_FALSE(check.ok);
+    CHECK_FALSE(check.success);
     CHECK(check.find("F_u")->maxRelativeError < 1e-7);
     const DerivativeComparison *c = check.find("jacobianDirectionalDerivative");
     CHECK(c->row == 1);
@@ -121,7 +121,7 @@ TEST_CASE("checkDerivatives catches a wrong second derivative and a wrong produc
 
     WrongProduct product(unit, 1.0 / unit, unit, unit * unit);
     const DerivativeCheck p = checkDerivatives(product, kPoint.cwiseProduct(s.unknowns), 1.2 * s.parameter);
-    CHECK_FALSE(p.ok);
+    CHECK_FALSE(p.success);
     CHECK(p.find("jacobianApply")->maxRelativeError > 1e-2);
     CHECK(p.find("jacobianTransposeApply")->maxRelativeError < 1e-7);
     CHECK(p.message.rfind("jacobianApply", 0) == 0);
@@ -139,23 +139,23 @@ TEST_CASE("checkDerivatives: a residual-only problem's derivatives are consisten
   const ProblemScales s = numeric.scales();
   const DerivativeCheck check = checkDerivatives(numeric, kPoint.cwiseProduct(s.unknowns), 1.2 * s.parameter);
   INFO(check.message);
-  CHECK(check.ok);
+  CHECK(check.success);
 }
 
 TEST_CASE("checkDerivatives refuses invalid input with a reason", "[derivative_check]") {
   toys::Bratu bratu(4);
   const DerivativeCheck size = checkDerivatives(bratu, Vector::Zero(3), 1.0);
-  CHECK_FALSE(size.ok);
+  CHECK_FALSE(size.success);
   CHECK(size.message.find("size N = 4") != std::string::npos);
   DerivativeCheckOptions options;
   options.direction = Vector::Ones(2);
   const DerivativeCheck direction = checkDerivatives(bratu, Vector::Zero(4), 1.0, options);
-  CHECK_FALSE(direction.ok);
+  CHECK_FALSE(direction.success);
   CHECK(direction.message.find("direction must be empty or have size N + 1 = 5") != std::string::npos);
   // A point the problem refuses: reported, not thrown.
   toys::LineWithDomain domain(0.5);
   const DerivativeCheck refused = checkDerivatives(domain, Vector::Constant(1, 0.5), 0.0);
-  CHECK_FALSE(refused.ok);
+  CHECK_FALSE(refused.success);
   CHECK(std::isinf(refused.maxRelativeError));
   CHECK(refused.message.find("refused") != std::string::npos);
 }

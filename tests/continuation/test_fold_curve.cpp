@@ -72,10 +72,10 @@ TEST_CASE("Fold curve: traced through the cusp, on μ = 3x²/2, λ = −x³", "[
   TracerOptions options;
   options.maxPoints = 500;
   options.lambdaMax = 0.97;  // μ: back out to x ≈ −0.804
-  options.newtonTolerance = 1e-12;
-  options.maxStep = 0.05;
-  options.detectBranchPoints = false;
-  options.computeStability = false;
+  options.corrector.tolerance = 1e-12;
+  options.step.maxStep = 0.05;
+  options.detection.branchPoints = false;
+  options.detection.stability = false;
   const Branch branch = trace(curve, U0, 0.96, InitialDirection::decreasingLambda(), options);
   REQUIRE(branch.stopReason == StopReason::LambdaRange);
   const double xMin = checkCuspFoldPoints(branch);
@@ -154,14 +154,14 @@ TEST_CASE("Minimal fold curve: traced with the bordered solver through the cusp,
   TracerOptions options;
   options.maxPoints = 500;
   options.lambdaMax = 0.97;
-  options.newtonTolerance = 1e-12;
-  options.maxStep = 0.05;
-  options.detectBranchPoints = false;
-  options.detectFolds = false;
-  options.computeStability = false;
+  options.corrector.tolerance = 1e-12;
+  options.step.maxStep = 0.05;
+  options.detection.branchPoints = false;
+  options.detection.folds = false;
+  options.detection.stability = false;
   options.linearAlgebra = TracerOptions::LinearAlgebra::Structured;
-  options.onStep = [&curve](const Branch& b) {
-    curve.adaptBorders(b.points.back().u, b.points.back().lambda);
+  options.onStep = [&curve](const StepInfo& step) {
+    curve.adaptBorders(step.point.u, step.point.lambda);
     return StepAction::Continue;
   };
   const Branch branch = trace(curve, MinimalFoldCurveProblem::start(u, -0.512), 0.96,

@@ -109,14 +109,14 @@ TEST_CASE("Tracer: a flag set while tracing stops within one step", "[interrupt]
   toys::Circle problem;
   std::atomic<bool> flag{false};
   TracerOptions options;
-  options.maxStep = 0.01;
-  options.initialStep = 0.01;
+  options.step.maxStep = 0.01;
+  options.step.initialStep = 0.01;
   options.maxPoints = 100000;  // the whole circle many times over: only the flag ends it
   options.interrupt.watch(&flag, "stop requested");
   int calls = 0;
-  options.onStep = [&](const Branch &branch) {
+  options.onStep = [&](const StepInfo &step) {
     ++calls;
-    if (branch.points.size() == 20) flag = true;  // as a signal handler would
+    if (step.pointCount == 20) flag = true;  // as a signal handler would
     return StepAction::Continue;
   };
   const Branch b = trace(problem, Vector::Constant(1, 1.0), 0.0, InitialDirection::increasingLambda(), options);
@@ -130,11 +130,11 @@ TEST_CASE("Tracer: a flag set while tracing stops within one step", "[interrupt]
 TEST_CASE("Tracer: the step callback sees every point and can stop the branch", "[interrupt]") {
   toys::Circle problem;
   TracerOptions options;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   std::vector<double> seen;
-  options.onStep = [&](const Branch &branch) {
-    seen.push_back(branch.points.back().lambda);
-    return branch.points.size() >= 7 ? StepAction::Stop : StepAction::Continue;
+  options.onStep = [&](const StepInfo &step) {
+    seen.push_back(step.point.lambda);
+    return step.pointCount >= 7 ? StepAction::Stop : StepAction::Continue;
   };
   const Branch b = trace(problem, Vector::Constant(1, 1.0), 0.0, InitialDirection::increasingLambda(), options);
   REQUIRE(b.stopReason == StopReason::Interrupted);
@@ -149,11 +149,11 @@ TEST_CASE("Tracer: the step callback's Join ends the branch as a regular end, an
   // start (within its last step), as deflated continuation closes an isola.
   toys::Circle problem;
   TracerOptions options;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   options.maxPoints = 10000;
   bool below = false;  // the branch has been at λ < 0 (past half way round)
-  options.onStep = [&](const Branch &branch) {
-    const ContinuationPoint &p = branch.points.back();
+  options.onStep = [&](const StepInfo &step) {
+    const ContinuationPoint &p = step.point;
     below = below || p.lambda < 0.0;
     return below && p.lambda >= 0.0 && p.u[0] > 0.0 ? StepAction::Join : StepAction::Continue;
   };
@@ -170,11 +170,11 @@ TEST_CASE("Tracer: the step callback's Join ends the branch as a regular end, an
 
   // In a tree, a joined branch does not stop the others (an interrupted one would).
   TracerOptions joinAtFive = options, stopAtFive = options;
-  joinAtFive.onStep = [](const Branch &branch) {
-    return branch.points.size() >= 5 ? StepAction::Join : StepAction::Continue;
+  joinAtFive.onStep = [](const StepInfo &step) {
+    return step.pointCount >= 5 ? StepAction::Join : StepAction::Continue;
   };
-  stopAtFive.onStep = [](const Branch &branch) {
-    return branch.points.size() >= 5 ? StepAction::Stop : StepAction::Continue;
+  stopAtFive.onStep = [](const StepInfo &step) {
+    return step.pointCount >= 5 ? StepAction::Stop : StepAction::Continue;
   };
   const std::vector<InitialDirection> both{InitialDirection::increasingLambda(), InitialDirection::decreasingLambda()};
   const BranchTree joined = traceTree(problem, Vector::Constant(1, 1.0), 0.0, both, joinAtFive, TreeOptions());
@@ -202,9 +202,9 @@ TEST_CASE("traceTree: both start directions, and an interrupt stops the tree wit
   TracerOptions options;
   options.lambdaMin = -0.3;
   options.lambdaMax = 0.8;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   TreeOptions treeOptions;
-  treeOptions.maxDepth = 1;
+  treeOptions.branchSwitching = 1;
   std::set<int> finished;
   treeOptions.onBranch = [&](const BranchTree &tree, const Branch &b) {
     // a branch as it joins the tree; a root again each time it went on (traced lazily)

@@ -47,7 +47,7 @@ TEST_CASE("Cubic folds at lambda = +-2/3, not reported again as branch points", 
   TracerOptions options;
   options.lambdaMin = -3.0;
   options.lambdaMax = 3.0;
-  options.maxStep = 0.2;
+  options.step.maxStep = 0.2;
   const double u0 = -2.5, lambda0 = -u0 + u0 * u0 * u0 / 3.0;
   const Branch branch = trace(cubic, vec1(u0), lambda0, InitialDirection::increasingLambda(), options);
   CHECK(branch.stopReason == StopReason::LambdaRange);
@@ -76,7 +76,7 @@ TEST_CASE("Folds with detection off are not mistaken for branch points", "[locat
   TracerOptions options;
   options.lambdaMin = -3.0;
   options.lambdaMax = 3.0;
-  options.detectFolds = false;
+  options.detection.folds = false;
   const double u0 = -2.5, lambda0 = -u0 + u0 * u0 * u0 / 3.0;
   const Branch branch = trace(cubic, vec1(u0), lambda0, InitialDirection::increasingLambda(), options);
   CHECK(branch.stopReason == StopReason::LambdaRange);
@@ -88,7 +88,7 @@ TEST_CASE("Bratu fold: F = 0 and F_u singular to the reported accuracy", "[locat
   const int n = 20;
   toys::Bratu bratu(n);
   TracerOptions options;
-  options.maxStep = 0.5;
+  options.step.maxStep = 0.5;
   options.maxPoints = 60;
   options.lambdaMin = -1.0;
   const Branch branch = trace(bratu, Vector::Zero(n), 0.0, InitialDirection::increasingLambda(), options);
@@ -119,7 +119,7 @@ TEST_CASE("Symmetric pitchforks located at lambda = 0 and lambda = c", "[locator
   toys::TwoPitchforks problem(c);
   TracerOptions options;
   options.lambdaMax = 1.0;
-  options.maxStep = 0.07;
+  options.step.maxStep = 0.07;
   const Branch branch = trace(problem, Vector::Zero(2), -0.3, InitialDirection::increasingLambda(), options);
   CHECK(branch.stopReason == StopReason::LambdaRange);
   const auto bps = branch.specialPointsOfType(SpecialPointType::BranchPoint);
@@ -149,8 +149,8 @@ TEST_CASE("Two branch points inside one step are separated and each located once
   const double c = 1e-3;
   toys::TwoPitchforks problem(c);
   TracerOptions options;
-  options.initialStep = 0.05;
-  options.maxStep = 0.05;
+  options.step.initialStep = 0.05;
+  options.step.maxStep = 0.05;
   options.lambdaMax = 0.2;
   const Branch branch = trace(problem, Vector::Zero(2), -0.37, InitialDirection::increasingLambda(), options);
   const auto bps = branch.specialPointsOfType(SpecialPointType::BranchPoint);
@@ -176,8 +176,8 @@ TEST_CASE("Two branch points inside one step are separated and each located once
 TEST_CASE("Double zero: one branch point of multiplicity 2", "[locator]") {
   toys::DoubleZero problem;
   TracerOptions options;
-  options.initialStep = 0.05;
-  options.maxStep = 0.05;
+  options.step.initialStep = 0.05;
+  options.step.maxStep = 0.05;
   options.lambdaMax = 0.2;
   const Branch branch = trace(problem, Vector::Zero(2), -0.37, InitialDirection::increasingLambda(), options);
   const auto bps = branch.specialPointsOfType(SpecialPointType::BranchPoint);
@@ -209,7 +209,7 @@ TEST_CASE("Transcritical branch point at the origin", "[locator]") {
   CHECK(bps[0]->inertiaAfter == 1);
 
   SECTION("detection toggles") {
-    options.detectBranchPoints = false;
+    options.detection.branchPoints = false;
     const Branch quiet = trace(problem, vec1(0.0), -0.5, InitialDirection::increasingLambda(), options);
     CHECK(quiet.specialPointsOfType(SpecialPointType::BranchPoint).empty());
     CHECK(quiet.stopReason == StopReason::LambdaRange);
@@ -219,7 +219,7 @@ TEST_CASE("Transcritical branch point at the origin", "[locator]") {
 TEST_CASE("Fold detection can be switched off", "[locator]") {
   toys::Circle circle;
   TracerOptions options;
-  options.detectFolds = false;
+  options.detection.folds = false;
   options.maxArclength = 3.0;
   const Branch branch = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), options);
   CHECK(branch.specialPointsOfType(SpecialPointType::Fold).empty());

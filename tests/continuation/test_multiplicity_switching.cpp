@@ -52,7 +52,7 @@ TracerOptions options() {
   TracerOptions o;
   o.lambdaMin = -1.0;
   o.lambdaMax = 1.0;
-  o.maxStep = 0.05;
+  o.step.maxStep = 0.05;
   o.maxPoints = 40;
   return o;
 }

@@ -85,7 +85,7 @@ TEST_CASE("Augmented Newton reaches the exact root and reports the last update",
   far << 1.5, 1.4;
   const AugmentedNewtonResult limited = augmentedNewton(system, far, 1, 1e-12, 20, 1e-3);
   CHECK_FALSE(limited.converged);
-  CHECK_THAT(limited.failure, Contains("left the step"));
+  CHECK_THAT(limited.message, Contains("left the step"));
   CHECK(far[0] == 1.5);  // restored
 }
 
@@ -116,7 +116,7 @@ TEST_CASE("Augmented Newton pivots past a zero leading entry and stops on a sing
   s << 0.0, 0.5;
   const AugmentedNewtonResult failed = augmentedNewton(singular, s, 1, 1e-12, 20, 10.0);
   CHECK_FALSE(failed.converged);
-  CHECK_THAT(failed.failure, Contains("singular"));
+  CHECK_THAT(failed.message, Contains("singular"));
   CHECK(s[0] == 0.0);  // restored
   CHECK(s[1] == 0.5);
 
@@ -130,7 +130,7 @@ TEST_CASE("Augmented Newton pivots past a zero leading entry and stops on a sing
     };
     Vector t(2);
     t << 0.0, 0.0;
-    CHECK_THAT(augmentedNewton(tiny, t, 1, 1e-12, 20, 10.0).failure, Contains("singular"));
+    CHECK_THAT(augmentedNewton(tiny, t, 1, 1e-12, 20, 10.0).message, Contains("singular"));
   }
 }
 

@@ -91,9 +91,9 @@ class BoundedOppositeCrossings : public OppositeCrossings {
 // Big fixed steps so that one step spans the whole event.
 TracerOptions bigSteps(double lambdaMax, bool certified) {
   TracerOptions o;
-  o.initialStep = o.maxStep = 0.1;
+  o.step.initialStep = o.step.maxStep = 0.1;
   o.lambdaMax = lambdaMax;
-  o.certifiedCounting = certified;
+  o.detection.certifiedCounting = certified;
   return o;
 }
 

@@ -6,8 +6,8 @@
 using namespace buckle::continuation;
 
 namespace {
-StepSizeControl control() {
-  StepSizeControl c;
+StepOptions control() {
+  StepOptions c;
   c.minStep = 1e-6;
   c.maxStep = 1.0;
   c.targetNewtonIterations = 4;
@@ -19,7 +19,7 @@ StepSizeControl control() {
 }  // namespace
 
 TEST_CASE("Next step scales by target/iterations within [stepShrink, stepGrowth]", "[step_control]") {
-  const StepSizeControl c = control();
+  const StepOptions c = control();
   CHECK(c.next(0.1, 4, 0.0) == 0.1);          // on target: unchanged
   CHECK(c.next(0.1, 2, 0.0) == 0.1 * 2.0);    // 4/2 = 2 = stepGrowth
   CHECK(c.next(0.1, 1, 0.0) == 0.1 * 2.0);    // one iteration: the full growth
@@ -29,14 +29,14 @@ TEST_CASE("Next step scales by target/iterations within [stepShrink, stepGrowth]
 }
 
 TEST_CASE("Slow Newton contraction caps the next step's factor at 0.7", "[step_control]") {
-  const StepSizeControl c = control();
+  const StepOptions c = control();
   CHECK(c.next(0.1, 1, 0.5) == 0.1 * 0.7);
   CHECK(c.next(0.1, 1, 0.3) == 0.1 * 2.0);    // at the threshold: not slow
   CHECK(c.next(0.1, 10, 0.5) == 0.1 * 0.4);   // already below 0.7
 }
 
 TEST_CASE("Steps stay in [minStep, maxStep], halving below minStep reports failure", "[step_control]") {
-  const StepSizeControl c = control();
+  const StepOptions c = control();
   CHECK(c.next(0.8, 1, 0.0) == 1.0);
   CHECK(c.next(2e-6, 40, 0.0) == 1e-6);
   double ds = 4e-6;
@@ -49,8 +49,8 @@ TEST_CASE("Steps stay in [minStep, maxStep], halving below minStep reports failu
 }
 
 TEST_CASE("Curvature rule: the next step aims at the target contraction and turning angle", "[step_control]") {
-  StepSizeControl c = control();
-  c.rule = StepSizeControl::Rule::Curvature;
+  StepOptions c = control();
+  c.rule = StepOptions::Rule::Curvature;
   c.targetContraction = 0.2;
   c.targetAngle = 0.2;
   StepObservation s;
@@ -81,8 +81,8 @@ TEST_CASE("Curvature rule: the next step aims at the target contraction and turn
 }
 
 TEST_CASE("NewtonCount rule through the observation is the iteration-count rule", "[step_control]") {
-  StepSizeControl c = control();
-  c.rule = StepSizeControl::Rule::NewtonCount;
+  StepOptions c = control();
+  c.rule = StepOptions::Rule::NewtonCount;
   StepObservation s;
   s.newtonIterations = 5;
   s.turningAngle = 1.0;  // ignored by this rule

@@ -22,7 +22,7 @@ namespace {
 double tolerance(double lambda) { return 1e-12 * std::max(1.0, std::abs(lambda)); }
 
 TracerOptions structuredOptions(TracerOptions options) {
-  options.maxDenseLocationDimension = 1;  // every N is "large": the O(N) path
+  options.location.maxDenseDimension = 1;  // every N is "large": the O(N) path
   return options;
 }
 
@@ -82,7 +82,7 @@ TEST_CASE("Structured path: Bratu fold equals the dense refinement, with its nul
   const int n = 20;
   toys::Bratu bratu(n);
   TracerOptions options;
-  options.maxStep = 0.5;
+  options.step.maxStep = 0.5;
   options.maxPoints = 60;
   options.lambdaMin = -1.0;
   const Branch dense = trace(bratu, Vector::Zero(n), 0.0, InitialDirection::increasingLambda(), options);
@@ -183,7 +183,7 @@ TEST_CASE("StructuredRefinement converges from a rough start to the pitchfork an
   const Vector tu = (Vector(3) << 1.0, 0.0, 0.0).finished();
   const StructuredRefinementResult f = refinement.fold(u, lambda, tu, v, 0.1);
   CHECK_FALSE(f.converged);
-  CHECK_FALSE(f.failure.empty());
+  CHECK_FALSE(f.message.empty());
   CHECK(lambda == 0.25);
   CHECK(u.norm() == 0.0);
 }

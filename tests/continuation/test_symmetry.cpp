@@ -93,9 +93,9 @@ TEST_CASE("Reflection: the mirrored child of a symmetric pitchfork equals the tr
   toys::TwoPitchforks problem(0.5);
   TracerOptions options;
   options.lambdaMax = 0.8;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   TreeOptions plain;
-  plain.maxDepth = 2;
+  plain.branchSwitching = 2;
   const BranchTree traced =
       traceTree(problem, Vector::Zero(2), -0.3, {InitialDirection::increasingLambda()}, options, plain);
   TreeOptions withMirror = plain;
@@ -129,9 +129,9 @@ TEST_CASE("Reflection: a branch point whose direction the reflection does not re
   TracerOptions options;
   options.lambdaMin = -0.5;
   options.lambdaMax = 0.5;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   TreeOptions plain;
-  plain.maxDepth = 1;
+  plain.branchSwitching = 1;
   TreeOptions withMirror = plain;
   withMirror.symmetry.signs = Vector::Constant(1, -1.0);
   const BranchTree a =
@@ -146,7 +146,7 @@ TEST_CASE("Reflection: a branch point whose direction the reflection does not re
 TEST_CASE("Reflection: invalid signs are refused by the tree driver", "[symmetry]") {
   toys::TwoPitchforks problem(0.5);
   TreeOptions tree;
-  tree.maxDepth = 1;
+  tree.branchSwitching = 1;
   tree.symmetry.signs = Vector::Constant(3, -1.0);  // the problem has 2 unknowns
   const BranchTree t =
       traceTree(problem, Vector::Zero(2), -0.3, {InitialDirection::increasingLambda()}, TracerOptions(), tree);

@@ -20,69 +20,6 @@ namespace {
 Vector vec1(double a) { return (Vector(1) << a).finished(); }
 }  // namespace
 
-TEST_CASE("TracerOptions::IsValid rejects bad options and names them", "[tracer]") {
-  std::string why;
-  TracerOptions ok;
-  CHECK(ok.IsValid(&why));
-
-  TracerOptions o;
-  o.initialStep = -0.1;
-  CHECK_FALSE(o.IsValid(&why));
-  CHECK_THAT(why, Contains("initialStep"));
-
-  o = TracerOptions();
-  o.minStep = -1e-3;
-  CHECK_FALSE(o.IsValid(&why));
-  CHECK_THAT(why, Contains("minStep"));
-
-  o = TracerOptions();
-  o.minStep = 0.5;
-  o.maxStep = 0.1;
-  CHECK_FALSE(o.IsValid(&why));
-  CHECK_THAT(why, Contains("minStep"));
-  CHECK_THAT(why, Contains("maxStep"));
-
-  o = TracerOptions();
-  o.maxStep = std::nan("");
-  CHECK_FALSE(o.IsValid(&why));
-  CHECK_THAT(why, Contains("maxStep"));
-
-  o = TracerOptions();
-  o.lambdaMin = std::nan("");
-  CHECK_FALSE(o.IsValid(&why));
-  CHECK_THAT(why, Contains("lambdaMin"));
-
-  o = TracerOptions();
-  o.lambdaMin = 2.0;
-  o.lambdaMax = 1.0;
-  CHECK_FALSE(o.IsValid(&why));
-  CHECK_THAT(why, Contains("lambdaMin"));
-
-  o = TracerOptions();
-  o.locationTolerance = 0.0;
-  CHECK_FALSE(o.IsValid(&why));
-  CHECK_THAT(why, Contains("locationTolerance"));
-
-  o = TracerOptions();
-  o.maxPoints = 1;
-  CHECK_FALSE(o.IsValid(&why));
-  CHECK_THAT(why, Contains("maxPoints"));
-
-  o = TracerOptions();
-  o.boxLower = Vector::Zero(2);
-  CHECK_FALSE(o.IsValid(&why));
-  CHECK_THAT(why, Contains("boxLower"));
-
-  // A tracer built with invalid options says so instead of running.
-  toys::Circle circle;
-  o = TracerOptions();
-  o.initialStep = std::nan("");
-  const Branch branch = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), o);
-  CHECK(branch.stopReason == StopReason::InvalidOptions);
-  CHECK_THAT(branch.stopMessage, Contains("initialStep"));
-  CHECK(branch.points.empty());
-}
-
 TEST_CASE("Bad input to the tracer is reported in the branch, never thrown", "[tracer]") {
   // A problem without unknowns: the tracer cannot build a corrector for it.
   struct Empty : Problem {
@@ -109,8 +46,8 @@ TEST_CASE("Bad input to the tracer is reported in the branch, never thrown", "[t
 TEST_CASE("Circle: both folds located exactly, points on the circle", "[tracer]") {
   toys::Circle circle;
   TracerOptions options;
-  options.initialStep = 0.05;
-  options.maxStep = 0.1;
+  options.step.initialStep = 0.05;
+  options.step.maxStep = 0.1;
   options.maxArclength = 2.0 * M_PI - 0.3;
   const Branch branch = trace(circle, vec1(1.02), 0.0, InitialDirection::increasingLambda(), options);
   REQUIRE(branch.points.size() > 10);
@@ -146,10 +83,10 @@ TEST_CASE("Circle: both folds located exactly, points on the circle", "[tracer]"
 TEST_CASE("Second-order predictor: same circle and folds with fewer Newton iterations", "[tracer]") {
   toys::Circle circle;
   TracerOptions options;
-  options.initialStep = options.maxStep = 0.1;  // the same steps for both predictors
+  options.step.initialStep = options.step.maxStep = 0.1;  // the same steps for both predictors
   options.maxArclength = 2.0 * M_PI - 0.3;
   const Branch first = trace(circle, vec1(1.02), 0.0, InitialDirection::increasingLambda(), options);
-  options.secondOrderPredictor = true;
+  options.step.secondOrderPredictor = true;
   const Branch second = trace(circle, vec1(1.02), 0.0, InitialDirection::increasingLambda(), options);
   REQUIRE(first.points.size() > 10);
   REQUIRE(second.points.size() > 10);
@@ -187,7 +124,7 @@ TEST_CASE("TracerOptions::leanNewton: the same branch and special points, bit fo
   options.maxArclength = 2.0 * M_PI - 0.3;
   toys::Circle circle;
   const Branch kinsol = trace(circle, vec1(1.02), 0.0, InitialDirection::increasingLambda(), options);
-  options.leanNewton = true;
+  options.corrector.leanNewton = true;
   const Branch lean = trace(circle, vec1(1.02), 0.0, InitialDirection::increasingLambda(), options);
   REQUIRE(kinsol.specialPointsOfType(SpecialPointType::Fold).size() == 2);
   same(kinsol, lean);
@@ -198,7 +135,7 @@ TEST_CASE("TracerOptions::leanNewton: the same branch and special points, bit fo
   p.lambdaMax = 3.0;
   const Vector u0 = Vector::Zero(pitchforks.dimension());
   const Branch k2 = trace(pitchforks, u0, -3.0, InitialDirection::increasingLambda(), p);
-  p.leanNewton = true;
+  p.corrector.leanNewton = true;
   const Branch l2 = trace(pitchforks, u0, -3.0, InitialDirection::increasingLambda(), p);
   REQUIRE(!k2.specialPointsOfType(SpecialPointType::BranchPoint).empty());
   same(k2, l2);
@@ -231,17 +168,17 @@ class CloseFolds : public Problem {
 // the pitchforks below: whole steps land on it to rounding).
 template <class Check>
 void forEveryStepSetting(Check check) {
-  for (const auto rule : {StepSizeControl::Rule::Curvature, StepSizeControl::Rule::NewtonCount})
+  for (const auto rule : {StepOptions::Rule::Curvature, StepOptions::Rule::NewtonCount})
     for (const bool secondOrder : {false, true})
       for (const double growth : {1.5, 3.0})
         for (const double maxStep : {0.05, 0.1, 0.2, 0.3, 0.5, 1.0, 1.5, 2.0}) {
           TracerOptions options;
-          options.stepRule = rule;
-          options.foldPairGuard = true;
-          options.secondOrderPredictor = secondOrder;
-          options.stepGrowth = growth;
-          options.maxStep = maxStep;
-          options.initialStep = std::min(0.1, maxStep);
+          options.step.rule = rule;
+          options.step.foldPairGuard = true;
+          options.step.secondOrderPredictor = secondOrder;
+          options.step.stepGrowth = growth;
+          options.step.maxStep = maxStep;
+          options.step.initialStep = std::min(0.1, maxStep);
           check(options);
         }
 }
@@ -261,7 +198,7 @@ TEST_CASE("No step jumps over two close folds undetected, at any step setting", 
     CHECK(std::abs(folds[0]->lambda - fold) <= 1e-12);
     CHECK(std::abs(folds[1]->lambda + fold) <= 1e-12);
     // The same settings without the guard: a step may well span both folds and see neither.
-    options.foldPairGuard = false;
+    options.step.foldPairGuard = false;
     const Branch blind = trace(problem, vec1(u0), lambda0, InitialDirection::increasingLambda(), options);
     if (blind.specialPointsOfType(SpecialPointType::Fold).empty()) ++stepsOverBoth;
   });
@@ -293,8 +230,8 @@ TEST_CASE("No step jumps over two close branch points undetected, at any step se
     forEveryStepSetting([&](TracerOptions options) {
       options.lambdaMax = 3.0;
       const Branch branch = trace(problem, Vector::Zero(2), -3.0, InitialDirection::increasingLambda(), options);
-      INFO("c " << c << " rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " growth "
-                << options.stepGrowth << " maxStep " << options.maxStep);
+      INFO("c " << c << " rule " << int(options.step.rule) << " P2 " << options.step.secondOrderPredictor << " growth "
+                << options.step.stepGrowth << " maxStep " << options.step.maxStep);
       CHECK(branch.stopReason == StopReason::LambdaRange);
       checkTwoBranchPoints(branch, c, 1e-12);
     });
@@ -305,8 +242,8 @@ TEST_CASE("No step jumps over two close branch points undetected, at any step se
     options.lambdaMax = 2.0;
     const Vector u0 = toys::CurvedPitchforks::shift(-2.0);
     const Branch branch = trace(curved, u0, -2.0, InitialDirection::increasingLambda(), options);
-    INFO("rule " << int(options.stepRule) << " P2 " << options.secondOrderPredictor << " growth " << options.stepGrowth
-                 << " maxStep " << options.maxStep);
+    INFO("rule " << int(options.step.rule) << " P2 " << options.step.secondOrderPredictor << " growth " << options.step.stepGrowth
+                 << " maxStep " << options.step.maxStep);
     checkTwoBranchPoints(branch, 1e-3, 1e-11);
   });
 }
@@ -331,7 +268,7 @@ TEST_CASE("onLocated tells of every special point as it is located, in the probl
     Problem &problem = scaled ? static_cast<Problem &>(big) : plain;
     TracerOptions options;
     options.lambdaMax = 3.0;
-    options.maxStep = 2.0;  // one step over both branch points
+    options.step.maxStep = 2.0;  // one step over both branch points
     std::vector<double> located;
     std::vector<SpecialPointType> types;
     int steps = 0;
@@ -339,7 +276,7 @@ TEST_CASE("onLocated tells of every special point as it is located, in the probl
       located.push_back(sp.lambda);
       types.push_back(sp.type);
     };
-    options.onStep = [&](const Branch &) {
+    options.onStep = [&](const StepInfo &) {
       ++steps;
       return StepAction::Continue;
     };
@@ -361,23 +298,23 @@ TEST_CASE("Curvature step control: tighter tolerances take the same steps, not m
   // The Newton count rule shrinks the steps when the tolerance asks for more iterations; the
   // contraction does not depend on the tolerance.
   toys::Circle circle;
-  auto pointsAt = [&](StepSizeControl::Rule rule, double tolerance) {
+  auto pointsAt = [&](StepOptions::Rule rule, double tolerance) {
     TracerOptions options;
-    options.stepRule = rule;
-    options.maxStep = 1.0;
-    options.minTangentCosine = 0.5;
-    options.targetAngle = 0.3;
-    options.newtonTolerance = tolerance;
+    options.step.rule = rule;
+    options.step.maxStep = 1.0;
+    options.step.minTangentCosine = 0.5;
+    options.step.targetAngle = 0.3;
+    options.corrector.tolerance = tolerance;
     options.maxArclength = 2.0 * M_PI - 0.3;
     const Branch b = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), options);
     for (const ContinuationPoint &p : b.points) CHECK(std::abs(p.u[0] * p.u[0] + p.lambda * p.lambda - 1.0) < 10 * tolerance);
     CHECK(b.specialPointsOfType(SpecialPointType::Fold).size() == 2);
     return b.points.size();
   };
-  const auto curvatureLoose = pointsAt(StepSizeControl::Rule::Curvature, 1e-6);
-  const auto curvatureTight = pointsAt(StepSizeControl::Rule::Curvature, 1e-13);
-  const auto countLoose = pointsAt(StepSizeControl::Rule::NewtonCount, 1e-6);
-  const auto countTight = pointsAt(StepSizeControl::Rule::NewtonCount, 1e-13);
+  const auto curvatureLoose = pointsAt(StepOptions::Rule::Curvature, 1e-6);
+  const auto curvatureTight = pointsAt(StepOptions::Rule::Curvature, 1e-13);
+  const auto countLoose = pointsAt(StepOptions::Rule::NewtonCount, 1e-6);
+  const auto countTight = pointsAt(StepOptions::Rule::NewtonCount, 1e-13);
   CHECK(curvatureTight <= curvatureLoose + 2);
   CHECK(countTight > countLoose + 2);
   // The circle turns by 1 rad per unit arclength: about 2π/0.3 ≈ 20 steps at the target angle,
@@ -388,20 +325,20 @@ TEST_CASE("Curvature step control: tighter tolerances take the same steps, not m
 TEST_CASE("Consecutive tangents respect the branch-jump guard", "[tracer]") {
   toys::Circle circle;
   TracerOptions options;
-  options.initialStep = 0.4;
-  options.maxStep = 0.8;  // 0.8 rad turns per step would violate cos ≥ 0.9
+  options.step.initialStep = 0.4;
+  options.step.maxStep = 0.8;  // 0.8 rad turns per step would violate cos ≥ 0.9
   options.maxPoints = 40;
   const Branch branch = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), options);
   REQUIRE(branch.points.size() == 40);
   CHECK(branch.stopReason == StopReason::MaxPoints);
   for (std::size_t i = 1; i < branch.points.size(); ++i)
-    CHECK(branch.points[i].tangent.dot(branch.points[i - 1].tangent) >= options.minTangentCosine);
+    CHECK(branch.points[i].tangent.dot(branch.points[i - 1].tangent) >= options.step.minTangentCosine);
 }
 
 TEST_CASE("Parameter range end is landed on exactly", "[tracer]") {
   toys::Circle circle;
   TracerOptions options;
-  options.initialStep = 0.03;
+  options.step.initialStep = 0.03;
   options.lambdaMax = 0.5;
   const Branch branch = trace(circle, vec1(1.0), 0.0, InitialDirection::increasingLambda(), options);
   CHECK(branch.stopReason == StopReason::LambdaRange);
@@ -429,8 +366,8 @@ TEST_CASE("Parameter range end is landed on exactly", "[tracer]") {
 TEST_CASE("Boundary g = 0.5 - u is located exactly", "[tracer]") {
   toys::LineWithDomain line(std::numeric_limits<double>::infinity(), true);
   TracerOptions options;
-  options.initialStep = 0.07;
-  options.maxStep = 0.07;
+  options.step.initialStep = 0.07;
+  options.step.maxStep = 0.07;
   const Branch branch = trace(line, vec1(0.0), 0.0, InitialDirection::increasingLambda(), options);
   CHECK(branch.stopReason == StopReason::Boundary);
   const SpecialPoint &bd = branch.specialPoints.back();
@@ -466,9 +403,9 @@ TEST_CASE("Box on (u, lambda) stops on its face", "[tracer]") {
 TEST_CASE("A refused domain stops with the KINSOL flag and keeps the points", "[tracer]") {
   toys::LineWithDomain line(0.3);
   TracerOptions options;
-  options.initialStep = 0.05;
-  options.maxStep = 0.05;
-  options.minStep = 1e-6;
+  options.step.initialStep = 0.05;
+  options.step.maxStep = 0.05;
+  options.step.minStep = 1e-6;
   const Branch branch = trace(line, vec1(0.0), 0.0, InitialDirection::increasingLambda(), options);
   CHECK(branch.stopReason == StopReason::StepSizeTooSmall);
   CHECK_THAT(branch.stopMessage, Contains("step size below minimum after KIN_FIRST_SYSFUNC_ERR"));
@@ -498,7 +435,7 @@ TEST_CASE("Stability is recorded at every point when asked", "[tracer]") {
     REQUIRE(p.stability.valid());
     CHECK(p.stability.negative == (p.u[0] * p.u[0] < 1.0 ? 1 : 0));
   }
-  options.computeStability = false;
+  options.detection.stability = false;
   const Branch without = trace(cubic, vec1(u0), lambda0, InitialDirection::decreasingLambda(), options);
   REQUIRE(without.points.size() > 2);
   for (const ContinuationPoint &p : without.points) CHECK_FALSE(p.stability.valid());
@@ -507,8 +444,8 @@ TEST_CASE("Stability is recorded at every point when asked", "[tracer]") {
 TEST_CASE("Step size grows on an easy branch and is clamped to maxStep", "[tracer]") {
   toys::LineWithDomain line;
   TracerOptions options;
-  options.initialStep = 0.001;
-  options.maxStep = 0.2;
+  options.step.initialStep = 0.001;
+  options.step.maxStep = 0.2;
   options.maxPoints = 40;
   const Branch branch = trace(line, vec1(0.0), 0.0, InitialDirection::increasingLambda(), options);
   REQUIRE(branch.points.size() == 40);
@@ -521,17 +458,17 @@ TEST_CASE("Per-point cost on a 50-unknown Bratu problem", "[.][timing]") {
   toys::Bratu bratu(50);
   TracerOptions options;
   options.maxPoints = 200;
-  options.maxStep = 0.5;
-  options.initialStep = 0.05;
+  options.step.maxStep = 0.5;
+  options.step.initialStep = 0.05;
   const auto t0 = std::chrono::steady_clock::now();
   const Branch branch = trace(bratu, Vector::Zero(50), 0.0, InitialDirection::increasingLambda(), options);
   const auto t1 = std::chrono::steady_clock::now();
   const double us = std::chrono::duration<double, std::micro>(t1 - t0).count();
   std::cout << "Bratu N=50: " << branch.points.size() << " points, " << us / branch.points.size()
             << " us/point (stability on), stop: " << branch.stopMessage << "\n";
-  options.computeStability = false;
-  options.detectBranchPoints = false;
-  options.detectFolds = false;
+  options.detection.stability = false;
+  options.detection.branchPoints = false;
+  options.detection.folds = false;
   const auto t2 = std::chrono::steady_clock::now();
   const Branch plain = trace(bratu, Vector::Zero(50), 0.0, InitialDirection::increasingLambda(), options);
   const auto t3 = std::chrono::steady_clock::now();
@@ -618,8 +555,8 @@ TEST_CASE("Tiny steps: the fold of the cubic is still found to 1e-12, in scaled 
     INFO("L " << L << " P " << P);
     UnitCubic problem(L, P);
     TracerOptions options;
-    options.initialStep = options.maxStep = 1e-6;
-    options.minStep = 1e-9;
+    options.step.initialStep = options.step.maxStep = 1e-6;
+    options.step.minStep = 1e-9;
     options.maxPoints = 400;
     const double v0 = -1.0 - 1e-4;  // 100 steps before the fold
     const double lambda0 = P * (-v0 + v0 * v0 * v0 / 3.0);
@@ -666,7 +603,7 @@ TEST_CASE("A branch paused at each branch point and continued is the branch trac
   toys::ManyPitchforks problem(6, 0.1);  // branch points at λ = 0, 0.1, …, 0.5
   TracerOptions options;
   options.lambdaMax = 0.75;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   Tracer whole(problem, options);
   const Branch reference = whole.trace(Vector::Zero(6), -0.2, InitialDirection::increasingLambda());
   REQUIRE(reference.stopReason == StopReason::LambdaRange);
@@ -693,7 +630,7 @@ TEST_CASE("A paused branch ended where it stands is interrupted there, with its 
   toys::ManyPitchforks problem(3, 0.1);
   TracerOptions options;
   options.lambdaMax = 0.5;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   Tracer tracer(problem, options);
   tracer.pauseAtBranchPoints(true);
   Branch branch = tracer.trace(Vector::Zero(3), -0.2, InitialDirection::increasingLambda());
@@ -717,8 +654,8 @@ TEST_CASE("A paused trace steps over at most kPausedCrossings branch points at a
   toys::ManyPitchforks problem(40, 0.001);
   TracerOptions options;
   options.lambdaMax = 0.05;
-  options.initialStep = 0.02;
-  options.maxStep = 0.05;
+  options.step.initialStep = 0.02;
+  options.step.maxStep = 0.05;
   Tracer tracer(problem, options);
   tracer.pauseAtBranchPoints(true);
   Branch branch = tracer.trace(Vector::Zero(40), -0.0005, InitialDirection::increasingLambda());

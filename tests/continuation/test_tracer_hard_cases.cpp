@@ -29,8 +29,8 @@ TEST_CASE("A pitchfork reached along its side branch: one BP at the tip, both wa
   for (const double start : {0.6, -0.6})
     for (const double maxStep : {0.013, 0.05, 0.1, 0.2, 0.3, 0.6}) {
       TracerOptions options;
-      options.maxStep = maxStep;
-      options.initialStep = std::min(0.02, maxStep);
+      options.step.maxStep = maxStep;
+      options.step.initialStep = std::min(0.02, maxStep);
       options.lambdaMax = 0.5;
       // through the tip: λ decreases to 0 at u₁ = 0, then grows again on the other side
       const Branch branch = trace(problem, sideBranch(start), start * start, InitialDirection::decreasingLambda(), options);

@@ -36,9 +36,9 @@ inline EquilibriumOptions withWall() {
 inline EquilibriumBranchOptions curledTrace(double to) {
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = to;
-  o.tracer.initialStep = 0.01;
-  o.tracer.maxStep = 0.02;
-  o.switchingDepth = 0;
+  o.tracer.step.initialStep = 0.01;
+  o.tracer.step.maxStep = 0.02;
+  o.tree.branchSwitching = 0;
   return o;
 }
 

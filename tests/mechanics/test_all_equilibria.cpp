@@ -258,8 +258,8 @@ TEST_CASE("n = 5 clamped-pinned: every equilibrium continuation reaches at the l
   EquilibriumBranchOptions opt;
   opt.tracer.lambdaMin = Fx - 0.2;
   opt.tracer.lambdaMax = 0.0;
-  opt.tracer.maxStep = 0.05;
-  opt.switchingDepth = 2;
+  opt.tracer.step.maxStep = 0.05;
+  opt.tree.branchSwitching = 2;
   const EquilibriumBranches tree =
       traceEquilibria(traced, Vector::Zero(5), 0.0, cont::InitialDirection::decreasingLambda(), opt);
   const EndCondition end = EndCondition::clampedPinned(Fx);

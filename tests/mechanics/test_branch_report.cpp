@@ -48,8 +48,8 @@ TEST_CASE("traced through the reaction, a branch is reported against the held co
   EquilibriumBranchOptions opt;
   opt.tracer.lambdaMin = -2.5;
   opt.tracer.lambdaMax = 0.0;
-  opt.tracer.maxStep = 0.05;
-  opt.switchingDepth = 1;
+  opt.tracer.step.maxStep = 0.05;
+  opt.tree.branchSwitching = 1;
   opt.report.heldCoordinate = 0;
   const double x0 = endPose(chain, Eigen::VectorXd::Zero(3))[0];
   opt.report.rangeLow = x0 - 1.0;  // the end moved in by at most one b
@@ -90,8 +90,8 @@ TEST_CASE("a fold with a stable side is a jump, between unstable parts no event"
   EquilibriumBranchOptions opt;
   opt.tracer.lambdaMin = -3.0;
   opt.tracer.lambdaMax = 0.5;
-  opt.tracer.maxStep = 0.05;
-  opt.switchingDepth = 1;
+  opt.tracer.step.maxStep = 0.05;
+  opt.tree.branchSwitching = 1;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), opt);
   int folds = 0;
@@ -121,7 +121,7 @@ TEST_CASE("KMIN: a deep local minimum of Kxx along a stable stretch, scale-free"
     EquilibriumBranchOptions opt;
     opt.tracer.lambdaMin = -2.0 * unit;
     opt.tracer.lambdaMax = 0.0;
-    opt.switchingDepth = 0;
+    opt.tree.branchSwitching = 0;
     opt.report.stiffness = true;
     const EquilibriumBranches r =
         traceEquilibria(problem, q0, 0.0, cont::InitialDirection::decreasingLambda(), opt);
@@ -157,8 +157,8 @@ TEST_CASE("after an interrupt the report skips the post-buckling refinements and
                              EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   EquilibriumBranchOptions o;
   o.tracer.lambdaMin = -1.6;
-  o.tracer.maxStep = 0.05;
-  o.switchingDepth = 0;
+  o.tracer.step.maxStep = 0.05;
+  o.tree.branchSwitching = 0;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
   const cont::Branch& straight = r.tree.branches.at(0);

@@ -189,10 +189,10 @@ TEST_CASE("Tracer on the chain: structured and dense give the same branch and br
   EquilibriumProblem structuredProblem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   EquilibriumProblem denseProblem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   buckle::continuation::TracerOptions options;
-  options.maxStep = 0.05;
+  options.step.maxStep = 0.05;
   options.lambdaMin = -0.6;
   options.maxPoints = 400;
-  options.lowestEigenvalues = 0;  // inertia only: the branch-point test needs nothing more
+  options.detection.lowestEigenvalues = 0;  // inertia only: the branch-point test needs nothing more
   options.linearAlgebra = buckle::continuation::TracerOptions::LinearAlgebra::Structured;
   buckle::continuation::Tracer structured(structuredProblem, options);
   options.linearAlgebra = buckle::continuation::TracerOptions::LinearAlgebra::Dense;

@@ -110,8 +110,8 @@ TEST_CASE("contact: a single segment pushed past its limit carries applied torqu
   EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 0, 1));  // Me = λ
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = 3.0 * springAtLimit;
-  o.tracer.maxStep = 0.1;
-  o.switchingDepth = 0;
+  o.tracer.step.maxStep = 0.1;
+  o.tree.branchSwitching = 0;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(1), 0.0, cont::InitialDirection::increasingLambda(), o);
   const BranchReport& rep = r.reports[0];
@@ -173,10 +173,10 @@ TEST_CASE("contact: a chain's locked branch agrees with an independent Newton so
   EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));  // Fy = λ
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = 6.0;
-  o.tracer.maxStep = 0.1;
-  o.tracer.newtonTolerance = 1e-14;  // the traced points themselves to the comparison's accuracy
+  o.tracer.step.maxStep = 0.1;
+  o.tracer.corrector.tolerance = 1e-14;  // the traced points themselves to the comparison's accuracy
   o.maxContactTorque = 1e3;          // Fy = 6 presses the locked joints with ~40 torque units
-  o.switchingDepth = 0;
+  o.tree.branchSwitching = 0;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
   const BranchReport& rep = r.reports[0];
@@ -272,8 +272,8 @@ TEST_CASE("contact: scaled units give the same contact events after rescaling", 
     EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));
     EquilibriumBranchOptions o;
     o.tracer.lambdaMax = 6.0 * ks * ls;
-    o.tracer.maxStep = 0.1;
-    o.switchingDepth = 0;
+    o.tracer.step.maxStep = 0.1;
+    o.tree.branchSwitching = 0;
     return traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
   };
   const EquilibriumBranches a = run(1.0, 1.0), b = run(Ls, Ks);
@@ -304,9 +304,9 @@ TEST_CASE("contact: a long chain (n = 50) continues locked, O(n) solver and inde
   EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = 0.01;
-  o.tracer.maxStep = 0.1;
-  o.tracer.newtonTolerance = 1e-14;
-  o.switchingDepth = 0;
+  o.tracer.step.maxStep = 0.1;
+  o.tracer.corrector.tolerance = 1e-14;
+  o.tree.branchSwitching = 0;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), o);
   const BranchReport& rep = r.reports[0];
@@ -340,8 +340,8 @@ TEST_CASE("contact: a curled chain's root joint locks and releases where the fre
   EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));  // Fy = λ
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = 1.0;
-  o.tracer.maxStep = 0.1;
-  o.switchingDepth = 0;
+  o.tracer.step.maxStep = 0.1;
+  o.tree.branchSwitching = 0;
   const EquilibriumBranches r = traceEquilibria(problem, q0, 0.0, cont::InitialDirection::increasingLambda(), o);
   const BranchReport& rep = r.reports[0];
   REQUIRE(countType(rep, EventType::Contact) == 1);
@@ -466,9 +466,9 @@ TEST_CASE("contact: a branch point on a locked stretch is switched, its children
 
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = 1.5 * firstCritical;
-  o.tracer.maxStep = 0.05;
+  o.tracer.step.maxStep = 0.05;
   o.tracer.maxPoints = 300;
-  o.switchingDepth = 1;
+  o.tree.branchSwitching = 1;
   const EquilibriumBranches r = traceEquilibria(problem, q0, 0.0, cont::InitialDirection::increasingLambda(), o);
   const cont::Branch& root = r.tree.branches[0];
   const BranchReport& rep = r.reports[0];

@@ -81,7 +81,7 @@ std::vector<SpecialPointReport> baseContacts(const Chain& chain) {
   const double forceUnit = chain.segment(0).parameters().k1 * chain.segment(0).parameters().b1;
   options.tracer.lambdaMin = -2.0 * forceUnit;
   options.tracer.lambdaMax = 0.0;
-  options.switchingDepth = 0;
+  options.tree.branchSwitching = 0;
   const EquilibriumBranches b =
       traceEquilibria(problem, fig10Q0(), 0.0, cont::InitialDirection::decreasingLambda(), options);
   std::vector<SpecialPointReport> found;

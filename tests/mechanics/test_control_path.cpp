@@ -40,8 +40,8 @@ cont::TracerOptions tracerOptions(double lambdaMin, double lambdaMax) {
   o.lambdaMin = lambdaMin;
   o.lambdaMax = lambdaMax;
   o.maxPoints = 5000;
-  o.computeStability = true;
-  o.newtonTolerance = 1e-12;
+  o.detection.stability = true;
+  o.corrector.tolerance = 1e-12;
   return o;
 }
 
@@ -161,7 +161,7 @@ TEST_CASE("equilibrium problem: control derivatives match finite differences", "
       for (int i = 0; i < u.size(); ++i) u[i] = i < n ? 0.3 * std::sin(1.7 * i + 0.4) : 0.2 + 0.1 * i;
       const cont::DerivativeCheck check = cont::checkDerivatives(problem, u, 0.55);
       INFO(check.message);
-      CHECK(check.ok);
+      CHECK(check.success);
       for (const char* name : {"F_lambda", "jacobianApply", "jacobianTransposeApply"}) {
         INFO(name);
         const cont::DerivativeComparison* c = check.find(name);
@@ -236,7 +236,7 @@ TEST_CASE("a fold of the dL0 path lies on the fold curve in (dL0, load) traced f
                             EndCondition::freeEnd(), kPayload, SecondParameter::parse("dL0"));
   REQUIRE(two.secondParameter() == Approx(mu0).epsilon(1e-14));
   cont::TracerOptions to = tracerOptions(0.0, 2.0);
-  to.computeStability = true;
+  to.detection.stability = true;
   const cont::Branch loadPath = cont::trace(two, before.u, 1.0, cont::InitialDirection::increasingLambda(), to);
   const cont::Branch loadBack = cont::trace(two, before.u, 1.0, cont::InitialDirection::decreasingLambda(), to);
   const cont::SpecialPoint* loadFold = nullptr;
@@ -249,9 +249,9 @@ TEST_CASE("a fold of the dL0 path lies on the fold curve in (dL0, load) traced f
   CriticalCurveOptions co;
   co.muMin = fold.lambda;
   co.muMax = mu0 + 1.0;
-  co.tracer.maxStep = 0.05;
+  co.tracer.step.maxStep = 0.05;
   co.tracer.maxPoints = 2000;
-  co.tracer.newtonTolerance = 1e-12;
+  co.tracer.corrector.tolerance = 1e-12;
   const CriticalCurve curve = foldCurve(two, *loadFold, co);
   REQUIRE(curve.type == "LP");
   const CriticalPoint* at = nullptr;
@@ -294,7 +294,7 @@ TEST_CASE("an actuation history snaps at the dL0 fold and lands on an equilibriu
   LoadHistoryOptions options;
   options.tracer = tracerOptions(-3.0, 3.0);
   const LoadHistoryResult h = followLoadHistory(actuated, loaded(chain, kPayload), {0.0, -3.0, 3.0}, options);
-  CHECK(h.completed);
+  CHECK(h.success);
   REQUIRE(!h.jumps.empty());
   const JumpRecord& j = h.jumps.front();
   CHECK(j.trigger == JumpTrigger::Fold);

@@ -28,9 +28,9 @@ CriticalCurveOptions curveOptions(double muMin, double muMax) {
   CriticalCurveOptions o;
   o.muMin = muMin;
   o.muMax = muMax;
-  o.tracer.maxStep = 0.05;
+  o.tracer.step.maxStep = 0.05;
   o.tracer.maxPoints = 400;
-  o.tracer.newtonTolerance = 1e-12;
+  o.tracer.corrector.tolerance = 1e-12;
   return o;
 }
 
@@ -269,7 +269,7 @@ namespace {
 // The first fold of the chain under an end torque Me (the eccentricity), traced from zero load.
 cont::Branch imperfectPath(ChainParameterProblem& p) {
   cont::TracerOptions to;
-  to.maxStep = 0.05;
+  to.step.maxStep = 0.05;
   to.lambdaMin = -20;
   to.maxPoints = 400;
   const Vector u0 = p.equilibrium().initialGuess(Vector::Zero(3), 0.0);
@@ -426,13 +426,14 @@ ChainParameterProblem snappingChain(int n, double Fx) {
 // The first fold of the torque path, located by the tracer (structured above its crossover).
 cont::SpecialPoint firstFold(ChainParameterProblem& p) {
   cont::TracerOptions to;
-  to.maxStep = 0.1;
+  to.step.maxStep = 0.1;
   to.lambdaMax = 10.0;
   to.maxPoints = 3000;
-  to.lowestEigenvalues = 0;
-  to.onStep = [](const cont::Branch& b) {
-    return b.specialPointsOfType(cont::SpecialPointType::Fold).empty() ? cont::StepAction::Continue
-                                                                        : cont::StepAction::Stop;
+  to.detection.lowestEigenvalues = 0;
+  to.onStep = [](const cont::StepInfo& step) {
+    for (const cont::SpecialPoint& sp : step.specialPoints)
+      if (sp.type == cont::SpecialPointType::Fold) return cont::StepAction::Stop;
+    return cont::StepAction::Continue;
   };
   const int n = p.equilibrium().segments();
   const cont::Branch path = cont::trace(p.equilibrium(), p.equilibrium().initialGuess(Vector::Zero(n), 0.0), 0.0,
@@ -446,12 +447,13 @@ cont::SpecialPoint firstFold(ChainParameterProblem& p) {
 // (or above) λ from u ± εv (off the singular point), traced toward λ until the tracer locates the fold.
 cont::SpecialPoint foldNear(ChainParameterProblem& p, const Vector& u, double lambda, const Vector& v) {
   cont::TracerOptions to;
-  to.maxStep = 0.01;
+  to.step.maxStep = 0.01;
   to.maxPoints = 200;
-  to.lowestEigenvalues = 0;
-  to.onStep = [](const cont::Branch& b) {
-    return b.specialPointsOfType(cont::SpecialPointType::Fold).empty() ? cont::StepAction::Continue
-                                                                        : cont::StepAction::Stop;
+  to.detection.lowestEigenvalues = 0;
+  to.onStep = [](const cont::StepInfo& step) {
+    for (const cont::SpecialPoint& sp : step.specialPoints)
+      if (sp.type == cont::SpecialPointType::Fold) return cont::StepAction::Stop;
+    return cont::StepAction::Continue;
   };
   const double delta = 1e-5 * std::max(1.0, std::abs(lambda));
   for (int side : {-1, 1})
@@ -531,12 +533,12 @@ cont::Branch stepTo(ChainParameterProblem& p, const cont::ContinuationPoint& a, 
                     const Vector& b, bool certified) {
   cont::TracerOptions o;
   const Vector t = a.tangent.dot(direction) >= 0.0 ? a.tangent : Vector(-a.tangent);
-  o.maxStep = o.initialStep = t.dot(b - a.state());
-  o.minStep = 1e-6 * o.maxStep;
+  o.step.maxStep = o.step.initialStep = t.dot(b - a.state());
+  o.step.minStep = 1e-6 * o.step.maxStep;
   o.maxPoints = 2;  // the start and the one step
   o.lambdaMin = -1.0;
   o.lambdaMax = 1.0;
-  o.certifiedCounting = certified;
+  o.detection.certifiedCounting = certified;
   return cont::trace(p, a.u, a.lambda, cont::InitialDirection::along(t), o);
 }
 
@@ -551,8 +553,8 @@ cont::Branch stepToMirror(ChainParameterProblem& p, const cont::ContinuationPoin
 // at Me = `stop` (< 0: after the Z's fold it comes back down).
 cont::Branch finePath(ChainParameterProblem& p, double stop, int lambdaSign) {
   cont::TracerOptions o;
-  o.maxStep = 2e-3;
-  o.initialStep = 1e-3;
+  o.step.maxStep = 2e-3;
+  o.step.initialStep = 1e-3;
   o.lambdaMin = lambdaSign > 0 ? stop : -1.0;
   o.lambdaMax = lambdaSign > 0 ? 1.0 : stop;
   o.maxPoints = 2000;
@@ -578,7 +580,7 @@ ZAndCusp zAndCusp(ChainParameterProblem& p) {
   REQUIRE(z.fold.lambda > 0.0);
   REQUIRE(z.fold.lambda < 0.01);
   CriticalCurveOptions co = curveOptions(0.2, 0.4);
-  co.tracer.maxStep = 0.01;
+  co.tracer.step.maxStep = 0.01;
   co.tracer.maxPoints = 200;
   const CriticalCurve curve = foldCurve(p, z.fold, co);
   const Codim2Point* cusp = nullptr;
@@ -661,8 +663,8 @@ StraightMode straightSecondMode(ChainParameterProblem& p, double tension) {
 cont::Branch pathThroughStraight(ChainParameterProblem& p, double tension, bool certified) {
   REQUIRE(p.setSecondParameter(tension));
   cont::TracerOptions o;
-  o.maxStep = 0.05;
-  o.initialStep = 0.01;
+  o.step.maxStep = 0.05;
+  o.step.initialStep = 0.01;
   o.lambdaMin = -0.0123;
   o.lambdaMax = 0.0123;
   o.maxPoints = 400;
@@ -671,7 +673,7 @@ cont::Branch pathThroughStraight(ChainParameterProblem& p, double tension, bool 
   REQUIRE(!out.points.empty());
   const cont::ContinuationPoint& start = out.points.back();
   REQUIRE(std::abs(start.lambda) == Approx(0.0123).margin(1e-12));
-  o.certifiedCounting = certified;
+  o.detection.certifiedCounting = certified;
   o.lambdaMin = -0.03;
   o.lambdaMax = 0.03;
   return cont::trace(p, start.u, start.lambda,

@@ -40,8 +40,8 @@ EquilibriumBranchOptions treeOptions(const Setup& s) {
   EquilibriumBranchOptions o;
   o.tracer.lambdaMin = s.lambdaEnd;
   o.tracer.lambdaMax = 0.0;
-  o.tracer.maxStep = 0.1;
-  o.switchingDepth = 1;
+  o.tracer.step.maxStep = 0.1;
+  o.tree.branchSwitching = 1;
   return o;
 }
 

@@ -25,10 +25,10 @@ EquilibriumBranchOptions pinnedOptions(double lambdaMin, int depth) {
   EquilibriumBranchOptions o;
   o.tracer.lambdaMin = lambdaMin;
   o.tracer.lambdaMax = 1.0;
-  o.tracer.maxStep = 0.05;
-  o.tracer.initialStep = 0.01;
+  o.tracer.step.maxStep = 0.05;
+  o.tracer.step.initialStep = 0.01;
   o.tracer.maxPoints = 2000;
-  o.switchingDepth = depth;
+  o.tree.branchSwitching = depth;
   return o;
 }
 
@@ -84,8 +84,8 @@ TEST_CASE("n = 4..50 clamped-pinned: branch points equal the linear-buckling eig
     const double stop = compressive.size() > 2 ? 0.5 * (compressive[1] + compressive[2]) : 1.2 * compressive[1];
     EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
     EquilibriumBranchOptions o = pinnedOptions(stop, 0);
-    o.tracer.maxStep = std::abs(compressive[0]) / 8;
-    o.tracer.initialStep = o.tracer.maxStep / 2;
+    o.tracer.step.maxStep = std::abs(compressive[0]) / 8;
+    o.tracer.step.initialStep = o.tracer.step.maxStep / 2;
     const EquilibriumBranches r =
         traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
     const auto bps = branchPoints(r.tree.branches.at(0));
@@ -102,7 +102,7 @@ TEST_CASE("switching at the branch points: U stable with dx = mu_U b q2^2, Z uns
   EquilibriumProblem problem(Chain::uniform(3, SegmentParameters::symmetric(a, b, k, L0)),
                              EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   EquilibriumBranchOptions o = pinnedOptions(-2.5, 1);
-  o.tracer.maxStep = 0.02;
+  o.tracer.step.maxStep = 0.02;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
   REQUIRE(r.tree.branches.size() == 5);  // trivial + 2 directions at each of the 2 BPs
@@ -148,9 +148,9 @@ EquilibriumBranchOptions iUpOptions() {
   EquilibriumBranchOptions o;
   o.tracer.lambdaMin = -1.0;
   o.tracer.lambdaMax = 1.0;
-  o.tracer.maxStep = 0.05;
+  o.tracer.step.maxStep = 0.05;
   o.tracer.maxPoints = 400;
-  o.switchingDepth = 0;
+  o.tree.branchSwitching = 0;
   o.tracer.boxLower = Eigen::VectorXd::Constant(4, -3.0);
   o.tracer.boxUpper = Eigen::VectorXd::Constant(4, 3.0);
   return o;
@@ -248,8 +248,8 @@ TEST_CASE("hard case: a path that runs into a joint limit stops exactly on it", 
   EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = 10.0;
-  o.tracer.maxStep = 0.1;
-  o.switchingDepth = 0;
+  o.tracer.step.maxStep = 0.1;
+  o.tree.branchSwitching = 0;
   o.contact = false;  // the old behaviour: the branch ends at the limit (contact: test_contact.cpp)
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
@@ -272,8 +272,8 @@ TEST_CASE("hard case: n = 200, closely spaced critical loads all found once", "[
   const double stop = 0.5 * (crit[4] + crit[5]);
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   EquilibriumBranchOptions o = pinnedOptions(stop, 0);
-  o.tracer.maxStep = std::abs(stop) / 3;
-  o.tracer.initialStep = o.tracer.maxStep;
+  o.tracer.step.maxStep = std::abs(stop) / 3;
+  o.tracer.step.initialStep = o.tracer.step.maxStep;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
   const auto bps = branchPoints(r.tree.branches.at(0));
@@ -294,9 +294,9 @@ TEST_CASE("hard case: an impossible target is reported and the points before it 
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = 10.0;
   o.tracer.maxPoints = 5000;
-  o.tracer.maxStep = 0.05;
-  o.tracer.minStep = 1e-6;
-  o.switchingDepth = 0;
+  o.tracer.step.maxStep = 0.05;
+  o.tracer.step.minStep = 1e-6;
+  o.tree.branchSwitching = 0;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
   const cont::Branch& br = r.tree.branches[0];
@@ -349,7 +349,7 @@ TEST_CASE("hard case: top of the spectrum, n = 60: six critical loads 2e-3 apart
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   EquilibriumBranchOptions o = pinnedOptions(stop, 0);
   o.tracer.lambdaMax = start;
-  o.tracer.maxStep = o.tracer.initialStep = (start - stop) / 3;
+  o.tracer.step.maxStep = o.tracer.step.initialStep = (start - stop) / 3;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(n), start, cont::InitialDirection::decreasingLambda(), o);
   const auto bps = branchPoints(r.tree.branches.at(0));
@@ -377,9 +377,9 @@ TEST_CASE("n = 500 clamped-pinned, default options: the clustered low end to 1e-
   const double stop = 0.5 * (crit[3] + crit[4]);
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   EquilibriumBranchOptions o = pinnedOptions(stop, 0);
-  REQUIRE(problem.dimension() > o.tracer.maxDenseLocationDimension);
-  o.tracer.maxStep = o.tracer.initialStep = std::abs(stop) / 3;
-  o.tracer.minStep = 1e-6 * o.tracer.maxStep;
+  REQUIRE(problem.dimension() > o.tracer.location.maxDenseDimension);
+  o.tracer.step.maxStep = o.tracer.step.initialStep = std::abs(stop) / 3;
+  o.tracer.step.minStep = 1e-6 * o.tracer.step.maxStep;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
   const auto bps = branchPoints(r.tree.branches.at(0));
@@ -413,11 +413,11 @@ TEST_CASE("structured and dense refinement agree on the same chain (crossover fo
     REQUIRE(crit.size() > 3);
     EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
     EquilibriumBranchOptions o = pinnedOptions(0.5 * (crit[2] + crit[3]), 0);
-    o.tracer.maxStep = o.tracer.initialStep = std::abs(crit[0]) / 2.7;
-    o.tracer.maxDenseLocationDimension = 400;  // N = 41: dense
+    o.tracer.step.maxStep = o.tracer.step.initialStep = std::abs(crit[0]) / 2.7;
+    o.tracer.location.maxDenseDimension = 400;  // N = 41: dense
     const EquilibriumBranches dense =
         traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
-    o.tracer.maxDenseLocationDimension = 10;
+    o.tracer.location.maxDenseDimension = 10;
     const EquilibriumBranches fast =
         traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
     const auto d = branchPoints(dense.tree.branches.at(0)), s = branchPoints(fast.tree.branches.at(0));
@@ -440,7 +440,7 @@ TEST_CASE("structured and dense refinement agree on the same chain (crossover fo
     EquilibriumBranchOptions o = iUpOptions();
     const EquilibriumBranches dense =
         traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
-    o.tracer.maxDenseLocationDimension = 1;
+    o.tracer.location.maxDenseDimension = 1;
     const EquilibriumBranches fast =
         traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
     const auto d = dense.tree.branches[0].specialPointsOfType(cont::SpecialPointType::Fold);
@@ -466,12 +466,12 @@ TEST_CASE("n = 500: the first branch point is switched on both sides above the d
   REQUIRE(crit.size() > 2);
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   EquilibriumBranchOptions o = pinnedOptions(0.5 * (crit[0] + crit[1]), 1);
-  o.tracer.maxStep = o.tracer.initialStep = std::abs(crit[0]) / 2.7;  // no step ends on the point
-  o.tracer.minStep = 1e-6 * o.tracer.maxStep;
+  o.tracer.step.maxStep = o.tracer.step.initialStep = std::abs(crit[0]) / 2.7;  // no step ends on the point
+  o.tracer.step.minStep = 1e-6 * o.tracer.step.maxStep;
   cont::TracerOptions children = o.tracer;
   children.maxPoints = 8;
   children.lambdaMin = 2.0 * crit[1];
-  o.childTracer = children;
+  o.tree.childTracer = children;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
   const auto bps = branchPoints(r.tree.branches.at(0));
@@ -530,9 +530,9 @@ struct QuarticRatio {
 EquilibriumBranches kappaZeroTree(EquilibriumProblem& problem, int n) {
   EquilibriumBranchOptions o = pinnedOptions(-0.5, 1);
   o.tracer.lambdaMax = 0.5;
-  o.childTracer = o.tracer;
-  o.childTracer->maxPoints = 12;
-  o.childTracer->maxStep = 0.02;
+  o.tree.childTracer = o.tracer;
+  o.tree.childTracer->maxPoints = 12;
+  o.tree.childTracer->step.maxStep = 0.02;
   return traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.3, cont::InitialDirection::decreasingLambda(), o);
 }
 
@@ -620,14 +620,14 @@ EquilibriumBranches tracePinnedAboveCrossover(const Chain& chain, double stop, d
                                               double childLambdaMin = 0.0) {
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   EquilibriumBranchOptions o = pinnedOptions(stop, childPoints > 0 ? 1 : 0);
-  REQUIRE(problem.dimension() > o.tracer.maxDenseLocationDimension);
-  o.tracer.maxStep = o.tracer.initialStep = step;
-  o.tracer.minStep = 1e-6 * step;
+  REQUIRE(problem.dimension() > o.tracer.location.maxDenseDimension);
+  o.tracer.step.maxStep = o.tracer.step.initialStep = step;
+  o.tracer.step.minStep = 1e-6 * step;
   if (childPoints > 0) {
     cont::TracerOptions children = o.tracer;
     children.maxPoints = childPoints;
     children.lambdaMin = childLambdaMin;
-    o.childTracer = children;
+    o.tree.childTracer = children;
   }
   return traceEquilibria(problem, Eigen::VectorXd::Zero(chain.size()), 0.0, cont::InitialDirection::decreasingLambda(), o);
 }
@@ -678,17 +678,17 @@ TEST_CASE("n = 10000: the children of a branch point traced in steps of 4e-9 sho
   const double stop = 0.5 * (crit[0] + crit[1]);
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   EquilibriumBranchOptions o = pinnedOptions(stop, 1);
-  o.tracer.maxStep = o.tracer.initialStep = std::abs(stop) / 39.0;
-  o.tracer.minStep = 1e-6 * o.tracer.maxStep;
+  o.tracer.step.maxStep = o.tracer.step.initialStep = std::abs(stop) / 39.0;
+  o.tracer.step.minStep = 1e-6 * o.tracer.step.maxStep;
   o.tracer.lambdaMax = 0.0;
   o.tracer.maxPoints = 43;
-  o.tracer.lowestEigenvalues = 1;
+  o.tracer.detection.lowestEigenvalues = 1;
   cont::TracerOptions child = o.tracer;
-  child.initialStep = child.maxStep = 4e-9;
-  child.minStep = 1e-6 * child.maxStep;
+  child.step.initialStep = child.step.maxStep = 4e-9;
+  child.step.minStep = 1e-6 * child.step.maxStep;
   child.maxPoints = 40;
   child.lambdaMin = 2.0 * crit[1];
-  o.childTracer = child;
+  o.tree.childTracer = child;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
   const auto& branches = r.tree.branches;

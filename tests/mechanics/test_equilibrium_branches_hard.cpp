@@ -46,12 +46,12 @@ TEST_CASE("hard case: three branch points at ~1e-10 of the range are located at 
     EquilibriumBranchOptions o;
     o.tracer.lambdaMin = -0.01 * forceUnit;
     o.tracer.lambdaMax = 0.0;
-    o.tracer.maxStep = 0.05;
-    o.tracer.initialStep = 0.02;
-    o.switchingDepth = 1;
+    o.tracer.step.maxStep = 0.05;
+    o.tracer.step.initialStep = 0.02;
+    o.tree.branchSwitching = 1;
     cont::TracerOptions child = o.tracer;
     child.maxPoints = 20;
-    o.childTracer = child;
+    o.tree.childTracer = child;
     const EquilibriumBranches r =
         traceEquilibria(problem, Eigen::VectorXd::Zero(4), 0.0, cont::InitialDirection::decreasingLambda(), o);
     INFO("scale " << scale);
@@ -86,12 +86,12 @@ TEST_CASE("hard case: unloading along the U branch to its tip gives one BP, stab
     EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), kAxial);
     const AnalyticBuckling3 exact = analyticClampedPinned3(0.5, 1.0, 1.0, 2.25);
     LoadHistoryOptions o;
-    o.tracer.maxStep = 0.05;
-    o.tracer.initialStep = 0.02;
+    o.tracer.step.maxStep = 0.05;
+    o.tracer.step.initialStep = 0.02;
     const LoadHistoryResult h =
         followLoadHistory(problem, Eigen::VectorXd::Zero(3), {0.0, -1.7 * forceUnit, 0.0}, o);
     INFO("scale " << scale << ": " << h.message);
-    CHECK(h.completed);
+    CHECK(h.success);
     CHECK(h.jumps.empty());
     int bps = 0, folds = 0;
     for (size_t s = 0; s < h.segments.size(); ++s)
@@ -133,13 +133,13 @@ TEST_CASE("hard case: kappa = 0, the multiple point at the start of the path is 
     EquilibriumBranchOptions o;
     o.tracer.lambdaMin = -0.5 * F;
     o.tracer.lambdaMax = 0.5 * F;
-    o.tracer.maxStep = 0.05;
-    o.tracer.initialStep = 0.01;
-    o.switchingDepth = 1;
+    o.tracer.step.maxStep = 0.05;
+    o.tracer.step.initialStep = 0.01;
+    o.tree.branchSwitching = 1;
     cont::TracerOptions child = o.tracer;
     child.maxPoints = 12;
-    child.maxStep = 0.02;
-    o.childTracer = child;
+    child.step.maxStep = 0.02;
+    o.tree.childTracer = child;
     return traceEquilibria(problem, Eigen::VectorXd::Zero(n), lambda0, starts, o);
   };
   const EquilibriumBranches atStart =
@@ -199,10 +199,10 @@ TEST_CASE("hard case: a multiple point above the simple points' dense crossover 
   EquilibriumBranchOptions o;
   o.tracer.lambdaMin = -0.5;
   o.tracer.lambdaMax = 0.5;
-  o.tracer.maxStep = 0.05;
-  o.tracer.initialStep = 0.01;
-  o.tracer.maxDenseLocationDimension = 1;
-  o.switchingDepth = 0;
+  o.tracer.step.maxStep = 0.05;
+  o.tracer.step.initialStep = 0.01;
+  o.tracer.location.maxDenseDimension = 1;
+  o.tree.branchSwitching = 0;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.3, {cont::InitialDirection::decreasingLambda()}, o);
   const auto bps = r.tree.branches.at(0).specialPointsOfType(cont::SpecialPointType::BranchPoint);

@@ -301,8 +301,8 @@ const buckle::continuation::SpecialPoint* tracedLimit(EquilibriumProblem& proble
                                                        double lambdaMax) {
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = lambdaMax;
-  o.tracer.maxStep = 0.1;
-  o.switchingDepth = 0;
+  o.tracer.step.maxStep = 0.1;
+  o.tree.branchSwitching = 0;
   o.contact = false;  // the limit itself (contact past it: test_contact.cpp)
   r = traceEquilibria(problem, Eigen::VectorXd::Zero(problem.segments()), 0.0,
                       buckle::continuation::InitialDirection::increasingLambda(), o);

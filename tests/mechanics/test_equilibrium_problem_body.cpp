@@ -90,8 +90,8 @@ double bisect(F f, double lo, double hi) {
 double firstBranchPoint(EquilibriumProblem& problem, int n, double lambdaMax) {
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = lambdaMax;
-  o.tracer.maxStep = 0.1;
-  o.switchingDepth = 0;
+  o.tracer.step.maxStep = 0.1;
+  o.tree.branchSwitching = 0;
   o.contact = false;
   const EquilibriumBranches r =
       traceEquilibria(problem, Vector::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), o);
@@ -219,7 +219,7 @@ TEST_CASE("a heavy cantilever sags as an independent Newton solve, in the paper'
                                BodyLoads::weight(chain, inertia, Eigen::Vector2d::Zero(), down));
     EquilibriumBranchOptions o;
     o.tracer.lambdaMax = g;
-    o.switchingDepth = 0;
+    o.tree.branchSwitching = 0;
     o.contact = false;
     const EquilibriumBranches r =
         traceEquilibria(problem, Vector::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), o);
@@ -251,7 +251,7 @@ TEST_CASE("continuation in the gravity magnitude passes through the fixed-gravit
                                BodyLoads::weight(chain, inertia, Eigen::Vector2d::Zero(), down));
     EquilibriumBranchOptions o;
     o.tracer.lambdaMax = 8.0;
-    o.switchingDepth = 0;
+    o.tree.branchSwitching = 0;
     o.contact = false;
     const EquilibriumBranches r =
         traceEquilibria(problem, Vector::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), o);

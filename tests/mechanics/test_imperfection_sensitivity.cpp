@@ -22,7 +22,7 @@ cont::SpecialPoint firstBranchPoint(EquilibriumProblem& p, double lambdaMin) {
   cont::TracerOptions o;
   o.lambdaMin = lambdaMin;
   o.lambdaMax = 1.0;
-  o.newtonTolerance = 1e-12;
+  o.corrector.tolerance = 1e-12;
   const cont::Branch b =
       cont::trace(p, Eigen::VectorXd::Zero(p.dimension()), 0.0, cont::InitialDirection::decreasingLambda(), o);
   const auto bps = b.specialPointsOfType(cont::SpecialPointType::BranchPoint);
@@ -41,11 +41,11 @@ double imperfectFold(const Chain& chain, const EndCondition& end, double lambdaS
   cont::TracerOptions o;
   o.lambdaMin = std::min(lambdaMin, lambdaStart);
   o.lambdaMax = std::max(lambdaMin, lambdaStart);
-  o.initialStep = 0.5 * step;
-  o.maxStep = step;
+  o.step.initialStep = 0.5 * step;
+  o.step.maxStep = step;
   o.maxPoints = 8000;
-  o.newtonTolerance = 1e-12;
-  o.detectBranchPoints = false;
+  o.corrector.tolerance = 1e-12;
+  o.detection.branchPoints = false;
   const cont::Branch b = cont::trace(p, p.initialGuess(Eigen::VectorXd::Zero(chain.size()), lambdaStart),
                                      lambdaStart, cont::InitialDirection::decreasingLambda(), o);
   REQUIRE(!b.points.empty());

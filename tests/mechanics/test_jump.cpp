@@ -643,8 +643,8 @@ TracedFold gradedChainFold(int n, double lengthScale = 1.0, double stiffnessScal
   buckle::continuation::TracerOptions o;
   o.maxPoints = 2000;
   o.lambdaMax = 2.0;
-  o.detectBranchPoints = false;
-  o.lowestEigenvalues = 0;
+  o.detection.branchPoints = false;
+  o.detection.lowestEigenvalues = 0;
   buckle::continuation::Tracer tracer(*t.problem, o);
   const auto branch = tracer.trace(start.u, 0.0, buckle::continuation::InitialDirection::increasingLambda());
   const auto folds = branch.specialPointsOfType(buckle::continuation::SpecialPointType::Fold);

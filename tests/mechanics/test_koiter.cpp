@@ -93,15 +93,15 @@ EquilibriumBranches traceChain(EquilibriumProblem& p, int n, double lambdaMin, i
   EquilibriumBranchOptions o;
   o.tracer.lambdaMin = lambdaMin;
   o.tracer.lambdaMax = 0.5 * std::abs(lambdaMin);
-  o.tracer.maxStep = 0.02 * std::abs(lambdaMin);
+  o.tracer.step.maxStep = 0.02 * std::abs(lambdaMin);
   o.tracer.maxPoints = 400;
-  o.tracer.newtonTolerance = 1e-12;
+  o.tracer.corrector.tolerance = 1e-12;
   cont::TracerOptions child = o.tracer;
-  child.maxStep = 0.01;
+  child.step.maxStep = 0.01;
   child.maxPoints = childPoints;
-  o.childTracer = child;
-  o.switchingDepth = depth;
-  o.switchAt = at;
+  o.tree.childTracer = child;
+  o.tree.branchSwitching = depth;
+  o.tree.switchAt = at;
   o.contact = false;
   return traceEquilibria(p, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
 }
@@ -118,7 +118,7 @@ int checkAgainstTraced(EquilibriumProblem& p, const EquilibriumBranches& r, int 
       if (x.source == int(s)) rep = &x;
     REQUIRE(rep);
     const KoiterCoefficients& k = rep->koiter;
-    INFO("branch " << parent << ", BP at " << b.specialPoints[s].lambda << ": " << k.error);
+    INFO("branch " << parent << ", BP at " << b.specialPoints[s].lambda << ": " << k.message);
     REQUIRE(k.valid);
     const Fit f = fitTracedChildren(p, r.tree, parent, int(s), k, xiMax);
     if (f.points < 8) continue;
@@ -172,7 +172,7 @@ TEST_CASE("Koiter coefficients at a secondary branch point of a bent branch", "[
       // the O(n) algebra on the bent parent: the same coefficients
       const cont::SpecialPoint& sp = r.tree.branches[b].specialPoints[size_t(s.source)];
       const KoiterCoefficients fast = koiterCoefficients(p, sp, cont::CoefficientAlgebra::Structured);
-      INFO(fast.error);
+      INFO(fast.message);
       REQUIRE(fast.valid);
       const double scale = std::max(std::abs(s.koiter.a), std::abs(s.koiter.b));
       CHECK(std::abs(fast.a - s.koiter.a) <= 1e-10 * scale);
@@ -204,7 +204,7 @@ TEST_CASE("Koiter coefficients scale with the units: lengths x1e-3, stiffness x1
     EquilibriumBranchOptions o;
     o.tracer.lambdaMin = -1.6 * k * l;
     o.tracer.lambdaMax = 1.0 * k * l;
-    o.switchingDepth = 0;
+    o.tree.branchSwitching = 0;
     const EquilibriumBranches r =
         traceEquilibria(p, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
     std::vector<KoiterCoefficients> out;
@@ -231,9 +231,9 @@ cont::SpecialPoint firstStraightBranchPoint(EquilibriumProblem& p, double lambda
   cont::TracerOptions o;
   o.lambdaMin = lambdaStop;
   o.lambdaMax = 0.5 * std::abs(lambdaStop);
-  o.maxStep = o.initialStep = std::abs(lambdaStop) / 2.7;
-  o.minStep = 1e-6 * o.maxStep;
-  o.newtonTolerance = 1e-12;
+  o.step.maxStep = o.step.initialStep = std::abs(lambdaStop) / 2.7;
+  o.step.minStep = 1e-6 * o.step.maxStep;
+  o.corrector.tolerance = 1e-12;
   const cont::Branch b = cont::trace(p, Eigen::VectorXd::Zero(p.dimension()), 0.0,
                                      cont::InitialDirection::decreasingLambda(), o);
   const auto bps = b.specialPointsOfType(cont::SpecialPointType::BranchPoint);
@@ -276,7 +276,7 @@ TEST_CASE("Koiter coefficients: the O(n) algebra equals the dense one at n = 40 
       const cont::SpecialPoint bp = firstStraightBranchPoint(p, 0.5 * (crit.first + crit.second));
       const KoiterCoefficients dense = koiterCoefficients(p, bp, cont::CoefficientAlgebra::Dense);
       const KoiterCoefficients fast = koiterCoefficients(p, bp, cont::CoefficientAlgebra::Structured);
-      INFO(dense.error << " / " << fast.error);
+      INFO(dense.message << " / " << fast.message);
       REQUIRE(dense.valid);
       REQUIRE(fast.valid);
       INFO("a = " << dense.a << " / " << fast.a << ", b = " << dense.b << " / " << fast.b);
@@ -305,15 +305,15 @@ TEST_CASE("Koiter coefficients at n = 1000 (scaled units) against the traced bif
   EquilibriumBranchOptions o;
   o.tracer.lambdaMin = 0.5 * (crit.first + crit.second);
   o.tracer.lambdaMax = -o.tracer.lambdaMin;
-  o.tracer.maxStep = o.tracer.initialStep = std::abs(crit.first) / 2.7;
-  o.tracer.minStep = 1e-6 * o.tracer.maxStep;
-  o.tracer.newtonTolerance = 1e-12;
+  o.tracer.step.maxStep = o.tracer.step.initialStep = std::abs(crit.first) / 2.7;
+  o.tracer.step.minStep = 1e-6 * o.tracer.step.maxStep;
+  o.tracer.corrector.tolerance = 1e-12;
   cont::TracerOptions child = o.tracer;
   child.lambdaMin = 2.0 * crit.second;
-  child.maxStep = child.initialStep = 0.002;  // scaled arclength: ~ξ (rad) per step
+  child.step.maxStep = child.step.initialStep = 0.002;  // scaled arclength: ~ξ (rad) per step
   child.maxPoints = 40;
-  o.childTracer = child;
-  o.switchingDepth = 1;
+  o.tree.childTracer = child;
+  o.tree.branchSwitching = 1;
   o.contact = false;
   const EquilibriumBranches r =
       traceEquilibria(p, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);

@@ -32,12 +32,12 @@ TEST_CASE("bistable segment under a cycled end torque: unstable start, two snaps
   const double Mfold = foldTorque(a, b, k, L0);  // equilibrium M + Me = 0: folds at Me = ±|Mfold|
   REQUIRE(Mfold > 0.0);
   LoadHistoryOptions o;
-  o.tracer.maxStep = 0.005;
-  o.tracer.initialStep = 0.001;
+  o.tracer.step.maxStep = 0.005;
+  o.tracer.step.initialStep = 0.001;
   const std::vector<double> waypoints = {0.0, 0.05, -0.05, 0.05};
   const LoadHistoryResult r = followLoadHistory(problem, Eigen::VectorXd::Zero(1), waypoints, o);
   INFO(r.message);
-  REQUIRE(r.completed);
+  REQUIRE(r.success);
   REQUIRE(r.jumps.size() >= 3);
   CHECK(r.jumps[0].trigger == JumpTrigger::UnstableStart);
   int folds = 0;
@@ -90,11 +90,11 @@ TEST_CASE("the default chain compressed past its buckling load follows the U bra
   const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   LoadHistoryOptions options;
-  options.tracer.maxStep = 0.05;
+  options.tracer.step.maxStep = 0.05;
   const AnalyticBuckling3 exact = analyticClampedPinned3(0.5, 1.0, 1.0, 2.25);
   const LoadHistoryResult h = followLoadHistory(problem, Eigen::VectorXd::Zero(3), {0.0, -1.7, 0.0}, options);
   INFO(h.message);
-  REQUIRE(h.completed);
+  REQUIRE(h.success);
   CHECK(h.jumps.empty());  // buckling without a jump, and unloading back along the same branches
   REQUIRE(h.segments.size() == 4);
   REQUIRE(h.segmentBifurcated.size() == h.segments.size());
@@ -130,7 +130,7 @@ TEST_CASE("compressed to -2.5, the default chain leaves the U branch by a jump a
   const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   LoadHistoryOptions options;
-  options.tracer.maxStep = 0.05;
+  options.tracer.step.maxStep = 0.05;
   const LoadHistoryResult h = followLoadHistory(problem, Eigen::VectorXd::Zero(3), {0.0, -2.5}, options);
   INFO(h.message);
   REQUIRE(h.segments.size() >= 2);
@@ -156,7 +156,7 @@ TEST_CASE("compressed to -2.5, the default chain leaves the U branch by a jump a
   CHECK(h.jumps[0].contactTorques[1] == Approx(g[1]).epsilon(1e-9));
   CHECK(std::abs(g[0]) < 1e-10);
   CHECK(std::abs(g[2]) < 1e-10);
-  CHECK(h.completed);
+  CHECK(h.success);
   INFO(h.message);
   REQUIRE(h.jumps[0].toSegment >= 0);
   const cont::Branch& after = h.segments[size_t(h.jumps[0].toSegment)];

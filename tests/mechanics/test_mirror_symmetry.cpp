@@ -22,10 +22,10 @@ EquilibriumBranchOptions defaultScene(bool mirror) {
   EquilibriumBranchOptions o;
   o.tracer.lambdaMin = -2.5;
   o.tracer.lambdaMax = 0.0;
-  o.tracer.initialStep = 0.02;
-  o.tracer.maxStep = 0.05;
-  o.tracer.lowestEigenvalues = 1;
-  o.switchingDepth = 1;
+  o.tracer.step.initialStep = 0.02;
+  o.tracer.step.maxStep = 0.05;
+  o.tracer.detection.lowestEigenvalues = 1;
+  o.tree.branchSwitching = 1;
   o.mirror = mirror;
   return o;
 }
@@ -198,7 +198,7 @@ TEST_CASE("mirror: an image's base and self contacts, mirrored from its source, 
   int imagesFinished = 0;
   if (interrupt) {
     o.tracer.interrupt = cont::Interrupt().watch(&stop, "test stop");
-    o.onBranch = [&](const cont::BranchTree&, const cont::Branch& finished) {
+    o.tree.onBranch = [&](const cont::BranchTree&, const cont::Branch& finished) {
       if (finished.mirrorOf >= 0 && ++imagesFinished == 2) stop = true;
     };
   }

@@ -71,7 +71,7 @@ TEST_CASE("traced through the reaction, a branch ends exactly at the held coordi
     EquilibriumBranchOptions opt;
     opt.tracer.lambdaMin = -rl.limit;
     opt.tracer.lambdaMax = 0.0;
-    opt.switchingDepth = 1;
+    opt.tree.branchSwitching = 1;
     opt.report.heldCoordinate = 0;
     opt.report.rangeLow = xEnd;
     opt.report.rangeHigh = x0;

@@ -39,8 +39,8 @@ std::vector<SpecialPointReport> kmin(EquilibriumProblem& problem, double forceUn
   EquilibriumBranchOptions opt;
   opt.tracer.lambdaMin = -2.0 * forceUnit;
   opt.tracer.lambdaMax = 0.0;
-  if (maxStep > 0.0) opt.tracer.maxStep = maxStep;
-  opt.switchingDepth = 0;
+  if (maxStep > 0.0) opt.tracer.step.maxStep = maxStep;
+  opt.tree.branchSwitching = 0;
   opt.report.stiffness = true;
   opt.report.stiffnessMeasure = measure;
   const EquilibriumBranches r =

@@ -37,7 +37,7 @@ Eigen::VectorXd loaded(const Chain& chain, const Eigen::Vector3d& load) {
   o.lambdaMin = -1.0;
   o.lambdaMax = 1.0;
   o.maxPoints = 5000;
-  o.newtonTolerance = 1e-12;
+  o.corrector.tolerance = 1e-12;
   const cont::Branch b = cont::trace(ramp, Eigen::VectorXd::Zero(chain.size()), 0.0,
                                      cont::InitialDirection::increasingLambda(), o);
   REQUIRE(b.stopReason == cont::StopReason::LambdaRange);
@@ -69,7 +69,7 @@ TaskPathResult follow(TaskPathProblem& p, const Eigen::VectorXd& q0, double dx, 
   Eigen::VectorXd to(2);
   to << pose[0] + dx * L, pose[1] + dy * L;
   TaskPathOptions opt;
-  opt.tracer.newtonTolerance = 1e-12;
+  opt.tracer.corrector.tolerance = 1e-12;
   opt.tracer.maxPoints = 2000;
   return traceTaskPath(p, q0, {to}, p.chain().length(), opt);
 }
@@ -133,7 +133,7 @@ TEST_CASE("task path: derivatives of both rules against finite differences", "[t
     pin << 2.4, 2.1;
     const cont::DerivativeCheck c = cont::checkDerivatives(p, p.pack(q, pin), 0.3);
     INFO(c.message);
-    CHECK(c.ok);
+    CHECK(c.success);
   }
   SECTION("rule (b) with multipliers, x, y and phi") {
     TaskSetup s = minChangeSetup(4, payload);
@@ -150,7 +150,7 @@ TEST_CASE("task path: derivatives of both rules against finite differences", "[t
     u.tail(3) << 0.4, -0.6, 0.3;              // ν
     const cont::DerivativeCheck c = cont::checkDerivatives(p, u, 0.2);
     INFO(c.message);
-    CHECK(c.ok);
+    CHECK(c.success);
   }
 }
 
@@ -196,7 +196,7 @@ TEST_CASE("task path rule (a): the task held and every point an equilibrium of t
   w1 << pose[0] - 0.1, pose[1] + 0.3;
   w2 << pose[0] - 0.2, pose[1] + 0.2;
   TaskPathOptions opt;
-  opt.tracer.newtonTolerance = 1e-12;
+  opt.tracer.corrector.tolerance = 1e-12;
   const TaskPathResult r = traceTaskPath(p, q0, {w1, w2}, chain.length(), opt);
   REQUIRE(r.end == TaskPathEvent::Completed);
   REQUIRE(r.legEnds.size() == 3);
@@ -329,7 +329,7 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
     const TaskPathResult rb = follow(bounded, q0, -0.2, 3.0);
     REQUIRE(rb.end == TaskPathEvent::InputBound);
     CHECK(std::abs(rb.specials[0].point.inputs[1] - 1.0) <= 1e-12);
-    CHECK(rb.specials[0].why == "input dL0[2] upper bound");
+    CHECK(rb.specials[0].note == "input dL0[2] upper bound");
   }
   SECTION("joint limit") {
     const Eigen::Vector3d payload(-0.3, -0.3, 0.0);

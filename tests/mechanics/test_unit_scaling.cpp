@@ -31,9 +31,9 @@ double relativeError(double x, double reference) { return std::abs(x - reference
 // [lambdaMin, lambdaMax]: the same (dimensionless) steps for every unit system.
 cont::TracerOptions options(double lambdaMin, double lambdaMax) {
   cont::TracerOptions o;
-  o.initialStep = 0.01;
-  o.maxStep = 0.05;
-  o.minStep = 1e-4;
+  o.step.initialStep = 0.01;
+  o.step.maxStep = 0.05;
+  o.step.minStep = 1e-4;
   o.lambdaMin = lambdaMin;
   o.lambdaMax = lambdaMax;
   o.maxPoints = 20000;

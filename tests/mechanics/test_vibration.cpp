@@ -275,9 +275,9 @@ TEST_CASE("vibration: the crossing omega^2 is zero at the located branch points 
           "operator's lowest eigenvalue at every traced point",
           "[vibration]") {
   cont::TracerOptions o;
-  o.initialStep = 0.01;
-  o.maxStep = 0.05;
-  o.minStep = 1e-4;
+  o.step.initialStep = 0.01;
+  o.step.maxStep = 0.05;
+  o.step.minStep = 1e-4;
   o.maxPoints = 20000;
   const auto check = [](EquilibriumProblem& problem, const cont::Branch& br, cont::SpecialPointType type,
                         size_t expected) {

@@ -161,9 +161,9 @@ TEST_CASE("vibration structured: omega^2 crosses zero at the located branch poin
     EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
     o.lambdaMin = 0.5 * (crit[1] + crit[2]);
     o.lambdaMax = 0.0;
-    o.initialStep = 0.05 * std::abs(crit[0]);
-    o.maxStep = 0.2 * std::abs(crit[0]);
-    o.minStep = 1e-6 * std::abs(crit[0]);
+    o.step.initialStep = 0.05 * std::abs(crit[0]);
+    o.step.maxStep = 0.2 * std::abs(crit[0]);
+    o.step.minStep = 1e-6 * std::abs(crit[0]);
     const cont::Branch br = cont::trace(problem, Vector::Zero(n + 1), 0.0, cont::InitialDirection::decreasingLambda(), o);
     VibrationAnalysis va(chain, InertiaData::uniformRods(chain, 1.0));
     REQUIRE(n >= VibrationAnalysis::kStructuredFrom);  // the automatic route is the structured one
@@ -217,9 +217,9 @@ TEST_CASE("vibration structured: omega^2 crosses zero at the located fold of a 1
   o.maxPoints = 20000;
   o.lambdaMin = -0.3;
   o.lambdaMax = 0.3;
-  o.initialStep = 0.003;
-  o.maxStep = 0.015;
-  o.minStep = 3e-7;
+  o.step.initialStep = 0.003;
+  o.step.maxStep = 0.015;
+  o.step.minStep = 3e-7;
   const cont::Branch br = cont::trace(problem, Vector::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), o);
   const auto folds = br.specialPointsOfType(cont::SpecialPointType::Fold);
   REQUIRE(folds.size() == 1);

@@ -39,6 +39,36 @@ def test_fold_normal_form_is_located_at_the_origin():
     assert branch["stop_reason"] == "parameter range end"
 
 
+def test_tracer_options_are_the_library_settings_and_the_keywords_their_short_forms():
+    opts = buckle.TracerOptions()
+    assert opts.validate() == ""
+    # the keyword and the options field are one setting: the same branch, point for point
+    opts.step.max_step = 0.05
+    opts.lambda_min, opts.lambda_max = -2.0, 2.0
+    by_options = buckle.trace(fold_residual, fold_jacobian, np.array([-1.0]), -1.0, options=opts)["branches"][0]
+    by_keywords = buckle.trace(fold_residual, fold_jacobian, np.array([-1.0]), -1.0, lambda_min=-2, lambda_max=2,
+                               max_step=0.05)["branches"][0]
+    assert np.array_equal(by_options["lambda"], by_keywords["lambda"])
+    steps = np.diff(by_options["arclength"])
+    assert steps.max() <= 0.05 * (1 + 1e-12)
+    # a keyword overrides the options' value; what it does not name keeps it
+    shorter = buckle.trace(fold_residual, fold_jacobian, np.array([-1.0]), -1.0, options=opts, max_points=5)
+    assert len(shorter["branches"][0]["lambda"]) == 5
+    assert opts.max_points != 5
+    # the nested groups reach the tracer: no fold looked for, none reported
+    opts.detection.folds = False
+    none = buckle.trace(fold_residual, fold_jacobian, np.array([-1.0]), -1.0, options=opts)["branches"][0]
+    assert [s for s in none["special_points"] if s["type"] == "LP"] == []
+    # a bad setting names the field as Python spells it
+    opts.step.min_step = 1.0
+    assert opts.validate() == "step.min_step must not exceed max_step"
+    with pytest.raises(ValueError, match="step.min_step"):
+        buckle.trace(fold_residual, fold_jacobian, np.array([-1.0]), -1.0, options=opts)
+    bad = buckle.CorrectorOptions()
+    bad.tolerance = -1.0
+    assert bad.validate() == "corrector.tolerance must be positive and finite"
+
+
 def test_pitchfork_normal_form_branch_point_and_switching():
     # F = λu − u³: the trivial branch u = 0 meets u² = λ at the branch point λ = 0
     res = lambda u, lam: np.array([lam * u[0] - u[0] ** 3])

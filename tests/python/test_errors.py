@@ -112,7 +112,7 @@ def test_numpy_numbers_in_a_scene_dict(source_dir):
     scene["chain"]["segments"] = np.int64(3)
     scene["chain"]["a"] = np.float64(0.5)
     scene["path"]["to"] = np.float32(-2.5)
-    scene["solver"]["max_step"] = np.array(0.05)
+    scene["solver"]["step"]["max_step"] = np.array(0.05)
     with_numpy = buckle.run_scene(scene)
     assert with_numpy["summary"]["complete"] == plain["summary"]["complete"]
     assert len(with_numpy["special_points"]) == len(plain["special_points"])

@@ -41,7 +41,7 @@ bool childBranchExpansion(Problem &problem, ConstVectorRef u0, double lambdaC, c
   std::unique_ptr<BorderedSolver> structured;
   if (n > kDenseCoefficientDimension) structured = scaled.makeStructuredSolver();
   CorrectorOptions options;
-  options.residualTolerance = 1e-13;
+  options.tolerance = 1e-13;
   options.maxIterations = 30;
   Corrector corrector(scaled, options, structured.get());
   const double vScaled = g.v.cwiseQuotient(scales.unknowns).norm();

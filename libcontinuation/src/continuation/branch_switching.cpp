@@ -132,7 +132,7 @@ Branch switchBranch(Tracer &tracer, const SpecialPoint &userBp, const Vector &us
     child.stopMessage = "branch point or direction has the wrong size";
     return child;
   }
-  const double h = options.amplitude > 0.0 ? options.amplitude : tracer.options().initialStep;
+  const double h = options.amplitude > 0.0 ? options.amplitude : tracer.options().step.initialStep;
   const Vector d = child.direction * direction.normalized();
   Vector xBP(n + 1);
   xBP << bp.u, bp.lambda;
@@ -199,7 +199,7 @@ std::vector<Branch> switchBothSides(Tracer &tracer, const SpecialPoint &bp, cons
                                     const Reflection &symmetry) {
   std::vector<Branch> sides;
   Vector direction;
-  const bool structured = tracer.problem().dimension() > tracer.options().maxDenseLocationDimension;
+  const bool structured = tracer.problem().dimension() > tracer.options().location.maxDenseDimension;
   if (!bifurcatingDirection(tracer.problem(), bp, direction, how, structured)) return sides;
   // A symmetric pitchfork (symmetry.h): bp fixed by S, direction reversed by it. Compared in the
   // tracer's scaled variables, where the tolerance is relative.
@@ -294,11 +294,11 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     return finish();
   }
   // With switching the roots are traced lazily (header): here up to their first branch point.
-  tracer.pauseAtBranchPoints(treeOptions.maxDepth > 0);
+  tracer.pauseAtBranchPoints(treeOptions.branchSwitching > 0);
   for (const InitialDirection &direction : starts) {
     if (tree.interrupted || interrupted()) return finish();
     add(tracer.trace(u0, lambda0, direction), 0);
-    if (treeOptions.maxDepth <= 0) finalize(tree.branches.size() - 1);
+    if (treeOptions.branchSwitching <= 0) finalize(tree.branches.size() - 1);
   }
   tracer.pauseAtBranchPoints(false);
   std::vector<Vector> switchedAt;
@@ -307,7 +307,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
   const BranchSwitchingOptions &switching = treeOptions.switching;
 
   for (std::size_t i = 0; i < tree.branches.size(); ++i) {
-    if (depth[i] >= treeOptions.maxDepth) continue;
+    if (depth[i] >= treeOptions.branchSwitching) continue;
     for (std::size_t k = 0;; ++k) {
       // past the last special point: a paused root goes on (and gains a branch point or its end)
       if (k >= tree.branches[i].specialPoints.size() && !(resume(i) && k < tree.branches[i].specialPoints.size()))
@@ -368,7 +368,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
       noteAfter += (noteAfter.empty() ? "" : "; ") + ("switched (" + how + "): branches " + children);
       // the children that will not be switched at are final now, after a mirror image joined its source
       for (std::size_t c = firstChild; c < tree.branches.size(); ++c)
-        if (depth[c] >= treeOptions.maxDepth) finalize(c);
+        if (depth[c] >= treeOptions.branchSwitching) finalize(c);
     }
     finalize(i);
   }
@@ -378,7 +378,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
 BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
                      const TracerOptions &options, int maxDepth, const BranchSwitchingOptions &switching) {
   TreeOptions tree;
-  tree.maxDepth = maxDepth;
+  tree.branchSwitching = maxDepth;
   tree.switching = switching;
   return traceTree(problem, u0, lambda0, std::vector<InitialDirection>{direction}, options, tree);
 }

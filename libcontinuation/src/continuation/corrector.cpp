@@ -11,20 +11,22 @@
 
 namespace buckle::continuation {
 
-bool CorrectorOptions::IsValid(std::string *why) const {
-  auto fail = [why](const char *message) {
-    if (why) *why = message;
-    return false;
-  };
-  if (!(residualTolerance > 0.0) || !std::isfinite(residualTolerance))
-    return fail("residualTolerance must be positive and finite");
+std::string CorrectorOptions::validate(const std::string &prefix) const {
+  auto bad = [&prefix](const char *field, const char *what) { return prefix + field + " " + what; };
+  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return bad("tolerance", "must be positive and finite");
   if (!(stepTolerance > 0.0) || !std::isfinite(stepTolerance))
-    return fail("stepTolerance must be positive and finite");
-  if (maxIterations < 1) return fail("maxIterations must be at least 1");
-  if (!(maxNewtonStep >= 0.0) || !std::isfinite(maxNewtonStep)) return fail("maxNewtonStep must be finite and >= 0");
+    return bad("stepTolerance", "must be positive and finite");
+  if (maxIterations < 1) return bad("maxIterations", "must be at least 1");
+  if (!(maxNewtonStep >= 0.0) || !std::isfinite(maxNewtonStep)) return bad("maxNewtonStep", "must be finite and >= 0");
   if (!(stagnationFactor >= 1.0) || !std::isfinite(stagnationFactor))
-    return fail("stagnationFactor must be finite and >= 1");
-  return true;
+    return bad("stagnationFactor", "must be finite and >= 1");
+  return {};
+}
+
+bool CorrectorOptions::IsValid(std::string *why) const {
+  const std::string problem = validate();
+  if (why) *why = problem;
+  return problem.empty();
 }
 
 Corrector::Corrector(Problem &problem, const CorrectorOptions &options, BorderedSolver *structured)
@@ -83,7 +85,7 @@ void Corrector::setOptions(const CorrectorOptions &options) {
 
 void Corrector::applyOptions() {
   void *mem = kinsol_.get();
-  KINSetFuncNormTol(mem, options_.residualTolerance);
+  KINSetFuncNormTol(mem, options_.tolerance);
   KINSetScaledStepTol(mem, options_.stepTolerance);
   KINSetNumMaxIters(mem, options_.maxIterations);
   // Exact Newton with step control left to the continuation: no KINSOL step truncation.
@@ -207,7 +209,7 @@ bool Corrector::leanNewton(CorrectorSummary &summary) {
   std::copy(predictor_.data(), predictor_.data() + m, iterate_.data());
   // KINSolInit: F at the initial guess; fmax = ‖F‖∞ against 0.01·fnormtol.
   if (evaluate(iterate_.data(), residual_.data()) != 0) return false;
-  const double fnormtol = options_.residualTolerance;
+  const double fnormtol = options_.tolerance;
   long iterations = 0;
   double fnorm = 0.0;
   int flag = KIN_SUCCESS;
@@ -303,7 +305,7 @@ CorrectorSummary Corrector::correct(ConstVectorRef predictor, ConstVectorRef tan
   for (std::size_t k = 1; k < stepNorms_.size(); ++k)
     if (stepNorms_[k - 1] > 0.0) summary.contraction = std::max(summary.contraction, stepNorms_[k] / stepNorms_[k - 1]);
   summary.converged = flag == KIN_SUCCESS || flag == KIN_INITIAL_GUESS_OK ||
-                      (flag == KIN_STEP_LT_STPTOL && fnorm <= options_.stagnationFactor * options_.residualTolerance);
+                      (flag == KIN_STEP_LT_STPTOL && fnorm <= options_.stagnationFactor * options_.tolerance);
   if (flag < 0 && lastError_[0] != '\0') summary.message = lastError_.data();
   x = Eigen::Map<const Vector>(NV_DATA_S(x_.get()), n_ + 1);
   return summary;

@@ -17,7 +17,7 @@ std::vector<CurveZero> locateCurveZeros(Problem &curve, const Branch &branch, co
   const UnitScaling units(curve.scales());
   ScaledProblem scaled(curve, units);
   CorrectorOptions co;
-  co.residualTolerance = options.residualTolerance;
+  co.tolerance = options.residualTolerance;
   co.maxIterations = 20;
   // the curve's structured solver when it offers one (O(N) curve systems), else dense LU
   const std::unique_ptr<BorderedSolver> structured = scaled.makeStructuredSolver();

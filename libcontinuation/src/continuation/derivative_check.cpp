@@ -242,8 +242,8 @@ DerivativeCheck checkDerivatives(Problem &problem, ConstVectorRef u, double lamb
   for (const DerivativeComparison &c : check.comparisons)
     if (!worst || c.maxRelativeError > worst->maxRelativeError) worst = &c;
   check.maxRelativeError = worst->maxRelativeError;
-  check.ok = check.maxRelativeError <= options.relativePrecision;
-  if (!check.ok && worst) check.message = describe(*worst, options.relativePrecision);
+  check.success = check.maxRelativeError <= options.relativePrecision;
+  if (!check.success && worst) check.message = describe(*worst, options.relativePrecision);
   return check;
 }
 

@@ -49,7 +49,7 @@ bool Locator::sample(double s, StepSample &out, CorrectorSummary *summary) {
                (-2.0 * theta3 + 3.0 * theta2) * (xa_ + dx_) + (theta3 - theta2) * chord * tb_;
   const CorrectorOptions saved = corrector_.options();
   CorrectorOptions tight = saved;
-  tight.residualTolerance = std::min(saved.residualTolerance, options_.newtonTolerance);
+  tight.tolerance = std::min(saved.tolerance, options_.location.newtonTolerance);
   tight.maxIterations = std::max(saved.maxIterations, 15);
   corrector_.setOptions(tight);
   const CorrectorSummary result = corrector_.correct(predictor_, ta_, x_);
@@ -91,7 +91,7 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
     return true;
   }
   if (sameSign(fLo, fHi)) {
-    root.failure = "test function does not change sign";
+    root.message = "test function does not change sign";
     return false;
   }
   StepSample left = lo, right = hi;
@@ -101,10 +101,10 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
   bracket.fLeft = fLo;
   bracket.fRight = fHi;
   double previousS = 0.0, previousLambda = 0.0;
-  const double tolS = (relativeTolerance > 0.0 ? relativeTolerance : options_.tolerance) *
+  const double tolS = (relativeTolerance > 0.0 ? relativeTolerance : options_.location.tolerance) *
                       std::max(1.0, std::abs(0.5 * (lo.point.lambda + hi.point.lambda)));
   StepSample trial;
-  for (int it = 0; it < options_.maxIterations; ++it) {
+  for (int it = 0; it < options_.location.maxIterations; ++it) {
     double s = bracket.next();
     CorrectorSummary summary;
     bool sampled = sample(s, trial, &summary);
@@ -113,12 +113,12 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
       sampled = sample(s, trial, &summary);
     }
     if (!sampled) {
-      root.failure = std::string("corrector failed while locating (") + summary.flagName + ")";
+      root.message = std::string("corrector failed while locating (") + summary.flagName + ")";
       return root.evaluations > 0;
     }
     double f = 0.0;
     if (!test(trial.point, f)) {
-      root.failure = "test function could not be evaluated";
+      root.message = "test function could not be evaluated";
       return root.evaluations > 0;
     }
     if (root.evaluations == 0) {
@@ -150,7 +150,7 @@ bool Locator::findRoot(const StepSample &lo, double fLo, const StepSample &hi, d
       break;
     }
   }
-  if (!root.converged) root.failure = "secant iteration limit reached";
+  if (!root.converged) root.message = "secant iteration limit reached";
   return true;
 }
 
@@ -169,8 +169,8 @@ std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &
     ensureEigenvalues(problem_, a_.point, needed);
     ensureEigenvalues(problem_, b_.point, needed);
   }
-  if (crossings.fold && options_.detectFolds) keep(found, locateFold(a_, b_));
-  if (crossings.branchPointCrossings > 0 && options_.detectBranchPoints) {
+  if (crossings.fold && options_.detection.folds) keep(found, locateFold(a_, b_));
+  if (crossings.branchPointCrossings > 0 && options_.detection.branchPoints) {
     std::vector<std::pair<StepSample, StepSample>> simple, multiple;
     separateCrossings(a_, b_, simple, multiple, 0);
     // As in locateBetween: an interrupt ends the location between two branch points.
@@ -201,9 +201,9 @@ void Locator::locateBetween(const std::vector<StepSample> &samples, std::vector<
   std::vector<std::pair<StepSample, StepSample>> simple, multiple;
   for (size_t i = 0; i + 1 < ends.size(); ++i) {
     // Two folds close together (near a cusp of the fold curve) are a pair of opposite crossings too.
-    if (options_.detectFolds && foldBetween(ends[i].point, ends[i + 1].point))
+    if (options_.detection.folds && foldBetween(ends[i].point, ends[i + 1].point))
       keep(found, locateFold(ends[i], ends[i + 1]));
-    if (options_.detectBranchPoints) separateCrossings(ends[i], ends[i + 1], simple, multiple, 0);
+    if (options_.detection.branchPoints) separateCrossings(ends[i], ends[i + 1], simple, multiple, 0);
   }
   // An interrupt ends the location between two branch points (below the dense crossover each
   // refinement is O(N³) work, and a step over a cluster holds many): the tracer then drops
@@ -239,7 +239,7 @@ void Locator::separateCrossings(const StepSample &lo, const StepSample &hi,
   // it (a few levels down to separationFraction): a crossing at the end itself is then located in
   // its own small bracket, the bracket's other crossings away from it.
   const bool loAmbiguous = lo.point.stability.zero > 0, hiAmbiguous = hi.point.stability.zero > 0;
-  if ((loAmbiguous || hiAmbiguous) && hi.s - lo.s > options_.separationFraction * std::abs(stepLength_) &&
+  if ((loAmbiguous || hiAmbiguous) && hi.s - lo.s > options_.location.separationFraction * std::abs(stepLength_) &&
       depth <= 200) {
     const double offset = loAmbiguous && hiAmbiguous ? 0.5 : 1e-3;
     const double s = loAmbiguous ? lo.s + offset * (hi.s - lo.s) : hi.s - offset * (hi.s - lo.s);
@@ -255,7 +255,7 @@ void Locator::separateCrossings(const StepSample &lo, const StepSample &hi,
     return;
   }
   // Bisection on the inertia count: each half keeps the crossings it contains.
-  if (hi.s - lo.s <= options_.separationFraction * std::abs(stepLength_) || depth > 200) {
+  if (hi.s - lo.s <= options_.location.separationFraction * std::abs(stepLength_) || depth > 200) {
     multiple.emplace_back(lo, hi);
     return;
   }
@@ -285,7 +285,7 @@ SpecialPoint Locator::locateFold(const StepSample &lo, const StepSample &hi) {
     placeAt(sp, at.point, at.point.foldTest);
     sp.lambdaAccuracy = found ? root.lastDLambda : std::abs(hi.point.lambda - lo.point.lambda);
     sp.locationIterations = evaluations;
-    sp.note = root.failure.empty() ? "" : "fold secant: " + root.failure;
+    sp.note = root.message.empty() ? "" : "fold secant: " + root.message;
   };
   adopt(ok);
   const bool refined =
@@ -306,7 +306,7 @@ void Locator::finishSecant(SpecialPoint &sp, Root &root, const TestFunction &tes
   evaluations += root.evaluations + refinementSteps;
   adopt(ok);
   sp.note = refinementNote;
-  if (!root.failure.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("secant: " + root.failure);
+  if (!root.message.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("secant: " + root.message);
 }
 
 bool Locator::refineFold(SpecialPoint &sp, const Vector &tangentRef) {
@@ -356,10 +356,10 @@ bool Locator::refineFold(SpecialPoint &sp, const Vector &tangentRef) {
   };
   const double maxDistance = 4.0 * dx_.norm() + 1e-8 + 4.0 * c.norm();
   const AugmentedNewtonResult result =
-      augmentedNewton(system, z, n, options_.tolerance, options_.maxRefinementIterations, maxDistance);
+      augmentedNewton(system, z, n, options_.location.tolerance, options_.location.maxRefinementIterations, maxDistance);
   sp.locationIterations += result.iterations;
   if (!result.converged) {
-    sp.note += (sp.note.empty() ? "" : "; ") + std::string("fold refinement: ") + result.failure;
+    sp.note += (sp.note.empty() ? "" : "; ") + std::string("fold refinement: ") + result.message;
     sp.nullVectors = c;
     return false;
   }
@@ -377,7 +377,7 @@ bool Locator::refineFoldStructured(SpecialPoint &sp, const Vector &tangentRef) {
       u, lambda, sp.tangent.size() == n_ + 1 ? sp.tangent : tangentRef, v, maxDistance);
   sp.locationIterations += result.iterations;
   if (!result.converged) {
-    sp.note += (sp.note.empty() ? "" : "; ") + std::string("fold refinement (structured): ") + result.failure;
+    sp.note += (sp.note.empty() ? "" : "; ") + std::string("fold refinement (structured): ") + result.message;
     return false;
   }
   sp.u = u;
@@ -413,7 +413,7 @@ void Locator::adoptRefinedFold(SpecialPoint &sp, const Vector &tangentRef, const
 double Locator::bracketingTolerance(const StepSample &lo, const StepSample &hi, double fraction) const {
   // findRoot's tolerance is relative to max(1, |λ|); the bracket's own width is not.
   const double scale = std::max(1.0, std::abs(0.5 * (lo.point.lambda + hi.point.lambda)));
-  return std::min(options_.coarseTolerance, fraction * std::abs(hi.s - lo.s) / scale);
+  return std::min(options_.location.coarseTolerance, fraction * std::abs(hi.s - lo.s) / scale);
 }
 
 bool Locator::insideBracket(const SpecialPoint &sp, const StepSample &lo, const StepSample &hi) const {

@@ -63,7 +63,7 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
     sp.locationIterations = evaluations;
     sp.note = testNote;
     if (!haveTest) sp.note += (sp.note.empty() ? "" : "; ") + std::string("no usable test function");
-    else if (!root.failure.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("branch point secant: " + root.failure);
+    else if (!root.message.empty()) sp.note += (sp.note.empty() ? "" : "; ") + ("branch point secant: " + root.message);
   };
   adopt(ok);
   // Several branch points in one step (a cluster at n = 10 000, or a coarse step): the bracket
@@ -157,7 +157,7 @@ bool Locator::refineBranchPoint(SpecialPoint &sp, const Vector &tangentRef) {
   };
   const double maxDistance = 4.0 * dx_.norm() + 1e-8 + 4.0;
   const AugmentedNewtonResult result =
-      augmentedNewton(system, z, n, options_.tolerance, options_.maxRefinementIterations, maxDistance);
+      augmentedNewton(system, z, n, options_.location.tolerance, options_.location.maxRefinementIterations, maxDistance);
   sp.locationIterations += result.iterations;
   if (result.converged) {
     sp.refined = true;
@@ -167,7 +167,7 @@ bool Locator::refineBranchPoint(SpecialPoint &sp, const Vector &tangentRef) {
     sp.augmentedResidualNorm = result.residualNorm;
     sp.arclength = a_.point.arclength + tangentRef.dot((Vector(n + 1) << sp.u, sp.lambda).finished() - xa_);
   } else {
-    sp.note += (sp.note.empty() ? "" : "; ") + std::string("Moore refinement: ") + result.failure;
+    sp.note += (sp.note.empty() ? "" : "; ") + std::string("Moore refinement: ") + result.message;
   }
   fillBranchPointGeometry(sp, tangentRef, options_.denseAlgebra);
   return result.converged;
@@ -182,7 +182,7 @@ bool Locator::refineBranchPointStructured(SpecialPoint &sp, const Vector &tangen
       u, lambda, sp.tangent.size() == n_ + 1 ? sp.tangent : tangentRef, K, psi, maxDistance);
   sp.locationIterations += result.iterations;
   if (!result.converged) {
-    sp.note += (sp.note.empty() ? "" : "; ") + std::string("branch-point refinement (structured): ") + result.failure;
+    sp.note += (sp.note.empty() ? "" : "; ") + std::string("branch-point refinement (structured): ") + result.message;
     return false;
   }
   sp.refined = true;
@@ -200,8 +200,8 @@ StructuredRefinement &Locator::structured() {
     refinementSolver_ = problem_.makeStructuredSolver();
     if (!refinementSolver_ || refinementSolver_->maxGeneralBorder() < 2)
       refinementSolver_ = std::make_unique<DenseBorderedSolver>(problem_);
-    structured_ = std::make_unique<StructuredRefinement>(problem_, *refinementSolver_, options_.tolerance,
-                                                         options_.maxRefinementIterations);
+    structured_ = std::make_unique<StructuredRefinement>(problem_, *refinementSolver_, options_.location.tolerance,
+                                                         options_.location.maxRefinementIterations);
   }
   return *structured_;
 }

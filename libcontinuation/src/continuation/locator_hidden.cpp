@@ -34,7 +34,7 @@ std::vector<SpecialPoint> Locator::locateHiddenCrossings(const std::vector<Suspe
     const double tolS = std::max(1e-10 * std::abs(length), 1e-15);
     int evaluations = 1;
     bool failed = false;
-    while (fx > 0.0 && evaluations < options_.maxIterations) {
+    while (fx > 0.0 && evaluations < options_.location.maxIterations) {
       const double m = 0.5 * (lo + hi);
       const double tol1 = 1.5e-8 * std::abs(x) + tolS, tol2 = 2.0 * tol1;
       if (std::abs(x - m) <= tol2 - 0.5 * (hi - lo)) break;
@@ -102,7 +102,7 @@ std::vector<SpecialPoint> Locator::locateHiddenCrossings(const std::vector<Suspe
       // touch whose minimum rounded to ≤ 0, as at a cusp of a fold curve. The touch test below.
       if (!pair.empty()) continue;
     }
-    if (std::abs(fx) > options_.touchTolerance * std::max({1.0, fa, fb})) continue;  // a dip that stays clear of zero
+    if (std::abs(fx) > options_.detection.touchTolerance * std::max({1.0, fa, fb})) continue;  // a dip that stays clear of zero
     SpecialPoint sp;
     sp.type = SpecialPointType::EigenvalueTouch;
     sp.arclength = best.point.arclength;

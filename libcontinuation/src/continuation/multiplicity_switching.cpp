@@ -496,7 +496,7 @@ std::vector<Branch> switchMultiple(Tracer &tracer, SpecialPoint &bp, const Branc
   // directions are nearby (the predictor x₀ + h·d is off the child by ~τh²), and a long first step
   // lets the corrector fall onto a neighbouring child.
   BranchSwitchingOptions first = options;
-  if (!(first.amplitude > 0.0)) first.amplitude = 0.25 * tracer.options().initialStep;
+  if (!(first.amplitude > 0.0)) first.amplitude = 0.25 * tracer.options().step.initialStep;
   for (size_t k = 0; k < rb.directions.size(); ++k) {
     for (int sign : {1, -1}) {
       Branch child = switchBranch(tracer, bp, rb.directions[k], sign, first);

@@ -42,7 +42,7 @@ AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, 
   double lastUpdate = std::numeric_limits<double>::infinity();
   for (int it = 0; it < maxIterations; ++it) {
     if (!system(z, R, &J)) {
-      result.failure = "the problem refused an iterate";
+      result.message = "the problem refused an iterate";
       break;
     }
     // Partial pivoting (blocked, several times faster than full pivoting at the (2N+1)² fold
@@ -51,12 +51,12 @@ AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, 
     Eigen::PartialPivLU<Matrix> lu(J);
     const auto pivots = lu.matrixLU().diagonal().cwiseAbs();
     if (!(pivots.minCoeff() > std::numeric_limits<double>::epsilon() * double(m) * pivots.maxCoeff())) {
-      result.failure = "singular augmented Jacobian";
+      result.message = "singular augmented Jacobian";
       break;
     }
     delta = -lu.solve(R);
     if (!delta.allFinite()) {
-      result.failure = "non-finite Newton update";
+      result.message = "non-finite Newton update";
       break;
     }
     z += delta;
@@ -64,12 +64,12 @@ AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, 
     result.lastDLambda = std::abs(delta[lambdaIndex]);
     lastUpdate = delta.cwiseAbs().maxCoeff();
     if ((z - z0).norm() > maxDistance) {
-      result.failure = "Newton iterate left the step";
+      result.message = "Newton iterate left the step";
       break;
     }
     if (lastUpdate <= tolerance * std::max(1.0, std::abs(z[lambdaIndex]))) break;
   }
-  if (!result.failure.empty()) {
+  if (!result.message.empty()) {
     z = z0;
     return result;
   }
@@ -80,7 +80,7 @@ AugmentedNewtonResult augmentedNewton(const AugmentedSystem &system, Vector &z, 
   if (!result.converged) {
     char message[80];
     std::snprintf(message, sizeof message, "no convergence: last |dlambda| = %.3g", result.lastDLambda);
-    result.failure = message;
+    result.message = message;
   }
   return result;
 }

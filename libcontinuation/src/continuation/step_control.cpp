@@ -1,11 +1,36 @@
 #include "buckle/continuation/step_control.h"
 
+#include "buckle/continuation/finite.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace buckle::continuation {
 
-double StepSizeControl::next(double ds, const StepObservation &step) const {
+std::string StepOptions::validate(const std::string &prefix) const {
+  auto bad = [&prefix](const std::string &field, const char *what) { return prefix + field + " " + what; };
+  if (!(initialStep > 0.0) || !finite(initialStep)) return bad("initialStep", "must be positive and finite");
+  if (!(minStep > 0.0) || !finite(minStep)) return bad("minStep", "must be positive and finite");
+  if (!(maxStep > 0.0) || !finite(maxStep)) return bad("maxStep", "must be positive and finite");
+  if (minStep > maxStep) return bad("minStep", "must not exceed maxStep");
+  if (initialStep < minStep || initialStep > maxStep) return bad("initialStep", "must lie in [minStep, maxStep]");
+  if (targetNewtonIterations < 1) return bad("targetNewtonIterations", "must be at least 1");
+  if (!(stepGrowth >= 1.0) || !finite(stepGrowth)) return bad("stepGrowth", "must be finite and >= 1");
+  if (!(stepShrink > 0.0 && stepShrink <= 1.0)) return bad("stepShrink", "must lie in (0, 1]");
+  if (!(slowContraction > 0.0) || !finite(slowContraction)) return bad("slowContraction", "must be positive");
+  if (!(targetContraction > 0.0 && targetContraction < 1.0)) return bad("targetContraction", "must lie in (0, 1)");
+  if (!(targetAngle > 0.0) || !finite(targetAngle)) return bad("targetAngle", "must be positive and finite");
+  if (!(minTangentCosine > -1.0 && minTangentCosine <= 1.0)) return bad("minTangentCosine", "must lie in (-1, 1]");
+  return {};
+}
+
+bool StepOptions::IsValid(std::string *why) const {
+  const std::string problem = validate();
+  if (why) *why = problem;
+  return problem.empty();
+}
+
+double StepOptions::next(double ds, const StepObservation &step) const {
   if (rule == Rule::NewtonCount) return next(ds, step.newtonIterations, step.contraction);
   double factor = stepGrowth;
   // Θ ∝ ds^(p+1) (step_control.h): the step that would have contracted at the target.
@@ -17,7 +42,7 @@ double StepSizeControl::next(double ds, const StepObservation &step) const {
   return std::min(maxStep, std::max(minStep, ds * factor));
 }
 
-double StepSizeControl::next(double ds, int newtonIterations, double contraction) const {
+double StepOptions::next(double ds, int newtonIterations, double contraction) const {
   // One iteration means the predictor was already on the branch: grow as much as allowed.
   double factor = newtonIterations <= 1 ? stepGrowth : static_cast<double>(targetNewtonIterations) / newtonIterations;
   factor = std::min(stepGrowth, std::max(stepShrink, factor));
@@ -25,7 +50,7 @@ double StepSizeControl::next(double ds, int newtonIterations, double contraction
   return std::min(maxStep, std::max(minStep, ds * factor));
 }
 
-bool StepSizeControl::halve(double &ds) const {
+bool StepOptions::halve(double &ds) const {
   ds *= 0.5;
   return !(ds < minStep);
 }

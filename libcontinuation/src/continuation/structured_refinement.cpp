@@ -120,7 +120,7 @@ struct StartPoint {
   double distance(const Vector &u, double lambda) const { return std::hypot((u - u0).norm(), lambda - lambda0); }
   StructuredRefinementResult restore(Vector &u, double &lambda, StructuredRefinementResult &result,
                                      const std::string &why) const {
-    result.failure = why;
+    result.message = why;
     result.converged = false;
     u = u0;
     lambda = lambda0;

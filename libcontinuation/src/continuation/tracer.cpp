@@ -12,8 +12,6 @@ namespace buckle::continuation {
 
 namespace {
 
-bool finite(double x) { return std::isfinite(x); }
-
 std::string formatDouble(const char *pattern, double value) {
   char buffer[200];
   std::snprintf(buffer, sizeof buffer, pattern, value);
@@ -54,57 +52,6 @@ bool retryShorter(const ContinuationPoint &a, const ContinuationPoint &b, double
 
 }  // namespace
 
-bool TracerOptions::IsValid(std::string *why) const {
-  auto fail = [why](const std::string &message) {
-    if (why) *why = message;
-    return false;
-  };
-  if (!(initialStep > 0.0) || !finite(initialStep)) return fail("initialStep must be positive and finite");
-  if (!(minStep > 0.0) || !finite(minStep)) return fail("minStep must be positive and finite");
-  if (!(maxStep > 0.0) || !finite(maxStep)) return fail("maxStep must be positive and finite");
-  if (minStep > maxStep) return fail("minStep must not exceed maxStep");
-  if (initialStep < minStep || initialStep > maxStep) return fail("initialStep must lie in [minStep, maxStep]");
-  if (targetNewtonIterations < 1) return fail("targetNewtonIterations must be at least 1");
-  if (!(stepGrowth >= 1.0) || !finite(stepGrowth)) return fail("stepGrowth must be finite and >= 1");
-  if (!(stepShrink > 0.0 && stepShrink <= 1.0)) return fail("stepShrink must lie in (0, 1]");
-  if (!(slowContraction > 0.0) || !finite(slowContraction)) return fail("slowContraction must be positive");
-  if (!(minTangentCosine > -1.0 && minTangentCosine <= 1.0))
-    return fail("minTangentCosine must lie in (-1, 1]");
-  if (maxPoints < 2) return fail("maxPoints must be at least 2");
-  if (std::isnan(lambdaMin) || std::isnan(lambdaMax)) return fail("lambdaMin/lambdaMax must not be NaN");
-  if (!(lambdaMin < lambdaMax)) return fail("lambdaMin must be smaller than lambdaMax");
-  if (!(maxArclength > 0.0)) return fail("maxArclength must be positive");
-  if (boxLower.size() != boxUpper.size()) return fail("boxLower and boxUpper must have the same size");
-  for (Eigen::Index i = 0; i < boxLower.size(); ++i)
-    if (std::isnan(boxLower[i]) || std::isnan(boxUpper[i]) || !(boxLower[i] < boxUpper[i]))
-      return fail("boxLower[" + std::to_string(i) + "] must be smaller than boxUpper[" + std::to_string(i) + "]");
-  if (!(newtonTolerance > 0.0) || !finite(newtonTolerance)) return fail("newtonTolerance must be positive and finite");
-  if (!(newtonStepTolerance > 0.0) || !finite(newtonStepTolerance))
-    return fail("newtonStepTolerance must be positive and finite");
-  if (maxNewtonIterations < 1) return fail("maxNewtonIterations must be at least 1");
-  if (!(locationTolerance > 0.0) || !finite(locationTolerance))
-    return fail("locationTolerance must be positive and finite");
-  if (!(locationNewtonTolerance > 0.0) || !finite(locationNewtonTolerance))
-    return fail("locationNewtonTolerance must be positive and finite");
-  if (maxLocationIterations < 1) return fail("maxLocationIterations must be at least 1");
-  if (!(touchTolerance > 0.0) || !finite(touchTolerance)) return fail("touchTolerance must be positive and finite");
-  if (maxRefinementIterations < 1) return fail("maxRefinementIterations must be at least 1");
-  if (!(separationFraction > 0.0 && separationFraction < 1.0)) return fail("separationFraction must lie in (0, 1)");
-  if (lowestEigenvalues < 0) return fail("lowestEigenvalues must be >= 0");
-  if (structuredFromDimension < 1) return fail("structuredFromDimension must be at least 1");
-  if (maxDenseLocationDimension < 1) return fail("maxDenseLocationDimension must be at least 1");
-  return true;
-}
-
-CorrectorOptions Tracer::stepCorrectorOptions() const {
-  CorrectorOptions c;
-  c.residualTolerance = options_.newtonTolerance;
-  c.stepTolerance = options_.newtonStepTolerance;
-  c.maxIterations = options_.maxNewtonIterations;
-  c.lineSearch = options_.lineSearch;
-  c.leanNewton = options_.leanNewton;
-  return c;
-}
 
 Tracer::Tracer(Problem &problem, const TracerOptions &options)
     : problem_(problem), options_(options), n_(problem.dimension()), work_(&problem) {
@@ -155,21 +102,16 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
     denseSolver_ = std::make_unique<DenseBorderedSolver>(*work_);
     solver = denseSolver_.get();
   }
-  corrector_ = std::make_unique<Corrector>(*work_, stepCorrectorOptions(), structuredSolver_.get());
-  evaluator_ = std::make_unique<PointEvaluator>(*work_, *solver, options_.computeStability, options_.lowestEigenvalues);
+  corrector_ = std::make_unique<Corrector>(*work_, options_.corrector, structuredSolver_.get());
+  evaluator_ = std::make_unique<PointEvaluator>(*work_, *solver, options_.detection.stability,
+                                                options_.detection.lowestEigenvalues);
   LocatorOptions lo;
-  lo.tolerance = options_.locationTolerance;
-  lo.newtonTolerance = options_.locationNewtonTolerance;
-  lo.maxIterations = options_.maxLocationIterations;
-  lo.maxRefinementIterations = options_.maxRefinementIterations;
-  lo.separationFraction = options_.separationFraction;
-  lo.minSampleCosine = options_.minTangentCosine;
-  lo.detectFolds = options_.detectFolds;
-  lo.detectBranchPoints = options_.detectBranchPoints;
-  lo.denseAlgebra = n_ <= options_.maxDenseLocationDimension;
+  lo.location = options_.location;
+  lo.detection = options_.detection;
+  lo.minSampleCosine = options_.step.minTangentCosine;
+  lo.denseAlgebra = n_ <= options_.location.maxDenseDimension;
   lo.denseMultiplePoints = n_ <= kMaxDenseMultiplePointDimension;
   lo.interrupt = options_.interrupt;
-  lo.touchTolerance = options_.touchTolerance;
   if (options_.onLocated)
     lo.onLocated = [this](const SpecialPoint &sp) {
       if (units_.identity()) return options_.onLocated(sp);
@@ -178,15 +120,6 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
       options_.onLocated(user);
     };
   locator_ = std::make_unique<Locator>(*work_, *corrector_, *evaluator_, lo);
-  stepControl_.rule = options_.stepRule;
-  stepControl_.minStep = options_.minStep;
-  stepControl_.maxStep = options_.maxStep;
-  stepControl_.targetNewtonIterations = options_.targetNewtonIterations;
-  stepControl_.stepGrowth = options_.stepGrowth;
-  stepControl_.stepShrink = options_.stepShrink;
-  stepControl_.slowContraction = options_.slowContraction;
-  stepControl_.targetContraction = options_.targetContraction;
-  stepControl_.targetAngle = options_.targetAngle;
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
   along_ = Vector::Zero(n_ + 1);
@@ -204,19 +137,23 @@ bool Tracer::completePoint(ContinuationPoint &point, ConstVectorRef referenceDir
   return evaluator_ && evaluator_->complete(point, referenceDirection);
 }
 
-StepAction Tracer::notifyStep(Branch &branch) {
-  if (units_.identity()) return options_.onStep(branch);
-  // The callback sees the new point and the special points in the problem's units; converting
-  // only those keeps a step O(N) (the earlier points are converted when the tracer returns).
-  // Restored from copies afterwards, so the tracer's own values are untouched bit for bit.
-  const ContinuationPoint last = branch.points.back();
-  const std::vector<SpecialPoint> specials = branch.specialPoints;
-  units_.toUser(branch.points.back());
-  for (SpecialPoint &sp : branch.specialPoints) units_.toUser(sp);
-  const StepAction action = options_.onStep(branch);
-  branch.points.back() = last;
-  branch.specialPoints = specials;
-  return action;
+StepAction Tracer::notifyStep(const Branch &branch, size_t firstNew) {
+  // The callback sees the new point and the step's special points in the problem's units, as
+  // copies into storage kept from step to step: a step stays O(N) and allocation-free (the
+  // branch's own points stay in the scaled variables until the tracer returns).
+  const ContinuationPoint *point = &branch.points.back();
+  if (!units_.identity()) {
+    stepPoint_ = *point;
+    units_.toUser(stepPoint_);
+    point = &stepPoint_;
+  }
+  stepSpecialPoints_.assign(branch.specialPoints.begin() + std::ptrdiff_t(std::min(firstNew, branch.specialPoints.size())),
+                            branch.specialPoints.end());
+  if (!units_.identity())
+    for (SpecialPoint &sp : stepSpecialPoints_) units_.toUser(sp);
+  const StepInfo info{*point,           stepSpecialPoints_, int(branch.points.size()), int(branch.specialPoints.size()),
+                      &branch,          branch.points.front().lambda * units_.parameter()};
+  return options_.onStep(info);
 }
 
 Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &direction) {
@@ -348,14 +285,14 @@ bool Tracer::takeStep(const ContinuationPoint &a, const ContinuationPoint *previ
   // The angle itself only where something reads it: the guard's message, and the step rule that
   // limits the turning (NewtonCount, the default, does not; an acos per point is ≈ 85 instructions).
   turningAngle = 0.0;
-  if (cosine < options_.minTangentCosine || stepControl_.rule != StepSizeControl::Rule::NewtonCount)
+  if (cosine < options_.step.minTangentCosine || options_.step.rule != StepOptions::Rule::NewtonCount)
     turningAngle = std::acos(std::max(-1.0, std::min(1.0, cosine)));
-  if (cosine < options_.minTangentCosine) {
+  if (cosine < options_.step.minTangentCosine) {
     failure = formatDouble("branch-jump guard (tangent turned by %.3g degrees)", turningAngle * 180.0 / std::acos(-1.0));
     return false;
   }
   // Two folds inside the step leave t_λ with the same sign at both ends (tracer.h).
-  if (options_.foldPairGuard && options_.detectFolds &&
+  if (options_.step.foldPairGuard && options_.detection.folds &&
       foldPairInside(a.lambda, a.tangent[n_], b.lambda, b.tangent[n_],
                      std::sqrt((b.u - a.u).squaredNorm() + (b.lambda - a.lambda) * (b.lambda - a.lambda)))) {
     failure = "fold-pair guard (lambda turns back and forth inside the step)";
@@ -369,10 +306,10 @@ bool Tracer::takeStep(const ContinuationPoint &a, const ContinuationPoint *previ
 }
 
 std::vector<SpecialPoint> Tracer::locateSpecialPoints(const ContinuationPoint &a, const ContinuationPoint &b) {
-  const IntervalCrossings crossings = classifyInterval(a, b, options_.detectFolds, options_.detectBranchPoints);
+  const IntervalCrossings crossings = classifyInterval(a, b, options_.detection.folds, options_.detection.branchPoints);
   if (!crossings.fold && crossings.branchPointCrossings == 0) {
     // Certified counting: the count saw nothing; do the eigenvalues next to zero agree?
-    if (!options_.certifiedCounting || !options_.detectBranchPoints) return {};
+    if (!options_.detection.certifiedCounting || !options_.detection.branchPoints) return {};
     const std::vector<SuspectedCrossing> suspects =
         suspectHiddenCrossings(a, b, stepAlong(a, b));
     if (suspects.empty()) return {};
@@ -401,7 +338,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
   eventsA_.resize(size_t(events));
   eventsB_.resize(size_t(events));
   eventValues(branch.points.back(), eventsA_);
-  double ds = branch.stopReason == StopReason::Paused ? branch.resumeStep : options_.initialStep;
+  double ds = branch.stopReason == StopReason::Paused ? branch.resumeStep : options_.step.initialStep;
   if (branch.stopReason == StopReason::Paused) branch.stopReason = StopReason::NotStarted;
   std::string lastFailure = "no failure";
   bool pause = false;  // a branch point was located in the last step (pauseAtBranchPoints)
@@ -418,7 +355,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
   };
   // After a failure: false (and the branch stopped, without an endpoint) once below minStep.
   auto halve = [&]() {
-    if (stepControl_.halve(ds)) return true;
+    if (options_.step.halve(ds)) return true;
     branch.stopReason = StopReason::StepSizeTooSmall;
     branch.stopMessage = "step size below minimum after " + lastFailure;
     return false;
@@ -451,12 +388,12 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     ContinuationPoint b;
     CorrectorSummary summary;
     double turningAngle = 0.0;
-    const ContinuationPoint *previous = options_.secondOrderPredictor && ia > 0 ? &branch.points[ia - 1] : nullptr;
+    const ContinuationPoint *previous = options_.step.secondOrderPredictor && ia > 0 ? &branch.points[ia - 1] : nullptr;
     if (!takeStep(a, previous, dsTry, b, summary, turningAngle, lastFailure)) {
       if (!halve()) return;
       continue;
     }
-    if (pauseAtBranchPoints_ && ia >= skipIntervals && retryShorter(a, b, dsTry, options_.minStep, ds)) continue;
+    if (pauseAtBranchPoints_ && ia >= skipIntervals && retryShorter(a, b, dsTry, options_.step.minStep, ds)) continue;
     // What the step showed, for the next one (read before `a` and `previous` dangle on the push).
     StepObservation observed;
     observed.newtonIterations = summary.iterations;
@@ -473,7 +410,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
 
     std::vector<SpecialPoint> found;
     if (ia >= skipIntervals && (hitEvent < 0 || b.arclength > a.arclength)) {
-      if (options_.certifiedCounting && options_.detectBranchPoints) {
+      if (options_.detection.certifiedCounting && options_.detection.branchPoints) {
         // The values next to zero at both ends; their slopes only where the problem's rate bound
         // cannot exclude a hidden crossing (spectral_monitor.h): the same steps are searched.
         ContinuationPoint &start = branch.points[size_t(ia)];
@@ -506,7 +443,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
     for (size_t k = firstNew; pauseAtBranchPoints_ && k < branch.specialPoints.size(); ++k)
       pause = pause || branch.specialPoints[k].type == SpecialPointType::BranchPoint;
     if (options_.onStep && !landedOnStart) {
-      const StepAction action = notifyStep(branch);
+      const StepAction action = notifyStep(branch, firstNew);
       if (action == StepAction::Stop) {
         interrupted("stopped by the step callback");
         return;
@@ -527,7 +464,7 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
       stop(StopReason::MaxArclength, "reached maxArclength", SpecialPointType::Endpoint, "max arclength");
       return;
     }
-    ds = stepControl_.next(ds, observed);
+    ds = options_.step.next(ds, observed);
     eventsA_.swap(eventsB_);
   }
 }

@@ -14,7 +14,7 @@ namespace buckle::continuation {
 // Events, g ≥ 0 inside: 0 λ ≥ λmin, 1 λ ≤ λmax, then the box faces of x = (u, λ) (lower,
 // upper per coordinate), then the problem's boundaries.
 int Tracer::eventCount() const {
-  const int boundaries = options_.detectBoundaries ? problem_.boundaryCount() : 0;
+  const int boundaries = options_.detection.boundaries ? problem_.boundaryCount() : 0;
   return 2 + boxEventCount() + boundaries;
 }
 
@@ -127,7 +127,7 @@ void Tracer::landOnCoordinateBound(int event, const ContinuationPoint &a, Contin
   predictor_[coordinate] = bound;
   const CorrectorOptions saved = corrector_->options();
   CorrectorOptions tight = saved;
-  tight.residualTolerance = std::min(saved.residualTolerance, options_.locationNewtonTolerance);
+  tight.tolerance = std::min(saved.tolerance, options_.location.newtonTolerance);
   corrector_->setOptions(tight);
   const CorrectorSummary fixed = corrector_->solveWithFixedCoordinate(predictor_, coordinate, x_);
   corrector_->setOptions(saved);

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "buckle/continuation/branch_point_coefficients.h"
-#include "buckle/mechanics/contact_geometry.h"
+#include "contact_geometry_report.h"
 #include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/stiffness_extremum.h"
@@ -65,7 +65,7 @@ void addPostBuckling(EquilibriumProblem& problem, const cont::SpecialPoint& sp, 
   }
   s.koiter = koiterCoefficients(problem, sp);
   if (!s.koiter.valid) {
-    s.note = s.koiter.error;
+    s.note = s.koiter.message;
     return;
   }
   for (int c = 0; c < 3; ++c) s.imperfections.push_back(imperfectionSensitivity(problem, sp, s.koiter, c));
@@ -74,7 +74,7 @@ void addPostBuckling(EquilibriumProblem& problem, const cont::SpecialPoint& sp, 
   if (problem.segments() > 1)
     s.imperfections.push_back(
         preloadImperfectionSensitivity(problem, sp, s.koiter, mostSensitivePreloadSegment(problem, sp, s.koiter)));
-  if (!s.koiter.error.empty()) s.note += (s.note.empty() ? "" : "; ") + s.koiter.error;
+  if (!s.koiter.message.empty()) s.note += (s.note.empty() ? "" : "; ") + s.koiter.message;
 }
 
 // A fold whose λ'' is zero to its accuracy: two folds merged, a cusp of the fold curve.

@@ -1,5 +1,7 @@
 #include "buckle/mechanics/contact_geometry.h"
 
+#include "contact_geometry_report.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>

@@ -63,17 +63,17 @@ std::vector<cont::Branch> traceBoth(cont::Problem& curve, const Vector& W0, doub
   cont::TracerOptions to = options.tracer;
   to.lambdaMin = options.muMin;
   to.lambdaMax = options.muMax;
-  to.computeStability = false;
-  to.detectBranchPoints = false;
+  to.detection.stability = false;
+  to.detection.branchPoints = false;
   if (structured) {
     to.linearAlgebra = cont::TracerOptions::LinearAlgebra::Structured;
-    to.detectFolds = false;
+    to.detection.folds = false;
   }
   if (accepted) {
     const cont::StepCallback user = options.tracer.onStep;
-    to.onStep = [accepted, user](const cont::Branch& b) {
-      accepted(b.points.back());
-      return user ? user(b) : cont::StepAction::Continue;
+    to.onStep = [accepted, user](const cont::StepInfo& step) {
+      accepted(step.point);
+      return user ? user(step) : cont::StepAction::Continue;
     };
   }
   std::vector<cont::Branch> out;

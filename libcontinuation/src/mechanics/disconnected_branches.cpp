@@ -87,17 +87,17 @@ class JoinWatch {
   std::vector<Curve> curves;
   int groupFrom = 0, seedCurve = -1;
 
-  cont::StepAction step(const cont::Branch& branch) {
-    const cont::ContinuationPoint& p = branch.points.back();
+  cont::StepAction step(const cont::StepInfo& step) {
+    const cont::ContinuationPoint& p = step.point;
     const Eigen::VectorXd b = scaling_.point(p), tb = scaling_.tangent(p);
     // A new branch (or contact stretch, or switched child that starts with points of its own)
     // begins: the earlier points may still be in the tracer's scaled variables, so the watch
     // starts from its newest point.
-    const bool fresh = &branch != branch_ || branch.points.size() <= std::max<size_t>(2, size_) ||
-                       branch.points.front().lambda != firstLambda_;
-    branch_ = &branch;
-    size_ = branch.points.size();
-    firstLambda_ = branch.points.front().lambda;
+    const bool fresh = step.branch != branch_ || size_t(step.pointCount) <= std::max<size_t>(2, size_) ||
+                       step.startLambda != firstLambda_;
+    branch_ = step.branch;
+    size_ = size_t(step.pointCount);
+    firstLambda_ = step.startLambda;
     if (fresh) {
       away_.clear();
       last_ = b;
@@ -119,7 +119,7 @@ class JoinWatch {
   const DisconnectedBranchOptions& options_;
   std::vector<bool> away_;
   Eigen::VectorXd last_;
-  const cont::Branch* branch_ = nullptr;  // the branch of the last step, its size and first λ
+  const void* branch_ = nullptr;  // the branch of the last step, its size and first λ
   size_t size_ = 0;
   double firstLambda_ = 0.0;
 };
@@ -243,15 +243,15 @@ DisconnectedBranches traceDisconnectedBranches(EquilibriumProblem& problem, cons
 
   EquilibriumBranchOptions o = options.branches;
   const cont::StepCallback userStep = o.tracer.onStep;
-  const auto userBranch = o.onBranch;
-  auto onStep = [&watch, userStep](const cont::Branch& b) {
-    if (userStep && userStep(b) == cont::StepAction::Stop) return cont::StepAction::Stop;
-    return watch.step(b);
+  const auto userBranch = o.tree.onBranch;
+  auto onStep = [&watch, userStep](const cont::StepInfo& step) {
+    if (userStep && userStep(step) == cont::StepAction::Stop) return cont::StepAction::Stop;
+    return watch.step(step);
   };
   o.tracer.onStep = onStep;
-  if (o.childTracer) o.childTracer->onStep = onStep;
+  if (o.tree.childTracer) o.tree.childTracer->onStep = onStep;
   // a finished branch is a curve the next ones may join (children, the other direction, later seeds)
-  o.onBranch = [&watch, &scaling, &userBranch](const cont::BranchTree& t, const cont::Branch& b) {
+  o.tree.onBranch = [&watch, &scaling, &userBranch](const cont::BranchTree& t, const cont::Branch& b) {
     if (userBranch) userBranch(t, b);
     watch.curves.push_back(curveOf(b, scaling));
     watch.curves.back().pending = true;

@@ -56,7 +56,7 @@ inline double weightedErrorNorm(const ExplicitState& e, const ExplicitState& x, 
 /// Step-size control as odeint's rosenbrock4_controller (Hairer & Wanner IV.8): the factor
 /// err^{1/p}/0.9 within [1/6, 5] and, after an accepted step, Gustafsson's predictive factor; no
 /// growth right after a rejection. p = 4 for Rosenbrock4's order-3 estimate, 5 for Dormand–Prince.
-struct StepSizeController {
+struct StepOptionsler {
   double exponent;  ///< 1/p
   bool haveOld = false, lastRejected = false;
   double dtOld = 0.0, errOld = 1.0;
@@ -193,7 +193,7 @@ class StructuredRosenbrock4 {
   DynamicsModel& model_;
   double atol_, rtol_;
   std::vector<double> unit_;
-  StepSizeController control_{0.25};
+  StepOptionsler control_{0.25};
   ExplicitState f_, r_, xtmp_, err_, xout_;
   ExplicitState g_[5];
 };
@@ -323,7 +323,7 @@ class SwitchingStepper {
   bool stiff_ = false, switchedBack_ = false;
   int stiffCount_ = 0, nonStiffRun_ = 0, backAfter_ = 15;
   long stiffSteps_ = 0;
-  StepSizeController control_{0.2};
+  StepOptionsler control_{0.2};
   ExplicitState f0_, f6_, f7_, x6_, xout_, err_;
   ExplicitState k_[5];
 };

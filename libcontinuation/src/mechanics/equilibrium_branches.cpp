@@ -161,7 +161,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // The locked problem has no O(n) stabilityEigenvalues (the dense default is O(n³) per point
     // and made the near-zero spectrum most of a 50-segment tree's time): locked stretches keep
     // the inertia count and the determinant, without the hidden-crossing monitor.
-    o.certifiedCounting = false;
+    o.detection.certifiedCounting = false;
     if (o.maxPoints < 2 || !(o.maxArclength > 0.0)) break;
     auto next = lockedProblem(problem, locked, maxContactTorque);
     const std::string what =
@@ -177,7 +177,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // by continueBranch, which only looks for crossings from g ≥ 0, not by trace(), which refuses a
     // start with g < 0.
     const ConstrainedEquilibrium start =
-        solveConstrainedEquilibrium(problem, locked, at.u, at.lambda, std::max(o.locationNewtonTolerance, 1e-12));
+        solveConstrainedEquilibrium(problem, locked, at.u, at.lambda, std::max(o.location.newtonTolerance, 1e-12));
     if (!start.converged) {
       giveUp("the equilibrium could not be polished (" + start.message + ")");
       break;
@@ -232,7 +232,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // A stretch that does not leave its start, or leaves it to the wrong side (a contact that
     // pulls at once, or a released joint or vertex that goes on past its limit or the wall),
     // would chatter: stop.
-    if (stretch.points.size() < 2 || !(stretch.points.back().arclength > options.minStep)) {
+    if (stretch.points.size() < 2 || !(stretch.points.back().arclength > options.step.minStep)) {
       giveUp("the branch does not leave the point (" + stretch.stopMessage + ")");
       break;
     }
@@ -272,21 +272,18 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
                                     const EquilibriumBranchOptions& options) {
   EquilibriumBranches result;
   const Eigen::VectorXd u0 = problem.initialGuess(q0, lambda0);
-  continuation::TreeOptions tree;
-  tree.maxDepth = options.switchingDepth;
-  tree.switching = options.switching;
+  continuation::TreeOptions tree = options.tree;
   // Not at a branch point on a stretch with vertices on the wall: its problem's unknowns carry
   // the wall forces, which the branch does not store (continueUnderContact); the point is reported.
   tree.switchAt = [&result, &options](const continuation::Branch& b, const continuation::SpecialPoint& bp) {
     if (size_t(b.id) < result.contact.size() && lockedAt(result.contact[size_t(b.id)], bp.index + 1).wallCount() > 0)
       return false;
-    return !options.switchAt || options.switchAt(b, bp);
+    return !options.tree.switchAt || options.tree.switchAt(b, bp);
   };
-  tree.childTracer = options.childTracer;
-  tree.onBranch = options.onBranch;
-  const bool box = options.tracer.boxLower.size() || (options.childTracer && options.childTracer->boxLower.size());
+  const bool box =
+      options.tracer.boxLower.size() || (options.tree.childTracer && options.tree.childTracer->boxLower.size());
   if (options.mirror && !box) tree.symmetry = mirrorSymmetry(problem);
-  const continuation::TracerOptions& childOptions = options.childTracer ? *options.childTracer : options.tracer;
+  const continuation::TracerOptions& childOptions = options.tree.childTracer ? *options.tree.childTracer : options.tracer;
 
   // traced[b]: the sizes of branch b as traced, before its contact stretches (a mirror image
   // takes its source's stretches from there on); geometric[b]: its base and self contacts.
@@ -340,7 +337,7 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
     auto owned = std::make_shared<Owned>();
     owned->problem = lockedProblem(problem, locked, options.maxContactTorque);
     continuation::TracerOptions o = childOptions;
-    o.certifiedCounting = false;  // as on the stretch itself (continueUnderContact)
+    o.detection.certifiedCounting = false;  // as on the stretch itself (continueUnderContact)
     owned->tracer.emplace(*owned->problem, o);
     return std::shared_ptr<continuation::Tracer>(owned, &*owned->tracer);
   };

@@ -42,7 +42,7 @@ ImperfectionSensitivity imperfectionSensitivity(const EquilibriumProblem& proble
   ImperfectionSensitivity s;
   s.coordinate = c;
   if (c < 0 || c > 2) {
-    s.error = "imperfection sensitivity: the end coordinate must be 0 (x), 1 (y) or 2 (phi), got " + std::to_string(c);
+    s.message = "imperfection sensitivity: the end coordinate must be 0 (x), 1 (y) or 2 (phi), got " + std::to_string(c);
     return s;
   }
   const EndCondition& end = problem.endCondition();
@@ -51,7 +51,7 @@ ImperfectionSensitivity imperfectionSensitivity(const EquilibriumProblem& proble
   static const char* const coordinates[] = {"x", "y", "phi"};
   s.name = held ? coordinates[c] : loads[c];
   if (!k.valid) {
-    s.error = "imperfection sensitivity: no Koiter coefficients (" + k.error + ")";
+    s.message = "imperfection sensitivity: no Koiter coefficients (" + k.message + ")";
     return s;
   }
   // F_ε: the residual is linear in the prescribed values, so F_ε is F_λ of the same chain whose
@@ -61,7 +61,7 @@ ImperfectionSensitivity imperfectionSensitivity(const EquilibriumProblem& proble
   cont::Vector lambdaDirection = cont::Vector::Zero(N + 1), Fe(N);
   lambdaDirection[N] = 1.0;
   if (!moved.jacobianApply(bp.u, bp.lambda, lambdaDirection, Fe)) {
-    s.error = "imperfection sensitivity: the chain refused the branch point";
+    s.message = "imperfection sensitivity: the chain refused the branch point";
     return s;
   }
   fromCoupling(k, Fe, s);
@@ -77,12 +77,12 @@ ImperfectionSensitivity preloadImperfectionSensitivity(const EquilibriumProblem&
   const Chain& chain = problem.chain();
   const int n = chain.size();
   if (segment < -1 || segment >= n) {
-    s.error = "imperfection sensitivity: the segment must be -1 (all) or 0 ... " + std::to_string(n - 1) + ", got " +
+    s.message = "imperfection sensitivity: the segment must be -1 (all) or 0 ... " + std::to_string(n - 1) + ", got " +
               std::to_string(segment);
     return s;
   }
   if (!k.valid) {
-    s.error = "imperfection sensitivity: no Koiter coefficients (" + k.error + ")";
+    s.message = "imperfection sensitivity: no Koiter coefficients (" + k.message + ")";
     return s;
   }
   // F_ε = ∂(∂E/∂q)/∂ε on the affected joints (the load terms do not depend on the free lengths)
@@ -91,7 +91,7 @@ ImperfectionSensitivity preloadImperfectionSensitivity(const EquilibriumProblem&
   for (int i = (segment < 0 ? 0 : segment); i < (segment < 0 ? n : segment + 1); ++i)
     Fe[i] = chain.segment(i).energyJetParameterDerivative(bp.u[i], d).d1;
   if (!Fe.allFinite()) {
-    s.error = "imperfection sensitivity: the chain refused the branch point";
+    s.message = "imperfection sensitivity: the chain refused the branch point";
     return s;
   }
   fromCoupling(k, Fe, s);

@@ -92,7 +92,7 @@ RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn
   for (int i = 0; i < n; ++i)
     if (rp.sides[size_t(i)] != 0) locked.lock(i, rp.sides[size_t(i)] > 0 ? LimitSide::Upper : LimitSide::Lower);
   const ConstrainedEquilibrium ce = solveConstrainedEquilibrium(problem, locked, problem.initialGuess(dyn.q, lambda), lambda,
-                                                                options.residualTolerance, options.maxIterations);
+                                                                options.tolerance, options.maxIterations);
   rp.polished.u = ce.u;
   rp.polished.converged = ce.converged;
   rp.polished.iterations = ce.iterations;
@@ -214,7 +214,7 @@ IntegrationOptions jumpIntegrationDefaults(int segments) {
 
 continuation::CorrectorOptions defaultPolishOptions() {
   continuation::CorrectorOptions o;
-  o.residualTolerance = 1e-12;
+  o.tolerance = 1e-12;
   o.maxIterations = 50;
   o.lineSearch = true;
   return o;

@@ -34,7 +34,7 @@ void classifyDegenerate(EquilibriumProblem& problem, const cont::SpecialPoint& b
   cont::ChildBranchExpansion ex;
   std::string why;
   if (!cont::childBranchExpansion(problem, bp.u, bp.lambda, g, c, ex, &why)) {
-    k.error = "degenerate pitchfork (|b| below its accuracy); " + why;
+    k.message = "degenerate pitchfork (|b| below its accuracy); " + why;
     return;
   }
   k.c4 = ex.c4;
@@ -51,14 +51,14 @@ KoiterCoefficients koiterCoefficients(EquilibriumProblem& problem, const cont::S
   KoiterCoefficients k;
   const int N = problem.dimension(), n = problem.segments();
   if (bp.type != cont::SpecialPointType::BranchPoint || bp.nullVectors.rows() != N + 1 || bp.nullVectors.cols() != 2) {
-    k.error = "Koiter coefficients: not a located simple branch point";
+    k.message = "Koiter coefficients: not a located simple branch point";
     return k;
   }
   // the joint part of ker F_u (the λ-free combination of ker F_x), unit, largest entry positive
   const Eigen::VectorXd t = bp.nullVectors.col(0), phi = bp.nullVectors.col(1);
   Eigen::VectorXd m = (t[N] * phi.head(N) - phi[N] * t.head(N)).head(n);
   if (!(m.norm() > 0.0) || !m.allFinite()) {
-    k.error = "Koiter coefficients: the null vector has no joint part";
+    k.message = "Koiter coefficients: the null vector has no joint part";
     return k;
   }
   Eigen::Index big = 0;
@@ -67,7 +67,7 @@ KoiterCoefficients koiterCoefficients(EquilibriumProblem& problem, const cont::S
   Eigen::VectorXd c = Eigen::VectorXd::Zero(N);
   c.head(n) = m;
   cont::BranchPointCoefficients g;
-  if (!cont::branchPointCoefficients(problem, bp, c, g, &k.error, algebra)) {
+  if (!cont::branchPointCoefficients(problem, bp, c, g, &k.message, algebra)) {
     // A branch point reached along a bifurcated branch, at its tip (the traced branch turns in λ
     // there, touching the other without crossing it): the coefficients are the pitchfork's, with
     // the other branch through the point, the one that is not vertical, as the parent.
@@ -79,7 +79,7 @@ KoiterCoefficients koiterCoefficients(EquilibriumProblem& problem, const cont::S
     other.tangent = phi;
     std::string why;
     if (!cont::branchPointCoefficients(problem, other, c, g, &why, algebra)) return k;
-    k.error.clear();
+    k.message.clear();
     k.parentIsOther = true;
   }
   k.valid = true;

@@ -315,7 +315,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       if ((target - lambda) * sign <= 0.0) break;  // the overshoot passed the waypoint
     }
   }
-  result.completed = true;
+  result.success = true;
   result.message = "all waypoints reached";
   return result;
 }

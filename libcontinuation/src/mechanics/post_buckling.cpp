@@ -50,19 +50,19 @@ FirstBuckling firstBuckling(const Chain& chain, const EndCondition& end, const E
     const double lc = first->lambda;
     EquilibriumProblem problem(chain, end, direction);
     EquilibriumBranchOptions opt;
-    opt.tracer.initialStep = std::min(0.05, 0.2 * std::abs(lc));
-    opt.tracer.maxStep = 0.1;
+    opt.tracer.step.initialStep = std::min(0.05, 0.2 * std::abs(lc));
+    opt.tracer.step.maxStep = 0.1;
     opt.tracer.lambdaMin = 1.3 * lc;
     opt.tracer.lambdaMax = -lc;
     opt.tracer.maxPoints = 400;
     cont::TracerOptions child = opt.tracer;
     child.maxPoints = 8;
-    child.initialStep = 0.02;
-    child.maxStep = 0.02;
-    opt.childTracer = child;
-    opt.switchingDepth = 1;
+    child.step.initialStep = 0.02;
+    child.step.maxStep = 0.02;
+    opt.tree.childTracer = child;
+    opt.tree.branchSwitching = 1;
     opt.contact = false;  // the classification only looks at the branches near the first BP
-    opt.switchAt = [lc](const cont::Branch& b, const cont::SpecialPoint& bp) {
+    opt.tree.switchAt = [lc](const cont::Branch& b, const cont::SpecialPoint& bp) {
       return b.parentId < 0 && std::abs(bp.lambda - lc) <= 1e-6 * std::abs(lc);
     };
     const EquilibriumBranches tree = traceEquilibria(problem, q0, 0.0, cont::InitialDirection::decreasingLambda(), opt);
@@ -75,14 +75,14 @@ FirstBuckling firstBuckling(const Chain& chain, const EndCondition& end, const E
     if (!bifurcated) {
       bool located = false;
       for (const cont::SpecialPoint& sp : tree.tree.branches.front().specialPoints)
-        located = located || (sp.type == cont::SpecialPointType::BranchPoint && opt.switchAt(tree.tree.branches.front(), sp));
+        located = located || (sp.type == cont::SpecialPointType::BranchPoint && opt.tree.switchAt(tree.tree.branches.front(), sp));
       r.kind = PostBuckling::Failed;
-      r.error = located ? "no bifurcating direction" : "first branch point not located on the straight branch";
+      r.message = located ? "no bifurcating direction" : "first branch point not located on the straight branch";
       return r;
     }
     if (bifurcated->points.size() < 3) {
       r.kind = PostBuckling::Failed;
-      r.error = "the new branch could not be followed";
+      r.message = "the new branch could not be followed";
       return r;
     }
     int stable = 0, checked = 0;
@@ -95,7 +95,7 @@ FirstBuckling firstBuckling(const Chain& chain, const EndCondition& end, const E
     r.kind = checked > 0 && stable == checked ? PostBuckling::Supercritical : PostBuckling::Subcritical;
   } catch (const std::exception& e) {
     r.kind = PostBuckling::Failed;
-    r.error = e.what();
+    r.message = e.what();
   }
   return r;
 }

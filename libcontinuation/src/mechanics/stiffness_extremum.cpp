@@ -166,7 +166,7 @@ class BranchSection {
   static cont::CorrectorOptions correctorOptions() {
     // Every evaluation of g must sit on the branch to rounding: g's error moves the root.
     cont::CorrectorOptions o;
-    o.residualTolerance = 1e-14;
+    o.tolerance = 1e-14;
     o.stepTolerance = 1e-15;
     o.maxIterations = 30;
     o.stagnationFactor = 1e3;

@@ -90,10 +90,10 @@ TaskPathSpecial special(TaskPathProblem& problem, const cont::SpecialPoint& sp, 
   out.point.leg = leg;
   switch (event) {
     case TaskPathEvent::Fold:
-      out.why = "fold of the task map: the inputs cannot move the end further along the path (s turns back)";
+      out.note = "fold of the task map: the inputs cannot move the end further along the path (s turns back)";
       break;
-    case TaskPathEvent::BranchPoint: out.why = "branch point of the task continuation: the path is not followed uniquely"; break;
-    default: out.why = sp.boundaryName; break;
+    case TaskPathEvent::BranchPoint: out.note = "branch point of the task continuation: the path is not followed uniquely"; break;
+    default: out.note = sp.boundaryName; break;
   }
   return out;
 }
@@ -121,16 +121,16 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
     cont::TracerOptions opt = options.tracer;
     opt.lambdaMin = s - length;
     opt.lambdaMax = s + length;
-    opt.computeStability = false;
-    opt.certifiedCounting = false;
-    opt.detectBoundaries = true;
+    opt.detection.stability = false;
+    opt.detection.certifiedCounting = false;
+    opt.detection.boundaries = true;
     const cont::StepCallback user = opt.onStep;
     // a fold or branch point ends the path: nothing past it follows the task stably and uniquely
-    opt.onStep = [user](const cont::Branch& b) {
-      for (const cont::SpecialPoint& sp : b.specialPoints)
+    opt.onStep = [user](const cont::StepInfo& step) {
+      for (const cont::SpecialPoint& sp : step.specialPoints)
         if (sp.type == cont::SpecialPointType::Fold || sp.type == cont::SpecialPointType::BranchPoint)
           return cont::StepAction::Stop;
-      return user ? user(b) : cont::StepAction::Continue;
+      return user ? user(step) : cont::StepAction::Continue;
     };
     const cont::Branch b = cont::trace(problem, u, s, cont::InitialDirection::increasingLambda(), opt);
     if (b.points.empty()) {
@@ -157,7 +157,7 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
       result.specials.push_back(special(problem, *stop, e, leg, options.stiffness));
       result.points.push_back(result.specials.back().point);
       result.end = e;
-      result.message = result.specials.back().why;
+      result.message = result.specials.back().note;
       return result;
     }
     switch (b.stopReason) {
@@ -248,7 +248,7 @@ BranchReport reportTaskPath(const TaskPathResult& path, const Wrench& payload, b
     s.accuracy = sp.accuracy;
     s.K = sp.point.K;
     s.refined = true;
-    s.note = sp.why;
+    s.note = sp.note;
     s.inputs = sp.point.inputs;
   }
   r.finished = path.end != TaskPathEvent::Failed && path.end != TaskPathEvent::Interrupted &&

@@ -62,7 +62,7 @@ std::vector<Branch> switchBothSides(Tracer &tracer, const SpecialPoint &bp, cons
                                     const Reflection &symmetry = Reflection());
 
 struct TreeOptions {
-  int maxDepth = 0;                    ///< switching generations (0: only the start branches)
+  int branchSwitching = 0;             ///< switching generations (0: only the start branches)
   BranchSwitchingOptions switching;
   /// Which branch points to switch at, among those the guards allow (default: all of them);
   /// e.g. only the first one, to see which way the first bifurcated branch goes.
@@ -88,7 +88,7 @@ struct TreeOptions {
   std::function<std::shared_ptr<Tracer>(const BranchTree &tree, std::size_t branch, const SpecialPoint &bp)>
       switchTracer;
   /// Called once per branch when it is final: its branch points were switched at (their notes
-  /// written) or will not be (its generation is maxDepth, or the tree was interrupted); a mirror
+  /// written) or will not be (its generation is branchSwitching, or the tree was interrupted); a mirror
   /// image's source is final only after its image joined the tree. Branches become final in
   /// this order: the children of a branch point right after they are traced, their parent when
   /// all its branch points are done. A consumer may report the branch here and release its
@@ -103,11 +103,11 @@ struct TreeOptions {
 
 /// The bifurcation tree from one start point, breadth first: the start branches, one per entry
 /// of `starts` (roots, in that order, whether or not they got off the start), then, down to
-/// maxDepth generations, both sides of every simple branch point that is not the one a branch
+/// branchSwitching generations, both sides of every simple branch point that is not the one a branch
 /// started from and was not already switched from another branch (the guards are noted on the
 /// branch point). Multiple points (multiplicity ≥ 2) are reported but not switched. A requested
 /// TracerOptions::interrupt stops the branch in progress and every later one; the tree then
-/// says so (`interrupted`, `message`). With maxDepth > 0 a root is traced lazily, up to the
+/// says so (`interrupted`, `message`). With branchSwitching > 0 a root is traced lazily, up to the
 /// next branch point the loop is about to switch at (Tracer::pauseAtBranchPoints): the ids,
 /// branches and points are those of tracing it whole first, but an interrupted tree holds the
 /// branches of a root's first branch points (the weakest, along a load path from zero) however
@@ -115,9 +115,9 @@ struct TreeOptions {
 BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
                      const TracerOptions &options, const TreeOptions &tree);
 
-/// One start direction: traceTree(problem, u0, λ0, {direction}, options, {maxDepth, switching}).
+/// One start direction: traceTree(problem, u0, λ0, {direction}, options, {branchSwitching, switching}).
 BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
-                     const TracerOptions &options, int maxDepth,
+                     const TracerOptions &options, int branchSwitching,
                      const BranchSwitchingOptions &switching = BranchSwitchingOptions());
 
 }  // namespace buckle::continuation

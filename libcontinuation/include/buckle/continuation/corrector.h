@@ -28,6 +28,7 @@
 #include "buckle/continuation/dense_lu.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/sundials_raii.h"
+#include "buckle/continuation/tracer_options.h"
 
 #include <array>
 #include <exception>
@@ -36,30 +37,6 @@
 #include <vector>
 
 namespace buckle::continuation {
-
-struct CorrectorOptions {
-  /// Converged when ‖G‖∞ ≤ residualTolerance (KINSOL fnormtol).
-  double residualTolerance = 1e-10;
-  /// KINSOL scaled step tolerance: stop when the Newton step is this small relative to x.
-  double stepTolerance = 1e-14;
-  int maxIterations = 10;
-  /// KIN_LINESEARCH instead of full Newton steps (KIN_NONE).
-  bool lineSearch = false;
-  /// Longest Newton step KINSOL may take (‖Δx‖₂). 0: unlimited. KINSOL's own default,
-  /// 1000·max(1, ‖x₀‖), silently truncates steps from predictors near the origin.
-  double maxNewtonStep = 0.0;
-  /// A solve that stalls on the step tolerance (KIN_STEP_LT_STPTOL: rounding floor reached)
-  /// still counts as converged if ‖G‖₂ ≤ stagnationFactor · residualTolerance.
-  double stagnationFactor = 100.0;
-  /// Opt-in: full Newton (lineSearch false) by Corrector's own reproduction of KINSOL's iteration
-  /// where it converges plainly (the same iterates, flag, counts and norms, bit for bit), KINSOL
-  /// itself otherwise. Off by default: the corrector is KINSOL's (the design card); on, it saves
-  /// KINSOL's per-call bookkeeping (≈ 1.8 k instructions per point at n = 3, benchmarks/RESULTS.md
-  /// "round 6") for callers that trace many tiny systems.
-  bool leanNewton = false;
-
-  bool IsValid(std::string *why) const;
-};
 
 /// Why and how a corrector solve ended.
 struct CorrectorSummary {

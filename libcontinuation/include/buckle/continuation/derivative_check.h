@@ -50,7 +50,7 @@ struct DerivativeComparison {
 };
 
 struct DerivativeCheck {
-  bool ok = false;                          ///< every comparison evaluated and within precision
+  bool success = false;                     ///< every comparison evaluated and within precision
   double maxRelativeError = 0.0;            ///< the worst over every comparison
   std::vector<DerivativeComparison> comparisons;
   Matrix jacobian;                          ///< the problem's [F_u F_λ] (N×(N+1))

@@ -30,6 +30,7 @@
 #include "buckle/continuation/spectral_monitor.h"
 #include "buckle/continuation/structured_refinement.h"
 #include "buckle/continuation/test_functions.h"
+#include "buckle/continuation/tracer_options.h"
 
 #include <functional>
 #include <memory>
@@ -39,33 +40,21 @@
 namespace buckle::continuation {
 
 struct LocatorOptions {
-  double tolerance = 1e-12;          ///< target |Δλ| ≤ tolerance·max(1, |λ|)
-  /// Secant tolerance before an augmented-Newton refinement: near a branch point the corrector
-  /// samples are ill-conditioned (the Keller Jacobian is singular there), so the secant stage
-  /// only brackets and Newton on the regular augmented system does the rest. If refinement
-  /// fails, the secant continues down to `tolerance`.
-  double coarseTolerance = 1e-7;
-  double newtonTolerance = 1e-13;    ///< corrector ‖G‖∞ while locating
-  int maxIterations = 60;            ///< secant/bisection evaluations
-  int maxRefinementIterations = 15;
-  double separationFraction = 1e-9;  ///< of the step length
-  /// A sample whose tangent makes cos < this with the interpolated step tangent is rejected.
+  LocationOptions location;    ///< TracerOptions::location
+  DetectionOptions detection;  ///< TracerOptions::detection (folds, branch points, touches)
+  /// A sample whose tangent makes cos < this with the interpolated step tangent is rejected
+  /// (StepOptions::minTangentCosine).
   double minSampleCosine = 0.9;
-  bool detectFolds = true;
-  bool detectBranchPoints = true;
-  /// Dense (N+1)² work allowed: ψ, the augmented-Newton refinements and the kernel (null
-  /// vectors, branch directions). False (large N): the same refinements and geometry with O(N)
-  /// algebra (structured_refinement.h: the problem's structured solver, or dense LU without one);
-  /// the secant brackets on O(N) test functions (t_λ, the determinant, the crossing eigenvalue).
+  /// Dense (N+1)² work allowed (N ≤ LocationOptions::maxDenseDimension): ψ, the augmented-Newton
+  /// refinements and the kernel (null vectors, branch directions). False (large N): the same
+  /// refinements and geometry with O(N) algebra (structured_refinement.h: the problem's
+  /// structured solver, or dense LU without one); the secant brackets on O(N) test functions
+  /// (t_λ, the determinant, the crossing eigenvalue).
   bool denseAlgebra = true;
   /// Dense kernel (SVD of F_x) at points of multiplicity m ≥ 2 even without denseAlgebra: their
   /// verification (`refined`: ker F_x (m+1)-dimensional) and null vectors (multiplicity_switching.h,
   /// kMaxDenseMultiplePointDimension).
   bool denseMultiplePoints = true;
-  /// Certified counting (spectral_monitor.h): a suspected interior minimum of |μ| whose value
-  /// is at most touchTolerance·max(1, |μ_a|, |μ_b|) (scaled stability units) without a sign change
-  /// is an eigenvalue touch.
-  double touchTolerance = 1e-8;
   /// A requested interrupt makes every further sample fail: the point in hand is reported as
   /// located so far, and the tracer stops at its next step.
   Interrupt interrupt;
@@ -97,7 +86,7 @@ class Locator {
     double lastDLambda = 0.0;  ///< |Δλ| of the last update
     int evaluations = 0;
     bool converged = false;
-    std::string failure;
+    std::string message;
     StepSample left, right;  ///< final bracket and its test values
     double fLeft = 0.0, fRight = 0.0;
   };
@@ -115,7 +104,7 @@ class Locator {
 
   const StepSample &start() const { return a_; }
   const StepSample &end() const { return b_; }
-  double tolerance(double lambda) const { return options_.tolerance * std::max(1.0, std::abs(lambda)); }
+  double tolerance(double lambda) const { return options_.location.tolerance * std::max(1.0, std::abs(lambda)); }
   /// ‖F(u, λ)‖₂ (+∞ if the problem refuses the point), into a workspace sized once: no allocation.
   double residualNorm(ConstVectorRef u, double lambda);
 

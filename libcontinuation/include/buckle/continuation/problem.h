@@ -7,7 +7,8 @@
 // derivative_check.h, checks hand-written ones), and optionally
 //   - a symmetric stability operator H with constraint rows C: the state is
 //     stable when H is positive definite on ker C (mechanics: the Hessian of the
-//     total potential, C = rows of the held end coordinates);
+//     total potential, C = rows of the held end coordinates; a gradient system
+//     derives from GradientProblem, gradient_problem.h, and gets H = ±F_u);
 //   - directional second derivatives (used to locate folds and branch points;
 //     the default takes central differences of the analytic Jacobian);
 //   - boundaries g_k(u, λ) > 0 (joint limits, a box): the tracer stops exactly on

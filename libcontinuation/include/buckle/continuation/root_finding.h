@@ -43,7 +43,7 @@ struct AugmentedNewtonResult {
   int iterations = 0;
   double lastDLambda = 0.0;
   double residualNorm = 0.0;
-  std::string failure;
+  std::string message;
 };
 using AugmentedSystem = std::function<bool(const Vector &z, Vector &R, Matrix *J)>;
 /// An iterate farther than maxDistance from the start is a failure and z is restored.

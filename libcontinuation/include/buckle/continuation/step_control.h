@@ -22,9 +22,11 @@
 // With one Newton iteration or none there is no contraction to measure: the predictor was on the
 // branch to the tolerance, and the step grows (by the angle rule at most).
 //
-// NewtonCount (AUTO-07p's rule; the tracer's default, TracerOptions::stepRule): ds·target/iterations, and at most 0.7 when Newton contracted
+// NewtonCount (AUTO-07p's rule; the tracer's default, StepOptions::rule): ds·target/iterations, and at most 0.7 when Newton contracted
 // slowly (contraction above slowContraction).
 #pragma once
+
+#include <string>
 
 namespace buckle::continuation {
 
@@ -36,17 +38,34 @@ struct StepObservation {
   int predictorOrder = 1;     ///< 1: Euler (off the branch by O(ds²)); 2: second order (O(ds³))
 };
 
-struct StepSizeControl {
-  enum class Rule { Curvature, NewtonCount };
-  Rule rule = Rule::NewtonCount;
+/// The tracer's steps (TracerOptions::step): their sizes, the rule that adapts them and the
+/// guards that reject a step. All sizes are dimensionless arclengths in the scaled variables.
+struct StepOptions {
+  double initialStep = 0.01;
   double minStep = 1e-8;
   double maxStep = 0.1;
-  int targetNewtonIterations = 3;  ///< NewtonCount
-  double stepGrowth = 1.5;
+  /// How the next step follows from the last one: Curvature from Newton's contraction and the
+  /// tangent's turning angle, or NewtonCount (AUTO-07p's iteration count). NewtonCount by
+  /// default until the curvature rule is measured against the regression baselines and the
+  /// work-precision benchmark (benchmarks/work_precision --rule curvature).
+  enum class Rule { Curvature, NewtonCount };
+  Rule rule = Rule::NewtonCount;
+  int targetNewtonIterations = 3;  ///< NewtonCount: ds·target/iterations
+  double stepGrowth = 1.5;         ///< factors of the next step clamped to [stepShrink, stepGrowth]
   double stepShrink = 0.5;
   double slowContraction = 0.3;    ///< NewtonCount: contraction above this caps the next factor at 0.7
   double targetContraction = 0.2;  ///< Curvature: Θ̄
   double targetAngle = 0.2;        ///< Curvature: ᾱ [rad]
+  double minTangentCosine = 0.9;   ///< branch-jump guard: t_newᵀt_old must stay ≥ this (MATCONT)
+  /// Fold-pair guard: a step whose λ turns back and forth inside it (foldPairInside below: two
+  /// folds that the sign test of t_λ at the ends cannot see) is rejected and retried smaller.
+  /// Off by default for the same reason as `rule`.
+  bool foldPairGuard = false;
+  /// Second-order predictor x_a + ds·t_a + ½ds²·(t_a − t_p)/Δs_a (the curvature from the last
+  /// two tangents) instead of x_a + ds·t_a: fewer Newton iterations per step on curved branches
+  /// (benchmarks/RESULTS.md, work-precision). Off by default: it moves the points, and on the
+  /// hysteresis scene's degenerate branch point that changes the reported mode shape.
+  bool secondOrderPredictor = false;
 
   /// The step after an accepted step of size ds (either rule).
   double next(double ds, const StepObservation &step) const;
@@ -55,6 +74,10 @@ struct StepSizeControl {
   double next(double ds, int newtonIterations, double contraction) const;
   /// After a failed step: halves ds; false once it is below minStep (the branch must stop).
   bool halve(double &ds) const;
+
+  /// Empty when valid, else what is wrong, the field named as `prefix` + its name.
+  std::string validate(const std::string &prefix = "step.") const;
+  bool IsValid(std::string *why) const;
 };
 
 }  // namespace buckle::continuation

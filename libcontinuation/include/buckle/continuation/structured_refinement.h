@@ -63,7 +63,7 @@ struct StructuredRefinementResult {
   double lastDLambda = 0.0;   ///< |Δλ| of the last Newton step
   double residualNorm = 0.0;  ///< ‖(F, g)‖ or ‖(F + βψ̂, h)‖ at the result
   double testValue = 0.0;     ///< g (fold) or ‖h‖ (branch point) at the result
-  std::string failure;
+  std::string message;
 };
 
 class StructuredRefinement {

@@ -22,13 +22,12 @@
 #include "buckle/continuation/interrupt.h"
 #include "buckle/mechanics/classification.h"
 #include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/contact_geometry.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/imperfection_sensitivity.h"
 #include "buckle/mechanics/stiffness_extremum.h"
 
 namespace buckle::mechanics {
-
-struct GeometricContacts;  // contact_geometry.h
 
 /// What kind of event a reported special point is. Labels (label): AUTO/MATCONT's where
 /// they exist.

@@ -32,7 +32,6 @@
 #include <vector>
 
 #include "buckle/continuation/branch.h"
-#include "buckle/mechanics/branch_report.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/equilibrium_problem.h"
@@ -89,13 +88,5 @@ struct GeometricContacts {
 std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
                                                       const std::vector<ContactSet>& locked, double tolerance = 1e-12,
                                                       const continuation::Interrupt& interrupt = {});
-
-/// The located contacts of `branch` as special points "BC" / "SC" of its report `r` (its points
-/// `all`: every point of the branch, with their locked joints), the reported parameter as the
-/// report's (ReportOptions::heldCoordinate). Called by reportBranch. `contacts`: those of
-/// locateGeometricContacts, or located here when null or empty with contacts.given false.
-void reportGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
-                             const std::vector<PointReport>& all, const ReportOptions& options, BranchReport& r,
-                             GeometricContacts* contacts = nullptr);
 
 }  // namespace buckle::mechanics

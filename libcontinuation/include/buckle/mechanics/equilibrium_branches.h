@@ -13,6 +13,7 @@
 #include "buckle/continuation/branch_switching.h"
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/branch_report.h"
+#include "buckle/mechanics/chain_tracer_options.h"
 #include "buckle/mechanics/classification.h"
 #include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/equilibrium_problem.h"
@@ -21,16 +22,17 @@ namespace buckle::mechanics {
 
 struct EquilibriumBranchOptions {
   continuation::TracerOptions tracer;
-  /// Options of the switched branches (default: `tracer`), e.g. fewer points to only see
-  /// which way a bifurcated branch goes.
-  std::optional<continuation::TracerOptions> childTracer;
-  continuation::BranchSwitchingOptions switching;
-  int switchingDepth = 1;          ///< generations of branch switching (0: only the start branches)
-  /// Which branch points to switch at (default: every simple one the tree's guards allow).
-  std::function<bool(const continuation::Branch&, const continuation::SpecialPoint&)> switchAt;
+  /// The bifurcation tree (branch_switching.h): generations of switching (one by default: a
+  /// chain's analysis wants the branches of its buckling modes), how and where to switch, the
+  /// switched branches' own tracer options and the per-branch callback. Its extend,
+  /// switchTracer, onFinal and symmetry are traceEquilibria's own (contact, the stretches'
+  /// problems, the reports and `mirror` below): set there, not here.
+  continuation::TreeOptions tree = [] {
+    continuation::TreeOptions oneGeneration;
+    oneGeneration.branchSwitching = 1;
+    return oneGeneration;
+  }();
   ReportOptions report;            ///< how the branches are reported (stiffness, held coordinate)
-  /// Called when a branch is finished, before the next one starts (progress reports).
-  std::function<void(const continuation::BranchTree&, const continuation::Branch&)> onBranch;
   /// Called with each branch and its report as soon as both are final (TreeOptions::onFinal:
   /// children right after they are traced, a parent when its branch points are all switched at).
   /// When given, the report is handed over, `reports[b]` stays empty and the branch's points are

@@ -44,7 +44,7 @@ struct ImperfectionSensitivity {
   /// The sign of ε that has a limit point: +1 / −1 (asymmetric), 0 for both (subcritical) or
   /// none (exponent 0).
   int sign = 0;
-  std::string error;         ///< why not valid
+  std::string message;       ///< why not valid
 };
 
 /// The knockdown of the branch point bp (coefficients k, valid) of `problem` for an imperfection

@@ -62,7 +62,7 @@ struct KoiterCoefficients {
   Eigen::VectorXd v;      ///< null vector of F_u (size N), its joint part m
   Eigen::VectorXd psi;    ///< left null vector, ψᵀv = 1
   Eigen::VectorXd parentSlope;  ///< du_p/dλ of the traced branch at the point (size N)
-  std::string error;      ///< why not valid
+  std::string message;    ///< why not valid
 };
 
 /// The coefficients at the branch point bp located on a branch of `problem` (free joints: not in

@@ -63,7 +63,7 @@ struct LoadHistoryResult {
   /// (the chain followed the bifurcated branch there, without a jump).
   std::vector<bool> segmentBifurcated;
   std::vector<JumpRecord> jumps;
-  bool completed = false;          ///< every waypoint was reached
+  bool success = false;            ///< every waypoint was reached
   std::string message;             ///< why it ended
 };
 

@@ -26,7 +26,7 @@ struct FirstBuckling {
   PostBuckling kind = PostBuckling::None;
   /// d|λ| along the bifurcated branch over its first steps (> 0: the load keeps rising).
   double slope = 0.0;
-  std::string error;            ///< why kind == Failed
+  std::string message;          ///< why kind == Failed
 };
 
 /// The first buckling of the chain at q0 under the load direction d (λ < 0: compression along

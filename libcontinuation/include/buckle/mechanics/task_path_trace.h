@@ -51,7 +51,7 @@ struct TaskPathPoint {
 struct TaskPathSpecial {
   TaskPathEvent event = TaskPathEvent::Fold;
   TaskPathPoint point;
-  std::string why;          ///< in words, with the boundary's name
+  std::string note;         ///< in words, with the boundary's name
   double accuracy = 0.0;    ///< |Δs| of the location
 };
 

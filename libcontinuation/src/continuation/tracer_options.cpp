@@ -1,0 +1,57 @@
+#include "buckle/continuation/tracer_options.h"
+
+#include "buckle/continuation/finite.h"
+
+#include <cmath>
+
+namespace buckle::continuation {
+
+namespace {
+
+bool reportValidity(const std::string &problem, std::string *why) {
+  if (why) *why = problem;
+  return problem.empty();
+}
+
+}  // namespace
+
+std::string LocationOptions::validate(const std::string &prefix) const {
+  auto bad = [&prefix](const char *field, const char *what) { return prefix + field + " " + what; };
+  if (!(tolerance > 0.0) || !finite(tolerance)) return bad("tolerance", "must be positive and finite");
+  if (!(coarseTolerance > 0.0) || !finite(coarseTolerance)) return bad("coarseTolerance", "must be positive and finite");
+  if (!(newtonTolerance > 0.0) || !finite(newtonTolerance)) return bad("newtonTolerance", "must be positive and finite");
+  if (maxIterations < 1) return bad("maxIterations", "must be at least 1");
+  if (maxRefinementIterations < 1) return bad("maxRefinementIterations", "must be at least 1");
+  if (!(separationFraction > 0.0 && separationFraction < 1.0)) return bad("separationFraction", "must lie in (0, 1)");
+  if (maxDenseDimension < 1) return bad("maxDenseDimension", "must be at least 1");
+  return {};
+}
+
+bool LocationOptions::IsValid(std::string *why) const { return reportValidity(validate(), why); }
+
+std::string DetectionOptions::validate(const std::string &prefix) const {
+  if (lowestEigenvalues < 0) return prefix + "lowestEigenvalues must be >= 0";
+  if (!(touchTolerance > 0.0) || !finite(touchTolerance)) return prefix + "touchTolerance must be positive and finite";
+  return {};
+}
+
+bool DetectionOptions::IsValid(std::string *why) const { return reportValidity(validate(), why); }
+
+std::string TracerOptions::validate() const {
+  for (const std::string &group : {step.validate(), corrector.validate(), location.validate(), detection.validate()})
+    if (!group.empty()) return group;
+  if (maxPoints < 2) return "maxPoints must be at least 2";
+  if (std::isnan(lambdaMin) || std::isnan(lambdaMax)) return "lambdaMin/lambdaMax must not be NaN";
+  if (!(lambdaMin < lambdaMax)) return "lambdaMin must be smaller than lambdaMax";
+  if (!(maxArclength > 0.0)) return "maxArclength must be positive";
+  if (boxLower.size() != boxUpper.size()) return "boxLower and boxUpper must have the same size";
+  for (Eigen::Index i = 0; i < boxLower.size(); ++i)
+    if (std::isnan(boxLower[i]) || std::isnan(boxUpper[i]) || !(boxLower[i] < boxUpper[i]))
+      return "boxLower[" + std::to_string(i) + "] must be smaller than boxUpper[" + std::to_string(i) + "]";
+  if (structuredFromDimension < 1) return "structuredFromDimension must be at least 1";
+  return {};
+}
+
+bool TracerOptions::IsValid(std::string *why) const { return reportValidity(validate(), why); }
+
+}  // namespace buckle::continuation
