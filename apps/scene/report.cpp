@@ -331,11 +331,11 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
     const PageSelection shown = pageSelection(cr, columns.size());
     cases += caseText(scene, cr, c, columns, shown);
     anyPoints = anyPoints || !cr.points.empty();
-    points += cr.points.size();
+    points += cr.recordedPoints;
     shownPoints += shown.points.size();
     specials += cr.specials.size();
     shownShapes += shown.specialShapes;
-    stride = std::max(stride, shown.stride);
+    stride = std::max(stride, shown.stride * cr.pointStride);  // of the points kept (runner.h)
   });
   if (shownPoints < points || shownShapes < specials) {
     std::ostringstream os;

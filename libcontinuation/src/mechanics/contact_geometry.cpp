@@ -56,6 +56,48 @@ double distanceAt(const Chain& chain, ConstVectorRef q, bool base) {
   return base ? baseClearance(chain, q).distance : selfClearance(chain, q).distance;
 }
 
+/// A positive lower bound of selfClearance's distance when the chain is monotone — the links'
+/// directions, unwrapped along the chain, span less than a half turn (less a margin), so every
+/// link advances along their bisector u and two links with one or more between them are
+/// separated along u by at least the links between them — else NaN. O(n): the sign of the
+/// clearance, which is all a point's scan needs, without the O(n log n) search of the nearest pair.
+double monotoneClearance(const Chain& chain, ConstVectorRef q) {
+  const Eigen::Matrix2Xd P = jointPositions(chain, q);
+  const int links = int(P.cols()) - 1;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (links < 3) return nan;
+  constexpr double kHalfTurn = 3.14159265358979323846 - 1e-3;
+  double theta = 0.0, lo = 0.0, hi = 0.0;
+  Point previous = P.col(1) - P.col(0);
+  for (int m = 1; m < links; ++m) {
+    const Point v = P.col(m + 1) - P.col(m);
+    theta += std::atan2(cross(previous, v), previous.dot(v));
+    lo = std::min(lo, theta), hi = std::max(hi, theta);
+    if (!(hi - lo < kHalfTurn)) return nan;
+    previous = v;
+  }
+  // u: the bisector of the directions' range, from the first link's direction
+  const Point first = P.col(1) - P.col(0);
+  const double turn = 0.5 * (lo + hi), c = std::cos(turn), s = std::sin(turn);
+  const Point u = Point(c * first.x() - s * first.y(), s * first.x() + c * first.y()).normalized();
+  double least = std::numeric_limits<double>::infinity();
+  for (int m = 1; m + 1 < links; ++m) least = std::min(least, (P.col(m + 1) - P.col(m)).dot(u));
+  // the advance of one link between: far above the rounding of the exact distance
+  double longest = 0.0;
+  for (int m = 0; m < links; ++m) longest = std::max(longest, (P.col(m + 1) - P.col(m)).norm());
+  return least > 1e-6 * longest && std::isfinite(least) ? least : nan;
+}
+
+/// The clearance of a point of a branch scanned for sign changes: exact, or for the self contact
+/// of a monotone chain the positive bound of monotoneClearance (the same sign).
+double scannedDistance(const Chain& chain, ConstVectorRef q, bool base) {
+  if (!base) {
+    const double bound = monotoneClearance(chain, q);
+    if (!std::isnan(bound)) return bound;
+  }
+  return distanceAt(chain, q, base);
+}
+
 }  // namespace
 
 BaseClearance baseClearance(const Chain& chain, ConstVectorRef q) {
@@ -147,9 +189,12 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
   for (bool base : {true, false}) {
     if (base && problem.wallIsBoundary()) continue;  // the wall is a constraint: WC / WR (contact.h)
     std::vector<double> d(count);
-    for (size_t i = 0; i < count; ++i) d[i] = distanceAt(chain, branch.points[i].u.head(n), base);
+    for (size_t i = 0; i < count; ++i) d[i] = scannedDistance(chain, branch.points[i].u.head(n), base);
     for (size_t i = 0; i + 1 < count; ++i) {
       if ((d[i] > 0.0) == (d[i + 1] > 0.0) || !std::isfinite(d[i]) || !std::isfinite(d[i + 1])) continue;
+      // a sign change: the clearances themselves on both sides (a bound has the sign only)
+      d[i] = distanceAt(chain, branch.points[i].u.head(n), base);
+      d[i + 1] = distanceAt(chain, branch.points[i + 1].u.head(n), base);
       const continuation::ContinuationPoint &p0 = branch.points[i], &p1 = branch.points[i + 1];
       GeometricContact g;
       g.base = base;
