@@ -50,7 +50,7 @@ std::string countsLine(const RunResult& run) {
   size_t points = 0, branches = 0, specials = 0;
   std::vector<std::pair<std::string, int>> byType;
   for (const CaseResult& c : run.cases) {
-    points += c.recordedPoints;
+    points += c.pointCount();
     branches += c.branches.size();
     specials += c.specials.size();
     for (const SpecialPointResult& s : c.specials) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <limits>
 #include <memory>
 #include <string>
@@ -102,6 +103,8 @@ struct CaseResult {
   std::vector<mechanics::PointReport> points;
   /// The points recorded, those streamed and not kept in `points` included.
   size_t recordedPoints = 0;
+  /// Every point of the case, streamed or held (a result built by hand counts its `points`).
+  size_t pointCount() const { return std::max(recordedPoints, points.size()); }
   /// The sampling of `points` (1: every point).
   size_t pointStride = 1;
   std::vector<SpecialPointResult> specials;

@@ -56,46 +56,42 @@ double distanceAt(const Chain& chain, ConstVectorRef q, bool base) {
   return base ? baseClearance(chain, q).distance : selfClearance(chain, q).distance;
 }
 
-/// A positive lower bound of selfClearance's distance when the chain is monotone — the links'
-/// directions, unwrapped along the chain, span less than a half turn (less a margin), so every
-/// link advances along their bisector u and two links with one or more between them are
-/// separated along u by at least the links between them — else NaN. O(n): the sign of the
-/// clearance, which is all a point's scan needs, without the O(n log n) search of the nearest pair.
-double monotoneClearance(const Chain& chain, ConstVectorRef q) {
-  const Eigen::Matrix2Xd P = jointPositions(chain, q);
-  const int links = int(P.cols()) - 1;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  if (links < 3) return nan;
-  constexpr double kHalfTurn = 3.14159265358979323846 - 1e-3;
-  double theta = 0.0, lo = 0.0, hi = 0.0;
-  Point previous = P.col(1) - P.col(0);
-  for (int m = 1; m < links; ++m) {
-    const Point v = P.col(m + 1) - P.col(m);
-    theta += std::atan2(cross(previous, v), previous.dot(v));
-    lo = std::min(lo, theta), hi = std::max(hi, theta);
-    if (!(hi - lo < kHalfTurn)) return nan;
-    previous = v;
+/// The clearances of a branch's points (distanceAt) as far as a scan for sign changes needs them:
+/// exact at the base, and for the self contact exact at a reference point and, while every joint
+/// has moved by at most δ from it, the bound d_ref − 2δ (or d_ref + 2δ) in its place — two links'
+/// distance changes by at most 2δ when their ends move by δ — as long as the bound keeps the sign
+/// of d_ref by a margin far above rounding. O(n) a point, the nearest-pair search (O(n log n))
+/// only where the clearance may change sign.
+std::vector<double> scannedDistances(const Chain& chain, const continuation::Branch& branch, bool base) {
+  const int n = chain.size();
+  const size_t count = branch.points.size();
+  std::vector<double> d(count);
+  Eigen::Matrix2Xd reference;
+  double dRef = std::numeric_limits<double>::quiet_NaN();
+  for (size_t i = 0; i < count; ++i) {
+    const auto q = branch.points[i].u.head(n);
+    if (base) {
+      d[i] = distanceAt(chain, q, true);
+      continue;
+    }
+    const Eigen::Matrix2Xd P = jointPositions(chain, q);
+    if (std::isfinite(dRef) && P.cols() == reference.cols()) {
+      const double moved = 2.0 * (P - reference).colwise().norm().maxCoeff();
+      const double margin = 1e-9 * std::max(1.0, P.cwiseAbs().maxCoeff());
+      if (dRef - moved > margin) {
+        d[i] = dRef - moved;
+        continue;
+      }
+      if (dRef + moved < -margin) {
+        d[i] = dRef + moved;
+        continue;
+      }
+    }
+    d[i] = selfClearance(chain, q).distance;
+    reference = P;
+    dRef = d[i];
   }
-  // u: the bisector of the directions' range, from the first link's direction
-  const Point first = P.col(1) - P.col(0);
-  const double turn = 0.5 * (lo + hi), c = std::cos(turn), s = std::sin(turn);
-  const Point u = Point(c * first.x() - s * first.y(), s * first.x() + c * first.y()).normalized();
-  double least = std::numeric_limits<double>::infinity();
-  for (int m = 1; m + 1 < links; ++m) least = std::min(least, (P.col(m + 1) - P.col(m)).dot(u));
-  // the advance of one link between: far above the rounding of the exact distance
-  double longest = 0.0;
-  for (int m = 0; m < links; ++m) longest = std::max(longest, (P.col(m + 1) - P.col(m)).norm());
-  return least > 1e-6 * longest && std::isfinite(least) ? least : nan;
-}
-
-/// The clearance of a point of a branch scanned for sign changes: exact, or for the self contact
-/// of a monotone chain the positive bound of monotoneClearance (the same sign).
-double scannedDistance(const Chain& chain, ConstVectorRef q, bool base) {
-  if (!base) {
-    const double bound = monotoneClearance(chain, q);
-    if (!std::isnan(bound)) return bound;
-  }
-  return distanceAt(chain, q, base);
+  return d;
 }
 
 }  // namespace
@@ -188,11 +184,10 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
   const double lambdaScale = problem.scales().parameter;
   for (bool base : {true, false}) {
     if (base && problem.wallIsBoundary()) continue;  // the wall is a constraint: WC / WR (contact.h)
-    std::vector<double> d(count);
-    for (size_t i = 0; i < count; ++i) d[i] = scannedDistance(chain, branch.points[i].u.head(n), base);
+    std::vector<double> d = scannedDistances(chain, branch, base);
     for (size_t i = 0; i + 1 < count; ++i) {
       if ((d[i] > 0.0) == (d[i + 1] > 0.0) || !std::isfinite(d[i]) || !std::isfinite(d[i + 1])) continue;
-      // a sign change: the clearances themselves on both sides (a bound has the sign only)
+      // a sign change: the clearances themselves on both sides (a bound has only their sign)
       d[i] = distanceAt(chain, branch.points[i].u.head(n), base);
       d[i + 1] = distanceAt(chain, branch.points[i + 1].u.head(n), base);
       const continuation::ContinuationPoint &p0 = branch.points[i], &p1 = branch.points[i + 1];
