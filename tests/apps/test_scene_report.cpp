@@ -60,6 +60,15 @@ Scene smallScene(const std::string& description) {
   return parseScene(s.dump(), "small.json");
 }
 
+/// A case of `n` paper segments added to `run` for a page built from synthetic results.
+CaseResult& syntheticCase(RunResult& run, int n) {
+  CaseResult& cr =
+      run.cases.emplace_back(mech::Chain::uniform(n, mech::SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)));
+  cr.label = "main";
+  cr.q0 = Eigen::VectorXd::Zero(n);
+  return cr;
+}
+
 }  // namespace
 
 TEST_CASE("the report embeds every traced point and special point of the run", "[scene][report]") {
@@ -192,10 +201,7 @@ TEST_CASE("the page of a large run stays a few megabytes and says what it left t
   const Scene scene = smallScene("large");
   RunResult run;
   const int n = 400;
-  CaseResult& cr =
-      run.cases.emplace_back(mech::Chain::uniform(n, mech::SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)));
-  cr.label = "main";
-  cr.q0 = Eigen::VectorXd::Zero(n);
+  CaseResult& cr = syntheticCase(run, n);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> angle(-0.01, 0.01);
   const int branches = 12, perBranch = 5000;
@@ -270,10 +276,7 @@ TEST_CASE("the page of a tree with thousands of special points lists the most im
   const Scene scene = smallScene("specials");
   RunResult run;
   const int n = 3;
-  CaseResult& cr =
-      run.cases.emplace_back(mech::Chain::uniform(n, mech::SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)));
-  cr.label = "main";
-  cr.q0 = Eigen::VectorXd::Zero(n);
+  CaseResult& cr = syntheticCase(run, n);
   for (int b = 0; b < 2; ++b) {
     BranchRecord br;
     br.id = b;
