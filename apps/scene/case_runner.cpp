@@ -12,6 +12,8 @@
 #include "buckle/mechanics/load_history.h"
 #include "buckle/mechanics/mirror_symmetry.h"
 #include "buckle/mechanics/unloaded_shape.h"
+#include "scene/branch_stream.h"
+#include "scene/point_sample.h"
 
 namespace buckle::scene {
 
@@ -64,12 +66,12 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   out_.branches.push_back(br);
 
   const bool frequencies = scene_.analyses.frequencies.enabled;
-  for (const mech::PointReport& p : report.points) {
-    mech::PointReport& r = out_.points.emplace_back(p);
-    r.branch = b.id;
-    if (frequencies) r.omega = naturalFrequencies(p.q, p.F, p.locked, p.parameter);
+  std::vector<mech::PointReport> points(report.points);
+  for (mech::PointReport& p : points) {
+    p.branch = b.id;
+    if (frequencies) p.omega = naturalFrequencies(p.q, p.F, p.locked, p.parameter);
   }
-  keepTimeForWriting(report.points.size());
+  keepPoints(std::move(points));
   run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
 
   for (const mech::SpecialPointReport& sp : report.specialPoints) {
@@ -84,6 +86,19 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
     }
     if (sp.source >= 0) run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
     out_.specials.push_back(std::move(s));
+  }
+}
+
+void CaseRunner::keepPoints(std::vector<mech::PointReport>&& points) {
+  out_.recordedPoints += points.size();
+  keepTimeForWriting(points.size());
+  if (run_.stream) {
+    // the rows written now, a bounded sample kept for the plots and report.html
+    run_.stream->add(caseIndex(), out_, points);
+    const size_t budget = kSampleBudget / std::max<size_t>(1, scene_.cases.size());
+    keepSample(out_.points, std::move(points), out_.pointStride, sampleBytes_, budget);
+  } else {
+    out_.points.insert(out_.points.end(), std::make_move_iterator(points.begin()), std::make_move_iterator(points.end()));
   }
 }
 
@@ -360,7 +375,7 @@ void CaseRunner::continuation() {
   // Each branch is recorded as soon as it is final (EquilibriumBranchOptions::onReport), so its
   // traced points are released while the tree goes on; the records are put in branch order after.
   const size_t firstBranch = out_.branches.size(), firstPoint = out_.points.size(),
-               firstSpecial = out_.specials.size();
+               firstSpecial = out_.specials.size(), firstPiece = run_.stream ? run_.stream->pieces(caseIndex()) : 0;
   // the curves a disconnected branch may join (disconnectedBranches), kept before their points go
   const bool keepCurves = scene_.analyses.equilibria.branches && !throughLoad();
   opt.onReport = [&](const cont::Branch& b, mech::BranchReport&& report) {
@@ -387,6 +402,7 @@ void CaseRunner::continuation() {
     run_.problems.push_back(os.str());
     return;
   }
+  if (run_.stream) run_.stream->sortByBranch(caseIndex(), firstPiece);
   const auto byBranch = [](const auto& a, const auto& b) { return a.branch < b.branch; };
   std::stable_sort(out_.branches.begin() + long(firstBranch), out_.branches.end(),
                    [](const BranchRecord& a, const BranchRecord& b) { return a.id < b.id; });

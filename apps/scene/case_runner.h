@@ -70,6 +70,9 @@ class CaseRunner {
   void equilibriaAt(double at);
   void disconnectedBranchesAt(EquilibriumSet& set);
   void record(const continuation::Branch& b, const mechanics::BranchReport& report, const std::string& origin);
+  /// One branch's points (in order) into the case: all of them, or streamed (RunControl::streamTo)
+  /// their rows written and a sample kept (point_sample.h).
+  void keepPoints(std::vector<mechanics::PointReport>&& points);
 
   /// `frequencies` (case_frequencies.cpp): the signed natural frequencies at joint angles q under
   /// the total end wrench F with the joints of `locked` locked (`parameter`: for a message).
@@ -166,6 +169,11 @@ class CaseRunner {
   /// will take beyond the runner's fixed reserve (case_runner.cpp).
   void keepTimeForWriting(size_t points);
   double storedValues_ = 0.0;  // values of the points this case recorded so far
+  /// The case's index in the scene (branches.csv's `case`).
+  size_t caseIndex() const { return size_t(&spec_ - scene_.cases.data()); }
+  /// Streamed (RunControl::streamTo): the memory of the sample of points kept, over the run's cases.
+  static constexpr size_t kSampleBudget = size_t(64) << 20;
+  size_t sampleBytes_ = 0;  // of this case's sample
   /// Warns at the start when the path's load, `ends` away from the start both ways, passes hundreds of
   /// critical loads of the unloaded shape that a tree of this depth would switch at
   /// (case_runner_ahead.cpp).

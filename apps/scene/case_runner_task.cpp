@@ -25,7 +25,8 @@ void CaseRunner::taskPath() {
     r.message = e.what();
   }
   mech::BranchReport report = mech::reportTaskPath(r, setup.payload, scene_.analyses.stiffness);
-  for (mech::PointReport& p : report.points) out_.points.push_back(std::move(p));
+  const size_t points = report.points.size();
+  keepPoints(std::move(report.points));
   for (mech::SpecialPointReport& sp : report.specialPoints) {
     run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
     out_.specials.push_back({std::move(sp), {}});
@@ -36,7 +37,7 @@ void CaseRunner::taskPath() {
   b.origin = "start (task path)";
   b.stopReason = report.stopReason;
   b.stopMessage = report.stopMessage;
-  b.points = int(report.points.size());
+  b.points = int(points);
   b.finished = report.finished;
   out_.branches.push_back(b);
   if (r.end == mech::TaskPathEvent::MaxPoints) {

@@ -50,7 +50,7 @@ std::string countsLine(const RunResult& run) {
   size_t points = 0, branches = 0, specials = 0;
   std::vector<std::pair<std::string, int>> byType;
   for (const CaseResult& c : run.cases) {
-    points += c.points.size();
+    points += c.pointCount();
     branches += c.branches.size();
     specials += c.specials.size();
     for (const SpecialPointResult& s : c.specials) {
@@ -86,6 +86,15 @@ continuation::Interrupt writingStop(double timeLimit, std::chrono::steady_clock:
   }
   if (signals) stop.watch(SignalGuard::flag(), "interrupted by a signal (SIGINT/SIGTERM/SIGHUP)");
   return stop;
+}
+
+/// Where the rows of branches.csv are spooled while the tree is traced: the target's parent
+/// directory (created), on the output's file system, like the staging directory.
+std::string spoolDirectory(const std::string& target) {
+  std::filesystem::path t = std::filesystem::absolute(std::filesystem::path(target)).lexically_normal();
+  if (t.filename().empty()) t = t.parent_path();
+  std::filesystem::create_directories(t.parent_path());
+  return t.parent_path().string();
 }
 
 }  // namespace
@@ -129,7 +138,15 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
     scene.solver.timeLimit = options.timeLimit;  // recorded as such in summary.json
   }
   if (signals) control.interrupt.watch(SignalGuard::flag(), "interrupted by a signal (SIGINT/SIGTERM/SIGHUP)");
-  RunResult run = runScene(scene, control);
+  // branches.csv's rows are written beside the target while the tree is traced (branch_stream.h)
+  RunResult run;
+  try {
+    control.streamTo = spoolDirectory(target);
+    run = runScene(scene, control);
+  } catch (const std::exception& e) {  // the spool files could not be written
+    err << "buckle run: cannot write the output: " << e.what() << "\n";
+    return kIncomplete;
+  }
   progress.finish();
   if (run.interrupted && signals && SignalGuard::signal() != 0) run.interruption = SignalGuard::description();
   PlotReport plots;

@@ -3,7 +3,6 @@
 #include "buckle/mechanics/shape_name.h"
 
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "scene/branch_stream.h"
 #include "scene/output_equilibria.h"
 #include "scene/output_numbers.h"
 #include "scene/escape.h"
@@ -29,8 +29,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // JSON has no NaN: write null.
 json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
@@ -48,132 +46,33 @@ void writeText(const fs::path& file, const std::string& text) {
   if (!out) throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
 }
 
-// Appends v as printf's %.12g, "nan" for NaN and "inf"/"-inf" for infinities (a rigid direction's
-// stiffness) (output_numbers.h: the same characters at a fraction of the cost of a formatting with
-// a precision; long chains write millions of numbers, inside the run's time limit).
-void appendNumber(std::string& out, double v) {
-  if (std::isinf(v)) {
-    out += v > 0.0 ? "inf" : "-inf";
-    return;
-  }
-  appendGeneral(out, v, 12);
-}
-
-void appendInteger(std::string& out, long long v) {
-  char buf[24];
-  const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, r.ptr);
-}
-
 std::string fmt(double v) {
   std::string s;
-  appendNumber(s, v);
+  appendCsvNumber(s, v);
   return s;
 }
 
-// Joint angles of every point, rows in branches.csv's order, as a NumPy .npy file (format 1.0:
-// magic, a Python-dict header padded to 64 bytes, then little-endian float64 in C order), which
-// numpy.load reads as it is. Shorter cases are padded with NaN.
-void writeJointAngles(const RunResult& run, int n, const fs::path& file) {
-  std::size_t rows = 0;
-  for (const CaseResult& cr : run.cases) rows += cr.points.size();
-  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(rows) + ", " +
-                       std::to_string(n) + "), }";
-  const std::size_t preamble = 10;  // magic (6), version (2), header length (2)
-  header.append(63 - (preamble + header.size()) % 64, ' ');
-  header += '\n';
-  std::string bytes = std::string("\x93NUMPY\x01\x00", 8);
-  bytes += char(header.size() & 0xff);
-  bytes += char(header.size() >> 8);
-  bytes += header;
-  static_assert(sizeof(double) == 8);
-  std::vector<double> row(static_cast<std::size_t>(n));
-  bytes.reserve(bytes.size() + rows * row.size() * sizeof(double));
-  for (const CaseResult& cr : run.cases)
-    for (const mechanics::PointReport& p : cr.points) {
-      for (int i = 0; i < n; ++i) row[std::size_t(i)] = i < p.q.size() ? p.q[i] : std::numeric_limits<double>::quiet_NaN();
-      bytes.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(double));  // x86-64/ARM: little-endian
-    }
-  writeText(file, bytes);
-}
-
+// branches.csv and joint_angles.npy (branch_rows.h): copied from the rows streamed as the
+// branches were final (branch_stream.h), or written from the points held in memory.
 void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir) {
-  const int n = scene.maxSegments();
-  // a long chain's joint angles go to joint_angles.npy: the CSV stays a table of loads, poses and
-  // stability (200 segments: 143 MB of CSV before)
-  const bool sideFile = n > kBranchesCsvJointColumns;
-  // One string appended to (no stream, no string per number): tens of thousands of rows.
-  std::string os = "case,branch,point,parameter,Fx,Fy,Me,x,y,phi,dx,dy";
-  if (sideFile) {
-    os += ",max_abs_q,sign_changes";
-  } else {
-    for (int i = 1; i <= n; ++i) {
-      os += ",q";
-      appendInteger(os, i);
-    }
+  if (run.stream) {
+    run.stream->write(dir.string());
+    return;
   }
-  os += ",stable,negative,min_eig,locked,contact_torque,wall,wall_force";
-  if (scene.analyses.stiffness)
-    for (const std::string& column : stiffnessColumns()) os += "," + column;
-  if (scene.analyses.frequencies.enabled)
-    for (const std::string& column : frequencyColumns(scene.analyses.frequencies.count)) os += "," + column;
-  const std::vector<std::string> inputs = scene.inputColumns();  // task paths: the inputs' values
-  for (const std::string& column : inputs) os += "," + escape::csvField(column);
-  os += '\n';
+  const BranchRows layout(scene);
   std::size_t rows = 0;
   for (const CaseResult& cr : run.cases) rows += cr.points.size();
-  // about 19 bytes a number (%.12g with sign, point and exponent)
-  os.reserve(os.size() + rows * std::size_t(20 + 19 * (sideFile ? 13 : 11 + n)));
-  for (size_t c = 0; c < run.cases.size(); ++c) {
-    const CaseResult& cr = run.cases[c];
-    for (const mechanics::PointReport& p : cr.points) {
-      auto field = [&os](double v) {
-        os += ',';
-        appendNumber(os, v);
-      };
-      appendInteger(os, (long long)c);
-      os += ',';
-      appendInteger(os, p.branch);
-      os += ',';
-      appendInteger(os, p.index);
-      field(p.parameter);
-      for (int k = 0; k < 3; ++k) field(p.F[k]);
-      for (int k = 0; k < 3; ++k) field(p.pose[k]);
-      field(cr.pose0[0] - p.pose[0]);
-      field(p.pose[1] - cr.pose0[1]);
-      if (sideFile) {
-        const double qmax = p.q.size() > 0 ? p.q.cwiseAbs().maxCoeff() : 0.0;
-        // sign changes of the bend, ignoring joints bent by less than 1e-9 of the largest
-        field(qmax);
-        os += ',';
-        appendInteger(os, mechanics::signChanges(p.q, 1e-9 * qmax));
-      } else {
-        for (int i = 0; i < n; ++i) {
-          if (i < p.q.size())
-            field(p.q[i]);
-          else
-            os += ',';
-        }
-      }
-      os += p.stable ? ",1," : ",0,";
-      appendInteger(os, p.negative);
-      field(p.minEigenvalue);
-      os += ',';
-      os += escape::csvField(p.locked.label());
-      field(p.contactTorque);
-      os += ',';
-      os += escape::csvField(p.locked.wallLabel());
-      field(p.wallForces.sum());
-      if (scene.analyses.stiffness)
-        for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C, p.rotationalStiffness));
-      if (scene.analyses.frequencies.enabled)
-        for (int i = 0; i < scene.analyses.frequencies.count; ++i) field(i < p.omega.size() ? p.omega[i] : kNaN);
-      for (const std::string& column : inputs) field(columnValue(column, p, cr));
-      os += '\n';
-    }
-  }
+  // one string appended to (no stream, no string per number): tens of thousands of rows
+  std::string os = layout.header();
+  os.reserve(os.size() + rows * layout.rowBytes());
+  for (size_t c = 0; c < run.cases.size(); ++c)
+    for (const mechanics::PointReport& p : run.cases[c].points) layout.appendRow(os, c, run.cases[c], p);
   writeText(dir / "branches.csv", os);
-  if (sideFile) writeJointAngles(run, n, dir / "joint_angles.npy");
+  if (!layout.sideFile()) return;
+  std::string bytes = layout.jointAnglesHeader(rows);
+  for (const CaseResult& cr : run.cases)
+    for (const mechanics::PointReport& p : cr.points) layout.appendJointAngles(bytes, p);
+  writeText(dir / "joint_angles.npy", bytes);
 }
 
 json wrenchJson(const mechanics::Wrench& F) { return json{{"Fx", number(F[0])}, {"Fy", number(F[1])}, {"Me", number(F[2])}}; }

@@ -8,16 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "scene/branch_rows.h"
 #include "scene/column_values.h"
 #include "scene/columns.h"
 #include "scene/runner.h"
 #include "scene/scene.h"
 
 namespace buckle::scene {
-
-/// Above this many segments branches.csv carries max_abs_q and sign_changes instead of the joint
-/// angles, which go to joint_angles.npy (docs/outputs.md).
-constexpr int kBranchesCsvJointColumns = 12;
 
 /// A directory created next to `target` (same parent, hidden name), renamed onto `target` by
 /// commit(); removed by the destructor unless committed. While it exists SIGINT, SIGTERM and

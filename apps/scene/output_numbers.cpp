@@ -202,6 +202,14 @@ double roundedSignificant(double v, int digits) {
   return r;
 }
 
+void appendCsvNumber(std::string& out, double v) {
+  if (std::isinf(v)) {
+    out += v > 0.0 ? "inf" : "-inf";
+    return;
+  }
+  appendGeneral(out, v, 12);
+}
+
 std::string secondsText(double seconds) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", seconds);

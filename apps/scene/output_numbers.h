@@ -15,6 +15,10 @@ namespace buckle::scene {
 /// same characters; "nan" when v is not finite (branches.csv's convention).
 void appendGeneral(std::string& out, double v, int precision);
 
+/// Appends v as branches.csv and the other CSV files write it: "%.12g", "nan" for NaN and
+/// "inf" / "-inf" for infinities (a rigid direction's stiffness).
+void appendCsvNumber(std::string& out, double v);
+
 /// The double nearest to printf's "%.*g" of a finite v (1 <= digits <= 17): v rounded to
 /// `digits` significant decimal digits, bit for bit what snprintf + strtod give.
 double roundedSignificant(double v, int digits);

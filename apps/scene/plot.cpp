@@ -94,6 +94,14 @@ PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string
         break;
       case PlotType::EquilibriumShapes: equilibriumShapesPlot(scene, run, spec, dir, s); break;
     }
+    if (spec.type == PlotType::Bifurcation || spec.type == PlotType::Stiffness || spec.type == PlotType::Shapes) {
+      size_t stride = 1;  // a streamed large tree's sample of points (runner.h, CaseResult::points)
+      for (size_t c : plot_detail::selected(spec)) stride = std::max(stride, run.cases[c].pointStride);
+      if (stride > 1)
+        report.notes.push_back("plot \"" + spec.name + "\" is drawn from every " + std::to_string(stride) +
+                               "th point of each branch (and its ends and changes of stability): every point is in "
+                               "branches.csv");
+    }
     std::ofstream(dir / (spec.name + "_body.gp")) << s.body.str();
     std::ostringstream gp;
     gp << "# gnuplot " << spec.name << ".gp (run from this directory)\n"

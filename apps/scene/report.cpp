@@ -97,11 +97,16 @@ constexpr size_t kPointBudget = 120000;
 /// (the start branches' come first) carry their shapes.
 constexpr size_t kSpecialShapeBudget = 80000;
 
+/// At most this many special points per case: beyond it the most important ones (the diagrams'
+/// ranking, special_marks.h), in their order; special_points.json beside the page has all.
+constexpr size_t kSpecialBudget = 2500;
+
 /// The points of a case the page shows (PageSelection).
 struct PageSelection {
   std::vector<size_t> points;  ///< indices into CaseResult::points, in order
   size_t stride = 1;           ///< every stride-th point of each branch (and its last)
-  size_t specialShapes = 0;    ///< the first this many special points carry their joints
+  std::vector<size_t> specials;  ///< indices into CaseResult::specials, in order
+  size_t specialShapes = 0;    ///< the first this many special points shown carry their joints
 };
 
 PageSelection pageSelection(const CaseResult& cr, size_t columns) {
@@ -115,8 +120,15 @@ PageSelection pageSelection(const CaseResult& cr, size_t columns) {
     const bool last = i + 1 == pts.size() || pts[i + 1].branch != pts[i].branch;
     if ((i - first) % s.stride == 0 || last) s.points.push_back(i);
   }
+  const std::vector<Importance> rank = importance(cr);
+  for (size_t k = 0; k < cr.specials.size(); ++k) s.specials.push_back(k);
+  if (s.specials.size() > kSpecialBudget) {
+    std::stable_sort(s.specials.begin(), s.specials.end(), [&rank](size_t a, size_t b) { return rank[a] < rank[b]; });
+    s.specials.resize(kSpecialBudget);
+    std::sort(s.specials.begin(), s.specials.end());
+  }
   const size_t perShape = 2 * static_cast<size_t>(cr.chain.size() + 2);
-  s.specialShapes = std::min(cr.specials.size(), kSpecialShapeBudget / perShape);
+  s.specialShapes = std::min(s.specials.size(), kSpecialShapeBudget / perShape);
   return s;
 }
 
@@ -184,9 +196,10 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
 
   json specials = json::array();
   const std::vector<Importance> rank = importance(cr);  // as the gnuplot diagrams rank them
-  for (size_t k = 0; k < cr.specials.size(); ++k) {
+  for (size_t shownIndex = 0; shownIndex < shown.specials.size(); ++shownIndex) {
+    const size_t k = shown.specials[shownIndex];
     const SpecialPointResult& s = cr.specials[k];
-    const bool shape = k < shown.specialShapes;
+    const bool shape = shownIndex < shown.specialShapes;
     json e{{"type", mechanics::label(s.type)},
            {"field", fieldName(cr, s)},
            {"branch", s.branch},
@@ -325,17 +338,18 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   const std::set<std::string> columns = drawnColumns(scene, mainX, mainY);
   bool anyPoints = false;
   std::string cases;
-  size_t points = 0, shownPoints = 0, specials = 0, shownShapes = 0, stride = 1;
+  size_t points = 0, shownPoints = 0, specials = 0, shownSpecials = 0, shownShapes = 0, stride = 1;
   appendArray(cases, run.cases.size(), [&](size_t c) {
     const CaseResult& cr = run.cases[c];
     const PageSelection shown = pageSelection(cr, columns.size());
     cases += caseText(scene, cr, c, columns, shown);
     anyPoints = anyPoints || !cr.points.empty();
-    points += cr.points.size();
+    points += cr.pointCount();
     shownPoints += shown.points.size();
     specials += cr.specials.size();
+    shownSpecials += shown.specials.size();
     shownShapes += shown.specialShapes;
-    stride = std::max(stride, shown.stride);
+    stride = std::max(stride, shown.stride * cr.pointStride);  // of the points kept (runner.h)
   });
   if (shownPoints < points || shownShapes < specials) {
     std::ostringstream os;
@@ -345,8 +359,13 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
          << (stride == 2 ? "nd" : stride == 3 ? "rd" : "th") << " point of each branch and its last)";
     else
       os << "every traced point";
-    os << " and the shapes of " << shownShapes << " of the " << specials
-       << " special points. Every point is in branches.csv and joint_angles.npy, every special point in "
+    if (shownSpecials < specials)
+      os << ", " << shownSpecials << " of the " << specials
+         << " special points (the primary branch's branch points, jumps and first folds first) and the shapes of "
+         << shownShapes << " of them";
+    else
+      os << " and the shapes of " << shownShapes << " of the " << specials << " special points";
+    os << ". Every point is in branches.csv and joint_angles.npy, every special point in "
           "special_points.json, beside this page.";
     data["abridged"] = os.str();
   }

@@ -7,6 +7,7 @@
 
 #include "buckle/mechanics/chain.h"
 #include "scene/analyses.h"
+#include "scene/branch_stream.h"
 #include "scene/case_runner.h"
 
 // Stage dispatch: the analyses a scene asks for (the registry, analyses.h) run case by case in
@@ -39,6 +40,7 @@ RunResult runScene(const Scene& scene, const RunControl& given) {
     control.interrupt.setDeadline(
         start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(compute)), limit);
   }
+  if (!control.streamTo.empty()) run.stream = std::make_shared<BranchStream>(scene, control.streamTo);
   std::vector<const Analysis*> stages;  // the registry's stages the scene asks for, in its order
   for (const Analysis& x : analyses()) {
     if (!x.asked(scene.analyses)) continue;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <limits>
 #include <memory>
 #include <string>
@@ -95,8 +96,17 @@ struct CaseResult {
   mechanics::Pose pose0 = mechanics::Pose::Zero();
   double startValue = 0.0;
   std::vector<BranchRecord> branches;
-  /// Every reported point of every branch, in the order the branches were reported.
+  /// Every reported point of every branch, in the order the branches were reported (the
+  /// continuation's branches by id); streamed (RunControl::streamTo): a sample of them, every
+  /// pointStride-th point of each branch with its first and last and those next to a change of
+  /// stability, for the plots and report.html (branches.csv has every point).
   std::vector<mechanics::PointReport> points;
+  /// The points recorded, those streamed and not kept in `points` included.
+  size_t recordedPoints = 0;
+  /// Every point of the case, streamed or held (a result built by hand counts its `points`).
+  size_t pointCount() const { return std::max(recordedPoints, points.size()); }
+  /// The sampling of `points` (1: every point).
+  size_t pointStride = 1;
   std::vector<SpecialPointResult> specials;
   /// Along a task path: the names of PointReport::inputs (mechanics::taskInputName), else empty.
   std::vector<std::string> inputNames;
@@ -116,8 +126,13 @@ struct CaseResult {
   explicit CaseResult(const mechanics::Chain& c) : chain(c) {}
 };
 
+class BranchStream;
+
 struct RunResult {
   std::vector<CaseResult> cases;
+  /// The rows of branches.csv written while the branches were traced (RunControl::streamTo,
+  /// branch_stream.h); null: the points are all in cases[c].points.
+  std::shared_ptr<BranchStream> stream;
   std::vector<std::string> computed;   ///< names of the analyses actually run
   bool complete = true;                ///< false: some computation could not finish (exit 1)
   std::vector<std::string> problems;   ///< why not complete
@@ -136,6 +151,11 @@ struct RunResult {
 struct RunControl {
   continuation::Interrupt interrupt;   ///< checked at every step of every stage
   Progress* progress = nullptr;        ///< optional
+  /// A directory for the spool files of branches.csv (branch_stream.h): each branch's rows are
+  /// written there as soon as it is final and only a bounded sample of its points is kept in
+  /// memory (CaseResult::points), so a run's memory follows its largest branch and the chain's
+  /// length, not the tree's size. Empty: every point is kept until the outputs are written.
+  std::string streamTo;
 };
 
 /// Runs every case of the scene. Never throws for a numerical failure (recorded in problems).

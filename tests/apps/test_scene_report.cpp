@@ -3,6 +3,7 @@
 // would end the <script> element early); the page is accepted as part of a buckle output.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -57,6 +58,15 @@ Scene smallScene(const std::string& description) {
             {"plots", json::array({{{"type", "bifurcation"}, {"x", "Fx"}, {"y", "q2"}},
                                    {{"type", "shapes"}, {"at", {-0.5}}}})}};
   return parseScene(s.dump(), "small.json");
+}
+
+/// A case of `n` paper segments added to `run` for a page built from synthetic results.
+CaseResult& syntheticCase(RunResult& run, int n) {
+  CaseResult& cr =
+      run.cases.emplace_back(mech::Chain::uniform(n, mech::SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)));
+  cr.label = "main";
+  cr.q0 = Eigen::VectorXd::Zero(n);
+  return cr;
 }
 
 }  // namespace
@@ -191,10 +201,7 @@ TEST_CASE("the page of a large run stays a few megabytes and says what it left t
   const Scene scene = smallScene("large");
   RunResult run;
   const int n = 400;
-  CaseResult& cr =
-      run.cases.emplace_back(mech::Chain::uniform(n, mech::SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)));
-  cr.label = "main";
-  cr.q0 = Eigen::VectorXd::Zero(n);
+  CaseResult& cr = syntheticCase(run, n);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> angle(-0.01, 0.01);
   const int branches = 12, perBranch = 5000;
@@ -261,4 +268,45 @@ TEST_CASE("the page of a small run is complete and says nothing about a summary"
   CHECK(!data.contains("abridged"));
   CHECK(data["cases"][0]["point"].size() == run.cases[0].points.size());
   for (const json& s : data["cases"][0]["specials"]) CHECK(s.contains("joints"));
+}
+
+TEST_CASE("the page of a tree with thousands of special points lists the most important ones", "[scene][report]") {
+  // 6000 special points: the primary branch's branch points (every 20th) come before the others;
+  // the page lists 2500 of them in their order, those first.
+  const Scene scene = smallScene("specials");
+  RunResult run;
+  const int n = 3;
+  CaseResult& cr = syntheticCase(run, n);
+  for (int b = 0; b < 2; ++b) {
+    BranchRecord br;
+    br.id = b;
+    br.parent = b == 0 ? -1 : 0;
+    cr.branches.push_back(br);
+  }
+  const int total = 6000;
+  std::vector<bool> important(total, false);
+  for (int s = 0; s < total; ++s) {
+    SpecialPointResult sp;
+    const bool primary = s % 20 == 0;
+    sp.type = primary ? mech::EventType::BranchPoint : mech::EventType::Release;
+    sp.branch = primary ? 0 : 1;
+    sp.parameter = -1e-3 * s;  // identifies it on the page
+    sp.q = Eigen::VectorXd::Constant(n, 1e-3);
+    important[size_t(s)] = primary;
+    cr.specials.push_back(std::move(sp));
+  }
+  const std::string page = reportHtml(scene, run, specialPointsJson(scene, run), summaryJson(scene, run, PlotReport{}));
+  const json data = embedded(page);
+  const json& listed = data["cases"][0]["specials"];
+  REQUIRE(listed.size() == 2500);
+  std::vector<int> shown;
+  for (const json& s : listed) shown.push_back(int(std::lround(-1e3 * s["parameter"].get<double>())));
+  CHECK(std::is_sorted(shown.begin(), shown.end()));
+  int primaries = 0;
+  for (int s : shown) primaries += important[size_t(s)];
+  CHECK(primaries == total / 20);  // every one of them
+  // then the others in their order: the first ones
+  CHECK(shown[1] == 1);
+  REQUIRE(data.contains("abridged"));
+  CHECK(data["abridged"].get<std::string>().find("2500 of the 6000 special points") != std::string::npos);
 }

@@ -219,3 +219,37 @@ TEST_CASE("self clearance: the swept cut-off finds the all-pairs pair on chains 
     CHECK(sc.linkB == bestB);
   }
 }
+
+TEST_CASE("self contacts along a branch: the bounded scan finds every sign change an exact scan finds",
+          "[contact_geometry]") {
+  // A chain curling into a spiral and back (every joint bent by t, t up and down with steps of
+  // varying size, fixed λ: no location, the contacts to the point spacing), its self contacts
+  // against the sign changes of selfClearance at every point.
+  const int n = 40;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Wrench::Zero()), Eigen::Vector3d(1, 0, 0));
+  cont::Branch branch;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> step(0.0002, 0.004);
+  double t = 0.0;
+  for (int sweep = 0; sweep < 4; ++sweep)
+    for (int k = 0; k < 300; ++k) {
+      t += (sweep % 2 == 0 ? 1.0 : -1.0) * step(rng);
+      cont::ContinuationPoint p;
+      p.lambda = 0.0;
+      p.u = Vector::Zero(problem.dimension());
+      for (int i = 0; i < n; ++i) p.u[i] = t * (1.0 + 0.3 * std::sin(0.7 * i));
+      branch.points.push_back(p);
+    }
+  std::vector<std::pair<int, bool>> exact;  // (index, entering)
+  for (size_t i = 0; i + 1 < branch.points.size(); ++i) {
+    const double a = selfClearance(chain, branch.points[i].u.head(n)).distance;
+    const double b = selfClearance(chain, branch.points[i + 1].u.head(n)).distance;
+    if ((a > 0.0) != (b > 0.0)) exact.emplace_back(int(i), a > 0.0);
+  }
+  REQUIRE(exact.size() >= 4);  // the spiral meets itself and separates again, more than once
+  std::vector<std::pair<int, bool>> found;
+  for (const GeometricContact& g : locateGeometricContacts(problem, branch, {}))
+    if (!g.base) found.emplace_back(g.index, g.entering);
+  CHECK(found == exact);
+}

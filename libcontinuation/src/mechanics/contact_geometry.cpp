@@ -58,6 +58,44 @@ double distanceAt(const Chain& chain, ConstVectorRef q, bool base) {
   return base ? baseClearance(chain, q).distance : selfClearance(chain, q).distance;
 }
 
+/// The clearances of a branch's points (distanceAt) as far as a scan for sign changes needs them:
+/// exact at the base, and for the self contact exact at a reference point and, while every joint
+/// has moved by at most δ from it, the bound d_ref − 2δ (or d_ref + 2δ) in its place — two links'
+/// distance changes by at most 2δ when their ends move by δ — as long as the bound keeps the sign
+/// of d_ref by a margin far above rounding. O(n) a point, the nearest-pair search (O(n log n))
+/// only where the clearance may change sign.
+std::vector<double> scannedDistances(const Chain& chain, const continuation::Branch& branch, bool base) {
+  const int n = chain.size();
+  const size_t count = branch.points.size();
+  std::vector<double> d(count);
+  Eigen::Matrix2Xd reference;
+  double dRef = std::numeric_limits<double>::quiet_NaN();
+  for (size_t i = 0; i < count; ++i) {
+    const auto q = branch.points[i].u.head(n);
+    if (base) {
+      d[i] = distanceAt(chain, q, true);
+      continue;
+    }
+    const Eigen::Matrix2Xd P = jointPositions(chain, q);
+    if (std::isfinite(dRef) && P.cols() == reference.cols()) {
+      const double moved = 2.0 * (P - reference).colwise().norm().maxCoeff();
+      const double margin = 1e-9 * std::max(1.0, P.cwiseAbs().maxCoeff());
+      if (dRef - moved > margin) {
+        d[i] = dRef - moved;
+        continue;
+      }
+      if (dRef + moved < -margin) {
+        d[i] = dRef + moved;
+        continue;
+      }
+    }
+    d[i] = selfClearance(chain, q).distance;
+    reference = P;
+    dRef = d[i];
+  }
+  return d;
+}
+
 }  // namespace
 
 BaseClearance baseClearance(const Chain& chain, ConstVectorRef q) {
@@ -148,10 +186,12 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
   const double lambdaScale = problem.scales().parameter;
   for (bool base : {true, false}) {
     if (base && problem.wallIsBoundary()) continue;  // the wall is a constraint: WC / WR (contact.h)
-    std::vector<double> d(count);
-    for (size_t i = 0; i < count; ++i) d[i] = distanceAt(chain, branch.points[i].u.head(n), base);
+    std::vector<double> d = scannedDistances(chain, branch, base);
     for (size_t i = 0; i + 1 < count; ++i) {
       if ((d[i] > 0.0) == (d[i + 1] > 0.0) || !std::isfinite(d[i]) || !std::isfinite(d[i + 1])) continue;
+      // a sign change: the clearances themselves on both sides (a bound has only their sign)
+      d[i] = distanceAt(chain, branch.points[i].u.head(n), base);
+      d[i + 1] = distanceAt(chain, branch.points[i + 1].u.head(n), base);
       const continuation::ContinuationPoint &p0 = branch.points[i], &p1 = branch.points[i + 1];
       GeometricContact g;
       g.base = base;
