@@ -97,7 +97,7 @@ TEST_CASE("solver: the nested keys are the C++ fields, the flat keys their short
 }
 
 TEST_CASE("solver: summary.json's block reads back to the same settings", "[scene][solver]") {
-  for (const std::string text :
+  for (const std::string& text :
        {std::string("{}"), std::string(R"({"step": {"rule": "curvature", "max_step": 0.1}, "tolerance": 1e-11})"),
         std::string(R"({"location": {"tolerance": 1e-15, "max_iterations": 3}, "max_points": 2, "time_limit": 5})")}) {
     INFO(text);
