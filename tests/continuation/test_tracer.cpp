@@ -250,21 +250,11 @@ TEST_CASE("No step jumps over two close branch points undetected, at any step se
 
 TEST_CASE("onLocated tells of every special point as it is located, in the problem's units", "[tracer]") {
   // TwoPitchforks with λ scaled by 1e3 inside the tracer: the callback must convert back
-  class Scaled : public toys::TwoPitchforks {
-   public:
-    using TwoPitchforks::TwoPitchforks;
-    ProblemScales scales() const override {
-      ProblemScales s = ProblemScales::ones(2);
-      s.parameter = 1e3;
-      s.unknowns << 1e-2, 1e-2;
-      return s;
-    }
-  };
   const double c = 1e-3;
   for (bool scaled : {false, true}) {
     INFO("scaled " << scaled);
     toys::TwoPitchforks plain(c);
-    Scaled big(c);
+    toys::ScaledTwoPitchforks big(c);
     Problem &problem = scaled ? static_cast<Problem &>(big) : plain;
     TracerOptions options;
     options.lambdaMax = 3.0;

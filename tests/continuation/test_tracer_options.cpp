@@ -125,20 +125,10 @@ TEST_CASE("TracerOptions: the tracer reads the nested groups", "[tracer_options]
 TEST_CASE("onStep sees every new point and its step's special points in the problem's units", "[tracer_options]") {
   // TwoPitchforks with u scaled by 1e-2 and λ by 1e3 inside the tracer: the callback's points and
   // special points must be those the tracer returns, bit for bit.
-  class Scaled : public toys::TwoPitchforks {
-   public:
-    using TwoPitchforks::TwoPitchforks;
-    ProblemScales scales() const override {
-      ProblemScales s = ProblemScales::ones(2);
-      s.parameter = 1e3;
-      s.unknowns << 1e-2, 1e-2;
-      return s;
-    }
-  };
   for (bool scaled : {false, true}) {
     INFO("scaled " << scaled);
     toys::TwoPitchforks plain(1e-3);
-    Scaled big(1e-3);
+    toys::ScaledTwoPitchforks big(1e-3);
     Problem &problem = scaled ? static_cast<Problem &>(big) : plain;
     TracerOptions options;
     options.lambdaMax = 3.0;

@@ -105,6 +105,19 @@ class TwoPitchforks : public Problem {
 
 /// m decoupled symmetric pitchforks (λ − c_j)u_j − u_j³, c_j = j·spacing, H = −F_u: m branch
 /// points on u = 0 at λ = c_j, one per step of a long trivial branch (the tree's lazy roots).
+/// TwoPitchforks with u scaled by 1e-2 and λ by 1e3 inside the tracer (ProblemScales): what a
+/// callback or a result shows must be in the problem's units whatever the tracer works in.
+class ScaledTwoPitchforks : public TwoPitchforks {
+ public:
+  using TwoPitchforks::TwoPitchforks;
+  ProblemScales scales() const override {
+    ProblemScales s = ProblemScales::ones(2);
+    s.parameter = 1e3;
+    s.unknowns << 1e-2, 1e-2;
+    return s;
+  }
+};
+
 class ManyPitchforks : public Problem {
  public:
   ManyPitchforks(int m, double spacing) : m_(m), spacing_(spacing) {}
