@@ -17,7 +17,7 @@ set(BUCKLE_PCH_STD <algorithm> <cmath> <limits> <memory> <stdexcept> <string> <v
 # targets that link it. Named by its include path, not its absolute one, so the cmake_pch.hxx
 # CMake writes has the same text in every clone. (GCC's .gch still differs between clones, so
 # files compiled against it miss ccache in a fresh clone: benchmarks/RESULTS.md, Build.)
-set(BUCKLE_PCH_EIGEN <buckle/continuation/eigen_instances.h>)
+set(BUCKLE_PCH_EIGEN <buckle/continuation/internal/eigen_instances.h>)
 
 # buckle_precompile(target header...): precompile the standard headers above and the given ones
 # for `target`.

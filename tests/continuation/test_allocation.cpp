@@ -1,9 +1,9 @@
 // The corrector's hot loop (KINSOL iterations, residual and Jacobian callbacks on mapped
 // SUNDIALS storage) must not touch the heap once the Corrector exists (malloc_counter.h).
 #include "buckle/continuation/corrector.h"
-#include "buckle/continuation/locator.h"
+#include "buckle/continuation/internal/locator.h"
 #include "buckle/continuation/numeric_diff.h"
-#include "buckle/continuation/spectral_monitor.h"
+#include "buckle/continuation/internal/spectral_monitor.h"
 
 #include "toy_problems.h"
 

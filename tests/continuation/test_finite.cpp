@@ -1,5 +1,5 @@
 // allFinite (finite.h): the corrector's and the bordered solver's finiteness test.
-#include "buckle/continuation/finite.h"
+#include "buckle/continuation/internal/finite.h"
 
 #include <catch2/catch.hpp>
 

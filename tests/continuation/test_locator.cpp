@@ -1,4 +1,4 @@
-#include "buckle/continuation/locator.h"
+#include "buckle/continuation/internal/locator.h"
 #include "buckle/continuation/tracer.h"
 
 #include "toy_problems.h"

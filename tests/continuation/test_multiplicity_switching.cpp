@@ -3,7 +3,7 @@
 #include "buckle/continuation/multiplicity_switching.h"
 
 #include "buckle/continuation/branch_switching.h"
-#include "buckle/continuation/test_functions.h"
+#include "buckle/continuation/internal/test_functions.h"
 #include "buckle/continuation/tracer.h"
 
 #include "toy_problems.h"

@@ -1,6 +1,6 @@
 // Certified counting (spectral_monitor.h): crossings the inertia count cannot see, on problems
 // whose eigenvalues are known in closed form.
-#include "buckle/continuation/spectral_monitor.h"
+#include "buckle/continuation/internal/spectral_monitor.h"
 #include "buckle/continuation/tracer.h"
 
 #include "toy_problems.h"

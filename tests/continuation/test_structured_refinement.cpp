@@ -2,7 +2,7 @@
 // forms and against the dense augmented systems of the same tracer: the crossover
 // maxDenseLocationDimension is forced below N so that the structured path runs (here through
 // DenseBorderedSolver::factorGeneral, the problems having no structured solver).
-#include "buckle/continuation/structured_refinement.h"
+#include "buckle/continuation/internal/structured_refinement.h"
 
 #include "buckle/continuation/branch_switching.h"
 #include "buckle/continuation/tracer.h"

@@ -1,5 +1,5 @@
-#include "buckle/continuation/sundials_raii.h"
-#include "buckle/continuation/serial_vector_ops.h"
+#include "buckle/continuation/internal/sundials_raii.h"
+#include "buckle/continuation/internal/serial_vector_ops.h"
 
 #include <catch2/catch.hpp>
 #include <sunmatrix/sunmatrix_dense.h>

@@ -1,4 +1,4 @@
-#include "buckle/continuation/test_functions.h"
+#include "buckle/continuation/internal/test_functions.h"
 
 #include "toy_problems.h"
 

@@ -1,6 +1,6 @@
 #include "buckle/continuation/bordered_solver.h"
 
-#include "buckle/continuation/finite.h"
+#include "buckle/continuation/internal/finite.h"
 
 #include <cmath>
 #include <limits>

@@ -2,7 +2,7 @@
 
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/scaled_problem.h"
-#include "buckle/continuation/structured_refinement.h"
+#include "buckle/continuation/internal/structured_refinement.h"
 
 #include <Eigen/LU>
 #include <algorithm>

@@ -2,7 +2,7 @@
 
 #include "buckle/continuation/multiplicity_switching.h"
 #include "buckle/continuation/scaled_problem.h"
-#include "buckle/continuation/test_functions.h"
+#include "buckle/continuation/internal/test_functions.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,17 +12,28 @@
 
 namespace buckle::continuation {
 
-bool BranchSwitchingOptions::IsValid(std::string *why) const {
-  if (!(amplitude >= 0.0) || !std::isfinite(amplitude)) {
-    if (why) *why = "amplitude must be finite and >= 0";
-    return false;
-  }
-  if (!(minOffBranchFraction > 0.0 && minOffBranchFraction < 1.0)) {
-    if (why) *why = "minOffBranchFraction must lie in (0, 1)";
-    return false;
-  }
-  return true;
+std::string BranchSwitchingOptions::validate(const std::string &prefix) const {
+  return firstProblem({require(amplitude >= 0.0 && std::isfinite(amplitude), prefix, "amplitude", "must be finite and >= 0"),
+                       require(minOffBranchFraction > 0.0 && minOffBranchFraction < 1.0, prefix,
+                               "minOffBranchFraction", "must lie in (0, 1)")});
 }
+
+std::string TreeOptions::validate(const std::string &prefix) const {
+  return firstProblem({require(branchSwitching >= 0, prefix, "branchSwitching", "must be >= 0"),
+                       switching.validate(prefix + "switching."),
+                       childTracer ? childTracer->validate(prefix + "childTracer.") : std::string()});
+}
+
+namespace {
+
+// What is wrong with a tree's options for a problem of dimension n (the symmetry's size too).
+std::string treeProblem(const TreeOptions &tree, int n) {
+  std::string why = tree.validate();
+  if (why.empty() && !tree.symmetry.IsValid(n, &why)) why = "symmetry: " + why;
+  return why;
+}
+
+}  // namespace
 
 namespace {
 
@@ -286,10 +297,10 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
     if (treeOptions.onBranch) treeOptions.onBranch(tree, tree.branches[i]);
     return true;
   };
-  if (std::string why; !treeOptions.symmetry.IsValid(problem.dimension(), &why)) {
+  if (const std::string why = treeProblem(treeOptions, problem.dimension()); !why.empty()) {
     Branch invalid;
     invalid.stopReason = StopReason::InvalidOptions;
-    invalid.stopMessage = "TreeOptions::symmetry: " + why;
+    invalid.stopMessage = "TreeOptions: " + why;
     add(std::move(invalid), 0);
     return finish();
   }

@@ -1,7 +1,7 @@
 #include "buckle/continuation/corrector.h"
 
-#include "buckle/continuation/finite.h"
-#include "buckle/continuation/serial_vector_ops.h"
+#include "buckle/continuation/internal/finite.h"
+#include "buckle/continuation/internal/serial_vector_ops.h"
 
 #include <algorithm>
 #include <cmath>
@@ -23,11 +23,7 @@ std::string CorrectorOptions::validate(const std::string &prefix) const {
   return {};
 }
 
-bool CorrectorOptions::IsValid(std::string *why) const {
-  const std::string problem = validate();
-  if (why) *why = problem;
-  return problem.empty();
-}
+bool CorrectorOptions::IsValid(std::string *why) const { return reportValidity(validate(), why); }
 
 Corrector::Corrector(Problem &problem, const CorrectorOptions &options, BorderedSolver *structured)
     : problem_(problem),

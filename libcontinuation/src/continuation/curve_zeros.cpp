@@ -6,22 +6,22 @@
 
 #include <cmath>
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 namespace buckle::continuation {
 
 std::vector<CurveZero> locateCurveZeros(Problem &curve, const Branch &branch, const CurveTest &g,
                                         const CurveZeroOptions &options) {
   std::vector<CurveZero> zeros;
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("CurveZeroOptions: " + why);
   const int n = curve.dimension();
   if (branch.points.size() < 2) return zeros;
   const UnitScaling units(curve.scales());
   ScaledProblem scaled(curve, units);
-  CorrectorOptions co;
-  co.tolerance = options.residualTolerance;
-  co.maxIterations = 20;
   // the curve's structured solver when it offers one (O(N) curve systems), else dense LU
   const std::unique_ptr<BorderedSolver> structured = scaled.makeStructuredSolver();
-  Corrector corrector(scaled, co, structured.get());
+  Corrector corrector(scaled, options.corrector, structured.get());
   Vector scales(n + 1);
   for (int i = 0; i <= n; ++i) scales[i] = units.state(i);
   auto toScaled = [&](const ContinuationPoint &p) {

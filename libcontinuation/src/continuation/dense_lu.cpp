@@ -1,4 +1,4 @@
-#include "buckle/continuation/dense_lu.h"
+#include "buckle/continuation/internal/dense_lu.h"
 
 #include <algorithm>
 #include <cmath>

@@ -8,15 +8,14 @@
 
 namespace buckle::continuation {
 
-std::string DerivativeCheckOptions::check(int n) const {
+std::string DerivativeCheckOptions::validate(int n) const {
   if (!(relativePrecision > 0.0 && relativePrecision < 1.0)) return "relativePrecision must lie in (0, 1)";
   if (direction.size() != 0 && direction.size() != n + 1)
     return "direction must be empty or have size N + 1 = " + std::to_string(n + 1);
   if (secondDirection.size() != 0 && secondDirection.size() != n + 1)
     return "secondDirection must be empty or have size N + 1 = " + std::to_string(n + 1);
   if (!direction.allFinite() || !secondDirection.allFinite()) return "directions must be finite";
-  const std::string steps = this->steps.check();
-  return steps.empty() ? "" : "steps: " + steps;
+  return steps.validate("steps.");
 }
 
 const DerivativeComparison *DerivativeCheck::find(const std::string &name) const {
@@ -206,7 +205,7 @@ DerivativeCheck checkDerivatives(Problem &problem, ConstVectorRef u, double lamb
     check.message = "u must have size N = " + std::to_string(n) + " (N > 0)";
     return check;
   }
-  if (const std::string why = options.check(n); !why.empty()) {
+  if (const std::string why = options.validate(n); !why.empty()) {
     check.message = "DerivativeCheckOptions: " + why;
     return check;
   }

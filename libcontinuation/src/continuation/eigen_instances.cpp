@@ -1,5 +1,5 @@
 // The one instantiation of Eigen's dense decompositions of MatrixXd (eigen_instances.h).
-#include "buckle/continuation/eigen_instances.h"
+#include "buckle/continuation/internal/eigen_instances.h"
 
 template class Eigen::BDCSVD<Eigen::MatrixXd>;
 template class Eigen::JacobiSVD<Eigen::MatrixXd>;

@@ -1,7 +1,7 @@
 // The locator (locator.h): samples of a step on its hyperplane, the roots of test functions
 // between them, and folds (secant location, Moore refinement); branch points in
 // locator_branch_points.cpp, hidden crossings in locator_hidden.cpp.
-#include "buckle/continuation/locator.h"
+#include "buckle/continuation/internal/locator.h"
 
 #include "locator_internal.h"
 
@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 
 namespace buckle::continuation {
 
@@ -17,6 +18,8 @@ using namespace locator_detail;
 
 Locator::Locator(Problem &problem, Corrector &corrector, PointEvaluator &evaluator, const LocatorOptions &options)
     : problem_(problem), corrector_(corrector), evaluator_(evaluator), options_(options), n_(problem.dimension()) {
+  std::string why;
+  if (!options_.IsValid(&why)) throw std::invalid_argument("LocatorOptions: " + why);
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
   residual_ = Vector::Zero(n_);

@@ -1,6 +1,6 @@
 // The locator's branch points (locator.h): simple ones by the bisection of their crossing
 // eigenvalue and Moore's refinement, their kernel geometry, and points of multiplicity m >= 2.
-#include "buckle/continuation/locator.h"
+#include "buckle/continuation/internal/locator.h"
 
 #include <Eigen/SVD>
 #include <algorithm>

@@ -1,6 +1,6 @@
 // Certified counting inside one step (spectral_monitor.h): the search for the interior minimum of
 // |μ| of an eigenvalue the monitor suspects, and what it finds there.
-#include "buckle/continuation/locator.h"
+#include "buckle/continuation/internal/locator.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <string>
 
-#include "buckle/continuation/locator.h"
+#include "buckle/continuation/internal/locator.h"
 
 namespace buckle::continuation::locator_detail {
 

@@ -1,7 +1,7 @@
 #include "buckle/continuation/multiplicity_switching.h"
 
 #include "buckle/continuation/scaled_problem.h"
-#include "buckle/continuation/structured_refinement.h"
+#include "buckle/continuation/internal/structured_refinement.h"
 
 #include <Eigen/Dense>
 #include <Eigen/SVD>

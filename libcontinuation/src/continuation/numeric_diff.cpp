@@ -2,14 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace buckle::continuation {
 
-std::string NumericDiffOptions::check() const {
+std::string NumericDiffOptions::validate(const std::string &prefix) const {
   auto inRange = [](double d) { return d > 0.0 && d <= 0.1; };
-  if (!inRange(relativeStep)) return "relativeStep must lie in (0, 0.1]";
-  if (!inRange(secondRelativeStep)) return "secondRelativeStep must lie in (0, 0.1]";
-  return "";
+  return firstProblem({require(inRange(relativeStep), prefix, "relativeStep", "must lie in (0, 0.1]"),
+                       require(inRange(secondRelativeStep), prefix, "secondRelativeStep", "must lie in (0, 0.1]")});
 }
 
 bool differenceJacobian(Problem &problem, const ProblemScales &scales, double relativeStep, ConstVectorRef u,
@@ -41,7 +41,10 @@ bool differenceJacobian(Problem &problem, const ProblemScales &scales, double re
   return Fu.allFinite() && Fl.allFinite();
 }
 
-NumericDiffProblem::NumericDiffProblem(const NumericDiffOptions &options) : options_(options) {}
+NumericDiffProblem::NumericDiffProblem(const NumericDiffOptions &options) : options_(options) {
+  std::string why;
+  if (!options_.IsValid(&why)) throw std::invalid_argument("NumericDiffOptions: " + why);
+}
 
 const ProblemScales &NumericDiffProblem::cachedScales() {
   const int n = dimension();

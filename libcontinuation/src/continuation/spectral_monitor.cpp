@@ -1,4 +1,4 @@
-#include "buckle/continuation/spectral_monitor.h"
+#include "buckle/continuation/internal/spectral_monitor.h"
 
 #include <Eigen/Core>
 #include <algorithm>

@@ -1,6 +1,6 @@
 #include "buckle/continuation/step_control.h"
 
-#include "buckle/continuation/finite.h"
+#include "buckle/continuation/internal/finite.h"
 
 #include <algorithm>
 #include <cmath>
@@ -24,11 +24,7 @@ std::string StepOptions::validate(const std::string &prefix) const {
   return {};
 }
 
-bool StepOptions::IsValid(std::string *why) const {
-  const std::string problem = validate();
-  if (why) *why = problem;
-  return problem.empty();
-}
+bool StepOptions::IsValid(std::string *why) const { return reportValidity(validate(), why); }
 
 double StepOptions::next(double ds, const StepObservation &step) const {
   if (rule == Rule::NewtonCount) return next(ds, step.newtonIterations, step.contraction);

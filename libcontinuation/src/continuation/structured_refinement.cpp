@@ -1,4 +1,4 @@
-#include "buckle/continuation/structured_refinement.h"
+#include "buckle/continuation/internal/structured_refinement.h"
 
 #include <algorithm>
 #include <cmath>

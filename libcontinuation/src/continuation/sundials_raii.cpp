@@ -1,6 +1,6 @@
-#include "buckle/continuation/sundials_raii.h"
+#include "buckle/continuation/internal/sundials_raii.h"
 
-#include "buckle/continuation/serial_vector_ops.h"
+#include "buckle/continuation/internal/serial_vector_ops.h"
 
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>

@@ -1,6 +1,6 @@
 #include "buckle/continuation/tracer.h"
 
-#include "buckle/continuation/locator.h"
+#include "buckle/continuation/internal/locator.h"
 #include "buckle/continuation/multiplicity_switching.h"
 
 #include <algorithm>

@@ -3,7 +3,7 @@
 // the crossing is located along the step by the locator's secant (its points are corrector
 // solves, so on the branch), and coordinate events are landed on exactly by one more solve
 // with that coordinate held at its bound.
-#include "buckle/continuation/locator.h"
+#include "buckle/continuation/internal/locator.h"
 #include "buckle/continuation/tracer.h"
 
 #include <algorithm>

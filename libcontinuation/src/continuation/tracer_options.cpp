@@ -1,19 +1,11 @@
 #include "buckle/continuation/tracer_options.h"
 
-#include "buckle/continuation/finite.h"
+#include "buckle/continuation/internal/finite.h"
+#include "buckle/continuation/options_validity.h"
 
 #include <cmath>
 
 namespace buckle::continuation {
-
-namespace {
-
-bool reportValidity(const std::string &problem, std::string *why) {
-  if (why) *why = problem;
-  return problem.empty();
-}
-
-}  // namespace
 
 std::string LocationOptions::validate(const std::string &prefix) const {
   auto bad = [&prefix](const char *field, const char *what) { return prefix + field + " " + what; };
@@ -37,18 +29,20 @@ std::string DetectionOptions::validate(const std::string &prefix) const {
 
 bool DetectionOptions::IsValid(std::string *why) const { return reportValidity(validate(), why); }
 
-std::string TracerOptions::validate() const {
-  for (const std::string &group : {step.validate(), corrector.validate(), location.validate(), detection.validate()})
+std::string TracerOptions::validate(const std::string &prefix) const {
+  const std::string &p = prefix;
+  for (const std::string &group : {step.validate(p + "step."), corrector.validate(p + "corrector."),
+                                   location.validate(p + "location."), detection.validate(p + "detection.")})
     if (!group.empty()) return group;
-  if (maxPoints < 2) return "maxPoints must be at least 2";
-  if (std::isnan(lambdaMin) || std::isnan(lambdaMax)) return "lambdaMin/lambdaMax must not be NaN";
-  if (!(lambdaMin < lambdaMax)) return "lambdaMin must be smaller than lambdaMax";
-  if (!(maxArclength > 0.0)) return "maxArclength must be positive";
-  if (boxLower.size() != boxUpper.size()) return "boxLower and boxUpper must have the same size";
+  if (maxPoints < 2) return p + "maxPoints must be at least 2";
+  if (std::isnan(lambdaMin) || std::isnan(lambdaMax)) return p + "lambdaMin/lambdaMax must not be NaN";
+  if (!(lambdaMin < lambdaMax)) return p + "lambdaMin must be smaller than lambdaMax";
+  if (!(maxArclength > 0.0)) return p + "maxArclength must be positive";
+  if (boxLower.size() != boxUpper.size()) return p + "boxLower and boxUpper must have the same size";
   for (Eigen::Index i = 0; i < boxLower.size(); ++i)
     if (std::isnan(boxLower[i]) || std::isnan(boxUpper[i]) || !(boxLower[i] < boxUpper[i]))
-      return "boxLower[" + std::to_string(i) + "] must be smaller than boxUpper[" + std::to_string(i) + "]";
-  if (structuredFromDimension < 1) return "structuredFromDimension must be at least 1";
+      return p + "boxLower[" + std::to_string(i) + "] must be smaller than boxUpper[" + std::to_string(i) + "]";
+  if (structuredFromDimension < 1) return p + "structuredFromDimension must be at least 1";
   return {};
 }
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 #include <stdexcept>
+#include <string>
 
 #include "all_equilibria_sweep.h"
 #include "buckle/mechanics/equilibrium_problem.h"
@@ -24,27 +25,6 @@ constexpr double kMaxAngleStep = 1.0;
 // chain's units: Newton's quadratic convergence takes it to rounding from there.
 constexpr double kHandOver = 1e-8;
 constexpr int kPolishIterations = 30;
-
-void requireOption(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("all equilibria: " + what);
-}
-
-void validate(const Chain& chain, const AllEquilibriaOptions& o) {
-  requireOption(o.randomStarts >= 0, "randomStarts must be >= 0");
-  requireOption(o.smoothStarts >= 0, "smoothStarts must be >= 0");
-  requireOption(o.maxRootsPerStart >= 1, "maxRootsPerStart must be >= 1");
-  requireOption(o.maxIterations >= 1, "maxIterations must be >= 1");
-  requireOption(std::isfinite(o.deflationPower) && o.deflationPower >= 1.0, "deflationPower must be >= 1");
-  requireOption(std::isfinite(o.deflationShift) && o.deflationShift >= 0.0, "deflationShift must be >= 0");
-  requireOption(std::isfinite(o.tolerance) && o.tolerance > 0.0 && o.tolerance < 1.0, "tolerance must be in (0, 1)");
-  requireOption(std::isfinite(o.duplicateTolerance) && o.duplicateTolerance > 0.0 && o.duplicateTolerance < 1.0,
-                "duplicateTolerance must be in (0, 1)");
-  requireOption(o.landscapeSamples >= 2, "landscapeSamples must be >= 2");
-  for (size_t k = 0; k < o.starts.size(); ++k)
-    requireOption(o.starts[k].size() == chain.size() && o.starts[k].allFinite(),
-                  "start " + std::to_string(k + 1) + " must have " + std::to_string(chain.size()) +
-                      " finite joint angles");
-}
 
 bool withinLimits(const Chain& chain, const Vector& q) {
   for (int i = 0; i < chain.size(); ++i)
@@ -309,8 +289,28 @@ bool sweepApplies(const Chain& chain, const EndCondition& end) {
          !end.isHeld(EndCoordinate::Phi) && end.value[2] == 0.0;
 }
 
+std::string AllEquilibriaOptions::validate(int segments, const std::string& prefix) const {
+  namespace cont = continuation;
+  auto inUnitInterval = [](double v) { return std::isfinite(v) && v > 0.0 && v < 1.0; };
+  std::string problem = cont::firstProblem(
+      {cont::require(randomStarts >= 0, prefix, "randomStarts", "must be >= 0"),
+       cont::require(smoothStarts >= 0, prefix, "smoothStarts", "must be >= 0"),
+       cont::require(maxRootsPerStart >= 1, prefix, "maxRootsPerStart", "must be at least 1"),
+       cont::require(maxIterations >= 1, prefix, "maxIterations", "must be at least 1"),
+       cont::require(std::isfinite(deflationPower) && deflationPower >= 1.0, prefix, "deflationPower", "must be >= 1"),
+       cont::require(std::isfinite(deflationShift) && deflationShift >= 0.0, prefix, "deflationShift", "must be >= 0"),
+       cont::require(inUnitInterval(tolerance), prefix, "tolerance", "must lie in (0, 1)"),
+       cont::require(inUnitInterval(duplicateTolerance), prefix, "duplicateTolerance", "must lie in (0, 1)"),
+       cont::require(landscapeSamples >= 2, prefix, "landscapeSamples", "must be at least 2")});
+  for (size_t k = 0; k < starts.size() && problem.empty(); ++k)
+    if (starts[k].size() != segments || !starts[k].allFinite())
+      problem = prefix + "starts[" + std::to_string(k) + "] must have " + std::to_string(segments) +
+                " finite joint angles";
+  return problem;
+}
+
 AllEquilibria allEquilibria(const Chain& chain, const EndCondition& end, const AllEquilibriaOptions& options) {
-  validate(chain, options);
+  if (std::string why; !options.IsValid(chain.size(), &why)) throw std::invalid_argument("AllEquilibriaOptions: " + why);
   const auto begin = std::chrono::steady_clock::now();
   EquilibriumOptions equilibriumOptions;
   equilibriumOptions.jointLimitsAsBoundaries = false;  // the domain is the geometric limits exactly

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "buckle/continuation/branch_point_coefficients.h"
@@ -513,12 +515,23 @@ void reportStiffnessMinima(EquilibriumProblem& problem, const cont::Branch& b, c
 
 }  // namespace
 
+std::string ReportOptions::validate(const std::string& prefix) const {
+  return cont::firstProblem(
+      {cont::require(heldCoordinate >= -1 && heldCoordinate <= 2, prefix, "heldCoordinate",
+                     "must be -1 (none), 0 (x), 1 (y) or 2 (phi)"),
+       cont::require(!std::isnan(rangeLow) && !std::isnan(rangeHigh) && rangeLow <= rangeHigh, prefix, "rangeLow",
+                     "must not exceed rangeHigh (neither NaN)"),
+       cont::require(deepStiffnessRatio > 0.0 && deepStiffnessRatio <= 1.0, prefix, "deepStiffnessRatio",
+                     "must lie in (0, 1]")});
+}
+
 BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options) {
   return reportBranch(problem, b, options, {});
 }
 
 BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options,
                           const std::vector<ContactStretch>& stretches, GeometricContacts* geometric) {
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("ReportOptions: " + why);
   const Chain& chain = problem.chain();
   const int n = chain.size();
   const int c = options.heldCoordinate;

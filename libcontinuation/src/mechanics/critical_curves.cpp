@@ -15,7 +15,7 @@
 #include "buckle/continuation/curve_zeros.h"
 #include "buckle/continuation/fold_curve.h"
 #include "buckle/continuation/root_finding.h"
-#include "buckle/continuation/structured_refinement.h"
+#include "buckle/continuation/internal/structured_refinement.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/linear_buckling.h"
 
@@ -195,7 +195,16 @@ PostBuckling koiterKind(double a, double b, double transversality, double aToler
   return b * transversality < 0.0 ? PostBuckling::Supercritical : PostBuckling::Subcritical;
 }
 
+std::string CriticalCurveOptions::validate(const std::string& prefix) const {
+  return cont::firstProblem(
+      {cont::require(!std::isnan(muMin) && !std::isnan(muMax) && muMin < muMax, prefix, "muMin",
+                     "must be smaller than muMax (neither NaN)"),
+       tracer.validate(prefix + "tracer."),
+       cont::require(structuredFromDimension >= 1, prefix, "structuredFromDimension", "must be at least 1")});
+}
+
 CriticalCurve branchPointCurve(ChainParameterProblem& problem, int mode, const CriticalCurveOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("CriticalCurveOptions: " + why);
   EquilibriumProblem& eq = problem.equilibrium();
   const int n = eq.segments();
   const int N = eq.dimension();
@@ -309,6 +318,7 @@ void addLimitPoints(const cont::Branch& b, int N, std::vector<Codim2Point>& spec
 // from a neighbouring point.
 CriticalCurve minimalFoldCurve(ChainParameterProblem& problem, const cont::SpecialPoint& fold, const Vector& v,
                                const CriticalCurveOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("CriticalCurveOptions: " + why);
   const int N = problem.dimension();
   const int n = problem.equilibrium().segments();
   const double mu0 = problem.secondParameter();

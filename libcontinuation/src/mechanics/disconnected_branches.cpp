@@ -5,6 +5,8 @@
 #include <cmath>
 #include <memory>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 
 namespace buckle::mechanics {
 
@@ -213,10 +215,20 @@ void append(EquilibriumBranches&& from, int offset, EquilibriumBranches& to) {
 
 }  // namespace
 
+std::string DisconnectedBranchOptions::validate(const std::string& prefix) const {
+  return cont::firstProblem({branches.validate(prefix + "branches."),
+                             cont::requirePositive(prefix, "onBranchTolerance", onBranchTolerance),
+                             cont::require(joinFraction > 0.0 && joinFraction < 1.0, prefix, "joinFraction",
+                                           "must lie in (0, 1)"),
+                             cont::require(joinCosine > 0.0 && joinCosine <= 1.0, prefix, "joinCosine",
+                                           "must lie in (0, 1]")});
+}
+
 DisconnectedBranches traceDisconnectedBranches(EquilibriumProblem& problem, const std::vector<Eigen::VectorXd>& q,
                                                double lambda, const std::vector<bool>& stable,
                                                const std::vector<cont::Branch>& known,
                                                const DisconnectedBranchOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("DisconnectedBranchOptions: " + why);
   const int n = problem.segments();
   const cont::ProblemScales scales = problem.scales();
   Scaling scaling;

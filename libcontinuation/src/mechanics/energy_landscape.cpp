@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "buckle/mechanics/shape_name.h"
 #include "buckle/mechanics/validation.h"
@@ -180,11 +181,21 @@ void locateEquilibria(const Chain& chain, double x, double y, const std::vector<
 
 }  // namespace
 
+std::string LandscapeOptions::validate(const std::string& prefix) const {
+  namespace cont = continuation;
+  auto bound = [](double q) { return std::isnan(q) || std::isfinite(q); };
+  return cont::firstProblem(
+      {cont::require(samples >= 2, prefix, "samples", "must be at least 2"),
+       cont::require(bound(q1Min) && bound(q1Max), prefix, "q1Min", "and q1Max must be finite (NaN: the joint's limit)"),
+       cont::require(std::isnan(q1Min) || std::isnan(q1Max) || q1Min < q1Max, prefix, "q1Min",
+                     "must be smaller than q1Max")});
+}
+
 EnergyLandscape energyLandscape(const Chain& chain, double x, double y, const LandscapeOptions& options) {
   if (chain.size() != 3) throw std::invalid_argument("energy landscape: the chain must have 3 segments (n = 3)");
   requireFinite("x", x);
   requireFinite("y", y);
-  if (options.samples < 2) throw std::invalid_argument("samples must be >= 2");
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("LandscapeOptions: " + why);
   EnergyLandscape L;
   L.x = x;
   L.y = y;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <stdexcept>
+#include <string>
 
 #include "buckle/continuation/multiplicity_switching.h"
 #include "buckle/mechanics/mirror_symmetry.h"
@@ -267,9 +269,18 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
 // locked stretches are switched at like the traced ones, on the stretch's own problem
 // (TreeOptions::switchTracer); each branch is reported as soon as it is final (onFinal), so an
 // interrupted tree has its finished branches reported and the time limit bounds the reports too.
+std::string EquilibriumBranchOptions::validate(const std::string& prefix) const {
+  namespace cont = continuation;
+  return cont::firstProblem({tracer.validate(prefix + "tracer."), tree.validate(prefix + "tree."),
+                             report.validate(prefix + "report."),
+                             cont::require(maxContactEvents >= 0, prefix, "maxContactEvents", "must be >= 0"),
+                             cont::requirePositive(prefix, "maxContactTorque", maxContactTorque)});
+}
+
 EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::VectorXd& q0, double lambda0,
                                     const std::vector<continuation::InitialDirection>& starts,
                                     const EquilibriumBranchOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("EquilibriumBranchOptions: " + why);
   EquilibriumBranches result;
   const Eigen::VectorXd u0 = problem.initialGuess(q0, lambda0);
   continuation::TreeOptions tree = options.tree;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
+#include <string>
 
 #include "buckle/mechanics/chain_solver.h"
 #include "buckle/mechanics/stiffness.h"
@@ -49,6 +50,15 @@ bool sameBits(const double* a, const double* b, size_t count) {
 }
 }  // namespace
 
+std::string EquilibriumOptions::validate(const std::string& prefix) const {
+  namespace cont = continuation;
+  if (!heldRange.active()) return {};
+  return cont::firstProblem(
+      {cont::require(heldRange.coordinate <= 2, prefix, "heldRange.coordinate", "must be -1 (none), 0, 1 or 2"),
+       cont::require(std::isfinite(heldRange.low) && std::isfinite(heldRange.high) && heldRange.low <= heldRange.high,
+                     prefix, "heldRange.low", "must be finite and not exceed heldRange.high")});
+}
+
 EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
                                        const Eigen::Vector3d& direction, EquilibriumOptions options,
                                        const ControlDirection& control, const BodyLoads& body)
@@ -80,12 +90,7 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
     requireFinite(std::string("end value ") + names[c], end.value[c]);
     requireFinite(std::string("load path direction ") + names[c], direction[c]);
   }
-  if (const EquilibriumOptions::CoordinateRange& range = options_.heldRange; range.active()) {
-    if (range.coordinate > 2 || !(range.low <= range.high))
-      throw std::invalid_argument("held range: expected coordinate 0, 1 or 2 and low <= high");
-    requireFinite("held range low", range.low);
-    requireFinite("held range high", range.high);
-  }
+  if (std::string why; !options_.IsValid(&why)) throw std::invalid_argument("EquilibriumOptions: " + why);
   if (control_.active()) {
     const int n = chain_.size();
     if (control_.rates.rows() != n)

@@ -14,14 +14,11 @@
 
 namespace buckle::mechanics {
 
+namespace cont = continuation;
+
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-bool fail(std::string* why, const std::string& message) {
-  if (why) *why = message;
-  return false;
-}
 
 /// Full unknowns (q, reactions) from q or u.
 Vector fullUnknowns(EquilibriumProblem& problem, ConstVectorRef u, double lambda) {
@@ -294,17 +291,17 @@ UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef 
   return d;
 }
 
-bool JumpOptions::IsValid(const EquilibriumProblem& problem, std::string* why) const {
-  if (!scene.IsValid(problem.chain(), why)) return false;
-  if (!integration.IsValid(why)) return false;
-  if (!polish.IsValid(why)) return false;
-  if (!std::isfinite(perturbation) || perturbation < 0.0) return fail(why, "perturbation must be >= 0");
-  if (direction.size() != 0) {
-    if (direction.size() != problem.segments()) return fail(why, "direction must be empty or have one entry per joint");
-    if (!direction.allFinite() || direction.norm() == 0.0) return fail(why, "direction must be finite and non-zero");
-  }
-  if (!std::isfinite(sameStateTolerance) || !(sameStateTolerance > 0.0)) return fail(why, "sameStateTolerance must be > 0");
-  return true;
+std::string JumpOptions::validate(const EquilibriumProblem& problem, const std::string& prefix) const {
+  if (std::string why; !scene.IsValid(problem.chain(), &why)) return prefix + "scene: " + why;
+  return cont::firstProblem(
+      {integration.validate(prefix + "integration."), polish.validate(prefix + "polish."),
+       cont::require(std::isfinite(perturbation) && perturbation >= 0.0, prefix, "perturbation", "must be >= 0"),
+       cont::require(direction.size() == 0 || direction.size() == problem.segments(), prefix, "direction",
+                     "must be empty or have one entry per joint"),
+       cont::require(direction.size() == 0 || (direction.allFinite() && direction.norm() > 0.0), prefix, "direction",
+                     "must be finite and non-zero"),
+       cont::require(std::isfinite(sameStateTolerance) && sameStateTolerance > 0.0, prefix, "sameStateTolerance",
+                     "must be > 0")});
 }
 
 JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double lambda, const JumpOptions& options) {
@@ -432,12 +429,12 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   return result;
 }
 
-bool SuddenLoadOptions::IsValid(const Chain& chain, std::string* why) const {
-  if (!scene.IsValid(chain, why)) return false;
-  if (!integration.IsValid(why)) return false;
-  if (!polish.IsValid(why)) return false;
-  if (!std::isfinite(sameStateTolerance) || !(sameStateTolerance > 0.0)) return fail(why, "sameStateTolerance must be > 0");
-  return true;
+std::string SuddenLoadOptions::validate(const Chain& chain, const std::string& prefix) const {
+  if (std::string why; !scene.IsValid(chain, &why)) return prefix + "scene: " + why;
+  return cont::firstProblem(
+      {integration.validate(prefix + "integration."), polish.validate(prefix + "polish."),
+       cont::require(std::isfinite(sameStateTolerance) && sameStateTolerance > 0.0, prefix, "sameStateTolerance",
+                     "must be > 0")});
 }
 
 const char* toString(LowerPotential lower) {

@@ -192,6 +192,14 @@ double forceUnit(const Chain& chain) {
 
 }  // namespace
 
+std::string LinearBucklingOptions::validate(const std::string& prefix) const {
+  namespace cont = continuation;
+  return cont::firstProblem(
+      {cont::require(direction.allFinite(), prefix, "direction", "must be finite"),
+       cont::require(count >= -1, prefix, "count", "must be >= -1 (-1: every mode)"),
+       cont::requirePositive(prefix, "gradientTolerance", gradientTolerance)});
+}
+
 LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const EndCondition& end,
                                     const LinearBucklingOptions& options) {
   const int n = chain.size();
@@ -201,7 +209,7 @@ LinearBucklingResult linearBuckling(const Chain& chain, ConstVectorRef q0, const
     throw std::invalid_argument(os.str());
   }
   for (int i = 0; i < n; ++i) requireFinite("q0[" + std::to_string(i + 1) + "]", q0[i]);
-  for (int c = 0; c < 3; ++c) requireFinite("load direction component " + std::to_string(c), options.direction[c]);
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("LinearBucklingOptions: " + why);
 
   Vector g(n), kq(n);
   energyGradient(chain, q0, g);

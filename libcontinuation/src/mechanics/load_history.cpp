@@ -23,18 +23,13 @@ const char* toString(JumpTrigger trigger) {
   return "?";
 }
 
-bool LoadHistoryOptions::IsValid(const EquilibriumProblem& problem, std::string* why) const {
-  auto fail = [&](const std::string& m) {
-    if (why) *why = m;
-    return false;
-  };
-  if (!(overshoot > 0.0) || !std::isfinite(overshoot)) return fail("overshoot must be > 0 and finite");
-  if (maxJumps < 0) return fail("maxJumps must be >= 0");
-  if (!jump.IsValid(problem, why)) return false;
-  cont::TracerOptions t = tracer;
+std::string LoadHistoryOptions::validate(const EquilibriumProblem& problem, const std::string& prefix) const {
+  cont::TracerOptions t = tracer;  // the λ range is set per leg
   t.lambdaMin = -1.0;
   t.lambdaMax = 1.0;
-  return t.IsValid(why);
+  return cont::firstProblem({cont::requirePositive(prefix, "overshoot", overshoot),
+                             cont::require(maxJumps >= 0, prefix, "maxJumps", "must be >= 0"),
+                             jump.validate(problem, prefix + "jump."), t.validate(prefix + "tracer.")});
 }
 
 namespace {
@@ -197,7 +192,7 @@ void addSegment(LoadHistoryResult& result, cont::Branch branch, int leg, bool bi
 LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::VectorXd& q0,
                                     const std::vector<double>& waypoints, const LoadHistoryOptions& options) {
   std::string why;
-  if (!options.IsValid(problem, &why)) throw std::invalid_argument("load history options: " + why);
+  if (!options.IsValid(problem, &why)) throw std::invalid_argument("LoadHistoryOptions: " + why);
   if (waypoints.size() < 2) throw std::invalid_argument("load history: at least two waypoints are needed");
   for (double w : waypoints)
     if (!std::isfinite(w)) throw std::invalid_argument("load history: waypoints must be finite");

@@ -43,6 +43,18 @@ bool borderedSolve(const Matrix& H, const Matrix& C, const Matrix& R, double tol
 
 }  // namespace
 
+std::string StiffnessOptions::validate(int segments, const std::string& prefix) const {
+  namespace cont = continuation;
+  auto generator = [&](const Vector& g, const char* field) {
+    return cont::require((g.size() == 0 || g.size() == segments) && g.allFinite(), prefix, field,
+                         "must be empty or hold one finite value per segment");
+  };
+  return cont::firstProblem({cont::require(singularTolerance > 0.0 && singularTolerance < 1.0, prefix,
+                                           "singularTolerance", "must lie in (0, 1)"),
+                             generator(bodyGenerator, "bodyGenerator"),
+                             generator(bodyGeneratorRate, "bodyGeneratorRate")});
+}
+
 CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, bool rotationHeld,
                                    const StiffnessOptions& options) {
   return loadedStiffness(chain, q, F, rotationHeld, Matrix(0, chain.size()), options);
@@ -56,6 +68,7 @@ CartesianStiffness loadedStiffness(const Chain& chain, ConstVectorRef q, const W
   if (q.size() != n) throw std::invalid_argument("q must have one angle per segment (size " + std::to_string(n) + ")");
   if (!q.allFinite()) throw std::invalid_argument("q must be finite");
   if (!F.allFinite()) throw std::invalid_argument("F must be finite");
+  if (std::string why; !options.IsValid(n, &why)) throw std::invalid_argument("StiffnessOptions: " + why);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   CartesianStiffness out;
   out.rotationHeld = rotationHeld;
@@ -168,6 +181,7 @@ bool loadedStiffnessDerivative(const Chain& chain, ConstVectorRef q, const Wrenc
     throw std::invalid_argument("q and dq must have one angle per segment (size " + std::to_string(n) + ")");
   if (!q.allFinite() || !dq.allFinite() || !F.allFinite() || !dF.allFinite())
     throw std::invalid_argument("q, dq, F and dF must be finite");
+  if (std::string why; !options.IsValid(n, &why)) throw std::invalid_argument("StiffnessOptions: " + why);
   ChainData data(chain);
   forwardKinematics(chain, q, data);
   Matrix J(3, n), dJ(3, n);

@@ -193,12 +193,18 @@ class BranchSection {
 
 }  // namespace
 
+std::string StiffnessExtremumOptions::validate(const std::string& prefix) const {
+  return cont::firstProblem({cont::require(tolerance > 0.0 && tolerance < 1.0, prefix, "tolerance", "must lie in (0, 1)"),
+                             cont::require(maxEvaluations >= 1, prefix, "maxEvaluations", "must be at least 1")});
+}
+
 StiffnessExtremum locateStiffnessMinimum(EquilibriumProblem& problem, const cont::ContinuationPoint& a,
                                          const cont::ContinuationPoint& b, StiffnessMeasure measure,
                                          const StiffnessExtremumOptions& options) {
   StiffnessExtremum out;
   const int N = problem.dimension();
   if (a.u.size() != N || b.u.size() != N) throw std::invalid_argument("bracket points must have the problem's dimension");
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("StiffnessExtremumOptions: " + why);
   BranchSection section(problem, a, b, measure);
   if (section.degenerate()) {
     out.message = "the bracket's two points coincide";

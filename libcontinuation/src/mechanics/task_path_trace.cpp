@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "buckle/mechanics/shape_name.h"
 
@@ -102,6 +104,7 @@ TaskPathSpecial special(TaskPathProblem& problem, const cont::SpecialPoint& sp, 
 
 TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const std::vector<Vector>& waypoints,
                              double angleLength, const TaskPathOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("TaskPathOptions: " + why);
   TaskPathResult result;
   const TaskSetup& setup = problem.setup();
   const int m = problem.taskCount();

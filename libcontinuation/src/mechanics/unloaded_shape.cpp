@@ -54,7 +54,14 @@ TorqueRoot makeRoot(const Segment& s, double q) {
 
 }  // namespace
 
+std::string UnloadedShapeOptions::validate(const std::string& prefix) const {
+  namespace cont = continuation;
+  return cont::firstProblem({cont::require(samples >= 2, prefix, "samples", "must be at least 2"),
+                             cont::requirePositive(prefix, "tolerance", tolerance)});
+}
+
 SegmentUnloadedAngle unloadedAngle(const Segment& s, const UnloadedShapeOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("UnloadedShapeOptions: " + why);
   SegmentUnloadedAngle out;
   // The geometric limits are excluded (a spring of zero length); user limits are included.
   const double lo = s.lowerLimit(), hi = s.upperLimit();

@@ -16,7 +16,7 @@
 // vectors): factorGeneral(), optional for a structured solver.
 #pragma once
 
-#include "buckle/continuation/dense_lu.h"
+#include "buckle/continuation/internal/dense_lu.h"
 #include "buckle/continuation/problem.h"
 
 #include <Eigen/LU>

@@ -11,6 +11,7 @@
 #pragma once
 
 #include "buckle/continuation/branch.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/symmetry.h"
 #include "buckle/continuation/tracer.h"
@@ -29,7 +30,9 @@ struct BranchSwitchingOptions {
   /// The first corrected point counts as off the parent branch when its distance from the
   /// parent's tangent line is at least this fraction of its distance from the BP.
   double minOffBranchFraction = 0.05;
-  bool IsValid(std::string *why) const;
+  /// Empty when valid, else what is wrong, the field named as `prefix` + its name.
+  std::string validate(const std::string &prefix = "") const;
+  bool IsValid(std::string *why) const { return reportValidity(validate(), why); }
 };
 
 /// Unit tangent (N+1) of the branch that crosses the traced one at the simple branch point bp
@@ -99,6 +102,11 @@ struct TreeOptions {
   /// + side one (Branch::mirrorOf) instead of a second trace: the same tree, up to rounding, in
   /// half the work.
   Reflection symmetry;
+
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`
+  /// (`symmetry` needs the problem's dimension: traceTree checks it).
+  std::string validate(const std::string &prefix = "") const;
+  bool IsValid(std::string *why) const { return reportValidity(validate(), why); }
 };
 
 /// The bifurcation tree from one start point, breadth first: the start branches, one per entry

@@ -25,9 +25,9 @@
 #pragma once
 
 #include "buckle/continuation/bordered_solver.h"
-#include "buckle/continuation/dense_lu.h"
+#include "buckle/continuation/internal/dense_lu.h"
 #include "buckle/continuation/problem.h"
-#include "buckle/continuation/sundials_raii.h"
+#include "buckle/continuation/internal/sundials_raii.h"
 #include "buckle/continuation/tracer_options.h"
 
 #include <array>

@@ -11,6 +11,7 @@
 
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/problem.h"
+#include "buckle/continuation/tracer_options.h"
 
 #include <functional>
 #include <string>
@@ -32,13 +33,28 @@ struct CurveZero {
 };
 
 struct CurveZeroOptions {
-  double tolerance = 1e-12;          ///< bracket width along the chord (scaled variables)
-  double residualTolerance = 1e-13;  ///< corrector ‖G̃‖∞ of each sample
-  int maxIterations = 80;
+  double tolerance = 1e-12;  ///< bracket width along the chord (scaled variables)
+  int maxIterations = 80;    ///< of the Illinois iteration
+  /// The corrector of each sample (its tolerance bounds ‖G̃‖∞ of the scaled Keller system).
+  CorrectorOptions corrector = [] {
+    CorrectorOptions tight;
+    tight.tolerance = 1e-13;
+    tight.maxIterations = 20;
+    return tight;
+  }();
+
+  /// Empty when valid, else what is wrong, the field named by its path.
+  std::string validate(const std::string &prefix = "") const {
+    return firstProblem({requirePositive(prefix, "tolerance", tolerance),
+                         require(maxIterations >= 1, prefix, "maxIterations", "must be at least 1"),
+                         corrector.validate(prefix + "corrector.")});
+  }
+  bool IsValid(std::string *why) const { return reportValidity(validate(), why); }
 };
 
 /// Every sign change of g between consecutive points of `branch` (traced on `curve`), located.
-/// Intervals where g is not evaluable at an end are skipped.
+/// Intervals where g is not evaluable at an end are skipped. Throws std::invalid_argument on
+/// invalid options.
 std::vector<CurveZero> locateCurveZeros(Problem &curve, const Branch &branch, const CurveTest &g,
                                         const CurveZeroOptions &options = CurveZeroOptions());
 

@@ -35,7 +35,8 @@ struct DerivativeCheckOptions {
   Vector secondDirection;
   NumericDiffOptions steps;
   /// Empty when valid for dimension n, else which field is wrong.
-  std::string check(int n) const;
+  std::string validate(int n) const;
+  bool IsValid(int n, std::string *why) const { return reportValidity(validate(n), why); }
 };
 
 /// One derivative compared: its largest relative error and where.
@@ -62,7 +63,7 @@ struct DerivativeCheck {
 };
 
 /// Compares the problem's derivatives at (u, λ) with finite differences (see the file comment).
-/// Invalid input (sizes, options) gives ok = false and the reason in message; nothing is thrown.
+/// Invalid input (sizes, options) gives success = false and the reason in message; nothing is thrown.
 DerivativeCheck checkDerivatives(Problem &problem, ConstVectorRef u, double lambda,
                                  const DerivativeCheckOptions &options = DerivativeCheckOptions());
 

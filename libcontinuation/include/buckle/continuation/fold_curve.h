@@ -19,7 +19,7 @@
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/problem.h"
-#include "buckle/continuation/structured_refinement.h"
+#include "buckle/continuation/internal/structured_refinement.h"
 #include "buckle/continuation/two_parameter.h"
 
 #include <Eigen/LU>

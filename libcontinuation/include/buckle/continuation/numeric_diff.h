@@ -20,6 +20,7 @@
 // To check a hand-written Jacobian against these differences, see derivative_check.h.
 #pragma once
 
+#include "buckle/continuation/options_validity.h"
 #include "buckle/continuation/problem.h"
 
 #include <string>
@@ -31,8 +32,10 @@ struct NumericDiffOptions {
   double relativeStep = 6.0554544523933395e-06;
   /// δ of the second-derivative steps: ε^{1/4} by default.
   double secondRelativeStep = 1.2207031250000000e-04;
-  /// Empty when valid, else which field is wrong and why (both steps in (0, 0.1]).
-  std::string check() const;
+  /// Empty when valid, else which field is wrong and why (both steps in (0, 0.1]), the field
+  /// named as `prefix` + its name.
+  std::string validate(const std::string &prefix = "") const;
+  bool IsValid(std::string *why) const { return reportValidity(validate(), why); }
 };
 
 /// Central-difference F_u, F_λ (step relative to each variable's scale) into Fu (N×N) and Fl:

@@ -26,6 +26,8 @@
 // slowly (contraction above slowContraction).
 #pragma once
 
+#include "buckle/continuation/options_validity.h"
+
 #include <string>
 
 namespace buckle::continuation {

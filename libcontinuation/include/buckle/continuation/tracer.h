@@ -24,7 +24,7 @@
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/scaled_problem.h"
 #include "buckle/continuation/step_control.h"
-#include "buckle/continuation/test_functions.h"
+#include "buckle/continuation/internal/test_functions.h"
 #include "buckle/continuation/tracer_options.h"
 
 #include <functional>

@@ -14,6 +14,7 @@
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/continuation/step_control.h"
 
 #include <functional>
@@ -165,8 +166,9 @@ struct TracerOptions {
   StepCallback onStep;              ///< optional; see StepCallback
   LocatedCallback onLocated;        ///< optional; see LocatedCallback
 
-  /// Empty when valid, else what is wrong, the field named by its path (e.g. "step.maxStep").
-  std::string validate() const;
+  /// Empty when valid, else what is wrong, the field named by its path (e.g. "step.maxStep"),
+  /// after `prefix` (the path of this struct inside an enclosing one, e.g. "tracer.").
+  std::string validate(const std::string &prefix = "") const;
   bool IsValid(std::string *why) const;
 };
 

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "buckle/continuation/interrupt.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/end_condition.h"
@@ -49,6 +50,12 @@ struct AllEquilibriaOptions {
   /// BodyLoads::atParameter(0)): in the equations, the stability, Π (+ V, eq B1) and the n = 3
   /// sweep (of E + V along the configuration curve).
   BodyLoads body;
+
+  /// Empty when valid for a chain of `segments`, else what is wrong, the field named by its path.
+  std::string validate(int segments, const std::string& prefix = "") const;
+  bool IsValid(int segments, std::string* why) const {
+    return continuation::reportValidity(validate(segments), why);
+  }
 };
 
 struct FoundEquilibrium {

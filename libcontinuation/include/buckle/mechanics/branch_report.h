@@ -20,6 +20,7 @@
 
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/interrupt.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/classification.h"
 #include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/contact_geometry.h"
@@ -78,6 +79,9 @@ struct ReportOptions {
   /// each with a note saying why: Koiter's coefficients and the imperfection sensitivities of the
   /// branch points, and the location of base and self contacts (then to the point spacing).
   continuation::Interrupt interrupt;
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
+  std::string validate(const std::string& prefix = "") const;
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 /// One point of a branch, in physical quantities.

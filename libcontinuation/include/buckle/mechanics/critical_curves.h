@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "buckle/continuation/branch.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/continuation/tracer.h"
 #include "buckle/continuation/two_parameter.h"
 #include "buckle/mechanics/chain.h"
@@ -178,6 +179,9 @@ struct CriticalCurveOptions {
   /// (coefficients, "DP") stay dense, O(n³) per point. Measured (benchmarks/RESULTS.md): the BP
   /// curve is faster structured from n = 10 (N = 12), the fold curve from about n = 20.
   int structuredFromDimension = 20;
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
+  std::string validate(const std::string& prefix = "") const;
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 /// Branch-point curve of the straight chain's compressive buckling mode `mode` (0: the first)

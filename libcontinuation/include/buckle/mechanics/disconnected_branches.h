@@ -14,9 +14,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "buckle/continuation/branch.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 
@@ -34,6 +36,9 @@ struct DisconnectedBranchOptions {
   double joinFraction = 0.1;
   /// ... with the unit tangents (scaled variables) parallel: |cos| at least this.
   double joinCosine = 0.95;
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
+  std::string validate(const std::string& prefix = "") const;
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 struct DisconnectedBranches {

@@ -58,6 +58,7 @@
 #include <vector>
 
 #include "buckle/continuation/interrupt.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/end_condition.h"
@@ -424,7 +425,9 @@ struct IntegrationOptions {
   double settleResidual = 1e-2;
   long settleInterval = 8;
 
-  bool IsValid(std::string* why) const;
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
+  std::string validate(const std::string& prefix = "") const;
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 /// Settled: stopped by IntegrationOptions::settled (not at rest; the caller's test says where

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "buckle/mechanics/body_loads.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/chain.h"
 
 namespace buckle::mechanics {
@@ -64,6 +65,11 @@ struct LandscapeOptions {
   double q1Max = std::numeric_limits<double>::quiet_NaN();
   /// The weight and point loads (their rates ignored: BodyLoads::atParameter(0)); none by default.
   BodyLoads body;
+
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix` (the body
+  /// loads are checked against the chain by energyLandscape).
+  std::string validate(const std::string& prefix = "") const;
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 /// Joint angles on one IK branch for a given q1; false when the end is out of reach.

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "buckle/continuation/branch_switching.h"
@@ -56,6 +57,9 @@ struct EquilibriumBranchOptions {
   /// mirror image of the + side one, contact stretches included, instead of a second trace.
   /// False: both traced (for checking).
   bool mirror = true;
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
+  std::string validate(const std::string& prefix = "") const;
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 struct EquilibriumBranches {

@@ -19,9 +19,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "buckle/continuation/problem.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
@@ -51,6 +53,9 @@ struct EquilibriumOptions {
   /// smallest x over the moving vertices, so the tracer stops where a vertex reaches x = 0 (where
   /// the wall contact begins, contact.h).
   bool wallAsBoundary = false;
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
+  std::string validate(const std::string& prefix = "") const;
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 class EquilibriumProblem final : public continuation::Problem {

@@ -136,7 +136,11 @@ struct JumpOptions {
   double sameStateTolerance = 1e-6;
   Handover handover = Handover::Automatic;
 
-  bool IsValid(const EquilibriumProblem& problem, std::string* why) const;
+  /// Empty when valid for `problem`, else what is wrong, the field named by its path.
+  std::string validate(const EquilibriumProblem& problem, const std::string& prefix = "") const;
+  bool IsValid(const EquilibriumProblem& problem, std::string* why) const {
+    return continuation::reportValidity(validate(problem), why);
+  }
 };
 
 struct JumpResult {
@@ -181,7 +185,9 @@ struct SuddenLoadOptions {
   /// ‖q_dynamic − q_static‖∞ above this: the two answers differ.
   double sameStateTolerance = 1e-6;
 
-  bool IsValid(const Chain& chain, std::string* why) const;
+  /// Empty when valid for `chain`, else what is wrong, the field named by its path.
+  std::string validate(const Chain& chain, const std::string& prefix = "") const;
+  bool IsValid(const Chain& chain, std::string* why) const { return continuation::reportValidity(validate(chain), why); }
 };
 
 enum class LowerPotential { Dynamic, Static, Equal };

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "buckle/mechanics/chain.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/end_condition.h"
 
 namespace buckle::mechanics {
@@ -49,6 +50,9 @@ struct LinearBucklingOptions {
   Eigen::Vector3d direction = Eigen::Vector3d(1.0, 0.0, 0.0);  ///< load direction d (Me part unused)
   int count = -1;                    ///< keep the first `count` modes (−1: all)
   double gradientTolerance = 1e-8;   ///< reject q0 with ‖∂E/∂q‖∞ above this (relative to max K_q)
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
+  std::string validate(const std::string& prefix = "") const;
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 /// Critical loads and modes at q0 with the coordinates held by `end` (its values are unused).

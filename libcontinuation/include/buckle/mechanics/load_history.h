@@ -29,7 +29,11 @@ struct LoadHistoryOptions {
   double overshoot = 1e-6;
   int maxJumps = 50;
 
-  bool IsValid(const EquilibriumProblem& problem, std::string* why) const;
+  /// Empty when valid for `problem`, else what is wrong, the field named by its path.
+  std::string validate(const EquilibriumProblem& problem, const std::string& prefix = "") const;
+  bool IsValid(const EquilibriumProblem& problem, std::string* why) const {
+    return continuation::reportValidity(validate(problem), why);
+  }
 };
 
 /// Why the equilibrium was left.

@@ -19,8 +19,10 @@
 
 #include <Eigen/Core>
 #include <limits>
+#include <string>
 
 #include "buckle/mechanics/chain.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/end_condition.h"
 
 namespace buckle::mechanics {
@@ -65,6 +67,12 @@ struct StiffnessOptions {
   Vector bodyGenerator;
   /// dγ along the direction of loadedStiffnessDerivative (eq B5). Empty: none.
   Vector bodyGeneratorRate;
+
+  /// Empty when valid for a chain of `segments`, else what is wrong, the field named by its path.
+  std::string validate(int segments, const std::string& prefix = "") const;
+  bool IsValid(int segments, std::string* why) const {
+    return continuation::reportValidity(validate(segments), why);
+  }
 };
 
 /// Loaded stiffness K_F at (q, F) (eq 24–29); rotation free or held.

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "buckle/continuation/branch.h"
+#include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 
 namespace buckle::mechanics {
@@ -52,6 +53,9 @@ struct StiffnessExtremumOptions {
   /// one; below rounding, Brent stops on its own.
   double tolerance = 1e-15;
   int maxEvaluations = 100;
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
+  std::string validate(const std::string& prefix = "") const;
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 struct StiffnessExtremum {

@@ -32,6 +32,10 @@ const char* toString(TaskPathEvent event);
 struct TaskPathOptions {
   continuation::TracerOptions tracer;  ///< the λ range is set per leg; stability is the problem's boundary
   bool stiffness = true;               ///< K_F, C_F at fixed inputs at every point (O(n))
+
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
+  std::string validate(const std::string& prefix = "") const { return tracer.validate(prefix + "tracer."); }
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 struct TaskPathPoint {

@@ -10,9 +10,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/segment.h"
 
@@ -40,6 +42,9 @@ struct UnloadedShape {
 struct UnloadedShapeOptions {
   int samples = 2000;         ///< scan resolution of each joint range for sign changes of M
   double tolerance = 1e-14;   ///< root tolerance on q (absolute, radians)
+  /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
+  std::string validate(const std::string& prefix = "") const;
+  bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
 };
 
 /// Roots of M(q) in the joint limits of one segment, and the chosen one.

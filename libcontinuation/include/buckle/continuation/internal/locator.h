@@ -27,9 +27,9 @@
 #include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/continuation/root_finding.h"
-#include "buckle/continuation/spectral_monitor.h"
-#include "buckle/continuation/structured_refinement.h"
-#include "buckle/continuation/test_functions.h"
+#include "buckle/continuation/internal/spectral_monitor.h"
+#include "buckle/continuation/internal/structured_refinement.h"
+#include "buckle/continuation/internal/test_functions.h"
 #include "buckle/continuation/tracer_options.h"
 
 #include <functional>
@@ -60,6 +60,14 @@ struct LocatorOptions {
   Interrupt interrupt;
   /// Optional: told of each point as it is located (TracerOptions::onLocated).
   std::function<void(const SpecialPoint &)> onLocated;
+
+  /// Empty when valid, else what is wrong, the field named by its path.
+  std::string validate(const std::string &prefix = "") const {
+    return firstProblem({location.validate(prefix + "location."), detection.validate(prefix + "detection."),
+                         require(minSampleCosine > -1.0 && minSampleCosine <= 1.0, prefix, "minSampleCosine",
+                                 "must lie in (-1, 1]")});
+  }
+  bool IsValid(std::string *why) const { return reportValidity(validate(), why); }
 };
 
 /// A point on the current step at offset s (s = 0: its start point a).
