@@ -10,7 +10,8 @@ namespace buckle::scene {
 namespace mech = buckle::mechanics;
 
 void CaseRunner::taskPath() {
-  const mech::TaskSetup& setup = spec_.path.taskSetup;
+  mech::TaskSetup setup = spec_.path.taskSetup;
+  setup.body = bodyLoads().atParameter(out_.startValue);  // the weight the start was found under
   out_.inputNames.clear();
   for (const mech::TaskInput& in : setup.inputs) out_.inputNames.push_back(mech::taskInputName(in));
   mech::TaskPathResult r;

@@ -121,7 +121,6 @@ void checkBodyAnalyses(const JsonReader& r, const Scene& scene) {
     const AnalysesSpec& a = scene.analyses;
     if (a.criticalForces.enabled) refuse("critical_forces", "critical forces (linear buckling of the unloaded shape)");
     if (a.twoParameter.enabled) refuse("two_parameter", "two-parameter critical curves");
-    if (c.path.task) r.fail(Pointer("/path/task"), "a task-space path does not take /gravity or /point_loads yet");
     // one mass model: the frequencies' rods are the weight's rods
     if (a.frequencies.enabled && c.body.haveGravity && c.body.massPerLength != a.frequencies.massPerLength)
       r.fail(Pointer("/analyses/frequencies/mass_per_length"),

@@ -62,11 +62,14 @@ Vector independentSag(const Chain& chain, const InertiaData& inertia, const Eige
 // ‖∂E/∂q + ∂V/∂q‖∞ at q: the torques of the springs and of the links' weight (uniform rods of
 // ρ = 0.01) under g, V from GravityPotential (absolute positions, eq G2), independent of the
 // library's body loads. Zero at an equilibrium of the free chain with no end load.
-double weightImbalance(const Chain& chain, const Eigen::Vector2d& g, const Vector& q) {
+Vector weightImbalanceVector(const Chain& chain, const Eigen::Vector2d& g, const Vector& q) {
   Vector dE(chain.size()), dV(chain.size());
   energyGradient(chain, q, dE);
   GravityPotential(chain, InertiaData::uniformRods(chain, 0.01), g).gradient(q, dV);
-  return (dE + dV).lpNorm<Eigen::Infinity>();
+  return dE + dV;
+}
+double weightImbalance(const Chain& chain, const Eigen::Vector2d& g, const Vector& q) {
+  return weightImbalanceVector(chain, g, q).lpNorm<Eigen::Infinity>();
 }
 
 }  // namespace
@@ -174,6 +177,41 @@ TEST_CASE("scene control path under the weight: the free lengths move, every poi
     sag = std::max(sag, q.lpNorm<Eigen::Infinity>());
   }
   CHECK(sag > 1e-3);  // the weight bends it
+}
+
+TEST_CASE("scene task path under the weight: the end is lifted by dL0, every point balances the springs at its "
+          "inputs against the weight and the payload", "[scene][body_loads][task_path]") {
+  // The heavy cantilever with a payload, its end driven up to y = 0 by the differential input of
+  // every segment: each traced point an equilibrium of E(q; dL0) + V − F·pose (GravityPotential,
+  // independent of the library's body loads), the end on the path.
+  const std::string text = R"({"chain": {"segments": 4, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+    "end": {"x": {"load": 0.0}, "y": {"load": -0.1}, "phi": {"load": 0.0}},
+    "gravity": {"value": 3.0, "direction": [0, -1], "mass_per_length": 0.01},
+    "path": {"task": {"coordinates": ["y"], "to": [0.0]}, "inputs": ["dL0"]},
+    "analyses": {"continuation": true}, "plots": []})";
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "task_weight", text);
+  INFO(o.err);
+  REQUIRE(o.rc == 0);
+  const Table t = readBranches(o.out);
+  REQUIRE(t.size() > 5);
+  const Eigen::Vector3d payload(0.0, -0.1, 0.0);
+  CHECK(t.front().at("y") < -3.0);  // the start sags under the weight and the payload
+  CHECK(std::abs(t.back().at("y")) <= 1e-9);
+  for (const auto& row : t) {
+    const double dL0 = row.at("dL0");  // L1_0 − L2_0 of every segment, the common mode kept
+    SegmentParameters segment = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
+    segment.L1_0 += 0.5 * dL0;
+    segment.L2_0 -= 0.5 * dL0;
+    const Chain chain = Chain::uniform(4, segment);
+    Vector q(4);
+    for (int i = 0; i < 4; ++i) q[i] = row.at("q" + std::to_string(i + 1));
+    ChainData data(chain);
+    forwardKinematics(chain, q, data);
+    Matrix J(3, 4);
+    endJacobian(data, J);
+    const Vector endLoad = J.transpose() * payload;
+    CHECK((weightImbalanceVector(chain, Eigen::Vector2d(0.0, -3.0), q) - endLoad).lpNorm<Eigen::Infinity>() <= 1e-10);
+  }
 }
 
 TEST_CASE("scene equilibria under the weight: each balances the springs against the weight, the lowest is the sag",
@@ -299,13 +337,6 @@ TEST_CASE("scene body loads: bad input names the JSON path, exit 2, nothing writ
   requireBadInput("mass_model",
                   scene(kGravity, kGravityPath, R"({"continuation": true, "frequencies": {"mass_per_length": 0.5}})"),
                   "/analyses/frequencies/mass_per_length", "one mass model");
-  requireBadInput("task_path",
-                  R"({"chain": {"segments": 4, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
-                      "end": {"x": {"load": 0.0}, "y": {"load": -0.1}, "phi": {"load": 0.0}}, )" +
-                      kGravity +
-                      R"(, "path": {"task": {"coordinates": ["x"], "to": [3.0]}, "inputs": [{"input": "dL0"}],
-                      "rule": "chosen"}, "analyses": {"continuation": true}, "plots": []})",
-                  "/path/task", "task-space path does not take");
   requireBadInput("mass_unit", R"({"units": {"length": "m", "force": "N"},)" + scene(kGravity, kGravityPath, cont).substr(1),
                   "/units/mass", "mass unit");
 }

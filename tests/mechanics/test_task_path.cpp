@@ -15,6 +15,7 @@
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/derivative_check.h"
 #include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/task_path.h"
 #include "buckle/mechanics/task_path_kkt_solver.h"
@@ -151,6 +152,102 @@ TEST_CASE("task path: derivatives of both rules against finite differences", "[t
     const cont::DerivativeCheck c = cont::checkDerivatives(p, u, 0.2);
     INFO(c.message);
     CHECK(c.success);
+  }
+}
+
+// The links' weight (rods of 0.3 mass per length under g = 0.5 along −y) and a point load at
+// joint 2, at their values (rates zero) or growing with λ (forces zero at λ = 0, `ramp`).
+namespace {
+BodyLoads heavyBody(const Chain& chain, bool ramp) {
+  const Eigen::Vector2d g(0.0, -0.5), f(0.05, -0.1);
+  BodyLoads body = BodyLoads::weight(chain, InertiaData::uniformRods(chain, 0.3), ramp ? Eigen::Vector2d::Zero() : g,
+                                     ramp ? g : Eigen::Vector2d::Zero());
+  body.points.push_back({2, ramp ? Eigen::Vector2d::Zero() : f, ramp ? f : Eigen::Vector2d::Zero()});
+  return body;
+}
+}  // namespace
+
+TEST_CASE("task path with weight and point loads: derivatives, solvers and equilibria of the heavy chain",
+          "[task_path]") {
+  const Eigen::Vector3d payload(-0.3, -0.2, 0.05);
+  SECTION("both rules' derivatives against finite differences, the O(n) solvers against dense LU") {
+    const Chain chain = chainOf(4);
+    Eigen::VectorXd q(4);
+    q << -0.4, 0.3, -0.2, 0.5;
+    TaskSetup a = chosenSetup(payload);
+    a.body = heavyBody(chain, false);
+    TaskPathProblem pa(chain, a);
+    Eigen::VectorXd t0(2), d2(2);
+    t0 << 3.0, 0.2;
+    d2 << 0.6, -0.8;
+    pa.setLeg({t0, d2, 0.1});
+    const Eigen::VectorXd ua = pa.pack(q, pa.startInputs() + Eigen::Vector2d(0.2, -0.1));
+    const cont::DerivativeCheck ca = cont::checkDerivatives(pa, ua, 0.3);
+    INFO(ca.message);
+    CHECK(ca.success);
+    TaskPathBorderedSolver fast(pa);
+    compareWithDense(pa, fast, ua);
+
+    TaskSetup b = minChangeSetup(4, payload);
+    b.coordinates = {0, 1, 2};
+    b.body = heavyBody(chain, false);
+    TaskPathProblem pb(chain, b);
+    Eigen::VectorXd t3(3), d3(3);
+    t3 << 3.0, 0.2, 0.1;
+    d3 << 0.6, -0.8, 0.0;
+    pb.setLeg({t3, d3, 0.0});
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(pb.dimension());
+    u.head(4) = q;
+    u.segment(4, 5) << 0.3, -0.2, 0.1, 0.4, 2.3;
+    u.segment(9, 4) << 0.7, -0.3, 0.2, 0.5;  // μ
+    u.tail(3) << 0.4, -0.6, 0.3;              // ν
+    const cont::DerivativeCheck cb = cont::checkDerivatives(pb, u, 0.2);
+    INFO(cb.message);
+    CHECK(cb.success);
+    TaskPathKktSolver kkt(pb);
+    compareWithDense(pb, kkt, u);
+  }
+  SECTION("every traced point an equilibrium of the heavy chain at its inputs, and the weight matters") {
+    const Chain chain = chainOf(3);
+    // the start: payload, weight and point load applied together from the straight shape, λ: 0 → 1
+    EquilibriumProblem ramp(chain, EndCondition::freeEnd(), payload, {}, {}, heavyBody(chain, true));
+    cont::TracerOptions o;
+    o.lambdaMin = -1.0;
+    o.lambdaMax = 1.0;
+    o.corrector.tolerance = 1e-12;
+    const cont::Branch start = cont::trace(ramp, Eigen::VectorXd::Zero(3), 0.0,
+                                           cont::InitialDirection::increasingLambda(), o);
+    REQUIRE(start.points.back().lambda == Approx(1.0).margin(1e-14));
+    const Eigen::VectorXd q0 = start.points.back().u;
+    TaskSetup s = chosenSetup(payload);
+    s.body = heavyBody(chain, false);
+    TaskPathProblem p(chain, s);
+    const Pose pose = endPose(chain, q0);
+    Eigen::VectorXd to(2);
+    to << pose[0] - 0.1, pose[1] + 0.2;
+    TaskPathOptions opt;
+    opt.tracer.corrector.tolerance = 1e-12;
+    const TaskPathResult r = traceTaskPath(p, q0, {to}, chain.length(), opt);
+    REQUIRE(r.end == TaskPathEvent::Completed);
+    REQUIRE(r.points.size() > 5);
+    // the start needed no change of the inputs: it is the heavy chain's equilibrium already
+    CHECK((r.points.front().inputs - p.startInputs()).cwiseAbs().maxCoeff() <= 1e-12);
+    double weightShare = 0.0;
+    for (const TaskPathPoint& pt : r.points) {
+      const Chain at = p.chainAt(pt.inputs);
+      EquilibriumProblem heavy(at, EndCondition::freeEnd(payload), Eigen::Vector3d::Zero(), {}, {}, s.body);
+      Eigen::VectorXd F(3);
+      REQUIRE(heavy.residual(pt.q, 0.0, F));
+      CHECK(F.cwiseAbs().maxCoeff() <= 1e-12);  // torques in k b² = 1
+      cont::StabilityInfo info;
+      REQUIRE(heavy.stability(pt.q, 0.0, 1, info));
+      CHECK(info.negative == pt.inertia.negative);
+      CHECK(info.smallest == Approx(pt.minEigenvalue).epsilon(1e-9));
+      EquilibriumProblem weightless(at, EndCondition::freeEnd(payload), Eigen::Vector3d::Zero());
+      REQUIRE(weightless.residual(pt.q, 0.0, F));
+      weightShare = std::max(weightShare, F.cwiseAbs().maxCoeff());
+    }
+    CHECK(weightShare > 0.05);  // the weight's torques are far above the tolerance: ignoring it fails
   }
 }
 

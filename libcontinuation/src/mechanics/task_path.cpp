@@ -62,6 +62,9 @@ TaskPathProblem::TaskPathProblem(const Chain& chain, const TaskSetup& setup)
       J_(3, chain.size()),
       structure_(chain.size()) {
   setup_.validate(n_);
+  setup_.body = setup_.body.atParameter(0.0);
+  body_ = BodyLoadTerms(chain_, setup_.body);  // throws as BodyLoads::check
+  tau_ = Vector::Zero(n_);
   dim_ = setup_.rule == TaskRule::Chosen ? n_ + mIn_ : 2 * n_ + mIn_ + m_;
   p0_.resize(mIn_);
   for (int j = 0; j < mIn_; ++j) {
@@ -147,6 +150,12 @@ bool TaskPathProblem::prepare(ConstVectorRef u) {
   forwardKinematics(chain_, q, data_);
   endJacobian(data_, J_);
   loadHessianGenerator(data_, setup_.payload, h_);
+  if (body_.active()) {  // the generator h − γ and ∂V/∂q = −τ (eq B2, B3)
+    body_.update(data_);
+    body_.torques(0.0, tau_);
+    body_.generator(0.0, work_);
+    h_ -= work_;
+  }
   inputColumns(e1_, B_);
   cachedKey_ = u.head(n_ + mIn_);
   cacheValid_ = true;
@@ -162,7 +171,7 @@ void TaskPathProblem::inputColumns(const Eigen::MatrixX2d& e, Matrix& out) const
 bool TaskPathProblem::residual(ConstVectorRef u, double s, VectorRef F) {
   if (!prepare(u)) return false;
   const Vector t = target(s);
-  const Vector g = grad_ - J_.transpose() * setup_.payload;  // eq 9
+  const Vector g = grad_ - J_.transpose() * setup_.payload - tau_;  // eq 9, eq B2 (τ = 0 without body loads)
   if (setup_.rule == TaskRule::Chosen) {
     F.head(n_) = g;
     for (int k = 0; k < m_; ++k) F[n_ + k] = data_.pose[setup_.coordinates[size_t(k)]] - t[k];
@@ -237,9 +246,9 @@ void TaskPathProblem::optimalityBlocks(ConstVectorRef u, Vector& diagA, Vector& 
   double prefix = 0.0, tail = 0.0;
   for (int m = 0; m < n_; ++m) prefix += mu[m], work_[m] = prefix;  // Σ_{j≤m} μ_j
   for (int m = n_ - 1; m >= 0; --m) {
-    const double gamma = F[0] * data_.S[m] - F[1] * data_.C[m];
-    const double a = gamma * work_[m] + tail;
-    tail += gamma * mu[m];
+    const double rho = F[0] * data_.S[m] - F[1] * data_.C[m] - tau_[m];  // ρ_m (header, eq B5)
+    const double a = rho * work_[m] + tail;
+    tail += rho * mu[m];
     genA[m] = -nx * data_.C[m] - ny * data_.S[m] - a;
   }
   diagA = third_.cwiseProduct(mu);

@@ -5,11 +5,12 @@
 // Inputs p_j (j = 1 … m_in), each a named input of one segment or of every segment, move the free
 // lengths from those of the chain (at the inputs' start values p⁰):
 //   L⁰_{i,s}(p) = L⁰_{i,s} + Σ_j (p_j − p⁰_j)·r_j(i, s)        (r_j: ControlDirection::named rates)
-// The equilibrium under the payload F and the task constraint on the chosen coordinates c (m of them):
-//   g(q, p) = ∂E/∂q(q, p) − J(q)ᵀF = 0                           (eq 9, n rows)
+// The equilibrium under the payload F, the links' weight and point loads (body_loads.h: potential
+// V, ∂V/∂q = −τ, eq B2) and the task constraint on the chosen coordinates c (m of them):
+//   g(q, p) = ∂E/∂q(q, p) − J(q)ᵀF − τ(q) = 0                    (eq 9 with eq B2, n rows)
 //   τ(q, s) = c(q) − t(s) = 0,   t(s) = a + (s − s_a)·d          (m rows; d = dt/ds, the leg's direction)
 // with s the arclength of the task path (an angle counted at the length `angleLength` per radian).
-// Derivatives: ∂g/∂q = H = K_q − K_g(F) (eq 27), ∂g/∂p_j = B_j with
+// Derivatives: ∂g/∂q = H = K_q − K_g(F) with the generator h − γ (eq 27, eq B3), ∂g/∂p_j = B_j with
 //   B(i, j) = Σ_s r_j(i, s)·∂²E/∂q_i∂L⁰_{i,s} = −Σ_s r_j(i, s) k_s L_s′(q_i),
 // ∂τ/∂q = J_c (rows of eq 11), ∂τ/∂s = −d.
 //
@@ -26,8 +27,9 @@
 //      with ℒ = ½(p − p⁰)ᵀW(p − p⁰)/b̄² + μᵀg + νᵀτ. Its Jacobian is the symmetric Hessian of ℒ:
 //        [[A, D, H, J_cᵀ], [Dᵀ, W/b̄², Bᵀ, 0], [H, B, 0, 0], [J_c, 0, 0, 0]]
 //      A = ∂(Hμ)/∂q + Σ_c ν_c ∂²c/∂q² = diag(E‴ ⊙ μ) − K_a + K_b, where K_a(i, k) = a_max(i,k),
-//        a_m = γ_m Σ_{j≤m} μ_j + Σ_{j>m} γ_j μ_j,  γ_m = Fx S_m − Fy C_m (the third derivative of
-//        F·pose depends on the largest index only, as eq 27's second does), and
+//        a_m = ρ_m Σ_{j≤m} μ_j + Σ_{j>m} ρ_j μ_j,  ρ_m = Fx S_m − Fy C_m − τ_m (the generator
+//        moves as dh_m − dγ_m = Θ_m ρ_m + Σ_{j>m} ρ_j dq_j, eq B5: the third derivative of
+//        F·pose − V depends on the largest index only, as eq 27's second does), and
 //        K_b(i, k) = −ν_x C_max(i,k) − ν_y S_max(i,k) (∂²x/∂q², ∂²y/∂q²; φ is linear in q);
 //      D(i, j) = ∂(K_q μ)_i/∂p_j = −Σ_s r_j(i, s) k_s L_s″(q_i) μ_i (E is quadratic in L⁰, so
 //      ∂B/∂p = 0). At the start p = p⁰, μ = ν = 0 solves it exactly.
@@ -51,6 +53,7 @@
 #include <vector>
 
 #include "buckle/continuation/problem.h"
+#include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/control_path.h"
@@ -73,6 +76,10 @@ enum class TaskRule { Chosen, MinimumChange };
 /// The payload, the constrained coordinates, the inputs and the rule (what does not move along a path).
 struct TaskSetup {
   Wrench payload = Wrench::Zero();
+  /// The links' weight and point loads, at their values for λ = 0 (BodyLoads::atParameter(0):
+  /// the path's parameter is the task's arclength, not a load). Checked against the chain by
+  /// TaskPathProblem.
+  BodyLoads body;
   std::vector<int> coordinates;  ///< ascending subset of {0 x, 1 y, 2 φ}, 1 … 3 of them
   std::vector<TaskInput> inputs;
   TaskRule rule = TaskRule::Chosen;
@@ -179,6 +186,8 @@ class TaskPathProblem final : public continuation::Problem {
   Vector grad_, stiff_, third_;  // E′, E″, E‴ per joint
   Eigen::MatrixX2d e1_, e2_;     // −k_s L_s′, −k_s L_s″ per joint and spring
   Vector h_, work_;
+  BodyLoadTerms body_;           // the weight and point loads (inactive: none)
+  Vector tau_;                   // their torques τ (eq B4)
   Matrix B_;                     // n × m_in
   ChainStructure structure_;
   Vector cachedKey_;          // (q, p) of the cache (bitwise)
