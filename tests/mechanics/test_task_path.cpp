@@ -116,6 +116,23 @@ void compareWithDense(TaskPathProblem& p, cont::BorderedSolver& fast, const Eige
 
 }  // namespace
 
+namespace {
+// Rule (b) on 4 segments with x, y and φ on a leg (minChangeSetup's five inputs): a generic point,
+// the inputs moved and every multiplier nonzero, so that no term of the Jacobian is multiplied away.
+Eigen::VectorXd genericOptimalityPoint(TaskPathProblem& p, const Eigen::VectorXd& q) {
+  Eigen::VectorXd a(3), d(3);
+  a << 3.0, 0.2, 0.1;
+  d << 0.6, -0.8, 0.0;
+  p.setLeg({a, d, 0.0});
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(p.dimension());
+  u.head(4) = q;
+  u.segment(4, 5) << 0.3, -0.2, 0.1, 0.4, 2.3;
+  u.segment(9, 4) << 0.7, -0.3, 0.2, 0.5;  // μ
+  u.tail(3) << 0.4, -0.6, 0.3;              // ν
+  return u;
+}
+}  // namespace
+
 TEST_CASE("task path: derivatives of both rules against finite differences", "[task_path]") {
   const Chain chain = chainOf(4);
   const Eigen::Vector3d payload(-0.3, -0.2, 0.05);
@@ -140,15 +157,7 @@ TEST_CASE("task path: derivatives of both rules against finite differences", "[t
     TaskSetup s = minChangeSetup(4, payload);
     s.coordinates = {0, 1, 2};
     TaskPathProblem p(chain, s);
-    Eigen::VectorXd a(3), d(3);
-    a << 3.0, 0.2, 0.1;
-    d << 0.6, -0.8, 0.0;
-    p.setLeg({a, d, 0.0});
-    Eigen::VectorXd u = Eigen::VectorXd::Zero(p.dimension());
-    u.head(4) = q;
-    u.segment(4, 5) << 0.3, -0.2, 0.1, 0.4, 2.3;
-    u.segment(9, 4) << 0.7, -0.3, 0.2, 0.5;  // μ
-    u.tail(3) << 0.4, -0.6, 0.3;              // ν
+    const Eigen::VectorXd u = genericOptimalityPoint(p, q);
     const cont::DerivativeCheck c = cont::checkDerivatives(p, u, 0.2);
     INFO(c.message);
     CHECK(c.success);
@@ -192,15 +201,7 @@ TEST_CASE("task path with weight and point loads: derivatives, solvers and equil
     b.coordinates = {0, 1, 2};
     b.body = heavyBody(chain, false);
     TaskPathProblem pb(chain, b);
-    Eigen::VectorXd t3(3), d3(3);
-    t3 << 3.0, 0.2, 0.1;
-    d3 << 0.6, -0.8, 0.0;
-    pb.setLeg({t3, d3, 0.0});
-    Eigen::VectorXd u = Eigen::VectorXd::Zero(pb.dimension());
-    u.head(4) = q;
-    u.segment(4, 5) << 0.3, -0.2, 0.1, 0.4, 2.3;
-    u.segment(9, 4) << 0.7, -0.3, 0.2, 0.5;  // μ
-    u.tail(3) << 0.4, -0.6, 0.3;              // ν
+    const Eigen::VectorXd u = genericOptimalityPoint(pb, q);
     const cont::DerivativeCheck cb = cont::checkDerivatives(pb, u, 0.2);
     INFO(cb.message);
     CHECK(cb.success);
