@@ -23,7 +23,7 @@ namespace {
 class DiagonalPitchforks : public toys::TwoPitchforks {
  public:
   using TwoPitchforks::TwoPitchforks;
-  bool stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values) override {
+  bool stabilityEigenvalues(ProblemWorkspace &, ConstVectorRef u, double lambda, int first, VectorRef values) const override {
     const double a = -(lambda - 3.0 * u[0] * u[0]), b = -(lambda - c() - 3.0 * u[1] * u[1]);
     const double sorted[2] = {std::min(a, b), std::max(a, b)};
     if (first < 0 || first + values.size() > 2) return false;
@@ -74,7 +74,8 @@ TEST_CASE("Corrector solves allocate nothing after construction", "[allocation]"
 
 TEST_CASE("Certified counting's slopes and the locator's residual norm allocate nothing", "[allocation]") {
 #if BUCKLE_COUNT_MALLOC
-  DiagonalPitchforks problem(0.5);
+  DiagonalPitchforks model(0.5);
+  const BoundProblem problem(model);  // one workspace for every call below
   // A point on the trivial branch between the two branch points (ν = 1: both eigenvalues tracked).
   ContinuationPoint p;
   p.u = Vector::Zero(2);
@@ -121,9 +122,10 @@ TEST_CASE("NumericDiffProblem's derivatives allocate nothing after the first cal
   class NumericBratu : public NumericDiffProblem {
    public:
     int dimension() const override { return exact.dimension(); }
-    bool residual(ConstVectorRef u, double lambda, VectorRef F) override { return exact.residual(u, lambda, F); }
+    bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override { return exact.residual(ws, u, lambda, F); }
     toys::Bratu exact{12};
-  } problem;
+  } model;
+  const BoundProblem problem(model);  // one workspace for every call below
   const int n = problem.dimension();
   const Vector u = Vector::Constant(n, 0.3), x = Vector::Constant(n + 1, 0.2), z = Vector::Constant(n + 1, -0.1);
   const Vector w = Vector::Constant(n, 0.5);

@@ -13,19 +13,19 @@ class Reduced : public Problem {
  public:
   double alpha = 0.0, beta = 0.0;
   int dimension() const override { return 2; }
-  bool residual(ConstVectorRef u, double l, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double l, VectorRef F) const override {
     const double x = u[0], y = u[1];
     F << (1.0 - l) * x + alpha * x * x + x * y + beta * x * x * x, 2.0 * y - x * x;
     return true;
   }
-  bool jacobian(ConstVectorRef u, double l, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double l, MatrixRef Fu, VectorRef Fl) const override {
     const double x = u[0], y = u[1];
     Fu << 1.0 - l + 2.0 * alpha * x + y + 3.0 * beta * x * x, x, -2.0 * x, 2.0;
     Fl << -x, 0.0;
     return true;
   }
-  bool jacobianDirectionalDerivative(ConstVectorRef u, double, ConstVectorRef du, double dl, MatrixRef dFu,
-                                     VectorRef dFl) override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double dl, MatrixRef dFu,
+                                     VectorRef dFl) const override {
     dFu << -dl + 2.0 * alpha * du[0] + du[1] + 6.0 * beta * u[0] * du[0], du[0], -2.0 * du[0], 0.0;
     dFl << -du[0], 0.0;
     return true;

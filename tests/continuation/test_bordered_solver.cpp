@@ -18,7 +18,7 @@ namespace {
 /// problem would hand it out through makeStructuredSolver().
 class CountingSolver final : public BorderedSolver {
  public:
-  explicit CountingSolver(Problem &problem) : dense_(problem) {}
+  explicit CountingSolver(const BoundProblem &problem) : dense_(problem) {}
   Factorization factor(ConstVectorRef u, double lambda, ConstVectorRef c) override {
     ++factors;
     return dense_.factor(u, lambda, c);
@@ -39,12 +39,12 @@ class CountingSolver final : public BorderedSolver {
 class StructuredBratu final : public toys::Bratu {
  public:
   using Bratu::Bratu;
-  std::unique_ptr<BorderedSolver> makeStructuredSolver() override {
-    auto solver = std::make_unique<CountingSolver>(*this);
+  std::unique_ptr<BorderedSolver> makeStructuredSolver(ProblemWorkspace &ws) const override {
+    auto solver = std::make_unique<CountingSolver>(BoundProblem(*this, ws));
     last = solver.get();
     return solver;
   }
-  CountingSolver *last = nullptr;
+  mutable CountingSolver *last = nullptr;  // a probe of this single-threaded test
 };
 
 }  // namespace
@@ -57,7 +57,7 @@ TEST_CASE("DenseBorderedSolver: determinant and solve of [[F_u, F_λ], [cᵀ]]",
   const double lambda = 1.3;
   REQUIRE(solver.factor(u, lambda, c) == Factorization::Regular);
   Matrix A = Matrix::Zero(n + 1, n + 1);
-  REQUIRE(bratu.jacobian(u, lambda, A.topLeftCorner(n, n), A.col(n).head(n)));
+  REQUIRE(BoundProblem(bratu).jacobian(u, lambda, A.topLeftCorner(n, n), A.col(n).head(n)));
   A.row(n) = c.transpose();
   const double det = A.determinant();
   CHECK(solver.determinantSign() == (det > 0 ? 1 : -1));
@@ -167,7 +167,7 @@ TEST_CASE("Deflated bordered solve: G through [[F_u, b], [c^T, 0]] equals the de
     REQUIRE(deflated.factor(u, -x * x * x, v, v, B, C, D) == Factorization::Regular);
     Matrix G = Matrix::Zero(4, 4);
     Vector Fl(2);
-    REQUIRE(toy.jacobian(u, -x * x * x, G.topLeftCorner(2, 2), Fl));
+    REQUIRE(BoundProblem(toy).jacobian(u, -x * x * x, G.topLeftCorner(2, 2), Fl));
     G.topRightCorner(2, 2) = B;
     G.bottomLeftCorner(2, 2) = C.transpose();
     G.bottomRightCorner(2, 2) = D;

@@ -24,7 +24,7 @@ class BentNormalForm : public Problem {
   static Vector dup(double l) { return (Vector(2) << 0.4 * std::cos(l), 0.6 * l).finished(); }
   static Vector ddup(double l) { return (Vector(2) << -0.4 * std::sin(l), 0.6).finished(); }
   int dimension() const override { return 2; }
-  bool residual(ConstVectorRef u, double l, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double l, VectorRef F) const override {
     const Vector z = u - up(l);
     const double x = z[0], y = z[1];
     F = A * (Vector(2) << (1.0 - l) * x + alpha * x * x + x * y + beta * x * x * x + gamma * std::pow(x, 5),
@@ -38,14 +38,14 @@ class BentNormalForm : public Problem {
             -2.0 * x, 2.0)
         .finished();
   }
-  bool jacobian(ConstVectorRef u, double l, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double l, MatrixRef Fu, VectorRef Fl) const override {
     const Vector z = u - up(l);
     Fu = A * Gz(z, l);
     Fl = A * ((Vector(2) << -z[0], 0.0).finished() - Gz(z, l) * dup(l));
     return true;
   }
-  bool jacobianDirectionalDerivative(ConstVectorRef u, double l, ConstVectorRef du, double dl, MatrixRef dFu,
-                                     VectorRef dFl) override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double l, ConstVectorRef du, double dl, MatrixRef dFu,
+                                     VectorRef dFl) const override {
     const Vector z = u - up(l), dz = du - dup(l) * dl;
     const Eigen::Matrix2d dGz =
         (Eigen::Matrix2d() << -dl + 2.0 * alpha * dz[0] + dz[1] + 6.0 * beta * z[0] * dz[0] +
@@ -189,17 +189,17 @@ class CuspFamily : public Problem {
  public:
   double mu = 0.0;
   int dimension() const override { return 1; }
-  bool residual(ConstVectorRef u, double l, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double l, VectorRef F) const override {
     F[0] = u[0] * u[0] * u[0] + mu * u[0] - l;
     return true;
   }
-  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) const override {
     Fu(0, 0) = 3.0 * u[0] * u[0] + mu;
     Fl[0] = -1.0;
     return true;
   }
-  bool jacobianDirectionalDerivative(ConstVectorRef u, double, ConstVectorRef du, double, MatrixRef dFu,
-                                     VectorRef dFl) override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double, MatrixRef dFu,
+                                     VectorRef dFl) const override {
     dFu(0, 0) = 6.0 * u[0] * du[0];
     dFl[0] = 0.0;
     return true;

@@ -42,18 +42,18 @@ TEST_CASE("Branch-point curve: the exact Jacobian against central differences", 
   const Vector W = (Vector(3) << 0.3, 0.8, 0.6).finished();
   Matrix GW(3, 3);
   Vector Gmu(3), Gp(3), Gm(3);
-  REQUIRE(curve.jacobian(W, 0.3, GW, Gmu));
+  REQUIRE(BoundProblem(curve).jacobian(W, 0.3, GW, Gmu));
   const double h = 1e-6;
   for (int j = 0; j < 3; ++j) {
     Vector Wp = W, Wm = W;
     Wp[j] += h;
     Wm[j] -= h;
-    REQUIRE(curve.residual(Wp, 0.3, Gp));
-    REQUIRE(curve.residual(Wm, 0.3, Gm));
+    REQUIRE(BoundProblem(curve).residual(Wp, 0.3, Gp));
+    REQUIRE(BoundProblem(curve).residual(Wm, 0.3, Gm));
     CHECK(((Gp - Gm) / (2 * h) - GW.col(j)).norm() <= 1e-8);
   }
-  REQUIRE(curve.residual(W, 0.3 + h, Gp));
-  REQUIRE(curve.residual(W, 0.3 - h, Gm));
+  REQUIRE(BoundProblem(curve).residual(W, 0.3 + h, Gp));
+  REQUIRE(BoundProblem(curve).residual(W, 0.3 - h, Gm));
   CHECK(((Gp - Gm) / (2 * h) - Gmu).norm() <= 1e-8);
 }
 

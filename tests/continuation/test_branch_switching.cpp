@@ -84,7 +84,7 @@ TEST_CASE("Two levels of switching on the double pitchfork", "[branch_switching]
     CHECK(branch.stopReason == StopReason::LambdaRange);
     Vector F(2);
     for (const ContinuationPoint &p : branch.points) {
-      problem.residual(p.u, p.lambda, F);
+      BoundProblem(problem).residual(p.u, p.lambda, F);
       CHECK(F.norm() < 1e-10);
     }
     if (branch.parentId > 0) {

@@ -117,7 +117,7 @@ TEST_CASE("Corrector line search reaches a root from farther away", "[corrector]
   const CorrectorSummary summary = corrector.solveAtFixedParameter(u0, 0.0, u);  // roots 0, ±√3
   REQUIRE(summary.converged);
   Vector F(1);
-  cubic.residual(u, 0.0, F);
+  BoundProblem(cubic).residual(u, 0.0, F);
   CHECK(std::abs(F[0]) < 1e-10);
 }
 
@@ -143,9 +143,9 @@ namespace {
 // correct() intact (not be lost, and not unwind through KINSOL's C frames).
 struct ThrowingCircle final : toys::Circle {
   double limit = 0.7;
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override {
     if (u[0] > limit) throw std::domain_error("residual refused to evaluate past the limit");
-    return toys::Circle::residual(u, lambda, F);
+    return toys::Circle::residual(ws, u, lambda, F);
   }
 };
 }  // namespace
@@ -176,7 +176,7 @@ struct ReferenceKeller {
     const int m = static_cast<int>(r.predictor.size()), n = m - 1;
     Eigen::Map<const Vector> x(N_VGetArrayPointer(xv), m);
     Eigen::Map<Vector> g(N_VGetArrayPointer(gv), m);
-    if (!r.problem->residual(x.head(n), x[n], g.head(n))) return 1;
+    if (!BoundProblem(*r.problem).residual(x.head(n), x[n], g.head(n))) return 1;
     g[n] = r.tangent.dot(x - r.predictor);
     return 0;
   }
@@ -186,7 +186,7 @@ struct ReferenceKeller {
     Eigen::Map<const Vector> x(N_VGetArrayPointer(xv), m);
     Eigen::Map<Matrix> A(SUNDenseMatrix_Data(J), m, m);
     A.setZero();
-    if (!r.problem->jacobian(x.head(n), x[n], A.topLeftCorner(n, n), A.col(n).head(n))) return -1;
+    if (!BoundProblem(*r.problem).jacobian(x.head(n), x[n], A.topLeftCorner(n, n), A.col(n).head(n))) return -1;
     A.row(n) = r.tangent.transpose();
     return 0;
   }

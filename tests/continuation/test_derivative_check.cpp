@@ -17,8 +17,8 @@ namespace {
 class WrongBratu : public toys::Bratu {
  public:
   WrongBratu(int n, int row, int column, bool lambdaColumn) : Bratu(n), row_(row), column_(column), lambda_(lambdaColumn) {}
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
-    if (!Bratu::jacobian(u, lambda, Fu, Fl)) return false;
+  bool jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
+    if (!Bratu::jacobian(ws, u, lambda, Fu, Fl)) return false;
     if (lambda_) Fl[row_] = -Fl[row_];
     else Fu(row_, column_) *= 1.001;  // a 0.1 % slip
     return true;
@@ -33,9 +33,9 @@ class WrongBratu : public toys::Bratu {
 class WrongSecondDerivative : public toys::ScaledExponentials {
  public:
   using ScaledExponentials::ScaledExponentials;
-  bool jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                     MatrixRef dFu, VectorRef dFl) override {
-    if (!ScaledExponentials::jacobianDirectionalDerivative(u, lambda, du, dlambda, dFu, dFl)) return false;
+  bool jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                     MatrixRef dFu, VectorRef dFl) const override {
+    if (!ScaledExponentials::jacobianDirectionalDerivative(ws, u, lambda, du, dlambda, dFu, dFl)) return false;
     const Vector s = scales().unknowns;
     dFu(1, 0) += scales().residuals[1] / s[0] * 6.0 * (u[0] / s[0]) * (du[0] / s[0]);  // the −6a·da term dropped
     return true;
@@ -46,9 +46,9 @@ class WrongSecondDerivative : public toys::ScaledExponentials {
 class WrongProduct : public toys::ScaledExponentials {
  public:
   using ScaledExponentials::ScaledExponentials;
-  bool jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) override {
+  bool jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const override {
     Matrix J(2, 3);
-    if (!jacobian(u, lambda, J.leftCols(2), J.col(2))) return false;
+    if (!jacobian(ws, u, lambda, J.leftCols(2), J.col(2))) return false;
     y = J.leftCols(2) * x.head(2);
     return true;
   }
@@ -132,7 +132,7 @@ TEST_CASE("checkDerivatives: a residual-only problem's derivatives are consisten
   class Numeric : public NumericDiffProblem {
    public:
     int dimension() const override { return 2; }
-    bool residual(ConstVectorRef u, double lambda, VectorRef F) override { return exact.residual(u, lambda, F); }
+    bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override { return exact.residual(ws, u, lambda, F); }
     ProblemScales scales() const override { return exact.scales(); }
     toys::ScaledExponentials exact{1e-3, 1e4, 1e6, 1e-5};
   } numeric;

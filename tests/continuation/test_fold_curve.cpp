@@ -25,18 +25,18 @@ void checkJacobian(Problem& curve, const Vector& U, double mu, double tolerance)
   const int m = curve.dimension();
   Matrix GU(m, m);
   Vector Gmu(m), Gp(m), Gm(m);
-  REQUIRE(curve.jacobian(U, mu, GU, Gmu));
+  REQUIRE(BoundProblem(curve).jacobian(U, mu, GU, Gmu));
   const double h = 1e-6;
   for (int j = 0; j < m; ++j) {
     Vector Up = U, Um = U;
     Up[j] += h;
     Um[j] -= h;
-    REQUIRE(curve.residual(Up, mu, Gp));
-    REQUIRE(curve.residual(Um, mu, Gm));
+    REQUIRE(BoundProblem(curve).residual(Up, mu, Gp));
+    REQUIRE(BoundProblem(curve).residual(Um, mu, Gm));
     CHECK(((Gp - Gm) / (2 * h) - GU.col(j)).norm() <= tolerance * (1.0 + GU.col(j).norm()));
   }
-  REQUIRE(curve.residual(U, mu + h, Gp));
-  REQUIRE(curve.residual(U, mu - h, Gm));
+  REQUIRE(BoundProblem(curve).residual(U, mu + h, Gp));
+  REQUIRE(BoundProblem(curve).residual(U, mu - h, Gm));
   CHECK(((Gp - Gm) / (2 * h) - Gmu).norm() <= tolerance * (1.0 + Gmu.norm()));
 }
 // Every point of a traced fold curve of the cusp toy on its closed form (x, x²/2, −x³) at
@@ -114,7 +114,7 @@ namespace {
 // The cusp toy with a "structured" solver: the dense one, which takes general borders.
 class BorderedCuspToy : public toys::CuspToy {
  public:
-  std::unique_ptr<BorderedSolver> makeStructuredSolver() override { return std::make_unique<DenseBorderedSolver>(*this); }
+  std::unique_ptr<BorderedSolver> makeStructuredSolver(ProblemWorkspace &) const override { return std::make_unique<DenseBorderedSolver>(*this); }
 };
 }  // namespace
 
@@ -124,7 +124,7 @@ TEST_CASE("Minimal fold curve: the Jacobian against central differences, g = 0 o
   const Vector u = (Vector(2) << 0.8, 0.32).finished();
   MinimalFoldCurveProblem curve(toy, u, -0.512, (Vector(2) << 1.0, 0.8).finished());
   Vector G(3);
-  REQUIRE(curve.residual(MinimalFoldCurveProblem::start(u, -0.512), toy.mu, G));
+  REQUIRE(BoundProblem(curve).residual(MinimalFoldCurveProblem::start(u, -0.512), toy.mu, G));
   CHECK(G.norm() <= 1e-14);  // F = 0 and g = 0 at the fold
   Vector U = MinimalFoldCurveProblem::start(u, -0.512);
   U += (Vector(3) << 0.01, -0.02, 0.03).finished();
@@ -133,12 +133,12 @@ TEST_CASE("Minimal fold curve: the Jacobian against central differences, g = 0 o
   checkJacobian(curve, U, mu, 1e-7);
   Matrix GU(3, 3);
   Vector Gmu(3), y(3), yt(4), x(4), w(3);
-  REQUIRE(curve.jacobian(U, mu, GU, Gmu));
+  REQUIRE(BoundProblem(curve).jacobian(U, mu, GU, Gmu));
   // the O(N) products are the dense Jacobian's
   x << 0.3, -0.2, 0.5, 0.7;
   w << -0.4, 0.1, 0.9;
-  REQUIRE(curve.jacobianApply(U, mu, x, y));
-  REQUIRE(curve.jacobianTransposeApply(U, mu, w, yt));
+  REQUIRE(BoundProblem(curve).jacobianApply(U, mu, x, y));
+  REQUIRE(BoundProblem(curve).jacobianTransposeApply(U, mu, w, yt));
   Matrix Gx(3, 4);
   Gx << GU, Gmu;
   CHECK((y - Gx * x).norm() <= 1e-13);

@@ -20,12 +20,12 @@ class Potential : public GradientProblem {
  public:
   explicit Potential(Residual r) : GradientProblem(r), sign_(r == Residual::Gradient ? 1.0 : -1.0) {}
   int dimension() const override { return 2; }
-  bool residual(ConstVectorRef u, double l, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double l, VectorRef F) const override {
     F << u[0] * u[0] * u[0] + (1.0 - l) * u[0] + kEps * u[1], u[1] * u[1] * u[1] + (2.0 - l) * u[1] + kEps * u[0];
     F *= sign_;
     return true;
   }
-  bool jacobian(ConstVectorRef u, double l, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double l, MatrixRef Fu, VectorRef Fl) const override {
     Fu << 3.0 * u[0] * u[0] + 1.0 - l, kEps, kEps, 3.0 * u[1] * u[1] + 2.0 - l;
     Fl << -u[0], -u[1];
     Fu *= sign_;
@@ -48,14 +48,14 @@ TEST_CASE("GradientProblem: H is the Hessian, whichever sign the residual has", 
     REQUIRE(p.hasStabilityOperator());
     Matrix H, C;
     const Vector u = (Vector(2) << 0.4, -0.7).finished();
-    REQUIRE(p.stabilityOperator(u, 0.6, H, C));
+    REQUIRE(BoundProblem(p).stabilityOperator(u, 0.6, H, C));
     CHECK(C.rows() == 0);
     CHECK(C.cols() == 2);
     const Matrix hessian = (Matrix(2, 2) << 3 * 0.16 + 1 - 0.6, kEps, kEps, 3 * 0.49 + 2 - 0.6).finished();
     CHECK((H - hessian).norm() <= 1e-15);
     // stability(): the inertia and the lowest eigenvalues of that Hessian
     StabilityInfo info;
-    REQUIRE(p.stability(Vector::Zero(2), 1.5, 2, info));
+    REQUIRE(BoundProblem(p).stability(Vector::Zero(2), 1.5, 2, info));
     CHECK(info.negative == 1);
     REQUIRE(info.lowest.size() == 2);
     CHECK(info.lowest[0] == Approx(-root()).margin(1e-14));

@@ -28,11 +28,11 @@ void requireOnCircle(const Branch &b) {
 /// Counts residual evaluations: a stopped tracer must stop evaluating.
 class CountingCircle : public toys::Circle {
  public:
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override {
     ++evaluations;
-    return toys::Circle::residual(u, lambda, F);
+    return toys::Circle::residual(ws, u, lambda, F);
   }
-  long evaluations = 0;
+  mutable long evaluations = 0;  // a probe of this single-threaded test
 };
 
 }  // namespace

@@ -100,10 +100,10 @@ TEST_CASE("Bratu fold: F = 0 and F_u singular to the reported accuracy", "[locat
   CHECK(std::abs(fold.lambda - 3.5138) < 0.02);  // continuum value 3.513830719
   for (const ContinuationPoint &p : branch.points) CHECK(p.lambda <= fold.lambda + tolerance(fold.lambda));
   Vector F(n);
-  bratu.residual(fold.u, fold.lambda, F);
+  BoundProblem(bratu).residual(fold.u, fold.lambda, F);
   Matrix Fu(n, n);
   Vector Fl(n);
-  bratu.jacobian(fold.u, fold.lambda, Fu, Fl);
+  BoundProblem(bratu).jacobian(fold.u, fold.lambda, Fu, Fl);
   CHECK(F.norm() < 1e-10 * Fu.norm());
   Eigen::SelfAdjointEigenSolver<Matrix> eig(Fu);
   const double smallest = eig.eigenvalues().cwiseAbs().minCoeff();

@@ -24,12 +24,12 @@ class CoupledPitchforks : public Problem {
  public:
   CoupledPitchforks(int m, double c) : m_(m), c_(c) {}
   int dimension() const override { return m_; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     const double s = u.squaredNorm();
     for (int i = 0; i < m_; ++i) F[i] = lambda * u[i] - u[i] * u[i] * u[i] - c_ * u[i] * (s - u[i] * u[i]);
     return true;
   }
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
     const double s = u.squaredNorm();
     for (int i = 0; i < m_; ++i) {
       for (int j = 0; j < m_; ++j) Fu(i, j) = i == j ? 0.0 : -2.0 * c_ * u[i] * u[j];
@@ -39,8 +39,8 @@ class CoupledPitchforks : public Problem {
     return true;
   }
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-    return toys::negatedJacobian(*this, u, lambda, H, C);
+  bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override {
+    return toys::negatedJacobian(*this, ws, u, lambda, H, C);
   }
 
  private:
@@ -134,7 +134,7 @@ class TwinChains : public Problem {
  public:
   explicit TwinChains(int n) : n_(n) {}
   int dimension() const override { return n_; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     const int h = n_ / 2;
     for (int i = 0; i < n_; ++i) {
       const int j = i % h;
@@ -143,7 +143,7 @@ class TwinChains : public Problem {
     }
     return true;
   }
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
     const int h = n_ / 2;
     Fu.setZero();
     for (int i = 0; i < n_; ++i) {

@@ -21,7 +21,7 @@ class NumericExponentials : public NumericDiffProblem {
  public:
   explicit NumericExponentials(const toys::ScaledExponentials &exact) : exact_(exact) {}
   int dimension() const override { return 2; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override { return exact_.residual(u, lambda, F); }
+  bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override { return exact_.residual(ws, u, lambda, F); }
   ProblemScales scales() const override { return exact_.scales(); }
 
  private:
@@ -34,7 +34,7 @@ class NumericTruss : public NumericDiffProblem {
  public:
   NumericTruss(double a, double h, double k) : a_(a), h_(h), k_(k), L0_(std::hypot(a, h)) {}
   int dimension() const override { return 1; }
-  bool residual(ConstVectorRef u, double P, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double P, VectorRef F) const override {
     F[0] = 2.0 * k_ * u[0] * (1.0 - L0_ / std::hypot(a_, u[0])) + P;
     return std::isfinite(F[0]);
   }
@@ -60,10 +60,10 @@ class NumericPitchforks : public NumericDiffProblem {
  public:
   explicit NumericPitchforks(double c) : exact_(c) {}
   int dimension() const override { return 2; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override { return exact_.residual(u, lambda, F); }
+  bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override { return exact_.residual(ws, u, lambda, F); }
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-    return toys::negatedJacobian(*this, u, lambda, H, C);
+  bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override {
+    return toys::negatedJacobian(*this, ws, u, lambda, H, C);
   }
 
  private:
@@ -93,25 +93,25 @@ TEST_CASE("NumericDiffProblem: derivatives agree with the closed form in any uni
     INFO("unknown scales " << s.unknowns.transpose() << ", parameter scale " << s.parameter);
 
     Matrix exactJ(2, 3), numericJ(2, 3);
-    REQUIRE(reference.jacobian(u, lambda, exactJ.leftCols(2), exactJ.col(2)));
-    REQUIRE(numeric.jacobian(u, lambda, numericJ.leftCols(2), numericJ.col(2)));
+    REQUIRE(BoundProblem(reference).jacobian(u, lambda, exactJ.leftCols(2), exactJ.col(2)));
+    REQUIRE(BoundProblem(numeric).jacobian(u, lambda, numericJ.leftCols(2), numericJ.col(2)));
     // Central differences: O(h²) + O(ε/h) with h ≈ ε^{1/3} relative, ~1e-10 of the O(1) entries.
     CHECK(scaledDifference(numericJ, exactJ, s) < 1e-9);
 
     const Vector x = (Vector(3) << 0.8 * s.unknowns[0], -0.6 * s.unknowns[1], 0.5 * s.parameter).finished();
     const Vector z = (Vector(3) << -0.4 * s.unknowns[0], 0.9 * s.unknowns[1], 0.7 * s.parameter).finished();
     Matrix exactD(2, 3), numericD(2, 3);
-    REQUIRE(reference.jacobianDirectionalDerivative(u, lambda, x.head(2), x[2], exactD.leftCols(2), exactD.col(2)));
-    REQUIRE(numeric.jacobianDirectionalDerivative(u, lambda, x.head(2), x[2], numericD.leftCols(2), numericD.col(2)));
+    REQUIRE(BoundProblem(reference).jacobianDirectionalDerivative(u, lambda, x.head(2), x[2], exactD.leftCols(2), exactD.col(2)));
+    REQUIRE(BoundProblem(numeric).jacobianDirectionalDerivative(u, lambda, x.head(2), x[2], numericD.leftCols(2), numericD.col(2)));
     // Second differences with steps ε^{1/4}: O(h²) + O(ε/h²), ~1e-8.
     CHECK(scaledDifference(numericD, exactD, s) < 1e-6);
 
     // F_xx[x, z] (four residuals) and (F_xx[x, ·])ᵀw against the exact directional derivative.
     Vector y(2), yt(3);
-    REQUIRE(numeric.secondDerivativeApply(u, lambda, x, z, y));
+    REQUIRE(BoundProblem(numeric).secondDerivativeApply(u, lambda, x, z, y));
     CHECK((s.residuals.cwiseInverse().asDiagonal() * (y - exactD * z)).cwiseAbs().maxCoeff() < 1e-6);
     const Vector w = (Vector(2) << 0.3, -1.1).finished().cwiseQuotient(s.residuals);
-    REQUIRE(numeric.secondDerivativeTransposeApply(u, lambda, x, w, yt));
+    REQUIRE(BoundProblem(numeric).secondDerivativeTransposeApply(u, lambda, x, w, yt));
     Vector column(3);
     column << s.unknowns, s.parameter;
     CHECK((yt - exactD.transpose() * w).cwiseProduct(column).cwiseAbs().maxCoeff() < 1e-6);
@@ -122,7 +122,7 @@ TEST_CASE("NumericDiffProblem: a refused perturbed point refuses the derivative"
   class HalfLine : public NumericDiffProblem {
    public:
     int dimension() const override { return 1; }
-    bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
       if (u[0] < 0.0) return false;
       F[0] = std::sqrt(u[0]) - lambda;
       return true;
@@ -130,11 +130,11 @@ TEST_CASE("NumericDiffProblem: a refused perturbed point refuses the derivative"
   } problem;
   Matrix Fu(1, 1);
   Vector Fl(1);
-  REQUIRE(problem.jacobian(Vector::Constant(1, 4.0), 1.0, Fu, Fl));
+  REQUIRE(BoundProblem(problem).jacobian(Vector::Constant(1, 4.0), 1.0, Fu, Fl));
   CHECK(Fu(0, 0) == Approx(0.25).epsilon(1e-9));
   CHECK(Fl[0] == Approx(-1.0).epsilon(1e-9));
   // At u = 0 the step reaches u < 0, outside the domain.
-  CHECK_FALSE(problem.jacobian(Vector::Zero(1), 0.0, Fu, Fl));
+  CHECK_FALSE(BoundProblem(problem).jacobian(Vector::Zero(1), 0.0, Fu, Fl));
 }
 
 TEST_CASE("NumericDiffProblem: the truss's limit points from its residual alone", "[numeric_diff][tracer]") {

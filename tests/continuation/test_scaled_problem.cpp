@@ -14,24 +14,24 @@ namespace {
 class RecordingBound : public Problem {
  public:
   int dimension() const override { return 2; }
-  bool residual(ConstVectorRef u, double, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double, VectorRef F) const override {
     F = u;
     return true;
   }
-  bool jacobian(ConstVectorRef, double, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef, double, MatrixRef Fu, VectorRef Fl) const override {
     Fu.setIdentity();
     Fl.setZero();
     return true;
   }
-  bool stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda, double &bound) override {
+  bool stabilityRateBound(ProblemWorkspace &, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda, double &bound) const override {
     seenU = u;
     seenLambda = lambda;
     bound = 2.0 * std::abs(du[0]) + 3.0 * std::abs(du[1]) + 5.0 * std::abs(dlambda);
     return offer;
   }
   bool offer = true;
-  Vector seenU;
-  double seenLambda = 0.0;
+  mutable Vector seenU;  // probes of this single-threaded test
+  mutable double seenLambda = 0.0;
 };
 
 }  // namespace
@@ -48,21 +48,21 @@ TEST_CASE("ScaledProblem's rate bound: the user's bound along the user direction
   u << 0.3, -2.0;
   du << 0.5, -1.5;
   double bound = 0.0;
-  REQUIRE(scaled.stabilityRateBound(u, 0.25, du, -0.75, bound));
+  REQUIRE(BoundProblem(scaled).stabilityRateBound(u, 0.25, du, -0.75, bound));
   // user direction (10·0.5, 0.1·(−1.5), 4·(−0.75)) = (5, −0.15, −3): 10 + 0.45 + 15, / 8
   CHECK(bound == Approx((10.0 + 0.45 + 15.0) / 8.0).epsilon(1e-15));
   CHECK(problem.seenU[0] == Approx(3.0).epsilon(1e-15));
   CHECK(problem.seenU[1] == Approx(-0.2).epsilon(1e-15));
   CHECK(problem.seenLambda == Approx(1.0).epsilon(1e-15));
   problem.offer = false;
-  CHECK_FALSE(scaled.stabilityRateBound(u, 0.25, du, -0.75, bound));
+  CHECK_FALSE(BoundProblem(scaled).stabilityRateBound(u, 0.25, du, -0.75, bound));
   // the default Problem offers no bound
   class NoBound : public RecordingBound {
    public:
-    bool stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                            double &bound) override {
-      return Problem::stabilityRateBound(u, lambda, du, dlambda, bound);
+    bool stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                            double &bound) const override {
+      return Problem::stabilityRateBound(ws, u, lambda, du, dlambda, bound);
     }
   } none;
-  CHECK_FALSE(none.stabilityRateBound(u, 0.25, du, -0.75, bound));
+  CHECK_FALSE(BoundProblem(none).stabilityRateBound(u, 0.25, du, -0.75, bound));
 }

@@ -37,7 +37,7 @@ TEST_CASE("DenseBorderedSolver::factorGeneral solves [[F_u, B], [C^T, D]] and it
   const double lambda = 2.0;
   Matrix Fu(n, n);
   Vector Fl(n);
-  REQUIRE(bratu.jacobian(u, lambda, Fu, Fl));
+  REQUIRE(BoundProblem(bratu).jacobian(u, lambda, Fu, Fl));
   Matrix B = Matrix::Random(n, 2), C = Matrix::Random(n, 2), D = Matrix::Random(2, 2);
   const Vector b = Vector::LinSpaced(n + 2, -1.0, 1.0);
   for (bool transposed : {false, true}) {
@@ -65,15 +65,15 @@ TEST_CASE("Problem's dense product defaults equal F_x, F_x^T and the directional
   const Vector w = (Vector(2) << -0.6, 1.1).finished();
   const double lambda = 0.37;
   Matrix Fx(2, 3), dFx(2, 3);
-  REQUIRE(problem.jacobian(u, lambda, Fx.leftCols(2), Fx.col(2)));
+  REQUIRE(BoundProblem(problem).jacobian(u, lambda, Fx.leftCols(2), Fx.col(2)));
   Vector y(2), yt(3), y2(3);
-  REQUIRE(problem.jacobianApply(u, lambda, x, y));
+  REQUIRE(BoundProblem(problem).jacobianApply(u, lambda, x, y));
   CHECK((y - Fx * x).norm() <= 1e-15 * Fx.norm() * x.norm());
-  REQUIRE(problem.jacobianTransposeApply(u, lambda, w, yt));
+  REQUIRE(BoundProblem(problem).jacobianTransposeApply(u, lambda, w, yt));
   CHECK((yt - Fx.transpose() * w).norm() <= 1e-15 * Fx.norm() * w.norm());
   // (F_xx[x, ·])ᵀw by central differences against the directional derivative of F_x along x.
-  REQUIRE(problem.secondDerivativeTransposeApply(u, lambda, x, w, y2));
-  REQUIRE(problem.Problem::jacobianDirectionalDerivative(u, lambda, x.head(2), x[2], dFx.leftCols(2), dFx.col(2)));
+  REQUIRE(BoundProblem(problem).secondDerivativeTransposeApply(u, lambda, x, w, y2));
+  REQUIRE(problem.Problem::jacobianDirectionalDerivative(*problem.createWorkspace(), u, lambda, x.head(2), x[2], dFx.leftCols(2), dFx.col(2)));
   CHECK((y2 - dFx.transpose() * w).norm() <= 1e-8 * std::max(1.0, y2.norm()));
 }
 
@@ -100,8 +100,8 @@ TEST_CASE("Structured path: Bratu fold equals the dense refinement, with its nul
   REQUIRE(s.nullVectors.rows() == n);
   Matrix Fu(n, n);
   Vector Fl(n), F(n);
-  REQUIRE(bratu.jacobian(s.u, s.lambda, Fu, Fl));
-  REQUIRE(bratu.residual(s.u, s.lambda, F));
+  REQUIRE(BoundProblem(bratu).jacobian(s.u, s.lambda, Fu, Fl));
+  REQUIRE(BoundProblem(bratu).residual(s.u, s.lambda, F));
   CHECK(F.norm() <= 1e-12 * Fu.norm());
   CHECK((Fu * s.nullVectors.col(0)).norm() <= 1e-9 * Fu.norm());
   CHECK(std::abs(s.nullVectors.col(0).dot(d.nullVectors.col(0))) >= 1.0 - 1e-10);

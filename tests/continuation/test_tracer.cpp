@@ -24,8 +24,8 @@ TEST_CASE("Bad input to the tracer is reported in the branch, never thrown", "[t
   // A problem without unknowns: the tracer cannot build a corrector for it.
   struct Empty : Problem {
     int dimension() const override { return 0; }
-    bool residual(ConstVectorRef, double, VectorRef) override { return true; }
-    bool jacobian(ConstVectorRef, double, MatrixRef, VectorRef) override { return true; }
+    bool residual(ProblemWorkspace &, ConstVectorRef, double, VectorRef) const override { return true; }
+    bool jacobian(ProblemWorkspace &, ConstVectorRef, double, MatrixRef, VectorRef) const override { return true; }
   } empty;
   Branch none;
   CHECK_NOTHROW(none = trace(empty, Vector(), 0.0, InitialDirection::increasingLambda()));
@@ -149,11 +149,11 @@ class CloseFolds : public Problem {
  public:
   explicit CloseFolds(double e) : e_(e) {}
   int dimension() const override { return 1; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     F[0] = lambda + e_ * e_ * u[0] - u[0] * u[0] * u[0] / 3.0;
     return true;
   }
-  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) const override {
     Fu(0, 0) = e_ * e_ - u[0] * u[0];
     Fl[0] = 1.0;
     return true;
@@ -514,20 +514,20 @@ TEST_CASE("Tiny steps: the fold of the cubic is still found to 1e-12, in scaled 
    public:
     UnitCubic(double L, double P) : L_(L), P_(P) {}
     int dimension() const override { return 1; }
-    bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+    bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
       const double v = u[0] / L_;
       F[0] = lambda / P_ + v - v * v * v / 3.0;
       return true;
     }
-    bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+    bool jacobian(ProblemWorkspace &, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) const override {
       const double v = u[0] / L_;
       Fu(0, 0) = (1.0 - v * v) / L_;
       Fl[0] = 1.0 / P_;
       return true;
     }
     bool hasStabilityOperator() const override { return true; }
-    bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-      return toys::negatedJacobian(*this, u, lambda, H, C);
+    bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override {
+      return toys::negatedJacobian(*this, ws, u, lambda, H, C);
     }
     ProblemScales scales() const override {
       ProblemScales s = ProblemScales::ones(1);

@@ -9,11 +9,11 @@
 namespace buckle::continuation::toys {
 
 /// The stability operator of a gradient system F = −∇V: H = −F_u, no constraints.
-inline bool negatedJacobian(Problem &problem, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) {
+inline bool negatedJacobian(const Problem &problem, ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) {
   const int n = problem.dimension();
   Vector Fl(n);
   H = Matrix::Zero(n, n);
-  if (!problem.jacobian(u, lambda, H, Fl)) return false;
+  if (!problem.jacobian(ws, u, lambda, H, Fl)) return false;
   H = -H;
   C.resize(0, n);
   return true;
@@ -23,11 +23,11 @@ inline bool negatedJacobian(Problem &problem, ConstVectorRef u, double lambda, M
 class Circle : public Problem {
  public:
   int dimension() const override { return 1; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     F[0] = u[0] * u[0] + lambda * lambda - 1.0;
     return true;
   }
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
     Fu(0, 0) = 2.0 * u[0];
     Fl[0] = 2.0 * lambda;
     return true;
@@ -38,11 +38,11 @@ class Circle : public Problem {
 class FoldNormalForm : public Problem {
  public:
   int dimension() const override { return 1; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     F[0] = u[0] * u[0] - lambda;
     return true;
   }
-  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) const override {
     Fu(0, 0) = 2.0 * u[0];
     Fl[0] = -1.0;
     return true;
@@ -53,17 +53,17 @@ class FoldNormalForm : public Problem {
 class CubicFold : public Problem {
  public:
   int dimension() const override { return 1; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     F[0] = lambda + u[0] - u[0] * u[0] * u[0] / 3.0;
     return true;
   }
-  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) const override {
     Fu(0, 0) = 1.0 - u[0] * u[0];
     Fl[0] = 1.0;
     return true;
   }
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(ConstVectorRef u, double, Matrix &H, Matrix &C) override {
+  bool stabilityOperator(ProblemWorkspace &, ConstVectorRef u, double, Matrix &H, Matrix &C) const override {
     H.resize(1, 1);
     H(0, 0) = u[0] * u[0] - 1.0;
     C.resize(0, 1);
@@ -77,12 +77,12 @@ class TwoPitchforks : public Problem {
  public:
   explicit TwoPitchforks(double c) : c_(c) {}
   int dimension() const override { return 2; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     F[0] = lambda * u[0] - u[0] * u[0] * u[0];
     F[1] = (lambda - c_) * u[1] - u[1] * u[1] * u[1];
     return true;
   }
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
     Fu.setZero();
     Fu(0, 0) = lambda - 3.0 * u[0] * u[0];
     Fu(1, 1) = lambda - c_ - 3.0 * u[1] * u[1];
@@ -90,7 +90,7 @@ class TwoPitchforks : public Problem {
     return true;
   }
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
+  bool stabilityOperator(ProblemWorkspace &, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override {
     H = Matrix::Zero(2, 2);
     H(0, 0) = -(lambda - 3.0 * u[0] * u[0]);
     H(1, 1) = -(lambda - c_ - 3.0 * u[1] * u[1]);
@@ -122,11 +122,11 @@ class ManyPitchforks : public Problem {
  public:
   ManyPitchforks(int m, double spacing) : m_(m), spacing_(spacing) {}
   int dimension() const override { return m_; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     for (int j = 0; j < m_; ++j) F[j] = (lambda - j * spacing_) * u[j] - u[j] * u[j] * u[j];
     return true;
   }
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
     Fu.setZero();
     for (int j = 0; j < m_; ++j) {
       Fu(j, j) = lambda - j * spacing_ - 3.0 * u[j] * u[j];
@@ -135,8 +135,8 @@ class ManyPitchforks : public Problem {
     return true;
   }
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-    return negatedJacobian(*this, u, lambda, H, C);
+  bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override {
+    return negatedJacobian(*this, ws, u, lambda, H, C);
   }
 
  private:
@@ -152,13 +152,13 @@ class CurvedPitchforks : public Problem {
   explicit CurvedPitchforks(double c) : c_(c) {}
   int dimension() const override { return 2; }
   static Vector shift(double lambda) { return (Vector(2) << 0.3 * std::sin(lambda), 0.2 * lambda * lambda).finished(); }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     const Vector v = u - shift(lambda);
     F[0] = lambda * v[0] - v[0] * v[0] * v[0];
     F[1] = (lambda - c_) * v[1] - v[1] * v[1] * v[1];
     return true;
   }
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
     const Vector v = u - shift(lambda);
     const Vector dg = (Vector(2) << 0.3 * std::cos(lambda), 0.4 * lambda).finished();
     Fu.setZero();
@@ -169,8 +169,8 @@ class CurvedPitchforks : public Problem {
     return true;
   }
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-    return negatedJacobian(*this, u, lambda, H, C);
+  bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override {
+    return negatedJacobian(*this, ws, u, lambda, H, C);
   }
 
  private:
@@ -188,17 +188,17 @@ class DoubleZero : public TwoPitchforks {
 class Transcritical : public Problem {
  public:
   int dimension() const override { return 1; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     F[0] = lambda * u[0] - u[0] * u[0];
     return true;
   }
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
     Fu(0, 0) = lambda - 2.0 * u[0];
     Fl[0] = u[0];
     return true;
   }
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
+  bool stabilityOperator(ProblemWorkspace &, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override {
     H.resize(1, 1);
     H(0, 0) = 2.0 * u[0] - lambda;
     C.resize(0, 1);
@@ -213,19 +213,19 @@ class LineWithDomain : public Problem {
   explicit LineWithDomain(double limit = std::numeric_limits<double>::infinity(), bool boundary = false)
       : limit_(limit), boundary_(boundary) {}
   int dimension() const override { return 1; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     if (u[0] > limit_) return false;
     F[0] = u[0] - lambda;
     return true;
   }
-  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) const override {
     if (u[0] > limit_) return false;
     Fu(0, 0) = 1.0;
     Fl[0] = -1.0;
     return true;
   }
   int boundaryCount() const override { return boundary_ ? 1 : 0; }
-  double boundary(int, ConstVectorRef u, double) override { return 0.5 - u[0]; }
+  double boundary(ProblemWorkspace &, int, ConstVectorRef u, double) const override { return 0.5 - u[0]; }
   std::string boundaryName(int) const override { return "u limit"; }
 
  private:
@@ -239,14 +239,14 @@ class Bratu : public Problem {
  public:
   explicit Bratu(int n) : n_(n), h_(1.0 / (n + 1)) {}
   int dimension() const override { return n_; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     for (int i = 0; i < n_; ++i) {
       const double left = i > 0 ? u[i - 1] : 0.0, right = i + 1 < n_ ? u[i + 1] : 0.0;
       F[i] = (left - 2.0 * u[i] + right) / (h_ * h_) + lambda * std::exp(u[i]);
     }
     return true;
   }
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
     Fu.setZero();
     for (int i = 0; i < n_; ++i) {
       Fu(i, i) = -2.0 / (h_ * h_) + lambda * std::exp(u[i]);
@@ -257,8 +257,8 @@ class Bratu : public Problem {
     return true;
   }
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override {
-    return negatedJacobian(*this, u, lambda, H, C);
+  bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override {
+    return negatedJacobian(*this, ws, u, lambda, H, C);
   }
 
  private:
@@ -274,21 +274,21 @@ class ScaledExponentials : public Problem {
   ScaledExponentials(double U0 = 1.0, double U1 = 1.0, double Lambda = 1.0, double Phi = 1.0)
       : U0_(U0), U1_(U1), L_(Lambda), P_(Phi) {}
   int dimension() const override { return 2; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     const double a = u[0] / U0_, b = u[1] / U1_, l = lambda / L_;
     F[0] = P_ * (l * std::exp(a) + a * b * b - 1.0);
     F[1] = P_ * (l * l * b + b * std::sin(a) - a * a * a);
     return true;
   }
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
     const double a = u[0] / U0_, b = u[1] / U1_, l = lambda / L_;
     Fu << P_ / U0_ * (l * std::exp(a) + b * b), P_ / U1_ * 2.0 * a * b,
         P_ / U0_ * (b * std::cos(a) - 3.0 * a * a), P_ / U1_ * (l * l + std::sin(a));
     Fl << P_ / L_ * std::exp(a), P_ / L_ * 2.0 * l * b;
     return true;
   }
-  bool jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                     MatrixRef dFu, VectorRef dFl) override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                     MatrixRef dFu, VectorRef dFl) const override {
     const double a = u[0] / U0_, b = u[1] / U1_, l = lambda / L_;
     const double da = du[0] / U0_, db = du[1] / U1_, dl = dlambda / L_;
     dFu << P_ / U0_ * ((dl + l * da) * std::exp(a) + 2.0 * b * db), P_ / U1_ * 2.0 * (da * b + a * db),

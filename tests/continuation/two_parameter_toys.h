@@ -25,23 +25,23 @@ class ToyTwoParameter : public TwoParameterProblem {
 class CuspToy : public ToyTwoParameter {
  public:
   CuspToy() { mu = 1.5; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     F[0] = lambda + mu * u[0] - u[0] * u[0] * u[0] + u[0] * u[1];
     F[1] = u[1] - 0.5 * u[0] * u[0];
     return true;
   }
-  bool jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fl) const override {
     Fu << mu - 3.0 * u[0] * u[0] + u[1], u[0], -u[0], 1.0;
     Fl << 1.0, 0.0;
     return true;
   }
-  bool jacobianDirectionalDerivative(ConstVectorRef u, double, ConstVectorRef du, double, MatrixRef dFu,
-                                     VectorRef dFl) override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double, MatrixRef dFu,
+                                     VectorRef dFl) const override {
     dFu << -6.0 * u[0] * du[0] + du[1], du[0], -du[0], 0.0;
     dFl.setZero();
     return true;
   }
-  bool secondParameterDerivatives(ConstVectorRef u, double, ConstVectorRef v, VectorRef Fmu, VectorRef FuMuV) override {
+  bool secondParameterDerivatives(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef v, VectorRef Fmu, VectorRef FuMuV) const override {
     Fmu << u[0], 0.0;
     FuMuV << v[0], 0.0;
     return true;
@@ -52,23 +52,23 @@ class CuspToy : public ToyTwoParameter {
 /// points at the eigenvalues of A, the lower one λ = 3/2 − √(1/4 + μ²).
 class EigenToy : public ToyTwoParameter {
  public:
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override {
+  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
     F[0] = (2.0 - lambda) * u[0] + mu * u[1] + u[0] * u[0] * u[0];
     F[1] = mu * u[0] + (1.0 - lambda) * u[1] + u[1] * u[1] * u[1];
     return true;
   }
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) override {
+  bool jacobian(ProblemWorkspace &, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Fl) const override {
     Fu << 2.0 - lambda + 3.0 * u[0] * u[0], mu, mu, 1.0 - lambda + 3.0 * u[1] * u[1];
     Fl = -u;
     return true;
   }
-  bool jacobianDirectionalDerivative(ConstVectorRef u, double, ConstVectorRef du, double dl, MatrixRef dFu,
-                                     VectorRef dFl) override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double dl, MatrixRef dFu,
+                                     VectorRef dFl) const override {
     dFu << 6.0 * u[0] * du[0] - dl, 0.0, 0.0, 6.0 * u[1] * du[1] - dl;
     dFl = -du;
     return true;
   }
-  bool secondParameterDerivatives(ConstVectorRef u, double, ConstVectorRef v, VectorRef Fmu, VectorRef FuMuV) override {
+  bool secondParameterDerivatives(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef v, VectorRef Fmu, VectorRef FuMuV) const override {
     Fmu << u[1], u[0];
     FuMuV << v[1], v[0];
     return true;

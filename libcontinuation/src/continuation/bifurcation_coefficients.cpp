@@ -4,7 +4,7 @@
 
 namespace buckle::continuation {
 
-bool bifurcationCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef v, ConstVectorRef c,
+bool bifurcationCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef v, ConstVectorRef c,
                              BifurcationCoefficients &out, std::string *why) {
   // the trivial branch is the parent with tangent (0, 1): p1 = p2 = 0 (branch_point_coefficients.h)
   const int n = problem.dimension();

@@ -12,7 +12,7 @@ Factorization BorderedSolver::factorGeneral(ConstVectorRef, double, ConstMatrixR
   return Factorization::Refused;
 }
 
-DenseBorderedSolver::DenseBorderedSolver(Problem &problem)
+DenseBorderedSolver::DenseBorderedSolver(const BoundProblem &problem)
     : problem_(problem),
       n_(problem.dimension()),
       A_(Matrix::Zero(n_ + 1, n_ + 1)),

@@ -42,7 +42,7 @@ class Algebra {
 /// jacobianDirectionalDerivative (kept for the last x and point: most products share them).
 class DenseAlgebra final : public Algebra {
  public:
-  DenseAlgebra(Problem &problem, ConstVectorRef u0, double lambda)
+  DenseAlgebra(const BoundProblem &problem, ConstVectorRef u0, double lambda)
       : problem_(problem), n_(problem.dimension()), u0_(u0), lambda_(lambda), Fu_(n_, n_), D_(n_, n_), Dl_(n_) {}
 
   bool linearise(Vector &Fl) override {
@@ -88,7 +88,7 @@ class DenseAlgebra final : public Algebra {
   }
 
  private:
-  Problem &problem_;
+  BoundProblem problem_;
   int n_;
   ConstVectorRef u0_;
   double lambda_;
@@ -105,7 +105,7 @@ class DenseAlgebra final : public Algebra {
 /// (RefinedBorderedSystem): O(N) per solve and product for a chain.
 class StructuredAlgebra final : public Algebra {
  public:
-  StructuredAlgebra(Problem &problem, std::unique_ptr<BorderedSolver> solver, ConstVectorRef u0, double lambda)
+  StructuredAlgebra(const BoundProblem &problem, std::unique_ptr<BorderedSolver> solver, ConstVectorRef u0, double lambda)
       : problem_(problem),
         n_(problem.dimension()),
         solver_(std::move(solver)),
@@ -145,7 +145,7 @@ class StructuredAlgebra final : public Algebra {
   }
 
  private:
-  Problem &problem_;
+  BoundProblem problem_;
   int n_;
   std::unique_ptr<BorderedSolver> solver_;
   RefinedBorderedSystem system_;
@@ -249,7 +249,7 @@ bool thirdOrder(const ThirdOrderInput &in, double factor, ThirdOrder &out) {
   return std::isfinite(out.b);
 }
 
-bool reduce(Problem &problem, Algebra &algebra, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
+bool reduce(const BoundProblem &problem, Algebra &algebra, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
             ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out, std::string *why) {
   const int n = problem.dimension();
   const double cv = c.dot(v0);
@@ -381,11 +381,12 @@ bool reduce(Problem &problem, Algebra &algebra, ConstVectorRef u0, double lambda
 /// Differences, solves and thresholds then act on O(1) quantities in every unit system: in the
 /// user's variables a chain in lengths of 1e−4 mixes rows and unknowns 1e4 apart, and the third
 /// derivatives lose four digits more than their estimate.
-bool scaledReduction(Problem &problem, const ProblemScales &s, ConstVectorRef u0, double lambdaC,
+bool scaledReduction(const BoundProblem &problem, const ProblemScales &s, ConstVectorRef u0, double lambdaC,
                      ConstVectorRef parentTangent, ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out,
                      std::string *why, CoefficientAlgebra algebra) {
   const UnitScaling units(s);
-  ScaledProblem scaled(problem, units);
+  const BoundScaledProblem scaledProblem(problem, units);
+  const BoundProblem &scaled = scaledProblem.bound();
   const Vector &Du = s.unknowns;
   const double l0 = s.parameter;
   BranchPointCoefficients g;
@@ -413,7 +414,7 @@ bool scaledReduction(Problem &problem, const ProblemScales &s, ConstVectorRef u0
 
 }  // namespace
 
-bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
+bool branchPointCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
                              ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out, std::string *why,
                              CoefficientAlgebra algebra) {
   const int n = problem.dimension();
@@ -440,7 +441,7 @@ bool branchPointCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC
   return false;
 }
 
-bool foldCoefficient(Problem &problem, const SpecialPoint &fold, FoldCoefficient &out, std::string *why) {
+bool foldCoefficient(const BoundProblem &problem, const SpecialPoint &fold, FoldCoefficient &out, std::string *why) {
   const int n = problem.dimension();
   if (fold.type != SpecialPointType::Fold || fold.u.size() != n || fold.nullVectors.rows() != n ||
       fold.nullVectors.cols() != 1)
@@ -475,7 +476,7 @@ bool foldCoefficient(Problem &problem, const SpecialPoint &fold, FoldCoefficient
   return std::isfinite(out.curvature);
 }
 
-bool branchPointCoefficients(Problem &problem, const SpecialPoint &bp, ConstVectorRef c, BranchPointCoefficients &out,
+bool branchPointCoefficients(const BoundProblem &problem, const SpecialPoint &bp, ConstVectorRef c, BranchPointCoefficients &out,
                              std::string *why, CoefficientAlgebra algebra) {
   const int n = problem.dimension();
   if (bp.type != SpecialPointType::BranchPoint || bp.u.size() != n || bp.tangent.size() != n + 1 ||

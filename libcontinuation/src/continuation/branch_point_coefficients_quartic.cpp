@@ -30,14 +30,15 @@ void powerFit(const double y[3], double h, const int powers[3], Eigen::Vector3d 
 
 }  // namespace
 
-bool childBranchExpansion(Problem &problem, ConstVectorRef u0, double lambdaC, const BranchPointCoefficients &g,
+bool childBranchExpansion(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, const BranchPointCoefficients &g,
                           ConstVectorRef c, ChildBranchExpansion &out, std::string *why, double amplitude) {
   const int n = problem.dimension();
   if (u0.size() != n || c.size() != n || g.v.size() != n || g.u2.size() != n)
     return fail(why, "child expansion: u0, c and the coefficients' vectors must have the problem's dimension");
   const ProblemScales scales = problem.scales();
   const UnitScaling units(scales);
-  ScaledProblem scaled(problem, units);
+  const BoundScaledProblem scaledProblem(problem, units);
+  const BoundProblem &scaled = scaledProblem.bound();
   std::unique_ptr<BorderedSolver> structured;
   if (n > kDenseCoefficientDimension) structured = scaled.makeStructuredSolver();
   CorrectorOptions options;

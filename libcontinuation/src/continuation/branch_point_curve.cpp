@@ -7,6 +7,7 @@ namespace buckle::continuation {
 
 BranchPointCurveProblem::BranchPointCurveProblem(TwoParameterProblem &problem, const Vector &u0, const Vector &c)
     : problem_(problem),
+      inner_(problem),
       n_(problem.dimension()),
       u0_(u0),
       c_(c),
@@ -33,29 +34,29 @@ Vector BranchPointCurveProblem::start(const Problem &problem, double lambda, Con
   return W;
 }
 
-bool BranchPointCurveProblem::residual(ConstVectorRef W, double mu, VectorRef G) {
+bool BranchPointCurveProblem::residual(ProblemWorkspace &, ConstVectorRef W, double mu, VectorRef G) const {
   if (!problem_.setSecondParameter(mu)) return false;
   if (structured_) {
     x_.resize(n_ + 1);
     x_ << W.head(n_), 0.0;
-    if (!problem_.jacobianApply(u0_, W[n_], x_, G.head(n_))) return false;
+    if (!inner_.jacobianApply(u0_, W[n_], x_, G.head(n_))) return false;
     G[n_] = c_.dot(W.head(n_)) - 1.0;
     return true;
   }
-  if (!problem_.jacobian(u0_, W[n_], Fu_, Flambda_)) return false;
+  if (!inner_.jacobian(u0_, W[n_], Fu_, Flambda_)) return false;
   const auto w = W.head(n_);
   G.head(n_).noalias() = Fu_ * w;
   G[n_] = c_.dot(w) - 1.0;
   return true;
 }
 
-bool BranchPointCurveProblem::jacobian(ConstVectorRef W, double mu, MatrixRef GW, VectorRef Gmu) {
+bool BranchPointCurveProblem::jacobian(ProblemWorkspace &, ConstVectorRef W, double mu, MatrixRef GW, VectorRef Gmu) const {
   if (!problem_.setSecondParameter(mu)) return false;
   const double lambda = W[n_];
   const auto w = W.head(n_);
-  if (!problem_.jacobian(u0_, lambda, Fu_, Flambda_)) return false;
-  if (!problem_.jacobianDirectionalDerivative(u0_, lambda, w, 0.0, dFu_, dFlambda_)) return false;
-  if (!problem_.secondParameterDerivatives(u0_, lambda, w, Fmu_, FuMuW_)) return false;
+  if (!inner_.jacobian(u0_, lambda, Fu_, Flambda_)) return false;
+  if (!inner_.jacobianDirectionalDerivative(u0_, lambda, w, 0.0, dFu_, dFlambda_)) return false;
+  if (!problem_.secondParameterDerivatives(inner_.workspace(), u0_, lambda, w, Fmu_, FuMuW_)) return false;
   GW.topLeftCorner(n_, n_) = Fu_;
   GW.block(0, n_, n_, 1) = dFlambda_;  // F_λu w = F_uλ w
   GW.block(n_, 0, 1, n_) = c_.transpose();
@@ -78,9 +79,10 @@ namespace {
 // residual rows (D_F² D_u² c: the left null vector when F_u is symmetric).
 class BranchPointCurveSolver final : public BorderedSolver {
  public:
-  BranchPointCurveSolver(TwoParameterProblem &problem, const Vector &u0, const Vector &c,
+  BranchPointCurveSolver(TwoParameterProblem &problem, const BoundProblem &inner, const Vector &u0, const Vector &c,
                          std::unique_ptr<BorderedSolver> base)
       : problem_(problem),
+        inner_(inner),
         n_(problem.dimension()),
         u0_(u0),
         c_(c),
@@ -100,8 +102,8 @@ class BranchPointCurveSolver final : public BorderedSolver {
     if (!problem_.setSecondParameter(mu) || !cc.allFinite()) return Factorization::Refused;
     const auto w = W.head(n_);
     const double lambda = W[n_];
-    if (!problem_.parameterJacobianApply(u0_, lambda, w, B_.col(0))) return Factorization::Refused;
-    if (!problem_.secondParameterDerivatives(u0_, lambda, w, Fmu_, B_.col(1))) return Factorization::Refused;
+    if (!problem_.parameterJacobianApply(inner_.workspace(), u0_, lambda, w, B_.col(0))) return Factorization::Refused;
+    if (!problem_.secondParameterDerivatives(inner_.workspace(), u0_, lambda, w, Fmu_, B_.col(1))) return Factorization::Refused;
     C_.col(1) = cc.head(n_);
     D_(1, 0) = cc[n_];
     D_(1, 1) = cc[n_ + 1];
@@ -113,6 +115,7 @@ class BranchPointCurveSolver final : public BorderedSolver {
 
  private:
   TwoParameterProblem &problem_;
+  BoundProblem inner_;
   int n_;
   Vector u0_, c_, b_;
   std::unique_ptr<BorderedSolver> base_;
@@ -123,11 +126,11 @@ class BranchPointCurveSolver final : public BorderedSolver {
 
 }  // namespace
 
-std::unique_ptr<BorderedSolver> BranchPointCurveProblem::makeStructuredSolver() {
+std::unique_ptr<BorderedSolver> BranchPointCurveProblem::makeStructuredSolver(ProblemWorkspace &) const {
   if (!structured_) return nullptr;
-  std::unique_ptr<BorderedSolver> base = problem_.makeStructuredSolver();
+  std::unique_ptr<BorderedSolver> base = inner_.makeStructuredSolver();
   if (!base || base->maxGeneralBorder() < 1) return nullptr;
-  return std::make_unique<BranchPointCurveSolver>(problem_, u0_, c_, std::move(base));
+  return std::make_unique<BranchPointCurveSolver>(problem_, inner_, u0_, c_, std::move(base));
 }
 
 }  // namespace buckle::continuation

@@ -77,7 +77,7 @@ bool switchedBefore(const std::vector<Vector> &switchedAt, const std::vector<dou
 
 }  // namespace
 
-bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note,
+bool bifurcatingDirection(const BoundProblem &problem, const SpecialPoint &bp, Vector &direction, std::string *note,
                           bool structured) {
   const int n = problem.dimension();
   // In the problem's scaled variables (scaled_problem.h), where the kernel and the
@@ -85,7 +85,8 @@ bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &dire
   const ProblemScales scales = problem.scales();
   if (!scales.identity() && scales.check(n).empty()) {
     const UnitScaling units(scales);
-    ScaledProblem scaled(problem, units);  // its own scales are ones: no further recursion
+    const BoundScaledProblem scaledProblem(problem, units);
+    const BoundProblem &scaled = scaledProblem.bound();  // its own scales are ones: no further recursion
     const bool found = bifurcatingDirection(scaled, units.scaled(bp), direction, note, structured);
     if (found) direction = units.directionToUser(direction);
     return found;
@@ -136,7 +137,7 @@ Branch switchBranch(Tracer &tracer, const SpecialPoint &userBp, const Vector &us
     child.stopMessage = "BranchSwitchingOptions: " + why;
     return child;
   }
-  Problem &problem = tracer.problem();
+  const BoundProblem &problem = tracer.problem();
   const int n = problem.dimension();
   if (direction.size() != n + 1 || bp.u.size() != n) {
     child.stopReason = StopReason::InvalidOptions;
@@ -235,7 +236,7 @@ std::vector<Branch> switchBothSides(Tracer &tracer, const SpecialPoint &bp, cons
   return sides;
 }
 
-BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
+BranchTree traceTree(const BoundProblem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
                      const TracerOptions &options, const TreeOptions &treeOptions) {
   BranchTree tree;
   Tracer tracer(problem, options);
@@ -386,7 +387,7 @@ BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const 
   return finish();
 }
 
-BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
+BranchTree traceTree(const BoundProblem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
                      const TracerOptions &options, int maxDepth, const BranchSwitchingOptions &switching) {
   TreeOptions tree;
   tree.branchSwitching = maxDepth;

@@ -25,7 +25,7 @@ std::string CorrectorOptions::validate(const std::string &prefix) const {
 
 bool CorrectorOptions::IsValid(std::string *why) const { return reportValidity(validate(), why); }
 
-Corrector::Corrector(Problem &problem, const CorrectorOptions &options, BorderedSolver *structured)
+Corrector::Corrector(const BoundProblem &problem, const CorrectorOptions &options, BorderedSolver *structured)
     : problem_(problem),
       structured_(structured),
       options_(options),

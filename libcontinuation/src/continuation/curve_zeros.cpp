@@ -11,14 +11,15 @@
 
 namespace buckle::continuation {
 
-std::vector<CurveZero> locateCurveZeros(Problem &curve, const Branch &branch, const CurveTest &g,
+std::vector<CurveZero> locateCurveZeros(const BoundProblem &curve, const Branch &branch, const CurveTest &g,
                                         const CurveZeroOptions &options) {
   std::vector<CurveZero> zeros;
   if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("CurveZeroOptions: " + why);
   const int n = curve.dimension();
   if (branch.points.size() < 2) return zeros;
   const UnitScaling units(curve.scales());
-  ScaledProblem scaled(curve, units);
+  const BoundScaledProblem scaledProblem(curve, units);
+  const BoundProblem &scaled = scaledProblem.bound();
   // the curve's structured solver when it offers one (O(N) curve systems), else dense LU
   const std::unique_ptr<BorderedSolver> structured = scaled.makeStructuredSolver();
   Corrector corrector(scaled, options.corrector, structured.get());

@@ -113,7 +113,7 @@ DerivativeComparison refused(const std::string &name) {
 }
 
 // [F_u F_λ] from problem.jacobian(), cleared first (a problem may write its nonzeros only).
-bool exactJacobian(Problem &problem, ConstVectorRef u, double lambda, Matrix &J) {
+bool exactJacobian(const BoundProblem &problem, ConstVectorRef u, double lambda, Matrix &J) {
   const int n = problem.dimension();
   J = Matrix::Zero(n, n + 1);
   return problem.jacobian(u, lambda, J.leftCols(n), J.col(n)) && J.allFinite();
@@ -121,7 +121,7 @@ bool exactJacobian(Problem &problem, ConstVectorRef u, double lambda, Matrix &J)
 
 // d/dε [F_u F_λ](z + εx) by central differences of the exact jacobian(); the step is relative
 // to the point in the scaled variables, like Problem's default.
-bool differencedSecondDerivative(Problem &problem, const Scaling &scaling, double relativeStep, ConstVectorRef u,
+bool differencedSecondDerivative(const BoundProblem &problem, const Scaling &scaling, double relativeStep, ConstVectorRef u,
                                  double lambda, const Vector &x, Matrix &dF) {
   const int n = problem.dimension();
   Vector z(n + 1);
@@ -135,7 +135,7 @@ bool differencedSecondDerivative(Problem &problem, const Scaling &scaling, doubl
   return dF.allFinite();
 }
 
-void compareProductsOfJacobian(Problem &problem, ConstVectorRef u, double lambda, const Matrix &J, const Vector &x,
+void compareProductsOfJacobian(const BoundProblem &problem, ConstVectorRef u, double lambda, const Matrix &J, const Vector &x,
                                const Vector &w, const Scaling &scaling, DerivativeCheck &check) {
   const int n = problem.dimension();
   Vector y(n), yt(n + 1);
@@ -151,7 +151,7 @@ void compareProductsOfJacobian(Problem &problem, ConstVectorRef u, double lambda
     check.comparisons.push_back(refused("jacobianTransposeApply"));
 }
 
-void compareSecondDerivatives(Problem &problem, ConstVectorRef u, double lambda, const Vector &x, const Vector &z,
+void compareSecondDerivatives(const BoundProblem &problem, ConstVectorRef u, double lambda, const Vector &x, const Vector &z,
                               const Vector &w, const Scaling &scaling, const DerivativeCheckOptions &options,
                               DerivativeCheck &check) {
   const int n = problem.dimension();
@@ -197,7 +197,7 @@ std::string describe(const DerivativeComparison &c, double precision) {
 
 }  // namespace
 
-DerivativeCheck checkDerivatives(Problem &problem, ConstVectorRef u, double lambda,
+DerivativeCheck checkDerivatives(const BoundProblem &problem, ConstVectorRef u, double lambda,
                                  const DerivativeCheckOptions &options) {
   DerivativeCheck check;
   const int n = problem.dimension();

@@ -8,6 +8,7 @@ namespace buckle::continuation {
 
 FoldCurveProblem::FoldCurveProblem(TwoParameterProblem &problem, const Vector &c)
     : problem_(problem),
+      inner_(problem),
       n_(problem.dimension()),
       c_(c),
       Fu_(n_, n_),
@@ -35,26 +36,26 @@ Vector FoldCurveProblem::start(const Problem &problem, ConstVectorRef u, double 
   return U;
 }
 
-bool FoldCurveProblem::residual(ConstVectorRef U, double mu, VectorRef G) {
+bool FoldCurveProblem::residual(ProblemWorkspace &, ConstVectorRef U, double mu, VectorRef G) const {
   if (!problem_.setSecondParameter(mu)) return false;
   const auto u = U.head(n_);
   const auto v = U.tail(n_);
-  if (!problem_.residual(u, U[n_], G.head(n_))) return false;
-  if (!problem_.jacobian(u, U[n_], Fu_, Flambda_)) return false;
+  if (!inner_.residual(u, U[n_], G.head(n_))) return false;
+  if (!inner_.jacobian(u, U[n_], Fu_, Flambda_)) return false;
   G.segment(n_, n_).noalias() = Fu_ * v;
   G[2 * n_] = c_.dot(v) - 1.0;
   return true;
 }
 
-bool FoldCurveProblem::jacobian(ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) {
+bool FoldCurveProblem::jacobian(ProblemWorkspace &, ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) const {
   if (!problem_.setSecondParameter(mu)) return false;
   const auto u = U.head(n_);
   const double lambda = U[n_];
   const auto v = U.tail(n_);
-  if (!problem_.jacobian(u, lambda, Fu_, Flambda_)) return false;
+  if (!inner_.jacobian(u, lambda, Fu_, Flambda_)) return false;
   // F_uu[v, ·] and F_uλ v: the derivative of [F_u, F_λ] in the direction (v, 0)
-  if (!problem_.jacobianDirectionalDerivative(u, lambda, v, 0.0, dFu_, dFlambda_)) return false;
-  if (!problem_.secondParameterDerivatives(u, lambda, v, Fmu_, FuMuV_)) return false;
+  if (!inner_.jacobianDirectionalDerivative(u, lambda, v, 0.0, dFu_, dFlambda_)) return false;
+  if (!problem_.secondParameterDerivatives(inner_.workspace(), u, lambda, v, Fmu_, FuMuV_)) return false;
   GU.setZero();
   GU.topLeftCorner(n_, n_) = Fu_;
   GU.block(0, n_, n_, 1) = Flambda_;
@@ -79,19 +80,19 @@ ProblemScales FoldCurveProblem::scales() const {
   return out;
 }
 
-double FoldCurveProblem::boundary(int k, ConstVectorRef U, double mu) {
+double FoldCurveProblem::boundary(ProblemWorkspace &, int k, ConstVectorRef U, double mu) const {
   // μ outside the domain: not a boundary crossing (residual() refuses the point anyway)
   if (!problem_.setSecondParameter(mu)) return 1.0;
-  return problem_.boundary(k, U.head(n_), U[n_]);
+  return inner_.boundary(k, U.head(n_), U[n_]);
 }
 
-bool FoldCurveProblem::cuspTest(ConstVectorRef U, double mu, double &value) {
+bool FoldCurveProblem::cuspTest(ConstVectorRef U, double mu, double &value) const {
   if (!problem_.setSecondParameter(mu)) return false;
   const auto u = U.head(n_);
   const double lambda = U[n_];
   const Vector v = U.tail(n_);
-  if (!problem_.jacobian(u, lambda, Fu_, Flambda_)) return false;
-  if (!problem_.jacobianDirectionalDerivative(u, lambda, v, 0.0, dFu_, dFlambda_)) return false;
+  if (!inner_.jacobian(u, lambda, Fu_, Flambda_)) return false;
+  if (!inner_.jacobianDirectionalDerivative(u, lambda, v, 0.0, dFu_, dFlambda_)) return false;
   // ψ: [[F_uᵀ, c], [vᵀ, 0]] [ψ; s] = [0; 1] (s = 0 exactly on the curve)
   Matrix A = Matrix::Zero(n_ + 1, n_ + 1);
   A.topLeftCorner(n_, n_) = Fu_.transpose();
@@ -115,6 +116,7 @@ bool FoldCurveProblem::cuspTest(ConstVectorRef U, double mu, double &value) {
 MinimalFoldCurveProblem::MinimalFoldCurveProblem(TwoParameterProblem &problem, ConstVectorRef u, double lambda,
                                                  ConstVectorRef v)
     : problem_(problem),
+      inner_(problem),
       n_(problem.dimension()),
       v_(n_),
       w_(n_),
@@ -132,10 +134,10 @@ MinimalFoldCurveProblem::MinimalFoldCurveProblem(TwoParameterProblem &problem, C
   if (u.size() != n_ || v.size() != n_)
     throw std::invalid_argument("fold curve: state of size " + std::to_string(u.size()) + " and null vector of size " +
                                 std::to_string(v.size()) + " for a problem of dimension " + std::to_string(n_));
-  solver_ = problem_.makeStructuredSolver();
+  solver_ = inner_.makeStructuredSolver();
   if (!solver_ || solver_->maxGeneralBorder() < 1)
     throw std::invalid_argument("fold curve: the minimally augmented system needs a structured solver with general borders");
-  system_ = std::make_unique<RefinedBorderedSystem>(problem_, *solver_);
+  system_ = std::make_unique<RefinedBorderedSystem>(inner_, *solver_);
   rhs_[n_] = 1.0;
   // c from v; b from v as well (exact for a symmetric F_u), then from the left null vector of
   // the first solve (one step of inverse iteration).
@@ -169,7 +171,7 @@ void MinimalFoldCurveProblem::setBorders(const Vector &v, const Vector &w) {
   cached_ = cachedGradient_ = false;
 }
 
-bool MinimalFoldCurveProblem::evaluate(ConstVectorRef U, double mu) {
+bool MinimalFoldCurveProblem::evaluate(ConstVectorRef U, double mu) const {
   if (cached_ && mu == cachedMu_ && (U.array() == cachedU_.array()).all()) return true;
   cached_ = cachedGradient_ = false;
   if (!problem_.setSecondParameter(mu) || !U.allFinite()) return false;
@@ -191,7 +193,7 @@ bool MinimalFoldCurveProblem::evaluate(ConstVectorRef U, double mu) {
   return true;
 }
 
-bool MinimalFoldCurveProblem::evaluateGradient(ConstVectorRef U, double mu) {
+bool MinimalFoldCurveProblem::evaluateGradient(ConstVectorRef U, double mu) const {
   if (!evaluate(U, mu)) return false;
   if (cachedGradient_) return true;
   const auto u = U.head(n_);
@@ -199,19 +201,19 @@ bool MinimalFoldCurveProblem::evaluateGradient(ConstVectorRef U, double mu) {
   // g_x = −wᵀF_xx[(v, 0), ·], g_μ = −wᵀF_uμ v
   ex_.head(n_) = v_;
   ex_[n_] = 0.0;
-  if (!problem_.secondDerivativeTransposeApply(u, lambda, ex_, w_, gx_)) return false;
+  if (!inner_.secondDerivativeTransposeApply(u, lambda, ex_, w_, gx_)) return false;
   gx_ = -gx_;
-  if (!problem_.secondParameterDerivatives(u, lambda, v_, Fmu_, FuMuV_)) return false;
+  if (!problem_.secondParameterDerivatives(inner_.workspace(), u, lambda, v_, Fmu_, FuMuV_)) return false;
   gmu_ = -w_.dot(FuMuV_);
   ex_.setZero();
   ex_[n_] = 1.0;
-  if (!problem_.jacobianApply(u, lambda, ex_, Flambda_)) return false;
+  if (!inner_.jacobianApply(u, lambda, ex_, Flambda_)) return false;
   cachedGradient_ = gx_.allFinite() && std::isfinite(gmu_);
   return cachedGradient_;
 }
 
 bool MinimalFoldCurveProblem::gradient(ConstVectorRef U, double mu, double &g, Vector &gx, double &gmu,
-                                       Vector &Flambda, Vector &Fmu) {
+                                       Vector &Flambda, Vector &Fmu) const {
   if (!evaluateGradient(U, mu)) return false;
   g = g_;
   gx = gx_;
@@ -221,33 +223,33 @@ bool MinimalFoldCurveProblem::gradient(ConstVectorRef U, double mu, double &g, V
   return true;
 }
 
-bool MinimalFoldCurveProblem::residual(ConstVectorRef U, double mu, VectorRef G) {
+bool MinimalFoldCurveProblem::residual(ProblemWorkspace &, ConstVectorRef U, double mu, VectorRef G) const {
   if (!evaluate(U, mu)) return false;
-  if (!problem_.residual(U.head(n_), U[n_], G.head(n_))) return false;
+  if (!inner_.residual(U.head(n_), U[n_], G.head(n_))) return false;
   G[n_] = g_;
   return true;
 }
 
-bool MinimalFoldCurveProblem::jacobian(ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) {
+bool MinimalFoldCurveProblem::jacobian(ProblemWorkspace &, ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) const {
   if (!evaluateGradient(U, mu)) return false;
-  if (!problem_.jacobian(U.head(n_), U[n_], GU.topLeftCorner(n_, n_), GU.col(n_).head(n_))) return false;
+  if (!inner_.jacobian(U.head(n_), U[n_], GU.topLeftCorner(n_, n_), GU.col(n_).head(n_))) return false;
   GU.row(n_) = gx_.transpose();
   Gmu.head(n_) = Fmu_;
   Gmu[n_] = gmu_;
   return true;
 }
 
-bool MinimalFoldCurveProblem::jacobianApply(ConstVectorRef U, double mu, ConstVectorRef x, VectorRef y) {
+bool MinimalFoldCurveProblem::jacobianApply(ProblemWorkspace &, ConstVectorRef U, double mu, ConstVectorRef x, VectorRef y) const {
   if (!evaluateGradient(U, mu)) return false;
-  if (!problem_.jacobianApply(U.head(n_), U[n_], x.head(n_ + 1), y.head(n_))) return false;
+  if (!inner_.jacobianApply(U.head(n_), U[n_], x.head(n_ + 1), y.head(n_))) return false;
   y.head(n_) += x[n_ + 1] * Fmu_;
   y[n_] = gx_.dot(x.head(n_ + 1)) + gmu_ * x[n_ + 1];
   return y.allFinite();
 }
 
-bool MinimalFoldCurveProblem::jacobianTransposeApply(ConstVectorRef U, double mu, ConstVectorRef w, VectorRef y) {
+bool MinimalFoldCurveProblem::jacobianTransposeApply(ProblemWorkspace &, ConstVectorRef U, double mu, ConstVectorRef w, VectorRef y) const {
   if (!evaluateGradient(U, mu)) return false;
-  if (!problem_.jacobianTransposeApply(U.head(n_), U[n_], w.head(n_), y.head(n_ + 1))) return false;
+  if (!inner_.jacobianTransposeApply(U.head(n_), U[n_], w.head(n_), y.head(n_ + 1))) return false;
   y.head(n_ + 1) += w[n_] * gx_;
   y[n_ + 1] = Fmu_.dot(w.head(n_)) + gmu_ * w[n_];
   return y.allFinite();
@@ -257,12 +259,12 @@ ProblemScales MinimalFoldCurveProblem::scales() const {
   return stateAndParameterScales(problem_);
 }
 
-double MinimalFoldCurveProblem::boundary(int k, ConstVectorRef U, double mu) {
+double MinimalFoldCurveProblem::boundary(ProblemWorkspace &, int k, ConstVectorRef U, double mu) const {
   if (!problem_.setSecondParameter(mu)) return 1.0;
-  return problem_.boundary(k, U.head(n_), U[n_]);
+  return inner_.boundary(k, U.head(n_), U[n_]);
 }
 
-bool MinimalFoldCurveProblem::nullVectors(ConstVectorRef U, double mu, Vector &v, Vector &w) {
+bool MinimalFoldCurveProblem::nullVectors(ConstVectorRef U, double mu, Vector &v, Vector &w) const {
   if (!evaluate(U, mu)) return false;
   v = v_;
   w = w_;
@@ -277,12 +279,12 @@ bool MinimalFoldCurveProblem::adaptBorders(ConstVectorRef U, double mu) {
   return true;
 }
 
-bool MinimalFoldCurveProblem::cuspTest(ConstVectorRef U, double mu, double &value) {
+bool MinimalFoldCurveProblem::cuspTest(ConstVectorRef U, double mu, double &value) const {
   if (!evaluate(U, mu)) return false;
   ex_.head(n_) = v_;
   ex_[n_] = 0.0;
   Vector second(n_ + 1);
-  if (!problem_.secondDerivativeTransposeApply(U.head(n_), U[n_], ex_, w_, second)) return false;
+  if (!inner_.secondDerivativeTransposeApply(U.head(n_), U[n_], ex_, w_, second)) return false;
   const ProblemScales s = problem_.scales();
   // ψᵀF_uu[v, v] with ψ = w; the norms are the scaled ones (as FoldCurveProblem::cuspTest)
   const double norm = w_.cwiseProduct(s.residuals).norm() * v_.cwiseQuotient(s.unknowns).squaredNorm();
@@ -298,7 +300,7 @@ namespace {
 // own base solver (the curve problem's is refactored by every residual evaluation).
 class MinimalFoldCurveSolver final : public BorderedSolver {
  public:
-  MinimalFoldCurveSolver(MinimalFoldCurveProblem &curve, std::unique_ptr<BorderedSolver> base)
+  MinimalFoldCurveSolver(const MinimalFoldCurveProblem &curve, std::unique_ptr<BorderedSolver> base)
       : curve_(curve),
         n_(curve.base()),
         base_(std::move(base)),
@@ -325,7 +327,7 @@ class MinimalFoldCurveSolver final : public BorderedSolver {
   double logAbsDeterminant() const override { return deflated_.logAbsDeterminant(); }
 
  private:
-  MinimalFoldCurveProblem &curve_;
+  const MinimalFoldCurveProblem &curve_;
   int n_;
   std::unique_ptr<BorderedSolver> base_;
   DeflatedBorderedSolve deflated_;
@@ -335,8 +337,8 @@ class MinimalFoldCurveSolver final : public BorderedSolver {
 
 }  // namespace
 
-std::unique_ptr<BorderedSolver> MinimalFoldCurveProblem::makeStructuredSolver() {
-  std::unique_ptr<BorderedSolver> base = problem_.makeStructuredSolver();
+std::unique_ptr<BorderedSolver> MinimalFoldCurveProblem::makeStructuredSolver(ProblemWorkspace &) const {
+  std::unique_ptr<BorderedSolver> base = inner_.makeStructuredSolver();
   if (!base || base->maxGeneralBorder() < 1) return nullptr;
   return std::make_unique<MinimalFoldCurveSolver>(*this, std::move(base));
 }

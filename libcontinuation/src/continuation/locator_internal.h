@@ -24,7 +24,7 @@ inline bool crossingEigenvalue(const ContinuationPoint &p, int index, double &va
 
 // The crossing eigenvalue's index may exceed what the tracer recorded (it may record the inertia
 // only): recompute the stability of a bracket end with enough eigenvalues.
-inline void ensureEigenvalues(Problem &problem, ContinuationPoint &p, int count) {
+inline void ensureEigenvalues(const BoundProblem &problem, ContinuationPoint &p, int count) {
   if (!p.stability.valid() || p.stability.lowest.size() >= count) return;
   StabilityInfo info;
   if (problem.stability(p.u, p.lambda, count, info)) p.stability = info;

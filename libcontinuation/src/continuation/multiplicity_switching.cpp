@@ -60,7 +60,7 @@ bool addUpToSign(std::vector<Vector> &roots, const Vector &z) {
 }
 
 struct SecondDerivative {
-  Problem &problem;
+  BoundProblem problem;
   int n;
   // D(x0)[v] = d/dε F_x(x0 + εv) (N×(N+1)) at the point (u, λ).
   bool operator()(ConstVectorRef u, double lambda, ConstVectorRef v, Matrix &D) const {
@@ -76,7 +76,7 @@ struct SecondDerivative {
 // the quadratic equation on the sphere or, where it vanishes on span φ, of the cubic one.
 class ReducedEquation {
  public:
-  ReducedEquation(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out)
+  ReducedEquation(const BoundProblem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out)
       : problem_(problem), bp_(bp), n_(problem.dimension()), m_(m), r_(n_ - m), D_{problem, n_}, out_(out) {}
 
   bool solve(double kernelTolerance, int maxDenseDimension) {
@@ -346,7 +346,7 @@ class ReducedEquation {
     return true;
   }
 
-  Problem &problem_;
+  BoundProblem problem_;
   const SpecialPoint &bp_;
   const int n_, m_, r_;  // dimension, multiplicity, rank of F_x
   const SecondDerivative D_;
@@ -361,7 +361,7 @@ class ReducedEquation {
   bool secondOk_ = true;
 };
 
-bool solveReduced(Problem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out, double kernelTolerance,
+bool solveReduced(const BoundProblem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out, double kernelTolerance,
                   int maxDenseDimension) {
   return ReducedEquation(problem, bp, m, out).solve(kernelTolerance, maxDenseDimension);
 }
@@ -383,7 +383,7 @@ Matrix orthonormalColumns(const Matrix &X) {
 
 }  // namespace
 
-bool structuredMultipleKernel(Problem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda, int m,
+bool structuredMultipleKernel(const BoundProblem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda, int m,
                               Matrix &K, Matrix &Psi, double &residual, std::string *why) {
   const int n = problem.dimension();
   const int k = m + 1;
@@ -461,14 +461,15 @@ bool structuredMultipleKernel(Problem &problem, BorderedSolver &solver, ConstVec
   return true;
 }
 
-bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
+bool reducedBifurcationDirections(const BoundProblem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
                                   double kernelTolerance, int maxDenseDimension) {
   // In the problem's scaled variables (as bifurcatingDirection); directions back in its units.
   const int n = problem.dimension();
   const ProblemScales scales = problem.scales();
   if (!scales.identity() && scales.check(n).empty()) {
     const UnitScaling units(scales);
-    ScaledProblem scaled(problem, units);
+    const BoundScaledProblem scaledProblem(problem, units);
+    const BoundProblem &scaled = scaledProblem.bound();
     const bool ok = solveReduced(scaled, units.scaled(bp), multiplicity, out, kernelTolerance, maxDenseDimension);
     for (Vector &d : out.directions) d = units.directionToUser(d);
     return ok;

@@ -12,7 +12,7 @@ std::string NumericDiffOptions::validate(const std::string &prefix) const {
                        require(inRange(secondRelativeStep), prefix, "secondRelativeStep", "must lie in (0, 0.1]")});
 }
 
-bool differenceJacobian(Problem &problem, const ProblemScales &scales, double relativeStep, ConstVectorRef u,
+bool differenceJacobian(const BoundProblem &problem, const ProblemScales &scales, double relativeStep, ConstVectorRef u,
                         double lambda, MatrixRef Fu, VectorRef Fl, VectorRef work, VectorRef Fplus,
                         VectorRef Fminus) {
   const Eigen::Index n = u.size();
@@ -46,25 +46,25 @@ NumericDiffProblem::NumericDiffProblem(const NumericDiffOptions &options) : opti
   if (!options_.IsValid(&why)) throw std::invalid_argument("NumericDiffOptions: " + why);
 }
 
-const ProblemScales &NumericDiffProblem::cachedScales() {
+const ProblemScales &NumericDiffProblem::cachedScales(Workspace &nd) const {
   const int n = dimension();
-  if (!scalesValid_ || scales_.unknowns.size() != n) {
-    scales_ = scales();
-    if (!scales_.check(n).empty()) scales_ = ProblemScales::ones(n);
-    scalesValid_ = true;
-    work_.resize(n);
-    Fplus_.resize(n);
-    Fminus_.resize(n);
-    corner_.resize(n);
-    Jplus_.resize(n, n + 1);
-    Jminus_.resize(n, n + 1);
+  if (!nd.scalesValid || nd.scales.unknowns.size() != n) {
+    nd.scales = scales();
+    if (!nd.scales.check(n).empty()) nd.scales = ProblemScales::ones(n);
+    nd.scalesValid = true;
+    nd.work.resize(n);
+    nd.Fplus.resize(n);
+    nd.Fminus.resize(n);
+    nd.corner.resize(n);
+    nd.Jplus.resize(n, n + 1);
+    nd.Jminus.resize(n, n + 1);
   }
-  return scales_;
+  return nd.scales;
 }
 
-double NumericDiffProblem::directionStep(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                         double relative) {
-  const ProblemScales &s = cachedScales();
+double NumericDiffProblem::directionStep(Workspace &nd, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                         double relative) const {
+  const ProblemScales &s = cachedScales(nd);
   // In the scaled variables (where "1" is a typical size), as Problem's default second derivative.
   const double size = std::max({1.0, u.cwiseQuotient(s.unknowns).lpNorm<Eigen::Infinity>(),
                                 std::abs(lambda) / s.parameter});
@@ -72,42 +72,45 @@ double NumericDiffProblem::directionStep(ConstVectorRef u, double lambda, ConstV
   return length == 0.0 ? 0.0 : relative * size / length;
 }
 
-bool NumericDiffProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) {
-  const ProblemScales &s = cachedScales();
-  return differenceJacobian(*this, s, options_.relativeStep, u, lambda, Fu, Flambda, work_, Fplus_, Fminus_);
+bool NumericDiffProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const {
+  Workspace &nd = workspaceAs<Workspace>(ws);
+  const ProblemScales &s = cachedScales(nd);
+  return differenceJacobian(BoundProblem(*this, ws), s, options_.relativeStep, u, lambda, Fu, Flambda, nd.work, nd.Fplus, nd.Fminus);
 }
 
-bool NumericDiffProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
-                                                       double dlambda, MatrixRef dFu, VectorRef dFlambda) {
-  const ProblemScales &s = cachedScales();
+bool NumericDiffProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                                       double dlambda, MatrixRef dFu, VectorRef dFlambda) const {
+  Workspace &nd = workspaceAs<Workspace>(ws);
+  const ProblemScales &s = cachedScales(nd);
   const double delta = options_.secondRelativeStep;
-  const double h = directionStep(u, lambda, du, dlambda, delta);
+  const double h = directionStep(nd, u, lambda, du, dlambda, delta);
   if (h == 0.0) {
     dFu.setZero();
     dFlambda.setZero();
     return true;
   }
-  // corner_ holds the shifted u while differenceJacobian perturbs its own copy (work_).
-  corner_ = u + h * du;
-  if (!differenceJacobian(*this, s, delta, corner_, lambda + h * dlambda, Jplus_.leftCols(dimension()),
-                          Jplus_.col(dimension()), work_, Fplus_, Fminus_))
+  // nd.corner holds the shifted u while differenceJacobian perturbs its own copy (nd.work).
+  nd.corner = u + h * du;
+  if (!differenceJacobian(BoundProblem(*this, ws), s, delta, nd.corner, lambda + h * dlambda, nd.Jplus.leftCols(dimension()),
+                          nd.Jplus.col(dimension()), nd.work, nd.Fplus, nd.Fminus))
     return false;
-  corner_ = u - h * du;
-  if (!differenceJacobian(*this, s, delta, corner_, lambda - h * dlambda, Jminus_.leftCols(dimension()),
-                          Jminus_.col(dimension()), work_, Fplus_, Fminus_))
+  nd.corner = u - h * du;
+  if (!differenceJacobian(BoundProblem(*this, ws), s, delta, nd.corner, lambda - h * dlambda, nd.Jminus.leftCols(dimension()),
+                          nd.Jminus.col(dimension()), nd.work, nd.Fplus, nd.Fminus))
     return false;
   const int n = dimension();
-  dFu = (Jplus_.leftCols(n) - Jminus_.leftCols(n)) / (2.0 * h);
-  dFlambda = (Jplus_.col(n) - Jminus_.col(n)) / (2.0 * h);
+  dFu = (nd.Jplus.leftCols(n) - nd.Jminus.leftCols(n)) / (2.0 * h);
+  dFlambda = (nd.Jplus.col(n) - nd.Jminus.col(n)) / (2.0 * h);
   return dFu.allFinite() && dFlambda.allFinite();
 }
 
-bool NumericDiffProblem::secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
-                                               VectorRef y) {
+bool NumericDiffProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
+                                               VectorRef y) const {
+  Workspace &nd = workspaceAs<Workspace>(ws);
   const int n = dimension();
   const double delta = options_.secondRelativeStep;
-  const double h = directionStep(u, lambda, x.head(n), x[n], delta);
-  const double k = directionStep(u, lambda, z.head(n), z[n], delta);
+  const double h = directionStep(nd, u, lambda, x.head(n), x[n], delta);
+  const double k = directionStep(nd, u, lambda, z.head(n), z[n], delta);
   if (h == 0.0 || k == 0.0) {
     y.setZero();
     return true;
@@ -116,23 +119,24 @@ bool NumericDiffProblem::secondDerivativeApply(ConstVectorRef u, double lambda, 
   y.setZero();
   for (int a = -1; a <= 1; a += 2) {
     for (int b = -1; b <= 1; b += 2) {
-      corner_ = u + (a * h) * x.head(n) + (b * k) * z.head(n);
-      if (!residual(corner_, lambda + a * h * x[n] + b * k * z[n], Fplus_)) return false;
-      y += (a * b) * Fplus_;
+      nd.corner = u + (a * h) * x.head(n) + (b * k) * z.head(n);
+      if (!residual(ws, nd.corner, lambda + a * h * x[n] + b * k * z[n], nd.Fplus)) return false;
+      y += (a * b) * nd.Fplus;
     }
   }
   y /= 4.0 * h * k;
   return y.allFinite();
 }
 
-bool NumericDiffProblem::secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x,
-                                                        ConstVectorRef w, VectorRef y) {
+bool NumericDiffProblem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                                        ConstVectorRef w, VectorRef y) const {
+  Workspace &nd = workspaceAs<Workspace>(ws);
   const int n = dimension();
-  cachedScales();
-  // Jplus_/Jminus_ are the directional derivative's own workspaces: use a separate block.
-  Matrix &dF = second_;
+  cachedScales(nd);
+  // nd.Jplus/nd.Jminus are the directional derivative's own workspaces: use a separate block.
+  Matrix &dF = nd.second;
   dF.resize(n, n + 1);
-  if (!jacobianDirectionalDerivative(u, lambda, x.head(n), x[n], dF.leftCols(n), dF.col(n))) return false;
+  if (!jacobianDirectionalDerivative(ws, u, lambda, x.head(n), x[n], dF.leftCols(n), dF.col(n))) return false;
   y.noalias() = dF.transpose() * w;
   return y.allFinite();
 }

@@ -1,4 +1,5 @@
 #include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 #include "buckle/continuation/bordered_solver.h"
 
@@ -6,6 +7,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace buckle::continuation {
 
@@ -52,8 +54,18 @@ double differenceStep(const Problem &problem, ConstVectorRef u, double lambda, C
 
 }  // namespace
 
-bool Problem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
-                                            double dlambda, MatrixRef dFu, VectorRef dFlambda) {
+ProblemWorkspace::~ProblemWorkspace() = default;
+
+std::unique_ptr<BorderedSolver> BoundProblem::makeStructuredSolver() const { return problem_->makeStructuredSolver(*ws_); }
+
+void throwForeignWorkspace() {
+  throw std::invalid_argument("a ProblemWorkspace evaluated by a problem that did not make it (createWorkspace)");
+}
+
+std::unique_ptr<ProblemWorkspace> Problem::createWorkspace() const { return std::make_unique<ProblemWorkspace>(); }
+
+bool Problem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                            double dlambda, MatrixRef dFu, VectorRef dFlambda) const {
   const int n = dimension();
   const double h = differenceStep(*this, u, lambda, du, dlambda);
   if (h == 0.0) {
@@ -64,31 +76,31 @@ bool Problem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, Con
   Vector up = u + h * du, um = u - h * du;
   Matrix Jp(n, n), Jm(n, n);
   Vector lp(n), lm(n);
-  if (!jacobian(up, lambda + h * dlambda, Jp, lp)) return false;
-  if (!jacobian(um, lambda - h * dlambda, Jm, lm)) return false;
+  if (!jacobian(ws, up, lambda + h * dlambda, Jp, lp)) return false;
+  if (!jacobian(ws, um, lambda - h * dlambda, Jm, lm)) return false;
   dFu = (Jp - Jm) / (2.0 * h);
   dFlambda = (lp - lm) / (2.0 * h);
   return true;
 }
 
-bool Problem::jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) {
+bool Problem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const {
   const int n = dimension();
-  applyFu_.resize(n, n + 1);
-  if (!jacobian(u, lambda, applyFu_.leftCols(n), applyFu_.col(n))) return false;
-  y.noalias() = applyFu_ * x;
+  ws.applyFu.resize(n, n + 1);
+  if (!jacobian(ws, u, lambda, ws.applyFu.leftCols(n), ws.applyFu.col(n))) return false;
+  y.noalias() = ws.applyFu * x;
   return true;
 }
 
-bool Problem::jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) {
+bool Problem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) const {
   const int n = dimension();
-  applyFu_.resize(n, n + 1);
-  if (!jacobian(u, lambda, applyFu_.leftCols(n), applyFu_.col(n))) return false;
-  y.noalias() = applyFu_.transpose() * w;
+  ws.applyFu.resize(n, n + 1);
+  if (!jacobian(ws, u, lambda, ws.applyFu.leftCols(n), ws.applyFu.col(n))) return false;
+  y.noalias() = ws.applyFu.transpose() * w;
   return true;
 }
 
-bool Problem::secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
-                                             VectorRef y) {
+bool Problem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
+                                             VectorRef y) const {
   const int n = dimension();
   const double h = differenceStep(*this, u, lambda, x.head(n), x[n]);
   if (h == 0.0) {
@@ -96,42 +108,42 @@ bool Problem::secondDerivativeTransposeApply(ConstVectorRef u, double lambda, Co
     return true;
   }
   Vector yp(n + 1), ym(n + 1);
-  if (!jacobianTransposeApply(u + h * x.head(n), lambda + h * x[n], w, yp)) return false;
-  if (!jacobianTransposeApply(u - h * x.head(n), lambda - h * x[n], w, ym)) return false;
+  if (!jacobianTransposeApply(ws, u + h * x.head(n), lambda + h * x[n], w, yp)) return false;
+  if (!jacobianTransposeApply(ws, u - h * x.head(n), lambda - h * x[n], w, ym)) return false;
   y = (yp - ym) / (2.0 * h);
   return y.allFinite();
 }
 
-bool Problem::secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z, VectorRef y) {
+bool Problem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z, VectorRef y) const {
   const int n = dimension();
-  secondFu_.resize(n, n);
-  secondFl_.resize(n);
-  if (!jacobianDirectionalDerivative(u, lambda, x.head(n), x[n], secondFu_, secondFl_)) return false;
-  y.noalias() = secondFu_ * z.head(n);
-  y += z[n] * secondFl_;
+  ws.secondFu.resize(n, n);
+  ws.secondFl.resize(n);
+  if (!jacobianDirectionalDerivative(ws, u, lambda, x.head(n), x[n], ws.secondFu, ws.secondFl)) return false;
+  y.noalias() = ws.secondFu * z.head(n);
+  y += z[n] * ws.secondFl;
   return y.allFinite();
 }
 
-std::unique_ptr<BorderedSolver> Problem::makeStructuredSolver() { return nullptr; }
+std::unique_ptr<BorderedSolver> Problem::makeStructuredSolver(ProblemWorkspace &) const { return nullptr; }
 
-void Problem::boundaries(ConstVectorRef u, double lambda, VectorRef g) {
-  for (Eigen::Index k = 0; k < g.size(); ++k) g[k] = boundary(static_cast<int>(k), u, lambda);
+void Problem::boundaries(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef g) const {
+  for (Eigen::Index k = 0; k < g.size(); ++k) g[k] = boundary(ws, static_cast<int>(k), u, lambda);
 }
 
-bool Problem::stabilityOperator(ConstVectorRef, double, Matrix&, Matrix&) { return false; }
+bool Problem::stabilityOperator(ProblemWorkspace &, ConstVectorRef, double, Matrix&, Matrix&) const { return false; }
 
-bool Problem::stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo& info) {
+bool Problem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount, StabilityInfo& info) const {
   if (!hasStabilityOperator()) return false;
-  if (!stabilityOperator(u, lambda, stabilityH_, stabilityC_)) return false;
-  info = projectedInertia(stabilityH_, stabilityC_, 1e-13, lowestCount, scales().stability);
+  if (!stabilityOperator(ws, u, lambda, ws.stabilityH, ws.stabilityC)) return false;
+  info = projectedInertia(ws.stabilityH, ws.stabilityC, 1e-13, lowestCount, scales().stability);
   return true;
 }
 
-bool Problem::stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values) {
+bool Problem::stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first, VectorRef values) const {
   if (!hasStabilityOperator() || first < 0) return false;
-  if (!stabilityOperator(u, lambda, stabilityH_, stabilityC_)) return false;
+  if (!stabilityOperator(ws, u, lambda, ws.stabilityH, ws.stabilityC)) return false;
   const StabilityInfo all =
-      projectedInertia(stabilityH_, stabilityC_, 1e-13, int(stabilityH_.rows()), scales().stability);
+      projectedInertia(ws.stabilityH, ws.stabilityC, 1e-13, int(ws.stabilityH.rows()), scales().stability);
   if (first + values.size() > all.lowest.size()) return false;
   values = all.lowest.segment(first, values.size());
   return true;

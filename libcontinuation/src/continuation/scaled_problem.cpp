@@ -126,12 +126,24 @@ void UnitScaling::toUser(Branch &b) const {
   for (SpecialPoint &p : b.specialPoints) toUser(p);
 }
 
-ScaledProblem::ScaledProblem(Problem &problem, const UnitScaling &units)
-    : problem_(problem), units_(units), n_(problem.dimension()), u_(Vector::Zero(n_)), du_(Vector::Zero(n_)) {}
+ScaledProblem::ScaledProblem(const Problem &problem, const UnitScaling &units)
+    : problem_(problem), units_(units), n_(problem.dimension()) {}
 
-const Vector &ScaledProblem::user(ConstVectorRef u) {
-  u_ = u.cwiseProduct(units_.scales().unknowns);
-  return u_;
+ScaledProblem::Workspace::Workspace(const BoundProblem &problem, int n)
+    : inner(problem), u(Vector::Zero(n)), du(Vector::Zero(n)) {}
+
+std::unique_ptr<ProblemWorkspace> ScaledProblem::createWorkspace() const {
+  return std::make_unique<Workspace>(BoundProblem(problem_), n_);
+}
+
+std::unique_ptr<ProblemWorkspace> ScaledProblem::workspaceOn(const BoundProblem &problem) const {
+  if (&problem.problem() != &problem_) throwForeignWorkspace();
+  return std::make_unique<Workspace>(problem, n_);
+}
+
+const Vector &ScaledProblem::user(Workspace &sw, ConstVectorRef u) const {
+  sw.u = u.cwiseProduct(units_.scales().unknowns);
+  return sw.u;
 }
 
 void ScaledProblem::scaleJacobian(MatrixRef Fu, VectorRef Flambda) const {
@@ -141,113 +153,127 @@ void ScaledProblem::scaleJacobian(MatrixRef Fu, VectorRef Flambda) const {
   Flambda.array() *= s.parameter / s.residuals.array();
 }
 
-bool ScaledProblem::residual(ConstVectorRef u, double lambda, VectorRef F) {
-  if (!problem_.residual(user(u), lambda * units_.parameter(), F)) return false;
+bool ScaledProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  if (!sw.inner.residual(user(sw, u), lambda * units_.parameter(), F)) return false;
   F.array() /= units_.scales().residuals.array();
   return true;
 }
 
-bool ScaledProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) {
-  if (!problem_.jacobian(user(u), lambda * units_.parameter(), Fu, Flambda)) return false;
+bool ScaledProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  if (!sw.inner.jacobian(user(sw, u), lambda * units_.parameter(), Fu, Flambda)) return false;
   scaleJacobian(Fu, Flambda);
   return true;
 }
 
-bool ScaledProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                                  MatrixRef dFu, VectorRef dFlambda) {
-  du_ = du.cwiseProduct(units_.scales().unknowns);
+bool ScaledProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                                  MatrixRef dFu, VectorRef dFlambda) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  sw.du = du.cwiseProduct(units_.scales().unknowns);
   const double lp = units_.parameter();
-  if (!problem_.jacobianDirectionalDerivative(user(u), lambda * lp, du_, dlambda * lp, dFu, dFlambda)) return false;
+  if (!sw.inner.jacobianDirectionalDerivative(user(sw, u), lambda * lp, sw.du, dlambda * lp, dFu, dFlambda)) return false;
   scaleJacobian(dFu, dFlambda);
   return true;
 }
 
-bool ScaledProblem::jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) {
+bool ScaledProblem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
   // F̃_x x̃ = D_F⁻¹ F_x S x̃, S = diag(D_u, λ₀).
-  x_.resize(n_ + 1);
-  x_.head(n_) = x.head(n_).cwiseProduct(units_.scales().unknowns);
-  x_[n_] = x[n_] * units_.parameter();
-  if (!problem_.jacobianApply(user(u), lambda * units_.parameter(), x_, y)) return false;
+  sw.x.resize(n_ + 1);
+  sw.x.head(n_) = x.head(n_).cwiseProduct(units_.scales().unknowns);
+  sw.x[n_] = x[n_] * units_.parameter();
+  if (!sw.inner.jacobianApply(user(sw, u), lambda * units_.parameter(), sw.x, y)) return false;
   y.array() /= units_.scales().residuals.array();
   return true;
 }
 
-bool ScaledProblem::jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) {
+bool ScaledProblem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
   // F̃_xᵀ w̃ = S F_xᵀ D_F⁻¹ w̃.
-  w_ = w.cwiseQuotient(units_.scales().residuals);
-  if (!problem_.jacobianTransposeApply(user(u), lambda * units_.parameter(), w_, y)) return false;
+  sw.w = w.cwiseQuotient(units_.scales().residuals);
+  if (!sw.inner.jacobianTransposeApply(user(sw, u), lambda * units_.parameter(), sw.w, y)) return false;
   y.head(n_).array() *= units_.scales().unknowns.array();
   y[n_] *= units_.parameter();
   return true;
 }
 
-bool ScaledProblem::secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x,
-                                                   ConstVectorRef w, VectorRef y) {
+bool ScaledProblem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                                   ConstVectorRef w, VectorRef y) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
   // F̃(x̃) = D_F⁻¹ F(S x̃): (F̃_xx[x̃, ·])ᵀ w̃ = S (F_xx[S x̃, ·])ᵀ D_F⁻¹ w̃.
-  x_.resize(n_ + 1);
-  x_.head(n_) = x.head(n_).cwiseProduct(units_.scales().unknowns);
-  x_[n_] = x[n_] * units_.parameter();
-  w_ = w.cwiseQuotient(units_.scales().residuals);
-  if (!problem_.secondDerivativeTransposeApply(user(u), lambda * units_.parameter(), x_, w_, y)) return false;
+  sw.x.resize(n_ + 1);
+  sw.x.head(n_) = x.head(n_).cwiseProduct(units_.scales().unknowns);
+  sw.x[n_] = x[n_] * units_.parameter();
+  sw.w = w.cwiseQuotient(units_.scales().residuals);
+  if (!sw.inner.secondDerivativeTransposeApply(user(sw, u), lambda * units_.parameter(), sw.x, sw.w, y)) return false;
   y.head(n_).array() *= units_.scales().unknowns.array();
   y[n_] *= units_.parameter();
   return true;
 }
 
-bool ScaledProblem::secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
-                                          VectorRef y) {
+bool ScaledProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
+                                          VectorRef y) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
   // F̃_xx[x̃, z̃] = D_F⁻¹ F_xx[S x̃, S z̃]: the problem's own (exact, O(N)) product.
-  x_.resize(n_ + 1);
-  x_.head(n_) = x.head(n_).cwiseProduct(units_.scales().unknowns);
-  x_[n_] = x[n_] * units_.parameter();
-  z_.resize(n_ + 1);
-  z_.head(n_) = z.head(n_).cwiseProduct(units_.scales().unknowns);
-  z_[n_] = z[n_] * units_.parameter();
-  if (!problem_.secondDerivativeApply(user(u), lambda * units_.parameter(), x_, z_, y)) return false;
+  sw.x.resize(n_ + 1);
+  sw.x.head(n_) = x.head(n_).cwiseProduct(units_.scales().unknowns);
+  sw.x[n_] = x[n_] * units_.parameter();
+  sw.z.resize(n_ + 1);
+  sw.z.head(n_) = z.head(n_).cwiseProduct(units_.scales().unknowns);
+  sw.z[n_] = z[n_] * units_.parameter();
+  if (!sw.inner.secondDerivativeApply(user(sw, u), lambda * units_.parameter(), sw.x, sw.z, y)) return false;
   y.array() /= units_.scales().residuals.array();
   return true;
 }
 
-bool ScaledProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) {
-  if (!problem_.stabilityOperator(user(u), lambda * units_.parameter(), H, C)) return false;
+bool ScaledProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  if (!sw.inner.stabilityOperator(user(sw, u), lambda * units_.parameter(), H, C)) return false;
   H /= units_.scales().stability;
   return true;
 }
 
-bool ScaledProblem::stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo &info) {
-  if (!problem_.stability(user(u), lambda * units_.parameter(), lowestCount, info)) return false;
+bool ScaledProblem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount, StabilityInfo &info) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  if (!sw.inner.stability(user(sw, u), lambda * units_.parameter(), lowestCount, info)) return false;
   info.lowest /= units_.scales().stability;
   info.smallest /= units_.scales().stability;
   return true;
 }
 
-bool ScaledProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values) {
-  if (!problem_.stabilityEigenvalues(user(u), lambda * units_.parameter(), first, values)) return false;
+bool ScaledProblem::stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first, VectorRef values) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  if (!sw.inner.stabilityEigenvalues(user(sw, u), lambda * units_.parameter(), first, values)) return false;
   values /= units_.scales().stability;
   return true;
 }
 
-bool ScaledProblem::stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                       double &bound) {
-  du_ = du.cwiseProduct(units_.scales().unknowns);
-  if (!problem_.stabilityRateBound(user(u), lambda * units_.parameter(), du_, dlambda * units_.parameter(), bound))
+bool ScaledProblem::stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                       double &bound) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  sw.du = du.cwiseProduct(units_.scales().unknowns);
+  if (!sw.inner.stabilityRateBound(user(sw, u), lambda * units_.parameter(), sw.du, dlambda * units_.parameter(), bound))
     return false;
   bound /= units_.scales().stability;
   return true;
 }
 
-std::unique_ptr<BorderedSolver> ScaledProblem::makeStructuredSolver() {
-  std::unique_ptr<BorderedSolver> solver = problem_.makeStructuredSolver();
+std::unique_ptr<BorderedSolver> ScaledProblem::makeStructuredSolver(ProblemWorkspace &ws) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  std::unique_ptr<BorderedSolver> solver = sw.inner.makeStructuredSolver();
   if (!solver) return nullptr;
   return std::make_unique<ScaledBorderedSolver>(std::move(solver), units_);
 }
 
-double ScaledProblem::boundary(int k, ConstVectorRef u, double lambda) {
-  return problem_.boundary(k, user(u), lambda * units_.parameter());
+double ScaledProblem::boundary(ProblemWorkspace &ws, int k, ConstVectorRef u, double lambda) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  return sw.inner.boundary(k, user(sw, u), lambda * units_.parameter());
 }
 
-void ScaledProblem::boundaries(ConstVectorRef u, double lambda, VectorRef g) {
-  problem_.boundaries(user(u), lambda * units_.parameter(), g);  // u scaled once, not once per k
+void ScaledProblem::boundaries(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef g) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  sw.inner.boundaries(user(sw, u), lambda * units_.parameter(), g);  // u scaled once, not once per k
 }
 
 ScaledBorderedSolver::ScaledBorderedSolver(std::unique_ptr<BorderedSolver> solver, const UnitScaling &units)

@@ -8,13 +8,13 @@ namespace buckle::continuation {
 
 namespace {
 
-bool eigenvaluesAt(Problem &problem, ConstVectorRef u, double lambda, int first, int count, Eigen::Vector2d &out) {
+bool eigenvaluesAt(const BoundProblem &problem, ConstVectorRef u, double lambda, int first, int count, Eigen::Vector2d &out) {
   return problem.stabilityEigenvalues(u, lambda, first, out.head(count)) && out.head(count).allFinite();
 }
 
 }  // namespace
 
-bool measureNearZeroValues(Problem &problem, ContinuationPoint &point) {
+bool measureNearZeroValues(const BoundProblem &problem, ContinuationPoint &point) {
   point.spectrum = NearZeroSpectrum();
   const int n = problem.dimension();
   if (!point.stability.valid() || point.tangent.size() != n + 1 || point.u.size() != n) return false;
@@ -40,7 +40,7 @@ bool measureNearZeroValues(Problem &problem, ContinuationPoint &point) {
   return true;
 }
 
-bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, Vector &workspace, double delta) {
+bool measureNearZeroSlopes(const BoundProblem &problem, ContinuationPoint &point, Vector &workspace, double delta) {
   NearZeroSpectrum &sp = point.spectrum;
   const int n = problem.dimension();
   if (!sp.valid() || point.tangent.size() != n + 1 || point.u.size() != n) return false;
@@ -64,12 +64,12 @@ bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, Vector &w
   return true;
 }
 
-bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, double delta) {
+bool measureNearZeroSlopes(const BoundProblem &problem, ContinuationPoint &point, double delta) {
   Vector workspace;
   return measureNearZeroSlopes(problem, point, workspace, delta);
 }
 
-bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double delta) {
+bool measureNearZeroSpectrum(const BoundProblem &problem, ContinuationPoint &point, double delta) {
   if (!measureNearZeroValues(problem, point)) return false;
   if (measureNearZeroSlopes(problem, point, delta)) return true;
   point.spectrum = NearZeroSpectrum();

@@ -40,7 +40,7 @@ constexpr int kRefinementSteps = 3;
 
 }  // namespace
 
-RefinedBorderedSystem::RefinedBorderedSystem(Problem &problem, BorderedSolver &solver)
+RefinedBorderedSystem::RefinedBorderedSystem(const BoundProblem &problem, BorderedSolver &solver)
     : problem_(problem),
       solver_(solver),
       n_(problem.dimension()),
@@ -95,7 +95,7 @@ bool RefinedBorderedSystem::solve(const Vector &b, Vector &x) {
   return x.allFinite();
 }
 
-StructuredRefinement::StructuredRefinement(Problem &problem, BorderedSolver &solver, double tolerance,
+StructuredRefinement::StructuredRefinement(const BoundProblem &problem, BorderedSolver &solver, double tolerance,
                                            int maxIterations)
     : problem_(problem),
       solver_(solver),

@@ -8,7 +8,7 @@
 
 namespace buckle::continuation {
 
-PointEvaluator::PointEvaluator(Problem &problem, BorderedSolver &solver, bool computeStability,
+PointEvaluator::PointEvaluator(const BoundProblem &problem, BorderedSolver &solver, bool computeStability,
                                int lowestEigenvalues)
     : problem_(problem),
       solver_(solver),
@@ -168,7 +168,7 @@ IntervalCrossings classifyInterval(const ContinuationPoint &a, const Continuatio
   return crossings;
 }
 
-bool jacobianKernel(Problem &problem, ConstVectorRef u, double lambda, KernelInfo &info) {
+bool jacobianKernel(const BoundProblem &problem, ConstVectorRef u, double lambda, KernelInfo &info) {
   const int n = problem.dimension();
   Matrix Fx = Matrix::Zero(n, n + 1);
   if (!problem.jacobian(u, lambda, Fx.leftCols(n), Fx.col(n))) return false;
@@ -198,7 +198,7 @@ bool bifurcationRoots(double a, double b, double c, ConstVectorRef k1, ConstVect
                       std::string *why);
 }  // namespace
 
-bool bifurcationDirections(Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi, ConstVectorRef k1,
+bool bifurcationDirections(const BoundProblem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi, ConstVectorRef k1,
                            ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why) {
   const int n = problem.dimension();
   Matrix D1(n, n + 1), D2(n, n + 1);
@@ -214,7 +214,7 @@ bool bifurcationDirections(Problem &problem, ConstVectorRef u, double lambda, Co
   return bifurcationRoots(a, b, c, k1, k2, d1, d2, why);
 }
 
-bool bifurcationDirectionsApplied(Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi,
+bool bifurcationDirectionsApplied(const BoundProblem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi,
                                   ConstVectorRef k1, ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why) {
   const int n = problem.dimension();
   Vector y1(n + 1), y2(n + 1);

@@ -53,8 +53,8 @@ bool retryShorter(const ContinuationPoint &a, const ContinuationPoint &b, double
 }  // namespace
 
 
-Tracer::Tracer(Problem &problem, const TracerOptions &options)
-    : problem_(problem), options_(options), n_(problem.dimension()), work_(&problem) {
+Tracer::Tracer(const BoundProblem &problem, const TracerOptions &options)
+    : problem_(problem), options_(options), n_(problem.dimension()), work_(problem) {
   // Invalid input is reported by trace()/continueBranch() as StopReason::InvalidOptions, never
   // thrown (docs/continuation.md, "Errors"): nothing below is built for it.
   if (n_ < 1) {
@@ -78,8 +78,9 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   }
   units_ = UnitScaling(scales);
   if (!units_.identity()) {
-    scaled_ = std::make_unique<ScaledProblem>(problem_, units_);
-    work_ = scaled_.get();
+    scaled_ = std::make_unique<ScaledProblem>(problem_.problem(), units_);
+    scaledWorkspace_ = scaled_->workspaceOn(problem_);
+    work_ = BoundProblem(*scaled_, *scaledWorkspace_);
   }
   lambdaMin_ = options_.lambdaMin / units_.parameter();
   lambdaMax_ = options_.lambdaMax / units_.parameter();
@@ -92,18 +93,18 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
   using LA = TracerOptions::LinearAlgebra;
   if (options_.linearAlgebra != LA::Dense &&
       (options_.linearAlgebra == LA::Structured || n_ >= options_.structuredFromDimension))
-    structuredSolver_ = work_->makeStructuredSolver();
+    structuredSolver_ = work_.makeStructuredSolver();
   if (options_.linearAlgebra == LA::Structured && !structuredSolver_) {
     invalidReason_ = "linearAlgebra = Structured, but the problem offers no structured solver";
     return;
   }
   BorderedSolver *solver = structuredSolver_.get();
   if (!solver) {
-    denseSolver_ = std::make_unique<DenseBorderedSolver>(*work_);
+    denseSolver_ = std::make_unique<DenseBorderedSolver>(work_);
     solver = denseSolver_.get();
   }
-  corrector_ = std::make_unique<Corrector>(*work_, options_.corrector, structuredSolver_.get());
-  evaluator_ = std::make_unique<PointEvaluator>(*work_, *solver, options_.detection.stability,
+  corrector_ = std::make_unique<Corrector>(work_, options_.corrector, structuredSolver_.get());
+  evaluator_ = std::make_unique<PointEvaluator>(work_, *solver, options_.detection.stability,
                                                 options_.detection.lowestEigenvalues);
   LocatorOptions lo;
   lo.location = options_.location;
@@ -119,7 +120,7 @@ Tracer::Tracer(Problem &problem, const TracerOptions &options)
       units_.toUser(user);
       options_.onLocated(user);
     };
-  locator_ = std::make_unique<Locator>(*work_, *corrector_, *evaluator_, lo);
+  locator_ = std::make_unique<Locator>(work_, *corrector_, *evaluator_, lo);
   predictor_ = Vector::Zero(n_ + 1);
   x_ = Vector::Zero(n_ + 1);
   along_ = Vector::Zero(n_ + 1);
@@ -207,7 +208,7 @@ Branch Tracer::trace(ConstVectorRef u0, double lambda0, const InitialDirection &
   }
   if (!t.size()) {
     KernelInfo kernel;
-    if (!jacobianKernel(*work_, start.u, start.lambda, kernel)) {
+    if (!jacobianKernel(work_, start.u, start.lambda, kernel)) {
       branch.stopReason = StopReason::StartFailed;
       branch.stopMessage = "the problem refused the Jacobian at the start point";
       return branch;
@@ -414,13 +415,13 @@ void Tracer::continueBranch(Branch &branch, int skipIntervals) {
         // The values next to zero at both ends; their slopes only where the problem's rate bound
         // cannot exclude a hidden crossing (spectral_monitor.h): the same steps are searched.
         ContinuationPoint &start = branch.points[size_t(ia)];
-        if (!start.spectrum.valid()) measureNearZeroValues(*work_, start);
-        measureNearZeroValues(*work_, b);
+        if (!start.spectrum.valid()) measureNearZeroValues(work_, start);
+        measureNearZeroValues(work_, b);
         if (!rateBoundsExcludeCrossing(start, b, stepAlong(start, b))) {
           // x_ (the corrector's output, already copied into b) is free here: the shifted points'
           // workspace, so the hot loop allocates nothing.
-          measureNearZeroSlopes(*work_, start, x_);
-          measureNearZeroSlopes(*work_, b, x_);
+          measureNearZeroSlopes(work_, start, x_);
+          measureNearZeroSlopes(work_, b, x_);
         }
       }
       found = locateSpecialPoints(a, b);
@@ -477,7 +478,7 @@ void Tracer::endPaused(Branch &branch, const std::string &message) {
   appendEndpoint(branch, SpecialPointType::Endpoint, "interrupted", 0.0, 0.0);
 }
 
-Branch trace(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
+Branch trace(const BoundProblem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
              const TracerOptions &options) {
   Tracer tracer(problem, options);
   return tracer.trace(u0, lambda0, direction);

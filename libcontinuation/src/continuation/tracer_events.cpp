@@ -38,14 +38,14 @@ double Tracer::eventValue(int event, const ContinuationPoint &p) {
     }
     e -= 2 * (n_ + 1);
   }
-  return work_->boundary(e, p.u, p.lambda);
+  return work_.boundary(e, p.u, p.lambda);
 }
 
 void Tracer::eventValues(const ContinuationPoint &p, std::vector<double> &values) {
   const int first = 2 + boxEventCount();
   for (int e = 0; e < first; ++e) values[size_t(e)] = eventValue(e, p);
   const int boundaries = static_cast<int>(values.size()) - first;
-  if (boundaries > 0) work_->boundaries(p.u, p.lambda, Eigen::Map<Vector>(values.data() + first, boundaries));
+  if (boundaries > 0) work_.boundaries(p.u, p.lambda, Eigen::Map<Vector>(values.data() + first, boundaries));
 }
 
 double Tracer::eventScale(int event) const {

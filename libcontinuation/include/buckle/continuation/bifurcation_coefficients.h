@@ -13,7 +13,7 @@
 // derivatives with one Richardson extrapolation (error O(h⁴), h = 10⁻² in the scaled variables).
 #pragma once
 
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 #include <string>
 
@@ -31,7 +31,7 @@ struct BifurcationCoefficients {
 /// Coefficients of the branch bifurcating from the trivial branch u0 at λc; v approximates the
 /// null vector of F_u(u0, λc) (rescaled so that cᵀv = 1). False with the reason in `why` when
 /// the problem refuses a point, the branch point is not simple or not transversal.
-bool bifurcationCoefficients(Problem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef v, ConstVectorRef c,
+bool bifurcationCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef v, ConstVectorRef c,
                              BifurcationCoefficients &out, std::string *why = nullptr);
 
 }  // namespace buckle::continuation

@@ -17,7 +17,7 @@
 #pragma once
 
 #include "buckle/continuation/internal/dense_lu.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 #include <Eigen/LU>
 
@@ -94,7 +94,7 @@ class DeflatedBorderedSolve {
 /// determinant and solutions); above it Eigen's blocked LU.
 class DenseBorderedSolver final : public BorderedSolver {
  public:
-  explicit DenseBorderedSolver(Problem &problem);
+  explicit DenseBorderedSolver(const BoundProblem &problem);
 
   Factorization factor(ConstVectorRef u, double lambda, ConstVectorRef c) override;
   bool solve(ConstVectorRef b, VectorRef x) override;
@@ -106,7 +106,7 @@ class DenseBorderedSolver final : public BorderedSolver {
                               bool transposed) override;
 
  private:
-  Problem &problem_;
+  BoundProblem problem_;
   int n_;
   Matrix A_;                              // A(c) above kEigenIdenticalSize
   DenseLU small_;                         // N+1 ≤ kEigenIdenticalSize

@@ -18,7 +18,7 @@
 #pragma once
 
 #include "buckle/continuation/bordered_solver.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 #include "buckle/continuation/two_parameter.h"
 
 #include <memory>
@@ -38,8 +38,8 @@ class BranchPointCurveProblem final : public Problem {
   int base() const { return n_; }
 
   int dimension() const override { return n_ + 1; }
-  bool residual(ConstVectorRef W, double mu, VectorRef G) override;
-  bool jacobian(ConstVectorRef W, double mu, MatrixRef GW, VectorRef Gmu) override;
+  bool residual(ProblemWorkspace &ws, ConstVectorRef W, double mu, VectorRef G) const override;
+  bool jacobian(ProblemWorkspace &ws, ConstVectorRef W, double mu, MatrixRef GW, VectorRef Gmu) const override;
   ProblemScales scales() const override;
 
   /// On: the residual through Problem::jacobianApply and makeStructuredSolver() from the base
@@ -47,15 +47,17 @@ class BranchPointCurveProblem final : public Problem {
   void useStructuredSolver(bool on) { structured_ = on; }
   /// The curve's bordered solver on the base problem's (which must take general borders with
   /// k ≥ 1); null when off or when the base problem has none.
-  std::unique_ptr<BorderedSolver> makeStructuredSolver() override;
+  std::unique_ptr<BorderedSolver> makeStructuredSolver(ProblemWorkspace &ws) const override;
 
  private:
-  TwoParameterProblem &problem_;
+  TwoParameterProblem &problem_;  // μ is set on it at every evaluation
+  BoundProblem inner_;             // its evaluations (a workspace of this curve problem's own)
   int n_;
   Vector u0_, c_;
-  Matrix Fu_, dFu_;
-  Vector Flambda_, dFlambda_, Fmu_, FuMuW_;
-  Vector x_;  // (w, 0) of the structured residual
+  // As FoldCurveProblem (fold_curve.h): one computation's object, its scratch its own.
+  mutable Matrix Fu_, dFu_;
+  mutable Vector Flambda_, dFlambda_, Fmu_, FuMuW_;
+  mutable Vector x_;  // (w, 0) of the structured residual
   bool structured_ = false;
 };
 

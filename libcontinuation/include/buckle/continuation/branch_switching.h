@@ -12,7 +12,7 @@
 
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/options_validity.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 #include "buckle/continuation/symmetry.h"
 #include "buckle/continuation/tracer.h"
 
@@ -40,7 +40,7 @@ struct BranchSwitchingOptions {
 /// `structured`: the bifurcation equation from O(N) products (bifurcationDirectionsApplied) and
 /// bp.leftNullVector required, no N×N matrix (switchBothSides: above the tracer's
 /// maxDenseLocationDimension).
-bool bifurcatingDirection(Problem &problem, const SpecialPoint &bp, Vector &direction, std::string *note = nullptr,
+bool bifurcatingDirection(const BoundProblem &problem, const SpecialPoint &bp, Vector &direction, std::string *note = nullptr,
                           bool structured = false);
 
 /// A new branch leaving bp along sign·direction: point 0 is the branch point itself, point 1
@@ -120,11 +120,11 @@ struct TreeOptions {
 /// branches and points are those of tracing it whole first, but an interrupted tree holds the
 /// branches of a root's first branch points (the weakest, along a load path from zero) however
 /// many it has further on.
-BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
+BranchTree traceTree(const BoundProblem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
                      const TracerOptions &options, const TreeOptions &tree);
 
 /// One start direction: traceTree(problem, u0, λ0, {direction}, options, {branchSwitching, switching}).
-BranchTree traceTree(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
+BranchTree traceTree(const BoundProblem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
                      const TracerOptions &options, int branchSwitching,
                      const BranchSwitchingOptions &switching = BranchSwitchingOptions());
 

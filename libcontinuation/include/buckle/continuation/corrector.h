@@ -26,7 +26,7 @@
 
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/internal/dense_lu.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 #include "buckle/continuation/internal/sundials_raii.h"
 #include "buckle/continuation/tracer_options.h"
 
@@ -56,7 +56,7 @@ class Corrector {
  public:
   /// `structured`: optional solver for the bordered Jacobian (not owned; must outlive the
   /// Corrector); null: dense LU.
-  explicit Corrector(Problem &problem, const CorrectorOptions &options = CorrectorOptions(),
+  explicit Corrector(const BoundProblem &problem, const CorrectorOptions &options = CorrectorOptions(),
                      BorderedSolver *structured = nullptr);
   Corrector(const Corrector &) = delete;
   Corrector &operator=(const Corrector &) = delete;
@@ -94,7 +94,7 @@ class Corrector {
   /// iteration limit) returns false and correct() runs KINSOL itself from the same predictor.
   bool leanNewton(CorrectorSummary &summary);
 
-  Problem &problem_;
+  BoundProblem problem_;
   BorderedSolver *structured_ = nullptr;
   std::optional<DenseLU> dense_;  // the Keller matrix and its factors when structured_ is null
   CorrectorOptions options_;

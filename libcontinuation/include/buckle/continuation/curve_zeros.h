@@ -10,7 +10,7 @@
 #pragma once
 
 #include "buckle/continuation/branch.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 #include "buckle/continuation/tracer_options.h"
 
 #include <functional>
@@ -55,7 +55,7 @@ struct CurveZeroOptions {
 /// Every sign change of g between consecutive points of `branch` (traced on `curve`), located.
 /// Intervals where g is not evaluable at an end are skipped. Throws std::invalid_argument on
 /// invalid options.
-std::vector<CurveZero> locateCurveZeros(Problem &curve, const Branch &branch, const CurveTest &g,
+std::vector<CurveZero> locateCurveZeros(const BoundProblem &curve, const Branch &branch, const CurveTest &g,
                                         const CurveZeroOptions &options = CurveZeroOptions());
 
 }  // namespace buckle::continuation

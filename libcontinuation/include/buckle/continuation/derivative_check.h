@@ -15,7 +15,7 @@
 #pragma once
 
 #include "buckle/continuation/numeric_diff.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 #include <string>
 #include <vector>
@@ -64,7 +64,7 @@ struct DerivativeCheck {
 
 /// Compares the problem's derivatives at (u, λ) with finite differences (see the file comment).
 /// Invalid input (sizes, options) gives success = false and the reason in message; nothing is thrown.
-DerivativeCheck checkDerivatives(Problem &problem, ConstVectorRef u, double lambda,
+DerivativeCheck checkDerivatives(const BoundProblem &problem, ConstVectorRef u, double lambda,
                                  const DerivativeCheckOptions &options = DerivativeCheckOptions());
 
 }  // namespace buckle::continuation

@@ -18,7 +18,7 @@
 
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 #include "buckle/continuation/internal/structured_refinement.h"
 #include "buckle/continuation/two_parameter.h"
 
@@ -44,29 +44,32 @@ class FoldCurveProblem final : public Problem {
   static Vector stateV(ConstVectorRef U, int n) { return U.tail(n); }
 
   int dimension() const override { return 2 * n_ + 1; }
-  bool residual(ConstVectorRef U, double mu, VectorRef G) override;
-  bool jacobian(ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) override;
+  bool residual(ProblemWorkspace &ws, ConstVectorRef U, double mu, VectorRef G) const override;
+  bool jacobian(ProblemWorkspace &ws, ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) const override;
   /// u and v in the problem's scales, λ in its parameter scale; rows: F and F_u v in the
   /// residual scales, the normalisation 1; μ in secondParameterScale().
   ProblemScales scales() const override;
 
   /// The problem's boundaries g_k(u, λ; μ) (joint limits): the tracer stops where the fold meets one.
   int boundaryCount() const override { return problem_.boundaryCount(); }
-  double boundary(int k, ConstVectorRef U, double mu) override;
+  double boundary(ProblemWorkspace &ws, int k, ConstVectorRef U, double mu) const override;
   std::string boundaryName(int k) const override { return problem_.boundaryName(k); }
 
   /// The cusp test: ψᵀF_uu[v, v] / (‖ψ‖ ‖v‖²) (norms in the scaled variables), ψ from
   /// [[F_uᵀ, c], [vᵀ, 0]] [ψ; s] = [0; 1]. Changes sign at a cusp. False outside the domain or
   /// when that bordered matrix is singular.
-  bool cuspTest(ConstVectorRef U, double mu, double &value);
+  bool cuspTest(ConstVectorRef U, double mu, double &value) const;
 
  private:
-  TwoParameterProblem &problem_;
+  // A curve problem sets μ on its base problem at every evaluation, so it is one computation's
+  // object (not shared between threads), and keeps its scratch itself.
+  TwoParameterProblem &problem_;  // μ is set on it at every evaluation
+  BoundProblem inner_;             // its evaluations (a workspace of this curve problem's own)
   int n_;
   Vector c_;
-  Matrix Fu_, dFu_;
-  Vector Flambda_, dFlambda_, Fmu_, FuMuV_, Fv_;
-  Eigen::PartialPivLU<Matrix> lu_;
+  mutable Matrix Fu_, dFu_;
+  mutable Vector Flambda_, dFlambda_, Fmu_, FuMuV_, Fv_;
+  mutable Eigen::PartialPivLU<Matrix> lu_;
 };
 
 /// The fold curve by the minimally augmented system (Govaerts 2000, §4.3; MATCONT's LP curve):
@@ -97,23 +100,23 @@ class MinimalFoldCurveProblem final : public Problem {
   static Vector start(ConstVectorRef u, double lambda);
 
   int dimension() const override { return n_ + 1; }
-  bool residual(ConstVectorRef U, double mu, VectorRef G) override;
+  bool residual(ProblemWorkspace &ws, ConstVectorRef U, double mu, VectorRef G) const override;
   /// Dense [[F_u, F_λ], [g_xᵀ]] (for dense callers; the tracer uses makeStructuredSolver()).
-  bool jacobian(ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) override;
+  bool jacobian(ProblemWorkspace &ws, ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) const override;
   /// O(N) products with [[F_u, F_λ, F_μ], [g_uᵀ, g_λ, g_μ]] and its transpose.
-  bool jacobianApply(ConstVectorRef U, double mu, ConstVectorRef x, VectorRef y) override;
-  bool jacobianTransposeApply(ConstVectorRef U, double mu, ConstVectorRef w, VectorRef y) override;
+  bool jacobianApply(ProblemWorkspace &ws, ConstVectorRef U, double mu, ConstVectorRef x, VectorRef y) const override;
+  bool jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef U, double mu, ConstVectorRef w, VectorRef y) const override;
   /// u in the problem's scales, λ in its parameter scale; rows: F in the residual scales, g 1;
   /// μ in secondParameterScale().
   ProblemScales scales() const override;
-  std::unique_ptr<BorderedSolver> makeStructuredSolver() override;
+  std::unique_ptr<BorderedSolver> makeStructuredSolver(ProblemWorkspace &ws) const override;
 
   int boundaryCount() const override { return problem_.boundaryCount(); }
-  double boundary(int k, ConstVectorRef U, double mu) override;
+  double boundary(ProblemWorkspace &ws, int k, ConstVectorRef U, double mu) const override;
   std::string boundaryName(int k) const override { return problem_.boundaryName(k); }
 
   /// Right null vector v (cᵀv = 1) and left one w at (U, μ) (null vectors of F_u on the curve).
-  bool nullVectors(ConstVectorRef U, double mu, Vector &v, Vector &w);
+  bool nullVectors(ConstVectorRef U, double mu, Vector &v, Vector &w) const;
   /// Borders from the null vectors at (U, μ): c ∝ D_u⁻²v, b ∝ D_F²w, unit in the scaled variables.
   bool adaptBorders(ConstVectorRef U, double mu);
   /// The current borders b (≈ left null vector) and c (≈ right null vector).
@@ -122,31 +125,33 @@ class MinimalFoldCurveProblem final : public Problem {
   /// Back to the borders of the start point (before tracing or revisiting a curve from there).
   void resetBorders();
   /// The cusp test of FoldCurveProblem::cuspTest, ψᵀF_uu[v, v] / (‖ψ‖ ‖v‖²) with ψ = w.
-  bool cuspTest(ConstVectorRef U, double mu, double &value);
+  bool cuspTest(ConstVectorRef U, double mu, double &value) const;
 
   /// g and its gradient (g_x, g_μ) at (U, μ), F_λ and F_μ there (the curve solver's borders).
-  bool gradient(ConstVectorRef U, double mu, double &g, Vector &gx, double &gmu, Vector &Flambda, Vector &Fmu);
+  bool gradient(ConstVectorRef U, double mu, double &g, Vector &gx, double &gmu, Vector &Flambda, Vector &Fmu) const;
 
  private:
   /// v, w, g at (U, μ) into the cache (nothing recomputed for the same U, μ and borders).
-  bool evaluate(ConstVectorRef U, double mu);
-  bool evaluateGradient(ConstVectorRef U, double mu);
+  bool evaluate(ConstVectorRef U, double mu) const;
+  bool evaluateGradient(ConstVectorRef U, double mu) const;
   void setBorders(const Vector &v, const Vector &w);
 
-  TwoParameterProblem &problem_;
+  // As FoldCurveProblem: one computation's object, its scratch and caches its own.
+  TwoParameterProblem &problem_;  // μ is set on it at every evaluation
+  BoundProblem inner_;             // its evaluations (a workspace of this curve problem's own)
   int n_;
   std::unique_ptr<BorderedSolver> solver_;  // the base problem's, for g, v, w
   std::unique_ptr<RefinedBorderedSystem> system_;
   Vector b_, c_;
   Vector b0_, c0_;  // the start's
   // Cache of evaluate() / evaluateGradient().
-  Vector cachedU_;
-  double cachedMu_ = 0.0;
-  bool cached_ = false, cachedGradient_ = false;
-  Vector v_, w_, gx_, Fmu_, FuMuV_, Flambda_, ex_;
-  double g_ = 0.0, gmu_ = 0.0;
-  Matrix Bm_, Cm_, Dm_;
-  Vector rhs_, z_, y_;
+  mutable Vector cachedU_;
+  mutable double cachedMu_ = 0.0;
+  mutable bool cached_ = false, cachedGradient_ = false;
+  mutable Vector v_, w_, gx_, Fmu_, FuMuV_, Flambda_, ex_;
+  mutable double g_ = 0.0, gmu_ = 0.0;
+  mutable Matrix Bm_, Cm_, Dm_;
+  mutable Vector rhs_, z_, y_;
 };
 
 }  // namespace buckle::continuation

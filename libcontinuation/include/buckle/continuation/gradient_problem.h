@@ -10,7 +10,7 @@
 // derivative_check.h, checks F_u itself).
 #pragma once
 
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 namespace buckle::continuation {
 
@@ -25,12 +25,11 @@ class GradientProblem : public Problem {
 
   bool hasStabilityOperator() const final { return true; }
   /// H = ±F_u (symmetrized), C empty. False when the problem refuses the point.
-  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override;
+  bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override;
   Residual residualKind() const { return residual_; }
 
  private:
   Residual residual_;
-  Vector flambda_;  // F_λ, computed with F_u and not needed
 };
 
 }  // namespace buckle::continuation

@@ -22,7 +22,7 @@
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch_switching.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 #include "buckle/continuation/tracer.h"
 
 #include <string>
@@ -51,7 +51,7 @@ constexpr int kMaxDenseMultiplePointDimension = 400;
 /// direction is found. Above N = maxDenseDimension the kernels come from structuredMultipleKernel
 /// instead of a dense SVD (through the problem's structured solver when it takes m + 1 borders,
 /// else dense LU).
-bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
+bool reducedBifurcationDirections(const BoundProblem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
                                   double kernelTolerance = 1e-7,
                                   int maxDenseDimension = kMaxDenseMultiplePointDimension);
 
@@ -64,7 +64,7 @@ bool reducedBifurcationDirections(Problem &problem, const SpecialPoint &bp, int 
 /// the first's kernels as borders (then G is as well conditioned as the point allows); solves
 /// refined on the problem's own products (RefinedBorderedSystem). `residual` receives
 /// max(‖F_x K‖, ‖Psiᵀ F_x‖) column-wise. False with `why` when a factorization fails.
-bool structuredMultipleKernel(Problem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda, int m,
+bool structuredMultipleKernel(const BoundProblem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda, int m,
                               Matrix &K, Matrix &Psi, double &residual, std::string *why = nullptr);
 
 /// Children of the multiple point bp, both sides of every direction, traced with `tracer`; sets

@@ -21,7 +21,7 @@
 #pragma once
 
 #include "buckle/continuation/options_validity.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 #include <string>
 
@@ -42,7 +42,7 @@ struct NumericDiffOptions {
 /// 2(N+1) evaluations of problem.residual(). `scales` as returned by problem.scales() (passed in
 /// so that a hot loop does not rebuild them). False when a perturbed point is refused. The
 /// workspace vectors (size N) are the caller's, so nothing is allocated.
-bool differenceJacobian(Problem &problem, const ProblemScales &scales, double relativeStep, ConstVectorRef u,
+bool differenceJacobian(const BoundProblem &problem, const ProblemScales &scales, double relativeStep, ConstVectorRef u,
                         double lambda, MatrixRef Fu, VectorRef Fl, VectorRef work, VectorRef Fplus,
                         VectorRef Fminus);
 
@@ -51,33 +51,36 @@ class NumericDiffProblem : public Problem {
   explicit NumericDiffProblem(const NumericDiffOptions &options = NumericDiffOptions());
 
   /// F_u and F_λ by central differences of residual().
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) override;
+  bool jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const override;
   bool jacobianWritesAllEntries() const override { return true; }
   /// d/dε [F_u, F_λ](z + εx): second differences of residual() along x and each coordinate.
-  bool jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                     MatrixRef dFu, VectorRef dFlambda) override;
+  bool jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                     MatrixRef dFu, VectorRef dFlambda) const override;
   /// F_xx[x, z]: one second difference of residual() along x and z (four evaluations).
-  bool secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
-                             VectorRef y) override;
+  bool secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
+                             VectorRef y) const override;
   /// (F_xx[x, ·])ᵀw = [dF_u, dF_λ]ᵀw with the directional derivative above.
-  bool secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
-                                      VectorRef y) override;
+  bool secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
+                                      VectorRef y) const override;
 
   const NumericDiffOptions &numericDiffOptions() const { return options_; }
-  /// The steps use scales() as first evaluated (the tracer evaluates them once per Tracer too);
-  /// call this after changing what scales() returns.
-  void refreshScales() { scalesValid_ = false; }
+
+  /// The differences' scratch. A problem with a workspace of its own derives it from this one.
+  struct Workspace : ProblemWorkspace {
+    ProblemScales scales;  // scales() as first evaluated in this workspace (the steps use them)
+    bool scalesValid = false;
+    Vector work, Fplus, Fminus, corner;  // size N
+    Matrix Jplus, Jminus, second;        // N×(N+1)
+  };
+  std::unique_ptr<ProblemWorkspace> createWorkspace() const override { return std::make_unique<Workspace>(); }
 
  private:
-  const ProblemScales &cachedScales();
+  const ProblemScales &cachedScales(Workspace &nd) const;
   // Step along the (N+1)-direction (dx, dλ) of relative size `relative`, 0 for a zero direction.
-  double directionStep(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda, double relative);
+  double directionStep(Workspace &nd, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                       double relative) const;
 
   NumericDiffOptions options_;
-  ProblemScales scales_;
-  bool scalesValid_ = false;
-  Vector work_, Fplus_, Fminus_, corner_;     // size N
-  Matrix Jplus_, Jminus_, second_;             // N×(N+1)
 };
 
 }  // namespace buckle::continuation

@@ -16,7 +16,7 @@
 
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 #include <memory>
 
@@ -77,46 +77,74 @@ class ScopedScaling {
 /// F̃(ũ, λ̃) of the header comment, on a problem that outlives it. Its own scales() are ones.
 class ScaledProblem final : public Problem {
  public:
-  ScaledProblem(Problem &problem, const UnitScaling &units);
+  ScaledProblem(const Problem &problem, const UnitScaling &units);
+
+  /// The inner problem's workspace (bound) and the change of variables' scratch.
+  struct Workspace : ProblemWorkspace {
+    Workspace(const BoundProblem &problem, int n);
+    BoundProblem inner;
+    Vector u, du;
+    Vector x, w, z;  // (D_u, λ₀)·x̃, w̃/D_F and (D_u, λ₀)·z̃ of the products
+  };
+  /// A new workspace of the problem.
+  std::unique_ptr<ProblemWorkspace> createWorkspace() const override;
+  /// A workspace that evaluates the problem in `problem`'s workspace (problem.problem() must be
+  /// the problem this one scales): the tracer's caller keeps its caches and warm starts.
+  std::unique_ptr<ProblemWorkspace> workspaceOn(const BoundProblem &problem) const;
 
   const UnitScaling &units() const { return units_; }
 
   int dimension() const override { return n_; }
-  bool residual(ConstVectorRef u, double lambda, VectorRef F) override;
-  bool jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) override;
+  bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override;
+  bool jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const override;
   bool jacobianWritesAllEntries() const override { return problem_.jacobianWritesAllEntries(); }
-  bool jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                     MatrixRef dFu, VectorRef dFlambda) override;
+  bool jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                     MatrixRef dFu, VectorRef dFlambda) const override;
   /// The problem's own O(N) products, through the change of variables.
-  bool jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) override;
-  bool jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) override;
-  bool secondDerivativeTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
-                                      VectorRef y) override;
-  bool secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
-                             VectorRef y) override;
+  bool jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const override;
+  bool jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) const override;
+  bool secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
+                                      VectorRef y) const override;
+  bool secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
+                             VectorRef y) const override;
   bool hasStabilityOperator() const override { return problem_.hasStabilityOperator(); }
-  bool stabilityOperator(ConstVectorRef u, double lambda, Matrix &H, Matrix &C) override;
+  bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override;
   /// The problem's own stability() (its inertia count must be relative to ‖H‖), eigenvalues / μ₀.
-  bool stability(ConstVectorRef u, double lambda, int lowestCount, StabilityInfo &info) override;
-  bool stabilityEigenvalues(ConstVectorRef u, double lambda, int first, VectorRef values) override;
+  bool stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount, StabilityInfo &info) const override;
+  bool stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first, VectorRef values) const override;
   /// The problem's bound along the user direction (D_u du, λ₀ dλ), / μ₀.
-  bool stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda, double &bound) override;
+  bool stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda, double &bound) const override;
   /// The problem's structured solver seen through the change of variables (still O(its cost)).
-  std::unique_ptr<BorderedSolver> makeStructuredSolver() override;
+  std::unique_ptr<BorderedSolver> makeStructuredSolver(ProblemWorkspace &ws) const override;
   int boundaryCount() const override { return problem_.boundaryCount(); }
-  double boundary(int k, ConstVectorRef u, double lambda) override;
-  void boundaries(ConstVectorRef u, double lambda, VectorRef g) override;
+  double boundary(ProblemWorkspace &ws, int k, ConstVectorRef u, double lambda) const override;
+  void boundaries(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef g) const override;
   std::string boundaryName(int k) const override { return problem_.boundaryName(k); }
 
  private:
   void scaleJacobian(MatrixRef Fu, VectorRef Flambda) const;
-  const Vector &user(ConstVectorRef u);
+  const Vector &user(Workspace &sw, ConstVectorRef u) const;
 
-  Problem &problem_;
+  const Problem &problem_;
   UnitScaling units_;
   int n_;
-  Vector u_, du_;
-  Vector x_, w_, z_;  // (D_u, λ₀)·x̃, w̃/D_F and (D_u, λ₀)·z̃ of the products
+};
+
+/// A ScaledProblem over a bound problem, evaluated in that problem's workspace (its caches and
+/// warm starts): what the core's computations in the scaled variables work on. Not movable (the
+/// handle points at the scaled problem it holds).
+class BoundScaledProblem {
+ public:
+  BoundScaledProblem(const BoundProblem &problem, const UnitScaling &units)
+      : scaled_(problem.problem(), units), ws_(scaled_.workspaceOn(problem)), bound_(scaled_, *ws_) {}
+  BoundScaledProblem(const BoundScaledProblem &) = delete;
+  BoundScaledProblem &operator=(const BoundScaledProblem &) = delete;
+  const BoundProblem &bound() const { return bound_; }
+
+ private:
+  ScaledProblem scaled_;
+  std::unique_ptr<ProblemWorkspace> ws_;
+  BoundProblem bound_;
 };
 
 /// A problem's BorderedSolver for A(c) seen in the scaled variables:

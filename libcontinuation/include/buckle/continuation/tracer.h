@@ -21,7 +21,7 @@
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/corrector.h"
 #include "buckle/continuation/interrupt.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 #include "buckle/continuation/scaled_problem.h"
 #include "buckle/continuation/step_control.h"
 #include "buckle/continuation/internal/test_functions.h"
@@ -51,7 +51,7 @@ class Locator;
 /// called repeatedly.
 class Tracer {
  public:
-  Tracer(Problem &problem, const TracerOptions &options);
+  Tracer(const BoundProblem &problem, const TracerOptions &options);
   ~Tracer();
   Tracer(const Tracer &) = delete;
   Tracer &operator=(const Tracer &) = delete;
@@ -86,7 +86,7 @@ class Tracer {
   /// The corrector on the scaled problem: its x = (ũ, λ̃), units().toScaled/toUser convert.
   Corrector &corrector() { return *corrector_; }
   /// The problem as given (user units).
-  Problem &problem() { return problem_; }
+  const BoundProblem &problem() { return problem_; }
   /// The change of variables between the problem's units and the tracer's (scaled_problem.h).
   const UnitScaling &units() const { return units_; }
   const TracerOptions &options() const { return options_; }
@@ -136,13 +136,14 @@ class Tracer {
   /// expression (bit for bit), without its two heap-allocated states per call.
   double stepAlong(const ContinuationPoint &a, const ContinuationPoint &b);
 
-  Problem &problem_;
+  BoundProblem problem_;
   TracerOptions options_;
   std::string invalidReason_;
   int n_;
   UnitScaling units_;
   std::unique_ptr<ScaledProblem> scaled_;  // null for the identity scaling
-  Problem *work_;                          // what the core evaluates: scaled_ or problem_
+  std::unique_ptr<ProblemWorkspace> scaledWorkspace_;  // scaled_'s, on problem_'s workspace
+  BoundProblem work_;                        // what the core evaluates: scaled_ or problem_
   double lambdaMin_ = 0.0, lambdaMax_ = 0.0;  // the λ range and the box in the scaled variables
   Vector boxLower_, boxUpper_;
   std::unique_ptr<BorderedSolver> structuredSolver_, denseSolver_;
@@ -167,7 +168,7 @@ class Tracer {
 void mergeCoincidentSpecialPoints(Branch &branch, size_t firstNew);
 
 /// One-shot convenience: Tracer(problem, options).trace(u0, λ0, direction).
-Branch trace(Problem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
+Branch trace(const BoundProblem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,
              const TracerOptions &options = TracerOptions());
 
 }  // namespace buckle::continuation

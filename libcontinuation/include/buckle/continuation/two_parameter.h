@@ -3,7 +3,7 @@
 // Problem; μ is a state of the problem, set before evaluating (AUTO's ICP(2), MATCONT's ap).
 #pragma once
 
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,19 +17,20 @@ class TwoParameterProblem : public Problem {
   /// Sets μ for the following evaluations; false (μ unchanged) when μ is outside the domain.
   virtual bool setSecondParameter(double mu) = 0;
   /// Exact F_μ (size N) and (∂F_u/∂μ)·v (size N) at (u, λ) and the current μ.
-  virtual bool secondParameterDerivatives(ConstVectorRef u, double lambda, ConstVectorRef v, VectorRef Fmu,
-                                          VectorRef FuMuV) = 0;
+  virtual bool secondParameterDerivatives(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef v,
+                                          VectorRef Fmu, VectorRef FuMuV) const = 0;
   /// (∂F_u/∂λ)·v (size N) at (u, λ) and the current μ: the λ-column of the branch-point curve's
   /// Jacobian (branch_point_curve.h) without forming F_u. Default: central differences of
   /// jacobianApply() in λ (O(N) with the problem's products; exact to rounding when F_u is
   /// affine in λ, as for dead loads). Override with the exact product.
-  virtual bool parameterJacobianApply(ConstVectorRef u, double lambda, ConstVectorRef v, VectorRef FuLambdaV) {
+  virtual bool parameterJacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef v,
+                                      VectorRef FuLambdaV) const {
     const int n = dimension();
     const double scale = scales().parameter;
     const double h = 6e-6 * std::max(scale, std::abs(lambda));
     Vector x(n + 1), yp(n), ym(n);
     x << v, 0.0;
-    if (!jacobianApply(u, lambda + h, x, yp) || !jacobianApply(u, lambda - h, x, ym)) return false;
+    if (!jacobianApply(ws, u, lambda + h, x, yp) || !jacobianApply(ws, u, lambda - h, x, ym)) return false;
     FuLambdaV = (yp - ym) / (2.0 * h);
     return FuLambdaV.allFinite();
   }

@@ -25,7 +25,7 @@
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/corrector.h"
 #include "buckle/continuation/interrupt.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 #include "buckle/continuation/root_finding.h"
 #include "buckle/continuation/internal/spectral_monitor.h"
 #include "buckle/continuation/internal/structured_refinement.h"
@@ -78,7 +78,7 @@ struct StepSample {
 
 class Locator {
  public:
-  Locator(Problem &problem, Corrector &corrector, PointEvaluator &evaluator, const LocatorOptions &options);
+  Locator(const BoundProblem &problem, Corrector &corrector, PointEvaluator &evaluator, const LocatorOptions &options);
 
   /// The step from a to b (b was corrected on t_aᵀ(x − x_a) = ds).
   void setStep(const ContinuationPoint &a, const ContinuationPoint &b);
@@ -150,7 +150,7 @@ class Locator {
   void adoptRefinedFold(SpecialPoint &point, const Vector &tangentRef, const Vector &v, double lastDLambda,
                         double augmentedResidual);
 
-  Problem &problem_;
+  BoundProblem problem_;
   Corrector &corrector_;
   PointEvaluator &evaluator_;
   LocatorOptions options_;

@@ -25,7 +25,7 @@
 #pragma once
 
 #include "buckle/continuation/branch.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 #include <vector>
 
@@ -38,18 +38,18 @@ constexpr double kSuspectMargin = 0.25;
 /// only ν when ν = 0, only ν − 1 when ν is the dimension) and their slopes along point.tangent,
 /// by a forward difference with step `delta` (backward if the problem refuses the forward point).
 /// False (spectrum left invalid) without stability or when the problem refuses the eigenvalues.
-bool measureNearZeroSpectrum(Problem &problem, ContinuationPoint &point, double delta = 1e-6);
+bool measureNearZeroSpectrum(const BoundProblem &problem, ContinuationPoint &point, double delta = 1e-6);
 
 /// The first half of measureNearZeroSpectrum: the values and the problem's rate bound at the
 /// point's tangent (spectrum.rateBound; +∞ without one), no slopes (spectrum.slopesMeasured false).
-bool measureNearZeroValues(Problem &problem, ContinuationPoint &point);
+bool measureNearZeroValues(const BoundProblem &problem, ContinuationPoint &point);
 /// The second half: the slopes of the values measureNearZeroValues recorded (forward difference
 /// with step `delta`, backward if refused). False (spectrum left without slopes) if refused.
 /// `workspace` holds the shifted point's u: once it has at least N entries the call allocates
 /// nothing itself (the tracer's hot loop; the problem's stabilityEigenvalues must not either).
-bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, Vector &workspace, double delta = 1e-6);
+bool measureNearZeroSlopes(const BoundProblem &problem, ContinuationPoint &point, Vector &workspace, double delta = 1e-6);
 /// The same with a workspace of its own (allocates: for tests and one-off use).
-bool measureNearZeroSlopes(Problem &problem, ContinuationPoint &point, double delta = 1e-6);
+bool measureNearZeroSlopes(const BoundProblem &problem, ContinuationPoint &point, double delta = 1e-6);
 
 /// True when suspectHiddenCrossings(a, b, stepLength, margin) returns no suspect for every pair
 /// of slopes within the two points' rate bounds: for each tracked eigenvalue of one sign at both

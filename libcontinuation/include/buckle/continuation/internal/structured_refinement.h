@@ -23,7 +23,7 @@
 #pragma once
 
 #include "buckle/continuation/bordered_solver.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 #include <string>
 
@@ -36,7 +36,7 @@ namespace buckle::continuation {
 class RefinedBorderedSystem {
  public:
   /// `problem` and `solver` are not owned and must outlive the system.
-  RefinedBorderedSystem(Problem &problem, BorderedSolver &solver);
+  RefinedBorderedSystem(const BoundProblem &problem, BorderedSolver &solver);
 
   /// Factors G at (u, λ) (B, C N×k, D k×k) and remembers it for solve(). False when the solver
   /// refuses the point or G is singular.
@@ -47,7 +47,7 @@ class RefinedBorderedSystem {
  private:
   bool applyG(const Vector &x, Vector &y);
 
-  Problem &problem_;
+  BoundProblem problem_;
   BorderedSolver &solver_;
   int n_;
   Vector u_;
@@ -70,7 +70,7 @@ class StructuredRefinement {
  public:
   /// `solver` must support factorGeneral() with k ≥ 2 (not owned; its factorizations are
   /// replaced). Tolerance: Newton stops when |Δλ| ≤ tolerance·max(1, |λ|), after one more step.
-  StructuredRefinement(Problem &problem, BorderedSolver &solver, double tolerance, int maxIterations);
+  StructuredRefinement(const BoundProblem &problem, BorderedSolver &solver, double tolerance, int maxIterations);
 
   /// Fold near (u, λ) with tangent t there (t_u ≈ the null vector). On success u, λ are the
   /// fold and v the unit null vector of F_u. An iterate farther than maxDistance from the
@@ -95,7 +95,7 @@ class StructuredRefinement {
   bool refinedSolve(const Vector &b, Vector &x) { return system_.solve(b, x); }
   bool parameterDerivative(ConstVectorRef u, double lambda, Vector &Fl);
 
-  Problem &problem_;
+  BoundProblem problem_;
   BorderedSolver &solver_;
   RefinedBorderedSystem system_;
   double tolerance_;

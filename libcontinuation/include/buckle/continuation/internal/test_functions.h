@@ -10,7 +10,7 @@
 
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/branch.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 
 #include <Eigen/LU>
 #include <string>
@@ -23,7 +23,7 @@ namespace buckle::continuation {
 /// one; not owned). Workspaces are sized once.
 class PointEvaluator {
  public:
-  PointEvaluator(Problem &problem, BorderedSolver &solver, bool computeStability, int lowestEigenvalues = 3);
+  PointEvaluator(const BoundProblem &problem, BorderedSolver &solver, bool computeStability, int lowestEigenvalues = 3);
 
   /// Eigenvalues asked of Problem::stability() by complete(); the locator raises it while it
   /// works, since it follows the crossing eigenvalue.
@@ -41,10 +41,10 @@ class PointEvaluator {
   bool borderedJacobian(ConstVectorRef u, double lambda, ConstVectorRef t, MatrixRef A);
 
   bool stabilityEnabled() const { return stability_; }
-  Problem &problem() { return problem_; }
+  const BoundProblem &problem() { return problem_; }
 
  private:
-  Problem &problem_;
+  BoundProblem problem_;
   BorderedSolver &solver_;
   int n_;
   bool stability_;
@@ -99,18 +99,18 @@ struct KernelInfo {
   Matrix right;           ///< columns: right singular vectors, same order ((N+1)×(N+1))
   Matrix left;            ///< columns: left singular vectors; left.col(k) pairs with singularValues[k + 1]
 };
-bool jacobianKernel(Problem &problem, ConstVectorRef u, double lambda, KernelInfo &info);
+bool jacobianKernel(const BoundProblem &problem, ConstVectorRef u, double lambda, KernelInfo &info);
 
 /// Tangents of the two branches crossing at a simple branch point: the real roots d ∈ span(k₁, k₂)
 /// (an orthonormal basis of ker F_x) of the algebraic bifurcation equation ψᵀF_xx[d, d] = 0,
 /// ψ the left null vector. Second derivatives from Problem::jacobianDirectionalDerivative.
 /// False (with the reason) when they are unavailable, the quadratic form vanishes, or its roots
 /// are complex (an isolated point, no crossing branches).
-bool bifurcationDirections(Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi, ConstVectorRef k1,
+bool bifurcationDirections(const BoundProblem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi, ConstVectorRef k1,
                            ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why = nullptr);
 /// The same from O(N) products (Problem::secondDerivativeTransposeApply), with no N×N matrix:
 /// for problems above the dense crossover.
-bool bifurcationDirectionsApplied(Problem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi,
+bool bifurcationDirectionsApplied(const BoundProblem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi,
                                   ConstVectorRef k1, ConstVectorRef k2, Vector &d1, Vector &d2,
                                   std::string *why = nullptr);
 
