@@ -36,7 +36,7 @@ bool withinLimits(const Chain& chain, const Vector& q) {
 class DeflatedNewton {
  public:
   DeflatedNewton(EquilibriumProblem& problem, const AllEquilibriaOptions& options)
-      : problem_(problem), options_(options), n_(problem.segments()), N_(problem.dimension()),
+      : problem_(problem), bound_(problem), options_(options), n_(problem.segments()), N_(problem.dimension()),
         scale_(problem.scales().residuals), unknownScale_(problem.scales().unknowns), F_(N_), trial_(N_), Fu_(N_, N_),
         Fl_(N_), gradLog_(n_) {}
 
@@ -58,7 +58,7 @@ class DeflatedNewton {
 
   /// ‖F(u)‖∞ with each row in the chain's unit; +∞ outside the domain.
   double residualNorm(const Vector& u, Vector& F) {
-    if (!problem_.residual(u, 0.0, F)) return std::numeric_limits<double>::infinity();
+    if (!bound_.residual(u, 0.0, F)) return std::numeric_limits<double>::infinity();
     const double r = (F.array() / scale_.array()).abs().maxCoeff();
     return std::isfinite(r) ? r : std::numeric_limits<double>::infinity();
   }
@@ -86,7 +86,7 @@ class DeflatedNewton {
       const double norm = residualNorm(u, F_);
       if (!std::isfinite(norm)) return false;
       if (norm <= kHandOver) return true;
-      if (!problem_.jacobian(u, 0.0, Fu_, Fl_)) return false;
+      if (!bound_.jacobian(u, 0.0, Fu_, Fl_)) return false;
       Vector du = newtonStep();
       const double m = deflation(u.head(n_));
       const double tau = 1.0 / (1.0 - gradLog_.dot(du.head(n_)));
@@ -113,7 +113,7 @@ class DeflatedNewton {
   double polish(Vector& u) {
     double best = residualNorm(u, F_);
     for (int it = 0; it < kPolishIterations && std::isfinite(best) && best > 0.0; ++it) {
-      if (!problem_.jacobian(u, 0.0, Fu_, Fl_)) break;
+      if (!bound_.jacobian(u, 0.0, Fu_, Fl_)) break;
       const Vector next = u + newtonStep();
       const double nt = residualNorm(next, trial_);
       if (!(nt < best)) break;
@@ -126,6 +126,7 @@ class DeflatedNewton {
 
  private:
   EquilibriumProblem& problem_;
+  const continuation::BoundProblem bound_;  // the search's workspace
   const AllEquilibriaOptions& options_;
   int n_, N_;
   Vector scale_, unknownScale_, F_, trial_;
@@ -142,7 +143,7 @@ FoundEquilibrium describe(EquilibriumProblem& problem, const Vector& u, double a
   e.reactions = u.tail(problem.heldCount());
   e.wrench = problem.wrench(u, 0.0);
   continuation::StabilityInfo info;
-  if (problem.stability(u, 0.0, 1, info)) {
+  if (continuation::BoundProblem(problem).stability(u, 0.0, 1, info)) {
     e.index = info.negative;
     e.zeroEigenvalues = info.zero;
     e.stable = info.stable();

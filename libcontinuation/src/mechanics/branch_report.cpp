@@ -103,6 +103,7 @@ class HeldStability {
  public:
   HeldStability(const EquilibriumProblem& traced, int c)
       : problem_(traced.chain(), heldEnd(traced.endCondition(), c), Eigen::Vector3d::Zero()),
+        bound_(problem_),
         held_(problem_.endCondition().heldIndices()),
         u_(traced.segments() + int(held_.size())) {}
 
@@ -114,7 +115,7 @@ class HeldStability {
     cont::StabilityInfo info;
     if (!locked.empty())
       info = constrainedStability(problem_, locked, u_, 0.0, smallest ? 1 : 0);
-    else if (!problem_.stability(u_, 0.0, smallest ? 1 : 0, info))
+    else if (!bound_.stability(u_, 0.0, smallest ? 1 : 0, info))
       return -1;
     if (!info.valid()) return -1;
     if (smallest) *smallest = info.smallest;
@@ -127,6 +128,7 @@ class HeldStability {
     return end;
   }
   EquilibriumProblem problem_;
+  cont::BoundProblem bound_;  // its workspace, for every point of the branch
   std::vector<int> held_;
   Eigen::VectorXd u_;
 };
@@ -178,7 +180,7 @@ void reportWallEvent(EquilibriumProblem& problem, const cont::Branch& b, const c
   if (vertex.segment < 0) return;
   const ContactSet& set = contact ? after : before;
   ContactProblem held(problem, set);
-  const Vector mu = held.wallForces(sp.u, sp.lambda);
+  const Vector mu = held.wallForces(*held.createWorkspace(), sp.u, sp.lambda);
   const auto k = std::lower_bound(set.wall().begin(), set.wall().end(), vertex) - set.wall().begin();
   const int n = problem.segments();
   const Eigen::Matrix2Xd P = jointPositions(problem.chain(), sp.u.head(n));
@@ -226,7 +228,7 @@ void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, cons
   s.type = contact ? EventType::Contact : EventType::Release;
   s.phenomenon = Phenomenon::None;  // a change of the constraints, none of the paper's three phenomena
   s.joint = joint;
-  s.contactTorque = locked.contactTorque(sp.u, sp.lambda, joint);
+  s.contactTorque = locked.contactTorque(*locked.createWorkspace(), sp.u, sp.lambda, joint);
   s.lockedAfter = after;
   if (size_t(sp.index + 1) < all.size()) s.negativeAfter = all[size_t(sp.index + 1)].negative;
   if (sp.index < int(b.points.size())) s.negativeBefore = all[size_t(sp.index)].negative;
@@ -286,10 +288,10 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
       // the wall forces close the free rows (ContactProblem::wallForces); the joints' contact
       // torques include their terms
       ContactProblem held(problem, pr.locked);
-      pr.wallForces = held.wallForces(p.u, p.lambda);
+      pr.wallForces = held.wallForces(*held.createWorkspace(), p.u, p.lambda);
       for (const LockedJoint& l : pr.locked.joints())
-        pr.contactTorque = std::max(pr.contactTorque, held.compression(p.u, p.lambda, l.joint));
-    } else if (!pr.locked.empty() && problem.residual(p.u, p.lambda, torques)) {
+        pr.contactTorque = std::max(pr.contactTorque, held.compression(*held.createWorkspace(), p.u, p.lambda, l.joint));
+    } else if (!pr.locked.empty() && cont::BoundProblem(problem).residual(p.u, p.lambda, torques)) {
       // The compression −side·τ_c of each locked joint (ContactProblem::compression), its contact
       // torque τ_c the free equilibrium's row: one residual for all of them.
       for (const LockedJoint& l : pr.locked.joints())

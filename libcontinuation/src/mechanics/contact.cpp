@@ -10,6 +10,9 @@
 
 namespace buckle::mechanics {
 
+using continuation::ProblemWorkspace;
+using continuation::workspaceAs;
+
 using continuation::ConstVectorRef;
 using continuation::Factorization;
 using continuation::MatrixRef;
@@ -155,31 +158,39 @@ void reduceToFreeJoints(const ChainStructure& full, const std::vector<int>& free
 
 // ---- ContactProblem ---------------------------------------------------------------------------
 
-ContactProblem::ContactProblem(EquilibriumProblem& base, ContactSet locked, double maxCompression)
+ContactProblem::ContactProblem(const EquilibriumProblem& base, ContactSet locked, double maxCompression)
     : base_(base),
       locked_((locked.check(base.segments()), std::move(locked))),
       maxCompression_(maxCompression),
       free_(freeJointsOf(locked_, base.segments())),
-      held_(base.endCondition().heldIndices()),
-      full_(base.segments()),
-      reduced_(std::max(1, int(free_.size()))),
-      J_(3, base.segments()),
-      Jf_(3, Eigen::Index(free_.size())),
-      heldRows_(Eigen::Index(held_.size() + size_t(locked_.wallCount())), Eigen::Index(free_.size())),
-      kf_(free_.size()),
-      hf_(free_.size()),
-      residual_(base.dimension()),
-      wallGrad_(base.segments(), locked_.wallCount()),
-      wallGen_(base.segments(), locked_.wallCount()),
-      wallX_(locked_.wallCount()) {
+      held_(base.endCondition().heldIndices()) {
   if (!(maxCompression > 0.0))
     throw std::invalid_argument("contact: the bound of the contact torque must be positive, got " +
                                 std::to_string(maxCompression));
-  reduced_.typicalScale = base.stiffnessUnit() * base.lengthUnit() * base.lengthUnit();
-  full_.typicalScale = reduced_.typicalScale;
 }
 
-bool ContactProblem::wallKinematics(ConstVectorRef q) {
+ContactProblem::Workspace::Workspace(const ContactProblem& problem)
+    : base(problem.base_.createWorkspace()),
+      full(problem.base_.segments()),
+      reduced(std::max(1, int(problem.free_.size()))),
+      J(3, problem.base_.segments()),
+      Jf(3, Eigen::Index(problem.free_.size())),
+      heldRows(Eigen::Index(problem.held_.size() + size_t(problem.locked_.wallCount())),
+               Eigen::Index(problem.free_.size())),
+      kf(problem.free_.size()),
+      hf(problem.free_.size()),
+      residual(problem.base_.dimension()),
+      wallGrad(problem.base_.segments(), problem.locked_.wallCount()),
+      wallGen(problem.base_.segments(), problem.locked_.wallCount()),
+      wallX(problem.locked_.wallCount()) {
+  reduced.typicalScale = problem.base_.stiffnessUnit() * problem.base_.lengthUnit() * problem.base_.lengthUnit();
+  full.typicalScale = reduced.typicalScale;
+}
+
+std::unique_ptr<ProblemWorkspace> ContactProblem::createWorkspace() const { return std::make_unique<Workspace>(*this); }
+
+bool ContactProblem::wallKinematics(ProblemWorkspace &ws, ConstVectorRef q) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   const int w = locked_.wallCount();
   if (w == 0) return true;
   if (!q.allFinite()) return false;
@@ -187,69 +198,74 @@ bool ContactProblem::wallKinematics(ConstVectorRef q) {
   for (int k = 0; k < w; ++k) {
     const WallVertex& v = locked_.wall()[size_t(k)];
     const Eigen::Vector2d x = wallVertexPoint(base_.chain(), q, P, v);
-    wallX_[k] = x.x();
-    wallVertexDerivatives(P, x, v, wallGrad_.col(k), wallGen_.col(k));
+    d.wallX[k] = x.x();
+    wallVertexDerivatives(P, x, v, d.wallGrad.col(k), d.wallGen.col(k));
   }
   return true;
 }
 
-bool ContactProblem::baseRowsWithWall(ConstVectorRef u, double lambda, VectorRef F) {
+bool ContactProblem::baseRowsWithWall(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension(), n = base_.segments(), w = locked_.wallCount();
-  if (!base_.residual(u.head(N), lambda, F)) return false;
+  if (!base_.residual(*d.base, u.head(N), lambda, F)) return false;
   if (w == 0) return true;
-  if (!wallKinematics(u.head(n))) return false;
-  F.head(n).noalias() -= wallGrad_ * u.segment(N, w);  // −Σ μ_v ∇x_v (wall_contact.h)
+  if (!wallKinematics(ws, u.head(n))) return false;
+  F.head(n).noalias() -= d.wallGrad * u.segment(N, w);  // −Σ μ_v ∇x_v (wall_contact.h)
   return true;
 }
 
-Vector ContactProblem::wallForces(ConstVectorRef u, double lambda) {
+Vector ContactProblem::wallForces(ProblemWorkspace &ws, ConstVectorRef u, double lambda) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension(), w = locked_.wallCount();
   Vector mu = Vector::Constant(w, std::numeric_limits<double>::quiet_NaN());
-  if (w == 0 || !base_.residual(u.head(N), lambda, residual_) || !wallKinematics(u.head(base_.segments()))) return mu;
+  if (w == 0 || !base_.residual(*d.base, u.head(N), lambda, d.residual) || !wallKinematics(ws, u.head(base_.segments()))) return mu;
   // the free joints' rows: R_F = G_Fᵀ μ (the locked rows carry the joints' own contact torques)
   Matrix A(Eigen::Index(free_.size()), w);
   Vector b(Eigen::Index(free_.size()));
   for (size_t a = 0; a < free_.size(); ++a) {
-    A.row(Eigen::Index(a)) = wallGrad_.row(free_[a]);
-    b[Eigen::Index(a)] = residual_[free_[a]];
+    A.row(Eigen::Index(a)) = d.wallGrad.row(free_[a]);
+    b[Eigen::Index(a)] = d.residual[free_[a]];
   }
   if (free_.empty()) return mu;
   mu = A.colPivHouseholderQr().solve(b);
   return mu;
 }
 
-Vector ContactProblem::withWallForces(ConstVectorRef u, double lambda) {
+Vector ContactProblem::withWallForces(ProblemWorkspace &ws, ConstVectorRef u, double lambda) const {
   const int N = base_.dimension();
   Vector full(dimension());
   full.head(N) = u.head(N);
-  full.tail(locked_.wallCount()) = wallForces(u, lambda);
+  full.tail(locked_.wallCount()) = wallForces(ws, u, lambda);
   return full;
 }
 
-double ContactProblem::contactTorque(ConstVectorRef u, double lambda, int joint) {
+double ContactProblem::contactTorque(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int joint) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   const bool withForces = u.size() == dimension();
-  const Vector full = withForces ? Vector(u) : withWallForces(u, lambda);
-  if (!baseRowsWithWall(full, lambda, residual_)) return std::numeric_limits<double>::quiet_NaN();
-  return residual_[joint];
+  const Vector full = withForces ? Vector(u) : withWallForces(ws, u, lambda);
+  if (!baseRowsWithWall(ws, full, lambda, d.residual)) return std::numeric_limits<double>::quiet_NaN();
+  return d.residual[joint];
 }
 
-double ContactProblem::compression(ConstVectorRef u, double lambda, int joint) {
-  return -double(int(locked_.side(joint))) * contactTorque(u, lambda, joint);
+double ContactProblem::compression(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int joint) const {
+  return -double(int(locked_.side(joint))) * contactTorque(ws, u, lambda, joint);
 }
 
-bool ContactProblem::residual(ConstVectorRef u, double lambda, VectorRef F) {
+bool ContactProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension();
-  if (!baseRowsWithWall(u, lambda, F.head(N))) return false;
-  F.tail(locked_.wallCount()) = -wallX_.head(locked_.wallCount());  // −x_v = 0
+  if (!baseRowsWithWall(ws, u, lambda, F.head(N))) return false;
+  F.tail(locked_.wallCount()) = -d.wallX.head(locked_.wallCount());  // −x_v = 0
   for (const LockedJoint& l : locked_.joints()) F[l.joint] = limitAngle(base_.chain(), l.joint, l.side) - u[l.joint];
   return true;
 }
 
-bool ContactProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) {
+bool ContactProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension(), n = base_.segments(), w = locked_.wallCount();
-  if (!base_.jacobian(u.head(N), lambda, Fu.topLeftCorner(N, N), Flambda.head(N))) return false;
+  if (!base_.jacobian(*d.base, u.head(N), lambda, Fu.topLeftCorner(N, N), Flambda.head(N))) return false;
   if (w > 0) {
-    if (!wallKinematics(u.head(n))) return false;
+    if (!wallKinematics(ws, u.head(n))) return false;
     Fu.rightCols(w).setZero();
     Fu.bottomRows(w).setZero();
     Flambda.tail(w).setZero();
@@ -257,10 +273,10 @@ bool ContactProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, Vec
       const double mu = u[N + k];
       const int last = locked_.wall()[size_t(k)].lastJoint();
       for (int j = 0; j <= last; ++j)
-        for (int l = 0; l <= last; ++l) Fu(j, l) += mu * wallGen_(std::max(j, l), k);
+        for (int l = 0; l <= last; ++l) Fu(j, l) += mu * d.wallGen(std::max(j, l), k);
     }
-    Fu.block(0, N, n, w) = -wallGrad_;
-    Fu.block(N, 0, w, n) = -wallGrad_.transpose();
+    Fu.block(0, N, n, w) = -d.wallGrad;
+    Fu.block(N, 0, w, n) = -d.wallGrad.transpose();
   }
   for (const LockedJoint& l : locked_.joints()) {
     Fu.row(l.joint).setZero();
@@ -270,11 +286,12 @@ bool ContactProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, Vec
   return true;
 }
 
-bool ContactProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
-                                                   double dlambda, MatrixRef dFu, VectorRef dFlambda) {
+bool ContactProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                                   double dlambda, MatrixRef dFu, VectorRef dFlambda) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   // With wall vertices, the central differences of jacobian() (the locked rows stay linear).
-  if (locked_.wallCount() > 0) return Problem::jacobianDirectionalDerivative(u, lambda, du, dlambda, dFu, dFlambda);
-  if (!base_.jacobianDirectionalDerivative(u, lambda, du, dlambda, dFu, dFlambda)) return false;
+  if (locked_.wallCount() > 0) return Problem::jacobianDirectionalDerivative(ws, u, lambda, du, dlambda, dFu, dFlambda);
+  if (!base_.jacobianDirectionalDerivative(*d.base, u, lambda, du, dlambda, dFu, dFlambda)) return false;
   for (const LockedJoint& l : locked_.joints()) {  // the locked rows are linear
     dFu.row(l.joint).setZero();
     dFlambda[l.joint] = 0.0;
@@ -282,56 +299,60 @@ bool ContactProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lamb
   return true;
 }
 
-bool ContactProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix& H, Matrix& C) {
+bool ContactProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   Matrix Ch;
   const int N = base_.dimension(), n = base_.segments(), w = locked_.wallCount();
-  if (!base_.stabilityOperator(u.head(N), lambda, H, Ch) || !wallKinematics(u.head(n))) return false;
+  if (!base_.stabilityOperator(*d.base, u.head(N), lambda, H, Ch) || !wallKinematics(ws, u.head(n))) return false;
   for (int k = 0; k < w; ++k) {
     const int last = locked_.wall()[size_t(k)].lastJoint();
     for (int j = 0; j <= last; ++j)
-      for (int l = 0; l <= last; ++l) H(j, l) += u[N + k] * wallGen_(std::max(j, l), k);
+      for (int l = 0; l <= last; ++l) H(j, l) += u[N + k] * d.wallGen(std::max(j, l), k);
   }
   C = Matrix::Zero(Ch.rows() + locked_.count() + w, n);
   C.topRows(Ch.rows()) = Ch;
   for (int k = 0; k < locked_.count(); ++k) C(Ch.rows() + k, locked_.joints()[size_t(k)].joint) = 1.0;
-  C.bottomRows(w) = wallGrad_.transpose();
+  C.bottomRows(w) = d.wallGrad.transpose();
   return true;
 }
 
-bool ContactProblem::assembleFull(ConstVectorRef u, double lambda, ChainStructure& full, MatrixRef J) {
+bool ContactProblem::assembleFull(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ChainStructure& full, MatrixRef J) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension(), w = locked_.wallCount();
-  if (!base_.assembleStructure(u.head(N), lambda, full, J)) return false;
+  if (!base_.assembleStructure(*d.base, u.head(N), lambda, full, J)) return false;
   if (w == 0) return true;
-  if (!wallKinematics(u.head(base_.segments()))) return false;
+  if (!wallKinematics(ws, u.head(base_.segments()))) return false;
   for (int k = 0; k < w; ++k)  // the generator h gains −μ_v g_v (wall_contact.h)
-    for (int m = 0; m <= locked_.wall()[size_t(k)].lastJoint(); ++m) full.h[m] -= u[N + k] * wallGen_(m, k);
+    for (int m = 0; m <= locked_.wall()[size_t(k)].lastJoint(); ++m) full.h[m] -= u[N + k] * d.wallGen(m, k);
   assemble(full.kappa, full.h, full);
   return true;
 }
 
-bool ContactProblem::assembleReduced(ConstVectorRef u, double lambda, ChainStructure& ws, MatrixRef Jf) {
-  if (free_.empty() || !assembleFull(u, lambda, full_, J_)) return false;
-  reduceToFreeJoints(full_, free_, kf_, hf_, ws);
-  for (size_t a = 0; a < free_.size(); ++a) Jf.col(Eigen::Index(a)) = J_.col(free_[a]);
+bool ContactProblem::assembleReduced(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ChainStructure& structure, MatrixRef Jf) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (free_.empty() || !assembleFull(ws, u, lambda, d.full, d.J)) return false;
+  reduceToFreeJoints(d.full, free_, d.kf, d.hf, structure);
+  for (size_t a = 0; a < free_.size(); ++a) Jf.col(Eigen::Index(a)) = d.J.col(free_[a]);
   return true;
 }
 
-bool ContactProblem::stability(ConstVectorRef u, double lambda, int lowestCount, continuation::StabilityInfo& info) {
+bool ContactProblem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount, continuation::StabilityInfo& info) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   if (free_.empty()) {  // every joint locked: nothing can move
-    if (!residual(u, lambda, residual_)) return false;
+    if (!residual(ws, u, lambda, d.residual)) return false;
     info = continuation::StabilityInfo();
     info.negative = 0;
     return true;
   }
   // the chain structure's counts take at most 3 constraint rows (setConstraints): with more held
   // coordinates and wall vertices together, the dense route of the core (O(n³))
-  if (heldRows_.rows() > 3) return Problem::stability(u, lambda, lowestCount, info);
-  if (!assembleReduced(u, lambda, reduced_, Jf_)) return false;
-  for (size_t k = 0; k < held_.size(); ++k) heldRows_.row(Eigen::Index(k)) = Jf_.row(held_[k]);
+  if (d.heldRows.rows() > 3) return Problem::stability(ws, u, lambda, lowestCount, info);
+  if (!assembleReduced(ws, u, lambda, d.reduced, d.Jf)) return false;
+  for (size_t k = 0; k < held_.size(); ++k) d.heldRows.row(Eigen::Index(k)) = d.Jf.row(held_[k]);
   for (int k = 0; k < locked_.wallCount(); ++k)  // the wall rows ∇x_vᵀ on the free joints
     for (size_t a = 0; a < free_.size(); ++a)
-      heldRows_(Eigen::Index(held_.size()) + k, Eigen::Index(a)) = wallGrad_(free_[a], k);
-  reducedStability(reduced_, heldRows_, lowestCount, lastLowest_, info);
+      d.heldRows(Eigen::Index(held_.size()) + k, Eigen::Index(a)) = d.wallGrad(free_[a], k);
+  reducedStability(d.reduced, d.heldRows, lowestCount, d.lastLowest, info);
   return true;
 }
 
@@ -359,19 +380,20 @@ int ContactProblem::wallReleaseBoundary(int k) const {
 }
 int ContactProblem::boundaryCount() const { return wallReleaseBoundary(locked_.wallCount()); }
 
-double ContactProblem::boundary(int k, ConstVectorRef u, double lambda) {
+double ContactProblem::boundary(ProblemWorkspace &ws, int k, ConstVectorRef u, double lambda) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   const int n = base_.segments(), N = base_.dimension();
   if (k == wallClearanceBoundary()) return nearestWallVertex(base_.chain(), u.head(n), locked_.wall()).distance;
   if (k >= wallReleaseBoundary(0)) {
     const int r = k - wallReleaseBoundary(0);
-    return u.size() == dimension() ? u[N + r] : wallForces(u, lambda)[r];  // μ_v ≥ 0
+    return u.size() == dimension() ? u[N + r] : wallForces(ws, u, lambda)[r];  // μ_v ≥ 0
   }
   if (k >= torqueBoundBegin())
-    return maxCompression_ - compression(u, lambda, locked_.joints()[size_t(k - torqueBoundBegin())].joint);
-  if (k >= 2 * n) return base_.boundary(base_.rangeBoundaryBegin() + k - 2 * n, u.head(N), lambda);
+    return maxCompression_ - compression(ws, u, lambda, locked_.joints()[size_t(k - torqueBoundBegin())].joint);
+  if (k >= 2 * n) return base_.boundary(*d.base, base_.rangeBoundaryBegin() + k - 2 * n, u.head(N), lambda);
   const LockedJoint b = limitOfBoundary(k, base_.segments());
-  if (locked_.locked(b.joint) && locked_.side(b.joint) == b.side) return compression(u, lambda, b.joint);
-  return base_.boundary(k, u.head(N), lambda);
+  if (locked_.locked(b.joint) && locked_.side(b.joint) == b.side) return compression(ws, u, lambda, b.joint);
+  return base_.boundary(*d.base, k, u.head(N), lambda);
 }
 
 std::string ContactProblem::boundaryName(int k) const {

@@ -14,7 +14,7 @@ namespace buckle::mechanics {
 using continuation::ConstVectorRef;
 using continuation::Factorization;
 
-ConstrainedEquilibrium solveConstrainedEquilibrium(EquilibriumProblem& base, const ContactSet& locked,
+ConstrainedEquilibrium solveConstrainedEquilibrium(const EquilibriumProblem& base, const ContactSet& locked,
                                                    ConstVectorRef u0, double lambda, double tolerance,
                                                    int maxIterations) {
   ConstrainedEquilibrium out;
@@ -23,18 +23,19 @@ ConstrainedEquilibrium solveConstrainedEquilibrium(EquilibriumProblem& base, con
     throw std::invalid_argument("solveConstrainedEquilibrium: u0 must have " + std::to_string(N) + " entries, got " +
                                 std::to_string(u0.size()));
   if (!std::isfinite(lambda)) throw std::invalid_argument("solveConstrainedEquilibrium: lambda must be finite");
-  ContactProblem problem(base, locked);
+  const ContactProblem problem(base, locked);
+  const continuation::BoundProblem bound(problem);  // this solve's workspace
   const continuation::ProblemScales s = problem.scales();
-  const std::unique_ptr<continuation::BorderedSolver> solver = problem.makeStructuredSolver();
+  const std::unique_ptr<continuation::BorderedSolver> solver = bound.makeStructuredSolver();
   const int D = problem.dimension();  // N + the wall forces
   Vector start = u0;
   for (const LockedJoint& l : locked.joints()) start[l.joint] = limitAngle(base.chain(), l.joint, l.side);
-  Vector u = problem.withWallForces(start, lambda), F(D), trial(D), b = Vector::Zero(D + 1), dx(D + 1),
+  Vector u = problem.withWallForces(bound.workspace(), start, lambda), F(D), trial(D), b = Vector::Zero(D + 1), dx(D + 1),
          c = Vector::Zero(D + 1);
   c[D] = 1.0;  // fixed λ: the border row e_λ
   if (!u.allFinite()) u.tail(D - N).setZero();  // no free row to read the forces from: start at 0
   auto scaledNorm = [&](const Vector& r) { return r.cwiseQuotient(s.residuals).cwiseAbs().maxCoeff(); };
-  if (!problem.residual(u, lambda, F)) {
+  if (!bound.residual(u, lambda, F)) {
     out.message = "the start is outside the model's domain";
     out.u = u.head(N);
     return out;
@@ -54,7 +55,7 @@ ConstrainedEquilibrium solveConstrainedEquilibrium(EquilibriumProblem& base, con
     double t = 1.0, trialNorm = std::numeric_limits<double>::infinity();
     for (int h = 0; h < 30; ++h, t *= 0.5) {
       trial = u - t * dx.head(D);
-      if (problem.residual(trial, lambda, F) && (trialNorm = scaledNorm(F)) < std::max(norm, tolerance) * 2.0) break;
+      if (bound.residual(trial, lambda, F) && (trialNorm = scaledNorm(F)) < std::max(norm, tolerance) * 2.0) break;
       trialNorm = std::numeric_limits<double>::infinity();
     }
     if (!std::isfinite(trialNorm)) {
@@ -64,7 +65,7 @@ ConstrainedEquilibrium solveConstrainedEquilibrium(EquilibriumProblem& base, con
     u = trial;
     norm = trialNorm;
   }
-  if (!problem.residual(u, lambda, F)) norm = std::numeric_limits<double>::infinity();
+  if (!bound.residual(u, lambda, F)) norm = std::numeric_limits<double>::infinity();
   out.u = u.head(N);
   out.residual = norm;
   out.converged = norm <= tolerance;
@@ -73,18 +74,19 @@ ConstrainedEquilibrium solveConstrainedEquilibrium(EquilibriumProblem& base, con
   out.wallForces = u.tail(D - N);
   out.minCompression = out.wallForces.size() > 0 ? out.wallForces.minCoeff() : std::numeric_limits<double>::infinity();
   for (const LockedJoint& l : locked.joints()) {
-    out.torques[l.joint] = problem.contactTorque(u, lambda, l.joint);
+    out.torques[l.joint] = problem.contactTorque(bound.workspace(), u, lambda, l.joint);
     out.minCompression = std::min(out.minCompression, -double(int(l.side)) * out.torques[l.joint]);
   }
   return out;
 }
 
-continuation::StabilityInfo constrainedStability(EquilibriumProblem& base, const ContactSet& locked, ConstVectorRef u,
+continuation::StabilityInfo constrainedStability(const EquilibriumProblem& base, const ContactSet& locked, ConstVectorRef u,
                                                  double lambda, int lowestCount) {
-  ContactProblem problem(base, locked);
+  const ContactProblem problem(base, locked);
+  const continuation::BoundProblem bound(problem);  // this solve's workspace
   continuation::StabilityInfo info;
-  const Vector full = u.size() == problem.dimension() ? Vector(u) : problem.withWallForces(u, lambda);
-  if (!problem.stability(full, lambda, lowestCount, info)) info.negative = -1;
+  const Vector full = u.size() == problem.dimension() ? Vector(u) : problem.withWallForces(bound.workspace(), u, lambda);
+  if (!bound.stability(full, lambda, lowestCount, info)) info.negative = -1;
   return info;
 }
 

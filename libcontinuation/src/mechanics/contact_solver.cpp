@@ -9,6 +9,9 @@
 
 namespace buckle::mechanics {
 
+using continuation::ProblemWorkspace;
+using continuation::workspaceAs;
+
 using continuation::ConstVectorRef;
 using continuation::Factorization;
 using continuation::VectorRef;
@@ -23,8 +26,9 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
  public:
   static constexpr int kDenseFallback = 400;
 
-  explicit ReducedChainSolver(ContactProblem& problem)
+  ReducedChainSolver(const ContactProblem& problem, continuation::ProblemWorkspace& problemWorkspace)
       : problem_(problem),
+        problemWorkspace_(problemWorkspace),
         n_(problem.base().segments()),
         m_(problem.base().heldCount()),
         w_(problem.contacts().wallCount()),
@@ -47,14 +51,14 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
         y_(p_) {
     for (const LockedJoint& l : problem.contacts().joints()) lockedIndex_.push_back(l.joint);
     if (n_ + m_ + w_ <= kDenseFallback || p_ > ChainStructure::kMaxBorder)
-      dense_ = std::make_unique<continuation::DenseBorderedSolver>(problem);
+      dense_ = std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
   }
 
   Factorization factor(ConstVectorRef u, double lambda, ConstVectorRef c) override {
     sign_ = 0;
     logAbs_ = -std::numeric_limits<double>::infinity();
     usingDense_ = false;
-    if (!c.allFinite() || !problem_.assembleFull(u, lambda, full_, J_)) return Factorization::Refused;
+    if (!c.allFinite() || !problem_.assembleFull(problemWorkspace_, u, lambda, full_, J_)) return Factorization::Refused;
     if (p_ > ChainStructure::kMaxBorder) {  // more borders than the chain structure holds
       usingDense_ = true;
       const Factorization f = dense_->factor(u, lambda, c);
@@ -65,7 +69,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
     c_ = c;
     reduceToFreeJoints(full_, free_, kf_, hf_, ws_);
     const Eigen::Vector3d& dir = problem_.base().direction();
-    grad_ = problem_.wallGradients();  // a copy: the problem's is rewritten by the next evaluation
+    grad_ = ContactProblem::wallGradients(problemWorkspace_);  // a copy: the problem's is rewritten by the next evaluation
     const Matrix& grad = grad_;
     const int nf = int(free_.size()), last = p_ - 1;
     D_.setZero();
@@ -73,7 +77,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
       const int i = free_[size_t(a)];
       double fl = 0.0;
       for (int cc : loaded_) fl -= J_(cc, i) * dir[cc];
-      if (problem_.base().hasBodyLoads()) fl -= problem_.base().bodyRateTorques()[i];  // eq (B2)
+      if (problem_.base().hasBodyLoads()) fl -= EquilibriumProblem::bodyRateTorques(*workspaceAs<ContactProblem::Workspace>(problemWorkspace_).base)[i];  // eq (B2)
       V_(a, last) = fl;
       W_(a, last) = c[i];
       for (int k = 0; k < m_; ++k) V_(a, k) = W_(a, k) = -J_(held_[size_t(k)], i);
@@ -123,7 +127,8 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
   double logAbsDeterminant() const override { return logAbs_; }
 
  private:
-  ContactProblem& problem_;
+  const ContactProblem& problem_;
+  continuation::ProblemWorkspace& problemWorkspace_;
   int n_, m_, w_, p_;
   std::vector<int> free_, held_, loaded_, lockedIndex_;
   ChainStructure full_, ws_;
@@ -140,9 +145,9 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
 
 }  // namespace
 
-std::unique_ptr<continuation::BorderedSolver> ContactProblem::makeStructuredSolver() {
-  if (free_.empty()) return std::make_unique<continuation::DenseBorderedSolver>(*this);
-  return std::make_unique<ReducedChainSolver>(*this);
+std::unique_ptr<continuation::BorderedSolver> ContactProblem::makeStructuredSolver(ProblemWorkspace &ws) const {
+  if (free_.empty()) return std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(*this, ws));
+  return std::make_unique<ReducedChainSolver>(*this, ws);
 }
 
 }  // namespace buckle::mechanics

@@ -43,7 +43,7 @@ Vector unitMode(const Vector& w, int n) {
 }
 
 // Right singular vector of the smallest singular value of F_u at (u, λ).
-Vector nullVector(cont::Problem& problem, const Vector& u, double lambda) {
+Vector nullVector(const cont::BoundProblem& problem, const Vector& u, double lambda) {
   const int N = problem.dimension();
   Matrix Fu(N, N);
   Vector Fl(N);
@@ -93,7 +93,7 @@ bool useStructured(const CriticalCurveOptions& options, int N) {
 
 // Null vector of F_u at (u, λ) near `guess` by two steps of inverse iteration with the bordered
 // matrix [[F_u, g], [gᵀ, 0]] (O(n) through the structured solver, refined on the chain's products).
-Vector structuredNullVector(cont::Problem& problem, const Vector& u, double lambda, const Vector& guess) {
+Vector structuredNullVector(const cont::BoundProblem& problem, const Vector& u, double lambda, const Vector& guess) {
   const int N = problem.dimension();
   const std::unique_ptr<cont::BorderedSolver> solver = problem.makeStructuredSolver();
   if (!solver) throw std::invalid_argument("critical curve: no structured solver for this problem");
@@ -139,7 +139,7 @@ void addZeroLoadPoints(ChainParameterProblem& problem, const cont::Branch& branc
   const double scale = problem.secondParameterScale();
   auto smallest = [&](double mu, double& g) {
     cont::StabilityInfo info;
-    if (!problem.setSecondParameter(mu) || !problem.stability(u0, 0.0, 1, info) || info.lowest.size() < 1) return false;
+    if (!problem.setSecondParameter(mu) || !cont::BoundProblem(problem).stability(u0, 0.0, 1, info) || info.lowest.size() < 1) return false;
     g = info.lowest[0];
     return true;
   };
@@ -205,7 +205,7 @@ std::string CriticalCurveOptions::validate(const std::string& prefix) const {
 
 CriticalCurve branchPointCurve(ChainParameterProblem& problem, int mode, const CriticalCurveOptions& options) {
   if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("CriticalCurveOptions: " + why);
-  EquilibriumProblem& eq = problem.equilibrium();
+  const EquilibriumProblem& eq = problem.equilibrium();
   const int n = eq.segments();
   const int N = eq.dimension();
   const double mu0 = problem.secondParameter();
@@ -214,7 +214,7 @@ CriticalCurve branchPointCurve(ChainParameterProblem& problem, int mode, const C
   const cont::ProblemScales scales = eq.scales();
   Vector F(N);
   for (double lambda : {0.0, scales.parameter}) {
-    if (!eq.residual(u0, lambda, F) || F.cwiseQuotient(scales.residuals).lpNorm<Eigen::Infinity>() > 1e-12)
+    if (!cont::BoundProblem(eq).residual(u0, lambda, F) || F.cwiseQuotient(scales.residuals).lpNorm<Eigen::Infinity>() > 1e-12)
       throw std::invalid_argument(
           "branch-point curve: the straight chain is not an equilibrium along the load path (unequal preloads, "
           "an off-axis load or a held coordinate off the axis)");

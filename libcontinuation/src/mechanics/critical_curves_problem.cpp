@@ -47,7 +47,7 @@ SegmentParameterDirection segmentDirection(Kind kind) {
 // rebuilds the EquilibriumProblem the chain solver is bound to).
 class ChainParameterSolver final : public cont::BorderedSolver {
  public:
-  explicit ChainParameterSolver(ChainParameterProblem& problem) : problem_(problem) {}
+  ChainParameterSolver(const ChainParameterProblem& problem, cont::ProblemWorkspace& ws) : problem_(problem), ws_(ws) {}
 
   cont::Factorization factor(cont::ConstVectorRef u, double lambda, cont::ConstVectorRef c) override {
     return sync() ? inner_->factor(u, lambda, c) : cont::Factorization::Refused;
@@ -66,13 +66,14 @@ class ChainParameterSolver final : public cont::BorderedSolver {
  private:
   bool sync() {
     if (!inner_ || generation_ != problem_.generation()) {
-      inner_ = problem_.equilibrium().makeStructuredSolver();
+      inner_ = problem_.equilibrium().makeStructuredSolver(problem_.equilibriumWorkspace(ws_));
       generation_ = problem_.generation();
     }
     return inner_ != nullptr;
   }
 
-  ChainParameterProblem& problem_;
+  const ChainParameterProblem& problem_;
+  cont::ProblemWorkspace& ws_;
   std::unique_ptr<cont::BorderedSolver> inner_;
   long generation_ = -1;
 };
@@ -188,12 +189,21 @@ bool ChainParameterProblem::setSecondParameter(double mu) {
   return true;
 }
 
-std::unique_ptr<cont::BorderedSolver> ChainParameterProblem::makeStructuredSolver() {
-  return std::make_unique<ChainParameterSolver>(*this);
+std::unique_ptr<cont::BorderedSolver> ChainParameterProblem::makeStructuredSolver(cont::ProblemWorkspace &ws) const {
+  return std::make_unique<ChainParameterSolver>(*this, ws);
 }
 
-bool ChainParameterProblem::parameterJacobianApply(cont::ConstVectorRef u, double lambda, cont::ConstVectorRef v,
-                                                   cont::VectorRef FuLambdaV) {
+cont::ProblemWorkspace& ChainParameterProblem::equilibriumWorkspace(cont::ProblemWorkspace& ws) const {
+  Workspace& w = cont::workspaceAs<Workspace>(ws);
+  if (!w.equilibrium || w.generation != generation_) {
+    w.equilibrium = equilibrium_->createWorkspace();
+    w.generation = generation_;
+  }
+  return *w.equilibrium;
+}
+
+bool ChainParameterProblem::parameterJacobianApply(cont::ProblemWorkspace &, cont::ConstVectorRef u, double lambda, cont::ConstVectorRef v,
+                                                   cont::VectorRef FuLambdaV) const {
   const Chain& chain = equilibrium_->chain();
   const int n = chain.size();
   const int N = equilibrium_->dimension();
@@ -227,8 +237,8 @@ double ChainParameterProblem::secondParameterScale() const {
   }
 }
 
-bool ChainParameterProblem::secondParameterDerivatives(cont::ConstVectorRef u, double lambda, cont::ConstVectorRef v,
-                                                       cont::VectorRef Fmu, cont::VectorRef FuMuV) {
+bool ChainParameterProblem::secondParameterDerivatives(cont::ProblemWorkspace &, cont::ConstVectorRef u, double lambda, cont::ConstVectorRef v,
+                                                       cont::VectorRef Fmu, cont::VectorRef FuMuV) const {
   const Chain& chain = equilibrium_->chain();
   const int n = chain.size();
   const int N = equilibrium_->dimension();

@@ -145,10 +145,11 @@ Eigen::VectorXd polishAt(EquilibriumProblem& problem, Eigen::VectorXd u, double 
   const cont::ProblemScales scales = problem.scales();
   Eigen::VectorXd F(N), Fl(N);
   Eigen::MatrixXd Fu(N, N);
+  const cont::BoundProblem bound(problem);  // this polish's workspace
   for (int it = 0; it < 30; ++it) {
-    if (!problem.residual(u, lambda, F)) return {};
+    if (!bound.residual(u, lambda, F)) return {};
     if (F.cwiseQuotient(scales.residuals).cwiseAbs().maxCoeff() <= 1e-11) return u;
-    if (!problem.jacobian(u, lambda, Fu, Fl)) return {};
+    if (!bound.jacobian(u, lambda, Fu, Fl)) return {};
     Eigen::PartialPivLU<Eigen::MatrixXd> lu(Fu);
     const Eigen::VectorXd du = lu.solve(-F);
     if (!du.allFinite()) return {};

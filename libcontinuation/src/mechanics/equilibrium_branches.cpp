@@ -116,7 +116,7 @@ double contactRate(EquilibriumProblem& problem, const ContactSet& before, const 
     ContactProblem prior(problem, before);  // the same wall vertices: the same unknowns
     continuation::Matrix Fu(D, D);
     continuation::Vector Fl(D);
-    if (!prior.jacobian(p0.u, p0.lambda, Fu, Fl)) return 0.0;
+    if (!continuation::BoundProblem(prior).jacobian(p0.u, p0.lambda, Fu, Fl)) return 0.0;
     return -sideSign * (Fu.row(i).dot(p0.tangent.head(D)) + Fl[i] * p0.tangent[D]);
   }
   if (!release) return p0.tangent[D - before.wallCount() - 1 + wallIndex];
@@ -238,7 +238,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       giveUp("the branch does not leave the point (" + stretch.stopMessage + ")");
       break;
     }
-    if (next->boundary(changed, stretch.points[1].u, stretch.points[1].lambda) < 0.0) {
+    if (continuation::BoundProblem(*next).boundary(changed, stretch.points[1].u, stretch.points[1].lambda) < 0.0) {
       giveUp(release ? (onJoint ? "the free joint would go past its limit" : "the vertex would go through the wall")
                      : "the contact would pull (tension)");
       break;

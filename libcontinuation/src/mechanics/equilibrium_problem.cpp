@@ -18,6 +18,8 @@ namespace buckle::mechanics {
 
 using continuation::ConstVectorRef;
 using continuation::MatrixRef;
+using continuation::ProblemWorkspace;
+using continuation::workspaceAs;
 using continuation::VectorRef;
 
 namespace {
@@ -68,23 +70,11 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
       options_(options),
       held_(end.heldIndices()),
       loaded_(end.loadedIndices()),
-      data_(chain),
-      J_(3, chain.size()),
-      grad_(chain.size()),
-      stiff_(chain.size()),
-      stiffRate_(chain.size()),
-      cachedQ_(chain.size()),
       control_(control),
-      sinHalf_(chain.size()),
-      cosHalf_(chain.size()),
       domainUpper_(chain.size()),
       domainLower_(chain.size()),
-      work_(chain.size()),
-      structure_(chain.size()),
-      heldRows_(static_cast<Eigen::Index>(held_.size()), chain.size()),
       body_(body),
-      bodyTerms_(chain, body),
-      bodyWork_(chain.size()) {
+      bodyTerms_(chain, body) {
   static const char* names[3] = {"x", "y", "phi"};
   for (int c = 0; c < 3; ++c) {
     requireFinite(std::string("end value ") + names[c], end.value[c]);
@@ -107,11 +97,7 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
       freeLength1_[i] = chain_.segment(i).parameters().L1_0;
       freeLength2_[i] = chain_.segment(i).parameters().L2_0;
     }
-    controlGrad_.resize(n);
-    controlStiff_.resize(n);
   }
-  structure_.typicalScale = stiffnessUnit() * lengthUnit() * lengthUnit();  // the inertia's zero floor
-  spectrumKey_.resize(dimension() + 1);
   const double overshoot = options_.jointLimitsAsBoundaries ? kGeometricOvershoot : 0.0;
   for (int i = 0; i < chain_.size(); ++i) {
     domainUpper_[i] = chain_.segment(i).geometricUpperLimit() + overshoot;
@@ -119,24 +105,50 @@ EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& e
   }
 }
 
-bool EquilibriumProblem::prepare(const ConstVectorRef& u, double lambda) {
+EquilibriumProblem::Workspace::Workspace(const EquilibriumProblem& problem)
+    : data(problem.chain_),
+      J(3, problem.segments()),
+      grad(problem.segments()),
+      stiff(problem.segments()),
+      stiffRate(problem.segments()),
+      cachedQ(problem.segments()),
+      sinHalf(problem.segments()),
+      cosHalf(problem.segments()),
+      work(problem.segments()),
+      structure(problem.segments()),
+      heldRows(problem.heldCount(), problem.segments()),
+      spectrumKey(problem.dimension() + 1),
+      bodyTerms(problem.bodyTerms_),
+      bodyWork(problem.segments()) {
+  if (problem.controlled()) {
+    controlGrad.resize(problem.segments());
+    controlStiff.resize(problem.segments());
+  }
+  structure.typicalScale = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();  // the inertia's zero floor
+}
+
+std::unique_ptr<ProblemWorkspace> EquilibriumProblem::createWorkspace() const {
+  return std::make_unique<Workspace>(*this);
+}
+
+bool EquilibriumProblem::prepare(Workspace& d, const ConstVectorRef& u, double lambda) const {
   const int n = chain_.size();
   for (Eigen::Index k = n; k < u.size(); ++k)
     if (!std::isfinite(u[k])) return false;
   const auto q = u.head(n);
   // Bitwise: a q that merely compares equal (−0.0 vs 0.0) is evaluated afresh.
   const bool controlled = control_.active();
-  if (cacheValid_ && sameBits(q.data(), cachedQ_.data(), size_t(n)) &&
-      (!controlled || sameBits(&lambda, &cachedLambda_, 1)))
+  if (d.cacheValid && sameBits(q.data(), d.cachedQ.data(), size_t(n)) &&
+      (!controlled || sameBits(&lambda, &d.cachedLambda, 1)))
     return true;
-  cacheValid_ = false;
+  d.cacheValid = false;
   if (!inDomain(u)) return false;
   // One sincos per joint serves its springs and the link directions (chain.h).
   const double t = lambda - control_.origin;
   for (int i = 0; i < n; ++i) {
     const double sh = std::sin(0.5 * q[i]), ch = std::cos(0.5 * q[i]);  // one sincos call at -O2
-    sinHalf_[i] = sh;
-    cosHalf_[i] = ch;
+    d.sinHalf[i] = sh;
+    d.cosHalf[i] = ch;
     Jet3 e;
     if (controlled) {
       // The same sums as chainWithControls(): the point at λ is bit for bit the chain at λ.
@@ -145,21 +157,21 @@ bool EquilibriumProblem::prepare(const ConstVectorRef& u, double lambda) {
       if (!(L1 > 0.0 && L2 > 0.0)) return false;  // no spring of non-positive free length (segment.cpp)
       Jet3 rate;
       e = chain_.segment(i).energyJet(q[i], sh, ch, L1, L2, r1, r2, rate);
-      controlGrad_[i] = rate.d1;
-      controlStiff_[i] = rate.d2;
+      d.controlGrad[i] = rate.d1;
+      d.controlStiff[i] = rate.d2;
     } else {
       e = chain_.segment(i).energyJet(q[i], sh, ch);
     }
-    grad_[i] = e.d1;
-    stiff_[i] = e.d2;
-    stiffRate_[i] = e.d3;
+    d.grad[i] = e.d1;
+    d.stiff[i] = e.d2;
+    d.stiffRate[i] = e.d3;
   }
-  forwardKinematics(chain_, q, sinHalf_.data(), cosHalf_.data(), data_);
-  endJacobian(data_, J_);
-  if (bodyTerms_.active()) bodyTerms_.update(data_);
-  cachedQ_ = q;
-  cachedLambda_ = lambda;
-  cacheValid_ = true;
+  forwardKinematics(chain_, q, d.sinHalf.data(), d.cosHalf.data(), d.data);
+  endJacobian(d.data, d.J);
+  if (d.bodyTerms.active()) d.bodyTerms.update(d.data);
+  d.cachedQ = q;
+  d.cachedLambda = lambda;
+  d.cacheValid = true;
   return true;
 }
 
@@ -210,33 +222,35 @@ bool EquilibriumProblem::inDomain(const ConstVectorRef& u) const {
   return true;
 }
 
-bool EquilibriumProblem::residual(ConstVectorRef u, double lambda, VectorRef F) {
-  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
+bool EquilibriumProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
   const Wrench W = wrench(u, lambda);
   auto top = F.head(n);
-  top = grad_;
-  top.noalias() -= J_.transpose() * W;
-  if (bodyTerms_.active()) {  // + ∂V/∂q = −τ(λ) (eq B2)
-    bodyTerms_.torques(lambda, bodyWork_);
-    top -= bodyWork_;
+  top = d.grad;
+  top.noalias() -= d.J.transpose() * W;
+  if (d.bodyTerms.active()) {  // + ∂V/∂q = −τ(λ) (eq B2)
+    d.bodyTerms.torques(lambda, d.bodyWork);
+    top -= d.bodyWork;
   }
   const Eigen::Vector3d value = prescribed(lambda);
-  for (size_t k = 0; k < held_.size(); ++k) F[n + int(k)] = value[held_[k]] - data_.pose[held_[k]];
+  for (size_t k = 0; k < held_.size(); ++k) F[n + int(k)] = value[held_[k]] - d.data.pose[held_[k]];
   return true;
 }
 
-bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) {
-  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
+bool EquilibriumProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
-  loadGenerator(u, lambda, work_);
+  loadGenerator(d, u, lambda, d.work);
   // Plain pointer loops (n + m is tiny in the hot path: Eigen's expressions on Refs, a max() per
   // entry and the vectorised fills' alias checks cost more than the arithmetic there; the
   // entries and their rounding are those of the textbook loops).
   double* const a = Fu.data();
   const Eigen::Index ld = Fu.outerStride();
-  const double* const w = work_.data();
-  const double* const kq = stiff_.data();
+  const double* const w = d.work.data();
+  const double* const kq = d.stiff.data();
   // K_q − K_g with K_g(i, j) = h_max(i,j)  (eq 27): column j is −h_j down to the diagonal, −h_i below
   for (int j = 0; j < n; ++j) {
     double* const col = a + j * ld;
@@ -246,7 +260,7 @@ bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu,
     for (int i = j + 1; i < n; ++i) col[i] = -w[i];
   }
   const int m = heldCount();
-  const double* const J = J_.data();  // 3 × n, column-major
+  const double* const J = d.J.data();  // 3 × n, column-major
   for (int k = 0; k < m; ++k) {
     const int h = held_[size_t(k)];
     double* const col = a + (n + k) * ld;
@@ -262,15 +276,16 @@ bool EquilibriumProblem::jacobian(ConstVectorRef u, double lambda, MatrixRef Fu,
     for (int i = 0; i < n; ++i) fl[i] -= J[c + 3 * i] * d;
   }
   if (control_.active())
-    for (int i = 0; i < n; ++i) fl[i] += controlGrad_[i];  // ∂²E/∂q∂λ of the moving free lengths
-  if (bodyTerms_.active())
-    for (int i = 0; i < n; ++i) fl[i] -= bodyTerms_.rateTorques()[i];  // ∂²V/∂q∂λ = −τ' (eq B2)
+    for (int i = 0; i < n; ++i) fl[i] += d.controlGrad[i];  // ∂²E/∂q∂λ of the moving free lengths
+  if (d.bodyTerms.active())
+    for (int i = 0; i < n; ++i) fl[i] -= d.bodyTerms.rateTorques()[i];  // ∂²V/∂q∂λ = −τ' (eq B2)
   return true;
 }
 
-bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double lambda, ConstVectorRef du,
-                                                       double dlambda, MatrixRef dFu, VectorRef dFlambda) {
-  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
+bool EquilibriumProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                                       double dlambda, MatrixRef dFu, VectorRef dFlambda) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
   const int m = heldCount();
   const Wrench W = wrench(u, lambda);
@@ -278,17 +293,17 @@ bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double 
   for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = du[n + k];
   // dJ rows: (−dS, dC, 0) with the tail-sum derivatives of stiffness.h
   Matrix dJ(3, n);
-  endJacobianDerivative(chain_, data_, du.head(n), dJ);
+  endJacobianDerivative(chain_, d.data, du.head(n), dJ);
   const Vector dS = -dJ.row(0).transpose(), dC = dJ.row(1).transpose();
   // dh_m for h_m = −Fx C_m − Fy S_m
-  Vector dh = -dW[0] * data_.C - W[0] * dC - dW[1] * data_.S - W[1] * dS;
-  if (bodyTerms_.active()) {  // − dγ (eq B5); F_λ's −τ' moves with q by Γ' dq
-    bodyGeneratorDerivative(du.head(n), lambda, dlambda);
-    dh -= bodyWork_;
+  Vector dh = -dW[0] * d.data.C - W[0] * dC - dW[1] * d.data.S - W[1] * dS;
+  if (d.bodyTerms.active()) {  // − dγ (eq B5); F_λ's −τ' moves with q by Γ' dq
+    bodyGeneratorDerivative(d, du.head(n), lambda, dlambda);
+    dh -= d.bodyWork;
   }
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) dFu(i, j) = -dh[std::max(i, j)];
-  for (int i = 0; i < n; ++i) dFu(i, i) += stiffRate_[i] * du[i];  // E‴ at (q, λ), from the cache
+  for (int i = 0; i < n; ++i) dFu(i, i) += d.stiffRate[i] * du[i];  // E‴ at (q, λ), from the cache
   for (int k = 0; k < m; ++k) {
     dFu.block(0, n + k, n, 1) = -dJ.row(held_[size_t(k)]).transpose();
     dFu.block(n + k, 0, 1, n) = -dJ.row(held_[size_t(k)]);
@@ -296,26 +311,27 @@ bool EquilibriumProblem::jacobianDirectionalDerivative(ConstVectorRef u, double 
   if (m > 0) dFu.bottomRightCorner(m, m).setZero();
   dFlambda.setZero();
   for (int cc : loaded_) dFlambda.head(n) -= dJ.row(cc).transpose() * direction_[cc];
-  if (bodyTerms_.active()) {
-    maxIndexProduct(bodyTerms_.rateGenerator(), du.head(n), bodyWork_);
-    dFlambda.head(n) += bodyWork_;
+  if (d.bodyTerms.active()) {
+    maxIndexProduct(d.bodyTerms.rateGenerator(), du.head(n), d.bodyWork);
+    dFlambda.head(n) += d.bodyWork;
   }
   if (control_.active()) {
     // K_q moves with λ; F_λ's control part ∂²E/∂q∂λ moves with q_i (∂/∂λ of it is zero)
     for (int i = 0; i < n; ++i) {
-      dFu(i, i) += controlStiff_[i] * dlambda;
-      dFlambda[i] += controlStiff_[i] * du[i];
+      dFu(i, i) += d.controlStiff[i] * dlambda;
+      dFlambda[i] += d.controlStiff[i] * du[i];
     }
   }
   return true;
 }
 
-bool EquilibriumProblem::jacobianApply(ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) {
-  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
+bool EquilibriumProblem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
   const int m = heldCount();
   Vector h(n);
-  loadGenerator(u, lambda, h);
+  loadGenerator(d, u, lambda, h);
   const double xl = x[n + m];  // the λ component
   // (K_g x)_i = h_i Σ_{j≤i} x_j + Σ_{j>i} h_j x_j  (K_g(i, j) = h_max(i,j), eq 27)
   double suffix = 0.0;
@@ -326,62 +342,64 @@ bool EquilibriumProblem::jacobianApply(ConstVectorRef u, double lambda, ConstVec
   double prefix = 0.0;
   for (int i = 0; i < n; ++i) {
     prefix += x[i];
-    y[i] += stiff_[i] * x[i] - h[i] * prefix;
+    y[i] += d.stiff[i] * x[i] - h[i] * prefix;
   }
-  for (int c : loaded_) y.head(n) -= (xl * direction_[c]) * J_.row(c).transpose();
-  if (control_.active()) y.head(n) += xl * controlGrad_;
-  if (bodyTerms_.active()) y.head(n) -= xl * bodyTerms_.rateTorques();
+  for (int c : loaded_) y.head(n) -= (xl * direction_[c]) * d.J.row(c).transpose();
+  if (control_.active()) y.head(n) += xl * d.controlGrad;
+  if (d.bodyTerms.active()) y.head(n) -= xl * d.bodyTerms.rateTorques();
   for (int k = 0; k < m; ++k) {
     const int c = held_[size_t(k)];
-    y.head(n) -= x[n + k] * J_.row(c).transpose();
-    y[n + k] = -J_.row(c).dot(x.head(n)) + direction_[c] * xl;
+    y.head(n) -= x[n + k] * d.J.row(c).transpose();
+    y[n + k] = -d.J.row(c).dot(x.head(n)) + direction_[c] * xl;
   }
   return y.allFinite();
 }
 
-bool EquilibriumProblem::jacobianTransposeApply(ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) {
+bool EquilibriumProblem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   const int n = chain_.size();
   const int N = dimension();
   Vector x(N + 1);
   x.head(N) = w;
   x[N] = 0.0;
-  if (!jacobianApply(u, lambda, x, y.head(N))) return false;  // F_u is symmetric
+  if (!jacobianApply(ws, u, lambda, x, y.head(N))) return false;  // F_u is symmetric
   // F_λ · w: −Σ_loaded dir_c J_c·w_q + Σ_held dir_c w_r
   double dot = 0.0;
-  for (int c : loaded_) dot -= direction_[c] * J_.row(c).dot(w.head(n));
+  for (int c : loaded_) dot -= direction_[c] * d.J.row(c).dot(w.head(n));
   for (int k = 0; k < heldCount(); ++k) dot += direction_[held_[size_t(k)]] * w[n + k];
-  if (control_.active()) dot += controlGrad_.dot(w.head(n));  // jacobianApply prepared (q, λ)
-  if (bodyTerms_.active()) dot -= bodyTerms_.rateTorques().dot(w.head(n));
+  if (control_.active()) dot += d.controlGrad.dot(w.head(n));  // jacobianApply prepared (q, λ)
+  if (d.bodyTerms.active()) dot -= d.bodyTerms.rateTorques().dot(w.head(n));
   y[N] = dot;
   return std::isfinite(dot);
 }
 
-bool EquilibriumProblem::secondDerivativeApply(ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
-                                               VectorRef y) {
-  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
+bool EquilibriumProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
+                                               VectorRef y) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
   const int m = heldCount();
   const Wrench W = wrench(u, lambda);
   Wrench dW = x[n + m] * direction_;  // the wrench along x: loads with x_λ, reactions with x_r
   for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = x[n + k];
   Matrix dJ(3, n);
-  endJacobianDerivative(chain_, data_, x.head(n), dJ);
+  endJacobianDerivative(chain_, d.data, x.head(n), dJ);
   // dh_m along x for h_m = −Fx C_m − Fy S_m, with dC = dJ_y, dS = −dJ_x (as in
   // jacobianDirectionalDerivative)
-  Vector dh = -dW[0] * data_.C - W[0] * dJ.row(1).transpose() - dW[1] * data_.S + W[1] * dJ.row(0).transpose();
-  if (bodyTerms_.active()) {  // − dγ along x (eq B5, x_λ included)
-    bodyGeneratorDerivative(x.head(n), lambda, x[n + m]);
-    dh -= bodyWork_;
+  Vector dh = -dW[0] * d.data.C - W[0] * dJ.row(1).transpose() - dW[1] * d.data.S + W[1] * dJ.row(0).transpose();
+  if (d.bodyTerms.active()) {  // − dγ along x (eq B5, x_λ included)
+    bodyGeneratorDerivative(d, x.head(n), lambda, x[n + m]);
+    dh -= d.bodyWork;
   }
   maxIndexProduct(dh, z.head(n), y.head(n));
   y.head(n) = -y.head(n);
-  if (bodyTerms_.active()) {  // F_λ's −τ' along x_q, times z_λ: Γ' x_q z_λ
-    maxIndexProduct(bodyTerms_.rateGenerator(), x.head(n), bodyWork_);
-    y.head(n) += z[n + m] * bodyWork_;
+  if (d.bodyTerms.active()) {  // F_λ's −τ' along x_q, times z_λ: Γ' x_q z_λ
+    maxIndexProduct(d.bodyTerms.rateGenerator(), x.head(n), d.bodyWork);
+    y.head(n) += z[n + m] * d.bodyWork;
   }
-  y.head(n) += stiffRate_.cwiseProduct(x.head(n)).cwiseProduct(z.head(n));  // E‴ at (q, λ)
+  y.head(n) += d.stiffRate.cwiseProduct(x.head(n)).cwiseProduct(z.head(n));  // E‴ at (q, λ)
   if (control_.active())  // ∂K_q/∂λ (x_q z_λ + x_λ z_q); ∂²F/∂λ² = 0
-    y.head(n) += controlStiff_.cwiseProduct(z[n + m] * x.head(n) + x[n + m] * z.head(n));
+    y.head(n) += d.controlStiff.cwiseProduct(z[n + m] * x.head(n) + x[n + m] * z.head(n));
   for (int c : loaded_) y.head(n) -= (z[n + m] * direction_[c]) * dJ.row(c).transpose();
   for (int k = 0; k < m; ++k) {
     const int c = held_[size_t(k)];
@@ -391,129 +409,134 @@ bool EquilibriumProblem::secondDerivativeApply(ConstVectorRef u, double lambda, 
   return y.allFinite();
 }
 
-bool EquilibriumProblem::stabilityOperator(ConstVectorRef u, double lambda, Matrix& H, Matrix& C) {
-  if (!prepare(u, lambda)) return false;
+bool EquilibriumProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!prepare(d, u, lambda)) return false;
   const int n = chain_.size();
   H.resize(n, n);
   C.resize(heldCount(), n);
   // totalPotentialHessian() from the cached kinematics and K_q
-  loadGenerator(u, lambda, work_);
+  loadGenerator(d, u, lambda, d.work);
   for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) H(i, j) = -work_[std::max(i, j)];
-  H.diagonal() += stiff_;
-  for (int k = 0; k < heldCount(); ++k) C.row(k) = J_.row(held_[size_t(k)]);
+    for (int i = 0; i < n; ++i) H(i, j) = -d.work[std::max(i, j)];
+  H.diagonal() += d.stiff;
+  for (int k = 0; k < heldCount(); ++k) C.row(k) = d.J.row(held_[size_t(k)]);
   return true;
 }
 
-void EquilibriumProblem::assembleFromCache(const ConstVectorRef& u, double lambda, ChainStructure& ws) {
-  loadGenerator(u, lambda, ws.h);
-  assemble(stiff_, ws.h, ws);
+void EquilibriumProblem::assembleFromCache(Workspace& d, const ConstVectorRef& u, double lambda, ChainStructure& ws) const {
+  loadGenerator(d, u, lambda, ws.h);
+  assemble(d.stiff, ws.h, ws);
 }
 
-bool EquilibriumProblem::assembleStructure(ConstVectorRef u, double lambda, ChainStructure& ws, MatrixRef J) {
-  if (!std::isfinite(lambda) || !prepare(u, lambda)) return false;
-  assembleFromCache(u, lambda, ws);
-  J = J_;
+bool EquilibriumProblem::assembleStructure(ProblemWorkspace& ws, ConstVectorRef u, double lambda,
+                                           ChainStructure& structure, MatrixRef J) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
+  assembleFromCache(d, u, lambda, structure);
+  J = d.J;
   return true;
 }
 
-bool EquilibriumProblem::smallDenseSpectrum(const ConstVectorRef& u, double lambda) {
+bool EquilibriumProblem::smallDenseSpectrum(Workspace& d, const ConstVectorRef& u, double lambda) const {
   const size_t N = size_t(u.size());
-  // Bitwise, like prepare(): the key was stored after prepare(u) accepted these very bits, so a
+  // Bitwise, like prepare(d, ): the key was stored after prepare(d, u) accepted these very bits, so a
   // hit needs neither the domain check nor the q-cache (which may hold another q by now, e.g.
   // the certified counting's point off the branch).
-  if (spectrumSize_ >= 0 && size_t(spectrumKey_.size()) == N + 1 &&
-      sameBits(u.data(), spectrumKey_.data(), N) && sameBits(&lambda, spectrumKey_.data() + N, 1))
+  if (d.spectrumSize >= 0 && size_t(d.spectrumKey.size()) == N + 1 &&
+      sameBits(u.data(), d.spectrumKey.data(), N) && sameBits(&lambda, d.spectrumKey.data() + N, 1))
     return true;
-  spectrumSize_ = -1;
-  if (!prepare(u, lambda)) return false;
+  d.spectrumSize = -1;
+  if (!prepare(d, u, lambda)) return false;
   // The dense route reads h and κ alone (smallDenseInertia), not the tridiagonal form assemble()
   // adds for the O(n) counts (every structured route assembles for itself).
-  loadGenerator(u, lambda, structure_.h);
-  structure_.kappa = stiff_;
+  loadGenerator(d, u, lambda, d.structure.h);
+  d.structure.kappa = d.stiff;
   const int n = chain_.size();
-  for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
+  for (int k = 0; k < heldCount(); ++k) d.heldRows.row(k) = d.J.row(held_[size_t(k)]);
   // All n − rank values: the eigen-solve computes them anyway (`count` only limits the copy), so
   // any later request at this point is served bit for bit as a fresh solve would serve it.
   int found = 0;
-  spectrumInertia_ = smallDenseInertia(structure_, heldRows_, n, spectrum_.head(n), found);
-  if (size_t(spectrumKey_.size()) != N + 1) spectrumKey_.resize(Eigen::Index(N) + 1);  // sized in the constructor
-  spectrumKey_.head(Eigen::Index(N)) = u;
-  spectrumKey_[Eigen::Index(N)] = lambda;
-  spectrumSize_ = found;
+  d.spectrumInertia = smallDenseInertia(d.structure, d.heldRows, n, d.spectrum.head(n), found);
+  if (size_t(d.spectrumKey.size()) != N + 1) d.spectrumKey.resize(Eigen::Index(N) + 1);  // sized in the constructor
+  d.spectrumKey.head(Eigen::Index(N)) = u;
+  d.spectrumKey[Eigen::Index(N)] = lambda;
+  d.spectrumSize = found;
   return true;
 }
 
-bool EquilibriumProblem::stability(ConstVectorRef u, double lambda, int lowestCount,
-                                   continuation::StabilityInfo& info) {
-  if (!options_.structuredStability) return Problem::stability(u, lambda, lowestCount, info);
+bool EquilibriumProblem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount,
+                                   continuation::StabilityInfo& info) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!options_.structuredStability) return Problem::stability(ws, u, lambda, lowestCount, info);
   const int n = chain_.size();
   const int wanted = std::max(0, std::min(lowestCount, kMaxLowest));
   if (n <= kDenseSpectrumUpTo && (wanted > 0 || n <= kDenseInertiaUpTo)) {
     // Small chains: one heap-free dense eigen-solve beats the counts + eigenvalue isolation,
     // and for n ≤ kDenseInertiaUpTo even the two Sturm counts of the inertia alone.
-    if (!smallDenseSpectrum(u, lambda)) return false;
-    const int found = std::min(wanted, spectrumSize_);
-    info.negative = spectrumInertia_.negative;
-    info.zero = spectrumInertia_.zero;
-    info.lowest = spectrum_.head(found);
-    info.smallest = found > 0 ? spectrum_[0] : 0.0;
+    if (!smallDenseSpectrum(d, u, lambda)) return false;
+    const int found = std::min(wanted, d.spectrumSize);
+    info.negative = d.spectrumInertia.negative;
+    info.zero = d.spectrumInertia.zero;
+    info.lowest = d.spectrum.head(found);
+    info.smallest = found > 0 ? d.spectrum[0] : 0.0;
     return true;
   }
-  if (!prepare(u, lambda)) return false;
-  assembleFromCache(u, lambda, structure_);
-  for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
+  if (!prepare(d, u, lambda)) return false;
+  assembleFromCache(d, u, lambda, d.structure);
+  for (int k = 0; k < heldCount(); ++k) d.heldRows.row(k) = d.J.row(held_[size_t(k)]);
   // Inertia by two O(n) Sturm counts (Sylvester); eigenvalues only when asked for.
-  const Inertia in = constrainedInertia(structure_, heldRows_);
+  const Inertia in = constrainedInertia(d.structure, d.heldRows);
   info.negative = in.negative;
   info.zero = in.zero;
   const int dim = in.size();
   info.lowest.resize(std::min(wanted, dim));
   if (info.lowest.size() > 0) {
-    if (guess_.size() != ChainStructure::kMaxBorder) guess_.resize(ChainStructure::kMaxBorder);
-    const bool guessed = found_.guesses(0, guess_.head(info.lowest.size()));
-    lowestEigenvalues(structure_, structure_.rank > 0, int(info.lowest.size()), info.lowest, 1e-13,
-                      guessed ? &guess_ : nullptr);
-    found_.remember(0, info.lowest);
+    if (d.guess.size() != ChainStructure::kMaxBorder) d.guess.resize(ChainStructure::kMaxBorder);
+    const bool guessed = d.found.guesses(0, d.guess.head(info.lowest.size()));
+    lowestEigenvalues(d.structure, d.structure.rank > 0, int(info.lowest.size()), info.lowest, 1e-13,
+                      guessed ? &d.guess : nullptr);
+    d.found.remember(0, info.lowest);
   }
   info.smallest = info.lowest.size() > 0 ? info.lowest[0] : 0.0;
   return true;
 }
 
-bool EquilibriumProblem::stabilityEigenvalues(ConstVectorRef u, double lambda, int first,
-                                              continuation::VectorRef values) {
-  if (!options_.structuredStability) return Problem::stabilityEigenvalues(u, lambda, first, values);
+bool EquilibriumProblem::stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first,
+                                              continuation::VectorRef values) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!options_.structuredStability) return Problem::stabilityEigenvalues(ws, u, lambda, first, values);
   if (first < 0) return false;
   const int n = chain_.size();
   const int wanted = first + int(values.size());
   if (n <= kDenseSpectrumUpTo) {
     // As stability(): one heap-free dense eigen-solve is cheaper than isolating on counts, and
     // at the point stability() was just asked about it is already done.
-    if (!smallDenseSpectrum(u, lambda) || spectrumSize_ < wanted) return false;
-    values = spectrum_.segment(first, values.size());
+    if (!smallDenseSpectrum(d, u, lambda) || d.spectrumSize < wanted) return false;
+    values = d.spectrum.segment(first, values.size());
     return true;
   }
-  if (!prepare(u, lambda)) return false;
-  assembleFromCache(u, lambda, structure_);
-  for (int k = 0; k < heldCount(); ++k) heldRows_.row(k) = J_.row(held_[size_t(k)]);
-  const int rank = heldCount() > 0 ? setConstraints(structure_, heldRows_) : (structure_.rank = 0);
+  if (!prepare(d, u, lambda)) return false;
+  assembleFromCache(d, u, lambda, d.structure);
+  for (int k = 0; k < heldCount(); ++k) d.heldRows.row(k) = d.J.row(held_[size_t(k)]);
+  const int rank = heldCount() > 0 ? setConstraints(d.structure, d.heldRows) : (d.structure.rank = 0);
   if (values.size() > ChainStructure::kMaxBorder) return false;  // the isolation's fixed-size brackets
   // Warm start from the values found lately (eigenvalue_memory.h): the monitor asks at a point
   // and then a step δ = 1e−6 along its tangent, then at the next point (spectral_monitor.h), the
   // locator at its samples, so the values found bracket the new ones within a few counts, also
   // where ν, and with it the indices asked for, changed. The counts still certify the
   // isolation; only the bisection from ±‖H‖_F is saved.
-  if (guess_.size() != ChainStructure::kMaxBorder) guess_.resize(ChainStructure::kMaxBorder);
-  const bool guessed = found_.guesses(first, guess_.head(values.size()));
-  if (eigenvaluesFrom(structure_, rank > 0, first, int(values.size()), values, 1e-13, guessed ? &guess_ : nullptr) !=
+  if (d.guess.size() != ChainStructure::kMaxBorder) d.guess.resize(ChainStructure::kMaxBorder);
+  const bool guessed = d.found.guesses(first, d.guess.head(values.size()));
+  if (eigenvaluesFrom(d.structure, rank > 0, first, int(values.size()), values, 1e-13, guessed ? &d.guess : nullptr) !=
       values.size())
     return false;
-  found_.remember(first, values);
+  d.found.remember(first, values);
   return true;
 }
 
-std::unique_ptr<continuation::BorderedSolver> EquilibriumProblem::makeStructuredSolver() {
-  return std::make_unique<ChainBorderedSolver>(*this);
+std::unique_ptr<continuation::BorderedSolver> EquilibriumProblem::makeStructuredSolver(ProblemWorkspace &ws) const {
+  return std::make_unique<ChainBorderedSolver>(*this, ws);
 }
 
 double EquilibriumProblem::lengthUnit() const {

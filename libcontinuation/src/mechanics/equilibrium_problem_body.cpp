@@ -6,17 +6,20 @@
 
 namespace buckle::mechanics {
 
+using continuation::ProblemWorkspace;
+using continuation::workspaceAs;
+
 using continuation::ConstVectorRef;
 
-void EquilibriumProblem::loadGenerator(const ConstVectorRef& u, double lambda, VectorRef h) const {
-  loadHessianGenerator(data_, wrench(u, lambda), h);  // eq 27
-  if (!bodyTerms_.active()) return;
+void EquilibriumProblem::loadGenerator(Workspace& d, const ConstVectorRef& u, double lambda, VectorRef h) const {
+  loadHessianGenerator(d.data, wrench(u, lambda), h);  // eq 27
+  if (!d.bodyTerms.active()) return;
   const int n = chain_.size();
-  for (int m = 0; m < n; ++m) h[m] -= bodyTerms_.gammaAt(m, lambda);  // eq (B3)
+  for (int m = 0; m < n; ++m) h[m] -= d.bodyTerms.gammaAt(m, lambda);  // eq (B3)
 }
 
-void EquilibriumProblem::bodyGeneratorDerivative(const ConstVectorRef& dq, double lambda, double dlambda) {
-  bodyTerms_.generatorDerivative(lambda, dq, dlambda, bodyWork_);  // eq (B5)
+void EquilibriumProblem::bodyGeneratorDerivative(Workspace& d, const ConstVectorRef& dq, double lambda, double dlambda) const {
+  d.bodyTerms.generatorDerivative(lambda, dq, dlambda, d.bodyWork);  // eq (B5)
 }
 
 namespace {

@@ -7,17 +7,21 @@
 
 namespace buckle::mechanics {
 
+using continuation::ProblemWorkspace;
+using continuation::workspaceAs;
+
 using continuation::ConstVectorRef;
 
-bool EquilibriumProblem::stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                            double& bound) {
-  if (!std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() || !prepare(u, lambda)) return false;
+bool EquilibriumProblem::stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                                            double& bound) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
   const int m = heldCount();
   const Wrench W = wrench(u, lambda);
   Wrench dW = dlambda * direction_;  // loads move with λ, reactions with their unknowns
   for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = du[n + k];
-  if (bodyTerms_.active()) bodyGeneratorDerivative(du.head(n), lambda, dlambda);  // dγ (eq B5)
+  if (d.bodyTerms.active()) bodyGeneratorDerivative(d, du.head(n), lambda, dlambda);  // dγ (eq B5)
   bool heldX = false, heldY = false;
   for (int c : held_) {
     heldX |= c == 0;
@@ -32,18 +36,18 @@ bool EquilibriumProblem::stabilityRateBound(ConstVectorRef u, double lambda, Con
   double thetaDot = du.head(n).sum(), dS = 0.0, dC = 0.0;
   double dH2 = 0.0, H2 = 0.0, dC2 = 0.0;
   for (int p = n - 1; p >= 0; --p) {
-    const double cNext = p + 1 < n ? data_.C[p + 1] : 0.0, sNext = p + 1 < n ? data_.S[p + 1] : 0.0;
-    dS += (data_.C[p] - cNext) * thetaDot;
-    dC -= (data_.S[p] - sNext) * thetaDot;
+    const double cNext = p + 1 < n ? d.data.C[p + 1] : 0.0, sNext = p + 1 < n ? d.data.S[p + 1] : 0.0;
+    dS += (d.data.C[p] - cNext) * thetaDot;
+    dC -= (d.data.S[p] - sNext) * thetaDot;
     thetaDot -= du[p];
-    double h = -W[0] * data_.C[p] - W[1] * data_.S[p];
-    double dh = -dW[0] * data_.C[p] - W[0] * dC - dW[1] * data_.S[p] - W[1] * dS;
-    if (bodyTerms_.active()) {  // the body loads' generator h − γ (eq B3) and its rate
-      h -= bodyTerms_.gammaAt(p, lambda);
-      dh -= bodyWork_[p];
+    double h = -W[0] * d.data.C[p] - W[1] * d.data.S[p];
+    double dh = -dW[0] * d.data.C[p] - W[0] * dC - dW[1] * d.data.S[p] - W[1] * dS;
+    if (d.bodyTerms.active()) {  // the body loads' generator h − γ (eq B3) and its rate
+      h -= d.bodyTerms.gammaAt(p, lambda);
+      dh -= d.bodyWork[p];
     }
-    const double dControl = control_.active() ? controlStiff_[p] * dlambda : 0.0;  // ∂K_q/∂λ dλ
-    const double dDiagonal = stiffRate_[p] * du[p] + dControl - dh, diagonal = stiff_[p] - h;
+    const double dControl = control_.active() ? d.controlStiff[p] * dlambda : 0.0;  // ∂K_q/∂λ dλ
+    const double dDiagonal = d.stiffRate[p] * du[p] + dControl - dh, diagonal = d.stiff[p] - h;
     dH2 += dDiagonal * dDiagonal + 2.0 * p * dh * dh;
     H2 += diagonal * diagonal + 2.0 * p * h * h;
     if (heldX) dC2 += dS * dS;
@@ -57,7 +61,7 @@ bool EquilibriumProblem::stabilityRateBound(ConstVectorRef u, double lambda, Con
   // padded above every eigenvalue of the m×m block, which stays decoupled).
   Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
   for (int k = 0; k < m; ++k)
-    for (int l = 0; l <= k; ++l) G(k, l) = G(l, k) = J_.row(held_[size_t(k)]).dot(J_.row(held_[size_t(l)]));
+    for (int l = 0; l <= k; ++l) G(k, l) = G(l, k) = d.J.row(held_[size_t(k)]).dot(d.J.row(held_[size_t(l)]));
   const double trace = G.trace();
   for (int k = m; k < 3; ++k) G(k, k) = 2.0 * trace + 1.0;
   const double sigma2 =

@@ -60,7 +60,7 @@ ImperfectionSensitivity imperfectionSensitivity(const EquilibriumProblem& proble
   const int N = moved.dimension();
   cont::Vector lambdaDirection = cont::Vector::Zero(N + 1), Fe(N);
   lambdaDirection[N] = 1.0;
-  if (!moved.jacobianApply(bp.u, bp.lambda, lambdaDirection, Fe)) {
+  if (!cont::BoundProblem(moved).jacobianApply(bp.u, bp.lambda, lambdaDirection, Fe)) {
     s.message = "imperfection sensitivity: the chain refused the branch point";
     return s;
   }

@@ -66,7 +66,7 @@ RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn
   rp.torques = Vector::Zero(n);
   if (dyn.reason == IntegrationStop::Settled && settled && !anyContact(rp.sides)) {
     rp.polished = *settled;
-    problem.stability(rp.polished.u, lambda, 3, rp.stability);
+    cont::BoundProblem(problem).stability(rp.polished.u, lambda, 3, rp.stability);
     rp.stable = rp.stability.valid() && rp.stability.stable();
     return rp;
   }
@@ -76,12 +76,12 @@ RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn
     rp.polished.message = "not polished";
     Vector F(problem.dimension());
     rp.polished.residual =
-        problem.residual(rp.polished.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+        cont::BoundProblem(problem).residual(rp.polished.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
     return rp;
   }
   if (!anyContact(rp.sides)) {
     rp.polished = polishEquilibrium(problem, dyn.q, lambda, options);
-    if (rp.polished.converged) problem.stability(rp.polished.u, lambda, 3, rp.stability);
+    if (rp.polished.converged) cont::BoundProblem(problem).stability(rp.polished.u, lambda, 3, rp.stability);
     rp.stable = rp.stability.valid() && rp.stability.stable();
     return rp;
   }
@@ -122,7 +122,7 @@ UnstableDirection structuredUnstableDirection(EquilibriumProblem& problem, const
   const int n = problem.segments();
   ChainStructure ws(n), shifted(n);
   Matrix J(3, n);
-  if (!problem.assembleStructure(u, lambda, ws, J)) return d;
+  if (!problem.assembleStructure(*problem.createWorkspace(), u, lambda, ws, J)) return d;
   ws.typicalScale = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();
   const std::vector<int> held = problem.endCondition().heldIndices();
   Matrix C(held.size(), n);
@@ -165,7 +165,7 @@ bool basinTest(EquilibriumProblem& problem, DynamicsModel& model, ConstVectorRef
   // positive definite on ker J_h: O(n) Sturm counts (no eigenvalues wanted)
   auto definite = [&](const Vector& u) {
     continuation::StabilityInfo s;
-    return problem.stability(u, lambda, 0, s) && s.valid() && s.stable();
+    return cont::BoundProblem(problem).stability(u, lambda, 0, s) && s.valid() && s.stable();
   };
   if (!definite(problem.initialGuess(q, lambda))) return false;
   PolishResult p = polishEquilibrium(problem, q, lambda, polish);
@@ -227,7 +227,8 @@ PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, do
   // EquilibriumProblem (the KKT matrix), so convergence from a rest point is quadratic. In the
   // problem's scaled variables (scaled_problem.h): the tolerance is relative, in any units.
   const continuation::UnitScaling units(problem.scales());
-  continuation::ScaledProblem scaled(problem, units);
+  const continuation::BoundScaledProblem scaledProblem(continuation::BoundProblem(problem), units);
+  const continuation::BoundProblem& scaled = scaledProblem.bound();
   // Long chains: the chain's O(n) bordered solver (chain_solver.h) instead of KINSOL's dense LU.
   const std::unique_ptr<continuation::BorderedSolver> structured =
       problem.segments() > kSmallDense ? scaled.makeStructuredSolver() : nullptr;
@@ -241,7 +242,7 @@ PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, do
   result.message = summary.flagName;
   if (!summary.message.empty()) result.message += ": " + summary.message;
   Vector F(N);
-  result.residual = problem.residual(result.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+  result.residual = cont::BoundProblem(problem).residual(result.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
   return result;
 }
 
@@ -259,7 +260,7 @@ UnstableDirection unstableDirection(EquilibriumProblem& problem, ConstVectorRef 
       route == DirectionRoute::Structured || (route == DirectionRoute::Automatic && problem.segments() > kSmallDense);
   if (structured) return structuredUnstableDirection(problem, uFull, lambda);
   Matrix H, C;
-  if (!problem.stabilityOperator(uFull, lambda, H, C)) return d;
+  if (!cont::BoundProblem(problem).stabilityOperator(uFull, lambda, H, C)) return d;
   const Eigen::Index n = H.rows();
   // Z: orthonormal basis of ker J_h (the last n − rank columns of Q in J_hᵀ = QR), as in the
   // core's projectedInertia(); the reduced Hessian Zᵀ(K_q − K_g)Z is then the stability operator.
@@ -314,7 +315,7 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.prescribed = problem.prescribed(lambda);
   result.from = fullUnknowns(problem, u, lambda);
   const Vector qFrom = result.from.head(n);
-  problem.stability(result.from, lambda, 3, result.stabilityFrom);
+  cont::BoundProblem(problem).stability(result.from, lambda, 3, result.stabilityFrom);
 
   const EndCondition end = frozenEnd(problem, lambda);
   // the chain with its control inputs (free lengths) and its body loads where it is released

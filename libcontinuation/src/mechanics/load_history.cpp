@@ -81,7 +81,7 @@ int firstLeavingPoint(const cont::Branch& branch, double sign, bool& isLoss) {
 // eigenvalues are evaluated at sp itself (its lowest is zero there, not the traced point's before
 // it); its count stays the piece's (the limit from the side the piece was traced on: a stable
 // piece ends stable at its fold).
-cont::Branch cutAt(cont::Problem& problem, const cont::Branch& branch, const cont::SpecialPoint& sp) {
+cont::Branch cutAt(const cont::BoundProblem& problem, const cont::Branch& branch, const cont::SpecialPoint& sp) {
   cont::Branch cut = branch;
   cut.points.resize(std::min(cut.points.size(), size_t(sp.index) + 1));
   cont::ContinuationPoint last = cut.points.back();
@@ -214,7 +214,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
   ContactSet locked;
 
   cont::StabilityInfo info;
-  if (problem.stability(u, lambda, 3, info) && info.negative > 0) {
+  if (cont::BoundProblem(problem).stability(u, lambda, 3, info) && info.negative > 0) {
     if (!releaseChain(problem, options, JumpTrigger::UnstableStart, u, lambda, lambda, -1, result)) {
       result.message = "the unstable start did not come to a stable rest: " + result.jumps.back().message;
       return result;

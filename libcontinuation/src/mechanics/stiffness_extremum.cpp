@@ -115,7 +115,8 @@ class BranchSection {
                 StiffnessMeasure measure)
       : problem_(problem),
         units_(problem.scales()),
-        scaled_(problem, units_),
+        scaledProblem_(cont::BoundProblem(problem), units_),
+        scaled_(scaledProblem_.bound()),
         corrector_(scaled_, correctorOptions()),
         measure_(measure),
         N_(problem.dimension()) {
@@ -182,7 +183,8 @@ class BranchSection {
 
   EquilibriumProblem& problem_;
   cont::UnitScaling units_;
-  cont::ScaledProblem scaled_;
+  cont::BoundScaledProblem scaledProblem_;
+  cont::BoundProblem scaled_;  // the section's one workspace
   cont::Corrector corrector_;
   StiffnessMeasure measure_;
   int N_;

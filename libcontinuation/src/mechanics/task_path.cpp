@@ -10,6 +10,9 @@
 
 namespace buckle::mechanics {
 
+using continuation::ProblemWorkspace;
+using continuation::workspaceAs;
+
 using continuation::ConstVectorRef;
 using continuation::MatrixRef;
 using continuation::VectorRef;
@@ -57,14 +60,10 @@ TaskPathProblem::TaskPathProblem(const Chain& chain, const TaskSetup& setup)
       n_(chain.size()),
       m_(int(setup.coordinates.size())),
       mIn_(int(setup.inputs.size())),
-      dim_(0),
-      data_(chain),
-      J_(3, chain.size()),
-      structure_(chain.size()) {
+      dim_(0) {
   setup_.validate(n_);
   setup_.body = setup_.body.atParameter(0.0);
   body_ = BodyLoadTerms(chain_, setup_.body);  // throws as BodyLoads::check
-  tau_ = Vector::Zero(n_);
   dim_ = setup_.rule == TaskRule::Chosen ? n_ + mIn_ : 2 * n_ + mIn_ + m_;
   p0_.resize(mIn_);
   for (int j = 0; j < mIn_; ++j) {
@@ -88,18 +87,28 @@ TaskPathProblem::TaskPathProblem(const Chain& chain, const TaskSetup& setup)
   }
   lengthUnit_ = b / n_;
   stiffnessUnit_ = k / n_;
-  structure_.typicalScale = stiffnessUnit_ * lengthUnit_ * lengthUnit_;
-  grad_.resize(n_);
-  stiff_.resize(n_);
-  third_.resize(n_);
-  e1_.resize(n_, 2);
-  e2_.resize(n_, 2);
-  h_.resize(n_);
-  work_.resize(n_);
-  B_.resize(n_, mIn_);
   leg_.start = Vector::Zero(m_);
   leg_.direction = Vector::Zero(m_);
 }
+
+TaskPathProblem::Workspace::Workspace(const TaskPathProblem& problem)
+    : data(problem.chain_),
+      J(3, problem.n_),
+      grad(problem.n_),
+      stiff(problem.n_),
+      third(problem.n_),
+      e1(problem.n_, 2),
+      e2(problem.n_, 2),
+      h(problem.n_),
+      work(problem.n_),
+      body(problem.body_),
+      tau(Vector::Zero(problem.n_)),
+      B(problem.n_, problem.mIn_),
+      structure(problem.n_) {
+  structure.typicalScale = problem.stiffnessUnit_ * problem.lengthUnit_ * problem.lengthUnit_;
+}
+
+std::unique_ptr<ProblemWorkspace> TaskPathProblem::createWorkspace() const { return std::make_unique<Workspace>(*this); }
 
 Vector TaskPathProblem::pack(ConstVectorRef q, ConstVectorRef p) const {
   Vector u = Vector::Zero(dim_);
@@ -120,11 +129,12 @@ Chain TaskPathProblem::chainAt(ConstVectorRef p) const {
   return chainWithControls(chain_, d, 1.0);
 }
 
-bool TaskPathProblem::prepare(ConstVectorRef u) {
+bool TaskPathProblem::prepare(ProblemWorkspace &ws, ConstVectorRef u) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   if (u.size() != dim_ || !u.allFinite()) return false;
   // the cache depends on (q, p) only; the tracer evaluates F, F_u and the boundaries at one point
-  if (cacheValid_ && std::memcmp(cachedKey_.data(), u.data(), sizeof(double) * size_t(n_ + mIn_)) == 0) return true;
-  cacheValid_ = false;
+  if (d.cacheValid && std::memcmp(d.cachedKey.data(), u.data(), sizeof(double) * size_t(n_ + mIn_)) == 0) return true;
+  d.cacheValid = false;
   const auto q = u.head(n_);
   const Eigen::MatrixX2d dL = freeLengthChange(u.segment(n_, mIn_));
   for (int i = 0; i < n_; ++i) {
@@ -137,28 +147,28 @@ bool TaskPathProblem::prepare(ConstVectorRef u) {
     const double sh = std::sin(0.5 * q[i]), ch = std::cos(0.5 * q[i]);
     Jet3 rate;
     const Jet3 e = seg.energyJet(q[i], sh, ch, L1, L2, 0.0, 0.0, rate);
-    grad_[i] = e.d1;
-    stiff_[i] = e.d2;
-    third_[i] = e.d3;
+    d.grad[i] = e.d1;
+    d.stiff[i] = e.d2;
+    d.third[i] = e.d3;
     // ∂E^(j)/∂L⁰_s = −k_s L_s^(j) (segment.h)
     const Jet3 s1 = seg.spring1(q[i]), s2 = seg.spring2(q[i]);
-    e1_(i, 0) = -seg.parameters().k1 * s1.d1;
-    e1_(i, 1) = -seg.parameters().k2 * s2.d1;
-    e2_(i, 0) = -seg.parameters().k1 * s1.d2;
-    e2_(i, 1) = -seg.parameters().k2 * s2.d2;
+    d.e1(i, 0) = -seg.parameters().k1 * s1.d1;
+    d.e1(i, 1) = -seg.parameters().k2 * s2.d1;
+    d.e2(i, 0) = -seg.parameters().k1 * s1.d2;
+    d.e2(i, 1) = -seg.parameters().k2 * s2.d2;
   }
-  forwardKinematics(chain_, q, data_);
-  endJacobian(data_, J_);
-  loadHessianGenerator(data_, setup_.payload, h_);
-  if (body_.active()) {  // the generator h − γ and ∂V/∂q = −τ (eq B2, B3)
-    body_.update(data_);
-    body_.torques(0.0, tau_);
-    body_.generator(0.0, work_);
-    h_ -= work_;
+  forwardKinematics(chain_, q, d.data);
+  endJacobian(d.data, d.J);
+  loadHessianGenerator(d.data, setup_.payload, d.h);
+  if (d.body.active()) {  // the generator h − γ and ∂V/∂q = −τ (eq B2, B3)
+    d.body.update(d.data);
+    d.body.torques(0.0, d.tau);
+    d.body.generator(0.0, d.work);
+    d.h -= d.work;
   }
-  inputColumns(e1_, B_);
-  cachedKey_ = u.head(n_ + mIn_);
-  cacheValid_ = true;
+  inputColumns(d.e1, d.B);
+  d.cachedKey = u.head(n_ + mIn_);
+  d.cacheValid = true;
   return true;
 }
 
@@ -168,51 +178,53 @@ void TaskPathProblem::inputColumns(const Eigen::MatrixX2d& e, Matrix& out) const
     out.col(j) = rates_[size_t(j)].col(0).cwiseProduct(e.col(0)) + rates_[size_t(j)].col(1).cwiseProduct(e.col(1));
 }
 
-bool TaskPathProblem::residual(ConstVectorRef u, double s, VectorRef F) {
-  if (!prepare(u)) return false;
+bool TaskPathProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double s, VectorRef F) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!prepare(ws, u)) return false;
   const Vector t = target(s);
-  const Vector g = grad_ - J_.transpose() * setup_.payload - tau_;  // eq 9, eq B2 (τ = 0 without body loads)
+  const Vector g = d.grad - d.J.transpose() * setup_.payload - d.tau;  // eq 9, eq B2 (τ = 0 without body loads)
   if (setup_.rule == TaskRule::Chosen) {
     F.head(n_) = g;
-    for (int k = 0; k < m_; ++k) F[n_ + k] = data_.pose[setup_.coordinates[size_t(k)]] - t[k];
+    for (int k = 0; k < m_; ++k) F[n_ + k] = d.data.pose[setup_.coordinates[size_t(k)]] - t[k];
     return true;
   }
   const auto p = u.segment(n_, mIn_);
   const auto mu = u.segment(n_ + mIn_, n_);
   const auto nu = u.segment(2 * n_ + mIn_, m_);
   // R_q = H μ + J_cᵀ ν, H μ = K_q μ − K_g μ (K_g(i, j) = h_max(i,j), eq 27)
-  maxIndexProduct(h_, mu, work_);
-  Vector Rq = stiff_.cwiseProduct(mu) - work_;
-  for (int k = 0; k < m_; ++k) Rq += nu[k] * J_.row(setup_.coordinates[size_t(k)]).transpose();
+  maxIndexProduct(d.h, mu, d.work);
+  Vector Rq = d.stiff.cwiseProduct(mu) - d.work;
+  for (int k = 0; k < m_; ++k) Rq += nu[k] * d.J.row(setup_.coordinates[size_t(k)]).transpose();
   F.head(n_) = Rq;
   const double b2 = lengthUnit_ * lengthUnit_;
   for (int j = 0; j < mIn_; ++j)
-    F[n_ + j] = setup_.inputs[size_t(j)].weight * (p[j] - p0_[j]) / b2 + B_.col(j).dot(mu);
+    F[n_ + j] = setup_.inputs[size_t(j)].weight * (p[j] - p0_[j]) / b2 + d.B.col(j).dot(mu);
   F.segment(n_ + mIn_, n_) = g;
-  for (int k = 0; k < m_; ++k) F[2 * n_ + mIn_ + k] = data_.pose[setup_.coordinates[size_t(k)]] - t[k];
+  for (int k = 0; k < m_; ++k) F[2 * n_ + mIn_ + k] = d.data.pose[setup_.coordinates[size_t(k)]] - t[k];
   return true;
 }
 
-bool TaskPathProblem::jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef Fs) {
-  if (!prepare(u)) return false;
+bool TaskPathProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fs) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!prepare(ws, u)) return false;
   Fu.setZero();
   Fs.setZero();
   // H = K_q − K_g, K_g(i, j) = h_max(i,j) (eq 27)
   Matrix H(n_, n_);
   for (int i = 0; i < n_; ++i)
-    for (int j = 0; j < n_; ++j) H(i, j) = -h_[std::max(i, j)];
-  H.diagonal() += stiff_;
+    for (int j = 0; j < n_; ++j) H(i, j) = -d.h[std::max(i, j)];
+  H.diagonal() += d.stiff;
   const int tRow = setup_.rule == TaskRule::Chosen ? n_ : 2 * n_ + mIn_;
   for (int k = 0; k < m_; ++k) Fs[tRow + k] = -leg_.direction[k];
   if (setup_.rule == TaskRule::Chosen) {
     Fu.topLeftCorner(n_, n_) = H;
-    Fu.topRightCorner(n_, mIn_) = B_;
-    for (int k = 0; k < m_; ++k) Fu.row(n_ + k).head(n_) = J_.row(setup_.coordinates[size_t(k)]);
+    Fu.topRightCorner(n_, mIn_) = d.B;
+    for (int k = 0; k < m_; ++k) Fu.row(n_ + k).head(n_) = d.J.row(setup_.coordinates[size_t(k)]);
     return true;
   }
   Vector diagA, genA;
   Matrix D;
-  optimalityBlocks(u, diagA, genA, D);
+  optimalityBlocks(ws, u, diagA, genA, D);
   const int P = n_, M = n_ + mIn_, N = 2 * n_ + mIn_;
   for (int i = 0; i < n_; ++i)
     for (int j = 0; j < n_; ++j) Fu(i, j) = genA[std::max(i, j)];
@@ -222,17 +234,18 @@ bool TaskPathProblem::jacobian(ConstVectorRef u, double, MatrixRef Fu, VectorRef
   Fu.block(0, M, n_, n_) = H;
   Fu.block(M, 0, n_, n_) = H;
   for (int j = 0; j < mIn_; ++j) Fu(P + j, P + j) = setup_.inputs[size_t(j)].weight / (lengthUnit_ * lengthUnit_);
-  Fu.block(P, M, mIn_, n_) = B_.transpose();
-  Fu.block(M, P, n_, mIn_) = B_;
+  Fu.block(P, M, mIn_, n_) = d.B.transpose();
+  Fu.block(M, P, n_, mIn_) = d.B;
   for (int k = 0; k < m_; ++k) {
-    const auto row = J_.row(setup_.coordinates[size_t(k)]);
+    const auto row = d.J.row(setup_.coordinates[size_t(k)]);
     Fu.block(0, N + k, n_, 1) = row.transpose();
     Fu.block(N + k, 0, 1, n_) = row;
   }
   return true;
 }
 
-void TaskPathProblem::optimalityBlocks(ConstVectorRef u, Vector& diagA, Vector& genA, Matrix& D) {
+void TaskPathProblem::optimalityBlocks(ProblemWorkspace &ws, ConstVectorRef u, Vector& diagA, Vector& genA, Matrix& D) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   const auto mu = u.segment(n_ + mIn_, n_);
   const auto nu = u.segment(2 * n_ + mIn_, m_);
   double nx = 0.0, ny = 0.0;
@@ -244,54 +257,58 @@ void TaskPathProblem::optimalityBlocks(ConstVectorRef u, Vector& diagA, Vector& 
   const Wrench& F = setup_.payload;
   genA.resize(n_);
   double prefix = 0.0, tail = 0.0;
-  for (int m = 0; m < n_; ++m) prefix += mu[m], work_[m] = prefix;  // Σ_{j≤m} μ_j
+  for (int m = 0; m < n_; ++m) prefix += mu[m], d.work[m] = prefix;  // Σ_{j≤m} μ_j
   for (int m = n_ - 1; m >= 0; --m) {
-    const double rho = F[0] * data_.S[m] - F[1] * data_.C[m] - tau_[m];  // ρ_m (header, eq B5)
-    const double a = rho * work_[m] + tail;
+    const double rho = F[0] * d.data.S[m] - F[1] * d.data.C[m] - d.tau[m];  // ρ_m (header, eq B5)
+    const double a = rho * d.work[m] + tail;
     tail += rho * mu[m];
-    genA[m] = -nx * data_.C[m] - ny * data_.S[m] - a;
+    genA[m] = -nx * d.data.C[m] - ny * d.data.S[m] - a;
   }
-  diagA = third_.cwiseProduct(mu);
-  inputColumns(e2_, D);
+  diagA = d.third.cwiseProduct(mu);
+  inputColumns(d.e2, D);
   D = mu.asDiagonal() * D;
 }
 
-bool TaskPathProblem::assembleOptimality(ConstVectorRef u, ChainStructure& ws, OptimalityBlocks& blocks) {
-  if (setup_.rule != TaskRule::MinimumChange || !prepare(u)) return false;
-  ws.typicalScale = structure_.typicalScale;
-  assemble(stiff_, h_, ws);
-  optimalityBlocks(u, blocks.diagA, blocks.genA, blocks.D);
-  blocks.B = B_;
+bool TaskPathProblem::assembleOptimality(ProblemWorkspace &ws, ConstVectorRef u, ChainStructure& structure, OptimalityBlocks& blocks) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (setup_.rule != TaskRule::MinimumChange || !prepare(ws, u)) return false;
+  structure.typicalScale = d.structure.typicalScale;
+  assemble(d.stiff, d.h, structure);
+  optimalityBlocks(ws, u, blocks.diagA, blocks.genA, blocks.D);
+  blocks.B = d.B;
   blocks.Jc.resize(m_, n_);
-  for (int k = 0; k < m_; ++k) blocks.Jc.row(k) = J_.row(setup_.coordinates[size_t(k)]);
+  for (int k = 0; k < m_; ++k) blocks.Jc.row(k) = d.J.row(setup_.coordinates[size_t(k)]);
   blocks.weights.resize(mIn_);
   for (int j = 0; j < mIn_; ++j) blocks.weights[j] = setup_.inputs[size_t(j)].weight / (lengthUnit_ * lengthUnit_);
   return true;
 }
 
-bool TaskPathProblem::assembleStructure(ConstVectorRef u, ChainStructure& ws, Matrix& B, Matrix& Jc) {
-  if (!prepare(u)) return false;
-  ws.typicalScale = structure_.typicalScale;
-  assemble(stiff_, h_, ws);
-  B = B_;
+bool TaskPathProblem::assembleStructure(ProblemWorkspace &ws, ConstVectorRef u, ChainStructure& structure, Matrix& B, Matrix& Jc) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!prepare(ws, u)) return false;
+  structure.typicalScale = d.structure.typicalScale;
+  assemble(d.stiff, d.h, structure);
+  B = d.B;
   Jc.resize(m_, n_);
-  for (int k = 0; k < m_; ++k) Jc.row(k) = J_.row(setup_.coordinates[size_t(k)]);
+  for (int k = 0; k < m_; ++k) Jc.row(k) = d.J.row(setup_.coordinates[size_t(k)]);
   return true;
 }
 
-bool TaskPathProblem::fixedInputStability(ConstVectorRef u, Inertia& inertia, double& smallest) {
-  if (!prepare(u)) return false;
-  assemble(stiff_, h_, structure_);
-  inertia = hessianInertia(structure_);
+bool TaskPathProblem::fixedInputStability(ProblemWorkspace &ws, ConstVectorRef u, Inertia& inertia, double& smallest) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!prepare(ws, u)) return false;
+  assemble(d.stiff, d.h, d.structure);
+  inertia = hessianInertia(d.structure);
   // warm start from the last point's value (the path moves continuously)
   Vector out(1);
-  lowestEigenvalues(structure_, false, 1, out, 1e-13, lastSmallest_.size() ? &lastSmallest_ : nullptr);
+  lowestEigenvalues(d.structure, false, 1, out, 1e-13, d.lastSmallest.size() ? &d.lastSmallest : nullptr);
   smallest = out[0];
-  lastSmallest_ = out;
+  d.lastSmallest = out;
   return true;
 }
 
-double TaskPathProblem::boundary(int k, ConstVectorRef u, double) {
+double TaskPathProblem::boundary(ProblemWorkspace &ws, int k, ConstVectorRef u, double) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
   if (k < n_) return chain_.upperLimits()[k] - u[k];
   if (k < 2 * n_) return u[k - n_] - chain_.lowerLimits()[k - n_];
   if (k < 2 * n_ + 2 * mIn_) {
@@ -311,8 +328,8 @@ double TaskPathProblem::boundary(int k, ConstVectorRef u, double) {
   if (!setup_.stabilityBoundary) return 1.0;
   Inertia inertia;
   double smallest = 0.0;
-  if (!fixedInputStability(u, inertia, smallest)) return 1.0;
-  return smallest / structure_.typicalScale;
+  if (!fixedInputStability(ws, u, inertia, smallest)) return 1.0;
+  return smallest / d.structure.typicalScale;
 }
 
 TaskPathProblem::BoundaryKind TaskPathProblem::boundaryKind(int k) const {
@@ -338,11 +355,11 @@ std::string TaskPathProblem::boundaryName(int k) const {
   return "loss of stability at fixed inputs (smallest eigenvalue of K_q - K_g crosses zero)";
 }
 
-std::unique_ptr<continuation::BorderedSolver> TaskPathProblem::makeStructuredSolver() {
+std::unique_ptr<continuation::BorderedSolver> TaskPathProblem::makeStructuredSolver(ProblemWorkspace &ws) const {
   if (setup_.rule == TaskRule::MinimumChange)
-    return mIn_ + m_ + 2 <= TaskPathKktSolver::kMaxSmall ? std::make_unique<TaskPathKktSolver>(*this) : nullptr;
+    return mIn_ + m_ + 2 <= TaskPathKktSolver::kMaxSmall ? std::make_unique<TaskPathKktSolver>(*this, ws) : nullptr;
   if (mIn_ + 3 > ChainStructure::kMaxBorder) return nullptr;
-  return std::make_unique<TaskPathBorderedSolver>(*this);
+  return std::make_unique<TaskPathBorderedSolver>(*this, ws);
 }
 
 continuation::ProblemScales TaskPathProblem::scales() const {

@@ -18,8 +18,9 @@ namespace {
 constexpr double kMinPivotRatio = 1e-12;
 }  // namespace
 
-TaskPathKktSolver::TaskPathKktSolver(TaskPathProblem& problem)
+TaskPathKktSolver::TaskPathKktSolver(const TaskPathProblem& problem, continuation::ProblemWorkspace& problemWorkspace)
     : problem_(problem),
+      problemWorkspace_(problemWorkspace),
       n_(problem.segments()),
       mIn_(problem.inputCount()),
       m_(problem.taskCount()),
@@ -27,7 +28,7 @@ TaskPathKktSolver::TaskPathKktSolver(TaskPathProblem& problem)
       ws_(problem.segments()),
       work1_(problem.segments()),
       work2_(problem.segments()) {
-  if (N_ <= kDenseFallback) dense_ = std::make_unique<continuation::DenseBorderedSolver>(problem);
+  if (N_ <= kDenseFallback) dense_ = std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
 }
 
 // K⁻¹ = [[0, H⁻¹], [H⁻¹, −H⁻¹ A H⁻¹]] (header): x_q = H⁻¹ f_μ, x_μ = H⁻¹ (f_q − A x_q).
@@ -60,7 +61,7 @@ Factorization TaskPathKktSolver::eliminate(ConstVectorRef u, ConstMatrixRef Bx, 
   usingDense_ = false;
   k_ = int(Bx.cols());
   TaskPathProblem::OptimalityBlocks blocks;
-  if (!problem_.assembleOptimality(u, ws_, blocks)) return Factorization::Refused;
+  if (!problem_.assembleOptimality(problemWorkspace_, u, ws_, blocks)) return Factorization::Refused;
   diagA_ = blocks.diagA;
   genA_ = blocks.genA;
   factorize(ws_, 0.0, true);

@@ -11,9 +11,10 @@ using continuation::ConstVectorRef;
 using continuation::Factorization;
 using continuation::VectorRef;
 
-TaskPathBorderedSolver::TaskPathBorderedSolver(TaskPathProblem& problem)
-    : problem_(problem), n_(problem.segments()), m_(problem.taskCount()), ws_(problem.segments()), x_(Vector::Zero(n_)) {
-  if (problem.dimension() <= kDenseFallback) dense_ = std::make_unique<continuation::DenseBorderedSolver>(problem);
+TaskPathBorderedSolver::TaskPathBorderedSolver(const TaskPathProblem& problem, continuation::ProblemWorkspace& problemWorkspace)
+    : problem_(problem),
+      problemWorkspace_(problemWorkspace), n_(problem.segments()), m_(problem.taskCount()), ws_(problem.segments()), x_(Vector::Zero(n_)) {
+  if (problem.dimension() <= kDenseFallback) dense_ = std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
 }
 
 template <class DenseFactor>
@@ -37,7 +38,7 @@ Factorization TaskPathBorderedSolver::factor(ConstVectorRef u, double s, ConstVe
   sign_ = 0;
   logAbs_ = -std::numeric_limits<double>::infinity();
   usingDense_ = false;
-  if (!c.allFinite() || !problem_.assembleStructure(u, ws_, B_, Jc_)) return Factorization::Refused;
+  if (!c.allFinite() || !problem_.assembleStructure(problemWorkspace_, u, ws_, B_, Jc_)) return Factorization::Refused;
   V_ = Matrix::Zero(n_, m_ + 1);
   W_.resize(n_, m_ + 1);
   D_ = Matrix::Zero(m_ + 1, m_ + 1);
@@ -58,7 +59,7 @@ Factorization TaskPathBorderedSolver::factorGeneral(ConstVectorRef u, double s, 
   if (k < 1 || p > ChainStructure::kMaxBorder || B.rows() != N || C.rows() != N || C.cols() != k || D.rows() != k ||
       D.cols() != k || !B.allFinite() || !C.allFinite() || !D.allFinite())
     return Factorization::Refused;
-  if (!problem_.assembleStructure(u, ws_, B_, Jc_)) return Factorization::Refused;
+  if (!problem_.assembleStructure(problemWorkspace_, u, ws_, B_, Jc_)) return Factorization::Refused;
   // F_u = [[H, B], [J_c, 0]]; F_uᵀ = [[H, J_cᵀ], [Bᵀ, 0]] (H symmetric)
   V_.resize(n_, p);
   W_.resize(n_, p);

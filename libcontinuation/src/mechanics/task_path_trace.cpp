@@ -36,14 +36,14 @@ double taskLegLength(const TaskSetup& setup, const Vector& from, const Vector& t
   return std::sqrt(sum);
 }
 
-bool taskPathPoint(TaskPathProblem& problem, const Vector& u, double s, bool stiffness, TaskPathPoint& out) {
+bool taskPathPoint(const TaskPathProblem& problem, cont::ProblemWorkspace& workspace, const Vector& u, double s, bool stiffness, TaskPathPoint& out) {
   const int n = problem.segments();
   out.s = s;
   out.q = u.head(n);
   out.inputs = u.segment(n, problem.inputCount());
   out.pose = endPose(problem.chain(), out.q);
   out.target = problem.target(s);
-  if (!problem.fixedInputStability(u, out.inertia, out.minEigenvalue)) return false;
+  if (!problem.fixedInputStability(workspace, u, out.inertia, out.minEigenvalue)) return false;
   out.stable = out.inertia.negative == 0 && out.inertia.zero == 0;
   out.K.setConstant(std::numeric_limits<double>::quiet_NaN());
   out.C.setConstant(std::numeric_limits<double>::quiet_NaN());
@@ -51,7 +51,7 @@ bool taskPathPoint(TaskPathProblem& problem, const Vector& u, double s, bool sti
   // C_F = J_p H⁻¹ J_pᵀ (eq 29, rotation free) by two O(n) solves through T (chain_structure.h)
   ChainStructure ws(n);
   Matrix B, Jc;
-  if (!problem.assembleStructure(u, ws, B, Jc)) return false;
+  if (!problem.assembleStructure(workspace, u, ws, B, Jc)) return false;
   ChainData data(problem.chain());
   forwardKinematics(problem.chain(), out.q, data);
   Matrix J(3, n);
@@ -83,12 +83,12 @@ TaskPathEvent boundaryEvent(TaskPathProblem& problem, const std::string& name) {
 }
 
 // The special point that ends a leg, from the tracer's located point.
-TaskPathSpecial special(TaskPathProblem& problem, const cont::SpecialPoint& sp, TaskPathEvent event, int leg,
-                        bool stiffness) {
+TaskPathSpecial special(const TaskPathProblem& problem, cont::ProblemWorkspace& workspace, const cont::SpecialPoint& sp,
+                        TaskPathEvent event, int leg, bool stiffness) {
   TaskPathSpecial out;
   out.event = event;
   out.accuracy = sp.lambdaAccuracy;
-  taskPathPoint(problem, sp.u, sp.lambda, stiffness, out.point);
+  taskPathPoint(problem, workspace, sp.u, sp.lambda, stiffness, out.point);
   out.point.leg = leg;
   switch (event) {
     case TaskPathEvent::Fold:
@@ -116,6 +116,7 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
   double s = 0.0;
   result.legEnds.push_back(0.0);
   const double tiny = 1e-12 * std::max(problem.lengthUnit(), problem.chain().length());
+  const cont::BoundProblem bound(problem);  // one workspace for every leg (warm starts carry over)
   for (size_t k = 0; k + 1 < corners.size(); ++k) {
     const double length = taskLegLength(setup, corners[k], corners[k + 1], angleLength);
     if (!(length > tiny)) continue;
@@ -135,7 +136,7 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
           return cont::StepAction::Stop;
       return user ? user(step) : cont::StepAction::Continue;
     };
-    const cont::Branch b = cont::trace(problem, u, s, cont::InitialDirection::increasingLambda(), opt);
+    const cont::Branch b = cont::trace(bound, u, s, cont::InitialDirection::increasingLambda(), opt);
     if (b.points.empty()) {
       result.end = TaskPathEvent::Failed;
       result.message = "leg " + std::to_string(leg + 1) + ": " + b.stopMessage;
@@ -151,13 +152,13 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
     for (size_t i = (k == 0 ? 0 : 1); i <= last; ++i) {
       TaskPathPoint p;
       p.leg = leg;
-      if (!taskPathPoint(problem, b.points[i].u, b.points[i].lambda, options.stiffness, p)) continue;
+      if (!taskPathPoint(problem, bound.workspace(), b.points[i].u, b.points[i].lambda, options.stiffness, p)) continue;
       result.points.push_back(p);
       result.worstResidual = std::max(result.worstResidual, b.points[i].residualNorm);
     }
     if (stop) {
       const TaskPathEvent e = stop->type == cont::SpecialPointType::Fold ? TaskPathEvent::Fold : TaskPathEvent::BranchPoint;
-      result.specials.push_back(special(problem, *stop, e, leg, options.stiffness));
+      result.specials.push_back(special(problem, bound.workspace(), *stop, e, leg, options.stiffness));
       result.points.push_back(result.specials.back().point);
       result.end = e;
       result.message = result.specials.back().note;
@@ -171,7 +172,7 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
         return result;
       case cont::StopReason::Boundary: {
         const cont::SpecialPoint& sp = b.specialPoints.back();
-        result.specials.push_back(special(problem, sp, boundaryEvent(problem, sp.boundaryName), leg, options.stiffness));
+        result.specials.push_back(special(problem, bound.workspace(), sp, boundaryEvent(problem, sp.boundaryName), leg, options.stiffness));
         result.end = result.specials.back().event;
         result.message = sp.boundaryName;
         return result;

@@ -29,7 +29,8 @@ class ChainBorderedSolver final : public continuation::BorderedSolver {
   static constexpr int kDenseFallback = 400;
 
   /// `problem` must outlive the solver.
-  explicit ChainBorderedSolver(EquilibriumProblem& problem);
+  /// On `problem` evaluated in `problemWorkspace` (its workspace, outliving the solver).
+  ChainBorderedSolver(const EquilibriumProblem& problem, continuation::ProblemWorkspace& problemWorkspace);
 
   continuation::Factorization factor(continuation::ConstVectorRef u, double lambda,
                                      continuation::ConstVectorRef c) override;
@@ -50,7 +51,8 @@ class ChainBorderedSolver final : public continuation::BorderedSolver {
   bool usedDenseFallback() const { return dense_ != nullptr && usingDense_; }
 
  private:
-  EquilibriumProblem& problem_;
+  const EquilibriumProblem& problem_;
+  continuation::ProblemWorkspace& problemWorkspace_;
   int n_, m_, p_;
   std::vector<int> held_, loaded_;
   ChainStructure ws_;

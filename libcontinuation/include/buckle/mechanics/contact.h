@@ -37,7 +37,7 @@
 #include <vector>
 
 #include "buckle/continuation/bordered_solver.h"
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/end_condition.h"
@@ -116,10 +116,10 @@ class ContactProblem final : public continuation::Problem {
  public:
   /// Throws std::invalid_argument if a locked joint is outside the chain or maxCompression is
   /// not positive.
-  ContactProblem(EquilibriumProblem& base, ContactSet locked,
+  ContactProblem(const EquilibriumProblem& base, ContactSet locked,
                  double maxCompression = std::numeric_limits<double>::infinity());
 
-  EquilibriumProblem& base() { return base_; }
+  const EquilibriumProblem& base() const { return base_; }
   const ContactSet& contacts() const { return locked_; }
   /// Free joints in increasing order.
   const std::vector<int>& freeJoints() const { return free_; }
@@ -127,34 +127,34 @@ class ContactProblem final : public continuation::Problem {
   /// Contact torque τ_c,i = ∂E/∂q_i − (JᵀF)_i − Σ_v μ_v ∂x_v/∂q_i of joint i at (u, λ) (any
   /// joint; ~0 for a free one at an equilibrium); u is (q, r, μ) or (q, r) (μ then from
   /// wallForces). NaN outside the domain.
-  double contactTorque(continuation::ConstVectorRef u, double lambda, int joint);
+  double contactTorque(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, int joint) const;
   /// Compression −side·τ_c,i of a locked joint (≥ 0 while the contact holds).
-  double compression(continuation::ConstVectorRef u, double lambda, int joint);
+  double compression(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, int joint) const;
   /// The wall forces μ (one per vertex of contacts().wall(), a force along +x on the chain) that
   /// close the free joints' rows of the base problem at (q, r) = u.head(base dimension) in the
   /// least-squares sense: exact at a constrained equilibrium. NaN outside the domain.
-  Vector wallForces(continuation::ConstVectorRef u, double lambda);
+  Vector wallForces(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda) const;
   /// (q, r) extended to this problem's unknowns (q, r, μ) with μ = wallForces.
-  Vector withWallForces(continuation::ConstVectorRef u, double lambda);
+  Vector withWallForces(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda) const;
 
   int dimension() const override { return base_.dimension() + locked_.wallCount(); }
-  bool residual(continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) override;
-  bool jacobian(continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
-                continuation::VectorRef Flambda) override;
-  bool jacobianDirectionalDerivative(continuation::ConstVectorRef u, double lambda,
+  bool residual(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) const override;
+  bool jacobian(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
+                continuation::VectorRef Flambda) const override;
+  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda,
                                      continuation::ConstVectorRef du, double dlambda,
-                                     continuation::MatrixRef dFu, continuation::VectorRef dFlambda) override;
+                                     continuation::MatrixRef dFu, continuation::VectorRef dFlambda) const override;
 
   bool hasStabilityOperator() const override { return true; }
   /// H = K_q − K_g − Σ μ_v ∂²x_v (n×n), C = the held rows J_h, one row e_iᵀ per locked joint and
   /// one row ∇x_vᵀ per vertex on the wall.
-  bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
+  bool stabilityOperator(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const override;
   /// Inertia and lowest eigenvalues of K_q − K_g on the free joints and ker J_h,F, O(n) through
   /// the reduced chain structure (file comment).
-  bool stability(continuation::ConstVectorRef u, double lambda, int lowestCount,
-                 continuation::StabilityInfo& info) override;
+  bool stability(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
+                 continuation::StabilityInfo& info) const override;
   /// The reduced structure's O(n) bordered solver (locked rows eliminated).
-  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver() override;
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace &ws) const override;
 
   /// base.scales(), with the locked rows (angles) at scale 1.
   continuation::ProblemScales scales() const override;
@@ -165,39 +165,51 @@ class ContactProblem final : public continuation::Problem {
   int torqueBoundBegin() const;
   int wallClearanceBoundary() const;
   int wallReleaseBoundary(int k) const;
-  double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
+  double boundary(continuation::ProblemWorkspace &ws, int k, continuation::ConstVectorRef u, double lambda) const override;
   std::string boundaryName(int k) const override;
 
   /// T of K_q − K_g (with the wall forces' terms) on the free joints into ws (size
   /// freeJoints().size()) and the end Jacobian's free columns into Jf (3×|F|); u = (q, r, μ).
   /// False outside the domain or when every joint is locked.
-  bool assembleReduced(continuation::ConstVectorRef u, double lambda, ChainStructure& ws,
-                       continuation::MatrixRef Jf);
+  bool assembleReduced(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, ChainStructure& structure,
+                       continuation::MatrixRef Jf) const;
   /// The full structure (every joint) of K_q − K_g with the wall forces' terms in its generator,
   /// and the end Jacobian (3×n), at u = (q, r, μ): what the reduced structure is cut from.
-  bool assembleFull(continuation::ConstVectorRef u, double lambda, ChainStructure& full, continuation::MatrixRef J);
+  bool assembleFull(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, ChainStructure& full,
+                    continuation::MatrixRef J) const;
   /// The wall vertices' ∇x_v (columns of wallGradients(), n×w) and generators of −∂²x_v (columns
   /// of wallGenerators(), wall_contact.h) at q; false when q is not finite.
-  bool wallKinematics(continuation::ConstVectorRef q);
-  const Matrix& wallGradients() const { return wallGrad_; }
-  const Matrix& wallGenerators() const { return wallGen_; }
+  bool wallKinematics(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef q) const;
+  static const Matrix& wallGradients(const continuation::ProblemWorkspace& ws) {
+    return continuation::workspaceAs<Workspace>(ws).wallGrad;
+  }
+  static const Matrix& wallGenerators(const continuation::ProblemWorkspace& ws) {
+    return continuation::workspaceAs<Workspace>(ws).wallGen;
+  }
+
+  /// The base problem's workspace and this problem's scratch (ProblemWorkspace).
+  struct Workspace : continuation::ProblemWorkspace {
+    explicit Workspace(const ContactProblem& problem);
+    std::unique_ptr<continuation::ProblemWorkspace> base;
+    ChainStructure full, reduced;
+    Matrix J, Jf, heldRows;
+    Vector kf, hf;       // κ_F, h_F of the reduced structure
+    Vector residual;     // the free equilibrium's rows (contact torques), size N
+    Vector lastLowest;
+    Matrix wallGrad, wallGen;  // n×w: ∇x_v and the generators of −∂²x_v (wallKinematics)
+    Vector wallX;              // x_v of the wall vertices
+  };
+  std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override;
 
  private:
   // The base problem's rows at (q, r) with the wall forces' terms −Σ μ_v ∇x_v added to the q rows.
-  bool baseRowsWithWall(continuation::ConstVectorRef u, double lambda, VectorRef F);
+  bool baseRowsWithWall(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, VectorRef F) const;
 
-  EquilibriumProblem& base_;
+  const EquilibriumProblem& base_;
   ContactSet locked_;
   double maxCompression_;
   std::vector<int> free_;
   std::vector<int> held_;
-  ChainStructure full_, reduced_;
-  Matrix J_, Jf_, heldRows_;
-  Vector kf_, hf_;       // κ_F, h_F of the reduced structure
-  Vector residual_;      // the free equilibrium's rows (contact torques), size N
-  Vector lastLowest_;
-  Matrix wallGrad_, wallGen_;  // n×w: ∇x_v and the generators of −∂²x_v (wallKinematics)
-  Vector wallX_;               // x_v of the wall vertices
 };
 
 /// K_q − K_g on the joints `free` (increasing) of `full`: the generator form κ_a δ_ab − h_max(a,b)
@@ -239,12 +251,12 @@ struct ConstrainedEquilibrium {
   double minCompression = 0.0;
   std::string message;             ///< why it did not converge
 };
-ConstrainedEquilibrium solveConstrainedEquilibrium(EquilibriumProblem& base, const ContactSet& locked,
+ConstrainedEquilibrium solveConstrainedEquilibrium(const EquilibriumProblem& base, const ContactSet& locked,
                                                    continuation::ConstVectorRef u0, double lambda,
                                                    double tolerance = 1e-12, int maxIterations = 30);
 
 /// Stability of the constrained system at (u, λ): K_q − K_g on the free joints and ker J_h,F.
-continuation::StabilityInfo constrainedStability(EquilibriumProblem& base, const ContactSet& locked,
+continuation::StabilityInfo constrainedStability(const EquilibriumProblem& base, const ContactSet& locked,
                                                  continuation::ConstVectorRef u, double lambda,
                                                  int lowestCount = 1);
 

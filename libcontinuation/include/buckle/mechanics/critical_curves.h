@@ -61,57 +61,69 @@ class ChainParameterProblem final : public continuation::TwoParameterProblem {
                         const Eigen::Vector3d& direction, const SecondParameter& parameter,
                         EquilibriumOptions options = {});
 
-  EquilibriumProblem& equilibrium() { return *equilibrium_; }
+  const EquilibriumProblem& equilibrium() const { return *equilibrium_; }
+
+  /// The workspace of the equilibrium problem at the current μ (setting μ rebuilds that problem,
+  /// so its workspace is rebuilt with it: its caches belong to the previous chain).
+  struct Workspace : continuation::ProblemWorkspace {
+    long generation = -1;
+    std::unique_ptr<continuation::ProblemWorkspace> equilibrium;
+  };
+  std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override {
+    return std::make_unique<Workspace>();
+  }
+  /// The equilibrium problem's workspace within `ws` (made for the current μ when needed).
+  continuation::ProblemWorkspace& equilibriumWorkspace(continuation::ProblemWorkspace& ws) const;
   const std::vector<SegmentParameters>& segments() const { return segments_; }
   const SecondParameter& parameter() const { return parameter_; }
 
   double secondParameter() const override { return mu_; }
   bool setSecondParameter(double mu) override;
-  bool secondParameterDerivatives(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef v,
-                                  continuation::VectorRef Fmu, continuation::VectorRef FuMuV) override;
+  bool secondParameterDerivatives(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef v,
+                                  continuation::VectorRef Fmu, continuation::VectorRef FuMuV) const override;
   /// b̄ for lengths, k̄ for k, k̄b̄ / k̄b̄² for an end force / torque, b̄ / 1 for a held position / angle.
   double secondParameterScale() const override;
 
   int dimension() const override { return equilibrium_->dimension(); }
-  bool residual(continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) override {
-    return equilibrium_->residual(u, lambda, F);
+  bool residual(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) const override {
+    return equilibrium_->residual(equilibriumWorkspace(ws), u, lambda, F);
   }
-  bool jacobian(continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
-                continuation::VectorRef Flambda) override {
-    return equilibrium_->jacobian(u, lambda, Fu, Flambda);
+  bool jacobian(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
+                continuation::VectorRef Flambda) const override {
+    return equilibrium_->jacobian(equilibriumWorkspace(ws), u, lambda, Fu, Flambda);
   }
-  bool jacobianDirectionalDerivative(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
+  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
                                      double dlambda, continuation::MatrixRef dFu,
-                                     continuation::VectorRef dFlambda) override {
-    return equilibrium_->jacobianDirectionalDerivative(u, lambda, du, dlambda, dFu, dFlambda);
+                                     continuation::VectorRef dFlambda) const override {
+    return equilibrium_->jacobianDirectionalDerivative(equilibriumWorkspace(ws), u, lambda, du, dlambda, dFu, dFlambda);
   }
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override {
-    return equilibrium_->stabilityOperator(u, lambda, H, C);
+  bool stabilityOperator(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const override {
+    return equilibrium_->stabilityOperator(equilibriumWorkspace(ws), u, lambda, H, C);
   }
-  bool stability(continuation::ConstVectorRef u, double lambda, int lowestCount,
-                 continuation::StabilityInfo& info) override {
-    return equilibrium_->stability(u, lambda, lowestCount, info);
+  bool stability(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
+                 continuation::StabilityInfo& info) const override {
+    return equilibrium_->stability(equilibriumWorkspace(ws), u, lambda, lowestCount, info);
   }
   /// Exact (∂F_u/∂λ)·v in O(n): the dead loads' λ-derivative of K_g (eq 27), −[h'_max(i,j)] v_q.
-  bool parameterJacobianApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef v,
-                              continuation::VectorRef FuLambdaV) override;
-  bool jacobianApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
-                     continuation::VectorRef y) override {
-    return equilibrium_->jacobianApply(u, lambda, x, y);
+  bool parameterJacobianApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef v,
+                              continuation::VectorRef FuLambdaV) const override;
+  bool jacobianApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
+                     continuation::VectorRef y) const override {
+    return equilibrium_->jacobianApply(equilibriumWorkspace(ws), u, lambda, x, y);
   }
-  bool jacobianTransposeApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef w,
-                              continuation::VectorRef y) override {
-    return equilibrium_->jacobianTransposeApply(u, lambda, w, y);
+  bool jacobianTransposeApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef w,
+                              continuation::VectorRef y) const override {
+    return equilibrium_->jacobianTransposeApply(equilibriumWorkspace(ws), u, lambda, w, y);
   }
   /// The chain's O(n) bordered solver, recreated for the current chain whenever μ has changed.
-  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver() override;
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace &ws) const override;
   /// Incremented whenever setting μ rebuilds the chain (what the structured solver follows).
   long generation() const { return generation_; }
   continuation::ProblemScales scales() const override { return equilibrium_->scales(); }
   int boundaryCount() const override { return equilibrium_->boundaryCount(); }
-  double boundary(int k, continuation::ConstVectorRef u, double lambda) override {
-    return equilibrium_->boundary(k, u, lambda);
+  double boundary(continuation::ProblemWorkspace &ws, int k, continuation::ConstVectorRef u, double lambda) const override {
+    return equilibrium_->boundary(equilibriumWorkspace(ws), k, u, lambda);
   }
   std::string boundaryName(int k) const override { return equilibrium_->boundaryName(k); }
 
@@ -128,8 +140,10 @@ class ChainParameterProblem final : public continuation::TwoParameterProblem {
   double mu_ = 0.0;
   long generation_ = 0;
   std::unique_ptr<EquilibriumProblem> equilibrium_;
-  std::unique_ptr<ChainData> data_;
-  Vector dl_, dS_, dC_, dE1_, dE2_, dh_;
+  // Scratch of the μ derivatives: like the curve problems (fold_curve.h), a two-parameter problem
+  // is one computation's object (μ is set on it), so it keeps its scratch itself.
+  mutable std::unique_ptr<ChainData> data_;
+  mutable Vector dl_, dS_, dC_, dE1_, dE2_, dh_;
 };
 
 /// One point of a critical curve.

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "buckle/continuation/problem.h"
+#include "buckle/continuation/bound_problem.h"
 #include "buckle/continuation/options_validity.h"
 #include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain.h"
@@ -79,9 +79,44 @@ class EquilibriumProblem final : public continuation::Problem {
   /// path): what the energy, stiffness and dynamics of a point at λ are computed on. Throws
   /// std::invalid_argument when a free length is not positive at λ.
   Chain chainAt(double lambda) const { return chainWithControls(chain_, control_, lambda); }
-  /// ∂²E/∂q∂λ (size n) at the (q, λ) of the last evaluation (residual, jacobian,
+  /// The caches of one computation (ProblemWorkspace), preallocated for the chain. Every cache is
+  /// keyed bitwise on the point it was computed at, so its values are pure functions of the
+  /// points evaluated; the eigenvalue searches' warm starts (found) only speed them up.
+  struct Workspace : continuation::ProblemWorkspace {
+    explicit Workspace(const EquilibriumProblem& problem);
+    // prepare()'s q-cache: kinematics, the end Jacobian (3×n), ∂E/∂q and the diagonal of K_q
+    // (size n), d³E/dq³ per joint (stabilityRateBound()), sin/cos(q_i/2), for cachedQ (and
+    // cachedLambda on a control path); controlGrad, controlStiff: ∂(∂E/∂q)/∂λ, ∂K_q/∂λ there.
+    ChainData data;
+    Matrix J;
+    Vector grad, stiff, stiffRate, cachedQ;
+    double cachedLambda = 0.0;
+    Vector controlGrad, controlStiff;
+    Vector sinHalf, cosHalf;
+    bool cacheValid = false;
+    Vector work;               // size n
+    ChainStructure structure;  // the structured stability()'s
+    Matrix heldRows;           // m×n held rows of J
+    // The whole small dense spectrum (n ≤ 16) of the last (u, λ) it was computed at, by
+    // stability() or stabilityEigenvalues(): the tracer asks stability() for the inertia and then
+    // the certified counting's values at the same point (spectral_monitor.h), one eigen-solve serves
+    // both. Keyed bitwise on (u, λ) like the q-cache (H depends on r and λ through the wrench).
+    Vector spectrumKey;                             // (u, λ) of spectrum (size N + 1)
+    Eigen::Matrix<double, kSmallDense, 1> spectrum;  // ascending eigenvalues on ker J_h ...
+    int spectrumSize = -1;                          // ... their number (n − rank); −1: none cached
+    Inertia spectrumInertia;                        // ... and the inertia that goes with them
+    BodyLoadTerms bodyTerms;  // the body loads' τ and γ at the cached q
+    Vector bodyWork;          // size n: dγ and other body-load scratch
+    EigenvalueMemory found;   // warm starts of the structured eigenvalue searches (by index)
+    Vector guess;             // their guesses (size kMaxBorder once used: no allocation per call)
+  };
+  std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override;
+
+  /// ∂²E/∂q∂λ (size n) at the (q, λ) of the workspace's last evaluation (residual, jacobian,
   /// assembleStructure …): the control part of F_λ. Empty when no control path.
-  const Vector& controlRate() const { return controlGrad_; }
+  static const Vector& controlRate(const continuation::ProblemWorkspace& ws) {
+    return continuation::workspaceAs<Workspace>(ws).controlGrad;
+  }
   /// The body loads (weight, point loads) and whether any of them is not zero.
   const BodyLoads& bodyLoads() const { return body_; }
   bool hasBodyLoads() const { return bodyTerms_.active(); }
@@ -93,7 +128,9 @@ class EquilibriumProblem final : public continuation::Problem {
                                double dlambda) const;
   /// τ' at the q of the last evaluation (eq B2: F_λ gains −τ'), for the structured solvers that
   /// form F_λ themselves; meaningful only with hasBodyLoads().
-  const Vector& bodyRateTorques() const { return bodyTerms_.rateTorques(); }
+  static const Vector& bodyRateTorques(const continuation::ProblemWorkspace& ws) {
+    return continuation::workspaceAs<Workspace>(ws).bodyTerms.rateTorques();
+  }
   /// V(q, λ) of the body loads (eq B1; 0 without them).
   double bodyLoadPotential(continuation::ConstVectorRef q, double lambda) const;
 
@@ -112,61 +149,63 @@ class EquilibriumProblem final : public continuation::Problem {
   Vector initialGuess(continuation::ConstVectorRef q, double lambda) const;
 
   int dimension() const override { return chain_.size() + heldCount(); }
-  bool residual(continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) override;
-  bool jacobian(continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
-                continuation::VectorRef Flambda) override;
+  bool residual(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) const override;
+  bool jacobian(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
+                continuation::VectorRef Flambda) const override;
   /// Every entry of F_u and F_λ, the zero block of the multipliers included.
   bool jacobianWritesAllEntries() const override { return true; }
-  bool jacobianDirectionalDerivative(continuation::ConstVectorRef u, double lambda,
+  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda,
                                      continuation::ConstVectorRef du, double dlambda,
-                                     continuation::MatrixRef dFu, continuation::VectorRef dFlambda) override;
+                                     continuation::MatrixRef dFu, continuation::VectorRef dFlambda) const override;
 
   /// O(n) products with F_x = [F_u, F_λ] in the joint coordinates (K_g x by prefix and suffix
   /// sums of h, eq 27): exact to rounding, with no cancellation beyond that of the dense product.
   /// F_u is symmetric, so F_xᵀ w = (F_u w, F_λ·w). The second derivative keeps the default
   /// (central differences of jacobianTransposeApply, O(n)).
-  bool jacobianApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
-                     continuation::VectorRef y) override;
-  bool jacobianTransposeApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef w,
-                              continuation::VectorRef y) override;
+  bool jacobianApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
+                     continuation::VectorRef y) const override;
+  bool jacobianTransposeApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef w,
+                              continuation::VectorRef y) const override;
   /// Exact F_xx[x, z] in O(n): jacobianDirectionalDerivative() along x applied to z, i.e.
   /// (q rows) E‴ ⊙ x_q ⊙ z_q − K_g(dh_x) z_q − dJ_h[x]ᵀ z_r − Σ_loaded dJ_c[x]ᵀ dir_c z_λ with
   /// dh_x = d h along x (eq 27 differentiated, the wrench moving with x_r and x_λ) and dJ the
   /// derivative of the end Jacobian (stiffness.h); (held rows) −dJ_h[x] z_q.
-  bool secondDerivativeApply(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
-                             continuation::ConstVectorRef z, continuation::VectorRef y) override;
+  bool secondDerivativeApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
+                             continuation::ConstVectorRef z, continuation::VectorRef y) const override;
 
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) override;
+  bool stabilityOperator(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const override;
   /// Inertia of K_q − K_g on ker J_h and its min(lowestCount, kMaxLowest) lowest eigenvalues.
   /// options.structuredStability: the inertia from two O(n) Sturm counts, the eigenvalues by
   /// Newton on the counts' determinant (chain_structure.h); for n <= 16 with eigenvalues wanted,
   /// one heap-free dense solve (faster there: benchmarks/RESULTS.md). Otherwise the dense
   /// Problem::stability().
   static constexpr int kMaxLowest = 4;  // the isolation's fixed-size brackets
-  bool stability(continuation::ConstVectorRef u, double lambda, int lowestCount,
-                 continuation::StabilityInfo& info) override;
+  bool stability(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
+                 continuation::StabilityInfo& info) const override;
   /// Eigenvalues by index of K_q − K_g on ker J_h, each isolated on O(n) Sturm counts of the
   /// shifted tridiagonal T − σM (chain_structure.h, eigenvaluesFrom).
-  bool stabilityEigenvalues(continuation::ConstVectorRef u, double lambda, int first,
-                            continuation::VectorRef values) override;
+  bool stabilityEigenvalues(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, int first,
+                            continuation::VectorRef values) const override;
   /// O(n) factorizations the structured stability() and stabilityEigenvalues() have taken so
   /// far (their cost; eigenvalue_memory.h).
-  long structuredFactorizations() const { return structure_.factorizations; }
+  static long structuredFactorizations(const continuation::ProblemWorkspace& ws) {
+    return continuation::workspaceAs<Workspace>(ws).structure.factorizations;
+  }
   /// ‖dH‖_F + 2‖H‖_F‖dC‖_F/σ_min(C) along (du, dλ), H = K_q − K_g and C = J_h (held rows of
   /// eq 11), in O(n) from the q-cache: an upper bound on every |dμ_i| (Problem). False when C is
   /// rank-deficient (no finite bound) or the point is refused.
-  bool stabilityRateBound(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
-                          double dlambda, double& bound) override;
+  bool stabilityRateBound(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
+                          double dlambda, double& bound) const override;
 
   /// T of H = K_q − K_g(F(u, λ)) into ws (chain_structure.h) and the end Jacobian (3×n) into J,
   /// from the q-cache: what the structured stability and the structured solver linearise on.
   /// False outside the domain.
-  bool assembleStructure(continuation::ConstVectorRef u, double lambda, ChainStructure& ws,
-                         continuation::MatrixRef J);
+  bool assembleStructure(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                         ChainStructure& structure, continuation::MatrixRef J) const;
 
   /// The O(n) bordered solver of the chain (chain_solver.h).
-  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver() override;
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace &ws) const override;
 
   /// The chain's own units (ProblemScales): with b̄, k̄ the mean triangle half-length and spring
   /// stiffness, angles 1, torque rows and the stability operator k̄b̄², held-position rows b̄,
@@ -180,8 +219,8 @@ class EquilibriumProblem final : public continuation::Problem {
   double stiffnessUnit() const;
 
   int boundaryCount() const override;
-  double boundary(int k, continuation::ConstVectorRef u, double lambda) override;
-  void boundaries(continuation::ConstVectorRef u, double lambda, continuation::VectorRef g) override;
+  double boundary(continuation::ProblemWorkspace &ws, int k, continuation::ConstVectorRef u, double lambda) const override;
+  void boundaries(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::VectorRef g) const override;
   std::string boundaryName(int k) const override;
   /// The first of the two boundaries of EquilibriumOptions::heldRange (after the joint limits'),
   /// and how many there are (0 or 2).
@@ -209,54 +248,31 @@ class EquilibriumProblem final : public continuation::Problem {
   /// False (nothing cached) if u is outside the domain.
   /// Along a control path the free lengths, and so ∂E/∂q and K_q, depend on λ: the key is then
   /// (q, λ), bitwise, and points where a free length is not positive are refused.
-  bool prepare(const continuation::ConstVectorRef& u, double lambda);
+  bool prepare(Workspace& d, const continuation::ConstVectorRef& u, double lambda) const;
   /// T at (u, λ) into ws from the cache (after prepare(u)).
-  void assembleFromCache(const continuation::ConstVectorRef& u, double lambda, ChainStructure& ws);
+  void assembleFromCache(Workspace& d, const continuation::ConstVectorRef& u, double lambda, ChainStructure& ws) const;
   /// The small dense route (n ≤ 16, equilibrium_problem.cpp) at (u, λ): the inertia and all eigenvalues on
   /// ker J_h into spectrumInertia_ and spectrum_, or nothing when (u, λ) is already their key.
   /// False (nothing cached) outside the domain.
-  bool smallDenseSpectrum(const continuation::ConstVectorRef& u, double lambda);
+  bool smallDenseSpectrum(Workspace& d, const continuation::ConstVectorRef& u, double lambda) const;
   /// The generator of K_q − H at (u, λ) from the cache: h(F) of eq 27 minus the body loads' γ
   /// (equilibrium_problem_body.cpp).
-  void loadGenerator(const continuation::ConstVectorRef& u, double lambda, VectorRef h) const;
+  void loadGenerator(Workspace& d, const continuation::ConstVectorRef& u, double lambda, VectorRef h) const;
   /// The body loads' dγ along (du_q, dλ) into bodyWork_ (zero without them).
-  void bodyGeneratorDerivative(const continuation::ConstVectorRef& dq, double lambda, double dlambda);
+  void bodyGeneratorDerivative(Workspace& d, const continuation::ConstVectorRef& dq, double lambda, double dlambda) const;
 
   Chain chain_;
   EndCondition end_;
   Eigen::Vector3d direction_;
   EquilibriumOptions options_;
   std::vector<int> held_, loaded_;
-  ChainData data_;
-  Matrix J_;             // 3×n
-  Vector grad_, stiff_;  // ∂E/∂q, diagonal of K_q (size n); with data_ and J_: prepare()'s cache
-  Vector stiffRate_;     // d³E/dq³ per joint (size n), from the same jets: stabilityRateBound()
-  Vector cachedQ_;       // q of the cache (size n)
   ControlDirection control_;
-  double cachedLambda_ = 0.0;     // λ of the cache (a control path only)
   Vector freeLength1_, freeLength2_;  // the chain's L1⁰, L2⁰ (control path only, size n)
-  Vector controlGrad_, controlStiff_; // ∂(∂E/∂q)/∂λ, ∂K_q/∂λ of the cache (control path only)
-  Vector sinHalf_, cosHalf_;  // sin(q_i/2), cos(q_i/2) of the cache: springs and kinematics share them
   // inDomain()'s bounds per joint, geometric limit ± the overshoot allowed while the limits are
   // traced as boundaries, formed once (the same sums inDomain() formed per call; size n).
   Vector domainUpper_, domainLower_;
-  bool cacheValid_ = false;
-  Vector work_;  // size n
-  ChainStructure structure_;  // workspace of the structured stability()
-  Matrix heldRows_;           // m×n held rows of J
-  // The whole small dense spectrum (n ≤ 16) of the last (u, λ) it was computed at, by
-  // stability() or stabilityEigenvalues(): the tracer asks stability() for the inertia and then the
-  // certified counting's values at the same point (spectral_monitor.h), one eigen-solve serves
-  // both. Keyed bitwise on (u, λ) like the q-cache (H depends on r and λ through the wrench).
-  Vector spectrumKey_;                             // (u, λ) of spectrum_ (size N + 1)
-  Eigen::Matrix<double, kSmallDense, 1> spectrum_; // ascending eigenvalues on ker J_h ...
-  int spectrumSize_ = -1;                          // ... their number (n − rank); −1: none cached
-  Inertia spectrumInertia_;                        // ... and the inertia that goes with them
   BodyLoads body_;
-  BodyLoadTerms bodyTerms_;   // the body loads' τ and γ of the cache (prepare())
-  Vector bodyWork_;           // size n: dγ and other body-load scratch
-  EigenvalueMemory found_;    // warm starts of the structured eigenvalue searches (by index)
-  Vector guess_;              // their guesses (size kMaxBorder once used: no allocation per call)
+  BodyLoadTerms bodyTerms_;  // the body loads' constant terms (a workspace updates its copy)
 };
 
 }  // namespace buckle::mechanics

@@ -126,26 +126,27 @@ class TaskPathProblem final : public continuation::Problem {
   Eigen::MatrixX2d freeLengthChange(continuation::ConstVectorRef p) const;
 
   int dimension() const override { return dim_; }
-  bool residual(continuation::ConstVectorRef u, double s, continuation::VectorRef F) override;
-  bool jacobian(continuation::ConstVectorRef u, double s, continuation::MatrixRef Fu,
-                continuation::VectorRef Fs) override;
+  bool residual(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double s, continuation::VectorRef F) const override;
+  bool jacobian(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double s, continuation::MatrixRef Fu,
+                continuation::VectorRef Fs) const override;
   bool jacobianWritesAllEntries() const override { return true; }
 
   /// Boundaries: joint upper limits (n), lower limits (n), input upper / lower bounds (2 m_in),
   /// the free lengths L1⁰, L2⁰ of every segment (2n, > 0: the inputs' admissible range), then
   /// the smallest eigenvalue of H at fixed inputs over the stability scale (1).
   int boundaryCount() const override { return 4 * n_ + 2 * mIn_ + 1; }
-  double boundary(int k, continuation::ConstVectorRef u, double s) override;
+  double boundary(continuation::ProblemWorkspace &ws, int k, continuation::ConstVectorRef u, double s) const override;
   std::string boundaryName(int k) const override;
   /// What kind of boundary k is.
   enum class BoundaryKind { JointLimit, InputBound, Stability };
   BoundaryKind boundaryKind(int k) const;
 
   /// Inertia and smallest eigenvalue of H = K_q − K_g at fixed inputs, O(n). False outside the domain.
-  bool fixedInputStability(continuation::ConstVectorRef u, Inertia& inertia, double& smallest);
+  bool fixedInputStability(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, Inertia& inertia,
+                           double& smallest) const;
 
   /// Rule (a): the O(n) bordered solver; rule (b): null (dense).
-  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver() override;
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace &ws) const override;
   /// q 1, inputs b̄, torque rows k̄b̄², task rows b̄ (x, y) or 1 (φ), s b̄; rule (b): μ 1/(k̄b̄²),
   /// ν 1/b̄ or 1, R_q rows 1, R_p rows 1/b̄.
   continuation::ProblemScales scales() const override;
@@ -158,17 +159,37 @@ class TaskPathProblem final : public continuation::Problem {
     Vector diagA, genA, weights;
     Matrix B, D, Jc;
   };
-  bool assembleOptimality(continuation::ConstVectorRef u, ChainStructure& ws, OptimalityBlocks& blocks);
+  bool assembleOptimality(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, ChainStructure& structure,
+                          OptimalityBlocks& blocks) const;
 
   /// T of H at (q, p) into ws, the inputs' columns B (n × m_in) and the task rows J_c (m × n):
   /// what the structured solver linearises on. False outside the domain.
-  bool assembleStructure(continuation::ConstVectorRef u, ChainStructure& ws, Matrix& B, Matrix& Jc);
+  bool assembleStructure(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, ChainStructure& structure, Matrix& B,
+                         Matrix& Jc) const;
+
+  /// prepare()'s cache (keyed bitwise on (q, p)) and the warm start of fixedInputStability().
+  struct Workspace : continuation::ProblemWorkspace {
+    explicit Workspace(const TaskPathProblem& problem);
+    ChainData data;
+    Matrix J;                    // 3×n
+    Vector grad, stiff, third;   // E′, E″, E‴ per joint
+    Eigen::MatrixX2d e1, e2;     // −k_s L_s′, −k_s L_s″ per joint and spring
+    Vector h, work;
+    BodyLoadTerms body;          // the body loads at the cached q
+    Vector tau;                  // their torques τ (eq B4)
+    Matrix B;                    // n × m_in
+    ChainStructure structure;
+    Vector cachedKey;            // (q, p) of the cache (bitwise)
+    bool cacheValid = false;
+    Vector lastSmallest;         // warm start of the smallest eigenvalue
+  };
+  std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override;
 
  private:
   /// Spring model, kinematics and the per-segment input derivatives at u (q, p). False outside the domain.
-  bool prepare(continuation::ConstVectorRef u);
+  bool prepare(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u) const;
   /// Rule (b), after prepare(u): A = diag(diagA) + [genA_max(i,k)] and D (header).
-  void optimalityBlocks(continuation::ConstVectorRef u, Vector& diagA, Vector& genA, Matrix& D);
+  void optimalityBlocks(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, Vector& diagA, Vector& genA, Matrix& D) const;
   /// Column j of B (or of D with the joint weights μ) from the per-segment derivatives e (n×2).
   void inputColumns(const Eigen::MatrixX2d& e, Matrix& out) const;
 
@@ -180,19 +201,7 @@ class TaskPathProblem final : public continuation::Problem {
   Vector domainUpper_, domainLower_;
   double lengthUnit_ = 1.0, stiffnessUnit_ = 1.0;
   TaskLeg leg_;
-  // prepare()'s cache
-  ChainData data_;
-  Matrix J_;                     // 3×n
-  Vector grad_, stiff_, third_;  // E′, E″, E‴ per joint
-  Eigen::MatrixX2d e1_, e2_;     // −k_s L_s′, −k_s L_s″ per joint and spring
-  Vector h_, work_;
-  BodyLoadTerms body_;           // the weight and point loads (inactive: none)
-  Vector tau_;                   // their torques τ (eq B4)
-  Matrix B_;                     // n × m_in
-  ChainStructure structure_;
-  Vector cachedKey_;          // (q, p) of the cache (bitwise)
-  bool cacheValid_ = false;
-  Vector lastSmallest_;       // warm start of the smallest eigenvalue
+  BodyLoadTerms body_;  // the weight and point loads (inactive: none); a workspace updates its copy
 };
 
 }  // namespace buckle::mechanics

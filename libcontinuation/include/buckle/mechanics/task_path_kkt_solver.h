@@ -30,7 +30,8 @@ class TaskPathKktSolver final : public continuation::BorderedSolver {
   /// The largest Schur complement (m_in + m + border) taken; more inputs are solved densely.
   static constexpr int kMaxSmall = 64;
   /// `problem` (rule (b)) must outlive the solver.
-  explicit TaskPathKktSolver(TaskPathProblem& problem);
+  /// On `problem` evaluated in `problemWorkspace` (its workspace, outliving the solver).
+  TaskPathKktSolver(const TaskPathProblem& problem, continuation::ProblemWorkspace& problemWorkspace);
 
   continuation::Factorization factor(continuation::ConstVectorRef u, double s, continuation::ConstVectorRef c) override;
   bool solve(continuation::ConstVectorRef b, continuation::VectorRef x) override;
@@ -50,7 +51,8 @@ class TaskPathKktSolver final : public continuation::BorderedSolver {
   /// y = K x (exact, O(n)).
   void applyK(const Eigen::Ref<const Vector>& x, Eigen::Ref<Vector> y);
 
-  TaskPathProblem& problem_;
+  const TaskPathProblem& problem_;
+  continuation::ProblemWorkspace& problemWorkspace_;
   int n_, mIn_, m_, N_;
   ChainStructure ws_;
   Vector diagA_, genA_, wdiag_;

@@ -24,7 +24,8 @@ class TaskPathBorderedSolver final : public continuation::BorderedSolver {
  public:
   static constexpr int kDenseFallback = 400;
   /// `problem` (rule (a), m + 3 ≤ ChainStructure::kMaxBorder) must outlive the solver.
-  explicit TaskPathBorderedSolver(TaskPathProblem& problem);
+  /// On `problem` evaluated in `problemWorkspace` (its workspace, outliving the solver).
+  TaskPathBorderedSolver(const TaskPathProblem& problem, continuation::ProblemWorkspace& problemWorkspace);
 
   continuation::Factorization factor(continuation::ConstVectorRef u, double s, continuation::ConstVectorRef c) override;
   bool solve(continuation::ConstVectorRef b, continuation::VectorRef x) override;
@@ -40,7 +41,8 @@ class TaskPathBorderedSolver final : public continuation::BorderedSolver {
   template <class DenseFactor>
   continuation::Factorization eliminate(DenseFactor dense);
 
-  TaskPathProblem& problem_;
+  const TaskPathProblem& problem_;
+  continuation::ProblemWorkspace& problemWorkspace_;
   int n_, m_;
   ChainStructure ws_;
   Matrix B_, Jc_, V_, W_, D_;
