@@ -24,7 +24,7 @@ class BracedTruss : public bc::NumericDiffProblem {
  public:
   BracedTruss(double a, double h, double k, double c) : a_(a), h_(h), k_(k), c_(c), L0_(std::hypot(a, h)) {}
   int dimension() const override { return 2; }
-  bool residual(bc::ConstVectorRef x, double P, bc::VectorRef F) override {
+  bool residual(bc::ProblemWorkspace &, bc::ConstVectorRef x, double P, bc::VectorRef F) const override {
     const double u = x[0], w = x[1];
     const double s1 = k_ * (1.0 - L0_ / std::hypot(u + a_, w)), s2 = k_ * (1.0 - L0_ / std::hypot(u - a_, w));
     F[0] = s1 * (u + a_) + s2 * (u - a_) + c_ * u;
@@ -33,7 +33,7 @@ class BracedTruss : public bc::NumericDiffProblem {
   }
   // F is the gradient of Π: the stability operator is its Jacobian (here the differenced one).
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(bc::ConstVectorRef x, double P, bc::Matrix &H, bc::Matrix &C) override {
+  bool stabilityOperator(bc::ProblemWorkspace &, bc::ConstVectorRef x, double P, bc::Matrix &H, bc::Matrix &C) const override {
     H.resize(2, 2);
     C.resize(0, 2);
     bc::Vector FP(2);

@@ -16,8 +16,8 @@ inline Eigen::VectorXd polishAtFixedLambda(mechanics::EquilibriumProblem& p, Eig
   Eigen::VectorXd F(N), Fl(N);
   Eigen::MatrixXd Fu(N, N);
   for (int it = 0; it < iterations; ++it) {
-    REQUIRE(p.residual(u, lambda, F));
-    REQUIRE(p.jacobian(u, lambda, Fu, Fl));
+    REQUIRE(buckle::continuation::BoundProblem(p).residual(u, lambda, F));
+    REQUIRE(buckle::continuation::BoundProblem(p).jacobian(u, lambda, Fu, Fl));
     u -= Fu.partialPivLu().solve(F);
   }
   return u;

@@ -52,12 +52,12 @@ bool plainNewton(EquilibriumProblem& problem, Vector& u) {
   Vector F(N), Ft(N), Fl(N);
   Matrix Fu(N, N);
   auto norm = [&](const Vector& v, Vector& out) {
-    return problem.residual(v, 0.0, out) ? (out.array() / scale.array()).abs().maxCoeff() : INFINITY;
+    return buckle::continuation::BoundProblem(problem).residual(v, 0.0, out) ? (out.array() / scale.array()).abs().maxCoeff() : INFINITY;
   };
   double r = norm(u, F);
   for (int it = 0; it < 100 && std::isfinite(r); ++it) {
     if (r < 1e-12) return true;
-    if (!problem.jacobian(u, 0.0, Fu, Fl)) return false;
+    if (!buckle::continuation::BoundProblem(problem).jacobian(u, 0.0, Fu, Fl)) return false;
     Vector du = -Fu.colPivHouseholderQr().solve(F);
     if (du.head(problem.segments()).lpNorm<Eigen::Infinity>() > 0.5)
       du *= 0.5 / du.head(problem.segments()).lpNorm<Eigen::Infinity>();

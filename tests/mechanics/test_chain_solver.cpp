@@ -44,7 +44,8 @@ Chain uniformChain(int n) {
 /// solutions within `tolerance` (relative). Returns whether the structured side used its fallback.
 bool agreesWithDense(EquilibriumProblem& problem, const Vector& u, double lambda, const Vector& c, const Vector& b,
                      double tolerance) {
-  ChainBorderedSolver fast(problem);
+  const auto fastWorkspace = problem.createWorkspace();
+  ChainBorderedSolver fast(problem, *fastWorkspace);
   DenseBorderedSolver dense(problem);
   REQUIRE(dense.factor(u, lambda, c) == Factorization::Regular);
   REQUIRE(fast.factor(u, lambda, c) == Factorization::Regular);
@@ -119,7 +120,8 @@ TEST_CASE("ChainBorderedSolver::factorGeneral equals the dense LU with the same 
     for (const auto& [name, end] : ends) {
       EquilibriumProblem problem(chain, end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
       const int N = problem.dimension();
-      ChainBorderedSolver fast(problem);
+      const auto fastWorkspace = problem.createWorkspace();
+      ChainBorderedSolver fast(problem, *fastWorkspace);
       DenseBorderedSolver dense(problem);
       Vector u(N);
       for (int i = 0; i < N; ++i) u[i] = i < n ? Q(rng) : W(rng);
@@ -236,7 +238,8 @@ namespace {
 // SUNLinearSolver) after one warm-up solve: the heap calls they make.
 long correctorAllocations(EquilibriumProblem& problem, double lambda0, double dlambda) {
   const int N = problem.dimension();
-  auto solver = problem.makeStructuredSolver();
+  const buckle::continuation::BoundProblem solverBound(problem);  // outlives the solver
+  auto solver = solverBound.makeStructuredSolver();
   REQUIRE(solver != nullptr);
   buckle::continuation::Corrector corrector(problem, {}, solver.get());
   Vector u0 = Vector::Zero(N), u(N), x(N + 1), predictor(N + 1), tangent = Vector::Zero(N + 1);

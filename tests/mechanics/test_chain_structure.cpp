@@ -534,13 +534,13 @@ TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense defa
         for (int k = n; k < u.size(); ++k) u[k] = R(rng);
         const double lambda = trial == 0 ? 0.0 : R(rng);
         StabilityInfo a, b;
-        REQUIRE(fast.stability(u, lambda, 3, a));
-        REQUIRE(dense.stability(u, lambda, 3, b));
+        REQUIRE(buckle::continuation::BoundProblem(fast).stability(u, lambda, 3, a));
+        REQUIRE(buckle::continuation::BoundProblem(dense).stability(u, lambda, 3, b));
         INFO("n = " << n << " held " << end.heldCount() << " trial " << trial);
         CHECK(a.negative == b.negative);
         CHECK(a.zero == b.zero);
         StabilityInfo c;  // inertia only (bench_cases' setting per point)
-        REQUIRE(fast.stability(u, lambda, 0, c));
+        REQUIRE(buckle::continuation::BoundProblem(fast).stability(u, lambda, 0, c));
         CHECK(c.negative == b.negative);
         CHECK(c.zero == b.zero);
         CHECK(c.lowest.size() == 0);

@@ -135,7 +135,7 @@ TEST_CASE("contact: a single segment pushed past its limit carries applied torqu
     // compression = applied torque − spring torque at the limit (closed form)
     CHECK(std::abs(pt.contactTorque - (pt.parameter - springAtLimit)) <= 1e-12 * springAtLimit);
     const cont::ContinuationPoint& cp = r.tree.branches[0].points[size_t(pt.index)];
-    CHECK(std::abs(contact.contactTorque(cp.u, cp.lambda, 0) - (springAtLimit - cp.lambda)) <= 1e-12 * springAtLimit);
+    CHECK(std::abs(contact.contactTorque(*contact.createWorkspace(), cp.u, cp.lambda, 0) - (springAtLimit - cp.lambda)) <= 1e-12 * springAtLimit);
     CHECK(pt.stable);
   }
   CHECK(locked >= 5);
@@ -196,8 +196,8 @@ TEST_CASE("contact: a chain's locked branch agrees with an independent Newton so
     for (const LockedJoint& l : pt.locked.joints()) {
       ContactProblem contact(problem, pt.locked);
       const cont::ContinuationPoint& cp = b.points[size_t(pt.index)];
-      CHECK(std::abs(contact.contactTorque(cp.u, cp.lambda, l.joint) - g[l.joint]) <= 1e-11 * std::max(1.0, std::abs(g[l.joint])));
-      CHECK(contact.compression(cp.u, cp.lambda, l.joint) >= 0.0);
+      CHECK(std::abs(contact.contactTorque(*contact.createWorkspace(), cp.u, cp.lambda, l.joint) - g[l.joint]) <= 1e-11 * std::max(1.0, std::abs(g[l.joint])));
+      CHECK(contact.compression(*contact.createWorkspace(), cp.u, cp.lambda, l.joint) >= 0.0);
     }
     ++checked;
   }
@@ -206,7 +206,8 @@ TEST_CASE("contact: a chain's locked branch agrees with an independent Newton so
   SECTION("the O(n) solver of the locked problem matches the dense LU") {
     const cont::ContinuationPoint& cp = b.points.back();
     ContactProblem contact(problem, rep.points.back().locked);
-    auto structured = contact.makeStructuredSolver();
+    const buckle::continuation::BoundProblem solverBound(contact);  // outlives the solver
+    auto structured = solverBound.makeStructuredSolver();
     cont::DenseBorderedSolver dense(contact);
     std::mt19937 rng(7);
     std::normal_distribution<double> N(0.0, 1.0);
@@ -241,9 +242,9 @@ TEST_CASE("contact: constrained stability equals a dense eigen-solve of the redu
       for (const LockedJoint& l : locked.joints()) u[l.joint] = limitAngle(chain, l.joint, l.side);
       const double lambda = -0.7;
       cont::StabilityInfo info;
-      REQUIRE(contact.stability(u, lambda, 3, info));
+      REQUIRE(buckle::continuation::BoundProblem(contact).stability(u, lambda, 3, info));
       Matrix H, C;
-      REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+      REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u, lambda, H, C));
       const Eigen::VectorXd ev = reducedSpectrum(H, C, locked);
       const double scale = std::max(1.0, ev.cwiseAbs().maxCoeff());
       INFO("n = " << n << ", held " << end.heldCount());
@@ -255,7 +256,7 @@ TEST_CASE("contact: constrained stability equals a dense eigen-solve of the redu
       const cont::StabilityInfo again = constrainedStability(problem, locked, u, lambda, 1);
       CHECK(again.negative == info.negative);
       Matrix Hc, Cc;
-      REQUIRE(contact.stabilityOperator(u, lambda, Hc, Cc));
+      REQUIRE(buckle::continuation::BoundProblem(contact).stabilityOperator(u, lambda, Hc, Cc));
       const cont::StabilityInfo dense = cont::projectedInertia(Hc, Cc, 1e-13, 3);
       CHECK(dense.negative == info.negative);
     }

@@ -174,7 +174,7 @@ TEST_CASE("wall: the constrained stability equals a dense eigen-solve on the ker
     u[N + 1] = 0.35;           // μ of joint n's vertex
     const double lambda = -0.4;
     cont::StabilityInfo info;
-    REQUIRE(cp.stability(u, lambda, 3, info));
+    REQUIRE(buckle::continuation::BoundProblem(cp).stability(u, lambda, 3, info));
     // Dense: Π's Hessian from the library's total potential (end wrench) plus the wall forces'
     // −Σ μ ∂²x_v, on ker [J_y; e_2; ∇x_v]. ∂x_v by central differences of the test's own vertex
     // x; ∂²x_v = −(x_v − x_P,max(j,l)) (a rotation about joint max(j, l) moves v by R90 (v − P)),
@@ -227,7 +227,7 @@ TEST_CASE("wall: the constrained stability equals a dense eigen-solve on the ker
     for (int i = 0; i < wanted; ++i) CHECK(info.lowest[i] == Approx(ev[i]).margin(1e-8));
     // the same operator from stabilityOperator() (the dense route of the core)
     Eigen::MatrixXd Hs, Cs;
-    REQUIRE(cp.stabilityOperator(u, lambda, Hs, Cs));
+    REQUIRE(buckle::continuation::BoundProblem(cp).stabilityOperator(u, lambda, Hs, Cs));
     CHECK((Hs - H).cwiseAbs().maxCoeff() <= 1e-11 * std::max(1.0, H.cwiseAbs().maxCoeff()));
     CHECK((Cs - C).cwiseAbs().maxCoeff() <= 1e-8);
   }
@@ -251,11 +251,12 @@ TEST_CASE("wall: the O(n) bordered solver of the wall-constrained chain equals a
   Eigen::VectorXd c = Eigen::VectorXd::LinSpaced(D + 1, 0.3, -0.5), b = Eigen::VectorXd::LinSpaced(D + 1, 1.0, 2.0);
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(D + 1, D + 1);
   Eigen::VectorXd Fl(D);
-  REQUIRE(cp.jacobian(u, lambda, A.topLeftCorner(D, D), Fl));
+  REQUIRE(buckle::continuation::BoundProblem(cp).jacobian(u, lambda, A.topLeftCorner(D, D), Fl));
   A.topRightCorner(D, 1) = Fl;
   A.row(D) = c.transpose();
   const Eigen::VectorXd dense = A.fullPivLu().solve(b);
-  auto solver = cp.makeStructuredSolver();
+  const buckle::continuation::BoundProblem solverBound(cp);  // outlives the solver
+  auto solver = solverBound.makeStructuredSolver();
   REQUIRE(solver->factor(u, lambda, c) == cont::Factorization::Regular);
   Eigen::VectorXd x(D + 1);
   REQUIRE(solver->solve(b, x));
@@ -267,8 +268,8 @@ TEST_CASE("wall: the O(n) bordered solver of the wall-constrained chain equals a
     Eigen::VectorXd up = u, um = u;
     up[j] += 1e-6;
     um[j] -= 1e-6;
-    REQUIRE(cp.residual(up, lambda, Fp));
-    REQUIRE(cp.residual(um, lambda, Fm));
+    REQUIRE(buckle::continuation::BoundProblem(cp).residual(up, lambda, Fp));
+    REQUIRE(buckle::continuation::BoundProblem(cp).residual(um, lambda, Fm));
     CHECK(((Fp - Fm) / 2e-6 - A.col(j).head(D)).cwiseAbs().maxCoeff() <= 1e-7);
   }
 }

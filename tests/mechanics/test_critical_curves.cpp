@@ -79,25 +79,25 @@ TEST_CASE("chain second-parameter derivatives match central differences for ever
       }
       const double lambda = 0.4, mu = p.secondParameter();
       Vector Fmu(N), FuMuV(N);
-      REQUIRE(p.secondParameterDerivatives(u, lambda, v, Fmu, FuMuV));
+      REQUIRE(p.secondParameterDerivatives(*p.createWorkspace(), u, lambda, v, Fmu, FuMuV));
       const double h = 1e-6 * std::max(1.0, std::abs(mu));
       Vector Fp(N), Fm(N), Fl(N);
       Matrix Jp(N, N), Jm(N, N);
       REQUIRE(p.setSecondParameter(mu + h));
-      REQUIRE(p.residual(u, lambda, Fp));
-      REQUIRE(p.jacobian(u, lambda, Jp, Fl));
+      REQUIRE(buckle::continuation::BoundProblem(p).residual(u, lambda, Fp));
+      REQUIRE(buckle::continuation::BoundProblem(p).jacobian(u, lambda, Jp, Fl));
       REQUIRE(p.setSecondParameter(mu - h));
-      REQUIRE(p.residual(u, lambda, Fm));
-      REQUIRE(p.jacobian(u, lambda, Jm, Fl));
+      REQUIRE(buckle::continuation::BoundProblem(p).residual(u, lambda, Fm));
+      REQUIRE(buckle::continuation::BoundProblem(p).jacobian(u, lambda, Jm, Fl));
       REQUIRE(p.setSecondParameter(mu));
       INFO(cs.kind << " segment " << cs.segment);
       CHECK(((Fp - Fm) / (2 * h) - Fmu).norm() <= 1e-7 * (1.0 + Fmu.norm()));
       CHECK(((Jp - Jm) * v / (2 * h) - FuMuV).norm() <= 1e-7 * (1.0 + FuMuV.norm()));
       // (∂F_u/∂λ)·v, exact, against central differences of the dense Jacobian in λ
       Vector FuLv(N);
-      REQUIRE(p.parameterJacobianApply(u, lambda, v, FuLv));
-      REQUIRE(p.jacobian(u, lambda + h, Jp, Fl));
-      REQUIRE(p.jacobian(u, lambda - h, Jm, Fl));
+      REQUIRE(p.parameterJacobianApply(*p.createWorkspace(), u, lambda, v, FuLv));
+      REQUIRE(buckle::continuation::BoundProblem(p).jacobian(u, lambda + h, Jp, Fl));
+      REQUIRE(buckle::continuation::BoundProblem(p).jacobian(u, lambda - h, Jm, Fl));
       CHECK(((Jp - Jm) * v / (2 * h) - FuLv).norm() <= 1e-7 * (1.0 + FuLv.norm()));
     }
   }
@@ -189,8 +189,8 @@ double lambdaAtAmplitude(ChainParameterProblem& p, const Vector& z, double lambd
   Vector R(N + 1), F(N), Fl(N);
   Matrix J(N + 1, N + 1), Fu(N, N);
   for (int it = 0; it < 30; ++it) {
-    REQUIRE(p.residual(x.head(N), x[N], F));
-    REQUIRE(p.jacobian(x.head(N), x[N], Fu, Fl));
+    REQUIRE(buckle::continuation::BoundProblem(p).residual(x.head(N), x[N], F));
+    REQUIRE(buckle::continuation::BoundProblem(p).jacobian(x.head(N), x[N], Fu, Fl));
     R << F, z.dot(x.head(n)) - xi;
     J.setZero();
     J.topLeftCorner(N, N) = Fu;
@@ -649,7 +649,7 @@ struct StraightMode {
 StraightMode straightSecondMode(ChainParameterProblem& p, double tension) {
   REQUIRE(p.setSecondParameter(tension));
   Matrix H, C;
-  REQUIRE(p.stabilityOperator(p.equilibrium().initialGuess(Vector::Zero(3), 0.0), 0.0, H, C));
+  REQUIRE(buckle::continuation::BoundProblem(p).stabilityOperator(p.equilibrium().initialGuess(Vector::Zero(3), 0.0), 0.0, H, C));
   REQUIRE(C.rows() == 0);  // free end
   const Eigen::SelfAdjointEigenSolver<Matrix> es(H);
   return {es.eigenvalues()[1], std::abs(es.eigenvectors().col(1).sum())};

@@ -64,7 +64,7 @@ std::vector<Eigen::VectorXd> crossingsAt(EquilibriumProblem& problem, const cont
     const Eigen::VectorXd u = buckle::test::polishAtFixedLambda(
         problem, b.points[i].u + (da / (da - db)) * (b.points[i + 1].u - b.points[i].u), lambda, 20);
     Eigen::VectorXd F(N);
-    REQUIRE(problem.residual(u, lambda, F));
+    REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, lambda, F));
     REQUIRE(F.cwiseQuotient(problem.scales().residuals).lpNorm<Eigen::Infinity>() < 1e-11);
     out.push_back(u.head(problem.segments()));
   }

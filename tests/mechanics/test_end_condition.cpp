@@ -48,7 +48,7 @@ TEST_CASE("load path through the reaction: at λ = the held coordinate's reactio
   u.head(4) << 0.06, 0.02, -0.02, -0.06;
   u = buckle::test::polishAtFixedLambda(displacement, u, held.startValue, 30);
   Eigen::VectorXd F(displacement.dimension());
-  REQUIRE(displacement.residual(u, held.startValue, F));
+  REQUIRE(buckle::continuation::BoundProblem(displacement).residual(u, held.startValue, F));
   REQUIRE(F.norm() <= 1e-12);
   const mech::Pose pose = mech::endPose(chain, u.head(4));
   REQUIRE(std::abs(pose[0] - 7.9) <= 1e-12);
@@ -66,7 +66,7 @@ TEST_CASE("load path through the reaction: at λ = the held coordinate's reactio
   Eigen::VectorXd v(5);
   v << u.head(4), u[5];  // the joint angles and y's reaction
   Eigen::VectorXd G(5);
-  REQUIRE(reaction.residual(v, Rx, G));
+  REQUIRE(buckle::continuation::BoundProblem(reaction).residual(v, Rx, G));
   CHECK(G.norm() <= 1e-12);
   CHECK((reaction.wrench(v, Rx) - displacement.wrench(u, held.startValue)).cwiseAbs().maxCoeff() <= 1e-14);
   // a load-controlled coordinate cannot be traced through its reaction

@@ -103,7 +103,7 @@ TEST_CASE("landscape: IK branches keep the end at (x, y), derivatives along the 
       EquilibriumProblem problem(chain, EndCondition::heldPosition(x, y), Eigen::Vector3d::Zero());
       Vector u(5), F(5);
       u << e.q, e.F[0], e.F[1];
-      REQUIRE(problem.residual(u, 0.0, F));
+      REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, 0.0, F));
       CHECK(F.lpNorm<Eigen::Infinity>() < 1e-10);
       const double Hp = projectedHessian(chain, e.q, e.F);
       CHECK((Hp > 0) == e.stable);
@@ -176,7 +176,7 @@ TEST_CASE("straight start pushed by dx > 0: U minima, Z maxima, eq 12 force, buc
     Vector u(5);
     u << 0, 0, 0, factor * an.FxU, 0;
     buckle::continuation::StabilityInfo info;
-    REQUIRE(held.stability(u, 0.0, 3, info));
+    REQUIRE(buckle::continuation::BoundProblem(held).stability(u, 0.0, 3, info));
     CHECK(info.stable() == (factor < 1.0));
   }
   // pulled (x > 6b): out of reach, no equilibria

@@ -56,19 +56,19 @@ TEST_CASE("EquilibriumProblem Jacobian and its directional derivative match fini
         const double lambda = Lam(rng);
         Matrix Fu(N, N), dFu(N, N);
         Vector Fl(N), dFl(N), F(N), Fp(N), Fm(N);
-        REQUIRE(problem.jacobian(u, lambda, Fu, Fl));
+        REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u, lambda, Fu, Fl));
         const double h = 1e-6;
         double err = 0.0;
         for (int j = 0; j < N; ++j) {
           Vector up = u, um = u;
           up[j] += h;
           um[j] -= h;
-          REQUIRE(problem.residual(up, lambda, Fp));
-          REQUIRE(problem.residual(um, lambda, Fm));
+          REQUIRE(buckle::continuation::BoundProblem(problem).residual(up, lambda, Fp));
+          REQUIRE(buckle::continuation::BoundProblem(problem).residual(um, lambda, Fm));
           err = std::max(err, (Fu.col(j) - (Fp - Fm) / (2 * h)).lpNorm<Eigen::Infinity>());
         }
-        REQUIRE(problem.residual(u, lambda + h, Fp));
-        REQUIRE(problem.residual(u, lambda - h, Fm));
+        REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, lambda + h, Fp));
+        REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, lambda - h, Fm));
         const double errL = (Fl - (Fp - Fm) / (2 * h)).lpNorm<Eigen::Infinity>();
         CHECK(err < 1e-7 * std::max(1.0, Fu.lpNorm<Eigen::Infinity>()));
         CHECK(errL < 1e-7 * std::max(1.0, Fl.lpNorm<Eigen::Infinity>()));
@@ -77,7 +77,7 @@ TEST_CASE("EquilibriumProblem Jacobian and its directional derivative match fini
         // the same entries, nothing written outside the block.
         Matrix big = Matrix::Constant(N + 2, N + 3, 7.0);
         Vector bigL = Vector::Constant(N + 1, 7.0);
-        REQUIRE(problem.jacobian(u, lambda, big.block(1, 2, N, N), bigL.head(N)));
+        REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u, lambda, big.block(1, 2, N, N), bigL.head(N)));
         CHECK(big.block(1, 2, N, N) == Fu);
         CHECK(bigL.head(N) == Fl);
         CHECK(bigL[N] == 7.0);
@@ -88,7 +88,7 @@ TEST_CASE("EquilibriumProblem Jacobian and its directional derivative match fini
         // An independent assembly: the K_q − K_g block is stabilityOperator's H (totalPotentialHessian
         // from the cache), the borders are −Cᵀ and −C, the multipliers' block is zero.
         Matrix H, C;
-        REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+        REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u, lambda, H, C));
         CHECK((Fu.topLeftCorner(n, n) - H).lpNorm<Eigen::Infinity>() <= 1e-14 * std::max(1.0, H.lpNorm<Eigen::Infinity>()));
         if (N > n) {
           CHECK(Fu.topRightCorner(n, N - n) == -C.transpose());
@@ -99,15 +99,15 @@ TEST_CASE("EquilibriumProblem Jacobian and its directional derivative match fini
         Vector du(N);
         for (int i = 0; i < N; ++i) du[i] = W(rng);
         const double dl = W(rng);
-        REQUIRE(problem.jacobianDirectionalDerivative(u, lambda, du, dl, dFu, dFl));
+        REQUIRE(buckle::continuation::BoundProblem(problem).jacobianDirectionalDerivative(u, lambda, du, dl, dFu, dFl));
         Matrix Jp(N, N), Jm(N, N);
         Vector Jlp(N), Jlm(N);
-        REQUIRE(problem.jacobian(u + h * du, lambda + h * dl, Jp, Jlp));
-        REQUIRE(problem.jacobian(u - h * du, lambda - h * dl, Jm, Jlm));
+        REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u + h * du, lambda + h * dl, Jp, Jlp));
+        REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u - h * du, lambda - h * dl, Jm, Jlm));
         CHECK((dFu - (Jp - Jm) / (2 * h)).lpNorm<Eigen::Infinity>() < 1e-6 * std::max(1.0, dFu.lpNorm<Eigen::Infinity>()));
         CHECK((dFl - (Jlp - Jlm) / (2 * h)).lpNorm<Eigen::Infinity>() < 1e-6 * std::max(1.0, dFl.lpNorm<Eigen::Infinity>()));
         // residual is ∂E/∂q − Jᵀ F(u, λ) in its first n rows
-        REQUIRE(problem.residual(u, lambda, F));
+        REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, lambda, F));
         Vector g(n);
         totalPotentialGradient(chain, u.head(n), problem.wrench(u, lambda), g);
         CHECK((F.head(n) - g).lpNorm<Eigen::Infinity>() < 1e-13 * std::max(1.0, g.lpNorm<Eigen::Infinity>()));
@@ -121,15 +121,15 @@ TEST_CASE("the straight chain is an equilibrium under any axial load", "[equilib
   for (double Fx : {-3.0, -0.1, 0.0, 0.7}) {
     EquilibriumProblem freeEnd(chain, EndCondition::freeEnd(Eigen::Vector3d(Fx, 0, 0)), Eigen::Vector3d(1, 0, 0));
     Vector F(5);
-    REQUIRE(freeEnd.residual(Vector::Zero(5), 0.0, F));
+    REQUIRE(buckle::continuation::BoundProblem(freeEnd).residual(Vector::Zero(5), 0.0, F));
     CHECK(F.lpNorm<Eigen::Infinity>() < 1e-15);
     EquilibriumProblem pinned(chain, EndCondition::clampedPinned(Fx), Eigen::Vector3d(1, 0, 0));
     Vector Fp(6);
-    REQUIRE(pinned.residual(Vector::Zero(6), 0.3, Fp));
+    REQUIRE(buckle::continuation::BoundProblem(pinned).residual(Vector::Zero(6), 0.3, Fp));
     CHECK(Fp.lpNorm<Eigen::Infinity>() < 1e-15);
     // a lateral load is not balanced by the straight chain
     EquilibriumProblem lateral(chain, EndCondition::freeEnd(Eigen::Vector3d(Fx, 0.2, 0)), Eigen::Vector3d(1, 0, 0));
-    REQUIRE(lateral.residual(Vector::Zero(5), 0.0, F));
+    REQUIRE(buckle::continuation::BoundProblem(lateral).residual(Vector::Zero(5), 0.0, F));
     CHECK(F.lpNorm<Eigen::Infinity>() > 0.1);
   }
 }
@@ -142,7 +142,7 @@ TEST_CASE("the corrector's fixed-parameter solve converges quadratically to an e
   REQUIRE(r.converged);
   CHECK(r.iterations <= 8);
   Vector F(4);
-  REQUIRE(problem.residual(r.u, 0.0, F));
+  REQUIRE(buckle::continuation::BoundProblem(problem).residual(r.u, 0.0, F));
   CHECK(F.lpNorm<Eigen::Infinity>() < 1e-12);
   CHECK(endPose(chain, r.u)[1] > 0.0);  // bends towards the lateral load
   // held position with a reaction
@@ -184,20 +184,20 @@ TEST_CASE("EquilibriumProblem: cached evaluations equal a fresh problem's in any
         const int op = Op(rng);
         if (op <= 1) {
           Vector F1(N), F2(N);
-          const bool ok1 = cached.residual(buffer, lambda, F1), ok2 = fresh.residual(buffer, lambda, F2);
+          const bool ok1 = buckle::continuation::BoundProblem(cached).residual(buffer, lambda, F1), ok2 = buckle::continuation::BoundProblem(fresh).residual(buffer, lambda, F2);
           REQUIRE(ok1 == ok2);
           CHECK(ok1 != outside);
           if (ok1) CHECK((F1.array() == F2.array()).all());
         } else if (op <= 3) {
           Matrix J1(N, N), J2(N, N);
           Vector L1(N), L2(N);
-          const bool ok1 = cached.jacobian(buffer, lambda, J1, L1), ok2 = fresh.jacobian(buffer, lambda, J2, L2);
+          const bool ok1 = buckle::continuation::BoundProblem(cached).jacobian(buffer, lambda, J1, L1), ok2 = buckle::continuation::BoundProblem(fresh).jacobian(buffer, lambda, J2, L2);
           REQUIRE(ok1 == ok2);
           if (ok1) CHECK(((J1.array() == J2.array()).all() && (L1.array() == L2.array()).all()));
         } else if (op == 4) {
           buckle::continuation::StabilityInfo i1, i2;
           const int count = call % 2 ? 3 : 0;
-          const bool ok1 = cached.stability(buffer, lambda, count, i1), ok2 = fresh.stability(buffer, lambda, count, i2);
+          const bool ok1 = buckle::continuation::BoundProblem(cached).stability(buffer, lambda, count, i1), ok2 = buckle::continuation::BoundProblem(fresh).stability(buffer, lambda, count, i2);
           REQUIRE(ok1 == ok2);
           if (ok1) {
             CHECK(i1.negative == i2.negative);
@@ -207,14 +207,14 @@ TEST_CASE("EquilibriumProblem: cached evaluations equal a fresh problem's in any
           }
         } else if (op == 6) {  // the small dense spectrum, shared with stability() at its point
           Vector v1(1), v2(1);
-          const bool ok1 = cached.stabilityEigenvalues(buffer, lambda, 0, v1);
-          const bool ok2 = fresh.stabilityEigenvalues(buffer, lambda, 0, v2);
+          const bool ok1 = buckle::continuation::BoundProblem(cached).stabilityEigenvalues(buffer, lambda, 0, v1);
+          const bool ok2 = buckle::continuation::BoundProblem(fresh).stabilityEigenvalues(buffer, lambda, 0, v2);
           REQUIRE(ok1 == ok2);
           if (ok1) CHECK(v1[0] == v2[0]);
         } else {
           Matrix H1, C1, H2, C2;
-          const bool ok1 = cached.stabilityOperator(buffer, lambda, H1, C1);
-          const bool ok2 = fresh.stabilityOperator(buffer, lambda, H2, C2);
+          const bool ok1 = buckle::continuation::BoundProblem(cached).stabilityOperator(buffer, lambda, H1, C1);
+          const bool ok2 = buckle::continuation::BoundProblem(fresh).stabilityOperator(buffer, lambda, H2, C2);
           REQUIRE(ok1 == ok2);
           if (ok1) CHECK(((H1.array() == H2.array()).all() && (C1.array() == C2.array()).all()));
           Matrix H3(n, n);
@@ -231,14 +231,14 @@ TEST_CASE("EquilibriumProblem: cached evaluations equal a fresh problem's in any
         if (call % 20 == 7 && !outside) {
           Matrix Fu(N, N);
           Vector Fl(N), Fp(N), Fm(N);
-          REQUIRE(cached.jacobian(buffer, lambda, Fu, Fl));
+          REQUIRE(buckle::continuation::BoundProblem(cached).jacobian(buffer, lambda, Fu, Fl));
           const double h = 1e-6;
           for (int j = 0; j < N; ++j) {
             Vector up = buffer, um = buffer;
             up[j] += h;
             um[j] -= h;
-            REQUIRE(cached.residual(up, lambda, Fp));
-            REQUIRE(cached.residual(um, lambda, Fm));
+            REQUIRE(buckle::continuation::BoundProblem(cached).residual(up, lambda, Fp));
+            REQUIRE(buckle::continuation::BoundProblem(cached).residual(um, lambda, Fm));
             CHECK((Fu.col(j) - (Fp - Fm) / (2 * h)).lpNorm<Eigen::Infinity>() < 1e-7 * std::max(1.0, Fu.lpNorm<Eigen::Infinity>()));
           }
         }
@@ -261,36 +261,36 @@ TEST_CASE("EquilibriumProblem's domain: the geometric limits, the traced oversho
     const int N = problem.dimension();
     const Vector u0 = randomState(rng, chain, N);
     Vector F(N);
-    REQUIRE(problem.residual(u0, 0.3, F));
+    REQUIRE(buckle::continuation::BoundProblem(problem).residual(u0, 0.3, F));
     const double overshoot = traced ? 0.05 : 0.0;
     for (int i = 0; i < chain.size(); ++i) {
       INFO("traced = " << traced << ", joint " << i);
       const double upper = chain.segment(i).geometricUpperLimit(), lower = chain.segment(i).geometricLowerLimit();
       Vector u = u0;
       u[i] = upper + overshoot - 1e-9;
-      CHECK(problem.residual(u, 0.3, F));
+      CHECK(buckle::continuation::BoundProblem(problem).residual(u, 0.3, F));
       u[i] = upper + overshoot + 1e-9;
-      CHECK_FALSE(problem.residual(u, 0.3, F));
+      CHECK_FALSE(buckle::continuation::BoundProblem(problem).residual(u, 0.3, F));
       u[i] = lower - overshoot + 1e-9;
-      CHECK(problem.residual(u, 0.3, F));
+      CHECK(buckle::continuation::BoundProblem(problem).residual(u, 0.3, F));
       u[i] = lower - overshoot - 1e-9;
-      CHECK_FALSE(problem.residual(u, 0.3, F));
+      CHECK_FALSE(buckle::continuation::BoundProblem(problem).residual(u, 0.3, F));
       for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
                          -std::numeric_limits<double>::infinity()}) {
         u[i] = bad;
-        CHECK_FALSE(problem.residual(u, 0.3, F));
+        CHECK_FALSE(buckle::continuation::BoundProblem(problem).residual(u, 0.3, F));
       }
       // back inside after a refusal: the same values as before it
       Vector G(N);
-      REQUIRE(problem.residual(u0, 0.3, G));
+      REQUIRE(buckle::continuation::BoundProblem(problem).residual(u0, 0.3, G));
       Vector F0(N);
       EquilibriumProblem fresh(chain, end, Eigen::Vector3d(1, 0, 0), options);
-      REQUIRE(fresh.residual(u0, 0.3, F0));
+      REQUIRE(buckle::continuation::BoundProblem(fresh).residual(u0, 0.3, F0));
       CHECK((G.array() == F0.array()).all());
     }
     Vector u = u0;
     u[N - 1] = std::numeric_limits<double>::quiet_NaN();  // a multiplier
-    CHECK_FALSE(problem.residual(u, 0.3, F));
+    CHECK_FALSE(buckle::continuation::BoundProblem(problem).residual(u, 0.3, F));
   }
 }
 
@@ -319,8 +319,8 @@ Vector solveWithJointAt(EquilibriumProblem& problem, Vector u, double& lambda, i
   Matrix Fu(n, n), A(n, n);
   int small = 0;
   for (int it = 0; it < 60 && small < 3; ++it) {
-    REQUIRE(problem.residual(u, lambda, F));
-    REQUIRE(problem.jacobian(u, lambda, Fu, Fl));
+    REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, lambda, F));
+    REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u, lambda, Fu, Fl));
     A = Fu;
     A.col(k) = Fl;  // column k now moves λ
     z = A.partialPivLu().solve(F);
@@ -411,34 +411,34 @@ TEST_CASE("EquilibriumProblem O(n) products equal the dense F_x, F_x^T and secon
       for (int i = 0; i <= N; ++i) x[i] = W(rng), dx[i] = W(rng);
       for (int i = 0; i < N; ++i) w[i] = W(rng);
       Matrix Fx(N, N + 1), dFx(N, N + 1);
-      REQUIRE(problem.jacobian(u, lambda, Fx.leftCols(N), Fx.col(N)));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u, lambda, Fx.leftCols(N), Fx.col(N)));
       // Rounding bound of the dense product: eps·|F_x|·|x| row by row.
       const double eps = std::numeric_limits<double>::epsilon();
       Vector y(N), yt(N + 1), y2(N + 1);
-      REQUIRE(problem.jacobianApply(u, lambda, x, y));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianApply(u, lambda, x, y));
       const Vector bound = Fx.cwiseAbs() * x.cwiseAbs();
       for (int i = 0; i < N; ++i) CHECK(std::abs(y[i] - Fx.row(i).dot(x)) <= 8.0 * (n + 3) * eps * bound[i]);
-      REQUIRE(problem.jacobianTransposeApply(u, lambda, w, yt));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianTransposeApply(u, lambda, w, yt));
       const Vector boundT = Fx.transpose().cwiseAbs() * w.cwiseAbs();
       for (int i = 0; i <= N; ++i) CHECK(std::abs(yt[i] - Fx.col(i).dot(w)) <= 8.0 * (n + 3) * eps * boundT[i]);
       // (F_xx[dx, ·])ᵀw (central differences of jacobianTransposeApply) against the exact
       // directional derivative of F_x.
-      REQUIRE(problem.secondDerivativeTransposeApply(u, lambda, dx, w, y2));
-      REQUIRE(problem.jacobianDirectionalDerivative(u, lambda, dx.head(N), dx[N], dFx.leftCols(N), dFx.col(N)));
+      REQUIRE(buckle::continuation::BoundProblem(problem).secondDerivativeTransposeApply(u, lambda, dx, w, y2));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianDirectionalDerivative(u, lambda, dx.head(N), dx[N], dFx.leftCols(N), dFx.col(N)));
       const Vector exact = dFx.transpose() * w;
       CHECK((y2 - exact).norm() <= 1e-7 * std::max(1.0, exact.norm()));
       // F_xx[dx, x] in O(n) (secondDerivativeApply): the exact matrix derivative applied to x, to
       // rounding; symmetric in its two directions; central differences of F_x x along dx
       Vector s2(N), s2t(N), yp(N), ym(N);
-      REQUIRE(problem.secondDerivativeApply(u, lambda, dx, x, s2));
+      REQUIRE(buckle::continuation::BoundProblem(problem).secondDerivativeApply(u, lambda, dx, x, s2));
       const Vector dense = dFx * x;
       const double size = std::max((dFx.cwiseAbs() * x.cwiseAbs()).maxCoeff(), 1e-300);
       CHECK((s2 - dense).lpNorm<Eigen::Infinity>() <= 1e-13 * size);
-      REQUIRE(problem.secondDerivativeApply(u, lambda, x, dx, s2t));
+      REQUIRE(buckle::continuation::BoundProblem(problem).secondDerivativeApply(u, lambda, x, dx, s2t));
       CHECK((s2 - s2t).lpNorm<Eigen::Infinity>() <= 1e-13 * size);
       const double h = 1e-5;
-      REQUIRE(problem.jacobianApply(u + h * dx.head(N), lambda + h * dx[N], x, yp));
-      REQUIRE(problem.jacobianApply(u - h * dx.head(N), lambda - h * dx[N], x, ym));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianApply(u + h * dx.head(N), lambda + h * dx[N], x, yp));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianApply(u - h * dx.head(N), lambda - h * dx[N], x, ym));
       CHECK((s2 - (yp - ym) / (2.0 * h)).lpNorm<Eigen::Infinity>() <= 1e-7 * std::max(size, 1.0));
     }
   }
@@ -457,17 +457,17 @@ TEST_CASE("stabilityEigenvalues by index: the O(n) counts and the small dense ro
       const Vector u = randomState(rng, chain, problem.dimension());
       const double lambda = Lam(rng);
       Matrix H, C;
-      REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+      REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u, lambda, H, C));
       const int dim = n - int(C.rows());
       const double scale = std::max(1.0, H.norm());
       for (int first : {0, dim / 2, dim - 2}) {
         Vector mine(2), reference(2);
-        REQUIRE(problem.stabilityEigenvalues(u, lambda, first, mine));
-        REQUIRE(dense.stabilityEigenvalues(u, lambda, first, reference));  // Problem's dense default
+        REQUIRE(buckle::continuation::BoundProblem(problem).stabilityEigenvalues(u, lambda, first, mine));
+        REQUIRE(buckle::continuation::BoundProblem(dense).stabilityEigenvalues(u, lambda, first, reference));  // Problem's dense default
         CHECK((mine - reference).cwiseAbs().maxCoeff() <= 1e-11 * scale);
       }
       Vector beyond(2);
-      CHECK_FALSE(problem.stabilityEigenvalues(u, lambda, dim - 1, beyond));
+      CHECK_FALSE(buckle::continuation::BoundProblem(problem).stabilityEigenvalues(u, lambda, dim - 1, beyond));
     }
   }
 }
@@ -513,6 +513,7 @@ TEST_CASE("along a load path past many critical loads: the inertia and the value
       // λ compresses the chain along x: the load Fx (free x) or, with x held, the reaction in u
       EquilibriumProblem problem(chain, e.end, Eigen::Vector3d(held ? 0.0 : -force, 0.0, 0.0), {}, {}, e.body);
       EquilibriumProblem dense(chain, e.end, problem.direction(), EquilibriumOptions{true, false}, {}, e.body);
+      const buckle::continuation::BoundProblem bound(problem);  // one workspace: the searches warm-start
       const int N = problem.dimension();
       Vector u0 = Vector::Zero(N), du(N);
       for (int i = 0; i < c.n; ++i) u0[i] = 1e-3 * W(rng);  // near the straight chain, not on it
@@ -528,22 +529,22 @@ TEST_CASE("along a load path past many critical loads: the inertia and the value
       buckle::continuation::StabilityInfo ref;
       for (;; tMax *= 2.0) {
         REQUIRE(tMax < 1e12);
-        REQUIRE(dense.stability(at(tMax), held ? 0.0 : tMax, 0, ref));
+        REQUIRE(buckle::continuation::BoundProblem(dense).stability(at(tMax), held ? 0.0 : tMax, 0, ref));
         if (ref.negative >= target) break;
       }
       const int points = 30;
       int changes = 0, lastNu = 0, values = 0;
-      const long before = problem.structuredFactorizations();
+      const long before = EquilibriumProblem::structuredFactorizations(bound.workspace());
       for (int j = 1; j <= points; ++j) {
         const double t = tMax * double(j * j) / double(points * points);
         const Vector u = at(t);
         const double lambda = held ? 0.0 : t;
         Matrix H, C;
-        REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+        REQUIRE(bound.stabilityOperator(u, lambda, H, C));
         const double scale = std::max(c.K * c.L * c.L, H.norm());
         buckle::continuation::StabilityInfo mine, theirs;
-        REQUIRE(problem.stability(u, lambda, 1, mine));
-        REQUIRE(dense.stability(u, lambda, 1, theirs));
+        REQUIRE(bound.stability(u, lambda, 1, mine));
+        REQUIRE(buckle::continuation::BoundProblem(dense).stability(u, lambda, 1, theirs));
         CHECK(mine.negative == theirs.negative);
         CHECK(mine.zero == theirs.zero);
         REQUIRE(mine.lowest.size() == 1);
@@ -554,18 +555,18 @@ TEST_CASE("along a load path past many critical loads: the inertia and the value
         // as the monitor: ν − 1 and ν at the point, then a step δ along a direction
         const int first = std::max(0, nu - 1);
         Vector here(2), reference(2);
-        REQUIRE(problem.stabilityEigenvalues(u, lambda, first, here));
-        REQUIRE(dense.stabilityEigenvalues(u, lambda, first, reference));
+        REQUIRE(bound.stabilityEigenvalues(u, lambda, first, here));
+        REQUIRE(buckle::continuation::BoundProblem(dense).stabilityEigenvalues(u, lambda, first, reference));
         CHECK((here - reference).cwiseAbs().maxCoeff() <= 1e-11 * scale);
         const Vector shifted = u + 1e-6 * du;
-        REQUIRE(problem.stabilityEigenvalues(shifted, lambda, first, here));
-        REQUIRE(dense.stabilityEigenvalues(shifted, lambda, first, reference));
+        REQUIRE(bound.stabilityEigenvalues(shifted, lambda, first, here));
+        REQUIRE(buckle::continuation::BoundProblem(dense).stabilityEigenvalues(shifted, lambda, first, reference));
         CHECK((here - reference).cwiseAbs().maxCoeff() <= 1e-11 * scale);
         values += 5;
       }
       if (c.n > 16) {  // the structured route (n ≤ 16: one small dense solve per point)
         CHECK(changes >= 4);  // the indices asked for moved along the path
-        const double perValue = double(problem.structuredFactorizations() - before) / double(values);
+        const double perValue = double(EquilibriumProblem::structuredFactorizations(bound.workspace()) - before) / double(values);
         INFO("factorizations per value " << perValue);
         CHECK(perValue <= 13.0);  // a bisection from ±‖H‖_F takes about 50, Newton from the last index's value 15 to 22
       }
@@ -597,7 +598,7 @@ TEST_CASE("the small dense spectrum is shared by stability and stabilityEigenval
       x[N] = Lam(rng);
       auto valuesOf = [&](EquilibriumProblem& p, Vector& out) {
         out.resize(dim);
-        return p.stabilityEigenvalues(x.head(N), x[N], 0, out);
+        return buckle::continuation::BoundProblem(p).stabilityEigenvalues(x.head(N), x[N], 0, out);
       };
       for (int component = -1; component <= N; ++component) {
         INFO("n = " << n << ", end: " << s.name << ", component " << component);
@@ -609,8 +610,8 @@ TEST_CASE("the small dense spectrum is shared by stability and stabilityEigenval
         }
         buckle::continuation::StabilityInfo mine, theirs;
         EquilibriumProblem fresh(chain, s.end, dir), fresh2(chain, s.end, dir);
-        REQUIRE(shared.stability(x.head(N), x[N], asked, mine));
-        REQUIRE(fresh.stability(x.head(N), x[N], asked, theirs));
+        REQUIRE(buckle::continuation::BoundProblem(shared).stability(x.head(N), x[N], asked, mine));
+        REQUIRE(buckle::continuation::BoundProblem(fresh).stability(x.head(N), x[N], asked, theirs));
         CHECK(mine.negative == theirs.negative);
         CHECK(mine.zero == theirs.zero);
         REQUIRE(mine.lowest.size() == theirs.lowest.size());
@@ -622,11 +623,11 @@ TEST_CASE("the small dense spectrum is shared by stability and stabilityEigenval
         if (component >= 0 && (freshValues.array() != before.array()).any()) ++changed;
         // Indices beyond the spectrum are refused from the cache as from a solve.
         Vector beyond(2);
-        CHECK_FALSE(shared.stabilityEigenvalues(x.head(N), x[N], dim - 1, beyond));
+        CHECK_FALSE(buckle::continuation::BoundProblem(shared).stabilityEigenvalues(x.head(N), x[N], dim - 1, beyond));
         // Another point in between (the slopes' point off the branch), then back: the same values.
         Vector off = x.head(N), elsewhere(dim), again(dim);
         off[0] += 1e-6;
-        REQUIRE(shared.stabilityEigenvalues(off, x[N], 0, elsewhere));
+        REQUIRE(buckle::continuation::BoundProblem(shared).stabilityEigenvalues(off, x[N], 0, elsewhere));
         if (dim > 0) CHECK((elsewhere.array() != freshValues.array()).any());
         REQUIRE(valuesOf(shared, again));
         CHECK((again.array() == freshValues.array()).all());
@@ -657,14 +658,14 @@ TEST_CASE("stabilityRateBound bounds the rate of every eigenvalue of H on ker C 
         for (int i = 0; i < N; ++i) du[i] = W(rng);
         const double dlambda = W(rng);
         double bound = -1.0;
-        REQUIRE(problem.stabilityRateBound(u, lambda, du, dlambda, bound));
+        REQUIRE(buckle::continuation::BoundProblem(problem).stabilityRateBound(u, lambda, du, dlambda, bound));
         Matrix H, C;
-        REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+        REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u, lambda, H, C));
         const int dim = n - int(C.rows());
         Vector plus(dim), minus(dim);
         const double h = 1e-6;
-        REQUIRE(dense.stabilityEigenvalues(u + h * du, lambda + h * dlambda, 0, plus));
-        REQUIRE(dense.stabilityEigenvalues(u - h * du, lambda - h * dlambda, 0, minus));
+        REQUIRE(buckle::continuation::BoundProblem(dense).stabilityEigenvalues(u + h * du, lambda + h * dlambda, 0, plus));
+        REQUIRE(buckle::continuation::BoundProblem(dense).stabilityEigenvalues(u - h * du, lambda - h * dlambda, 0, minus));
         const double rate = ((plus - minus) / (2.0 * h)).cwiseAbs().maxCoeff();
         // the difference quotient: O(h²) truncation, rounding ≈ ε‖H‖/h
         CHECK(rate <= bound + 1e-7 * std::max(1.0, H.norm()));
@@ -684,15 +685,15 @@ TEST_CASE("stabilityRateBound of the unconstrained chain is ‖dH‖_F, by diffe
   for (int i = 0; i < du.size(); ++i) du[i] = W(rng);
   const double lambda = Lam(rng), dlambda = W(rng), h = 1e-6;
   double bound = 0.0;
-  REQUIRE(problem.stabilityRateBound(u, lambda, du, dlambda, bound));
+  REQUIRE(buckle::continuation::BoundProblem(problem).stabilityRateBound(u, lambda, du, dlambda, bound));
   Matrix Hp, Hm, C;
-  REQUIRE(problem.stabilityOperator(u + h * du, lambda + h * dlambda, Hp, C));
-  REQUIRE(problem.stabilityOperator(u - h * du, lambda - h * dlambda, Hm, C));
+  REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u + h * du, lambda + h * dlambda, Hp, C));
+  REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u - h * du, lambda - h * dlambda, Hm, C));
   CHECK(bound == Approx(((Hp - Hm) / (2.0 * h)).norm()).epsilon(1e-7));
   // the straight chain with x held: C = J_h is rank-deficient there, no finite bound
   EquilibriumProblem held(chain, EndCondition::heldPosition(chain.linkLengths().sum(), 0.0), Eigen::Vector3d(1, 0, 0));
   double none = 0.0;
-  CHECK_FALSE(held.stabilityRateBound(Vector::Zero(held.dimension()), 0.0, Vector::Ones(held.dimension()), 1.0, none));
+  CHECK_FALSE(buckle::continuation::BoundProblem(held).stabilityRateBound(Vector::Zero(held.dimension()), 0.0, Vector::Ones(held.dimension()), 1.0, none));
 }
 
 TEST_CASE("EquilibriumProblem's boundaries in one call equal boundary(k) one by one, also scaled", "[equilibrium]") {
@@ -709,11 +710,11 @@ TEST_CASE("EquilibriumProblem's boundaries in one call equal boundary(k) one by 
     REQUIRE(K == 2 * n);
     const Vector u = randomState(rng, chain, N);
     Vector g(K);
-    problem.boundaries(u, 0.3, g);
-    for (int k = 0; k < K; ++k) CHECK(g[k] == problem.boundary(k, u, 0.3));
+    buckle::continuation::BoundProblem(problem).boundaries(u, 0.3, g);
+    for (int k = 0; k < K; ++k) CHECK(g[k] == buckle::continuation::BoundProblem(problem).boundary(k, u, 0.3));
     // a shorter g takes the first ones
     Vector head(n);
-    problem.boundaries(u, 0.3, head);
+    buckle::continuation::BoundProblem(problem).boundaries(u, 0.3, head);
     CHECK(head == g.head(n));
 
     buckle::continuation::ProblemScales scales = buckle::continuation::ProblemScales::ones(N);
@@ -723,8 +724,8 @@ TEST_CASE("EquilibriumProblem's boundaries in one call equal boundary(k) one by 
     buckle::continuation::ScaledProblem scaled(problem, units);
     const Vector v = u.cwiseQuotient(scales.unknowns);
     Vector gs(K);
-    scaled.boundaries(v, 0.3e-3, gs);
-    for (int k = 0; k < K; ++k) CHECK(gs[k] == scaled.boundary(k, v, 0.3e-3));
+    buckle::continuation::BoundProblem(scaled).boundaries(v, 0.3e-3, gs);
+    for (int k = 0; k < K; ++k) CHECK(gs[k] == buckle::continuation::BoundProblem(scaled).boundary(k, v, 0.3e-3));
   }
 }
 
@@ -744,8 +745,8 @@ TEST_CASE("EquilibriumProblem's Jacobian writes every entry of F_u and F_lambda,
       nanFilled.setConstant(std::numeric_limits<double>::quiet_NaN());
       Vector lz = Vector::Zero(N), ln = Vector::Constant(N, std::numeric_limits<double>::quiet_NaN());
       // a block of a larger matrix, as the Keller matrix hands it over
-      REQUIRE(problem.jacobian(u, 0.4, zeroFilled.block(1, 1, N, N), lz));
-      REQUIRE(problem.jacobian(u, 0.4, nanFilled.block(1, 1, N, N), ln));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u, 0.4, zeroFilled.block(1, 1, N, N), lz));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u, 0.4, nanFilled.block(1, 1, N, N), ln));
       CHECK(nanFilled.block(1, 1, N, N).allFinite());
       CHECK((nanFilled.block(1, 1, N, N).array() == zeroFilled.block(1, 1, N, N).array()).all());
       CHECK((ln.array() == lz.array()).all());

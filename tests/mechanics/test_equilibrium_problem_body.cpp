@@ -124,10 +124,10 @@ TEST_CASE("body loads in EquilibriumProblem: residual, Jacobian, F_lambda, secon
       const double lambda = Lam(rng), h = 1e-6;
       Matrix Fu(N, N), dFu(N, N), Jp(N, N), Jm(N, N);
       Vector Fl(N), dFl(N), F(N), Fp(N), Fm(N), Jlp(N), Jlm(N);
-      REQUIRE(problem.jacobian(u, lambda, Fu, Fl));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u, lambda, Fu, Fl));
       const double scale = std::max(1.0, Fu.lpNorm<Eigen::Infinity>());
       // the q rows are ∂Π/∂q of Π = E − F·p + V (F the wrench at (u, λ), held fixed)
-      REQUIRE(problem.residual(u, lambda, F));
+      REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, lambda, F));
       const Wrench Wr = problem.wrench(u, lambda);
       for (int j = 0; j < n; ++j) {
         Vector qp = u.head(n), qm = u.head(n);
@@ -142,35 +142,35 @@ TEST_CASE("body loads in EquilibriumProblem: residual, Jacobian, F_lambda, secon
         Vector up = u, um = u;
         up[j] += h;
         um[j] -= h;
-        REQUIRE(problem.residual(up, lambda, Fp));
-        REQUIRE(problem.residual(um, lambda, Fm));
+        REQUIRE(buckle::continuation::BoundProblem(problem).residual(up, lambda, Fp));
+        REQUIRE(buckle::continuation::BoundProblem(problem).residual(um, lambda, Fm));
         err = std::max(err, (Fu.col(j) - (Fp - Fm) / (2 * h)).lpNorm<Eigen::Infinity>());
       }
       CHECK(err <= 1e-7 * scale);
-      REQUIRE(problem.residual(u, lambda + h, Fp));
-      REQUIRE(problem.residual(u, lambda - h, Fm));
+      REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, lambda + h, Fp));
+      REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, lambda - h, Fm));
       CHECK((Fl - (Fp - Fm) / (2 * h)).lpNorm<Eigen::Infinity>() <= 1e-7 * scale);
       Matrix H, C;
-      REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+      REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u, lambda, H, C));
       CHECK((Fu.topLeftCorner(n, n) - H).lpNorm<Eigen::Infinity>() <= 1e-14 * scale);
       // F_u's directional derivative and the O(n) second derivative along (du, dλ)
       Vector x(N + 1), z(N + 1);
       for (int i = 0; i <= N; ++i) x[i] = W(rng), z[i] = W(rng);
-      REQUIRE(problem.jacobianDirectionalDerivative(u, lambda, x.head(N), x[N], dFu, dFl));
-      REQUIRE(problem.jacobian(u + h * x.head(N), lambda + h * x[N], Jp, Jlp));
-      REQUIRE(problem.jacobian(u - h * x.head(N), lambda - h * x[N], Jm, Jlm));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianDirectionalDerivative(u, lambda, x.head(N), x[N], dFu, dFl));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u + h * x.head(N), lambda + h * x[N], Jp, Jlp));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u - h * x.head(N), lambda - h * x[N], Jm, Jlm));
       CHECK((dFu - (Jp - Jm) / (2 * h)).lpNorm<Eigen::Infinity>() <= 1e-6 * scale);
       CHECK((dFl - (Jlp - Jlm) / (2 * h)).lpNorm<Eigen::Infinity>() <= 1e-6 * scale);
       Vector s2(N), s2t(N), y(N), yt(N + 1);
-      REQUIRE(problem.secondDerivativeApply(u, lambda, x, z, s2));
-      REQUIRE(problem.secondDerivativeApply(u, lambda, z, x, s2t));
+      REQUIRE(buckle::continuation::BoundProblem(problem).secondDerivativeApply(u, lambda, x, z, s2));
+      REQUIRE(buckle::continuation::BoundProblem(problem).secondDerivativeApply(u, lambda, z, x, s2t));
       const Vector dense = dFu * z.head(N) + dFl * z[N];
       CHECK((s2 - dense).lpNorm<Eigen::Infinity>() <= 1e-12 * scale * N);
       CHECK((s2 - s2t).lpNorm<Eigen::Infinity>() <= 1e-12 * scale * N);
       // O(n) products with F_x and F_xᵀ
-      REQUIRE(problem.jacobianApply(u, lambda, x, y));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianApply(u, lambda, x, y));
       CHECK((y - Fu * x.head(N) - Fl * x[N]).lpNorm<Eigen::Infinity>() <= 1e-13 * scale * N);
-      REQUIRE(problem.jacobianTransposeApply(u, lambda, z.head(N), yt));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianTransposeApply(u, lambda, z.head(N), yt));
       CHECK((yt.head(N) - Fu.transpose() * z.head(N)).lpNorm<Eigen::Infinity>() <= 1e-13 * scale * N);
       CHECK(std::abs(yt[N] - Fl.dot(z.head(N))) <= 1e-13 * scale * N);
       // the O(n) stability: inertia and lowest eigenvalues of H on ker C, against a dense solve
@@ -186,7 +186,7 @@ TEST_CASE("body loads in EquilibriumProblem: residual, Jacobian, F_lambda, secon
         mu = Eigen::SelfAdjointEigenSolver<Matrix>(Q.transpose() * H * Q).eigenvalues();
       }
       cont::StabilityInfo info;
-      REQUIRE(problem.stability(u, lambda, 2, info));
+      REQUIRE(buckle::continuation::BoundProblem(problem).stability(u, lambda, 2, info));
       int negative = 0;
       for (int i = 0; i < mu.size(); ++i) negative += mu[i] < 0.0;
       CHECK(info.negative == negative);
@@ -194,10 +194,10 @@ TEST_CASE("body loads in EquilibriumProblem: residual, Jacobian, F_lambda, secon
       for (int i = 0; i < info.lowest.size(); ++i) CHECK(std::abs(info.lowest[i] - mu[i]) <= 1e-9 * scale * n);
       // the eigenvalue rate bound holds along (du, dλ)
       double bound = 0.0;
-      if (problem.stabilityRateBound(u, lambda, x.head(N), x[N], bound)) {
+      if (buckle::continuation::BoundProblem(problem).stabilityRateBound(u, lambda, x.head(N), x[N], bound)) {
         Matrix Hp, Cp, Hm, Cm;
-        REQUIRE(problem.stabilityOperator(u + h * x.head(N), lambda + h * x[N], Hp, Cp));
-        REQUIRE(problem.stabilityOperator(u - h * x.head(N), lambda - h * x[N], Hm, Cm));
+        REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u + h * x.head(N), lambda + h * x[N], Hp, Cp));
+        REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u - h * x.head(N), lambda - h * x[N], Hm, Cm));
         if (C.rows() == 0) CHECK(((Hp - Hm) / (2 * h)).norm() <= bound * (1 + 1e-6) + 1e-6 * scale);
       }
     }

@@ -158,8 +158,8 @@ TEST_CASE("Koiter's 2/3 law for a preload asymmetry (dL0), against the traced im
     EquilibriumProblem plus(preloadAsymmetric(chain, segment, h), p.endCondition(), kAxial);
     EquilibriumProblem minus(preloadAsymmetric(chain, segment, -h), p.endCondition(), kAxial);
     cont::Vector Fp(p.dimension()), Fm(p.dimension());
-    REQUIRE(plus.residual(bp.u, bp.lambda, Fp));
-    REQUIRE(minus.residual(bp.u, bp.lambda, Fm));
+    REQUIRE(buckle::continuation::BoundProblem(plus).residual(bp.u, bp.lambda, Fp));
+    REQUIRE(buckle::continuation::BoundProblem(minus).residual(bp.u, bp.lambda, Fm));
     CHECK(std::abs(k.psi.dot(Fp - Fm) / (2.0 * h) - s.coupling) <= 1e-7 * std::abs(s.coupling));
     const std::vector<double> eps{1e-6, 4e-6};
     std::vector<double> traced;

@@ -482,7 +482,7 @@ namespace {
 UnstableDirection denseUnstableDirection(EquilibriumProblem& problem, const Vector& u, double lambda) {
   UnstableDirection d;
   Matrix H, C;
-  REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+  REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u, lambda, H, C));
   const Eigen::Index n = H.rows();
   Eigen::ColPivHouseholderQR<Matrix> qr(C.transpose());
   const Matrix Q = qr.householderQ() * Matrix::Identity(n, n);
@@ -517,7 +517,7 @@ TEST_CASE("long chains: the O(n) unstable direction and polish equal the dense o
     CHECK(std::abs(s.eigenvalue - d.eigenvalue) < 1e-11 * scale);
     CHECK(std::abs(std::abs(s.direction.dot(d.direction)) - 1.0) < 1e-10);
     Matrix H, C;
-    REQUIRE(problem.stabilityOperator(u, lambda, H, C));
+    REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u, lambda, H, C));
     CHECK((C * s.direction).cwiseAbs().maxCoeff() < 1e-12 * C.norm());
     // the eigen-equation on ker C: P(H v − μ v) = 0
     Vector res = H * s.direction - s.eigenvalue * s.direction;
@@ -537,9 +537,9 @@ TEST_CASE("long chains: the O(n) unstable direction and polish equal the dense o
     Matrix Fu(N, N);
     Vector F(N), Fl(N);
     for (int it = 0; it < 30; ++it) {
-      REQUIRE(problem.residual(ref, lambda, F));
+      REQUIRE(buckle::continuation::BoundProblem(problem).residual(ref, lambda, F));
       if (F.cwiseAbs().maxCoeff() < 1e-14) break;
-      REQUIRE(problem.jacobian(ref, lambda, Fu, Fl));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(ref, lambda, Fu, Fl));
       ref -= Fu.fullPivLu().solve(F);
     }
     CHECK((p.u - ref).cwiseAbs().maxCoeff() < 1e-12);
@@ -591,7 +591,7 @@ TEST_CASE("direction rule for a multiple lowest eigenvalue: the dense and O(n) r
     CHECK(dense.eigenvalue == Approx(kappa).epsilon(1e-12));
     CHECK(fast.eigenvalue == Approx(kappa).epsilon(1e-12));
     Matrix H, C;
-    REQUIRE(problem.stabilityOperator(u, 0.0, H, C));
+    REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u, 0.0, H, C));
     REQUIRE(C.rows() == 1);
     CHECK((H - kappa * Matrix::Identity(n, n)).cwiseAbs().maxCoeff() < 1e-14);
     const Vector c = C.row(0).transpose();
@@ -859,7 +859,7 @@ TEST_CASE("a heavy column released past its critical weight falls to a bent stab
     double g = 1e-3 * K;  // the weight torque ρ g ℓ² against κ ~ K L²: the critical g scales with K
     buckle::continuation::StabilityInfo info;
     for (int i = 0; i < 80; ++i, g *= 1.25) {
-      REQUIRE(problem.stability(u, g, 1, info));
+      REQUIRE(buckle::continuation::BoundProblem(problem).stability(u, g, 1, info));
       if (info.negative > 0) break;
     }
     REQUIRE(info.negative == 1);
@@ -876,7 +876,7 @@ TEST_CASE("a heavy column released past its critical weight falls to a bent stab
     CHECK((qn - q).cwiseAbs().maxCoeff() < 1e-9);
     // and the weight mattered: the same release without it is no jump (the straight chain is stable)
     EquilibriumProblem weightless(chain, EndCondition::freeEnd(), Eigen::Vector3d::Zero());
-    REQUIRE(weightless.stability(u, 0.0, 1, info));
+    REQUIRE(buckle::continuation::BoundProblem(weightless).stability(u, 0.0, 1, info));
     CHECK(info.negative == 0);
   }
 }

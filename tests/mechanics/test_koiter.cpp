@@ -32,9 +32,10 @@ Eigen::VectorXd parentAt(EquilibriumProblem& p, const cont::SpecialPoint& bp, co
   Eigen::VectorXd u = bp.u + k.parentSlope * (lambda - bp.lambda), F(N), rhs = Eigen::VectorXd::Zero(N + 1),
                   step(N + 1), c = Eigen::VectorXd::Zero(N + 1);
   c[N] = 1.0;
-  const auto solver = p.makeStructuredSolver();
+  const buckle::continuation::BoundProblem solverBound(p);  // outlives the solver
+  const auto solver = solverBound.makeStructuredSolver();
   for (int it = 0; it < 30; ++it) {
-    REQUIRE(p.residual(u, lambda, F));
+    REQUIRE(buckle::continuation::BoundProblem(p).residual(u, lambda, F));
     REQUIRE(solver->factor(u, lambda, c) == cont::Factorization::Regular);
     rhs.head(N) = -F;
     REQUIRE(solver->solve(rhs, step));

@@ -97,8 +97,8 @@ TEST_CASE("mirror: the equations are equivariant, F(S u, lambda) = S F(u, lambda
       Su = u;
       r.apply(Su);
       const double lambda = reaction(rng);
-      REQUIRE(problem.residual(u, lambda, F));
-      REQUIRE(problem.residual(Su, lambda, FS));
+      REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, lambda, F));
+      REQUIRE(buckle::continuation::BoundProblem(problem).residual(Su, lambda, FS));
       r.apply(F);
       CHECK((FS - F).norm() <= 1e-13 * std::max(1.0, F.norm()));
     }
@@ -110,8 +110,8 @@ TEST_CASE("mirror: the equations are equivariant, F(S u, lambda) = S F(u, lambda
   cont::Reflection r;
   r.signs = Eigen::VectorXd::Constant(problem.dimension(), -1.0);
   Eigen::VectorXd u = Eigen::VectorXd::Constant(8, 0.2), Su = -u, F(8), FS(8);
-  REQUIRE(problem.residual(u, 0.1, F));
-  REQUIRE(problem.residual(Su, 0.1, FS));
+  REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, 0.1, F));
+  REQUIRE(buckle::continuation::BoundProblem(problem).residual(Su, 0.1, FS));
   CHECK((FS + F).norm() > 1e-3);
 }
 
@@ -214,7 +214,7 @@ TEST_CASE("mirror: an image's base and self contacts, mirrored from its source, 
       ContactProblem contact(problem, p.locked);
       const cont::ContinuationPoint& at = branch.points[size_t(p.index)];
       double largest = 0.0;
-      for (const LockedJoint& l : p.locked.joints()) largest = std::max(largest, contact.compression(at.u, at.lambda, l.joint));
+      for (const LockedJoint& l : p.locked.joints()) largest = std::max(largest, contact.compression(*contact.createWorkspace(), at.u, at.lambda, l.joint));
       CHECK(p.contactTorque == largest);
     }
     if (branch.mirrorOf < 0) continue;

@@ -59,8 +59,8 @@ Vector newtonAt(EquilibriumProblem& problem, Vector u, double lambda) {
   Matrix Fu(N, N);
   int small = 0;
   for (int it = 0; it < 60 && small < 3; ++it) {
-    REQUIRE(problem.residual(u, lambda, F));
-    REQUIRE(problem.jacobian(u, lambda, Fu, Fl));
+    REQUIRE(buckle::continuation::BoundProblem(problem).residual(u, lambda, F));
+    REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u, lambda, Fu, Fl));
     const Vector du = Fu.partialPivLu().solve(F);
     u -= du;
     if (du.lpNorm<Eigen::Infinity>() < 1e-15) ++small;

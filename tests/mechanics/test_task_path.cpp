@@ -81,7 +81,7 @@ void constraintBlocks(TaskPathProblem& p, const Eigen::VectorXd& u, double s, Ei
   const int n = p.segments(), mi = p.inputCount(), m = p.taskCount(), N = p.dimension();
   Eigen::MatrixXd Fu(N, N);
   Eigen::VectorXd Fs(N);
-  REQUIRE(p.jacobian(u, s, Fu, Fs));
+  REQUIRE(buckle::continuation::BoundProblem(p).jacobian(u, s, Fu, Fs));
   H = Fu.block(n + mi, 0, n, n);
   B = Fu.block(n + mi, n, n, mi);
   Jc = Fu.block(2 * n + mi, 0, m, n);
@@ -194,7 +194,8 @@ TEST_CASE("task path with weight and point loads: derivatives, solvers and equil
     const cont::DerivativeCheck ca = cont::checkDerivatives(pa, ua, 0.3);
     INFO(ca.message);
     CHECK(ca.success);
-    TaskPathBorderedSolver fast(pa);
+    const auto fastWorkspace = pa.createWorkspace();
+    TaskPathBorderedSolver fast(pa, *fastWorkspace);
     compareWithDense(pa, fast, ua);
 
     TaskSetup b = minChangeSetup(4, payload);
@@ -205,7 +206,8 @@ TEST_CASE("task path with weight and point loads: derivatives, solvers and equil
     const cont::DerivativeCheck cb = cont::checkDerivatives(pb, u, 0.2);
     INFO(cb.message);
     CHECK(cb.success);
-    TaskPathKktSolver kkt(pb);
+    const auto kktWorkspace = pb.createWorkspace();
+    TaskPathKktSolver kkt(pb, *kktWorkspace);
     compareWithDense(pb, kkt, u);
   }
   SECTION("every traced point an equilibrium of the heavy chain at its inputs, and the weight matters") {
@@ -238,14 +240,14 @@ TEST_CASE("task path with weight and point loads: derivatives, solvers and equil
       const Chain at = p.chainAt(pt.inputs);
       EquilibriumProblem heavy(at, EndCondition::freeEnd(payload), Eigen::Vector3d::Zero(), {}, {}, s.body);
       Eigen::VectorXd F(3);
-      REQUIRE(heavy.residual(pt.q, 0.0, F));
+      REQUIRE(buckle::continuation::BoundProblem(heavy).residual(pt.q, 0.0, F));
       CHECK(F.cwiseAbs().maxCoeff() <= 1e-12);  // torques in k b² = 1
       cont::StabilityInfo info;
-      REQUIRE(heavy.stability(pt.q, 0.0, 1, info));
+      REQUIRE(buckle::continuation::BoundProblem(heavy).stability(pt.q, 0.0, 1, info));
       CHECK(info.negative == pt.inertia.negative);
       CHECK(info.smallest == Approx(pt.minEigenvalue).epsilon(1e-9));
       EquilibriumProblem weightless(at, EndCondition::freeEnd(payload), Eigen::Vector3d::Zero());
-      REQUIRE(weightless.residual(pt.q, 0.0, F));
+      REQUIRE(buckle::continuation::BoundProblem(weightless).residual(pt.q, 0.0, F));
       weightShare = std::max(weightShare, F.cwiseAbs().maxCoeff());
     }
     CHECK(weightShare > 0.05);  // the weight's torques are far above the tolerance: ignoring it fails
@@ -263,7 +265,8 @@ TEST_CASE("task path: the O(n) bordered solver agrees with dense LU", "[task_pat
   d << 0.48, 0.6, 0.64;
   p.setLeg({a, d, 0.0});
   const Eigen::VectorXd u = p.pack(q, p.startInputs() + Eigen::Vector3d(0.1, -0.2, 0.05));
-  TaskPathBorderedSolver fast(p);
+  const auto fastWorkspace = p.createWorkspace();
+  TaskPathBorderedSolver fast(p, *fastWorkspace);
   compareWithDense(p, fast, u);
 }
 
@@ -279,7 +282,8 @@ TEST_CASE("task path: the O(n) elimination of rule (b)'s optimality system agree
   const int N = p.dimension(), mi = p.inputCount();
   Eigen::VectorXd u = Eigen::VectorXd::LinSpaced(N, -0.3, 0.4);
   u.segment(n, mi) = p.startInputs() + Eigen::VectorXd::LinSpaced(mi, 0.1, -0.1);
-  TaskPathKktSolver fast(p);
+  const auto fastWorkspace = p.createWorkspace();
+  TaskPathKktSolver fast(p, *fastWorkspace);
   compareWithDense(p, fast, u);
 }
 
@@ -307,10 +311,10 @@ TEST_CASE("task path rule (a): the task held and every point an equilibrium of t
     const Chain at = p.chainAt(pt.inputs);
     EquilibriumProblem plain(at, EndCondition::freeEnd(payload), Eigen::Vector3d::Zero());
     Eigen::VectorXd F(3);
-    REQUIRE(plain.residual(pt.q, 0.0, F));
+    REQUIRE(buckle::continuation::BoundProblem(plain).residual(pt.q, 0.0, F));
     CHECK(F.cwiseAbs().maxCoeff() <= 1e-12 * torque);
     cont::StabilityInfo info;
-    REQUIRE(plain.stability(pt.q, 0.0, 1, info));
+    REQUIRE(buckle::continuation::BoundProblem(plain).stability(pt.q, 0.0, 1, info));
     CHECK(info.negative == pt.inertia.negative);
     CHECK(info.smallest == Approx(pt.minEigenvalue).epsilon(1e-9));
     // only the chosen inputs move: segment 3's free lengths are the chain's
@@ -363,7 +367,7 @@ TEST_CASE("task path rule (b): least weighted change against a brute-force searc
           uu.head(n) = qq;
           uu.segment(n, mi) = pt.inputs + eps * Z.col(col) + G.transpose() * y;
           Eigen::VectorXd F(p.dimension());
-          REQUIRE(p.residual(uu, pt.s, F));
+          REQUIRE(buckle::continuation::BoundProblem(p).residual(uu, pt.s, F));
           Eigen::VectorXd rr(n + 2);
           rr << F.segment(n + mi, n), F.tail(2);
           if (rr.norm() < 1e-15) break;
@@ -395,7 +399,7 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
     for (const TaskPathPoint& pt : r.points) CHECK(pt.s <= f.s + 1e-12);
     Eigen::MatrixXd Fu(5, 5);
     Eigen::VectorXd Fs(5);
-    REQUIRE(p.jacobian(p.pack(f.q, f.inputs), f.s, Fu, Fs));
+    REQUIRE(buckle::continuation::BoundProblem(p).jacobian(p.pack(f.q, f.inputs), f.s, Fu, Fs));
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Fu);  // rows and unknowns O(1) here (k = b = 1)
     CHECK(svd.singularValues()[4] <= 1e-8 * svd.singularValues()[0]);
   }

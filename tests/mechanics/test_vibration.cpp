@@ -294,7 +294,7 @@ TEST_CASE("vibration: the crossing omega^2 is zero at the located branch points 
     int compared = 0;
     for (const cont::ContinuationPoint& p : br.points) {
       cont::StabilityInfo info;
-      REQUIRE(problem.stability(p.u, p.lambda, 1, info));
+      REQUIRE(buckle::continuation::BoundProblem(problem).stability(p.u, p.lambda, 1, info));
       const double w = omega2(p.u, p.lambda);
       if (std::abs(info.smallest) > 1e-6) {
         CHECK((w > 0) == (info.smallest > 0));
