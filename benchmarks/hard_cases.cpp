@@ -108,7 +108,7 @@ Row unitsBranchPoints(const UnitScale& us, bool nondim) {
   NondimensionalProblem view(problem, typicalUnits(problem.chain()));
   const double F0 = nondim ? view.lambdaScale() : 1.0;  // λ unit seen by the tracer
   const Timer timer;
-  cont::Tracer tracer(nondim ? static_cast<cont::Problem&>(view) : problem,
+  cont::Tracer tracer(nondim ? static_cast<const cont::Problem&>(view) : problem,
                       tracerOptions(Settings(), -2.5 * us.force() / F0, 0.0));
   const cont::Branch br = tracer.trace(Eigen::VectorXd::Zero(4), 0.0, cont::InitialDirection::decreasingLambda());
   row.ms = timer.ms();
@@ -130,7 +130,7 @@ Row unitsFold(const UnitScale& us, bool nondim) {
   NondimensionalProblem view(problem, typicalUnits(problem.chain()));
   const double F0 = nondim ? view.lambdaScale() : 1.0;
   const Timer timer;
-  cont::Tracer tracer(nondim ? static_cast<cont::Problem&>(view) : problem,
+  cont::Tracer tracer(nondim ? static_cast<const cont::Problem&>(view) : problem,
                       tracerOptions(Settings(), -3.0 * us.force() / F0, 3.0 * us.force() / F0));
   const cont::Branch br = tracer.trace(Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda());
   row.ms = timer.ms();
@@ -157,7 +157,7 @@ LimitEnd unitsLimitEnd(const UnitScale& us, bool nondim, double& ms) {
   p.qMaxUser = 1.5;
   EquilibriumProblem problem(Chain::uniform(3, p), EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   NondimensionalProblem view(problem, typicalUnits(problem.chain()));
-  cont::Problem& traced = nondim ? static_cast<cont::Problem&>(view) : problem;
+  const cont::Problem& traced = nondim ? static_cast<const cont::Problem&>(view) : problem;
   const double F0 = nondim ? view.lambdaScale() : 1.0;
   const Timer timer;
   cont::Tracer tracer(traced, tracerOptions(Settings(), -3.0 * us.force() / F0, 0.0));
@@ -368,7 +368,7 @@ Row jointLimit(int n) {
   auto G = [&](const Eigen::VectorXd& x) {
     Eigen::VectorXd q(n), F(n);
     for (int i = 0, c = 0; i < n; ++i) q[i] = i == j ? qj : x[c++];
-    problem.residual(q, x[n - 1], F);
+    cont::BoundProblem(problem).residual(q, x[n - 1], F);
     return F;
   };
   for (int it = 0; it < 12; ++it) {

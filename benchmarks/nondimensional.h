@@ -43,13 +43,12 @@ inline UnitScale typicalUnits(const mechanics::Chain& chain) {
 /// direction is assumed to be a force (λ₀ = F₀) unless `lambdaScale` says otherwise.
 class NondimensionalProblem final : public continuation::Problem {
  public:
-  NondimensionalProblem(mechanics::EquilibriumProblem& problem, UnitScale scale, double lambdaScale = 0.0)
+  NondimensionalProblem(const mechanics::EquilibriumProblem& problem, UnitScale scale, double lambdaScale = 0.0)
       : p_(problem),
         lambdaScale_(lambdaScale > 0.0 ? lambdaScale : scale.force()),
         torque_(scale.torque()),
         uScale_(Eigen::VectorXd::Ones(problem.dimension())),
-        rowScale_(Eigen::VectorXd::Constant(problem.dimension(), scale.torque())),
-        u_(problem.dimension()) {
+        rowScale_(Eigen::VectorXd::Constant(problem.dimension(), scale.torque())) {
     const std::vector<int> held = problem.endCondition().heldIndices();
     constraintScale_.resize(Eigen::Index(held.size()));
     for (size_t c = 0; c < held.size(); ++c) {
@@ -61,31 +60,46 @@ class NondimensionalProblem final : public continuation::Problem {
     }
   }
 
+  /// The equilibrium problem's workspace and the physical unknowns of the last evaluation.
+  struct Workspace : continuation::ProblemWorkspace {
+    std::unique_ptr<continuation::ProblemWorkspace> inner;
+    Eigen::VectorXd u;
+  };
+  std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override {
+    auto w = std::make_unique<Workspace>();
+    w->inner = p_.createWorkspace();
+    w->u.resize(p_.dimension());
+    return w;
+  }
+
   double lambdaScale() const { return lambdaScale_; }
   /// Physical unknowns of nondimensional ones.
   Eigen::VectorXd physical(continuation::ConstVectorRef u) const { return u.cwiseProduct(uScale_); }
   Eigen::VectorXd nondimensional(continuation::ConstVectorRef u) const { return u.cwiseQuotient(uScale_); }
 
   int dimension() const override { return p_.dimension(); }
-  bool residual(continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) override {
-    u_ = u.cwiseProduct(uScale_);
-    if (!p_.residual(u_, lambda * lambdaScale_, F)) return false;
+  bool residual(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) const override {
+    Workspace& w = continuation::workspaceAs<Workspace>(ws);
+    w.u = u.cwiseProduct(uScale_);
+    if (!p_.residual(*w.inner, w.u, lambda * lambdaScale_, F)) return false;
     F.array() /= rowScale_.array();
     return true;
   }
-  bool jacobian(continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
-                continuation::VectorRef Flambda) override {
-    u_ = u.cwiseProduct(uScale_);
-    if (!p_.jacobian(u_, lambda * lambdaScale_, Fu, Flambda)) return false;
+  bool jacobian(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
+                continuation::VectorRef Flambda) const override {
+    Workspace& w = continuation::workspaceAs<Workspace>(ws);
+    w.u = u.cwiseProduct(uScale_);
+    if (!p_.jacobian(*w.inner, w.u, lambda * lambdaScale_, Fu, Flambda)) return false;
     scaleJacobian(Fu, Flambda);
     return true;
   }
-  bool jacobianDirectionalDerivative(continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
+  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
                                      double dlambda, continuation::MatrixRef dFu,
-                                     continuation::VectorRef dFlambda) override {
-    u_ = u.cwiseProduct(uScale_);
+                                     continuation::VectorRef dFlambda) const override {
+    Workspace& w = continuation::workspaceAs<Workspace>(ws);
+    w.u = u.cwiseProduct(uScale_);
     const Eigen::VectorXd duPhysical = du.cwiseProduct(uScale_);
-    if (!p_.jacobianDirectionalDerivative(u_, lambda * lambdaScale_, duPhysical, dlambda * lambdaScale_, dFu, dFlambda))
+    if (!p_.jacobianDirectionalDerivative(*w.inner, w.u, lambda * lambdaScale_, duPhysical, dlambda * lambdaScale_, dFu, dFlambda))
       return false;
     scaleJacobian(dFu, dFlambda);
     return true;
@@ -93,10 +107,11 @@ class NondimensionalProblem final : public continuation::Problem {
 
   // Stability: H and C rescaled; the inertia is then the default dense one of Problem (n small).
   bool hasStabilityOperator() const override { return p_.hasStabilityOperator(); }
-  bool stabilityOperator(continuation::ConstVectorRef u, double lambda, continuation::Matrix& H,
-                         continuation::Matrix& C) override {
-    u_ = u.cwiseProduct(uScale_);
-    if (!p_.stabilityOperator(u_, lambda * lambdaScale_, H, C)) return false;
+  bool stabilityOperator(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::Matrix& H,
+                         continuation::Matrix& C) const override {
+    Workspace& w = continuation::workspaceAs<Workspace>(ws);
+    w.u = u.cwiseProduct(uScale_);
+    if (!p_.stabilityOperator(*w.inner, w.u, lambda * lambdaScale_, H, C)) return false;
     H /= torque_;
     if (C.rows() == constraintScale_.size()) C.array().colwise() /= constraintScale_.array();
     return true;
@@ -104,9 +119,10 @@ class NondimensionalProblem final : public continuation::Problem {
 
   // Boundaries are joint-angle limits: unit-free.
   int boundaryCount() const override { return p_.boundaryCount(); }
-  double boundary(int k, continuation::ConstVectorRef u, double lambda) override {
-    u_ = u.cwiseProduct(uScale_);
-    return p_.boundary(k, u_, lambda * lambdaScale_);
+  double boundary(continuation::ProblemWorkspace &ws, int k, continuation::ConstVectorRef u, double lambda) const override {
+    Workspace& w = continuation::workspaceAs<Workspace>(ws);
+    w.u = u.cwiseProduct(uScale_);
+    return p_.boundary(*w.inner, k, w.u, lambda * lambdaScale_);
   }
   std::string boundaryName(int k) const override { return p_.boundaryName(k); }
 
@@ -117,10 +133,9 @@ class NondimensionalProblem final : public continuation::Problem {
     Flambda.array() *= lambdaScale_ / rowScale_.array();
   }
 
-  mechanics::EquilibriumProblem& p_;
+  const mechanics::EquilibriumProblem& p_;
   double lambdaScale_, torque_;
   Eigen::VectorXd uScale_, rowScale_, constraintScale_;
-  Eigen::VectorXd u_;
 };
 
 }  // namespace buckle::bench

@@ -113,6 +113,7 @@ class Projector {
   /// free == false: the clamped–pinned chain (unknowns q and the end reaction), else the free end.
   Projector(bool free, double L0)
       : problem_(free ? free3(L0, 0.01) : pinned3(L0)),
+        bound_(problem_),
         free_(free),
         corrector_(problem_, options()),
         n_(problem_.dimension()) {}
@@ -125,9 +126,9 @@ class Projector {
       // The reaction is linear in the residual: its least-squares value at (q, Fx).
       Eigen::VectorXd f0(n_), f1(n_);
       u[3] = 0.0;
-      problem_.residual(u, fx, f0);
+      bound_.residual(u, fx, f0);
       u[3] = 1.0;
-      problem_.residual(u, fx, f1);
+      bound_.residual(u, fx, f1);
       const Eigen::VectorXd c = f1 - f0;
       u[3] = -c.dot(f0) / c.squaredNorm();
     }
@@ -135,7 +136,7 @@ class Projector {
     xp << u, fx;
     Eigen::MatrixXd J(n_, n_ + 1);
     Eigen::VectorXd Fl(n_);
-    problem_.jacobian(u, fx, J.leftCols(n_), Fl);
+    bound_.jacobian(u, fx, J.leftCols(n_), Fl);
     J.col(n_) = Fl;
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
     const Eigen::VectorXd t = svd.matrixV().col(n_);
@@ -165,6 +166,7 @@ class Projector {
     return co;
   }
   EquilibriumProblem problem_;
+  cont::BoundProblem bound_;  // its workspace
   bool free_;
   cont::Corrector corrector_;
   int n_;
@@ -245,14 +247,14 @@ Outcome foldOutcome(const cont::Branch& b) {
 
 class GridSolver {
  public:
-  explicit GridSolver(EquilibriumProblem& p) : p_(p), n_(p.dimension()), F_(n_), Fl_(n_), J_(n_, n_), du_(n_) {}
+  explicit GridSolver(EquilibriumProblem& p) : p_(p), bound_(p), n_(p.dimension()), F_(n_), Fl_(n_), J_(n_, n_), du_(n_) {}
 
   /// Newton at fixed Fx from u (in place): ‖F‖∞ ≤ 1e-12 (the residual's own scale is 1 here).
   bool solve(Eigen::VectorXd& u, double fx) {
     for (int it = 0; it < 40; ++it) {
-      if (!p_.residual(u, fx, F_)) return false;
+      if (!bound_.residual(u, fx, F_)) return false;
       if (F_.lpNorm<Eigen::Infinity>() <= 1e-12) return true;
-      if (!p_.jacobian(u, fx, J_, Fl_)) return false;
+      if (!bound_.jacobian(u, fx, J_, Fl_)) return false;
       lu_.compute(J_);
       du_ = lu_.solve(F_);
       if (!du_.allFinite()) return false;
@@ -262,12 +264,13 @@ class GridSolver {
   }
   int index(const Eigen::VectorXd& u, double fx) {
     cont::StabilityInfo info;
-    p_.stability(u, fx, 0, info);
+    bound_.stability(u, fx, 0, info);
     return info.negative;
   }
 
  private:
   EquilibriumProblem& p_;
+  cont::BoundProblem bound_;  // its workspace
   int n_;
   Eigen::VectorXd F_, Fl_;
   Eigen::MatrixXd J_;
@@ -284,7 +287,7 @@ bool naiveBuckledBranch(EquilibriumProblem& p, GridSolver& g, const char* name, 
                         double& end) {
   Eigen::MatrixXd J(4, 4);
   Eigen::VectorXd Fl(4), zero = Eigen::VectorXd::Zero(4);
-  p.jacobian(zero, fxStart, J, Fl);
+  cont::BoundProblem(p).jacobian(zero, fxStart, J, Fl);
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
   const Eigen::VectorXd mode = svd.matrixV().col(3) / svd.matrixV().col(3).head(3).lpNorm<Eigen::Infinity>();
   Eigen::VectorXd u;

@@ -3,11 +3,13 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <thread>
 
 #include <Eigen/LU>
 #include <limits>
 
 #include "buckle/continuation/scaled_problem.h"
+#include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/jump.h"
@@ -754,5 +756,57 @@ TEST_CASE("EquilibriumProblem's Jacobian writes every entry of F_u and F_lambda,
       CHECK(std::isnan(nanFilled(0, 0)));
       CHECK(std::isnan(nanFilled(N + 1, N + 1)));
     }
+  }
+}
+
+TEST_CASE("One const EquilibriumProblem traced from two threads at once: each trace as when run alone",
+          "[equilibrium_problem][threads]") {
+  // 30 segments: the structured stability isolates the lowest eigenvalues with warm starts
+  // (the workspace's EigenvalueMemory) and every evaluation goes through the q-cache.
+  const int n = 30;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  buckle::continuation::TracerOptions options;
+  options.step.maxStep = 0.05;
+  options.lambdaMin = -0.6;
+  options.lambdaMax = 0.3;
+  options.maxPoints = 150;
+  options.detection.lowestEigenvalues = 3;
+  const Vector u0 = Vector::Zero(problem.dimension());
+  using buckle::continuation::Branch;
+  using buckle::continuation::InitialDirection;
+  auto compress = [&] { return buckle::continuation::trace(problem, u0, 0.0, InitialDirection::decreasingLambda(), options); };
+  auto stretch = [&] { return buckle::continuation::trace(problem, u0, 0.0, InitialDirection::increasingLambda(), options); };
+  const Branch compressedAlone = compress(), stretchedAlone = stretch();
+  int branchPoints = 0;
+  for (const auto& sp : compressedAlone.specialPoints)
+    branchPoints += sp.type == buckle::continuation::SpecialPointType::BranchPoint ? 1 : 0;
+  REQUIRE(branchPoints >= 1);  // the compressed chain buckles within the range
+  REQUIRE(stretchedAlone.points.size() > 2);
+
+  auto identical = [](const Branch& a, const Branch& b) {
+    CHECK(a.stopReason == b.stopReason);
+    REQUIRE(a.points.size() == b.points.size());
+    for (size_t k = 0; k < a.points.size(); ++k) {
+      CHECK(a.points[k].u == b.points[k].u);
+      CHECK(a.points[k].lambda == b.points[k].lambda);
+      CHECK(a.points[k].stability.negative == b.points[k].stability.negative);
+      CHECK(a.points[k].stability.lowest == b.points[k].stability.lowest);
+    }
+    REQUIRE(a.specialPoints.size() == b.specialPoints.size());
+    for (size_t k = 0; k < a.specialPoints.size(); ++k) {
+      CHECK(a.specialPoints[k].type == b.specialPoints[k].type);
+      CHECK(a.specialPoints[k].lambda == b.specialPoints[k].lambda);
+    }
+  };
+  for (const bool sameStart : {false, true}) {
+    INFO((sameStart ? "the same start" : "different starts"));
+    Branch a, b;
+    std::thread first([&] { a = compress(); });
+    std::thread second([&] { b = sameStart ? compress() : stretch(); });
+    first.join();
+    second.join();
+    identical(a, compressedAlone);
+    identical(b, sameStart ? compressedAlone : stretchedAlone);
   }
 }
