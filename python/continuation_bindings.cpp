@@ -121,7 +121,7 @@ class PythonProblem : public cont::Problem {
   }
 
   template <class Body>
-  bool call(Body body) {
+  bool call(Body body) const {
     if (failed_) return false;
     py::gil_scoped_acquire gil;
     try {
@@ -140,9 +140,12 @@ class PythonProblem : public cont::Problem {
   int n_;
   py::function residual_, jacobian_;
   py::object stability_;
-  bool failed_ = false;
-  std::optional<py::error_already_set> error_;
-  std::string message_, typeMessage_;
+  // The first error a callable raised, for trace() to re-raise: the Python callables run one at
+  // a time under the GIL and the module traces one problem per call, so the const evaluations
+  // record it here (mutable) rather than in a workspace.
+  mutable bool failed_ = false;
+  mutable std::optional<py::error_already_set> error_;
+  mutable std::string message_, typeMessage_;
 };
 
 py::dict specialPointDict(const cont::SpecialPoint& s) {
