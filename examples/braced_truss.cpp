@@ -33,11 +33,11 @@ class BracedTruss : public bc::NumericDiffProblem {
   }
   // F is the gradient of Π: the stability operator is its Jacobian (here the differenced one).
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(bc::ProblemWorkspace &, bc::ConstVectorRef x, double P, bc::Matrix &H, bc::Matrix &C) const override {
+  bool stabilityOperator(bc::ProblemWorkspace &ws, bc::ConstVectorRef x, double P, bc::Matrix &H, bc::Matrix &C) const override {
     H.resize(2, 2);
     C.resize(0, 2);
     bc::Vector FP(2);
-    return jacobian(x, P, H, FP);
+    return jacobian(ws, x, P, H, FP);
   }
   // Units: the span a for u, the rise h for w, k h for P and F (the steps of the differences are
   // relative to these).

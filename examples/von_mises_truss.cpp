@@ -30,11 +30,11 @@ class VonMisesTruss : public bc::Problem {
   }
   // F is the gradient of Π: its Jacobian is the stiffness, stable where positive.
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(bc::ProblemWorkspace &, bc::ConstVectorRef u, double P, bc::Matrix &H, bc::Matrix &C) const override {
+  bool stabilityOperator(bc::ProblemWorkspace &ws, bc::ConstVectorRef u, double P, bc::Matrix &H, bc::Matrix &C) const override {
     H.resize(1, 1);
     bc::Vector FP(1);
     C.resize(0, 1);
-    return jacobian(u, P, H, FP);
+    return jacobian(ws, u, P, H, FP);
   }
   // Units: the rise h for w, the shallow-truss limit load k h³/a² for P and F.
   bc::ProblemScales scales() const override {

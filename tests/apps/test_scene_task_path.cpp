@@ -104,7 +104,7 @@ TEST_CASE("task path scene: rows on the straight path, each an equilibrium of th
                                    Eigen::Vector3d::Zero());
     Eigen::VectorXd q(3), F(3);
     q << row[size_t(q1)], row[size_t(q1) + 1], row[size_t(q1) + 2];
-    REQUIRE(plain.residual(q, 0.0, F));
+    REQUIRE(buckle::continuation::BoundProblem(plain).residual(q, 0.0, F));
     CHECK(F.cwiseAbs().maxCoeff() <= 1e-10);  // k b² = 1; the CSV's 12 digits
   }
   std::ifstream in(o.out / "special_points.json");

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <thread>
@@ -114,38 +115,27 @@ TEST_CASE("One const problem traced from two threads at once: each trace as when
   REQUIRE(downAlone.points.size() > 10);
   CHECK(firstOf(downAlone, SpecialPointType::Fold) == nullptr);
 
-  // Several traces per thread, so that the two interleave over many evaluations.
-  const int rounds = 4;
-  SECTION("different starts") {
+  // Several traces per thread, so that the two interleave over many evaluations; each result
+  // compared with the same trace run alone.
+  auto concurrently = [&](const std::function<Branch()> &first, const Branch &firstAlone,
+                          const std::function<Branch()> &second, const Branch &secondAlone) {
+    const int rounds = 4;
     std::vector<Branch> a(rounds), b(rounds);
-    std::thread first([&] {
-      for (Branch &r : a) r = up();
+    std::thread one([&] {
+      for (Branch &r : a) r = first();
     });
-    std::thread second([&] {
-      for (Branch &r : b) r = down();
+    std::thread two([&] {
+      for (Branch &r : b) r = second();
     });
-    first.join();
-    second.join();
+    one.join();
+    two.join();
     for (int k = 0; k < rounds; ++k) {
-      requireIdentical(a[size_t(k)], upAlone);
-      requireIdentical(b[size_t(k)], downAlone);
+      requireIdentical(a[size_t(k)], firstAlone);
+      requireIdentical(b[size_t(k)], secondAlone);
     }
-  }
-  SECTION("the same start") {
-    std::vector<Branch> a(rounds), b(rounds);
-    std::thread first([&] {
-      for (Branch &r : a) r = up();
-    });
-    std::thread second([&] {
-      for (Branch &r : b) r = up();
-    });
-    first.join();
-    second.join();
-    for (int k = 0; k < rounds; ++k) {
-      requireIdentical(a[size_t(k)], upAlone);
-      requireIdentical(b[size_t(k)], upAlone);
-    }
-  }
+  };
+  SECTION("different starts") { concurrently(up, upAlone, down, downAlone); }
+  SECTION("the same start") { concurrently(up, upAlone, up, upAlone); }
 }
 
 TEST_CASE("Each workspace keeps its own cache; a bound problem borrows or owns one", "[bound_problem]") {

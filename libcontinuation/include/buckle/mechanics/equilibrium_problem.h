@@ -240,9 +240,9 @@ class EquilibriumProblem final : public continuation::Problem {
   /// Inside the model's domain: finite, every joint within its geometric limits (or just past one,
   /// while the limits are traced as boundaries: equilibrium_problem.cpp).
   bool inDomain(const continuation::ConstVectorRef& u) const;
-  /// The q-dependent part of every evaluation at u = (q, r): kinematics (data_), the end
-  /// Jacobian (J_), ∂E/∂q (grad_) and the diagonal of K_q (stiff_), from one pass of the spring
-  /// model. Cached for the last q (bitwise comparison; it does not depend on r or λ): KINSOL
+  /// The q-dependent part of every evaluation at u = (q, r): kinematics (d.data), the end
+  /// Jacobian (d.J), ∂E/∂q (d.grad) and the diagonal of K_q (d.stiff), from one pass of the spring
+  /// model. Cached in the workspace d for its last q (bitwise; it does not depend on r or λ): KINSOL
   /// evaluates F and then J at the same iterate, and the tracer then J and the stability at the
   /// corrected point, so each distinct q evaluates the spring model once.
   /// False (nothing cached) if u is outside the domain.
@@ -252,13 +252,13 @@ class EquilibriumProblem final : public continuation::Problem {
   /// T at (u, λ) into ws from the cache (after prepare(u)).
   void assembleFromCache(Workspace& d, const continuation::ConstVectorRef& u, double lambda, ChainStructure& ws) const;
   /// The small dense route (n ≤ 16, equilibrium_problem.cpp) at (u, λ): the inertia and all eigenvalues on
-  /// ker J_h into spectrumInertia_ and spectrum_, or nothing when (u, λ) is already their key.
+  /// ker J_h into the workspace's spectrumInertia and spectrum, or nothing when (u, λ) is already their key.
   /// False (nothing cached) outside the domain.
   bool smallDenseSpectrum(Workspace& d, const continuation::ConstVectorRef& u, double lambda) const;
   /// The generator of K_q − H at (u, λ) from the cache: h(F) of eq 27 minus the body loads' γ
   /// (equilibrium_problem_body.cpp).
   void loadGenerator(Workspace& d, const continuation::ConstVectorRef& u, double lambda, VectorRef h) const;
-  /// The body loads' dγ along (du_q, dλ) into bodyWork_ (zero without them).
+  /// The body loads' dγ along (du_q, dλ) into the workspace's bodyWork (zero without them).
   void bodyGeneratorDerivative(Workspace& d, const continuation::ConstVectorRef& dq, double lambda, double dlambda) const;
 
   Chain chain_;
