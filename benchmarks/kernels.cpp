@@ -41,7 +41,7 @@ void structuredSizes(benchmark::internal::Benchmark* b) { sizes(b, 10000); }
 void BM_Residual(benchmark::State& state) {
   const int n = int(state.range(0));
   auto p = clampedPinned(n);
-  const cont::BoundProblem bound(p);  // one workspace, as a trace has
+  const continuation::BoundProblem bound(p);  // one workspace, as a trace has
   // Two states in turn: the problem caches the kinematics and spring jets of the last q, and a
   // fixed u would time that cache hit (see BM_ResidualCached), not the evaluation.
   const Eigen::VectorXd us[2] = {bentState(n, 1), bentState(n, 1) * (1.0 + 1e-9)};
@@ -59,7 +59,7 @@ BENCHMARK(BM_Residual)->Apply(structuredSizes);
 void BM_ResidualCached(benchmark::State& state) {
   const int n = int(state.range(0));
   auto p = clampedPinned(n);
-  const cont::BoundProblem bound(p);  // one workspace, as a trace has
+  const continuation::BoundProblem bound(p);  // one workspace, as a trace has
   const Eigen::VectorXd u = bentState(n, 1);
   Eigen::VectorXd F(n + 1);
   for (auto _ : state) {
@@ -72,7 +72,7 @@ BENCHMARK(BM_ResidualCached)->Apply(structuredSizes);
 void BM_JacobianDense(benchmark::State& state) {
   const int n = int(state.range(0));
   auto p = clampedPinned(n);
-  const cont::BoundProblem bound(p);  // one workspace, as a trace has
+  const continuation::BoundProblem bound(p);  // one workspace, as a trace has
   const Eigen::VectorXd u = bentState(n, 1);
   const Eigen::VectorXd us[2] = {u, u * (1.0 + 1e-9)};  // two states in turn: no cache hit
   Eigen::MatrixXd Fu(n + 1, n + 1);
@@ -88,7 +88,7 @@ BENCHMARK(BM_JacobianDense)->Apply(allSizes);
 void BM_TridiagonalAssemble(benchmark::State& state) {
   const int n = int(state.range(0));
   auto p = clampedPinned(n);
-  const cont::BoundProblem bound(p);  // one workspace, as a trace has
+  const continuation::BoundProblem bound(p);  // one workspace, as a trace has
   const Eigen::VectorXd u = bentState(n, 1);
   mechanics::ChainStructure ws(n);
   mechanics::ChainData data(p.chain());
@@ -106,7 +106,7 @@ BENCHMARK(BM_TridiagonalAssemble)->Apply(structuredSizes);
 void stabilityLoop(benchmark::State& state, bool structured, int lowestCount) {
   const int n = int(state.range(0));
   auto p = clampedPinned(n, structured);
-  const cont::BoundProblem bound(p);  // one workspace, as a trace has
+  const continuation::BoundProblem bound(p);  // one workspace, as a trace has
   const Eigen::VectorXd u = bentState(n, 1);
   continuation::StabilityInfo info;
   for (auto _ : state) {
@@ -129,7 +129,7 @@ BENCHMARK(BM_StabilityInertiaOnly)->Apply(structuredSizes)->Unit(benchmark::kMic
 void BM_InertiaStructured(benchmark::State& state) {
   const int n = int(state.range(0));
   auto p = clampedPinned(n);
-  const cont::BoundProblem bound(p);  // one workspace, as a trace has
+  const continuation::BoundProblem bound(p);  // one workspace, as a trace has
   const Eigen::VectorXd u = bentState(n, 1);
   mechanics::ChainStructure ws(n);
   mechanics::ChainData data(p.chain());
@@ -149,7 +149,7 @@ BENCHMARK(BM_InertiaStructured)->Apply(structuredSizes)->Unit(benchmark::kMicros
 void BM_SolveDenseLU(benchmark::State& state) {
   const int n = int(state.range(0));
   auto p = clampedPinned(n);
-  const cont::BoundProblem bound(p);  // one workspace, as a trace has
+  const continuation::BoundProblem bound(p);  // one workspace, as a trace has
   const Eigen::VectorXd u = bentState(n, 1);
   const int N = n + 1;
   Eigen::MatrixXd A(N + 1, N + 1);
@@ -171,7 +171,7 @@ BENCHMARK(BM_SolveDenseLU)->Apply(denseSizes)->Unit(benchmark::kMicrosecond);
 void BM_SolveStructured(benchmark::State& state) {
   const int n = int(state.range(0));
   auto p = clampedPinned(n);
-  const cont::BoundProblem bound(p);  // one workspace, as a trace has
+  const continuation::BoundProblem bound(p);  // one workspace, as a trace has
   const Eigen::VectorXd u = bentState(n, 1);
   mechanics::ChainStructure ws(n);
   mechanics::ChainData data(p.chain());
@@ -197,7 +197,7 @@ BENCHMARK(BM_SolveStructured)->Apply(structuredSizes)->Unit(benchmark::kMicrosec
 void BM_CorrectorSolve(benchmark::State& state) {
   const int n = int(state.range(0));
   auto p = clampedPinned(n);
-  const cont::BoundProblem bound(p);  // one workspace, as a trace has
+  const continuation::BoundProblem bound(p);  // one workspace, as a trace has
   const int N = n + 1;
   continuation::Corrector corrector(p);
   Eigen::VectorXd pred = Eigen::VectorXd::Zero(N + 1), t = Eigen::VectorXd::Zero(N + 1), x(N + 1);
