@@ -68,7 +68,7 @@ TEST_CASE("Corrector solves allocate nothing after construction", "[allocation]"
   fresh.setZero();
   CHECK(mallocCalls.load() - probe >= 1);
 #else
-  SUCCEED("malloc interposition is disabled under AddressSanitizer");
+  SUCCEED("malloc interposition is disabled under AddressSanitizer and ThreadSanitizer");
 #endif
 }
 
@@ -113,7 +113,7 @@ TEST_CASE("Certified counting's slopes and the locator's residual norm allocate 
   CHECK(sameNorm);
   CHECK(after - before == 0);
 #else
-  SUCCEED("malloc interposition is disabled under AddressSanitizer");
+  SUCCEED("malloc interposition is disabled under AddressSanitizer and ThreadSanitizer");
 #endif
 }
 
@@ -145,6 +145,6 @@ TEST_CASE("NumericDiffProblem's derivatives allocate nothing after the first cal
   CHECK(ok);
   CHECK(after - before == 0);
 #else
-  SUCCEED("malloc interposition is disabled under AddressSanitizer");
+  SUCCEED("malloc interposition is disabled under AddressSanitizer and ThreadSanitizer");
 #endif
 }

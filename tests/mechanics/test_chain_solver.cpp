@@ -272,7 +272,7 @@ TEST_CASE("Corrector on the chain's structured solver allocates nothing after co
   EquilibriumProblem problem(uniformChain(n), EndCondition::clampedPinned(0.0, 0.5), Eigen::Vector3d(1, 0, 0));
   CHECK(correctorAllocations(problem, 0.2, 0.05) == 0);
 #else
-  SUCCEED("malloc interposition is disabled under AddressSanitizer");
+  SUCCEED("malloc interposition is disabled under AddressSanitizer and ThreadSanitizer");
 #endif
 }
 
@@ -285,6 +285,6 @@ TEST_CASE("Corrector along a control path (dL0, end held) allocates nothing afte
                              ControlDirection::named(n, ControlInput::dL0));
   CHECK(correctorAllocations(problem, 0.02, 0.005) == 0);
 #else
-  SUCCEED("malloc interposition is disabled under AddressSanitizer");
+  SUCCEED("malloc interposition is disabled under AddressSanitizer and ThreadSanitizer");
 #endif
 }

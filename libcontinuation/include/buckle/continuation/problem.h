@@ -72,8 +72,6 @@ struct ProblemScales {
   std::string check(int n) const;
 };
 
-class Problem;
-
 /// Mutable state of one computation on a Problem: the scratch of the defaults below, and in a
 /// derived type (Problem::createWorkspace) the problem's own caches and warm starts. Everything
 /// cached in it is a pure function of the points evaluated, so results do not depend on which
@@ -108,6 +106,9 @@ class Problem {
   /// A workspace for evaluations of this problem (ProblemWorkspace; a problem with caches
   /// returns its own derived type, preallocated for its dimension). Default: the base scratch.
   virtual std::unique_ptr<ProblemWorkspace> createWorkspace() const;
+
+  // Every evaluation below is const and takes, first, a workspace this problem's
+  // createWorkspace() made (a problem with caches reads it with workspaceAs<its type>).
 
   /// Number of unknowns N.
   virtual int dimension() const = 0;
