@@ -78,28 +78,30 @@ class NondimensionalProblem final : public continuation::Problem {
   Eigen::VectorXd nondimensional(continuation::ConstVectorRef u) const { return u.cwiseQuotient(uScale_); }
 
   int dimension() const override { return p_.dimension(); }
-  bool residual(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) const override {
+  bool residual(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                continuation::VectorRef F) const override {
     Workspace& w = continuation::workspaceAs<Workspace>(ws);
     w.u = u.cwiseProduct(uScale_);
     if (!p_.residual(*w.inner, w.u, lambda * lambdaScale_, F)) return false;
     F.array() /= rowScale_.array();
     return true;
   }
-  bool jacobian(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
-                continuation::VectorRef Flambda) const override {
+  bool jacobian(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                continuation::MatrixRef Fu, continuation::VectorRef Flambda) const override {
     Workspace& w = continuation::workspaceAs<Workspace>(ws);
     w.u = u.cwiseProduct(uScale_);
     if (!p_.jacobian(*w.inner, w.u, lambda * lambdaScale_, Fu, Flambda)) return false;
     scaleJacobian(Fu, Flambda);
     return true;
   }
-  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
-                                     double dlambda, continuation::MatrixRef dFu,
+  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                                     continuation::ConstVectorRef du, double dlambda, continuation::MatrixRef dFu,
                                      continuation::VectorRef dFlambda) const override {
     Workspace& w = continuation::workspaceAs<Workspace>(ws);
     w.u = u.cwiseProduct(uScale_);
     const Eigen::VectorXd duPhysical = du.cwiseProduct(uScale_);
-    if (!p_.jacobianDirectionalDerivative(*w.inner, w.u, lambda * lambdaScale_, duPhysical, dlambda * lambdaScale_, dFu, dFlambda))
+    if (!p_.jacobianDirectionalDerivative(*w.inner, w.u, lambda * lambdaScale_, duPhysical, dlambda * lambdaScale_, dFu,
+                                          dFlambda))
       return false;
     scaleJacobian(dFu, dFlambda);
     return true;
@@ -107,8 +109,8 @@ class NondimensionalProblem final : public continuation::Problem {
 
   // Stability: H and C rescaled; the inertia is then the default dense one of Problem (n small).
   bool hasStabilityOperator() const override { return p_.hasStabilityOperator(); }
-  bool stabilityOperator(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::Matrix& H,
-                         continuation::Matrix& C) const override {
+  bool stabilityOperator(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                         continuation::Matrix& H, continuation::Matrix& C) const override {
     Workspace& w = continuation::workspaceAs<Workspace>(ws);
     w.u = u.cwiseProduct(uScale_);
     if (!p_.stabilityOperator(*w.inner, w.u, lambda * lambdaScale_, H, C)) return false;
@@ -119,7 +121,8 @@ class NondimensionalProblem final : public continuation::Problem {
 
   // Boundaries are joint-angle limits: unit-free.
   int boundaryCount() const override { return p_.boundaryCount(); }
-  double boundary(continuation::ProblemWorkspace &ws, int k, continuation::ConstVectorRef u, double lambda) const override {
+  double boundary(continuation::ProblemWorkspace& ws, int k, continuation::ConstVectorRef u,
+                  double lambda) const override {
     Workspace& w = continuation::workspaceAs<Workspace>(ws);
     w.u = u.cwiseProduct(uScale_);
     return p_.boundary(*w.inner, k, w.u, lambda * lambdaScale_);

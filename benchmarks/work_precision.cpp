@@ -247,7 +247,8 @@ Outcome foldOutcome(const cont::Branch& b) {
 
 class GridSolver {
  public:
-  explicit GridSolver(EquilibriumProblem& p) : p_(p), bound_(p), n_(p.dimension()), F_(n_), Fl_(n_), J_(n_, n_), du_(n_) {}
+  explicit GridSolver(EquilibriumProblem& p)
+      : p_(p), bound_(p), n_(p.dimension()), F_(n_), Fl_(n_), J_(n_, n_), du_(n_) {}
 
   /// Newton at fixed Fx from u (in place): ‖F‖∞ ≤ 1e-12 (the residual's own scale is 1 here).
   bool solve(Eigen::VectorXd& u, double fx) {

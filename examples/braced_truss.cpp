@@ -33,7 +33,8 @@ class BracedTruss : public bc::NumericDiffProblem {
   }
   // F is the gradient of Π: the stability operator is its Jacobian (here the differenced one).
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(bc::ProblemWorkspace &ws, bc::ConstVectorRef x, double P, bc::Matrix &H, bc::Matrix &C) const override {
+  bool stabilityOperator(bc::ProblemWorkspace &ws, bc::ConstVectorRef x, double P, bc::Matrix &H,
+                         bc::Matrix &C) const override {
     H.resize(2, 2);
     C.resize(0, 2);
     bc::Vector FP(2);

@@ -22,7 +22,8 @@ class VonMisesTruss : public bc::Problem {
     F[0] = 2.0 * k_ * u[0] * (1.0 - L0_ / std::hypot(a_, u[0])) + P;
     return std::isfinite(F[0]);
   }
-  bool jacobian(bc::ProblemWorkspace &, bc::ConstVectorRef u, double, bc::MatrixRef Fu, bc::VectorRef FP) const override {
+  bool jacobian(bc::ProblemWorkspace &, bc::ConstVectorRef u, double, bc::MatrixRef Fu,
+                bc::VectorRef FP) const override {
     const double L = std::hypot(a_, u[0]);
     Fu(0, 0) = 2.0 * k_ * (1.0 - L0_ * a_ * a_ / (L * L * L));
     FP[0] = 1.0;
@@ -30,7 +31,8 @@ class VonMisesTruss : public bc::Problem {
   }
   // F is the gradient of Π: its Jacobian is the stiffness, stable where positive.
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(bc::ProblemWorkspace &ws, bc::ConstVectorRef u, double P, bc::Matrix &H, bc::Matrix &C) const override {
+  bool stabilityOperator(bc::ProblemWorkspace &ws, bc::ConstVectorRef u, double P, bc::Matrix &H,
+                         bc::Matrix &C) const override {
     H.resize(1, 1);
     bc::Vector FP(1);
     C.resize(0, 1);

@@ -37,7 +37,7 @@ class PythonProblem : public cont::Problem {
 
   int dimension() const override { return n_; }
 
-  bool residual(cont::ProblemWorkspace &, cont::ConstVectorRef u, double lambda, cont::VectorRef F) const override {
+  bool residual(cont::ProblemWorkspace&, cont::ConstVectorRef u, double lambda, cont::VectorRef F) const override {
     return call([&] {
       const VectorXd r = vector(residual_(VectorXd(u), lambda), "residual(u, lam)", "an array of N numbers");
       expectSize(r.size(), n_, "residual");
@@ -46,7 +46,8 @@ class PythonProblem : public cont::Problem {
     });
   }
 
-  bool jacobian(cont::ProblemWorkspace &, cont::ConstVectorRef u, double lambda, cont::MatrixRef Fu, cont::VectorRef Flambda) const override {
+  bool jacobian(cont::ProblemWorkspace&, cont::ConstVectorRef u, double lambda, cont::MatrixRef Fu,
+                cont::VectorRef Flambda) const override {
     return call([&] {
       const py::object returned = jacobian_(VectorXd(u), lambda);
       if (!py::isinstance<py::tuple>(returned) && !py::isinstance<py::list>(returned))
@@ -67,7 +68,8 @@ class PythonProblem : public cont::Problem {
 
   bool hasStabilityOperator() const override { return !stability_.is_none(); }
 
-  bool stabilityOperator(cont::ProblemWorkspace &, cont::ConstVectorRef u, double lambda, MatrixXd& H, MatrixXd& C) const override {
+  bool stabilityOperator(cont::ProblemWorkspace&, cont::ConstVectorRef u, double lambda, MatrixXd& H,
+                         MatrixXd& C) const override {
     return call([&] {
       H = matrix(stability_(VectorXd(u), lambda), "stability(u, lam)");
       if (H.rows() != n_ || H.cols() != n_)

@@ -23,7 +23,8 @@ namespace {
 class DiagonalPitchforks : public toys::TwoPitchforks {
  public:
   using TwoPitchforks::TwoPitchforks;
-  bool stabilityEigenvalues(ProblemWorkspace &, ConstVectorRef u, double lambda, int first, VectorRef values) const override {
+  bool stabilityEigenvalues(ProblemWorkspace &, ConstVectorRef u, double lambda, int first,
+                            VectorRef values) const override {
     const double a = -(lambda - 3.0 * u[0] * u[0]), b = -(lambda - c() - 3.0 * u[1] * u[1]);
     const double sorted[2] = {std::min(a, b), std::max(a, b)};
     if (first < 0 || first + values.size() > 2) return false;
@@ -122,7 +123,9 @@ TEST_CASE("NumericDiffProblem's derivatives allocate nothing after the first cal
   class NumericBratu : public NumericDiffProblem {
    public:
     int dimension() const override { return exact.dimension(); }
-    bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override { return exact.residual(ws, u, lambda, F); }
+    bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override {
+      return exact.residual(ws, u, lambda, F);
+    }
     toys::Bratu exact{12};
   } model;
   const BoundProblem problem(model);  // one workspace for every call below

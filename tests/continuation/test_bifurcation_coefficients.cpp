@@ -24,8 +24,8 @@ class Reduced : public Problem {
     Fl << -x, 0.0;
     return true;
   }
-  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double dl, MatrixRef dFu,
-                                     VectorRef dFl) const override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double dl,
+                                     MatrixRef dFu, VectorRef dFl) const override {
     dFu << -dl + 2.0 * alpha * du[0] + du[1] + 6.0 * beta * u[0] * du[0], du[0], -2.0 * du[0], 0.0;
     dFl << -du[0], 0.0;
     return true;

@@ -44,8 +44,8 @@ class BentNormalForm : public Problem {
     Fl = A * ((Vector(2) << -z[0], 0.0).finished() - Gz(z, l) * dup(l));
     return true;
   }
-  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double l, ConstVectorRef du, double dl, MatrixRef dFu,
-                                     VectorRef dFl) const override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double l, ConstVectorRef du, double dl,
+                                     MatrixRef dFu, VectorRef dFl) const override {
     const Vector z = u - up(l), dz = du - dup(l) * dl;
     const Eigen::Matrix2d dGz =
         (Eigen::Matrix2d() << -dl + 2.0 * alpha * dz[0] + dz[1] + 6.0 * beta * z[0] * dz[0] +
@@ -198,8 +198,8 @@ class CuspFamily : public Problem {
     Fl[0] = -1.0;
     return true;
   }
-  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double, MatrixRef dFu,
-                                     VectorRef dFl) const override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double,
+                                     MatrixRef dFu, VectorRef dFl) const override {
     dFu(0, 0) = 6.0 * u[0] * du[0];
     dFl[0] = 0.0;
     return true;

@@ -33,8 +33,8 @@ class WrongBratu : public toys::Bratu {
 class WrongSecondDerivative : public toys::ScaledExponentials {
  public:
   using ScaledExponentials::ScaledExponentials;
-  bool jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                     MatrixRef dFu, VectorRef dFl) const override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                     double dlambda, MatrixRef dFu, VectorRef dFl) const override {
     if (!ScaledExponentials::jacobianDirectionalDerivative(ws, u, lambda, du, dlambda, dFu, dFl)) return false;
     const Vector s = scales().unknowns;
     dFu(1, 0) += scales().residuals[1] / s[0] * 6.0 * (u[0] / s[0]) * (du[0] / s[0]);  // the −6a·da term dropped
@@ -46,7 +46,8 @@ class WrongSecondDerivative : public toys::ScaledExponentials {
 class WrongProduct : public toys::ScaledExponentials {
  public:
   using ScaledExponentials::ScaledExponentials;
-  bool jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const override {
+  bool jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                     VectorRef y) const override {
     Matrix J(2, 3);
     if (!jacobian(ws, u, lambda, J.leftCols(2), J.col(2))) return false;
     y = J.leftCols(2) * x.head(2);
@@ -132,7 +133,9 @@ TEST_CASE("checkDerivatives: a residual-only problem's derivatives are consisten
   class Numeric : public NumericDiffProblem {
    public:
     int dimension() const override { return 2; }
-    bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override { return exact.residual(ws, u, lambda, F); }
+    bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override {
+      return exact.residual(ws, u, lambda, F);
+    }
     ProblemScales scales() const override { return exact.scales(); }
     toys::ScaledExponentials exact{1e-3, 1e4, 1e6, 1e-5};
   } numeric;

@@ -114,7 +114,9 @@ namespace {
 // The cusp toy with a "structured" solver: the dense one, which takes general borders.
 class BorderedCuspToy : public toys::CuspToy {
  public:
-  std::unique_ptr<BorderedSolver> makeStructuredSolver(ProblemWorkspace &) const override { return std::make_unique<DenseBorderedSolver>(*this); }
+  std::unique_ptr<BorderedSolver> makeStructuredSolver(ProblemWorkspace&) const override {
+    return std::make_unique<DenseBorderedSolver>(*this);
+  }
 };
 }  // namespace
 

@@ -21,7 +21,9 @@ class NumericExponentials : public NumericDiffProblem {
  public:
   explicit NumericExponentials(const toys::ScaledExponentials &exact) : exact_(exact) {}
   int dimension() const override { return 2; }
-  bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override { return exact_.residual(ws, u, lambda, F); }
+  bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override {
+    return exact_.residual(ws, u, lambda, F);
+  }
   ProblemScales scales() const override { return exact_.scales(); }
 
  private:
@@ -60,7 +62,9 @@ class NumericPitchforks : public NumericDiffProblem {
  public:
   explicit NumericPitchforks(double c) : exact_(c) {}
   int dimension() const override { return 2; }
-  bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override { return exact_.residual(ws, u, lambda, F); }
+  bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override {
+    return exact_.residual(ws, u, lambda, F);
+  }
   bool hasStabilityOperator() const override { return true; }
   bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override {
     return toys::negatedJacobian(*this, ws, u, lambda, H, C);
@@ -101,8 +105,10 @@ TEST_CASE("NumericDiffProblem: derivatives agree with the closed form in any uni
     const Vector x = (Vector(3) << 0.8 * s.unknowns[0], -0.6 * s.unknowns[1], 0.5 * s.parameter).finished();
     const Vector z = (Vector(3) << -0.4 * s.unknowns[0], 0.9 * s.unknowns[1], 0.7 * s.parameter).finished();
     Matrix exactD(2, 3), numericD(2, 3);
-    REQUIRE(BoundProblem(reference).jacobianDirectionalDerivative(u, lambda, x.head(2), x[2], exactD.leftCols(2), exactD.col(2)));
-    REQUIRE(BoundProblem(numeric).jacobianDirectionalDerivative(u, lambda, x.head(2), x[2], numericD.leftCols(2), numericD.col(2)));
+    REQUIRE(BoundProblem(reference).jacobianDirectionalDerivative(u, lambda, x.head(2), x[2], exactD.leftCols(2),
+                                                                  exactD.col(2)));
+    REQUIRE(BoundProblem(numeric).jacobianDirectionalDerivative(u, lambda, x.head(2), x[2], numericD.leftCols(2),
+                                                                numericD.col(2)));
     // Second differences with steps ε^{1/4}: O(h²) + O(ε/h²), ~1e-8.
     CHECK(scaledDifference(numericD, exactD, s) < 1e-6);
 

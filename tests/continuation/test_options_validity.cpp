@@ -31,7 +31,7 @@ class DifferencedCircle : public NumericDiffProblem {
  public:
   using NumericDiffProblem::NumericDiffProblem;
   int dimension() const override { return 1; }
-  bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
+  bool residual(ProblemWorkspace&, ConstVectorRef u, double lambda, VectorRef F) const override {
     F[0] = u[0] * u[0] + lambda * lambda - 1.0;
     return true;
   }

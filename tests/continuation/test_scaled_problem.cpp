@@ -23,7 +23,8 @@ class RecordingBound : public Problem {
     Fl.setZero();
     return true;
   }
-  bool stabilityRateBound(ProblemWorkspace &, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda, double &bound) const override {
+  bool stabilityRateBound(ProblemWorkspace &, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                          double &bound) const override {
     seenU = u;
     seenLambda = lambda;
     bound = 2.0 * std::abs(du[0]) + 3.0 * std::abs(du[1]) + 5.0 * std::abs(dlambda);

@@ -73,11 +73,13 @@ class Touch : public Problem {
 class BoundedOppositeCrossings : public OppositeCrossings {
  public:
   BoundedOppositeCrossings(double c, bool offerBound) : OppositeCrossings(c), offerBound_(offerBound) {}
-  bool stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first, VectorRef values) const override {
+  bool stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first,
+                            VectorRef values) const override {
     ++evaluations;
     return Problem::stabilityEigenvalues(ws, u, lambda, first, values);
   }
-  bool stabilityRateBound(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double dlambda, double &bound) const override {
+  bool stabilityRateBound(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double dlambda,
+                          double &bound) const override {
     if (!offerBound_) return false;
     bound = std::max(std::abs(-dlambda + 6.0 * u[0] * du[0]), std::abs(dlambda + 6.0 * u[1] * du[1]));
     return true;

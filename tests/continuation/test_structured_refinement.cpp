@@ -73,7 +73,8 @@ TEST_CASE("Problem's dense product defaults equal F_x, F_x^T and the directional
   CHECK((yt - Fx.transpose() * w).norm() <= 1e-15 * Fx.norm() * w.norm());
   // (F_xx[x, ·])ᵀw by central differences against the directional derivative of F_x along x.
   REQUIRE(BoundProblem(problem).secondDerivativeTransposeApply(u, lambda, x, w, y2));
-  REQUIRE(problem.Problem::jacobianDirectionalDerivative(*problem.createWorkspace(), u, lambda, x.head(2), x[2], dFx.leftCols(2), dFx.col(2)));
+  REQUIRE(problem.Problem::jacobianDirectionalDerivative(*problem.createWorkspace(), u, lambda, x.head(2), x[2],
+                                                         dFx.leftCols(2), dFx.col(2)));
   CHECK((y2 - dFx.transpose() * w).norm() <= 1e-8 * std::max(1.0, y2.norm()));
 }
 

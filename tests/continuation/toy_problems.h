@@ -9,7 +9,8 @@
 namespace buckle::continuation::toys {
 
 /// The stability operator of a gradient system F = −∇V: H = −F_u, no constraints.
-inline bool negatedJacobian(const Problem &problem, ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) {
+inline bool negatedJacobian(const Problem &problem, ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H,
+                            Matrix &C) {
   const int n = problem.dimension();
   Vector Fl(n);
   H = Matrix::Zero(n, n);
@@ -287,8 +288,8 @@ class ScaledExponentials : public Problem {
     Fl << P_ / L_ * std::exp(a), P_ / L_ * 2.0 * l * b;
     return true;
   }
-  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                     MatrixRef dFu, VectorRef dFl) const override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                     double dlambda, MatrixRef dFu, VectorRef dFl) const override {
     const double a = u[0] / U0_, b = u[1] / U1_, l = lambda / L_;
     const double da = du[0] / U0_, db = du[1] / U1_, dl = dlambda / L_;
     dFu << P_ / U0_ * ((dl + l * da) * std::exp(a) + 2.0 * b * db), P_ / U1_ * 2.0 * (da * b + a * db),

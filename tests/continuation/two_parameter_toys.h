@@ -35,13 +35,14 @@ class CuspToy : public ToyTwoParameter {
     Fl << 1.0, 0.0;
     return true;
   }
-  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double, MatrixRef dFu,
-                                     VectorRef dFl) const override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double,
+                                     MatrixRef dFu, VectorRef dFl) const override {
     dFu << -6.0 * u[0] * du[0] + du[1], du[0], -du[0], 0.0;
     dFl.setZero();
     return true;
   }
-  bool secondParameterDerivatives(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef v, VectorRef Fmu, VectorRef FuMuV) const override {
+  bool secondParameterDerivatives(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef v, VectorRef Fmu,
+                                  VectorRef FuMuV) const override {
     Fmu << u[0], 0.0;
     FuMuV << v[0], 0.0;
     return true;
@@ -62,13 +63,14 @@ class EigenToy : public ToyTwoParameter {
     Fl = -u;
     return true;
   }
-  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double dl, MatrixRef dFu,
-                                     VectorRef dFl) const override {
+  bool jacobianDirectionalDerivative(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef du, double dl,
+                                     MatrixRef dFu, VectorRef dFl) const override {
     dFu << 6.0 * u[0] * du[0] - dl, 0.0, 0.0, 6.0 * u[1] * du[1] - dl;
     dFl = -du;
     return true;
   }
-  bool secondParameterDerivatives(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef v, VectorRef Fmu, VectorRef FuMuV) const override {
+  bool secondParameterDerivatives(ProblemWorkspace &, ConstVectorRef u, double, ConstVectorRef v, VectorRef Fmu,
+                                  VectorRef FuMuV) const override {
     Fmu << u[1], u[0];
     FuMuV << v[1], v[0];
     return true;

@@ -52,7 +52,9 @@ bool plainNewton(EquilibriumProblem& problem, Vector& u) {
   Vector F(N), Ft(N), Fl(N);
   Matrix Fu(N, N);
   auto norm = [&](const Vector& v, Vector& out) {
-    return buckle::continuation::BoundProblem(problem).residual(v, 0.0, out) ? (out.array() / scale.array()).abs().maxCoeff() : INFINITY;
+    return buckle::continuation::BoundProblem(problem).residual(v, 0.0, out)
+               ? (out.array() / scale.array()).abs().maxCoeff()
+               : INFINITY;
   };
   double r = norm(u, F);
   for (int it = 0; it < 100 && std::isfinite(r); ++it) {

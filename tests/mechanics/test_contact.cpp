@@ -135,7 +135,8 @@ TEST_CASE("contact: a single segment pushed past its limit carries applied torqu
     // compression = applied torque − spring torque at the limit (closed form)
     CHECK(std::abs(pt.contactTorque - (pt.parameter - springAtLimit)) <= 1e-12 * springAtLimit);
     const cont::ContinuationPoint& cp = r.tree.branches[0].points[size_t(pt.index)];
-    CHECK(std::abs(contact.contactTorque(*contact.createWorkspace(), cp.u, cp.lambda, 0) - (springAtLimit - cp.lambda)) <= 1e-12 * springAtLimit);
+    CHECK(std::abs(contact.contactTorque(*contact.createWorkspace(), cp.u, cp.lambda, 0) -
+                   (springAtLimit - cp.lambda)) <= 1e-12 * springAtLimit);
     CHECK(pt.stable);
   }
   CHECK(locked >= 5);
@@ -196,7 +197,8 @@ TEST_CASE("contact: a chain's locked branch agrees with an independent Newton so
     for (const LockedJoint& l : pt.locked.joints()) {
       ContactProblem contact(problem, pt.locked);
       const cont::ContinuationPoint& cp = b.points[size_t(pt.index)];
-      CHECK(std::abs(contact.contactTorque(*contact.createWorkspace(), cp.u, cp.lambda, l.joint) - g[l.joint]) <= 1e-11 * std::max(1.0, std::abs(g[l.joint])));
+      CHECK(std::abs(contact.contactTorque(*contact.createWorkspace(), cp.u, cp.lambda, l.joint) - g[l.joint]) <=
+            1e-11 * std::max(1.0, std::abs(g[l.joint])));
       CHECK(contact.compression(*contact.createWorkspace(), cp.u, cp.lambda, l.joint) >= 0.0);
     }
     ++checked;

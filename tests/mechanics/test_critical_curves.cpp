@@ -649,7 +649,8 @@ struct StraightMode {
 StraightMode straightSecondMode(ChainParameterProblem& p, double tension) {
   REQUIRE(p.setSecondParameter(tension));
   Matrix H, C;
-  REQUIRE(buckle::continuation::BoundProblem(p).stabilityOperator(p.equilibrium().initialGuess(Vector::Zero(3), 0.0), 0.0, H, C));
+  REQUIRE(buckle::continuation::BoundProblem(p).stabilityOperator(p.equilibrium().initialGuess(Vector::Zero(3), 0.0),
+                                                                  0.0, H, C));
   REQUIRE(C.rows() == 0);  // free end
   const Eigen::SelfAdjointEigenSolver<Matrix> es(H);
   return {es.eigenvalues()[1], std::abs(es.eigenvectors().col(1).sum())};

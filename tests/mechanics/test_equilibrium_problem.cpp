@@ -186,20 +186,23 @@ TEST_CASE("EquilibriumProblem: cached evaluations equal a fresh problem's in any
         const int op = Op(rng);
         if (op <= 1) {
           Vector F1(N), F2(N);
-          const bool ok1 = buckle::continuation::BoundProblem(cached).residual(buffer, lambda, F1), ok2 = buckle::continuation::BoundProblem(fresh).residual(buffer, lambda, F2);
+          const bool ok1 = buckle::continuation::BoundProblem(cached).residual(buffer, lambda, F1),
+                     ok2 = buckle::continuation::BoundProblem(fresh).residual(buffer, lambda, F2);
           REQUIRE(ok1 == ok2);
           CHECK(ok1 != outside);
           if (ok1) CHECK((F1.array() == F2.array()).all());
         } else if (op <= 3) {
           Matrix J1(N, N), J2(N, N);
           Vector L1(N), L2(N);
-          const bool ok1 = buckle::continuation::BoundProblem(cached).jacobian(buffer, lambda, J1, L1), ok2 = buckle::continuation::BoundProblem(fresh).jacobian(buffer, lambda, J2, L2);
+          const bool ok1 = buckle::continuation::BoundProblem(cached).jacobian(buffer, lambda, J1, L1),
+                     ok2 = buckle::continuation::BoundProblem(fresh).jacobian(buffer, lambda, J2, L2);
           REQUIRE(ok1 == ok2);
           if (ok1) CHECK(((J1.array() == J2.array()).all() && (L1.array() == L2.array()).all()));
         } else if (op == 4) {
           buckle::continuation::StabilityInfo i1, i2;
           const int count = call % 2 ? 3 : 0;
-          const bool ok1 = buckle::continuation::BoundProblem(cached).stability(buffer, lambda, count, i1), ok2 = buckle::continuation::BoundProblem(fresh).stability(buffer, lambda, count, i2);
+          const bool ok1 = buckle::continuation::BoundProblem(cached).stability(buffer, lambda, count, i1),
+                     ok2 = buckle::continuation::BoundProblem(fresh).stability(buffer, lambda, count, i2);
           REQUIRE(ok1 == ok2);
           if (ok1) {
             CHECK(i1.negative == i2.negative);
@@ -426,7 +429,8 @@ TEST_CASE("EquilibriumProblem O(n) products equal the dense F_x, F_x^T and secon
       // (F_xx[dx, ·])ᵀw (central differences of jacobianTransposeApply) against the exact
       // directional derivative of F_x.
       REQUIRE(buckle::continuation::BoundProblem(problem).secondDerivativeTransposeApply(u, lambda, dx, w, y2));
-      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianDirectionalDerivative(u, lambda, dx.head(N), dx[N], dFx.leftCols(N), dFx.col(N)));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianDirectionalDerivative(u, lambda, dx.head(N), dx[N],
+                                                                                        dFx.leftCols(N), dFx.col(N)));
       const Vector exact = dFx.transpose() * w;
       CHECK((y2 - exact).norm() <= 1e-7 * std::max(1.0, exact.norm()));
       // F_xx[dx, x] in O(n) (secondDerivativeApply): the exact matrix derivative applied to x, to
@@ -465,7 +469,8 @@ TEST_CASE("stabilityEigenvalues by index: the O(n) counts and the small dense ro
       for (int first : {0, dim / 2, dim - 2}) {
         Vector mine(2), reference(2);
         REQUIRE(buckle::continuation::BoundProblem(problem).stabilityEigenvalues(u, lambda, first, mine));
-        REQUIRE(buckle::continuation::BoundProblem(dense).stabilityEigenvalues(u, lambda, first, reference));  // Problem's dense default
+        REQUIRE(buckle::continuation::BoundProblem(dense).stabilityEigenvalues(u, lambda, first,
+                                                                               reference));  // Problem's dense default
         CHECK((mine - reference).cwiseAbs().maxCoeff() <= 1e-11 * scale);
       }
       Vector beyond(2);
@@ -568,7 +573,8 @@ TEST_CASE("along a load path past many critical loads: the inertia and the value
       }
       if (c.n > 16) {  // the structured route (n ≤ 16: one small dense solve per point)
         CHECK(changes >= 4);  // the indices asked for moved along the path
-        const double perValue = double(EquilibriumProblem::structuredFactorizations(bound.workspace()) - before) / double(values);
+        const double perValue =
+            double(EquilibriumProblem::structuredFactorizations(bound.workspace()) - before) / double(values);
         INFO("factorizations per value " << perValue);
         CHECK(perValue <= 13.0);  // a bisection from ±‖H‖_F takes about 50, Newton from the last index's value 15 to 22
       }
@@ -666,8 +672,10 @@ TEST_CASE("stabilityRateBound bounds the rate of every eigenvalue of H on ker C 
         const int dim = n - int(C.rows());
         Vector plus(dim), minus(dim);
         const double h = 1e-6;
-        REQUIRE(buckle::continuation::BoundProblem(dense).stabilityEigenvalues(u + h * du, lambda + h * dlambda, 0, plus));
-        REQUIRE(buckle::continuation::BoundProblem(dense).stabilityEigenvalues(u - h * du, lambda - h * dlambda, 0, minus));
+        REQUIRE(
+            buckle::continuation::BoundProblem(dense).stabilityEigenvalues(u + h * du, lambda + h * dlambda, 0, plus));
+        REQUIRE(
+            buckle::continuation::BoundProblem(dense).stabilityEigenvalues(u - h * du, lambda - h * dlambda, 0, minus));
         const double rate = ((plus - minus) / (2.0 * h)).cwiseAbs().maxCoeff();
         // the difference quotient: O(h²) truncation, rounding ≈ ε‖H‖/h
         CHECK(rate <= bound + 1e-7 * std::max(1.0, H.norm()));
@@ -695,7 +703,8 @@ TEST_CASE("stabilityRateBound of the unconstrained chain is ‖dH‖_F, by diffe
   // the straight chain with x held: C = J_h is rank-deficient there, no finite bound
   EquilibriumProblem held(chain, EndCondition::heldPosition(chain.linkLengths().sum(), 0.0), Eigen::Vector3d(1, 0, 0));
   double none = 0.0;
-  CHECK_FALSE(buckle::continuation::BoundProblem(held).stabilityRateBound(Vector::Zero(held.dimension()), 0.0, Vector::Ones(held.dimension()), 1.0, none));
+  CHECK_FALSE(buckle::continuation::BoundProblem(held).stabilityRateBound(Vector::Zero(held.dimension()), 0.0,
+                                                                          Vector::Ones(held.dimension()), 1.0, none));
 }
 
 TEST_CASE("EquilibriumProblem's boundaries in one call equal boundary(k) one by one, also scaled", "[equilibrium]") {
@@ -775,8 +784,12 @@ TEST_CASE("One const EquilibriumProblem traced from two threads at once: each tr
   const Vector u0 = Vector::Zero(problem.dimension());
   using buckle::continuation::Branch;
   using buckle::continuation::InitialDirection;
-  auto compress = [&] { return buckle::continuation::trace(problem, u0, 0.0, InitialDirection::decreasingLambda(), options); };
-  auto stretch = [&] { return buckle::continuation::trace(problem, u0, 0.0, InitialDirection::increasingLambda(), options); };
+  auto compress = [&] {
+    return buckle::continuation::trace(problem, u0, 0.0, InitialDirection::decreasingLambda(), options);
+  };
+  auto stretch = [&] {
+    return buckle::continuation::trace(problem, u0, 0.0, InitialDirection::increasingLambda(), options);
+  };
   const Branch compressedAlone = compress(), stretchedAlone = stretch();
   int branchPoints = 0;
   for (const auto& sp : compressedAlone.specialPoints)

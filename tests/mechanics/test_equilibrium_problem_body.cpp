@@ -156,7 +156,8 @@ TEST_CASE("body loads in EquilibriumProblem: residual, Jacobian, F_lambda, secon
       // F_u's directional derivative and the O(n) second derivative along (du, dλ)
       Vector x(N + 1), z(N + 1);
       for (int i = 0; i <= N; ++i) x[i] = W(rng), z[i] = W(rng);
-      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianDirectionalDerivative(u, lambda, x.head(N), x[N], dFu, dFl));
+      REQUIRE(buckle::continuation::BoundProblem(problem).jacobianDirectionalDerivative(u, lambda, x.head(N), x[N], dFu,
+                                                                                        dFl));
       REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u + h * x.head(N), lambda + h * x[N], Jp, Jlp));
       REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u - h * x.head(N), lambda - h * x[N], Jm, Jlm));
       CHECK((dFu - (Jp - Jm) / (2 * h)).lpNorm<Eigen::Infinity>() <= 1e-6 * scale);
@@ -196,8 +197,10 @@ TEST_CASE("body loads in EquilibriumProblem: residual, Jacobian, F_lambda, secon
       double bound = 0.0;
       if (buckle::continuation::BoundProblem(problem).stabilityRateBound(u, lambda, x.head(N), x[N], bound)) {
         Matrix Hp, Cp, Hm, Cm;
-        REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u + h * x.head(N), lambda + h * x[N], Hp, Cp));
-        REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u - h * x.head(N), lambda - h * x[N], Hm, Cm));
+        REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u + h * x.head(N), lambda + h * x[N], Hp,
+                                                                              Cp));
+        REQUIRE(buckle::continuation::BoundProblem(problem).stabilityOperator(u - h * x.head(N), lambda - h * x[N], Hm,
+                                                                              Cm));
         if (C.rows() == 0) CHECK(((Hp - Hm) / (2 * h)).norm() <= bound * (1 + 1e-6) + 1e-6 * scale);
       }
     }

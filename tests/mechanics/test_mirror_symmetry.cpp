@@ -214,7 +214,8 @@ TEST_CASE("mirror: an image's base and self contacts, mirrored from its source, 
       ContactProblem contact(problem, p.locked);
       const cont::ContinuationPoint& at = branch.points[size_t(p.index)];
       double largest = 0.0;
-      for (const LockedJoint& l : p.locked.joints()) largest = std::max(largest, contact.compression(*contact.createWorkspace(), at.u, at.lambda, l.joint));
+      for (const LockedJoint& l : p.locked.joints())
+        largest = std::max(largest, contact.compression(*contact.createWorkspace(), at.u, at.lambda, l.joint));
       CHECK(p.contactTorque == largest);
     }
     if (branch.mirrorOf < 0) continue;

@@ -4,8 +4,8 @@
 
 namespace buckle::continuation {
 
-bool bifurcationCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef v, ConstVectorRef c,
-                             BifurcationCoefficients &out, std::string *why) {
+bool bifurcationCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef v,
+                             ConstVectorRef c, BifurcationCoefficients &out, std::string *why) {
   // the trivial branch is the parent with tangent (0, 1): p1 = p2 = 0 (branch_point_coefficients.h)
   const int n = problem.dimension();
   if (u0.size() != n || v.size() != n || c.size() != n) {

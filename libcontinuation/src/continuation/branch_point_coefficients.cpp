@@ -105,7 +105,8 @@ class DenseAlgebra final : public Algebra {
 /// (RefinedBorderedSystem): O(N) per solve and product for a chain.
 class StructuredAlgebra final : public Algebra {
  public:
-  StructuredAlgebra(const BoundProblem &problem, std::unique_ptr<BorderedSolver> solver, ConstVectorRef u0, double lambda)
+  StructuredAlgebra(const BoundProblem &problem, std::unique_ptr<BorderedSolver> solver, ConstVectorRef u0,
+                    double lambda)
       : problem_(problem),
         n_(problem.dimension()),
         solver_(std::move(solver)),
@@ -249,8 +250,9 @@ bool thirdOrder(const ThirdOrderInput &in, double factor, ThirdOrder &out) {
   return std::isfinite(out.b);
 }
 
-bool reduce(const BoundProblem &problem, Algebra &algebra, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
-            ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out, std::string *why) {
+bool reduce(const BoundProblem &problem, Algebra &algebra, ConstVectorRef u0, double lambdaC,
+            ConstVectorRef parentTangent, ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out,
+            std::string *why) {
   const int n = problem.dimension();
   const double cv = c.dot(v0);
   if (!(std::abs(cv) > 0.0) || !std::isfinite(cv))
@@ -414,9 +416,9 @@ bool scaledReduction(const BoundProblem &problem, const ProblemScales &s, ConstV
 
 }  // namespace
 
-bool branchPointCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
-                             ConstVectorRef v0, ConstVectorRef c, BranchPointCoefficients &out, std::string *why,
-                             CoefficientAlgebra algebra) {
+bool branchPointCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC,
+                             ConstVectorRef parentTangent, ConstVectorRef v0, ConstVectorRef c,
+                             BranchPointCoefficients &out, std::string *why, CoefficientAlgebra algebra) {
   const int n = problem.dimension();
   if (u0.size() != n || v0.size() != n || c.size() != n || parentTangent.size() != n + 1)
     return fail(why, "branch-point coefficients: u0, v and c must have the problem's dimension " + std::to_string(n) +
@@ -476,8 +478,8 @@ bool foldCoefficient(const BoundProblem &problem, const SpecialPoint &fold, Fold
   return std::isfinite(out.curvature);
 }
 
-bool branchPointCoefficients(const BoundProblem &problem, const SpecialPoint &bp, ConstVectorRef c, BranchPointCoefficients &out,
-                             std::string *why, CoefficientAlgebra algebra) {
+bool branchPointCoefficients(const BoundProblem &problem, const SpecialPoint &bp, ConstVectorRef c,
+                             BranchPointCoefficients &out, std::string *why, CoefficientAlgebra algebra) {
   const int n = problem.dimension();
   if (bp.type != SpecialPointType::BranchPoint || bp.u.size() != n || bp.tangent.size() != n + 1 ||
       bp.nullVectors.rows() != n + 1 || bp.nullVectors.cols() != 2)

@@ -30,8 +30,9 @@ void powerFit(const double y[3], double h, const int powers[3], Eigen::Vector3d 
 
 }  // namespace
 
-bool childBranchExpansion(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, const BranchPointCoefficients &g,
-                          ConstVectorRef c, ChildBranchExpansion &out, std::string *why, double amplitude) {
+bool childBranchExpansion(const BoundProblem &problem, ConstVectorRef u0, double lambdaC,
+                          const BranchPointCoefficients &g, ConstVectorRef c, ChildBranchExpansion &out,
+                          std::string *why, double amplitude) {
   const int n = problem.dimension();
   if (u0.size() != n || c.size() != n || g.v.size() != n || g.u2.size() != n)
     return fail(why, "child expansion: u0, c and the coefficients' vectors must have the problem's dimension");

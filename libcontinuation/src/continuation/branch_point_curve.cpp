@@ -50,7 +50,8 @@ bool BranchPointCurveProblem::residual(ProblemWorkspace &, ConstVectorRef W, dou
   return true;
 }
 
-bool BranchPointCurveProblem::jacobian(ProblemWorkspace &, ConstVectorRef W, double mu, MatrixRef GW, VectorRef Gmu) const {
+bool BranchPointCurveProblem::jacobian(ProblemWorkspace &, ConstVectorRef W, double mu, MatrixRef GW,
+                                       VectorRef Gmu) const {
   if (!problem_.setSecondParameter(mu)) return false;
   const double lambda = W[n_];
   const auto w = W.head(n_);
@@ -103,7 +104,8 @@ class BranchPointCurveSolver final : public BorderedSolver {
     const auto w = W.head(n_);
     const double lambda = W[n_];
     if (!problem_.parameterJacobianApply(inner_.workspace(), u0_, lambda, w, B_.col(0))) return Factorization::Refused;
-    if (!problem_.secondParameterDerivatives(inner_.workspace(), u0_, lambda, w, Fmu_, B_.col(1))) return Factorization::Refused;
+    if (!problem_.secondParameterDerivatives(inner_.workspace(), u0_, lambda, w, Fmu_, B_.col(1)))
+      return Factorization::Refused;
     C_.col(1) = cc.head(n_);
     D_(1, 0) = cc[n_];
     D_(1, 1) = cc[n_ + 1];

@@ -236,8 +236,8 @@ std::vector<Branch> switchBothSides(Tracer &tracer, const SpecialPoint &bp, cons
   return sides;
 }
 
-BranchTree traceTree(const BoundProblem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
-                     const TracerOptions &options, const TreeOptions &treeOptions) {
+BranchTree traceTree(const BoundProblem &problem, ConstVectorRef u0, double lambda0,
+                     const std::vector<InitialDirection> &starts, const TracerOptions &options, const TreeOptions &treeOptions) {
   BranchTree tree;
   Tracer tracer(problem, options);
   std::unique_ptr<Tracer> childTracer;  // only when the children have options of their own

@@ -121,8 +121,8 @@ bool exactJacobian(const BoundProblem &problem, ConstVectorRef u, double lambda,
 
 // d/dε [F_u F_λ](z + εx) by central differences of the exact jacobian(); the step is relative
 // to the point in the scaled variables, like Problem's default.
-bool differencedSecondDerivative(const BoundProblem &problem, const Scaling &scaling, double relativeStep, ConstVectorRef u,
-                                 double lambda, const Vector &x, Matrix &dF) {
+bool differencedSecondDerivative(const BoundProblem &problem, const Scaling &scaling, double relativeStep,
+                                 ConstVectorRef u, double lambda, const Vector &x, Matrix &dF) {
   const int n = problem.dimension();
   Vector z(n + 1);
   z << u, lambda;
@@ -135,8 +135,8 @@ bool differencedSecondDerivative(const BoundProblem &problem, const Scaling &sca
   return dF.allFinite();
 }
 
-void compareProductsOfJacobian(const BoundProblem &problem, ConstVectorRef u, double lambda, const Matrix &J, const Vector &x,
-                               const Vector &w, const Scaling &scaling, DerivativeCheck &check) {
+void compareProductsOfJacobian(const BoundProblem &problem, ConstVectorRef u, double lambda, const Matrix &J,
+                               const Vector &x, const Vector &w, const Scaling &scaling, DerivativeCheck &check) {
   const int n = problem.dimension();
   Vector y(n), yt(n + 1);
   if (problem.jacobianApply(u, lambda, x, y) && y.allFinite())
@@ -151,9 +151,9 @@ void compareProductsOfJacobian(const BoundProblem &problem, ConstVectorRef u, do
     check.comparisons.push_back(refused("jacobianTransposeApply"));
 }
 
-void compareSecondDerivatives(const BoundProblem &problem, ConstVectorRef u, double lambda, const Vector &x, const Vector &z,
-                              const Vector &w, const Scaling &scaling, const DerivativeCheckOptions &options,
-                              DerivativeCheck &check) {
+void compareSecondDerivatives(const BoundProblem &problem, ConstVectorRef u, double lambda, const Vector &x,
+                              const Vector &z, const Vector &w, const Scaling &scaling,
+                              const DerivativeCheckOptions &options, DerivativeCheck &check) {
   const int n = problem.dimension();
   Matrix dFnumeric;
   const char *names[] = {"jacobianDirectionalDerivative", "secondDerivativeApply", "secondDerivativeTransposeApply"};

@@ -212,8 +212,8 @@ bool MinimalFoldCurveProblem::evaluateGradient(ConstVectorRef U, double mu) cons
   return cachedGradient_;
 }
 
-bool MinimalFoldCurveProblem::gradient(ConstVectorRef U, double mu, double &g, Vector &gx, double &gmu,
-                                       Vector &Flambda, Vector &Fmu) const {
+bool MinimalFoldCurveProblem::gradient(ConstVectorRef U, double mu, double &g, Vector &gx, double &gmu, Vector &Flambda,
+                                       Vector &Fmu) const {
   if (!evaluateGradient(U, mu)) return false;
   g = g_;
   gx = gx_;
@@ -230,7 +230,8 @@ bool MinimalFoldCurveProblem::residual(ProblemWorkspace &, ConstVectorRef U, dou
   return true;
 }
 
-bool MinimalFoldCurveProblem::jacobian(ProblemWorkspace &, ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) const {
+bool MinimalFoldCurveProblem::jacobian(ProblemWorkspace &, ConstVectorRef U, double mu, MatrixRef GU,
+                                       VectorRef Gmu) const {
   if (!evaluateGradient(U, mu)) return false;
   if (!inner_.jacobian(U.head(n_), U[n_], GU.topLeftCorner(n_, n_), GU.col(n_).head(n_))) return false;
   GU.row(n_) = gx_.transpose();
@@ -239,7 +240,8 @@ bool MinimalFoldCurveProblem::jacobian(ProblemWorkspace &, ConstVectorRef U, dou
   return true;
 }
 
-bool MinimalFoldCurveProblem::jacobianApply(ProblemWorkspace &, ConstVectorRef U, double mu, ConstVectorRef x, VectorRef y) const {
+bool MinimalFoldCurveProblem::jacobianApply(ProblemWorkspace &, ConstVectorRef U, double mu, ConstVectorRef x,
+                                            VectorRef y) const {
   if (!evaluateGradient(U, mu)) return false;
   if (!inner_.jacobianApply(U.head(n_), U[n_], x.head(n_ + 1), y.head(n_))) return false;
   y.head(n_) += x[n_ + 1] * Fmu_;
@@ -247,7 +249,8 @@ bool MinimalFoldCurveProblem::jacobianApply(ProblemWorkspace &, ConstVectorRef U
   return y.allFinite();
 }
 
-bool MinimalFoldCurveProblem::jacobianTransposeApply(ProblemWorkspace &, ConstVectorRef U, double mu, ConstVectorRef w, VectorRef y) const {
+bool MinimalFoldCurveProblem::jacobianTransposeApply(ProblemWorkspace &, ConstVectorRef U, double mu, ConstVectorRef w,
+                                                     VectorRef y) const {
   if (!evaluateGradient(U, mu)) return false;
   if (!inner_.jacobianTransposeApply(U.head(n_), U[n_], w.head(n_), y.head(n_ + 1))) return false;
   y.head(n_ + 1) += w[n_] * gx_;

@@ -2,7 +2,8 @@
 
 namespace buckle::continuation {
 
-bool GradientProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const {
+bool GradientProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H,
+                                        Matrix &C) const {
   const int n = dimension();
   H.setZero(n, n);  // a Jacobian may write its nonzeros only
   C.resize(0, n);

@@ -16,7 +16,8 @@ namespace buckle::continuation {
 
 using namespace locator_detail;
 
-Locator::Locator(const BoundProblem &problem, Corrector &corrector, PointEvaluator &evaluator, const LocatorOptions &options)
+Locator::Locator(const BoundProblem &problem, Corrector &corrector, PointEvaluator &evaluator,
+                 const LocatorOptions &options)
     : problem_(problem), corrector_(corrector), evaluator_(evaluator), options_(options), n_(problem.dimension()) {
   std::string why;
   if (!options_.IsValid(&why)) throw std::invalid_argument("LocatorOptions: " + why);

@@ -361,8 +361,8 @@ class ReducedEquation {
   bool secondOk_ = true;
 };
 
-bool solveReduced(const BoundProblem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out, double kernelTolerance,
-                  int maxDenseDimension) {
+bool solveReduced(const BoundProblem &problem, const SpecialPoint &bp, int m, ReducedBifurcation &out,
+                  double kernelTolerance, int maxDenseDimension) {
   return ReducedEquation(problem, bp, m, out).solve(kernelTolerance, maxDenseDimension);
 }
 
@@ -383,8 +383,8 @@ Matrix orthonormalColumns(const Matrix &X) {
 
 }  // namespace
 
-bool structuredMultipleKernel(const BoundProblem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda, int m,
-                              Matrix &K, Matrix &Psi, double &residual, std::string *why) {
+bool structuredMultipleKernel(const BoundProblem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda,
+                              int m, Matrix &K, Matrix &Psi, double &residual, std::string *why) {
   const int n = problem.dimension();
   const int k = m + 1;
   if (m < 1 || m > n || solver.maxGeneralBorder() < k) {
@@ -461,8 +461,8 @@ bool structuredMultipleKernel(const BoundProblem &problem, BorderedSolver &solve
   return true;
 }
 
-bool reducedBifurcationDirections(const BoundProblem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
-                                  double kernelTolerance, int maxDenseDimension) {
+bool reducedBifurcationDirections(const BoundProblem &problem, const SpecialPoint &bp, int multiplicity,
+                                  ReducedBifurcation &out, double kernelTolerance, int maxDenseDimension) {
   // In the problem's scaled variables (as bifurcatingDirection); directions back in its units.
   const int n = problem.dimension();
   const ProblemScales scales = problem.scales();

@@ -13,8 +13,7 @@ std::string NumericDiffOptions::validate(const std::string &prefix) const {
 }
 
 bool differenceJacobian(const BoundProblem &problem, const ProblemScales &scales, double relativeStep, ConstVectorRef u,
-                        double lambda, MatrixRef Fu, VectorRef Fl, VectorRef work, VectorRef Fplus,
-                        VectorRef Fminus) {
+                        double lambda, MatrixRef Fu, VectorRef Fl, VectorRef work, VectorRef Fplus, VectorRef Fminus) {
   const Eigen::Index n = u.size();
   work = u;
   // Column j = n is F_λ. The step is the representable difference of the two abscissae, so the
@@ -62,8 +61,8 @@ const ProblemScales &NumericDiffProblem::cachedScales(Workspace &nd) const {
   return nd.scales;
 }
 
-double NumericDiffProblem::directionStep(Workspace &nd, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                         double relative) const {
+double NumericDiffProblem::directionStep(Workspace &nd, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                         double dlambda, double relative) const {
   const ProblemScales &s = cachedScales(nd);
   // In the scaled variables (where "1" is a typical size), as Problem's default second derivative.
   const double size = std::max({1.0, u.cwiseQuotient(s.unknowns).lpNorm<Eigen::Infinity>(),
@@ -72,14 +71,17 @@ double NumericDiffProblem::directionStep(Workspace &nd, ConstVectorRef u, double
   return length == 0.0 ? 0.0 : relative * size / length;
 }
 
-bool NumericDiffProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const {
+bool NumericDiffProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu,
+                                  VectorRef Flambda) const {
   Workspace &nd = workspaceAs<Workspace>(ws);
   const ProblemScales &s = cachedScales(nd);
-  return differenceJacobian(BoundProblem(*this, ws), s, options_.relativeStep, u, lambda, Fu, Flambda, nd.work, nd.Fplus, nd.Fminus);
+  return differenceJacobian(BoundProblem(*this, ws), s, options_.relativeStep, u, lambda, Fu, Flambda, nd.work,
+                            nd.Fplus, nd.Fminus);
 }
 
-bool NumericDiffProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
-                                                       double dlambda, MatrixRef dFu, VectorRef dFlambda) const {
+bool NumericDiffProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda,
+                                                       ConstVectorRef du, double dlambda, MatrixRef dFu,
+                                                       VectorRef dFlambda) const {
   Workspace &nd = workspaceAs<Workspace>(ws);
   const ProblemScales &s = cachedScales(nd);
   const double delta = options_.secondRelativeStep;
@@ -91,12 +93,12 @@ bool NumericDiffProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, Con
   }
   // nd.corner holds the shifted u while differenceJacobian perturbs its own copy (nd.work).
   nd.corner = u + h * du;
-  if (!differenceJacobian(BoundProblem(*this, ws), s, delta, nd.corner, lambda + h * dlambda, nd.Jplus.leftCols(dimension()),
-                          nd.Jplus.col(dimension()), nd.work, nd.Fplus, nd.Fminus))
+  if (!differenceJacobian(BoundProblem(*this, ws), s, delta, nd.corner, lambda + h * dlambda,
+                          nd.Jplus.leftCols(dimension()), nd.Jplus.col(dimension()), nd.work, nd.Fplus, nd.Fminus))
     return false;
   nd.corner = u - h * du;
-  if (!differenceJacobian(BoundProblem(*this, ws), s, delta, nd.corner, lambda - h * dlambda, nd.Jminus.leftCols(dimension()),
-                          nd.Jminus.col(dimension()), nd.work, nd.Fplus, nd.Fminus))
+  if (!differenceJacobian(BoundProblem(*this, ws), s, delta, nd.corner, lambda - h * dlambda,
+                          nd.Jminus.leftCols(dimension()), nd.Jminus.col(dimension()), nd.work, nd.Fplus, nd.Fminus))
     return false;
   const int n = dimension();
   dFu = (nd.Jplus.leftCols(n) - nd.Jminus.leftCols(n)) / (2.0 * h);
@@ -104,8 +106,8 @@ bool NumericDiffProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, Con
   return dFu.allFinite() && dFlambda.allFinite();
 }
 
-bool NumericDiffProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
-                                               VectorRef y) const {
+bool NumericDiffProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                               ConstVectorRef z, VectorRef y) const {
   Workspace &nd = workspaceAs<Workspace>(ws);
   const int n = dimension();
   const double delta = options_.secondRelativeStep;
@@ -128,8 +130,8 @@ bool NumericDiffProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVector
   return y.allFinite();
 }
 
-bool NumericDiffProblem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
-                                                        ConstVectorRef w, VectorRef y) const {
+bool NumericDiffProblem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda,
+                                                        ConstVectorRef x, ConstVectorRef w, VectorRef y) const {
   Workspace &nd = workspaceAs<Workspace>(ws);
   const int n = dimension();
   cachedScales(nd);

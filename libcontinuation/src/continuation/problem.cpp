@@ -56,7 +56,9 @@ double differenceStep(const Problem &problem, ConstVectorRef u, double lambda, C
 
 ProblemWorkspace::~ProblemWorkspace() = default;
 
-std::unique_ptr<BorderedSolver> BoundProblem::makeStructuredSolver() const { return problem_->makeStructuredSolver(*ws_); }
+std::unique_ptr<BorderedSolver> BoundProblem::makeStructuredSolver() const {
+  return problem_->makeStructuredSolver(*ws_);
+}
 
 void throwForeignWorkspace() {
   throw std::invalid_argument("a ProblemWorkspace evaluated by a problem that did not make it (createWorkspace)");
@@ -83,7 +85,8 @@ bool Problem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef
   return true;
 }
 
-bool Problem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const {
+bool Problem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                            VectorRef y) const {
   const int n = dimension();
   ws.applyFu.resize(n, n + 1);
   if (!jacobian(ws, u, lambda, ws.applyFu.leftCols(n), ws.applyFu.col(n))) return false;
@@ -91,7 +94,8 @@ bool Problem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambd
   return true;
 }
 
-bool Problem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) const {
+bool Problem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w,
+                                     VectorRef y) const {
   const int n = dimension();
   ws.applyFu.resize(n, n + 1);
   if (!jacobian(ws, u, lambda, ws.applyFu.leftCols(n), ws.applyFu.col(n))) return false;
@@ -99,8 +103,8 @@ bool Problem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, dou
   return true;
 }
 
-bool Problem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
-                                             VectorRef y) const {
+bool Problem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                             ConstVectorRef w, VectorRef y) const {
   const int n = dimension();
   const double h = differenceStep(*this, u, lambda, x.head(n), x[n]);
   if (h == 0.0) {
@@ -114,7 +118,8 @@ bool Problem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRe
   return y.allFinite();
 }
 
-bool Problem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z, VectorRef y) const {
+bool Problem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                    ConstVectorRef z, VectorRef y) const {
   const int n = dimension();
   ws.secondFu.resize(n, n);
   ws.secondFl.resize(n);
@@ -130,16 +135,18 @@ void Problem::boundaries(ProblemWorkspace &ws, ConstVectorRef u, double lambda, 
   for (Eigen::Index k = 0; k < g.size(); ++k) g[k] = boundary(ws, static_cast<int>(k), u, lambda);
 }
 
-bool Problem::stabilityOperator(ProblemWorkspace &, ConstVectorRef, double, Matrix&, Matrix&) const { return false; }
+bool Problem::stabilityOperator(ProblemWorkspace &, ConstVectorRef, double, Matrix &, Matrix &) const { return false; }
 
-bool Problem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount, StabilityInfo& info) const {
+bool Problem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount,
+                        StabilityInfo &info) const {
   if (!hasStabilityOperator()) return false;
   if (!stabilityOperator(ws, u, lambda, ws.stabilityH, ws.stabilityC)) return false;
   info = projectedInertia(ws.stabilityH, ws.stabilityC, 1e-13, lowestCount, scales().stability);
   return true;
 }
 
-bool Problem::stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first, VectorRef values) const {
+bool Problem::stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first,
+                                   VectorRef values) const {
   if (!hasStabilityOperator() || first < 0) return false;
   if (!stabilityOperator(ws, u, lambda, ws.stabilityH, ws.stabilityC)) return false;
   const StabilityInfo all =

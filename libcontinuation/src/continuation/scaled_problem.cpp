@@ -160,24 +160,28 @@ bool ScaledProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double lamb
   return true;
 }
 
-bool ScaledProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const {
+bool ScaledProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu,
+                             VectorRef Flambda) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   if (!sw.inner.jacobian(user(sw, u), lambda * units_.parameter(), Fu, Flambda)) return false;
   scaleJacobian(Fu, Flambda);
   return true;
 }
 
-bool ScaledProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                                  MatrixRef dFu, VectorRef dFlambda) const {
+bool ScaledProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda,
+                                                  ConstVectorRef du, double dlambda, MatrixRef dFu,
+                                                  VectorRef dFlambda) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   sw.du = du.cwiseProduct(units_.scales().unknowns);
   const double lp = units_.parameter();
-  if (!sw.inner.jacobianDirectionalDerivative(user(sw, u), lambda * lp, sw.du, dlambda * lp, dFu, dFlambda)) return false;
+  if (!sw.inner.jacobianDirectionalDerivative(user(sw, u), lambda * lp, sw.du, dlambda * lp, dFu, dFlambda))
+    return false;
   scaleJacobian(dFu, dFlambda);
   return true;
 }
 
-bool ScaledProblem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const {
+bool ScaledProblem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                  VectorRef y) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   // F̃_x x̃ = D_F⁻¹ F_x S x̃, S = diag(D_u, λ₀).
   sw.x.resize(n_ + 1);
@@ -188,7 +192,8 @@ bool ScaledProblem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double
   return true;
 }
 
-bool ScaledProblem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) const {
+bool ScaledProblem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w,
+                                           VectorRef y) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   // F̃_xᵀ w̃ = S F_xᵀ D_F⁻¹ w̃.
   sw.w = w.cwiseQuotient(units_.scales().residuals);
@@ -198,8 +203,8 @@ bool ScaledProblem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef 
   return true;
 }
 
-bool ScaledProblem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
-                                                   ConstVectorRef w, VectorRef y) const {
+bool ScaledProblem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda,
+                                                   ConstVectorRef x, ConstVectorRef w, VectorRef y) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   // F̃(x̃) = D_F⁻¹ F(S x̃): (F̃_xx[x̃, ·])ᵀ w̃ = S (F_xx[S x̃, ·])ᵀ D_F⁻¹ w̃.
   sw.x.resize(n_ + 1);
@@ -212,8 +217,8 @@ bool ScaledProblem::secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVe
   return true;
 }
 
-bool ScaledProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
-                                          VectorRef y) const {
+bool ScaledProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                          ConstVectorRef z, VectorRef y) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   // F̃_xx[x̃, z̃] = D_F⁻¹ F_xx[S x̃, S z̃]: the problem's own (exact, O(N)) product.
   sw.x.resize(n_ + 1);
@@ -227,14 +232,16 @@ bool ScaledProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u
   return true;
 }
 
-bool ScaledProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const {
+bool ScaledProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H,
+                                      Matrix &C) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   if (!sw.inner.stabilityOperator(user(sw, u), lambda * units_.parameter(), H, C)) return false;
   H /= units_.scales().stability;
   return true;
 }
 
-bool ScaledProblem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount, StabilityInfo &info) const {
+bool ScaledProblem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount,
+                              StabilityInfo &info) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   if (!sw.inner.stability(user(sw, u), lambda * units_.parameter(), lowestCount, info)) return false;
   info.lowest /= units_.scales().stability;
@@ -242,18 +249,20 @@ bool ScaledProblem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lam
   return true;
 }
 
-bool ScaledProblem::stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first, VectorRef values) const {
+bool ScaledProblem::stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first,
+                                         VectorRef values) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   if (!sw.inner.stabilityEigenvalues(user(sw, u), lambda * units_.parameter(), first, values)) return false;
   values /= units_.scales().stability;
   return true;
 }
 
-bool ScaledProblem::stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                       double &bound) const {
+bool ScaledProblem::stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                       double dlambda, double &bound) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   sw.du = du.cwiseProduct(units_.scales().unknowns);
-  if (!sw.inner.stabilityRateBound(user(sw, u), lambda * units_.parameter(), sw.du, dlambda * units_.parameter(), bound))
+  if (!sw.inner.stabilityRateBound(user(sw, u), lambda * units_.parameter(), sw.du, dlambda * units_.parameter(),
+                                   bound))
     return false;
   bound /= units_.scales().stability;
   return true;

@@ -8,7 +8,8 @@ namespace buckle::continuation {
 
 namespace {
 
-bool eigenvaluesAt(const BoundProblem &problem, ConstVectorRef u, double lambda, int first, int count, Eigen::Vector2d &out) {
+bool eigenvaluesAt(const BoundProblem &problem, ConstVectorRef u, double lambda, int first, int count,
+                   Eigen::Vector2d &out) {
   return problem.stabilityEigenvalues(u, lambda, first, out.head(count)) && out.head(count).allFinite();
 }
 

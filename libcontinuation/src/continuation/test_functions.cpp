@@ -198,8 +198,8 @@ bool bifurcationRoots(double a, double b, double c, ConstVectorRef k1, ConstVect
                       std::string *why);
 }  // namespace
 
-bool bifurcationDirections(const BoundProblem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi, ConstVectorRef k1,
-                           ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why) {
+bool bifurcationDirections(const BoundProblem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi,
+                           ConstVectorRef k1, ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why) {
   const int n = problem.dimension();
   Matrix D1(n, n + 1), D2(n, n + 1);
   if (!problem.jacobianDirectionalDerivative(u, lambda, k1.head(n), k1[n], D1.leftCols(n), D1.col(n)) ||

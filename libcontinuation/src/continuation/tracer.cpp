@@ -52,7 +52,6 @@ bool retryShorter(const ContinuationPoint &a, const ContinuationPoint &b, double
 
 }  // namespace
 
-
 Tracer::Tracer(const BoundProblem &problem, const TracerOptions &options)
     : problem_(problem), options_(options), n_(problem.dimension()), work_(problem) {
   // Invalid input is reported by trace()/continueBranch() as StopReason::InvalidOptions, never

@@ -36,9 +36,18 @@ bool withinLimits(const Chain& chain, const Vector& q) {
 class DeflatedNewton {
  public:
   DeflatedNewton(EquilibriumProblem& problem, const AllEquilibriaOptions& options)
-      : problem_(problem), bound_(problem), options_(options), n_(problem.segments()), N_(problem.dimension()),
-        scale_(problem.scales().residuals), unknownScale_(problem.scales().unknowns), F_(N_), trial_(N_), Fu_(N_, N_),
-        Fl_(N_), gradLog_(n_) {}
+      : problem_(problem),
+        bound_(problem),
+        options_(options),
+        n_(problem.segments()),
+        N_(problem.dimension()),
+        scale_(problem.scales().residuals),
+        unknownScale_(problem.scales().unknowns),
+        F_(N_),
+        trial_(N_),
+        Fu_(N_, N_),
+        Fl_(N_),
+        gradLog_(n_) {}
 
   const std::vector<Vector>& roots() const { return roots_; }
   void deflate(const Vector& q) { roots_.push_back(q); }

@@ -290,7 +290,8 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
       ContactProblem held(problem, pr.locked);
       pr.wallForces = held.wallForces(*held.createWorkspace(), p.u, p.lambda);
       for (const LockedJoint& l : pr.locked.joints())
-        pr.contactTorque = std::max(pr.contactTorque, held.compression(*held.createWorkspace(), p.u, p.lambda, l.joint));
+        pr.contactTorque =
+            std::max(pr.contactTorque, held.compression(*held.createWorkspace(), p.u, p.lambda, l.joint));
     } else if (!pr.locked.empty() && cont::BoundProblem(problem).residual(p.u, p.lambda, torques)) {
       // The compression −side·τ_c of each locked joint (ContactProblem::compression), its contact
       // torque τ_c the free equilibrium's row: one residual for all of them.

@@ -11,7 +11,8 @@ using continuation::ConstVectorRef;
 using continuation::Factorization;
 using continuation::VectorRef;
 
-ChainBorderedSolver::ChainBorderedSolver(const EquilibriumProblem& problem, continuation::ProblemWorkspace& problemWorkspace)
+ChainBorderedSolver::ChainBorderedSolver(const EquilibriumProblem& problem,
+                                         continuation::ProblemWorkspace& problemWorkspace)
     : problem_(problem),
       problemWorkspace_(problemWorkspace),
       n_(problem.segments()),
@@ -34,13 +35,16 @@ Factorization ChainBorderedSolver::factor(ConstVectorRef u, double lambda, Const
   sign_ = 0;
   logAbs_ = -std::numeric_limits<double>::infinity();
   usingDense_ = false;
-  if (!c.allFinite() || !problem_.assembleStructure(problemWorkspace_, u, lambda, ws_, J_)) return Factorization::Refused;
+  if (!c.allFinite() || !problem_.assembleStructure(problemWorkspace_, u, lambda, ws_, J_))
+    return Factorization::Refused;
   // Borders: V = [−J_hᵀ, F_λ,q], W = [−J_hᵀ, c_q], D = [[0, F_λ,r], [c_rᵀ, c_λ]] (see header).
   const Eigen::Vector3d& dir = problem_.direction();
   V_.col(m_).setZero();
   for (int cc : loaded_) V_.col(m_) -= J_.row(cc).transpose() * dir[cc];
-  if (problem_.controlled()) V_.col(m_) += EquilibriumProblem::controlRate(problemWorkspace_);  // moving free lengths (equilibrium_problem.h)
-  if (problem_.hasBodyLoads()) V_.col(m_) -= EquilibriumProblem::bodyRateTorques(problemWorkspace_);  // body loads growing with λ (eq B2)
+  if (problem_.controlled())
+    V_.col(m_) += EquilibriumProblem::controlRate(problemWorkspace_);  // moving free lengths (equilibrium_problem.h)
+  if (problem_.hasBodyLoads())
+    V_.col(m_) -= EquilibriumProblem::bodyRateTorques(problemWorkspace_);  // body loads growing with λ (eq B2)
   D_.setZero();
   for (int k = 0; k < m_; ++k) {
     const int h = held_[size_t(k)];

@@ -189,7 +189,7 @@ ContactProblem::Workspace::Workspace(const ContactProblem& problem)
 
 std::unique_ptr<ProblemWorkspace> ContactProblem::createWorkspace() const { return std::make_unique<Workspace>(*this); }
 
-bool ContactProblem::wallKinematics(ProblemWorkspace &ws, ConstVectorRef q) const {
+bool ContactProblem::wallKinematics(ProblemWorkspace& ws, ConstVectorRef q) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int w = locked_.wallCount();
   if (w == 0) return true;
@@ -204,7 +204,7 @@ bool ContactProblem::wallKinematics(ProblemWorkspace &ws, ConstVectorRef q) cons
   return true;
 }
 
-bool ContactProblem::baseRowsWithWall(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const {
+bool ContactProblem::baseRowsWithWall(ProblemWorkspace& ws, ConstVectorRef u, double lambda, VectorRef F) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension(), n = base_.segments(), w = locked_.wallCount();
   if (!base_.residual(*d.base, u.head(N), lambda, F)) return false;
@@ -214,11 +214,13 @@ bool ContactProblem::baseRowsWithWall(ProblemWorkspace &ws, ConstVectorRef u, do
   return true;
 }
 
-Vector ContactProblem::wallForces(ProblemWorkspace &ws, ConstVectorRef u, double lambda) const {
+Vector ContactProblem::wallForces(ProblemWorkspace& ws, ConstVectorRef u, double lambda) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension(), w = locked_.wallCount();
   Vector mu = Vector::Constant(w, std::numeric_limits<double>::quiet_NaN());
-  if (w == 0 || !base_.residual(*d.base, u.head(N), lambda, d.residual) || !wallKinematics(ws, u.head(base_.segments()))) return mu;
+  if (w == 0 || !base_.residual(*d.base, u.head(N), lambda, d.residual) ||
+      !wallKinematics(ws, u.head(base_.segments())))
+    return mu;
   // the free joints' rows: R_F = G_Fᵀ μ (the locked rows carry the joints' own contact torques)
   Matrix A(Eigen::Index(free_.size()), w);
   Vector b(Eigen::Index(free_.size()));
@@ -231,7 +233,7 @@ Vector ContactProblem::wallForces(ProblemWorkspace &ws, ConstVectorRef u, double
   return mu;
 }
 
-Vector ContactProblem::withWallForces(ProblemWorkspace &ws, ConstVectorRef u, double lambda) const {
+Vector ContactProblem::withWallForces(ProblemWorkspace& ws, ConstVectorRef u, double lambda) const {
   const int N = base_.dimension();
   Vector full(dimension());
   full.head(N) = u.head(N);
@@ -239,7 +241,7 @@ Vector ContactProblem::withWallForces(ProblemWorkspace &ws, ConstVectorRef u, do
   return full;
 }
 
-double ContactProblem::contactTorque(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int joint) const {
+double ContactProblem::contactTorque(ProblemWorkspace& ws, ConstVectorRef u, double lambda, int joint) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const bool withForces = u.size() == dimension();
   const Vector full = withForces ? Vector(u) : withWallForces(ws, u, lambda);
@@ -247,11 +249,11 @@ double ContactProblem::contactTorque(ProblemWorkspace &ws, ConstVectorRef u, dou
   return d.residual[joint];
 }
 
-double ContactProblem::compression(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int joint) const {
+double ContactProblem::compression(ProblemWorkspace& ws, ConstVectorRef u, double lambda, int joint) const {
   return -double(int(locked_.side(joint))) * contactTorque(ws, u, lambda, joint);
 }
 
-bool ContactProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const {
+bool ContactProblem::residual(ProblemWorkspace& ws, ConstVectorRef u, double lambda, VectorRef F) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension();
   if (!baseRowsWithWall(ws, u, lambda, F.head(N))) return false;
@@ -260,7 +262,8 @@ bool ContactProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double lam
   return true;
 }
 
-bool ContactProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const {
+bool ContactProblem::jacobian(ProblemWorkspace& ws, ConstVectorRef u, double lambda, MatrixRef Fu,
+                              VectorRef Flambda) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension(), n = base_.segments(), w = locked_.wallCount();
   if (!base_.jacobian(*d.base, u.head(N), lambda, Fu.topLeftCorner(N, N), Flambda.head(N))) return false;
@@ -286,8 +289,9 @@ bool ContactProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lam
   return true;
 }
 
-bool ContactProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
-                                                   double dlambda, MatrixRef dFu, VectorRef dFlambda) const {
+bool ContactProblem::jacobianDirectionalDerivative(ProblemWorkspace& ws, ConstVectorRef u, double lambda,
+                                                   ConstVectorRef du, double dlambda, MatrixRef dFu,
+                                                   VectorRef dFlambda) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   // With wall vertices, the central differences of jacobian() (the locked rows stay linear).
   if (locked_.wallCount() > 0) return Problem::jacobianDirectionalDerivative(ws, u, lambda, du, dlambda, dFu, dFlambda);
@@ -299,7 +303,8 @@ bool ContactProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVe
   return true;
 }
 
-bool ContactProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const {
+bool ContactProblem::stabilityOperator(ProblemWorkspace& ws, ConstVectorRef u, double lambda, Matrix& H,
+                                       Matrix& C) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   Matrix Ch;
   const int N = base_.dimension(), n = base_.segments(), w = locked_.wallCount();
@@ -316,7 +321,8 @@ bool ContactProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, d
   return true;
 }
 
-bool ContactProblem::assembleFull(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ChainStructure& full, MatrixRef J) const {
+bool ContactProblem::assembleFull(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ChainStructure& full,
+                                  MatrixRef J) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension(), w = locked_.wallCount();
   if (!base_.assembleStructure(*d.base, u.head(N), lambda, full, J)) return false;
@@ -328,7 +334,8 @@ bool ContactProblem::assembleFull(ProblemWorkspace &ws, ConstVectorRef u, double
   return true;
 }
 
-bool ContactProblem::assembleReduced(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ChainStructure& structure, MatrixRef Jf) const {
+bool ContactProblem::assembleReduced(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ChainStructure& structure,
+                                     MatrixRef Jf) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (free_.empty() || !assembleFull(ws, u, lambda, d.full, d.J)) return false;
   reduceToFreeJoints(d.full, free_, d.kf, d.hf, structure);
@@ -336,7 +343,8 @@ bool ContactProblem::assembleReduced(ProblemWorkspace &ws, ConstVectorRef u, dou
   return true;
 }
 
-bool ContactProblem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount, continuation::StabilityInfo& info) const {
+bool ContactProblem::stability(ProblemWorkspace& ws, ConstVectorRef u, double lambda, int lowestCount,
+                               continuation::StabilityInfo& info) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (free_.empty()) {  // every joint locked: nothing can move
     if (!residual(ws, u, lambda, d.residual)) return false;
@@ -380,7 +388,7 @@ int ContactProblem::wallReleaseBoundary(int k) const {
 }
 int ContactProblem::boundaryCount() const { return wallReleaseBoundary(locked_.wallCount()); }
 
-double ContactProblem::boundary(ProblemWorkspace &ws, int k, ConstVectorRef u, double lambda) const {
+double ContactProblem::boundary(ProblemWorkspace& ws, int k, ConstVectorRef u, double lambda) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int n = base_.segments(), N = base_.dimension();
   if (k == wallClearanceBoundary()) return nearestWallVertex(base_.chain(), u.head(n), locked_.wall()).distance;

@@ -30,8 +30,8 @@ ConstrainedEquilibrium solveConstrainedEquilibrium(const EquilibriumProblem& bas
   const int D = problem.dimension();  // N + the wall forces
   Vector start = u0;
   for (const LockedJoint& l : locked.joints()) start[l.joint] = limitAngle(base.chain(), l.joint, l.side);
-  Vector u = problem.withWallForces(bound.workspace(), start, lambda), F(D), trial(D), b = Vector::Zero(D + 1), dx(D + 1),
-         c = Vector::Zero(D + 1);
+  Vector u = problem.withWallForces(bound.workspace(), start, lambda), F(D), trial(D), b = Vector::Zero(D + 1),
+         dx(D + 1), c = Vector::Zero(D + 1);
   c[D] = 1.0;  // fixed λ: the border row e_λ
   if (!u.allFinite()) u.tail(D - N).setZero();  // no free row to read the forces from: start at 0
   auto scaledNorm = [&](const Vector& r) { return r.cwiseQuotient(s.residuals).cwiseAbs().maxCoeff(); };
@@ -80,12 +80,13 @@ ConstrainedEquilibrium solveConstrainedEquilibrium(const EquilibriumProblem& bas
   return out;
 }
 
-continuation::StabilityInfo constrainedStability(const EquilibriumProblem& base, const ContactSet& locked, ConstVectorRef u,
-                                                 double lambda, int lowestCount) {
+continuation::StabilityInfo constrainedStability(const EquilibriumProblem& base, const ContactSet& locked,
+                                                 ConstVectorRef u, double lambda, int lowestCount) {
   const ContactProblem problem(base, locked);
   const continuation::BoundProblem bound(problem);  // this solve's workspace
   continuation::StabilityInfo info;
-  const Vector full = u.size() == problem.dimension() ? Vector(u) : problem.withWallForces(bound.workspace(), u, lambda);
+  const Vector full =
+      u.size() == problem.dimension() ? Vector(u) : problem.withWallForces(bound.workspace(), u, lambda);
   if (!bound.stability(full, lambda, lowestCount, info)) info.negative = -1;
   return info;
 }

@@ -51,14 +51,16 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
         y_(p_) {
     for (const LockedJoint& l : problem.contacts().joints()) lockedIndex_.push_back(l.joint);
     if (n_ + m_ + w_ <= kDenseFallback || p_ > ChainStructure::kMaxBorder)
-      dense_ = std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
+      dense_ =
+          std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
   }
 
   Factorization factor(ConstVectorRef u, double lambda, ConstVectorRef c) override {
     sign_ = 0;
     logAbs_ = -std::numeric_limits<double>::infinity();
     usingDense_ = false;
-    if (!c.allFinite() || !problem_.assembleFull(problemWorkspace_, u, lambda, full_, J_)) return Factorization::Refused;
+    if (!c.allFinite() || !problem_.assembleFull(problemWorkspace_, u, lambda, full_, J_))
+      return Factorization::Refused;
     if (p_ > ChainStructure::kMaxBorder) {  // more borders than the chain structure holds
       usingDense_ = true;
       const Factorization f = dense_->factor(u, lambda, c);
@@ -69,7 +71,8 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
     c_ = c;
     reduceToFreeJoints(full_, free_, kf_, hf_, ws_);
     const Eigen::Vector3d& dir = problem_.base().direction();
-    grad_ = ContactProblem::wallGradients(problemWorkspace_);  // a copy: the problem's is rewritten by the next evaluation
+    grad_ =
+        ContactProblem::wallGradients(problemWorkspace_);  // a copy: the problem's is rewritten by the next evaluation
     const Matrix& grad = grad_;
     const int nf = int(free_.size()), last = p_ - 1;
     D_.setZero();
@@ -77,7 +80,9 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
       const int i = free_[size_t(a)];
       double fl = 0.0;
       for (int cc : loaded_) fl -= J_(cc, i) * dir[cc];
-      if (problem_.base().hasBodyLoads()) fl -= EquilibriumProblem::bodyRateTorques(*workspaceAs<ContactProblem::Workspace>(problemWorkspace_).base)[i];  // eq (B2)
+      if (problem_.base().hasBodyLoads())
+        fl -= EquilibriumProblem::bodyRateTorques(
+            *workspaceAs<ContactProblem::Workspace>(problemWorkspace_).base)[i];  // eq (B2)
       V_(a, last) = fl;
       W_(a, last) = c[i];
       for (int k = 0; k < m_; ++k) V_(a, k) = W_(a, k) = -J_(held_[size_t(k)], i);
@@ -145,7 +150,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
 
 }  // namespace
 
-std::unique_ptr<continuation::BorderedSolver> ContactProblem::makeStructuredSolver(ProblemWorkspace &ws) const {
+std::unique_ptr<continuation::BorderedSolver> ContactProblem::makeStructuredSolver(ProblemWorkspace& ws) const {
   if (free_.empty()) return std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(*this, ws));
   return std::make_unique<ReducedChainSolver>(*this, ws);
 }

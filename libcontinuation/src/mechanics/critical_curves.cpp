@@ -139,7 +139,9 @@ void addZeroLoadPoints(ChainParameterProblem& problem, const cont::Branch& branc
   const double scale = problem.secondParameterScale();
   auto smallest = [&](double mu, double& g) {
     cont::StabilityInfo info;
-    if (!problem.setSecondParameter(mu) || !cont::BoundProblem(problem).stability(u0, 0.0, 1, info) || info.lowest.size() < 1) return false;
+    if (!problem.setSecondParameter(mu) || !cont::BoundProblem(problem).stability(u0, 0.0, 1, info) ||
+        info.lowest.size() < 1)
+      return false;
     g = info.lowest[0];
     return true;
   };
@@ -214,7 +216,8 @@ CriticalCurve branchPointCurve(ChainParameterProblem& problem, int mode, const C
   const cont::ProblemScales scales = eq.scales();
   Vector F(N);
   for (double lambda : {0.0, scales.parameter}) {
-    if (!cont::BoundProblem(eq).residual(u0, lambda, F) || F.cwiseQuotient(scales.residuals).lpNorm<Eigen::Infinity>() > 1e-12)
+    if (!cont::BoundProblem(eq).residual(u0, lambda, F) ||
+        F.cwiseQuotient(scales.residuals).lpNorm<Eigen::Infinity>() > 1e-12)
       throw std::invalid_argument(
           "branch-point curve: the straight chain is not an equilibrium along the load path (unequal preloads, "
           "an off-axis load or a held coordinate off the axis)");

@@ -189,7 +189,7 @@ bool ChainParameterProblem::setSecondParameter(double mu) {
   return true;
 }
 
-std::unique_ptr<cont::BorderedSolver> ChainParameterProblem::makeStructuredSolver(cont::ProblemWorkspace &ws) const {
+std::unique_ptr<cont::BorderedSolver> ChainParameterProblem::makeStructuredSolver(cont::ProblemWorkspace& ws) const {
   return std::make_unique<ChainParameterSolver>(*this, ws);
 }
 
@@ -202,8 +202,8 @@ cont::ProblemWorkspace& ChainParameterProblem::equilibriumWorkspace(cont::Proble
   return *w.equilibrium;
 }
 
-bool ChainParameterProblem::parameterJacobianApply(cont::ProblemWorkspace &, cont::ConstVectorRef u, double lambda, cont::ConstVectorRef v,
-                                                   cont::VectorRef FuLambdaV) const {
+bool ChainParameterProblem::parameterJacobianApply(cont::ProblemWorkspace&, cont::ConstVectorRef u, double lambda,
+                                                   cont::ConstVectorRef v, cont::VectorRef FuLambdaV) const {
   const Chain& chain = equilibrium_->chain();
   const int n = chain.size();
   const int N = equilibrium_->dimension();
@@ -237,8 +237,9 @@ double ChainParameterProblem::secondParameterScale() const {
   }
 }
 
-bool ChainParameterProblem::secondParameterDerivatives(cont::ProblemWorkspace &, cont::ConstVectorRef u, double lambda, cont::ConstVectorRef v,
-                                                       cont::VectorRef Fmu, cont::VectorRef FuMuV) const {
+bool ChainParameterProblem::secondParameterDerivatives(cont::ProblemWorkspace&, cont::ConstVectorRef u, double lambda,
+                                                       cont::ConstVectorRef v, cont::VectorRef Fmu,
+                                                       cont::VectorRef FuMuV) const {
   const Chain& chain = equilibrium_->chain();
   const int n = chain.size();
   const int N = equilibrium_->dimension();

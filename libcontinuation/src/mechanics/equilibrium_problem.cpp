@@ -19,8 +19,8 @@ namespace buckle::mechanics {
 using continuation::ConstVectorRef;
 using continuation::MatrixRef;
 using continuation::ProblemWorkspace;
-using continuation::workspaceAs;
 using continuation::VectorRef;
+using continuation::workspaceAs;
 
 namespace {
 // How far past a geometric limit points are still evaluated while the joint limits are traced
@@ -61,9 +61,9 @@ std::string EquilibriumOptions::validate(const std::string& prefix) const {
                      prefix, "heldRange.low", "must be finite and not exceed heldRange.high")});
 }
 
-EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end,
-                                       const Eigen::Vector3d& direction, EquilibriumOptions options,
-                                       const ControlDirection& control, const BodyLoads& body)
+EquilibriumProblem::EquilibriumProblem(const Chain& chain, const EndCondition& end, const Eigen::Vector3d& direction,
+                                       EquilibriumOptions options, const ControlDirection& control,
+                                       const BodyLoads& body)
     : chain_(chain),
       end_(end),
       direction_(direction),
@@ -124,7 +124,8 @@ EquilibriumProblem::Workspace::Workspace(const EquilibriumProblem& problem)
     controlGrad.resize(problem.segments());
     controlStiff.resize(problem.segments());
   }
-  structure.typicalScale = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();  // the inertia's zero floor
+  structure.typicalScale =
+      problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();  // the inertia's zero floor
 }
 
 std::unique_ptr<ProblemWorkspace> EquilibriumProblem::createWorkspace() const {
@@ -222,7 +223,7 @@ bool EquilibriumProblem::inDomain(const ConstVectorRef& u) const {
   return true;
 }
 
-bool EquilibriumProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const {
+bool EquilibriumProblem::residual(ProblemWorkspace& ws, ConstVectorRef u, double lambda, VectorRef F) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
@@ -239,7 +240,8 @@ bool EquilibriumProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double
   return true;
 }
 
-bool EquilibriumProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const {
+bool EquilibriumProblem::jacobian(ProblemWorkspace& ws, ConstVectorRef u, double lambda, MatrixRef Fu,
+                                  VectorRef Flambda) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
@@ -282,8 +284,9 @@ bool EquilibriumProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double
   return true;
 }
 
-bool EquilibriumProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
-                                                       double dlambda, MatrixRef dFu, VectorRef dFlambda) const {
+bool EquilibriumProblem::jacobianDirectionalDerivative(ProblemWorkspace& ws, ConstVectorRef u, double lambda,
+                                                       ConstVectorRef du, double dlambda, MatrixRef dFu,
+                                                       VectorRef dFlambda) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
@@ -325,7 +328,8 @@ bool EquilibriumProblem::jacobianDirectionalDerivative(ProblemWorkspace &ws, Con
   return true;
 }
 
-bool EquilibriumProblem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const {
+bool EquilibriumProblem::jacobianApply(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                       VectorRef y) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
@@ -355,7 +359,8 @@ bool EquilibriumProblem::jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, d
   return y.allFinite();
 }
 
-bool EquilibriumProblem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) const {
+bool EquilibriumProblem::jacobianTransposeApply(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ConstVectorRef w,
+                                                VectorRef y) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int n = chain_.size();
   const int N = dimension();
@@ -373,8 +378,8 @@ bool EquilibriumProblem::jacobianTransposeApply(ProblemWorkspace &ws, ConstVecto
   return std::isfinite(dot);
 }
 
-bool EquilibriumProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
-                                               VectorRef y) const {
+bool EquilibriumProblem::secondDerivativeApply(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                               ConstVectorRef z, VectorRef y) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!std::isfinite(lambda) || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
@@ -409,7 +414,8 @@ bool EquilibriumProblem::secondDerivativeApply(ProblemWorkspace &ws, ConstVector
   return y.allFinite();
 }
 
-bool EquilibriumProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const {
+bool EquilibriumProblem::stabilityOperator(ProblemWorkspace& ws, ConstVectorRef u, double lambda, Matrix& H,
+                                           Matrix& C) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!prepare(d, u, lambda)) return false;
   const int n = chain_.size();
@@ -424,7 +430,8 @@ bool EquilibriumProblem::stabilityOperator(ProblemWorkspace &ws, ConstVectorRef 
   return true;
 }
 
-void EquilibriumProblem::assembleFromCache(Workspace& d, const ConstVectorRef& u, double lambda, ChainStructure& ws) const {
+void EquilibriumProblem::assembleFromCache(Workspace& d, const ConstVectorRef& u, double lambda,
+                                           ChainStructure& ws) const {
   loadGenerator(d, u, lambda, ws.h);
   assemble(d.stiff, ws.h, ws);
 }
@@ -443,8 +450,8 @@ bool EquilibriumProblem::smallDenseSpectrum(Workspace& d, const ConstVectorRef& 
   // Bitwise, like prepare(d, ): the key was stored after prepare(d, u) accepted these very bits, so a
   // hit needs neither the domain check nor the q-cache (which may hold another q by now, e.g.
   // the certified counting's point off the branch).
-  if (d.spectrumSize >= 0 && size_t(d.spectrumKey.size()) == N + 1 &&
-      sameBits(u.data(), d.spectrumKey.data(), N) && sameBits(&lambda, d.spectrumKey.data() + N, 1))
+  if (d.spectrumSize >= 0 && size_t(d.spectrumKey.size()) == N + 1 && sameBits(u.data(), d.spectrumKey.data(), N) &&
+      sameBits(&lambda, d.spectrumKey.data() + N, 1))
     return true;
   d.spectrumSize = -1;
   if (!prepare(d, u, lambda)) return false;
@@ -465,7 +472,7 @@ bool EquilibriumProblem::smallDenseSpectrum(Workspace& d, const ConstVectorRef& 
   return true;
 }
 
-bool EquilibriumProblem::stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount,
+bool EquilibriumProblem::stability(ProblemWorkspace& ws, ConstVectorRef u, double lambda, int lowestCount,
                                    continuation::StabilityInfo& info) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!options_.structuredStability) return Problem::stability(ws, u, lambda, lowestCount, info);
@@ -502,7 +509,7 @@ bool EquilibriumProblem::stability(ProblemWorkspace &ws, ConstVectorRef u, doubl
   return true;
 }
 
-bool EquilibriumProblem::stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first,
+bool EquilibriumProblem::stabilityEigenvalues(ProblemWorkspace& ws, ConstVectorRef u, double lambda, int first,
                                               continuation::VectorRef values) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!options_.structuredStability) return Problem::stabilityEigenvalues(ws, u, lambda, first, values);
@@ -535,7 +542,7 @@ bool EquilibriumProblem::stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorR
   return true;
 }
 
-std::unique_ptr<continuation::BorderedSolver> EquilibriumProblem::makeStructuredSolver(ProblemWorkspace &ws) const {
+std::unique_ptr<continuation::BorderedSolver> EquilibriumProblem::makeStructuredSolver(ProblemWorkspace& ws) const {
   return std::make_unique<ChainBorderedSolver>(*this, ws);
 }
 

@@ -18,7 +18,8 @@ void EquilibriumProblem::loadGenerator(Workspace& d, const ConstVectorRef& u, do
   for (int m = 0; m < n; ++m) h[m] -= d.bodyTerms.gammaAt(m, lambda);  // eq (B3)
 }
 
-void EquilibriumProblem::bodyGeneratorDerivative(Workspace& d, const ConstVectorRef& dq, double lambda, double dlambda) const {
+void EquilibriumProblem::bodyGeneratorDerivative(Workspace& d, const ConstVectorRef& dq, double lambda,
+                                                 double dlambda) const {
   d.bodyTerms.generatorDerivative(lambda, dq, dlambda, d.bodyWork);  // eq (B5)
 }
 

@@ -13,15 +13,15 @@ namespace buckle::mechanics {
 
 using continuation::ConstVectorRef;
 using continuation::ProblemWorkspace;
-using continuation::workspaceAs;
 using continuation::VectorRef;
+using continuation::workspaceAs;
 
 int EquilibriumProblem::boundaryCount() const { return wallBoundaryIndex() + (options_.wallAsBoundary ? 1 : 0); }
 
 // A joint limit is the joint angle at the limit itself, geometric (the closing spring's length
 // is zero, or |c1 − c2|) or the user's: the spring model is regular there (inDomain,
 // equilibrium_problem.cpp).
-double EquilibriumProblem::boundary(ProblemWorkspace &ws, int k, ConstVectorRef u, double lambda) const {
+double EquilibriumProblem::boundary(ProblemWorkspace& ws, int k, ConstVectorRef u, double lambda) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int n = chain_.size();
   if (options_.wallAsBoundary && k == wallBoundaryIndex()) return nearestWallVertex(chain_, u.head(n)).distance;
@@ -31,7 +31,8 @@ double EquilibriumProblem::boundary(ProblemWorkspace &ws, int k, ConstVectorRef 
     // A slack of 1e-12 of the range's scale keeps a start on the range end inside: the path's
     // start value is the same pose summed by another route (endPose), equal to a few ulp.
     const EquilibriumOptions::CoordinateRange& range = options_.heldRange;
-    const double v = prepare(d, u, lambda) ? d.data.pose[range.coordinate] : endPose(chain_, u.head(n))[range.coordinate];
+    const double v =
+        prepare(d, u, lambda) ? d.data.pose[range.coordinate] : endPose(chain_, u.head(n))[range.coordinate];
     const double slack = 1e-12 * std::max({range.high - range.low, std::abs(range.low), std::abs(range.high)});
     return r == 0 ? v - range.low + slack : range.high - v + slack;
   }
@@ -39,7 +40,7 @@ double EquilibriumProblem::boundary(ProblemWorkspace &ws, int k, ConstVectorRef 
   return u[k - n] - chain_.lowerLimits()[k - n];
 }
 
-void EquilibriumProblem::boundaries(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef g) const {
+void EquilibriumProblem::boundaries(ProblemWorkspace& ws, ConstVectorRef u, double lambda, VectorRef g) const {
   const int n = chain_.size();
   const Eigen::Index count = g.size();
   const int limits = rangeBoundaryBegin();

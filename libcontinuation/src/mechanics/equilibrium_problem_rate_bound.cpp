@@ -12,8 +12,8 @@ using continuation::workspaceAs;
 
 using continuation::ConstVectorRef;
 
-bool EquilibriumProblem::stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                            double& bound) const {
+bool EquilibriumProblem::stabilityRateBound(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                            double dlambda, double& bound) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();

@@ -75,8 +75,9 @@ RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn
     rp.polished.u = problem.initialGuess(dyn.q, lambda);
     rp.polished.message = "not polished";
     Vector F(problem.dimension());
-    rp.polished.residual =
-        cont::BoundProblem(problem).residual(rp.polished.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+    rp.polished.residual = cont::BoundProblem(problem).residual(rp.polished.u, lambda, F)
+                               ? F.cwiseAbs().maxCoeff()
+                               : std::numeric_limits<double>::infinity();
     return rp;
   }
   if (!anyContact(rp.sides)) {
@@ -242,7 +243,8 @@ PolishResult polishEquilibrium(EquilibriumProblem& problem, ConstVectorRef q, do
   result.message = summary.flagName;
   if (!summary.message.empty()) result.message += ": " + summary.message;
   Vector F(N);
-  result.residual = cont::BoundProblem(problem).residual(result.u, lambda, F) ? F.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+  result.residual = cont::BoundProblem(problem).residual(result.u, lambda, F) ? F.cwiseAbs().maxCoeff()
+                                                                              : std::numeric_limits<double>::infinity();
   return result;
 }
 

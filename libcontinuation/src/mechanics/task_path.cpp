@@ -108,7 +108,9 @@ TaskPathProblem::Workspace::Workspace(const TaskPathProblem& problem)
   structure.typicalScale = problem.stiffnessUnit_ * problem.lengthUnit_ * problem.lengthUnit_;
 }
 
-std::unique_ptr<ProblemWorkspace> TaskPathProblem::createWorkspace() const { return std::make_unique<Workspace>(*this); }
+std::unique_ptr<ProblemWorkspace> TaskPathProblem::createWorkspace() const {
+  return std::make_unique<Workspace>(*this);
+}
 
 Vector TaskPathProblem::pack(ConstVectorRef q, ConstVectorRef p) const {
   Vector u = Vector::Zero(dim_);
@@ -129,7 +131,7 @@ Chain TaskPathProblem::chainAt(ConstVectorRef p) const {
   return chainWithControls(chain_, d, 1.0);
 }
 
-bool TaskPathProblem::prepare(ProblemWorkspace &ws, ConstVectorRef u) const {
+bool TaskPathProblem::prepare(ProblemWorkspace& ws, ConstVectorRef u) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (u.size() != dim_ || !u.allFinite()) return false;
   // the cache depends on (q, p) only; the tracer evaluates F, F_u and the boundaries at one point
@@ -178,7 +180,7 @@ void TaskPathProblem::inputColumns(const Eigen::MatrixX2d& e, Matrix& out) const
     out.col(j) = rates_[size_t(j)].col(0).cwiseProduct(e.col(0)) + rates_[size_t(j)].col(1).cwiseProduct(e.col(1));
 }
 
-bool TaskPathProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double s, VectorRef F) const {
+bool TaskPathProblem::residual(ProblemWorkspace& ws, ConstVectorRef u, double s, VectorRef F) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!prepare(ws, u)) return false;
   const Vector t = target(s);
@@ -204,7 +206,7 @@ bool TaskPathProblem::residual(ProblemWorkspace &ws, ConstVectorRef u, double s,
   return true;
 }
 
-bool TaskPathProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fs) const {
+bool TaskPathProblem::jacobian(ProblemWorkspace& ws, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fs) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!prepare(ws, u)) return false;
   Fu.setZero();
@@ -244,7 +246,8 @@ bool TaskPathProblem::jacobian(ProblemWorkspace &ws, ConstVectorRef u, double, M
   return true;
 }
 
-void TaskPathProblem::optimalityBlocks(ProblemWorkspace &ws, ConstVectorRef u, Vector& diagA, Vector& genA, Matrix& D) const {
+void TaskPathProblem::optimalityBlocks(ProblemWorkspace& ws, ConstVectorRef u, Vector& diagA, Vector& genA,
+                                       Matrix& D) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const auto mu = u.segment(n_ + mIn_, n_);
   const auto nu = u.segment(2 * n_ + mIn_, m_);
@@ -269,7 +272,8 @@ void TaskPathProblem::optimalityBlocks(ProblemWorkspace &ws, ConstVectorRef u, V
   D = mu.asDiagonal() * D;
 }
 
-bool TaskPathProblem::assembleOptimality(ProblemWorkspace &ws, ConstVectorRef u, ChainStructure& structure, OptimalityBlocks& blocks) const {
+bool TaskPathProblem::assembleOptimality(ProblemWorkspace& ws, ConstVectorRef u, ChainStructure& structure,
+                                         OptimalityBlocks& blocks) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (setup_.rule != TaskRule::MinimumChange || !prepare(ws, u)) return false;
   structure.typicalScale = d.structure.typicalScale;
@@ -283,7 +287,8 @@ bool TaskPathProblem::assembleOptimality(ProblemWorkspace &ws, ConstVectorRef u,
   return true;
 }
 
-bool TaskPathProblem::assembleStructure(ProblemWorkspace &ws, ConstVectorRef u, ChainStructure& structure, Matrix& B, Matrix& Jc) const {
+bool TaskPathProblem::assembleStructure(ProblemWorkspace& ws, ConstVectorRef u, ChainStructure& structure, Matrix& B,
+                                        Matrix& Jc) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!prepare(ws, u)) return false;
   structure.typicalScale = d.structure.typicalScale;
@@ -294,7 +299,8 @@ bool TaskPathProblem::assembleStructure(ProblemWorkspace &ws, ConstVectorRef u, 
   return true;
 }
 
-bool TaskPathProblem::fixedInputStability(ProblemWorkspace &ws, ConstVectorRef u, Inertia& inertia, double& smallest) const {
+bool TaskPathProblem::fixedInputStability(ProblemWorkspace& ws, ConstVectorRef u, Inertia& inertia,
+                                          double& smallest) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!prepare(ws, u)) return false;
   assemble(d.stiff, d.h, d.structure);
@@ -307,7 +313,7 @@ bool TaskPathProblem::fixedInputStability(ProblemWorkspace &ws, ConstVectorRef u
   return true;
 }
 
-double TaskPathProblem::boundary(ProblemWorkspace &ws, int k, ConstVectorRef u, double) const {
+double TaskPathProblem::boundary(ProblemWorkspace& ws, int k, ConstVectorRef u, double) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (k < n_) return chain_.upperLimits()[k] - u[k];
   if (k < 2 * n_) return u[k - n_] - chain_.lowerLimits()[k - n_];
@@ -355,7 +361,7 @@ std::string TaskPathProblem::boundaryName(int k) const {
   return "loss of stability at fixed inputs (smallest eigenvalue of K_q - K_g crosses zero)";
 }
 
-std::unique_ptr<continuation::BorderedSolver> TaskPathProblem::makeStructuredSolver(ProblemWorkspace &ws) const {
+std::unique_ptr<continuation::BorderedSolver> TaskPathProblem::makeStructuredSolver(ProblemWorkspace& ws) const {
   if (setup_.rule == TaskRule::MinimumChange)
     return mIn_ + m_ + 2 <= TaskPathKktSolver::kMaxSmall ? std::make_unique<TaskPathKktSolver>(*this, ws) : nullptr;
   if (mIn_ + 3 > ChainStructure::kMaxBorder) return nullptr;

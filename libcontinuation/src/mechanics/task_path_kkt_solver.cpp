@@ -28,7 +28,8 @@ TaskPathKktSolver::TaskPathKktSolver(const TaskPathProblem& problem, continuatio
       ws_(problem.segments()),
       work1_(problem.segments()),
       work2_(problem.segments()) {
-  if (N_ <= kDenseFallback) dense_ = std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
+  if (N_ <= kDenseFallback)
+    dense_ = std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
 }
 
 // K⁻¹ = [[0, H⁻¹], [H⁻¹, −H⁻¹ A H⁻¹]] (header): x_q = H⁻¹ f_μ, x_μ = H⁻¹ (f_q − A x_q).

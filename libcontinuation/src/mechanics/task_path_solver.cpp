@@ -11,10 +11,16 @@ using continuation::ConstVectorRef;
 using continuation::Factorization;
 using continuation::VectorRef;
 
-TaskPathBorderedSolver::TaskPathBorderedSolver(const TaskPathProblem& problem, continuation::ProblemWorkspace& problemWorkspace)
+TaskPathBorderedSolver::TaskPathBorderedSolver(const TaskPathProblem& problem,
+                                               continuation::ProblemWorkspace& problemWorkspace)
     : problem_(problem),
-      problemWorkspace_(problemWorkspace), n_(problem.segments()), m_(problem.taskCount()), ws_(problem.segments()), x_(Vector::Zero(n_)) {
-  if (problem.dimension() <= kDenseFallback) dense_ = std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
+      problemWorkspace_(problemWorkspace),
+      n_(problem.segments()),
+      m_(problem.taskCount()),
+      ws_(problem.segments()),
+      x_(Vector::Zero(n_)) {
+  if (problem.dimension() <= kDenseFallback)
+    dense_ = std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
 }
 
 template <class DenseFactor>

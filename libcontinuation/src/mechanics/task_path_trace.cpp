@@ -36,7 +36,8 @@ double taskLegLength(const TaskSetup& setup, const Vector& from, const Vector& t
   return std::sqrt(sum);
 }
 
-bool taskPathPoint(const TaskPathProblem& problem, cont::ProblemWorkspace& workspace, const Vector& u, double s, bool stiffness, TaskPathPoint& out) {
+bool taskPathPoint(const TaskPathProblem& problem, cont::ProblemWorkspace& workspace, const Vector& u, double s,
+                   bool stiffness, TaskPathPoint& out) {
   const int n = problem.segments();
   out.s = s;
   out.q = u.head(n);
@@ -172,7 +173,8 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
         return result;
       case cont::StopReason::Boundary: {
         const cont::SpecialPoint& sp = b.specialPoints.back();
-        result.specials.push_back(special(problem, bound.workspace(), sp, boundaryEvent(problem, sp.boundaryName), leg, options.stiffness));
+        result.specials.push_back(
+            special(problem, bound.workspace(), sp, boundaryEvent(problem, sp.boundaryName), leg, options.stiffness));
         result.end = result.specials.back().event;
         result.message = sp.boundaryName;
         return result;

@@ -31,7 +31,7 @@ struct BifurcationCoefficients {
 /// Coefficients of the branch bifurcating from the trivial branch u0 at λc; v approximates the
 /// null vector of F_u(u0, λc) (rescaled so that cᵀv = 1). False with the reason in `why` when
 /// the problem refuses a point, the branch point is not simple or not transversal.
-bool bifurcationCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef v, ConstVectorRef c,
-                             BifurcationCoefficients &out, std::string *why = nullptr);
+bool bifurcationCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef v,
+                             ConstVectorRef c, BifurcationCoefficients &out, std::string *why = nullptr);
 
 }  // namespace buckle::continuation

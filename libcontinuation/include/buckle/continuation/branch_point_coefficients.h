@@ -71,13 +71,15 @@ constexpr int kDenseCoefficientDimension = 60;
 /// refined, then rescaled so that cᵀv = 1). False with the reason in `why` when the problem
 /// refuses a point, F_u is not singular there, the parent is vertical (a fold), the point is
 /// not transversal, or (structured) the problem's solver cannot factor the bordered F_u.
-bool branchPointCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, ConstVectorRef parentTangent,
-                             ConstVectorRef v, ConstVectorRef c, BranchPointCoefficients &out,
-                             std::string *why = nullptr, CoefficientAlgebra algebra = CoefficientAlgebra::Automatic);
+bool branchPointCoefficients(const BoundProblem &problem, ConstVectorRef u0, double lambdaC,
+                             ConstVectorRef parentTangent, ConstVectorRef v, ConstVectorRef c,
+                             BranchPointCoefficients &out, std::string *why = nullptr,
+                             CoefficientAlgebra algebra = CoefficientAlgebra::Automatic);
 
 /// Same at a branch point located by the tracer (bp.tangent the parent's, v from bp.nullVectors).
-bool branchPointCoefficients(const BoundProblem &problem, const SpecialPoint &bp, ConstVectorRef c, BranchPointCoefficients &out,
-                             std::string *why = nullptr, CoefficientAlgebra algebra = CoefficientAlgebra::Automatic);
+bool branchPointCoefficients(const BoundProblem &problem, const SpecialPoint &bp, ConstVectorRef c,
+                             BranchPointCoefficients &out, std::string *why = nullptr,
+                             CoefficientAlgebra algebra = CoefficientAlgebra::Automatic);
 
 /// λ(s) = λ0 + ½λ''s² + … through a located fold (u = u0 + s v, |v| = 1): λ'' = −ψᵀF_uu[v, v] /
 /// ψᵀF_λ. Where λ'' is zero to its accuracy (its terms' rounding and the point's location error)
@@ -88,7 +90,8 @@ struct FoldCoefficient {
   double accuracy = 0.0;
   bool cusp = false;
 };
-bool foldCoefficient(const BoundProblem &problem, const SpecialPoint &fold, FoldCoefficient &out, std::string *why = nullptr);
+bool foldCoefficient(const BoundProblem &problem, const SpecialPoint &fold, FoldCoefficient &out,
+                     std::string *why = nullptr);
 
 /// The child's λ(ξ) beyond b, from the child itself: at a degenerate pitchfork (|b| ≤ bAccuracy)
 /// the quartic term decides which side the branch lies on (Golubitsky & Schaeffer ch. VI: the
@@ -104,8 +107,8 @@ struct ChildBranchExpansion {
   double amplitude = 0.0;                          ///< h, in the units of ξ = cᵀ(u − u0)
 };
 
-bool childBranchExpansion(const BoundProblem &problem, ConstVectorRef u0, double lambdaC, const BranchPointCoefficients &g,
-                          ConstVectorRef c, ChildBranchExpansion &out, std::string *why = nullptr,
-                          double amplitude = 0.0);
+bool childBranchExpansion(const BoundProblem &problem, ConstVectorRef u0, double lambdaC,
+                          const BranchPointCoefficients &g, ConstVectorRef c, ChildBranchExpansion &out,
+                          std::string *why = nullptr, double amplitude = 0.0);
 
 }  // namespace buckle::continuation

@@ -51,7 +51,7 @@ class BranchPointCurveProblem final : public Problem {
 
  private:
   TwoParameterProblem &problem_;  // μ is set on it at every evaluation
-  BoundProblem inner_;             // its evaluations (a workspace of this curve problem's own)
+  BoundProblem inner_;            // its evaluations (a workspace of this curve problem's own)
   int n_;
   Vector u0_, c_;
   // As FoldCurveProblem (fold_curve.h): one computation's object, its scratch its own.

@@ -40,8 +40,8 @@ struct BranchSwitchingOptions {
 /// `structured`: the bifurcation equation from O(N) products (bifurcationDirectionsApplied) and
 /// bp.leftNullVector required, no N×N matrix (switchBothSides: above the tracer's
 /// maxDenseLocationDimension).
-bool bifurcatingDirection(const BoundProblem &problem, const SpecialPoint &bp, Vector &direction, std::string *note = nullptr,
-                          bool structured = false);
+bool bifurcatingDirection(const BoundProblem &problem, const SpecialPoint &bp, Vector &direction,
+                          std::string *note = nullptr, bool structured = false);
 
 /// A new branch leaving bp along sign·direction: point 0 is the branch point itself, point 1
 /// the first corrected point (confirmed off the parent branch), then traced with `tracer`.
@@ -120,8 +120,9 @@ struct TreeOptions {
 /// branches and points are those of tracing it whole first, but an interrupted tree holds the
 /// branches of a root's first branch points (the weakest, along a load path from zero) however
 /// many it has further on.
-BranchTree traceTree(const BoundProblem &problem, ConstVectorRef u0, double lambda0, const std::vector<InitialDirection> &starts,
-                     const TracerOptions &options, const TreeOptions &tree);
+BranchTree traceTree(const BoundProblem &problem, ConstVectorRef u0, double lambda0,
+                     const std::vector<InitialDirection> &starts, const TracerOptions &options,
+                     const TreeOptions &tree);
 
 /// One start direction: traceTree(problem, u0, λ0, {direction}, options, {branchSwitching, switching}).
 BranchTree traceTree(const BoundProblem &problem, ConstVectorRef u0, double lambda0, const InitialDirection &direction,

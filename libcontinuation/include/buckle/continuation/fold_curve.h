@@ -64,7 +64,7 @@ class FoldCurveProblem final : public Problem {
   // A curve problem sets μ on its base problem at every evaluation, so it is one computation's
   // object (not shared between threads), and keeps its scratch itself.
   TwoParameterProblem &problem_;  // μ is set on it at every evaluation
-  BoundProblem inner_;             // its evaluations (a workspace of this curve problem's own)
+  BoundProblem inner_;            // its evaluations (a workspace of this curve problem's own)
   int n_;
   Vector c_;
   mutable Matrix Fu_, dFu_;
@@ -105,7 +105,8 @@ class MinimalFoldCurveProblem final : public Problem {
   bool jacobian(ProblemWorkspace &ws, ConstVectorRef U, double mu, MatrixRef GU, VectorRef Gmu) const override;
   /// O(N) products with [[F_u, F_λ, F_μ], [g_uᵀ, g_λ, g_μ]] and its transpose.
   bool jacobianApply(ProblemWorkspace &ws, ConstVectorRef U, double mu, ConstVectorRef x, VectorRef y) const override;
-  bool jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef U, double mu, ConstVectorRef w, VectorRef y) const override;
+  bool jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef U, double mu, ConstVectorRef w,
+                              VectorRef y) const override;
   /// u in the problem's scales, λ in its parameter scale; rows: F in the residual scales, g 1;
   /// μ in secondParameterScale().
   ProblemScales scales() const override;
@@ -138,7 +139,7 @@ class MinimalFoldCurveProblem final : public Problem {
 
   // As FoldCurveProblem: one computation's object, its scratch and caches its own.
   TwoParameterProblem &problem_;  // μ is set on it at every evaluation
-  BoundProblem inner_;             // its evaluations (a workspace of this curve problem's own)
+  BoundProblem inner_;            // its evaluations (a workspace of this curve problem's own)
   int n_;
   std::unique_ptr<BorderedSolver> solver_;  // the base problem's, for g, v, w
   std::unique_ptr<RefinedBorderedSystem> system_;

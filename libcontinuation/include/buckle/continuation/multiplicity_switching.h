@@ -51,8 +51,8 @@ constexpr int kMaxDenseMultiplePointDimension = 400;
 /// direction is found. Above N = maxDenseDimension the kernels come from structuredMultipleKernel
 /// instead of a dense SVD (through the problem's structured solver when it takes m + 1 borders,
 /// else dense LU).
-bool reducedBifurcationDirections(const BoundProblem &problem, const SpecialPoint &bp, int multiplicity, ReducedBifurcation &out,
-                                  double kernelTolerance = 1e-7,
+bool reducedBifurcationDirections(const BoundProblem &problem, const SpecialPoint &bp, int multiplicity,
+                                  ReducedBifurcation &out, double kernelTolerance = 1e-7,
                                   int maxDenseDimension = kMaxDenseMultiplePointDimension);
 
 /// The kernel of F_x = [F_u, F_λ] at a point of multiplicity m without a dense SVD: K ((N+1)×(m+1))
@@ -64,8 +64,8 @@ bool reducedBifurcationDirections(const BoundProblem &problem, const SpecialPoin
 /// the first's kernels as borders (then G is as well conditioned as the point allows); solves
 /// refined on the problem's own products (RefinedBorderedSystem). `residual` receives
 /// max(‖F_x K‖, ‖Psiᵀ F_x‖) column-wise. False with `why` when a factorization fails.
-bool structuredMultipleKernel(const BoundProblem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda, int m,
-                              Matrix &K, Matrix &Psi, double &residual, std::string *why = nullptr);
+bool structuredMultipleKernel(const BoundProblem &problem, BorderedSolver &solver, ConstVectorRef u, double lambda,
+                              int m, Matrix &K, Matrix &Psi, double &residual, std::string *why = nullptr);
 
 /// Children of the multiple point bp, both sides of every direction, traced with `tracer`; sets
 /// bp.branchesPredicted (2 per direction) and bp.branchesFound (children that left bp along their

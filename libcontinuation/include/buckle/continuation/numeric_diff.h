@@ -43,8 +43,7 @@ struct NumericDiffOptions {
 /// so that a hot loop does not rebuild them). False when a perturbed point is refused. The
 /// workspace vectors (size N) are the caller's, so nothing is allocated.
 bool differenceJacobian(const BoundProblem &problem, const ProblemScales &scales, double relativeStep, ConstVectorRef u,
-                        double lambda, MatrixRef Fu, VectorRef Fl, VectorRef work, VectorRef Fplus,
-                        VectorRef Fminus);
+                        double lambda, MatrixRef Fu, VectorRef Fl, VectorRef work, VectorRef Fplus, VectorRef Fminus);
 
 class NumericDiffProblem : public Problem {
  public:
@@ -54,14 +53,14 @@ class NumericDiffProblem : public Problem {
   bool jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const override;
   bool jacobianWritesAllEntries() const override { return true; }
   /// d/dε [F_u, F_λ](z + εx): second differences of residual() along x and each coordinate.
-  bool jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                     MatrixRef dFu, VectorRef dFlambda) const override;
+  bool jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                     double dlambda, MatrixRef dFu, VectorRef dFlambda) const override;
   /// F_xx[x, z]: one second difference of residual() along x and z (four evaluations).
   bool secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
                              VectorRef y) const override;
   /// (F_xx[x, ·])ᵀw = [dF_u, dF_λ]ᵀw with the directional derivative above.
-  bool secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
-                                      VectorRef y) const override;
+  bool secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                      ConstVectorRef w, VectorRef y) const override;
 
   const NumericDiffOptions &numericDiffOptions() const { return options_; }
 

@@ -117,7 +117,8 @@ class Problem {
   virtual bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const = 0;
 
   /// Exact F_u (N×N, Fu may be a block of a larger matrix) and F_λ (size N).
-  virtual bool jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const = 0;
+  virtual bool jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu,
+                        VectorRef Flambda) const = 0;
   /// True if jacobian() writes every entry of Fu and Flambda, zeros included. The core then does
   /// not clear them before each call (the default, false: a problem may write its nonzeros only).
   virtual bool jacobianWritesAllEntries() const { return false; }
@@ -135,43 +136,47 @@ class Problem {
   // central differences of jacobianTransposeApply() (only used in Newton matrices and in the
   // bifurcation equation, never in a residual).
   /// y = F_x x = F_u x_u + F_λ x_λ (x size N+1, y size N).
-  virtual bool jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const;
+  virtual bool jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                             VectorRef y) const;
   /// y = F_xᵀ w (w size N, y size N+1).
-  virtual bool jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) const;
+  virtual bool jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w,
+                                      VectorRef y) const;
   /// y = (F_xx[x, ·])ᵀ w = d/dε F_x(z + εx)ᵀ w at ε = 0, z = (u, λ) (x size N+1, w size N,
   /// y size N+1): the gradient of wᵀF_x x, i.e. y_j = wᵀF_xx[x, e_j].
-  virtual bool secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
-                                              VectorRef y) const;
+  virtual bool secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                              ConstVectorRef w, VectorRef y) const;
   /// y = F_xx[x, z] = d/dε F_x(z0 + εx) z at ε = 0, z0 = (u, λ) (x, z size N+1, y size N): the
   /// second directional derivative as a vector (the post-buckling coefficients,
   /// branch_point_coefficients.h). Default: the matrix of jacobianDirectionalDerivative() times z
   /// (O(N²)); a structured problem overrides it with an exact O(N) product.
-  virtual bool secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
-                                     VectorRef y) const;
+  virtual bool secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                     ConstVectorRef z, VectorRef y) const;
 
   // ---- optional: mechanical stability ---------------------------------------------------
   virtual bool hasStabilityOperator() const { return false; }
   /// Symmetric H (n_s×n_s) and constraint rows C (m×n_s, m may be 0); resized by the problem.
-  virtual bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const;
+  virtual bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const;
   /// Inertia of H on ker C and its `lowestCount` lowest eigenvalues (info.lowest, info.smallest).
   /// lowestCount = 0 asks for the inertia only: that is all the branch-point test needs, and for
   /// structured problems it is much cheaper than isolating eigenvalues (benchmarks/RESULTS.md).
   /// Default: dense eigen-decomposition of Zᵀ H Z (Z a basis of ker C), which gets every
   /// eigenvalue anyway. Problems with structure override this (e.g. an O(n) Sturm count).
-  virtual bool stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount, StabilityInfo& info) const;
+  virtual bool stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount,
+                         StabilityInfo &info) const;
   /// Eigenvalues of H on ker C with ascending indices first … first + values.size() − 1 (the
   /// certified counting of spectral_monitor.h follows the two next to zero, indices ν − 1 and ν).
   /// False when the point is refused or an index is out of range. Default: dense
   /// eigen-decomposition of Zᵀ H Z; structured problems override it (e.g. isolation on O(n)
   /// Sturm counts of the shifted operator).
-  virtual bool stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first, VectorRef values) const;
+  virtual bool stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first,
+                                    VectorRef values) const;
   /// An upper bound on |dμ_i/dε| for every eigenvalue μ_i of H on ker C along
   /// (u + ε·du, λ + ε·dlambda) at ε = 0 (Weyl: |dμ_i| ≤ ‖dH‖₂ + 2‖ζ_i‖‖dC‖₂, ζ_i the multiplier of
   /// the eigenvector). Certified counting uses it to skip the eigenvalue slopes on steps where no
   /// eigenvalue can come near zero (spectral_monitor.h). False (the default): no bound offered,
   /// the slopes are measured at every point.
-  virtual bool stabilityRateBound(ProblemWorkspace &, ConstVectorRef /*u*/, double /*lambda*/, ConstVectorRef /*du*/, double /*dlambda*/,
-                                  double & /*bound*/) const {
+  virtual bool stabilityRateBound(ProblemWorkspace &, ConstVectorRef /*u*/, double /*lambda*/, ConstVectorRef /*du*/,
+                                  double /*dlambda*/, double & /*bound*/) const {
     return false;
   }
 
@@ -194,7 +199,6 @@ class Problem {
   /// Typical scales (ProblemScales). Default: all ones, i.e. the problem is already posed in
   /// O(1) variables. Evaluated once per Tracer.
   virtual ProblemScales scales() const { return ProblemScales::ones(dimension()); }
-
 };
 
 /// Inertia of the symmetric H restricted to ker C (C may have zero rows), by a dense

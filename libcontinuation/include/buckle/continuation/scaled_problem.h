@@ -98,22 +98,27 @@ class ScaledProblem final : public Problem {
   bool residual(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef F) const override;
   bool jacobian(ProblemWorkspace &ws, ConstVectorRef u, double lambda, MatrixRef Fu, VectorRef Flambda) const override;
   bool jacobianWritesAllEntries() const override { return problem_.jacobianWritesAllEntries(); }
-  bool jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
-                                     MatrixRef dFu, VectorRef dFlambda) const override;
+  bool jacobianDirectionalDerivative(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                     double dlambda, MatrixRef dFu, VectorRef dFlambda) const override;
   /// The problem's own O(N) products, through the change of variables.
-  bool jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, VectorRef y) const override;
-  bool jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w, VectorRef y) const override;
-  bool secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef w,
-                                      VectorRef y) const override;
+  bool jacobianApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                     VectorRef y) const override;
+  bool jacobianTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef w,
+                              VectorRef y) const override;
+  bool secondDerivativeTransposeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                      ConstVectorRef w, VectorRef y) const override;
   bool secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x, ConstVectorRef z,
                              VectorRef y) const override;
   bool hasStabilityOperator() const override { return problem_.hasStabilityOperator(); }
   bool stabilityOperator(ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H, Matrix &C) const override;
   /// The problem's own stability() (its inertia count must be relative to ‖H‖), eigenvalues / μ₀.
-  bool stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount, StabilityInfo &info) const override;
-  bool stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first, VectorRef values) const override;
+  bool stability(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int lowestCount,
+                 StabilityInfo &info) const override;
+  bool stabilityEigenvalues(ProblemWorkspace &ws, ConstVectorRef u, double lambda, int first,
+                            VectorRef values) const override;
   /// The problem's bound along the user direction (D_u du, λ₀ dλ), / μ₀.
-  bool stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda, double &bound) const override;
+  bool stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                          double &bound) const override;
   /// The problem's structured solver seen through the change of variables (still O(its cost)).
   std::unique_ptr<BorderedSolver> makeStructuredSolver(ProblemWorkspace &ws) const override;
   int boundaryCount() const override { return problem_.boundaryCount(); }

@@ -143,7 +143,7 @@ class Tracer {
   UnitScaling units_;
   std::unique_ptr<ScaledProblem> scaled_;  // null for the identity scaling
   std::unique_ptr<ProblemWorkspace> scaledWorkspace_;  // scaled_'s, on problem_'s workspace
-  BoundProblem work_;                        // what the core evaluates: scaled_ or problem_
+  BoundProblem work_;                                  // what the core evaluates: scaled_ or problem_
   double lambdaMin_ = 0.0, lambdaMax_ = 0.0;  // the λ range and the box in the scaled variables
   Vector boxLower_, boxUpper_;
   std::unique_ptr<BorderedSolver> structuredSolver_, denseSolver_;

@@ -127,9 +127,11 @@ class ContactProblem final : public continuation::Problem {
   /// Contact torque τ_c,i = ∂E/∂q_i − (JᵀF)_i − Σ_v μ_v ∂x_v/∂q_i of joint i at (u, λ) (any
   /// joint; ~0 for a free one at an equilibrium); u is (q, r, μ) or (q, r) (μ then from
   /// wallForces). NaN outside the domain.
-  double contactTorque(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, int joint) const;
+  double contactTorque(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                       int joint) const;
   /// Compression −side·τ_c,i of a locked joint (≥ 0 while the contact holds).
-  double compression(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, int joint) const;
+  double compression(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                     int joint) const;
   /// The wall forces μ (one per vertex of contacts().wall(), a force along +x on the chain) that
   /// close the free joints' rows of the base problem at (q, r) = u.head(base dimension) in the
   /// least-squares sense: exact at a constrained equilibrium. NaN outside the domain.
@@ -138,23 +140,25 @@ class ContactProblem final : public continuation::Problem {
   Vector withWallForces(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda) const;
 
   int dimension() const override { return base_.dimension() + locked_.wallCount(); }
-  bool residual(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) const override;
-  bool jacobian(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
-                continuation::VectorRef Flambda) const override;
-  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda,
-                                     continuation::ConstVectorRef du, double dlambda,
-                                     continuation::MatrixRef dFu, continuation::VectorRef dFlambda) const override;
+  bool residual(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                continuation::VectorRef F) const override;
+  bool jacobian(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                continuation::MatrixRef Fu, continuation::VectorRef Flambda) const override;
+  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                                     continuation::ConstVectorRef du, double dlambda, continuation::MatrixRef dFu,
+                                     continuation::VectorRef dFlambda) const override;
 
   bool hasStabilityOperator() const override { return true; }
   /// H = K_q − K_g − Σ μ_v ∂²x_v (n×n), C = the held rows J_h, one row e_iᵀ per locked joint and
   /// one row ∇x_vᵀ per vertex on the wall.
-  bool stabilityOperator(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const override;
+  bool stabilityOperator(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, Matrix& H,
+                         Matrix& C) const override;
   /// Inertia and lowest eigenvalues of K_q − K_g on the free joints and ker J_h,F, O(n) through
   /// the reduced chain structure (file comment).
-  bool stability(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
+  bool stability(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
                  continuation::StabilityInfo& info) const override;
   /// The reduced structure's O(n) bordered solver (locked rows eliminated).
-  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace &ws) const override;
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace& ws) const override;
 
   /// base.scales(), with the locked rows (angles) at scale 1.
   continuation::ProblemScales scales() const override;
@@ -165,18 +169,19 @@ class ContactProblem final : public continuation::Problem {
   int torqueBoundBegin() const;
   int wallClearanceBoundary() const;
   int wallReleaseBoundary(int k) const;
-  double boundary(continuation::ProblemWorkspace &ws, int k, continuation::ConstVectorRef u, double lambda) const override;
+  double boundary(continuation::ProblemWorkspace& ws, int k, continuation::ConstVectorRef u,
+                  double lambda) const override;
   std::string boundaryName(int k) const override;
 
   /// T of K_q − K_g (with the wall forces' terms) on the free joints into ws (size
   /// freeJoints().size()) and the end Jacobian's free columns into Jf (3×|F|); u = (q, r, μ).
   /// False outside the domain or when every joint is locked.
-  bool assembleReduced(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, ChainStructure& structure,
-                       continuation::MatrixRef Jf) const;
+  bool assembleReduced(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                       ChainStructure& structure, continuation::MatrixRef Jf) const;
   /// The full structure (every joint) of K_q − K_g with the wall forces' terms in its generator,
   /// and the end Jacobian (3×n), at u = (q, r, μ): what the reduced structure is cut from.
-  bool assembleFull(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, ChainStructure& full,
-                    continuation::MatrixRef J) const;
+  bool assembleFull(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                    ChainStructure& full, continuation::MatrixRef J) const;
   /// The wall vertices' ∇x_v (columns of wallGradients(), n×w) and generators of −∂²x_v (columns
   /// of wallGenerators(), wall_contact.h) at q; false when q is not finite.
   bool wallKinematics(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef q) const;
@@ -193,8 +198,8 @@ class ContactProblem final : public continuation::Problem {
     std::unique_ptr<continuation::ProblemWorkspace> base;
     ChainStructure full, reduced;
     Matrix J, Jf, heldRows;
-    Vector kf, hf;       // κ_F, h_F of the reduced structure
-    Vector residual;     // the free equilibrium's rows (contact torques), size N
+    Vector kf, hf;    // κ_F, h_F of the reduced structure
+    Vector residual;  // the free equilibrium's rows (contact torques), size N
     Vector lastLowest;
     Matrix wallGrad, wallGen;  // n×w: ∇x_v and the generators of −∂²x_v (wallKinematics)
     Vector wallX;              // x_v of the wall vertices
@@ -203,7 +208,8 @@ class ContactProblem final : public continuation::Problem {
 
  private:
   // The base problem's rows at (q, r) with the wall forces' terms −Σ μ_v ∇x_v added to the q rows.
-  bool baseRowsWithWall(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, VectorRef F) const;
+  bool baseRowsWithWall(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                        VectorRef F) const;
 
   const EquilibriumProblem& base_;
   ContactSet locked_;
@@ -257,8 +263,7 @@ ConstrainedEquilibrium solveConstrainedEquilibrium(const EquilibriumProblem& bas
 
 /// Stability of the constrained system at (u, λ): K_q − K_g on the free joints and ker J_h,F.
 continuation::StabilityInfo constrainedStability(const EquilibriumProblem& base, const ContactSet& locked,
-                                                 continuation::ConstVectorRef u, double lambda,
-                                                 int lowestCount = 1);
+                                                 continuation::ConstVectorRef u, double lambda, int lowestCount = 1);
 
 /// The joints within `tolerance` (radians) of a limit at q, on that side.
 ContactSet jointsAtLimits(const Chain& chain, continuation::ConstVectorRef q, double tolerance);

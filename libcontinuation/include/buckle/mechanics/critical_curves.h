@@ -79,50 +79,54 @@ class ChainParameterProblem final : public continuation::TwoParameterProblem {
 
   double secondParameter() const override { return mu_; }
   bool setSecondParameter(double mu) override;
-  bool secondParameterDerivatives(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef v,
-                                  continuation::VectorRef Fmu, continuation::VectorRef FuMuV) const override;
+  bool secondParameterDerivatives(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                                  continuation::ConstVectorRef v, continuation::VectorRef Fmu,
+                                  continuation::VectorRef FuMuV) const override;
   /// b̄ for lengths, k̄ for k, k̄b̄ / k̄b̄² for an end force / torque, b̄ / 1 for a held position / angle.
   double secondParameterScale() const override;
 
   int dimension() const override { return equilibrium_->dimension(); }
-  bool residual(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) const override {
+  bool residual(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                continuation::VectorRef F) const override {
     return equilibrium_->residual(equilibriumWorkspace(ws), u, lambda, F);
   }
-  bool jacobian(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
-                continuation::VectorRef Flambda) const override {
+  bool jacobian(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                continuation::MatrixRef Fu, continuation::VectorRef Flambda) const override {
     return equilibrium_->jacobian(equilibriumWorkspace(ws), u, lambda, Fu, Flambda);
   }
-  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
-                                     double dlambda, continuation::MatrixRef dFu,
+  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                                     continuation::ConstVectorRef du, double dlambda, continuation::MatrixRef dFu,
                                      continuation::VectorRef dFlambda) const override {
     return equilibrium_->jacobianDirectionalDerivative(equilibriumWorkspace(ws), u, lambda, du, dlambda, dFu, dFlambda);
   }
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const override {
+  bool stabilityOperator(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, Matrix& H,
+                         Matrix& C) const override {
     return equilibrium_->stabilityOperator(equilibriumWorkspace(ws), u, lambda, H, C);
   }
-  bool stability(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
+  bool stability(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
                  continuation::StabilityInfo& info) const override {
     return equilibrium_->stability(equilibriumWorkspace(ws), u, lambda, lowestCount, info);
   }
   /// Exact (∂F_u/∂λ)·v in O(n): the dead loads' λ-derivative of K_g (eq 27), −[h'_max(i,j)] v_q.
-  bool parameterJacobianApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef v,
-                              continuation::VectorRef FuLambdaV) const override;
-  bool jacobianApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
-                     continuation::VectorRef y) const override {
+  bool parameterJacobianApply(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                              continuation::ConstVectorRef v, continuation::VectorRef FuLambdaV) const override;
+  bool jacobianApply(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                     continuation::ConstVectorRef x, continuation::VectorRef y) const override {
     return equilibrium_->jacobianApply(equilibriumWorkspace(ws), u, lambda, x, y);
   }
-  bool jacobianTransposeApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef w,
-                              continuation::VectorRef y) const override {
+  bool jacobianTransposeApply(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                              continuation::ConstVectorRef w, continuation::VectorRef y) const override {
     return equilibrium_->jacobianTransposeApply(equilibriumWorkspace(ws), u, lambda, w, y);
   }
   /// The chain's O(n) bordered solver, recreated for the current chain whenever μ has changed.
-  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace &ws) const override;
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace& ws) const override;
   /// Incremented whenever setting μ rebuilds the chain (what the structured solver follows).
   long generation() const { return generation_; }
   continuation::ProblemScales scales() const override { return equilibrium_->scales(); }
   int boundaryCount() const override { return equilibrium_->boundaryCount(); }
-  double boundary(continuation::ProblemWorkspace &ws, int k, continuation::ConstVectorRef u, double lambda) const override {
+  double boundary(continuation::ProblemWorkspace& ws, int k, continuation::ConstVectorRef u,
+                  double lambda) const override {
     return equilibrium_->boundary(equilibriumWorkspace(ws), k, u, lambda);
   }
   std::string boundaryName(int k) const override { return equilibrium_->boundaryName(k); }

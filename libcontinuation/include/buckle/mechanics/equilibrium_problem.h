@@ -101,14 +101,14 @@ class EquilibriumProblem final : public continuation::Problem {
     // stability() or stabilityEigenvalues(): the tracer asks stability() for the inertia and then
     // the certified counting's values at the same point (spectral_monitor.h), one eigen-solve serves
     // both. Keyed bitwise on (u, λ) like the q-cache (H depends on r and λ through the wrench).
-    Vector spectrumKey;                             // (u, λ) of spectrum (size N + 1)
+    Vector spectrumKey;                              // (u, λ) of spectrum (size N + 1)
     Eigen::Matrix<double, kSmallDense, 1> spectrum;  // ascending eigenvalues on ker J_h ...
-    int spectrumSize = -1;                          // ... their number (n − rank); −1: none cached
-    Inertia spectrumInertia;                        // ... and the inertia that goes with them
-    BodyLoadTerms bodyTerms;  // the body loads' τ and γ at the cached q
-    Vector bodyWork;          // size n: dγ and other body-load scratch
-    EigenvalueMemory found;   // warm starts of the structured eigenvalue searches (by index)
-    Vector guess;             // their guesses (size kMaxBorder once used: no allocation per call)
+    int spectrumSize = -1;                           // ... their number (n − rank); −1: none cached
+    Inertia spectrumInertia;                         // ... and the inertia that goes with them
+    BodyLoadTerms bodyTerms;                         // the body loads' τ and γ at the cached q
+    Vector bodyWork;                                 // size n: dγ and other body-load scratch
+    EigenvalueMemory found;                          // warm starts of the structured eigenvalue searches (by index)
+    Vector guess;  // their guesses (size kMaxBorder once used: no allocation per call)
   };
   std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override;
 
@@ -149,44 +149,47 @@ class EquilibriumProblem final : public continuation::Problem {
   Vector initialGuess(continuation::ConstVectorRef q, double lambda) const;
 
   int dimension() const override { return chain_.size() + heldCount(); }
-  bool residual(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::VectorRef F) const override;
-  bool jacobian(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::MatrixRef Fu,
-                continuation::VectorRef Flambda) const override;
+  bool residual(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                continuation::VectorRef F) const override;
+  bool jacobian(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                continuation::MatrixRef Fu, continuation::VectorRef Flambda) const override;
   /// Every entry of F_u and F_λ, the zero block of the multipliers included.
   bool jacobianWritesAllEntries() const override { return true; }
-  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda,
-                                     continuation::ConstVectorRef du, double dlambda,
-                                     continuation::MatrixRef dFu, continuation::VectorRef dFlambda) const override;
+  bool jacobianDirectionalDerivative(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                                     continuation::ConstVectorRef du, double dlambda, continuation::MatrixRef dFu,
+                                     continuation::VectorRef dFlambda) const override;
 
   /// O(n) products with F_x = [F_u, F_λ] in the joint coordinates (K_g x by prefix and suffix
   /// sums of h, eq 27): exact to rounding, with no cancellation beyond that of the dense product.
   /// F_u is symmetric, so F_xᵀ w = (F_u w, F_λ·w). The second derivative keeps the default
   /// (central differences of jacobianTransposeApply, O(n)).
-  bool jacobianApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
-                     continuation::VectorRef y) const override;
-  bool jacobianTransposeApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef w,
-                              continuation::VectorRef y) const override;
+  bool jacobianApply(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                     continuation::ConstVectorRef x, continuation::VectorRef y) const override;
+  bool jacobianTransposeApply(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                              continuation::ConstVectorRef w, continuation::VectorRef y) const override;
   /// Exact F_xx[x, z] in O(n): jacobianDirectionalDerivative() along x applied to z, i.e.
   /// (q rows) E‴ ⊙ x_q ⊙ z_q − K_g(dh_x) z_q − dJ_h[x]ᵀ z_r − Σ_loaded dJ_c[x]ᵀ dir_c z_λ with
   /// dh_x = d h along x (eq 27 differentiated, the wrench moving with x_r and x_λ) and dJ the
   /// derivative of the end Jacobian (stiffness.h); (held rows) −dJ_h[x] z_q.
-  bool secondDerivativeApply(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef x,
-                             continuation::ConstVectorRef z, continuation::VectorRef y) const override;
+  bool secondDerivativeApply(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                             continuation::ConstVectorRef x, continuation::ConstVectorRef z,
+                             continuation::VectorRef y) const override;
 
   bool hasStabilityOperator() const override { return true; }
-  bool stabilityOperator(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, Matrix& H, Matrix& C) const override;
+  bool stabilityOperator(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, Matrix& H,
+                         Matrix& C) const override;
   /// Inertia of K_q − K_g on ker J_h and its min(lowestCount, kMaxLowest) lowest eigenvalues.
   /// options.structuredStability: the inertia from two O(n) Sturm counts, the eigenvalues by
   /// Newton on the counts' determinant (chain_structure.h); for n <= 16 with eigenvalues wanted,
   /// one heap-free dense solve (faster there: benchmarks/RESULTS.md). Otherwise the dense
   /// Problem::stability().
   static constexpr int kMaxLowest = 4;  // the isolation's fixed-size brackets
-  bool stability(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
+  bool stability(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
                  continuation::StabilityInfo& info) const override;
   /// Eigenvalues by index of K_q − K_g on ker J_h, each isolated on O(n) Sturm counts of the
   /// shifted tridiagonal T − σM (chain_structure.h, eigenvaluesFrom).
-  bool stabilityEigenvalues(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, int first,
-                            continuation::VectorRef values) const override;
+  bool stabilityEigenvalues(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                            int first, continuation::VectorRef values) const override;
   /// O(n) factorizations the structured stability() and stabilityEigenvalues() have taken so
   /// far (their cost; eigenvalue_memory.h).
   static long structuredFactorizations(const continuation::ProblemWorkspace& ws) {
@@ -195,8 +198,8 @@ class EquilibriumProblem final : public continuation::Problem {
   /// ‖dH‖_F + 2‖H‖_F‖dC‖_F/σ_min(C) along (du, dλ), H = K_q − K_g and C = J_h (held rows of
   /// eq 11), in O(n) from the q-cache: an upper bound on every |dμ_i| (Problem). False when C is
   /// rank-deficient (no finite bound) or the point is refused.
-  bool stabilityRateBound(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::ConstVectorRef du,
-                          double dlambda, double& bound) const override;
+  bool stabilityRateBound(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                          continuation::ConstVectorRef du, double dlambda, double& bound) const override;
 
   /// T of H = K_q − K_g(F(u, λ)) into ws (chain_structure.h) and the end Jacobian (3×n) into J,
   /// from the q-cache: what the structured stability and the structured solver linearise on.
@@ -205,7 +208,7 @@ class EquilibriumProblem final : public continuation::Problem {
                          ChainStructure& structure, continuation::MatrixRef J) const;
 
   /// The O(n) bordered solver of the chain (chain_solver.h).
-  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace &ws) const override;
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace& ws) const override;
 
   /// The chain's own units (ProblemScales): with b̄, k̄ the mean triangle half-length and spring
   /// stiffness, angles 1, torque rows and the stability operator k̄b̄², held-position rows b̄,
@@ -219,8 +222,10 @@ class EquilibriumProblem final : public continuation::Problem {
   double stiffnessUnit() const;
 
   int boundaryCount() const override;
-  double boundary(continuation::ProblemWorkspace &ws, int k, continuation::ConstVectorRef u, double lambda) const override;
-  void boundaries(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double lambda, continuation::VectorRef g) const override;
+  double boundary(continuation::ProblemWorkspace& ws, int k, continuation::ConstVectorRef u,
+                  double lambda) const override;
+  void boundaries(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                  continuation::VectorRef g) const override;
   std::string boundaryName(int k) const override;
   /// The first of the two boundaries of EquilibriumOptions::heldRange (after the joint limits'),
   /// and how many there are (0 or 2).
@@ -259,7 +264,8 @@ class EquilibriumProblem final : public continuation::Problem {
   /// (equilibrium_problem_body.cpp).
   void loadGenerator(Workspace& d, const continuation::ConstVectorRef& u, double lambda, VectorRef h) const;
   /// The body loads' dγ along (du_q, dλ) into the workspace's bodyWork (zero without them).
-  void bodyGeneratorDerivative(Workspace& d, const continuation::ConstVectorRef& dq, double lambda, double dlambda) const;
+  void bodyGeneratorDerivative(Workspace& d, const continuation::ConstVectorRef& dq, double lambda,
+                               double dlambda) const;
 
   Chain chain_;
   EndCondition end_;

@@ -126,16 +126,17 @@ class TaskPathProblem final : public continuation::Problem {
   Eigen::MatrixX2d freeLengthChange(continuation::ConstVectorRef p) const;
 
   int dimension() const override { return dim_; }
-  bool residual(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double s, continuation::VectorRef F) const override;
-  bool jacobian(continuation::ProblemWorkspace &ws, continuation::ConstVectorRef u, double s, continuation::MatrixRef Fu,
-                continuation::VectorRef Fs) const override;
+  bool residual(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double s,
+                continuation::VectorRef F) const override;
+  bool jacobian(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double s,
+                continuation::MatrixRef Fu, continuation::VectorRef Fs) const override;
   bool jacobianWritesAllEntries() const override { return true; }
 
   /// Boundaries: joint upper limits (n), lower limits (n), input upper / lower bounds (2 m_in),
   /// the free lengths L1⁰, L2⁰ of every segment (2n, > 0: the inputs' admissible range), then
   /// the smallest eigenvalue of H at fixed inputs over the stability scale (1).
   int boundaryCount() const override { return 4 * n_ + 2 * mIn_ + 1; }
-  double boundary(continuation::ProblemWorkspace &ws, int k, continuation::ConstVectorRef u, double s) const override;
+  double boundary(continuation::ProblemWorkspace& ws, int k, continuation::ConstVectorRef u, double s) const override;
   std::string boundaryName(int k) const override;
   /// What kind of boundary k is.
   enum class BoundaryKind { JointLimit, InputBound, Stability };
@@ -146,7 +147,7 @@ class TaskPathProblem final : public continuation::Problem {
                            double& smallest) const;
 
   /// Rule (a): the O(n) bordered solver; rule (b): null (dense).
-  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace &ws) const override;
+  std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace& ws) const override;
   /// q 1, inputs b̄, torque rows k̄b̄², task rows b̄ (x, y) or 1 (φ), s b̄; rule (b): μ 1/(k̄b̄²),
   /// ν 1/b̄ or 1, R_q rows 1, R_p rows 1/b̄.
   continuation::ProblemScales scales() const override;
@@ -164,24 +165,24 @@ class TaskPathProblem final : public continuation::Problem {
 
   /// T of H at (q, p) into ws, the inputs' columns B (n × m_in) and the task rows J_c (m × n):
   /// what the structured solver linearises on. False outside the domain.
-  bool assembleStructure(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, ChainStructure& structure, Matrix& B,
-                         Matrix& Jc) const;
+  bool assembleStructure(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, ChainStructure& structure,
+                         Matrix& B, Matrix& Jc) const;
 
   /// prepare()'s cache (keyed bitwise on (q, p)) and the warm start of fixedInputStability().
   struct Workspace : continuation::ProblemWorkspace {
     explicit Workspace(const TaskPathProblem& problem);
     ChainData data;
-    Matrix J;                    // 3×n
-    Vector grad, stiff, third;   // E′, E″, E‴ per joint
-    Eigen::MatrixX2d e1, e2;     // −k_s L_s′, −k_s L_s″ per joint and spring
+    Matrix J;                   // 3×n
+    Vector grad, stiff, third;  // E′, E″, E‴ per joint
+    Eigen::MatrixX2d e1, e2;    // −k_s L_s′, −k_s L_s″ per joint and spring
     Vector h, work;
-    BodyLoadTerms body;          // the body loads at the cached q
-    Vector tau;                  // their torques τ (eq B4)
-    Matrix B;                    // n × m_in
+    BodyLoadTerms body;  // the body loads at the cached q
+    Vector tau;          // their torques τ (eq B4)
+    Matrix B;            // n × m_in
     ChainStructure structure;
-    Vector cachedKey;            // (q, p) of the cache (bitwise)
+    Vector cachedKey;  // (q, p) of the cache (bitwise)
     bool cacheValid = false;
-    Vector lastSmallest;         // warm start of the smallest eigenvalue
+    Vector lastSmallest;  // warm start of the smallest eigenvalue
   };
   std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override;
 
@@ -189,7 +190,8 @@ class TaskPathProblem final : public continuation::Problem {
   /// Spring model, kinematics and the per-segment input derivatives at u (q, p). False outside the domain.
   bool prepare(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u) const;
   /// Rule (b), after prepare(u): A = diag(diagA) + [genA_max(i,k)] and D (header).
-  void optimalityBlocks(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, Vector& diagA, Vector& genA, Matrix& D) const;
+  void optimalityBlocks(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, Vector& diagA, Vector& genA,
+                        Matrix& D) const;
   /// Column j of B (or of D with the joint weights μ) from the per-segment derivatives e (n×2).
   void inputColumns(const Eigen::MatrixX2d& e, Matrix& out) const;
 

@@ -47,7 +47,8 @@ bool measureNearZeroValues(const BoundProblem &problem, ContinuationPoint &point
 /// with step `delta`, backward if refused). False (spectrum left without slopes) if refused.
 /// `workspace` holds the shifted point's u: once it has at least N entries the call allocates
 /// nothing itself (the tracer's hot loop; the problem's stabilityEigenvalues must not either).
-bool measureNearZeroSlopes(const BoundProblem &problem, ContinuationPoint &point, Vector &workspace, double delta = 1e-6);
+bool measureNearZeroSlopes(const BoundProblem &problem, ContinuationPoint &point, Vector &workspace,
+                           double delta = 1e-6);
 /// The same with a workspace of its own (allocates: for tests and one-off use).
 bool measureNearZeroSlopes(const BoundProblem &problem, ContinuationPoint &point, double delta = 1e-6);
 

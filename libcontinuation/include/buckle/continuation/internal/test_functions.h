@@ -106,8 +106,8 @@ bool jacobianKernel(const BoundProblem &problem, ConstVectorRef u, double lambda
 /// ψ the left null vector. Second derivatives from Problem::jacobianDirectionalDerivative.
 /// False (with the reason) when they are unavailable, the quadratic form vanishes, or its roots
 /// are complex (an isolated point, no crossing branches).
-bool bifurcationDirections(const BoundProblem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi, ConstVectorRef k1,
-                           ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why = nullptr);
+bool bifurcationDirections(const BoundProblem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi,
+                           ConstVectorRef k1, ConstVectorRef k2, Vector &d1, Vector &d2, std::string *why = nullptr);
 /// The same from O(N) products (Problem::secondDerivativeTransposeApply), with no N×N matrix:
 /// for problems above the dense crossover.
 bool bifurcationDirectionsApplied(const BoundProblem &problem, ConstVectorRef u, double lambda, ConstVectorRef psi,
