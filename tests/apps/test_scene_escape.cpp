@@ -196,7 +196,7 @@ TEST_CASE("csvField: an RFC 4180 reader gets every field back", "[escape]") {
   CHECK(escape::csvField("3U 5L") == "3U 5L");  // plain text stays unquoted
 }
 
-TEST_CASE("jsonText never throws and parses back; jsonForHtmlScript holds no '<'", "[escape]") {
+TEST_CASE("jsonText never throws and parses back, jsonForHtmlScript holds no '<'", "[escape]") {
   nlohmann::json doc = nlohmann::json::array();
   for (const std::string& s : hostileStrings()) doc.push_back({{"label", s}, {s.substr(0, 40), 1}});
   CHECK_THROWS(doc.dump());  // nlohmann's default: invalid UTF-8 throws

@@ -138,7 +138,7 @@ TEST_CASE("One const problem traced from two threads at once: each trace as when
   SECTION("the same start") { concurrently(up, upAlone, up, upAlone); }
 }
 
-TEST_CASE("Each workspace keeps its own cache; a bound problem borrows or owns one", "[bound_problem]") {
+TEST_CASE("Each workspace keeps its own cache, a bound problem borrows or owns one", "[bound_problem]") {
   const int n = 5;
   const CachedBratu bratu(n);
   const Vector u1 = Vector::Constant(n, 0.1), u2 = Vector::Constant(n, -0.2);

@@ -190,7 +190,7 @@ TEST_CASE("Switching from a point that is not a branch point is refused", "[bran
   CHECK_THAT(why, Contains("minOffBranchFraction"));
 }
 
-TEST_CASE("The tree's hooks: a branch extended past its trace is switched at on its own tracer; each branch final once",
+TEST_CASE("The tree's hooks: a branch extended past its trace is switched at on its own tracer, each branch final once",
           "[branch_switching]") {
   // TwoPitchforks: branch points at λ = 0 (u₁ = ±√λ) and λ = c (u₂ = ±√(λ − c)). The start
   // branch is traced to λ = 0.25 only; `extend` goes on to 0.8 with a tracer of its own and

@@ -337,7 +337,7 @@ TEST_CASE("scaled units (lengths x1e4, stiffness x1e-8): the same set, scaled", 
   }
 }
 
-TEST_CASE("options: bad values are named; an interrupt keeps what was found", "[all_equilibria]") {
+TEST_CASE("options: bad values are named, an interrupt keeps what was found", "[all_equilibria]") {
   const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   const EndCondition end = EndCondition::freeEnd(Wrench(-0.2, 0.0, 0.0));
   AllEquilibriaOptions o;
@@ -345,7 +345,7 @@ TEST_CASE("options: bad values are named; an interrupt keeps what was found", "[
   CHECK_THROWS_WITH(allEquilibria(chain, end, o), Catch::Contains("tolerance"));
   o = AllEquilibriaOptions{};
   o.starts.push_back(Vector::Zero(4));
-  CHECK_THROWS_WITH(allEquilibria(chain, end, o), Catch::Contains("start 1") && Catch::Contains("3"));
+  CHECK_THROWS_WITH(allEquilibria(chain, end, o), Catch::Contains("starts[0]") && Catch::Contains("3"));
   o = AllEquilibriaOptions{};
   o.randomStarts = -1;
   CHECK_THROWS_WITH(allEquilibria(chain, end, o), Catch::Contains("randomStarts"));

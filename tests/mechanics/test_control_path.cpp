@@ -349,7 +349,7 @@ TEST_CASE("stiffness along a control path: K_F of the free lengths at the point,
   }
 }
 
-TEST_CASE("the straight column under a fixed Fx buckles along an L0 path where eq 17 gives that Fx; the "
+TEST_CASE("the straight column under a fixed Fx buckles along an L0 path where eq 17 gives that Fx, the "
           "buckled branch is switched to", "[control_path]") {
   // Fx_U = λ_U κ/b with κ = k(b L0 − 2(b² − a²)) (eq 17) is affine in L0: the L0 where it equals Fx
   const double Fx = -0.5;

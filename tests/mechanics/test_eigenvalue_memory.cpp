@@ -46,7 +46,7 @@ TEST_CASE("EigenvalueMemory: a remembered index's latest value, interpolation be
   CHECK(g[0] == Approx(38.0).epsilon(1e-15));  // from μ14 = 13 and μ11 = 0.5: spacing 12.5/3
 }
 
-TEST_CASE("EigenvalueMemory: one value alone moves by its own magnitude per index; the oldest is forgotten first",
+TEST_CASE("EigenvalueMemory: one value alone moves by its own magnitude per index, the oldest is forgotten first",
           "[eigenvalue_memory]") {
   EigenvalueMemory m;
   Vector g(1);

@@ -703,7 +703,7 @@ TEST_CASE("n = 10000: the children of a branch point traced in steps of 4e-9 sho
   }
 }
 
-TEST_CASE("reports handed over as branches become final equal the kept ones; the traced points are released",
+TEST_CASE("reports handed over as branches become final equal the kept ones, the traced points are released",
           "[equilibrium_branches]") {
   // The paper's chain to Fx = −2.5: the U branches reach joint 2's limit and go on locked
   // (contact stretches), the − sides are mirror images. Streaming (onReport) must not change

@@ -86,7 +86,7 @@ Agreement compareRoutes(VibrationAnalysis& va, const Vector& q, const Wrench& F,
 
 }  // namespace
 
-TEST_CASE("vibration structured: the O(n) route equals the dense route (free, held, locked, weight; stable and unstable)",
+TEST_CASE("vibration structured: the O(n) route equals the dense route (free, held, locked, weight, stable and unstable)",
           "[vibration][vibration_structured]") {
   std::mt19937 rng(29);
   std::uniform_real_distribution<double> U(-0.6, 0.6);
@@ -124,7 +124,7 @@ TEST_CASE("vibration structured: the O(n) route equals the dense route (free, he
   WARN("structured vs dense: values " << worstValues << " of the spectrum, shapes " << worstShapes);
 }
 
-TEST_CASE("vibration structured: extreme units (lengths x1e4 with stiffness x1e-8; x1e-4 with x1e8) agree with the dense "
+TEST_CASE("vibration structured: extreme units (lengths x1e4 with stiffness x1e-8, x1e-4 with x1e8) agree with the dense "
           "route and scale omega^2 by k / L (rods: inertia ~ L^3)",
           "[vibration][vibration_structured]") {
   const int n = 60;

@@ -12,14 +12,13 @@
 namespace buckle::continuation {
 
 std::string CorrectorOptions::validate(const std::string &prefix) const {
-  auto bad = [&prefix](const char *field, const char *what) { return prefix + field + " " + what; };
-  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return bad("tolerance", "must be positive and finite");
+  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return prefix + "tolerance must be positive and finite";
   if (!(stepTolerance > 0.0) || !std::isfinite(stepTolerance))
-    return bad("stepTolerance", "must be positive and finite");
-  if (maxIterations < 1) return bad("maxIterations", "must be at least 1");
-  if (!(maxNewtonStep >= 0.0) || !std::isfinite(maxNewtonStep)) return bad("maxNewtonStep", "must be finite and >= 0");
+    return prefix + "stepTolerance must be positive and finite";
+  if (maxIterations < 1) return prefix + "maxIterations must be at least 1";
+  if (!(maxNewtonStep >= 0.0) || !std::isfinite(maxNewtonStep)) return prefix + "maxNewtonStep must be finite and >= 0";
   if (!(stagnationFactor >= 1.0) || !std::isfinite(stagnationFactor))
-    return bad("stagnationFactor", "must be finite and >= 1");
+    return prefix + "stagnationFactor must be finite and >= 1";
   return {};
 }
 

@@ -8,19 +8,18 @@
 namespace buckle::continuation {
 
 std::string StepOptions::validate(const std::string &prefix) const {
-  auto bad = [&prefix](const std::string &field, const char *what) { return prefix + field + " " + what; };
-  if (!(initialStep > 0.0) || !finite(initialStep)) return bad("initialStep", "must be positive and finite");
-  if (!(minStep > 0.0) || !finite(minStep)) return bad("minStep", "must be positive and finite");
-  if (!(maxStep > 0.0) || !finite(maxStep)) return bad("maxStep", "must be positive and finite");
-  if (minStep > maxStep) return bad("minStep", "must not exceed maxStep");
-  if (initialStep < minStep || initialStep > maxStep) return bad("initialStep", "must lie in [minStep, maxStep]");
-  if (targetNewtonIterations < 1) return bad("targetNewtonIterations", "must be at least 1");
-  if (!(stepGrowth >= 1.0) || !finite(stepGrowth)) return bad("stepGrowth", "must be finite and >= 1");
-  if (!(stepShrink > 0.0 && stepShrink <= 1.0)) return bad("stepShrink", "must lie in (0, 1]");
-  if (!(slowContraction > 0.0) || !finite(slowContraction)) return bad("slowContraction", "must be positive");
-  if (!(targetContraction > 0.0 && targetContraction < 1.0)) return bad("targetContraction", "must lie in (0, 1)");
-  if (!(targetAngle > 0.0) || !finite(targetAngle)) return bad("targetAngle", "must be positive and finite");
-  if (!(minTangentCosine > -1.0 && minTangentCosine <= 1.0)) return bad("minTangentCosine", "must lie in (-1, 1]");
+  if (!(initialStep > 0.0) || !finite(initialStep)) return prefix + "initialStep must be positive and finite";
+  if (!(minStep > 0.0) || !finite(minStep)) return prefix + "minStep must be positive and finite";
+  if (!(maxStep > 0.0) || !finite(maxStep)) return prefix + "maxStep must be positive and finite";
+  if (minStep > maxStep) return prefix + "minStep must not exceed maxStep";
+  if (initialStep < minStep || initialStep > maxStep) return prefix + "initialStep must lie in [minStep, maxStep]";
+  if (targetNewtonIterations < 1) return prefix + "targetNewtonIterations must be at least 1";
+  if (!(stepGrowth >= 1.0) || !finite(stepGrowth)) return prefix + "stepGrowth must be finite and >= 1";
+  if (!(stepShrink > 0.0 && stepShrink <= 1.0)) return prefix + "stepShrink must lie in (0, 1]";
+  if (!(slowContraction > 0.0) || !finite(slowContraction)) return prefix + "slowContraction must be positive";
+  if (!(targetContraction > 0.0 && targetContraction < 1.0)) return prefix + "targetContraction must lie in (0, 1)";
+  if (!(targetAngle > 0.0) || !finite(targetAngle)) return prefix + "targetAngle must be positive and finite";
+  if (!(minTangentCosine > -1.0 && minTangentCosine <= 1.0)) return prefix + "minTangentCosine must lie in (-1, 1]";
   return {};
 }
 

@@ -8,14 +8,13 @@
 namespace buckle::continuation {
 
 std::string LocationOptions::validate(const std::string &prefix) const {
-  auto bad = [&prefix](const char *field, const char *what) { return prefix + field + " " + what; };
-  if (!(tolerance > 0.0) || !finite(tolerance)) return bad("tolerance", "must be positive and finite");
-  if (!(coarseTolerance > 0.0) || !finite(coarseTolerance)) return bad("coarseTolerance", "must be positive and finite");
-  if (!(newtonTolerance > 0.0) || !finite(newtonTolerance)) return bad("newtonTolerance", "must be positive and finite");
-  if (maxIterations < 1) return bad("maxIterations", "must be at least 1");
-  if (maxRefinementIterations < 1) return bad("maxRefinementIterations", "must be at least 1");
-  if (!(separationFraction > 0.0 && separationFraction < 1.0)) return bad("separationFraction", "must lie in (0, 1)");
-  if (maxDenseDimension < 1) return bad("maxDenseDimension", "must be at least 1");
+  if (!(tolerance > 0.0) || !finite(tolerance)) return prefix + "tolerance must be positive and finite";
+  if (!(coarseTolerance > 0.0) || !finite(coarseTolerance)) return prefix + "coarseTolerance must be positive and finite";
+  if (!(newtonTolerance > 0.0) || !finite(newtonTolerance)) return prefix + "newtonTolerance must be positive and finite";
+  if (maxIterations < 1) return prefix + "maxIterations must be at least 1";
+  if (maxRefinementIterations < 1) return prefix + "maxRefinementIterations must be at least 1";
+  if (!(separationFraction > 0.0 && separationFraction < 1.0)) return prefix + "separationFraction must lie in (0, 1)";
+  if (maxDenseDimension < 1) return prefix + "maxDenseDimension must be at least 1";
   return {};
 }
 
