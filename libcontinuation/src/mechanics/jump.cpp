@@ -163,10 +163,12 @@ UnstableDirection structuredUnstableDirection(EquilibriumProblem& problem, const
 bool basinTest(EquilibriumProblem& problem, DynamicsModel& model, ConstVectorRef q, double lambda,
                const continuation::CorrectorOptions& polish, PolishResult& landing) {
   const int n = problem.segments();
-  // positive definite on ker J_h: O(n) Sturm counts (no eigenvalues wanted)
+  // positive definite on ker J_h: O(n) Sturm counts (no eigenvalues wanted), one workspace for
+  // the test's three points
+  const cont::BoundProblem bound(problem);
   auto definite = [&](const Vector& u) {
     continuation::StabilityInfo s;
-    return cont::BoundProblem(problem).stability(u, lambda, 0, s) && s.valid() && s.stable();
+    return bound.stability(u, lambda, 0, s) && s.valid() && s.stable();
   };
   if (!definite(problem.initialGuess(q, lambda))) return false;
   PolishResult p = polishEquilibrium(problem, q, lambda, polish);
