@@ -207,4 +207,74 @@ py::list plotSpecs(const std::vector<scene::PlotSpec>& plots) {
   return out;
 }
 
+
+py::dict workspaceArrays(const scene::CaseResult& cr) {
+  const mechanics::WorkspaceMap& m = cr.workspace;
+  const Eigen::Index r = m.count2, c = m.count1;
+  Eigen::MatrixXd u1(r, c), u2(r, c), x(r, c), y(r, c), phi(r, c), minEig(r, c), stiffness(r, c), residual(r, c);
+  Eigen::MatrixXi reached(r, c), stable(r, c), negative(r, c), folds(r, c);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (Eigen::Index j = 0; j < r; ++j)
+    for (Eigen::Index i = 0; i < c; ++i) {
+      const mechanics::WorkspaceCell& cell = m.cell(int(i), int(j));
+      u1(j, i) = cell.u1;
+      u2(j, i) = cell.u2;
+      reached(j, i) = cell.reached;
+      stable(j, i) = cell.stable();
+      negative(j, i) = cell.reached ? cell.negative : -1;
+      folds(j, i) = cell.reached ? cell.folds : -1;
+      x(j, i) = cell.reached ? cell.pose[0] : nan;
+      y(j, i) = cell.reached ? cell.pose[1] : nan;
+      phi(j, i) = cell.reached ? cell.pose[2] : nan;
+      minEig(j, i) = cell.reached ? cell.smallestEigenvalue : nan;
+      stiffness(j, i) = cell.reached ? cell.stiffness : nan;
+      residual(j, i) = cell.reached ? cell.residual : nan;
+    }
+  py::dict d;
+  d["inputs"] = std::vector<std::string>{m.input1, m.input2};
+  d["u1"] = u1;
+  d["u2"] = u2;
+  d["reached"] = reached;
+  d["x"] = x;
+  d["y"] = y;
+  d["phi"] = phi;
+  d["stable"] = stable;
+  d["negative_eigenvalues"] = negative;
+  d["min_eig"] = minEig;
+  d["stiffness_min"] = stiffness;
+  d["folds"] = folds;
+  d["residual"] = residual;
+  py::list curves;
+  for (const mechanics::WorkspaceCurve& cu : m.curves) {
+    const Eigen::Index k = static_cast<Eigen::Index>(cu.points.size());
+    VectorXd a1(k), a2(k), ax(k), ay(k), aphi(k), ares(k);
+    Eigen::VectorXi ast(k);
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const mechanics::WorkspaceCurvePoint& p = cu.points[size_t(i)];
+      a1[i] = p.u1;
+      a2[i] = p.u2;
+      ax[i] = p.pose[0];
+      ay[i] = p.pose[1];
+      aphi[i] = p.pose[2];
+      ares[i] = p.residual;
+      ast[i] = p.negative == 0;
+    }
+    py::dict cd;
+    cd["cause"] = mechanics::boundaryCauseName(cu.cause);
+    cd["name"] = cu.name;
+    cd["stop"] = cu.stop;
+    cd["u1"] = a1;
+    cd["u2"] = a2;
+    cd["x"] = ax;
+    cd["y"] = ay;
+    cd["phi"] = aphi;
+    cd["stable"] = ast;
+    cd["residual"] = ares;
+    curves.append(cd);
+  }
+  d["curves"] = curves;
+  d["problems"] = m.problems;
+  return d;
+}
+
 }  // namespace buckle::python

@@ -31,6 +31,11 @@ pybind11::dict specialArrays(const scene::Scene& s, const scene::CaseResult& cr,
 /// "branches", the branch through each (−1: none) and the disconnected branches' seeds.
 pybind11::dict equilibriaArrays(const scene::CaseResult& cr);
 
+/// The workspace analysis of a case: the grid as (count2 × count1) arrays (u1, u2, reached, x, y,
+/// phi, stable, negative_eigenvalues, min_eig, stiffness_min, folds, residual: the columns of
+/// workspace_map.csv) and the curves, each a dict of cause, name, stop and its points' arrays.
+pybind11::dict workspaceArrays(const scene::CaseResult& cr);
+
 /// Column name → axis label with the scene's unit, plain Unicode ("Fx (N)", "δx = x₀ − x (m)"),
 /// as report.html writes them: every value column, q1 … qn and "parameter" (the path
 /// parameter's label).

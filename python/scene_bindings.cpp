@@ -75,6 +75,7 @@ py::dict resultDict(const scene::Scene& s, const scene::RunResult& run, const sc
     c["branches"] = branchArrays(s, cr);
     c["special_points"] = specialArrays(s, cr, specials);
     if (!cr.equilibriumSets.empty()) c["equilibria"] = equilibriaArrays(cr);
+    if (cr.haveWorkspace) c["workspace"] = workspaceArrays(cr);
     cases.append(c);
     specials += static_cast<int>(cr.specials.size());
     segments = std::max(segments, cr.chain.size());
@@ -194,7 +195,9 @@ void bindScene(py::module_& m) {
       "omega1 … with frequencies, a task path's inputs; `special_points`: the case's special points in the same "
       "value columns as arrays, with type, field, shape, branch and index (into the run's `special_points`); with the equilibria analysis `equilibria`: the rows of equilibria.csv as "
       "arrays — at, q (m×n), potential, index, stable, shape, branch (the branch through each, -1: none or not "
-      "traced) — and `disconnected_branches` (id, parent, from_equilibrium: the seed's rank, joins)); "
+      "traced) — and `disconnected_branches` (id, parent, from_equilibrium: the seed's rank, joins); with the "
+      "workspace analysis `workspace`: the grid of workspace_map.csv as (count2 × count1) arrays and `curves` "
+      "(cause, name, stop, u1, u2, x, y, phi, stable, residual)); "
       "`special_points` (the dicts of special_points.json); `results` (all of special_points.json: "
       "critical_loads, energy_equilibria, ... when asked); `summary` (summary.json, with `units`); `labels` "
       "(column → axis label in the scene's units, as the plots write it). Raises SceneError (a ValueError) for a "

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 
 #include "buckle/mechanics/shape_name.h"
 #include "problems/auto_cases.h"
@@ -49,6 +50,15 @@ MeasuredCase fromScene(const scene::CaseResult& c) {
     // disconnected branch traced from another seed, or none, is a drift
     for (size_t i = 0; i < set.onBranch.size(); ++i)
       m.specials.push_back({-1, "EQBRANCH", double(set.onBranch[i]), "equilibrium " + std::to_string(i + 1), 0.0, {}});
+  }
+  if (c.haveWorkspace) {
+    // the workspace map: its stable grid values and its bounding curves by cause (counts)
+    int stable = 0;
+    for (const mechanics::WorkspaceCell& cell : c.workspace.cells) stable += cell.stable();
+    m.specials.push_back({-1, "WSSTABLE", double(stable), "stable grid values", 0.0, {}});
+    std::map<std::string, int> curves;
+    for (const mechanics::WorkspaceCurve& curve : c.workspace.curves) ++curves[mechanics::boundaryCauseName(curve.cause)];
+    for (const auto& [cause, count] : curves) m.specials.push_back({-1, "WSCURVES", double(count), cause, 0.0, {}});
   }
   if (c.haveTorque)
     for (const auto& [q, stable] : c.torque.equilibria) m.specials.push_back({-1, "TEQ", q, stable ? "stable" : "unstable", 0.0, {}});

@@ -46,6 +46,12 @@ const std::vector<Analysis>& analyses() {
       {nullptr, nullptr, [](A a) { return a.equilibria.enabled && a.equilibria.branches; },
        [](S) -> std::string { return "the branches through the equilibria the continuation does not reach"; },
        "disconnected_branches", [](CaseRunner& r) { r.disconnectedBranches(); }, false},
+      {"workspace", detail::parseWorkspace, [](A a) { return a.workspace.enabled; },
+       [](S s) {
+         return "workspace and stability maps over " + s.analyses.workspace.options.first.input.name() + " and " +
+                s.analyses.workspace.options.second.input.name() + " under the payload, bounding curves traced";
+       },
+       "workspace", [](CaseRunner& r) { r.workspaceMap(); }, true},
       {"load_history", detail::parseLoadHistory, [](A a) { return a.loadHistory.enabled; },
        [](S s) {
          return "quasi-static load history with jumps (hysteresis), " +

@@ -46,6 +46,8 @@ class CaseRunner {
   void torqueAngle();
   /// equilibria (case_runner_equilibria.cpp)
   void equilibria();
+  /// workspace (case_runner_workspace.cpp): the maps over two control inputs under the payload.
+  void workspaceMap();
   /// `jump` (after the branches are traced): where the chain lands from every fold of them.
   void jumps();
   /// The branches through the equilibria that the continuation's tree does not reach

@@ -16,6 +16,7 @@
 
 #include "scene/branch_stream.h"
 #include "scene/output_equilibria.h"
+#include "scene/output_workspace.h"
 #include "scene/output_numbers.h"
 #include "scene/escape.h"
 #include "scene/output_target.h"
@@ -193,6 +194,7 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
   if (scene.analyses.energyCurves.enabled) doc["energy_equilibria"] = equilibria;
   if (scene.analyses.torqueAngle.enabled) doc["torque_zeros"] = torque;
   if (scene.analyses.equilibria.enabled) doc["equilibria"] = equilibriaJson(run);
+  if (scene.analyses.workspace.enabled) doc["workspace"] = workspaceJson(run);
   if (scene.analyses.suddenLoad.enabled) {
     json sudden = json::array();
     for (size_t c = 0; c < run.cases.size(); ++c) {
@@ -269,6 +271,10 @@ void writeCurves(const Scene& scene, const RunResult& run, const fs::path& dir) 
     writeText(dir / "energy_curves.csv", os.str());
   }
   if (scene.analyses.equilibria.enabled) writeText(dir / "equilibria.csv", equilibriaCsv(run));
+  if (scene.analyses.workspace.enabled) {
+    writeText(dir / "workspace_map.csv", workspaceMapCsv(run));
+    writeText(dir / "workspace_curves.csv", workspaceCurvesCsv(run));
+  }
   if (scene.analyses.torqueAngle.enabled) {
     std::ostringstream os;
     os << "case,q,M,Kq\n";

@@ -23,7 +23,8 @@ namespace {
 const std::set<std::string> kTopLevelFiles = {"summary.json",       "special_points.json", "branches.csv",
                                               "energy_curves.csv",  "torque_angle.csv",    "sudden_load.csv",
                                               "atlas.csv",          "report.html", "joint_angles.npy",
-                                              "critical_curves.csv", "equilibria.csv"};
+                                              "critical_curves.csv", "equilibria.csv",
+                                              "workspace_map.csv",  "workspace_curves.csv"};
 const std::set<std::string> kPlotExtensions = {".png", ".svg", ".gp", ".dat", ".log"};
 
 /// `a` equals `b` or is one of its ancestors (both absolute and canonical).

@@ -93,6 +93,8 @@ PlotReport drawPlots(const Scene& scene, const RunResult& run, const std::string
         shapesPlot(scene, run, spec, size_t(&spec - scene.plots.data()), dir, s, report.notes);
         break;
       case PlotType::EquilibriumShapes: equilibriumShapesPlot(scene, run, spec, dir, s); break;
+      case PlotType::Workspace: workspacePlot(scene, run, spec, dir, s); break;
+      case PlotType::InputMap: inputMapPlot(scene, run, spec, dir, s); break;
     }
     if (spec.type == PlotType::Bifurcation || spec.type == PlotType::Stiffness || spec.type == PlotType::Shapes) {
       size_t stride = 1;  // a streamed large tree's sample of points (runner.h, CaseResult::points)

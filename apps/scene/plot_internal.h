@@ -130,6 +130,9 @@ void suddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, 
 /// `equilibrium_shapes` (plot_shapes.cpp): every equilibrium of the `equilibria` analysis, one
 /// panel each in ascending potential, stable ones marked.
 void equilibriumShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s);
+/// `workspace` and `input_map` (plot_workspace.cpp): the workspace analysis's two plots.
+void workspacePlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s);
+void inputMapPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, const fs::path& dir, Script& s);
 void shapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec, size_t plotIndex, const fs::path& dir,
                 Script& s, std::vector<std::string>& notes);
 

@@ -123,6 +123,9 @@ struct CaseResult {
   std::vector<mechanics::CriticalCurve> criticalCurves;  ///< two_parameter: BP curves by mode, then LP curves
   /// equilibria: every equilibrium at each state of the controls asked (`at`), in the scene's order
   std::vector<EquilibriumSet> equilibriumSets;
+  /// workspace: the map over two control inputs and its bounding curves
+  bool haveWorkspace = false;
+  mechanics::WorkspaceMap workspace;
   explicit CaseResult(const mechanics::Chain& c) : chain(c) {}
 };
 

@@ -33,6 +33,8 @@ const char* toString(PlotType t) {
     case PlotType::Shapes: return "shapes";
     case PlotType::SuddenLoad: return "sudden_load";
     case PlotType::CriticalCurves: return "critical_curves";
+    case PlotType::Workspace: return "workspace";
+    case PlotType::InputMap: return "input_map";
     case PlotType::EquilibriumShapes: return "equilibrium_shapes";
   }
   return "?";

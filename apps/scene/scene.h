@@ -16,6 +16,7 @@
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/stiffness_extremum.h"
 #include "buckle/mechanics/task_path.h"
+#include "buckle/mechanics/workspace_map.h"
 #include "buckle/mechanics/segment.h"
 #include "scene/json_reader.h"
 #include "scene/units.h"
@@ -203,6 +204,13 @@ struct EquilibriaSpec {
   bool branches = false;
 };
 
+/// Workspace and stability maps over two control inputs (mechanics/workspace_map.h): the library's
+/// options as they are, their tracer set from /solver when the case runs.
+struct WorkspaceSpec {
+  bool enabled = false;
+  mechanics::WorkspaceMapOptions options;
+};
+
 struct AnalysesSpec {
   ContinuationSpec continuation;
   FrequenciesSpec frequencies;
@@ -217,6 +225,7 @@ struct AnalysesSpec {
   CriticalForcesSpec criticalForces;
   TwoParameterSpec twoParameter;
   EquilibriaSpec equilibria;
+  WorkspaceSpec workspace;
 };
 
 /// /solver: the tracer settings of every analysis (the library's mechanics::chainTracerOptions(),
@@ -226,7 +235,18 @@ struct SolverSpec {
   double timeLimit = 120.0;    ///< seconds for the whole scene; past it the run stops (exit 1)
 };
 
-enum class PlotType { Bifurcation, Stiffness, EnergyCurves, TorqueAngle, Shapes, SuddenLoad, CriticalCurves, EquilibriumShapes };
+enum class PlotType {
+  Bifurcation,
+  Stiffness,
+  EnergyCurves,
+  TorqueAngle,
+  Shapes,
+  SuddenLoad,
+  CriticalCurves,
+  EquilibriumShapes,
+  Workspace,
+  InputMap
+};
 const char* toString(PlotType t);
 
 /// Which special points a bifurcation or stiffness plot labels (docs/scenes.md, `plots`): all of

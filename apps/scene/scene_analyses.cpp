@@ -209,12 +209,14 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
                                                  {"shapes", PlotType::Shapes},
                                                  {"sudden_load", PlotType::SuddenLoad},
                                                  {"critical_curves", PlotType::CriticalCurves},
-                                                 {"equilibrium_shapes", PlotType::EquilibriumShapes}};
+                                                 {"equilibrium_shapes", PlotType::EquilibriumShapes},
+                                                 {"workspace", PlotType::Workspace},
+                                                 {"input_map", PlotType::InputMap}};
   auto it = types.find(type);
   if (it == types.end())
     r.expected(pt, obj["type"],
                "one of bifurcation, stiffness, energy_curves, torque_angle, shapes, sudden_load, critical_curves, "
-               "equilibrium_shapes");
+               "equilibrium_shapes, workspace, input_map");
   s.type = it->second;
   auto needs = [&](bool have, const char* analysis) {
     if (!have) r.fail(pt, std::string("a ") + type + " plot needs /analyses/" + analysis);
@@ -228,6 +230,8 @@ PlotSpec parsePlot(const Reader& r, const json& v, const Pointer& p, const Analy
     case PlotType::SuddenLoad: needs(a.suddenLoad.enabled, "sudden_load"); break;
     case PlotType::CriticalCurves: needs(a.twoParameter.enabled, "two_parameter"); break;
     case PlotType::EquilibriumShapes: needs(a.equilibria.enabled, "equilibria"); break;
+    case PlotType::Workspace:
+    case PlotType::InputMap: needs(a.workspace.enabled, "workspace"); break;
   }
   s.name = type;
   if (obj.contains("name")) {
@@ -292,6 +296,7 @@ void checkAnalysesAgainstCases(const Reader& r, const Scene& scene) {
   checkTaskPathAnalyses(r, scene);
   checkTwoParameterAgainstCases(r, scene);
   checkEquilibriaAgainstCases(r, scene);
+  checkWorkspaceAgainstCases(r, scene);
   if (scene.analyses.energyCurves.enabled)
     for (size_t i = 0; i < scene.cases.size(); ++i)
       if (scene.cases[i].chain.segments.size() != 3)
@@ -341,6 +346,10 @@ std::vector<PlotSpec> defaultPlots(const AnalysesSpec& a, int nCases) {
   if (a.suddenLoad.enabled) out.push_back({PlotType::SuddenLoad, "sudden_load", "", {}, {}, "", all});
   if (a.twoParameter.enabled) out.push_back({PlotType::CriticalCurves, "critical_curves", "", {}, {}, "", all});
   if (a.equilibria.enabled) out.push_back({PlotType::EquilibriumShapes, "equilibrium_shapes", "", {}, {}, "", all});
+  if (a.workspace.enabled) {
+    out.push_back({PlotType::Workspace, "workspace", "", {}, {}, "", all});
+    out.push_back({PlotType::InputMap, "input_map", "", {}, {}, "", all});
+  }
   return out;
 }
 

@@ -77,6 +77,11 @@ void checkAnalysesAgainstCases(const JsonReader& r, const Scene& scene);
 EquilibriaSpec parseEquilibria(const JsonReader& r, const json& v, const Pointer& p);
 /// Its `at` inside every case's path range.
 void checkEquilibriaAgainstCases(const JsonReader& r, const Scene& scene);
+/// /analyses/workspace (scene_workspace.cpp): false or an object of options.
+void parseWorkspace(const JsonReader& r, const json& v, const Pointer& p, AnalysesSpec& s);
+/// Every case's end holds nothing, the inputs exist on its chain and their ranges contain its own
+/// values with every free length positive.
+void checkWorkspaceAgainstCases(const JsonReader& r, const Scene& scene);
 /// `inputColumns`: the task paths' input columns (taskInputColumns), allowed on the axes too.
 PlotSpec parsePlot(const JsonReader& r, const json& v, const Pointer& p, const AnalysesSpec& a, int maxN, int nCases,
                    const std::vector<std::string>& inputColumns = {});

@@ -40,7 +40,8 @@ mechanics::TaskInput parseInput(const JsonReader& r, const json& v, const Pointe
   inputName(r.required(v, p, "input"), p / "input");
   if (v.contains("segment")) in.segment = r.integer(v["segment"], p / "segment", 1, chain.size()) - 1;
   if (v.contains("weight")) {
-    if (!minChange) r.fail(p / "weight", "a weight only applies to the rule \"min_change\"; remove this key");
+    if (!minChange)
+      r.fail(p / "weight", "a weight only applies to the rules \"min_change\" and \"most_stable\"; remove this key");
     in.weight = r.positive(v["weight"], p / "weight");
   }
   if (v.contains("min")) in.lower = r.number(v["min"], p / "min");
@@ -111,13 +112,17 @@ PathSpec parseTaskPath(const JsonReader& r, const json& path, const Pointer& p, 
   }
   std::string rule = "chosen";
   if (path.contains("rule")) rule = r.string(path["rule"], p / "rule");
-  if (rule != "chosen" && rule != "min_change") r.expected(p / "rule", path["rule"], "one of chosen, min_change");
-  setup.rule = rule == "chosen" ? mechanics::TaskRule::Chosen : mechanics::TaskRule::MinimumChange;
+  if (rule != "chosen" && rule != "min_change" && rule != "most_stable")
+    r.expected(p / "rule", path["rule"], "one of chosen, min_change, most_stable");
+  setup.rule = rule == "chosen"       ? mechanics::TaskRule::Chosen
+               : rule == "min_change" ? mechanics::TaskRule::MinimumChange
+                                      : mechanics::TaskRule::MostStable;
   const json& inputs = r.required(path, p, "inputs");
   if (!inputs.is_array() || inputs.empty()) r.expected(p / "inputs", inputs, "a non-empty array of inputs");
   std::set<std::string> seen;
   for (size_t j = 0; j < inputs.size(); ++j) {
-    setup.inputs.push_back(parseInput(r, inputs[j], p / "inputs" / j, chain, setup.rule == mechanics::TaskRule::MinimumChange));
+    setup.inputs.push_back(
+        parseInput(r, inputs[j], p / "inputs" / j, chain, setup.rule != mechanics::TaskRule::Chosen));
     if (!seen.insert(mechanics::taskInputName(setup.inputs.back())).second)
       r.fail(p / "inputs" / j, "the input " + mechanics::taskInputName(setup.inputs.back()) + " is listed twice");
   }
@@ -125,8 +130,8 @@ PathSpec parseTaskPath(const JsonReader& r, const json& path, const Pointer& p, 
   if (setup.rule == mechanics::TaskRule::Chosen && setup.inputs.size() != m)
     r.fail(p / "inputs", "the rule \"chosen\" needs as many inputs as task coordinates (" + std::to_string(m) +
                              "), got " + std::to_string(setup.inputs.size()) + " (or use \"rule\": \"min_change\")");
-  if (setup.rule == mechanics::TaskRule::MinimumChange && setup.inputs.size() < m)
-    r.fail(p / "inputs", "the rule \"min_change\" needs at least as many inputs as task coordinates (" +
+  if (setup.rule != mechanics::TaskRule::Chosen && setup.inputs.size() < m)
+    r.fail(p / "inputs", "the rule \"" + rule + "\" needs at least as many inputs as task coordinates (" +
                              std::to_string(m) + "), got " + std::to_string(setup.inputs.size()));
   spec.from = 0.0;
   spec.to = 0.0;  // the path's length is known once the start pose is (case runner)

@@ -40,9 +40,11 @@ void TaskSetup::validate(int segments) const {
   if (rule == TaskRule::Chosen && inputs.size() != m)
     throw std::invalid_argument("task path: the rule \"chosen\" needs as many inputs as task coordinates (" +
                                 std::to_string(m) + "), got " + std::to_string(inputs.size()));
-  if (rule == TaskRule::MinimumChange && inputs.size() < m)
-    throw std::invalid_argument("task path: the rule \"min_change\" needs at least as many inputs as task coordinates (" +
-                                std::to_string(m) + "), got " + std::to_string(inputs.size()));
+  if (rule != TaskRule::Chosen && inputs.size() < m)
+    throw std::invalid_argument(std::string("task path: the rule \"") +
+                                (rule == TaskRule::MinimumChange ? "min_change" : "most_stable") +
+                                "\" needs at least as many inputs as task coordinates (" + std::to_string(m) + "), got " +
+                                std::to_string(inputs.size()));
   for (const TaskInput& in : inputs) {
     if (in.segment < -1 || in.segment >= segments)
       throw std::invalid_argument("task path: input " + taskInputName(in) + ": segment out of range 1.." +
@@ -64,7 +66,9 @@ TaskPathProblem::TaskPathProblem(const Chain& chain, const TaskSetup& setup)
   setup_.validate(n_);
   setup_.body = setup_.body.atParameter(0.0);
   body_ = BodyLoadTerms(chain_, setup_.body);  // throws as BodyLoads::check
-  dim_ = setup_.rule == TaskRule::Chosen ? n_ + mIn_ : 2 * n_ + mIn_ + m_;
+  dim_ = setup_.rule == TaskRule::Chosen ? n_ + mIn_
+         : setup_.rule == TaskRule::MinimumChange ? 2 * n_ + mIn_ + m_
+                                                  : 3 * n_ + mIn_ + m_ + 1;
   p0_.resize(mIn_);
   for (int j = 0; j < mIn_; ++j) {
     const TaskInput& in = setup_.inputs[size_t(j)];
@@ -181,6 +185,7 @@ void TaskPathProblem::inputColumns(const Eigen::MatrixX2d& e, Matrix& out) const
 }
 
 bool TaskPathProblem::residual(ProblemWorkspace& ws, ConstVectorRef u, double s, VectorRef F) const {
+  if (setup_.rule == TaskRule::MostStable) return mostStableResidual(ws, u, s, 1.0, F);
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!prepare(ws, u)) return false;
   const Vector t = target(s);
@@ -206,7 +211,8 @@ bool TaskPathProblem::residual(ProblemWorkspace& ws, ConstVectorRef u, double s,
   return true;
 }
 
-bool TaskPathProblem::jacobian(ProblemWorkspace& ws, ConstVectorRef u, double, MatrixRef Fu, VectorRef Fs) const {
+bool TaskPathProblem::jacobian(ProblemWorkspace& ws, ConstVectorRef u, double s, MatrixRef Fu, VectorRef Fs) const {
+  if (setup_.rule == TaskRule::MostStable) return mostStableJacobian(ws, u, s, 1.0, Fu, Fs, false);
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!prepare(ws, u)) return false;
   Fu.setZero();
@@ -248,7 +254,6 @@ bool TaskPathProblem::jacobian(ProblemWorkspace& ws, ConstVectorRef u, double, M
 
 void TaskPathProblem::optimalityBlocks(ProblemWorkspace& ws, ConstVectorRef u, Vector& diagA, Vector& genA,
                                        Matrix& D) const {
-  Workspace& d = workspaceAs<Workspace>(ws);
   const auto mu = u.segment(n_ + mIn_, n_);
   const auto nu = u.segment(2 * n_ + mIn_, m_);
   double nx = 0.0, ny = 0.0;
@@ -256,20 +261,26 @@ void TaskPathProblem::optimalityBlocks(ProblemWorkspace& ws, ConstVectorRef u, V
     if (setup_.coordinates[size_t(k)] == 0) nx = nu[k];
     if (setup_.coordinates[size_t(k)] == 1) ny = nu[k];
   }
-  // A = diag(E‴ ⊙ μ) − K_a + K_b (header): one generator genA_m = b_m − a_m of a max-index matrix
+  hessianDerivative(ws, mu, nx, ny, diagA, genA);
+  inputColumns(workspaceAs<Workspace>(ws).e2, D);
+  D = mu.asDiagonal() * D;
+}
+
+void TaskPathProblem::hessianDerivative(ProblemWorkspace& ws, ConstVectorRef w, double nx, double ny, Vector& diagA,
+                                        Vector& genA) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  // A = diag(E‴ ⊙ w) − K_a + K_b (header): one generator genA_m = b_m − a_m of a max-index matrix
   const Wrench& F = setup_.payload;
   genA.resize(n_);
   double prefix = 0.0, tail = 0.0;
-  for (int m = 0; m < n_; ++m) prefix += mu[m], d.work[m] = prefix;  // Σ_{j≤m} μ_j
+  for (int m = 0; m < n_; ++m) prefix += w[m], d.work[m] = prefix;  // Σ_{j≤m} w_j
   for (int m = n_ - 1; m >= 0; --m) {
     const double rho = F[0] * d.data.S[m] - F[1] * d.data.C[m] - d.tau[m];  // ρ_m (header, eq B5)
     const double a = rho * d.work[m] + tail;
-    tail += rho * mu[m];
+    tail += rho * w[m];
     genA[m] = -nx * d.data.C[m] - ny * d.data.S[m] - a;
   }
-  diagA = d.third.cwiseProduct(mu);
-  inputColumns(d.e2, D);
-  D = mu.asDiagonal() * D;
+  diagA = d.third.cwiseProduct(w);
 }
 
 bool TaskPathProblem::assembleOptimality(ProblemWorkspace& ws, ConstVectorRef u, ChainStructure& structure,
@@ -331,6 +342,7 @@ double TaskPathProblem::boundary(ProblemWorkspace& ws, int k, ConstVectorRef u, 
     for (int j = 0; j < mIn_; ++j) L += (u[n_ + j] - p0_[j]) * rates_[size_t(j)](i, spring);
     return L;
   }
+  if (k == 4 * n_ + 2 * mIn_ + 1) return coalescenceGap(ws, u);
   if (!setup_.stabilityBoundary) return 1.0;
   Inertia inertia;
   double smallest = 0.0;
@@ -341,7 +353,7 @@ double TaskPathProblem::boundary(ProblemWorkspace& ws, int k, ConstVectorRef u, 
 TaskPathProblem::BoundaryKind TaskPathProblem::boundaryKind(int k) const {
   if (k < 2 * n_) return BoundaryKind::JointLimit;
   if (k < 4 * n_ + 2 * mIn_) return BoundaryKind::InputBound;
-  return BoundaryKind::Stability;
+  return k == 4 * n_ + 2 * mIn_ ? BoundaryKind::Stability : BoundaryKind::Coalescence;
 }
 
 std::string TaskPathProblem::boundaryName(int k) const {
@@ -358,10 +370,14 @@ std::string TaskPathProblem::boundaryName(int k) const {
     return std::string("free length ") + (f % 2 == 0 ? "L1_0" : "L2_0") + " of segment " + std::to_string(f / 2 + 1) +
            " reaches zero (the inputs' admissible range)";
   }
+  if (k == 4 * n_ + 2 * mIn_ + 1)
+    return "the optimised smallest eigenvalue of K_q - K_g meets the next one (the most stable configuration stops "
+           "being smooth: two modes are equally weak)";
   return "loss of stability at fixed inputs (smallest eigenvalue of K_q - K_g crosses zero)";
 }
 
 std::unique_ptr<continuation::BorderedSolver> TaskPathProblem::makeStructuredSolver(ProblemWorkspace& ws) const {
+  if (setup_.rule == TaskRule::MostStable) return nullptr;  // a dense Jacobian (header)
   if (setup_.rule == TaskRule::MinimumChange)
     return mIn_ + m_ + 2 <= TaskPathKktSolver::kMaxSmall ? std::make_unique<TaskPathKktSolver>(*this, ws) : nullptr;
   if (mIn_ + 3 > ChainStructure::kMaxBorder) return nullptr;
@@ -373,6 +389,7 @@ continuation::ProblemScales TaskPathProblem::scales() const {
   continuation::ProblemScales s = continuation::ProblemScales::ones(dim_);
   s.parameter = b;
   s.stability = torque;
+  if (setup_.rule == TaskRule::MostStable) return mostStableScales(s);
   const bool chosen = setup_.rule == TaskRule::Chosen;
   const int gRow = chosen ? 0 : n_ + mIn_, tRow = chosen ? n_ : 2 * n_ + mIn_;
   s.unknowns.segment(n_, mIn_).setConstant(b);

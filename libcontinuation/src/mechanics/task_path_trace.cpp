@@ -20,6 +20,7 @@ const char* toString(TaskPathEvent event) {
     case TaskPathEvent::StabilityLoss: return "loss of stability";
     case TaskPathEvent::JointLimit: return "joint limit";
     case TaskPathEvent::InputBound: return "input bound";
+    case TaskPathEvent::EigenvalueCoalescence: return "eigenvalue coalescence";
     case TaskPathEvent::MaxPoints: return "max points";
     case TaskPathEvent::Failed: return "failed";
     case TaskPathEvent::Interrupted: return "interrupted";
@@ -78,6 +79,7 @@ TaskPathEvent boundaryEvent(TaskPathProblem& problem, const std::string& name) {
         case TaskPathProblem::BoundaryKind::JointLimit: return TaskPathEvent::JointLimit;
         case TaskPathProblem::BoundaryKind::InputBound: return TaskPathEvent::InputBound;
         case TaskPathProblem::BoundaryKind::Stability: return TaskPathEvent::StabilityLoss;
+        case TaskPathProblem::BoundaryKind::Coalescence: return TaskPathEvent::EigenvalueCoalescence;
       }
     }
   return TaskPathEvent::Failed;
@@ -113,11 +115,19 @@ TaskPathResult traceTaskPath(TaskPathProblem& problem, const Vector& q0, const s
   std::vector<Vector> corners{Vector(m)};
   for (int k = 0; k < m; ++k) corners[0][k] = pose0[setup.coordinates[size_t(k)]];
   for (const Vector& w : waypoints) corners.push_back(w);
-  Vector u = problem.pack(q0, problem.startInputs());
+  const cont::BoundProblem bound(problem);  // one workspace for every leg (warm starts carry over)
+  problem.setLeg({corners[0], Vector::Zero(m), 0.0});
+  Vector u;
+  try {
+    u = problem.startPoint(bound.workspace(), q0, options.tracer);
+  } catch (const std::runtime_error& e) {
+    result.end = TaskPathEvent::Failed;
+    result.message = e.what();
+    return result;
+  }
   double s = 0.0;
   result.legEnds.push_back(0.0);
   const double tiny = 1e-12 * std::max(problem.lengthUnit(), problem.chain().length());
-  const cont::BoundProblem bound(problem);  // one workspace for every leg (warm starts carry over)
   for (size_t k = 0; k + 1 < corners.size(); ++k) {
     const double length = taskLegLength(setup, corners[k], corners[k + 1], angleLength);
     if (!(length > tiny)) continue;

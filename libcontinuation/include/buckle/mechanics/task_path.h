@@ -34,6 +34,23 @@
 //      D(i, j) = ∂(K_q μ)_i/∂p_j = −Σ_s r_j(i, s) k_s L_s″(q_i) μ_i (E is quadratic in L⁰, so
 //      ∂B/∂p = 0). At the start p = p⁰, μ = ν = 0 solves it exactly.
 //
+//  (c) MostStable: m_in ≥ m inputs chosen to keep the equilibrium as stable as the task allows:
+//        maximise μ = μ_min(H(q, p)), the smallest eigenvalue of K_q − K_g at fixed inputs,
+//        subject to g = 0, τ = 0,
+//      continued along the path through its optimality system with the eigenpair (v, μ) as
+//      unknowns, u = (q, p, α, β, v, μ) (size 3n + m_in + m + 1):
+//        R_q = −θ ∇_q μ + H α + J_cᵀ β = 0,      ∇_q μ = vᵀ(∂H/∂q)v = A(v) v
+//        R_p = (1 − θ) T W (p − p⁰)/b̄² − θ ∇_p μ + Bᵀ α = 0,   (∇_p μ)_j = Σ_i v_i² ∂²(K_q)_ii/∂p_j
+//        R_α = g = 0,  R_β = τ = 0,  R_v = H v − μ v = 0,  R_μ = ½(vᵀv − 1) = 0
+//      with A(v) = ∂(H v)/∂q as in (b) (ν = 0), T = k̄b̄² the torque unit. θ = 1 on the path; the
+//      start is reached from rule (b)'s trivial point at the chain's own inputs (p = p⁰,
+//      α = β = 0, v the lowest eigenvector) by continuation in θ from 0 to 1 at s = 0
+//      (mostStableStart), so the path starts at the optimum connected to the chain's own
+//      inputs. The Jacobian needs ∂(A(v)v)/∂(q, p), fourth derivatives of E: it is differenced
+//      centrally from the exact residual (the points' accuracy is the residual's). The optimum
+//      stays smooth while μ is a simple eigenvalue: where the next eigenvalue meets it (a
+//      max–min optimum typically ends there), a boundary stops the path and says so.
+//
 // Stability of a point is that of the equilibrium at fixed inputs: H positive definite (the end
 // is free under the payload). It is O(n) through the chain structure (chain_structure.h) and is
 // reported to the tracer as a boundary (smallest eigenvalue ≥ 0), so the path ends on the exact
@@ -53,6 +70,7 @@
 #include <vector>
 
 #include "buckle/continuation/problem.h"
+#include "buckle/continuation/tracer_options.h"
 #include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
@@ -71,7 +89,7 @@ struct TaskInput {
 /// "dL0" (every segment) or "dL0[3]" (segment 3, 1-based): the name of an input column.
 std::string taskInputName(const TaskInput& input);
 
-enum class TaskRule { Chosen, MinimumChange };
+enum class TaskRule { Chosen, MinimumChange, MostStable };
 
 /// The payload, the constrained coordinates, the inputs and the rule (what does not move along a path).
 struct TaskSetup {
@@ -134,17 +152,29 @@ class TaskPathProblem final : public continuation::Problem {
 
   /// Boundaries: joint upper limits (n), lower limits (n), input upper / lower bounds (2 m_in),
   /// the free lengths L1⁰, L2⁰ of every segment (2n, > 0: the inputs' admissible range), then
-  /// the smallest eigenvalue of H at fixed inputs over the stability scale (1).
-  int boundaryCount() const override { return 4 * n_ + 2 * mIn_ + 1; }
+  /// the smallest eigenvalue of H at fixed inputs over the stability scale (1); rule (c) also
+  /// the gap from the tracked eigenvalue μ to the nearest other one (1, header).
+  int boundaryCount() const override { return 4 * n_ + 2 * mIn_ + 1 + (setup_.rule == TaskRule::MostStable ? 1 : 0); }
   double boundary(continuation::ProblemWorkspace& ws, int k, continuation::ConstVectorRef u, double s) const override;
   std::string boundaryName(int k) const override;
   /// What kind of boundary k is.
-  enum class BoundaryKind { JointLimit, InputBound, Stability };
+  enum class BoundaryKind { JointLimit, InputBound, Stability, Coalescence };
   BoundaryKind boundaryKind(int k) const;
 
   /// Inertia and smallest eigenvalue of H = K_q − K_g at fixed inputs, O(n). False outside the domain.
   bool fixedInputStability(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, Inertia& inertia,
                            double& smallest) const;
+
+  /// Rule (c): the residual with the objective's homotopy weight θ (header; θ = 1 on the path).
+  bool mostStableResidual(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double s, double theta,
+                          continuation::VectorRef F) const;
+  /// The path's first point at joint angles q0 (the chain's own inputs, the end at the leg's
+  /// start): pack(q0, p⁰) for rules (a), (b); for rule (c) the optimum reached by continuation in
+  /// θ (header) with `options`' step settings. Throws std::runtime_error saying why it failed.
+  Vector startPoint(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef q0,
+                    const continuation::TracerOptions& options) const;
+  /// Rule (c): the tracked eigenvalue μ and eigenvector v of u.
+  double trackedEigenvalue(continuation::ConstVectorRef u) const { return u[dim_ - 1]; }
 
   /// Rule (a): the O(n) bordered solver; rule (b): null (dense).
   std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace& ws) const override;
@@ -192,6 +222,17 @@ class TaskPathProblem final : public continuation::Problem {
   /// Rule (b), after prepare(u): A = diag(diagA) + [genA_max(i,k)] and D (header).
   void optimalityBlocks(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, Vector& diagA, Vector& genA,
                         Matrix& D) const;
+  /// A(w) = ∂(H w)/∂q + ν_x ∂²x/∂q² + ν_y ∂²y/∂q² = diag(diagA) + [genA_max(i,k)] (header), after prepare.
+  void hessianDerivative(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef w, double nx, double ny,
+                         Vector& diagA, Vector& genA) const;
+  /// Rule (c): its Jacobian by central differences of mostStableResidual (header).
+  bool mostStableJacobian(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double s, double theta,
+                          continuation::MatrixRef Fu, continuation::VectorRef Fparameter, bool parameterIsTheta) const;
+  /// Rule (c): the gap boundary (header), after prepare.
+  double coalescenceGap(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u) const;
+  /// Rule (c)'s scales (header) on top of the common ones in `s`.
+  continuation::ProblemScales mostStableScales(continuation::ProblemScales s) const;
+  friend class MostStableHomotopy;
   /// Column j of B (or of D with the joint weights μ) from the per-segment derivatives e (n×2).
   void inputColumns(const Eigen::MatrixX2d& e, Matrix& out) const;
 

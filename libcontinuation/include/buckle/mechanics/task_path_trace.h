@@ -21,12 +21,13 @@ enum class TaskPathEvent {
   StabilityLoss,  ///< the equilibrium at fixed inputs loses its stability
   JointLimit,
   InputBound,
+  EigenvalueCoalescence,  ///< rule (c): the optimised smallest eigenvalue meets the next (task_path.h)
   MaxPoints,      ///< the tracer's point limit reached on a leg (TracerOptions::maxPoints)
   Failed,         ///< the continuation could not go on (its message says why)
   Interrupted,    ///< time limit or signal
 };
-/// "completed", "fold", "branch point", "loss of stability", "joint limit", "input bound", "max points", "failed",
-/// "interrupted".
+/// "completed", "fold", "branch point", "loss of stability", "joint limit", "input bound", "eigenvalue coalescence",
+/// "max points", "failed", "interrupted".
 const char* toString(TaskPathEvent event);
 
 struct TaskPathOptions {

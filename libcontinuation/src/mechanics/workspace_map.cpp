@@ -1,0 +1,339 @@
+#include "buckle/mechanics/workspace_map.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "buckle/continuation/corrector.h"
+#include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/stiffness.h"
+#include "workspace_curves.h"
+
+namespace buckle::mechanics {
+
+namespace cont = buckle::continuation;
+
+const char* boundaryCauseName(BoundaryCause cause) {
+  switch (cause) {
+    case BoundaryCause::InputBound: return "input bound";
+    case BoundaryCause::Fold: return "fold";
+    case BoundaryCause::Singular: return "singular";
+    case BoundaryCause::JointLimit: return "joint limit";
+  }
+  return "";
+}
+
+std::string WorkspaceMapOptions::validate(const std::string& prefix) const {
+  const auto axis = [&](const InputAxisRange& a, const std::string& name) -> std::string {
+    if (!std::isfinite(a.from) || !std::isfinite(a.to) || a.from >= a.to)
+      return prefix + name + ".from: expected finite from < to";
+    if (a.count < 2 || a.count > 1000) return prefix + name + ".count: expected an integer in [2, 1000]";
+    return "";
+  };
+  for (const std::string& why : {axis(first, "first"), axis(second, "second")})
+    if (!why.empty()) return why;
+  if (maxCurves < 0 || maxCurves > 1000) return prefix + "maxCurves: expected an integer in [0, 1000]";
+  if (maxCurvePoints < 2) return prefix + "maxCurvePoints: expected an integer >= 2";
+  if (threads < 0) return prefix + "threads: expected >= 0";
+  return tracer.validate(prefix + "tracer.");
+}
+
+namespace {
+
+// A branch through a start and both ways along λ within [lo, hi]; the two halves in tracing order.
+struct TwoWays {
+  cont::Branch up, down;
+};
+
+cont::TracerOptions rowOptions(const cont::TracerOptions& base, double lo, double hi) {
+  cont::TracerOptions o = base;
+  o.lambdaMin = lo;
+  o.lambdaMax = hi;
+  o.detection.branchPoints = false;
+  o.detection.folds = true;
+  o.detection.boundaries = true;
+  o.detection.stability = true;
+  o.detection.lowestEigenvalues = 0;
+  // the rows run on several threads: the caller's callbacks are for one
+  o.onStep = nullptr;
+  o.onLocated = nullptr;
+  return o;
+}
+
+TwoWays traceBothWays(const EquilibriumProblem& p, ConstVectorRef q, double lambda, const cont::TracerOptions& o) {
+  TwoWays t;
+  cont::BoundProblem bound(p);
+  t.up = cont::trace(bound, q, lambda, cont::InitialDirection::increasingLambda(), o);
+  t.down = cont::trace(bound, q, lambda, cont::InitialDirection::decreasingLambda(), o);
+  return t;
+}
+
+// The states of a traced pair of halves at the values `targets`, each taken where the branch
+// first reaches it from the start; `folds` counts the folds passed on the way (−1: not reached).
+void sampleAlong(const EquilibriumProblem& p, const TwoWays& t, const std::vector<double>& targets,
+                 std::vector<Vector>& states, std::vector<int>& folds) {
+  const size_t m = targets.size();
+  states.assign(m, Vector());
+  folds.assign(m, -1);
+  detail::ScaledCorrector corrector{cont::BoundProblem(p)};
+  Vector u(p.dimension());
+  for (const cont::Branch* b : {&t.up, &t.down}) {
+    int passed = 0;
+    for (size_t k = 0; k + 1 < b->points.size(); ++k) {
+      const cont::ContinuationPoint &a = b->points[k], &c = b->points[k + 1];
+      if (k > 0 && (a.foldTest > 0) != (b->points[k - 1].foldTest > 0)) ++passed;
+      const double lo = std::min(a.lambda, c.lambda), hi = std::max(a.lambda, c.lambda);
+      for (size_t i = 0; i < m; ++i) {
+        if (folds[i] >= 0 || targets[i] < lo || targets[i] > hi) continue;
+        const double s = c.lambda == a.lambda ? 0.0 : (targets[i] - a.lambda) / (c.lambda - a.lambda);
+        const Vector guess = a.u + s * (c.u - a.u);
+        if (!corrector.atFixedParameter(guess, targets[i], u)) continue;
+        states[i] = u;
+        folds[i] = passed;
+      }
+    }
+  }
+}
+
+void evaluateCell(const EquilibriumProblem& p, cont::ProblemWorkspace& ws, WorkspaceCell& cell, double lambda) {
+  const int n = p.segments();
+  const auto q = cell.q.head(n);
+  Vector F(p.dimension());
+  p.residual(ws, cell.q, lambda, F);
+  cell.residual = F.norm();
+  cell.pose = endPose(p.chain(), q);
+  cont::StabilityInfo info;
+  if (p.stability(ws, cell.q, lambda, 1, info)) {
+    cell.negative = info.negative;
+    cell.smallestEigenvalue = info.lowest.size() > 0 ? info.lowest[0] : info.smallest;
+  }
+  cell.stiffness = std::numeric_limits<double>::quiet_NaN();
+  StiffnessOptions so;
+  so.bodyGenerator = p.bodyLoadGenerator(q, lambda);
+  const CartesianStiffness s = loadedStiffness(p.chainAt(lambda), q, p.wrench(cell.q, lambda), p.endCondition(), so);
+  if (s.positiveDefinite) cell.stiffness = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s.stiffness).eigenvalues()[0];
+}
+
+std::string stopWords(const cont::Branch& b) {
+  return b.stopMessage.empty() ? std::string("stopped") : b.stopMessage;
+}
+
+// The rows: along u₁ at every grid u₂ from the spine's state there (file comment of the header).
+void computeRows(const InputPlane& plane, const WorkspaceMapOptions& o, const std::vector<Vector>& starts,
+                 const std::vector<int>& startFolds, WorkspaceMap& map, std::vector<TwoWays>& rows) {
+  const int c1 = o.first.count, c2 = o.second.count;
+  std::vector<double> targets(static_cast<size_t>(c1));
+  for (int i = 0; i < c1; ++i) targets[size_t(i)] = o.first.value(i);
+  const cont::TracerOptions ro = rowOptions(o.tracer, o.first.from, o.first.to);
+  std::atomic<int> next{0};
+  std::mutex problemsMutex;
+  const auto work = [&]() {
+    for (int j = next++; j < c2; j = next++) {
+      const double u2 = o.second.value(j);
+      WorkspaceCell* row = &map.cells[size_t(j) * size_t(c1)];
+      for (int i = 0; i < c1; ++i) {
+        row[i].u1 = targets[size_t(i)];
+        row[i].u2 = u2;
+      }
+      if (startFolds[size_t(j)] < 0) {
+        for (int i = 0; i < c1; ++i) row[i].note = "the spine along " + plane.input(1).name() + " did not reach it";
+        continue;
+      }
+      try {
+        const auto p = plane.along(0, u2);
+        rows[size_t(j)] = traceBothWays(*p, starts[size_t(j)], plane.origin(0), ro);
+        std::vector<Vector> states;
+        std::vector<int> folds;
+        sampleAlong(*p, rows[size_t(j)], targets, states, folds);
+        auto ws = p->createWorkspace();
+        for (int i = 0; i < c1; ++i) {
+          if (folds[size_t(i)] < 0) {
+            const cont::Branch& b = targets[size_t(i)] >= plane.origin(0) ? rows[size_t(j)].up : rows[size_t(j)].down;
+            row[i].note = "the row ended first: " + stopWords(b);
+            continue;
+          }
+          row[i].reached = true;
+          row[i].q = states[size_t(i)];
+          row[i].folds = folds[size_t(i)] + startFolds[size_t(j)];
+          evaluateCell(*p, *ws, row[i], targets[size_t(i)]);
+        }
+      } catch (const std::exception& e) {
+        std::lock_guard<std::mutex> lock(problemsMutex);
+        map.problems.push_back("row " + plane.input(1).name() + " = " + std::to_string(u2) + ": " + e.what());
+      }
+    }
+  };
+  int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  threads = std::min(threads, c2);
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+}
+
+// A traced pair of halves as one curve, the down half reversed; u₁ is λ on a row (axis 0), u₂
+// on a column (axis 1).
+WorkspaceCurve edgeCurve(const InputPlane& plane, const EquilibriumProblem& p, const TwoWays& t, int axis,
+                         double other, const std::string& name) {
+  WorkspaceCurve c;
+  c.cause = BoundaryCause::InputBound;
+  c.name = name;
+  const int n = plane.segments();
+  const auto add = [&](const cont::ContinuationPoint& pt) {
+    WorkspaceCurvePoint w;
+    w.u1 = axis == 0 ? pt.lambda : other;
+    w.u2 = axis == 0 ? other : pt.lambda;
+    w.q = pt.u.head(n);
+    w.pose = endPose(p.chain(), w.q);
+    w.negative = pt.stability.valid() ? pt.stability.negative : -1;
+    w.residual = pt.residualNorm;
+    c.points.push_back(w);
+  };
+  for (size_t k = t.down.points.size(); k-- > 1;) add(t.down.points[k]);
+  for (const cont::ContinuationPoint& pt : t.up.points) add(pt);
+  c.stop = stopWords(t.down) + "; " + stopWords(t.up);
+  return c;
+}
+
+// Curve starts from the grid: the rows' located folds and joint stops, and the sign changes of
+// the singular condition between neighbouring reached cells on one sheet.
+std::vector<detail::CurveStart> curveStarts(const InputPlane& plane, const WorkspaceMapOptions& o,
+                                            const std::vector<TwoWays>& rows, const WorkspaceMap& map) {
+  using Condition = InputPlaneCurveProblem::Condition;
+  std::vector<detail::CurveStart> starts;
+  const int n = plane.segments();
+  for (size_t j = 0; j < rows.size(); ++j) {
+    const double u2 = o.second.value(int(j));
+    for (const cont::Branch* b : {&rows[j].up, &rows[j].down})
+      for (const cont::SpecialPoint& sp : b->specialPoints) {
+        detail::CurveStart s;
+        if (sp.type == cont::SpecialPointType::Fold && o.folds) {
+          s.condition = Condition::Fold;
+          s.name = "fold";
+        } else if (sp.type == cont::SpecialPointType::Boundary && o.limits && !sp.boundaryName.empty()) {
+          const auto p = plane.along(0, u2);
+          for (int k = 0; k < p->boundaryCount(); ++k)
+            if (p->boundaryName(k) == sp.boundaryName) s.boundary = k;
+          if (s.boundary < 0) continue;
+          s.condition = Condition::Limit;
+          s.name = sp.boundaryName;
+        } else {
+          continue;
+        }
+        s.x.resize(n + 2);
+        s.x << sp.u.head(n), u2, sp.lambda;
+        s.fixed = n;
+        starts.push_back(std::move(s));
+      }
+  }
+  if (!o.singular) return starts;
+  InputPlaneCurveProblem singular(plane, Condition::Singular);
+  auto ws = singular.createWorkspace();
+  std::vector<double> c(map.cells.size(), std::numeric_limits<double>::quiet_NaN());
+  for (size_t k = 0; k < map.cells.size(); ++k) {
+    const WorkspaceCell& cell = map.cells[k];
+    double v = 0.0;
+    if (cell.reached && singular.condition(*ws, cell.q.head(n), cell.u1, cell.u2, v)) c[k] = v;
+  }
+  const auto edge = [&](int i1, int j1, int i2, int j2, int fixed) {
+    const size_t a = size_t(j1) * size_t(map.count1) + size_t(i1), b = size_t(j2) * size_t(map.count1) + size_t(i2);
+    if (!std::isfinite(c[a]) || !std::isfinite(c[b]) || (c[a] > 0) == (c[b] > 0)) return;
+    if (map.cells[a].folds != map.cells[b].folds) return;  // not one sheet between them
+    const double s = c[a] / (c[a] - c[b]);
+    detail::CurveStart st;
+    st.condition = Condition::Singular;
+    st.name = "singular";
+    st.x.resize(n + 2);
+    st.x << map.cells[a].q.head(n) + s * (map.cells[b].q.head(n) - map.cells[a].q.head(n)),
+        map.cells[a].u2 + s * (map.cells[b].u2 - map.cells[a].u2), map.cells[a].u1 + s * (map.cells[b].u1 - map.cells[a].u1);
+    st.fixed = fixed;
+    starts.push_back(std::move(st));
+  };
+  for (int j = 0; j < map.count2; ++j)
+    for (int i = 0; i + 1 < map.count1; ++i) edge(i, j, i + 1, j, n);
+  for (int j = 0; j + 1 < map.count2; ++j)
+    for (int i = 0; i < map.count1; ++i) edge(i, j, i, j + 1, n + 1);
+  return starts;
+}
+
+}  // namespace
+
+WorkspaceMap computeWorkspaceMap(const InputPlane& plane, ConstVectorRef q0, const WorkspaceMapOptions& o) {
+  const std::string why = o.validate();
+  if (!why.empty()) throw std::invalid_argument("workspace map: " + why);
+  const int n = plane.segments();
+  if (q0.size() != n) throw std::invalid_argument("workspace map: q0 needs one angle per segment");
+  for (int axis = 0; axis < 2; ++axis) {
+    const InputAxisRange& a = axis == 0 ? o.first : o.second;
+    const double u0 = plane.origin(axis);
+    const double tol = 1e-12 * std::max(1.0, std::abs(u0));
+    if (u0 < a.from - tol || u0 > a.to + tol) {
+      std::ostringstream os;
+      os << "workspace map: " << (axis == 0 ? "first" : "second") << ".from/to: expected a range that contains the "
+         << "chain's own value " << plane.input(axis).name() << " = " << u0;
+      throw std::invalid_argument(os.str());
+    }
+    const auto [lo, hi] = plane.admissibleRange(axis);
+    if (!(a.from > lo && a.to < hi)) {
+      std::ostringstream os;
+      os << "workspace map: " << (axis == 0 ? "first" : "second") << ".from/to: expected a range inside (" << lo << ", "
+         << hi << "), where every free length " << plane.input(axis).name() << " moves stays > 0";
+      throw std::invalid_argument(os.str());
+    }
+  }
+  WorkspaceMap map;
+  map.input1 = plane.input(0).name();
+  map.input2 = plane.input(1).name();
+  map.count1 = o.first.count;
+  map.count2 = o.second.count;
+  map.cells.resize(size_t(map.count1) * size_t(map.count2));
+
+  // the spine: along u₂ through u₁⁰, sampled at the rows' u₂
+  std::vector<double> u2s(static_cast<size_t>(map.count2));
+  for (int j = 0; j < map.count2; ++j) u2s[size_t(j)] = o.second.value(j);
+  const auto spineProblem = plane.along(1, plane.origin(0));
+  const TwoWays spine =
+      traceBothWays(*spineProblem, q0, plane.origin(1), rowOptions(o.tracer, o.second.from, o.second.to));
+  std::vector<Vector> starts;
+  std::vector<int> startFolds;
+  sampleAlong(*spineProblem, spine, u2s, starts, startFolds);
+
+  std::vector<TwoWays> rows(static_cast<size_t>(map.count2));
+  computeRows(plane, o, starts, startFolds, map, rows);
+  if (o.tracer.interrupt.requested()) {
+    map.interrupted = true;
+    return map;
+  }
+  // the box's edges: the first and last rows, and the columns at u₁ = from, to
+  for (int j : {0, map.count2 - 1}) {
+    if (rows[size_t(j)].up.points.empty()) continue;
+    const auto p = plane.along(0, u2s[size_t(j)]);
+    map.curves.push_back(edgeCurve(plane, *p, rows[size_t(j)], 0, u2s[size_t(j)],
+                                   map.input2 + (j == 0 ? " = from" : " = to")));
+  }
+  for (int i : {0, map.count1 - 1}) {
+    int best = -1;  // the reached cell of that column nearest u₂⁰, on the sheet of the start
+    for (int j = 0; j < map.count2; ++j)
+      if (map.cell(i, j).reached && map.cell(i, j).folds == 0 &&
+          (best < 0 || std::abs(u2s[size_t(j)] - plane.origin(1)) < std::abs(u2s[size_t(best)] - plane.origin(1))))
+        best = j;
+    if (best < 0) continue;
+    const double u1 = o.first.value(i);
+    const auto p = plane.along(1, u1);
+    const TwoWays column =
+        traceBothWays(*p, map.cell(i, best).q, u2s[size_t(best)], rowOptions(o.tracer, o.second.from, o.second.to));
+    map.curves.push_back(edgeCurve(plane, *p, column, 1, u1, map.input1 + (i == 0 ? " = from" : " = to")));
+  }
+  detail::traceBoundaryCurves(plane, o, curveStarts(plane, o, rows, map), map);
+  map.interrupted = o.tracer.interrupt.requested();
+  return map;
+}
+
+}  // namespace buckle::mechanics

@@ -1,0 +1,235 @@
+// Workspace and stability maps over two control inputs (workspace_map.h; issue 29): every grid
+// equilibrium solved and classified (against a dense eigen-solve), every change of stability or
+// of the map's orientation between neighbouring grid values crossed by a traced curve, every
+// curve point on its curve (the condition recomputed), a fold curve's point found again as the
+// fold of a one-parameter control path, and the same map in scaled units.
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <map>
+
+#include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/unloaded_shape.h"
+#include "buckle/mechanics/workspace_map.h"
+#include "fixed_lambda_newton.h"
+#include "payload_start.h"
+
+using namespace buckle::mechanics;
+namespace cont = buckle::continuation;
+
+namespace {
+
+// The default segment (a/b = 0.5, L0/b = 2.25) under Fx = Fy = −0.3 k b, three segments; L, k the units.
+struct MapCase {
+  double L = 1.0, k = 1.0;
+  Chain chain() const { return Chain::uniform(3, SegmentParameters::symmetric(0.5 * L, L, k, 2.25 * L)); }
+  Eigen::Vector3d payload() const { return Eigen::Vector3d(-0.3 * k * L, -0.3 * k * L, 0.0); }
+  WorkspaceMapOptions options() const {
+    WorkspaceMapOptions o;
+    o.first = {{ControlInput::L0, -1}, 1.7 * L, 2.6 * L, 13};
+    o.second = {{ControlInput::dL0, -1}, -3.0 * L, 1.6 * L, 17};
+    o.tracer.maxPoints = 4000;
+    o.threads = 2;
+    return o;
+  }
+};
+
+struct Computed {
+  MapCase c;
+  std::unique_ptr<InputPlane> plane;
+  WorkspaceMap map;
+};
+
+Computed compute(const MapCase& c) {
+  Computed out;
+  out.c = c;
+  const Chain chain = c.chain();
+  out.plane = std::make_unique<InputPlane>(chain, EndCondition::freeEnd(c.payload()), BodyLoads{},
+                                           c.options().first.input, c.options().second.input);
+  out.map = computeWorkspaceMap(*out.plane, buckle::test::underPayload(chain, c.payload()), c.options());
+  return out;
+}
+
+const Computed& reference() {
+  static const Computed computed = compute(MapCase{});
+  return computed;
+}
+
+// Distance from (u1, u2) to the nearest point of a curve of `cause`, in grid cells.
+double cellsToCurve(const WorkspaceMap& m, const WorkspaceMapOptions& o, BoundaryCause cause, double u1, double u2) {
+  const double w1 = (o.first.to - o.first.from) / (o.first.count - 1);
+  const double w2 = (o.second.to - o.second.from) / (o.second.count - 1);
+  double best = std::numeric_limits<double>::infinity();
+  for (const WorkspaceCurve& c : m.curves)
+    if (c.cause == cause)
+      for (const WorkspaceCurvePoint& p : c.points) best = std::min(best, std::hypot((p.u1 - u1) / w1, (p.u2 - u2) / w2));
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("workspace map: every grid equilibrium solved and classified as a dense eigen-solve does",
+          "[workspace_map]") {
+  const Computed& r = reference();
+  const WorkspaceMap& m = r.map;
+  REQUIRE(m.problems.empty());
+  int reached = 0, stable = 0, unstable = 0;
+  for (const WorkspaceCell& cell : m.cells) {
+    if (!cell.reached) continue;
+    ++reached;
+    auto p = r.plane->along(0, cell.u2);
+    const cont::BoundProblem bound(*p);
+    Eigen::VectorXd F(3), Fl(3);
+    Eigen::MatrixXd H(3, 3);
+    REQUIRE(bound.residual(cell.q, cell.u1, F));
+    REQUIRE(bound.jacobian(cell.q, cell.u1, H, Fl));
+    CHECK(F.norm() < 1e-10);
+    const Eigen::VectorXd mu = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues();
+    const int negative = int((mu.array() < 0.0).count());
+    CHECK(cell.negative == negative);
+    CHECK(cell.smallestEigenvalue == Approx(mu[0]).margin(1e-12));
+    CHECK(cell.pose.head<2>().isApprox(endPose(p->chain(), cell.q).head<2>(), 1e-14));
+    stable += negative == 0;
+    unstable += negative > 0;
+    if (negative == 0) CHECK(cell.stiffness > 0.0);
+  }
+  // the box was chosen to hold both: the test would mean little on a map of one kind
+  CHECK(reached == int(m.cells.size()));
+  CHECK(stable > 0);
+  CHECK(unstable > 0);
+}
+
+TEST_CASE("workspace map: every change of stability or orientation between grid neighbours is crossed by a curve",
+          "[workspace_map]") {
+  const Computed& r = reference();
+  const WorkspaceMap& m = r.map;
+  const WorkspaceMapOptions o = r.c.options();
+  const InputPlaneCurveProblem singular(*r.plane, InputPlaneCurveProblem::Condition::Singular);
+  auto ws = singular.createWorkspace();
+  std::vector<double> c(m.cells.size(), std::numeric_limits<double>::quiet_NaN());
+  for (size_t k = 0; k < m.cells.size(); ++k)
+    if (m.cells[k].reached) singular.condition(*ws, m.cells[k].q, m.cells[k].u1, m.cells[k].u2, c[k]);
+  int stabilityChanges = 0, orientationChanges = 0;
+  // along a row the path between two neighbours is the traced branch itself (a fold of the row
+  // is where stability changes); between rows only neighbours on one sheet are comparable
+  const auto pair = [&](int i1, int j1, int i2, int j2) {
+    const WorkspaceCell &a = m.cell(i1, j1), &b = m.cell(i2, j2);
+    const bool row = j1 == j2;
+    if (!a.reached || !b.reached || (!row && a.folds != b.folds) || std::abs(a.folds - b.folds) > 1) return;
+    const double u1 = 0.5 * (a.u1 + b.u1), u2 = 0.5 * (a.u2 + b.u2);
+    if ((a.negative == 0) != (b.negative == 0)) {
+      ++stabilityChanges;
+      INFO("stability changes between (" << a.u1 << ", " << a.u2 << ") and (" << b.u1 << ", " << b.u2 << ")");
+      CHECK(cellsToCurve(m, o, BoundaryCause::Fold, u1, u2) < 1.5);
+    }
+    const double ca = c[size_t(&a - m.cells.data())], cb = c[size_t(&b - m.cells.data())];
+    if (std::isfinite(ca) && std::isfinite(cb) && (ca > 0) != (cb > 0) && a.negative == 0 && b.negative == 0 &&
+        a.folds == b.folds) {
+      ++orientationChanges;
+      INFO("det dp/du changes sign between (" << a.u1 << ", " << a.u2 << ") and (" << b.u1 << ", " << b.u2 << ")");
+      CHECK(cellsToCurve(m, o, BoundaryCause::Singular, u1, u2) < 1.5);
+    }
+  };
+  for (int j = 0; j < m.count2; ++j)
+    for (int i = 0; i < m.count1; ++i) {
+      if (i + 1 < m.count1) pair(i, j, i + 1, j);
+      if (j + 1 < m.count2) pair(i, j, i, j + 1);
+    }
+  CHECK(stabilityChanges > 0);
+  CHECK(orientationChanges > 0);
+}
+
+TEST_CASE("workspace map: every curve point is an equilibrium on its curve, inside the box", "[workspace_map]") {
+  const Computed& r = reference();
+  const WorkspaceMapOptions o = r.c.options();
+  std::map<BoundaryCause, int> count;
+  for (const WorkspaceCurve& curve : r.map.curves) {
+    ++count[curve.cause];
+    std::unique_ptr<InputPlaneCurveProblem> problem;
+    if (curve.cause == BoundaryCause::Fold)
+      problem = std::make_unique<InputPlaneCurveProblem>(*r.plane, InputPlaneCurveProblem::Condition::Fold);
+    if (curve.cause == BoundaryCause::Singular)
+      problem = std::make_unique<InputPlaneCurveProblem>(*r.plane, InputPlaneCurveProblem::Condition::Singular);
+    auto ws = problem ? problem->createWorkspace() : nullptr;
+    for (const WorkspaceCurvePoint& p : curve.points) {
+      INFO(curve.name << " at (" << p.u1 << ", " << p.u2 << ")");
+      const double e1 = 1e-12 * (o.first.to - o.first.from), e2 = 1e-12 * (o.second.to - o.second.from);
+      CHECK(p.u1 >= o.first.from - e1);
+      CHECK(p.u1 <= o.first.to + e1);
+      CHECK(p.u2 >= o.second.from - e2);
+      CHECK(p.u2 <= o.second.to + e2);
+      auto eq = r.plane->along(0, p.u2);
+      Eigen::VectorXd F(3);
+      REQUIRE(cont::BoundProblem(*eq).residual(p.q, p.u1, F));
+      CHECK(F.norm() < 1e-9);
+      if (!problem) continue;
+      double c = 1.0;
+      REQUIRE(problem->condition(*ws, p.q, p.u1, p.u2, c));
+      CHECK(std::abs(c) < 1e-8);
+    }
+  }
+  CHECK(count[BoundaryCause::InputBound] == 4);
+  CHECK(count[BoundaryCause::Fold] >= 1);
+  CHECK(count[BoundaryCause::Singular] >= 1);
+}
+
+TEST_CASE("workspace map: a fold curve's point is the fold of the control path through it", "[workspace_map]") {
+  const Computed& r = reference();
+  const WorkspaceCurve* fold = nullptr;
+  for (const WorkspaceCurve& c : r.map.curves)
+    if (c.cause == BoundaryCause::Fold && c.points.size() > 4) fold = &c;
+  REQUIRE(fold != nullptr);
+  const WorkspaceCurvePoint& P = fold->points[fold->points.size() / 2];
+  // the control path along u1 at P's u2, from an equilibrium a little off the fold on the side
+  // where equilibria exist, traced both ways: one direction meets the fold at P's u1
+  auto p = r.plane->along(0, P.u2);
+  const double scale = p->scales().parameter;
+  bool found = false;
+  for (double side : {-1.0, 1.0}) {
+    const double u1 = P.u1 + side * 1e-3 * scale;
+    Eigen::VectorXd q = P.q;
+    Eigen::VectorXd F(3), Fl(3);
+    Eigen::MatrixXd H(3, 3);
+    const cont::BoundProblem bound(*p);
+    bool converged = false;
+    for (int it = 0; it < 30 && !converged; ++it) {
+      REQUIRE(bound.residual(q, u1, F));
+      converged = F.norm() < 1e-13;
+      REQUIRE(bound.jacobian(q, u1, H, Fl));
+      q -= H.partialPivLu().solve(F);
+    }
+    if (!converged || !q.allFinite()) continue;
+    cont::TracerOptions o;
+    o.lambdaMin = P.u1 - 0.05 * scale;
+    o.lambdaMax = P.u1 + 0.05 * scale;
+    for (const auto& dir : {cont::InitialDirection::increasingLambda(), cont::InitialDirection::decreasingLambda()}) {
+      const cont::Branch b = cont::trace(bound, q, u1, dir, o);
+      for (const cont::SpecialPoint* sp : b.specialPointsOfType(cont::SpecialPointType::Fold))
+        if (std::abs(sp->lambda - P.u1) < 1e-8 * scale) found = true;
+    }
+  }
+  CHECK(found);
+}
+
+TEST_CASE("workspace map: the same map in scaled units", "[workspace_map]") {
+  const Computed& ref = reference();
+  const double L = GENERATE(1e-4, 1e4);
+  const double k = GENERATE(1e-8, 1e8);
+  INFO("L = " << L << ", k = " << k);
+  const Computed scaled = compute(MapCase{L, k});
+  REQUIRE(scaled.map.cells.size() == ref.map.cells.size());
+  for (size_t i = 0; i < ref.map.cells.size(); ++i) {
+    const WorkspaceCell &a = ref.map.cells[i], &b = scaled.map.cells[i];
+    REQUIRE(a.reached == b.reached);
+    if (!a.reached) continue;
+    CHECK(a.negative == b.negative);
+    CHECK((b.pose.head<2>() / L - a.pose.head<2>()).norm() < 1e-9);
+    CHECK(b.smallestEigenvalue / (k * L * L) == Approx(a.smallestEigenvalue).margin(1e-9));
+    if (a.negative == 0) CHECK(b.stiffness / k == Approx(a.stiffness).epsilon(1e-8));
+  }
+  std::map<BoundaryCause, int> ca, cb;
+  for (const WorkspaceCurve& c : ref.map.curves) ++ca[c.cause];
+  for (const WorkspaceCurve& c : scaled.map.curves) ++cb[c.cause];
+  CHECK(ca == cb);
+}
