@@ -5,7 +5,9 @@
 // the special points (fold of the task map, loss of stability, joint limit, input bound) located.
 // Rule (a) `chosen`: the inputs dL0 and L0 of every segment, O(n) bordered solves. Rule (b)
 // `min_change`: those two and dL0 of segment 1, the optimality system (2n + 5 unknowns) by block
-// elimination through H, O(n) with 3 inputs. The start (the straight chain loaded to the payload)
+// elimination through H, O(n) with 3 inputs. Rule (c) `most_stable`: the same three inputs, its
+// optimality system (3n + 6 unknowns, the start optimum by continuation in the objective's weight,
+// timed) with a dense differenced Jacobian, n = 3 and 50 only. The start (the straight chain loaded to the payload)
 // is not timed. Units:
 // nondimensional (b = 1, k = 1) and SI (b = 0.02 m, k = 2000 N/m). Best of `reps` runs.
 //
@@ -51,7 +53,7 @@ Row run(int n, double b, double k, TaskRule rule, int reps) {
   setup.coordinates = {0, 1};
   setup.rule = rule;
   setup.inputs = {{ControlInput::dL0, -1}, {ControlInput::L0, -1}};
-  if (rule == TaskRule::MinimumChange) setup.inputs.push_back({ControlInput::dL0, 0});
+  if (rule != TaskRule::Chosen) setup.inputs.push_back({ControlInput::dL0, 0});
   const Pose pose = endPose(chain, q0);
   Eigen::VectorXd to(2);
   to << pose[0] - 0.05 * chain.length(), pose[1] + 0.1 * chain.length();
@@ -78,11 +80,16 @@ int main(int argc, char** argv) {
   std::printf("%-16s %-10s %6s %8s %12s %12s %12s  %s\n", "units", "rule", "n", "points", "s at end (b)", "time (ms)",
               "us/point", "end");
   for (const auto& u : buckle::bench::kBenchUnits)
-    for (TaskRule rule : {TaskRule::Chosen, TaskRule::MinimumChange})
+    for (TaskRule rule : {TaskRule::Chosen, TaskRule::MinimumChange, TaskRule::MostStable})
       for (int n : {3, 50, 1000}) {
         if (quick && n > 50) continue;
+        // most_stable's optimality system (3n + 6 unknowns) has a dense, differenced Jacobian
+        // (task_path.h): O(n³) per Newton step, not meant for n = 1000
+        if (rule == TaskRule::MostStable && n > 50) continue;
         const Row r = run(n, u.b, u.k, rule, quick ? 1 : reps);
-        const char* ruleName = rule == TaskRule::Chosen ? "chosen" : "min_change";
+        const char* ruleName = rule == TaskRule::Chosen          ? "chosen"
+                               : rule == TaskRule::MinimumChange ? "min_change"
+                                                                 : "most_stable";
         if (!r.started) {
           std::printf("%-16s %-10s %6d   the payload could not be applied to the straight chain\n", u.name, ruleName, n);
           continue;

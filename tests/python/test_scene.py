@@ -144,6 +144,46 @@ def test_module_equilibria_equal_equilibria_csv(name, source_dir, run_cli, tmp_p
             assert b["id"] in set(np.unique(case["branches"]["branch"]).tolist())
 
 
+WORKSPACE_SCENES = [name for name in SCENES if "workspace" in json.loads(
+    (pathlib.Path(__file__).resolve().parents[2] / "data" / "scenes" / name).read_text()).get("analyses", {})]
+
+
+@pytest.mark.parametrize("name", WORKSPACE_SCENES)
+def test_module_workspace_equals_workspace_csvs(name, source_dir, run_cli, tmp_path):
+    scene, out = run_shipped_scene(name, source_dir, run_cli, tmp_path)
+    with open(out / "workspace_map.csv", newline="") as f:
+        grid = list(csv.DictReader(f))
+    with open(out / "workspace_curves.csv", newline="") as f:
+        points = list(csv.DictReader(f))
+    r = buckle.run_scene(str(scene))
+    assert len(WORKSPACE_SCENES) >= 2
+    for c, case in enumerate(r["cases"]):
+        w = case["workspace"]
+        mine = [row for row in grid if int(row["case"]) == c]
+        rows, cols = w["u1"].shape
+        assert rows * cols == len(mine) > 0
+        # row-major: u2 outer, u1 inner, as the CSV
+        np.testing.assert_allclose(w["u1"].ravel(), [float(row["u1"]) for row in mine], rtol=1e-14)
+        np.testing.assert_allclose(w["u2"].ravel(), [float(row["u2"]) for row in mine], rtol=1e-14, atol=1e-15)
+        np.testing.assert_array_equal(w["reached"].ravel(), [int(row["reached"]) for row in mine])
+        reached = w["reached"].ravel() == 1
+        for key in ("x", "y", "min_eig"):
+            np.testing.assert_allclose(w[key].ravel()[reached], [float(row[key]) for row in mine if row["reached"] == "1"],
+                                       rtol=1e-13, atol=1e-14)
+        assert np.isnan(w["x"].ravel()[~reached]).all()
+        np.testing.assert_array_equal(w["stable"].ravel(), [int(row["stable"] or 0) for row in mine])
+        # a stable grid value has no negative eigenvalue and a positive definite end stiffness
+        stable = w["stable"].ravel() == 1
+        assert (w["negative_eigenvalues"].ravel()[stable] == 0).all()
+        assert (w["stiffness_min"].ravel()[stable] > 0).all()
+        curves = [row for row in points if int(row["case"]) == c]
+        assert sum(len(cu["u1"]) for cu in w["curves"]) == len(curves)
+        for k, cu in enumerate(w["curves"]):
+            mine_k = [row for row in curves if int(row["curve"]) == k]
+            assert cu["cause"] == mine_k[0]["cause"] and cu["name"] == mine_k[0]["name"]
+            np.testing.assert_allclose(cu["x"], [float(row["x"]) for row in mine_k], rtol=1e-13, atol=1e-14)
+
+
 def test_a_dict_runs_like_its_file(source_dir):
     path = source_dir / "data" / "scenes" / "fig2.json"
     from_file = buckle.run_scene(path)
