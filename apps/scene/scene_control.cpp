@@ -10,21 +10,6 @@
 namespace buckle::scene::detail {
 
 namespace {
-// The λ for which every free length the direction moves stays positive: L + (λ − origin) r > 0.
-std::pair<double, double> admissibleRange(const mechanics::Chain& chain, const mechanics::ControlDirection& d) {
-  double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < chain.size(); ++i) {
-    const mechanics::SegmentParameters& sp = chain.segment(i).parameters();
-    const double L[2] = {sp.L1_0, sp.L2_0};
-    for (int s = 0; s < 2; ++s) {
-      const double r = d.rates(i, s);
-      if (r > 0.0) lo = std::max(lo, d.origin - L[s] / r);
-      if (r < 0.0) hi = std::min(hi, d.origin - L[s] / r);
-    }
-  }
-  return {lo, hi};
-}
-
 // The other input of the parameter's pair: (L1_0, L2_0) and (L0, dL0) each span a segment's two
 // free lengths, so moving the complement leaves the parameter's own value λ.
 std::string complementOf(const std::string& parameter) {
@@ -95,7 +80,7 @@ PathSpec parseControlPath(const JsonReader& r, const json& path, const Pointer& 
        << show(spec.start) << " (set by /chain), got [" << show(spec.from) << ", " << show(spec.to) << "]";
     r.fail(p / (std::abs(spec.from - spec.start) <= std::abs(spec.to - spec.start) ? "from" : "to"), os.str());
   }
-  const auto [admLo, admHi] = admissibleRange(chain, spec.controlDirection);
+  const auto [admLo, admHi] = mechanics::admissibleRange(chain, spec.controlDirection);
   for (const char* key : {"from", "to"}) {
     const double v = std::string(key) == "from" ? spec.from : spec.to;
     if (v > admLo && v < admHi) continue;

@@ -21,6 +21,7 @@
 #include "buckle/mechanics/task_path_kkt_solver.h"
 #include "buckle/mechanics/task_path_solver.h"
 #include "buckle/mechanics/task_path_trace.h"
+#include "task_path_follow.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -62,17 +63,6 @@ TaskSetup minChangeSetup(int n, const Eigen::Vector3d& payload) {
   for (int i = 0; i < n; ++i) s.inputs.push_back({ControlInput::dL0, i, 1.0 + 0.5 * i});
   s.inputs.push_back({ControlInput::L0, -1, 2.0});
   return s;
-}
-
-// The straight task path from the start pose by (dx, dy) (scaled by L).
-TaskPathResult follow(TaskPathProblem& p, const Eigen::VectorXd& q0, double dx, double dy, double L = 1.0) {
-  const Pose pose = endPose(p.chain(), q0);
-  Eigen::VectorXd to(2);
-  to << pose[0] + dx * L, pose[1] + dy * L;
-  TaskPathOptions opt;
-  opt.tracer.corrector.tolerance = 1e-12;
-  opt.tracer.maxPoints = 2000;
-  return traceTaskPath(p, q0, {to}, p.chain().length(), opt);
 }
 
 // [H, B; J_c] blocks of the constraints g, τ from the dense Jacobian (rule (b) layout).
@@ -336,7 +326,7 @@ TEST_CASE("task path rule (b): least weighted change against a brute-force searc
   const Eigen::Vector3d payload(-0.3, -0.3, 0.0);
   const Eigen::VectorXd q0 = loaded(chain, payload);
   TaskPathProblem p(chain, minChangeSetup(3, payload));
-  const TaskPathResult r = follow(p, q0, -0.2, 0.5);
+  const TaskPathResult r = buckle::test::followTaskPath(p, q0, -0.2, 0.5);
   REQUIRE(r.end == TaskPathEvent::Completed);
   const int n = 3, mi = 4;
   Eigen::VectorXd w(mi);
@@ -392,7 +382,7 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
   SECTION("fold of the task map: F_u singular, s largest there") {
     const Eigen::Vector3d payload(-0.3, -0.1, 0.0);
     TaskPathProblem p(chain, chosenSetup(payload));
-    const TaskPathResult r = follow(p, loaded(chain, payload), -0.2, -1.0);
+    const TaskPathResult r = buckle::test::followTaskPath(p, loaded(chain, payload), -0.2, -1.0);
     REQUIRE(r.end == TaskPathEvent::Fold);
     REQUIRE(r.specials.size() == 1);
     const TaskPathPoint& f = r.specials[0].point;
@@ -406,7 +396,7 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
   SECTION("loss of stability at fixed inputs: an eigenvalue of the dense Hessian reaches zero") {
     const Eigen::Vector3d payload(-0.3, -0.3, 0.0);
     TaskPathProblem p(chain, minChangeSetup(3, payload));
-    const TaskPathResult r = follow(p, loaded(chain, payload), -0.2, 6.0);
+    const TaskPathResult r = buckle::test::followTaskPath(p, loaded(chain, payload), -0.2, 6.0);
     REQUIRE(r.end == TaskPathEvent::StabilityLoss);
     // every point before the special one (the last point) is stable
     for (size_t i = 0; i + 1 < r.points.size(); ++i) CHECK(r.points[i].stable);
@@ -422,13 +412,13 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
     TaskSetup s = chosenSetup(payload);
     TaskPathProblem free(chain, s);
     const Eigen::VectorXd q0 = loaded(chain, payload);
-    const TaskPathResult r = follow(free, q0, -0.2, 3.0);
+    const TaskPathResult r = buckle::test::followTaskPath(free, q0, -0.2, 3.0);
     REQUIRE(r.end == TaskPathEvent::InputBound);
     const Chain at = free.chainAt(r.specials[0].point.inputs + Eigen::Vector2d(0.0, -1e-9));  // just inside
     CHECK(std::abs(at.segment(1).parameters().L2_0) <= 1e-9);
     s.inputs[1].upper = 1.0;
     TaskPathProblem bounded(chain, s);
-    const TaskPathResult rb = follow(bounded, q0, -0.2, 3.0);
+    const TaskPathResult rb = buckle::test::followTaskPath(bounded, q0, -0.2, 3.0);
     REQUIRE(rb.end == TaskPathEvent::InputBound);
     CHECK(std::abs(rb.specials[0].point.inputs[1] - 1.0) <= 1e-12);
     CHECK(rb.specials[0].note == "input dL0[2] upper bound");
@@ -437,7 +427,7 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
     const Eigen::Vector3d payload(-0.3, -0.3, 0.0);
     const Eigen::VectorXd q0 = loaded(chain, payload);
     TaskPathProblem p(chain, chosenSetup(payload));
-    const TaskPathResult r = follow(p, q0, -0.2, 0.5);
+    const TaskPathResult r = buckle::test::followTaskPath(p, q0, -0.2, 0.5);
     REQUIRE(r.end == TaskPathEvent::Completed);
     const Eigen::VectorXd dq = r.points.back().q - q0;
     int j = 0;
@@ -447,7 +437,7 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
     (dq[j] > 0 ? segs[size_t(j)].qMaxUser : segs[size_t(j)].qMinUser) = limit;
     const Chain limited(segs);
     TaskPathProblem pl(limited, chosenSetup(payload));
-    const TaskPathResult rl = follow(pl, q0, -0.2, 0.5);
+    const TaskPathResult rl = buckle::test::followTaskPath(pl, q0, -0.2, 0.5);
     REQUIRE(rl.end == TaskPathEvent::JointLimit);
     CHECK(std::abs(rl.specials[0].point.q[j] - limit) <= 1e-12);
   }
@@ -459,11 +449,11 @@ TEST_CASE("task path: the same path in scaled units (lengths x1e-4, stiffness x1
     const Eigen::Vector3d payload(-0.3, -0.1, 0.0);
     TaskSetup s = rule == TaskRule::Chosen ? chosenSetup(payload) : minChangeSetup(3, payload);
     TaskPathProblem unit(chainOf(3), s);
-    const TaskPathResult r1 = follow(unit, loaded(chainOf(3), payload), -0.2, -1.0);
+    const TaskPathResult r1 = buckle::test::followTaskPath(unit, loaded(chainOf(3), payload), -0.2, -1.0);
     s.payload *= k * L;
     for (TaskInput& in : s.inputs) in.upper *= L, in.lower *= L;
     TaskPathProblem scaled(chainOf(3, L, k), s);
-    const TaskPathResult r2 = follow(scaled, loaded(chainOf(3, L, k), s.payload), -0.2, -1.0, L);
+    const TaskPathResult r2 = buckle::test::followTaskPath(scaled, loaded(chainOf(3, L, k), s.payload), -0.2, -1.0, L);
     REQUIRE(r1.end == r2.end);
     REQUIRE(r1.points.size() == r2.points.size());
     for (size_t i = 0; i < r1.points.size(); ++i) {

@@ -11,6 +11,7 @@
 
 #include "buckle/mechanics/task_path.h"
 #include "buckle/mechanics/task_path_trace.h"
+#include "task_path_follow.h"
 #include "payload_start.h"
 
 using namespace buckle::mechanics;
@@ -31,16 +32,6 @@ struct Scaled {
     return s;
   }
 };
-
-TaskPathResult follow(TaskPathProblem& p, const Eigen::VectorXd& q0, double dx, double dy, double L) {
-  const Pose pose = endPose(p.chain(), q0);
-  Eigen::VectorXd to(2);
-  to << pose[0] + dx * L, pose[1] + dy * L;
-  TaskPathOptions opt;
-  opt.tracer.corrector.tolerance = 1e-12;
-  opt.tracer.maxPoints = 2000;
-  return traceTaskPath(p, q0, {to}, p.chain().length(), opt);
-}
 
 // The smallest eigenvalue of K_q − K_g on the task's manifold with the first input at `p1`: the
 // other two inputs and q solved (rule (a) on the chain with the first input moved) by Newton from
@@ -99,7 +90,7 @@ TEST_CASE("task path rule (c): the most stable configuration against a brute-for
   const Scaled c;
   const Eigen::VectorXd q0 = buckle::test::underPayload(c.chain(), c.payload());
   TaskPathProblem p(c.chain(), c.setup());
-  const TaskPathResult r = follow(p, q0, -0.1, 0.2, c.L);
+  const TaskPathResult r = buckle::test::followTaskPath(p, q0, -0.1, 0.2, c.L);
   INFO(r.message);
   REQUIRE(r.points.size() > 4);
   // the start is the optimum at the start pose, not the chain's own inputs
@@ -110,13 +101,13 @@ TEST_CASE("task path rule (c): the most stable configuration against a brute-for
 TEST_CASE("task path rule (c): the same path in scaled units", "[task_path]") {
   const Scaled ref;
   TaskPathProblem p0(ref.chain(), ref.setup());
-  const TaskPathResult r0 = follow(p0, buckle::test::underPayload(ref.chain(), ref.payload()), -0.1, 0.2, 1.0);
+  const TaskPathResult r0 = buckle::test::followTaskPath(p0, buckle::test::underPayload(ref.chain(), ref.payload()), -0.1, 0.2, 1.0);
   REQUIRE(r0.points.size() > 4);
   const double L = GENERATE(1e-4, 1e4);
   const double k = GENERATE(1e-8, 1e8);
   const Scaled c{L, k};
   TaskPathProblem p(c.chain(), c.setup());
-  const TaskPathResult r = follow(p, buckle::test::underPayload(c.chain(), c.payload()), -0.1, 0.2, L);
+  const TaskPathResult r = buckle::test::followTaskPath(p, buckle::test::underPayload(c.chain(), c.payload()), -0.1, 0.2, L);
   INFO("L = " << L << ", k = " << k << ": " << r.message);
   REQUIRE(r.end == r0.end);
   // the first and the last point: the same optimum in the scaled units

@@ -1,5 +1,7 @@
 #include "buckle/mechanics/control_path.h"
 
+#include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -75,6 +77,20 @@ Chain chainWithControls(const Chain& chain, const ControlDirection& control, dou
     p[size_t(i)].L2_0 += t * control.rates(i, 1);
   }
   return Chain(p);  // validates: "segment i: L1_0 must be > 0 …"
+}
+
+std::pair<double, double> admissibleRange(const Chain& chain, const ControlDirection& d) {
+  double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < chain.size(); ++i) {
+    const SegmentParameters& sp = chain.segment(i).parameters();
+    const double L[2] = {sp.L1_0, sp.L2_0};
+    for (int s = 0; s < 2; ++s) {
+      const double r = d.rates(i, s);
+      if (r > 0.0) lo = std::max(lo, d.origin - L[s] / r);
+      if (r < 0.0) hi = std::min(hi, d.origin - L[s] / r);
+    }
+  }
+  return {lo, hi};
 }
 
 }  // namespace buckle::mechanics

@@ -53,18 +53,7 @@ Chain InputPlane::chainAt(double u1, double u2) const {
 }
 
 std::pair<double, double> InputPlane::admissibleRange(int axis) const {
-  const ControlDirection& d = direction(axis);
-  double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < chain_.size(); ++i) {
-    const SegmentParameters& sp = chain_.segment(i).parameters();
-    const double L[2] = {sp.L1_0, sp.L2_0};
-    for (int s = 0; s < 2; ++s) {
-      const double r = d.rates(i, s);
-      if (r > 0.0) lo = std::max(lo, d.origin - L[s] / r);
-      if (r < 0.0) hi = std::min(hi, d.origin - L[s] / r);
-    }
-  }
-  return {lo, hi};
+  return mechanics::admissibleRange(chain_, direction(axis));
 }
 
 const char* conditionName(InputPlaneCurveProblem::Condition condition) {

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 
 #include "buckle/mechanics/chain.h"
 
@@ -40,6 +41,10 @@ bool parseControlInput(const std::string& name, ControlInput& input);
 /// The input's value on the chain: that of segment `segment` (0-based), or the mean over the
 /// segments (−1).
 double controlInputValue(const Chain& chain, ControlInput input, int segment = -1);
+
+/// The λ for which every free length the direction moves stays positive:
+/// L⁰ + (λ − origin)·rate > 0 (±inf where the direction moves none the other way).
+std::pair<double, double> admissibleRange(const Chain& chain, const ControlDirection& control);
 
 /// The chain's segments with the free lengths at λ (the others unchanged). Throws
 /// std::invalid_argument naming the segment when a free length is not positive there.
