@@ -1,5 +1,6 @@
 #include "scene/escape.h"
 
+#include <algorithm>
 #include <cstddef>
 
 namespace buckle::scene::escape {
@@ -139,11 +140,15 @@ std::string jsonText(const nlohmann::json& doc, int indent) {
 std::string jsonForHtmlScript(const nlohmann::json& doc) { return htmlScriptSafe(jsonText(doc, -1)); }
 
 std::string htmlScriptSafe(std::string_view text) {
+  // Whole runs between the '<' appended at once: a page's data is megabytes of text with few or
+  // no '<', and appending it character by character cost more than writing it.
   std::string out;
   out.reserve(text.size());
-  for (char c : text) {
-    if (c == '<') out += "\\u003c";
-    else out += c;
+  for (size_t from = 0; from < text.size();) {
+    const size_t lt = std::min(text.find('<', from), text.size());
+    out.append(text, from, lt - from);
+    if (lt < text.size()) out += "\\u003c";
+    from = lt + 1;
   }
   return out;
 }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <system_error>
 
@@ -30,8 +31,12 @@ bool scaledDigits(double a, int digits, std::uint64_t& m, int& x) {
   // The decade from the binary exponent: a = f·2^e, f in [0.5, 1), so log10(a) lies in
   // [(e − 1)·log10(2), e·log10(2)): x is floor of the lower end or one more, and the loop below
   // moves it up when it is one short (std::log10 was a tenth of a long chain's writing).
-  int e = 0;
-  std::frexp(a, &e);
+  // frexp's exponent read from the bits (a library call per number otherwise); subnormals
+  // through frexp itself
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &a, sizeof bits);
+  int e = int((bits >> 52) & 0x7ff) - 1022;
+  if (e == -1022) std::frexp(a, &e);
   x = int(std::floor((e - 1) * 0.30102999566398120));
   for (int attempt = 0; attempt < 3; ++attempt) {
     const int k = digits - 1 - x;

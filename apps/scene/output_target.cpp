@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
@@ -39,28 +40,19 @@ bool sameOrAncestor(const fs::path& a, const fs::path& b) {
 
 std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 
-/// summary.json `plots.written` of the output in `dir`: every file the run wrote into plots/
-/// (none when the summary has no such list).
-std::optional<std::set<std::string>> plotsWritten(const fs::path& dir) {
-  std::ifstream in(dir / "summary.json", std::ios::binary);
-  const nlohmann::json doc = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (!doc.is_object() || !doc.contains("plots") || !doc["plots"].is_object() || !doc["plots"].contains("written") ||
-      !doc["plots"]["written"].is_array())
-    return std::nullopt;
-  std::set<std::string> files;
-  for (const nlohmann::json& f : doc["plots"]["written"])
-    if (f.is_string()) files.insert(f.get<std::string>());
-  return files;
+/// The summary.json in `dir` parsed (discarded when it is no JSON or cannot be read): read whole
+/// and parsed from memory, once for both questions below.
+nlohmann::json readSummary(const fs::path& dir) {
+  const fs::path summary = dir / "summary.json";
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::symlink_status(summary, ec))) return nlohmann::json(nlohmann::json::value_t::discarded);
+  std::ifstream in(summary, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
 }
 
-}  // namespace
-
-std::string outputGenerator(const std::string& dirName) {
-  const fs::path summary = fs::path(dirName) / "summary.json";
-  std::error_code ec;
-  if (!fs::is_regular_file(fs::symlink_status(summary, ec))) return "";
-  std::ifstream in(summary, std::ios::binary);
-  const nlohmann::json doc = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+/// The generator marker of a parsed summary.json (outputGenerator).
+std::string generatorOf(const nlohmann::json& doc) {
   if (!doc.is_object()) return "";
   if (doc.contains("generator")) {
     const std::string g = doc["generator"].is_string() ? doc["generator"].get<std::string>() : "";
@@ -78,6 +70,22 @@ std::string outputGenerator(const std::string& dirName) {
   return "";
 }
 
+/// summary.json `plots.written` of a parsed summary: every file the run wrote into plots/
+/// (none when the summary has no such list).
+std::optional<std::set<std::string>> plotsWritten(const nlohmann::json& doc) {
+  if (!doc.is_object() || !doc.contains("plots") || !doc["plots"].is_object() || !doc["plots"].contains("written") ||
+      !doc["plots"]["written"].is_array())
+    return std::nullopt;
+  std::set<std::string> files;
+  for (const nlohmann::json& f : doc["plots"]["written"])
+    if (f.is_string()) files.insert(f.get<std::string>());
+  return files;
+}
+
+}  // namespace
+
+std::string outputGenerator(const std::string& dirName) { return generatorOf(readSummary(dirName)); }
+
 bool isBuckleOutput(const std::string& dirName, std::string* why) {
   auto no = [why](const std::string& reason) {
     if (why) *why = reason;
@@ -86,9 +94,10 @@ bool isBuckleOutput(const std::string& dirName, std::string* why) {
   const fs::path dir(dirName);
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return no("it is not a directory");
-  if (outputGenerator(dirName).empty())
+  const nlohmann::json summary = readSummary(dir);
+  if (generatorOf(summary).empty())
     return no("it has no summary.json with the \"generator\" marker buckle writes");
-  const std::optional<std::set<std::string>> written = plotsWritten(dir);
+  const std::optional<std::set<std::string>> written = plotsWritten(summary);
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
     const fs::file_status st = e.symlink_status(ec);
@@ -176,11 +185,16 @@ std::string checkOutputTarget(const std::string& target, const std::vector<std::
     existing = existing.parent_path();
   if (!fs::is_directory(existing, ec))
     throw OutputTargetError("cannot create " + what + ": " + existing.string() + " is not a directory");
+  // The probe is an empty file, not a directory: it holds no disk block, so removing it frees
+  // none (a directory holds one, and on a file system mounted with `discard` freeing a block
+  // waits for the device's discard).
   std::string probe = (existing / ".buckle-probe-XXXXXX").string();
-  if (!::mkdtemp(probe.data()))
+  const int fd = ::mkstemp(probe.data());
+  if (fd < 0)
     throw OutputTargetError("cannot create " + what + ": cannot write in " + existing.string() + ": " +
                             std::strerror(errno));
-  ::rmdir(probe.c_str());
+  ::close(fd);
+  ::unlink(probe.c_str());
   return resolved.string();
 }
 

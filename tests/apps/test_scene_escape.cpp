@@ -209,3 +209,21 @@ TEST_CASE("jsonText never throws and parses back, jsonForHtmlScript holds no '<'
   REQUIRE(back.size() == strings.size());
   for (size_t i = 0; i < strings.size(); ++i) CHECK(back[i]["label"] == escape::validUtf8(strings[i]));
 }
+
+TEST_CASE("htmlScriptSafe writes every '<' as \\u003c and keeps every other byte", "[escape]") {
+  // against the character-by-character definition, '<' at the ends, in runs, and absent
+  const auto reference = [](const std::string& text) {
+    std::string out;
+    for (char c : text) out += c == '<' ? std::string("\\u003c") : std::string(1, c);
+    return out;
+  };
+  std::vector<std::string> cases = {"", "<", "<<", "a<b", "<a", "a<", "no angle", "</script><!--", std::string(3, '\0') + "<"};
+  std::string large;
+  for (int i = 0; i < 100000; ++i) large += (i % 997 == 0 ? '<' : char('a' + i % 26));
+  cases.push_back(large);
+  for (const std::string& s : hostileStrings()) cases.push_back(s);
+  for (const std::string& s : cases) {
+    INFO(s.substr(0, 40));
+    CHECK(escape::htmlScriptSafe(s) == reference(s));
+  }
+}
