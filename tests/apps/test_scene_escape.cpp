@@ -210,7 +210,7 @@ TEST_CASE("jsonText never throws and parses back, jsonForHtmlScript holds no '<'
   for (size_t i = 0; i < strings.size(); ++i) CHECK(back[i]["label"] == escape::validUtf8(strings[i]));
 }
 
-TEST_CASE("htmlScriptSafe writes every '<' as \\u003c and keeps every other byte", "[escape]") {
+TEST_CASE("htmlScriptSafe writes every '<' as the JSON escape u003c and keeps every other byte", "[escape]") {
   // against the character-by-character definition, '<' at the ends, in runs, and absent
   const auto reference = [](const std::string& text) {
     std::string out;

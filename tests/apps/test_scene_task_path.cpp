@@ -188,7 +188,7 @@ TEST_CASE("task path scene: bad input names the JSON path, exit 2, nothing writt
       {"twice", R"({"task": {"coordinates": ["x", "y"], "to": [-1, -3]}, "inputs": ["dL0", "dL0"]})", cont, "",
        "/path/inputs/1", "listed twice"},
       {"weight", R"({"task": {"coordinates": ["x"], "to": [-1]}, "inputs": [{"input": "dL0", "weight": 2}]})", cont, "",
-       "/path/inputs/0/weight", "only applies to the rule \"min_change\""},
+       "/path/inputs/0/weight", "only applies to the rules \"min_change\" and \"most_stable\""},
       {"bounds", R"({"task": {"coordinates": ["x"], "to": [-1]}, "inputs": [{"input": "L0", "min": 2.5}]})", cont, "",
        "/path/inputs/0/min", "contain the input's start value L0 = 2.25"},
       {"segment", R"({"task": {"coordinates": ["x"], "to": [-1]}, "inputs": [{"input": "L0", "segment": 4}]})", cont, "",

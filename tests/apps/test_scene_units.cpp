@@ -181,6 +181,10 @@ json rewrite(json scene, const Units& u) {
     if (s.contains("mass_per_length")) s["mass_per_length"] = s["mass_per_length"].get<double>() * u.stiffness / u.length;
     if (s.contains("damping")) s["damping"] = s["damping"].get<double>() * u.torque();
   }
+  if (a.contains("workspace"))  // the inputs are free lengths
+    for (const char* axis : {"first", "second"})
+      for (const char* key : {"from", "to"})
+        a["workspace"][axis][key] = a["workspace"][axis][key].get<double>() * u.length;
   if (a.contains("frequencies"))  // the same masses per length as the sudden load: time unit unchanged
     a["frequencies"]["mass_per_length"] = a["frequencies"]["mass_per_length"].get<double>() * u.stiffness / u.length;
   scene["plots"] = json::array();
@@ -297,6 +301,21 @@ void compare(const json& got, const json& ref, const json& scene, const Units& u
     sameWrench(gj["loads"], rj["loads"], u, what + " landing");
     same(gj["energy_released"], rj["energy_released"], u.torque(), what + " energy released", 1e-8);
   }
+  if (ref.contains("workspace")) {
+    // the grid's counts and the curves by cause and name are the same; the stable workspace's
+    // extent scales with the lengths
+    REQUIRE(got["workspace"].size() == ref["workspace"].size());
+    for (size_t c = 0; c < ref["workspace"].size(); ++c) {
+      const json &g = got["workspace"][c], &r = ref["workspace"][c];
+      for (const char* key : {"reached", "stable", "grid", "inputs"}) CHECK(g[key] == r[key]);
+      REQUIRE(g["curves"].size() == r["curves"].size());
+      for (size_t k = 0; k < r["curves"].size(); ++k)
+        for (const char* key : {"cause", "name", "stable_points"}) CHECK(g["curves"][k][key] == r["curves"][k][key]);
+      for (const char* axis : {"x", "y"})
+        for (size_t e = 0; e < 2; ++e)
+          same(g["stable_extent"][axis][e], r["stable_extent"][axis][e], u.length, std::string("workspace extent ") + axis);
+    }
+  }
   if (ref.contains("critical_loads")) {
     REQUIRE(got["critical_loads"].size() == ref["critical_loads"].size());
     for (size_t i = 0; i < ref["critical_loads"].size(); ++i) {
@@ -399,7 +418,8 @@ TEST_CASE("every shipped scene gives the same special points in five other unit 
       // the comparison must have something to compare
       CHECK((!reference["special_points"].empty() || reference.contains("critical_curves") ||
              reference.contains("energy_equilibria") || reference.contains("equilibria") ||
-             reference.contains("torque_zeros") || reference.contains("sudden_load")));
+             reference.contains("torque_zeros") || reference.contains("sudden_load") ||
+             reference.contains("workspace")));
       for (const Units& u : kSystems) {
         INFO("unit system " << u.name << " (lengths x " << u.length << ", stiffness x " << u.stiffness << ")");
         const json scaled = rewrite(shipped, u);
