@@ -134,11 +134,15 @@ void CaseRunner::jumps() {
       opt.perturbation = scene_.analyses.jump.perturbation;
       opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
       opt.integration.recordTrajectory = false;
+      opt.wall = tracesWall();
       s.landing = mech::jumpFromFold(problem, fold, opt);
     }
     landings[{s.branch, s.source}] = s.landing;
     if (s.landing.interrupted) {
       interrupted();
+    } else if (s.landing.wallBlocked) {  // a known outcome: the chain cannot pass the base wall
+      run_.warnings.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter + " = " +
+                              std::to_string(fold.lambda) + " not landed: " + s.landing.message);
     } else if (!s.landing.success) {
       run_.complete = false;
       run_.problems.push_back("case \"" + spec_.label + "\": jump from the fold at " + spec_.path.parameter + " = " +
@@ -156,6 +160,7 @@ void CaseRunner::loadHistory() {
   opt.tracer = solverOptions();
   opt.jump.perturbation = scene_.analyses.loadHistory.perturbation;
   opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
+  opt.jump.wall = tracesWall();
   mech::LoadHistoryResult h;
   try {
     h = mech::followLoadHistory(problem, out_.qStart, scene_.analyses.loadHistory.waypoints, opt);
@@ -188,8 +193,11 @@ void CaseRunner::loadHistory() {
     s.landing = mech::landingOf(problem, j);
   }
   if (!h.success && !interrupted()) {
-    run_.complete = false;
-    run_.problems.push_back("case \"" + spec_.label + "\": load history stopped: " + h.message);
+    // a jump that cannot land because of the base wall ends the history, a known outcome
+    const bool wall = !h.jumps.empty() && h.jumps.back().wallBlocked;
+    if (!wall) run_.complete = false;
+    (wall ? run_.warnings : run_.problems)
+        .push_back("case \"" + spec_.label + "\": load history stopped: " + (wall ? "not landed: " : "") + h.message);
   }
 }
 
@@ -212,6 +220,7 @@ void CaseRunner::suddenLoad() {
     mech::LoadHistoryOptions opt;
     opt.tracer = solverOptions();
     opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
+    opt.jump.wall = tracesWall();
     try {
       const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.qStart, {s0, spec.value}, opt);
       if (h.success && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);
@@ -226,6 +235,7 @@ void CaseRunner::suddenLoad() {
   const mech::EndCondition loaded = loadPath().at(spec.value);
   mech::SuddenLoadOptions opt;
   opt.integration = integrationOptions();
+  opt.wall = tracesWall();
   if (spec.massPerLength > 0) {
     opt.scene.inertia = mech::InertiaData::uniformRods(out_.chain, spec.massPerLength);
     if (spec.damping > 0) opt.scene.jointDamping.assign(size_t(n), spec.damping);
@@ -333,7 +343,7 @@ void CaseRunner::continuation() {
   const int c = spec_.path.coordinate;
   mech::EquilibriumOptions equilibriumOptions;
   // with contact and the wall, the base wall is a unilateral constraint like the joint stops (contact.h)
-  equilibriumOptions.wallAsBoundary = scene_.analyses.continuation.contact && scene_.analyses.continuation.wall;
+  equilibriumOptions.wallAsBoundary = tracesWall();
   if (throughLoad()) {
     // trace with the held coordinate's reaction as parameter (PathSpec::throughReaction), each
     // branch ending where the coordinate leaves the path's range

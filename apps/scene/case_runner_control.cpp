@@ -39,6 +39,7 @@ bool CaseRunner::actuationStart() {
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();
   opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(n));
+  opt.jump.wall = tracesWall();
   mech::LoadHistoryResult h;
   try {
     h = mech::followLoadHistory(problem, out_.q0, {0.0, 1.0}, opt);

@@ -163,6 +163,12 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
         j["energy_released"] = number(l.energyReleased);
         j["distance"] = number(l.distance);
         j["contacts"] = contactsJson(l.contacts);
+        if (!l.wall.empty()) {  // vertices held on the base wall
+          json w = json::array();
+          for (const mechanics::WallSupport& v : l.wall) w.push_back({{"vertex", v.vertex.label()}, {"wall_force", number(v.force)}});
+          j["wall"] = w;
+        }
+        if (!l.success && l.wallBlocked) j["landing"] = "not landed: " + l.message;
         p["jump_to"] = j;
       }
       points.push_back(p);

@@ -222,7 +222,8 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
     e["rank"] = static_cast<int>(rank[k]);
     if (shape && s.q.size() == cr.chain.size()) e["joints"] = jointsJson(cr.chain, s.q);
     if (const mechanics::Landing& l = s.landing; l.tried) {
-      e["jump"] = l.success ? l.kind + (l.shape.empty() ? "" : " (" + l.shape + ")") : "failed: " + l.message;
+      e["jump"] = l.success ? l.kind + (l.shape.empty() ? "" : " (" + l.shape + ")")
+                            : (l.wallBlocked ? "not landed: " : "failed: ") + l.message;
       if (shape && l.q.size() == cr.chain.size()) e["jump_joints"] = jointsJson(cr.chain, l.q);
       if (l.success && l.q.size() == cr.chain.size()) {  // where the diagrams' jump arrow ends
         mechanics::SpecialPointReport to = s;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <initializer_list>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -52,6 +53,7 @@ const char* toString(IntegrationStop reason) {
     case IntegrationStop::NonFinite: return "non-finite state";
     case IntegrationStop::Interrupted: return "interrupted";
     case IntegrationStop::Settled: return "settled";
+    case IntegrationStop::Barrier: return "barrier";
   }
   return "unknown";
 }
@@ -252,6 +254,35 @@ class ContactTracker {
   Vector torques_;
 };
 
+/// The stop after the step size fell below minStep while steps kept leaving the admissible states
+/// at x (the last accepted state): at the barrier when the last trial was finite and within the
+/// limits (only IntegrationOptions::admissible rejected it), else at the nearest joint limit, or
+/// a model failure for a non-finite trial far from every limit.
+void stopOutside(DynamicsModel& model, const IntegrationOptions& options, Monitor& monitor, const double* x, double t,
+                 bool finiteTrial, bool withinLimits) {
+  if (finiteTrial && withinLimits) {
+    monitor.stop(IntegrationStop::Barrier, "reached the barrier at t = " + std::to_string(t));
+    return;
+  }
+  const int n = model.segments();
+  int joint = 0;
+  double margin = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n; ++i) {
+    const double mi = std::min(x[i] - model.chain().lowerLimits()[i], model.chain().upperLimits()[i] - x[i]);
+    if (mi < margin) {
+      margin = mi;
+      joint = i;
+    }
+  }
+  // A trial that only failed by being non-finite far from every limit is a model failure.
+  if (!finiteTrial && (options.contact || margin > 1e-6)) {
+    monitor.stop(IntegrationStop::NonFinite, "the right-hand side became non-finite at t = " + std::to_string(t));
+  } else {
+    monitor.stop(IntegrationStop::JointLimit, "joint " + std::to_string(joint + 1) + " reached its limit (q = " +
+                                                 std::to_string(x[joint]) + ") at t = " + std::to_string(t));
+  }
+}
+
 template <class Controller, class System, class State, class SubStep>
 void runLoop(Controller& controller, System system, State& x, const double* (*data)(const State&), SubStep subStep,
              DynamicsModel& model, const IntegrationOptions& options, Monitor& monitor, DynamicsResult& result) {
@@ -270,6 +301,11 @@ void runLoop(Controller& controller, System system, State& x, const double* (*da
     gPrevious = contacts.events(data(x));
   }
   monitor.start(data(x));
+  if (options.admissible && !options.admissible(Eigen::Map<const Vector>(data(x), n))) {
+    monitor.stop(IntegrationStop::Barrier, "the start is beyond the barrier");
+    monitor.finish(t, data(x));
+    return;
+  }
   State previous = x, trial = x;
   int eventsWithoutProgress = 0;
   for (;;) {
@@ -303,35 +339,20 @@ void runLoop(Controller& controller, System system, State& x, const double* (*da
     // Without contact, a step past a joint limit is too (past a geometric limit a spring would
     // pass through zero length), which bisects the time at which a joint reaches its limit down
     // to minStep; the chain then stops there. With contact the model is evaluated just past a
-    // limit (its analytic continuation, segment.cpp) and the crossing is located as an event.
+    // limit (its analytic continuation, segment.cpp) and the crossing is located as an event. A
+    // step past the caller's barrier (IntegrationOptions::admissible) is bisected the same way.
     const double* xs = data(x);
     bool finiteState = true;
     for (int i = 0; finiteState && i < model.stateSize(); ++i) finiteState = std::isfinite(xs[i]);
     const bool inside = finiteState && (options.contact || model.withinLimits(Eigen::Map<const Vector>(xs, n)));
-    if (!inside) {
+    if (!inside || (options.admissible && !options.admissible(Eigen::Map<const Vector>(xs, n)))) {
       x = previous;
       t = tPrevious;
       resetController(controller, 0);
       ++result.rejectedSteps;
       dt = 0.5 * dtTried;
       if (dt < options.minStep) {
-        const double* xp = data(x);
-        int joint = 0;
-        double margin = std::numeric_limits<double>::infinity();
-        for (int i = 0; i < n; ++i) {
-          const double mi = std::min(xp[i] - model.chain().lowerLimits()[i], model.chain().upperLimits()[i] - xp[i]);
-          if (mi < margin) {
-            margin = mi;
-            joint = i;
-          }
-        }
-        // A trial that only failed by being non-finite far from every limit is a model failure.
-        if (!finiteState && (options.contact || margin > 1e-6)) {
-          monitor.stop(IntegrationStop::NonFinite, "the right-hand side became non-finite at t = " + std::to_string(t));
-        } else {
-          monitor.stop(IntegrationStop::JointLimit, "joint " + std::to_string(joint + 1) + " reached its limit (q = " +
-                                                   std::to_string(xp[joint]) + ") at t = " + std::to_string(t));
-        }
+        stopOutside(model, options, monitor, data(x), t, finiteState, inside);
         break;
       }
       continue;

@@ -3,6 +3,8 @@
 #include "buckle/continuation/scaled_problem.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/wall_contact.h"
+#include "buckle/mechanics/wall_landing.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -54,16 +56,53 @@ struct RestPoint {
   std::vector<int> sides;
   Vector torques;
   bool stable = false;
+  std::vector<WallVertex> wall;  ///< vertices on the wall (a barrier stop's landing)
+  Vector wallForces;
 };
+
+/// The landing of dynamics stopped at the base wall (IntegrationStop::Barrier): the vertex of
+/// `chain` (the model's) nearest to the wall and the joints locked then start the active set of
+/// landOnWall (wall_landing.h).
+RestPoint wallRestPoint(EquilibriumProblem& problem, const Chain& chain, const DynamicsResult& dyn, double lambda,
+                        const continuation::CorrectorOptions& options) {
+  RestPoint rp;
+  const int n = problem.segments();
+  ContactSet start;
+  for (int i = 0; i < n && dyn.contactSides.size() == size_t(n); ++i)
+    if (dyn.contactSides[size_t(i)] != 0) start.lock(i, dyn.contactSides[size_t(i)] > 0 ? LimitSide::Upper : LimitSide::Lower);
+  start.touch(nearestWallVertex(chain, dyn.q).vertex);
+  const WallLanding w = landOnWall(problem, start, dyn.q, lambda, options.tolerance, options.maxIterations);
+  rp.polished.u = w.u;
+  rp.polished.converged = w.converged;
+  rp.polished.iterations = w.solves;
+  rp.polished.residual = w.residual;
+  rp.polished.message = w.message;
+  rp.sides.assign(size_t(n), 0);
+  for (const LockedJoint& l : w.contacts.joints()) rp.sides[size_t(l.joint)] = int(l.side);
+  rp.torques = w.torques.size() == n ? w.torques : Vector::Zero(n);
+  rp.stability = w.stability;
+  rp.stable = w.stable;
+  rp.wall = w.contacts.wall();
+  rp.wallForces = w.wallForces;
+  return rp;
+}
+
+/// Whether the integration ended where a landing can be read off: at rest, handed over, or at
+/// the wall with a converged constrained equilibrium.
+bool arrivedAt(const DynamicsResult& dyn, const RestPoint& rest) {
+  return dyn.reason == IntegrationStop::Rest || dyn.reason == IntegrationStop::Settled ||
+         (dyn.reason == IntegrationStop::Barrier && rest.polished.converged);
+}
 
 /// `settled`: the equilibrium the basin test certified when the integration ended Settled
 /// (no joint in contact then: the test runs only without locked joints).
-RestPoint polishRestPoint(EquilibriumProblem& problem, const DynamicsResult& dyn, double lambda,
+RestPoint polishRestPoint(EquilibriumProblem& problem, const Chain& chain, const DynamicsResult& dyn, double lambda,
                           const continuation::CorrectorOptions& options, const PolishResult* settled = nullptr) {
   RestPoint rp;
   const int n = problem.segments();
   rp.sides = dyn.contactSides.size() == size_t(n) ? dyn.contactSides : std::vector<int>(size_t(n), 0);
   rp.torques = Vector::Zero(n);
+  if (dyn.reason == IntegrationStop::Barrier) return wallRestPoint(problem, chain, dyn, lambda, options);
   if (dyn.reason == IntegrationStop::Settled && settled && !anyContact(rp.sides)) {
     rp.polished = *settled;
     cont::BoundProblem(problem).stability(rp.polished.u, lambda, 3, rp.stability);
@@ -393,8 +432,15 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
       ++result.basinTests;
       return basinTest(problem, *model, q, lambda, options.polish, certified);
     };
+  if (options.wall) integration.admissible = wallBarrier(model->chain());
   result.dynamics = simulate(*model, qStart, Vector::Zero(n), integration);
   const DynamicsResult& dyn = result.dynamics;
+  if (dyn.reason == IntegrationStop::Barrier) {
+    const WallApproach at = nearestWallVertex(model->chain(), dyn.q);
+    result.reachedWall = true;
+    result.wallVertex = at.vertex;
+    result.wallGap = at.distance;
+  }
   result.stopReason = dyn.reason;
   result.duration = dyn.time;
   result.steps = dyn.steps;
@@ -403,7 +449,7 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.restPoint = dyn.q;
 
   // 3. Polish at fixed λ (with the joints in contact fixed) and check stability.
-  const RestPoint rest = polishRestPoint(problem, dyn, lambda, options.polish, &certified);
+  const RestPoint rest = polishRestPoint(problem, model->chain(), dyn, lambda, options.polish, &certified);
   const PolishResult& polished = rest.polished;
   result.to = polished.u;
   result.polishConverged = polished.converged;
@@ -418,12 +464,18 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.stable = rest.stable;
   result.contactSides = rest.sides;
   result.contactTorques = rest.torques;
+  result.wallContacts = rest.wall;
+  result.wallForces = rest.wallForces;
 
   std::ostringstream os;
-  os << "integration stopped: " << dyn.message << "; polish: " << (polished.converged ? "converged" : "not converged") << " ("
-     << polished.message << ", residual " << polished.residual << "); landing " << describe(result.stabilityTo);
+  os << "integration stopped: " << dyn.message << "; " << (result.reachedWall ? "landing on the wall: " : "polish: ")
+     << (polished.converged ? "converged" : "not converged") << " (" << polished.message << ", residual "
+     << polished.residual << "); landing " << describe(result.stabilityTo);
   if (anyContact(rest.sides)) os << " with the joints locked; in contact: " << describeContacts(rest.sides, rest.torques);
-  const bool arrived = dyn.reason == IntegrationStop::Rest || dyn.reason == IntegrationStop::Settled;
+  const std::string behind = polished.converged ? behindWall(model->chain(), qTo, problem.lengthUnit()) : "";
+  os << behind;
+  result.behindWall = !behind.empty();
+  const bool arrived = arrivedAt(dyn, rest);
   if (!arrived) {
     os << "; no rest point reached";
   } else if (polished.converged && result.distance <= options.sameStateTolerance) {
@@ -473,14 +525,20 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
     return result;
   }
 
-  result.dynamics = simulate(*model, result.start, Vector::Zero(n), options.integration);
+  IntegrationOptions integration = options.integration;
+  if (options.wall) integration.admissible = wallBarrier(model->chain());
+  result.dynamics = simulate(*model, result.start, Vector::Zero(n), integration);
   const DynamicsResult& dyn = result.dynamics;
+  if (dyn.reason == IntegrationStop::Barrier) {
+    result.reachedWall = true;
+    result.wallVertex = nearestWallVertex(model->chain(), dyn.q).vertex;
+  }
   for (const TrajectorySample& s : dyn.trajectory) {
     result.peakKinetic = std::max(result.peakKinetic, s.kinetic);
     result.maxExcursion = std::max(result.maxExcursion, (s.q - result.start).cwiseAbs().maxCoeff());
   }
 
-  const RestPoint restPoint = polishRestPoint(problem, dyn, 0.0, options.polish);
+  const RestPoint restPoint = polishRestPoint(problem, model->chain(), dyn, 0.0, options.polish);
   const PolishResult& polished = restPoint.polished;
   result.restUnknowns = polished.u;
   result.rest = polished.u.head(n);
@@ -490,6 +548,8 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
   result.stable = restPoint.stable;
   result.contactSides = restPoint.sides;
   result.contactTorques = restPoint.torques;
+  result.wallContacts = restPoint.wall;
+  result.wallForces = restPoint.wallForces;
   result.potentialDynamic = model->potential(result.rest);
 
   std::ostringstream os;
@@ -498,6 +558,8 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
      << "); rest shape " << describe(result.stability);
   if (anyContact(restPoint.sides))
     os << " with the joints locked; in contact: " << describeContacts(restPoint.sides, restPoint.torques);
+  const std::string behind = polished.converged ? behindWall(model->chain(), result.rest, problem.lengthUnit()) : "";
+  os << behind;
   if (qStatic.size() == n) {
     result.compared = true;
     result.staticShape = qStatic;
@@ -516,7 +578,7 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
     result.maxDifference = kNaN;
   }
   result.message = os.str();
-  result.success = dyn.reason == IntegrationStop::Rest && polished.converged && result.stable;
+  result.success = arrivedAt(dyn, restPoint) && polished.converged && result.stable;
   return result;
 }
 

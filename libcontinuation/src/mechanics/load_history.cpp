@@ -137,17 +137,19 @@ LockedJoint stoppedOn(const cont::Problem& traced, const cont::Branch& branch, i
   return {};
 }
 
-ContactSet contactSetOf(const std::vector<int>& sides) {
+ContactSet contactSetOf(const std::vector<int>& sides, const std::vector<WallVertex>& wall = {}) {
   ContactSet set;
   for (size_t i = 0; i < sides.size(); ++i)
     if (sides[i] != 0) set.lock(int(i), sides[i] > 0 ? LimitSide::Upper : LimitSide::Lower);
+  for (const WallVertex& v : wall) set.touch(v);
   return set;
 }
 
 // Releases the chain from `from` with the load held at `at` (simulateJump; again from a saddle
 // it came to rest on) and records the jump; true when it landed.
 bool releaseChain(EquilibriumProblem& problem, const LoadHistoryOptions& options, JumpTrigger trigger,
-                  const Vector& from, double critical, double at, int fromSegment, LoadHistoryResult& result) {
+                  const Vector& start, double critical, double at, int fromSegment, LoadHistoryResult& result) {
+  const Vector from = start.head(problem.dimension());  // without the wall forces of a piece on the wall
   JumpRecord rec;
   rec.trigger = trigger;
   rec.fromSegment = fromSegment;
@@ -164,6 +166,7 @@ bool releaseChain(EquilibriumProblem& problem, const LoadHistoryOptions& options
     jr = simulateJump(problem, saddle, at, options.jump);
   }
   rec.success = jr.success;
+  rec.wallBlocked = !jr.success && jr.reachedWall;
   rec.message = jr.message;
   if (jr.to.size() == from.size()) {
     rec.to = jr.to;
@@ -172,6 +175,8 @@ bool releaseChain(EquilibriumProblem& problem, const LoadHistoryOptions& options
     rec.distance = jr.distance;
     rec.contactSides = jr.contactSides;
     rec.contactTorques = jr.contactTorques;
+    rec.wallContacts = jr.wallContacts;
+    rec.wallForces = jr.wallForces;
   }
   result.jumps.push_back(rec);
   return jr.success;
@@ -220,7 +225,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       return result;
     }
     u = result.jumps.back().to;
-    locked = contactSetOf(result.jumps.back().contactSides);
+    locked = contactSetOf(result.jumps.back().contactSides, result.jumps.back().wallContacts);
   }
 
   for (size_t leg = 1; leg < waypoints.size(); ++leg) {
@@ -242,6 +247,11 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
           sign > 0 ? cont::InitialDirection::increasingLambda() : cont::InitialDirection::decreasingLambda();
       std::unique_ptr<ContactProblem> lockedProblem;
       if (!locked.empty()) lockedProblem = std::make_unique<ContactProblem>(problem, locked);
+      // a piece with vertices on the wall has their forces among its unknowns (contact.h)
+      if (lockedProblem && u.size() == problem.dimension() && locked.wallCount() > 0)
+        u = lockedProblem->withWallForces(*lockedProblem->createWorkspace(), u, lambda);
+      else if (u.size() > problem.dimension() && (!lockedProblem || locked.wallCount() == 0))
+        u = Vector(u.head(problem.dimension()));
       cont::Branch branch = lockedProblem ? cont::trace(*lockedProblem, u, lambda, direction, legOptions)
                                           : cont::trace(problem, u, lambda, direction, legOptions);
       if (!lockedProblem) {
@@ -258,7 +268,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
           if (next.locked(hit.joint) && next.side(hit.joint) == hit.side) next.release(hit.joint);
           else next.lock(hit.joint, hit.side);
           const cont::SpecialPoint& at = branch.specialPoints.back();
-          const ConstrainedEquilibrium ce = solveConstrainedEquilibrium(problem, next, at.u, at.lambda);
+          const ConstrainedEquilibrium ce = solveConstrainedEquilibrium(problem, next, at.u.head(problem.dimension()), at.lambda);
           if (ce.converged) {
             addSegment(result, branch, int(leg), false);
             locked = next;
@@ -306,7 +316,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       }
       u = result.jumps.back().to;
       lambda = at;
-      locked = contactSetOf(result.jumps.back().contactSides);
+      locked = contactSetOf(result.jumps.back().contactSides, result.jumps.back().wallContacts);
       if ((target - lambda) * sign <= 0.0) break;  // the overshoot passed the waypoint
     }
   }

@@ -72,6 +72,8 @@ Landing mirrored(const Landing& landing) {
     c.side = -c.side;
     c.torque = -c.torque;
   }
+  for (WallSupport& w : image.wall)  // +a and −a corners trade places; the force along x is kept
+    w.vertex.corner = w.vertex.corner == 0 ? 0 : w.vertex.corner % 2 == 1 ? w.vertex.corner + 1 : w.vertex.corner - 1;
   image.message = mirrorText(landing.message);
   return image;
 }

@@ -424,6 +424,12 @@ struct IntegrationOptions {
   std::function<bool(ConstVectorRef q)> settled;
   double settleResidual = 1e-2;
   long settleInterval = 8;
+  /// A barrier the chain may not cross (optional; e.g. the base wall, jump.h JumpOptions::wall):
+  /// false for joint angles outside the admissible set. A step that ends outside is rolled back
+  /// and retried at half the size, as a step past a joint limit without contact, so the
+  /// integration stops (IntegrationStop::Barrier) at the last admissible state, within minStep of
+  /// the instant the barrier is reached. A start outside stops at once.
+  std::function<bool(ConstVectorRef q)> admissible;
 
   /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
   std::string validate(const std::string& prefix = "") const;
@@ -431,8 +437,10 @@ struct IntegrationOptions {
 };
 
 /// Settled: stopped by IntegrationOptions::settled (not at rest; the caller's test says where
-/// the flow goes).
-enum class IntegrationStop { Rest, MaxTime, MaxSteps, JointLimit, StepSizeUnderflow, NonFinite, Interrupted, Settled };
+/// the flow goes). Barrier: stopped at IntegrationOptions::admissible's boundary (not at rest).
+enum class IntegrationStop {
+  Rest, MaxTime, MaxSteps, JointLimit, StepSizeUnderflow, NonFinite, Interrupted, Settled, Barrier
+};
 const char* toString(IntegrationStop reason);
 
 struct TrajectorySample {

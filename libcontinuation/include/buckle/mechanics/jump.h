@@ -47,6 +47,7 @@
 #include "buckle/continuation/problem.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/wall_contact.h"
 
 namespace buckle::mechanics {
 
@@ -135,6 +136,12 @@ struct JumpOptions {
   /// A landing closer than this (‖Δq‖∞) to the start means the chain did not jump.
   double sameStateTolerance = 1e-6;
   Handover handover = Handover::Automatic;
+  /// The base wall x = 0 as a barrier (wall_contact.h; the scene traces the wall): the dynamics
+  /// stop where a moving vertex reaches it (IntegrationStop::Barrier) and the chain lands on the
+  /// equilibrium with that vertex held on the wall (wall_landing.h). false: the wall is ignored
+  /// (the chain passes through it, as the continuation without the wall); a landing behind it is
+  /// flagged (JumpResult::behindWall) and said so in the message.
+  bool wall = false;
 
   /// Empty when valid for `problem`, else what is wrong, the field named by its path.
   std::string validate(const EquilibriumProblem& problem, const std::string& prefix = "") const;
@@ -170,6 +177,17 @@ struct JumpResult {
   /// and their contact torques τ_c,i (contact.h: ∂E/∂q_i − (JᵀF)_i, 0 at free joints).
   std::vector<int> contactSides;
   Vector contactTorques;
+  /// JumpOptions::wall: the dynamics stopped where `wallVertex` reached the base wall
+  /// (IntegrationStop::Barrier), its x there `wallGap` (0 to the step size).
+  bool reachedWall = false;
+  WallVertex wallVertex;
+  double wallGap = 0.0;
+  /// Vertices held on the wall at the landing and their forces μ_v (wall_contact.h; empty: none).
+  std::vector<WallVertex> wallContacts;
+  Vector wallForces;
+  /// Without JumpOptions::wall: the polished landing has a vertex behind the base wall (the
+  /// dynamics passed through it; detected, not prevented).
+  bool behindWall = false;
   DynamicsResult dynamics;           ///< the trajectory and its energies
 };
 
@@ -184,6 +202,8 @@ struct SuddenLoadOptions {
   continuation::CorrectorOptions polish = defaultPolishOptions();
   /// ‖q_dynamic − q_static‖∞ above this: the two answers differ.
   double sameStateTolerance = 1e-6;
+  /// The base wall as a barrier (as JumpOptions::wall).
+  bool wall = false;
 
   /// Empty when valid for `chain`, else what is wrong, the field named by its path.
   std::string validate(const Chain& chain, const std::string& prefix = "") const;
@@ -206,6 +226,10 @@ struct SuddenLoadResult {
   bool stable = false;               ///< (in contact: of the constrained system, contacts compressive)
   std::vector<int> contactSides;     ///< joints in contact at rest (as JumpResult)
   Vector contactTorques;             ///< their contact torques τ_c,i
+  bool reachedWall = false;          ///< as JumpResult
+  WallVertex wallVertex;
+  std::vector<WallVertex> wallContacts;
+  Vector wallForces;
   double peakKinetic = 0.0;          ///< over the recorded trajectory
   double maxExcursion = 0.0;         ///< max ‖q(t) − start‖∞ over the recorded trajectory
   // comparison with the quasi-static answer (NaN / false when no q_static was given)

@@ -2,7 +2,10 @@
 // history's jump (load_history.h), in physical quantities. Joint limits are one-sided contacts
 // during the jump (dynamics.h): a chain that comes to rest against limits lands on a stable
 // constrained equilibrium ("stable equilibrium in contact"), reported with the joints in contact
-// and their contact torques. Only dynamics run without contact (IntegrationOptions::contact =
+// and their contact torques. With the base wall as a barrier (JumpOptions::wall) a chain that
+// reaches the wall lands on the stable equilibrium with vertices held on it ("stable equilibrium
+// on the wall", wall_landing.h), reported with those vertices and their wall forces, or is not
+// landed (wallBlocked); without it a landing behind the wall is flagged in the message. Only dynamics run without contact (IntegrationOptions::contact =
 // false) still stop at a limit ("joint limit": the state reached, a known outcome, not a failure).
 #pragma once
 
@@ -15,6 +18,7 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/jump.h"
 #include "buckle/mechanics/load_history.h"
+#include "buckle/mechanics/wall_contact.h"
 
 namespace buckle::mechanics {
 
@@ -25,13 +29,24 @@ struct JointContact {
   double torque = 0.0;   ///< contact torque τ_c (jump.h, contactTorques): −side·τ_c > 0
 };
 
+/// A vertex held on the base wall at a landing (wall_landing.h).
+struct WallSupport {
+  WallVertex vertex;
+  double force = 0.0;    ///< the wall force μ_v (along +x on the chain): > 0
+};
+
 struct Landing {
   bool tried = false;
   bool success = false;         ///< came to rest on a stable (constrained) equilibrium or on a joint limit
   bool interrupted = false;     ///< the integration was stopped by the time limit or a signal
-  /// "stable equilibrium", "stable equilibrium in contact", "joint limit" or "none"
+  /// Not landed because of the base wall: the dynamics stopped at it (JumpOptions::wall) and no
+  /// stable equilibrium on it was found.
+  bool wallBlocked = false;
+  /// "stable equilibrium", "stable equilibrium in contact", "stable equilibrium on the wall",
+  /// "joint limit" or "none"
   std::string kind;
   std::vector<JointContact> contacts;  ///< joints in contact at the landing (empty: none)
+  std::vector<WallSupport> wall;       ///< vertices held on the base wall (empty: none)
   std::string message;
   Eigen::VectorXd q;            ///< joint angles at the landing (empty: none)
   Wrench F = Wrench::Zero();    ///< end wrench there (loads and reactions)

@@ -54,7 +54,11 @@ struct JumpRecord {
   /// and their contact torques (jump.h).
   std::vector<int> contactSides;
   Vector contactTorques;
+  /// Vertices held on the base wall at the landing and their forces (jump.h; empty: none).
+  std::vector<WallVertex> wallContacts;
+  Vector wallForces;
   bool success = false;
+  bool wallBlocked = false;     ///< not landed because of the base wall (landing.h, Landing::wallBlocked)
   std::string message;
 };
 
