@@ -92,7 +92,10 @@ void sampleAlong(const EquilibriumProblem& p, const TwoWays& t, const std::vecto
       const double lo = std::min(a.lambda, c.lambda), hi = std::max(a.lambda, c.lambda);
       for (size_t i = 0; i < m; ++i) {
         if (folds[i] >= 0 || targets[i] < lo || targets[i] > hi) continue;
-        const double s = c.lambda == a.lambda ? 0.0 : (targets[i] - a.lambda) / (c.lambda - a.lambda);
+        // across a fold both ends lie on the same side of it and the chord between them is no
+        // guess: Newton from the end reached first keeps the first-reach rule
+        const bool foldInside = (a.foldTest > 0) != (c.foldTest > 0);
+        const double s = foldInside || c.lambda == a.lambda ? 0.0 : (targets[i] - a.lambda) / (c.lambda - a.lambda);
         const Vector guess = a.u + s * (c.u - a.u);
         if (!corrector.atFixedParameter(guess, targets[i], u)) continue;
         states[i] = u;
