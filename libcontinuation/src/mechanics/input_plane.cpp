@@ -181,6 +181,7 @@ bool InputPlaneCurveProblem::jacobian(cont::ProblemWorkspace& ws, cont::ConstVec
   // the condition row by central differences in x = (q, u₂, u₁) (file comment)
   w.x << q, u2, u1;
   for (int j = 0; j < n_ + 2; ++j) {
+    if (stop_ && stop_->requested()) return false;
     const double unit = j < n_ ? 1.0 : (j == n_ ? scale2_ : scale1_);
     const double h = 1e-6 * std::max(unit, std::abs(w.x[j]));
     double cp = 0.0, cm = 0.0;

@@ -88,6 +88,7 @@ void traceBoundaryCurves(const InputPlane& plane, const WorkspaceMapOptions& o, 
     const double u1 = s.x[n + 1], u2 = s.x[n];
     if (traced[s.name] >= o.maxCurves || onTracedCurve(map, s.name, u1, u2, metric, 0.75)) continue;
     InputPlaneCurveProblem problem(plane, s.condition, s.boundary);
+    problem.watch(&o.tracer.interrupt);
     auto ws = problem.createWorkspace();
     cont::BoundProblem bound(problem, *ws);
     Vector x(n + 2);

@@ -78,7 +78,7 @@ TwoWays traceBothWays(const EquilibriumProblem& p, ConstVectorRef q, double lamb
 // The states of a traced pair of halves at the values `targets`, each taken where the branch
 // first reaches it from the start; `folds` counts the folds passed on the way (−1: not reached).
 void sampleAlong(const EquilibriumProblem& p, const TwoWays& t, const std::vector<double>& targets,
-                 std::vector<Vector>& states, std::vector<int>& folds) {
+                 const cont::Interrupt& stop, std::vector<Vector>& states, std::vector<int>& folds) {
   const size_t m = targets.size();
   states.assign(m, Vector());
   folds.assign(m, -1);
@@ -91,7 +91,7 @@ void sampleAlong(const EquilibriumProblem& p, const TwoWays& t, const std::vecto
       if (k > 0 && (a.foldTest > 0) != (b->points[k - 1].foldTest > 0)) ++passed;
       const double lo = std::min(a.lambda, c.lambda), hi = std::max(a.lambda, c.lambda);
       for (size_t i = 0; i < m; ++i) {
-        if (folds[i] >= 0 || targets[i] < lo || targets[i] > hi) continue;
+        if (folds[i] >= 0 || targets[i] < lo || targets[i] > hi || stop.requested()) continue;
         // across a fold both ends lie on the same side of it and the chord between them is no
         // guess: Newton from the end reached first keeps the first-reach rule
         const bool foldInside = (a.foldTest > 0) != (c.foldTest > 0);
@@ -145,6 +145,10 @@ void computeRows(const InputPlane& plane, const WorkspaceMapOptions& o, const st
         row[i].u1 = targets[size_t(i)];
         row[i].u2 = u2;
       }
+      if (o.tracer.interrupt.requested()) {  // the rows done are kept; the others say why not
+        for (int i = 0; i < c1; ++i) row[i].note = "not computed: " + o.tracer.interrupt.describe();
+        continue;
+      }
       if (startFolds[size_t(j)] < 0) {
         for (int i = 0; i < c1; ++i) row[i].note = "the spine along " + plane.input(1).name() + " did not reach it";
         continue;
@@ -154,9 +158,13 @@ void computeRows(const InputPlane& plane, const WorkspaceMapOptions& o, const st
         rows[size_t(j)] = traceBothWays(*p, starts[size_t(j)], plane.origin(0), ro);
         std::vector<Vector> states;
         std::vector<int> folds;
-        sampleAlong(*p, rows[size_t(j)], targets, states, folds);
+        sampleAlong(*p, rows[size_t(j)], targets, o.tracer.interrupt, states, folds);
         auto ws = p->createWorkspace();
         for (int i = 0; i < c1; ++i) {
+          if (o.tracer.interrupt.requested()) {
+            row[i].note = "not computed: " + o.tracer.interrupt.describe();
+            continue;
+          }
           if (folds[size_t(i)] < 0) {
             const cont::Branch& b = targets[size_t(i)] >= plane.origin(0) ? rows[size_t(j)].up : rows[size_t(j)].down;
             row[i].note = "the row ended first: " + stopWords(b);
@@ -240,7 +248,7 @@ std::vector<detail::CurveStart> curveStarts(const InputPlane& plane, const Works
   InputPlaneCurveProblem singular(plane, Condition::Singular);
   auto ws = singular.createWorkspace();
   std::vector<double> c(map.cells.size(), std::numeric_limits<double>::quiet_NaN());
-  for (size_t k = 0; k < map.cells.size(); ++k) {
+  for (size_t k = 0; k < map.cells.size() && !o.tracer.interrupt.requested(); ++k) {
     const WorkspaceCell& cell = map.cells[k];
     double v = 0.0;
     if (cell.reached && singular.condition(*ws, cell.q.head(n), cell.u1, cell.u2, v)) c[k] = v;
@@ -306,7 +314,7 @@ WorkspaceMap computeWorkspaceMap(const InputPlane& plane, ConstVectorRef q0, con
       traceBothWays(*spineProblem, q0, plane.origin(1), rowOptions(o.tracer, o.second.from, o.second.to));
   std::vector<Vector> starts;
   std::vector<int> startFolds;
-  sampleAlong(*spineProblem, spine, u2s, starts, startFolds);
+  sampleAlong(*spineProblem, spine, u2s, o.tracer.interrupt, starts, startFolds);
 
   std::vector<TwoWays> rows(static_cast<size_t>(map.count2));
   computeRows(plane, o, starts, startFolds, map, rows);

@@ -29,6 +29,7 @@
 #include <memory>
 #include <string>
 
+#include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
 #include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain.h"
@@ -115,6 +116,9 @@ class InputPlaneCurveProblem final : public continuation::Problem {
                                        continuation::ProblemWorkspace*& eqWs) const;
 
   Condition kind() const { return condition_; }
+  /// A time limit or signal to honour inside one Jacobian (n + 2 dense solves: minutes for a long
+  /// chain): once it is requested the Jacobian fails, and the tracer stops on its own check.
+  void watch(const continuation::Interrupt* stop) { stop_ = stop; }
   int boundaryIndex() const { return boundary_; }
 
  private:
@@ -125,6 +129,7 @@ class InputPlaneCurveProblem final : public continuation::Problem {
   int boundary_;
   int n_;
   double scale1_, scale2_, stiffness_;
+  const continuation::Interrupt* stop_ = nullptr;
 };
 
 /// "fold", "singular", "limit".
