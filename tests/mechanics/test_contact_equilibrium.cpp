@@ -15,37 +15,17 @@
 #include "buckle/mechanics/unloaded_shape.h"
 
 #include "curled_chain.h"
+#include "test_geometry.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
 
 namespace {
 
-Eigen::Vector2d along(double t) { return {std::cos(t), std::sin(t)}; }
-Eigen::Vector2d across(double t) { return {-std::sin(t), std::cos(t)}; }
-
-// The test's own geometry: joints P_j (0-based joint j at column j), the end, the absolute link
-// angles θ_m, from the link lengths b_11, b_i2 + b_(i+1)1, b_n2.
-struct Geometry {
-  Eigen::Matrix2Xd P;
-  Eigen::Vector2d end;
-  Eigen::VectorXd theta;  // θ_m of link m (m = 0 … n)
-};
-Geometry geometry(const Chain& chain, const Eigen::VectorXd& q) {
-  const int n = chain.size();
-  Geometry g;
-  g.P.resize(2, n);
-  g.theta = Eigen::VectorXd::Zero(n + 1);
-  Eigen::Vector2d at(chain.segment(0).parameters().b1, 0.0);
-  for (int j = 0; j < n; ++j) {
-    g.P.col(j) = at;
-    g.theta[j + 1] = g.theta[j] + q[j];
-    const double link = chain.segment(j).parameters().b2 + (j + 1 < n ? chain.segment(j + 1).parameters().b1 : 0.0);
-    at += link * along(g.theta[j + 1]);
-  }
-  g.end = at;
-  return g;
-}
+using buckle::test::across;
+using buckle::test::along;
+using buckle::test::geometry;
+using buckle::test::Geometry;
 
 // Distal base corner −a of segment i: its joint + b2 along θ_(i+1) − a2 across it.
 Eigen::Vector2d distalMinus(const Chain& chain, const Geometry& g, int i) {

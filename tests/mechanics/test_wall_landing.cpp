@@ -15,36 +15,16 @@
 #include "buckle/mechanics/wall_landing.h"
 
 #include "curled_chain.h"
+#include "test_geometry.h"
 
 using namespace buckle::mechanics;
 
 namespace {
 
-Eigen::Vector2d along(double t) { return {std::cos(t), std::sin(t)}; }
-Eigen::Vector2d across(double t) { return {-std::sin(t), std::cos(t)}; }
-
-// The test's own geometry: joints P_j (0-based joint j at column j), the end, the absolute link
-// angles θ_m (link m between joints m − 1 and m), from the link lengths b_11, b_i2 + b_(i+1)1, b_n2.
-struct Geometry {
-  Eigen::Matrix2Xd P;
-  Eigen::Vector2d end;
-  Eigen::VectorXd theta;
-};
-Geometry geometry(const Chain& chain, const Eigen::VectorXd& q) {
-  const int n = chain.size();
-  Geometry g;
-  g.P.resize(2, n);
-  g.theta = Eigen::VectorXd::Zero(n + 1);
-  Eigen::Vector2d at(chain.segment(0).parameters().b1, 0.0);
-  for (int j = 0; j < n; ++j) {
-    g.P.col(j) = at;
-    g.theta[j + 1] = g.theta[j] + q[j];
-    const double link = chain.segment(j).parameters().b2 + (j + 1 < n ? chain.segment(j + 1).parameters().b1 : 0.0);
-    at += link * along(g.theta[j + 1]);
-  }
-  g.end = at;
-  return g;
-}
+using buckle::test::across;
+using buckle::test::along;
+using buckle::test::geometry;
+using buckle::test::Geometry;
 
 // Every moving vertex: the joints 2 … n, the proximal triangles' base corners of segments 2 … n,
 // the distal ones of every segment (segment 1's proximal triangle is the clamp).
