@@ -673,6 +673,14 @@
     var panel = html('div', {'class': 'panel view', id: 'view-' + p.name}, views);
     var chosen = D.cases.filter(function (c) { return !p.cases || p.cases.indexOf(c.index) >= 0; });
     if (p.type === 'bifurcation' || p.type === 'stiffness') { branchChart(panel, p, null); return; }
+    if (['shapes', 'energy_curves', 'torque_angle', 'sudden_load'].indexOf(p.type) < 0) {
+      // the views the page does not draw itself (critical_curves, equilibrium_shapes, workspace,
+      // input_map): gnuplot's image beside the page (p.name is letters, digits, '_' and '-')
+      html('p', {'class': 'note'}, panel, (p.title || p.name) + ' (plots/' + p.name + '.png, drawn by gnuplot):');
+      html('img', {src: 'plots/' + p.name + '.png', alt: 'plots/' + p.name + '.png (not drawn: see summary.json plots)',
+                   style: 'max-width: 100%'}, panel);
+      return;
+    }
     var lines = [], marks = [], legend = [];
     if (p.type === 'shapes') {
       var frameXs = [0], frameYs = [0], shapes = [];
