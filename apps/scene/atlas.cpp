@@ -26,8 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 void checkAxis(const AtlasAxis& a, const std::string& opt) {
   if (a.name != "a" && a.name != "L0" && a.name != "n")
     throw std::invalid_argument(opt + " must be one of a, L0, n (got \"" + a.name + "\")");
@@ -54,7 +52,7 @@ void computeCell(AtlasCell& c) {
     c.postSlope = fb.slope;
     c.error = fb.message;
   } catch (const std::exception& e) {  // an invalid segment (e.g. a/b too large) names itself
-    c.firstCritical = kNaN;
+    c.firstCritical = std::numeric_limits<double>::quiet_NaN();
     c.postBuckling = "failed";
     c.error = e.what();
   }
@@ -150,7 +148,7 @@ std::vector<AtlasCell> atlasGrid(const AtlasOptions& o) {
         if (axis->name == "n") c.n = static_cast<int>(std::lround(v));
       }
       c.kappa = c.L0 - 2.0 * (1.0 - c.a * c.a);
-      c.firstCritical = kNaN;
+      c.firstCritical = std::numeric_limits<double>::quiet_NaN();
       c.postBuckling = "not computed";
     }
   return cells;

@@ -11,8 +11,6 @@ namespace buckle::scene {
 
 namespace {
 
-const double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 double commonColumn(const std::string& c, double parameter, const mechanics::Wrench& F, const mechanics::Pose& pose,
                     const Eigen::VectorXd& q, const mechanics::Pose& pose0, bool& found) {
   found = true;

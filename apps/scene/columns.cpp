@@ -8,12 +8,6 @@ namespace buckle::scene {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-}  // namespace
-
-namespace {
-
 struct Entry {
   const char* column;
   const char* gnuplot;  // enhanced text

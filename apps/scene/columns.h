@@ -11,6 +11,9 @@
 
 namespace buckle::scene {
 
+/// A value not computed or not defined: the CSV writers print "nan", JSON null.
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 /// How a label is written: gnuplot's enhanced text ("K_{xx}") or plain Unicode ("Kxx").
 enum class LabelStyle { Gnuplot, Plain };
 /// Axis label of a column with the scene's unit: "F_x (N)", "F_x (units of k b)",

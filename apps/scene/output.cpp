@@ -23,6 +23,7 @@
 #include "scene/report.h"
 #include "scene/solver_settings.h"
 #include "scene/special_marks.h"
+#include "scene/json_values.h"
 
 namespace buckle::scene {
 
@@ -30,15 +31,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-// JSON has no NaN: write null.
-json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-json vectorJson(const Eigen::VectorXd& v) {
-  json a = json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(number(v[i]));
-  return a;
-}
 
 void writeText(const fs::path& file, const std::string& text) {
   std::ofstream out(file, std::ios::binary);
@@ -76,13 +68,13 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
   writeText(dir / "joint_angles.npy", bytes);
 }
 
-json wrenchJson(const mechanics::Wrench& F) { return json{{"Fx", number(F[0])}, {"Fy", number(F[1])}, {"Me", number(F[2])}}; }
-json poseJson(const mechanics::Pose& p) { return json{{"x", number(p[0])}, {"y", number(p[1])}, {"phi", number(p[2])}}; }
+json wrenchJson(const mechanics::Wrench& F) { return json{{"Fx", jsonNumber(F[0])}, {"Fy", jsonNumber(F[1])}, {"Me", jsonNumber(F[2])}}; }
+json poseJson(const mechanics::Pose& p) { return json{{"x", jsonNumber(p[0])}, {"y", jsonNumber(p[1])}, {"phi", jsonNumber(p[2])}}; }
 /// Joints resting against their limits: 1-based joint, side, contact torque τ_c (k b²).
 json contactsJson(const std::vector<mechanics::JointContact>& contacts) {
   json a = json::array();
   for (const mechanics::JointContact& c : contacts)
-    a.push_back({{"joint", c.joint + 1}, {"side", c.side > 0 ? "upper" : "lower"}, {"contact_torque", number(c.torque)}});
+    a.push_back({{"joint", c.joint + 1}, {"side", c.side > 0 ? "upper" : "lower"}, {"contact_torque", jsonNumber(c.torque)}});
   return a;
 }
 
@@ -101,43 +93,43 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       p["type"] = mechanics::label(s.type);
       p["field"] = fieldName(cr, s);
       p["branch"] = s.branch;
-      p["parameter"] = number(s.parameter);
+      p["parameter"] = jsonNumber(s.parameter);
       p["loads"] = wrenchJson(s.F);
       p["position"] = poseJson(s.pose);
-      p["q"] = vectorJson(s.q);
+      p["q"] = jsonVector(s.q);
       p["shape"] = s.shape;
       p["stability_before"] = s.stabilityBefore;
       p["stability_after"] = s.stabilityAfter;
-      p["accuracy"] = {{"parameter", number(s.accuracy)}, {"residual", number(s.residual)}, {"refined", s.refined}};
+      p["accuracy"] = {{"parameter", jsonNumber(s.accuracy)}, {"residual", jsonNumber(s.residual)}, {"refined", s.refined}};
       // K_F where the report computed it (a located KMIN: the stiffness at the minimum itself)
-      if (s.K.allFinite()) p["stiffness"] = {{"Kxx", number(s.K(0, 0))}, {"Kyy", number(s.K(1, 1))}, {"Kxy", number(s.K(0, 1))}};
+      if (s.K.allFinite()) p["stiffness"] = {{"Kxx", jsonNumber(s.K(0, 0))}, {"Kyy", jsonNumber(s.K(1, 1))}, {"Kxy", jsonNumber(s.K(0, 1))}};
       if (!s.note.empty()) p["note"] = s.note;
       if (!cr.inputNames.empty()) {  // a task path: the inputs at the point
         json in = json::object();
         for (size_t j = 0; j < cr.inputNames.size() && Eigen::Index(j) < s.inputs.size(); ++j)
-          in[cr.inputNames[j]] = number(s.inputs[Eigen::Index(j)]);
+          in[cr.inputNames[j]] = jsonNumber(s.inputs[Eigen::Index(j)]);
         p["inputs"] = in;
       }
       if (s.multiplicity > 1) p["multiplicity"] = s.multiplicity;
       if (s.branchesPredicted >= 0)
         p["branches"] = {{"predicted", s.branchesPredicted}, {"found", s.branchesFound}};
-      if (s.contactPoint.allFinite()) p["contact_point"] = json::array({number(s.contactPoint.x()), number(s.contactPoint.y())});
+      if (s.contactPoint.allFinite()) p["contact_point"] = json::array({jsonNumber(s.contactPoint.x()), jsonNumber(s.contactPoint.y())});
       if (s.koiter.valid) {  // BP: λ(ξ) = λ + aξ + bξ², ξ in rad of the unit joint-angle mode
-        p["koiter_a"] = number(s.koiter.a);
-        p["koiter_b"] = number(s.koiter.b);
-        p["koiter_b_accuracy"] = number(s.koiter.bAccuracy);
+        p["koiter_a"] = jsonNumber(s.koiter.a);
+        p["koiter_b"] = jsonNumber(s.koiter.b);
+        p["koiter_b_accuracy"] = jsonNumber(s.koiter.bAccuracy);
         if (s.koiter.degenerate) {  // b = 0 to its accuracy: λ = λ + c4 ξ⁴ decides
-          p["koiter_c4"] = number(s.koiter.c4);
-          p["koiter_c4_accuracy"] = number(s.koiter.c4Accuracy);
+          p["koiter_c4"] = jsonNumber(s.koiter.c4);
+          p["koiter_c4_accuracy"] = jsonNumber(s.koiter.c4Accuracy);
         }
         p["post_buckling"] = mechanics::postBucklingName(s.koiter);
         json imperfections = json::array();
         for (const mechanics::ImperfectionSensitivity& im : s.imperfections)
           if (im.valid) {
             json entry = {{"imperfection", im.name},
-                          {"coupling", number(im.coupling)},
-                          {"exponent", number(im.exponent)},
-                          {"prefactor", number(im.prefactor)},
+                          {"coupling", jsonNumber(im.coupling)},
+                          {"exponent", jsonNumber(im.exponent)},
+                          {"prefactor", jsonNumber(im.prefactor)},
                           {"sign", im.sign}};
             if (im.coordinate < 0) entry["segment"] = im.segment < 0 ? json("all") : json(im.segment + 1);
             imperfections.push_back(entry);
@@ -145,9 +137,9 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
         p["imperfection_sensitivity"] = imperfections;
       }
       if (s.joint >= 0)  // CT / RL
-        p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", number(s.contactTorque)}, {"locked_after", s.lockedAfter.label()}};
+        p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", jsonNumber(s.contactTorque)}, {"locked_after", s.lockedAfter.label()}};
       if (s.vertex.segment >= 0)  // WC / WR
-        p["wall_contact"] = {{"vertex", s.vertex.label()}, {"contact_force", number(s.contactForce)},
+        p["wall_contact"] = {{"vertex", s.vertex.label()}, {"contact_force", jsonNumber(s.contactForce)},
                              {"wall_after", s.lockedAfter.wallLabel()}};
       if (const mechanics::Landing& l = s.landing; l.tried) {
         json j;
@@ -155,17 +147,17 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
         j["landing"] = l.kind;
         j["message"] = l.message;
         if (l.q.size() > 0) {
-          j["q"] = vectorJson(l.q);
+          j["q"] = jsonVector(l.q);
           j["loads"] = wrenchJson(l.F);
           j["position"] = poseJson(l.pose);
           j["shape"] = l.shape;
         }
-        j["energy_released"] = number(l.energyReleased);
-        j["distance"] = number(l.distance);
+        j["energy_released"] = jsonNumber(l.energyReleased);
+        j["distance"] = jsonNumber(l.distance);
         j["contacts"] = contactsJson(l.contacts);
         if (!l.wall.empty()) {  // vertices held on the base wall
           json w = json::array();
-          for (const mechanics::WallSupport& v : l.wall) w.push_back({{"vertex", v.vertex.label()}, {"wall_force", number(v.force)}});
+          for (const mechanics::WallSupport& v : l.wall) w.push_back({{"vertex", v.vertex.label()}, {"wall_force", jsonNumber(v.force)}});
           j["wall"] = w;
         }
         if (!l.success && l.wallBlocked) j["landing"] = "not landed: " + l.message;
@@ -175,8 +167,8 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
     }
     if (cr.haveCritical) {
       for (const mechanics::BucklingMode& m : cr.critical.modes) {
-        json e{{"case", c}, {"case_label", cr.label}, {"load_factor", number(m.lambda)}, {"shape", m.shape},
-               {"mode", vectorJson(m.mode)}, {"shortening", number(m.shortening)}};
+        json e{{"case", c}, {"case_label", cr.label}, {"load_factor", jsonNumber(m.lambda)}, {"shape", m.shape},
+               {"mode", jsonVector(m.mode)}, {"shortening", jsonNumber(m.shortening)}};
         if (std::isfinite(m.mu)) e["mu"] = m.mu;
         critical.push_back(e);
       }
@@ -185,8 +177,8 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       for (const mechanics::LandscapeEquilibrium& e : cr.landscape.equilibria) {
         Eigen::VectorXd q = e.q;
         equilibria.push_back(json{{"case", c}, {"case_label", cr.label}, {"ik_branch", e.branch}, {"q1", e.q1},
-                                  {"q", vectorJson(q)}, {"energy", number(e.energy)},
-                                  {"d2E_dq1", number(e.d2Edq1)}, {"stable", e.stable}, {"shape", e.shape},
+                                  {"q", jsonVector(q)}, {"energy", jsonNumber(e.energy)},
+                                  {"d2E_dq1", jsonNumber(e.d2Edq1)}, {"stable", e.stable}, {"shape", e.shape},
                                   {"loads", wrenchJson(e.F)}});
       }
     }
@@ -209,25 +201,25 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       const SuddenLoadRecord& r = cr.sudden;
       json e{{"case", c},
              {"case_label", cr.label},
-             {"value", number(r.value)},
+             {"value", jsonNumber(r.value)},
              {"success", r.success},
              {"message", r.message},
              {"model", r.inertial ? "inertial" : "gradient flow"},
              {"stable", r.stable},
-             {"peak_kinetic", number(r.peakKinetic)},
-             {"max_excursion", number(r.maxExcursion)},
-             {"duration", number(r.duration)},
-             {"residual", number(r.residual)},
-             {"energy_balance_error", number(r.energyBalanceError)}};
+             {"peak_kinetic", jsonNumber(r.peakKinetic)},
+             {"max_excursion", jsonNumber(r.maxExcursion)},
+             {"duration", jsonNumber(r.duration)},
+             {"residual", jsonNumber(r.residual)},
+             {"energy_balance_error", jsonNumber(r.energyBalanceError)}};
       if (r.rest.size() > 0)
-        e["rest"] = json{{"q", vectorJson(r.rest)}, {"position", poseJson(r.restPose)}, {"contacts", contactsJson(r.contacts)}};
+        e["rest"] = json{{"q", jsonVector(r.rest)}, {"position", poseJson(r.restPose)}, {"contacts", contactsJson(r.contacts)}};
       if (r.haveStatic)
-        e["quasi_static"] = json{{"q", vectorJson(r.staticShape)},
+        e["quasi_static"] = json{{"q", jsonVector(r.staticShape)},
                                  {"position", poseJson(r.staticPose)},
                                  {"differs", r.differs},
-                                 {"max_difference", number(r.maxDifference)},
-                                 {"potential_dynamic", number(r.potentialDynamic)},
-                                 {"potential_static", number(r.potentialStatic)},
+                                 {"max_difference", jsonNumber(r.maxDifference)},
+                                 {"potential_dynamic", jsonNumber(r.potentialDynamic)},
+                                 {"potential_static", jsonNumber(r.potentialStatic)},
                                  {"lower", r.lower}};
       else
         e["quasi_static"] = nullptr;
@@ -330,10 +322,10 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
                           {"straight_stiffness", cr.chain.segment(i).straightStiffness()}});
     }
     c["segment_parameters"] = segs;
-    c["q0"] = vectorJson(cr.q0);
+    c["q0"] = jsonVector(cr.q0);
     c["start_position"] = poseJson(cr.pose0);
     c["start_parameter"] = cr.startValue;
-    if (cr.qStart.size() == cr.q0.size() && cr.qStart != cr.q0) c["start_q"] = vectorJson(cr.qStart);
+    if (cr.qStart.size() == cr.q0.size() && cr.qStart != cr.q0) c["start_q"] = jsonVector(cr.qStart);
     if (!cr.startNote.empty()) c["start_note"] = cr.startNote;
     if (cr.loadLimit > 0.0) {
       c["load_limit"] = cr.loadLimit;

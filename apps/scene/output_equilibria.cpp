@@ -4,36 +4,30 @@
 #include <cmath>
 #include <sstream>
 
+#include "scene/json_values.h"
+
 namespace buckle::scene {
 
 namespace {
 
 using nlohmann::json;
 
-json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-json vectorJson(const Eigen::VectorXd& v) {
-  json a = json::array();
-  for (int i = 0; i < v.size(); ++i) a.push_back(number(v[i]));
-  return a;
-}
-
 json equilibriumJson(const mechanics::FoundEquilibrium& e, const mechanics::EndCondition& end) {
-  json j{{"q", vectorJson(e.q)},
+  json j{{"q", jsonVector(e.q)},
          {"index", e.index},
          {"stable", e.stable},
-         {"potential", number(e.potential)},
+         {"potential", jsonNumber(e.potential)},
          {"shape", e.shape},
-         {"loads", json{{"Fx", number(e.wrench[0])}, {"Fy", number(e.wrench[1])}, {"Me", number(e.wrench[2])}}},
-         {"pose", json{{"x", number(e.pose[0])}, {"y", number(e.pose[1])}, {"phi", number(e.pose[2])}}},
-         {"accuracy", number(e.accuracy)},
+         {"loads", json{{"Fx", jsonNumber(e.wrench[0])}, {"Fy", jsonNumber(e.wrench[1])}, {"Me", jsonNumber(e.wrench[2])}}},
+         {"pose", json{{"x", jsonNumber(e.pose[0])}, {"y", jsonNumber(e.pose[1])}, {"phi", jsonNumber(e.pose[2])}}},
+         {"accuracy", jsonNumber(e.accuracy)},
          {"by_deflation", e.byDeflation},
          {"by_sweep", e.bySweep}};
   if (e.zeroEigenvalues > 0) j["zero_eigenvalues"] = e.zeroEigenvalues;
   const std::vector<int> held = end.heldIndices();
   if (!held.empty()) {
     json r = json::object();
-    for (size_t k = 0; k < held.size(); ++k) r[kEndLoadNames[held[k]]] = number(e.reactions[Eigen::Index(k)]);
+    for (size_t k = 0; k < held.size(); ++k) r[kEndLoadNames[held[k]]] = jsonNumber(e.reactions[Eigen::Index(k)]);
     j["reactions"] = r;
   }
   return j;
@@ -59,7 +53,7 @@ json equilibriaJson(const RunResult& run) {
     for (int k : a.endCondition.heldIndices()) held.push_back(kEndCoordinateNames[k]);
     out.push_back(json{{"case", c},
                        {"case_label", cr.label},
-                       {"at", number(set.at)},
+                       {"at", jsonNumber(set.at)},
                        {"held", held},
                        {"count", a.equilibria.size()},
                        {"stable_count", stable},

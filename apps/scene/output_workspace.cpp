@@ -6,14 +6,13 @@
 #include <sstream>
 
 #include "scene/escape.h"
+#include "scene/json_values.h"
 
 namespace buckle::scene {
 
 namespace {
 
 using nlohmann::json;
-
-json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 // NaN as an empty CSV field.
 void field(std::ostream& os, double v) {
@@ -54,7 +53,7 @@ json workspaceJson(const RunResult& run) {
                             {"name", cu.name},
                             {"points", cu.points.size()},
                             {"stable_points", stablePoints},
-                            {"worst_residual", number(worst)},
+                            {"worst_residual", jsonNumber(worst)},
                             {"stop", cu.stop}});
     }
     out.push_back(json{{"case", c},
@@ -63,8 +62,8 @@ json workspaceJson(const RunResult& run) {
                        {"grid", json::array({m.count1, m.count2})},
                        {"reached", reached},
                        {"stable", stable},
-                       {"stable_extent", json{{"x", json::array({number(xLo), number(xHi)})},
-                                              {"y", json::array({number(yLo), number(yHi)})}}},
+                       {"stable_extent", json{{"x", json::array({jsonNumber(xLo), jsonNumber(xHi)})},
+                                              {"y", json::array({jsonNumber(yLo), jsonNumber(yHi)})}}},
                        {"curves", curves},
                        {"problems", m.problems},
                        {"interrupted", m.interrupted}});

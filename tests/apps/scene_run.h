@@ -2,6 +2,8 @@
 // the scene tests that feed the program hand-written (often bad) scenes share.
 #pragma once
 
+#include <catch2/catch.hpp>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -32,6 +34,14 @@ inline SceneOutcome runSceneText(const std::string& tag, const std::string& name
   std::ostringstream log, err;
   const int rc = buckle::scene::runSceneCommand(opt, log, err);
   return {rc, err.str(), file, dir / "out"};
+}
+
+/// `s` with the first `from` replaced by `to` (the test fails if there is none): a scene text
+/// edited into a bad one.
+inline std::string replaceOnce(std::string s, const std::string& from, const std::string& to) {
+  const size_t pos = s.find(from);
+  REQUIRE(pos != std::string::npos);
+  return s.replace(pos, from.size(), to);
 }
 
 }  // namespace buckle::test

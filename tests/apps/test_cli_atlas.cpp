@@ -21,7 +21,7 @@ using buckle::test::slurp;
 
 namespace {
 
-fs::path work(const std::string& name) { return buckle::test::freshDirectory("cli_atlas", name); }
+fs::path atlasDir(const std::string& name) { return buckle::test::freshDirectory("cli_atlas", name); }
 
 // A 2 x 2 atlas: a few hundred milliseconds.
 const std::string kSmall = "atlas --x a --x-range 0.4 0.6 2 --y L0 --y-range 2.0 2.5 2 -j 1 --quiet";
@@ -29,7 +29,7 @@ const std::string kSmall = "atlas --x a --x-range 0.4 0.6 2 --y L0 --y-range 2.0
 }  // namespace
 
 TEST_CASE("atlas.csv names every column once and summary.json says which are the axes", "[cli][atlas]") {
-  const fs::path dir = work("columns");
+  const fs::path dir = atlasDir("columns");
   REQUIRE(exitCode(kSmall + " --out '" + (dir / "out").string() + "'", dir / "log.txt") == 0);
   std::ifstream csv(dir / "out" / "atlas.csv");
   std::string header;
@@ -52,7 +52,7 @@ TEST_CASE("atlas.csv names every column once and summary.json says which are the
 }
 
 TEST_CASE("buckle atlas --out is checked before computing", "[cli][atlas][output]") {
-  const fs::path dir = work("out");
+  const fs::path dir = atlasDir("out");
   std::ofstream(dir / "notes.txt") << "my notes";
   fs::create_directories(dir / "mine");
   std::ofstream(dir / "mine" / "data.csv") << "1,2";

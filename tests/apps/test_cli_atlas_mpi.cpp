@@ -24,7 +24,7 @@ namespace {
 
 const std::string kBuckleMpi = std::string(BUCKLE_BINARY_DIR) + "/bin/buckle-mpi";
 
-fs::path work(const std::string& name) { return buckle::test::freshDirectory("cli_atlas_mpi", name); }
+fs::path mpiDir(const std::string& name) { return buckle::test::freshDirectory("cli_atlas_mpi", name); }
 
 // `mpirun -np RANKS PROGRAM ARGS` (PROGRAM: buckle-mpi unless given), output into `capture`. CI runs as root in a container:
 // Open MPI then wants its two permissions, --oversubscribe (more ranks than cores),
@@ -56,7 +56,7 @@ int count(const std::string& text, const std::string& what) {
 }  // namespace
 
 TEST_CASE("atlas.csv under mpirun -np 2 and -np 3 is the threaded run's, byte for byte", "[cli][atlas][mpi]") {
-  const fs::path dir = work("same");
+  const fs::path dir = mpiDir("same");
   const int threaded = exitCode(kGrid + " -j 2 --out '" + (dir / "threads").string() + "'", dir / "threads.log");
   const std::string reference = slurp(dir / "threads" / "atlas.csv");
   REQUIRE(count(reference, "\n") == 29);
@@ -79,7 +79,7 @@ TEST_CASE("atlas.csv under mpirun -np 2 and -np 3 is the threaded run's, byte fo
 TEST_CASE("a time limit under mpirun keeps every cell's parameters and marks the rest not computed",
           "[cli][atlas][mpi]") {
   // A limit already passed when the cells start: no rank computes any, rank 0 still writes them.
-  const fs::path dir = work("time_limit");
+  const fs::path dir = mpiDir("time_limit");
   const fs::path log = dir / "log.txt";
   CHECK(mpiExitCode(2, kGrid + " -j 1 --time-limit 1e-9 --out '" + (dir / "atlas").string() + "'", log) == 1);
   INFO(slurp(log));
@@ -98,7 +98,7 @@ TEST_CASE("a time limit under mpirun keeps every cell's parameters and marks the
 }
 
 TEST_CASE("bad input under mpirun: one message, exit 2, nothing written, no rank left waiting", "[cli][atlas][mpi]") {
-  const fs::path dir = work("bad");
+  const fs::path dir = mpiDir("bad");
   const fs::path log = dir / "log.txt";
   CHECK(mpiExitCode(2, "atlas --x a --x-range 0.1 1 0 --out '" + (dir / "a").string() + "'", log) == 2);
   CHECK(count(slurp(log), "--x-range takes FROM TO COUNT") == 1);
@@ -111,7 +111,7 @@ TEST_CASE("bad input under mpirun: one message, exit 2, nothing written, no rank
 
 TEST_CASE("buckle links no MPI: under mpirun with 2 ranks it names buckle-mpi and writes nothing",
           "[cli][atlas][mpi]") {
-  const fs::path dir = work("plain");
+  const fs::path dir = mpiDir("plain");
   const fs::path log = dir / "log.txt";
   CHECK(mpiExitCode(2, kGrid + " --out '" + (dir / "a").string() + "'", log, buckle::test::kBuckle) == 2);
   INFO(slurp(log));
@@ -127,7 +127,7 @@ TEST_CASE("buckle links no MPI: under mpirun with 2 ranks it names buckle-mpi an
 }
 
 TEST_CASE("buckle-mpi has the atlas alone", "[cli][atlas][mpi]") {
-  const fs::path dir = work("help");
+  const fs::path dir = mpiDir("help");
   const std::string cmd = "'" + kBuckleMpi + "' --help > '" + (dir / "help.txt").string() + "' 2>&1";
   CHECK(std::system(cmd.c_str()) == 0);
   const std::string help = slurp(dir / "help.txt");

@@ -21,7 +21,7 @@ struct Run {
 };
 
 // Runs `buckle <args>`; `withStderr` merges stderr into the captured output.
-Run buckle(const std::string& args, bool withStderr = false) {
+Run runBuckle(const std::string& args, bool withStderr = false) {
   const std::string cmd = std::string(BUCKLE_BINARY_DIR) + "/bin/buckle " + args + (withStderr ? " 2>&1" : " 2>/dev/null");
   Run r;
   FILE* pipe = popen(cmd.c_str(), "r");
@@ -35,7 +35,7 @@ Run buckle(const std::string& args, bool withStderr = false) {
 }
 
 nlohmann::json critical(const std::string& args) {
-  const Run r = buckle("critical --json " + args);
+  const Run r = runBuckle("critical --json " + args);
   INFO("buckle critical --json " << args << "\n" << r.out);
   REQUIRE(r.status == 0);
   return nlohmann::json::parse(r.out);
@@ -46,7 +46,7 @@ const double r21 = std::sqrt(21.0);
 }  // namespace
 
 TEST_CASE("buckle --version prints the project version", "[cli]") {
-  const Run r = buckle("--version");
+  const Run r = runBuckle("--version");
   CHECK(r.status == 0);
   CHECK_THAT(r.out, Catch::Contains(BUCKLE_VERSION));
 }
@@ -111,7 +111,7 @@ TEST_CASE("buckle critical: count, free end, many segments, text output", "[cli]
   CHECK_FALSE(u["straight_stable"].get<bool>());
   CHECK(u["critical"][0]["Fx"].get<double>() > 0.0);
   // human-readable output
-  const Run t = buckle("critical");
+  const Run t = runBuckle("critical");
   CHECK(t.status == 0);
   CHECK_THAT(t.out, Catch::Contains("stable") && Catch::Contains("U") && Catch::Contains("eq 17"));
 }
@@ -124,13 +124,13 @@ TEST_CASE("buckle critical: bad arguments exit with 2 and name the argument", "[
                        Bad{"--end bogus", "--end"}, Bad{"--L0 0", "--L0"}, Bad{"--a -0.5", "--a"},
                        Bad{"--count 0", "--count"}, Bad{"--segments three", "--segments"}, Bad{"--k inf", "--k"},
                        Bad{"--bogus 1", "--bogus"}, Bad{"--segments 1000000000", "--segments must be an integer in [1, 5000]"}}) {
-    const Run r = buckle("critical " + b.args, true);
+    const Run r = runBuckle("critical " + b.args, true);
     INFO("buckle critical " << b.args << " → " << r.out);
     CHECK(r.status == 2);
     CHECK_THAT(r.out, Catch::Contains(b.name));
   }
-  CHECK(buckle("").status == 2);  // a subcommand is required
-  CHECK(buckle("critical --help").status == 0);
+  CHECK(runBuckle("").status == 2);  // a subcommand is required
+  CHECK(runBuckle("critical --help").status == 0);
 }
 
 TEST_CASE("buckle critical: the whole double range, or a refusal naming the option", "[cli]") {
@@ -167,7 +167,7 @@ TEST_CASE("buckle critical: the whole double range, or a refusal naming the opti
                        Bad{"--a inf", "--a"}, Bad{"--b -inf", "--b"}, Bad{"--L0 1e999", "--L0"}, Bad{"--k -0", "--k"},
                        Bad{"--segments 99999999999", "--segments"}, Bad{"--segments 1e3", "--segments"},
                        Bad{"--count -1", "--count"}, Bad{"--count nan", "--count"}}) {
-    const Run r = buckle("critical " + b.args, true);
+    const Run r = runBuckle("critical " + b.args, true);
     INFO("buckle critical " << b.args << " → " << r.out);
     CHECK(r.status == 2);
     CHECK_THAT(r.out, Catch::Contains(b.name));
@@ -188,12 +188,12 @@ TEST_CASE("buckle critical says how many critical loads exist and in which units
     CHECK_THAT(free["note"].get<std::string>(), Catch::Contains("has " + std::to_string(n)));
     CHECK_FALSE(critical("--segments " + std::to_string(n) + " --count " + std::to_string(n - 1)).contains("note"));
   }
-  const Run text = buckle("critical --segments 2 --count 3");
+  const Run text = runBuckle("critical --segments 2 --count 3");
   CHECK_THAT(text.out, Catch::Contains("note: --count 3"));
 
   // named units: the first critical load of the SI chain of the README's example is the unit
   // chain's times k b = 40 N, printed with N
-  const Run si = buckle("critical --segments 10 --a 0.01 --b 0.02 --k 2000 --L0 0.045 --length-unit m --force-unit N");
+  const Run si = runBuckle("critical --segments 10 --a 0.01 --b 0.02 --k 2000 --L0 0.045 --length-unit m --force-unit N");
   REQUIRE(si.status == 0);
   CHECK_THAT(si.out, Catch::Contains("k = 2000 N/m"));
   CHECK_THAT(si.out, Catch::Contains("forces N"));
@@ -205,15 +205,15 @@ TEST_CASE("buckle critical says how many critical loads exist and in which units
   CHECK(siJson["critical"][0]["Fx"].get<double>() ==
         Approx(40.0 * unit["critical"][0]["Fx"].get<double>()).epsilon(1e-13));
   // without names the printout says which units the numbers are in, never "units of k b"
-  const Run plain = buckle("critical --b 0.02 --k 2000 --a 0.01 --L0 0.045");
+  const Run plain = runBuckle("critical --b 0.02 --k 2000 --a 0.01 --L0 0.045");
   CHECK_THAT(plain.out, Catch::Contains("k's force unit times b's length unit"));
   for (const char* bad : {"--length-unit m", "--length-unit 'm\"' --force-unit N", "--length-unit m --force-unit '<N>'"}) {
-    const Run r = buckle(std::string("critical ") + bad, true);
+    const Run r = runBuckle(std::string("critical ") + bad, true);
     INFO(bad << " → " << r.out);
     CHECK(r.status == 2);
     CHECK_THAT(r.out, Catch::Contains("unit"));
   }
   // every printed column is explained by --help
-  const Run help = buckle("critical --help");
+  const Run help = runBuckle("critical --help");
   for (const char* word : {"mode shape", "mu", "kappa", "Fx"}) CHECK_THAT(help.out, Catch::Contains(word));
 }

@@ -23,7 +23,7 @@ namespace {
 
 const std::string kScenes = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes";
 
-fs::path work(const std::string& name) { return buckle::test::freshDirectory("cli_regress", name); }
+fs::path regressDir(const std::string& name) { return buckle::test::freshDirectory("cli_regress", name); }
 
 // A small selection: a scene with branch switching and a benchmark problem (fast).
 std::string update(const fs::path& dir, const std::string& extra = "") {
@@ -47,7 +47,7 @@ std::string withoutTiming(const fs::path& p) {
 }  // namespace
 
 TEST_CASE("buckle regress --update writes baselines that then pass", "[cli][regress]") {
-  const fs::path dir = work("fresh");
+  const fs::path dir = regressDir("fresh");
   const fs::path log = dir.parent_path() / "fresh.txt";
   REQUIRE(exitCode(update(dir), log) == 0);
   INFO(slurp(log));
@@ -68,7 +68,7 @@ TEST_CASE("buckle regress --update writes baselines that then pass", "[cli][regr
 }
 
 TEST_CASE("buckle regress --update is deterministic", "[cli][regress]") {
-  const fs::path a = work("a"), b = work("b");
+  const fs::path a = regressDir("a"), b = regressDir("b");
   const fs::path log = a.parent_path() / "det.txt";
   REQUIRE(exitCode(update(a), log) == 0);
   REQUIRE(exitCode(update(b), log) == 0);
@@ -87,7 +87,7 @@ TEST_CASE("buckle regress --update is deterministic", "[cli][regress]") {
 }
 
 TEST_CASE("buckle regress reports a value shifted beyond its tolerance as FAIL, exit 1", "[cli][regress]") {
-  const fs::path dir = work("perturbed");
+  const fs::path dir = regressDir("perturbed");
   const fs::path log = dir.parent_path() / "perturbed.txt";
   REQUIRE(exitCode(update(dir), log) == 0);
   nlohmann::ordered_json doc = nlohmann::ordered_json::parse(slurp(dir / "default.json"));
@@ -130,7 +130,7 @@ TEST_CASE("buckle regress reports a value shifted beyond its tolerance as FAIL, 
 }
 
 TEST_CASE("buckle regress on a malformed baseline exits 2 naming the file and the JSON path", "[cli][regress]") {
-  const fs::path dir = work("malformed");
+  const fs::path dir = regressDir("malformed");
   const fs::path log = dir.parent_path() / "malformed.txt";
   REQUIRE(exitCode(update(dir, "") , log) == 0);
   nlohmann::ordered_json doc = nlohmann::ordered_json::parse(slurp(dir / "default.json"));
@@ -162,7 +162,7 @@ TEST_CASE("buckle regress on a malformed baseline exits 2 naming the file and th
 
 TEST_CASE("a time-limited baseline: stopped on time, what it computed agrees, the rest is not reached",
           "[cli][regress]") {
-  const fs::path dir = work("limited");
+  const fs::path dir = regressDir("limited");
   const fs::path log = dir.parent_path() / "limited.txt";
   // the shipped baseline: long_chain_jumps (its continuation takes 0.35 s in Release here) stopped after 0.05 s
   fs::copy_file(std::string(BUCKLE_SOURCE_DIR) + "/data/regression/long_chain_jumps_time_limited.json",
@@ -206,7 +206,7 @@ TEST_CASE("a time-limited baseline: stopped on time, what it computed agrees, th
 }
 
 TEST_CASE("buckle regress --update finds a gallery one folder down and records its cusp points", "[cli][regress]") {
-  const fs::path dir = work("gallery");
+  const fs::path dir = regressDir("gallery");
   const fs::path log = dir.parent_path() / "gallery.txt";
   REQUIRE(exitCode("regress --update --baselines '" + dir.string() + "' --scenes '" + kScenes +
                        "' --only hard_folds_near_cusp --repetitions 1",

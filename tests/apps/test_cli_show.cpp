@@ -22,7 +22,7 @@ using nlohmann::json;
 
 namespace {
 
-fs::path work() { return buckle::test::scratchDirectory("cli_show"); }
+fs::path showDir() { return buckle::test::scratchDirectory("cli_show"); }
 
 std::string g(double v, const char* format) {
   char buf[48];
@@ -47,12 +47,12 @@ std::vector<std::string> words(const std::string& line) {
 
 /// Runs data/scenes/NAME.json into a fresh directory, then `buckle show` on it: its output.
 std::string runAndShow(const std::string& name, fs::path& out) {
-  out = work() / name;
+  out = showDir() / name;
   fs::remove_all(out);
   const std::string scene = std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/" + name + ".json";
-  REQUIRE(exitCode("run '" + scene + "' --quiet --out '" + out.string() + "'", work() / (name + "_run.txt")) == 0);
-  REQUIRE(exitCode("show '" + out.string() + "'", work() / (name + "_show.txt")) == 0);
-  return slurp(work() / (name + "_show.txt"));
+  REQUIRE(exitCode("run '" + scene + "' --quiet --out '" + out.string() + "'", showDir() / (name + "_run.txt")) == 0);
+  REQUIRE(exitCode("show '" + out.string() + "'", showDir() / (name + "_show.txt")) == 0);
+  return slurp(showDir() / (name + "_show.txt"));
 }
 
 }  // namespace
@@ -171,11 +171,11 @@ TEST_CASE("buckle show prints the branch through each equilibrium when the branc
 }
 
 TEST_CASE("buckle show on something that is not a run's output exits 2", "[cli][show]") {
-  const fs::path dir = work() / "not_output";
+  const fs::path dir = showDir() / "not_output";
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "notes.txt") << "x";
-  const fs::path log = work() / "not_output.txt";
+  const fs::path log = showDir() / "not_output.txt";
   CHECK(exitCode("show '" + dir.string() + "'", log) == 2);
   CHECK(slurp(log).find("buckle show: " + dir.string() + " is not a buckle output") != std::string::npos);
   CHECK(exitCode("show '" + (dir / "notes.txt").string() + "'", log) == 2);
@@ -192,7 +192,7 @@ TEST_CASE("buckle show on something that is not a run's output exits 2", "[cli][
 }
 
 TEST_CASE("buckle show prints a scene's text on one line, without terminal control characters", "[cli][show]") {
-  const fs::path dir = work() / "hostile";
+  const fs::path dir = showDir() / "hostile";
   fs::remove_all(dir);
   fs::create_directories(dir);
   json scene = json::parse(slurp(std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/default.json"));

@@ -30,7 +30,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-fs::path work() { return buckle::test::scratchDirectory("cli_signals"); }
+fs::path signalsDir() { return buckle::test::scratchDirectory("cli_signals"); }
 
 /// A stand-in for gnuplot: writes its pid to $BUCKLE_TEST_MARKER, then sleeps (the signal's window).
 fs::path fakeGnuplot(const fs::path& dir) {
@@ -132,7 +132,7 @@ void requireConsistentOutput(const fs::path& dir, const std::string& signalName)
 TEST_CASE("each stop signal while computing: 128 + signal, partial results, no plots drawn", "[cli][signals]") {
   for (const auto& [sig, name] : {std::pair<int, std::string>{SIGINT, "SIGINT"}, {SIGTERM, "SIGTERM"}, {SIGHUP, "SIGHUP"}}) {
     DYNAMIC_SECTION(name) {
-      const fs::path dir = work() / ("computing_" + name);
+      const fs::path dir = signalsDir() / ("computing_" + name);
       fs::remove_all(dir);
       fs::create_directories(dir);
       const Stopped s = runAndSignal(dir, sceneFile(dir, 100), sig,
@@ -150,7 +150,7 @@ TEST_CASE("each stop signal while computing: 128 + signal, partial results, no p
 TEST_CASE("each stop signal while the plots are drawn: 128 + signal, gnuplot ended, output complete", "[cli][signals]") {
   for (const auto& [sig, name] : {std::pair<int, std::string>{SIGINT, "SIGINT"}, {SIGTERM, "SIGTERM"}, {SIGHUP, "SIGHUP"}}) {
     DYNAMIC_SECTION(name) {
-      const fs::path dir = work() / ("writing_" + name);
+      const fs::path dir = signalsDir() / ("writing_" + name);
       fs::remove_all(dir);
       fs::create_directories(dir);
       const fs::path marker = dir / "gnuplot.pid";
@@ -167,7 +167,7 @@ TEST_CASE("each stop signal while the plots are drawn: 128 + signal, gnuplot end
 }
 
 TEST_CASE("the time limit bounds the plotting: a plot that would take minutes is ended at the limit", "[cli][time]") {
-  const fs::path dir = work() / "plot_time_limit";
+  const fs::path dir = signalsDir() / "plot_time_limit";
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path scene = sceneFile(dir, 3);

@@ -21,7 +21,7 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-fs::path work() { return buckle::test::scratchDirectory("cli_time"); }
+fs::path timeLimitDir() { return buckle::test::scratchDirectory("cli_time"); }
 
 /// The default scene (branch switching, jumps) with 100 segments: far more than a few seconds of
 /// work (its 50-segment version takes about 5 s in Release).
@@ -77,7 +77,7 @@ struct LongRun {
 };
 LongRun runLong(const std::string& name, double timeLimit, const std::string& extra = "") {
   LongRun r;
-  r.dir = work() / name;
+  r.dir = timeLimitDir() / name;
   fs::remove_all(r.dir);
   fs::create_directories(r.dir);
   const fs::path scene = longScene(r.dir, timeLimit);
@@ -128,7 +128,7 @@ TEST_CASE("the command line's time limit overrides the scene's, quiet silences t
 TEST_CASE("SIGINT and SIGTERM stop a long run with partial results and no temporary directory", "[cli][time]") {
   for (const auto& [name, expected] : {std::pair<std::string, int>{"INT", 130}, {"TERM", 143}}) {
     DYNAMIC_SECTION("SIG" << name) {
-      const fs::path dir = work() / ("signal_" + name);
+      const fs::path dir = timeLimitDir() / ("signal_" + name);
       fs::remove_all(dir);
       fs::create_directories(dir);
       const fs::path scene = longScene(dir, 600.0);

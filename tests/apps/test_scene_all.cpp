@@ -17,6 +17,7 @@
 #include "scene/output.h"
 #include "scene/output_target.h"
 #include "temp_dir.h"
+#include "read_output.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -25,13 +26,9 @@ namespace {
 
 fs::path sceneDir() { return fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes"; }
 
-fs::path freshDir(const std::string& name) { return buckle::test::absentPath("scene_all", name); }
+fs::path allDir(const std::string& name) { return buckle::test::absentPath("scene_all", name); }
 
-json readJson(const fs::path& p) {
-  std::ifstream in(p);
-  REQUIRE(in.good());
-  return json::parse(in);
-}
+using buckle::test::readJson;
 
 struct Closed {
   double FxU, FxZ;
@@ -55,7 +52,7 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
 
   for (const fs::path& scene : scenes) {
     DYNAMIC_SECTION(scene.filename().string()) {
-      const fs::path out = freshDir(scene.stem().string());
+      const fs::path out = allDir(scene.stem().string());
       std::ostringstream log, err;
       buckle::scene::RunCommandOptions opt;
       opt.scene = scene.string();
@@ -273,7 +270,7 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
 }
 
 TEST_CASE("the default scene is the paper's chain with both buckled branches", "[scene]") {
-  const fs::path out = freshDir("default_check");
+  const fs::path out = allDir("default_check");
   std::ostringstream log, err;
   buckle::scene::RunCommandOptions opt;
   opt.scene = (sceneDir() / "default.json").string();

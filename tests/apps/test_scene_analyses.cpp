@@ -13,17 +13,14 @@
 #include "scene/runner.h"
 #include "scene/scene.h"
 #include "small_scene.h"
+#include "scene_run.h"
 
 namespace {
 
+using buckle::test::replaceOnce;
+
 using buckle::scene::Analysis;
 using buckle::scene::analyses;
-
-std::string replaceOnce(std::string s, const std::string& from, const std::string& to) {
-  const size_t pos = s.find(from);
-  REQUIRE(pos != std::string::npos);
-  return s.replace(pos, from.size(), to);
-}
 
 std::set<std::string> registryKeys() {
   std::set<std::string> keys;

@@ -33,7 +33,7 @@ using Table = buckle::test::BranchesTable;
 using buckle::test::readBranches;
 
 // Four segments (a, b, k, L0) = (0.5, 1, 1, 2.25), free end; `extra` goes into the top level.
-std::string scene(const std::string& extra, const std::string& path, const std::string& analyses) {
+std::string bodyScene(const std::string& extra, const std::string& path, const std::string& analyses) {
   return R"({"chain": {"segments": 4, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
   "end": {"x": {"load": 0.0}, "y": {"load": 0.0}, "phi": "free"}, )" +
          extra + R"(, "path": )" + path + R"(, "analyses": )" + analyses + R"(, "plots": []})";
@@ -42,7 +42,7 @@ std::string scene(const std::string& extra, const std::string& path, const std::
 const std::string kGravity = R"("gravity": {"value": 0.0, "direction": [0, -1], "mass_per_length": 0.01})";
 const std::string kGravityPath = R"({"parameter": "gravity", "from": 0.0, "to": 3.0})";
 
-void requireBadInput(const std::string& name, const std::string& text, const std::string& path,
+void requireBadBody(const std::string& name, const std::string& text, const std::string& path,
                      const std::string& expected) {
   const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", name, text);
   INFO(o.err);
@@ -76,7 +76,7 @@ double weightImbalance(const Chain& chain, const Eigen::Vector2d& g, const Vecto
 
 TEST_CASE("scene gravity path: a heavy cantilever's angles and frequencies equal the library's independent ones",
           "[scene][body_loads]") {
-  const std::string text = scene(kGravity, kGravityPath, R"({"continuation": true, "frequencies": {"count": 2, "mass_per_length": 0.01}})");
+  const std::string text = bodyScene(kGravity, kGravityPath, R"({"continuation": true, "frequencies": {"count": 2, "mass_per_length": 0.01}})");
   const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "cantilever", text);
   INFO(o.err);
   REQUIRE(o.rc == 0);
@@ -110,7 +110,7 @@ TEST_CASE("scene load history under the weight: the column buckles under its own
   // there; every point it keeps is an equilibrium of E + V at its g (independent Newton,
   // GravityPotential with absolute positions).
   const std::string text =
-      scene(R"("gravity": {"value": 0.0, "direction": [-1, 0], "mass_per_length": 0.01})",
+      bodyScene(R"("gravity": {"value": 0.0, "direction": [-1, 0], "mass_per_length": 0.01})",
             R"({"parameter": "gravity", "from": 0.0, "to": 10.0})", R"({"load_history": {"waypoints": [0.0, 10.0]}})");
   const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "heavy_history", text);
   INFO(o.err);
@@ -136,7 +136,7 @@ TEST_CASE("scene sudden weight: the cantilever released under its full weight at
           "sag", "[scene][body_loads]") {
   // g jumps from 0 to 3 (the gravity path's sudden load): the gradient flow with the weight ends at
   // the one stable equilibrium, the sag of the independent Newton solve on E + V.
-  const std::string text = scene(kGravity, kGravityPath, R"({"sudden_load": {"value": 3.0}})");
+  const std::string text = bodyScene(kGravity, kGravityPath, R"({"sudden_load": {"value": 3.0}})");
   const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "sudden_weight", text);
   INFO(o.err);
   REQUIRE(o.rc == 0);
@@ -160,7 +160,7 @@ TEST_CASE("scene control path under the weight: the free lengths move, every poi
   // The horizontal heavy cantilever with L0 of every segment the path parameter (both springs):
   // its start is the sag under the weight (applied with the payload), and each traced point is an
   // equilibrium of E(q; L0 = λ) + V (GravityPotential, independent of the library's body loads).
-  const std::string text = scene(R"("gravity": {"value": 3.0, "direction": [0, -1], "mass_per_length": 0.01})",
+  const std::string text = bodyScene(R"("gravity": {"value": 3.0, "direction": [0, -1], "mass_per_length": 0.01})",
                                  R"({"parameter": "L0", "from": 2.0, "to": 2.5})", R"({"continuation": true})");
   const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "control_weight", text);
   INFO(o.err);
@@ -219,7 +219,7 @@ TEST_CASE("scene equilibria under the weight: each balances the springs against 
   // Every equilibrium of the heavy horizontal cantilever at g = 3, by deflation with the body loads:
   // each found one balances ∂E/∂q + ∂V/∂q = 0 and reports Π = E + V (V from GravityPotential, with
   // absolute positions); the one of lowest Π is stable and is the independent static sag.
-  const std::string text = scene(kGravity, kGravityPath, R"({"equilibria": {"at": 3.0, "starts": 16, "smooth_starts": 16}})");
+  const std::string text = bodyScene(kGravity, kGravityPath, R"({"equilibria": {"at": 3.0, "starts": 16, "smooth_starts": 16}})");
   const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "equilibria_weight", text);
   INFO(o.err);
   REQUIRE(o.rc == 0);
@@ -292,7 +292,7 @@ TEST_CASE("scene energy curves under the weight: E + V along the configuration c
 TEST_CASE("scene point loads: a force at the last joint growing along an Fx path: the traced end point balances the "
           "joint torques of the end load and that force, summed here from the joint positions", "[scene][body_loads]") {
   // Fy = 0.02 + 0.1·Fx at joint 4 along Fx from 0 to −0.3
-  const std::string text = scene(R"("point_loads": [{"joint": 4, "Fy": 0.02, "rate": {"Fy": 0.1}}])",
+  const std::string text = bodyScene(R"("point_loads": [{"joint": 4, "Fy": 0.02, "rate": {"Fy": 0.1}}])",
                                  R"({"parameter": "Fx", "from": 0.0, "to": -0.3})", R"({"continuation": true})");
   const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_body", "point_load", text);
   INFO(o.err);
@@ -317,26 +317,26 @@ TEST_CASE("scene point loads: a force at the last joint growing along an Fx path
 
 TEST_CASE("scene body loads: bad input names the JSON path, exit 2, nothing written", "[scene][body_loads][errors]") {
   const std::string cont = R"({"continuation": true})";
-  requireBadInput("no_value", scene(R"("gravity": {"mass_per_length": 0.1})", kGravityPath, cont), "/gravity/value",
+  requireBadBody("no_value", bodyScene(R"("gravity": {"mass_per_length": 0.1})", kGravityPath, cont), "/gravity/value",
                   "missing");
-  requireBadInput("negative", scene(R"("gravity": {"value": -1, "mass_per_length": 0.1})", kGravityPath, cont),
+  requireBadBody("negative", bodyScene(R"("gravity": {"value": -1, "mass_per_length": 0.1})", kGravityPath, cont),
                   "/gravity/value", ">= 0");
-  requireBadInput("zero_direction",
-                  scene(R"("gravity": {"value": 0, "direction": [0, 0], "mass_per_length": 0.1})", kGravityPath, cont),
+  requireBadBody("zero_direction",
+                  bodyScene(R"("gravity": {"value": 0, "direction": [0, 0], "mass_per_length": 0.1})", kGravityPath, cont),
                   "/gravity/direction", "not zero");
-  requireBadInput("no_mass", scene(R"("gravity": {"value": 0})", kGravityPath, cont), "/gravity/mass_per_length",
+  requireBadBody("no_mass", bodyScene(R"("gravity": {"value": 0})", kGravityPath, cont), "/gravity/mass_per_length",
                   "needs masses");
-  requireBadInput("path_without_gravity", scene(R"("description": "x")", kGravityPath, cont), "/path/parameter",
+  requireBadBody("path_without_gravity", bodyScene(R"("description": "x")", kGravityPath, cont), "/path/parameter",
                   "needs /gravity");
-  requireBadInput("range", scene(kGravity, R"({"parameter": "gravity", "from": 1.0, "to": 3.0})", cont), "/path/from",
+  requireBadBody("range", bodyScene(kGravity, R"({"parameter": "gravity", "from": 1.0, "to": 3.0})", cont), "/path/from",
                   "contains the start value gravity = 0");
-  requireBadInput("joint", scene(R"("point_loads": [{"joint": 5, "Fy": 1}])", kGravityPath, cont),
+  requireBadBody("joint", bodyScene(R"("point_loads": [{"joint": 5, "Fy": 1}])", kGravityPath, cont),
                   "/point_loads/0/joint", "");
-  requireBadInput("critical_forces", scene(kGravity, kGravityPath, R"({"continuation": true, "critical_forces": true})"),
+  requireBadBody("critical_forces", bodyScene(kGravity, kGravityPath, R"({"continuation": true, "critical_forces": true})"),
                   "/analyses/critical_forces", "do not include the weight");
-  requireBadInput("mass_model",
-                  scene(kGravity, kGravityPath, R"({"continuation": true, "frequencies": {"mass_per_length": 0.5}})"),
+  requireBadBody("mass_model",
+                  bodyScene(kGravity, kGravityPath, R"({"continuation": true, "frequencies": {"mass_per_length": 0.5}})"),
                   "/analyses/frequencies/mass_per_length", "one mass model");
-  requireBadInput("mass_unit", R"({"units": {"length": "m", "force": "N"},)" + scene(kGravity, kGravityPath, cont).substr(1),
+  requireBadBody("mass_unit", R"({"units": {"length": "m", "force": "N"},)" + bodyScene(kGravity, kGravityPath, cont).substr(1),
                   "/units/mass", "mass unit");
 }

@@ -24,7 +24,7 @@ using buckle::scene::stiffnessColumnValue;
 
 namespace {
 
-const double kNaN = std::numeric_limits<double>::quiet_NaN();
+using buckle::scene::kNaN;
 const double kInf = std::numeric_limits<double>::infinity();
 
 std::map<std::string, double> columns(const Eigen::Matrix2d& K, const Eigen::Matrix2d& C) {

@@ -15,6 +15,7 @@
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "scene_run.h"
+#include "read_output.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -44,10 +45,7 @@ std::string actuationScene(double L, double k, const std::string& path, const st
 const std::string kPath = R"({"parameter": "dL0", "from": -3.0, "to": 3.0})";
 const std::string kContinuation = R"({"continuation": {}})";
 
-json readJson(const fs::path& file) {
-  std::ifstream in(file);
-  return json::parse(in);
-}
+using buckle::test::readJson;
 
 std::vector<double> foldParameters(const fs::path& out) {
   std::vector<double> lp;

@@ -15,17 +15,14 @@
 #include "buckle/mechanics/linear_buckling.h"
 #include "buckle/mechanics/reaction_path.h"
 #include "scene_run.h"
+#include "read_output.h"
 
 using nlohmann::json;
 namespace mech = buckle::mechanics;
 
 namespace {
 
-json readJson(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  REQUIRE(in.good());
-  return json::parse(in);
-}
+using buckle::test::readJson;
 
 std::string sceneText(const std::string& pathExtra, const std::string& continuation) {
   return R"({"units": {"length": "m", "force": "N"},

@@ -12,13 +12,14 @@
 
 #include "buckle/mechanics/all_equilibria.h"
 #include "scene_run.h"
+#include "read_output.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
 
-std::string scene(const std::string& equilibria, bool withPath = true) {
+std::string equilibriaScene(const std::string& equilibria, bool withPath = true) {
   return std::string(R"({"units": "nondimensional",
     "chain": {"segments": 4, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
     "end": {"x": {"load": 0.0}, "y": {"held": 0.0}, "phi": "free"},)") +
@@ -26,10 +27,7 @@ std::string scene(const std::string& equilibria, bool withPath = true) {
          R"("analyses": {"equilibria": )" + equilibria + "}}";
 }
 
-json readJson(const fs::path& file) {
-  std::ifstream in(file);
-  return json::parse(in);
-}
+using buckle::test::readJson;
 
 int csvRows(const fs::path& file) {
   std::ifstream in(file);
@@ -56,7 +54,7 @@ buckle::mechanics::AllEquilibria libraryEquilibria(double Fx) {
 TEST_CASE("scene equilibria: the list at `at` is the library's, in special_points.json and the CSV",
           "[scene][equilibria]") {
   const buckle::test::SceneOutcome o =
-      buckle::test::runSceneText("scene_equilibria", "at", scene(R"({"starts": 24, "seed": 3, "at": -0.9})"));
+      buckle::test::runSceneText("scene_equilibria", "at", equilibriaScene(R"({"starts": 24, "seed": 3, "at": -0.9})"));
   INFO(o.err);
   REQUIRE(o.rc == 0);
   const json sp = readJson(o.out / "special_points.json");
@@ -87,7 +85,7 @@ TEST_CASE("scene equilibria: a list `at`, one complete set per value, each the l
           "[scene][equilibria]") {
   const std::vector<double> at{-0.2, -0.9, -1.1};
   const buckle::test::SceneOutcome o = buckle::test::runSceneText(
-      "scene_equilibria", "at_list", scene(R"({"starts": 24, "seed": 3, "at": [-0.2, -0.9, -1.1]})"));
+      "scene_equilibria", "at_list", equilibriaScene(R"({"starts": 24, "seed": 3, "at": [-0.2, -0.9, -1.1]})"));
   INFO(o.err);
   REQUIRE(o.rc == 0);
   const json sp = readJson(o.out / "special_points.json");
@@ -154,13 +152,13 @@ TEST_CASE("scene equilibria: bad options name the JSON path, exit 2, nothing wri
                                        {"at_list_type", R"({"at": [-0.5, "x"]})", "/analyses/equilibria/at/1", true},
                                        {"at_path", R"({"at": -0.5})", "/path", false}}) {
     INFO(b.name);
-    const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_equilibria", b.name, scene(b.value, b.withPath));
+    const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_equilibria", b.name, equilibriaScene(b.value, b.withPath));
     CHECK(o.rc == 2);
     CHECK(o.err.find(b.path) != std::string::npos);
     CHECK(!fs::exists(o.out));
   }
   // no path needed without `at`: the end condition as given
-  const buckle::test::SceneOutcome ok = buckle::test::runSceneText("scene_equilibria", "no_path", scene("true", false));
+  const buckle::test::SceneOutcome ok = buckle::test::runSceneText("scene_equilibria", "no_path", equilibriaScene("true", false));
   INFO(ok.err);
   CHECK(ok.rc == 0);
 }

@@ -24,15 +24,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using buckle::test::replaceOnce;
+
 const std::string kGood = buckle::test::smallScene(0);
 
-fs::path workDir() { return buckle::test::scratchDirectory("scene_errors"); }
-
-std::string replaceOnce(std::string s, const std::string& from, const std::string& to) {
-  const size_t pos = s.find(from);
-  REQUIRE(pos != std::string::npos);
-  return s.replace(pos, from.size(), to);
-}
+fs::path errorsDir() { return buckle::test::scratchDirectory("scene_errors"); }
 
 using Outcome = buckle::test::SceneOutcome;
 
@@ -195,11 +191,11 @@ TEST_CASE("extreme numbers the model can compute are accepted", "[scene][errors]
 }
 
 TEST_CASE("a directory as the scene file says so", "[scene][errors]") {
-  const fs::path dir = workDir() / "scene_dir";
+  const fs::path dir = errorsDir() / "scene_dir";
   fs::create_directories(dir);
   buckle::scene::RunCommandOptions opt;
   opt.scene = dir.string();
-  opt.out = (workDir() / "dir_out").string();
+  opt.out = (errorsDir() / "dir_out").string();
   std::ostringstream log, err;
   CHECK(buckle::scene::runSceneCommand(opt, log, err) == 2);
   CHECK(err.str().find(dir.string() + ": (document): is a directory") != std::string::npos);
@@ -233,8 +229,8 @@ TEST_CASE("inconsistent scenes", "[scene][errors]") {
 
 TEST_CASE("missing file", "[scene][errors]") {
   buckle::scene::RunCommandOptions opt;
-  opt.scene = (workDir() / "does_not_exist.json").string();
-  opt.out = (workDir() / "missing_out").string();
+  opt.scene = (errorsDir() / "does_not_exist.json").string();
+  opt.out = (errorsDir() / "missing_out").string();
   std::ostringstream log, err;
   CHECK(buckle::scene::runSceneCommand(opt, log, err) == 2);
   CHECK(err.str().find("cannot open") != std::string::npos);

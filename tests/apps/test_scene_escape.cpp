@@ -16,12 +16,15 @@
 #include "scene/output.h"
 #include "rfc4180.h"
 #include "temp_dir.h"
+#include "read_output.h"
 
 namespace fs = std::filesystem;
 namespace escape = buckle::scene::escape;
 using namespace std::string_literals;
 
 namespace {
+
+using buckle::test::readText;
 
 const std::string kFffd = "\xEF\xBF\xBD";
 
@@ -52,12 +55,7 @@ std::vector<std::string> hostileStrings() {
   return s;
 }
 
-fs::path work() { return buckle::test::scratchDirectory("escape"); }
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+fs::path escapeDir() { return buckle::test::scratchDirectory("escape"); }
 
 /// Runs gnuplot on `script` in `dir`; true when it exited 0.
 bool gnuplot(const std::string& program, const fs::path& dir, const std::string& script) {
@@ -101,7 +99,7 @@ TEST_CASE("displayText: line breaks as LF, other control characters as U+FFFD", 
 
 TEST_CASE("gnuplotString: gnuplot reads back the display text and runs nothing", "[escape]") {
   const std::string program = buckle::scene::findGnuplot();
-  const fs::path dir = work() / "gnuplot";
+  const fs::path dir = escapeDir() / "gnuplot";
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::vector<std::string> strings = hostileStrings();
@@ -124,7 +122,7 @@ TEST_CASE("gnuplotString: gnuplot reads back the display text and runs nothing",
   REQUIRE(gnuplot(program, dir, script));
   std::string expected;
   for (const std::string& s : strings) expected += escape::displayText(s) + "\n<end>\n";
-  CHECK(slurp(dir / "printed.txt") == expected);
+  CHECK(readText(dir / "printed.txt") == expected);
   CHECK_FALSE(fs::exists(dir / "PWNED"));
 }
 
@@ -141,7 +139,7 @@ TEST_CASE("commentText is one line without control characters", "[escape]") {
 
 TEST_CASE("datField: gnuplot reads one label column back", "[escape]") {
   const std::string program = buckle::scene::findGnuplot();
-  const fs::path dir = work() / "dat";
+  const fs::path dir = escapeDir() / "dat";
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::vector<std::string> strings = hostileStrings();

@@ -31,7 +31,7 @@ using buckle::test::readBranches;
 
 // A chain of `segments` (a, b, k, L0) = (0.5, 1, 1, 2.25)·(L, L, K, L), the end held in y (or
 // free) and pushed along x to −1.2·K·L, frequencies of rods of mass per length rho.
-std::string scene(int segments, double L, double K, double rho, bool heldY, const std::string& units = "",
+std::string frequencyScene(int segments, double L, double K, double rho, bool heldY, const std::string& units = "",
                   int count = 3) {
   std::ostringstream s;
   s.precision(17);
@@ -56,7 +56,7 @@ double relativeError(double x, double reference) { return std::abs(x - reference
 }  // namespace
 
 TEST_CASE("frequencies: one free segment at rest oscillates at sqrt(K_q / (rho l^3 / 3))", "[scene]") {
-  const Table t = runTable("one", scene(1, 1.0, 1.0, 2.0, false, "", 2));
+  const Table t = runTable("one", frequencyScene(1, 1.0, 1.0, 2.0, false, "", 2));
   const Chain chain = Chain::uniform(1, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   Vector kq(1);
   jointStiffness(chain, Vector::Zero(1), kq);
@@ -67,10 +67,10 @@ TEST_CASE("frequencies: one free segment at rest oscillates at sqrt(K_q / (rho l
 }
 
 TEST_CASE("frequencies: masses x4 halve every omega, the chain in mm gives omega times sqrt(1e-3 s)", "[scene]") {
-  const Table si = runTable("si", scene(4, 0.02, 2000.0, 0.5, true, R"({"length": "m", "force": "N", "mass": "kg"})"));
-  const Table heavy = runTable("heavy", scene(4, 0.02, 2000.0, 2.0, true, R"({"length": "m", "force": "N", "mass": "kg"})"));
+  const Table si = runTable("si", frequencyScene(4, 0.02, 2000.0, 0.5, true, R"({"length": "m", "force": "N", "mass": "kg"})"));
+  const Table heavy = runTable("heavy", frequencyScene(4, 0.02, 2000.0, 2.0, true, R"({"length": "m", "force": "N", "mass": "kg"})"));
   // mm: lengths ×1e3, k in N/mm ×1e-3, ρ in kg/mm ×1e-3; time unit √(kg·mm/N) = √1e-3 s
-  const Table mm = runTable("mm", scene(4, 20.0, 2.0, 5e-4, true, R"({"length": "mm", "force": "N", "mass": "kg"})"));
+  const Table mm = runTable("mm", frequencyScene(4, 20.0, 2.0, 5e-4, true, R"({"length": "mm", "force": "N", "mass": "kg"})"));
   REQUIRE(si.size() == heavy.size());
   REQUIRE(si.size() == mm.size());
   int unstable = 0;
@@ -154,7 +154,7 @@ TEST_CASE("frequencies: refused with the key, the path and the accepted range", 
   struct Bad {
     std::string text, path, words;
   };
-  const std::string base = scene(3, 1.0, 1.0, 1.0, true);
+  const std::string base = frequencyScene(3, 1.0, 1.0, 1.0, true);
   const auto with = [&](const std::string& from, const std::string& to) {
     std::string s = base;
     const size_t at = s.find(from);
@@ -162,7 +162,7 @@ TEST_CASE("frequencies: refused with the key, the path and the accepted range", 
     return s.replace(at, from.size(), to);
   };
   const std::vector<Bad> bad = {
-      {scene(3, 0.02, 2000.0, 0.5, true, R"({"length": "m", "force": "N"})"), "/units/mass", "rad/s"},
+      {frequencyScene(3, 0.02, 2000.0, 0.5, true, R"({"length": "m", "force": "N"})"), "/units/mass", "rad/s"},
       {with("\"continuation\": true, ", ""), "/analyses", "continuation or load_history"},
       {with("\"count\": 3", "\"count\": 0"), "/analyses/frequencies/count", ""},
       {with("\"count\": 3", "\"count\": 51"), "/analyses/frequencies/count", ""},

@@ -15,16 +15,14 @@
 #include "rfc4180.h"
 #include "scene_run.h"
 #include "small_scene.h"
+#include "read_output.h"
 
 namespace fs = std::filesystem;
 namespace escape = buckle::scene::escape;
 
 namespace {
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+using buckle::test::readText;
 
 const std::string kTitle = "x\"\nsystem \"touch PWNED\"\n#";
 const std::string kLabel1 = "a'b\"c\\d`touch PWNED`$(touch PWNED)\r\n# system 'touch PWNED'";
@@ -61,7 +59,7 @@ TEST_CASE("hostile text in a scene is written, never executed, and reads back fr
     CHECK(summary["plots"]["files"].size() == 4);  // both plots drawn, PNG and SVG
     CHECK_FALSE(summary["plots"].contains("failures"));
     // the title reached gnuplot as text: its line is in the SVG (XML-escaped by gnuplot)
-    const std::string svg = slurp(o.out / "plots" / "inj.svg");
+    const std::string svg = readText(o.out / "plots" / "inj.svg");
     CHECK((svg.find("system &quot;touch PWNED&quot;") != std::string::npos ||
            svg.find("system \"touch PWNED\"") != std::string::npos));
   } else {
@@ -77,7 +75,7 @@ TEST_CASE("hostile text in a scene is written, never executed, and reads back fr
   for (const auto& e : fs::directory_iterator(o.out)) {
     if (e.path().extension() != ".csv") continue;
     INFO(e.path());
-    const auto rows = buckle::test::readCsv(slurp(e.path()));
+    const auto rows = buckle::test::readCsv(readText(e.path()));
     REQUIRE(rows.size() > 1);
     for (const auto& row : rows) CHECK(row.size() == rows[0].size());
   }
@@ -85,14 +83,14 @@ TEST_CASE("hostile text in a scene is written, never executed, and reads back fr
   // gnuplot data files: the label stays inside its comment line
   for (const auto& e : fs::directory_iterator(o.out / "plots")) {
     if (e.path().extension() != ".dat") continue;
-    const std::string text = slurp(e.path());
+    const std::string text = readText(e.path());
     CHECK(text.find("\n# system") == std::string::npos);  // the label's second line stays in its comment
     CHECK(text.find('\r') == std::string::npos);
     CHECK(text.find('\0') == std::string::npos);
   }
 
   // report.html: one data element, whose text is the JSON with the labels intact
-  const std::string html = slurp(o.out / "report.html");
+  const std::string html = readText(o.out / "report.html");
   const std::string open = "<script type=\"application/json\" id=\"buckle-data\">";
   const size_t begin = html.find(open), end = html.find("</script>", begin);
   REQUIRE(begin != std::string::npos);

@@ -14,6 +14,7 @@
 
 #include "scene/json_reader.h"
 #include "temp_dir.h"
+#include "sanitized_build.h"
 
 namespace fs = std::filesystem;
 using buckle::scene::JsonInputError;
@@ -23,7 +24,7 @@ using buckle::scene::readInputFile;
 
 namespace {
 
-fs::path workDir() { return buckle::test::scratchDirectory("json_reader"); }
+fs::path readerDir() { return buckle::test::scratchDirectory("json_reader"); }
 
 // An array of n small objects, the shape that took O(n²) with nlohmann's callback parser.
 std::string arrayOfObjects(int n) {
@@ -60,17 +61,7 @@ JsonInputError errorOf(const std::string& text) {
   return JsonInputError("", "", "");
 }
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
+using buckle::test::kSanitizedBuild;
 
 }  // namespace
 
@@ -92,7 +83,7 @@ TEST_CASE("an array of 200 000 objects parses in linear time", "[scene][json]") 
   INFO("50 000 objects: " << tSmall << " s, 200 000: " << tLarge << " s (thread CPU time)");
   CHECK(tLarge / tSmall < 8.0);
   // the absolute target of issue 11 (Release: about 0.1 s), scaled for the sanitizers' slowdown
-  CHECK(tLarge < (kSanitized ? 10.0 : 1.0));
+  CHECK(tLarge < (kSanitizedBuild ? 10.0 : 1.0));
 }
 
 TEST_CASE("duplicate keys are rejected at any depth, naming the duplicate's path", "[scene][json]") {
@@ -132,7 +123,7 @@ TEST_CASE("nesting deeper than the limit is refused", "[scene][json]") {
 }
 
 TEST_CASE("a directory, an unreadable path and an oversized file are named as such", "[scene][json]") {
-  const fs::path dir = workDir() / "a_directory.json";
+  const fs::path dir = readerDir() / "a_directory.json";
   fs::create_directories(dir);
   try {
     readInputFile(dir.string());
@@ -141,7 +132,7 @@ TEST_CASE("a directory, an unreadable path and an oversized file are named as su
     CHECK(e.file() == dir.string());
     CHECK_THAT(e.message(), Catch::Contains("is a directory"));
   }
-  const fs::path file = workDir() / "scene.json";
+  const fs::path file = readerDir() / "scene.json";
   std::ofstream(file) << "{}";
   try {
     readInputFile((file / "x.json").string());  // a path through a regular file
@@ -150,7 +141,7 @@ TEST_CASE("a directory, an unreadable path and an oversized file are named as su
     CHECK_THAT(e.message(), Catch::Contains("cannot open the file (Not a directory)"));
   }
   if (::geteuid() != 0) {  // root reads everything
-    const fs::path locked = workDir() / "locked.json";
+    const fs::path locked = readerDir() / "locked.json";
     std::ofstream(locked) << "{}";
     ::chmod(locked.c_str(), 0);
     try {
@@ -161,7 +152,7 @@ TEST_CASE("a directory, an unreadable path and an oversized file are named as su
     }
   }
   // one byte over the limit (a sparse file: no disk space used)
-  const fs::path big = workDir() / "big.json";
+  const fs::path big = readerDir() / "big.json";
   std::ofstream(big) << "{}";
   fs::resize_file(big, buckle::scene::kMaxInputBytes + 1);
   try {
@@ -177,5 +168,5 @@ TEST_CASE("a directory, an unreadable path and an oversized file are named as su
   } catch (const JsonInputError& e) {
     CHECK_THAT(e.message(), Catch::Contains("larger than the limit"));
   }
-  fs::remove_all(workDir());
+  fs::remove_all(readerDir());
 }

@@ -30,7 +30,7 @@ using buckle::test::stagingLeftovers;
 
 namespace {
 
-fs::path freshDir(const std::string& name) { return buckle::test::freshDirectory("output", name); }
+fs::path outputDir(const std::string& name) { return buckle::test::freshDirectory("output", name); }
 
 /// Sets the umask for the test's lifetime.
 struct Umask {
@@ -46,7 +46,7 @@ struct Umask {
 TEST_CASE("the staging directory and its files follow the umask", "[scene][output]") {
   for (const mode_t mask : {mode_t(022), mode_t(077), mode_t(002), mode_t(027)}) {
     INFO("umask 0" << std::oct << mask);
-    const fs::path dir = freshDir("umask");
+    const fs::path dir = outputDir("umask");
     const Umask umask(mask);
     {
       StagingDirectory staging((dir / "out").string());
@@ -63,7 +63,7 @@ TEST_CASE("the staging directory and its files follow the umask", "[scene][outpu
 }
 
 TEST_CASE("a staging directory that is not committed leaves nothing behind", "[scene][output]") {
-  const fs::path dir = freshDir("abandoned");
+  const fs::path dir = outputDir("abandoned");
   std::ofstream(dir / "keep.txt") << "keep";
   SECTION("destroyed normally") {
     StagingDirectory staging((dir / "out").string());
@@ -84,7 +84,7 @@ TEST_CASE("a staging directory that is not committed leaves nothing behind", "[s
 }
 
 TEST_CASE("commit replaces a previous output as a whole and only then", "[scene][output]") {
-  const fs::path dir = freshDir("replace");
+  const fs::path dir = outputDir("replace");
   fs::create_directories(dir / "out" / "plots");
   std::ofstream(dir / "out" / "summary.json") << "old";
   std::ofstream(dir / "out" / "plots" / "old.png") << "old";
@@ -103,7 +103,7 @@ TEST_CASE("commit replaces a previous output as a whole and only then", "[scene]
 }
 
 TEST_CASE("the staging directory's parents are created as needed", "[scene][output]") {
-  const fs::path dir = freshDir("parents");
+  const fs::path dir = outputDir("parents");
   {
     StagingDirectory staging((dir / "a" / "b" / "out").string());
     CHECK(fs::path(staging.path()).parent_path() == dir / "a" / "b");
@@ -120,7 +120,7 @@ extern "C" void recordSignal(int sig) { gDelivered = sig; }
 }  // namespace
 
 TEST_CASE("a signal while the output is staged is delivered once the staging directory is gone", "[scene][output]") {
-  const fs::path dir = freshDir("signal");
+  const fs::path dir = outputDir("signal");
   struct sigaction record {}, previous {};
   record.sa_handler = recordSignal;
   sigemptyset(&record.sa_mask);
@@ -142,7 +142,7 @@ TEST_CASE("a signal while the output is staged is delivered once the staging dir
 
 TEST_CASE("a long chain's joint angles go to joint_angles.npy, rows as in branches.csv", "[scene][output]") {
   // 20 segments, past the first branch points with switching: straight and bent rows
-  const fs::path dir = freshDir("npy");
+  const fs::path dir = outputDir("npy");
   fs::create_directories(dir);
   std::ofstream(dir / "long.json") << R"({
   "chain": {"segments": 20, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},

@@ -25,6 +25,7 @@
 #include "buckle/mechanics/chain.h"
 #include "scene/command.h"
 #include "temp_dir.h"
+#include "read_output.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -32,16 +33,19 @@ using namespace buckle::mechanics;
 
 namespace {
 
+using buckle::test::readJson;
+using buckle::test::readText;
+
 fs::path scenePath(const std::string& name) { return fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes" / name; }
 
-fs::path freshDir(const std::string& name) { return buckle::test::absentPath("scene_plot", name); }
+fs::path plotDir(const std::string& name) { return buckle::test::absentPath("scene_plot", name); }
 
 struct Run {
   int rc;
   std::string log, err;
 };
 
-Run run(const fs::path& scene, const fs::path& out) {
+Run runPlotScene(const fs::path& scene, const fs::path& out) {
   std::ostringstream log, err;
   buckle::scene::RunCommandOptions opt;
   opt.scene = scene.string();
@@ -49,16 +53,6 @@ Run run(const fs::path& scene, const fs::path& out) {
   const int rc = buckle::scene::runSceneCommand(opt, log, err);
   return {rc, log.str(), err.str()};
 }
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  REQUIRE(in.good());
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-json readJson(const fs::path& p) { return json::parse(slurp(p)); }
 
 /// The blocks of a BlockFile data file (gnuplot `index`), each a list of rows of numbers; "#"
 /// comment lines of a block kept apart.
@@ -69,7 +63,7 @@ struct Block {
 
 std::vector<Block> readBlocks(const fs::path& p) {
   std::vector<Block> blocks;
-  std::istringstream in(slurp(p));
+  std::istringstream in(readText(p));
   std::string line;
   while (std::getline(in, line)) {
     if (line.rfind("# block ", 0) == 0) {
@@ -196,13 +190,13 @@ struct PixelFrame {
   bool logY = false;  ///< `set logscale y`: the stiffness over decades (y0, y1 then their logarithms)
   static constexpr double W = 1000, H = 700;
   explicit PixelFrame(const fs::path& plots, const std::string& stem) {
-    const std::string body = slurp(plots / (stem + "_body.gp"));
+    const std::string body = readText(plots / (stem + "_body.gp"));
     l = setting(body, "lmargin"), r = setting(body, "rmargin"), b = setting(body, "bmargin"), t = setting(body, "tmargin");
     std::tie(x0, x1) = range(body, "x");
     std::tie(y0, y1) = range(body, "y");
     logY = body.find("set logscale y") != std::string::npos;
     if (logY) y0 = std::log10(y0), y1 = std::log10(y1);
-    CHECK(slurp(plots / (stem + ".gp")).find("size 1000,700") != std::string::npos);
+    CHECK(readText(plots / (stem + ".gp")).find("size 1000,700") != std::string::npos);
   }
   std::pair<double, double> px(double x, double y) const {
     const double v = logY ? std::log10(y) : y;
@@ -274,9 +268,9 @@ struct Csv {
   }
 };
 
-Csv readCsv(const fs::path& p) {
+Csv readBranchesCsv(const fs::path& p) {
   Csv csv;
-  std::istringstream in(slurp(p));
+  std::istringstream in(readText(p));
   std::string line, tok;
   std::getline(in, line);
   std::istringstream hs(line);
@@ -304,8 +298,8 @@ const char* kTwoCases = R"({
 
 /// Runs data/scenes/SCENE.json into a fresh directory NAME, which it returns; the run must succeed.
 fs::path runShipped(const std::string& scene, const std::string& name) {
-  const fs::path out = freshDir(name);
-  const Run r = run(scenePath(scene + ".json"), out);
+  const fs::path out = plotDir(name);
+  const Run r = runPlotScene(scenePath(scene + ".json"), out);
   INFO(r.err);
   REQUIRE(r.rc == 0);
   return out;
@@ -315,17 +309,17 @@ fs::path runShipped(const std::string& scene, const std::string& name) {
 Run runTwoCases(const fs::path& dir) {
   const fs::path scene = dir.string() + ".json";
   std::ofstream(scene) << kTwoCases;
-  return run(scene, dir / "out");
+  return runPlotScene(scene, dir / "out");
 }
 
 }  // namespace
 
 TEST_CASE("multi-case bifurcation plot: one colour and key entry per case, stability in the key", "[scene][plot]") {
-  const fs::path dir = freshDir("two_cases"), out = dir / "out";
+  const fs::path dir = plotDir("two_cases"), out = dir / "out";
   const Run r = runTwoCases(dir);
   INFO(r.err);
   REQUIRE(r.rc == 0);
-  const std::string body = slurp(out / "plots" / "two_body.gp");
+  const std::string body = readText(out / "plots" / "two_body.gp");
   const std::vector<std::string> clauses = plotClauses(body);
   const std::vector<Block> curves = readBlocks(out / "plots" / "two.dat");
   // curves: one colour per case (its stable and unstable parts alike), distinct between cases,
@@ -402,13 +396,13 @@ TEST_CASE("special-point labels do not overlap one another, a marker or the plot
       CHECK(plots >= 2);
       if (name == "hysteresis") {
         // the fold's branch point and the jump released there share one label
-        const std::string labels = slurp(out / "plots" / "hysteresis_q1_labels.dat");
+        const std::string labels = readText(out / "plots" / "hysteresis_q1_labels.dat");
         CHECK(labels.find(", JUMP\"") != std::string::npos);
       }
       if (name == "fig9_fig10") {
         // Kxx falls by decades into the quasi-buckling minimum and stays positive: a log axis,
         // whose pixel positions the labels above were checked in
-        const Csv csv = readCsv(out / "branches.csv");
+        const Csv csv = readBranchesCsv(out / "branches.csv");
         double lo = INFINITY, hi = 0.0;
         for (const auto& row : csv.rows)
           if (row[csv.col("case")] <= 2.0 && std::isfinite(row[csv.col("Kxx")]))
@@ -423,7 +417,7 @@ TEST_CASE("special-point labels do not overlap one another, a marker or the plot
 
 TEST_CASE("stiffness plots mark KMIN at its located stiffness and joint limits at the traced one", "[scene][plot]") {
   const fs::path out = runShipped("fig9_fig10", "fig9_fig10_kmin");
-  const Csv csv = readCsv(out / "branches.csv");
+  const Csv csv = readBranchesCsv(out / "branches.csv");
   const json sp = readJson(out / "special_points.json");
   const std::vector<Block> special = readBlocks(out / "plots" / "fig10a_Kxx_special.dat");
   std::map<std::string, int> marked;
@@ -480,7 +474,7 @@ TEST_CASE("stiffness plots mark KMIN at its located stiffness and joint limits a
 }
 
 TEST_CASE("a shape requested where no stable point was traced is reported, not moved", "[scene][plot]") {
-  const fs::path dir = freshDir("shape_outside"), out = dir / "out";
+  const fs::path dir = plotDir("shape_outside"), out = dir / "out";
   const Run r = runTwoCases(dir);
   REQUIRE(r.rc == 0);  // a plot note, not a failed computation
   const json summary = readJson(out / "summary.json");
@@ -495,7 +489,7 @@ TEST_CASE("a shape requested where no stable point was traced is reported, not m
   // the panel at -2.4 has no chain in it; the one at -0.5 has the three joints
   CHECK(readBlocks(out / "plots" / "shapes_0_1_jnt.dat")[0].rows.empty());
   CHECK(readBlocks(out / "plots" / "shapes_0_0_jnt.dat")[0].rows.size() == 3);
-  const std::string body = slurp(out / "plots" / "shapes_body.gp");
+  const std::string body = readText(out / "plots" / "shapes_body.gp");
   CHECK(body.find("Fx = -2.4: not drawn") != std::string::npos);
   fs::remove_all(dir.parent_path());
 }
@@ -548,7 +542,7 @@ TEST_CASE("sudden-load plot: energies with a constant sum, rest shape beside the
     CHECK(last[1] + L * std::sin(phi) == Approx(double(pos["y"])).margin(1e-8));
   }
   // the two answers differ in this scene, and the plot says so
-  const std::string body = slurp(out / "plots" / "sudden_load_body.gp");
+  const std::string body = readText(out / "plots" / "sudden_load_body.gp");
   CHECK(body.find("quasi-static: ") != std::string::npos);
   CHECK(body.find(bool(s["quasi_static"]["differs"]) ? "(differs" : "(same") != std::string::npos);
   const json summary = readJson(out / "summary.json");
@@ -562,7 +556,7 @@ TEST_CASE("load history: its stable pieces are the branches of branches.csv, in 
           "[scene][plot]") {
   const fs::path out = runShipped("hysteresis", "hysteresis_branches");
   REQUIRE(fs::exists(out / "branches.csv"));
-  const Csv csv = readCsv(out / "branches.csv");
+  const Csv csv = readBranchesCsv(out / "branches.csv");
   const json summary = readJson(out / "summary.json");
   const json& branches = summary["cases"][0]["branches"];
   REQUIRE(branches.size() >= 4);  // up to the fold, back down to the other fold, up again
@@ -637,10 +631,10 @@ fs::path runDefault(int segments, const std::string& labels, const std::string& 
     if (!labels.empty() && p["type"] == "bifurcation") p["labels"] = labels;
     if (!at.empty() && p["type"] == "shapes") p["at"] = at;
   }
-  const fs::path dir = freshDir(name);
+  const fs::path dir = plotDir(name);
   fs::create_directories(dir);
   std::ofstream(dir / "scene.json") << scene.dump(1);
-  const Run r = run(dir / "scene.json", dir / "out");
+  const Run r = runPlotScene(dir / "scene.json", dir / "out");
   INFO(r.err);
   REQUIRE(r.rc == 0);
   return dir / "out";
@@ -685,7 +679,7 @@ Specials specials(const fs::path& out) {
 size_t checkSummary(const fs::path& out, const std::string& stem, size_t extra) {
   const fs::path plots = out / "plots";
   const Specials sp = specials(out);
-  const std::string body = slurp(plots / (stem + "_body.gp"));
+  const std::string body = readText(plots / (stem + "_body.gp"));
   CHECK(body.find("set key title \"labelled: ") != std::string::npos);
   const std::vector<Label> labels = labelsApart(plots, stem);
   const PixelFrame f(plots, stem);
@@ -764,9 +758,9 @@ TEST_CASE("n = 3: labels auto labels every special point, as labels all does", "
   for (const std::string& stem : {std::string("bifurcation_q2"), std::string("force_deflection")}) {
     INFO(stem);
     // the same labels, placed the same, and the same script as with every label asked for
-    CHECK(slurp(autoOut / "plots" / (stem + "_labels.dat")) == slurp(allOut / "plots" / (stem + "_labels.dat")));
-    CHECK(slurp(autoOut / "plots" / (stem + "_body.gp")) == slurp(allOut / "plots" / (stem + "_body.gp")));
-    CHECK(slurp(autoOut / "plots" / (stem + "_body.gp")).find("set key title") == std::string::npos);
+    CHECK(readText(autoOut / "plots" / (stem + "_labels.dat")) == readText(allOut / "plots" / (stem + "_labels.dat")));
+    CHECK(readText(autoOut / "plots" / (stem + "_body.gp")) == readText(allOut / "plots" / (stem + "_body.gp")));
+    CHECK(readText(autoOut / "plots" / (stem + "_body.gp")).find("set key title") == std::string::npos);
   }
   // every special point (Fx, q2) has a label naming its type within 3 px (the distance under which
   // one case's labels merge, "BP, JUMP")
@@ -815,14 +809,14 @@ TEST_CASE("a long chain's bifurcation diagram is a summary: bounded labels, ever
   CHECK(labels < sp.total / 4);
   CHECK(sp.primaryBranchPoints.size() >= 10);
   // many branches: thinner, translucent lines (#AARRGGBB), the stable ones solid
-  const std::string body = slurp(out / "plots" / "bifurcation_q2_body.gp");
+  const std::string body = readText(out / "plots" / "bifurcation_q2_body.gp");
   for (const std::string& c : plotClauses(body)) {
     if (c.rfind("\"bifurcation_q2.dat\"", 0) != 0) continue;
     CHECK(field(c, "rgb").size() == 9);
     CHECK(std::stod(c.substr(c.find(" lw ") + 4)) < 2.0);
   }
   // shapes: the centre line alone (base, joints, end: n + 2 points) to scale, no joint dots
-  const std::string shapes = slurp(out / "plots" / "shapes_body.gp");
+  const std::string shapes = readText(out / "plots" / "shapes_body.gp");
   CHECK(shapes.find("set size ratio -1") != std::string::npos);
   CHECK(shapes.find("_jnt.dat") == std::string::npos);
   CHECK(shapes.find("_spr.dat") == std::string::npos);
@@ -839,7 +833,7 @@ TEST_CASE("a branch point on the straight branch is marked at the value interpol
   // C_yy exists only at traced points: the marker of a branch point takes the value between the two
   // traced points around it. On the straight branch every q is 0, so the interpolation is in Fx
   // (by the shape it would put every marker at the branch's first point).
-  const fs::path dir = freshDir("straight_marker"), out = dir / "out";
+  const fs::path dir = plotDir("straight_marker"), out = dir / "out";
   std::ofstream(dir.string() + ".json") << R"({
     "chain": {"segments": 3, "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
     "end": {"x": {"load": 0.0}, "y": {"held": 0.0}, "phi": "free"},
@@ -847,10 +841,10 @@ TEST_CASE("a branch point on the straight branch is marked at the value interpol
     "analyses": {"continuation": {"branch_switching": 0, "contact": false}, "stiffness": true},
     "plots": [{"type": "stiffness", "name": "cyy", "x": "Fx", "y": ["Cyy"]}]
   })";
-  const Run r = run(dir.string() + ".json", out);
+  const Run r = runPlotScene(dir.string() + ".json", out);
   INFO(r.err);
   REQUIRE(r.rc == 0);
-  const Csv csv = readCsv(out / "branches.csv");
+  const Csv csv = readBranchesCsv(out / "branches.csv");
   int marked = 0;
   for (const Block& b : readBlocks(out / "plots" / "cyy_special.dat")) {
     if (b.comments.empty() || b.comments[0].find(": BP") == std::string::npos) continue;

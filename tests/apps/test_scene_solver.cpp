@@ -13,6 +13,7 @@
 
 #include "scene_run.h"
 #include "small_scene.h"
+#include "read_output.h"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
@@ -25,10 +26,7 @@ std::string withSolver(const std::string& solver) {
   return s.replace(s.find(plots), plots.size(), "\"plots\": [], \"solver\": " + solver);
 }
 
-json readJson(const fs::path& file) {
-  std::ifstream in(file);
-  return json::parse(in);
-}
+using buckle::test::readJson;
 
 /// The first branch point of the run: its parameter and reported accuracy |Δλ|.
 struct Located {

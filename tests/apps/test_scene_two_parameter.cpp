@@ -20,7 +20,7 @@ using nlohmann::json;
 
 namespace {
 
-std::string scene(const std::string& twoParameter, const std::string& chain = R"("a": 0.5, "L0": 2.25)") {
+std::string twoParameterScene(const std::string& twoParameter, const std::string& chain = R"("a": 0.5, "L0": 2.25)") {
   return R"({
   "description": "two-parameter test chain",
   "chain": {"segments": 3, "b": 1.0, "k": 1.0, )" +
@@ -35,13 +35,13 @@ std::string scene(const std::string& twoParameter, const std::string& chain = R"
 
 using Outcome = buckle::test::SceneOutcome;
 
-Outcome run(const std::string& name, const std::string& text) {
+Outcome runTwoParameter(const std::string& name, const std::string& text) {
   return buckle::test::runSceneText("scene_two_parameter", name, text);
 }
 
-void requireBadInput(const std::string& name, const std::string& text, const std::string& path,
+void requireBadTwoParameter(const std::string& name, const std::string& text, const std::string& path,
                      const std::string& expected) {
-  const Outcome o = run(name, text);
+  const Outcome o = runTwoParameter(name, text);
   INFO(o.err);
   CHECK(o.rc == 2);
   CHECK(o.err.find(": " + path + ": ") != std::string::npos);
@@ -52,7 +52,7 @@ void requireBadInput(const std::string& name, const std::string& text, const std
 }  // namespace
 
 TEST_CASE("two_parameter: the BP curve in L0 is eq 17, K0 at b L0 = 2(b^2 - a^2)", "[scene][two_parameter]") {
-  const Outcome o = run("good", scene(R"({"parameter": "L0", "from": 1.0, "to": 3.0})"));
+  const Outcome o = runTwoParameter("good", twoParameterScene(R"({"parameter": "L0", "from": 1.0, "to": 3.0})"));
   INFO(o.err);
   REQUIRE(o.rc == 0);
   std::ifstream csv(o.out / "critical_curves.csv");
@@ -89,7 +89,7 @@ TEST_CASE("two_parameter: the BP curve in L0 is eq 17, K0 at b L0 = 2(b^2 - a^2)
 
 TEST_CASE("two_parameter: a chain off the trivial branch is reported, not crashed on", "[scene][two_parameter]") {
   // unequal preloads bend the unloaded chain: no straight branch to follow (run incomplete, exit 1)
-  const Outcome o = run("bent", scene(R"({"parameter": "L0", "from": 1.0, "to": 3.0})",
+  const Outcome o = runTwoParameter("bent", twoParameterScene(R"({"parameter": "L0", "from": 1.0, "to": 3.0})",
                                       R"("a": 0.5, "L1_0": 2.3, "L2_0": 2.2)"));
   INFO(o.err);
   CHECK(o.rc == 1);
@@ -100,21 +100,21 @@ TEST_CASE("two_parameter: a chain off the trivial branch is reported, not crashe
 }
 
 TEST_CASE("two_parameter: bad input names the key", "[scene][two_parameter]") {
-  requireBadInput("missing_parameter", scene(R"({"from": 1.0, "to": 3.0})"), "/analyses/two_parameter/parameter",
+  requireBadTwoParameter("missing_parameter", twoParameterScene(R"({"from": 1.0, "to": 3.0})"), "/analyses/two_parameter/parameter",
                   "missing (required)");
-  requireBadInput("unknown_parameter", scene(R"({"parameter": "c", "from": 1.0, "to": 3.0})"),
+  requireBadTwoParameter("unknown_parameter", twoParameterScene(R"({"parameter": "c", "from": 1.0, "to": 3.0})"),
                   "/analyses/two_parameter/parameter", "not one of a, b, k, L0, dL0");
-  requireBadInput("segment_of_end", scene(R"({"parameter": "y", "segment": 1, "from": -1, "to": 1})"),
+  requireBadTwoParameter("segment_of_end", twoParameterScene(R"({"parameter": "y", "segment": 1, "from": -1, "to": 1})"),
                   "/analyses/two_parameter/segment", "no segment");
-  requireBadInput("segment_range", scene(R"({"parameter": "a", "segment": 4, "from": 0.1, "to": 0.9})"),
+  requireBadTwoParameter("segment_range", twoParameterScene(R"({"parameter": "a", "segment": 4, "from": 0.1, "to": 0.9})"),
                   "/analyses/two_parameter/segment", "expected a segment");
-  requireBadInput("range_without_value", scene(R"({"parameter": "L0", "from": 2.5, "to": 3.0})"),
+  requireBadTwoParameter("range_without_value", twoParameterScene(R"({"parameter": "L0", "from": 2.5, "to": 3.0})"),
                   "/analyses/two_parameter/from", "expected a range containing L0 = 2.25");
-  requireBadInput("empty_range", scene(R"({"parameter": "L0", "from": 3.0, "to": 1.0})"), "/analyses/two_parameter/to",
+  requireBadTwoParameter("empty_range", twoParameterScene(R"({"parameter": "L0", "from": 3.0, "to": 1.0})"), "/analyses/two_parameter/to",
                   "expected to > from");
-  requireBadInput("no_curve", scene(R"({"parameter": "L0", "from": 1.0, "to": 3.0, "modes": 0})"),
+  requireBadTwoParameter("no_curve", twoParameterScene(R"({"parameter": "L0", "from": 1.0, "to": 3.0, "modes": 0})"),
                   "/analyses/two_parameter/modes", "no curve asked");
-  requireBadInput("unknown_key", scene(R"({"parameter": "L0", "from": 1.0, "to": 3.0, "mode": 1})"),
+  requireBadTwoParameter("unknown_key", twoParameterScene(R"({"parameter": "L0", "from": 1.0, "to": 3.0, "mode": 1})"),
                   "/analyses/two_parameter/mode", "unknown key");
-  requireBadInput("not_object", scene("true"), "/analyses/two_parameter", "expected an object");
+  requireBadTwoParameter("not_object", twoParameterScene("true"), "/analyses/two_parameter", "expected an object");
 }

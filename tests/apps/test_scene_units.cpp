@@ -28,13 +28,9 @@ namespace {
 
 fs::path sceneDir() { return fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes"; }
 
-fs::path workDir() { return buckle::test::scratchDirectory("scene_units"); }
+fs::path unitsDir() { return buckle::test::scratchDirectory("scene_units"); }
 
-json readJson(const fs::path& p) {
-  std::ifstream in(p);
-  REQUIRE(in.good());
-  return json::parse(in);
-}
+using buckle::test::readJson;
 
 struct Units {
   const char* name;
@@ -191,7 +187,7 @@ json rewrite(json scene, const Units& u) {
   return scene;
 }
 
-json run(const json& scene, const fs::path& dir, const std::string& name) {
+json runInUnits(const json& scene, const fs::path& dir, const std::string& name) {
   fs::create_directories(dir);
   const fs::path file = dir / (name + ".json");
   {
@@ -413,11 +409,11 @@ TEST_CASE("every shipped scene gives the same special points in five other unit 
     if (e.path().extension() == ".json") scenes.push_back(e.path());
   std::sort(scenes.begin(), scenes.end());
   REQUIRE(scenes.size() >= 10);
-  const fs::path dir = workDir();
+  const fs::path dir = unitsDir();
   for (const fs::path& file : scenes) {
     DYNAMIC_SECTION(file.stem().string()) {
       const json shipped = readJson(file);
-      const json reference = run(rewrite(shipped, Units{"shipped", 1.0, 1.0}), dir, file.stem().string());
+      const json reference = runInUnits(rewrite(shipped, Units{"shipped", 1.0, 1.0}), dir, file.stem().string());
       // the comparison must have something to compare
       CHECK((!reference["special_points"].empty() || reference.contains("critical_curves") ||
              reference.contains("energy_equilibria") || reference.contains("equilibria") ||
@@ -426,7 +422,7 @@ TEST_CASE("every shipped scene gives the same special points in five other unit 
       for (const Units& u : kSystems) {
         INFO("unit system " << u.name << " (lengths x " << u.length << ", stiffness x " << u.stiffness << ")");
         const json scaled = rewrite(shipped, u);
-        const json got = run(scaled, dir, file.stem().string() + "_" + std::to_string(&u - kSystems));
+        const json got = runInUnits(scaled, dir, file.stem().string() + "_" + std::to_string(&u - kSystems));
         compare(got, reference, shipped, u);
       }
     }
@@ -459,6 +455,7 @@ TEST_CASE("the rewrite scales what it should", "[scene][units]") {
 #include "scene/json_reader.h"
 #include "scene/scene.h"
 #include "scene/units.h"
+#include "read_output.h"
 
 using buckle::scene::Dimension;
 using buckle::scene::UnitSystem;
@@ -557,10 +554,10 @@ TEST_CASE("bad units are refused at /units with what is accepted", "[scene][unit
 }
 
 TEST_CASE("the SI chain says N, m and N/m in every plot, column doc and the report", "[scene][units][labels]") {
-  const fs::path dir = workDir() / "si_labels";
+  const fs::path dir = unitsDir() / "si_labels";
   fs::remove_all(dir);
   const json scene = readJson(sceneDir() / "si_chain.json");
-  run(scene, dir, "si");
+  runInUnits(scene, dir, "si");
   const json summary = readJson(dir / "si" / "summary.json");
   CHECK(summary["units"]["force"] == "N");
   CHECK(summary["units"]["stiffness"] == "N/m");
@@ -601,10 +598,10 @@ TEST_CASE("the SI chain says N, m and N/m in every plot, column doc and the repo
 TEST_CASE("the design map in units of 1e-4 (lengths) and 1e-8 (stiffness)", "[scene][units]") {
   // b = 1e-4 and k = 1e-8: forces of 1e-12, torques of 1e-16, far from every threshold of 1
   const json shipped = readJson(sceneDir() / "design_map.json");
-  const fs::path dir = workDir();
-  const json reference = run(rewrite(shipped, Units{"shipped", 1.0, 1.0}), dir, "design_map_reference");
+  const fs::path dir = unitsDir();
+  const json reference = runInUnits(rewrite(shipped, Units{"shipped", 1.0, 1.0}), dir, "design_map_reference");
   REQUIRE(reference.contains("critical_curves"));
   const Units tiny{"1e-4, 1e-8", 1e-4, 1e-8};
-  const json got = run(rewrite(shipped, tiny), dir, "design_map_tiny");
+  const json got = runInUnits(rewrite(shipped, tiny), dir, "design_map_tiny");
   compare(got, reference, shipped, tiny);
 }

@@ -14,9 +14,7 @@
 using namespace buckle::continuation;
 using Catch::Matchers::Contains;
 
-namespace {
-Vector vec1(double a) { return (Vector(1) << a).finished(); }
-}  // namespace
+using toys::vec1;
 
 TEST_CASE("Pitchfork: both bifurcating directions, closed-form branch and its stability", "[branch_switching]") {
   const double c = 0.5;

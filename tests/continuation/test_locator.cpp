@@ -13,7 +13,7 @@ using namespace buckle::continuation;
 using Catch::Matchers::Contains;
 
 namespace {
-Vector vec1(double a) { return (Vector(1) << a).finished(); }
+using toys::vec1;
 
 double tolerance(double lambda) { return 1e-12 * std::max(1.0, std::abs(lambda)); }
 }  // namespace

@@ -24,7 +24,7 @@ using Catch::Matchers::StartsWith;
 
 namespace {
 
-Vector vec1(double a) { return (Vector(1) << a).finished(); }
+using toys::vec1;
 
 // The residual of a circle only: its derivatives by differences.
 class DifferencedCircle : public NumericDiffProblem {

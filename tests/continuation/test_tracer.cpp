@@ -16,9 +16,7 @@
 using namespace buckle::continuation;
 using Catch::Matchers::Contains;
 
-namespace {
-Vector vec1(double a) { return (Vector(1) << a).finished(); }
-}  // namespace
+using toys::vec1;
 
 TEST_CASE("Bad input to the tracer is reported in the branch, never thrown", "[tracer]") {
   // A problem without unknowns: the tracer cannot build a corrector for it.

@@ -18,7 +18,7 @@ using Catch::Matchers::StartsWith;
 
 namespace {
 
-Vector vec1(double a) { return (Vector(1) << a).finished(); }
+using toys::vec1;
 
 // One bad setting: the options refuse it, naming `field` (its path), and a tracer built with them
 // says so in the branch instead of running.

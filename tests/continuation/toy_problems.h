@@ -8,6 +8,9 @@
 
 namespace buckle::continuation::toys {
 
+/// A one-entry vector: a point of a one-dimensional problem.
+inline Vector vec1(double a) { return (Vector(1) << a).finished(); }
+
 /// The stability operator of a gradient system F = −∇V: H = −F_u, no constraints.
 inline bool negatedJacobian(const Problem &problem, ProblemWorkspace &ws, ConstVectorRef u, double lambda, Matrix &H,
                             Matrix &C) {

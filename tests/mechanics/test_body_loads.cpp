@@ -13,10 +13,13 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/gravity.h"
 #include "random_segments.h"
+#include "test_chains.h"
 
 using namespace buckle::mechanics;
 
 namespace {
+
+using testing::randomAngles;
 
 // A random chain with lengths ×L and stiffnesses ×k.
 Chain scaledChain(std::mt19937& rng, int n, double L, double k) {
@@ -29,7 +32,7 @@ Chain scaledChain(std::mt19937& rng, int n, double L, double k) {
   return Chain(segs);
 }
 
-InertiaData unevenInertia(const Chain& chain, double massScale) {
+InertiaData unevenMasses(const Chain& chain, double massScale) {
   InertiaData data;
   for (int i = 0; i < chain.size(); ++i)
     data.links.push_back({massScale * (0.7 + 0.3 * i), 0.0,
@@ -55,15 +58,6 @@ Terms termsAt(const Chain& chain, BodyLoadTerms& terms, const Vector& q, double 
   return t;
 }
 
-Vector randomAngles(std::mt19937& rng, const Chain& chain) {
-  Vector q(chain.size());
-  for (int i = 0; i < chain.size(); ++i) {
-    std::uniform_real_distribution<double> Q(0.7 * chain.lowerLimits()[i], 0.7 * chain.upperLimits()[i]);
-    q[i] = Q(rng);
-  }
-  return q;
-}
-
 }  // namespace
 
 TEST_CASE("body loads: the weight's torques, generator and potential equal GravityPotential's", "[body_loads]") {
@@ -72,14 +66,14 @@ TEST_CASE("body loads: the weight's torques, generator and potential equal Gravi
     const double k = L == 1.0 ? 1.0 : 1e8, force = k * L;  // masses scale with the force unit (g fixed)
     for (int n : {1, 4, 12}) {
       const Chain chain = scaledChain(rng, n, L, k);
-      const InertiaData inertia = unevenInertia(chain, force);
+      const InertiaData inertia = unevenMasses(chain, force);
       const Eigen::Vector2d g0(0.7, -9.81), rate(-0.2, 0.5);
       const double lambda = 0.8;
       BodyLoadTerms terms(chain, BodyLoads::weight(chain, inertia, g0, rate));
       REQUIRE(terms.active());
       GravityPotential V(chain, inertia, g0 + lambda * rate);
       for (int trial = 0; trial < 3; ++trial) {
-        const Vector q = randomAngles(rng, chain);
+        const Vector q = randomAngles(rng, chain, 0.7);
         const Terms t = termsAt(chain, terms, q, lambda);
         Vector grad(n), gamma(n);
         V.gradient(q, grad);
@@ -102,13 +96,13 @@ TEST_CASE("body loads: point loads at joints, torques and generator by central d
     const double k = L == 1.0 ? 1.0 : 1e8, force = k * L;
     for (int n : {1, 3, 9}) {
       const Chain chain = scaledChain(rng, n, L, k);
-      BodyLoads loads = BodyLoads::weight(chain, unevenInertia(chain, force), {0.3, -1.0}, {0.1, -0.4});
+      BodyLoads loads = BodyLoads::weight(chain, unevenMasses(chain, force), {0.3, -1.0}, {0.1, -0.4});
       for (int j = 1; j <= n + 1; j += 2)
         loads.points.push_back({j, force * Eigen::Vector2d(W(rng), W(rng)), force * Eigen::Vector2d(W(rng), W(rng))});
       BodyLoadTerms terms(chain, loads);
       const double lambda = 0.6, scale = force * chain.length() * (n + 2);
       INFO("L = " << L << ", n = " << n);
-      const Vector q = randomAngles(rng, chain);
+      const Vector q = randomAngles(rng, chain, 0.7);
       const Terms t = termsAt(chain, terms, q, lambda);
       const double h = 1e-5;
       for (int j = 0; j < n; ++j) {
@@ -148,7 +142,7 @@ TEST_CASE("body loads: a force at the end is the end wrench (torques J^T F, gene
   BodyLoads loads;
   loads.points.push_back({n + 1, f, Eigen::Vector2d::Zero()});
   BodyLoadTerms terms(chain, loads);
-  const Vector q = randomAngles(rng, chain);
+  const Vector q = randomAngles(rng, chain, 0.7);
   const Terms t = termsAt(chain, terms, q, 0.0);
   ChainData data(chain);
   forwardKinematics(chain, q, data);
@@ -182,7 +176,7 @@ TEST_CASE("body loads: a payload added to the end link (withPayload) weighs as t
   BodyLoads split = BodyLoads::weight(chain, rods, g, Eigen::Vector2d::Zero());
   split.points.push_back({n + 1, mp * g, Eigen::Vector2d::Zero()});
   BodyLoadTerms a(chain, split), b(chain, BodyLoads::weight(chain, withEnd, g, Eigen::Vector2d::Zero()));
-  const Vector q = randomAngles(rng, chain);
+  const Vector q = randomAngles(rng, chain, 0.7);
   const Terms ta = termsAt(chain, a, q, 0.0), tb = termsAt(chain, b, q, 0.0);
   const double scale = (m * n + mp) * g.norm() * chain.length();
   CHECK((ta.tau - tb.tau).cwiseAbs().maxCoeff() <= 1e-14 * scale);

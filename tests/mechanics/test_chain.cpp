@@ -11,25 +11,15 @@
 #include "buckle/mechanics/chain.h"
 
 #include "random_segments.h"
+#include "test_chains.h"
 
 using namespace buckle::mechanics;
 
 namespace {
 
-Chain randomChain(std::mt19937& rng, int n) {
-  std::vector<SegmentParameters> s;
-  for (int i = 0; i < n; ++i) s.push_back(testing::randomSegment(rng));
-  return Chain(s);
-}
-
-Vector randomAngles(std::mt19937& rng, const Chain& chain, double fraction = 0.8) {
-  Vector q(chain.size());
-  for (int i = 0; i < chain.size(); ++i) {
-    std::uniform_real_distribution<double> Q(fraction * chain.lowerLimits()[i], fraction * chain.upperLimits()[i]);
-    q[i] = Q(rng);
-  }
-  return q;
-}
+using testing::randomAngles;
+using testing::randomChain;
+using testing::rejection;
 
 // Jᵀ F as a function of q.
 Vector jtF(const Chain& chain, const Vector& q, const Wrench& F) {
@@ -38,15 +28,6 @@ Vector jtF(const Chain& chain, const Vector& q, const Wrench& F) {
   Matrix J(3, chain.size());
   endJacobian(d, J);
   return J.transpose() * F;
-}
-
-std::string rejection(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "accepted";
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include "../malloc_counter.h"
 #include "random_segments.h"
+#include "test_chains.h"
 
 using namespace buckle::mechanics;
 using buckle::continuation::DenseBorderedSolver;
@@ -18,17 +19,13 @@ using buckle::continuation::Factorization;
 
 namespace {
 
+using testing::randomChain;
+
 EndCondition allHeld(double x, double y, double phi) {
   EndCondition e;
   e.control = {Control::Held, Control::Held, Control::Held};
   e.value = Eigen::Vector3d(x, y, phi);
   return e;
-}
-
-Chain randomChain(std::mt19937& rng, int n) {
-  std::vector<SegmentParameters> segs;
-  for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
-  return Chain(segs);
 }
 
 Chain uniformChain(int n) {

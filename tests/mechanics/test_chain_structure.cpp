@@ -21,7 +21,7 @@ using buckle::continuation::StabilityInfo;
 namespace {
 
 // b in [0.8, 1.4]: away from degenerate geometry.
-const testing::SegmentRanges kNarrow{0.1, 0.9, 0.8, 1.4, 0.5, 3.0, 1.0, 2.8};
+const testing::SegmentRanges kNarrowChain{0.1, 0.9, 0.8, 1.4, 0.5, 3.0, 1.0, 2.8};
 
 struct Instance {
   Chain chain;
@@ -32,7 +32,7 @@ struct Instance {
 
 Instance randomInstance(int n, std::mt19937& rng, double loadScale = 1.0) {
   std::vector<SegmentParameters> segs;
-  for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng, kNarrow));
+  for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng, kNarrowChain));
   Chain chain(segs);
   Vector q(n);
   for (int i = 0; i < n; ++i) {
@@ -515,7 +515,7 @@ TEST_CASE("EquilibriumProblem: structured stability() agrees with the dense defa
                                           EndCondition::clampedPinned(-0.5), EndCondition::heldPosition(3.0, 0.5)};
   for (int n : {1, 2, 3, 4, 17, 40, 100}) {  // inertia alone: dense up to n = 3, counts from 4; n >= 32 O(n)
     std::vector<SegmentParameters> segs;
-    for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng, kNarrow));
+    for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng, kNarrowChain));
     Chain chain(segs);
     for (const EndCondition& end : ends) {
       if (end.heldCount() >= n) continue;

@@ -26,17 +26,12 @@ using buckle::test::across;
 using buckle::test::along;
 using buckle::test::geometry;
 using buckle::test::Geometry;
+using buckle::test::moment;
 
 // Distal base corner −a of segment i: its joint + b2 along θ_(i+1) − a2 across it.
 Eigen::Vector2d distalMinus(const Chain& chain, const Geometry& g, int i) {
   const SegmentParameters& p = chain.segment(i).parameters();
   return g.P.col(i) + p.b2 * along(g.theta[i + 1]) - p.a2 * across(g.theta[i + 1]);
-}
-
-// Moment about point c of a force f at r.
-double moment(const Eigen::Vector2d& r, const Eigen::Vector2d& c, const Eigen::Vector2d& f) {
-  const Eigen::Vector2d d = r - c;
-  return d.x() * f.y() - d.y() * f.x();
 }
 
 // The contact_release chain without its joint stop, lengths scaled by sL, stiffnesses by sK.

@@ -13,12 +13,14 @@
 #include "buckle/mechanics/post_buckling.h"
 
 #include "random_segments.h"
+#include "test_chains.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
 
 namespace {
-const Eigen::Vector3d kAxial(1.0, 0.0, 0.0);
+
+using testing::kAxial;
 
 std::vector<SegmentParameters> paperChain(int n, double a, double b, double k, double L0) {
   return std::vector<SegmentParameters>(size_t(n), SegmentParameters::symmetric(a, b, k, L0));

@@ -11,26 +11,17 @@
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 
+#include "test_chains.h"
+
 using namespace buckle::mechanics;
 
 namespace {
 
+using testing::stiffChain;
+using testing::unevenInertia;
+
 // κ = −0.3 < 0 with wells at q* = ±2 acos 0.8 inside the joint limits (see test_jump.cpp).
 Chain bistableChain(int n = 3) { return Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 1.2)); }
-// The paper's main case, κ = 0.75 > 0.
-Chain stiffChain(int n = 3) { return Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)); }
-
-InertiaData unevenInertia(const Chain& chain) {
-  InertiaData data;
-  for (int i = 0; i < chain.size(); ++i) {
-    LinkInertia L;
-    L.mass = 0.7 + 0.3 * i;
-    L.inertia = 0.05 + 0.02 * i;
-    L.comOffset = (i % 2 == 0) ? 0.3 * chain.linkLengths()[i + 1] : std::numeric_limits<double>::quiet_NaN();
-    data.links.push_back(L);
-  }
-  return data;
-}
 
 // Kinetic energy from first principles: centre-of-mass velocities by central differences of the
 // COM positions along q̇, link angular rates θ̇ = prefix sums of q̇.

@@ -14,6 +14,7 @@
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/linear_buckling.h"
 #include "critical_loads.h"
+#include "test_chains.h"
 #include "buckle/mechanics/load_history.h"
 
 using namespace buckle::mechanics;
@@ -21,7 +22,7 @@ namespace cont = buckle::continuation;
 
 namespace {
 
-const Eigen::Vector3d kAxial(1.0, 0.0, 0.0);
+using testing::kAxial;
 
 using buckle::mechanics::test::compressiveCriticalLoads;
 

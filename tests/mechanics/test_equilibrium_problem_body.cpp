@@ -87,7 +87,7 @@ double bisect(F f, double lo, double hi) {
   return 0.5 * (lo + hi);
 }
 
-double firstBranchPoint(EquilibriumProblem& problem, int n, double lambdaMax) {
+double firstCriticalLoad(EquilibriumProblem& problem, int n, double lambdaMax) {
   EquilibriumBranchOptions o;
   o.tracer.lambdaMax = lambdaMax;
   o.tracer.step.maxStep = 0.1;
@@ -289,7 +289,7 @@ TEST_CASE("the critical payload and the critical gravity of a heavy column equal
       const double g = 1.0;
       EquilibriumProblem payload(chain, EndCondition::freeEnd(), Eigen::Vector3d(-1, 0, 0), {}, {},
                                  BodyLoads::weight(chain, inertia, Eigen::Vector2d(-g, 0.0), Eigen::Vector2d::Zero()));
-      const double located = firstBranchPoint(payload, n, 5.0 * force);
+      const double located = firstCriticalLoad(payload, n, 5.0 * force);
       const double direct =
           bisect([&](double P) { return smallestEigenvalue(columnHessian(chain, mass, g, P)); }, 0.0, 5.0 * force);
       CHECK(located == Approx(direct).epsilon(1e-9));
@@ -298,7 +298,7 @@ TEST_CASE("the critical payload and the critical gravity of a heavy column equal
       const double P = 0.5 * located;
       EquilibriumProblem heavy(chain, EndCondition::freeEnd(Eigen::Vector3d(-P, 0, 0)), Eigen::Vector3d::Zero(), {}, {},
                                BodyLoads::weight(chain, inertia, Eigen::Vector2d::Zero(), Eigen::Vector2d(-1.0, 0.0)));
-      const double gLocated = firstBranchPoint(heavy, n, 1e4);
+      const double gLocated = firstCriticalLoad(heavy, n, 1e4);
       const double gDirect =
           bisect([&](double gg) { return smallestEigenvalue(columnHessian(chain, mass, gg, P)); }, 0.0, 1e4);
       CHECK(gLocated == Approx(gDirect).epsilon(1e-9));

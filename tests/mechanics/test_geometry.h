@@ -13,6 +13,12 @@ namespace buckle::test {
 inline Eigen::Vector2d along(double t) { return {std::cos(t), std::sin(t)}; }
 inline Eigen::Vector2d across(double t) { return {-std::sin(t), std::cos(t)}; }
 
+/// The moment about c of a force f applied at r: (r − c) × f.
+inline double moment(const Eigen::Vector2d& r, const Eigen::Vector2d& c, const Eigen::Vector2d& f) {
+  const Eigen::Vector2d d = r - c;
+  return d.x() * f.y() - d.y() * f.x();
+}
+
 struct Geometry {
   Eigen::Matrix2Xd P;
   Eigen::Vector2d end;

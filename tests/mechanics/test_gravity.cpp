@@ -13,20 +13,14 @@
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/gravity.h"
 #include "heavy_newton.h"
+#include "test_chains.h"
 
 using namespace buckle::mechanics;
 
 namespace {
 
-Chain stiffChain(int n) { return Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)); }
-
-InertiaData unevenInertia(const Chain& chain) {
-  InertiaData data;
-  for (int i = 0; i < chain.size(); ++i)
-    data.links.push_back({0.7 + 0.3 * i, 0.05 + 0.02 * i,
-                          i % 2 == 0 ? 0.3 * chain.linkLengths()[i + 1] : std::numeric_limits<double>::quiet_NaN()});
-  return data;
-}
+using testing::stiffChain;
+using testing::unevenInertia;
 
 }  // namespace
 

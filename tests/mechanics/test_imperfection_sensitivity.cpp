@@ -10,12 +10,14 @@
 #include "buckle/mechanics/imperfection_sensitivity.h"
 
 #include "unequal_springs.h"
+#include "test_chains.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
 
 namespace {
-const Eigen::Vector3d kAxial(1.0, 0.0, 0.0);
+
+using testing::kAxial;
 
 /// The first branch point of the straight clamped–pinned chain under compression.
 cont::SpecialPoint firstBranchPoint(EquilibriumProblem& p, double lambdaMin) {

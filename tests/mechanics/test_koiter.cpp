@@ -16,12 +16,14 @@
 
 #include "random_segments.h"
 #include "unequal_springs.h"
+#include "test_chains.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
 
 namespace {
-const Eigen::Vector3d kAxial(1.0, 0.0, 0.0);
+
+using testing::kAxial;
 
 /// u on the parent branch at λ: Newton at fixed λ from the parent's tangent line, each step the
 /// bordered solve [[F_u, F_λ], [e_λᵀ]] of the chain's structured solver (O(n); dense below its

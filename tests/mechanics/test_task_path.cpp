@@ -33,7 +33,7 @@ Chain chainOf(int n, double L = 1.0, double k = 1.0) {
 }
 
 // The chain under `load` reached from the straight unloaded shape by loading it, λ: 0 → 1.
-Eigen::VectorXd loaded(const Chain& chain, const Eigen::Vector3d& load) {
+Eigen::VectorXd loadedAngles(const Chain& chain, const Eigen::Vector3d& load) {
   EquilibriumProblem ramp(chain, EndCondition::freeEnd(), load);
   cont::TracerOptions o;
   o.lambdaMin = -1.0;
@@ -280,7 +280,7 @@ TEST_CASE("task path: the O(n) elimination of rule (b)'s optimality system agree
 TEST_CASE("task path rule (a): the task held and every point an equilibrium of the chain at its inputs", "[task_path]") {
   const Chain chain = chainOf(3);
   const Eigen::Vector3d payload(-0.3, -0.3, 0.0);
-  const Eigen::VectorXd q0 = loaded(chain, payload);
+  const Eigen::VectorXd q0 = loadedAngles(chain, payload);
   TaskPathProblem p(chain, chosenSetup(payload));
   // two legs: a corner at the first waypoint
   const Pose pose = endPose(chain, q0);
@@ -324,7 +324,7 @@ TEST_CASE("task path rule (b): least weighted change against a brute-force searc
           "[task_path]") {
   const Chain chain = chainOf(3);
   const Eigen::Vector3d payload(-0.3, -0.3, 0.0);
-  const Eigen::VectorXd q0 = loaded(chain, payload);
+  const Eigen::VectorXd q0 = loadedAngles(chain, payload);
   TaskPathProblem p(chain, minChangeSetup(3, payload));
   const TaskPathResult r = buckle::test::followTaskPath(p, q0, -0.2, 0.5);
   REQUIRE(r.end == TaskPathEvent::Completed);
@@ -382,7 +382,7 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
   SECTION("fold of the task map: F_u singular, s largest there") {
     const Eigen::Vector3d payload(-0.3, -0.1, 0.0);
     TaskPathProblem p(chain, chosenSetup(payload));
-    const TaskPathResult r = buckle::test::followTaskPath(p, loaded(chain, payload), -0.2, -1.0);
+    const TaskPathResult r = buckle::test::followTaskPath(p, loadedAngles(chain, payload), -0.2, -1.0);
     REQUIRE(r.end == TaskPathEvent::Fold);
     REQUIRE(r.specials.size() == 1);
     const TaskPathPoint& f = r.specials[0].point;
@@ -396,7 +396,7 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
   SECTION("loss of stability at fixed inputs: an eigenvalue of the dense Hessian reaches zero") {
     const Eigen::Vector3d payload(-0.3, -0.3, 0.0);
     TaskPathProblem p(chain, minChangeSetup(3, payload));
-    const TaskPathResult r = buckle::test::followTaskPath(p, loaded(chain, payload), -0.2, 6.0);
+    const TaskPathResult r = buckle::test::followTaskPath(p, loadedAngles(chain, payload), -0.2, 6.0);
     REQUIRE(r.end == TaskPathEvent::StabilityLoss);
     // every point before the special one (the last point) is stable
     for (size_t i = 0; i + 1 < r.points.size(); ++i) CHECK(r.points[i].stable);
@@ -411,7 +411,7 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
     const Eigen::Vector3d payload(-0.3, -0.3, 0.0);
     TaskSetup s = chosenSetup(payload);
     TaskPathProblem free(chain, s);
-    const Eigen::VectorXd q0 = loaded(chain, payload);
+    const Eigen::VectorXd q0 = loadedAngles(chain, payload);
     const TaskPathResult r = buckle::test::followTaskPath(free, q0, -0.2, 3.0);
     REQUIRE(r.end == TaskPathEvent::InputBound);
     const Chain at = free.chainAt(r.specials[0].point.inputs + Eigen::Vector2d(0.0, -1e-9));  // just inside
@@ -425,7 +425,7 @@ TEST_CASE("task path: the special points are what they say", "[task_path]") {
   }
   SECTION("joint limit") {
     const Eigen::Vector3d payload(-0.3, -0.3, 0.0);
-    const Eigen::VectorXd q0 = loaded(chain, payload);
+    const Eigen::VectorXd q0 = loadedAngles(chain, payload);
     TaskPathProblem p(chain, chosenSetup(payload));
     const TaskPathResult r = buckle::test::followTaskPath(p, q0, -0.2, 0.5);
     REQUIRE(r.end == TaskPathEvent::Completed);
@@ -449,11 +449,11 @@ TEST_CASE("task path: the same path in scaled units (lengths x1e-4, stiffness x1
     const Eigen::Vector3d payload(-0.3, -0.1, 0.0);
     TaskSetup s = rule == TaskRule::Chosen ? chosenSetup(payload) : minChangeSetup(3, payload);
     TaskPathProblem unit(chainOf(3), s);
-    const TaskPathResult r1 = buckle::test::followTaskPath(unit, loaded(chainOf(3), payload), -0.2, -1.0);
+    const TaskPathResult r1 = buckle::test::followTaskPath(unit, loadedAngles(chainOf(3), payload), -0.2, -1.0);
     s.payload *= k * L;
     for (TaskInput& in : s.inputs) in.upper *= L, in.lower *= L;
     TaskPathProblem scaled(chainOf(3, L, k), s);
-    const TaskPathResult r2 = buckle::test::followTaskPath(scaled, loaded(chainOf(3, L, k), s.payload), -0.2, -1.0, L);
+    const TaskPathResult r2 = buckle::test::followTaskPath(scaled, loadedAngles(chainOf(3, L, k), s.payload), -0.2, -1.0, L);
     REQUIRE(r1.end == r2.end);
     REQUIRE(r1.points.size() == r2.points.size());
     for (size_t i = 0; i < r1.points.size(); ++i) {

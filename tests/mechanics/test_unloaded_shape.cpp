@@ -10,18 +10,13 @@
 
 #include "buckle/mechanics/unloaded_shape.h"
 
+#include "test_chains.h"
+
 using namespace buckle::mechanics;
 
 namespace {
 
-std::string rejection(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "accepted";
-}
+using testing::rejection;
 
 }  // namespace
 

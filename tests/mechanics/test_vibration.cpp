@@ -16,17 +16,16 @@
 #include "buckle/mechanics/gravity.h"
 #include "buckle/mechanics/vibration.h"
 
+#include "test_chains.h"
+
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using testing::stiffChain;
 
-// The paper's main case (κ = 0.75 > 0) in lengths ×L and stiffness ×k.
-Chain stiffChain(int n, double L = 1.0, double k = 1.0) {
-  return Chain::uniform(n, SegmentParameters::symmetric(0.5 * L, L, k, 2.25 * L));
-}
+constexpr double kPi = 3.14159265358979323846;
 
 double relativeError(double x, double reference) { return std::abs(x - reference) / std::abs(reference); }
 

@@ -24,6 +24,7 @@ namespace {
 using buckle::test::across;
 using buckle::test::along;
 using buckle::test::geometry;
+using buckle::test::moment;
 using buckle::test::Geometry;
 
 // Every moving vertex: the joints 2 … n, the proximal triangles' base corners of segments 2 … n,
@@ -40,11 +41,6 @@ double smallestVertexX(const Chain& chain, const Eigen::VectorXd& q) {
     if (i > 0) x = std::min(x, g.P(0, i));
   }
   return x;
-}
-
-double moment(const Eigen::Vector2d& r, const Eigen::Vector2d& c, const Eigen::Vector2d& f) {
-  const Eigen::Vector2d d = r - c;
-  return d.x() * f.y() - d.y() * f.x();
 }
 
 double chainLength(const Chain& chain) { return chain.linkLengths().sum(); }

@@ -12,7 +12,7 @@ namespace buckle::continuation {
 
 namespace {
 
-bool fail(std::string *why, const std::string &reason) {
+bool failExpansion(std::string *why, const std::string &reason) {
   if (why) *why = reason;
   return false;
 }
@@ -35,7 +35,7 @@ bool childBranchExpansion(const BoundProblem &problem, ConstVectorRef u0, double
                           std::string *why, double amplitude) {
   const int n = problem.dimension();
   if (u0.size() != n || c.size() != n || g.v.size() != n || g.u2.size() != n)
-    return fail(why, "child expansion: u0, c and the coefficients' vectors must have the problem's dimension");
+    return failExpansion(why, "child expansion: u0, c and the coefficients' vectors must have the problem's dimension");
   const ProblemScales scales = problem.scales();
   const UnitScaling units(scales);
   const BoundScaledProblem scaledProblem(problem, units);
@@ -47,7 +47,7 @@ bool childBranchExpansion(const BoundProblem &problem, ConstVectorRef u0, double
   options.maxIterations = 30;
   Corrector corrector(scaled, options, structured.get());
   const double vScaled = g.v.cwiseQuotient(scales.unknowns).norm();
-  if (!(vScaled > 0.0)) return fail(why, "child expansion: the null vector vanishes");
+  if (!(vScaled > 0.0)) return failExpansion(why, "child expansion: the null vector vanishes");
   const double h = amplitude > 0.0 ? amplitude : 0.05 / vScaled;
   // the hyperplane cᵀ(u − u0) = ξ in the scaled unknowns: normal (c ⊙ D_u, 0)
   Vector normal = Vector::Zero(n + 1);
@@ -77,7 +77,7 @@ bool childBranchExpansion(const BoundProblem &problem, ConstVectorRef u0, double
     for (int k = 0; k < 3; ++k) {
       double plus = 0.0, minus = 0.0;
       if (!lambdaAt((k + 1) * step, plus) || !lambdaAt(-(k + 1) * step, minus))
-        return fail(why, "child expansion: no point of the child at amplitude " + std::to_string((k + 1) * step) +
+        return failExpansion(why, "child expansion: no point of the child at amplitude " + std::to_string((k + 1) * step) +
                              " (the corrector did not converge on its hyperplane)");
       e[k] = 0.5 * (plus + minus) - lambdaC;
       o[k] = 0.5 * (plus - minus);

@@ -25,7 +25,7 @@ bool opposite(double a, double b) { return (a < 0.0) != (b < 0.0); }
 
 // The configuration curve with the end held at (x, y) and what acts on the chain: its samples
 // (energy_landscape.h), E + V with the body loads.
-struct Curve {
+struct SweepCurve {
   const Chain& chain;
   double x, y;
   BodyLoadTerms* body;  // null: none (landscapeSample overwrites its last update)
@@ -35,7 +35,7 @@ struct Curve {
 // Bisection of the sign change of f (a member of the sample) on [lo, hi], f(lo) of sign `fLo`.
 // Bisection alone: the refined cells are those where Newton's derivative changes sign.
 template <class Value>
-bool bisect(const Curve& c, int branch, double lo, double hi, double fLo, Value value,
+bool bisect(const SweepCurve& c, int branch, double lo, double hi, double fLo, Value value,
             LandscapeSample& out) {
   for (int it = 0; it < 200 && hi - lo > 4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(lo));
        ++it) {
@@ -54,7 +54,7 @@ bool bisect(const Curve& c, int branch, double lo, double hi, double fLo, Value 
 
 // A cell where dE/dq1 keeps its sign but d²E/dq1² changes it holds an extremum of dE/dq1: where
 // that extremum crosses zero, two roots share the cell and the sign test missed both.
-void refineCells(const Curve& c, const std::vector<LandscapeSample>& s, int branch,
+void refineCells(const SweepCurve& c, const std::vector<LandscapeSample>& s, int branch,
                  std::vector<SweepPoint>& out) {
   auto d1 = [](const LandscapeSample& p) { return p.dEdq1; };
   auto d2 = [](const LandscapeSample& p) { return p.d2Edq1; };
@@ -88,7 +88,7 @@ const std::vector<LandscapeSample>& samplesOf(const EnergyLandscape& L, int bran
 // The last feasible point between a feasible q1 and an infeasible one, by bisection, moved back
 // towards the feasible side until dE/dq1 is defined (it is not at a junction itself, where the
 // q1-parametrisation turns).
-LandscapeSample boundarySample(const Curve& c, int branch, double inside, double out) {
+LandscapeSample boundarySample(const SweepCurve& c, int branch, double inside, double out) {
   double in = inside;
   for (int it = 0; it < 60; ++it) {
     const double mid = 0.5 * (in + out);
@@ -103,7 +103,7 @@ LandscapeSample boundarySample(const Curve& c, int branch, double inside, double
 
 // The runs of both branches with their ends' boundary points; false (with the reason) when the
 // curve jumps between two samples.
-bool findRuns(const Curve& c, const EnergyLandscape& L, std::vector<Run>& runs, std::string& why) {
+bool findRuns(const SweepCurve& c, const EnergyLandscape& L, std::vector<Run>& runs, std::string& why) {
   for (int branch : {+1, -1}) {
     const std::vector<LandscapeSample>& s = samplesOf(L, branch);
     const int N = int(s.size());
@@ -146,7 +146,7 @@ bool findRuns(const Curve& c, const EnergyLandscape& L, std::vector<Run>& runs, 
 // boundary point, and on the short piece through a junction, where q1 turns back and the curve
 // passes onto the other branch (E's rate along the curve is +dE/dq1 outward on one branch and
 // −dE/dq1 coming back on the other: a root lies between when both dE/dq1 have one sign).
-void refineEnds(const Curve& c, const EnergyLandscape& L, const std::vector<Run>& runs,
+void refineEnds(const SweepCurve& c, const EnergyLandscape& L, const std::vector<Run>& runs,
                 std::vector<SweepPoint>& out) {
   auto d1 = [](const LandscapeSample& p) { return p.dEdq1; };
   for (const Run& r : runs)
@@ -252,7 +252,7 @@ SweepResult sweepEquilibria(const Chain& chain, double x, double y, int samples,
   options.body = body;
   const EnergyLandscape L = energyLandscape(chain, x, y, options);
   BodyLoadTerms terms(chain, body.atParameter(0.0));
-  const Curve c{chain, x, y, terms.active() ? &terms : nullptr};
+  const SweepCurve c{chain, x, y, terms.active() ? &terms : nullptr};
   SweepResult result;
   for (const LandscapeEquilibrium& e : L.equilibria) result.equilibria.push_back({e.q, e.stable, false});
   refineCells(c, L.positive, +1, result.equilibria);

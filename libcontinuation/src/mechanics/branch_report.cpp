@@ -87,10 +87,6 @@ void noteCusp(EquilibriumProblem& problem, const cont::SpecialPoint& sp, Special
               formatShort(fc.curvature) + " is zero to its accuracy " + formatShort(fc.accuracy);
 }
 
-// Shapes of equilibria are named with a small straightness tolerance relative to the angles'
-// own unit (radians): a chain bent by less than 1e-6 rad at every joint is straight.
-constexpr double kStraightTolerance = 1e-6;
-
 bool regularStop(cont::StopReason r) {
   return r == cont::StopReason::LambdaRange || r == cont::StopReason::Boundary || r == cont::StopReason::Box ||
          r == cont::StopReason::MaxArclength || r == cont::StopReason::Joined;

@@ -9,10 +9,10 @@
 
 namespace buckle::mechanics {
 
-namespace {
+using structure::kBunchAlpha;
+using structure::kTinyPivot;
 
-constexpr double kBunchAlpha = 0.6180339887498949;  // (√5 − 1)/2
-constexpr double kTinyPivot = 1e-290;
+namespace {
 
 /// Diagonal of the q-space identity in θ-coordinates, M = U⁻¹U⁻ᵀ (off-diagonal −1).
 inline double metricDiagonal(int k, int n) { return k + 1 < n ? 2.0 : 1.0; }

@@ -19,8 +19,6 @@ bool fail(std::string* why, const std::string& message) {
   return false;
 }
 
-bool finite(double v) { return std::isfinite(v); }
-
 }  // namespace
 
 // ---- scene data ------------------------------------------------------------------------------
@@ -57,10 +55,10 @@ bool InertiaData::IsValid(const Chain& chain, std::string* why) const {
   for (int i = 0; i < n; ++i) {
     const LinkInertia& L = links[size_t(i)];
     const std::string name = "inertia link " + std::to_string(i + 1) + ": ";
-    if (!finite(L.mass) || !(L.mass > 0.0)) return fail(why, name + "mass must be > 0");
-    if (!finite(L.inertia) || L.inertia < 0.0) return fail(why, name + "inertia must be >= 0");
+    if (!std::isfinite(L.mass) || !(L.mass > 0.0)) return fail(why, name + "mass must be > 0");
+    if (!std::isfinite(L.inertia) || L.inertia < 0.0) return fail(why, name + "inertia must be >= 0");
     const double len = chain.linkLengths()[i + 1];
-    if (!std::isnan(L.comOffset) && (!finite(L.comOffset) || L.comOffset < 0.0 || L.comOffset > len))
+    if (!std::isnan(L.comOffset) && (!std::isfinite(L.comOffset) || L.comOffset < 0.0 || L.comOffset > len))
       return fail(why, name + "comOffset must lie in [0, link length]");
     const double d = std::isnan(L.comOffset) ? 0.5 * len : L.comOffset;
     // Link i's own angular rate is seen by the kinetic energy only through m d² + I: a link with
@@ -71,14 +69,14 @@ bool InertiaData::IsValid(const Chain& chain, std::string* why) const {
 }
 
 bool DynamicsScene::IsValid(const Chain& chain, std::string* why) const {
-  if (!finite(flowDamping) || !(flowDamping > 0.0)) return fail(why, "flowDamping must be > 0");
+  if (!std::isfinite(flowDamping) || !(flowDamping > 0.0)) return fail(why, "flowDamping must be > 0");
   if (!jointDamping.empty() && static_cast<int>(jointDamping.size()) != chain.size())
     return fail(why, "jointDamping must be empty or have one entry per joint (" + std::to_string(chain.size()) + ")");
   for (size_t i = 0; i < jointDamping.size(); ++i)
-    if (!finite(jointDamping[i]) || jointDamping[i] < 0.0)
+    if (!std::isfinite(jointDamping[i]) || jointDamping[i] < 0.0)
       return fail(why, "jointDamping[" + std::to_string(i) + "] must be >= 0");
-  if (!finite(constraintStiffness)) return fail(why, "constraintStiffness must be finite");
-  if (!finite(baumgarteRate)) return fail(why, "baumgarteRate must be finite");
+  if (!std::isfinite(constraintStiffness)) return fail(why, "constraintStiffness must be finite");
+  if (!std::isfinite(baumgarteRate)) return fail(why, "baumgarteRate must be finite");
   if (inertia && !inertia->IsValid(chain, why)) return false;
   if (body) {
     try {
@@ -116,7 +114,7 @@ DynamicsModel::DynamicsModel(const Chain& chain, const EndCondition& end)
       tmpM_(end.heldCount()),
       tmpN_(chain.size()) {
   for (int c = 0; c < 3; ++c)
-    if (!finite(end.value[c])) throw std::invalid_argument("end condition value " + std::to_string(c) + " must be finite");
+    if (!std::isfinite(end.value[c])) throw std::invalid_argument("end condition value " + std::to_string(c) + " must be finite");
   for (int c : loaded_) loads_[c] = end.value[c];
   llt_.compute(Matrix::Identity(heldCount(), heldCount()));  // defines its status flag
   double b = 0.0, k = 0.0;

@@ -10,8 +10,6 @@ namespace buckle::mechanics {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
-
 /// out = ∇²p_c v for the end coordinate c: ∂²x/∂q_i∂q_j = −C_max(i,j), ∂²y/∂q_i∂q_j = −S_max(i,j)
 /// (eq 26–27), ∂²φ = 0; as (G v)_i = g_i Σ_{j≤i} v_j + Σ_{j>i} g_j v_j, O(n).
 void applyEndHessian(const ChainData& data, int c, ConstVectorRef v, VectorRef out) {
@@ -43,7 +41,7 @@ GradientFlowModel::GradientFlowModel(const Chain& chain, const EndCondition& end
       scaledRhs_(chain.size()), y_(end.heldCount()), zeroM_(Vector::Zero(end.heldCount())),
       V_(chain.size(), end.heldCount()), W_(chain.size(), end.heldCount()) {
   // (held rows only until setContacts() adds locked joints: resizeConstraints())
-  if (!finite(c_) || !(c_ > 0.0)) throw std::invalid_argument("flowDamping must be > 0");
+  if (!std::isfinite(c_) || !(c_ > 0.0)) throw std::invalid_argument("flowDamping must be > 0");
   if (q0.size() != chain.size()) throw std::invalid_argument("q0 must have one entry per joint");
   if (!(kappaH_ > 0.0)) {
     Vector kq(chain.size());

@@ -15,8 +15,6 @@ namespace {
 
 std::atomic<long> inertialModelsConstructed{0};
 
-bool finite(double v) { return std::isfinite(v); }
-
 }  // namespace
 
 // ---- inertial (D2) ---------------------------------------------------------------------------
@@ -41,7 +39,7 @@ InertialModel::InertialModel(const Chain& chain, const EndCondition& end, const 
   if (!jointDamping.empty() && static_cast<int>(jointDamping.size()) != n)
     throw std::invalid_argument("jointDamping must be empty or have one entry per joint");
   if (q0.size() != n) throw std::invalid_argument("q0 must have one entry per joint");
-  if (!finite(baumgarteRate)) throw std::invalid_argument("baumgarteRate must be finite");
+  if (!std::isfinite(baumgarteRate)) throw std::invalid_argument("baumgarteRate must be finite");
   ++inertialModelsConstructed;
 
   mass_.resize(n);
@@ -52,7 +50,7 @@ InertialModel::InertialModel(const Chain& chain, const EndCondition& end, const 
     mass_[i] = L.mass;
     inertia_[i] = L.inertia;
     if (!jointDamping.empty()) {
-      if (!finite(jointDamping[size_t(i)]) || jointDamping[size_t(i)] < 0.0)
+      if (!std::isfinite(jointDamping[size_t(i)]) || jointDamping[size_t(i)] < 0.0)
         throw std::invalid_argument("jointDamping[" + std::to_string(i) + "] must be >= 0");
       d_[i] = jointDamping[size_t(i)];
     }

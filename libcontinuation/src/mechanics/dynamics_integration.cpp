@@ -17,28 +17,22 @@
 
 namespace buckle::mechanics {
 
-namespace {
-
-bool finite(double v) { return std::isfinite(v); }
-
-}  // namespace
-
 // ---- integration -----------------------------------------------------------------------------
 
 std::string IntegrationOptions::validate(const std::string& prefix) const {
-  if (!finite(absoluteTolerance) || !(absoluteTolerance > 0.0)) return prefix + "absoluteTolerance must be > 0";
-  if (!finite(relativeTolerance) || relativeTolerance < 0.0) return prefix + "relativeTolerance must be >= 0";
-  if (!finite(initialStep) || !(initialStep > 0.0)) return prefix + "initialStep must be > 0";
-  if (!finite(maxStep) || maxStep < 0.0) return prefix + "maxStep must be >= 0 (0: unlimited)";
-  if (!finite(minStep) || !(minStep > 0.0)) return prefix + "minStep must be > 0";
+  if (!std::isfinite(absoluteTolerance) || !(absoluteTolerance > 0.0)) return prefix + "absoluteTolerance must be > 0";
+  if (!std::isfinite(relativeTolerance) || relativeTolerance < 0.0) return prefix + "relativeTolerance must be >= 0";
+  if (!std::isfinite(initialStep) || !(initialStep > 0.0)) return prefix + "initialStep must be > 0";
+  if (!std::isfinite(maxStep) || maxStep < 0.0) return prefix + "maxStep must be >= 0 (0: unlimited)";
+  if (!std::isfinite(minStep) || !(minStep > 0.0)) return prefix + "minStep must be > 0";
   if (maxStep > 0.0 && maxStep < minStep) return prefix + "maxStep must be >= minStep";
   if (!(maxTime > 0.0) || std::isnan(maxTime)) return prefix + "maxTime must be > 0";
   if (maxSteps < 1) return prefix + "maxSteps must be >= 1";
-  if (!finite(velocityTolerance) || !(velocityTolerance > 0.0)) return prefix + "velocityTolerance must be > 0";
-  if (!finite(residualTolerance) || !(residualTolerance > 0.0)) return prefix + "residualTolerance must be > 0";
-  if (!finite(recordInterval) || recordInterval < 0.0) return prefix + "recordInterval must be >= 0";
+  if (!std::isfinite(velocityTolerance) || !(velocityTolerance > 0.0)) return prefix + "velocityTolerance must be > 0";
+  if (!std::isfinite(residualTolerance) || !(residualTolerance > 0.0)) return prefix + "residualTolerance must be > 0";
+  if (!std::isfinite(recordInterval) || recordInterval < 0.0) return prefix + "recordInterval must be >= 0";
   if (maxSamples < 2) return prefix + "maxSamples must be >= 2";
-  if (!finite(settleResidual) || !(settleResidual > 0.0)) return prefix + "settleResidual must be > 0";
+  if (!std::isfinite(settleResidual) || !(settleResidual > 0.0)) return prefix + "settleResidual must be > 0";
   if (settleInterval < 1) return prefix + "settleInterval must be >= 1";
   return {};
 }

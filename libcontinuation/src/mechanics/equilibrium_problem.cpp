@@ -23,9 +23,6 @@ using continuation::VectorRef;
 using continuation::workspaceAs;
 
 namespace {
-// How far past a geometric limit points are still evaluated while the joint limits are traced
-// as boundaries (inDomain() below).
-constexpr double kGeometricOvershoot = 0.05;  // rad: a few halvings of a step that crosses a limit
 // Up to this chain length stability() takes the inertia alone from smallDenseInertia (unrolled
 // for n ≤ 4) rather than two robust Sturm counts: per call with one held row, n = 2: 0.7 k
 // against 1.4 k instructions, n = 3: 1.1 k against 1.7 k, n = 4: 2.6 k against 2.0 k

@@ -8,8 +8,6 @@
 namespace buckle::mechanics {
 
 namespace {
-// Shapes are named with a straightness tolerance in radians (the angles' own unit).
-constexpr double kStraightTolerance = 1e-6;
 
 void setState(const EquilibriumProblem& problem, const Eigen::VectorXd& q, const Wrench& F, Landing& l) {
   l.q = q;

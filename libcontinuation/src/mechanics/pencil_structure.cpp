@@ -14,13 +14,8 @@
 
 namespace buckle::mechanics {
 
-namespace {
-
-// A pivot this small relative to G_σ's scale is an exact zero to the recursion (dstebz's pivmin).
-constexpr double kTinyPivot = 1e-290;
-constexpr double kBunchAlpha = 0.6180339887498949;  // (√5 − 1)/2, as chain_structure's tridiagonal pivoting
-
-}  // namespace
+using structure::kBunchAlpha;
+using structure::kTinyPivot;
 
 MassGenerators massGenerators(const Chain& chain, const InertiaData& inertia) {
   const int n = chain.size();

@@ -10,6 +10,12 @@
 
 namespace buckle::mechanics::structure {
 
+/// Bunch's pivoting threshold for the symmetric tridiagonal factorizations: (√5 − 1)/2.
+constexpr double kBunchAlpha = 0.6180339887498949;
+/// A pivot this small relative to the matrix's scale is an exact zero to the recursion
+/// (LAPACK dstebz's pivmin).
+constexpr double kTinyPivot = 1e-290;
+
 /// A product of many pivots kept as mantissa · 2^exponent (a log per pivot would dominate the
 /// factorization's cost; the plain product over- or underflows for long chains).
 struct ScaledProduct {

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "buckle/continuation/bordered_solver.h"
+#include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/task_path_kkt_solver.h"
 #include "buckle/mechanics/task_path_solver.h"
 
@@ -16,12 +17,6 @@ using continuation::workspaceAs;
 using continuation::ConstVectorRef;
 using continuation::MatrixRef;
 using continuation::VectorRef;
-
-namespace {
-// A step that crosses a joint limit may overshoot it by a few halvings while the tracer locates
-// the limit (as EquilibriumProblem does).
-constexpr double kGeometricOvershoot = 0.05;
-}  // namespace
 
 std::string taskInputName(const TaskInput& input) {
   const std::string base = controlInputName(input.input);
@@ -84,8 +79,8 @@ TaskPathProblem::TaskPathProblem(const Chain& chain, const TaskSetup& setup)
     const Segment& s = chain_.segment(i);
     L1_[i] = s.parameters().L1_0;
     L2_[i] = s.parameters().L2_0;
-    domainUpper_[i] = s.geometricUpperLimit() + kGeometricOvershoot;
-    domainLower_[i] = s.geometricLowerLimit() - kGeometricOvershoot;
+    domainUpper_[i] = s.geometricUpperLimit() + EquilibriumProblem::kGeometricOvershoot;
+    domainLower_[i] = s.geometricLowerLimit() - EquilibriumProblem::kGeometricOvershoot;
     b += 0.5 * (s.parameters().b1 + s.parameters().b2);
     k += 0.5 * (s.parameters().k1 + s.parameters().k2);
   }
@@ -148,7 +143,8 @@ bool TaskPathProblem::prepare(ProblemWorkspace& ws, ConstVectorRef u) const {
     const double L1 = L1_[i] + dL(i, 0), L2 = L2_[i] + dL(i, 1);
     // the spring model holds for any free length; a little past zero is let through so that the
     // tracer can locate the free-length boundary (L⁰ = 0) from both sides
-    if (!(L1 > -kGeometricOvershoot * lengthUnit_ && L2 > -kGeometricOvershoot * lengthUnit_)) return false;
+    const double margin = EquilibriumProblem::kGeometricOvershoot * lengthUnit_;
+    if (!(L1 > -margin && L2 > -margin)) return false;
     const Segment& seg = chain_.segment(i);
     const double sh = std::sin(0.5 * q[i]), ch = std::cos(0.5 * q[i]);
     Jet3 rate;

@@ -10,14 +10,11 @@
 #include <string>
 
 #include "buckle/mechanics/body_loads.h"
+#include "buckle/mechanics/chain_structure.h"
 
 namespace buckle::mechanics {
 
 namespace {
-
-// Rows of C_h whose remainder falls below this (relative to the largest) do not constrain: x
-// held on a straight chain (J_x = 0), as in chain_structure.h's setConstraints().
-constexpr double kRankTolerance = 1e-10;
 
 /// Symmetric tridiagonal T (diagonal d, off-diagonal e) minus σI, factored by Gaussian elimination
 /// with partial pivoting (LAPACK dgttrf): U has two superdiagonals, L unit lower bidiagonal
@@ -168,7 +165,7 @@ VibrationModes VibrationAnalysis::denseModes(ConstVectorRef q, const Wrench& F, 
   Eigen::ColPivHouseholderQR<Matrix> qr(n, std::max(int(C.rows()), 1));
   int rank = 0;
   if (C.rows() > 0) {
-    qr.setThreshold(kRankTolerance);
+    qr.setThreshold(kConstraintRankTolerance);
     qr.compute(C.transpose());
     rank = qr.rank();
     H.applyOnTheLeft(qr.householderQ().adjoint());

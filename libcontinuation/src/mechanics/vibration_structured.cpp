@@ -15,9 +15,6 @@ namespace buckle::mechanics {
 
 namespace {
 
-// Rows of C_h whose remainder falls below this (relative to the largest) do not constrain (as the
-// dense route and chain_structure.h's setConstraints()).
-constexpr double kRankTolerance = 1e-10;
 // The search's tolerance unit: 1e-6 of the pencil's scale, so that the low frequencies of a long
 // chain (ω₁² ≪ max ω²) are still resolved to many digits; isolation by counts does not depend on
 // it and the polish converges superlinearly, so it costs a few more evaluations, not more bisection.
@@ -220,7 +217,7 @@ VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench
     auto C = s.C.topLeftCorner(Eigen::Index(held.size()), m);
     for (size_t row = 0; row < held.size(); ++row)
       for (int c = 0; c < m; ++c) C(Eigen::Index(row), c) = s.J(held[row], s.freeJoints[size_t(c)]);
-    setPencilConstraints(ws, C, kRankTolerance);
+    setPencilConstraints(ws, C, kConstraintRankTolerance);
   }
   const int p = m - ws.rank;
   out.dimension = p;

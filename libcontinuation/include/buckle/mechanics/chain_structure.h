@@ -139,6 +139,11 @@ int countBelow(const ChainStructure& ws, double sigma);
 void solveFactored(const ChainStructure& ws, MatrixRef Y, int cols);
 void solveFactored(const ChainStructure& ws, VectorRef y);
 
+/// Rows of a constraint Jacobian whose remainder falls below this (relative to the largest row
+/// norm) do not constrain: x held on a straight chain (J_x = 0). setConstraints()' default, and
+/// the vibration pencil's (vibration.h).
+inline constexpr double kConstraintRankTolerance = 1e-10;
+
 /// Zero threshold τ = zeroTolerance · max(typicalScale, ‖H‖_F).
 double zeroThreshold(const ChainStructure& ws, double zeroTolerance);
 
@@ -148,13 +153,13 @@ Inertia hessianInertia(const ChainStructure& ws, double zeroTolerance = 1e-13);
 /// Orthonormalise the rows of C (m×n, m ≤ 3) into ws.Q (first ws.rank columns) and form
 /// B = U⁻¹Q. Rows whose remainder falls below rankTolerance (relative to the largest row norm)
 /// are dropped, so rank-deficient C (e.g. x held on a straight chain, J_x = 0) is handled.
-int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double rankTolerance = 1e-10);
+int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double rankTolerance = kConstraintRankTolerance);
 /// Number of eigenvalues of Zᵀ H Z below σ (after setConstraints()); refactorizes at σ (with the
 /// determinant of T − σM only if `determinant`).
 int constrainedCountBelow(ChainStructure& ws, double sigma, bool determinant = true);
 /// Inertia of H on ker C (n − rank(C) eigenvalues). C may have zero rows.
 Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double zeroTolerance = 1e-13,
-                           double rankTolerance = 1e-10);
+                           double rankTolerance = kConstraintRankTolerance);
 
 /// The `count` lowest eigenvalues (ascending) of H, or of Zᵀ H Z (after setConstraints()) when
 /// useConstraints, to absolute accuracy ~tolerance · max(1, ‖H‖_F), written to out[0 … k−1];
@@ -180,7 +185,7 @@ double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolera
 /// faster than the O(n) counts plus eigenvalue isolation (benchmarks/RESULTS.md).
 constexpr int kSmallDense = 32;
 Inertia smallDenseInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, int count, VectorRef lowest,
-                          int& found, double zeroTolerance = 1e-13, double rankTolerance = 1e-10);
+                          int& found, double zeroTolerance = 1e-13, double rankTolerance = kConstraintRankTolerance);
 
 // ---- solves --------------------------------------------------------------------------------
 /// H x = r (x may alias r). Factorizes T at σ = 0; false if T is singular to working precision.

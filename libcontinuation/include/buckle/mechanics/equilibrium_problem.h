@@ -184,6 +184,9 @@ class EquilibriumProblem final : public continuation::Problem {
   /// one heap-free dense solve (faster there: benchmarks/RESULTS.md). Otherwise the dense
   /// Problem::stability().
   static constexpr int kMaxLowest = 4;  // the isolation's fixed-size brackets
+  /// How far (rad) past a geometric limit points are still evaluated while the joint limits are
+  /// traced as boundaries (inDomain()): a few halvings of a step that crosses a limit.
+  static constexpr double kGeometricOvershoot = 0.05;
   bool stability(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
                  continuation::StabilityInfo& info) const override;
   /// Eigenvalues by index of K_q − K_g on ker J_h, each isolated on O(n) Sturm counts of the

@@ -18,6 +18,10 @@ int signChanges(const Eigen::Ref<const Eigen::VectorXd>& v, double tolerance = 0
 ///    is "mode 1" (the U shape has one), the first cantilever mode "mode 0".
 std::string shapeName(const Eigen::Ref<const Eigen::VectorXd>& q, double straightTolerance = 1e-9);
 
+/// The straightness tolerance (rad, the angles' own unit) the reports and landings name the
+/// shapes of equilibria with: a chain bent by less than 1e-6 rad at every joint is straight.
+inline constexpr double kStraightTolerance = 1e-6;
+
 /// Shape name of a mode vector, scale-free: the tolerance is relative to max |z_i|.
 std::string modeShapeName(const Eigen::Ref<const Eigen::VectorXd>& z, double relativeTolerance = 1e-9);
 
