@@ -345,7 +345,7 @@ TEST_CASE("Long chains: the O(n) path equals the dense pencil to rounding (loads
     }
   }
   WARN("largest relative difference O(n) vs dense: " << worst);
-  CHECK(compared >= 15);
+  CHECK(compared >= 5 * int(sizes.size()));  // at least five comparisons per chain length
 }
 
 TEST_CASE("Long chains: cantilever loads equal the discrete closed form at any n", "[linear_buckling]") {
