@@ -49,9 +49,9 @@ MpiWorld::MpiWorld() {
 #else
   if (launcherSize() > 1)
     throw std::runtime_error("started by mpirun with " + std::to_string(launcherSize()) +
-                             " processes, but `buckle` has no MPI: run `mpirun -np N buckle-mpi atlas ...` (built "
-                             "beside buckle when CMake finds MPI: libopenmpi-dev), or `buckle atlas` without mpirun: "
-                             "it uses all cores on threads");
+                             " processes, but `buckle` has no MPI: run `mpirun -np N buckle-mpi atlas ...` or "
+                             "`mpirun -np N buckle-mpi run ...` (built beside buckle when CMake finds MPI: "
+                             "libopenmpi-dev), or buckle without mpirun: it uses all cores on threads");
 #endif
 }
 
@@ -68,12 +68,12 @@ int MpiWorld::broadcast(int value) const {
   return value;
 }
 
-std::vector<std::string> MpiWorld::gather(const std::string& mine) const {
+std::vector<std::string> MpiWorld::allgather(const std::string& mine) const {
   if (!initialised_) return {mine};
   std::vector<std::string> all;
 #if BUCKLE_WITH_MPI
   // Every rank learns every size first, so a total too large for MPI's int counts is refused
-  // by all of them alike instead of leaving the others waiting in MPI_Gatherv.
+  // by all of them alike instead of leaving the others waiting in MPI_Allgatherv.
   unsigned long long size = mine.size();
   std::vector<unsigned long long> sizes(size_t(size_), 0);
   MPI_Allgather(&size, 1, MPI_UNSIGNED_LONG_LONG, sizes.data(), 1, MPI_UNSIGNED_LONG_LONG, MPI_COMM_WORLD);
@@ -88,13 +88,17 @@ std::vector<std::string> MpiWorld::gather(const std::string& mine) const {
     offsets[size_t(r)] = at;
     at += counts[size_t(r)];
   }
-  std::string received(rank_ == 0 ? size_t(total) : 0, '\0');
-  MPI_Gatherv(mine.data(), int(mine.size()), MPI_CHAR, received.data(), counts.data(), offsets.data(), MPI_CHAR, 0,
-              MPI_COMM_WORLD);
-  if (rank_ == 0)
-    for (int r = 0; r < size_; ++r)
-      all.push_back(received.substr(size_t(offsets[size_t(r)]), size_t(counts[size_t(r)])));
+  std::string received(size_t(total), '\0');
+  MPI_Allgatherv(mine.data(), int(mine.size()), MPI_CHAR, received.data(), counts.data(), offsets.data(), MPI_CHAR,
+                 MPI_COMM_WORLD);
+  for (int r = 0; r < size_; ++r) all.push_back(received.substr(size_t(offsets[size_t(r)]), size_t(counts[size_t(r)])));
 #endif
+  return all;
+}
+
+std::vector<std::string> MpiWorld::gather(const std::string& mine) const {
+  std::vector<std::string> all = allgather(mine);
+  if (rank_ != 0) all.clear();
   return all;
 }
 

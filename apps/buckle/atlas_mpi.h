@@ -1,4 +1,4 @@
-// `buckle atlas` across processes. Started by mpirun (or another MPI launcher), every rank
+// `buckle atlas` and `buckle run` across processes. Started by mpirun (or another MPI launcher), every rank
 // computes its share of the cells (scene::AtlasShare) on its own threads and rank 0 gathers
 // them and writes the output; started without one, MPI is never initialised and the atlas runs
 // on threads alone, as on any machine without MPI. The only unit that includes <mpi.h>, and only
@@ -37,9 +37,11 @@ class MpiWorld {
 
   /// Rank 0's value, on every rank.
   int broadcast(int value) const;
-  /// Every rank's bytes on rank 0, in rank order (empty on the others). Collective: every rank
-  /// calls it. Throws std::runtime_error on every rank alike when the total exceeds what one
-  /// MPI message can count (2^31 − 1 bytes).
+  /// Every rank's bytes on every rank, in rank order. Collective: every rank calls it. Throws
+  /// std::runtime_error on every rank alike when the total exceeds what one MPI message can
+  /// count (2^31 − 1 bytes).
+  std::vector<std::string> allgather(const std::string& mine) const;
+  /// allgather's result on rank 0, empty on the others.
   std::vector<std::string> gather(const std::string& mine) const;
 
  private:

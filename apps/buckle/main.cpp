@@ -1,7 +1,7 @@
 // buckle: command-line front end of the dual-triangle chain mechanics.
 // Subcommands are registered here, each implemented in its own <name>_command.cpp.
 // Compiled twice: `buckle` (every subcommand, no MPI) and, with BUCKLE_MPI_PROGRAM, `buckle-mpi`
-// (the atlas alone, for mpirun): only the program that needs MPI loads its libraries at start-up.
+// (the atlas and the scene runner, for mpirun): only the program that needs MPI loads its libraries at start-up.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #if defined(__GLIBC__)
@@ -52,7 +52,8 @@ int main(int argc, char** argv) {
   adviseHugePagesForHeap();
 #endif
 #if BUCKLE_MPI_PROGRAM
-  CLI::App app{"buckle-mpi: `buckle atlas` shared among the processes of mpirun (mpirun -np N buckle-mpi atlas ...)"};
+  CLI::App app{"buckle-mpi: `buckle atlas` and `buckle run` shared among the processes of mpirun (mpirun -np N "
+               "buckle-mpi atlas|run ...)"};
   app.set_version_flag("--version", std::string("buckle-mpi ") + BUCKLE_VERSION);
 #else
   CLI::App app{"buckle: mechanics of compliant serial manipulators made of dual-triangle segments"};
@@ -62,8 +63,8 @@ int main(int argc, char** argv) {
   buckle::cli::Outcome outcome;
 #if !BUCKLE_MPI_PROGRAM
   buckle::cli::addCriticalCommand(app, outcome);
-  buckle::cli::addRunCommand(app, outcome);
 #endif
+  buckle::cli::addRunCommand(app, outcome);
   buckle::cli::addAtlasCommand(app, outcome);
 #if !BUCKLE_MPI_PROGRAM
   buckle::cli::addRegressCommand(app, outcome);

@@ -1,15 +1,44 @@
 #include "run_command.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <unistd.h>
 
+#include "atlas_mpi.h"
 #include "scene/command.h"
 
 namespace buckle::cli {
+
+namespace {
+
+// scene::SharedWork::exchange over MPI: an all-gather of tagged bytes; a rank whose tag differs
+// is at another exchange (or finished) and sent nothing for this one.
+std::vector<std::string> taggedExchange(const MpiWorld& world, const std::string& tag, const std::string& mine) {
+  const std::string head = tag + '\n';
+  std::vector<std::string> parts = world.allgather(head + mine);
+  for (std::string& p : parts) p = p.compare(0, head.size(), head) == 0 ? p.substr(head.size()) : std::string();
+  return parts;
+}
+
+// Waits until every rank has finished its run; the exchanges of ranks still running meanwhile
+// get nothing from this one (they compute its share themselves). Every rank leaves in the same
+// round, so no collective call is left unmatched.
+void finishShared(const MpiWorld& world) {
+  const std::string done = "done\n";
+  for (;;) {
+    const std::vector<std::string> all = world.allgather(done);
+    if (std::all_of(all.begin(), all.end(), [&](const std::string& s) { return s == done; })) return;
+  }
+}
+
+}  // namespace
 
 void addRunCommand(CLI::App& app, Outcome& outcome) {
   auto options = std::make_shared<scene::RunCommandOptions>();
@@ -24,7 +53,9 @@ void addRunCommand(CLI::App& app, Outcome& outcome) {
       "written), 130 / 143 stopped by SIGINT / SIGTERM (what was computed is written; a second signal ends the "
       "program, once the output directory is complete or removed).\n"
       "Progress goes to stderr: a live line on a terminal, a plain line every few seconds otherwise; --quiet "
-      "silences it.");
+      "silences it.\n"
+      "Under mpirun (`mpirun -np N buckle-mpi run SCENE`): rank 0 runs the scene and writes it; the rows of a "
+      "workspace map are shared among the ranks (the same output as one process, byte for byte but the timings).");
   run->add_option("scene", options->scene, "Scene file (JSON, schema: docs/scenes.md), e.g. data/scenes/default.json")
       ->required();
   run->add_option("--out,-o", options->out,
@@ -51,9 +82,32 @@ void addRunCommand(CLI::App& app, Outcome& outcome) {
     // an empty --out is a mistake, not the default directory
     if (run->count("--out") > 0 && options->out.empty())
       throw BadArgument{"--out is empty: give the output directory (or leave --out out for out/<scene>)"};
-    options->handleSignals = true;
-    options->progress = ::isatty(STDERR_FILENO) == 1 ? scene::Progress::Mode::Live : scene::Progress::Mode::Lines;
-    const int code = scene::runSceneCommand(*options, std::cout, std::cerr);
+    std::optional<MpiWorld> world;  // MPI only when started by mpirun (buckle-mpi); one process otherwise
+    try {
+      world.emplace();
+    } catch (const std::runtime_error& e) {
+      throw BadArgument{e.what()};
+    }
+    scene::RunCommandOptions o = *options;
+    o.handleSignals = true;
+    // no live line under mpirun: it hands the ranks a terminal even when its own output is a file
+    o.progress = ::isatty(STDERR_FILENO) == 1 && !world->distributed() ? scene::Progress::Mode::Live
+                                                                        : scene::Progress::Mode::Lines;
+    if (world->distributed() && world->size() > 1) {
+      o.shared.part = world->rank();
+      o.shared.parts = world->size();
+      o.shared.threads = std::max(1, int(std::thread::hardware_concurrency()) / world->ranksOnThisNode());
+      o.shared.exchange = [&w = *world](const std::string& tag, const std::string& mine) {
+        return taggedExchange(w, tag, mine);
+      };
+      o.quiet = o.quiet || !world->root();
+    }
+    int code = scene::runSceneCommand(o, std::cout, std::cerr);
+    if (o.shared.shared()) {
+      finishShared(*world);
+      // rank 0 carries the exit status: mpirun ends the job when any rank exits non-zero
+      if (!world->root()) code = scene::kSuccess;
+    }
     // 128 + signal after SIGINT/SIGTERM (partial results written), as a shell reports it
     outcome.code = code == scene::kSuccess    ? kSuccess
                    : code == scene::kBadInput ? kBadInput

@@ -13,9 +13,11 @@
 #include <stdexcept>
 #include <thread>
 
+#include "buckle/continuation/byte_packing.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/post_buckling.h"
 #include "scene/child_process.h"
+#include "scene/columns.h"
 #include "scene/output.h"
 #include "scene/signals.h"
 
@@ -52,7 +54,7 @@ void computeCell(AtlasCell& c) {
     c.postSlope = fb.slope;
     c.error = fb.message;
   } catch (const std::exception& e) {  // an invalid segment (e.g. a/b too large) names itself
-    c.firstCritical = std::numeric_limits<double>::quiet_NaN();
+    c.firstCritical = kNaN;
     c.postBuckling = "failed";
     c.error = e.what();
   }
@@ -65,45 +67,6 @@ int postCode(const std::string& s) {
   if (s == "none") return 3;
   return -1;
 }
-
-// The atlas' packed cells: fixed-size fields copied byte for byte (the receiver is the same
-// program on the same kind of machine), strings as a length and their bytes.
-template <class T>
-void put(std::string& out, const T& v) {
-  out.append(reinterpret_cast<const char*>(&v), sizeof v);
-}
-void putString(std::string& out, const std::string& s) {
-  put(out, std::uint64_t(s.size()));
-  out += s;
-}
-
-class Reader {
- public:
-  explicit Reader(const std::string& bytes) : bytes_(bytes) {}
-  bool done() const { return at_ == bytes_.size(); }
-  template <class T>
-  T get() {
-    T v;
-    need(sizeof v);
-    std::memcpy(&v, bytes_.data() + at_, sizeof v);
-    at_ += sizeof v;
-    return v;
-  }
-  std::string getString() {
-    const auto n = get<std::uint64_t>();
-    need(n);
-    std::string s = bytes_.substr(at_, size_t(n));
-    at_ += size_t(n);
-    return s;
-  }
-
- private:
-  void need(std::uint64_t n) const {
-    if (n > bytes_.size() - at_) throw std::runtime_error("atlas cells: the packed data ends early");
-  }
-  const std::string& bytes_;
-  size_t at_ = 0;
-};
 
 std::string axisLabel(const std::string& name) {
   if (name == "a") return "a/b";
@@ -148,7 +111,7 @@ std::vector<AtlasCell> atlasGrid(const AtlasOptions& o) {
         if (axis->name == "n") c.n = static_cast<int>(std::lround(v));
       }
       c.kappa = c.L0 - 2.0 * (1.0 - c.a * c.a);
-      c.firstCritical = std::numeric_limits<double>::quiet_NaN();
+      c.firstCritical = kNaN;
       c.postBuckling = "not computed";
     }
   return cells;
@@ -199,28 +162,27 @@ std::vector<AtlasCell> computeAtlas(const AtlasOptions& o, const std::function<v
 }
 
 std::string packAtlasCells(const std::vector<AtlasCell>& cells, const AtlasShare& share) {
-  std::string out;
+  continuation::ByteWriter out;
   for (size_t k = 0; k < cells.size(); ++k) {
     if (!share.owns(k)) continue;
     const AtlasCell& c = cells[k];
-    put(out, std::uint64_t(k));
-    put(out, std::uint8_t(c.straightStable ? 1 : 0));
-    put(out, c.firstCritical);
-    put(out, c.postSlope);
-    putString(out, c.firstShape);
-    putString(out, c.postBuckling);
-    putString(out, c.error);
+    out.put(std::uint64_t(k));
+    out.put(std::uint8_t(c.straightStable ? 1 : 0));
+    out.put(c.firstCritical);
+    out.put(c.postSlope);
+    out.putString(c.firstShape);
+    out.putString(c.postBuckling);
+    out.putString(c.error);
   }
-  return out;
+  return out.release();
 }
 
 void unpackAtlasCells(const std::string& bytes, std::vector<AtlasCell>& cells) {
-  Reader in(bytes);
+  continuation::ByteReader in(bytes, "atlas cells");
   while (!in.done()) {
     const auto k = in.get<std::uint64_t>();
     if (k >= cells.size())
-      throw std::runtime_error("atlas cells: cell " + std::to_string(k) + " is outside the grid of " +
-                               std::to_string(cells.size()));
+      in.fail("cell " + std::to_string(k) + " is outside the grid of " + std::to_string(cells.size()));
     AtlasCell& c = cells[size_t(k)];
     c.straightStable = in.get<std::uint8_t>() != 0;
     c.firstCritical = in.get<double>();

@@ -15,12 +15,20 @@ void CaseRunner::workspaceMap() {
   if (!actuationStart()) return;  // said in the run's problems
   mech::WorkspaceMapOptions o = scene_.analyses.workspace.options;
   o.tracer = solverOptions();
+  if (control_.shared.shared()) {  // the rows shared among the processes of the run
+    o.share.part = control_.shared.part;
+    o.share.parts = control_.shared.parts;
+    o.share.rowsOnly = !control_.shared.writer();
+    const std::string tag = "workspace map of case " + std::to_string(&spec_ - scene_.cases.data());
+    o.share.exchange = [exchange = control_.shared.exchange, tag](const std::string& mine) { return exchange(tag, mine); };
+    if (o.threads == 0) o.threads = control_.shared.threads;
+  }
   try {
     const mech::InputPlane plane(out_.chain, spec_.end.condition, bodyLoads().atParameter(out_.startValue),
                                  o.first.input, o.second.input);
     out_.workspace = mech::computeWorkspaceMap(plane, out_.qStart, o);
     out_.haveWorkspace = true;
-  } catch (const std::invalid_argument& e) {
+  } catch (const std::exception& e) {  // invalid options, or rows from another process that do not fit
     run_.complete = false;
     run_.problems.push_back("case \"" + spec_.label + "\": workspace map: " + e.what());
     return;

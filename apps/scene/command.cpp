@@ -99,14 +99,37 @@ std::string spoolDirectory(const std::string& target) {
 
 }  // namespace
 
+namespace {
+
+// A process of a shared run that does not write (RunCommandOptions::shared): its share of the
+// scene's shared work, nothing written, nothing said.
+int runSceneShare(const RunCommandOptions& options, Scene& scene) {
+  std::optional<SignalGuard> signals;
+  if (options.handleSignals) signals.emplace();
+  RunControl control;
+  control.shared = options.shared;
+  if (!std::isnan(options.timeLimit)) scene.solver.timeLimit = options.timeLimit;
+  if (signals) control.interrupt.watch(SignalGuard::flag(), "interrupted by a signal (SIGINT/SIGTERM/SIGHUP)");
+  const RunResult run = runScene(scene, control);
+  if (signals && SignalGuard::signal() != 0) return SignalGuard::exitCode();
+  return run.complete ? kSuccess : kIncomplete;
+}
+
+}  // namespace
+
 int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::ostream& err) {
   const auto started = std::chrono::steady_clock::now();
+  const bool writer = options.shared.writer();
   Scene scene;
   try {
     scene = loadScene(options.scene);
   } catch (const SceneError& e) {
-    err << "buckle run: bad scene: " << e.what() << "\n";
+    if (writer) err << "buckle run: bad scene: " << e.what() << "\n";
     return kBadInput;
+  }
+  if (!writer) {  // the writer checks the rest and says whether the run goes on
+    const std::vector<std::string> verdict = options.shared.exchange("start", "");
+    return verdict.empty() || verdict[0] != "go" ? kBadInput : runSceneShare(options, scene);
   }
   if (!std::isnan(options.timeLimit) && !(options.timeLimit > 0.0)) {
     err << "buckle run: --time-limit must be a positive number of seconds\n";
@@ -120,6 +143,7 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
     err << "buckle run: " << e.what() << "\n";
     return kBadInput;
   }
+  if (options.shared.shared()) options.shared.exchange("start", "go");
   std::optional<SignalGuard> signals;
   if (options.handleSignals) signals.emplace();
   // printed once the signal handlers are in place: from here on a signal stops the run cleanly
@@ -134,6 +158,7 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
   Progress progress(err, options.quiet ? Progress::Mode::Off : options.progress);
   RunControl control;
   control.progress = &progress;
+  control.shared = options.shared;
   if (!std::isnan(options.timeLimit)) {
     scene.solver.timeLimit = options.timeLimit;  // recorded as such in summary.json
   }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "scene/progress.h"
+#include "scene/shared_work.h"
 
 namespace buckle::scene {
 
@@ -25,6 +26,10 @@ struct RunCommandOptions {
   Progress::Mode progress = Progress::Mode::Lines;
   /// Stop on SIGINT/SIGTERM with partial results (the CLI); off for in-process callers.
   bool handleSignals = false;
+  /// The other processes of `mpirun -np N buckle-mpi run` (shared_work.h): the writer checks
+  /// `out` and writes; the others compute their share and write nothing (not even an error
+  /// message: the writer says it).
+  SharedWork shared;
 };
 
 /// The problems of a run for a human: the first `keep` as they are, then the rest grouped by

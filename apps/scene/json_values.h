@@ -16,4 +16,12 @@ inline nlohmann::json jsonVector(const Eigen::VectorXd& v) {
   return a;
 }
 
+/// An end wrench (Fx, Fy, Me) and an end pose (x, y, phi), under the names of branches.csv.
+inline nlohmann::json wrenchJson(const Eigen::Vector3d& F) {
+  return {{"Fx", jsonNumber(F[0])}, {"Fy", jsonNumber(F[1])}, {"Me", jsonNumber(F[2])}};
+}
+inline nlohmann::json poseJson(const Eigen::Vector3d& p) {
+  return {{"x", jsonNumber(p[0])}, {"y", jsonNumber(p[1])}, {"phi", jsonNumber(p[2])}};
+}
+
 }  // namespace buckle::scene

@@ -68,8 +68,6 @@ void writeBranches(const Scene& scene, const RunResult& run, const fs::path& dir
   writeText(dir / "joint_angles.npy", bytes);
 }
 
-json wrenchJson(const mechanics::Wrench& F) { return json{{"Fx", jsonNumber(F[0])}, {"Fy", jsonNumber(F[1])}, {"Me", jsonNumber(F[2])}}; }
-json poseJson(const mechanics::Pose& p) { return json{{"x", jsonNumber(p[0])}, {"y", jsonNumber(p[1])}, {"phi", jsonNumber(p[2])}}; }
 /// Joints resting against their limits: 1-based joint, side, contact torque τ_c (k b²).
 json contactsJson(const std::vector<mechanics::JointContact>& contacts) {
   json a = json::array();

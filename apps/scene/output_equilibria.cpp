@@ -18,8 +18,8 @@ json equilibriumJson(const mechanics::FoundEquilibrium& e, const mechanics::EndC
          {"stable", e.stable},
          {"potential", jsonNumber(e.potential)},
          {"shape", e.shape},
-         {"loads", json{{"Fx", jsonNumber(e.wrench[0])}, {"Fy", jsonNumber(e.wrench[1])}, {"Me", jsonNumber(e.wrench[2])}}},
-         {"pose", json{{"x", jsonNumber(e.pose[0])}, {"y", jsonNumber(e.pose[1])}, {"phi", jsonNumber(e.pose[2])}}},
+         {"loads", wrenchJson(e.wrench)},
+         {"pose", poseJson(e.pose)},
          {"accuracy", jsonNumber(e.accuracy)},
          {"by_deflation", e.byDeflation},
          {"by_sweep", e.bySweep}};

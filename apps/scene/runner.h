@@ -23,6 +23,7 @@
 #include "buckle/mechanics/unloaded_shape.h"
 #include "scene/progress.h"
 #include "scene/scene.h"
+#include "scene/shared_work.h"
 
 namespace buckle::scene {
 
@@ -159,6 +160,9 @@ struct RunControl {
   /// memory (CaseResult::points), so a run's memory follows its largest branch and the chain's
   /// length, not the tree's size. Empty: every point is kept until the outputs are written.
   std::string streamTo;
+  /// Other processes sharing the run (shared_work.h); by default this process alone. A part
+  /// that is not the writer runs only the stages whose work is shared.
+  SharedWork shared;
 };
 
 /// Runs every case of the scene. Never throws for a numerical failure (recorded in problems).

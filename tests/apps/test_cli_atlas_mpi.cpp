@@ -8,6 +8,7 @@
 #ifdef BUCKLE_MPIEXEC
 
 #include "cli_helpers.h"
+#include "mpi_run.h"
 #include "temp_dir.h"
 
 #include <filesystem>
@@ -17,41 +18,19 @@
 #include <string>
 
 namespace fs = std::filesystem;
+using buckle::test::count;
 using buckle::test::exitCode;
+using buckle::test::kBuckleMpi;
+using buckle::test::mpiExitCode;
 using buckle::test::slurp;
 
 namespace {
 
-const std::string kBuckleMpi = std::string(BUCKLE_BINARY_DIR) + "/bin/buckle-mpi";
-
 fs::path mpiDir(const std::string& name) { return buckle::test::freshDirectory("cli_atlas_mpi", name); }
-
-// `mpirun -np RANKS PROGRAM ARGS` (PROGRAM: buckle-mpi unless given), output into `capture`. CI runs as root in a container:
-// Open MPI then wants its two permissions, --oversubscribe (more ranks than cores),
-// --bind-to none, and no single-copy shared-memory transport (CMA needs ptrace rights that
-// containers often lack). Under the sanitizers, complete allocation stacks and the
-// suppressions of Open MPI's own leaks (mpi_lsan.supp); ignored in other builds.
-int mpiExitCode(int ranks, const std::string& args, const fs::path& capture,
-                const std::string& program = kBuckleMpi) {
-  const std::string cmd =
-      "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none "
-      "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}fast_unwind_on_malloc=0\" "
-      "LSAN_OPTIONS=\"${LSAN_OPTIONS:+$LSAN_OPTIONS:}suppressions=" BUCKLE_MPI_LSAN_SUPPRESSIONS "\" '" BUCKLE_MPIEXEC
-      "' --oversubscribe --bind-to none -np " +
-      std::to_string(ranks) + " '" + program + "' " + args + " > '" + capture.string() + "' 2>&1";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 // 7 x 4 = 28 cells: a/b up to 20 gives failed cells with their error message besides
 // supercritical, subcritical and unstable starts, so every field of a cell travels.
 const std::string kGrid = "atlas --x a --x-range 0.1 20 7 --y L0 --y-range 0.1 3 4 --quiet";
-
-int count(const std::string& text, const std::string& what) {
-  int n = 0;
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
 
 }  // namespace
 
@@ -126,14 +105,15 @@ TEST_CASE("buckle links no MPI: under mpirun with 2 ranks it names buckle-mpi an
   CHECK(summary["mpi_ranks"] == 1);
 }
 
-TEST_CASE("buckle-mpi has the atlas alone", "[cli][atlas][mpi]") {
+TEST_CASE("buckle-mpi has the atlas and run alone", "[cli][atlas][mpi]") {
   const fs::path dir = mpiDir("help");
   const std::string cmd = "'" + kBuckleMpi + "' --help > '" + (dir / "help.txt").string() + "' 2>&1";
   CHECK(std::system(cmd.c_str()) == 0);
   const std::string help = slurp(dir / "help.txt");
-  CHECK(count(help, "atlas") >= 1);
-  CHECK(count(help, "  run ") == 0);
+  CHECK(count(help, "  atlas ") == 1);
+  CHECK(count(help, "  run ") == 1);
   CHECK(count(help, "  regress ") == 0);
+  CHECK(count(help, "  critical ") == 0);
 }
 
 #endif  // BUCKLE_MPIEXEC

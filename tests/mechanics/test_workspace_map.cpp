@@ -2,12 +2,18 @@
 // equilibrium solved and classified (against a dense eigen-solve), every change of stability or
 // of the map's orientation between neighbouring grid values crossed by a traced curve, every
 // curve point on its curve (the condition recomputed), a fold curve's point found again as the
-// fold of a one-parameter control path, and the same map in scaled units.
+// fold of a one-parameter control path, the same map in scaled units, and the same map when
+// several parts (the processes of buckle-mpi, threads here) share its rows.
 #include <catch2/catch.hpp>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <map>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
 
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/unloaded_shape.h"
@@ -235,4 +241,132 @@ TEST_CASE("workspace map: the same map in scaled units", "[workspace_map]") {
   for (const WorkspaceCurve& c : ref.map.curves) ++ca[c.cause];
   for (const WorkspaceCurve& c : scaled.map.curves) ++cb[c.cause];
   CHECK(ca == cb);
+}
+
+namespace {
+
+// An all-gather among the threads of this process standing for the processes of buckle-mpi (one
+// exchange per map). A part in `absent` never calls it: its slot stays "" (it took no part).
+class ThreadExchange {
+ public:
+  ThreadExchange(int parts, std::vector<int> absent) : slots_(size_t(parts)), arrived_(int(absent.size())) {}
+  std::vector<std::string> operator()(int part, const std::string& mine) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    slots_[size_t(part)] = mine;
+    if (++arrived_ == int(slots_.size()))
+      ready_.notify_all();
+    else
+      ready_.wait(lock, [&] { return arrived_ == int(slots_.size()); });
+    return slots_;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable ready_;
+  std::vector<std::string> slots_;
+  int arrived_;
+};
+
+// The map of each part, the parts run on threads (`rowsOnly`: parts that return after the exchange).
+std::vector<WorkspaceMap> sharedMaps(int parts, const std::vector<int>& absent, const std::vector<int>& rowsOnly) {
+  const MapCase c;
+  const Chain chain = c.chain();
+  const InputPlane plane(chain, EndCondition::freeEnd(c.payload()), BodyLoads{}, c.options().first.input,
+                         c.options().second.input);
+  const Vector q0 = buckle::test::underPayload(chain, c.payload());
+  ThreadExchange exchange(parts, absent);
+  std::vector<WorkspaceMap> maps(static_cast<size_t>(parts));
+  std::vector<std::thread> threads;
+  for (int part = 0; part < parts; ++part) {
+    if (std::count(absent.begin(), absent.end(), part)) continue;
+    threads.emplace_back([&, part] {
+      WorkspaceMapOptions o = c.options();
+      o.threads = 1;
+      o.share.part = part;
+      o.share.parts = parts;
+      o.share.rowsOnly = std::count(rowsOnly.begin(), rowsOnly.end(), part) > 0;
+      o.share.exchange = [&exchange, part](const std::string& mine) { return exchange(part, mine); };
+      maps[size_t(part)] = computeWorkspaceMap(plane, q0, o);
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  return maps;
+}
+
+bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+void requireSameCell(const WorkspaceCell& a, const WorkspaceCell& b) {
+  REQUIRE(a.reached == b.reached);
+  CHECK(a.u1 == b.u1);
+  CHECK(a.u2 == b.u2);
+  CHECK(a.note == b.note);
+  CHECK(a.q == b.q);  // bit for bit: the same computation from the same spine state
+  CHECK(a.pose == b.pose);
+  CHECK(a.negative == b.negative);
+  CHECK(same(a.smallestEigenvalue, b.smallestEigenvalue));
+  CHECK(same(a.stiffness, b.stiffness));
+  CHECK(a.folds == b.folds);
+  CHECK(same(a.residual, b.residual));
+}
+
+void requireSameMap(const WorkspaceMap& a, const WorkspaceMap& b) {
+  REQUIRE(a.cells.size() == b.cells.size());
+  for (size_t i = 0; i < a.cells.size(); ++i) requireSameCell(a.cells[i], b.cells[i]);
+  REQUIRE(a.curves.size() == b.curves.size());
+  for (size_t k = 0; k < a.curves.size(); ++k) {
+    const WorkspaceCurve &x = a.curves[k], &y = b.curves[k];
+    CHECK(x.cause == y.cause);
+    CHECK(x.name == y.name);
+    CHECK(x.stop == y.stop);
+    REQUIRE(x.points.size() == y.points.size());
+    for (size_t p = 0; p < x.points.size(); ++p) {
+      CHECK(x.points[p].q == y.points[p].q);
+      CHECK(x.points[p].u1 == y.points[p].u1);
+      CHECK(x.points[p].u2 == y.points[p].u2);
+      CHECK(x.points[p].negative == y.points[p].negative);
+    }
+  }
+  CHECK(a.problems == b.problems);
+}
+
+}  // namespace
+
+TEST_CASE("workspace map: rows shared among parts give every part the map computed alone, bit for bit",
+          "[workspace_map]") {
+  const WorkspaceMap& alone = reference().map;
+  REQUIRE(alone.curves.size() >= 5);  // edges and curves travel: every kind is compared
+  for (int parts : {2, 3}) {
+    INFO(parts << " parts");
+    for (const WorkspaceMap& m : sharedMaps(parts, {}, {})) requireSameMap(m, alone);
+  }
+}
+
+TEST_CASE("workspace map: the rows of a part that takes no part are traced by the writer, and rowsOnly parts stop at the rows",
+          "[workspace_map]") {
+  const WorkspaceMap& alone = reference().map;
+  const std::vector<WorkspaceMap> maps = sharedMaps(3, {2}, {1});
+  requireSameMap(maps[0], alone);
+  const WorkspaceMap& rowsOnly = maps[1];
+  CHECK(rowsOnly.curves.empty());
+  for (int j = 0; j < rowsOnly.count2; ++j)
+    for (int i = 0; i < rowsOnly.count1; ++i) {
+      if (j % 3 == 2) continue;  // the absent part's rows: nobody sent them to part 1
+      requireSameCell(rowsOnly.cell(i, j), alone.cell(i, j));
+    }
+}
+
+TEST_CASE("workspace map: rows from another part that do not fit the grid are refused", "[workspace_map]") {
+  const MapCase c;
+  const Chain chain = c.chain();
+  const InputPlane plane(chain, EndCondition::freeEnd(c.payload()), BodyLoads{}, c.options().first.input,
+                         c.options().second.input);
+  const Vector q0 = buckle::test::underPayload(chain, c.payload());
+  WorkspaceMapOptions o = c.options();
+  o.share.parts = 2;
+  for (const std::string& other : {std::string("\x01\x02\x03", 3), std::string(4, '\x7f') + std::string(64, '\0')}) {
+    o.share.exchange = [&other](const std::string& mine) { return std::vector<std::string>{mine, other}; };
+    CHECK_THROWS_AS(computeWorkspaceMap(plane, q0, o), std::runtime_error);
+  }
+  o.share.part = 2;
+  CHECK_THROWS_WITH(computeWorkspaceMap(plane, q0, o), Catch::Contains("share.part"));
 }

@@ -6,7 +6,6 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -14,7 +13,7 @@
 #include "buckle/continuation/corrector.h"
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/stiffness.h"
-#include "workspace_curves.h"
+#include "workspace_rows.h"
 
 namespace buckle::mechanics {
 
@@ -42,6 +41,8 @@ std::string WorkspaceMapOptions::validate(const std::string& prefix) const {
   if (maxCurves < 0 || maxCurves > 1000) return prefix + "maxCurves: expected an integer in [0, 1000]";
   if (maxCurvePoints < 2) return prefix + "maxCurvePoints: expected an integer >= 2";
   if (threads < 0) return prefix + "threads: expected >= 0";
+  if (share.parts < 1 || share.part < 0 || share.part >= share.parts)
+    return prefix + "share.part: expected 0 <= part < parts";
   return tracer.validate(prefix + "tracer.");
 }
 
@@ -128,67 +129,6 @@ std::string stopWords(const cont::Branch& b) {
   return b.stopMessage.empty() ? std::string("stopped") : b.stopMessage;
 }
 
-// The rows: along u₁ at every grid u₂ from the spine's state there (file comment of the header).
-void computeRows(const InputPlane& plane, const WorkspaceMapOptions& o, const std::vector<Vector>& starts,
-                 const std::vector<int>& startFolds, WorkspaceMap& map, std::vector<TwoWays>& rows) {
-  const int c1 = o.first.count, c2 = o.second.count;
-  std::vector<double> targets(static_cast<size_t>(c1));
-  for (int i = 0; i < c1; ++i) targets[size_t(i)] = o.first.value(i);
-  const cont::TracerOptions ro = rowOptions(o.tracer, o.first.from, o.first.to);
-  std::atomic<int> next{0};
-  std::mutex problemsMutex;
-  const auto work = [&]() {
-    for (int j = next++; j < c2; j = next++) {
-      const double u2 = o.second.value(j);
-      WorkspaceCell* row = &map.cells[size_t(j) * size_t(c1)];
-      for (int i = 0; i < c1; ++i) {
-        row[i].u1 = targets[size_t(i)];
-        row[i].u2 = u2;
-      }
-      if (o.tracer.interrupt.requested()) {  // the rows done are kept; the others say why not
-        for (int i = 0; i < c1; ++i) row[i].note = "not computed: " + o.tracer.interrupt.describe();
-        continue;
-      }
-      if (startFolds[size_t(j)] < 0) {
-        for (int i = 0; i < c1; ++i) row[i].note = "the spine along " + plane.input(1).name() + " did not reach it";
-        continue;
-      }
-      try {
-        const auto p = plane.along(0, u2);
-        rows[size_t(j)] = traceBothWays(*p, starts[size_t(j)], plane.origin(0), ro);
-        std::vector<Vector> states;
-        std::vector<int> folds;
-        sampleAlong(*p, rows[size_t(j)], targets, o.tracer.interrupt, states, folds);
-        auto ws = p->createWorkspace();
-        for (int i = 0; i < c1; ++i) {
-          if (o.tracer.interrupt.requested()) {
-            row[i].note = "not computed: " + o.tracer.interrupt.describe();
-            continue;
-          }
-          if (folds[size_t(i)] < 0) {
-            const cont::Branch& b = targets[size_t(i)] >= plane.origin(0) ? rows[size_t(j)].up : rows[size_t(j)].down;
-            row[i].note = "the row ended first: " + stopWords(b);
-            continue;
-          }
-          row[i].reached = true;
-          row[i].q = states[size_t(i)];
-          row[i].folds = folds[size_t(i)] + startFolds[size_t(j)];
-          evaluateCell(*p, *ws, row[i], targets[size_t(i)]);
-        }
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lock(problemsMutex);
-        map.problems.push_back("row " + plane.input(1).name() + " = " + std::to_string(u2) + ": " + e.what());
-      }
-    }
-  };
-  int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-  threads = std::min(threads, c2);
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
-}
-
 // A traced pair of halves as one curve, the down half reversed; u₁ is λ on a row (axis 0), u₂
 // on a column (axis 1).
 WorkspaceCurve edgeCurve(const InputPlane& plane, const EquilibriumProblem& p, const TwoWays& t, int axis,
@@ -213,37 +153,138 @@ WorkspaceCurve edgeCurve(const InputPlane& plane, const EquilibriumProblem& p, c
   return c;
 }
 
+// The curves a traced row starts: its located folds and joint stops (x = (q, u₂, u₁), u₂ kept).
+void rowCurveStarts(const InputPlane& plane, const WorkspaceMapOptions& o, const EquilibriumProblem& p,
+                    const TwoWays& t, double u2, std::vector<detail::CurveStart>& starts) {
+  using Condition = InputPlaneCurveProblem::Condition;
+  const int n = plane.segments();
+  for (const cont::Branch* b : {&t.up, &t.down})
+    for (const cont::SpecialPoint& sp : b->specialPoints) {
+      detail::CurveStart s;
+      if (sp.type == cont::SpecialPointType::Fold && o.folds) {
+        s.condition = Condition::Fold;
+        s.name = "fold";
+      } else if (sp.type == cont::SpecialPointType::Boundary && o.limits && !sp.boundaryName.empty()) {
+        for (int k = 0; k < p.boundaryCount(); ++k)
+          if (p.boundaryName(k) == sp.boundaryName) s.boundary = k;
+        if (s.boundary < 0) continue;
+        s.condition = Condition::Limit;
+        s.name = sp.boundaryName;
+      } else {
+        continue;
+      }
+      s.x.resize(n + 2);
+      s.x << sp.u.head(n), u2, sp.lambda;
+      s.fixed = n;
+      starts.push_back(std::move(s));
+    }
+}
+
+// Row j: along u₁ at u₂ = second.value(j) from the spine's state there (file comment of the
+// header); its cells into the map, the rest into `row`.
+void traceRow(const InputPlane& plane, const WorkspaceMapOptions& o, int j, const std::vector<Vector>& spine,
+              const std::vector<int>& spineFolds, WorkspaceMap& map, detail::WorkspaceRow& row) {
+  const int c1 = o.first.count;
+  const double u2 = o.second.value(j);
+  WorkspaceCell* cells = &map.cells[size_t(j) * size_t(c1)];
+  std::vector<double> targets(static_cast<size_t>(c1));
+  for (int i = 0; i < c1; ++i) {
+    targets[size_t(i)] = o.first.value(i);
+    cells[i] = WorkspaceCell();
+    cells[i].u1 = targets[size_t(i)];
+    cells[i].u2 = u2;
+  }
+  row = detail::WorkspaceRow();
+  if (o.tracer.interrupt.requested()) {  // the rows done are kept; the others say why not
+    for (int i = 0; i < c1; ++i) cells[i].note = "not computed: " + o.tracer.interrupt.describe();
+    return;
+  }
+  if (spineFolds[size_t(j)] < 0) {
+    for (int i = 0; i < c1; ++i) cells[i].note = "the spine along " + plane.input(1).name() + " did not reach it";
+    row.done = true;
+    return;
+  }
+  try {
+    const auto p = plane.along(0, u2);
+    const TwoWays t = traceBothWays(*p, spine[size_t(j)], plane.origin(0), rowOptions(o.tracer, o.first.from, o.first.to));
+    std::vector<Vector> states;
+    std::vector<int> folds;
+    sampleAlong(*p, t, targets, o.tracer.interrupt, states, folds);
+    auto ws = p->createWorkspace();
+    for (int i = 0; i < c1; ++i) {
+      if (o.tracer.interrupt.requested()) {
+        cells[i].note = "not computed: " + o.tracer.interrupt.describe();
+        continue;
+      }
+      if (folds[size_t(i)] < 0) {
+        cells[i].note = "the row ended first: " + stopWords(targets[size_t(i)] >= plane.origin(0) ? t.up : t.down);
+        continue;
+      }
+      cells[i].reached = true;
+      cells[i].q = states[size_t(i)];
+      cells[i].folds = folds[size_t(i)] + spineFolds[size_t(j)];
+      evaluateCell(*p, *ws, cells[i], targets[size_t(i)]);
+    }
+    rowCurveStarts(plane, o, *p, t, u2, row.starts);
+    if ((j == 0 || j == map.count2 - 1) && !t.up.points.empty()) {  // the box's edge u₂ = from or to
+      row.hasEdge = true;
+      row.edge = edgeCurve(plane, *p, t, 0, u2, map.input2 + (j == 0 ? " = from" : " = to"));
+    }
+  } catch (const std::exception& e) {
+    row.problem = "row " + plane.input(1).name() + " = " + std::to_string(u2) + ": " + e.what();
+  }
+  row.done = !o.tracer.interrupt.requested();  // an interrupted row is traced again by whoever can
+}
+
+// The rows `which` on o.threads threads.
+void traceRows(const InputPlane& plane, const WorkspaceMapOptions& o, const std::vector<int>& which,
+               const std::vector<Vector>& spine, const std::vector<int>& spineFolds, WorkspaceMap& map,
+               std::vector<detail::WorkspaceRow>& rows) {
+  std::atomic<size_t> next{0};
+  const auto work = [&]() {
+    for (size_t k = next++; k < which.size(); k = next++)
+      traceRow(plane, o, which[k], spine, spineFolds, map, rows[size_t(which[k])]);
+  };
+  int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  threads = std::min(threads, int(which.size()));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+}
+
+// Every row of the map: this process's share traced here, the others' received (WorkspaceShare);
+// false when only the share was wanted (rowsOnly) and the map is left incomplete.
+bool computeRows(const InputPlane& plane, const WorkspaceMapOptions& o, const std::vector<Vector>& spine,
+                 const std::vector<int>& spineFolds, WorkspaceMap& map, std::vector<detail::WorkspaceRow>& rows) {
+  const WorkspaceShare& share = o.share;
+  std::vector<int> mine;
+  for (int j = 0; j < map.count2; ++j)
+    if (share.owns(j)) mine.push_back(j);
+  traceRows(plane, o, mine, spine, spineFolds, map, rows);
+  if (!share.shared()) return true;
+  std::vector<int> done;
+  for (int j : mine)
+    if (rows[size_t(j)].done) done.push_back(j);
+  const std::vector<std::string> parts = share.exchange(detail::packWorkspaceRows(map, rows, done));
+  for (size_t k = 0; k < parts.size(); ++k)
+    if (int(k) != share.part) detail::unpackWorkspaceRows(parts[k], map, rows);
+  if (share.rowsOnly) return false;
+  std::vector<int> missing;  // the rows of parts interrupted first, or that took no part in this map
+  for (int j = 0; j < map.count2; ++j)
+    if (!rows[size_t(j)].done) missing.push_back(j);
+  traceRows(plane, o, missing, spine, spineFolds, map, rows);
+  return true;
+}
+
 // Curve starts from the grid: the rows' located folds and joint stops, and the sign changes of
 // the singular condition between neighbouring reached cells on one sheet.
 std::vector<detail::CurveStart> curveStarts(const InputPlane& plane, const WorkspaceMapOptions& o,
-                                            const std::vector<TwoWays>& rows, const WorkspaceMap& map) {
+                                            const std::vector<detail::WorkspaceRow>& rows, const WorkspaceMap& map) {
   using Condition = InputPlaneCurveProblem::Condition;
   std::vector<detail::CurveStart> starts;
   const int n = plane.segments();
-  for (size_t j = 0; j < rows.size(); ++j) {
-    const double u2 = o.second.value(int(j));
-    for (const cont::Branch* b : {&rows[j].up, &rows[j].down})
-      for (const cont::SpecialPoint& sp : b->specialPoints) {
-        detail::CurveStart s;
-        if (sp.type == cont::SpecialPointType::Fold && o.folds) {
-          s.condition = Condition::Fold;
-          s.name = "fold";
-        } else if (sp.type == cont::SpecialPointType::Boundary && o.limits && !sp.boundaryName.empty()) {
-          const auto p = plane.along(0, u2);
-          for (int k = 0; k < p->boundaryCount(); ++k)
-            if (p->boundaryName(k) == sp.boundaryName) s.boundary = k;
-          if (s.boundary < 0) continue;
-          s.condition = Condition::Limit;
-          s.name = sp.boundaryName;
-        } else {
-          continue;
-        }
-        s.x.resize(n + 2);
-        s.x << sp.u.head(n), u2, sp.lambda;
-        s.fixed = n;
-        starts.push_back(std::move(s));
-      }
-  }
+  for (const detail::WorkspaceRow& row : rows) starts.insert(starts.end(), row.starts.begin(), row.starts.end());
   if (!o.singular) return starts;
   InputPlaneCurveProblem singular(plane, Condition::Singular);
   auto ws = singular.createWorkspace();
@@ -316,19 +357,17 @@ WorkspaceMap computeWorkspaceMap(const InputPlane& plane, ConstVectorRef q0, con
   std::vector<int> startFolds;
   sampleAlong(*spineProblem, spine, u2s, o.tracer.interrupt, starts, startFolds);
 
-  std::vector<TwoWays> rows(static_cast<size_t>(map.count2));
-  computeRows(plane, o, starts, startFolds, map, rows);
-  if (o.tracer.interrupt.requested()) {
-    map.interrupted = true;
+  std::vector<detail::WorkspaceRow> rows(static_cast<size_t>(map.count2));
+  const bool whole = computeRows(plane, o, starts, startFolds, map, rows);
+  for (const detail::WorkspaceRow& row : rows)
+    if (!row.problem.empty()) map.problems.push_back(row.problem);
+  if (!whole || o.tracer.interrupt.requested()) {
+    map.interrupted = o.tracer.interrupt.requested();
     return map;
   }
   // the box's edges: the first and last rows, and the columns at u₁ = from, to
-  for (int j : {0, map.count2 - 1}) {
-    if (rows[size_t(j)].up.points.empty()) continue;
-    const auto p = plane.along(0, u2s[size_t(j)]);
-    map.curves.push_back(edgeCurve(plane, *p, rows[size_t(j)], 0, u2s[size_t(j)],
-                                   map.input2 + (j == 0 ? " = from" : " = to")));
-  }
+  for (int j : {0, map.count2 - 1})
+    if (rows[size_t(j)].hasEdge) map.curves.push_back(rows[size_t(j)].edge);
   for (int i : {0, map.count1 - 1}) {
     int best = -1;  // the reached cell of that column nearest u₂⁰, on the sheet of the start
     for (int j = 0; j < map.count2; ++j)

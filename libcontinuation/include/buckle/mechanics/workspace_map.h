@@ -18,6 +18,7 @@
 // critical set of the map).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,22 @@ struct InputAxisRange {
   double value(int i) const { return count == 1 ? from : from + (to - from) * i / (count - 1); }
 };
 
+/// Several processes computing one map (`mpirun -np N buckle-mpi run`): this one traces the rows
+/// j with j mod parts = part (interleaved: a row's cost grows towards the folds), the rows are
+/// exchanged, and every process holds the whole grid. The library knows nothing of how the bytes
+/// travel; every part must call computeWorkspaceMap with the same plane and options.
+struct WorkspaceShare {
+  int part = 0, parts = 1;
+  /// Collective: every part's bytes in part order, on every part (an all-gather). A part's empty
+  /// string: it took no part in this map (interrupted first); its rows are then traced here.
+  std::function<std::vector<std::string>(const std::string&)> exchange;
+  /// Return once the rows are exchanged: a process whose map is not written (the curves and the
+  /// rows the others did not send are left to the process that writes it).
+  bool rowsOnly = false;
+  bool shared() const { return parts > 1 && exchange != nullptr; }
+  bool owns(int row) const { return !shared() || row % parts == part; }
+};
+
 struct WorkspaceMapOptions {
   InputAxisRange first, second;
   /// Tracing of the rows, the edges and the curves (its detection settings are set per use; its
@@ -42,6 +59,7 @@ struct WorkspaceMapOptions {
   int maxCurves = 16;       ///< per kind: crossings already on a traced curve start none
   int maxCurvePoints = 2000;
   int threads = 0;          ///< rows computed in parallel; 0: std::thread::hardware_concurrency()
+  WorkspaceShare share;     ///< the rows shared among processes (default: all rows here)
   /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
   std::string validate(const std::string& prefix = "") const;
 };
