@@ -38,6 +38,10 @@ constexpr BoundaryCause kCauses[] = {BoundaryCause::InputBound, BoundaryCause::F
 std::string inputLabel(const Scene& scene, const mechanics::PlaneInput& in) {
   std::string label = columnLabel(mechanics::controlInputName(in.input), scene.units);
   if (in.segment >= 0) label += " of segment " + std::to_string(in.segment + 1);
+  if (in.along.size() > 0) {  // a direction: say what else moves with it
+    const std::string other = mechanics::controlInputName(mechanics::complementaryInput(in.input));
+    label += ", " + other + (in.along.size() == 1 ? " moved " + num(in.along[0]) + " per unit" : " moved at per-segment rates");
+  }
   return label;
 }
 

@@ -9,40 +9,25 @@
 
 namespace buckle::scene::detail {
 
-namespace {
-// The other input of the parameter's pair: (L1_0, L2_0) and (L0, dL0) each span a segment's two
-// free lengths, so moving the complement leaves the parameter's own value λ.
-std::string complementOf(const std::string& parameter) {
-  if (parameter == "L1_0") return "L2_0";
-  if (parameter == "L2_0") return "L1_0";
-  return parameter == "L0" ? "dL0" : "L0";
+Eigen::VectorXd parseControlDirection(const JsonReader& r, const json& d, const Pointer& pd,
+                                      mechanics::ControlInput input) {
+  r.requireObject(d, pd);
+  const std::string own = mechanics::controlInputName(input);
+  const std::string allowed = mechanics::controlInputName(mechanics::complementaryInput(input));
+  for (auto it = d.begin(); it != d.end(); ++it)
+    if (it.key() != allowed)
+      r.fail(pd / it.key(), "unknown key \"" + it.key() + "\" (allowed here: " + allowed + ", the input that with " +
+                                own + " sets both free lengths; " + own + "'s own rate is 1)");
+  if (!d.contains(allowed)) return Eigen::VectorXd();  // {}: the named input alone
+  const Pointer pk = pd / allowed;
+  const json& v = d[allowed];
+  if (!v.is_array()) return Eigen::VectorXd::Constant(1, r.number(v, pk));
+  if (v.empty()) r.fail(pk, "expected a number or a list of rates (one per segment), got an empty list");
+  Eigen::VectorXd rates(Eigen::Index(v.size()));
+  for (size_t i = 0; i < v.size(); ++i) rates[Eigen::Index(i)] = r.number(v[i], pk / i);
+  return rates;
 }
 
-// /path/direction of a control path: the rate of the complementary input per unit of the
-// parameter, a number (every segment) or a list of one per segment, added to the named rates.
-void addDirection(const JsonReader& r, const json& d, const Pointer& pd, const std::string& parameter, int n,
-                  mechanics::ControlDirection& out) {
-  r.requireObject(d, pd);
-  const std::string allowed = complementOf(parameter);
-  for (auto it = d.begin(); it != d.end(); ++it) {
-    mechanics::ControlInput input;
-    if (it.key() != allowed || !mechanics::parseControlInput(it.key(), input))
-      r.fail(pd / it.key(), "unknown key \"" + it.key() + "\" (allowed here: " + allowed + ", the input that with " +
-                                parameter + " sets both free lengths; " + parameter + "'s own rate is 1)");
-    const Pointer pk = pd / it.key();
-    const mechanics::ControlDirection unit = mechanics::ControlDirection::named(n, input);
-    const json& v = it.value();
-    if (v.is_array()) {
-      if (int(v.size()) != n)
-        r.fail(pk, "expected a number or a list of " + std::to_string(n) + " rates (one per segment), got " +
-                       std::to_string(v.size()));
-      for (int i = 0; i < n; ++i) out.rates.row(i) += r.number(v[size_t(i)], pk / size_t(i)) * unit.rates.row(i);
-    } else {
-      out.rates += r.number(v, pk) * unit.rates;
-    }
-  }
-}
-}  // namespace
 
 bool isControlPath(const json& path) {
   mechanics::ControlInput input;
@@ -64,7 +49,14 @@ PathSpec parseControlPath(const JsonReader& r, const json& path, const Pointer& 
   const int n = chain.size();
   if (path.contains("segment")) spec.segment = r.integer(path["segment"], p / "segment", 1, n) - 1;
   spec.controlDirection = mechanics::ControlDirection::named(n, input, spec.segment);
-  if (path.contains("direction")) addDirection(r, path["direction"], p / "direction", spec.parameter, n, spec.controlDirection);
+  if (path.contains("direction")) {
+    const Eigen::VectorXd rates = parseControlDirection(r, path["direction"], p / "direction", input);
+    const std::string key = mechanics::controlInputName(mechanics::complementaryInput(input));
+    if (rates.size() > 1 && rates.size() != n)
+      r.fail(p / "direction" / key, "expected a number or a list of " + std::to_string(n) +
+                                        " rates (one per segment), got " + std::to_string(rates.size()));
+    if (rates.size() > 0) mechanics::addComplementaryRates(spec.controlDirection, input, rates);
+  }
   spec.start = mechanics::controlInputValue(chain, input, spec.segment);
   spec.controlDirection.origin = spec.start;
   spec.direction.setZero();

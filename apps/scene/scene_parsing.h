@@ -38,6 +38,11 @@ void checkBodyAnalyses(const JsonReader& r, const Scene& scene);
 bool isControlPath(const json& path);
 /// Parses it against the chain: /path/segment (1-based, optional), the range (containing the
 /// inputs' value on the chain, every free length positive over it); /path/direction is refused.
+/// A direction in control space at `pd` ({"<complementary input>": rate or [rate per segment]}:
+/// /path/direction, a workspace axis's direction): the rates, one value or one per segment (the
+/// caller checks the count against the chain); empty for {}.
+Eigen::VectorXd parseControlDirection(const JsonReader& r, const json& d, const Pointer& pd,
+                                      mechanics::ControlInput input);
 PathSpec parseControlPath(const JsonReader& r, const json& path, const Pointer& p, const mechanics::Chain& chain);
 /// The analyses a control path cannot run (critical forces, two-parameter, sudden load) refused.
 void checkControlPathAnalyses(const JsonReader& r, const Scene& scene);

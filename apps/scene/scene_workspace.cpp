@@ -11,13 +11,15 @@ namespace {
 mechanics::InputAxisRange parseAxis(const JsonReader& r, const json& v, const Pointer& p,
                                     const mechanics::InputAxisRange& defaults) {
   r.requireObject(v, p);
-  r.onlyKeys(v, p, {"input", "segment", "from", "to", "count"});
+  r.onlyKeys(v, p, {"input", "segment", "direction", "from", "to", "count"});
   mechanics::InputAxisRange a = defaults;
   const std::string name = r.string(r.required(v, p, "input"), p / "input");
   if (!mechanics::parseControlInput(name, a.input.input))
     r.fail(p / "input", "expected one of L1_0, L2_0, L0, dL0 (a control input), got \"" + name + "\"");
   // the segment's upper bound is checked against every case's chain (checkWorkspaceAgainstCases)
   if (v.contains("segment")) a.input.segment = r.integer(v["segment"], p / "segment", 1, 1000000000) - 1;
+  // its count is checked against every case's chain (checkWorkspaceAgainstCases)
+  if (v.contains("direction")) a.input.along = parseControlDirection(r, v["direction"], p / "direction", a.input.input);
   a.from = r.number(r.required(v, p, "from"), p / "from");
   a.to = r.number(r.required(v, p, "to"), p / "to");
   if (!(a.from < a.to)) r.fail(p / "to", "expected to > from, got " + show(a.to) + " <= " + show(a.from));
@@ -65,6 +67,10 @@ void checkWorkspaceAgainstCases(const JsonReader& r, const Scene& scene) {
       if (a.input.segment >= n)
         r.fail(pa / "segment", "expected a segment in 1.." + std::to_string(n) + " (" + which + "), got " +
                                    std::to_string(a.input.segment + 1));
+      if (a.input.along.size() > 1 && a.input.along.size() != n)
+        r.fail(pa / "direction" / mechanics::controlInputName(mechanics::complementaryInput(a.input.input)),
+               "expected a number or a list of " + std::to_string(n) + " rates (one per segment, " + which + "), got " +
+                   std::to_string(a.input.along.size()));
       const double value = mechanics::controlInputValue(chain, a.input.input, a.input.segment);
       const double tol = 1e-12 * std::max(1.0, std::abs(value));
       if (value < a.from - tol || value > a.to + tol) {

@@ -127,3 +127,51 @@ TEST_CASE("input plane: dependent inputs and a held end are refused", "[input_pl
                                {ControlInput::dL0, -1}),
                     Catch::Contains("hold no coordinate"));
 }
+
+namespace {
+
+Eigen::MatrixX2d freeLengths(const Chain& chain) {
+  Eigen::MatrixX2d L(chain.size(), 2);
+  for (int i = 0; i < chain.size(); ++i)
+    L.row(i) << chain.segment(i).parameters().L1_0, chain.segment(i).parameters().L2_0;
+  return L;
+}
+
+}  // namespace
+
+TEST_CASE("input plane: an input along a direction moves its complement by the given rates, its reading kept",
+          "[input_plane]") {
+  const Chain chain = planeChain();
+  const EndCondition payload = EndCondition::freeEnd(kPlanePayload);
+  const Eigen::MatrixX2d L = freeLengths(chain);
+  // dL0 of segment 1 with L0 of segment 1 moving 0.3 per unit, against dL0 of segment 3
+  PlaneInput first{ControlInput::dL0, 0, Eigen::Vector3d(0.3, 0.0, 0.0)};
+  const PlaneInput second{ControlInput::dL0, 2, {}};
+  const InputPlane plane(chain, payload, {}, first, second);
+  CHECK(first.name() == "dL0[1] + (0.3 0 0) L0");
+  CHECK(plane.origin(0) == L(0, 0) - L(0, 1));
+  for (const auto& [d1, d2] : {std::pair{0.4, -0.25}, std::pair{-0.7, 0.6}}) {
+    const Chain moved = plane.chainAt(plane.origin(0) + d1, plane.origin(1) + d2);
+    Eigen::MatrixX2d expected = L;
+    expected.row(0) += d1 * Eigen::RowVector2d(0.5 + 0.3, -0.5 + 0.3);  // d(L1, L2) = du (½, −½) + 0.3 du (1, 1)
+    expected.row(2) += d2 * Eigen::RowVector2d(0.5, -0.5);
+    CHECK((freeLengths(moved) - expected).cwiseAbs().maxCoeff() < 1e-14);
+    // the readings stay absolute: dL0 of segment 1 is u₁, dL0 of segment 3 is u₂
+    CHECK(controlInputValue(moved, ControlInput::dL0, 0) == Approx(plane.origin(0) + d1).margin(1e-14));
+    CHECK(controlInputValue(moved, ControlInput::dL0, 2) == Approx(plane.origin(1) + d2).margin(1e-14));
+  }
+  // L1_0 of segment 1 moving L2_0 of segment 1 one for one is L0 of segment 1 (rates (1, 1))
+  const InputPlane named(chain, payload, {}, {ControlInput::L0, 0, {}}, second);
+  const InputPlane along(chain, payload, {}, {ControlInput::L1_0, 0, Eigen::Vector3d(1.0, 0.0, 0.0)}, second);
+  for (double d1 : {-0.3, 0.25}) {
+    const Eigen::MatrixX2d a = freeLengths(named.chainAt(named.origin(0) + d1, named.origin(1)));
+    const Eigen::MatrixX2d b = freeLengths(along.chainAt(along.origin(0) + d1, along.origin(1)));
+    CHECK((a - b).cwiseAbs().maxCoeff() < 1e-14);
+  }
+  // one rate for every segment: L0 every segment moves with dL0 of segment 1, so L0 of segment 3 would not be absolute
+  first.along = Eigen::VectorXd::Constant(1, 0.3);
+  CHECK_THROWS_WITH(InputPlane(chain, payload, {}, first, {ControlInput::L0, 2, {}}), Catch::Contains("not independent"));
+  CHECK_NOTHROW(InputPlane(chain, payload, {}, first, {ControlInput::dL0, 2, {}}));
+  first.along = Eigen::Vector2d(0.3, 0.1);
+  CHECK_THROWS_WITH(InputPlane(chain, payload, {}, first, second), Catch::Contains("one per segment (3), got 2"));
+}

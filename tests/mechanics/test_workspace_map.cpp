@@ -8,6 +8,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <condition_variable>
 #include <map>
@@ -369,4 +370,112 @@ TEST_CASE("workspace map: rows from another part that do not fit the grid are re
   }
   o.share.part = 2;
   CHECK_THROWS_WITH(computeWorkspaceMap(plane, q0, o), Catch::Contains("share.part"));
+}
+
+namespace {
+
+double distanceToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d d = b - a;
+  const double t = d.squaredNorm() > 0 ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+  return (p - (a + t * d)).norm();
+}
+
+}  // namespace
+
+TEST_CASE("workspace map: the edge of a 4x denser grid's stable region lies on the traced curves",
+          "[workspace_map]") {
+  // An independent sample: a grid four times finer, its stable equilibria on the start's sheet.
+  // The workspace is their image; its edge must lie on the images of the curves traced on the
+  // coarse grid (the image of a region is bounded by the image of its boundary and of the map's
+  // critical set). Checked twice:
+  //  - in the inputs' plane: every sample with a neighbour that is not one (unstable, another
+  //    sheet, not reached, or outside the box) lies within 1.5 fine cells of a traced curve;
+  //  - in the end's plane: the images of the cells with four stable corners, filled on a lattice
+  //    of spacing h (the median distance between neighbouring samples' images); every occupied
+  //    lattice cell beside an empty one lies within 2h of a traced curve's image, where the map is
+  //    regular at that scale (the cells that fill it no larger than 2h: next to a fold the image
+  //    of the last fine cell before it grows like the square root of its distance).
+  const Computed& r = reference();
+  WorkspaceMapOptions o = r.c.options();
+  o.first.count = 4 * (o.first.count - 1) + 1;
+  o.second.count = 4 * (o.second.count - 1) + 1;
+  o.folds = o.singular = o.limits = false;  // the dense grid is the sample, not the curves
+  const WorkspaceMap dense =
+      computeWorkspaceMap(*r.plane, buckle::test::underPayload(r.c.chain(), r.c.payload()), o);
+  const auto sample = [&](int i, int j) {
+    return i >= 0 && j >= 0 && i < dense.count1 && j < dense.count2 && dense.cell(i, j).stable() &&
+           dense.cell(i, j).folds == 0;
+  };
+  const double w1 = (o.first.to - o.first.from) / (o.first.count - 1);
+  const double w2 = (o.second.to - o.second.from) / (o.second.count - 1);
+  int inputEdges = 0;
+  for (int j = 0; j < dense.count2; ++j)
+    for (int i = 0; i < dense.count1; ++i) {
+      if (!sample(i, j) || (sample(i + 1, j) && sample(i - 1, j) && sample(i, j + 1) && sample(i, j - 1))) continue;
+      ++inputEdges;
+      const WorkspaceCell& c = dense.cell(i, j);
+      const Eigen::Vector2d at(c.u1 / w1, c.u2 / w2);
+      double d = std::numeric_limits<double>::infinity();
+      for (const WorkspaceCurve& curve : r.map.curves)
+        for (size_t k = 0; k + 1 < curve.points.size(); ++k)
+          d = std::min(d, distanceToSegment(at, {curve.points[k].u1 / w1, curve.points[k].u2 / w2},
+                                            {curve.points[k + 1].u1 / w1, curve.points[k + 1].u2 / w2}));
+      INFO("edge sample at (" << c.u1 << ", " << c.u2 << ")");
+      CHECK(d < 1.5);
+    }
+  CHECK(inputEdges > 50);
+
+  const auto xy = [&](int i, int j) { return Eigen::Vector2d(dense.cell(i, j).pose.head<2>()); };
+  std::vector<std::array<Eigen::Vector2d, 4>> quads;
+  std::vector<double> spacing;
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = -lo;
+  for (int j = 0; j + 1 < dense.count2; ++j)
+    for (int i = 0; i + 1 < dense.count1; ++i) {
+      if (!sample(i, j) || !sample(i + 1, j) || !sample(i, j + 1) || !sample(i + 1, j + 1)) continue;
+      quads.push_back({xy(i, j), xy(i + 1, j), xy(i + 1, j + 1), xy(i, j + 1)});
+      spacing.push_back((xy(i, j) - xy(i + 1, j)).norm());
+      spacing.push_back((xy(i, j) - xy(i, j + 1)).norm());
+      for (const Eigen::Vector2d& p : quads.back()) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+    }
+  REQUIRE(quads.size() > 500);
+  std::nth_element(spacing.begin(), spacing.begin() + long(spacing.size() / 2), spacing.end());
+  const double h = spacing[spacing.size() / 2];
+  const int nx = int((hi[0] - lo[0]) / h) + 1, ny = int((hi[1] - lo[1]) / h) + 1;
+  std::vector<double> largest(size_t(nx) * size_t(ny), -1.0);  // the largest quad filling a lattice cell; < 0: empty
+  const auto at = [&](int ix, int iy) -> double& { return largest[size_t(iy) * size_t(nx) + size_t(ix)]; };
+  for (const auto& q : quads) {
+    double side = 0.0;
+    for (size_t k = 0; k < 4; ++k) side = std::max(side, (q[k] - q[(k + 1) % 4]).norm());
+    const int m = 4 + int(4.0 * side / h);
+    for (int a = 0; a <= m; ++a)
+      for (int b = 0; b <= m; ++b) {
+        const double s = double(a) / m, t = double(b) / m;
+        const Eigen::Vector2d p = (1 - s) * (1 - t) * q[0] + s * (1 - t) * q[1] + s * t * q[2] + (1 - s) * t * q[3];
+        double& cell = at(std::min(nx - 1, int((p[0] - lo[0]) / h)), std::min(ny - 1, int((p[1] - lo[1]) / h)));
+        cell = std::max(cell, side);
+      }
+  }
+  int edges = 0;
+  for (int iy = 0; iy < ny; ++iy)
+    for (int ix = 0; ix < nx; ++ix) {
+      if (at(ix, iy) < 0 || at(ix, iy) > 2.0 * h) continue;
+      bool edge = false;
+      for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+        const int x = ix + dx, y = iy + dy;
+        edge = edge || x < 0 || y < 0 || x >= nx || y >= ny || at(x, y) < 0;
+      }
+      if (!edge) continue;
+      ++edges;
+      const Eigen::Vector2d centre = lo + h * Eigen::Vector2d(ix + 0.5, iy + 0.5);
+      double d = std::numeric_limits<double>::infinity();
+      for (const WorkspaceCurve& c : r.map.curves)
+        for (size_t k = 0; k + 1 < c.points.size(); ++k)
+          d = std::min(d, distanceToSegment(centre, c.points[k].pose.head<2>(), c.points[k + 1].pose.head<2>()));
+      INFO("edge cell at (" << centre[0] << ", " << centre[1] << "), h = " << h);
+      CHECK(d < 2.0 * h);
+    }
+  CHECK(edges > 20);
 }

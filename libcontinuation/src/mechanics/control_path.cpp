@@ -32,6 +32,26 @@ ControlDirection ControlDirection::named(int n, ControlInput input, int segment)
   return d;
 }
 
+ControlInput complementaryInput(ControlInput input) {
+  switch (input) {
+    case ControlInput::L1_0: return ControlInput::L2_0;
+    case ControlInput::L2_0: return ControlInput::L1_0;
+    case ControlInput::L0: return ControlInput::dL0;
+    case ControlInput::dL0: return ControlInput::L0;
+  }
+  return ControlInput::L0;
+}
+
+void addComplementaryRates(ControlDirection& d, ControlInput input, const Eigen::VectorXd& rates) {
+  const int n = int(d.rates.rows());
+  if (rates.size() != 1 && rates.size() != n)
+    throw std::invalid_argument("control direction: expected one rate of " + controlInputName(complementaryInput(input)) +
+                                " or one per segment (" + std::to_string(n) + "), got " + std::to_string(rates.size()));
+  if (!rates.allFinite()) throw std::invalid_argument("control direction: the rates must be finite");
+  const ControlDirection unit = ControlDirection::named(n, complementaryInput(input));
+  for (int i = 0; i < n; ++i) d.rates.row(i) += rates[rates.size() == 1 ? 0 : i] * unit.rates.row(i);
+}
+
 std::string controlInputName(ControlInput input) {
   switch (input) {
     case ControlInput::L1_0: return "L1_0";

@@ -4,6 +4,7 @@
 #include <Eigen/LU>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 namespace buckle::mechanics {
@@ -11,7 +12,17 @@ namespace buckle::mechanics {
 namespace cont = buckle::continuation;
 
 std::string PlaneInput::name() const {
-  return controlInputName(input) + (segment >= 0 ? "[" + std::to_string(segment + 1) + "]" : "");
+  std::string s = controlInputName(input) + (segment >= 0 ? "[" + std::to_string(segment + 1) + "]" : "");
+  if (along.size() == 0) return s;
+  std::ostringstream os;
+  os.precision(6);
+  // no commas: the name is a CSV field and a plot label
+  if (along.size() <= 6)
+    for (Eigen::Index i = 0; i < along.size(); ++i) os << (i ? " " : "") << along[i];
+  else
+    os << "per-segment rates";
+  return s + " + " + (along.size() == 1 ? os.str() : "(" + os.str() + ")") + " " +
+         controlInputName(complementaryInput(input));
 }
 
 InputPlane::InputPlane(const Chain& chain, const EndCondition& end, const BodyLoads& body, const PlaneInput& first,
@@ -23,6 +34,8 @@ InputPlane::InputPlane(const Chain& chain, const EndCondition& end, const BodyLo
   const int n = chain.size();
   d1_ = ControlDirection::named(n, first.input, first.segment);
   d2_ = ControlDirection::named(n, second.input, second.segment);
+  if (first.along.size() > 0) addComplementaryRates(d1_, first.input, first.along);
+  if (second.along.size() > 0) addComplementaryRates(d2_, second.input, second.along);
   d1_.origin = controlInputValue(chain, first.input, first.segment);
   d2_.origin = controlInputValue(chain, second.input, second.segment);
   // ℓ₁(r₂) = ℓ₂(r₁) = 0: a small move of one input leaves the other's value (file comment); the

@@ -34,6 +34,14 @@ struct ControlDirection {
   static ControlDirection named(int n, ControlInput input, int segment = -1);
 };
 
+/// The input that with `input` sets both free lengths: L1_0 ↔ L2_0, L0 ↔ dL0.
+ControlInput complementaryInput(ControlInput input);
+
+/// Adds to `d` the rates of `input`'s complementary input per unit of d's parameter (a
+/// direction in control space): `rates` one value for every segment, or one per segment.
+/// Throws std::invalid_argument for another length or a rate that is not finite.
+void addComplementaryRates(ControlDirection& d, ControlInput input, const Eigen::VectorXd& rates);
+
 /// "L1_0", "L2_0", "L0", "dL0".
 std::string controlInputName(ControlInput input);
 /// Parses controlInputName(); false for any other text.

@@ -5,7 +5,8 @@
 // with u⁰ the inputs' values on the chain and the end under a fixed payload (end loads, weight,
 // point loads). The inputs must be independent: moving one leaves the other's value unchanged
 // (ℓ₁(r₂) = ℓ₂(r₁) = 0 for the inputs' linear functionals ℓ), so both readings are absolute
-// (L0 and dL0 of the same segments, L1_0 and L2_0, or inputs of different segments).
+// (L0 and dL0 of the same segments, L1_0 and L2_0, or inputs of different segments). An input
+// may be a direction in control space (PlaneInput::along): r adds rates of its complementary input.
 //
 // Equilibria F(q; u) = ∂E/∂q − Jᵀ W = 0 (eq 11 with the payload W) form a two-dimensional sheet
 // over the plane. Three kinds of curve bound the part of the end's workspace held by a stable
@@ -28,6 +29,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "buckle/continuation/interrupt.h"
 #include "buckle/continuation/problem.h"
@@ -39,11 +41,21 @@
 
 namespace buckle::mechanics {
 
-/// One input of the plane: a named input of every segment (−1) or of one (0-based).
+/// One input of the plane: a named input of every segment (−1) or of one (0-based), optionally
+/// a direction in control space: moving it by du also moves the complementary input
+/// (complementaryInput: L0 ↔ dL0, L1_0 ↔ L2_0) by along·du, as a control path's /path/direction.
+/// Its value is still the named input's.
 struct PlaneInput {
+  PlaneInput() = default;
+  PlaneInput(ControlInput input_, int segment_ = -1, Eigen::VectorXd along_ = Eigen::VectorXd())
+      : input(input_), segment(segment_), along(std::move(along_)) {}
   ControlInput input = ControlInput::dL0;
   int segment = -1;
-  /// "dL0", "L0[2]" (1-based segment).
+  /// Rates of the complementary input per unit of this one: empty (none), one value for every
+  /// segment, or one per segment.
+  Eigen::VectorXd along;
+  /// "dL0", "L0[2]" (1-based segment); with `along`, "dL0 + 0.5 L0" or "dL0 + (0.5 0 1) L0" (up to
+  /// six rates, else "(per-segment rates)").
   std::string name() const;
 };
 
