@@ -97,10 +97,6 @@ std::string spoolDirectory(const std::string& target) {
   return t.parent_path().string();
 }
 
-}  // namespace
-
-namespace {
-
 // A process of a shared run that does not write (RunCommandOptions::shared): its share of the
 // scene's shared work, nothing written, nothing said.
 int runSceneShare(const RunCommandOptions& options, Scene& scene) {

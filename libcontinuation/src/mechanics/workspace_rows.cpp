@@ -9,6 +9,12 @@ namespace {
 using continuation::ByteReader;
 using continuation::ByteWriter;
 
+Pose getPose(ByteReader& in) {
+  const Vector pose = in.getVector();
+  if (pose.size() != 3) in.fail("a pose of " + std::to_string(pose.size()) + " coordinates");
+  return pose;
+}
+
 void putCell(ByteWriter& out, const WorkspaceCell& c) {
   out.put(c.u1);
   out.put(c.u2);
@@ -29,9 +35,7 @@ void getCell(ByteReader& in, WorkspaceCell& c) {
   c.reached = in.get<std::uint8_t>() != 0;
   c.note = in.getString();
   c.q = in.getVector();
-  const Vector pose = in.getVector();
-  if (pose.size() != 3) in.fail("a pose of " + std::to_string(pose.size()) + " coordinates");
-  c.pose = pose;
+  c.pose = getPose(in);
   c.negative = in.get<std::int32_t>();
   c.smallestEigenvalue = in.get<double>();
   c.stiffness = in.get<double>();
@@ -85,9 +89,7 @@ void getCurve(ByteReader& in, WorkspaceCurve& c) {
     p.u1 = in.get<double>();
     p.u2 = in.get<double>();
     p.q = in.getVector();
-    const Vector pose = in.getVector();
-    if (pose.size() != 3) in.fail("a pose of " + std::to_string(pose.size()) + " coordinates");
-    p.pose = pose;
+    p.pose = getPose(in);
     p.negative = in.get<std::int32_t>();
     p.residual = in.get<double>();
   }
