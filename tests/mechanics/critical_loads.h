@@ -8,7 +8,7 @@
 
 #include "buckle/mechanics/linear_buckling.h"
 
-namespace buckle::mechanics::test {
+namespace buckle::mechanics::testing {
 
 /// Compressive critical loads (λ < 0) of the straight clamped–pinned chain, closest to 0 first.
 inline std::vector<double> compressiveCriticalLoads(const Chain& chain) {
@@ -21,4 +21,4 @@ inline std::vector<double> compressiveCriticalLoads(const Chain& chain) {
   return crit;
 }
 
-}  // namespace buckle::mechanics::test
+}  // namespace buckle::mechanics::testing

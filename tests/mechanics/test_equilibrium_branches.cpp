@@ -42,7 +42,7 @@ const Classification& nameOf(const EquilibriumBranches& r, size_t bi, const cont
   return r.classifications[bi][size_t(sp - b.specialPoints.data())];
 }
 
-using buckle::mechanics::test::compressiveCriticalLoads;
+using buckle::mechanics::testing::compressiveCriticalLoads;
 
 }  // namespace
 

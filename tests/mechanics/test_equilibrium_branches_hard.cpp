@@ -24,7 +24,7 @@ namespace {
 
 using testing::kAxial;
 
-using buckle::mechanics::test::compressiveCriticalLoads;
+using buckle::mechanics::testing::compressiveCriticalLoads;
 
 }  // namespace
 

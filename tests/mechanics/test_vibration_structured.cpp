@@ -157,7 +157,7 @@ TEST_CASE("vibration structured: omega^2 crosses zero at the located branch poin
   o.maxPoints = 20000;
   SECTION("branch points of the compressed clamped-pinned column") {
     const Chain chain = stiffChain(n);
-    const std::vector<double> crit = test::compressiveCriticalLoads(chain);
+    const std::vector<double> crit = testing::compressiveCriticalLoads(chain);
     REQUIRE(crit.size() >= 2);
     EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
     o.lambdaMin = 0.5 * (crit[1] + crit[2]);
