@@ -174,11 +174,18 @@ void inputMapPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec
          << quote(inputLabel(scene, o.second.input)) << "\n";
   s.body << "set xrange [" << num(o.first.from) << ":" << num(o.first.to) << "]\nset yrange [" << num(o.second.from)
          << ":" << num(o.second.to) << "]\n";
-  s.body << "set logscale cb\nset palette rgb 33,13,10\nset cblabel "
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+  for (const mechanics::WorkspaceCell& x : m.cells)
+    if (x.stable() && x.stiffness > 0.0) {
+      lo = std::min(lo, x.stiffness);
+      hi = std::max(hi, x.stiffness);
+    }
+  const bool anyStable = hi > 0.0;
+  // a log scale over less than a decade has no labelled tic: linear there
+  if (anyStable && hi >= 10.0 * lo) s.body << "set logscale cb\n";
+  s.body << "set palette rgb 33,13,10\nset cblabel "
          << quote("smallest eigenvalue of the loaded stiffness K_F" + scene.units.suffix(Dimension::Stiffness))
          << " noenhanced\n";
-  const bool anyStable = std::any_of(m.cells.begin(), m.cells.end(),
-                                     [](const mechanics::WorkspaceCell& x) { return x.stable() && x.stiffness > 0.0; });
   BlockFile start;
   start.begin();
   start.point({mechanics::controlInputValue(cr.chain, o.first.input.input, o.first.input.segment),
