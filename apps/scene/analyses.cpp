@@ -51,7 +51,7 @@ const std::vector<Analysis>& analyses() {
          return "workspace and stability maps over " + s.analyses.workspace.options.first.input.name() + " and " +
                 s.analyses.workspace.options.second.input.name() + " under the payload, bounding curves traced";
        },
-       "workspace", [](CaseRunner& r) { r.workspaceMap(); }, true},
+       "workspace", [](CaseRunner& r) { r.workspaceMap(); }, true, true},
       {"load_history", detail::parseLoadHistory, [](A a) { return a.loadHistory.enabled; },
        [](S s) {
          return "quasi-static load history with jumps (hysteresis), " +

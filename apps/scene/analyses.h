@@ -34,6 +34,9 @@ struct Analysis {
   void (*run)(CaseRunner& runner);
   /// It may be a scene's only analysis (false: it needs the branches of another).
   bool standalone;
+  /// Its work is shared among the processes of a shared run (shared_work.h): the processes that
+  /// do not write run this stage alone.
+  bool shared = false;
 };
 
 /// Every analysis, in the order the stages run.

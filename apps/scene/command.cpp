@@ -97,16 +97,22 @@ std::string spoolDirectory(const std::string& target) {
   return t.parent_path().string();
 }
 
+// The steering of a run from the command's options: the processes sharing it, the command
+// line's time limit (recorded in the scene, so summary.json says it), the signals.
+RunControl commandControl(const RunCommandOptions& options, Scene& scene, bool signals) {
+  RunControl control;
+  control.shared = options.shared;
+  if (!std::isnan(options.timeLimit)) scene.solver.timeLimit = options.timeLimit;
+  if (signals) control.interrupt.watch(SignalGuard::flag(), "interrupted by a signal (SIGINT/SIGTERM/SIGHUP)");
+  return control;
+}
+
 // A process of a shared run that does not write (RunCommandOptions::shared): its share of the
 // scene's shared work, nothing written, nothing said.
 int runSceneShare(const RunCommandOptions& options, Scene& scene) {
   std::optional<SignalGuard> signals;
   if (options.handleSignals) signals.emplace();
-  RunControl control;
-  control.shared = options.shared;
-  if (!std::isnan(options.timeLimit)) scene.solver.timeLimit = options.timeLimit;
-  if (signals) control.interrupt.watch(SignalGuard::flag(), "interrupted by a signal (SIGINT/SIGTERM/SIGHUP)");
-  const RunResult run = runScene(scene, control);
+  const RunResult run = runScene(scene, commandControl(options, scene, signals.has_value()));
   if (signals && SignalGuard::signal() != 0) return SignalGuard::exitCode();
   return run.complete ? kSuccess : kIncomplete;
 }
@@ -152,13 +158,8 @@ int runSceneCommand(const RunCommandOptions& options, std::ostream& log, std::os
     log << "\n" << std::flush;
   }
   Progress progress(err, options.quiet ? Progress::Mode::Off : options.progress);
-  RunControl control;
+  RunControl control = commandControl(options, scene, signals.has_value());
   control.progress = &progress;
-  control.shared = options.shared;
-  if (!std::isnan(options.timeLimit)) {
-    scene.solver.timeLimit = options.timeLimit;  // recorded as such in summary.json
-  }
-  if (signals) control.interrupt.watch(SignalGuard::flag(), "interrupted by a signal (SIGINT/SIGTERM/SIGHUP)");
   // branches.csv's rows are written beside the target while the tree is traced (branch_stream.h)
   RunResult run;
   try {

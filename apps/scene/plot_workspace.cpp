@@ -164,8 +164,10 @@ void inputMapPlot(const Scene& scene, const RunResult& run, const PlotSpec& spec
   unstable.write(dir / (stem + "_unstable.dat"));
   curves.write(dir / (stem + "_curves.dat"));
   const mechanics::WorkspaceMapOptions& o = scene.analyses.workspace.options;
-  header(s, spec.title.empty() ? "Inputs " + m.input1 + ", " + m.input2 +
-                                     ": the end's stiffness where the equilibrium is stable" +
+  // long names (inputs along a direction) stay in the axis labels: a title line has no room for them
+  const std::string inputs =
+      m.input1.size() + m.input2.size() <= 30 ? "Inputs " + m.input1 + ", " + m.input2 : "Over the two inputs";
+  header(s, spec.title.empty() ? inputs + ": the end's stiffness where the equilibrium is stable" +
                                      (run.cases.size() > 1 ? " (" + cr.label + ")" : "")
                                : spec.title);
   s.width = 1100;

@@ -45,7 +45,7 @@ RunResult runScene(const Scene& scene, const RunControl& given) {
   for (const Analysis& x : analyses()) {
     if (!x.asked(scene.analyses)) continue;
     // a process that does not write runs only the work shared among the processes (shared_work.h)
-    if (!control.shared.writer() && std::string(x.stage ? x.stage : "") != "workspace") continue;
+    if (!control.shared.writer() && !x.shared) continue;
     run.computed.push_back(x.computed(scene));
     if (x.stage) stages.push_back(&x);
   }
