@@ -3,6 +3,7 @@
 #include "contact_geometry_report.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -29,39 +30,90 @@ double pointSegment(const Point& p, const Point& a, const Point& b, Point* neare
   return (p - c).norm();
 }
 
-double cross(const Point& a, const Point& b) { return a.x() * b.y() - a.y() * b.x(); }
+using Triangle = std::array<Point, 3>;
 
-/// Signed distance of segments [a, b] and [c, d] (file comment of the header): the distance
-/// while disjoint, minus the smallest end-point-to-other-segment distance while they cross.
-double segmentSegment(const Point& a, const Point& b, const Point& c, const Point& d, Point& onAB) {
-  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
-  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
-  const bool crossing = ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0));
-  Point pc, pd, tmp;
-  const double dc = pointSegment(c, a, b, &pc), dd = pointSegment(d, a, b, &pd);
-  const double da = pointSegment(a, c, d, &tmp), db = pointSegment(b, c, d, &tmp);
-  double best = dc;
-  onAB = pc;
-  if (dd < best) best = dd, onAB = pd;
-  if (da < best) best = da, onAB = a;
-  if (db < best) best = db, onAB = b;
-  if (crossing) {
-    // the crossing point itself is where the links meet
-    const double t = d1 / (d1 - d2);
-    onAB = c + t * (d - c);
-    return -best;
+/// Gap of the projections of A and B on the unit axis u: > 0 separated by that much, ≤ 0 overlapping.
+double projectedGap(const Triangle& A, const Triangle& B, const Point& u) {
+  double minA = u.dot(A[0]), maxA = minA, minB = u.dot(B[0]), maxB = minB;
+  for (int k = 1; k < 3; ++k) {
+    minA = std::min(minA, u.dot(A[k])), maxA = std::max(maxA, u.dot(A[k]));
+    minB = std::min(minB, u.dot(B[k])), maxB = std::max(maxB, u.dot(B[k]));
   }
-  return best;
+  return std::max(minB - maxA, minA - maxB);
+}
+
+/// Signed distance of two triangles (either may be flat): the distance while they are disjoint,
+/// else the largest projected gap over their edges' normals (separating axes), ≤ 0 and minus the
+/// depth of the overlap; continuous at the first touch. onA: the point of A nearest to B (while
+/// overlapping, the nearest pair of a vertex and an edge).
+double triangleTriangle(const Triangle& A, const Triangle& B, Point& onA) {
+  double gap = -std::numeric_limits<double>::infinity();
+  for (const Triangle* T : {&A, &B})
+    for (int e = 0; e < 3; ++e) {
+      const Point d = (*T)[(e + 1) % 3] - (*T)[e];
+      const double len = d.norm();
+      if (len > 0.0) gap = std::max(gap, projectedGap(A, B, Point(-d.y(), d.x()) / len));
+    }
+  double best = std::numeric_limits<double>::infinity();
+  Point nearest;
+  for (int e = 0; e < 3; ++e) {
+    const Point &a0 = A[e], &a1 = A[(e + 1) % 3], &b0 = B[e], &b1 = B[(e + 1) % 3];
+    for (int k = 0; k < 3; ++k) {
+      const double toA = pointSegment(B[k], a0, a1, &nearest);
+      if (toA < best) best = toA, onA = nearest;
+      const double toB = pointSegment(A[k], b0, b1);
+      if (toB < best) best = toB, onA = A[k];
+    }
+  }
+  return gap > 0.0 ? best : gap;
+}
+
+/// The links' rigid bodies (contact_geometry.h): link 0 the clamped proximal triangle of the first
+/// segment, link m (1 ≤ m < n) segment m's distal and segment m + 1's proximal triangle (1-based),
+/// link n the last segment's distal one; each triangle's apex is its segment's joint.
+struct LinkBodies {
+  std::vector<Triangle> triangles;  ///< link m's are triangles[first[m]] … [first[m + 1] − 1]
+  std::vector<int> first;
+};
+LinkBodies linkBodies(const Chain& chain, ConstVectorRef q, const Eigen::Matrix2Xd& P) {
+  const int n = chain.size();
+  LinkBodies L;
+  L.triangles.reserve(size_t(2 * n));
+  L.first.reserve(size_t(n + 2));
+  double theta = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const SegmentParameters& p = chain.segment(i).parameters();
+    const Point joint = P.col(i + 1);
+    const double before = theta, after = theta + q[i];
+    // the proximal triangle closes link i, the distal one opens link i + 1
+    L.triangles.push_back({joint, segmentVertex(p, joint, before, after, 1), segmentVertex(p, joint, before, after, 2)});
+    L.first.push_back(int(L.triangles.size()) - (i == 0 ? 1 : 2));
+    L.triangles.push_back({joint, segmentVertex(p, joint, before, after, 3), segmentVertex(p, joint, before, after, 4)});
+    theta = after;
+  }
+  L.first.push_back(int(L.triangles.size()) - 1);
+  L.first.push_back(int(L.triangles.size()));
+  return L;
 }
 
 double distanceAt(const Chain& chain, ConstVectorRef q, bool base) {
   return base ? baseClearance(chain, q).distance : selfClearance(chain, q).distance;
 }
 
+/// Every vertex of the links' bodies (the triangles' apexes are the joints), 2 × 3·(2n) columns.
+Eigen::Matrix2Xd bodyVertices(const Chain& chain, ConstVectorRef q) {
+  const LinkBodies bodies = linkBodies(chain, q, jointPositions(chain, q));
+  Eigen::Matrix2Xd V(2, 3 * Eigen::Index(bodies.triangles.size()));
+  for (size_t t = 0; t < bodies.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) V.col(3 * Eigen::Index(t) + k) = bodies.triangles[t][size_t(k)];
+  return V;
+}
+
 /// The clearances of a branch's points (distanceAt) as far as a scan for sign changes needs them:
-/// exact at the base, and for the self contact exact at a reference point and, while every joint
-/// has moved by at most δ from it, the bound d_ref − 2δ (or d_ref + 2δ) in its place — two links'
-/// distance changes by at most 2δ when their ends move by δ — as long as the bound keeps the sign
+/// exact at the base, and for the self contact exact at a reference point and, while every
+/// vertex of the bodies has moved by at most δ from it, the bound d_ref − 2δ (or d_ref + 2δ) in
+/// its place — a rigid triangle's points move by at most its vertices' largest move (the move is
+/// affine in the point), so two bodies' signed distance changes by at most 2δ — as long as the bound keeps the sign
 /// of d_ref by a margin far above rounding. O(n) a point, the nearest-pair search (O(n log n))
 /// only where the clearance may change sign.
 std::vector<double> scannedDistances(const Chain& chain, const continuation::Branch& branch, bool base) {
@@ -76,7 +128,7 @@ std::vector<double> scannedDistances(const Chain& chain, const continuation::Bra
       d[i] = distanceAt(chain, q, true);
       continue;
     }
-    const Eigen::Matrix2Xd P = jointPositions(chain, q);
+    const Eigen::Matrix2Xd P = bodyVertices(chain, q);
     if (std::isfinite(dRef) && P.cols() == reference.cols()) {
       const double moved = 2.0 * (P - reference).colwise().norm().maxCoeff();
       const double margin = 1e-9 * std::max(1.0, P.cwiseAbs().maxCoeff());
@@ -114,14 +166,18 @@ SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) {
   SelfClearance c;
   c.distance = std::numeric_limits<double>::infinity();
   if (links < 3) return c;
-  // Bounding circles of the links (mid-point, half length), and the links sorted by the x of
-  // their mid-points: the pairs scanned are those whose circles could beat the best so far.
+  const LinkBodies bodies = linkBodies(chain, q, P);
+  // Bounding circles of the bodies (the link's mid-point, the farthest vertex), and the links
+  // sorted by the x of their mid-points: the pairs scanned are those whose circles could beat the
+  // best so far.
   Eigen::Matrix2Xd mid(2, links);
   Eigen::VectorXd radius(links);
   double rmax = 0.0, extent = 0.0;
   for (int a = 0; a < links; ++a) {
     mid.col(a) = 0.5 * (P.col(a) + P.col(a + 1));
-    radius[a] = 0.5 * (P.col(a + 1) - P.col(a)).norm();
+    radius[a] = 0.0;
+    for (int t = bodies.first[size_t(a)]; t < bodies.first[size_t(a) + 1]; ++t)
+      for (const Point& v : bodies.triangles[size_t(t)]) radius[a] = std::max(radius[a], (v - mid.col(a)).norm());
     rmax = std::max(rmax, radius[a]);
     extent = std::max(extent, mid.col(a).cwiseAbs().maxCoeff() + radius[a]);
   }
@@ -130,21 +186,20 @@ SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) {
   std::sort(byX.begin(), byX.end(), [&mid](int i, int j) { return mid(0, i) < mid(0, j); });
   std::vector<double> xs(byX.size());
   for (size_t i = 0; i < byX.size(); ++i) xs[i] = mid(0, byX[i]);
-  // A pair whose mid-points differ by more than reach in x or y has bound = |Δm| − r_a − r_b >
-  // the best so far (+ a margin far above the rounding of the bound): the all-pairs scan below
-  // would skip it too, so scanning only the others, in the same order with the same test, gives
-  // the same pair, bit for bit.
+  // A pair's signed distance is at least its circles' gap |Δm| − r_a − r_b where that is
+  // positive, and at least −r_a − r_b (every projected gap is) where they overlap: the lower
+  // bound below. A pair whose mid-points differ by more than the reach in x or y has disjoint
+  // circles and a bound above the best so far (+ a margin far above the rounding of the bound):
+  // the all-pairs scan would skip it too, so scanning only the others, in the same order with the
+  // same test, gives the same pair, bit for bit.
   const double margin = 1e-9 * extent;
   std::vector<int> candidates;
   candidates.reserve(static_cast<size_t>(links));
   for (int a = 0; a < links - 2; ++a) {
-    const Point a0 = P.col(a), a1 = P.col(a + 1);
-    const Point ma = 0.5 * (a0 + a1);
-    const double ra = 0.5 * (a1 - a0).norm();
+    const double ra = radius[a];
     candidates.clear();
     if (std::isfinite(c.distance)) {
-      const double reach = c.distance + ra + rmax + margin;
-      if (reach < 0.0) continue;  // every bound ≥ −r_a − r_b exceeds a crossing this deep
+      const double reach = std::max(c.distance, 0.0) + ra + rmax + margin;
       const auto lo = std::lower_bound(xs.begin(), xs.end(), mid(0, a) - reach);
       const auto hi = std::upper_bound(xs.begin(), xs.end(), mid(0, a) + reach);
       for (auto it = lo; it != hi; ++it) {
@@ -156,20 +211,20 @@ SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) {
       for (int b = a + 2; b < links; ++b) candidates.push_back(b);
     }
     for (const int b : candidates) {
-      const Point b0 = P.col(b), b1 = P.col(b + 1);
-      const double rb = 0.5 * (b1 - b0).norm();
-      // bounding circles: a lower bound of the pair's distance, exact evaluation only if it
-      // could beat the best so far
-      const double bound = (0.5 * (b0 + b1) - ma).norm() - ra - rb;
+      const double circles = (mid.col(b) - mid.col(a)).norm() - ra - radius[b];
+      const double bound = circles > 0.0 ? circles : -ra - radius[b];
       if (bound >= c.distance) continue;
-      Point on;
-      const double d = segmentSegment(a0, a1, b0, b1, on);
-      if (d < c.distance) {
-        c.distance = d;
-        c.linkA = a;
-        c.linkB = b;
-        c.point = on;
-      }
+      for (int s = bodies.first[size_t(a)]; s < bodies.first[size_t(a) + 1]; ++s)
+        for (int t = bodies.first[size_t(b)]; t < bodies.first[size_t(b) + 1]; ++t) {
+          Point on;
+          const double d = triangleTriangle(bodies.triangles[size_t(s)], bodies.triangles[size_t(t)], on);
+          if (d < c.distance) {
+            c.distance = d;
+            c.linkA = a;
+            c.linkB = b;
+            c.point = on;
+          }
+        }
     }
   }
   return c;
@@ -187,9 +242,33 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
   for (bool base : {true, false}) {
     if (base && problem.wallIsBoundary()) continue;  // the wall is a constraint: WC / WR (contact.h)
     std::vector<double> d = scannedDistances(chain, branch, base);
-    for (size_t i = 0; i + 1 < count; ++i) {
-      if ((d[i] > 0.0) == (d[i + 1] > 0.0) || !std::isfinite(d[i]) || !std::isfinite(d[i + 1])) continue;
-      // a sign change: the clearances themselves on both sides (a bound has only their sign)
+    // Bodies that rest on each other (a vertex on the wall, triangles meeting where joints lock at
+    // their limits) keep their distance within rounding of zero, of either sign: the sign changes
+    // that count are between points clear of that band, each in the interval where the sign flips.
+    const double band = kTouchingBand * chain.length();
+    for (size_t i = 0; i < count; ++i)
+      if (std::abs(d[i]) <= band) d[i] = distanceAt(chain, branch.points[i].u.head(n), base);  // not a bound
+    std::vector<size_t> changes;
+    int lastSign = 0;
+    size_t lastClear = 0;
+    for (size_t i = 0; i < count; ++i) {
+      if (!std::isfinite(d[i])) {
+        lastSign = 0;
+        continue;
+      }
+      const int sign = d[i] > band ? 1 : (d[i] < -band ? -1 : 0);
+      if (sign == 0) continue;
+      if (lastSign != 0 && sign != lastSign)
+        for (size_t j = lastClear; j < i; ++j)
+          if ((d[j] > 0.0) != (d[j + 1] > 0.0)) {
+            changes.push_back(j);
+            break;
+          }
+      lastSign = sign;
+      lastClear = i;
+    }
+    for (const size_t i : changes) {
+      // the clearances themselves on both sides (a bound has only their sign)
       d[i] = distanceAt(chain, branch.points[i].u.head(n), base);
       d[i + 1] = distanceAt(chain, branch.points[i + 1].u.head(n), base);
       const continuation::ContinuationPoint &p0 = branch.points[i], &p1 = branch.points[i + 1];

@@ -14,9 +14,9 @@ using Point = Eigen::Vector2d;
 Point dir(double t) { return Point(std::cos(t), std::sin(t)); }
 Point nrm(double t) { return Point(-std::sin(t), std::cos(t)); }
 
-// The vertex from its joint (P column segment + 1) and the angles of the links on either side
-// of the joint: the same sums as the shape plots and baseClearance.
-Point vertexAt(const SegmentParameters& p, const Point& joint, double before, double after, int corner) {
+}  // namespace
+
+Point segmentVertex(const SegmentParameters& p, const Point& joint, double before, double after, int corner) {
   switch (corner) {
     case 0: return joint;
     case 1: return joint - p.b1 * dir(before) + p.a1 * nrm(before);
@@ -25,8 +25,6 @@ Point vertexAt(const SegmentParameters& p, const Point& joint, double before, do
     default: return joint + p.b2 * dir(after) - p.a2 * nrm(after);
   }
 }
-
-}  // namespace
 
 std::string WallVertex::label() const {
   static const char* const names[] = {"j", "p+", "p-", "d+", "d-"};
@@ -45,7 +43,7 @@ void checkWallVertex(const WallVertex& v, int segments) {
 Eigen::Vector2d wallVertexPoint(const Chain& chain, ConstVectorRef q, const Eigen::Matrix2Xd& P, const WallVertex& v) {
   double before = 0.0;
   for (int j = 0; j < v.segment; ++j) before += q[j];
-  return vertexAt(chain.segment(v.segment).parameters(), P.col(v.segment + 1), before, before + q[v.segment], v.corner);
+  return segmentVertex(chain.segment(v.segment).parameters(), P.col(v.segment + 1), before, before + q[v.segment], v.corner);
 }
 
 void wallVertexDerivatives(const Eigen::Matrix2Xd& P, const Eigen::Vector2d& point, const WallVertex& v,
@@ -74,7 +72,7 @@ WallApproach nearestWallVertex(const Chain& chain, ConstVectorRef q, const std::
       if (shared && (corner == 1 || corner == 2)) continue;
       const WallVertex v{i, corner};
       if (std::find(exclude.begin(), exclude.end(), v) != exclude.end()) continue;
-      const Point x = vertexAt(p, P.col(i + 1), before, after, corner);
+      const Point x = segmentVertex(p, P.col(i + 1), before, after, corner);
       if (x.x() < c.distance) {
         c.distance = x.x();
         c.vertex = v;

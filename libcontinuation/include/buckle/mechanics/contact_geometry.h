@@ -7,20 +7,23 @@
 //    triangle vertices. A convex body's smallest x is at a vertex, so the signed distance
 //        d_base(q) = min over the moving triangles' vertices of x          (> 0: clear)
 //    is exact for this geometry and costs O(n).
-//  * Self contact. Link m (the base link ℓ_0 from the base to joint 1, and ℓ_m from joint m to
-//    m + 1 or to the end) is the straight centre line of the rigid body made of segment m's
-//    distal and segment m + 1's proximal triangle. Two links that share a joint always touch
-//    there; links two or more apart are in contact when their centre lines meet. The signed
-//    distance of a pair is the segment–segment distance while they are disjoint and minus the
-//    smallest distance of an end point to the other segment while they cross (continuous at the
-//    first touch, negative after it), and
+//  * Self contact. Link m's rigid body is made of two triangles, their real outlines from a and b
+//    (the base link ℓ_0: the first segment's clamped proximal triangle; link m: segment m's distal
+//    and segment m + 1's proximal triangle, base to base; the last link: the last segment's
+//    distal one), each with its apex at its segment's joint. Links that share a joint always
+//    touch there (the joint's own limit is contact.h); links two or more apart are in contact
+//    when their triangles meet. The signed distance of two triangles is their distance while
+//    they are disjoint and, while they overlap, the largest gap of their projections on their
+//    edges' normals — minus the depth of the overlap (separating axes; continuous at the first
+//    touch, negative after it); a pair of links takes the smallest over their triangles, and
 //        d_self(q) = min over non-adjacent pairs                            (> 0: clear).
-//    Pairs are rejected by their bounding circles (a pair whose mid-points are farther apart
-//    than the best distance so far plus half their lengths' sum is never evaluated exactly), and
-//    only the links whose mid-points lie within that reach in x and y of a link's (a sweep over
-//    the links sorted by x) are looked at: nothing is missed, the pair found is the all-pairs
-//    scan's, and a chain that does not fold onto itself costs O(n log n) per point. The triangles' widths are not part of the self-contact test (the centre lines meet
-//    only after the bodies do: a detection, not a contact model).
+//    Pairs are rejected by their bounding circles (the link's mid-point, its farthest vertex: a
+//    pair is evaluated exactly only if its circles' gap, or −r_a − r_b where they overlap, could
+//    beat the best so far), and only the links whose mid-points lie within that reach in x and y
+//    of a link's (a sweep over the links sorted by x) are looked at: nothing is missed, the pair
+//    found is the all-pairs scan's, and a chain that does not fold onto itself costs O(n log n)
+//    per point. Detection: the chain does not yet stop at a self contact (the base wall can be a
+//    constraint, wall_contact.h).
 //
 // Along a traced branch (branch_report.h) a sign change of d_base or d_self between two
 // consecutive points is a special point "BC" / "SC", located by root finding on the signed
@@ -48,14 +51,18 @@ struct BaseClearance {
 /// O(n). Throws std::invalid_argument when q does not have one angle per segment.
 BaseClearance baseClearance(const Chain& chain, ConstVectorRef q);
 
-/// The nearest approach of two non-adjacent links (file comment).
+/// The nearest approach of two non-adjacent links' bodies (file comment).
 struct SelfClearance {
   double distance = 0.0;  ///< d_self (+inf with fewer than three links)
   int linkA = -1, linkB = -1;  ///< links m (0: the base link ℓ_0), linkA < linkB − 1
-  Eigen::Vector2d point = Eigen::Vector2d::Zero();  ///< nearest / crossing point on link A
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();  ///< the point of link A's body nearest to link B's (overlapping: near the overlap)
 };
 /// Bounding-circle cut-off and an x sweep (file comment): O(n log n) unless the chain folds onto itself.
 SelfClearance selfClearance(const Chain& chain, ConstVectorRef q);
+
+/// Clearances within this fraction of the chain's length of zero are "touching": bodies resting on
+/// each other within rounding (locateGeometricContacts counts sign changes between points outside it).
+inline constexpr double kTouchingBand = 1e-9;
 
 /// Base (true) or self (false) contact located on a branch.
 struct GeometricContact {
@@ -80,8 +87,8 @@ struct GeometricContacts {
 };
 
 /// The base and self contacts along `branch` traced on `problem`; `locked[i]` the joints locked
-/// at point i (empty: none anywhere). Each sign change of d_base / d_self between consecutive
-/// points is located by Illinois iteration on λ, each trial an equilibrium solved at fixed λ with
+/// at point i (empty: none anywhere). Each sign change of d_base / d_self between points clear of
+/// zero by more than kTouchingBand × the chain's length (in the interval where it flips) is located by Illinois iteration on λ, each trial an equilibrium solved at fixed λ with
 /// the interval's locked joints fixed (solveConstrainedEquilibrium), to |Δλ| <= tolerance·max(λ
 /// scale, |λ|). Not located (to the point spacing) across a fold inside the interval, where λ
 /// does not parametrize the branch, nor once `interrupt` is requested.

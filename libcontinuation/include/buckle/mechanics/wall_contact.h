@@ -50,6 +50,11 @@ struct WallVertex {
 /// Throws std::invalid_argument naming the vertex when it is not a moving vertex of the chain.
 void checkWallVertex(const WallVertex& v, int segments);
 
+/// Corner `corner` (0–4, as WallVertex) of segment p's triangles, from its joint's position and
+/// the absolute angles of the links before and after the joint (the same sums as the shape plots).
+Eigen::Vector2d segmentVertex(const SegmentParameters& p, const Eigen::Vector2d& joint, double before, double after,
+                              int corner);
+
 /// The vertex's position at q, from the joint positions P = jointPositions(chain, q). O(1).
 Eigen::Vector2d wallVertexPoint(const Chain& chain, ConstVectorRef q, const Eigen::Matrix2Xd& P, const WallVertex& v);
 
