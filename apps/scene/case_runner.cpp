@@ -401,6 +401,7 @@ void CaseRunner::continuation() {
                                                     (b.direction > 0 ? ", + side" : ", - side");
     record(b, report, origin);
   };
+  warnOfOverlappingStart();
   const mech::EquilibriumBranches result = mech::traceEquilibria(problem, out_.qStart, s0, starts, opt);
   const auto& branches = result.tree.branches;
   if (!branches.empty() && branches.front().stopReason == cont::StopReason::StartFailed) {

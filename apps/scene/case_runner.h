@@ -183,6 +183,9 @@ class CaseRunner {
   /// critical loads of the unloaded shape that a tree of this depth would switch at
   /// (case_runner_ahead.cpp).
   void warnOfLargeTree(const mechanics::CriticalLoading& loading, const std::vector<double>& ends, int depth);
+  /// A warning when the start shape already has two links' bodies overlapping (contact_geometry.h):
+  /// self contact is detected, not enforced, so the chain starts as a ghost there.
+  void warnOfOverlappingStart();
   std::vector<continuation::Branch> traced_;  // the continuation's tree (not through a reaction)
   /// `frequencies`: the case's chain with its rods (built at the first point)
   std::unique_ptr<mechanics::VibrationAnalysis> vibration_;

@@ -1,9 +1,12 @@
 // The tree's size ahead (docs/scenes.md, "Progress"): the branch points the tree has found and
 // not yet switched at, shown with the progress line; and the warning at the start when the path
-// crosses hundreds of critical loads, each a branch point the tree would switch at.
+// crosses hundreds of critical loads, each a branch point the tree would switch at; and the warning
+// when the start shape already overlaps itself.
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
+#include "buckle/mechanics/contact_geometry.h"
 #include "scene/case_runner.h"
 
 namespace buckle::scene {
@@ -78,6 +81,19 @@ void CaseRunner::warnOfLargeTree(const mech::CriticalLoading& loading, const std
      << " branches or more to trace. Give /analyses/continuation/branch_points (switch at the first k on each "
         "branch), a shorter path range or --time-limit; under a limit the weakest branch points are switched "
         "first";
+  run_.warnings.push_back(os.str());
+  if (control_.progress) control_.progress->warn(os.str());
+}
+
+void CaseRunner::warnOfOverlappingStart() {
+  const mech::SelfClearance c = mech::selfClearance(out_.chain, out_.qStart.head(out_.chain.size()));
+  if (!(c.distance < -mech::kTouchingBand * out_.chain.length())) return;
+  std::ostringstream os;
+  os.precision(6);
+  os << "case \"" << spec_.label << "\": the start shape overlaps itself: the bodies of links " << c.linkA << " and "
+     << c.linkB << " (0: the clamped base link) overlap by " << -c.distance << scene_.units.suffix(Dimension::Length)
+     << " near (" << c.point.x() << ", " << c.point.y()
+     << "); self contact is detected, not enforced, so the chain passes through itself there until they separate (SC)";
   run_.warnings.push_back(os.str());
   if (control_.progress) control_.progress->warn(os.str());
 }

@@ -146,3 +146,49 @@ TEST_CASE("scene: a path across hundreds of critical loads is warned of at the s
     CHECK(few.err.find("warning") == std::string::npos);
   }
 }
+
+TEST_CASE("scene: a start shape whose links' bodies overlap is warned of, with the depth in the scene's units",
+          "[progress]") {
+  // contact_release's curled chain: its last link's triangle lies inside the clamped one
+  const auto scene = [](double curl, const std::string& units, double length) {
+    std::ostringstream s;
+    s.precision(17);
+    s << R"({"units": )" << units << R"(, "chain": {"segments": [{"q0": 0.2}, {"q0": )" << curl << R"(}, {"q0": )"
+      << curl << R"(}, {"q0": )" << curl << R"(}, {"q0": )" << curl << R"(}], "a": )" << 0.5 * length
+      << R"(, "b": )" << length << R"(, "k": 1.0, "L0": )" << 2.25 * length << R"(},
+      "end": {"x": {"load": 0.0}, "y": {"load": 0.0}, "phi": "free"},
+      "path": {"parameter": "Fy", "from": 0.0, "to": )" << 0.01 * length << R"(},
+      "analyses": {"continuation": true}})";
+    return s.str();
+  };
+  const auto warnings = [](const buckle::test::SceneOutcome& o) {
+    std::ifstream in(o.out / "summary.json");
+    const nlohmann::json s = nlohmann::json::parse(in);
+    return s.contains("warnings") ? s["warnings"] : nlohmann::json::array();
+  };
+  using namespace buckle::mechanics;
+  for (double length : {1.0, 0.02}) {
+    const std::string units = length == 1.0 ? R"("nondimensional")" : R"({"length": "m", "force": "N"})";
+    INFO("units " << units);
+    const buckle::test::SceneOutcome curled = buckle::test::runSceneText("scene_progress", "curled", scene(1.3, units, length));
+    INFO(curled.err);
+    const nlohmann::json w = warnings(curled);
+    REQUIRE(w.size() == 1);
+    const std::string warning = w[0].get<std::string>();
+    CHECK_THAT(warning, Contains("the start shape overlaps itself: the bodies of links 0 and 5"));
+    CHECK_THAT(warning, Contains(length == 1.0 ? " (units of b)" : " (m)"));
+    // the depth: −d_self of the chain at its q0 (the same chain built here)
+    Vector q(5);
+    q << 0.2, 1.3, 1.3, 1.3, 1.3;
+    const double depth = -selfClearance(Chain::uniform(5, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)), q).distance;
+    REQUIRE(depth > 0.0);
+    std::ostringstream d;
+    d.precision(6);
+    d << depth * length;
+    CHECK_THAT(warning, Contains("overlap by " + d.str()));
+    CHECK_THAT(curled.err, Contains("buckle: warning: " + warning.substr(0, 60)));
+    // curled less, the bodies are clear: nothing to warn of
+    const buckle::test::SceneOutcome clear = buckle::test::runSceneText("scene_progress", "clear", scene(1.2, units, length));
+    CHECK(warnings(clear).empty());
+  }
+}

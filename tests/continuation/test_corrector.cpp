@@ -352,3 +352,45 @@ TEST_CASE("Corrector's lean Newton: KINSOL's outcome bit for bit on every path w
   CHECK(lean > 0);
   CHECK(handed > 0);
 }
+
+TEST_CASE("Corrector: a residual whose rounding floor lies above the tolerance converges within stagnationFactor of it",
+          "[corrector]") {
+  // F = u − λ + A·sin(1e12·u): the sine stands for the rounding noise of a long sum (its slope
+  // left out of the Jacobian, as rounding is), amplitude A. Newton's steps chase the noise, never
+  // smaller than the step tolerance, until the iterations are used up (KIN_MAXITER_REACHED).
+  class Noisy : public Problem {
+   public:
+    explicit Noisy(double amplitude) : amplitude_(amplitude) {}
+    int dimension() const override { return 1; }
+    bool residual(ProblemWorkspace &, ConstVectorRef u, double lambda, VectorRef F) const override {
+      F[0] = u[0] - lambda + amplitude_ * std::sin(1e12 * u[0]);
+      return true;
+    }
+    bool jacobian(ProblemWorkspace &, ConstVectorRef, double, MatrixRef Fu, VectorRef Fl) const override {
+      Fu(0, 0) = 1.0;
+      Fl[0] = -1.0;
+      return true;
+    }
+
+   private:
+    double amplitude_;
+  };
+  CorrectorOptions o;  // tolerance 1e-10, stagnationFactor 100
+  for (double amplitude : {1e-9, 1e-7}) {
+    Noisy problem(amplitude);
+    Corrector corrector(problem, o);
+    Vector u(1), guess(1);
+    guess << 0.3;
+    const CorrectorSummary s = corrector.solveAtFixedParameter(guess, 0.7, u);
+    INFO("amplitude " << amplitude << ": " << s.flagName << ", residual " << s.residualNorm);
+    CHECK(std::string(s.flagName) == "KIN_MAXITER_REACHED");
+    CHECK(s.residualNorm > o.tolerance);  // the floor: never below the tolerance
+    if (amplitude * 10.0 <= o.stagnationFactor * o.tolerance) {
+      CHECK(s.converged);
+      CHECK(s.residualNorm <= o.stagnationFactor * o.tolerance);
+      CHECK(std::abs(u[0] - 0.7) <= 2.0 * amplitude);
+    } else {
+      CHECK_FALSE(s.converged);  // a floor above the factor is a failure, as before
+    }
+  }
+}

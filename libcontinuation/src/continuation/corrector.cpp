@@ -299,8 +299,14 @@ CorrectorSummary Corrector::correct(ConstVectorRef predictor, ConstVectorRef tan
   if (!stepNorms_.empty()) summary.lastStepNorm = stepNorms_.back();
   for (std::size_t k = 1; k < stepNorms_.size(); ++k)
     if (stepNorms_[k - 1] > 0.0) summary.contraction = std::max(summary.contraction, stepNorms_[k] / stepNorms_[k - 1]);
+  // A residual whose rounding floor lies above the tolerance (a long chain's held end coordinate
+  // sums thousands of terms of the chain's length) never gets below it: Newton stalls at the
+  // floor, on the step tolerance or, where a nearly singular Jacobian turns the floor's noise into
+  // steps, by using up its iterations. Either counts as converged within stagnationFactor·tolerance
+  // (the point keeps the residual it reached: ContinuationPoint::residualNorm).
+  const bool stalled = flag == KIN_STEP_LT_STPTOL || flag == KIN_MAXITER_REACHED;
   summary.converged = flag == KIN_SUCCESS || flag == KIN_INITIAL_GUESS_OK ||
-                      (flag == KIN_STEP_LT_STPTOL && fnorm <= options_.stagnationFactor * options_.tolerance);
+                      (stalled && fnorm <= options_.stagnationFactor * options_.tolerance);
   if (flag < 0 && lastError_[0] != '\0') summary.message = lastError_.data();
   x = Eigen::Map<const Vector>(NV_DATA_S(x_.get()), n_ + 1);
   return summary;

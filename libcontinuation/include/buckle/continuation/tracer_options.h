@@ -35,8 +35,9 @@ struct CorrectorOptions {
   /// Longest Newton step KINSOL may take (‖Δx‖₂). 0: unlimited. KINSOL's own default,
   /// 1000·max(1, ‖x₀‖), silently truncates steps from predictors near the origin.
   double maxNewtonStep = 0.0;
-  /// A solve that stalls on the step tolerance (KIN_STEP_LT_STPTOL: rounding floor reached)
-  /// still counts as converged if ‖G‖₂ ≤ stagnationFactor · tolerance.
+  /// A solve that stalls at the residual's rounding floor — on the step tolerance
+  /// (KIN_STEP_LT_STPTOL) or with its iterations used up (KIN_MAXITER_REACHED) — still counts
+  /// as converged if ‖G‖₂ ≤ stagnationFactor · tolerance.
   double stagnationFactor = 100.0;
   /// Opt-in: full Newton (lineSearch false) by Corrector's own reproduction of KINSOL's iteration
   /// where it converges plainly (the same iterates, flag, counts and norms, bit for bit), KINSOL
