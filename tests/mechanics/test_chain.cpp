@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -48,6 +49,36 @@ TEST_CASE("end pose of three identical segments is eq 5", "[chain]") {
   const Chain straight = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   CHECK(endPose(straight, Vector::Zero(3))[0] == Approx(6.0).margin(1e-15));
   CHECK(straight.length() == Approx(6.0).margin(1e-15));
+}
+
+TEST_CASE("a long curled chain's end position is exact to a fraction of eps times its length", "[chain]") {
+  // A spiral of 1.3 turns: the end comes back near the base, so the link terms of x and y cancel
+  // and their plain running sums keep their rounding. Reference: the same sums in long double
+  // (64-bit mantissa); beside it the plain double sums, to show the test can tell.
+  double plainWorst = 0.0;
+  for (int n : {10000, 100000}) {
+    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+    Vector q(n);
+    for (int i = 0; i < n; ++i) q[i] = 2.0 * M_PI * 1.3 / n * (1.0 + 0.3 * std::sin(0.37 * i));
+    long double t = 0.0L, x = chain.linkLengths()[0], y = 0.0L;
+    double tp = 0.0, xp = chain.linkLengths()[0], yp = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double l = chain.linkLengths()[i + 1];
+      t += q[i];
+      x += l * std::cos(t);
+      y += l * std::sin(t);
+      tp += q[i];
+      xp += l * std::cos(tp);
+      yp += l * std::sin(tp);
+    }
+    const double epsL = std::numeric_limits<double>::epsilon() * chain.length();
+    const Pose pose = endPose(chain, q);
+    INFO("n = " << n);
+    CHECK(std::abs(pose.x() - double(x)) <= epsL);
+    CHECK(std::abs(pose.y() - double(y)) <= epsL);
+    plainWorst = std::max({plainWorst, std::abs(xp - double(x)) / epsL, std::abs(yp - double(y)) / epsL});
+  }
+  CHECK(plainWorst > 3.0);  // plain sums miss by several eps·L here
 }
 
 TEST_CASE("chain derivatives match central finite differences", "[chain]") {

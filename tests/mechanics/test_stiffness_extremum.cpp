@@ -52,7 +52,8 @@ std::vector<SpecialPointReport> kmin(EquilibriumProblem& problem, double forceUn
 }
 
 // Independent equilibrium at fixed λ: plain dense Newton on the problem's residual, iterated to
-// the rounding floor (a few steps past the first step below 1e-15 of the angles' unit).
+// the rounding floor (three steps below 1e-14 of the unknowns' size: a few ulps, whatever
+// rounding the residual's sums leave).
 Vector newtonAt(EquilibriumProblem& problem, Vector u, double lambda) {
   const int N = problem.dimension();
   Vector F(N), Fl(N);
@@ -63,7 +64,7 @@ Vector newtonAt(EquilibriumProblem& problem, Vector u, double lambda) {
     REQUIRE(buckle::continuation::BoundProblem(problem).jacobian(u, lambda, Fu, Fl));
     const Vector du = Fu.partialPivLu().solve(F);
     u -= du;
-    if (du.lpNorm<Eigen::Infinity>() < 1e-15) ++small;
+    if (du.lpNorm<Eigen::Infinity>() < 1e-14 * std::max(1.0, u.lpNorm<Eigen::Infinity>())) ++small;
   }
   REQUIRE(small >= 3);
   return u;

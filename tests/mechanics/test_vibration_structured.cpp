@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -40,6 +41,7 @@ InertiaData periodicInertia(const Chain& chain, double massScale) {
 struct Agreement {
   double values = 0.0;  // max |ω²_s − ω²_d| / max |ω²_d|
   double shapes = 0.0;  // max ‖v_s − v_d‖ / ‖v_d‖
+  double shapesPerGap = 0.0;  // the same in units of ε·max|ω²|/gap, the eigenvectors' own accuracy
   int negative = 0;     // ω²_d < 0 among those compared
 };
 
@@ -58,7 +60,8 @@ Agreement compareRoutes(VibrationAnalysis& va, const Vector& q, const Wrench& F,
   Agreement a;
   if (d.omegaSquared.size() == 0) return a;
   // the dense route's whole spectrum sets the scale of the comparison
-  const double scale = va.modes(q, F, held, locked, d.dimension, false, gamma).omegaSquared.cwiseAbs().maxCoeff();
+  const Vector all = va.modes(q, F, held, locked, d.dimension, false, gamma).omegaSquared;
+  const double scale = all.cwiseAbs().maxCoeff();
   const int n = int(q.size());
   Matrix M(n, n);
   va.massMatrix(q, M);
@@ -66,7 +69,12 @@ Agreement compareRoutes(VibrationAnalysis& va, const Vector& q, const Wrench& F,
     a.values = std::max(a.values, std::abs(s.omegaSquared[j] - d.omegaSquared[j]) / scale);
     a.negative += d.omegaSquared[j] < 0 ? 1 : 0;
     // simple, well separated ω² here: the shapes agree up to rounding
-    a.shapes = std::max(a.shapes, (s.shapes.col(j) - d.shapes.col(j)).norm() / d.shapes.col(j).norm());
+    const double shape = (s.shapes.col(j) - d.shapes.col(j)).norm() / d.shapes.col(j).norm();
+    a.shapes = std::max(a.shapes, shape);
+    double gap = scale;  // a single mode: its vector is fixed to rounding
+    for (Eigen::Index k = 0; k < all.size(); ++k)
+      if (k != j) gap = std::min(gap, std::abs(all[k] - d.omegaSquared[j]));
+    a.shapesPerGap = std::max(a.shapesPerGap, shape / (std::numeric_limits<double>::epsilon() * scale / gap));
   }
   const Matrix G = s.shapes.transpose() * M * s.shapes;
   CHECK((G - Matrix::Identity(G.rows(), G.cols())).norm() <= 1e-9);
@@ -90,7 +98,7 @@ TEST_CASE("vibration structured: the O(n) route equals the dense route (free, he
           "[vibration][vibration_structured]") {
   std::mt19937 rng(29);
   std::uniform_real_distribution<double> U(-0.6, 0.6);
-  double worstValues = 0.0, worstShapes = 0.0;
+  double worstValues = 0.0, worstShapes = 0.0, worstShapesPerGap = 0.0;
   int unstableCases = 0;
   const int large = buckle::test::kSanitizedBuild ? 100 : 300;  // (sanitized_build.h)
   for (int n : {3, 10, 60, large}) {
@@ -112,7 +120,10 @@ TEST_CASE("vibration structured: the O(n) route equals the dense route (free, he
             const int k = std::min(5, n);
             const Agreement a = compareRoutes(va, q, F, held, locked, k, weight ? gamma : Vector());
             CHECK(a.values <= 1e-11);
-            CHECK(a.shapes <= 1e-6);  // the dense route's vectors: ~ε‖spectrum‖/gap
+            // the dense route's vectors are accurate to ~ε‖spectrum‖/gap times a modest constant (its backward
+            // error grows with n: Davis–Kahan)
+            CHECK(a.shapesPerGap <= 1e4);
+            worstShapesPerGap = std::max(worstShapesPerGap, a.shapesPerGap);
             worstValues = std::max(worstValues, a.values);
             worstShapes = std::max(worstShapes, a.shapes);
             if (a.negative >= 2) ++unstableCases;
@@ -122,7 +133,8 @@ TEST_CASE("vibration structured: the O(n) route equals the dense route (free, he
     }
   }
   CHECK(unstableCases >= 20);  // the compressed cases do have several negative ω²
-  WARN("structured vs dense: values " << worstValues << " of the spectrum, shapes " << worstShapes);
+  WARN("structured vs dense: values " << worstValues << " of the spectrum, shapes " << worstShapes << " ("
+                                       << worstShapesPerGap << " eps |spectrum| / gap)");
 }
 
 TEST_CASE("vibration structured: extreme units (lengths x1e4 with stiffness x1e-8, x1e-4 with x1e8) agree with the dense "

@@ -39,27 +39,41 @@ ChainData::ChainData(const Chain& chain)
     : theta(Vector::Zero(chain.size())), S(Vector::Zero(chain.size())), C(Vector::Zero(chain.size())) {}
 
 namespace {
+// Compensated (Neumaier) running sums for the link angles and the tail sums: a long chain's end
+// position sums thousands of terms of the chain's length, and their plain rounding (≈ √n·ε·L)
+// is the floor of the held coordinates' residuals, which the corrector's tolerance must clear.
+struct RunningSum {
+  double sum = 0.0, correction = 0.0;
+  void add(double x) {
+    const double t = sum + x;
+    correction += std::abs(sum) >= std::abs(x) ? (sum - t) + x : (x - t) + sum;
+    sum = t;
+  }
+  double value() const { return sum + correction; }
+};
+
 // The link directions stand in S[m] = sin θ_m, C[m] = cos θ_m; the tail sums replace them in place,
 // from the end, and the pose follows (forwardKinematics' one summation order).
 void tailSumsInPlace(const Vector& l, ChainData& data) {
   const Eigen::Index n = data.S.size();
-  double s = 0.0, c = 0.0;
+  RunningSum s, c;
   for (Eigen::Index m = n - 1; m >= 0; --m) {
-    s += l[m + 1] * data.S[m];
-    c += l[m + 1] * data.C[m];
-    data.S[m] = s;
-    data.C[m] = c;
+    s.add(l[m + 1] * data.S[m]);
+    c.add(l[m + 1] * data.C[m]);
+    data.S[m] = s.value();
+    data.C[m] = c.value();
   }
-  data.pose = Pose(l[0] + c, s, data.theta[n - 1]);
+  data.pose = Pose(l[0] + c.value(), s.value(), data.theta[n - 1]);
 }
 constexpr int kReanchor = 16;  // links per exact sincos in the half-angle recurrence
 }  // namespace
 
 void forwardKinematics(const Chain& chain, ConstVectorRef q, ChainData& data) {
   const int n = chain.size();
-  double t = 0.0;
+  RunningSum theta;
   for (int m = 0; m < n; ++m) {
-    t += q[m];
+    theta.add(q[m]);
+    const double t = theta.value();
     data.theta[m] = t;
     data.S[m] = std::sin(t);  // one sincos call at -O2
     data.C[m] = std::cos(t);
@@ -70,9 +84,11 @@ void forwardKinematics(const Chain& chain, ConstVectorRef q, ChainData& data) {
 void forwardKinematics(const Chain& chain, ConstVectorRef q, const double* sinHalf, const double* cosHalf,
                        ChainData& data) {
   const int n = chain.size();
-  double t = 0.0, ct = 1.0, st = 0.0;
+  RunningSum theta;
+  double ct = 1.0, st = 0.0;
   for (int m = 0; m < n; ++m) {
-    t += q[m];
+    theta.add(q[m]);
+    const double t = theta.value();
     data.theta[m] = t;
     if (m % kReanchor == kReanchor - 1) {
       ct = std::cos(t);

@@ -34,9 +34,10 @@ namespace {
 // onto that space of the unit rotation of the first joint it reaches the most (ties within a
 // relative 1e-9 go to the lower joint). Three identical joints at the fold of their common
 // torque-angle curve (the hysteresis scene): span{(1,1,1)}⊥, joint 1's projection (2,−1,−1)/3.
-Eigen::VectorXd bifurcatingMode(const SpecialPoint& point, int joints) {
+// Returned whole (joints, reactions, λ).
+Eigen::VectorXd bifurcatingDirection(const SpecialPoint& point, int joints) {
   const Eigen::MatrixXd& V = point.nullVectors;
-  if (V.cols() < 3) return V.col(1).head(joints);
+  if (V.cols() < 3) return V.col(1);
   const Eigen::MatrixXd directions = V.rightCols(V.cols() - 1);  // orthonormal (locator.cpp)
   int best = 0;
   double bestNorm = -1.0;
@@ -47,8 +48,25 @@ Eigen::VectorXd bifurcatingMode(const SpecialPoint& point, int joints) {
       bestNorm = norm;
     }
   }
-  const Eigen::VectorXd mode = directions * directions.row(best).transpose();
-  return mode.head(joints);
+  return directions * directions.row(best).transpose();
+}
+
+/// The shape of the family crossing the traced branch at a branch point: its mode's name, or
+/// "straight" where that direction moves no joint beyond rounding (the traced branch meets the
+/// straight chain at its tip: the other family moves λ and the reactions alone, and the sign
+/// pattern of its joints' rounding would name a shape at random).
+std::string bifurcatingShape(const EquilibriumProblem& problem, const SpecialPoint& point, int joints) {
+  const Eigen::VectorXd direction = bifurcatingDirection(point, joints);
+  const Eigen::VectorXd mode = direction.head(joints);
+  // compared in the problem's own scales (joints, reactions and λ in their typical sizes): any units
+  const continuation::ProblemScales scales = problem.scales();
+  Eigen::VectorXd scaled = direction;
+  if (scales.unknowns.size() + 1 == direction.size()) {
+    scaled.head(scales.unknowns.size()) = direction.head(scales.unknowns.size()).cwiseQuotient(scales.unknowns);
+    scaled[scaled.size() - 1] /= scales.parameter;
+  }
+  if (!(scaled.head(joints).norm() > 1e-6 * scaled.norm())) return "straight";
+  return modeShapeName(mode, 1e-6);
 }
 
 }  // namespace
@@ -70,7 +88,7 @@ Classification classify(const EquilibriumProblem& problem, const SpecialPoint& p
   switch (point.type) {
     case SpecialPointType::BranchPoint: {
       // The bifurcating direction is the kernel vector orthogonal to the traced branch.
-      if (point.nullVectors.cols() >= 2) c.shape = modeShapeName(bifurcatingMode(point, n), 1e-6);
+      if (point.nullVectors.cols() >= 2) c.shape = bifurcatingShape(problem, point, n);
       c.phenomenon = Phenomenon::Buckling;
       c.explanation = "branch point: the " + shapeName(point.u.head(n), 1e-7) +
                       " configuration loses stability to the " + c.shape + " family";
