@@ -1,7 +1,8 @@
 // `buckle regress`'s comparison (apps/regress/compare.cpp) of a special point: a complete run is
 // held to the baseline's allowance; a run stopped by its time limit may report a point whose
 // location the stop cut short, and agrees when within the accuracy that run states for it — not
-// beyond it, and never more loosely in a complete run.
+// beyond it, and never more loosely in a complete run. A branch point's post-buckling direction
+// is known once its branches are traced: a stopped run may not have reached it, a complete run must.
 #include <catch2/catch.hpp>
 
 #include <string>
@@ -15,9 +16,12 @@ namespace reg = buckle::regress;
 
 namespace {
 
-// A baseline of one case with one self contact at λ = −0.0094 (allowance 2e-12), and a run that
-// reports it at λ + shift with the stated accuracy.
-reg::Status selfContact(bool stopped, double shift, double accuracy) {
+// A baseline of one case with one special point at λ = −0.0094 (allowance 2e-12), and a run that
+// reports it at λ + shift with the stated accuracy and post-buckling direction; the status of the
+// row named `quantity` ("lambda", "post_buckling").
+reg::Status pointRow(const std::string& type, bool stopped, double shift, double accuracy,
+                     const std::string& basePostBuckling, const std::string& postBuckling,
+                     const std::string& quantity) {
   reg::Baseline b;
   b.name = "limited";
   b.source.timeLimit = stopped ? 0.05 : 0.0;
@@ -26,7 +30,8 @@ reg::Status selfContact(bool stopped, double shift, double accuracy) {
   c.branches = 1;
   reg::SpecialEntry s;
   s.branch = 0;
-  s.type = "SC";
+  s.type = type;
+  s.postBuckling = basePostBuckling;
   s.lambda = -0.0094;
   s.tolerance.absolute = 2e-12;
   s.tolerance.relative = 1e-10;
@@ -39,12 +44,21 @@ reg::Status selfContact(bool stopped, double shift, double accuracy) {
   mc.label = "limited";
   mc.branches.resize(1);
   mc.branches[0].id = 0;
-  mc.specials.push_back({0, "SC", s.lambda + shift, "", accuracy, ""});
+  mc.specials.push_back({0, type, s.lambda + shift, "", accuracy, postBuckling});
   m.cases.push_back(mc);
+  const std::string row = "b0 " + type + "#0 " + quantity;
   for (const reg::Row& r : reg::compare(b, m, reg::TimingCheck{}))
-    if (r.quantity == "SC#0 lambda" || r.quantity == "b0 SC#0 lambda") return r.status;
-  FAIL("no row for the self contact");
+    if (r.quantity == row) return r.status;
+  FAIL("no row " << row);
   return reg::Status::Fail;
+}
+
+reg::Status selfContact(bool stopped, double shift, double accuracy) {
+  return pointRow("SC", stopped, shift, accuracy, "", "", "lambda");
+}
+
+reg::Status bifurcation(bool stopped, const std::string& postBuckling) {
+  return pointRow("BP", stopped, 0.0, 1e-13, "supercritical", postBuckling, "post_buckling");
 }
 
 }  // namespace
@@ -59,4 +73,13 @@ TEST_CASE("regress: a stopped run's point agrees within the accuracy it states, 
   CHECK(selfContact(true, 2.9e-4, 1e-5) == reg::Status::Fail);  // more off than it claims
   // a complete run that got worse fails, whatever accuracy it states
   CHECK(selfContact(false, 2.9e-4, 3e-4) == reg::Status::Fail);
+}
+
+TEST_CASE("regress: a stopped run may not have traced a branch point's branches, a complete run must",
+          "[regress]") {
+  CHECK(bifurcation(true, "") == reg::Status::Info);
+  CHECK(bifurcation(false, "") == reg::Status::Fail);
+  CHECK(bifurcation(true, "supercritical") == reg::Status::Pass);
+  CHECK(bifurcation(true, "subcritical") == reg::Status::Fail);
+  CHECK(bifurcation(false, "subcritical") == reg::Status::Fail);
 }
