@@ -248,3 +248,54 @@ TEST_CASE("wall: the O(n) bordered solver of the wall-constrained chain equals a
     CHECK(((Fp - Fm) / 2e-6 - A.col(j).head(D)).cwiseAbs().maxCoeff() <= 1e-7);
   }
 }
+
+TEST_CASE("wall: the O(n) solver takes the locator's general borders, F_u and its transpose, as a dense solve",
+          "[contact][wall]") {
+  // G = [[F_u, B], [Cᵀ, D]] and [[F_uᵀ, B], [Cᵀ, D]] with k = 1, 2 dense random border columns
+  // (nonzero on the locked rows too): locked joints, wall vertices and a held coordinate together,
+  // and locked joints alone; the solution and the sign of det G against a dense LU of G.
+  const int n = 30;
+  std::vector<SegmentParameters> segs(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const Chain chain(segs);
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(-0.3), Eigen::Vector3d(1, 0, 0));
+  for (int variant = 0; variant < 2; ++variant) {
+    ContactSet set;
+    if (variant == 0) {
+      set.touch(WallVertex{7, 1});
+      set.touch(WallVertex{20, 4});
+      set.lock(3, LimitSide::Lower);
+    } else {
+      set.lock(0, LimitSide::Upper);
+      set.lock(11, LimitSide::Lower);
+      set.lock(12, LimitSide::Lower);
+      set.lock(29, LimitSide::Upper);
+    }
+    ContactProblem cp(problem, set);
+    const int N = cp.dimension();
+    Eigen::VectorXd u(N);
+    for (int i = 0; i < n; ++i) u[i] = 0.3 * std::cos(0.9 * i);
+    for (int j = n; j < N; ++j) u[j] = 0.1 + 0.2 * (j - n);
+    const double lambda = -0.2;
+    Eigen::MatrixXd Fu(N, N);
+    Eigen::VectorXd Fl(N);
+    REQUIRE(cont::BoundProblem(cp).jacobian(u, lambda, Fu, Fl));
+    const cont::BoundProblem bound(cp);  // outlives the solver
+    auto solver = bound.makeStructuredSolver();
+    REQUIRE(solver->maxGeneralBorder() >= 2);
+    for (int k = 1; k <= 2; ++k)
+      for (bool transposed : {false, true}) {
+        INFO("variant " << variant << ", k = " << k << (transposed ? ", transposed" : ""));
+        const Eigen::MatrixXd B = Eigen::MatrixXd::Random(N, k), C = Eigen::MatrixXd::Random(N, k);
+        const Eigen::MatrixXd D = Eigen::MatrixXd::Random(k, k);
+        Eigen::MatrixXd G(N + k, N + k);
+        G << (transposed ? Eigen::MatrixXd(Fu.transpose()) : Fu), B, C.transpose(), D;
+        const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(N + k, 1.0, -2.0);
+        const Eigen::VectorXd dense = G.partialPivLu().solve(b);
+        REQUIRE(solver->factorGeneral(u, lambda, B, C, D, transposed) == cont::Factorization::Regular);
+        Eigen::VectorXd x(N + k);
+        REQUIRE(solver->solve(b, x));
+        CHECK((x - dense).cwiseAbs().maxCoeff() <= 1e-10 * dense.cwiseAbs().maxCoeff());
+        CHECK(solver->determinantSign() == (G.determinant() > 0 ? 1 : -1));
+      }
+  }
+}

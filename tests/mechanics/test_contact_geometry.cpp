@@ -319,13 +319,65 @@ TEST_CASE("self clearance: the swept cut-off finds the all-pairs pair on chains 
   }
 }
 
+TEST_CASE("self clearance from a hint: the same nearest pair, and a pair below stopBelow bounds it from above",
+          "[contact_geometry]") {
+  // Circles of 1.3 to 2.7 turns (the second turn on the first: overlapping far along the chain)
+  // and random 50-segment shapes, each hinted with
+  // every 7th pair of links: without a stop the hint changes nothing; with a stop between d_self
+  // and 0 the search may end at any pair below it, whose distance is then ≥ the brute-force d_self.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> wiggle(-0.02, 0.02), turns(1.3, 2.7), bend(-0.6, 0.6);
+  int stopped = 0, overlapping = 0;
+  for (int trial = 0; trial < 8; ++trial) {
+    const int n = trial < 4 ? 120 : 50;
+    const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+    Vector q(n);
+    const double total = 2.0 * M_PI * turns(rng);
+    for (int i = 0; i < n; ++i) q[i] = trial < 4 ? total / n + wiggle(rng) : bend(rng);
+    const SelfClearance exact = selfClearance(chain, q);
+    int bruteA = -1, bruteB = -1;
+    const double brute = bruteSelfClearance(chain, q, bruteA, bruteB);
+    INFO("trial " << trial << ": d_self " << exact.distance << " at " << exact.linkA << ", " << exact.linkB);
+    CHECK(exact.distance == Approx(brute).epsilon(brute > 0.0 ? 1e-13 : 1e-10).margin(1e-13));
+    if (exact.distance < 0.0) ++overlapping;
+    for (int a = 0; a + 2 <= n; a += 7)
+      for (int b = a + 2; b <= n; b += 7) {
+        SelfClearanceHint hint;
+        hint.linkA = a;
+        hint.linkB = b;
+        bool isExact = false;
+        const SelfClearance plain = selfClearance(chain, q, hint, &isExact);
+        CHECK(isExact);
+        CHECK(plain.distance == exact.distance);
+        CHECK((plain.linkA == exact.linkA && plain.linkB == exact.linkB));
+        if (exact.distance >= 0.0) continue;
+        hint.stopBelow = 0.5 * exact.distance;
+        const SelfClearance early = selfClearance(chain, q, hint, &isExact);
+        if (!isExact) {
+          ++stopped;
+          CHECK(early.distance < hint.stopBelow);
+          CHECK(early.distance >= exact.distance);
+        } else {
+          CHECK(early.distance == exact.distance);
+        }
+        hint.stopBelow = 2.0 * exact.distance;  // below d_self: never met, the search is complete
+        CHECK(selfClearance(chain, q, hint, &isExact).distance == exact.distance);
+        CHECK(isExact);
+      }
+  }
+  CHECK(overlapping >= 3);
+  CHECK(stopped >= 10);
+}
+
 TEST_CASE("self contacts along a branch: the bounded scan finds every sign change an exact scan finds",
           "[contact_geometry]") {
   // A chain curling into a spiral and back (every joint bent by t, t up and down with steps of
   // varying size, fixed λ: no location, the contacts to the point spacing), its self contacts
-  // against the sign changes of selfClearance at every point.
+  // against the sign changes of selfClearance at every point; in three length units (the bounds
+  // and the touching band are relative to the chain's length).
   const int n = 40;
-  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const double length = GENERATE(1.0, 1e-4, 1e4);
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5 * length, 1.0 * length, 1.0, 2.25 * length));
   EquilibriumProblem problem(chain, EndCondition::freeEnd(Wrench::Zero()), Eigen::Vector3d(1, 0, 0));
   cont::Branch branch;
   std::mt19937 rng(11);

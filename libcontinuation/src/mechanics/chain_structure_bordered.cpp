@@ -57,7 +57,8 @@ bool factorBordered(ChainStructure& ws, const Eigen::Ref<const Matrix>& V, const
   // det [[H, V], [Wᵀ, D]] = det H · det S with det H = det T (det U = 1).
   ws.schur.resize(p, p);
   if (p > 0) {  // (an empty matrix is not valid LU input)
-    ws.schur.noalias() = D - ws.W2.leftCols(p).transpose() * ws.V2.leftCols(p);
+    // p² dot products of length n, coefficient-wise (not a packed general matrix product)
+    ws.schur.noalias() = D - ws.W2.leftCols(p).transpose().lazyProduct(ws.V2.leftCols(p));
     ws.schurLU.compute(ws.schur);
     if (!ws.schurLU.isInvertible()) return false;
   }

@@ -68,10 +68,9 @@ int constrainedCountBelow(ChainStructure& ws, double sigma, bool determinant) {
   ws.X.leftCols(r) = ws.B.leftCols(r);
   solveFactored(ws, ws.X, r);
   ws.S.resize(r, r);
-  // (product, then negate in place: −(BᵀX) as one expression evaluated the product into a heap
-  // temporary on every call)
-  ws.S.noalias() = ws.B.leftCols(r).transpose() * ws.X.leftCols(r);
-  ws.S = -ws.S;
+  // r ≤ kMaxBorder dot products of length n: coefficient-wise (a general matrix product would
+  // pack both n×r operands for a few entries, and −(BᵀX) as one expression allocated a temporary)
+  ws.S.noalias() = -ws.B.leftCols(r).transpose().lazyProduct(ws.X.leftCols(r));
   return ws.factorInertia.negative + smallNegativeCount(ws.S) - r;
 }
 

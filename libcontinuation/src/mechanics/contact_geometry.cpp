@@ -110,18 +110,25 @@ Eigen::Matrix2Xd bodyVertices(const Chain& chain, ConstVectorRef q) {
 }
 
 /// The clearances of a branch's points (distanceAt) as far as a scan for sign changes needs them:
-/// exact at the base, and for the self contact exact at a reference point and, while every
-/// vertex of the bodies has moved by at most δ from it, the bound d_ref − 2δ (or d_ref + 2δ) in
-/// its place — a rigid triangle's points move by at most its vertices' largest move (the move is
-/// affine in the point), so two bodies' signed distance changes by at most 2δ — as long as the bound keeps the sign
-/// of d_ref by a margin far above rounding. O(n) a point, the nearest-pair search (O(n log n))
-/// only where the clearance may change sign.
+/// exact at the base; for the self contact a value with the sign of d_self outside the touching
+/// band. At a reference point selfClearance, warm-started from the previous nearest pair and
+/// ended by a pair deeper than twice the band (its distance then bounds d_self from above); while
+/// every vertex of the bodies has moved by at most δ from the reference, the bound d_ref − 2δ (an
+/// exact d_ref) or d_ref + 2δ in its place — a rigid triangle's points move by at most its
+/// vertices' largest move (the move is affine in the point), so two bodies' signed distance
+/// changes by at most 2δ — as long as the bound keeps the sign of d_ref by the band. O(n) a
+/// point while the nearest pair stays the nearest or overlapping; the nearest-pair search
+/// (O(n log n)) only where the clearance may change sign.
 std::vector<double> scannedDistances(const Chain& chain, const continuation::Branch& branch, bool base) {
   const int n = chain.size();
   const size_t count = branch.points.size();
   std::vector<double> d(count);
+  const double band = kTouchingBand * chain.length();
   Eigen::Matrix2Xd reference;
   double dRef = std::numeric_limits<double>::quiet_NaN();
+  bool exactRef = false;
+  SelfClearanceHint hint;
+  hint.stopBelow = -2.0 * band;
   for (size_t i = 0; i < count; ++i) {
     const auto q = branch.points[i].u.head(n);
     if (base) {
@@ -131,17 +138,19 @@ std::vector<double> scannedDistances(const Chain& chain, const continuation::Bra
     const Eigen::Matrix2Xd P = bodyVertices(chain, q);
     if (std::isfinite(dRef) && P.cols() == reference.cols()) {
       const double moved = 2.0 * (P - reference).colwise().norm().maxCoeff();
-      const double margin = 1e-9 * std::max(1.0, P.cwiseAbs().maxCoeff());
-      if (dRef - moved > margin) {
+      if (exactRef && dRef - moved > band) {
         d[i] = dRef - moved;
         continue;
       }
-      if (dRef + moved < -margin) {
+      if (dRef + moved < -band) {
         d[i] = dRef + moved;
         continue;
       }
     }
-    d[i] = selfClearance(chain, q).distance;
+    const SelfClearance c = selfClearance(chain, q, hint, &exactRef);
+    d[i] = c.distance;
+    hint.linkA = c.linkA;
+    hint.linkB = c.linkB;
     reference = P;
     dRef = d[i];
   }
@@ -160,13 +169,36 @@ BaseClearance baseClearance(const Chain& chain, ConstVectorRef q) {
   return c;
 }
 
-SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) {
+SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) { return selfClearance(chain, q, {}, nullptr); }
+
+SelfClearance selfClearance(const Chain& chain, ConstVectorRef q, const SelfClearanceHint& hint, bool* exact) {
   const Eigen::Matrix2Xd P = jointPositions(chain, q);
   const int links = int(P.cols()) - 1;  // ℓ_0 … ℓ_n: link m from column m to m + 1
   SelfClearance c;
   c.distance = std::numeric_limits<double>::infinity();
+  if (exact) *exact = true;
   if (links < 3) return c;
   const LinkBodies bodies = linkBodies(chain, q, P);
+  // the smallest signed distance of two links' triangles; true when it ends the search
+  const auto measure = [&](int a, int b) {
+    for (int s = bodies.first[size_t(a)]; s < bodies.first[size_t(a) + 1]; ++s)
+      for (int t = bodies.first[size_t(b)]; t < bodies.first[size_t(b) + 1]; ++t) {
+        Point on;
+        const double d = triangleTriangle(bodies.triangles[size_t(s)], bodies.triangles[size_t(t)], on);
+        if (d < c.distance) {
+          c.distance = d;
+          c.linkA = a;
+          c.linkB = b;
+          c.point = on;
+        }
+      }
+    return c.distance < hint.stopBelow;
+  };
+  const bool hinted = hint.linkA >= 0 && hint.linkB >= hint.linkA + 2 && hint.linkB < links;
+  if (hinted && measure(hint.linkA, hint.linkB)) {
+    if (exact) *exact = false;
+    return c;
+  }
   // Bounding circles of the bodies (the link's mid-point, the farthest vertex), and the links
   // sorted by the x of their mid-points: the pairs scanned are those whose circles could beat the
   // best so far.
@@ -213,18 +245,11 @@ SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) {
     for (const int b : candidates) {
       const double circles = (mid.col(b) - mid.col(a)).norm() - ra - radius[b];
       const double bound = circles > 0.0 ? circles : -ra - radius[b];
-      if (bound >= c.distance) continue;
-      for (int s = bodies.first[size_t(a)]; s < bodies.first[size_t(a) + 1]; ++s)
-        for (int t = bodies.first[size_t(b)]; t < bodies.first[size_t(b) + 1]; ++t) {
-          Point on;
-          const double d = triangleTriangle(bodies.triangles[size_t(s)], bodies.triangles[size_t(t)], on);
-          if (d < c.distance) {
-            c.distance = d;
-            c.linkA = a;
-            c.linkB = b;
-            c.point = on;
-          }
-        }
+      if (bound >= c.distance || (hinted && a == hint.linkA && b == hint.linkB)) continue;
+      if (measure(a, b)) {
+        if (exact) *exact = false;
+        return c;
+      }
     }
   }
   return c;

@@ -18,6 +18,25 @@ using continuation::VectorRef;
 
 namespace {
 
+/// out(t, ·) += sign · Σ_s h[max(s, t)] M(s, ·) over the source joints s (rows of M) and the
+/// target joints t (rows of out), both ascending and disjoint: the coupling of locked and free
+/// joints through −K_g (eq 27: an entry depends on max(i, j) only), in O((|S| + |T|)·k) as
+/// h[t]·Σ_{s<t} M_s + Σ_{s>t} h[s]·M_s.
+void addMaxCoupling(const Vector& h, const std::vector<int>& sources, continuation::ConstMatrixRef M,
+                    const std::vector<int>& targets, double sign, continuation::MatrixRef out) {
+  const Eigen::Index k = M.cols();
+  Eigen::RowVectorXd below = Eigen::RowVectorXd::Zero(k), weightedAbove = Eigen::RowVectorXd::Zero(k);
+  for (size_t s = 0; s < sources.size(); ++s) weightedAbove += h[sources[s]] * M.row(Eigen::Index(s));
+  size_t s = 0;
+  for (size_t t = 0; t < targets.size(); ++t) {
+    for (; s < sources.size() && sources[s] < targets[t]; ++s) {
+      below += M.row(Eigen::Index(s));
+      weightedAbove -= h[sources[s]] * M.row(Eigen::Index(s));
+    }
+    out.row(Eigen::Index(t)) += sign * (h[targets[t]] * below + weightedAbove);
+  }
+}
+
 /// A(c) = [[F_u, F_λ], [cᵀ]] of ContactProblem in O(n): the locked rows give x_L = −b_L; the rest
 /// is the reduced chain's bordered system (chain_solver.h's borders on the free joints: the held
 /// rows, the wall rows −∇x_v, then F_λ | c) with the known x_L moved to the right-hand side.
@@ -50,6 +69,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
         x_(problem.freeJoints().size()),
         y_(p_) {
     for (const LockedJoint& l : problem.contacts().joints()) lockedIndex_.push_back(l.joint);
+    std::sort(lockedIndex_.begin(), lockedIndex_.end());  // addMaxCoupling's order
     if (n_ + m_ + w_ <= kDenseFallback || p_ > ChainStructure::kMaxBorder)
       dense_ =
           std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
@@ -59,6 +79,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
     sign_ = 0;
     logAbs_ = -std::numeric_limits<double>::infinity();
     usingDense_ = false;
+    general_ = false;
     if (!c.allFinite() || !problem_.assembleFull(problemWorkspace_, u, lambda, full_, J_))
       return Factorization::Refused;
     if (p_ > ChainStructure::kMaxBorder) {  // more borders than the chain structure holds
@@ -108,16 +129,19 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
   bool solve(ConstVectorRef b, VectorRef x) override {
     if (sign_ == 0) return false;
     if (usingDense_) return dense_->solve(b, x);
+    if (general_) return solveGeneral(b, x);
     // x_L = −b_L, then the free rows, held rows and the border row with x_L moved right:
     // free a: H_aL x_L = −Σ_i h_max(a,i) x_i (a ≠ i).
     const int nf = int(free_.size());
     const Matrix& grad = grad_;
     for (int a = 0; a < nf; ++a) f_[a] = b[free_[size_t(a)]];
     g_ = b.segment(n_, p_);
+    xL_.resize(Eigen::Index(lockedIndex_.size()), 1);
+    for (size_t l = 0; l < lockedIndex_.size(); ++l) xL_(Eigen::Index(l), 0) = -b[lockedIndex_[l]];
+    addMaxCoupling(full_.h, lockedIndex_, xL_, free_, 1.0, f_);
     for (int i : lockedIndex_) {
       const double xi = -b[i];
       x[i] = xi;
-      for (int a = 0; a < nf; ++a) f_[a] += full_.h[std::max(free_[size_t(a)], i)] * xi;
       for (int k = 0; k < m_; ++k) g_[k] += J_(held_[size_t(k)], i) * xi;
       for (int k = 0; k < w_; ++k) g_[m_ + k] += grad(i, k) * xi;
       g_[p_ - 1] -= c_[i] * xi;
@@ -131,7 +155,106 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
   int determinantSign() const override { return sign_; }
   double logAbsDeterminant() const override { return logAbs_; }
 
+  int maxGeneralBorder() const override { return std::max(0, ChainStructure::kMaxBorder - m_ - w_); }
+
+  /// G = [[F_u, B], [Cᵀ, D]] (or F_uᵀ) by the same reduction (derivation in docs/mechanics.md,
+  /// "Contact at the joints", Structure): the locked rows give x_L, the reduced chain's borders
+  /// are the held and wall columns and B | C with the locked joints' coupling folded in.
+  Factorization factorGeneral(ConstVectorRef u, double lambda, continuation::ConstMatrixRef B,
+                              continuation::ConstMatrixRef C, continuation::ConstMatrixRef D, bool transposed) override {
+    sign_ = 0;
+    logAbs_ = -std::numeric_limits<double>::infinity();
+    usingDense_ = false;
+    general_ = true;
+    transposed_ = transposed;
+    const int k = int(B.cols()), N = n_ + m_ + w_, o = m_ + w_, p = o + k;
+    if (k < 1 || B.rows() != N || C.rows() != N || C.cols() != k || D.rows() != k || D.cols() != k ||
+        !B.allFinite() || !C.allFinite() || !D.allFinite())
+      return Factorization::Refused;
+    if (p > ChainStructure::kMaxBorder) return denseGeneral(u, lambda, B, C, D, transposed);
+    if (!problem_.assembleFull(problemWorkspace_, u, lambda, full_, J_)) return Factorization::Refused;
+    reduceToFreeJoints(full_, free_, kf_, hf_, ws_);
+    grad_ = ContactProblem::wallGradients(problemWorkspace_);
+    const int nf = int(free_.size()), nl = int(lockedIndex_.size());
+    BL_.resize(nl, k);
+    CL_.resize(nl, k);
+    for (int l = 0; l < nl; ++l) BL_.row(l) = B.row(lockedIndex_[size_t(l)]), CL_.row(l) = C.row(lockedIndex_[size_t(l)]);
+    Vg_.resize(nf, p);
+    Wg_.resize(nf, p);
+    Dg_ = Matrix::Zero(p, p);
+    for (int a = 0; a < nf; ++a) {
+      const int i = free_[size_t(a)];
+      for (int h = 0; h < m_; ++h) Vg_(a, h) = Wg_(a, h) = -J_(held_[size_t(h)], i);
+      for (int v = 0; v < w_; ++v) Vg_(a, m_ + v) = Wg_(a, m_ + v) = -grad_(i, v);
+      Vg_.row(a).tail(k) = B.row(i);
+      Wg_.row(a).tail(k) = C.row(i);
+    }
+    // P_L = [−J_h,Lᵀ | −∇x_v,L]: the locked joints' entries of the held and wall columns
+    PL_.resize(nl, o);
+    for (int l = 0; l < nl; ++l) {
+      const int i = lockedIndex_[size_t(l)];
+      for (int h = 0; h < m_; ++h) PL_(l, h) = -J_(held_[size_t(h)], i);
+      for (int v = 0; v < w_; ++v) PL_(l, m_ + v) = -grad_(i, v);
+    }
+    Dg_.topRightCorner(o, k) = B.middleRows(n_, o);
+    Dg_.bottomLeftCorner(k, o) = C.middleRows(n_, o).transpose();
+    Dg_.bottomRightCorner(k, k) = D + CL_.transpose() * BL_;
+    if (!transposed) {
+      // x_L = B_L y − b_L into the free rows (H_FL B_L), the held and wall rows (P_Lᵀ B_L)
+      addMaxCoupling(full_.h, lockedIndex_, BL_, free_, -1.0, Vg_.rightCols(k));
+      Dg_.topRightCorner(o, k) += PL_.transpose() * BL_;
+    } else {
+      // x_L = H_LF x_F + P_L z + B_L y − b_L into the border rows
+      addMaxCoupling(full_.h, lockedIndex_, CL_, free_, -1.0, Wg_.rightCols(k));
+      Dg_.bottomLeftCorner(k, o) += CL_.transpose() * PL_;
+    }
+    const int lockedSign = nl % 2 == 0 ? 1 : -1;
+    if (factorBordered(ws_, Vg_, Wg_, Dg_)) {
+      sign_ = lockedSign * ws_.borderedDetSign;
+      logAbs_ = ws_.borderedLogAbsDet;
+      return Factorization::Regular;
+    }
+    return dense_ ? denseGeneral(u, lambda, B, C, D, transposed) : Factorization::Singular;
+  }
+
  private:
+  Factorization denseGeneral(ConstVectorRef u, double lambda, continuation::ConstMatrixRef B,
+                             continuation::ConstMatrixRef C, continuation::ConstMatrixRef D, bool transposed) {
+    if (!dense_) return Factorization::Refused;
+    usingDense_ = true;
+    const Factorization f = dense_->factorGeneral(u, lambda, B, C, D, transposed);
+    sign_ = dense_->determinantSign();
+    return f;
+  }
+
+  bool solveGeneral(ConstVectorRef b, VectorRef x) {
+    const int nf = int(free_.size()), nl = int(lockedIndex_.size()), o = m_ + w_, k = int(Vg_.cols()) - o;
+    fg_.resize(nf);
+    for (int a = 0; a < nf; ++a) fg_[a] = b[free_[size_t(a)]];
+    xL_.resize(nl, 1);
+    for (int l = 0; l < nl; ++l) xL_(l, 0) = b[lockedIndex_[size_t(l)]];  // b_L
+    gg_ = b.segment(n_, o + k);
+    gg_.tail(k) += CL_.transpose() * xL_.col(0);
+    if (!transposed_) {
+      addMaxCoupling(full_.h, lockedIndex_, xL_, free_, -1.0, fg_);
+      gg_.head(o) += PL_.transpose() * xL_.col(0);
+    }
+    xg_.resize(nf);
+    yg_.resize(o + k);
+    if (!solveFactoredBordered(ws_, Vg_, Wg_, Dg_, fg_, gg_, xg_, yg_)) return false;
+    for (int a = 0; a < nf; ++a) x[free_[size_t(a)]] = xg_[a];
+    x.segment(n_, o) = yg_.head(o);
+    x.tail(k) = yg_.tail(k);
+    // the locked unknowns: B_L y − b_L (+ H_LF x_F + P_L z for the transpose)
+    Matrix xLocked = BL_ * yg_.tail(k) - xL_.col(0);
+    if (transposed_) {
+      xLocked += PL_ * yg_.head(o);
+      addMaxCoupling(full_.h, free_, xg_, lockedIndex_, -1.0, xLocked);
+    }
+    for (int l = 0; l < nl; ++l) x[lockedIndex_[size_t(l)]] = xLocked(l, 0);
+    return x.allFinite();
+  }
+
   const ContactProblem& problem_;
   continuation::ProblemWorkspace& problemWorkspace_;
   int n_, m_, w_, p_;
@@ -143,6 +266,10 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
   Matrix grad_;  // ∇x_v of the wall vertices at the factored point (n×w)
   Vector c_, f_, g_, x_, y_;
   std::unique_ptr<continuation::DenseBorderedSolver> dense_;
+  // factorGeneral(): the reduced borders, the locked rows of B and C, P_L, and solve scratch
+  Matrix Vg_, Wg_, Dg_, BL_, CL_, PL_, xL_;
+  Vector fg_, gg_, xg_, yg_;
+  bool general_ = false, transposed_ = false;
   bool usingDense_ = false;
   int sign_ = 0;
   double logAbs_ = 0.0;

@@ -31,6 +31,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,18 @@ struct SelfClearance {
 };
 /// Bounding-circle cut-off and an x sweep (file comment): O(n log n) unless the chain folds onto itself.
 SelfClearance selfClearance(const Chain& chain, ConstVectorRef q);
+
+/// A scan's question to selfClearance: is the clearance below `stopBelow`? The pair (linkA, linkB),
+/// typically the previous point's nearest, is measured first: its distance starts the search's
+/// cut-off (tight from the first pair), and a pair found below `stopBelow` ends the search — the
+/// result is then that pair's distance, an upper bound of d_self that has its sign.
+struct SelfClearanceHint {
+  int linkA = -1, linkB = -1;
+  double stopBelow = -std::numeric_limits<double>::infinity();
+};
+/// As selfClearance(chain, q), exact unless a pair below hint.stopBelow ended the search
+/// (`exact` false: then distance < stopBelow and d_self ≤ distance).
+SelfClearance selfClearance(const Chain& chain, ConstVectorRef q, const SelfClearanceHint& hint, bool* exact);
 
 /// Clearances within this fraction of the chain's length of zero are "touching": bodies resting on
 /// each other within rounding (locateGeometricContacts counts sign changes between points outside it).
