@@ -72,12 +72,15 @@ double triangleTriangle(const Triangle& A, const Triangle& B, Point& onA) {
 /// segment, link m (1 ≤ m < n) segment m's distal and segment m + 1's proximal triangle (1-based),
 /// link n the last segment's distal one; each triangle's apex is its segment's joint.
 struct LinkBodies {
+  Eigen::Matrix2Xd P;               ///< the joint positions (jointPositions)
   std::vector<Triangle> triangles;  ///< link m's are triangles[first[m]] … [first[m + 1] − 1]
   std::vector<int> first;
 };
-LinkBodies linkBodies(const Chain& chain, ConstVectorRef q, const Eigen::Matrix2Xd& P) {
+LinkBodies linkBodies(const Chain& chain, ConstVectorRef q) {
   const int n = chain.size();
   LinkBodies L;
+  L.P = jointPositions(chain, q);
+  const Eigen::Matrix2Xd& P = L.P;
   L.triangles.reserve(size_t(2 * n));
   L.first.reserve(size_t(n + 2));
   double theta = 0.0;
@@ -100,14 +103,15 @@ double distanceAt(const Chain& chain, ConstVectorRef q, bool base) {
   return base ? baseClearance(chain, q).distance : selfClearance(chain, q).distance;
 }
 
-/// Every vertex of the links' bodies (the triangles' apexes are the joints), 2 × 3·(2n) columns.
-Eigen::Matrix2Xd bodyVertices(const Chain& chain, ConstVectorRef q) {
-  const LinkBodies bodies = linkBodies(chain, q, jointPositions(chain, q));
-  Eigen::Matrix2Xd V(2, 3 * Eigen::Index(bodies.triangles.size()));
-  for (size_t t = 0; t < bodies.triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k) V.col(3 * Eigen::Index(t) + k) = bodies.triangles[t][size_t(k)];
-  return V;
+/// The largest distance a vertex of the bodies has moved between two shapes of the same chain.
+double largestMove(const LinkBodies& now, const LinkBodies& before) {
+  double move = 0.0;
+  for (size_t t = 0; t < now.triangles.size(); ++t)
+    for (size_t k = 0; k < 3; ++k) move = std::max(move, (now.triangles[t][k] - before.triangles[t][k]).norm());
+  return move;
 }
+
+SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint& hint, bool* exact);
 
 /// The clearances of a branch's points (distanceAt) as far as a scan for sign changes needs them:
 /// exact at the base; for the self contact a value with the sign of d_self outside the touching
@@ -124,7 +128,7 @@ std::vector<double> scannedDistances(const Chain& chain, const continuation::Bra
   const size_t count = branch.points.size();
   std::vector<double> d(count);
   const double band = kTouchingBand * chain.length();
-  Eigen::Matrix2Xd reference;
+  LinkBodies reference;
   double dRef = std::numeric_limits<double>::quiet_NaN();
   bool exactRef = false;
   SelfClearanceHint hint;
@@ -135,9 +139,9 @@ std::vector<double> scannedDistances(const Chain& chain, const continuation::Bra
       d[i] = distanceAt(chain, q, true);
       continue;
     }
-    const Eigen::Matrix2Xd P = bodyVertices(chain, q);
-    if (std::isfinite(dRef) && P.cols() == reference.cols()) {
-      const double moved = 2.0 * (P - reference).colwise().norm().maxCoeff();
+    LinkBodies bodies = linkBodies(chain, q);
+    if (std::isfinite(dRef)) {
+      const double moved = 2.0 * largestMove(bodies, reference);
       if (exactRef && dRef - moved > band) {
         d[i] = dRef - moved;
         continue;
@@ -147,11 +151,11 @@ std::vector<double> scannedDistances(const Chain& chain, const continuation::Bra
         continue;
       }
     }
-    const SelfClearance c = selfClearance(chain, q, hint, &exactRef);
+    const SelfClearance c = selfClearanceOf(bodies, hint, &exactRef);
     d[i] = c.distance;
     hint.linkA = c.linkA;
     hint.linkB = c.linkB;
-    reference = P;
+    reference = std::move(bodies);
     dRef = d[i];
   }
   return d;
@@ -172,17 +176,31 @@ BaseClearance baseClearance(const Chain& chain, ConstVectorRef q) {
 SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) { return selfClearance(chain, q, {}, nullptr); }
 
 SelfClearance selfClearance(const Chain& chain, ConstVectorRef q, const SelfClearanceHint& hint, bool* exact) {
-  const Eigen::Matrix2Xd P = jointPositions(chain, q);
+  return selfClearanceOf(linkBodies(chain, q), hint, exact);
+}
+
+namespace {
+
+SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint& hint, bool* exact) {
+  const Eigen::Matrix2Xd& P = bodies.P;
   const int links = int(P.cols()) - 1;  // ℓ_0 … ℓ_n: link m from column m to m + 1
   SelfClearance c;
   c.distance = std::numeric_limits<double>::infinity();
   if (exact) *exact = true;
   if (links < 3) return c;
-  const LinkBodies bodies = linkBodies(chain, q, P);
+  // Each triangle's circle about its apex (the joint) through its farthest vertex: a pair of
+  // triangles is measured only where its circles' lower bound (as the links' below) beats the best.
+  std::vector<double> reach(bodies.triangles.size());
+  for (size_t t = 0; t < reach.size(); ++t)
+    reach[t] = std::max((bodies.triangles[t][1] - bodies.triangles[t][0]).norm(),
+                        (bodies.triangles[t][2] - bodies.triangles[t][0]).norm());
   // the smallest signed distance of two links' triangles; true when it ends the search
   const auto measure = [&](int a, int b) {
     for (int s = bodies.first[size_t(a)]; s < bodies.first[size_t(a) + 1]; ++s)
       for (int t = bodies.first[size_t(b)]; t < bodies.first[size_t(b) + 1]; ++t) {
+        const double r = reach[size_t(s)] + reach[size_t(t)];
+        const double gap = (bodies.triangles[size_t(t)][0] - bodies.triangles[size_t(s)][0]).norm() - r;
+        if ((gap > 0.0 ? gap : -r) >= c.distance) continue;
         Point on;
         const double d = triangleTriangle(bodies.triangles[size_t(s)], bodies.triangles[size_t(t)], on);
         if (d < c.distance) {
@@ -254,6 +272,8 @@ SelfClearance selfClearance(const Chain& chain, ConstVectorRef q, const SelfClea
   }
   return c;
 }
+
+}  // namespace
 
 std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& problem, const continuation::Branch& branch,
                                                       const std::vector<ContactSet>& locked, double tolerance,
