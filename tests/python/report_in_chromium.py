@@ -34,6 +34,7 @@ import subprocess
 import sys
 import tempfile
 import zlib
+from html import unescape
 
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync",
@@ -218,6 +219,10 @@ def check_page(html, out, specials, browser, flags, tmp, report):
     if not time or time.group(1) != "%.3g" % summary["timings_seconds"]["total"]:
         fail(f"the page's computation time {time and time.group(1)!r} is not summary.json's "
              f"{summary['timings_seconds']['total']}")
+    # the run's warnings (summary.json), each in the run box
+    shown_warnings = [unescape(w) for w in re.findall(r'<p class="note warning">warning: ([^<]*)</p>', html)]
+    if shown_warnings != summary.get("warnings", [])[:20]:
+        fail(f"the page's warnings {shown_warnings} are not summary.json's {summary.get('warnings', [])[:20]}")
     rows = re.search(r'<table id="points-table" data-rows="([0-9]+)"', html)
     if not rows:
         fail("no traced points table (table#points-table)")

@@ -767,6 +767,7 @@
   });
   html('p', {'class': 'note'}, rb, 'The computation time is summary.json\'s timings_seconds.total, the time the run\'s last ' +
        'line gives as "computed in"; writing the plots and this page comes after it.');
+  (s.warnings || []).slice(0, 20).forEach(function (w) { html('p', {'class': 'note warning'}, rb, 'warning: ' + w); });
   (s.problems || []).slice(0, 20).forEach(function (p) { html('p', {'class': 'note'}, rb, p); });
 
   // first view: the first stable point of the main diagram's first case, else the unloaded chain
