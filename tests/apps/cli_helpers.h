@@ -7,6 +7,7 @@
 #include <iterator>
 #include <string>
 #include <sys/wait.h>
+#include "build_paths.h"
 
 namespace buckle::test {
 

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include "build_paths.h"
 
 namespace buckle::test {
 
@@ -22,8 +23,8 @@ inline int mpiExitCode(int ranks, const std::string& args, const std::filesystem
   const std::string cmd =
       "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none "
       "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}fast_unwind_on_malloc=0\" "
-      "LSAN_OPTIONS=\"${LSAN_OPTIONS:+$LSAN_OPTIONS:}suppressions=" BUCKLE_MPI_LSAN_SUPPRESSIONS "\" '" BUCKLE_MPIEXEC
-      "' --oversubscribe --bind-to none -np " +
+      "LSAN_OPTIONS=\"${LSAN_OPTIONS:+$LSAN_OPTIONS:}suppressions=" + std::string(BUCKLE_SOURCE_DIR) +
+      "/tests/apps/mpi_lsan.supp\" '" BUCKLE_MPIEXEC "' --oversubscribe --bind-to none -np " +
       std::to_string(ranks) + " '" + program + "' " + args + " > '" + capture.string() + "' 2>&1";
   const int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -12,6 +12,7 @@
 #include <vector>
 #include <nlohmann/json.hpp>
 #include <string>
+#include "build_paths.h"
 
 namespace {
 

@@ -14,6 +14,7 @@
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using buckle::test::exitCode;

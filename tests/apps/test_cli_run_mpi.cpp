@@ -16,6 +16,7 @@
 #include "cli_helpers.h"
 #include "mpi_run.h"
 #include "temp_dir.h"
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using buckle::test::count;

@@ -14,6 +14,7 @@
 #include <string>
 #include <unistd.h>
 #include <vector>
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using buckle::test::exitCode;

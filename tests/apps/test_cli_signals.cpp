@@ -22,6 +22,7 @@
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using buckle::test::slurp;

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <unistd.h>
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using buckle::test::exitCode;

@@ -18,6 +18,7 @@
 #include "scene/output_target.h"
 #include "temp_dir.h"
 #include "read_output.h"
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

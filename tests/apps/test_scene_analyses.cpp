@@ -14,6 +14,7 @@
 #include "scene/scene.h"
 #include "small_scene.h"
 #include "scene_run.h"
+#include "build_paths.h"
 
 namespace {
 

@@ -17,6 +17,7 @@
 #include "scene/runner.h"
 #include "scene/scene.h"
 #include "temp_dir.h"
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using namespace buckle::scene;

@@ -18,6 +18,7 @@
 #include "scene/columns.h"
 #include "scene/command.h"
 #include "temp_dir.h"
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using buckle::scene::stiffnessColumnValue;

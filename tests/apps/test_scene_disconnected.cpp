@@ -15,6 +15,7 @@
 
 #include "rfc4180.h"
 #include "scene_run.h"
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

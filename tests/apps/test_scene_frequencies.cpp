@@ -20,6 +20,7 @@
 #include "scene/columns.h"
 #include "scene/scene.h"
 #include "scene_run.h"
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using namespace buckle::mechanics;

@@ -11,6 +11,7 @@
 
 #include "scene/command.h"
 #include "temp_dir.h"
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -26,6 +26,7 @@
 #include "scene/command.h"
 #include "temp_dir.h"
 #include "read_output.h"
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

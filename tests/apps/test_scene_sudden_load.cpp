@@ -12,6 +12,7 @@
 #include "buckle/mechanics/chain.h"
 #include "scene/command.h"
 #include "temp_dir.h"
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

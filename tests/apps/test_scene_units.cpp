@@ -25,6 +25,7 @@
 #include "scene/scene.h"
 #include "scene/units.h"
 #include "temp_dir.h"
+#include "build_paths.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
