@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/mechanics/contact.h"
@@ -24,8 +25,11 @@ namespace {
 /// h[t]·Σ_{s<t} M_s + Σ_{s>t} h[s]·M_s.
 void addMaxCoupling(const Vector& h, const std::vector<int>& sources, continuation::ConstMatrixRef M,
                     const std::vector<int>& targets, double sign, continuation::MatrixRef out) {
+  // fixed capacity: no heap allocation, also where the corrector's solves call this
+  using Row = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, ChainStructure::kMaxBorder>;
   const Eigen::Index k = M.cols();
-  Eigen::RowVectorXd below = Eigen::RowVectorXd::Zero(k), weightedAbove = Eigen::RowVectorXd::Zero(k);
+  if (k > ChainStructure::kMaxBorder) throw std::invalid_argument("addMaxCoupling: more columns than kMaxBorder");
+  Row below = Row::Zero(k), weightedAbove = Row::Zero(k);
   for (size_t s = 0; s < sources.size(); ++s) weightedAbove += h[sources[s]] * M.row(Eigen::Index(s));
   size_t s = 0;
   for (size_t t = 0; t < targets.size(); ++t) {
@@ -246,12 +250,13 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
     x.segment(n_, o) = yg_.head(o);
     x.tail(k) = yg_.tail(k);
     // the locked unknowns: B_L y − b_L (+ H_LF x_F + P_L z for the transpose)
-    Matrix xLocked = BL_ * yg_.tail(k) - xL_.col(0);
+    xLocked_.noalias() = BL_ * yg_.tail(k);
+    xLocked_ -= xL_;
     if (transposed_) {
-      xLocked += PL_ * yg_.head(o);
-      addMaxCoupling(full_.h, free_, xg_, lockedIndex_, -1.0, xLocked);
+      xLocked_.noalias() += PL_ * yg_.head(o);
+      addMaxCoupling(full_.h, free_, xg_, lockedIndex_, -1.0, xLocked_);
     }
-    for (int l = 0; l < nl; ++l) x[lockedIndex_[size_t(l)]] = xLocked(l, 0);
+    for (int l = 0; l < nl; ++l) x[lockedIndex_[size_t(l)]] = xLocked_(l, 0);
     return x.allFinite();
   }
 
@@ -267,7 +272,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
   Vector c_, f_, g_, x_, y_;
   std::unique_ptr<continuation::DenseBorderedSolver> dense_;
   // factorGeneral(): the reduced borders, the locked rows of B and C, P_L, and solve scratch
-  Matrix Vg_, Wg_, Dg_, BL_, CL_, PL_, xL_;
+  Matrix Vg_, Wg_, Dg_, BL_, CL_, PL_, xL_, xLocked_;
   Vector fg_, gg_, xg_, yg_;
   bool general_ = false, transposed_ = false;
   bool usingDense_ = false;
