@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <thread>
 
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/critical_loading.h"
@@ -308,6 +309,9 @@ mech::EquilibriumBranchOptions CaseRunner::branchOptions(double lambdaLo, double
   opt.tree.branchSwitching = scene_.analyses.continuation.depth(throughLoad());
   opt.contact = scene_.analyses.continuation.contact;
   opt.mirror = scene_.analyses.continuation.mirror;
+  opt.tree.threads = scene_.analyses.continuation.threads;
+  if (opt.tree.threads == 0) opt.tree.threads = control_.shared.threads;
+  if (opt.tree.threads == 0) opt.tree.threads = int(std::max(1u, std::thread::hardware_concurrency()));
   opt.report = reportOptions();
   if (const int first = scene_.analyses.continuation.branchPoints; first > 0) {
     // the first `first` simple branch points along the branch, not counting the one it starts from

@@ -123,6 +123,9 @@ struct ContinuationSpec {
   /// An exactly mirror-symmetric scene (mechanics/mirror_symmetry.h) mirrors the − side child of
   /// every symmetric pitchfork instead of tracing it; false: both traced (for checking).
   bool mirror = true;
+  /// Threads that trace the children of different branch points at once (0: all cores, or under
+  /// mpirun the cores of this rank); the outputs are the same for any number.
+  int threads = 0;
 };
 
 struct EnergyCurvesSpec {

@@ -49,7 +49,7 @@ void parseContinuation(const Reader& r, const json& c, const Pointer& pc, Analys
   if (c.is_boolean()) {
     s.continuation.enabled = c.get<bool>();
   } else {
-    r.onlyKeys(c, pc, {"branch_switching", "contact", "wall", "branch_points", "child_points", "mirror"});
+    r.onlyKeys(c, pc, {"branch_switching", "contact", "wall", "branch_points", "child_points", "mirror", "threads"});
     s.continuation.enabled = true;
     if (c.contains("branch_switching"))
       s.continuation.branchSwitching = r.integer(c["branch_switching"], pc / "branch_switching", 0, 4);
@@ -60,6 +60,7 @@ void parseContinuation(const Reader& r, const json& c, const Pointer& pc, Analys
       s.continuation.branchPoints = r.integer(c["branch_points"], pc / "branch_points", 1, 10000000);
     if (c.contains("child_points"))
       s.continuation.childPoints = r.integer(c["child_points"], pc / "child_points", 2, 10000000);
+    if (c.contains("threads")) s.continuation.threads = r.integer(c["threads"], pc / "threads", 0, 4096);
   }
 }
 

@@ -752,6 +752,71 @@ TEST_CASE("reports handed over as branches become final equal the kept ones, the
   CHECK(streamed.startUnstable == kept.startUnstable);
 }
 
+TEST_CASE("the tree on two and three threads reports what one thread does: stretches, mirror images, contacts",
+          "[equilibrium_branches]") {
+  // Six segments to Fx = −2.5: five branch points, their U-like children reach joint limits and go
+  // on locked, the − sides are mirror images. The children are traced, extended and reported on
+  // workers (TreeOptions::threads, childWork); the tree must be the same: ids, parents, the named
+  // special points, every reported point (the eigenvalue searches start from the worker's own
+  // previous values: the same to rounding).
+  EquilibriumProblem problem(Chain::uniform(6, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)),
+                             EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o = pinnedOptions(-2.5, 1);
+  o.report.stiffness = true;
+  auto run = [&](int threads) {
+    o.tree.threads = threads;
+    std::vector<std::pair<int, BranchReport>> handed;
+    o.onReport = [&](const cont::Branch& b, BranchReport&& report) { handed.emplace_back(b.id, std::move(report)); };
+    EquilibriumBranches r =
+        traceEquilibria(problem, Eigen::VectorXd::Zero(6), 0.0, cont::InitialDirection::decreasingLambda(), o);
+    std::sort(handed.begin(), handed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    return std::make_pair(std::move(r), std::move(handed));
+  };
+  const auto [one, oneReports] = run(1);
+  REQUIRE(one.tree.branches.size() == 11);
+  bool locked = false, mirrored = false;
+  for (int threads : {2, 3}) {
+    INFO("threads " << threads);
+    const auto [many, manyReports] = run(threads);
+    REQUIRE(many.tree.branches.size() == one.tree.branches.size());
+    REQUIRE(manyReports.size() == oneReports.size());
+    for (size_t b = 0; b < one.tree.branches.size(); ++b) {
+      INFO("branch " << b);
+      const cont::Branch &x = one.tree.branches[b], &y = many.tree.branches[b];
+      CHECK(y.parentId == x.parentId);
+      CHECK(y.parentSpecialPoint == x.parentSpecialPoint);
+      CHECK(y.mirrorOf == x.mirrorOf);
+      mirrored = mirrored || x.mirrorOf >= 0;
+      REQUIRE(many.classifications[b].size() == one.classifications[b].size());
+      for (size_t s = 0; s < one.classifications[b].size(); ++s)
+        CHECK(many.classifications[b][s].explanation == one.classifications[b][s].explanation);
+      const BranchReport &ref = oneReports[b].second, &got = manyReports[b].second;
+      REQUIRE(manyReports[b].first == int(b));
+      REQUIRE(got.points.size() == ref.points.size());
+      for (size_t i = 0; i < ref.points.size(); ++i) {
+        CHECK(std::abs(got.points[i].parameter - ref.points[i].parameter) <= 1e-12 * std::max(1.0, std::abs(ref.points[i].parameter)));
+        CHECK((got.points[i].q - ref.points[i].q).norm() <= 1e-12 * std::max(1.0, ref.points[i].q.norm()));
+        CHECK(got.points[i].negative == ref.points[i].negative);
+        CHECK(got.points[i].locked == ref.points[i].locked);
+        CHECK(got.points[i].branch == int(b));
+        CHECK(std::abs(got.points[i].minEigenvalue - ref.points[i].minEigenvalue) <=
+              1e-9 * std::max(1.0, std::abs(ref.points[i].minEigenvalue)));
+        locked = locked || !ref.points[i].locked.empty();
+      }
+      REQUIRE(got.specialPoints.size() == ref.specialPoints.size());
+      for (size_t s = 0; s < ref.specialPoints.size(); ++s) {
+        CHECK(got.specialPoints[s].type == ref.specialPoints[s].type);
+        CHECK(got.specialPoints[s].branch == int(b));
+        CHECK(got.specialPoints[s].stabilityAfter == ref.specialPoints[s].stabilityAfter);
+        CHECK(std::abs(got.specialPoints[s].parameter - ref.specialPoints[s].parameter) <=
+              1e-12 * std::max(1.0, std::abs(ref.specialPoints[s].parameter)));
+      }
+    }
+  }
+  CHECK(locked);    // the comparison covered contact stretches
+  CHECK(mirrored);  // and mirror images
+}
+
 using testing::curledChain;
 using testing::curledShape;
 using testing::curledTrace;

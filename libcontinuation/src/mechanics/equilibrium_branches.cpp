@@ -1,6 +1,7 @@
 #include "buckle/mechanics/equilibrium_branches.h"
 
 #include <algorithm>
+#include <any>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -124,6 +125,29 @@ double contactRate(EquilibriumProblem& problem, const ContactSet& before, const 
   continuation::Vector grad(n), gen(n);
   wallVertexDerivatives(P, wallVertexPoint(problem.chain(), p0.u.head(n), P, hit.vertex), hit.vertex, grad, gen);
   return grad.dot(p0.tangent.head(n));
+}
+
+// What a child's own work (TreeOptions::childWork) computed on the thread that traced it: its
+// sizes as traced and its contact stretches; for a child never switched at, its report too.
+struct PreparedChild {
+  std::pair<size_t, size_t> traced;
+  std::vector<ContactStretch> contact;
+  bool reported = false;
+  std::vector<Classification> classifications;
+  GeometricContacts geometric;
+  BranchReport report;
+};
+
+PreparedChild* preparedOf(const continuation::Branch& b) {
+  const auto* p = std::any_cast<std::shared_ptr<PreparedChild>>(&b.prepared);
+  return p ? p->get() : nullptr;
+}
+
+// Switching generation of branch b (0: a root).
+int generationOf(const continuation::BranchTree& t, size_t b) {
+  int g = 0;
+  for (int p = t.branches[b].parentId; p >= 0; p = t.branches[size_t(p)].parentId) ++g;
+  return g;
 }
 
 }  // namespace
@@ -277,6 +301,49 @@ std::string EquilibriumBranchOptions::validate(const std::string& prefix) const 
                              cont::requirePositive(prefix, "maxContactTorque", maxContactTorque)});
 }
 
+namespace {
+
+// The children's own work (TreeOptions::childWork) on the thread that traced them: their contact
+// stretches from the parent's contacts at the branch point (`locked`, copied when the switch was
+// scheduled) and, for children never switched at (`leaves`), their classifications and reports.
+continuation::TreeOptions::ChildWork childWork(EquilibriumProblem& problem, const EquilibriumBranchOptions& options,
+                                               const continuation::TracerOptions& workerOptions,
+                                               const continuation::Reflection& symmetry, ContactSet locked, bool leaves) {
+  return [&problem, &options, &workerOptions, &symmetry, locked = std::move(locked),
+          leaves](std::vector<continuation::Branch>& sides) {
+    std::vector<std::shared_ptr<PreparedChild>> done;
+    for (continuation::Branch& child : sides) {
+      auto p = std::make_shared<PreparedChild>();
+      p->traced = {child.points.size(), child.specialPoints.size()};
+      const PreparedChild* source = child.mirrorOf >= 0 ? done[size_t(child.mirrorOf)].get() : nullptr;
+      if (!options.contact || child.stopReason == continuation::StopReason::Interrupted) {
+        p->contact = std::vector<ContactStretch>{ContactStretch{0, locked}};
+      } else if (source) {
+        p->contact = mirrored(source->contact);
+        appendMirroredTail(symmetry, sides[size_t(child.mirrorOf)], source->traced, child);
+      } else {
+        p->contact = continueUnderContact(problem, child, workerOptions, options.maxContactEvents,
+                                          options.maxContactTorque, locked);
+      }
+      if (leaves) {
+        for (const continuation::SpecialPoint& sp : child.specialPoints)
+          p->classifications.push_back(classify(problem, sp));
+        if (source) {  // a mirror image's base and self contacts are its source's mirrored
+          p->geometric.given = true;
+          for (const GeometricContact& g : source->geometric.list)
+            p->geometric.list.push_back(mirrored(symmetry, g));
+        }
+        p->report = reportBranch(problem, child, options.report, p->contact, &p->geometric);
+        p->reported = true;
+      }
+      done.push_back(p);
+    }
+    for (size_t c = 0; c < sides.size(); ++c) sides[c].prepared = std::move(done[c]);
+  };
+}
+
+}  // namespace
+
 EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::VectorXd& q0, double lambda0,
                                     const std::vector<continuation::InitialDirection>& starts,
                                     const EquilibriumBranchOptions& options) {
@@ -321,6 +388,11 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
   tree.extend = [&](const continuation::BranchTree& t, continuation::Branch& branch) {
     const size_t id = size_t(branch.id);
     slot(id);
+    if (PreparedChild* p = preparedOf(branch)) {  // its work done where it was traced (childWork)
+      traced[id] = p->traced;
+      result.contact[id] = std::move(p->contact);
+      return;
+    }
     traced[id] = {branch.points.size(), branch.specialPoints.size()};
     const ContactSet locked = lockedAtParent(t, branch);
     if (!options.contact || branch.stopReason == continuation::StopReason::Interrupted) {
@@ -334,6 +406,16 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
       result.contact[id] =
           continueUnderContact(problem, branch, o, options.maxContactEvents, options.maxContactTorque, locked);
     }
+  };
+  // The children's stretches, and the reports of those never switched at, on the thread that
+  // traced them (TreeOptions::threads; their progress callbacks stay on this thread).
+  continuation::TracerOptions workerOptions = childOptions;
+  if (options.tree.threads > 1) workerOptions.onStep = nullptr, workerOptions.onLocated = nullptr;
+  tree.childWork = [&](const continuation::BranchTree& t, size_t b,
+                       const continuation::SpecialPoint& bp) -> continuation::TreeOptions::ChildWork {
+    slot(b);
+    const bool leaves = generationOf(t, b) + 1 >= tree.branchSwitching;
+    return childWork(problem, options, workerOptions, tree.symmetry, lockedAt(result.contact[b], bp.index + 1), leaves);
   };
   tree.switchTracer = [&](const continuation::BranchTree&, size_t b,
                           const continuation::SpecialPoint& bp) -> std::shared_ptr<continuation::Tracer> {
@@ -359,18 +441,28 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
       result.reports.resize(t.branches.size());
       result.classifications.resize(t.branches.size());
     }
-    std::vector<Classification> names;
-    for (const continuation::SpecialPoint& sp : branch.specialPoints) names.push_back(classify(problem, sp));
-    result.classifications[b] = std::move(names);
+    BranchReport report;
+    if (PreparedChild* prepared = preparedOf(branch); prepared && prepared->reported) {
+      result.classifications[b] = std::move(prepared->classifications);
+      geometric[b] = std::move(prepared->geometric);
+      report = std::move(prepared->report);
+      branch.prepared.reset();
+      for (PointReport& p : report.points) p.branch = branch.id;  // its id is known from here on
+      for (SpecialPointReport& sp : report.specialPoints) sp.branch = branch.id;
+    } else {
+      std::vector<Classification> names;
+      for (const continuation::SpecialPoint& sp : branch.specialPoints) names.push_back(classify(problem, sp));
+      result.classifications[b] = std::move(names);
     // A mirror image's base and self contacts are its source's mirrored (mirror_symmetry.h): the
     // source is final before its image (the + side is traced and reported first).
-    const int source = branch.mirrorOf;
-    if (source >= 0 && size_t(source) < b) {
-      geometric[b].given = true;
-      for (const GeometricContact& g : geometric[size_t(source)].list)
-        geometric[b].list.push_back(mirrored(tree.symmetry, g));
+      const int source = branch.mirrorOf;
+      if (source >= 0 && size_t(source) < b) {
+        geometric[b].given = true;
+        for (const GeometricContact& g : geometric[size_t(source)].list)
+          geometric[b].list.push_back(mirrored(tree.symmetry, g));
+      }
+      report = reportBranch(problem, branch, options.report, result.contact[b], &geometric[b]);
     }
-    BranchReport report = reportBranch(problem, branch, options.report, result.contact[b], &geometric[b]);
     if (b == 0) result.startUnstable = startIsUnstable(branch);
     if (!options.onReport) {
       result.reports[b] = std::move(report);

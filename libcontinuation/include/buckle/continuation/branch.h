@@ -5,6 +5,7 @@
 
 #include "buckle/continuation/problem.h"
 
+#include <any>
 #include <limits>
 #include <string>
 #include <vector>
@@ -124,6 +125,9 @@ struct Branch {
   StopReason stopReason = StopReason::NotStarted;
   std::string stopMessage;
   double resumeStep = 0.0;  ///< StopReason::Paused: the step (scaled arclength) continueBranch takes next
+  /// What TreeOptions::childWork computed for this branch on a worker, for the tree's later
+  /// callbacks (extend, onFinal) to take instead of computing it again; empty otherwise.
+  std::any prepared;
 
   /// Special points of one type, in arclength order.
   std::vector<const SpecialPoint *> specialPointsOfType(SpecialPointType type) const;

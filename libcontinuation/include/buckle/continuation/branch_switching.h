@@ -97,6 +97,23 @@ struct TreeOptions {
   /// all its branch points are done. A consumer may report the branch here and release its
   /// points (the tree touches a final branch's points no more).
   std::function<void(BranchTree &tree, std::size_t branch)> onFinal;
+  /// Threads that switch at branch points (≤ 1: the calling thread alone). With more, the
+  /// children of different branch points are traced at once, each worker on a tracer and a
+  /// problem workspace of its own, while the calling thread goes on along the parent; the
+  /// children join the tree in the order of their branch points, so ids, notes and the guards
+  /// are those of one thread, and at most 2·threads switches are ahead of the oldest unjoined one
+  /// (memory: that many children). The tracers' onStep and onLocated are not called for
+  /// the children then (they run on other threads); onBranch reports each child as it joins.
+  int threads = 1;
+  /// The children's own work, done right after their trace and before they join the tree, on the
+  /// thread that traced them (a worker with threads > 1, concurrently with the calling thread
+  /// and the other workers: it must touch nothing the tree's other callbacks change). Made on the
+  /// calling thread when a switch at `bp` of branch `branch` is scheduled (it may copy what it
+  /// needs from the tree then); called with the traced sides of that branch point (parentId and
+  /// parentSpecialPoint set, id not yet, mirrorOf an index into `sides`), it may extend them (as
+  /// `extend` would) and leave results in Branch::prepared for extend and onFinal to take.
+  using ChildWork = std::function<void(std::vector<Branch> &sides)>;
+  std::function<ChildWork(const BranchTree &tree, std::size_t branch, const SpecialPoint &bp)> childWork;
   /// A reflection symmetry of the problem (symmetry.h; empty: none): at the simple branch points
   /// it fixes, with a bifurcating direction it reverses, the − side child is the image of the
   /// + side one (Branch::mirrorOf) instead of a second trace: the same tree, up to rounding, in
