@@ -17,14 +17,20 @@ using namespace buckle::continuation;
 
 namespace {
 
+// Options of the trees below: to λ = lambdaMax in steps of at most 0.05.
+TracerOptions upTo(double lambdaMax) {
+  TracerOptions options;
+  options.lambdaMax = lambdaMax;
+  options.step.maxStep = 0.05;
+  return options;
+}
+
 // A tree of ManyPitchforks (branch points at λ = 0, 0.1, …, 0.4 on u = 0), two generations deep,
 // on `threads` threads; childWork counts its calls and leaves the sides' sizes in `prepared`.
 BranchTree manyPitchforksTree(int threads, int &works, const std::function<void(int)> &onWork = nullptr,
                               const Interrupt &interrupt = Interrupt()) {
   static const toys::ManyPitchforks problem(5, 0.1);
-  TracerOptions options;
-  options.lambdaMax = 0.6;
-  options.step.maxStep = 0.05;
+  TracerOptions options = upTo(0.6);
   options.interrupt = interrupt;
   TreeOptions tree;
   tree.branchSwitching = 2;
@@ -114,9 +120,7 @@ TEST_CASE("The tree's hooks: a branch extended past its trace is switched at on 
   // extension. The tree switches there with the tracer `switchTracer` gives (a few points only).
   const double c = 0.5;
   toys::TwoPitchforks problem(c);
-  TracerOptions options;
-  options.lambdaMax = 0.25;
-  options.step.maxStep = 0.05;
+  TracerOptions options = upTo(0.25);
   TracerOptions beyond = options;
   beyond.lambdaMax = 0.8;
   TreeOptions tree;
@@ -193,9 +197,7 @@ TEST_CASE("The tree's hooks: a branch extended past its trace is switched at on 
 
 TEST_CASE("An interrupted tree makes every branch final, the unfinished ones included", "[branch_tree]") {
   toys::TwoPitchforks problem(0.5);
-  TracerOptions options;
-  options.lambdaMax = 0.8;
-  options.step.maxStep = 0.05;
+  TracerOptions options = upTo(0.8);
   TreeOptions tree;
   tree.branchSwitching = 2;
   std::atomic<bool> stop{false};
@@ -220,9 +222,7 @@ TEST_CASE("An interrupted tree makes every branch final, the unfinished ones inc
 TEST_CASE("A root is traced lazily: the tree's root is the branch traced whole, its children in branch-point order",
           "[branch_tree]") {
   toys::ManyPitchforks problem(5, 0.1);  // branch points at λ = 0, 0.1, …, 0.4 on u = 0
-  TracerOptions options;
-  options.lambdaMax = 0.6;
-  options.step.maxStep = 0.05;
+  TracerOptions options = upTo(0.6);
   Tracer whole(problem, options);
   const Branch reference = whole.trace(Vector::Zero(5), -0.2, InitialDirection::increasingLambda());
   REQUIRE(reference.specialPointsOfType(SpecialPointType::BranchPoint).size() == 5);
@@ -268,9 +268,7 @@ TEST_CASE("A root is traced lazily: the tree's root is the branch traced whole, 
 TEST_CASE("Under an interrupt the tree holds the branches of the root's first branch points, not a whole root",
           "[branch_tree]") {
   toys::ManyPitchforks problem(5, 0.1);
-  TracerOptions options;
-  options.lambdaMax = 0.6;
-  options.step.maxStep = 0.05;
+  TracerOptions options = upTo(0.6);
   TreeOptions tree;
   tree.branchSwitching = 1;
   std::atomic<bool> stop{false};

@@ -762,7 +762,6 @@ TEST_CASE("the tree on two and three threads reports what one thread does: stret
   EquilibriumProblem problem(Chain::uniform(6, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25)),
                              EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
   EquilibriumBranchOptions o = pinnedOptions(-2.5, 1);
-  o.report.stiffness = true;
   auto run = [&](int threads) {
     o.tree.threads = threads;
     std::vector<std::pair<int, BranchReport>> handed;
