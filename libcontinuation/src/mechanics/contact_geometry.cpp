@@ -84,15 +84,17 @@ LinkBodies linkBodies(const Chain& chain, ConstVectorRef q) {
   L.triangles.reserve(size_t(2 * n));
   L.first.reserve(size_t(n + 2));
   double theta = 0.0;
+  Point before(1.0, 0.0);  // the links' directions (wall_contact.h: one sine and cosine a joint)
   for (int i = 0; i < n; ++i) {
     const SegmentParameters& p = chain.segment(i).parameters();
     const Point joint = P.col(i + 1);
-    const double before = theta, after = theta + q[i];
+    const Point after(std::cos(theta + q[i]), std::sin(theta + q[i]));
     // the proximal triangle closes link i, the distal one opens link i + 1
     L.triangles.push_back({joint, segmentVertex(p, joint, before, after, 1), segmentVertex(p, joint, before, after, 2)});
     L.first.push_back(int(L.triangles.size()) - (i == 0 ? 1 : 2));
     L.triangles.push_back({joint, segmentVertex(p, joint, before, after, 3), segmentVertex(p, joint, before, after, 4)});
-    theta = after;
+    theta += q[i];
+    before = after;
   }
   L.first.push_back(int(L.triangles.size()) - 1);
   L.first.push_back(int(L.triangles.size()));

@@ -12,17 +12,22 @@ namespace {
 using Point = Eigen::Vector2d;
 
 Point dir(double t) { return Point(std::cos(t), std::sin(t)); }
-Point nrm(double t) { return Point(-std::sin(t), std::cos(t)); }
 
 }  // namespace
 
 Point segmentVertex(const SegmentParameters& p, const Point& joint, double before, double after, int corner) {
+  return segmentVertex(p, joint, dir(before), dir(after), corner);
+}
+
+Point segmentVertex(const SegmentParameters& p, const Point& joint, const Point& before, const Point& after,
+                    int corner) {
+  // the link's normal is its direction turned by +90°
   switch (corner) {
     case 0: return joint;
-    case 1: return joint - p.b1 * dir(before) + p.a1 * nrm(before);
-    case 2: return joint - p.b1 * dir(before) - p.a1 * nrm(before);
-    case 3: return joint + p.b2 * dir(after) + p.a2 * nrm(after);
-    default: return joint + p.b2 * dir(after) - p.a2 * nrm(after);
+    case 1: return joint - p.b1 * before + p.a1 * Point(-before.y(), before.x());
+    case 2: return joint - p.b1 * before - p.a1 * Point(-before.y(), before.x());
+    case 3: return joint + p.b2 * after + p.a2 * Point(-after.y(), after.x());
+    default: return joint + p.b2 * after - p.a2 * Point(-after.y(), after.x());
   }
 }
 
@@ -62,9 +67,10 @@ WallApproach nearestWallVertex(const Chain& chain, ConstVectorRef q, const std::
   WallApproach c;
   c.distance = std::numeric_limits<double>::infinity();
   double theta = 0.0;
+  Point before = dir(0.0);
   for (int i = 0; i < n; ++i) {
     const SegmentParameters& p = chain.segment(i).parameters();
-    const double before = theta, after = theta + q[i];
+    const Point after = dir(theta + q[i]);
     // segment 1's proximal triangle is clamped; a proximal corner on the previous segment's distal
     // one (equal half-heights: the link's two triangles share their base) is that vertex
     const bool shared = i > 0 && p.a1 == chain.segment(i - 1).parameters().a2;
@@ -79,7 +85,8 @@ WallApproach nearestWallVertex(const Chain& chain, ConstVectorRef q, const std::
         c.point = x;
       }
     }
-    theta = after;
+    theta += q[i];
+    before = after;
   }
   return c;
 }

@@ -54,6 +54,10 @@ void checkWallVertex(const WallVertex& v, int segments);
 /// the absolute angles of the links before and after the joint (the same sums as the shape plots).
 Eigen::Vector2d segmentVertex(const SegmentParameters& p, const Eigen::Vector2d& joint, double before, double after,
                               int corner);
+/// The same from the links' directions (cos, sin) of those angles: a chain's every vertex with
+/// one sine and cosine per joint, not four per vertex.
+Eigen::Vector2d segmentVertex(const SegmentParameters& p, const Eigen::Vector2d& joint, const Eigen::Vector2d& before,
+                              const Eigen::Vector2d& after, int corner);
 
 /// The vertex's position at q, from the joint positions P = jointPositions(chain, q). O(1).
 Eigen::Vector2d wallVertexPoint(const Chain& chain, ConstVectorRef q, const Eigen::Matrix2Xd& P, const WallVertex& v);
