@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -267,6 +268,7 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
   std::vector<PointReport> all;  // every point, also out of range (stability of neighbours)
   all.reserve(b.points.size());
   Eigen::VectorXd torques(problem.dimension());
+  std::optional<cont::BoundProblem> free;  // one workspace for the locked points' residuals
   for (size_t i = 0; i < b.points.size(); ++i) {
     const cont::ContinuationPoint& p = b.points[i];
     PointReport pr;
@@ -288,7 +290,7 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
       for (const LockedJoint& l : pr.locked.joints())
         pr.contactTorque =
             std::max(pr.contactTorque, held.compression(*held.createWorkspace(), p.u, p.lambda, l.joint));
-    } else if (!pr.locked.empty() && cont::BoundProblem(problem).residual(p.u, p.lambda, torques)) {
+    } else if (!pr.locked.empty() && (free ? *free : free.emplace(problem)).residual(p.u, p.lambda, torques)) {
       // The compression −side·τ_c of each locked joint (ContactProblem::compression), its contact
       // torque τ_c the free equilibrium's row: one residual for all of them.
       for (const LockedJoint& l : pr.locked.joints())
