@@ -69,12 +69,13 @@ UZSTOP={{'Fx':[{g(fxend)}, 0.0], 'qmax':{QSTOP}}}
         "description": f"Race task T, n = {n} (peers/auto07p-n): trivial branch Fx 0 -> 1.25 x Fx_cr{len(crit)}, "
                        f"switch at the first {NBP} BPs (both sides: + traced, - its mirror image), children until "
                        f"max|q| = {QSTOP} (joint limits +-{QSTOP}, contact off: BD ends the branch), the path range "
-                       f"or {NMX} points. Same step sizes and tolerance as the AUTO constants file c.T_n{n}.",
+                       f"or {NMX} points. Same step sizes and tolerance as the AUTO constants file c.T_n{n}; one thread, as AUTO.",
         "chain": {"segments": n, "a": A, "b": B, "k": K, "L0": L0, "q_min": -QSTOP, "q_max": QSTOP},
         "end": {"x": {"load": 0}, "y": {"held": 0}, "phi": "free"},
         "path": {"parameter": "Fx", "from": 0, "to": fxend},
+        # one thread, as AUTO runs (OMP_NUM_THREADS=1): the same cores for both
         "analyses": {"continuation": {"branch_switching": 1, "branch_points": NBP, "contact": False,
-                                      "child_points": NMX}},
+                                      "child_points": NMX, "threads": 1}},
         "solver": {"initial_step": ds, "min_step": dsmin, "max_step": dsmax, "tolerance": 1e-10,
                    "max_points": NMX, "time_limit": 3000},
         "plots": [],

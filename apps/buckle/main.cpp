@@ -3,6 +3,7 @@
 // Compiled twice: `buckle` (every subcommand, no MPI) and, with BUCKLE_MPI_PROGRAM, `buckle-mpi`
 // (the atlas and the scene runner, for mpirun): only the program that needs MPI loads its libraries at start-up.
 #include <CLI/CLI.hpp>
+#include <cstring>
 #include <iostream>
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -66,27 +67,38 @@ int main(int argc, char** argv) {
 #endif
   app.require_subcommand(1);
   buckle::cli::Outcome outcome;
+  struct Subcommand {
+    const char* name;
+    void (*add)(CLI::App&, buckle::cli::Outcome&);
+  };
+  static const Subcommand kSubcommands[] = {
 #if !BUCKLE_MPI_PROGRAM
-  buckle::cli::addCriticalCommand(app, outcome);
+      {"critical", buckle::cli::addCriticalCommand},
 #endif
-  buckle::cli::addRunCommand(app, outcome);
-  buckle::cli::addAtlasCommand(app, outcome);
+      {"run", buckle::cli::addRunCommand},
+      {"atlas", buckle::cli::addAtlasCommand},
 #if !BUCKLE_MPI_PROGRAM
-  buckle::cli::addRegressCommand(app, outcome);
-  buckle::cli::addShowCommand(app, outcome);
+      {"regress", buckle::cli::addRegressCommand},
+      {"show", buckle::cli::addShowCommand},
 #endif
-  // CLI11 would only say "A subcommand is required" for a mistyped one: name it
+  };
+  // A named subcommand: only its options are set up (the others' would cost a run's start-up
+  // for nothing); the program's own --help and --version list them all. CLI11 would only say "A
+  // subcommand is required" for a mistyped one: name it.
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;
-    bool known = false;
-    for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
-      known = known || sub->get_name() == argv[1];
-      names += (names.empty() ? "" : ", ") + sub->get_name();
+    const Subcommand* chosen = nullptr;
+    for (const Subcommand& sub : kSubcommands) {
+      if (std::strcmp(sub.name, argv[1]) == 0) chosen = &sub;
+      names += (names.empty() ? "" : ", ") + std::string(sub.name);
     }
-    if (!known) {
+    if (!chosen) {
       std::cerr << "error: unknown subcommand \"" << argv[1] << "\" (one of: " << names << "; see buckle --help)\n";
       return buckle::cli::kBadInput;
     }
+    chosen->add(app, outcome);
+  } else {
+    for (const Subcommand& sub : kSubcommands) sub.add(app, outcome);
   }
   try {
     app.parse(argc, argv);
