@@ -64,7 +64,7 @@ bool switchedBefore(const std::vector<Vector> &switchedAt, const std::vector<dou
 struct SwitchJob {
   std::size_t parent = 0, k = 0;
   SpecialPoint bp;
-  std::shared_ptr<Tracer> own;  // TreeOptions::switchTracer's, or null: the worker's
+  std::shared_ptr<Tracer> own;  // TreeOptions::switchTracer's, or null: a new one (runSwitch)
   TreeOptions::ChildWork work;
   std::vector<Branch> sides;
   std::string how;

@@ -429,7 +429,7 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
     };
     auto owned = std::make_shared<Owned>();
     owned->problem = lockedProblem(problem, locked, options.maxContactTorque);
-    continuation::TracerOptions o = childOptions;
+    continuation::TracerOptions o = workerOptions;  // it may run on a worker (TreeOptions::threads)
     o.detection.certifiedCounting = false;  // as on the stretch itself (continueUnderContact)
     owned->tracer.emplace(*owned->problem, o);
     return std::shared_ptr<continuation::Tracer>(owned, &*owned->tracer);
