@@ -453,8 +453,8 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
       std::vector<Classification> names;
       for (const continuation::SpecialPoint& sp : branch.specialPoints) names.push_back(classify(problem, sp));
       result.classifications[b] = std::move(names);
-    // A mirror image's base and self contacts are its source's mirrored (mirror_symmetry.h): the
-    // source is final before its image (the + side is traced and reported first).
+      // A mirror image's base and self contacts are its source's mirrored (mirror_symmetry.h): the
+      // source is final before its image (the + side is traced and reported first).
       const int source = branch.mirrorOf;
       if (source >= 0 && size_t(source) < b) {
         geometric[b].given = true;
