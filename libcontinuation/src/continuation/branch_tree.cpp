@@ -311,8 +311,9 @@ void TreeTracer::schedule(std::size_t i, std::size_t k) {
     join(job);
     return;
   }
-  // at most 2·threads children ahead of the oldest unjoined switch (TreeOptions::threads)
-  for (SwitchJob oldest; pool_->pending() >= 2 * std::size_t(to_.threads) && pool_->oldest(oldest, false);)
+  // at most threads + 2 switches scheduled and not joined (TreeOptions::threads): a worker that
+  // finished is not kept waiting, and memory holds that many switches' children at most
+  for (SwitchJob oldest; pool_->pending() >= std::size_t(to_.threads) + 2 && pool_->oldest(oldest, false);)
     join(oldest);
   pool_->schedule(std::move(job));
   joinDone(false);

@@ -98,10 +98,10 @@ struct TreeOptions {
   /// points (the tree touches a final branch's points no more).
   std::function<void(BranchTree &tree, std::size_t branch)> onFinal;
   /// Threads that switch at branch points (≤ 1: the calling thread alone). With more, the
-  /// children of different branch points are traced at once, each worker on a tracer and a
+  /// children of different branch points are traced at once, each switch on a tracer and a
   /// problem workspace of its own, while the calling thread goes on along the parent; the
   /// children join the tree in the order of their branch points, so ids, notes and the guards
-  /// are those of one thread, and at most 2·threads switches are ahead of the oldest unjoined one
+  /// are those of one thread, and at most threads + 2 switches are scheduled and not joined
   /// (memory: that many children). The tracers' onStep and onLocated are not called for
   /// the children then (they run on other threads); onBranch reports each child as it joins.
   int threads = 1;
