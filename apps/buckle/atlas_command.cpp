@@ -1,4 +1,5 @@
 #include "atlas_command.h"
+#include "buckle/continuation/available_cores.h"
 
 #include <algorithm>
 #include <chrono>
@@ -10,7 +11,6 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <unistd.h>
 #include <vector>
 
@@ -80,7 +80,7 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
   }
   // Threads per rank: the ranks on one machine share its cores.
   const int threads = o.threads > 0 ? o.threads
-                                    : std::max(1, int(std::thread::hardware_concurrency()) / world->ranksOnThisNode());
+                                    : std::max(1, buckle::continuation::availableCores() / world->ranksOnThisNode());
   // No progress bar under mpirun: a rank sees only its share, and mpirun hands the ranks a
   // terminal even when its own output goes to a file.
   const bool tty = !world->distributed() && ::isatty(STDOUT_FILENO) == 1 && !args.quiet;

@@ -1,4 +1,5 @@
 #include "run_command.h"
+#include "buckle/continuation/available_cores.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,6 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <unistd.h>
 
 #include "atlas_mpi.h"
@@ -96,7 +96,7 @@ void addRunCommand(CLI::App& app, Outcome& outcome) {
     if (world->distributed() && world->size() > 1) {
       o.shared.part = world->rank();
       o.shared.parts = world->size();
-      o.shared.threads = std::max(1, int(std::thread::hardware_concurrency()) / world->ranksOnThisNode());
+      o.shared.threads = std::max(1, buckle::continuation::availableCores() / world->ranksOnThisNode());
       o.shared.exchange = [&w = *world](const std::string& tag, const std::string& mine) {
         return taggedExchange(w, tag, mine);
       };

@@ -1,4 +1,5 @@
 #include "scene/atlas.h"
+#include "buckle/continuation/available_cores.h"
 
 #include <atomic>
 #include <cmath>
@@ -126,7 +127,7 @@ size_t computeCells(std::vector<AtlasCell>& cells, const AtlasShare& share, int 
   for (size_t k = 0; k < cells.size(); ++k)
     if (share.owns(k)) mine.push_back(k);
   const int total = static_cast<int>(mine.size());
-  unsigned threads = threadCount > 0 ? unsigned(threadCount) : std::max(1u, std::thread::hardware_concurrency());
+  unsigned threads = threadCount > 0 ? unsigned(threadCount) : unsigned(continuation::availableCores());
   threads = std::min<unsigned>(threads, unsigned(std::max(total, 1)));
   std::atomic<int> next{0}, done{0};
   std::mutex progressMutex;

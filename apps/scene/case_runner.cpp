@@ -1,9 +1,9 @@
 #include "scene/case_runner.h"
+#include "buckle/continuation/available_cores.h"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-#include <thread>
 
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/critical_loading.h"
@@ -311,7 +311,7 @@ mech::EquilibriumBranchOptions CaseRunner::branchOptions(double lambdaLo, double
   opt.mirror = scene_.analyses.continuation.mirror;
   opt.tree.threads = scene_.analyses.continuation.threads;
   if (opt.tree.threads == 0) opt.tree.threads = control_.shared.threads;
-  if (opt.tree.threads == 0) opt.tree.threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  if (opt.tree.threads == 0) opt.tree.threads = cont::availableCores();
   opt.report = reportOptions();
   if (const int first = scene_.analyses.continuation.branchPoints; first > 0) {
     // the first `first` simple branch points along the branch, not counting the one it starts from

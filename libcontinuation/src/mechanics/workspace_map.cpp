@@ -1,4 +1,5 @@
 #include "buckle/mechanics/workspace_map.h"
+#include "buckle/continuation/available_cores.h"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
@@ -245,7 +246,7 @@ void traceRows(const InputPlane& plane, const WorkspaceMapOptions& o, const std:
     for (size_t k = next++; k < which.size(); k = next++)
       traceRow(plane, o, which[k], spine, spineFolds, map, rows[size_t(which[k])]);
   };
-  int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  int threads = o.threads > 0 ? o.threads : continuation::availableCores();
   threads = std::min(threads, int(which.size()));
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) pool.emplace_back(work);
