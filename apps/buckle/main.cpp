@@ -52,8 +52,8 @@ int main(int argc, char** argv) {
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   // One heap for every thread: the tree's workers (TreeOptions::threads) allocate a child's
   // points and report and the main thread frees them, so per-thread arenas would each keep
-  // their own freed 64 MB above (a 200-segment tree: +40 % peak memory). The workers'
-  // allocations are per branch, not per point (the tracer's loop allocates nothing): no contention.
+  // their own freed 64 MB above (benchmarks/RESULTS.md, issue 27). The workers' allocations
+  // are per branch, not per point (the tracer's loop allocates nothing): no contention.
   mallopt(M_ARENA_MAX, 1);
   adviseHugePagesForHeap();
 #endif
