@@ -129,6 +129,28 @@ TEST_CASE("counts below a shift match the dense spectrum", "[chain_structure]") 
       CHECK(countBelow(ws, s) == i + 1);
       factorize(ws, s);
       CHECK(ws.factorInertia.negative == i + 1);
+      // the smallest pivot relative to max |T − σM| (M: 2, …, 2, 1 on the diagonal, −1 beside it),
+      // from the pivots themselves; a count without the determinant is the same count
+      Matrix shifted = tridiagonalMatrix(ws);
+      for (int k = 0; k < n; ++k) {
+        shifted(k, k) -= s * (k + 1 < n ? 2.0 : 1.0);
+        if (k + 1 < n) shifted(k, k + 1) += s, shifted(k + 1, k) += s;
+      }
+      const double scale = shifted.cwiseAbs().maxCoeff();
+      double ratio = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < n; k += ws.blockStart[size_t(k)]) {
+        if (ws.blockStart[size_t(k)] == 1) {
+          ratio = std::min(ratio, std::abs(ws.pivA[k]) / scale);
+        } else {
+          const double a = ws.pivA[k], b = ws.pivA[k + 1], e = ws.pivE[k];
+          const double big = 0.5 * std::abs(a + b) + std::hypot(0.5 * (a - b), e);
+          ratio = std::min(ratio, std::abs(a * b - e * e) / (big * scale));
+        }
+      }
+      CHECK(ws.minPivotRatio == Approx(ratio).epsilon(1e-15));
+      factorize(ws, s, false);
+      CHECK(ws.factorInertia.negative == i + 1);
+      CHECK(ws.minPivotRatio == Approx(ratio).epsilon(1e-15));
     }
   }
 }

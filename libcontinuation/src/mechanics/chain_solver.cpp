@@ -27,7 +27,7 @@ ChainBorderedSolver::ChainBorderedSolver(const EquilibriumProblem& problem,
       D_(Matrix::Zero(problem.heldCount() + 1, problem.heldCount() + 1)),
       x_(Vector::Zero(problem.segments())),
       y_(Vector::Zero(problem.heldCount() + 1)) {
-  if (n_ + m_ <= kDenseFallback) dense_ = std::make_unique<continuation::DenseBorderedSolver>(problem);
+  denseAllowed_ = n_ + m_ <= kDenseFallback;
 }
 
 Factorization ChainBorderedSolver::factor(ConstVectorRef u, double lambda, ConstVectorRef c) {
@@ -60,12 +60,19 @@ Factorization ChainBorderedSolver::factor(ConstVectorRef u, double lambda, Const
     logAbs_ = ws_.borderedLogAbsDet;
     return Factorization::Regular;
   }
-  if (!dense_) return Factorization::Singular;
+  if (!dense()) return Factorization::Singular;
   usingDense_ = true;
   const Factorization f = dense_->factor(u, lambda, c);
   sign_ = dense_->determinantSign();
   logAbs_ = dense_->logAbsDeterminant();
   return f;
+}
+
+continuation::DenseBorderedSolver* ChainBorderedSolver::dense() {
+  // made where a factorization first needs it: most solvers never do, and an (n + 1)² LU made
+  // up front for each costs more than their solves on a short branch
+  if (!dense_ && denseAllowed_) dense_ = std::make_unique<continuation::DenseBorderedSolver>(problem_);
+  return dense_.get();
 }
 
 Factorization ChainBorderedSolver::factorGeneral(ConstVectorRef u, double lambda, continuation::ConstMatrixRef B,
@@ -98,7 +105,7 @@ Factorization ChainBorderedSolver::factorGeneral(ConstVectorRef u, double lambda
     logAbs_ = ws_.borderedLogAbsDet;
     return Factorization::Regular;
   }
-  if (!dense_) return Factorization::Singular;
+  if (!dense()) return Factorization::Singular;
   usingDense_ = true;
   const Factorization f = dense_->factorGeneral(u, lambda, B, C, D, transposed);
   sign_ = dense_->determinantSign();

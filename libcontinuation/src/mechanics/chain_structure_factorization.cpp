@@ -31,14 +31,19 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
     if (determinant) det.multiply(v);
   };
   int sign = 1;
-  double scale = 0.0;
-  for (int k = 0; k < n; ++k) {
-    scale = std::max(scale, std::abs(ws.diag[k] - sigma * metricDiagonal(k, n)));
-    if (k + 1 < n) scale = std::max(scale, std::abs(ws.off[k] + sigma));
+  // max |entry| of T − σM (M: diagonal 2, …, 2, 1; off-diagonal −1) as whole-array reductions,
+  // which vectorise (a max is exact: the same value as entry by entry)
+  double scale = std::abs(ws.diag[n - 1] - sigma);
+  if (n > 1) {
+    scale = std::max(scale, (ws.diag.head(n - 1).array() - 2.0 * sigma).abs().maxCoeff());
+    scale = std::max(scale, (ws.off.head(n - 1).array() + sigma).abs().maxCoeff());
   }
   if (scale == 0.0) scale = 1.0;
   const double pivmin = kTinyPivot * scale;
+  // The 1×1 pivots' smallest |d| divided by the scale once at the end (x ↦ x/scale is monotonic
+  // in rounding too: the same ratio as dividing each), the 2×2 blocks' ratios as they come.
   double minRatio = std::numeric_limits<double>::infinity();
+  double minPivot = std::numeric_limits<double>::infinity();
   auto a = [&](int k) { return ws.diag[k] - sigma * metricDiagonal(k, n); };
   auto e = [&](int k) { return ws.off[k] + sigma; };  // M off-diagonal is −1
 
@@ -64,7 +69,7 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
         ++ws.factorInertia.positive;
       }
       accumulate(dk);
-      minRatio = std::min(minRatio, std::abs(dk) / scale);
+      minPivot = std::min(minPivot, std::abs(dk));
       if (determinant) dLog += ddk / dk;
       if (k + 1 < n) {
         const double l = ek / dk;
@@ -104,7 +109,7 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
       k += 2;
     }
   }
-  ws.minPivotRatio = minRatio;
+  ws.minPivotRatio = std::min(minRatio, minPivot / scale);
   ws.logAbsDet = determinant ? det.logAbs() : std::numeric_limits<double>::quiet_NaN();
   ws.detSign = sign;
   ws.dLogAbsDet = determinant ? dLog : std::numeric_limits<double>::quiet_NaN();
@@ -130,25 +135,19 @@ int countBelow(const ChainStructure& ws, double sigma) {
 
 void solveFactored(const ChainStructure& ws, VectorRef y) {
   const int n = ws.n;
-  // forward: L
+  // forward with L, and the block diagonal in the same pass: a block's entries are final once
+  // the rows above are eliminated
   for (int k = 0; k < n;) {
     if (ws.blockStart[size_t(k)] == 1) {
-      if (k + 1 < n) y[k + 1] -= ws.l1[k] * y[k];
+      const double y0 = y[k];
+      if (k + 1 < n) y[k + 1] -= ws.l1[k] * y0;
+      y[k] = y0 / ws.pivA[k];
       k += 1;
     } else {
-      if (k + 2 < n) y[k + 2] -= ws.l1[k] * y[k] + ws.l2[k] * y[k + 1];
-      k += 2;
-    }
-  }
-  // block diagonal
-  for (int k = 0; k < n;) {
-    if (ws.blockStart[size_t(k)] == 1) {
-      y[k] /= ws.pivA[k];
-      k += 1;
-    } else {
+      const double y0 = y[k], y1 = y[k + 1];
+      if (k + 2 < n) y[k + 2] -= ws.l1[k] * y0 + ws.l2[k] * y1;
       const double a = ws.pivA[k], b = ws.pivA[k + 1], e = ws.pivE[k];
       const double det = a * b - e * e;
-      const double y0 = y[k], y1 = y[k + 1];
       y[k] = (b * y0 - e * y1) / det;
       y[k + 1] = (a * y1 - e * y0) / det;
       k += 2;

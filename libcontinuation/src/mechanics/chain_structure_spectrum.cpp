@@ -114,9 +114,15 @@ namespace {
 
 using search::ShiftEvaluation;
 
-ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double sigma) {
+ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double sigma, bool countOnly) {
   ShiftEvaluation ev;
   const int r = useConstraints ? ws.rank : 0;
+  if (countOnly) {
+    // the same factorization's inertia without the determinant's products and derivative
+    ev.below = r == 0 ? (factorize(ws, sigma, false), ws.factorInertia.negative) : constrainedCountBelow(ws, sigma, false);
+    ev.determinant = false;
+    return ev;
+  }
   if (r == 0) {
     factorize(ws, sigma);
     ev.below = ws.factorInertia.negative;
@@ -157,7 +163,8 @@ int eigenvaluesFrom(ChainStructure& ws, bool useConstraints, int first, int coun
                     const Vector* guess) {
   const int dim = ws.n - (useConstraints ? ws.rank : 0);
   const double scale = std::max(ws.typicalScale, ws.frobeniusH);  // as zeroThreshold: any units
-  return search::searchEigenvalues([&](double s) { return evaluateShift(ws, useConstraints, s); }, dim, scale,
+  return search::searchEigenvalues([&](double s, bool countOnly) { return evaluateShift(ws, useConstraints, s, countOnly); },
+                                   dim, scale,
                                    ws.frobeniusH, first, count, out, tolerance, guess);
 }
 

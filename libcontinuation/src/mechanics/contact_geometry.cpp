@@ -45,8 +45,11 @@ double projectedGap(const Triangle& A, const Triangle& B, const Point& u) {
 /// Signed distance of two triangles (either may be flat): the distance while they are disjoint,
 /// else the largest projected gap over their edges' normals (separating axes), ≤ 0 and minus the
 /// depth of the overlap; continuous at the first touch. onA: the point of A nearest to B (while
-/// overlapping, the nearest pair of a vertex and an edge).
-double triangleTriangle(const Triangle& A, const Triangle& B, Point& onA) {
+/// overlapping, the nearest pair of a vertex and an edge). A separating gap of at least `cutoff`
+/// is returned as it is, onA unset: the distance is at least every projected gap, so it is not
+/// below the cutoff either (the caller's best so far), and the 18 vertex–edge distances are saved.
+double triangleTriangle(const Triangle& A, const Triangle& B, Point& onA,
+                        double cutoff = std::numeric_limits<double>::infinity()) {
   double gap = -std::numeric_limits<double>::infinity();
   for (const Triangle* T : {&A, &B})
     for (int e = 0; e < 3; ++e) {
@@ -54,6 +57,7 @@ double triangleTriangle(const Triangle& A, const Triangle& B, Point& onA) {
       const double len = d.norm();
       if (len > 0.0) gap = std::max(gap, projectedGap(A, B, Point(-d.y(), d.x()) / len));
     }
+  if (gap > 0.0 && gap >= cutoff) return gap;
   double best = std::numeric_limits<double>::infinity();
   Point nearest;
   for (int e = 0; e < 3; ++e) {
@@ -203,8 +207,8 @@ SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint&
         const double r = reach[size_t(s)] + reach[size_t(t)];
         const double gap = (bodies.triangles[size_t(t)][0] - bodies.triangles[size_t(s)][0]).norm() - r;
         if ((gap > 0.0 ? gap : -r) >= c.distance) continue;
-        Point on;
-        const double d = triangleTriangle(bodies.triangles[size_t(s)], bodies.triangles[size_t(t)], on);
+        Point on = Point::Zero();
+        const double d = triangleTriangle(bodies.triangles[size_t(s)], bodies.triangles[size_t(t)], on, c.distance);
         if (d < c.distance) {
           c.distance = d;
           c.linkA = a;

@@ -74,9 +74,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
         y_(p_) {
     for (const LockedJoint& l : problem.contacts().joints()) lockedIndex_.push_back(l.joint);
     std::sort(lockedIndex_.begin(), lockedIndex_.end());  // addMaxCoupling's order
-    if (n_ + m_ + w_ <= kDenseFallback || p_ > ChainStructure::kMaxBorder)
-      dense_ =
-          std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem, problemWorkspace));
+    denseAllowed_ = n_ + m_ + w_ <= kDenseFallback || p_ > ChainStructure::kMaxBorder;
   }
 
   Factorization factor(ConstVectorRef u, double lambda, ConstVectorRef c) override {
@@ -88,7 +86,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
       return Factorization::Refused;
     if (p_ > ChainStructure::kMaxBorder) {  // more borders than the chain structure holds
       usingDense_ = true;
-      const Factorization f = dense_->factor(u, lambda, c);
+      const Factorization f = dense()->factor(u, lambda, c);
       sign_ = dense_->determinantSign();
       logAbs_ = dense_->logAbsDeterminant();
       return f;
@@ -122,7 +120,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
       logAbs_ = ws_.borderedLogAbsDet;
       return Factorization::Regular;
     }
-    if (!dense_) return Factorization::Singular;
+    if (!dense()) return Factorization::Singular;
     usingDense_ = true;
     const Factorization f = dense_->factor(u, lambda, c);
     sign_ = dense_->determinantSign();
@@ -218,10 +216,18 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
       logAbs_ = ws_.borderedLogAbsDet;
       return Factorization::Regular;
     }
-    return dense_ ? denseGeneral(u, lambda, B, C, D, transposed) : Factorization::Singular;
+    return dense() ? denseGeneral(u, lambda, B, C, D, transposed) : Factorization::Singular;
   }
 
  private:
+  // The dense fallback, made where a factorization first needs it: most solvers never do, and
+  // an (n + 1)² LU made up front for each costs more than their solves on a short branch.
+  continuation::DenseBorderedSolver* dense() {
+    if (!dense_ && denseAllowed_)
+      dense_ = std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(problem_, problemWorkspace_));
+    return dense_.get();
+  }
+
   Factorization denseGeneral(ConstVectorRef u, double lambda, continuation::ConstMatrixRef B,
                              continuation::ConstMatrixRef C, continuation::ConstMatrixRef D, bool transposed) {
     if (!dense_) return Factorization::Refused;
@@ -271,6 +277,7 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
   Matrix grad_;  // ∇x_v of the wall vertices at the factored point (n×w)
   Vector c_, f_, g_, x_, y_;
   std::unique_ptr<continuation::DenseBorderedSolver> dense_;
+  bool denseAllowed_ = false;
   // factorGeneral(): the reduced borders, the locked rows of B and C, P_L, and solve scratch
   Matrix Vg_, Wg_, Dg_, BL_, CL_, PL_, xL_, xLocked_;
   Vector fg_, gg_, xg_, yg_;

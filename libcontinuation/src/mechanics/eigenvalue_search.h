@@ -2,10 +2,11 @@
 // vibration pencil (pencil_structure.h): isolation of each eigenvalue by counts, Newton on the
 // determinant from a warm start, Illinois polish. Private to libcontinuation/src/mechanics.
 //
-// `evaluate(σ)` returns a ShiftEvaluation: the number of eigenvalues below σ (exact, from a
-// factorization's inertia) and the determinant of a matrix whose roots in σ are exactly the
-// eigenvalues wanted (log|det|, its sign, and d log|det|/dσ, NaN when not carried: Newton then
-// gives way to the counts).
+// `evaluate(σ, countOnly)` returns a ShiftEvaluation: the number of eigenvalues below σ (exact,
+// from a factorization's inertia) and, unless countOnly, the determinant of a matrix whose roots
+// in σ are exactly the eigenvalues wanted (log|det|, its sign, and d log|det|/dσ, NaN when not
+// carried: Newton then gives way to the counts). A count alone is all the certification of a
+// converged Newton iterate reads, and costs less (no determinant, no derivative).
 #pragma once
 
 #include <algorithm>
@@ -29,6 +30,7 @@ struct ShiftEvaluation {
   double logAbsDet = 0.0;
   int sign = 1;
   double dLog = 0.0;
+  bool determinant = true;  ///< false: `below` only (a count asked for with countOnly)
 };
 
 /// Newton on det K_σ from σ0 towards eigenvalue `index` (ascending, counted by the evaluations),
@@ -50,8 +52,8 @@ template <class Evaluate, class Record>
 bool newtonFrom(Evaluate&& evaluateShift, int index, double sigma0, double tol, int maxSteps, double lo, double hi,
                 Record&& record, double& last, double& lastStepOut) {
   int countLo = -1, countHi = -1;  // counts at lo and hi once evaluated
-  auto evaluate = [&](double s) {
-    const ShiftEvaluation ev = evaluateShift(s);
+  auto evaluate = [&](double s, bool countOnly) {
+    const ShiftEvaluation ev = evaluateShift(s, countOnly);
     record(s, ev);
     if (ev.below > index) {
       if (s < hi) hi = s, countHi = ev.below;
@@ -67,7 +69,7 @@ bool newtonFrom(Evaluate&& evaluateShift, int index, double sigma0, double tol, 
   lastStepOut = std::numeric_limits<double>::infinity();
   for (int step = 0; step < maxSteps; ++step) {
     if (!(c > lo && c < hi)) return false;
-    const ShiftEvaluation ev = evaluate(c);
+    const ShiftEvaluation ev = evaluate(c, false);
     last = c;
     if (!std::isfinite(ev.dLog) || ev.dLog == 0.0) return false;
     double next = c - 1.0 / ev.dLog;  // Newton: the model with R = 0
@@ -109,8 +111,8 @@ bool newtonFrom(Evaluate&& evaluateShift, int index, double sigma0, double tol, 
       // counts at next ∓ 0.45 tol (the bracket then narrower than tol after rounding), or at
       // lo / hi where they already lie that close.
       const double a = next - 0.45 * tol, b = next + 0.45 * tol;
-      if (!(lo >= a && countLo == index) && !(a > lo && evaluate(a).below == index)) return false;
-      return (hi <= b && countHi == index + 1) || (b < hi && evaluate(b).below == index + 1);
+      if (!(lo >= a && countLo == index) && !(a > lo && evaluate(a, true).below == index)) return false;
+      return (hi <= b && countHi == index + 1) || (b < hi && evaluate(b, true).below == index + 1);
     }
     c = next;
   }
@@ -139,15 +141,16 @@ int searchEigenvalues(Evaluate&& evaluateShift, int dim, double scale, double bo
   ChainStructure::SmallVector cntHi = ChainStructure::SmallVector::Constant(k, double(dim));
   std::array<ShiftEvaluation, ChainStructure::kMaxBorder> evLo, evHi;
   std::array<bool, ChainStructure::kMaxBorder> haveLo{}, haveHi{};
+  // (a count alone moves the bracket; Illinois evaluates the determinant at such an end anew)
   auto record = [&](double s, const ShiftEvaluation& e) {
     for (int j = 0; j < k; ++j) {
       if (e.below > first + j) {
-        if (s < hi[j]) { hi[j] = s; cntHi[j] = e.below; evHi[size_t(j)] = e; haveHi[size_t(j)] = true; }
+        if (s < hi[j]) { hi[j] = s; cntHi[j] = e.below; evHi[size_t(j)] = e; haveHi[size_t(j)] = e.determinant; }
       } else if (s > lo[j]) {
         lo[j] = s;
         cntLo[j] = e.below;
         evLo[size_t(j)] = e;
-        haveLo[size_t(j)] = true;
+        haveLo[size_t(j)] = e.determinant;
       }
     }
   };
@@ -157,9 +160,9 @@ int searchEigenvalues(Evaluate&& evaluateShift, int dim, double scale, double bo
     outerConfirmed = true;
     const double lo1 = lo0, hi1 = hi0;
     ShiftEvaluation e;
-    while ((e = evaluateShift(lo0)).below > 0) lo0 = 2.0 * lo0 - scale;
+    while ((e = evaluateShift(lo0, false)).below > 0) lo0 = 2.0 * lo0 - scale;
     const ShiftEvaluation eLo = e;
-    while ((e = evaluateShift(hi0)).below < first + k) hi0 = 2.0 * hi0 + scale;
+    while ((e = evaluateShift(hi0, false)).below < first + k) hi0 = 2.0 * hi0 + scale;
     for (int j = 0; j < k; ++j) {  // ends still at the unconfirmed bounds take the confirmed ones
       if (lo[j] == lo1) { lo[j] = lo0; evLo[size_t(j)] = eLo; haveLo[size_t(j)] = true; }
       if (hi[j] == hi1) { hi[j] = hi0; evHi[size_t(j)] = e; haveHi[size_t(j)] = true; }
@@ -192,8 +195,8 @@ int searchEigenvalues(Evaluate&& evaluateShift, int dim, double scale, double bo
       double delta = std::max(1e-9 * scale, std::min(0.02 * std::abs(centre), 2.0 * width));
       for (int attempt = 0; attempt < 12 && !isolated(j); ++attempt, delta *= 8.0) {
         const double a = centre - delta, b = centre + delta;
-        if (a > lo[j]) record(a, evaluateShift(a));
-        if (b < hi[j]) record(b, evaluateShift(b));
+        if (a > lo[j]) record(a, evaluateShift(a, false));
+        if (b < hi[j]) record(b, evaluateShift(b, false));
       }
     }
     if (!isolated(j)) outer();
@@ -201,7 +204,7 @@ int searchEigenvalues(Evaluate&& evaluateShift, int dim, double scale, double bo
     while (!isolated(j) && hi[j] - lo[j] > tol) {
       const double mid = 0.5 * (lo[j] + hi[j]);
       if (mid <= lo[j] || mid >= hi[j]) break;
-      record(mid, evaluateShift(mid));
+      record(mid, evaluateShift(mid, false));
     }
     // Isolated: the model iteration from the bracket's middle (a failed try has at least halved
     // the bracket by its first count), a few times, before Illinois.
@@ -216,8 +219,8 @@ int searchEigenvalues(Evaluate&& evaluateShift, int dim, double scale, double bo
       // Illinois on det, one simple root in the bracket; the counts keep the bracket honest.
       // (Newton from here, far from the root, fails its halving test almost always: 10 of 345
       // brackets in the n = 300 race.)
-      const ShiftEvaluation ea = haveLo[size_t(j)] ? evLo[size_t(j)] : evaluateShift(lo[j]);
-      const ShiftEvaluation eb = haveHi[size_t(j)] ? evHi[size_t(j)] : evaluateShift(hi[j]);
+      const ShiftEvaluation ea = haveLo[size_t(j)] ? evLo[size_t(j)] : evaluateShift(lo[j], false);
+      const ShiftEvaluation eb = haveHi[size_t(j)] ? evHi[size_t(j)] : evaluateShift(hi[j], false);
       const double ref = 0.5 * (ea.logAbsDet + eb.logAbsDet);
       auto value = [&](const ShiftEvaluation& e) {
         return e.sign * std::exp(std::max(-700.0, std::min(700.0, e.logAbsDet - ref)));
@@ -227,7 +230,7 @@ int searchEigenvalues(Evaluate&& evaluateShift, int dim, double scale, double bo
       for (int it = 0; it < 200 && br.width() > tol; ++it) {
         // keep progress: never closer than tol/4 to an end
         const double c = std::min(std::max(br.next(), br.left + 0.25 * tol), br.right - 0.25 * tol);
-        const ShiftEvaluation ec = evaluateShift(c);
+        const ShiftEvaluation ec = evaluateShift(c, false);
         const double fc = value(ec);
         br.replace(ec.below > first + j ? 1 : -1, c, fc);  // the root is below c: c is the new right end
         if (fc == 0.0) {

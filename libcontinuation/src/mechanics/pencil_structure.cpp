@@ -297,9 +297,13 @@ int pencilCountBelow(PencilStructure& ws, double sigma, bool determinant) {
 
 namespace {
 
-search::ShiftEvaluation evaluatePencil(PencilStructure& ws, double sigma) {
+search::ShiftEvaluation evaluatePencil(PencilStructure& ws, double sigma, bool countOnly) {
   search::ShiftEvaluation ev;
-  ev.below = pencilCountBelow(ws, sigma, true);
+  ev.below = pencilCountBelow(ws, sigma, !countOnly);
+  if (countOnly) {
+    ev.determinant = false;
+    return ev;
+  }
   ev.logAbsDet = ws.logAbsDet;
   ev.sign = ws.detSign;
   ev.dLog = ws.dLogAbsDet;
@@ -344,7 +348,7 @@ int pencilEigenvalues(PencilStructure& ws, int first, int count, VectorRef out, 
       ws.guessChunk = guess->segment(done, ws.guessChunk.size());
       chunkGuess = &ws.guessChunk;
     }
-    done += search::searchEigenvalues([&](double s) { return evaluatePencil(ws, s); }, dim, unit, bound,
+    done += search::searchEigenvalues([&](double s, bool countOnly) { return evaluatePencil(ws, s, countOnly); }, dim, unit, bound,
                                       first + done, m, out.segment(done, m), tolerance, chunkGuess);
   }
   return k;

@@ -51,6 +51,9 @@ class ChainBorderedSolver final : public continuation::BorderedSolver {
   bool usedDenseFallback() const { return dense_ != nullptr && usingDense_; }
 
  private:
+  /// The dense fallback (created on first use; null above kDenseFallback).
+  continuation::DenseBorderedSolver* dense();
+
   const EquilibriumProblem& problem_;
   continuation::ProblemWorkspace& problemWorkspace_;
   int n_, m_, p_;
@@ -62,6 +65,7 @@ class ChainBorderedSolver final : public continuation::BorderedSolver {
   Vector yg_;
   bool general_ = false;  // solve() uses the general borders
   std::unique_ptr<continuation::DenseBorderedSolver> dense_;
+  bool denseAllowed_ = false;
   bool usingDense_ = false;
   int sign_ = 0;
   double logAbs_ = 0.0;
