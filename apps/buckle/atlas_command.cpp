@@ -193,10 +193,10 @@ void runAtlas(const AtlasArgs& args, Outcome& outcome) {
 
 }  // namespace
 
-void addAtlasCommand(CLI::App& app, Outcome& outcome) {
+void addAtlasCommand(CLI::App& app, Outcome& outcome, const char* name) {
   auto args = std::make_shared<AtlasArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "atlas", "Two-parameter map (a/b, L0/b, n) of straight-chain stability, first critical force, post-buckling");
+      name, "Two-parameter map (a/b, L0/b, n) of straight-chain stability, first critical force, post-buckling");
   cmd->footer(
       "Clamped-pinned chain (y held, rotation free) of n identical symmetric segments, b = k = 1, under "
       "compression Fx. For every cell: stability of the straight chain, first critical force (linear "

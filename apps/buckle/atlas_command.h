@@ -8,7 +8,8 @@
 
 namespace buckle::cli {
 
-/// Adds the `atlas` subcommand to `app`; its status is written to `outcome` when it runs.
-void addAtlasCommand(CLI::App& app, Outcome& outcome);
+/// Adds the `atlas` subcommand to `app` under `name` (main.cpp's table of subcommands); its status
+/// is written to `outcome` when it runs.
+void addAtlasCommand(CLI::App& app, Outcome& outcome, const char* name);
 
 }  // namespace buckle::cli

@@ -221,10 +221,10 @@ int run(const CriticalOptions& o) {
 
 }  // namespace
 
-void addCriticalCommand(CLI::App& app, Outcome& outcome) {
+void addCriticalCommand(CLI::App& app, Outcome& outcome, const char* name) {
   auto options = std::make_shared<CriticalOptions>();
   CLI::App* sub = app.add_subcommand(
-      "critical", "Stability of the straight chain and its critical end forces Fx (linear buckling, eq 14-18)");
+      name, "Stability of the straight chain and its critical end forces Fx (linear buckling, eq 14-18)");
   sub->add_option("--segments", options->segments, "number of segments n (1 to 5000)")->capture_default_str();
   sub->add_option("--a", options->a, "triangle half-height a (a length)")->capture_default_str();
   sub->add_option("--b", options->b, "triangle half-length b (a length)")->capture_default_str();

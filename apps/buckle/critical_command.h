@@ -7,7 +7,8 @@
 
 namespace buckle::cli {
 
-/// Adds the `critical` subcommand to `app`; its status is written to `outcome` when it runs.
-void addCriticalCommand(CLI::App& app, Outcome& outcome);
+/// Adds the `critical` subcommand to `app` under `name` (main.cpp's table of subcommands); its status
+/// is written to `outcome` when it runs.
+void addCriticalCommand(CLI::App& app, Outcome& outcome, const char* name);
 
 }  // namespace buckle::cli

@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
   buckle::cli::Outcome outcome;
   struct Subcommand {
     const char* name;
-    void (*add)(CLI::App&, buckle::cli::Outcome&);
+    void (*add)(CLI::App&, buckle::cli::Outcome&, const char*);
   };
   static const Subcommand kSubcommands[] = {
 #if !BUCKLE_MPI_PROGRAM
@@ -96,9 +96,9 @@ int main(int argc, char** argv) {
       std::cerr << "error: unknown subcommand \"" << argv[1] << "\" (one of: " << names << "; see buckle --help)\n";
       return buckle::cli::kBadInput;
     }
-    chosen->add(app, outcome);
+    chosen->add(app, outcome, chosen->name);
   } else {
-    for (const Subcommand& sub : kSubcommands) sub.add(app, outcome);
+    for (const Subcommand& sub : kSubcommands) sub.add(app, outcome, sub.name);
   }
   try {
     app.parse(argc, argv);

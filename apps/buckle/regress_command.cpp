@@ -8,10 +8,10 @@
 
 namespace buckle::cli {
 
-void addRegressCommand(CLI::App& app, Outcome& outcome) {
+void addRegressCommand(CLI::App& app, Outcome& outcome, const char* name) {
   auto options = std::make_shared<regress::RegressOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "regress", "Re-run the regression baselines (docs/regression.md) and report drift in values and time");
+      name, "Re-run the regression baselines (docs/regression.md) and report drift in values and time");
   cmd->footer(
       "Each baseline names a scene or a benchmark problem; it is re-run in memory (nothing is written) and its "
       "special points (type, load, shape), branch samples and median time are compared with the baseline.\n"

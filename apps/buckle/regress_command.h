@@ -7,7 +7,8 @@
 
 namespace buckle::cli {
 
-/// Adds the `regress` subcommand to `app`; its status is written to `outcome` when it runs.
-void addRegressCommand(CLI::App& app, Outcome& outcome);
+/// Adds the `regress` subcommand to `app` under `name` (main.cpp's table of subcommands); its status
+/// is written to `outcome` when it runs.
+void addRegressCommand(CLI::App& app, Outcome& outcome, const char* name);
 
 }  // namespace buckle::cli

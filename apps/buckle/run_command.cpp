@@ -40,10 +40,10 @@ void finishShared(const MpiWorld& world) {
 
 }  // namespace
 
-void addRunCommand(CLI::App& app, Outcome& outcome) {
+void addRunCommand(CLI::App& app, Outcome& outcome, const char* name) {
   auto options = std::make_shared<scene::RunCommandOptions>();
   CLI::App* run = app.add_subcommand(
-      "run", "Run a scene file (docs/scenes.md): branches, special points, stiffness, curves and plots");
+      name, "Run a scene file (docs/scenes.md): branches, special points, stiffness, curves and plots");
   run->footer(
       "Computes only what the scene asks for and writes DIR/branches.csv, DIR/special_points.json, "
       "DIR/summary.json, DIR/plots/*.png|svg (gnuplot) and DIR/report.html (one self-contained page: diagram, "

@@ -7,7 +7,8 @@
 
 namespace buckle::cli {
 
-/// Adds the `run` subcommand to `app`; its status is written to `outcome` when it runs.
-void addRunCommand(CLI::App& app, Outcome& outcome);
+/// Adds the `run` subcommand to `app` under `name` (main.cpp's table of subcommands); its status
+/// is written to `outcome` when it runs.
+void addRunCommand(CLI::App& app, Outcome& outcome, const char* name);
 
 }  // namespace buckle::cli

@@ -271,10 +271,10 @@ void show(const std::string& dirName, std::ostream& os) {
 
 }  // namespace
 
-void addShowCommand(CLI::App& app, Outcome& outcome) {
+void addShowCommand(CLI::App& app, Outcome& outcome, const char* name) {
   auto dir = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand(
-      "show", "Print the results of a `buckle run` (special points, branches, critical loads) as tables");
+      name, "Print the results of a `buckle run` (special points, branches, critical loads) as tables");
   cmd->footer(
       "Reads DIR/summary.json and DIR/special_points.json of a `buckle run` output. Exit status: 0, 2 when DIR is "
       "not the output directory of a `buckle run`.");

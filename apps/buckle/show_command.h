@@ -8,7 +8,8 @@
 
 namespace buckle::cli {
 
-/// Adds the `show` subcommand to `app`; its status is written to `outcome` when it runs.
-void addShowCommand(CLI::App& app, Outcome& outcome);
+/// Adds the `show` subcommand to `app` under `name` (main.cpp's table of subcommands); its status
+/// is written to `outcome` when it runs.
+void addShowCommand(CLI::App& app, Outcome& outcome, const char* name);
 
 }  // namespace buckle::cli

@@ -109,6 +109,26 @@ double distanceAt(const Chain& chain, ConstVectorRef q, bool base) {
   return base ? baseClearance(chain, q).distance : selfClearance(chain, q).distance;
 }
 
+/// distanceAt along a branch: the self clearance measured from the pair nearest at the last call
+/// first, so the search prunes the others from its distance at once. The same exact value (the
+/// smallest over every pair), a fraction of the cost where nearby shapes follow each other.
+class ClearanceProbe {
+ public:
+  ClearanceProbe(const Chain& chain, bool base) : chain_(chain), base_(base) {}
+  double operator()(ConstVectorRef q) {
+    if (base_) return baseClearance(chain_, q).distance;
+    const SelfClearance c = selfClearance(chain_, q, hint_, nullptr);
+    hint_.linkA = c.linkA;
+    hint_.linkB = c.linkB;
+    return c.distance;
+  }
+
+ private:
+  const Chain& chain_;
+  bool base_;
+  SelfClearanceHint hint_;
+};
+
 /// The largest distance a vertex of the bodies has moved between two shapes of the same chain.
 double largestMove(const LinkBodies& now, const LinkBodies& before) {
   double move = 0.0;
@@ -293,12 +313,13 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
   for (bool base : {true, false}) {
     if (base && problem.wallIsBoundary()) continue;  // the wall is a constraint: WC / WR (contact.h)
     std::vector<double> d = scannedDistances(chain, branch, base);
+    ClearanceProbe distance(chain, base);
     // Bodies that rest on each other (a vertex on the wall, triangles meeting where joints lock at
     // their limits) keep their distance within rounding of zero, of either sign: the sign changes
     // that count are between points clear of that band, each in the interval where the sign flips.
     const double band = kTouchingBand * chain.length();
     for (size_t i = 0; i < count; ++i)
-      if (std::abs(d[i]) <= band) d[i] = distanceAt(chain, branch.points[i].u.head(n), base);  // not a bound
+      if (std::abs(d[i]) <= band) d[i] = distance(branch.points[i].u.head(n));  // not a bound
     std::vector<size_t> changes;
     int lastSign = 0;
     size_t lastClear = 0;
@@ -320,8 +341,8 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
     }
     for (const size_t i : changes) {
       // the clearances themselves on both sides (a bound has only their sign)
-      d[i] = distanceAt(chain, branch.points[i].u.head(n), base);
-      d[i + 1] = distanceAt(chain, branch.points[i + 1].u.head(n), base);
+      d[i] = distance(branch.points[i].u.head(n));
+      d[i + 1] = distance(branch.points[i + 1].u.head(n));
       const continuation::ContinuationPoint &p0 = branch.points[i], &p1 = branch.points[i + 1];
       GeometricContact g;
       g.base = base;
@@ -351,7 +372,7 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
             solved = false;
             break;
           }
-          const double f = distanceAt(chain, e.u.head(n), base);
+          const double f = distance(e.u.head(n));
           if (std::abs(f) < bestF) {
             bestF = std::abs(f);
             g.lambda = s;
