@@ -44,8 +44,20 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
   // in rounding too: the same ratio as dividing each), the 2×2 blocks' ratios as they come.
   double minRatio = std::numeric_limits<double>::infinity();
   double minPivot = std::numeric_limits<double>::infinity();
-  auto a = [&](int k) { return ws.diag[k] - sigma * metricDiagonal(k, n); };
-  auto e = [&](int k) { return ws.off[k] + sigma; };  // M off-diagonal is −1
+  // The factor's arrays through local pointers and the counts in locals: the block markers are
+  // bytes, and a byte store may alias anything, so through `ws` every marker written would make
+  // the compiler reload each array's address and the counts from memory.
+  const double* diag = ws.diag.data();
+  const double* off = ws.off.data();
+  double* pivA = ws.pivA.data();
+  double* pivE = ws.pivE.data();
+  double* l1 = ws.l1.data();
+  double* l2 = ws.l2.data();
+  unsigned char* blockStart = ws.blockStart.data();
+  int negative = 0, positive = 0;
+  bool singular = false;
+  auto a = [&](int k) { return diag[k] - sigma * metricDiagonal(k, n); };
+  auto e = [&](int k) { return off[k] + sigma; };  // M off-diagonal is −1
 
   // With the determinant: its logarithmic derivative d log|det(T − σM)|/dσ = Σ p'/p over the
   // pivots p (the 2×2 blocks' determinants), carried through the recurrence (dk' is the σ-derivative
@@ -58,22 +70,21 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
     if (k + 1 == n || std::abs(dk) * scale >= kBunchAlpha * ek * ek) {
       if (dk == 0.0) {
         dk = -pivmin;
-        ws.singular = true;
+        singular = true;
       }
-      ws.blockStart[size_t(k)] = 1;
-      ws.pivA[k] = dk;
-      if (dk < 0.0) {
-        ++ws.factorInertia.negative;
-        sign = -sign;
-      } else {
-        ++ws.factorInertia.positive;
-      }
+      blockStart[k] = 1;
+      pivA[k] = dk;
+      // without a branch: the pivots' signs follow the spectrum about σ, no pattern to predict
+      const bool below = dk < 0.0;
+      negative += below;
+      positive += !below;
+      sign = below ? -sign : sign;
       accumulate(dk);
       minPivot = std::min(minPivot, std::abs(dk));
       if (determinant) dLog += ddk / dk;
       if (k + 1 < n) {
         const double l = ek / dk;
-        ws.l1[k] = l;
+        l1[k] = l;
         dk = a(k + 1) - ek * l;
         if (determinant) ddk = -metricDiagonal(k + 1, n) - 2.0 * l + l * l * ddk;  // (a − e²/d)'
       }
@@ -82,13 +93,13 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
       // 2×2 pivot [[dk, ek], [ek, a_{k+1}]]: det < −(1 − α) ek² < 0, one eigenvalue of each sign.
       const double b = a(k + 1);
       const double det = dk * b - ek * ek;
-      ws.blockStart[size_t(k)] = 2;
-      ws.blockStart[size_t(k) + 1] = 0;
-      ws.pivA[k] = dk;
-      ws.pivA[k + 1] = b;
-      ws.pivE[k] = ek;
-      ++ws.factorInertia.negative;
-      ++ws.factorInertia.positive;
+      blockStart[k] = 2;
+      blockStart[k + 1] = 0;
+      pivA[k] = dk;
+      pivA[k + 1] = b;
+      pivE[k] = ek;
+      ++negative;
+      ++positive;
       sign = -sign;
       accumulate(det);
       // smallest |eigenvalue| of the block ≥ |det| / (largest |eigenvalue|)
@@ -98,8 +109,8 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
       if (determinant) dLog += ddet / det;
       if (k + 2 < n) {
         const double ek1 = e(k + 1);
-        ws.l1[k] = -ek1 * ek / det;
-        ws.l2[k] = ek1 * dk / det;
+        l1[k] = -ek1 * ek / det;
+        l2[k] = ek1 * dk / det;
         if (determinant) {
           const double r = dk / det, dr = (ddk - r * ddet) / det;  // dk/det and its derivative
           ddk = -metricDiagonal(k + 2, n) - 2.0 * ek1 * r - ek1 * ek1 * dr;
@@ -109,6 +120,9 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
       k += 2;
     }
   }
+  ws.factorInertia.negative = negative;
+  ws.factorInertia.positive = positive;
+  ws.singular = singular;
   ws.minPivotRatio = std::min(minRatio, minPivot / scale);
   ws.logAbsDet = determinant ? det.logAbs() : std::numeric_limits<double>::quiet_NaN();
   ws.detSign = sign;
