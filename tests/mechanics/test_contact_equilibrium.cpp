@@ -299,3 +299,46 @@ TEST_CASE("wall: the O(n) solver takes the locator's general borders, F_u and it
       }
   }
 }
+
+TEST_CASE("contact: every boundary at once equals each boundary alone, a compression the free row's torque",
+          "[contact]") {
+  // locked joints on both sides with a torque bound, with and without vertices on the wall, u with
+  // and without the wall forces among its entries (they then come from least squares)
+  const int n = 12;
+  std::vector<SegmentParameters> segs(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const Chain chain(segs);
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(-0.3), Eigen::Vector3d(1, 0, 0));
+  for (int variant = 0; variant < 2; ++variant) {
+    ContactSet set;
+    set.lock(2, LimitSide::Lower);
+    set.lock(7, LimitSide::Upper);
+    if (variant == 1) {
+      set.touch(WallVertex{5, 1});
+      set.touch(WallVertex{9, 4});
+    }
+    ContactProblem cp(problem, set, 40.0);
+    const cont::BoundProblem bound(cp);
+    Eigen::VectorXd u(cp.dimension());
+    for (int i = 0; i < n; ++i) u[i] = 0.3 * std::cos(0.9 * i);
+    for (int j = n; j < cp.dimension(); ++j) u[j] = 0.1 + 0.2 * (j - n);
+    const double lambda = -0.2;
+    for (const Eigen::VectorXd& at : {u, Eigen::VectorXd(u.head(problem.dimension()))}) {
+      INFO("variant " << variant << ", " << at.size() << " unknowns");
+      Eigen::VectorXd all(cp.boundaryCount());
+      bound.boundaries(at, lambda, all);
+      for (int k = 0; k < cp.boundaryCount(); ++k) {
+        INFO("boundary " << k << ": " << cp.boundaryName(k));
+        const double one = bound.boundary(k, at, lambda);
+        CHECK(((all[k] == one) || (std::isnan(all[k]) && std::isnan(one))));
+      }
+      if (variant == 0) {
+        // without the wall: the contact torque is the free equilibrium's row, ∂E/∂q_i − (JᵀF)_i
+        Eigen::VectorXd rows(problem.dimension());
+        REQUIRE(cont::BoundProblem(problem).residual(at, lambda, rows));
+        CHECK(all[2 + n] == Approx(rows[2]).margin(1e-14));  // lower side of joint 3: c = +τ
+        CHECK(all[7] == Approx(-rows[7]).margin(1e-14));     // upper side of joint 8: c = −τ
+        CHECK(all[cp.torqueBoundBegin()] == Approx(40.0 - rows[2]).margin(1e-13));
+      }
+    }
+  }
+}

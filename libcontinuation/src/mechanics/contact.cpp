@@ -404,6 +404,46 @@ double ContactProblem::boundary(ProblemWorkspace& ws, int k, ConstVectorRef u, d
   return base_.boundary(*d.base, k, u.head(N), lambda);
 }
 
+void ContactProblem::boundaries(ProblemWorkspace& ws, ConstVectorRef u, double lambda, VectorRef g) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  const int n = base_.segments(), N = base_.dimension();
+  const bool withForces = u.size() == dimension();
+  // the contact torques (contactTorque's rows) and the wall forces, each formed once when needed
+  bool rowsFormed = false, rowsValid = false, forcesFormed = false;
+  Vector forces;
+  const auto compressionOf = [&](int joint) {
+    if (!rowsFormed) {
+      rowsFormed = true;
+      if (withForces) d.unknowns = u;
+      else d.unknowns = withWallForces(ws, u, lambda);
+      rowsValid = baseRowsWithWall(ws, d.unknowns, lambda, d.residual);
+    }
+    const double torque = rowsValid ? d.residual[joint] : std::numeric_limits<double>::quiet_NaN();
+    return -double(int(locked_.side(joint))) * torque;
+  };
+  for (int k = 0; k < int(g.size()); ++k) {
+    if (k == wallClearanceBoundary()) {
+      g[k] = nearestWallVertex(base_.chain(), u.head(n), locked_.wall()).distance;
+    } else if (k >= wallReleaseBoundary(0)) {
+      const int r = k - wallReleaseBoundary(0);
+      if (withForces) {
+        g[k] = u[N + r];
+      } else {
+        if (!forcesFormed) forces = wallForces(ws, u, lambda), forcesFormed = true;
+        g[k] = forces[r];  // μ_v ≥ 0
+      }
+    } else if (k >= torqueBoundBegin()) {
+      g[k] = maxCompression_ - compressionOf(locked_.joints()[size_t(k - torqueBoundBegin())].joint);
+    } else if (k >= 2 * n) {
+      g[k] = base_.boundary(*d.base, base_.rangeBoundaryBegin() + k - 2 * n, u.head(N), lambda);
+    } else {
+      const LockedJoint b = limitOfBoundary(k, n);
+      g[k] = locked_.locked(b.joint) && locked_.side(b.joint) == b.side ? compressionOf(b.joint)
+                                                                          : base_.boundary(*d.base, k, u.head(N), lambda);
+    }
+  }
+}
+
 std::string ContactProblem::boundaryName(int k) const {
   const int n = base_.segments();
   if (k == wallClearanceBoundary()) return EquilibriumProblem::wallBoundaryName();

@@ -171,6 +171,10 @@ class ContactProblem final : public continuation::Problem {
   int wallReleaseBoundary(int k) const;
   double boundary(continuation::ProblemWorkspace& ws, int k, continuation::ConstVectorRef u,
                   double lambda) const override;
+  /// Every boundary(k) at once: the rows whose locked entries are the contact torques, and the
+  /// wall forces, evaluated once for the point (boundary(k) evaluates them per locked joint).
+  void boundaries(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                  continuation::VectorRef g) const override;
   std::string boundaryName(int k) const override;
 
   /// T of K_q − K_g (with the wall forces' terms) on the free joints into ws (size
@@ -203,6 +207,7 @@ class ContactProblem final : public continuation::Problem {
     Vector lastLowest;
     Matrix wallGrad, wallGen;  // n×w: ∇x_v and the generators of −∂²x_v (wallKinematics)
     Vector wallX;              // x_v of the wall vertices
+    Vector unknowns;           // (q, r, μ) of boundaries()
   };
   std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override;
 
