@@ -51,6 +51,19 @@ const SpecialPointReport* firstOf(const BranchReport& r, EventType t) {
 
 }  // namespace
 
+namespace {
+
+/// n equal segments (a = 0.5, b = 1, k = 1, L0 = 2.25), clamped with y held at −0.3, loaded along x.
+struct PinnedChain {
+  explicit PinnedChain(int n)
+      : chain(std::vector<SegmentParameters>(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25))),
+        problem(chain, EndCondition::clampedPinned(-0.3), Eigen::Vector3d(1, 0, 0)) {}
+  const Chain chain;
+  EquilibriumProblem problem;
+};
+
+}  // namespace
+
 TEST_CASE("wall: a segment pressed against the wall holds its vertex there with the force of a moment balance",
           "[contact][wall]") {
   const Chain chain = curledChain();
@@ -210,9 +223,8 @@ TEST_CASE("wall: the constrained stability equals a dense eigen-solve on the ker
 
 TEST_CASE("wall: the O(n) bordered solver of the wall-constrained chain equals a dense solve", "[contact][wall]") {
   const int n = 30;
-  std::vector<SegmentParameters> segs(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  const Chain chain(segs);
-  EquilibriumProblem problem(chain, EndCondition::clampedPinned(-0.3), Eigen::Vector3d(1, 0, 0));
+  PinnedChain pinned(n);
+  EquilibriumProblem& problem = pinned.problem;
   ContactSet set;
   set.touch(WallVertex{7, 1});
   set.touch(WallVertex{20, 4});
@@ -255,9 +267,8 @@ TEST_CASE("wall: the O(n) solver takes the locator's general borders, F_u and it
   // (nonzero on the locked rows too): locked joints, wall vertices and a held coordinate together,
   // and locked joints alone; the solution and the sign of det G against a dense LU of G.
   const int n = 30;
-  std::vector<SegmentParameters> segs(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  const Chain chain(segs);
-  EquilibriumProblem problem(chain, EndCondition::clampedPinned(-0.3), Eigen::Vector3d(1, 0, 0));
+  PinnedChain pinned(n);
+  EquilibriumProblem& problem = pinned.problem;
   for (int variant = 0; variant < 2; ++variant) {
     ContactSet set;
     if (variant == 0) {
@@ -305,9 +316,8 @@ TEST_CASE("contact: every boundary at once equals each boundary alone, a compres
   // locked joints on both sides with a torque bound, with and without vertices on the wall, u with
   // and without the wall forces among its entries (they then come from least squares)
   const int n = 12;
-  std::vector<SegmentParameters> segs(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  const Chain chain(segs);
-  EquilibriumProblem problem(chain, EndCondition::clampedPinned(-0.3), Eigen::Vector3d(1, 0, 0));
+  PinnedChain pinned(n);
+  EquilibriumProblem& problem = pinned.problem;
   for (int variant = 0; variant < 2; ++variant) {
     ContactSet set;
     set.lock(2, LimitSide::Lower);
