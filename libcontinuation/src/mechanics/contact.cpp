@@ -388,27 +388,41 @@ int ContactProblem::wallReleaseBoundary(int k) const {
 }
 int ContactProblem::boundaryCount() const { return wallReleaseBoundary(locked_.wallCount()); }
 
+namespace {
+
+/// Boundary k of `p` (ContactProblem's class comment) with the compression of a locked joint and
+/// the force of wall vertex r from the caller: boundary() forms each anew, boundaries() once a point.
+template <class Compression, class WallForce>
+double boundaryValue(const ContactProblem& p, ContactProblem::Workspace& d, int k, ConstVectorRef u, double lambda,
+                     double maxCompression, Compression&& compression, WallForce&& wallForce) {
+  const EquilibriumProblem& base = p.base();
+  const int n = base.segments(), N = base.dimension();
+  if (k == p.wallClearanceBoundary()) return nearestWallVertex(base.chain(), u.head(n), p.contacts().wall()).distance;
+  if (k >= p.wallReleaseBoundary(0)) return wallForce(k - p.wallReleaseBoundary(0));  // μ_v ≥ 0
+  if (k >= p.torqueBoundBegin())
+    return maxCompression - compression(p.contacts().joints()[size_t(k - p.torqueBoundBegin())].joint);
+  if (k >= 2 * n) return base.boundary(*d.base, base.rangeBoundaryBegin() + k - 2 * n, u.head(N), lambda);
+  const LockedJoint b = limitOfBoundary(k, n);
+  if (p.contacts().locked(b.joint) && p.contacts().side(b.joint) == b.side) return compression(b.joint);
+  return base.boundary(*d.base, k, u.head(N), lambda);
+}
+
+}  // namespace
+
 double ContactProblem::boundary(ProblemWorkspace& ws, int k, ConstVectorRef u, double lambda) const {
-  Workspace& d = workspaceAs<Workspace>(ws);
-  const int n = base_.segments(), N = base_.dimension();
-  if (k == wallClearanceBoundary()) return nearestWallVertex(base_.chain(), u.head(n), locked_.wall()).distance;
-  if (k >= wallReleaseBoundary(0)) {
-    const int r = k - wallReleaseBoundary(0);
-    return u.size() == dimension() ? u[N + r] : wallForces(ws, u, lambda)[r];  // μ_v ≥ 0
-  }
-  if (k >= torqueBoundBegin())
-    return maxCompression_ - compression(ws, u, lambda, locked_.joints()[size_t(k - torqueBoundBegin())].joint);
-  if (k >= 2 * n) return base_.boundary(*d.base, base_.rangeBoundaryBegin() + k - 2 * n, u.head(N), lambda);
-  const LockedJoint b = limitOfBoundary(k, base_.segments());
-  if (locked_.locked(b.joint) && locked_.side(b.joint) == b.side) return compression(ws, u, lambda, b.joint);
-  return base_.boundary(*d.base, k, u.head(N), lambda);
+  const int N = base_.dimension();
+  return boundaryValue(
+      *this, workspaceAs<Workspace>(ws), k, u, lambda, maxCompression_,
+      [&](int joint) { return compression(ws, u, lambda, joint); },
+      [&](int r) { return u.size() == dimension() ? u[N + r] : wallForces(ws, u, lambda)[r]; });
 }
 
 void ContactProblem::boundaries(ProblemWorkspace& ws, ConstVectorRef u, double lambda, VectorRef g) const {
   Workspace& d = workspaceAs<Workspace>(ws);
-  const int n = base_.segments(), N = base_.dimension();
+  const int N = base_.dimension();
   const bool withForces = u.size() == dimension();
-  // the contact torques (contactTorque's rows) and the wall forces, each formed once when needed
+  // the rows whose locked entries are the contact torques (contactTorque's), and the wall
+  // forces, each formed once for the point when first needed
   bool rowsFormed = false, rowsValid = false, forcesFormed = false;
   Vector forces;
   const auto compressionOf = [&](int joint) {
@@ -421,27 +435,13 @@ void ContactProblem::boundaries(ProblemWorkspace& ws, ConstVectorRef u, double l
     const double torque = rowsValid ? d.residual[joint] : std::numeric_limits<double>::quiet_NaN();
     return -double(int(locked_.side(joint))) * torque;
   };
-  for (int k = 0; k < int(g.size()); ++k) {
-    if (k == wallClearanceBoundary()) {
-      g[k] = nearestWallVertex(base_.chain(), u.head(n), locked_.wall()).distance;
-    } else if (k >= wallReleaseBoundary(0)) {
-      const int r = k - wallReleaseBoundary(0);
-      if (withForces) {
-        g[k] = u[N + r];
-      } else {
-        if (!forcesFormed) forces = wallForces(ws, u, lambda), forcesFormed = true;
-        g[k] = forces[r];  // μ_v ≥ 0
-      }
-    } else if (k >= torqueBoundBegin()) {
-      g[k] = maxCompression_ - compressionOf(locked_.joints()[size_t(k - torqueBoundBegin())].joint);
-    } else if (k >= 2 * n) {
-      g[k] = base_.boundary(*d.base, base_.rangeBoundaryBegin() + k - 2 * n, u.head(N), lambda);
-    } else {
-      const LockedJoint b = limitOfBoundary(k, n);
-      g[k] = locked_.locked(b.joint) && locked_.side(b.joint) == b.side ? compressionOf(b.joint)
-                                                                          : base_.boundary(*d.base, k, u.head(N), lambda);
-    }
-  }
+  const auto wallForceOf = [&](int r) {
+    if (withForces) return u[N + r];
+    if (!forcesFormed) forces = wallForces(ws, u, lambda), forcesFormed = true;
+    return forces[r];
+  };
+  for (int k = 0; k < int(g.size()); ++k)
+    g[k] = boundaryValue(*this, d, k, u, lambda, maxCompression_, compressionOf, wallForceOf);
 }
 
 std::string ContactProblem::boundaryName(int k) const {
