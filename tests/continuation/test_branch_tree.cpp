@@ -104,6 +104,46 @@ TEST_CASE("On threads, an interrupted tree keeps the first branch points' childr
   CHECK(works <= 3 + 2 + 2);  // the scheduled ones not started are dropped: at most threads + 2 scheduled
 }
 
+TEST_CASE("A tree stopped anywhere numbers its branches as the complete tree does", "[branch_tree]") {
+  // A stop that falls between the + and the − side of a switch must not shift the ids of the
+  // children joined after it: a stopped run's branch b is the complete run's branch b.
+  const toys::ManyPitchforks problem(5, 0.1);
+  TreeOptions tree;
+  tree.branchSwitching = 2;
+  auto run = [&](int stopAfter) {
+    TracerOptions options = upTo(0.6);
+    std::atomic<bool> stop{false};
+    options.interrupt.watch(&stop, "test stop");
+    int steps = 0;
+    options.onStep = [&](const StepInfo &) {
+      if (++steps == stopAfter) stop = true;
+      return StepAction::Continue;
+    };
+    return traceTree(problem, Vector::Zero(5), -0.2, {InitialDirection::increasingLambda()}, options, tree);
+  };
+  const BranchTree complete = run(-1);
+  REQUIRE(!complete.interrupted);
+  int stoppedInsideASwitch = 0;
+  for (int stopAfter = 1; stopAfter < 400; stopAfter += 3) {
+    const BranchTree stopped = run(stopAfter);
+    if (!stopped.interrupted) break;
+    INFO("stopped after step " << stopAfter);
+    REQUIRE(stopped.branches.size() <= complete.branches.size());
+    for (std::size_t b = 0; b < stopped.branches.size(); ++b) {
+      const Branch &x = complete.branches[b], &y = stopped.branches[b];
+      INFO("branch " << b);
+      CHECK(y.parentId == x.parentId);
+      CHECK(y.parentSpecialPoint == x.parentSpecialPoint);
+      CHECK(y.direction == x.direction);
+      CHECK(std::abs(y.points.front().lambda - x.points.front().lambda) <= 1e-12);
+    }
+    // the − side of a switch the stop cut: there, ended at its first point
+    for (const Branch &b : stopped.branches)
+      if (b.parentId >= 0 && b.direction < 0 && b.points.size() <= 2) ++stoppedInsideASwitch;
+  }
+  CHECK(stoppedInsideASwitch > 0);
+}
+
 TEST_CASE("On threads, what a worker throws reaches the caller", "[branch_tree]") {
   int works = 0;
   CHECK_THROWS_WITH(manyPitchforksTree(2, works, [](int call) {

@@ -79,15 +79,14 @@ void runSwitch(SwitchJob &job, const BoundProblem &problem, const TracerOptions 
   std::optional<Tracer> fresh;
   if (!job.own) fresh.emplace(BoundProblem(problem.problem()), options);
   Tracer &t = job.own ? *job.own : *fresh;
-  const Interrupt &interrupt = options.interrupt;
   if (job.bp.multiplicity > 1) {
     // every solution direction of the m-dimensional reduced equation, both sides
     job.sides = switchMultiple(t, job.bp, tree.switching, &job.how);
   } else {
-    // after the + side, the − side only if no stop was asked for meanwhile
-    job.sides = switchBothSides(t, job.bp, tree.switching, &job.how,
-                                [&](const Branch &) { return interrupt.requested(); },
-                                job.own ? Reflection() : tree.symmetry);
+    // both sides even after a stop (the − side then ends at its first point): a switch that
+    // lost a side would shift the ids of every child joined after it, and a stopped run's
+    // branch b would not be the complete run's branch b
+    job.sides = switchBothSides(t, job.bp, tree.switching, &job.how, nullptr, job.own ? Reflection() : tree.symmetry);
   }
   for (Branch &child : job.sides) {
     child.parentId = static_cast<int>(job.parent);
