@@ -1,7 +1,7 @@
 // `frequencies` (docs/scenes.md): the natural frequencies of small oscillations about every
 // reported point of the traced branches, from the library's vibration analysis
-// (mechanics/vibration.h) of the constrained chain at that point: its held end coordinates and
-// the joints locked at their limits there.
+// (mechanics/vibration.h) of the constrained chain at that point: its held end coordinates, the
+// joints locked at their limits and the vertices held on the base wall there.
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -14,7 +14,8 @@ namespace buckle::scene {
 namespace mech = buckle::mechanics;
 
 Eigen::VectorXd CaseRunner::naturalFrequencies(const Eigen::VectorXd& q, const mech::Wrench& F,
-                                               const mech::ContactSet& contacts, double parameter) {
+                                               const mech::ContactSet& contacts, const Eigen::VectorXd& wallForces,
+                                               double parameter) {
   const FrequenciesSpec& spec = scene_.analyses.frequencies;
   Eigen::VectorXd omega = Eigen::VectorXd::Constant(spec.count, std::numeric_limits<double>::quiet_NaN());
   try {
@@ -24,15 +25,12 @@ Eigen::VectorXd CaseRunner::naturalFrequencies(const Eigen::VectorXd& q, const m
       vibration_ = std::make_unique<mech::VibrationAnalysis>(
           control.active() ? mech::chainWithControls(out_.chain, control, parameter) : out_.chain,
           caseInertia(spec.massPerLength));
-    // vertices held on the wall: their rows ∇x_v are no joint locks; not computed there (NaN)
-    if (contacts.wallCount() > 0) return omega;
-    std::vector<int> locked;
-    for (const mech::LockedJoint& j : contacts.joints()) locked.push_back(j.joint);
+    if (wallForces.size() != contacts.wallCount()) return omega;
     // with weight or point loads the Hessian's generator h − γ (body_loads.h, eq B3)
     if (!bodyProblem_ && spec_.body.any()) bodyProblem_ = std::make_unique<mech::EquilibriumProblem>(pathProblem());
     const Eigen::VectorXd gamma = bodyProblem_ ? bodyProblem_->bodyLoadGenerator(q, parameter) : Eigen::VectorXd();
     const mech::VibrationModes m =
-        vibration_->modes(q, F, spec_.end.condition.heldIndices(), locked, spec.count, false, gamma);
+        vibration_->modes(q, F, spec_.end.condition.heldIndices(), contacts, wallForces, spec.count, false, gamma);
     for (int i = 0; i < m.omegaSquared.size(); ++i) omega[i] = mech::signedFrequency(m.omegaSquared[i]);
   } catch (const std::exception& e) {
     if (!vibrationFailed_) {

@@ -70,7 +70,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   std::vector<mech::PointReport> points(report.points);
   for (mech::PointReport& p : points) {
     p.branch = b.id;
-    if (frequencies) p.omega = naturalFrequencies(p.q, p.F, p.locked, p.parameter);
+    if (frequencies) p.omega = naturalFrequencies(p.q, p.F, p.locked, p.wallForces, p.parameter);
   }
   keepPoints(std::move(points));
   run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
@@ -78,12 +78,13 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   for (const mech::SpecialPointReport& sp : report.specialPoints) {
     SpecialPointResult s{sp, {}};
     s.branch = b.id;
-    // at the located point itself (plots mark it there), the joints locked as at the traced point before it
+    // at the located point itself (plots mark it there), the joints locked as at the traced point
+    // before it (its wall forces are not reported: NaN on a stretch with vertices on the wall)
     if (frequencies && sp.q.size() == out_.chain.size() && !report.points.empty()) {
       const mech::PointReport* before = &report.points.front();
       for (const mech::PointReport& p : report.points)
         if (p.index <= sp.index) before = &p;
-      s.omega = naturalFrequencies(sp.q, sp.F, before->locked, sp.parameter);
+      s.omega = naturalFrequencies(sp.q, sp.F, before->locked, Eigen::VectorXd(), sp.parameter);
     }
     if (sp.source >= 0) run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
     out_.specials.push_back(std::move(s));

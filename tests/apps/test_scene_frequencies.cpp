@@ -1,7 +1,8 @@
 // `frequencies` (docs/scenes.md): the omega columns of branches.csv against the closed form of one
 // segment, the mass scaling law, the same chain in m and in mm, their sign against the stability
-// column, the shipped scene data/scenes/vibration.json at its branch point, the labels' units and
-// the refusals (a named-unit scene without a mass unit, no traced branches, bad keys).
+// column, the shipped scene data/scenes/vibration.json at its branch point, a vertex held on the
+// base wall, the labels' units and the refusals (a named-unit scene without a mass unit, no traced
+// branches, bad keys).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -12,12 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "buckle/mechanics/branch_report.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/control_path.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/vibration.h"
 #include "branches_table.h"
 #include "scene/columns.h"
+#include "scene/runner.h"
 #include "scene/scene.h"
 #include "scene_run.h"
 #include "build_paths.h"
@@ -215,4 +218,42 @@ TEST_CASE("frequencies along a control path are those of the chain at the point'
   }
   CHECK(checked >= 10);
   CHECK(spread > 1e-2 * std::abs(t.front().at("omega1")));  // the free lengths matter here
+}
+
+TEST_CASE("frequencies on a wall stretch are those of the chain held there, their sign the stability's", "[scene]") {
+  // contact_release's chain (data/scenes/contact_release.json): segment 5's corner is held on the
+  // base wall between WC (Fy = 0.110) and WR (0.150); every point there against the library's
+  // vibration analysis with that vertex held by its wall force, and against the chain without it.
+  const std::string text = R"({
+    "chain": {"segments": [{"q0": 0.2, "q_min": 0.1}, {"q0": 1.3}, {"q0": 1.3}, {"q0": 1.3}, {"q0": 1.3}],
+              "a": 0.5, "b": 1.0, "k": 1.0, "L0": 2.25},
+    "end": {"x": "free", "y": {"load": 0.0}, "phi": "free"},
+    "path": {"parameter": "Fy", "from": 0.0, "to": 0.3},
+    "analyses": {"continuation": {"wall": true}, "frequencies": {"count": 3, "mass_per_length": 0.5}},
+    "solver": {"step": {"initial_step": 0.005, "max_step": 0.005}}, "plots": []
+  })";
+  const buckle::test::SceneOutcome r = buckle::test::runSceneText("scene_frequencies", "wall", text);
+  INFO(r.err);
+  REQUIRE(r.rc == 0);
+  const buckle::scene::RunResult run = buckle::scene::runScene(buckle::scene::loadScene(r.file.string()));
+  REQUIRE(run.cases.size() == 1);
+  const buckle::scene::CaseResult& c = run.cases.front();
+  VibrationAnalysis vib(c.chain, InertiaData::uniformRods(c.chain, 0.5));
+  int onWall = 0;
+  for (const PointReport& p : c.points) {
+    if (p.locked.wallCount() == 0) continue;
+    ++onWall;
+    INFO("Fy = " << p.parameter);
+    REQUIRE(p.omega.size() == 3);
+    REQUIRE(p.omega.allFinite());
+    const VibrationModes held = vib.modes(p.q, p.F, {}, p.locked, p.wallForces, 3, false);
+    std::vector<int> locked;
+    for (const LockedJoint& j : p.locked.joints()) locked.push_back(j.joint);
+    const VibrationModes unheld = vib.modes(p.q, p.F, {}, locked, 3, false);
+    for (int i = 0; i < 3; ++i) CHECK(p.omega[i] == Approx(signedFrequency(held.omegaSquared[i])).epsilon(1e-9));
+    CHECK(std::abs(held.omegaSquared[0] - unheld.omegaSquared[0]) > 1e-3 * std::abs(unheld.omegaSquared[0]));
+    // Sylvester: the pencil's inertia is the constrained stability operator's
+    CHECK((p.omega[0] > 0.0) == (p.negative == 0));
+  }
+  CHECK(onWall >= 5);
 }

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/gravity.h"
 #include "buckle/mechanics/vibration.h"
+#include "buckle/mechanics/wall_contact.h"
 
 #include "test_chains.h"
 
@@ -51,13 +53,18 @@ struct DenseReference {
   Matrix shapes;  // n × dimension, M-orthonormal
 };
 DenseReference denseReference(VibrationAnalysis& va, const Vector& q, const Wrench& F, const std::vector<int>& held,
-                              const std::vector<int>& locked, const Matrix* extraHessian = nullptr) {
+                              const std::vector<int>& locked, const Matrix* extraHessian = nullptr,
+                              const Matrix* extraRows = nullptr) {
   const int n = va.chain().size();
   Matrix H(n, n), M(n, n);
   totalPotentialHessian(va.chain(), q, F, H);
   if (extraHessian) H += *extraHessian;
   va.massMatrix(q, M);
-  const Matrix C = va.constraintRows(q, held, locked);
+  Matrix C = va.constraintRows(q, held, locked);
+  if (extraRows) {
+    C.conservativeResize(C.rows() + extraRows->rows(), n);
+    C.bottomRows(extraRows->rows()) = *extraRows;
+  }
   Matrix Z = Matrix::Identity(n, n);
   if (C.rows() > 0) {
     Eigen::FullPivLU<Matrix> lu(C);
@@ -69,6 +76,22 @@ DenseReference denseReference(VibrationAnalysis& va, const Vector& q, const Wren
   Eigen::GeneralizedSelfAdjointEigenSolver<Matrix> es(Z.transpose() * H * Z, Z.transpose() * M * Z);
   REQUIRE(es.info() == Eigen::Success);
   return {es.eigenvalues(), Z * es.eigenvectors()};
+}
+
+// Links of masses 0.5 … 0.9 (period 5), small rotary inertia, centres at 0.3 of each link.
+InertiaData variedLinks(const Chain& chain) {
+  InertiaData inertia;
+  for (int i = 0; i < chain.size(); ++i)
+    inertia.links.push_back({0.5 + 0.1 * (i % 5), 0.01, 0.3 * chain.linkLengths()[i + 1]});
+  return inertia;
+}
+
+// Joint angles uniform in ±1.8/n: a chain bent by a total of up to ±1.8 rad.
+Vector bentAngles(std::mt19937& rng, int n) {
+  std::uniform_real_distribution<double> U(-0.6, 0.6);
+  Vector q(n);
+  for (int i = 0; i < n; ++i) q[i] = U(rng) * 3.0 / n;
+  return q;
 }
 
 // Times where s(t) = v₁ᵀ M (q − q*) changes sign, by a cubic Hermite interpolant on (s, ṡ) between
@@ -341,14 +364,11 @@ TEST_CASE("vibration: the crossing omega^2 is zero at the located branch points 
 TEST_CASE("vibration: with the links' weight the modes are those of K_q - K_g + the weight's Hessian (GravityPotential)",
           "[vibration][body_loads]") {
   std::mt19937 rng(17);
-  std::uniform_real_distribution<double> U(-0.6, 0.6);
   for (int n : {3, 25}) {
     const Chain chain = stiffChain(n);
-    InertiaData inertia;
-    for (int i = 0; i < n; ++i) inertia.links.push_back({0.5 + 0.1 * (i % 5), 0.01, 0.3 * chain.linkLengths()[i + 1]});
+    const InertiaData inertia = variedLinks(chain);
     VibrationAnalysis va(chain, inertia);
-    Vector q(n);
-    for (int i = 0; i < n; ++i) q[i] = U(rng) * 3.0 / n;
+    const Vector q = bentAngles(rng, n);
     const Wrench F(-0.1, 0.05, 0.0);
     const Eigen::Vector2d g(0.3, -2.0);
     EquilibriumProblem problem(chain, EndCondition::freeEnd(F), Eigen::Vector3d::Zero(), {}, {},
@@ -365,5 +385,66 @@ TEST_CASE("vibration: with the links' weight the modes are those of K_q - K_g + 
       for (int j = 0; j < m.omegaSquared.size(); ++j) CHECK(std::abs(m.omegaSquared[j] - ref.values[j]) <= 1e-11 * scale);
       CHECK(std::abs(without.values[0] - ref.values[0]) > 1e-3 * std::abs(ref.values[0]));  // the weight matters
     }
+  }
+}
+
+TEST_CASE("vibration: vertices held on the base wall add their rows grad x_v to C_h and -mu d2x_v to H "
+          "(central differences of the vertex's x), on both routes",
+          "[vibration][wall]") {
+  std::mt19937 rng(29);
+  for (int n : {6, 40}) {
+    const Chain chain = stiffChain(n);
+    VibrationAnalysis va(chain, variedLinks(chain));
+    const Vector q = bentAngles(rng, n);
+    const Wrench F(-0.1, 0.05, 0.0);
+    ContactSet contacts;
+    contacts.touch(WallVertex{2, 3});
+    contacts.touch(WallVertex{n - 2, 0});
+    contacts.lock(1, LimitSide::Upper);
+    const Vector mu = (Vector(2) << 0.4, 0.7).finished();
+    // the reference's rows and Hessian term from x_v(q) alone, by central differences
+    auto x = [&](const Vector& angles, const WallVertex& v) {
+      return wallVertexPoint(chain, angles, jointPositions(chain, angles), v).x();
+    };
+    Matrix rows(2, n), wallHessian = Matrix::Zero(n, n);
+    const double h1 = 1e-6, h2 = 1e-4;
+    for (int k = 0; k < 2; ++k) {
+      const WallVertex& v = contacts.wall()[size_t(k)];
+      for (int i = 0; i < n; ++i) {
+        Vector p = q, m = q;
+        p[i] += h1;
+        m[i] -= h1;
+        rows(k, i) = (x(p, v) - x(m, v)) / (2 * h1);
+        for (int j = 0; j < n; ++j) {
+          Vector pp = q, pm = q, mp = q, mm = q;
+          pp[i] += h2, pp[j] += h2, pm[i] += h2, pm[j] -= h2, mp[i] -= h2, mp[j] += h2, mm[i] -= h2, mm[j] -= h2;
+          wallHessian(i, j) -= mu[k] * (x(pp, v) - x(pm, v) - x(mp, v) + x(mm, v)) / (4 * h2 * h2);
+        }
+      }
+    }
+    for (const std::vector<int>& held : {std::vector<int>{}, {1}, {0, 1}}) {
+      INFO("n = " << n << ", held " << held.size());
+      const DenseReference ref = denseReference(va, q, F, held, {1}, &wallHessian, &rows);
+      const DenseReference unheld = denseReference(va, q, F, held, {1});
+      const DenseReference forceless = denseReference(va, q, F, held, {1}, nullptr, &rows);
+      const double scale = ref.values.cwiseAbs().maxCoeff();
+      for (VibrationRoute route : {VibrationRoute::Dense, VibrationRoute::Structured}) {
+        va.setRoute(route);
+        const int dimension = n - 1 - 2 - int(held.size()), count = std::min(4, dimension);
+        const VibrationModes m = va.modes(q, F, held, contacts, mu, count, false);
+        // the structured route borders at most three rows: two held and two wall rows go dense
+        CHECK(m.route == (route == VibrationRoute::Structured && held.size() < 2 ? VibrationRoute::Structured
+                                                                                 : VibrationRoute::Dense));
+        CHECK(m.fallback.empty() == (route == VibrationRoute::Dense || held.size() < 2));
+        REQUIRE(m.dimension == dimension);
+        REQUIRE(m.omegaSquared.size() == count);
+        for (int j = 0; j < count; ++j) CHECK(std::abs(m.omegaSquared[j] - ref.values[j]) <= 1e-6 * scale);
+      }
+      va.setRoute(VibrationRoute::Automatic);
+      // the wall matters, its rows and its forces' Hessian both
+      CHECK(std::abs(unheld.values[0] - ref.values[0]) > 1e-3 * std::abs(ref.values[0]));
+      CHECK(std::abs(forceless.values[0] - ref.values[0]) > 1e-4 * scale);
+    }
+    CHECK_THROWS_AS(va.modes(q, F, {}, contacts, Vector(1), 2, false), std::invalid_argument);
   }
 }

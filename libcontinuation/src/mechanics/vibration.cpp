@@ -11,6 +11,7 @@
 
 #include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain_structure.h"
+#include "buckle/mechanics/wall_contact.h"
 
 namespace buckle::mechanics {
 
@@ -110,18 +111,54 @@ VibrationAnalysis::VibrationAnalysis(const Chain& chain, const InertiaData& iner
       inertia_(inertia),
       model_(chain, EndCondition::freeEnd(), inertia, {}, 1.0, Vector::Zero(chain.size())) {}
 
-VibrationModes VibrationAnalysis::modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
-                                        const std::vector<int>& lockedJoints, int count, bool shapes,
-                                        const Vector& bodyGenerator) {
+void VibrationAnalysis::checkArguments(ConstVectorRef q, int count, const Vector& bodyGenerator) const {
   const int n = chain_.size();
   if (q.size() != n) throw std::invalid_argument("VibrationAnalysis::modes: q must have one angle per joint");
   if (count < 0) throw std::invalid_argument("VibrationAnalysis::modes: count must be >= 0");
   if (bodyGenerator.size() != 0 && bodyGenerator.size() != n)
     throw std::invalid_argument("body loads: the generator must have one entry per joint");
-  const bool structured =
-      route_ == VibrationRoute::Structured || (route_ == VibrationRoute::Automatic && n >= kStructuredFrom);
-  if (structured) return structuredModes(q, F, held, lockedJoints, count, shapes, bodyGenerator);
-  return denseModes(q, F, held, lockedJoints, count, shapes, bodyGenerator);
+}
+
+VibrationModes VibrationAnalysis::modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
+                                        const std::vector<int>& lockedJoints, int count, bool shapes,
+                                        const Vector& bodyGenerator) {
+  checkArguments(q, count, bodyGenerator);
+  return route(q, F, held, lockedJoints, Matrix(), count, shapes, bodyGenerator);
+}
+
+VibrationModes VibrationAnalysis::modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
+                                        const ContactSet& contacts, ConstVectorRef wallForces, int count, bool shapes,
+                                        const Vector& bodyGenerator) {
+  const int n = chain_.size(), w = contacts.wallCount();
+  contacts.check(n);
+  if (wallForces.size() != w)
+    throw std::invalid_argument("VibrationAnalysis::modes: one wall force per vertex on the wall (" + std::to_string(w) +
+                                "), got " + std::to_string(wallForces.size()));
+  std::vector<int> locked;
+  for (const LockedJoint& j : contacts.joints()) locked.push_back(j.joint);
+  checkArguments(q, count, bodyGenerator);
+  if (w == 0) return route(q, F, held, locked, Matrix(), count, shapes, bodyGenerator);
+  // As lockedLoadedStiffness: the rows ∇x_v, and −Σ μ_v ∂²x_v as the generator γ += μ_v g_v.
+  Vector gamma = bodyGenerator.size() == n ? bodyGenerator : Vector::Zero(n);
+  Matrix wallRows(w, n);
+  const Eigen::Matrix2Xd P = jointPositions(chain_, q);
+  Vector gradient(n), generator(n);
+  for (int k = 0; k < w; ++k) {
+    const WallVertex& v = contacts.wall()[size_t(k)];
+    wallVertexDerivatives(P, wallVertexPoint(chain_, q, P, v), v, gradient, generator);
+    wallRows.row(k) = gradient.transpose();
+    gamma += wallForces[k] * generator;
+  }
+  return route(q, F, held, locked, wallRows, count, shapes, gamma);
+}
+
+VibrationModes VibrationAnalysis::route(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
+                                        const std::vector<int>& lockedJoints, const Matrix& wallRows, int count,
+                                        bool shapes, const Vector& bodyGenerator) {
+  const bool structured = route_ == VibrationRoute::Structured ||
+                          (route_ == VibrationRoute::Automatic && chain_.size() >= kStructuredFrom);
+  if (structured) return structuredModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator);
+  return denseModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator);
 }
 
 void VibrationAnalysis::massMatrix(ConstVectorRef q, MatrixRef M) {
@@ -152,14 +189,18 @@ Matrix VibrationAnalysis::constraintRows(ConstVectorRef q, const std::vector<int
 }
 
 VibrationModes VibrationAnalysis::denseModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
-                                             const std::vector<int>& lockedJoints, int count, bool shapes,
-                                             const Vector& bodyGenerator) {
+                                             const std::vector<int>& lockedJoints, const Matrix& wallRows, int count,
+                                             bool shapes, const Vector& bodyGenerator) {
   const int n = chain_.size();
   Matrix H(n, n), M(n, n);
   totalPotentialHessian(chain_, q, F, H);  // K_q − K_g(F), eq 27
   addBodyLoadHessian(bodyGenerator, H);     // the body loads' Γ (eq B3)
   model_.massMatrix(q, M);
-  const Matrix C = constraintRows(q, held, lockedJoints);
+  Matrix C = constraintRows(q, held, lockedJoints);
+  if (wallRows.rows() > 0) {
+    C.conservativeResize(C.rows() + wallRows.rows(), n);
+    C.bottomRows(wallRows.rows()) = wallRows;
+  }
 
   // Z: the trailing columns of the reflectors of a rank-revealing QR of Cᵀ (ker C_h).
   Eigen::ColPivHouseholderQR<Matrix> qr(n, std::max(int(C.rows()), 1));

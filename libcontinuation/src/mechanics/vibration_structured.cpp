@@ -55,6 +55,7 @@ struct VibrationAnalysis::Structured {
   std::vector<int> freeJoints;
   // the previous call's constraints and values: the warm start of the eigenvalue search
   std::vector<int> lastHeld, lastLocked;
+  Eigen::Index lastWallRows = 0;
   Vector lastValues, values;
   // inverse iteration: the current iterate, the next and its mass product; the modes' M ξ
   Vector xi, z, Mz;
@@ -183,13 +184,20 @@ bool inverseIteration(PencilStructure& ws, const Vector& values, int j, double f
 }  // namespace
 
 VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
-                                                  const std::vector<int>& lockedJoints, int count, bool shapes,
-                                                  const Vector& bodyGenerator) {
+                                                  const std::vector<int>& lockedJoints, const Matrix& wallRows,
+                                                  int count, bool shapes, const Vector& bodyGenerator) {
   const int n = chain_.size();
-  if (!structured_) structured_.reset(new Structured(chain_, inertia_));
-  Structured& s = *structured_;
   for (int c : held)
     if (c < 0 || c > 2) throw std::invalid_argument("held end coordinate " + std::to_string(c) + " outside 0…2");
+  const Eigen::Index rows = Eigen::Index(held.size()) + wallRows.rows();
+  if (rows > 3) {
+    // the pencil is bordered by at most three rows (pencil_structure.h)
+    VibrationModes dense = denseModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator);
+    dense.fallback = std::to_string(rows) + " held and wall rows (the structured route borders at most 3): the dense route";
+    return dense;
+  }
+  if (!structured_) structured_.reset(new Structured(chain_, inertia_));
+  Structured& s = *structured_;
   std::fill(s.locked.begin(), s.locked.end(), 0);
   for (int j : lockedJoints) {
     if (j < 0 || j >= n)
@@ -214,9 +222,11 @@ VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench
     if (!pencilMassPositive(ws))
       throw std::runtime_error("the mass matrix is not positive definite on the constraints at this point");
     endJacobian(s.data, s.J);
-    auto C = s.C.topLeftCorner(Eigen::Index(held.size()), m);
+    auto C = s.C.topLeftCorner(rows, m);
     for (size_t row = 0; row < held.size(); ++row)
       for (int c = 0; c < m; ++c) C(Eigen::Index(row), c) = s.J(held[row], s.freeJoints[size_t(c)]);
+    for (Eigen::Index k = 0; k < wallRows.rows(); ++k)
+      for (int c = 0; c < m; ++c) C(Eigen::Index(held.size()) + k, c) = wallRows(k, s.freeJoints[size_t(c)]);
     setPencilConstraints(ws, C, kConstraintRankTolerance);
   }
   const int p = m - ws.rank;
@@ -227,12 +237,14 @@ VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench
 
   // the next ω² too when shapes are wanted: the last shape's shift is placed by its gap
   const int want = shapes ? std::min(k + 1, p) : k;
-  const bool warm = held == s.lastHeld && lockedJoints == s.lastLocked && s.lastValues.size() > 0;
+  const bool warm = held == s.lastHeld && lockedJoints == s.lastLocked && wallRows.rows() == s.lastWallRows &&
+                    s.lastValues.size() > 0;
   Vector& values = s.values;  // (workspace: sized once, resized only when `want` changes)
   values.resize(want);
   pencilEigenvalues(ws, 0, want, values, kSearchTolerance * kSearchUnit, warm ? &s.lastValues : nullptr);
   s.lastHeld = held;
   s.lastLocked = lockedJoints;
+  s.lastWallRows = wallRows.rows();
   s.lastValues = values;
   out.omegaSquared = values.head(k);
   if (!shapes) return out;
@@ -242,7 +254,7 @@ VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench
   const double floor = 100.0 * kSearchTolerance * kSearchUnit * ws.scale;
   for (int j = 0; j < k; ++j) {
     if (!inverseIteration(ws, values, j, floor, s.modesTheta, s.massModes, s.BtB, s.xi, s.z, s.Mz)) {
-      VibrationModes dense = denseModes(q, F, held, lockedJoints, count, true, bodyGenerator);
+      VibrationModes dense = denseModes(q, F, held, lockedJoints, wallRows, count, true, bodyGenerator);
       dense.fallback = "the structured inverse iteration did not converge for mode " + std::to_string(j + 1) +
                        ": shapes (and values) from the dense route";
       return dense;

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/dynamics.h"
 
 namespace buckle::mechanics {
@@ -84,6 +85,14 @@ class VibrationAnalysis {
   VibrationModes modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                        const std::vector<int>& lockedJoints, int count, bool shapes = true,
                        const Vector& bodyGenerator = Vector());
+  /// The same on a contact stretch: the joints of `contacts` locked, and each of its vertices on
+  /// the base wall held there (x_v = 0, friction-free) by its force wallForces[k] (order of
+  /// contacts.wall()). The wall rows ∇x_v join C_h and the forces' −Σ μ_v ∂²x_v join H
+  /// (wall_contact.h), so (V1) is the linearisation about the constrained equilibrium while
+  /// every contact stays closed. Throws std::invalid_argument when wallForces has not one force
+  /// per wall vertex or a contact is not one of the chain's.
+  VibrationModes modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held, const ContactSet& contacts,
+                       ConstVectorRef wallForces, int count, bool shapes = true, const Vector& bodyGenerator = Vector());
 
   /// Joint-space mass matrix M(q) (dense, n×n).
   void massMatrix(ConstVectorRef q, MatrixRef M);
@@ -95,10 +104,18 @@ class VibrationAnalysis {
   struct StructuredDeleter {  // (defined where Structured is complete)
     void operator()(Structured* p) const;
   };
+  // Throws std::invalid_argument for a q, count or generator that does not fit the chain.
+  void checkArguments(ConstVectorRef q, int count, const Vector& bodyGenerator) const;
+  // Both routes take the wall rows (w×n, below C_h's rows; empty: none) beside the held and
+  // locked ones; the wall forces' term is already in bodyGenerator.
+  VibrationModes route(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
+                       const std::vector<int>& lockedJoints, const Matrix& wallRows, int count, bool shapes,
+                       const Vector& bodyGenerator);
   VibrationModes denseModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
-                            const std::vector<int>& lockedJoints, int count, bool shapes, const Vector& bodyGenerator);
+                            const std::vector<int>& lockedJoints, const Matrix& wallRows, int count, bool shapes,
+                            const Vector& bodyGenerator);
   VibrationModes structuredModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
-                                 const std::vector<int>& lockedJoints, int count, bool shapes,
+                                 const std::vector<int>& lockedJoints, const Matrix& wallRows, int count, bool shapes,
                                  const Vector& bodyGenerator);
 
   Chain chain_;
