@@ -78,13 +78,12 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   for (const mech::SpecialPointReport& sp : report.specialPoints) {
     SpecialPointResult s{sp, {}};
     s.branch = b.id;
-    // at the located point itself (plots mark it there), the joints locked as at the traced point
-    // before it (its wall forces are not reported: NaN on a stretch with vertices on the wall)
+    // at the located point itself (plots mark it there), the contacts as at the traced point before it
     if (frequencies && sp.q.size() == out_.chain.size() && !report.points.empty()) {
       const mech::PointReport* before = &report.points.front();
       for (const mech::PointReport& p : report.points)
         if (p.index <= sp.index) before = &p;
-      s.omega = naturalFrequencies(sp.q, sp.F, before->locked, Eigen::VectorXd(), sp.parameter);
+      s.omega = naturalFrequencies(sp.q, sp.F, before->locked, sp.wallForces, sp.parameter);
     }
     if (sp.source >= 0) run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
     out_.specials.push_back(std::move(s));

@@ -256,4 +256,14 @@ TEST_CASE("frequencies on a wall stretch are those of the chain held there, thei
     CHECK((p.omega[0] > 0.0) == (p.negative == 0));
   }
   CHECK(onWall >= 5);
+  // the located points of the stretch (WR at Fy = 0.150) with the wall forces they report
+  int located = 0;
+  for (const buckle::scene::SpecialPointResult& s : c.specials) {
+    if (s.wallForces.size() == 0) continue;
+    ++located;
+    INFO("special point at Fy = " << s.parameter);
+    REQUIRE(s.omega.size() == 3);
+    CHECK(s.omega.allFinite());
+  }
+  CHECK(located >= 1);
 }

@@ -446,5 +446,14 @@ TEST_CASE("vibration: vertices held on the base wall add their rows grad x_v to 
       CHECK(std::abs(forceless.values[0] - ref.values[0]) > 1e-4 * scale);
     }
     CHECK_THROWS_AS(va.modes(q, F, {}, contacts, Vector(1), 2, false), std::invalid_argument);
+    // in other units, lengths x1e4 and stiffness x1e-8: the same angles under the end load and
+    // the wall forces x k L, omega^2 x k / L (rods of the same mass per length, as above)
+    const double L = 1e4, k = 1e-8;
+    const Chain scaled = stiffChain(n, L, k);
+    VibrationAnalysis rods(chain, InertiaData::uniformRods(chain, 1.0));
+    VibrationAnalysis scaledRods(scaled, InertiaData::uniformRods(scaled, 1.0));
+    const VibrationModes a = rods.modes(q, F, {1}, contacts, mu, 2, false);
+    const VibrationModes b = scaledRods.modes(q, Wrench(F.x() * k * L, F.y() * k * L, 0.0), {1}, contacts, mu * k * L, 2, false);
+    for (int j = 0; j < 2; ++j) CHECK(relativeError(b.omegaSquared[j], a.omegaSquared[j] * k / L) <= 1e-9);
   }
 }

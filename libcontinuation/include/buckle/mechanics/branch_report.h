@@ -156,6 +156,9 @@ struct SpecialPointReport {
   /// at the point (≈ 0 there; NaN otherwise).
   WallVertex vertex{-1, 0};
   double contactForce = std::numeric_limits<double>::quiet_NaN();
+  /// Located on a stretch with vertices on the wall: their forces μ_v at the point, one per vertex
+  /// of the stretch's contacts (those of the traced point before it); empty otherwise.
+  Eigen::VectorXd wallForces;
   /// BC / SC / WC / WR: where the chain touches the wall or itself (NaN otherwise).
   Eigen::Vector2d contactPoint = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
   /// BP of free joints: Koiter's coefficients of the bifurcated branch, λ(ξ) = λ + aξ + bξ² in the
