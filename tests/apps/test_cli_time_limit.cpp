@@ -96,7 +96,10 @@ TEST_CASE("a 100-segment default scene with time_limit 5 returns within 6 s with
   const LongRun run = runLong("limit", 5.0);
   INFO(run.log);
   CHECK(run.rc == 1);
-  CHECK(run.wall > 3.9);   // it used its time (the computation stops 1 s before the limit)
+  // it used its time: the computation stops before the limit by the time it expects writing to
+  // take, at least 1 s and at most half the limit (CaseRunner::keepTimeForWriting), which grows
+  // with the points computed, so a fast machine stops earlier
+  CHECK(run.wall > 2.5);
 #if defined(__SANITIZE_ADDRESS__)
   CHECK(run.wall < 15.0);  // the writers and plots are slower under the sanitizers
 #else
