@@ -422,6 +422,10 @@ TEST_CASE("vibration: vertices held on the base wall add their rows grad x_v to 
         }
       }
     }
+    Matrix H(n, n), M(n, n);
+    totalPotentialHessian(chain, q, F, H);
+    H += wallHessian;
+    va.massMatrix(q, M);
     for (const std::vector<int>& held : {std::vector<int>{}, {1}, {0, 1}}) {
       INFO("n = " << n << ", held " << held.size());
       const DenseReference ref = denseReference(va, q, F, held, {1}, &wallHessian, &rows);
@@ -431,7 +435,7 @@ TEST_CASE("vibration: vertices held on the base wall add their rows grad x_v to 
       for (VibrationRoute route : {VibrationRoute::Dense, VibrationRoute::Structured}) {
         va.setRoute(route);
         const int dimension = n - 1 - 2 - int(held.size()), count = std::min(4, dimension);
-        const VibrationModes m = va.modes(q, F, held, contacts, mu, count, false);
+        const VibrationModes m = va.modes(q, F, held, contacts, mu, count, true);
         // the structured route borders at most three rows: two held and two wall rows go dense
         CHECK(m.route == (route == VibrationRoute::Structured && held.size() < 2 ? VibrationRoute::Structured
                                                                                  : VibrationRoute::Dense));
@@ -439,6 +443,14 @@ TEST_CASE("vibration: vertices held on the base wall add their rows grad x_v to 
         REQUIRE(m.dimension == dimension);
         REQUIRE(m.omegaSquared.size() == count);
         for (int j = 0; j < count; ++j) CHECK(std::abs(m.omegaSquared[j] - ref.values[j]) <= 1e-6 * scale);
+        // each shape keeps the vertices on the wall and the locked joint still, M-orthonormal, and
+        // its Rayleigh quotient on the reference's H is its ω²
+        REQUIRE(m.shapes.cols() == count);
+        CHECK((rows * m.shapes).norm() <= 1e-6 * rows.norm() * m.shapes.norm());
+        CHECK(m.shapes.row(1).norm() <= 1e-12 * m.shapes.norm());
+        CHECK((m.shapes.transpose() * M * m.shapes - Matrix::Identity(count, count)).norm() <= 1e-8);
+        for (int j = 0; j < count; ++j)
+          CHECK(std::abs(m.shapes.col(j).dot(H * m.shapes.col(j)) - ref.values[j]) <= 1e-6 * scale);
       }
       va.setRoute(VibrationRoute::Automatic);
       // the wall matters, its rows and its forces' Hessian both
