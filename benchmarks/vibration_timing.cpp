@@ -5,7 +5,9 @@
 // count, route, wall and CPU seconds per point (best of `reps`; the structured route cold, i.e.
 // without the previous point's values, and warm, the same point again: its Newton start along a
 // branch), and ω₁² (a figure to compare across runs and routes). The dense route runs up to
-// n = 1000 (O(n³)).
+// n = 1000 (O(n³)). Then the same with the middle segment's distal corner held on the base wall by
+// a force of 0.05 (a wall stretch: one more bordered row and the force's Hessian term; the rows
+// "…+wall").
 //
 //   vibration_timing [--quick] [--n N] [--reps R] [--count K]
 //     --quick    CI size: n = 3 and 50, one repetition
@@ -58,7 +60,7 @@ int main(int argc, char** argv) {
       return usage(("bad argument " + a).c_str());
     }
   }
-  std::printf("%6s %6s %-16s %12s %12s %22s\n", "n", "count", "route", "wall_s", "cpu_s", "omega1_sq");
+  std::printf("%6s %6s %-21s %12s %12s %22s\n", "n", "count", "route", "wall_s", "cpu_s", "omega1_sq");
   for (int n : sizes) {
     const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
     Vector q(n);
@@ -68,23 +70,32 @@ int main(int argc, char** argv) {
       VibrationRoute route;
       bool warm;
     };
-    for (const Run& run : {Run{"dense", VibrationRoute::Dense, false}, Run{"structured-cold", VibrationRoute::Structured, false},
-                           Run{"structured-warm", VibrationRoute::Structured, true}}) {
-      if (run.route == VibrationRoute::Dense && n > 1000) continue;
-      double wall = 1e300, cpu = 1e300, omega1 = 0.0;
-      for (int r = 0; r < reps; ++r) {
-        // a fresh analysis per cold repetition (no previous values); warm: one call before the timed one
-        VibrationAnalysis va(chain, InertiaData::uniformRods(chain, 1.0));
-        va.setRoute(run.route);
-        if (run.warm) va.modes(q, Wrench(-0.1, 0.0, 0.0), {1}, {}, count, true);
-        const auto t0 = std::chrono::steady_clock::now();
-        const std::clock_t c0 = std::clock();
-        const VibrationModes m = va.modes(q, Wrench(-0.1, 0.0, 0.0), {1}, {}, count, true);
-        cpu = std::min(cpu, double(std::clock() - c0) / CLOCKS_PER_SEC);
-        wall = std::min(wall, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-        omega1 = m.omegaSquared[0];
+    ContactSet onWall;
+    onWall.touch(WallVertex{n / 2, 3});
+    const Vector wallForce = Vector::Constant(1, 0.05);
+    const ContactSet none;
+    for (const bool wallStretch : {false, true}) {
+      const ContactSet& contacts = wallStretch ? onWall : none;
+      const Vector forces = wallStretch ? wallForce : Vector();
+      for (const Run& run : {Run{"dense", VibrationRoute::Dense, false}, Run{"structured-cold", VibrationRoute::Structured, false},
+                             Run{"structured-warm", VibrationRoute::Structured, true}}) {
+        if (run.route == VibrationRoute::Dense && n > 1000) continue;
+        double wall = 1e300, cpu = 1e300, omega1 = 0.0;
+        for (int r = 0; r < reps; ++r) {
+          // a fresh analysis per cold repetition (no previous values); warm: one call before the timed one
+          VibrationAnalysis va(chain, InertiaData::uniformRods(chain, 1.0));
+          va.setRoute(run.route);
+          if (run.warm) va.modes(q, Wrench(-0.1, 0.0, 0.0), {1}, contacts, forces, count, true);
+          const auto t0 = std::chrono::steady_clock::now();
+          const std::clock_t c0 = std::clock();
+          const VibrationModes m = va.modes(q, Wrench(-0.1, 0.0, 0.0), {1}, contacts, forces, count, true);
+          cpu = std::min(cpu, double(std::clock() - c0) / CLOCKS_PER_SEC);
+          wall = std::min(wall, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+          omega1 = m.omegaSquared[0];
+        }
+        const std::string name = std::string(run.name) + (wallStretch ? "+wall" : "");
+        std::printf("%6d %6d %-21s %12.4g %12.4g %22.15g\n", n, count, name.c_str(), wall, cpu, omega1);
       }
-      std::printf("%6d %6d %-16s %12.4g %12.4g %22.15g\n", n, count, run.name, wall, cpu, omega1);
     }
   }
   return 0;
