@@ -76,6 +76,24 @@ json contactsJson(const std::vector<mechanics::JointContact>& contacts) {
   return a;
 }
 
+/// A special point's contacts: where the chain touches the wall or itself, the joint that locks
+/// or releases (CT / RL), the vertex that reaches or leaves the wall (WC / WR) and, located on a
+/// wall stretch, the forces of its vertices there.
+void addContacts(const mechanics::SpecialPointReport& s, json& p) {
+  if (s.contactPoint.allFinite()) p["contact_point"] = json::array({jsonNumber(s.contactPoint.x()), jsonNumber(s.contactPoint.y())});
+  if (s.joint >= 0)
+    p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", jsonNumber(s.contactTorque)}, {"locked_after", s.lockedAfter.label()}};
+  if (!s.wallVertices.empty()) {
+    json w = json::array();
+    for (size_t k = 0; k < s.wallVertices.size() && Eigen::Index(k) < s.wallForces.size(); ++k)
+      w.push_back({{"vertex", s.wallVertices[k].label()}, {"wall_force", jsonNumber(s.wallForces[Eigen::Index(k)])}});
+    p["wall"] = w;
+  }
+  if (s.vertex.segment >= 0)
+    p["wall_contact"] = {{"vertex", s.vertex.label()}, {"contact_force", jsonNumber(s.contactForce)},
+                         {"wall_after", s.lockedAfter.wallLabel()}};
+}
+
 }  // namespace
 
 json specialPointsJson(const Scene& scene, const RunResult& run) {
@@ -111,7 +129,7 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
       if (s.multiplicity > 1) p["multiplicity"] = s.multiplicity;
       if (s.branchesPredicted >= 0)
         p["branches"] = {{"predicted", s.branchesPredicted}, {"found", s.branchesFound}};
-      if (s.contactPoint.allFinite()) p["contact_point"] = json::array({jsonNumber(s.contactPoint.x()), jsonNumber(s.contactPoint.y())});
+      addContacts(s, p);
       if (s.koiter.valid) {  // BP: λ(ξ) = λ + aξ + bξ², ξ in rad of the unit joint-angle mode
         p["koiter_a"] = jsonNumber(s.koiter.a);
         p["koiter_b"] = jsonNumber(s.koiter.b);
@@ -134,11 +152,6 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
           }
         p["imperfection_sensitivity"] = imperfections;
       }
-      if (s.joint >= 0)  // CT / RL
-        p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", jsonNumber(s.contactTorque)}, {"locked_after", s.lockedAfter.label()}};
-      if (s.vertex.segment >= 0)  // WC / WR
-        p["wall_contact"] = {{"vertex", s.vertex.label()}, {"contact_force", jsonNumber(s.contactForce)},
-                             {"wall_after", s.lockedAfter.wallLabel()}};
       if (const mechanics::Landing& l = s.landing; l.tried) {
         json j;
         j["success"] = l.success;

@@ -195,6 +195,16 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
         const std::string before = p["stability_before"], after = p["stability_after"];
         INFO(scene.stem().string() << ": " << type << " at " << p["parameter"] << " (" << field << ", " << before
                                    << " -> " << after << ")");
+        // located on a stretch held on the base wall: the wall pushes there (it releases where a
+        // force returns to zero), and at WR the leaving vertex is among them with its force zero
+        if (p.contains("wall"))
+          for (const json& w : p["wall"]) CHECK(w["wall_force"].get<double>() >= -1e-9);
+        if (type == "WR") {
+          REQUIRE(p.contains("wall"));
+          bool leaving = false;
+          for (const json& w : p["wall"]) leaving = leaving || w["vertex"] == p["wall_contact"]["vertex"];
+          CHECK(leaving);
+        }
         if (field == "task path") {
           // where a task path ends (case_runner_task.cpp): why, in words, and the inputs there
           CHECK((type == "LP" || type == "BP" || type == "LS" || type == "BD" || type == "IB"));

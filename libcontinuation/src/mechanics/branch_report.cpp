@@ -357,6 +357,7 @@ void reportLocatedPoints(EquilibriumProblem& problem, const cont::Branch& b, con
     s.branchesFound = sp.branchesFound;
     if (const ContactSet& set = lockedAt(stretches, sp.index); set.wallCount() > 0) {
       ContactProblem held(problem, set);  // the forces of the stretch's wall vertices at the point
+      s.wallVertices = set.wall();
       s.wallForces = held.wallForces(*held.createWorkspace(), sp.u, sp.lambda);
     }
     const Classification cl = classify(problem, sp);

@@ -156,8 +156,9 @@ struct SpecialPointReport {
   /// at the point (≈ 0 there; NaN otherwise).
   WallVertex vertex{-1, 0};
   double contactForce = std::numeric_limits<double>::quiet_NaN();
-  /// Located on a stretch with vertices on the wall: their forces μ_v at the point, one per vertex
-  /// of the stretch's contacts (those of the traced point before it); empty otherwise.
+  /// Located on a stretch with vertices on the wall: those vertices (the stretch's, i.e. the traced
+  /// point's before it) and their forces μ_v at the point, in the same order; empty otherwise.
+  std::vector<WallVertex> wallVertices;
   Eigen::VectorXd wallForces;
   /// BC / SC / WC / WR: where the chain touches the wall or itself (NaN otherwise).
   Eigen::Vector2d contactPoint = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
