@@ -514,3 +514,76 @@ TEST_CASE("contact: a branch point on a locked stretch is switched, its children
   CHECK(children == 2);
   CHECK(bp.note.find("switched (") != std::string::npos);  // by the tree driver itself, like a traced BP
 }
+
+TEST_CASE("contact: a branch that comes back to one of its contact events, same contacts and direction, ends there "
+          "as a closed loop",
+          "[contact][switching]") {
+  // The default scene's chain with 20 segments (a = 0.5, b = 1, k = 1, L0 = 2.25, clamped–pinned,
+  // compressed by Fx to −2.5): a child of the trivial branch locks and releases joints 9, 11 and 13
+  // in a cycle of contact events, its second half the mirror image of the first. Traced on, it
+  // would go round until maxContactEvents; it ends where it is back at an event it has passed.
+  const int n = 20;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMin = -2.5;
+  o.tracer.lambdaMax = 0.0;
+  o.tracer.step.initialStep = 0.02;
+  o.tracer.step.maxStep = 0.05;
+  o.tracer.maxPoints = 4000;
+  o.tracer.detection.lowestEigenvalues = 1;
+  o.tree.threads = 1;
+  const int maxEvents = 200;
+  o.maxContactEvents = maxEvents;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  int loops = 0;
+  for (size_t b = 0; b < r.tree.branches.size(); ++b) {
+    const cont::Branch& branch = r.tree.branches[b];
+    if (branch.stopReason != cont::StopReason::ClosedLoop) continue;
+    ++loops;
+    const std::vector<ContactStretch>& stretches = r.contact[b];
+    INFO("branch " << b << ": " << branch.stopMessage);
+    CHECK(int(stretches.size()) - 1 < maxEvents / 4);  // ended by the loop, far from the guard
+    // The stretch that started at the point the branch came back to: the same point to far below
+    // the test's 1e-6 (a loop, not a near miss).
+    const cont::ContinuationPoint& last = branch.points.back();
+    int from = -1;
+    for (size_t k = 1; k + 1 < stretches.size() && from < 0; ++k) {
+      const cont::ContinuationPoint& p = branch.points[size_t(stretches[k].firstPoint - 1)];
+      if ((p.u - last.u).cwiseAbs().maxCoeff() <= 1e-6 && std::abs(p.lambda - last.lambda) <= 1e-6) from = int(k);
+    }
+    REQUIRE(from > 0);
+    const cont::ContinuationPoint& back = branch.points[size_t(stretches[size_t(from)].firstPoint - 1)];
+    CHECK((back.u - last.u).cwiseAbs().maxCoeff() < 1e-9);
+    CHECK(std::abs(back.lambda - last.lambda) < 1e-9);
+    // One period: at least two events; a contact set may come back inside it, but elsewhere (not
+    // the same point: no loop there, and the branch went on); the mirror image of the loop's first
+    // half in its second (joint j upper ↔ lower at the same load).
+    const int period = int(stretches.size()) - from;
+    REQUIRE(period >= 2);
+    int setsAgain = 0;
+    for (int k = from; k < int(stretches.size()); ++k)
+      for (int l = k + 1; l < int(stretches.size()); ++l)
+        if (stretches[size_t(k)].locked == stretches[size_t(l)].locked) {
+          ++setsAgain;
+          const cont::ContinuationPoint& pk = branch.points[size_t(stretches[size_t(k)].firstPoint - 1)];
+          const cont::ContinuationPoint& pl = branch.points[size_t(stretches[size_t(l)].firstPoint - 1)];
+          CHECK((pk.u - pl.u).cwiseAbs().maxCoeff() + std::abs(pk.lambda - pl.lambda) > 1e-3);
+        }
+    CHECK(setsAgain > 0);
+    if (period % 2 == 0)
+      for (int k = from; k < from + period / 2; ++k) {
+        const ContactSet &a = stretches[size_t(k)].locked, &m = stretches[size_t(k + period / 2)].locked;
+        REQUIRE(a.joints().size() == m.joints().size());
+        for (size_t j = 0; j < a.joints().size(); ++j) {
+          CHECK(a.joints()[j].joint == m.joints()[j].joint);
+          CHECK(a.joints()[j].side != m.joints()[j].side);
+        }
+        const double la = branch.points[size_t(stretches[size_t(k)].firstPoint - 1)].lambda;
+        const double lm = branch.points[size_t(stretches[size_t(k + period / 2)].firstPoint - 1)].lambda;
+        CHECK(std::abs(la - lm) < 1e-9);
+      }
+  }
+  CHECK(loops >= 1);
+}

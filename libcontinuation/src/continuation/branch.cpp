@@ -33,6 +33,7 @@ const char *toString(StopReason reason) {
     case StopReason::SwitchFailed: return "branch switching failed";
     case StopReason::Interrupted: return "interrupted";
     case StopReason::Joined: return "joined a traced branch";
+    case StopReason::ClosedLoop: return "closed loop";
     case StopReason::Paused: return "paused at a branch point";
   }
   return "unknown";

@@ -67,7 +67,14 @@ bool Locator::sample(double s, StepSample &out, CorrectorSummary *summary) {
   out.point.stepSize = s;
   out.point.newtonIterations = result.iterations;
   out.point.residualNorm = result.residualNorm;
-  if (!evaluator_.complete(out.point, ta_) && !evaluator_.lastWasSingular()) return false;
+  // A sample's stability is its inertia alone (what the crossings' count and separation read): a
+  // test that follows an eigenvalue asks for it (crossingEigenvalue), and the one sample that
+  // becomes a traced point, a stop event's, gets the tracer's eigenvalues there (locateStopEvent).
+  const int lowest = evaluator_.lowestEigenvalues();
+  evaluator_.setLowestEigenvalues(0);
+  const bool completed = evaluator_.complete(out.point, ta_);
+  evaluator_.setLowestEigenvalues(lowest);
+  if (!completed && !evaluator_.lastWasSingular()) return false;
   // A sample whose tangent disagrees with the interpolated one AND that Newton moved far from
   // the predictor converged onto the crossing branch. Within a tiny distance of the branch
   // point the computed tangent itself is unreliable (F_x nearly rank-deficient), but there both
@@ -165,14 +172,6 @@ double Locator::residualNorm(ConstVectorRef u, double lambda) {
 
 std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &crossings) {
   std::vector<SpecialPoint> found;
-  // Eigenvalue tests follow μ_k, k = the smaller negative count: make every sample carry it.
-  const int savedEigenvalues = evaluator_.lowestEigenvalues();
-  if (crossings.branchPointCrossings > 0 && a_.point.stability.valid() && b_.point.stability.valid()) {
-    const int needed = std::max({3, savedEigenvalues, crossingIndex(a_.point, b_.point) + 2});
-    evaluator_.setLowestEigenvalues(needed);
-    ensureEigenvalues(problem_, a_.point, needed);
-    ensureEigenvalues(problem_, b_.point, needed);
-  }
   if (crossings.fold && options_.detection.folds) keep(found, locateFold(a_, b_));
   if (crossings.branchPointCrossings > 0 && options_.detection.branchPoints) {
     std::vector<std::pair<StepSample, StepSample>> simple, multiple;
@@ -188,20 +187,13 @@ std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &
       keep(found, multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
     }
   }
-  evaluator_.setLowestEigenvalues(savedEigenvalues);
   std::sort(found.begin(), found.end(),
             [](const SpecialPoint &p, const SpecialPoint &q) { return p.arclength < q.arclength; });
   return found;
 }
 
 void Locator::locateBetween(const std::vector<StepSample> &samples, std::vector<SpecialPoint> &found) {
-  const int savedEigenvalues = evaluator_.lowestEigenvalues();
-  int needed = std::max(3, savedEigenvalues);
-  for (const StepSample &x : samples)
-    if (x.point.stability.valid()) needed = std::max(needed, x.point.stability.negative + 2);
-  evaluator_.setLowestEigenvalues(needed);
-  std::vector<StepSample> ends = samples;
-  for (StepSample &x : ends) ensureEigenvalues(problem_, x.point, needed);
+  const std::vector<StepSample> &ends = samples;
   std::vector<std::pair<StepSample, StepSample>> simple, multiple;
   for (size_t i = 0; i + 1 < ends.size(); ++i) {
     // Two folds close together (near a cusp of the fold curve) are a pair of opposite crossings too.
@@ -221,7 +213,6 @@ void Locator::locateBetween(const std::vector<StepSample> &samples, std::vector<
     const int m = std::abs(bracket.second.point.stability.negative - bracket.first.point.stability.negative);
     keep(found, multipleBranchPoint(bracket.first, bracket.second, std::max(m, 2)));
   }
-  evaluator_.setLowestEigenvalues(savedEigenvalues);
 }
 
 void Locator::keep(std::vector<SpecialPoint> &found, SpecialPoint &&sp) const {

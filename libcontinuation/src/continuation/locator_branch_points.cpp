@@ -46,7 +46,7 @@ SpecialPoint Locator::locateSimpleBranchPoint(const StepSample &lo, const StepSa
     }
   } else {
     const int index = crossingIndex(lo.point, hi.point);
-    test = [index](const ContinuationPoint &p, double &f) { return crossingEigenvalue(p, index, f); };
+    test = [this, index](const ContinuationPoint &p, double &f) { return crossingEigenvalue(problem_, p, index, f); };
     haveTest = test(lo.point, fLo) && test(hi.point, fHi) && !sameSign(fLo, fHi);
     sp.note = "inertia change without determinant sign change; located on the crossing eigenvalue";
   }
@@ -282,7 +282,9 @@ SpecialPoint Locator::multipleBranchPoint(const StepSample &lo, const StepSample
     f = mu.mean();
     return std::isfinite(f);
   };
-  const TestFunction single = [index](const ContinuationPoint &p, double &f) { return crossingEigenvalue(p, index, f); };
+  const TestFunction single = [this, index](const ContinuationPoint &p, double &f) {
+    return crossingEigenvalue(problem_, p, index, f);
+  };
   double fLo = 0.0, fHi = 0.0;
   Root root;
   bool ok = false;

@@ -15,19 +15,19 @@ inline int crossingIndex(const ContinuationPoint &lo, const ContinuationPoint &h
 }
 
 // The eigenvalue with this ascending index is the one that passes through zero inside the
-// bracket: with k negative eigenvalues on one side and k+m on the other, μ_k changes sign.
-inline bool crossingEigenvalue(const ContinuationPoint &p, int index, double &value) {
-  if (!p.stability.valid() || index < 0 || index >= p.stability.lowest.size()) return false;
-  value = p.stability.lowest[index];
-  return true;
-}
-
-// The crossing eigenvalue's index may exceed what the tracer recorded (it may record the inertia
-// only): recompute the stability of a bracket end with enough eigenvalues.
-inline void ensureEigenvalues(const BoundProblem &problem, ContinuationPoint &p, int count) {
-  if (!p.stability.valid() || p.stability.lowest.size() >= count) return;
+// bracket: with k negative eigenvalues on one side and k+m on the other, μ_k changes sign. From
+// the point's recorded eigenvalues where they reach it (a sample records the inertia only,
+// Locator::sample), else from the problem's stability() with as many.
+inline bool crossingEigenvalue(const BoundProblem &problem, const ContinuationPoint &p, int index, double &value) {
+  if (!p.stability.valid() || index < 0) return false;
+  if (index < p.stability.lowest.size()) {
+    value = p.stability.lowest[index];
+    return true;
+  }
   StabilityInfo info;
-  if (problem.stability(p.u, p.lambda, count, info)) p.stability = info;
+  if (!problem.stability(p.u, p.lambda, index + 1, info) || index >= info.lowest.size()) return false;
+  value = info.lowest[index];
+  return true;
 }
 
 inline std::string format(const char *pattern, double value) {

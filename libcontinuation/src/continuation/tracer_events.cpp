@@ -110,6 +110,11 @@ void Tracer::locateStopEvent(const ContinuationPoint &a, const ContinuationPoint
     }
   }
   if (hit.event >= 0) {
+    // the landed point is traced: the eigenvalues a traced point records (a sample has its inertia only)
+    const int lowest = options_.detection.lowestEigenvalues;
+    if (options_.detection.stability && hit.point.stability.valid() && hit.point.stability.lowest.size() < lowest &&
+        !work_.stability(hit.point.u, hit.point.lambda, lowest, hit.point.stability))
+      hit.point.stability = StabilityInfo();
     const double s = stepAlong(a, hit.point);
     hit.point.arclength = a.arclength + s;
     hit.point.stepSize = s;

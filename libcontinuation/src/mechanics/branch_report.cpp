@@ -90,7 +90,7 @@ void noteCusp(EquilibriumProblem& problem, const cont::SpecialPoint& sp, Special
 
 bool regularStop(cont::StopReason r) {
   return r == cont::StopReason::LambdaRange || r == cont::StopReason::Boundary || r == cont::StopReason::Box ||
-         r == cont::StopReason::MaxArclength || r == cont::StopReason::Joined;
+         r == cont::StopReason::MaxArclength || r == cont::StopReason::Joined || r == cont::StopReason::ClosedLoop;
 }
 
 /// The chain under the path's own end condition, for a branch traced through the reaction of

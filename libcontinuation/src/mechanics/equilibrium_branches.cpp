@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <any>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -150,6 +151,38 @@ int generationOf(const continuation::BranchTree& t, size_t b) {
   return g;
 }
 
+// The earlier stretch that started where the branch stands now (its last point, a located contact
+// event), with the same contacts and leaving in the same direction as p0 (the new stretch's
+// start, oriented), or −1. Continuation from that start traced the curve the branch would trace
+// again (the events are points of the curve, located to the location tolerance): the branch is a
+// closed loop from there.
+int repeatedStretch(const EquilibriumProblem& problem, const continuation::Branch& branch,
+                    const std::vector<ContactStretch>& stretches, const ContactSet& locked,
+                    const continuation::ContinuationPoint& p0) {
+  const continuation::ContinuationPoint& here = branch.points.back();
+  const continuation::ProblemScales s = problem.scales();
+  const int N = problem.dimension(), D = int(p0.u.size());
+  // relative to the unknowns' and λ's scales: far above the events' location accuracy (≈1e−12),
+  // far below any distance between two different events with the same contacts
+  constexpr double kSame = 1e-6;
+  const auto near = [](double a, double b, double scale) {
+    return std::abs(a - b) <= kSame * std::max(scale, std::max(std::abs(a), std::abs(b)));
+  };
+  for (size_t k = 1; k < stretches.size(); ++k) {
+    const int e = stretches[k].firstPoint - 1;
+    if (!(stretches[k].locked == locked) || e < 0 || e + 1 >= int(branch.points.size()) - 1) continue;
+    const continuation::ContinuationPoint &then = branch.points[size_t(e)], &next = branch.points[size_t(e) + 1];
+    bool same = near(here.lambda, then.lambda, s.parameter);
+    for (int i = 0; same && i < N; ++i) same = near(here.u[i], then.u[i], s.unknowns[i]);
+    if (!same) continue;
+    // the direction the earlier stretch left in (its first step) against p0's tangent, in scaled units
+    double along = (next.lambda - then.lambda) * p0.tangent[D] / (s.parameter * s.parameter);
+    for (int i = 0; i < N; ++i) along += (next.u[i] - then.u[i]) * p0.tangent[i] / (s.unknowns[i] * s.unknowns[i]);
+    if (along > 0.0) return int(k);
+  }
+  return -1;
+}
+
 }  // namespace
 
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
@@ -249,6 +282,16 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     const double rate = contactRate(problem, stretches.back().locked, hit, release, wallIndex, p0);
     if (rate < 0.0 && !startPoint(-p0.tangent, p0)) {
       giveUp("no unique tangent at the point");
+      break;
+    }
+    if (const int k = repeatedStretch(problem, branch, stretches, locked, p0); k > 0) {
+      const continuation::ContinuationPoint& then = branch.points[size_t(stretches[size_t(k)].firstPoint - 1)];
+      branch.stopReason = continuation::StopReason::ClosedLoop;
+      char at[64];
+      std::snprintf(at, sizeof at, "%.10g", then.lambda);
+      branch.stopMessage = "closed loop: back at point " + std::to_string(stretches[size_t(k)].firstPoint - 1) +
+                           " (parameter " + at + ") with the same contacts and direction; from there it repeats itself";
+      giveUp(branch.stopMessage);
       break;
     }
     p0.arclength = 0.0;

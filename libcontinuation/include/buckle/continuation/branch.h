@@ -103,6 +103,9 @@ enum class StopReason {
   SwitchFailed,        ///< branch switching did not reach a point off the parent branch
   Interrupted,         ///< the Interrupt (time limit, signal) or the step callback asked to stop
   Joined,              ///< the step callback found the branch on one already traced (StepAction::Join)
+  /// A regular end: the branch came back to a point it had passed, in the same direction (a
+  /// closed loop; from there it would trace the same curve again).
+  ClosedLoop,
   /// Not ended: the tracer returned after a step that located a branch point, as asked
   /// (Tracer::pauseAtBranchPoints); Tracer::continueBranch goes on from its last point with
   /// the step it would have taken (Branch::resumeStep): the same points as without the pause,
