@@ -182,6 +182,65 @@ void solveFactored(const ChainStructure& ws, VectorRef y) {
   }
 }
 
+namespace {
+
+/// factoredSchur for R border columns. Row k of W = L⁻¹B is b_k less one term from the pivot
+/// block just above it (a 1×1 at k − 1 or a 2×2 at k − 2; the second row of a 2×2 gets none):
+/// that term is carried, nothing is stored.
+template <int R>
+void forwardSchur(const ChainStructure& ws, ChainStructure::SmallMatrix& S) {
+  const int n = ws.n;
+  const unsigned char* block = ws.blockStart.data();
+  const double *pivA = ws.pivA.data(), *pivE = ws.pivE.data(), *l1 = ws.l1.data(), *l2 = ws.l2.data();
+  const double* b[R];
+  for (int c = 0; c < R; ++c) b[c] = ws.B.col(c).data();
+  double carry[R] = {}, z0[R], z1[R], acc[R][R] = {};
+  for (int k = 0; k < n;) {
+    if (block[k] == 1) {
+      const double inv = 1.0 / pivA[k], l = k + 1 < n ? l1[k] : 0.0;
+      for (int c = 0; c < R; ++c) {
+        z0[c] = b[c][k] - carry[c];
+        carry[c] = l * z0[c];
+      }
+      for (int c = 0; c < R; ++c)
+        for (int d = 0; d <= c; ++d) acc[c][d] += z0[c] * z0[d] * inv;
+      k += 1;
+    } else {
+      // [z0 z1] D_b⁻¹ [z0; z1]ᵀ with D_b⁻¹ = [[b, −e], [−e, a]]/det
+      const double a = pivA[k], bb = pivA[k + 1], e = pivE[k];
+      const double inv = 1.0 / (a * bb - e * e);
+      const double m0 = k + 2 < n ? l1[k] : 0.0, m1 = k + 2 < n ? l2[k] : 0.0;
+      for (int c = 0; c < R; ++c) {
+        z0[c] = b[c][k] - carry[c];
+        z1[c] = b[c][k + 1];
+        carry[c] = m0 * z0[c] + m1 * z1[c];
+      }
+      for (int c = 0; c < R; ++c)
+        for (int d = 0; d <= c; ++d)
+          acc[c][d] += (bb * z0[c] * z0[d] - e * (z0[c] * z1[d] + z1[c] * z0[d]) + a * z1[c] * z1[d]) * inv;
+      k += 2;
+    }
+  }
+  S.resize(R, R);
+  for (int c = 0; c < R; ++c)
+    for (int d = 0; d <= c; ++d) S(c, d) = S(d, c) = acc[c][d];
+}
+
+}  // namespace
+
+void structure::factoredSchur(ChainStructure& ws, int r) {
+  switch (r) {
+    case 1: return forwardSchur<1>(ws, ws.S);
+    case 2: return forwardSchur<2>(ws, ws.S);
+    case 3: return forwardSchur<3>(ws, ws.S);
+    default: break;
+  }
+  // more columns than constraints have (kMaxBorder): the solve, as the determinant's path does
+  ws.X.leftCols(r) = ws.B.leftCols(r);
+  solveFactored(ws, ws.X, r);
+  ws.S.noalias() = ws.B.leftCols(r).transpose().lazyProduct(ws.X.leftCols(r));
+}
+
 void solveFactored(const ChainStructure& ws, MatrixRef Y, int cols) {
   for (int j = 0; j < cols; ++j) solveFactored(ws, Y.col(j));
 }

@@ -65,6 +65,12 @@ int constrainedCountBelow(ChainStructure& ws, double sigma, bool determinant) {
   const int r = ws.rank;
   factorize(ws, sigma, determinant);
   if (r == 0) return ws.factorInertia.negative;
+  if (!determinant) {
+    // a count reads S alone: the factor's forward sweep gives it without the solve for X
+    structure::factoredSchur(ws, r);
+    ws.S = -ws.S;
+    return ws.factorInertia.negative + smallNegativeCount(ws.S) - r;
+  }
   ws.X.leftCols(r) = ws.B.leftCols(r);
   solveFactored(ws, ws.X, r);
   ws.S.resize(r, r);

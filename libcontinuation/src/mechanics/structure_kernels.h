@@ -33,6 +33,10 @@ struct ScaledProduct {
   double logAbs() const { return std::log(std::abs(mantissa)) + double(exponent) * 0.6931471805599453; }
 };
 
+/// ws.S = Bᵀ(T − σM)⁻¹B for the first r columns of ws.B, after factorize(ws, σ): WᵀD⁻¹W with
+/// W = L⁻¹B by the factor's forward sweep alone, without the solve for (T − σM)⁻¹B.
+void factoredSchur(ChainStructure& ws, int r);
+
 /// Orthonormalise the rows of C (m×n) by modified Gram–Schmidt, twice, into the first columns of Q
 /// (n rows), with B = U⁻¹Q alongside; rows whose remainder is below rankTolerance of the largest
 /// row norm are dropped. Returns the rank.
