@@ -8,6 +8,7 @@
 
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/wall_constraint.h"
 
 namespace buckle::mechanics {
 
@@ -91,30 +92,36 @@ continuation::StabilityInfo constrainedStability(const EquilibriumProblem& base,
   return info;
 }
 
+void wallConstraintTerms(const Chain& chain, ConstVectorRef q, const ContactSet& contacts, ConstVectorRef wallForces,
+                         const char* caller, MatrixRef rows, Vector& generator) {
+  const int n = chain.size(), w = contacts.wallCount();
+  if (wallForces.size() != w)
+    throw std::invalid_argument(std::string(caller) + ": one wall force per vertex on the wall (" + std::to_string(w) +
+                                "), got " + std::to_string(wallForces.size()));
+  if (w == 0) return;
+  if (generator.size() != n) generator = Vector::Zero(n);
+  const Eigen::Matrix2Xd P = jointPositions(chain, q);
+  Vector gradient(n), vertexGenerator(n);
+  for (int k = 0; k < w; ++k) {
+    const WallVertex& v = contacts.wall()[size_t(k)];
+    wallVertexDerivatives(P, wallVertexPoint(chain, q, P, v), v, gradient, vertexGenerator);
+    rows.row(k) = gradient.transpose();
+    generator += wallForces[k] * vertexGenerator;
+  }
+}
+
 CartesianStiffness lockedLoadedStiffness(const Chain& chain, ConstVectorRef q, const Wrench& F, const EndCondition& end,
                                          const ContactSet& locked, const StiffnessOptions& options,
                                          ConstVectorRef wallForces) {
   if (locked.empty()) return loadedStiffness(chain, q, F, end, options);
   locked.check(chain.size());
   const int n = chain.size(), w = locked.wallCount();
-  if (wallForces.size() != w)
-    throw std::invalid_argument("lockedLoadedStiffness: one wall force per vertex on the wall (" + std::to_string(w) +
-                                "), got " + std::to_string(wallForces.size()));
   Matrix E = Matrix::Zero(locked.count() + w, n);  // δq_i = 0 at the locked joints, δx_v = 0 on the wall
   for (int k = 0; k < locked.count(); ++k) E(k, locked.joints()[size_t(k)].joint) = 1.0;
-  if (w == 0) return loadedStiffness(chain, q, F, end.isHeld(EndCoordinate::Phi), E, options);
   // The wall forces' −Σ μ_v ∂²x_v enters as a body-load generator γ (the Hessian's generator is
-  // h − γ, stiffness.h): γ += μ_v g_v (wall_contact.h).
+  // h − γ, stiffness.h).
   StiffnessOptions o = options;
-  if (o.bodyGenerator.size() == 0) o.bodyGenerator = Vector::Zero(n);
-  const Eigen::Matrix2Xd P = jointPositions(chain, q);
-  Vector grad(n), gen(n);
-  for (int k = 0; k < w; ++k) {
-    const WallVertex& v = locked.wall()[size_t(k)];
-    wallVertexDerivatives(P, wallVertexPoint(chain, q, P, v), v, grad, gen);
-    E.row(locked.count() + k) = grad.transpose();
-    o.bodyGenerator += wallForces[k] * gen;
-  }
+  wallConstraintTerms(chain, q, locked, wallForces, "lockedLoadedStiffness", E.bottomRows(w), o.bodyGenerator);
   return loadedStiffness(chain, q, F, end.isHeld(EndCoordinate::Phi), E, o);
 }
 

@@ -11,7 +11,7 @@
 
 #include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain_structure.h"
-#include "buckle/mechanics/wall_contact.h"
+#include "buckle/mechanics/wall_constraint.h"
 
 namespace buckle::mechanics {
 
@@ -131,24 +131,12 @@ VibrationModes VibrationAnalysis::modes(ConstVectorRef q, const Wrench& F, const
                                         const Vector& bodyGenerator) {
   const int n = chain_.size(), w = contacts.wallCount();
   contacts.check(n);
-  if (wallForces.size() != w)
-    throw std::invalid_argument("VibrationAnalysis::modes: one wall force per vertex on the wall (" + std::to_string(w) +
-                                "), got " + std::to_string(wallForces.size()));
   std::vector<int> locked;
   for (const LockedJoint& j : contacts.joints()) locked.push_back(j.joint);
   checkArguments(q, count, bodyGenerator);
-  if (w == 0) return route(q, F, held, locked, Matrix(), count, shapes, bodyGenerator);
-  // As lockedLoadedStiffness: the rows ∇x_v, and −Σ μ_v ∂²x_v as the generator γ += μ_v g_v.
-  Vector gamma = bodyGenerator.size() == n ? bodyGenerator : Vector::Zero(n);
   Matrix wallRows(w, n);
-  const Eigen::Matrix2Xd P = jointPositions(chain_, q);
-  Vector gradient(n), generator(n);
-  for (int k = 0; k < w; ++k) {
-    const WallVertex& v = contacts.wall()[size_t(k)];
-    wallVertexDerivatives(P, wallVertexPoint(chain_, q, P, v), v, gradient, generator);
-    wallRows.row(k) = gradient.transpose();
-    gamma += wallForces[k] * generator;
-  }
+  Vector gamma = bodyGenerator;  // as lockedLoadedStiffness: the wall's rows and its forces' generator
+  wallConstraintTerms(chain_, q, contacts, wallForces, "VibrationAnalysis::modes", wallRows, gamma);
   return route(q, F, held, locked, wallRows, count, shapes, gamma);
 }
 
