@@ -70,11 +70,7 @@ bool Locator::sample(double s, StepSample &out, CorrectorSummary *summary) {
   // A sample's stability is its inertia alone (what the crossings' count and separation read): a
   // test that follows an eigenvalue asks for it (crossingEigenvalue), and the one sample that
   // becomes a traced point, a stop event's, gets the tracer's eigenvalues there (locateStopEvent).
-  const int lowest = evaluator_.lowestEigenvalues();
-  evaluator_.setLowestEigenvalues(0);
-  const bool completed = evaluator_.complete(out.point, ta_);
-  evaluator_.setLowestEigenvalues(lowest);
-  if (!completed && !evaluator_.lastWasSingular()) return false;
+  if (!evaluator_.complete(out.point, ta_, true) && !evaluator_.lastWasSingular()) return false;
   // A sample whose tangent disagrees with the interpolated one AND that Newton moved far from
   // the predictor converged onto the crossing branch. Within a tiny distance of the branch
   // point the computed tangent itself is unreliable (F_x nearly rank-deficient), but there both
@@ -193,13 +189,12 @@ std::vector<SpecialPoint> Locator::locateSpecialPoints(const IntervalCrossings &
 }
 
 void Locator::locateBetween(const std::vector<StepSample> &samples, std::vector<SpecialPoint> &found) {
-  const std::vector<StepSample> &ends = samples;
   std::vector<std::pair<StepSample, StepSample>> simple, multiple;
-  for (size_t i = 0; i + 1 < ends.size(); ++i) {
+  for (size_t i = 0; i + 1 < samples.size(); ++i) {
     // Two folds close together (near a cusp of the fold curve) are a pair of opposite crossings too.
-    if (options_.detection.folds && foldBetween(ends[i].point, ends[i + 1].point))
-      keep(found, locateFold(ends[i], ends[i + 1]));
-    if (options_.detection.branchPoints) separateCrossings(ends[i], ends[i + 1], simple, multiple, 0);
+    if (options_.detection.folds && foldBetween(samples[i].point, samples[i + 1].point))
+      keep(found, locateFold(samples[i], samples[i + 1]));
+    if (options_.detection.branchPoints) separateCrossings(samples[i], samples[i + 1], simple, multiple, 0);
   }
   // An interrupt ends the location between two branch points (below the dense crossover each
   // refinement is O(N³) work, and a step over a cluster holds many): the tracer then drops

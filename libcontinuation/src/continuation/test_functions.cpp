@@ -27,13 +27,13 @@ bool PointEvaluator::borderedJacobian(ConstVectorRef u, double lambda, ConstVect
   return A.allFinite();
 }
 
-bool PointEvaluator::complete(ContinuationPoint &point, ConstVectorRef reference) {
+bool PointEvaluator::complete(ContinuationPoint &point, ConstVectorRef reference, bool inertiaOnly) {
   singular_ = false;
   const Factorization f = solver_.factor(point.u, point.lambda, reference);
   if (f == Factorization::Refused) return false;
   singular_ = f == Factorization::Singular;
   if (stability_) {
-    if (!problem_.stability(point.u, point.lambda, lowestEigenvalues_, point.stability))
+    if (!problem_.stability(point.u, point.lambda, inertiaOnly ? 0 : lowestEigenvalues_, point.stability))
       point.stability = StabilityInfo();
   } else {
     point.stability = StabilityInfo();

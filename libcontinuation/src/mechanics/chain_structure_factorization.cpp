@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace buckle::mechanics {
 
@@ -233,12 +235,8 @@ void structure::factoredSchur(ChainStructure& ws, int r) {
     case 1: return forwardSchur<1>(ws, ws.S);
     case 2: return forwardSchur<2>(ws, ws.S);
     case 3: return forwardSchur<3>(ws, ws.S);
-    default: break;
+    default: throw std::invalid_argument("factoredSchur: 1 to 3 constraint rows (setConstraints), got " + std::to_string(r));
   }
-  // more columns than constraints have (kMaxBorder): the solve, as the determinant's path does
-  ws.X.leftCols(r) = ws.B.leftCols(r);
-  solveFactored(ws, ws.X, r);
-  ws.S.noalias() = ws.B.leftCols(r).transpose().lazyProduct(ws.X.leftCols(r));
 }
 
 void solveFactored(const ChainStructure& ws, MatrixRef Y, int cols) {

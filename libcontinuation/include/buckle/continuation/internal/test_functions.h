@@ -25,16 +25,13 @@ class PointEvaluator {
  public:
   PointEvaluator(const BoundProblem &problem, BorderedSolver &solver, bool computeStability, int lowestEigenvalues = 3);
 
-  /// Eigenvalues asked of Problem::stability() by complete(); the locator raises it while it
-  /// works, since it follows the crossing eigenvalue.
-  void setLowestEigenvalues(int count) { lowestEigenvalues_ = count; }
-  int lowestEigenvalues() const { return lowestEigenvalues_; }
-
   /// Tangent from [[F_u, F_λ], [referenceᵀ]] t = e_{N+1}, normalised, so tᵀreference > 0.
   /// False when the problem refuses the point or the bordered matrix is exactly singular; in
   /// the singular case (lastWasSingular()) the point still gets determinantSign = 0, the
   /// normalised reference as tangent and its stability, so test functions stay evaluable.
-  bool complete(ContinuationPoint &point, ConstVectorRef reference);
+  /// The stability with the evaluator's lowest eigenvalues, or its inertia alone (inertiaOnly:
+  /// the locator's samples, whose tests read the counts).
+  bool complete(ContinuationPoint &point, ConstVectorRef reference, bool inertiaOnly = false);
   bool lastWasSingular() const { return singular_; }
 
   /// Writes [[F_u, F_λ], [tᵀ]] into A ((N+1)×(N+1)).
