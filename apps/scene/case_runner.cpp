@@ -156,7 +156,8 @@ void CaseRunner::jumps() {
 // branch of the output; each jump a special point "JUMP" (field "jumping") with its landing,
 // drawn as an arrow in the bifurcation plots.
 void CaseRunner::loadHistory() {
-  mech::EquilibriumProblem problem = pathProblem();
+  // its pieces are held at the base wall as the continuation's branches are
+  mech::EquilibriumProblem problem = pathProblem(tracesWall());
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();
   opt.jump.perturbation = scene_.analyses.loadHistory.perturbation;
@@ -185,7 +186,7 @@ void CaseRunner::loadHistory() {
     origin << "load history, leg " << h.segmentLeg[k] << " (" << spec_.path.parameter << " -> "
            << scene_.analyses.loadHistory.waypoints[size_t(h.segmentLeg[k])] << ")"
            << (h.segmentBifurcated[k] ? ", on the stable branch born at the branch point" : "");
-    record(b, mech::reportBranch(problem, b, reportOptions()), origin.str());
+    record(b, mech::reportBranch(problem, b, reportOptions(), h.segmentContacts[k]), origin.str());
   }
   for (const mech::JumpRecord& j : h.jumps) {
     SpecialPointResult& s = out_.specials.emplace_back();
@@ -223,7 +224,8 @@ void CaseRunner::suddenLoad() {
     opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
     opt.jump.wall = tracesWall();
     try {
-      const mech::LoadHistoryResult h = mech::followLoadHistory(problem, out_.qStart, {s0, spec.value}, opt);
+      mech::EquilibriumProblem held = pathProblem(tracesWall());  // held at the wall as the history is
+      const mech::LoadHistoryResult h = mech::followLoadHistory(held, out_.qStart, {s0, spec.value}, opt);
       if (h.success && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);
       if (problem.bodyLoads().active() && !h.segments.empty() && !h.segments.front().points.empty())
         qRest = h.segments.front().points.front().u.head(n);

@@ -127,9 +127,11 @@ class CaseRunner {
   }
   /// The scene's path of the end condition: prescribed(λ) = start values + (λ − s0)·direction.
   mechanics::LoadPath loadPath() const { return {spec_.end.condition, spec_.path.direction, out_.startValue}; }
-  /// The path as an EquilibriumProblem.
-  mechanics::EquilibriumProblem pathProblem() const {
-    return mechanics::EquilibriumProblem(out_.chain, loadPath().problemEnd(), spec_.path.direction, {},
+  /// The path as an EquilibriumProblem; with `wall` the base wall is a constraint (tracesWall()).
+  mechanics::EquilibriumProblem pathProblem(bool wall = false) const {
+    mechanics::EquilibriumOptions options;
+    options.wallAsBoundary = wall;
+    return mechanics::EquilibriumProblem(out_.chain, loadPath().problemEnd(), spec_.path.direction, options,
                                          controlDirection(), bodyLoads());
   }
   /// The case's weight and point loads along the path (case_body.cpp): g(λ) = λ·direction on a

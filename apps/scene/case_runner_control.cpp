@@ -35,7 +35,9 @@ bool CaseRunner::actuationStart() {
   }
   // exactly zero, not Eigen's isZero() (1e-12 absolute: a payload of 3e-13 N would count as none)
   if ((direction.array() == 0.0).all() && !full.active()) return true;  // no payload: the unloaded shape
-  mech::EquilibriumProblem problem(out_.chain, ramp, direction, {}, {}, body);
+  mech::EquilibriumOptions held;
+  held.wallAsBoundary = tracesWall();  // the payload's history is held at the wall as the path is
+  mech::EquilibriumProblem problem(out_.chain, ramp, direction, held, {}, body);
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();
   opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(n));

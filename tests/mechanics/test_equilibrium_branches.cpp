@@ -821,6 +821,22 @@ using testing::curledShape;
 using testing::curledTrace;
 using testing::withWall;
 
+TEST_CASE("contact: a branch that runs out of points on a later stretch names the branch's max_points, not the "
+          "stretch's share",
+          "[equilibrium][contact]") {
+  const Chain chain = curledChain(true);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), withWall());
+  EquilibriumBranchOptions o = curledTrace(1.0);
+  o.tracer.maxPoints = 30;  // past the wall contact near Fy = 0.11 (point ~10), before the release
+  const EquilibriumBranches r = traceEquilibria(problem, curledShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const cont::Branch& b = r.tree.branches[0];
+  REQUIRE(r.contact[0].size() >= 2);  // it did run into a second stretch
+  CHECK(b.stopReason == cont::StopReason::MaxPoints);
+  CHECK(int(b.points.size()) == o.tracer.maxPoints);
+  INFO(b.stopMessage);
+  CHECK(b.stopMessage.rfind("reached maxPoints = 30 ", 0) == 0);
+}
+
 TEST_CASE("wall: contact_release no longer passes through the wall, holding segment 5 on it between WC and WR",
           "[equilibrium][wall]") {
   const Chain chain = curledChain(true);

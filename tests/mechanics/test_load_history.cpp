@@ -1,15 +1,26 @@
 // Hysteresis: a bistable segment (κ < 0) under an end torque cycled up and down snaps at the
-// folds of its torque–angle curve, from the closed form, and each snap releases energy.
+// folds of its torque–angle curve, from the closed form, and each snap releases energy; and a
+// history held at the base wall, against the tests' own statics (wall_statics.h).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
+#include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/linear_buckling.h"
 #include "buckle/mechanics/load_history.h"
 #include "buckle/mechanics/shape_name.h"
 
+#include "curled_chain.h"
+#include "wall_statics.h"
+
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
+using buckle::test::smallestVertexX;
+using buckle::test::Statics;
+using buckle::test::vertexAt;
+using buckle::test::wallStatics;
 
 namespace {
 
@@ -162,4 +173,75 @@ TEST_CASE("compressed to -2.5, the default chain leaves the U branch by a jump a
   const cont::Branch& after = h.segments[size_t(h.jumps[0].toSegment)];
   CHECK(after.points.back().lambda == Approx(-2.5));
   for (const cont::ContinuationPoint& p : after.points) CHECK(p.u[1] == chain.upperLimits()[1]);  // still locked
+}
+
+TEST_CASE("load history at the base wall: held on it to the waypoint, released where the reversed load brings its "
+          "force back to zero",
+          "[load_history][wall]") {
+  // contact_release's curled chain (curled_chain.h), free end, Fy from 0 up to 0.13 and back:
+  // on the way up segment 5's distal corner reaches the wall and is held on it; on the way down
+  // it leaves the wall where its wall force returns to zero, at the load where it came.
+  const Chain chain = testing::curledChain(false);
+  const double L = chain.linkLengths().sum();
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0), testing::withWall());
+  LoadHistoryOptions o;
+  o.tracer.step.initialStep = 0.01;
+  o.tracer.step.maxStep = 0.02;
+  o.jump.wall = true;
+  const LoadHistoryResult h = followLoadHistory(problem, testing::curledShape(), {0.0, 0.13, 0.0}, o);
+  INFO(h.message);
+  REQUIRE(h.success);
+  CHECK(h.jumps.empty());
+  REQUIRE(h.segments.size() == 2);
+  REQUIRE(h.segmentContacts.size() == 2);
+  const WallVertex v{4, 4};
+  // every point clear of the wall or on it, the held vertex's force that of the test's statics
+  int onWall = 0;
+  for (size_t k = 0; k < 2; ++k)
+    for (size_t i = 0; i < h.segments[k].points.size(); ++i) {
+      const cont::ContinuationPoint& p = h.segments[k].points[i];
+      const Eigen::VectorXd q = p.u.head(5);
+      CHECK(smallestVertexX(chain, q) >= -1e-12 * L);
+      const ContactSet& set = lockedAt(h.segmentContacts[k], int(i));
+      if (set.wallCount() == 0) continue;
+      ++onWall;
+      REQUIRE(set.wallCount() == 1);
+      CHECK(set.wall()[0] == v);
+      CHECK(std::abs(vertexAt(chain, q, v).x()) <= 1e-12 * L);
+      const Statics s = wallStatics(chain, q, Eigen::Vector2d(0.0, p.lambda), v);
+      CHECK(s.imbalance <= 1e-10);
+      CHECK(s.mu >= -1e-12);
+      ContactProblem held(problem, set);
+      CHECK(held.wallForces(*held.createWorkspace(), p.u, p.lambda)[0] == Approx(s.mu).margin(1e-10));
+    }
+  CHECK(onWall >= 4);
+  // leg 1: free, then on the wall from the contact to the waypoint; leg 2: on the wall from the
+  // waypoint to the release, then free again
+  REQUIRE(h.segmentContacts[0].size() == 2);
+  REQUIRE(h.segmentContacts[1].size() == 2);
+  CHECK(h.segmentContacts[0][1].locked.wallCount() == 1);
+  CHECK(h.segmentContacts[1][0].locked.wallCount() == 1);
+  CHECK(h.segmentContacts[1][1].locked.wallCount() == 0);
+  const cont::ContinuationPoint& contact = h.segments[0].points[size_t(h.segmentContacts[0][1].firstPoint - 1)];
+  const cont::ContinuationPoint& release = h.segments[1].points[size_t(h.segmentContacts[1][1].firstPoint - 1)];
+  // both events on the wall with zero force: the same state of the chain, reached from both sides
+  for (const cont::ContinuationPoint* e : {&contact, &release}) {
+    CHECK(std::abs(vertexAt(chain, e->u.head(5), v).x()) <= 1e-12 * L);
+    CHECK(std::abs(wallStatics(chain, e->u.head(5), Eigen::Vector2d(0.0, e->lambda), v).mu) <= 1e-10);
+  }
+  CHECK(release.lambda == Approx(contact.lambda).epsilon(1e-10));
+  CHECK((release.u.head(5) - contact.u.head(5)).cwiseAbs().maxCoeff() <= 1e-8);
+  // the continuation's wall contact on the same chain (equilibrium_branches.h) at the same load
+  const EquilibriumBranches traced = traceEquilibria(problem, testing::curledShape(), 0.0,
+                                                     cont::InitialDirection::increasingLambda(), testing::curledTrace(0.13));
+  const auto& sps = traced.tree.branches[0].specialPoints;
+  const auto wc = std::find_if(sps.begin(), sps.end(),
+                               [](const cont::SpecialPoint& sp) { return sp.boundaryName == EquilibriumProblem::wallBoundaryName(); });
+  REQUIRE(wc != sps.end());
+  CHECK(contact.lambda == Approx(wc->lambda).epsilon(1e-10));
+  // without the wall the same history passes through it
+  EquilibriumProblem ghost(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));
+  const LoadHistoryResult through = followLoadHistory(ghost, testing::curledShape(), {0.0, 0.13}, o);
+  REQUIRE(through.success);
+  CHECK(smallestVertexX(chain, through.segments.back().points.back().u.head(5)) < -1e-3 * L);
 }

@@ -105,13 +105,10 @@ LinkBodies linkBodies(const Chain& chain, ConstVectorRef q) {
   return L;
 }
 
-double distanceAt(const Chain& chain, ConstVectorRef q, bool base) {
-  return base ? baseClearance(chain, q).distance : selfClearance(chain, q).distance;
-}
-
-/// distanceAt along a branch: the self clearance measured from the pair nearest at the last call
-/// first, so the search prunes the others from its distance at once. The same exact value (the
-/// smallest over every pair), a fraction of the cost where nearby shapes follow each other.
+/// The clearance d_base or d_self at q along a branch: the self clearance measured from the pair
+/// nearest at the last call first, so the search prunes the others from its distance at once. The
+/// same exact value (the smallest over every pair), a fraction of the cost where nearby shapes
+/// follow each other.
 class ClearanceProbe {
  public:
   ClearanceProbe(const Chain& chain, bool base) : chain_(chain), base_(base) {}
@@ -139,20 +136,32 @@ double largestMove(const LinkBodies& now, const LinkBodies& before) {
 
 SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint& hint, bool* exact);
 
-/// The clearances of a branch's points (distanceAt) as far as a scan for sign changes needs them:
-/// exact at the base; for the self contact a value with the sign of d_self outside the touching
-/// band. At a reference point selfClearance, warm-started from the previous nearest pair and
-/// ended by a pair deeper than twice the band (its distance then bounds d_self from above); while
-/// every vertex of the bodies has moved by at most δ from the reference, the bound d_ref − 2δ (an
-/// exact d_ref) or d_ref + 2δ in its place — a rigid triangle's points move by at most its
-/// vertices' largest move (the move is affine in the point), so two bodies' signed distance
-/// changes by at most 2δ — as long as the bound keeps the sign of d_ref by the band. O(n) a
-/// point while the nearest pair stays the nearest or overlapping; the nearest-pair search
-/// (O(n log n)) only where the clearance may change sign.
-std::vector<double> scannedDistances(const Chain& chain, const continuation::Branch& branch, bool base) {
+/// d_base of the bodies: the smallest x of the moving vertices (nearestWallVertex's, from the
+/// same positions: the clamped triangle and segment 1's joint left out).
+double baseDistanceOf(const LinkBodies& bodies) {
+  double x = std::numeric_limits<double>::infinity();
+  for (size_t t = 1; t < bodies.triangles.size(); ++t)
+    for (size_t k = t == 1 ? 1 : 0; k < 3; ++k) x = std::min(x, bodies.triangles[t][k].x());
+  return x;
+}
+
+/// The clearances of a branch's points (ClearanceProbe's) as far as a scan for sign changes needs them,
+/// the bodies computed once a point for both: d_base exact at every point (when `base`); for the
+/// self contact a value with the sign of d_self outside the touching band. At a reference point
+/// selfClearance, warm-started from the previous nearest pair and ended by a pair deeper than
+/// twice the band (its distance then bounds d_self from above); while every vertex of the bodies
+/// has moved by at most δ from the reference, the bound d_ref − 2δ (an exact d_ref) or d_ref + 2δ
+/// in its place — a rigid triangle's points move by at most its vertices' largest move (the move
+/// is affine in the point), so two bodies' signed distance changes by at most 2δ — as long as the
+/// bound keeps the sign of d_ref by the band. O(n) a point while the nearest pair stays the
+/// nearest or overlapping; the nearest-pair search (O(n log n)) only where the clearance may
+/// change sign.
+void scanDistances(const Chain& chain, const continuation::Branch& branch, bool base, std::vector<double>& dBase,
+                   std::vector<double>& dSelf) {
   const int n = chain.size();
   const size_t count = branch.points.size();
-  std::vector<double> d(count);
+  dBase.assign(base ? count : 0, 0.0);
+  dSelf.assign(count, 0.0);
   const double band = kTouchingBand * chain.length();
   LinkBodies reference;
   double dRef = std::numeric_limits<double>::quiet_NaN();
@@ -160,31 +169,26 @@ std::vector<double> scannedDistances(const Chain& chain, const continuation::Bra
   SelfClearanceHint hint;
   hint.stopBelow = -2.0 * band;
   for (size_t i = 0; i < count; ++i) {
-    const auto q = branch.points[i].u.head(n);
-    if (base) {
-      d[i] = distanceAt(chain, q, true);
-      continue;
-    }
-    LinkBodies bodies = linkBodies(chain, q);
+    LinkBodies bodies = linkBodies(chain, branch.points[i].u.head(n));
+    if (base) dBase[i] = baseDistanceOf(bodies);
     if (std::isfinite(dRef)) {
       const double moved = 2.0 * largestMove(bodies, reference);
       if (exactRef && dRef - moved > band) {
-        d[i] = dRef - moved;
+        dSelf[i] = dRef - moved;
         continue;
       }
       if (dRef + moved < -band) {
-        d[i] = dRef + moved;
+        dSelf[i] = dRef + moved;
         continue;
       }
     }
     const SelfClearance c = selfClearanceOf(bodies, hint, &exactRef);
-    d[i] = c.distance;
+    dSelf[i] = c.distance;
     hint.linkA = c.linkA;
     hint.linkB = c.linkB;
     reference = std::move(bodies);
-    dRef = d[i];
+    dRef = dSelf[i];
   }
-  return d;
 }
 
 }  // namespace
@@ -310,9 +314,12 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
   const size_t count = branch.points.size();
   if (count < 2) return found;
   const double lambdaScale = problem.scales().parameter;
+  const bool scanBase = !problem.wallIsBoundary();  // the wall as a constraint: WC / WR (contact.h)
+  std::vector<double> dBase, dSelf;
+  scanDistances(chain, branch, scanBase, dBase, dSelf);
   for (bool base : {true, false}) {
-    if (base && problem.wallIsBoundary()) continue;  // the wall is a constraint: WC / WR (contact.h)
-    std::vector<double> d = scannedDistances(chain, branch, base);
+    if (base && !scanBase) continue;
+    std::vector<double>& d = base ? dBase : dSelf;
     ClearanceProbe distance(chain, base);
     // Bodies that rest on each other (a vertex on the wall, triangles meeting where joints lock at
     // their limits) keep their distance within rounding of zero, of either sign: the sign changes

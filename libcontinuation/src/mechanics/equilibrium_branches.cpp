@@ -95,14 +95,6 @@ void appendMirroredTail(const continuation::Reflection& mirror, const continuati
   image.stopMessage = mirror.mapText(source.stopMessage);
 }
 
-// The problem of a stretch with `locked` joints, its contact torques bounded by maxContactTorque
-// torque units (what continueUnderContact traces a locked stretch on).
-std::unique_ptr<ContactProblem> lockedProblem(EquilibriumProblem& problem, const ContactSet& locked,
-                                              double maxContactTorque) {
-  const double torqueUnit = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();
-  return std::make_unique<ContactProblem>(problem, locked, maxContactTorque * torqueUnit);
-}
-
 // dg/ds at the start p0 of a stretch (on its problem's unknowns (q, r, μ), λ) for the changed
 // contact's boundary g: a released joint's g = side·(q̄ − q) moves with −side·t_q; a joint contact's
 // compression −side·τ_c with −side·(F_u,i t_u + F_λ,i t_λ) (row i of the stretch before, exact); a
@@ -184,6 +176,12 @@ int repeatedStretch(const EquilibriumProblem& problem, const continuation::Branc
 }
 
 }  // namespace
+
+std::unique_ptr<ContactProblem> lockedProblem(EquilibriumProblem& problem, const ContactSet& locked,
+                                              double maxContactTorque) {
+  const double torqueUnit = problem.stiffnessUnit() * problem.lengthUnit() * problem.lengthUnit();
+  return std::make_unique<ContactProblem>(problem, locked, maxContactTorque * torqueUnit);
+}
 
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
                                                  const continuation::TracerOptions& options, int maxContactEvents,
@@ -325,6 +323,9 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     }
     branch.stopReason = stretch.stopReason;
     branch.stopMessage = stretch.stopMessage;
+    if (branch.stopReason == continuation::StopReason::MaxPoints)  // the stretch's share named the branch's
+      branch.stopMessage = "reached maxPoints = " + std::to_string(options.maxPoints) + " (the whole branch, over " +
+                           std::to_string(stretches.size() + 1) + " contact stretches)";
     stretches.push_back(ContactStretch{base + 1, locked});
     current = std::move(next);
   }

@@ -77,11 +77,23 @@ int firstLeavingPoint(const cont::Branch& branch, double sign, bool& isLoss) {
   return isLoss ? lost : turn;
 }
 
-// Keeps the points of `branch` up to the special point `sp` and ends it there. The last point's
-// eigenvalues are evaluated at sp itself (its lowest is zero there, not the traced point's before
-// it); its count stays the piece's (the limit from the side the piece was traced on: a stable
-// piece ends stable at its fold).
-cont::Branch cutAt(const cont::BoundProblem& problem, const cont::Branch& branch, const cont::SpecialPoint& sp) {
+// The stability of (u, λ) (the problem's unknowns (q, r)) on the contacts `set` it stands on:
+// that of the stretch's problem (contact.h), the wall forces recovered for its unknowns.
+bool stabilityOn(EquilibriumProblem& problem, const ContactSet& set, const Vector& u, double lambda, int wanted,
+                 cont::StabilityInfo& info) {
+  if (set.empty()) return cont::BoundProblem(problem).stability(u, lambda, wanted, info);
+  const std::unique_ptr<ContactProblem> stretch = lockedProblem(problem, set, EquilibriumBranchOptions().maxContactTorque);
+  const Vector x = set.wallCount() > 0 ? stretch->withWallForces(*stretch->createWorkspace(), u, lambda) : u;
+  return cont::BoundProblem(*stretch).stability(x, lambda, wanted, info);
+}
+
+// Keeps the points of `branch` up to the special point `sp` and ends it there, its contact
+// stretches with it. The last point's eigenvalues are evaluated at sp itself, on the contacts
+// there (its lowest is zero there, not the traced point's before it); its count stays the
+// piece's (the limit from the side the piece was traced on: a stable piece ends stable at its
+// fold).
+cont::Branch cutAt(EquilibriumProblem& problem, const cont::Branch& branch, std::vector<ContactStretch>& stretches,
+                   const cont::SpecialPoint& sp) {
   cont::Branch cut = branch;
   cut.points.resize(std::min(cut.points.size(), size_t(sp.index) + 1));
   cont::ContinuationPoint last = cut.points.back();
@@ -92,8 +104,12 @@ cont::Branch cutAt(const cont::BoundProblem& problem, const cont::Branch& branch
   last.foldTest = sp.tangent.size() > 0 ? sp.tangent[sp.tangent.size() - 1] : last.foldTest;
   last.spectrum = {};
   const int wanted = std::max<int>(1, int(last.stability.lowest.size()));
+  const int lastIndex = int(cut.points.size());
+  stretches.erase(std::remove_if(stretches.begin() + 1, stretches.end(),
+                                 [&](const ContactStretch& s) { return s.firstPoint > lastIndex; }),
+                  stretches.end());
   cont::StabilityInfo info;
-  if (problem.stability(sp.u, sp.lambda, wanted, info) && info.lowest.size() > 0) {
+  if (stabilityOn(problem, stretches.back().locked, sp.u, sp.lambda, wanted, info) && info.lowest.size() > 0) {
     last.stability.lowest = info.lowest;
     last.stability.smallest = info.smallest;
   }
@@ -125,16 +141,6 @@ bool followBifurcated(EquilibriumProblem& problem, const cont::SpecialPoint& sp,
   if (sides.empty() || !supercritical(sides.back())) return false;
   child = std::move(sides.back());
   return true;
-}
-
-// The boundary (joint, side) the branch traced on `traced` stopped on; joint −1: none.
-LockedJoint stoppedOn(const cont::Problem& traced, const cont::Branch& branch, int segments) {
-  if (branch.stopReason != cont::StopReason::Boundary || branch.specialPoints.empty()) return {};
-  const cont::SpecialPoint& sp = branch.specialPoints.back();
-  if (sp.type != cont::SpecialPointType::Boundary) return {};
-  for (int k = 0; k < std::min(traced.boundaryCount(), 2 * segments); ++k)  // the joints' limits
-    if (traced.boundaryName(k) == sp.boundaryName) return limitOfBoundary(k, segments);
-  return {};
 }
 
 ContactSet contactSetOf(const std::vector<int>& sides, const std::vector<WallVertex>& wall = {}) {
@@ -184,8 +190,10 @@ bool releaseChain(EquilibriumProblem& problem, const LoadHistoryOptions& options
 
 // A quasi-static piece of the history, traced in leg `leg`; the last jump landed on it if it has
 // no landing piece yet.
-void addSegment(LoadHistoryResult& result, cont::Branch branch, int leg, bool bifurcated) {
+void addSegment(LoadHistoryResult& result, cont::Branch branch, std::vector<ContactStretch> stretches, int leg,
+                bool bifurcated) {
   result.segments.push_back(std::move(branch));
+  result.segmentContacts.push_back(std::move(stretches));
   result.segmentLeg.push_back(leg);
   result.segmentBifurcated.push_back(bifurcated);
   if (!result.jumps.empty() && result.jumps.back().toSegment < 0)
@@ -245,39 +253,22 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       legOptions.lambdaMax = std::max(lambda, target);
       const cont::InitialDirection direction =
           sign > 0 ? cont::InitialDirection::increasingLambda() : cont::InitialDirection::decreasingLambda();
-      std::unique_ptr<ContactProblem> lockedProblem;
-      if (!locked.empty()) lockedProblem = std::make_unique<ContactProblem>(problem, locked);
+      // A piece starts with the contacts it stands on (a landing against joint stops or on the
+      // base wall, a piece before it run into them) and, as the continuation's branches, goes
+      // on through the joint limits and the wall (EquilibriumOptions::wallAsBoundary) it meets:
+      // a contact holds until its force returns to zero (continueUnderContact).
+      const EquilibriumBranchOptions contact;  // the continuation's bounds on contact events and torques
+      std::unique_ptr<ContactProblem> stretchProblem;
+      if (!locked.empty()) stretchProblem = lockedProblem(problem, locked, contact.maxContactTorque);
       // a piece with vertices on the wall has their forces among its unknowns (contact.h)
-      if (lockedProblem && u.size() == problem.dimension() && locked.wallCount() > 0)
-        u = lockedProblem->withWallForces(*lockedProblem->createWorkspace(), u, lambda);
-      else if (u.size() > problem.dimension() && (!lockedProblem || locked.wallCount() == 0))
+      if (stretchProblem && u.size() == problem.dimension() && locked.wallCount() > 0)
+        u = stretchProblem->withWallForces(*stretchProblem->createWorkspace(), u, lambda);
+      else if (u.size() > problem.dimension() && (!stretchProblem || locked.wallCount() == 0))
         u = Vector(u.head(problem.dimension()));
-      cont::Branch branch = lockedProblem ? cont::trace(*lockedProblem, u, lambda, direction, legOptions)
-                                          : cont::trace(problem, u, lambda, direction, legOptions);
-      if (!lockedProblem) {
-        // a free piece that runs into a joint limit goes on with the joint locked (and released
-        // again where its contact torque vanishes), in the same piece
-        const std::vector<ContactStretch> stretches = continueUnderContact(problem, branch, legOptions);
-        locked = stretches.back().locked;
-      } else {
-        // a locked piece that ends where a contact releases or another joint reaches its limit:
-        // the next piece starts there with the new set (polished), at the end of this one
-        const LockedJoint hit = stoppedOn(*lockedProblem, branch, problem.segments());
-        if (hit.joint >= 0 && firstLossOfStability(branch) < 0) {
-          ContactSet next = locked;
-          if (next.locked(hit.joint) && next.side(hit.joint) == hit.side) next.release(hit.joint);
-          else next.lock(hit.joint, hit.side);
-          const cont::SpecialPoint& at = branch.specialPoints.back();
-          const ConstrainedEquilibrium ce = solveConstrainedEquilibrium(problem, next, at.u.head(problem.dimension()), at.lambda);
-          if (ce.converged) {
-            addSegment(result, branch, int(leg), false);
-            locked = next;
-            u = ce.u;
-            lambda = at.lambda;
-            continue;
-          }
-        }
-      }
+      cont::Branch branch = stretchProblem ? cont::trace(*stretchProblem, u, lambda, direction, legOptions)
+                                           : cont::trace(problem, u, lambda, direction, legOptions);
+      std::vector<ContactStretch> stretches =
+          continueUnderContact(problem, branch, legOptions, contact.maxContactEvents, contact.maxContactTorque, locked);
       if (branch.points.empty()) {
         result.message = "continuation could not start at lambda = " + std::to_string(lambda) + ": " + branch.stopMessage;
         return result;
@@ -287,15 +278,21 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       // supercritical branch points (and the pitchfork's tip reached while unloading): the chain
       // goes on along the stable branch through the point that continues in the loading direction
       cont::Branch child;
-      while (lost >= 0 && followBifurcated(problem, branch.specialPoints[size_t(lost)], legOptions, sign, child)) {
-        addSegment(result, cutAt(problem, branch, branch.specialPoints[size_t(lost)]), int(leg), bifurcated);
+      // (the bifurcated branch is traced on the free chain: at a branch point with contacts the
+      // chain jumps instead)
+      while (lost >= 0 && lockedAt(stretches, branch.specialPoints[size_t(lost)].index + 1).empty() &&
+             followBifurcated(problem, branch.specialPoints[size_t(lost)], legOptions, sign, child)) {
+        cont::Branch piece = cutAt(problem, branch, stretches, branch.specialPoints[size_t(lost)]);
+        addSegment(result, std::move(piece), std::move(stretches), int(leg), bifurcated);
         branch = std::move(child);
+        stretches = {ContactStretch{}};
         bifurcated = true;
         lost = firstLeavingPoint(branch, sign, isLoss);
       }
       if (lost >= 0 && !isLoss) lost = firstLossOfStability(branch);  // a turn not followed: as before
       if (lost < 0) {
-        addSegment(result, branch, int(leg), bifurcated);
+        locked = stretches.back().locked;
+        addSegment(result, branch, std::move(stretches), int(leg), bifurcated);
         const cont::ContinuationPoint& end = branch.points.back();
         if (branch.stopReason != cont::StopReason::LambdaRange || std::abs(end.lambda - target) > 1e-9 * std::max(lambdaUnit, std::abs(target))) {
           result.message = "leg " + std::to_string(leg) + " stopped before its waypoint: " + branch.stopMessage;
@@ -306,7 +303,8 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
         break;
       }
       const cont::SpecialPoint sp = branch.specialPoints[size_t(lost)];
-      addSegment(result, cutAt(problem, branch, sp), int(leg), bifurcated);
+      cont::Branch piece = cutAt(problem, branch, stretches, sp);
+      addSegment(result, std::move(piece), std::move(stretches), int(leg), bifurcated);
       const double at = sp.lambda + sign * options.overshoot * std::max(lambdaUnit, std::abs(sp.lambda));
       const JumpTrigger trigger = sp.type == cont::SpecialPointType::Fold ? JumpTrigger::Fold : JumpTrigger::BranchPoint;
       if (!releaseChain(problem, options, trigger, sp.u, sp.lambda, at, int(result.segments.size()) - 1, result)) {

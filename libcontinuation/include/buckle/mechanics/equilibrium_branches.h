@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,6 +83,12 @@ struct EquilibriumBranches {
 /// keeps (q, r) per point: the wall forces of stretches with vertices on the wall (contact.h),
 /// also those of a branch traced with `initial` vertices on the wall, are dropped
 /// (ContactProblem::wallForces recovers them), and its branch points are not switched at.
+/// The problem of a stretch with `locked` joints and wall vertices, its contact torques bounded by
+/// maxContactTorque torque units (k b² of the problem's scales): what continueUnderContact traces
+/// a stretch on.
+std::unique_ptr<ContactProblem> lockedProblem(EquilibriumProblem& problem, const ContactSet& locked,
+                                              double maxContactTorque);
+
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
                                                  const continuation::TracerOptions& options,
                                                  int maxContactEvents = 50, double maxContactTorque = 10.0,

@@ -14,6 +14,7 @@
 
 #include "buckle/continuation/branch.h"
 #include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/jump.h"
 
@@ -66,6 +67,10 @@ struct LoadHistoryResult {
   /// Stable quasi-static pieces, in the order they were followed; each ends at a waypoint, at a
   /// point where stability was lost, or where the history stopped.
   std::vector<continuation::Branch> segments;
+  /// The contacts of each segment's points: its stretches (equilibrium_branches.h), the first
+  /// from its first point; a segment runs on through the joint limits and, with
+  /// EquilibriumOptions::wallAsBoundary, the base wall it meets, as a continuation branch does.
+  std::vector<std::vector<ContactStretch>> segmentContacts;
   std::vector<int> segmentLeg;     ///< leg (waypoint interval) of each segment
   /// True for a segment that starts at the supercritical branch point ending the one before it
   /// (the chain followed the bifurcated branch there, without a jump).
