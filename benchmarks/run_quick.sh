@@ -36,4 +36,5 @@ run vibration_timing "$BIN/vibration_timing" --quick
 run actuation_path "$BIN/actuation_path" --quick   # issue 29
 run task_path "$BIN/task_path" --quick   # issue 29, task-space paths
 run gravity_path "$BIN/gravity_path" --quick   # issue 31, weight
+run wall_path "$BIN/wall_path" --quick   # issue 31, the base wall
 exit $status
