@@ -2,10 +2,12 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <cmath>
-#include <string>
-#include <cstdlib>
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
 
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/end_condition.h"
@@ -54,6 +56,27 @@ inline void parseRepsQuick(int argc, char** argv, int& reps, bool& quick) {
     else if (std::string(argv[i]) == "--quick") quick = true;
   }
   if (quick) reps = 1;
+}
+
+/// A path benchmark's command line: `--reps R`, `--quick` (parseRepsQuick) and the chain sizes of
+/// `--n N` options (each ≥ 3; `defaults` when none is given).
+struct PathArgs {
+  int reps = 3;
+  bool quick = false;
+  std::vector<int> sizes;
+};
+inline PathArgs pathArgs(int argc, char** argv, std::vector<int> defaults) {
+  PathArgs a;
+  parseRepsQuick(argc, argv, a.reps, a.quick);
+  for (int i = 1; i + 1 < argc; ++i)
+    if (std::string(argv[i]) == "--n") a.sizes.push_back(std::max(3, std::atoi(argv[++i])));
+  if (a.sizes.empty()) a.sizes = std::move(defaults);
+  return a;
+}
+
+/// Seconds since t0 on the steady clock.
+inline double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace buckle::bench

@@ -33,10 +33,6 @@ struct Row {
   double gEnd = 0.0, tipEnd = 0.0;
 };
 
-double elapsed(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 Row run(int n, double b, double k, int reps) {
   const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5 * b, b, k, 2.25 * b));
   const double gRef = 9.81, rho = 0.5 * k * b / (gRef * n * n * b);
@@ -53,14 +49,14 @@ Row run(int n, double b, double k, int reps) {
     EquilibriumProblem heavy(chain, EndCondition::freeEnd(), Eigen::Vector3d::Zero(), {}, {}, body);
     auto t0 = std::chrono::steady_clock::now();
     const cont::Branch br = cont::trace(heavy, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), o);
-    row.seconds = std::min(row.seconds, elapsed(t0));
+    row.seconds = std::min(row.seconds, buckle::bench::secondsSince(t0));
     row.points = br.points.size();
     row.gEnd = br.points.back().lambda;
     row.tipEnd = endPose(chain, br.points.back().u.head(n))[1] / chain.length();
     EquilibriumProblem endLoad(chain, EndCondition::freeEnd(), Eigen::Vector3d(0.0, -1.0, 0.0));
     t0 = std::chrono::steady_clock::now();
     const cont::Branch be = cont::trace(endLoad, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::increasingLambda(), o);
-    row.endLoadSeconds = std::min(row.endLoadSeconds, elapsed(t0));
+    row.endLoadSeconds = std::min(row.endLoadSeconds, buckle::bench::secondsSince(t0));
     row.endLoadPoints = be.points.size();
   }
   return row;

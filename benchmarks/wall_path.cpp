@@ -17,9 +17,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
-#include <string>
 #include <vector>
 
 #include "buckle/continuation/tracer.h"
@@ -42,10 +40,6 @@ struct Row {
   double lambdaEnd = 0;  // Fx = −λ at the end, in k b
 };
 
-double elapsed(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 Row run(int n, double b, double k, int reps) {
   const Eigen::VectorXd q0 = Eigen::VectorXd::Constant(n, 2.8 / n);
   const std::vector<SegmentParameters> segments(size_t(n), SegmentParameters::symmetric(0.5 * b, b, k, 2.25 * b));
@@ -62,18 +56,18 @@ Row run(int n, double b, double k, int reps) {
     EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(-1.0, 0.0, 0.0), wall);
     auto t0 = std::chrono::steady_clock::now();
     cont::Branch branch = cont::trace(problem, q0, 0.0, cont::InitialDirection::increasingLambda(), o);
-    row.freeSeconds = std::min(row.freeSeconds, elapsed(t0));
+    row.freeSeconds = std::min(row.freeSeconds, buckle::bench::secondsSince(t0));
     row.freePoints = branch.points.size();
     t0 = std::chrono::steady_clock::now();
     const std::vector<ContactStretch> stretches = continueUnderContact(problem, branch, o);
-    row.wallSeconds = std::min(row.wallSeconds, elapsed(t0));
+    row.wallSeconds = std::min(row.wallSeconds, buckle::bench::secondsSince(t0));
     row.wallPoints = branch.points.size() - row.freePoints;
     row.held = stretches.back().locked.wallCount();
     row.lambdaEnd = branch.points.back().lambda / (k * b);
     EquilibriumProblem ghost(chain, EndCondition::freeEnd(), Eigen::Vector3d(-1.0, 0.0, 0.0));
     t0 = std::chrono::steady_clock::now();
     const cont::Branch through = cont::trace(ghost, q0, 0.0, cont::InitialDirection::increasingLambda(), o);
-    row.ghostSeconds = std::min(row.ghostSeconds, elapsed(t0));
+    row.ghostSeconds = std::min(row.ghostSeconds, buckle::bench::secondsSince(t0));
     row.ghostPoints = through.points.size();
   }
   return row;
@@ -82,19 +76,13 @@ Row run(int n, double b, double k, int reps) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int reps = 3;
-  bool quick = false;
-  buckle::bench::parseRepsQuick(argc, argv, reps, quick);
-  std::vector<int> sizes;
-  for (int i = 1; i + 1 < argc; ++i)
-    if (std::string(argv[i]) == "--n") sizes.push_back(std::max(3, std::atoi(argv[++i])));
-  if (sizes.empty()) sizes = {3, 50, 1000};
+  const buckle::bench::PathArgs args = buckle::bench::pathArgs(argc, argv, {3, 50, 1000});
   std::printf("%-16s %6s %12s %14s %12s %14s %6s %14s %18s\n", "units", "n", "free points", "free us/point",
               "wall points", "wall us/point", "held", "-Fx end (k b)", "no wall us/point");
   for (const buckle::bench::BenchUnits& u : buckle::bench::kBenchUnits)
-    for (int n : sizes) {
-      if (quick && n > 50) continue;
-      const Row r = run(n, u.b, u.k, reps);
+    for (int n : args.sizes) {
+      if (args.quick && n > 50) continue;
+      const Row r = run(n, u.b, u.k, args.reps);
       std::printf("%-16s %6d %12zu %14.1f %12zu %14.1f %6d %14.6g %18.1f\n", u.name, n, r.freePoints,
                   1e6 * r.freeSeconds / double(std::max<size_t>(1, r.freePoints)), r.wallPoints,
                   1e6 * r.wallSeconds / double(std::max<size_t>(1, r.wallPoints)), r.held, r.lambdaEnd,
