@@ -534,6 +534,50 @@ TEST_CASE("eigenvalues from a warm start a step away cost a few factorizations e
   CHECK(double(total) / double(eigenvalues) <= 5.0);
 }
 
+TEST_CASE("eigenvalues in a cluster: a warm start is certified within the tolerance, not bisected from the outer bounds",
+          "[chain_structure]") {
+  // An unloaded uniform chain (a stretch whose load the base wall takes) has H = K_q: every
+  // eigenvalue at κ within rounding, or, under a load of 1e-14 k, hundreds within 1e-10 of it
+  // (wider than the tolerance). From the previous point's value (here the exact one or 1e-12 of
+  // it away) Newton on det stops at the cluster; the counts either side then put eigenvalue j
+  // in a bracket narrower than the tolerance. Both against the dense reduced spectrum, on and off
+  // ker C; the tight cluster in at most 10 factorizations an eigenvalue (a demand for isolation
+  // bisected from ±‖H‖: about 25), the wider one from below in at most 10 too (the bracket's
+  // end widening towards it).
+  const int n = 300;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const Vector q = Vector::Constant(n, 0.01);
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  Matrix J(3, n);
+  endJacobian(data, J);
+  for (double load : {0.0, 1e-14}) {
+    const Wrench F(-load, 0.5 * load, 0.0);
+    Matrix H(n, n);
+    totalPotentialHessian(chain, q, F, H);
+    ChainStructure ws(n);
+    assemble(chain, data, q, F, ws);
+    const double scale = std::max(1.0, H.norm());
+    for (const auto& held : kHeldSets) {
+      INFO("load " << load << ", " << held.size() << " held rows");
+      const Matrix C = rows(J, held);
+      const Vector all = reducedEigenvalues(H, C);
+      const Vector exact = all.head(2);
+      const double spread = all.maxCoeff() - all.minCoeff();
+      CHECK(spread <= (load == 0.0 ? 1e-13 : 1e-9) * scale);  // a cluster, within the tolerance or not
+      for (double rel : {0.0, -1e-12, 1e-12}) {
+        const Vector guess = exact.array() * (1.0 + rel);
+        setConstraints(ws, C);
+        const long before = ws.factorizations;
+        Vector out(2);
+        REQUIRE(lowestEigenvalues(ws, !held.empty(), 2, out, 1e-13, &guess) == 2);
+        for (int j = 0; j < 2; ++j) CHECK(std::abs(out[j] - exact[j]) <= 1e-11 * scale);
+        if (load == 0.0 || rel <= 0.0) CHECK(ws.factorizations - before <= 2 * 10);
+      }
+    }
+  }
+}
+
 TEST_CASE("lowest eigenvalues from a warm start that isolates some brackets and not others, with held joints",
           "[chain_structure]") {
   // A guess that isolates eigenvalue j needs no outer bound ±‖H‖_F; one that does not falls back
