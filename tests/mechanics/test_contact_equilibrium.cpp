@@ -16,23 +16,18 @@
 
 #include "curled_chain.h"
 #include "test_geometry.h"
+#include "wall_statics.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
 
 namespace {
 
-using buckle::test::across;
-using buckle::test::along;
 using buckle::test::geometry;
 using buckle::test::Geometry;
-using buckle::test::moment;
-
-// Distal base corner −a of segment i: its joint + b2 along θ_(i+1) − a2 across it.
-Eigen::Vector2d distalMinus(const Chain& chain, const Geometry& g, int i) {
-  const SegmentParameters& p = chain.segment(i).parameters();
-  return g.P.col(i) + p.b2 * along(g.theta[i + 1]) - p.a2 * across(g.theta[i + 1]);
-}
+using buckle::test::Statics;
+using buckle::test::vertexAt;
+using buckle::test::wallStatics;
 
 // The contact_release chain without its joint stop, lengths scaled by sL, stiffnesses by sK.
 Chain curledChain(double sL = 1.0, double sK = 1.0) { return testing::curledChain(false, sL, sK); }
@@ -82,21 +77,15 @@ TEST_CASE("wall: a segment pressed against the wall holds its vertex there with 
     if (pt.locked.wallCount() == 0) continue;
     REQUIRE(pt.locked.wall() == std::vector<WallVertex>{WallVertex{4, 4}});
     ++pressed;
-    const Geometry g = geometry(chain, pt.q);
-    const Eigen::Vector2d v = distalMinus(chain, g, 4);
-    CHECK(std::abs(v.x()) <= 1e-12);  // on the wall
-    // Moment balance of the part beyond each joint j: the springs' ∂E/∂q_j carries the moments
-    // of the end force and of the wall's push μ (along +x, at v) about P_j. Joint 5's row gives μ;
-    // the four others must then balance with it.
-    Eigen::VectorXd dE(5);
-    for (int j = 0; j < 5; ++j) dE[j] = -chain.segment(j).torque(pt.q[j]);
-    const Eigen::Vector2d F(pt.F[0], pt.F[1]);
-    const double mu = (dE[4] - moment(g.end, g.P.col(4), F)) / moment(v, g.P.col(4), Eigen::Vector2d(1.0, 0.0));
-    for (int j = 0; j < 5; ++j)
-      CHECK(std::abs(dE[j] - moment(g.end, g.P.col(j), F) - mu * moment(v, g.P.col(j), {1.0, 0.0})) <= 1e-12);
+    CHECK(std::abs(vertexAt(chain, pt.q, WallVertex{4, 4}).x()) <= 1e-12);  // on the wall
+    // Moment balance of the part beyond each joint j (wall_statics.h): the springs' ∂E/∂q_j
+    // carries the moments of the end force and of the wall's push μ (along +x, at the vertex)
+    // about P_j. Joint 5's row gives μ; the four others must then balance with it.
+    const Statics st = wallStatics(chain, pt.q, Eigen::Vector2d(pt.F[0], pt.F[1]), WallVertex{4, 4});
+    CHECK(st.imbalance <= 1e-12);
     REQUIRE(pt.wallForces.size() == 1);
-    CHECK(pt.wallForces[0] == Approx(mu).epsilon(1e-10).margin(1e-13));
-    CHECK(mu >= -1e-13);  // the wall pushes
+    CHECK(pt.wallForces[0] == Approx(st.mu).epsilon(1e-10).margin(1e-13));
+    CHECK(st.mu >= -1e-13);  // the wall pushes
   }
   CHECK(pressed >= 5);
   // the force grows from zero at the contact
@@ -169,33 +158,26 @@ TEST_CASE("wall: the constrained stability equals a dense eigen-solve on the ker
     // checked against central differences.
     Eigen::MatrixXd H(n, n);
     totalPotentialHessian(chain, q, Wrench(-0.3 + lambda, 0.2, 0.0), H);
-    auto vertexAt = [&](const Eigen::VectorXd& qq, const WallVertex& v) -> Eigen::Vector2d {
-      const Geometry g = geometry(chain, qq);
-      const SegmentParameters& p = chain.segment(v.segment).parameters();
-      if (v.corner == 0) return g.P.col(v.segment);
-      const double t = g.theta[v.segment + 1];
-      return g.P.col(v.segment) + p.b2 * along(t) + (v.corner == 3 ? 1.0 : -1.0) * p.a2 * across(t);
-    };
     Eigen::MatrixXd C = Eigen::MatrixXd::Zero(4, n);
     const Geometry g = geometry(chain, q);
     for (int j = 0; j < n; ++j) C(0, j) = g.end.x() - g.P(0, j);  // ∂y/∂q_j
     C(1, 1) = 1.0;
     for (int k = 0; k < 2; ++k) {
       const WallVertex& v = set.wall()[size_t(k)];
-      const Eigen::Vector2d x = vertexAt(q, v);
+      const Eigen::Vector2d x = vertexAt(chain, q, v);
       const int last = v.corner == 0 ? v.segment - 1 : v.segment;
       for (int j = 0; j < n; ++j) {
         Eigen::VectorXd a = q, b = q;
         a[j] += 1e-6;
         b[j] -= 1e-6;
-        C(2 + k, j) = (vertexAt(a, v).x() - vertexAt(b, v).x()) / 2e-6;
+        C(2 + k, j) = (vertexAt(chain, a, v).x() - vertexAt(chain, b, v).x()) / 2e-6;
         for (int l = 0; l < n; ++l) {
           const double d2 = j <= last && l <= last ? -(x.x() - g.P(0, std::max(j, l))) : 0.0;
           if (j % 7 == 0 && l % 5 == 0) {  // spot checks of the closed form
             Eigen::VectorXd pp = q, pm = q, mp = q, mm = q;
             const double h = 1e-4;
             pp[j] += h, pp[l] += h, pm[j] += h, pm[l] -= h, mp[j] -= h, mp[l] += h, mm[j] -= h, mm[l] -= h;
-            const double fd = (vertexAt(pp, v).x() - vertexAt(pm, v).x() - vertexAt(mp, v).x() + vertexAt(mm, v).x()) /
+            const double fd = (vertexAt(chain, pp, v).x() - vertexAt(chain, pm, v).x() - vertexAt(chain, mp, v).x() + vertexAt(chain, mm, v).x()) /
                               (4 * h * h);
             CHECK(std::abs(fd - d2) <= 1e-5 * std::max(1.0, std::abs(d2)));
           }

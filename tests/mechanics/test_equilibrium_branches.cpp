@@ -16,6 +16,7 @@
 #include "buckle/mechanics/unloaded_shape.h"
 #include "buckle/mechanics/wall_contact.h"
 #include "curled_chain.h"
+#include "wall_statics.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -855,24 +856,10 @@ TEST_CASE("wall: contact_release no longer passes through the wall, holding segm
   CHECK(selfClearance(chain, curledShape()).distance < 0.0);
   CHECK(r.tree.branches[0].stopReason == cont::StopReason::LambdaRange);
   // every traced point, and every point of the free chain's own trace (wall off) in between,
-  // against the test's own vertices: the moving triangles' corners and joints
-  auto smallestX = [&chain](const Eigen::VectorXd& q) {
-    const Eigen::Matrix2Xd P = jointPositions(chain, q);
-    double x = std::numeric_limits<double>::infinity(), theta = 0.0;
-    for (int i = 0; i < chain.size(); ++i) {
-      const SegmentParameters& p = chain.segment(i).parameters();
-      const double before = theta, after = theta + q[i];
-      const Eigen::Vector2d j = P.col(i + 1);
-      for (double s : {1.0, -1.0}) {
-        if (i > 0) x = std::min({x, j.x(), j.x() - p.b1 * std::cos(before) - s * p.a1 * std::sin(before)});
-        x = std::min(x, j.x() + p.b2 * std::cos(after) - s * p.a2 * std::sin(after));
-      }
-      theta = after;
-    }
-    return x;
-  };
+  // against the test's own vertices (wall_statics.h): the moving triangles' corners and joints
   double deepest = 0.0;
-  for (const cont::ContinuationPoint& p : r.tree.branches[0].points) deepest = std::min(deepest, smallestX(p.u.head(5)));
+  for (const cont::ContinuationPoint& p : r.tree.branches[0].points)
+    deepest = std::min(deepest, buckle::test::smallestVertexX(chain, p.u.head(5)));
   CHECK(deepest >= -1e-12);
   // the wall stretch: vertex 5d- held, pushed (μ ≥ 0); the wall forces 0 at both ends
   const SpecialPointReport* wc = nullptr;
@@ -900,7 +887,8 @@ TEST_CASE("wall: contact_release no longer passes through the wall, holding segm
   EquilibriumProblem ghost(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 1, 0));
   const EquilibriumBranches g = traceEquilibria(ghost, curledShape(), 0.0, cont::InitialDirection::increasingLambda(), o);
   double ghostDeepest = 0.0;
-  for (const cont::ContinuationPoint& p : g.tree.branches[0].points) ghostDeepest = std::min(ghostDeepest, smallestX(p.u.head(5)));
+  for (const cont::ContinuationPoint& p : g.tree.branches[0].points)
+    ghostDeepest = std::min(ghostDeepest, buckle::test::smallestVertexX(chain, p.u.head(5)));
   CHECK(ghostDeepest < -1e-2);
 }
 
