@@ -12,6 +12,7 @@
 namespace buckle::mechanics {
 
 using structure::kBunchAlpha;
+using structure::largestBlockEigenvalue;
 using structure::kTinyPivot;
 
 namespace {
@@ -105,7 +106,7 @@ void factorize(ChainStructure& ws, double sigma, bool determinant) {
       sign = -sign;
       accumulate(det);
       // smallest |eigenvalue| of the block ≥ |det| / (largest |eigenvalue|)
-      const double big = 0.5 * std::abs(dk + b) + std::hypot(0.5 * (dk - b), ek);
+      const double big = largestBlockEigenvalue(dk, b, ek);
       minRatio = std::min(minRatio, std::abs(det) / (big * scale));
       const double ddet = ddk * b - dk * metricDiagonal(k + 1, n) - 2.0 * ek;
       if (determinant) dLog += ddet / det;

@@ -80,11 +80,12 @@ struct LinkBodies {
   std::vector<Triangle> triangles;  ///< link m's are triangles[first[m]] … [first[m + 1] − 1]
   std::vector<int> first;
 };
-LinkBodies linkBodies(const Chain& chain, ConstVectorRef q) {
+void linkBodies(const Chain& chain, ConstVectorRef q, LinkBodies& L) {
   const int n = chain.size();
-  LinkBodies L;
   L.P = jointPositions(chain, q);
   const Eigen::Matrix2Xd& P = L.P;
+  L.triangles.clear();
+  L.first.clear();
   L.triangles.reserve(size_t(2 * n));
   L.first.reserve(size_t(n + 2));
   double theta = 0.0;
@@ -102,8 +103,23 @@ LinkBodies linkBodies(const Chain& chain, ConstVectorRef q) {
   }
   L.first.push_back(int(L.triangles.size()) - 1);
   L.first.push_back(int(L.triangles.size()));
+}
+LinkBodies linkBodies(const Chain& chain, ConstVectorRef q) {
+  LinkBodies L;
+  linkBodies(chain, q, L);
   return L;
 }
+
+/// selfClearanceOf's working storage, kept across the points of a scan: no allocation per point,
+/// and the links' order by x from the last shape, which the next one mostly keeps.
+struct ClearanceScratch {
+  std::vector<double> reach, xs, radius;
+  Eigen::Matrix2Xd mid;
+  std::vector<int> byX, candidates;
+};
+
+SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint& hint, bool* exact,
+                              ClearanceScratch& scratch);
 
 /// The clearance d_base or d_self at q along a branch: the self clearance measured from the pair
 /// nearest at the last call first, so the search prunes the others from its distance at once. The
@@ -114,7 +130,7 @@ class ClearanceProbe {
   ClearanceProbe(const Chain& chain, bool base) : chain_(chain), base_(base) {}
   double operator()(ConstVectorRef q) {
     if (base_) return baseClearance(chain_, q).distance;
-    const SelfClearance c = selfClearance(chain_, q, hint_, nullptr);
+    const SelfClearance c = selfClearanceOf(linkBodies(chain_, q), hint_, nullptr, scratch_);
     hint_.linkA = c.linkA;
     hint_.linkB = c.linkB;
     return c.distance;
@@ -124,6 +140,7 @@ class ClearanceProbe {
   const Chain& chain_;
   bool base_;
   SelfClearanceHint hint_;
+  ClearanceScratch scratch_;
 };
 
 /// The largest distance a vertex of the bodies has moved between two shapes of the same chain.
@@ -133,8 +150,6 @@ double largestMove(const LinkBodies& now, const LinkBodies& before) {
     for (size_t k = 0; k < 3; ++k) move = std::max(move, (now.triangles[t][k] - before.triangles[t][k]).norm());
   return move;
 }
-
-SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint& hint, bool* exact);
 
 /// d_base of the bodies: the smallest x of the moving vertices (nearestWallVertex's, from the
 /// same positions: the clamped triangle and segment 1's joint left out).
@@ -163,13 +178,14 @@ void scanDistances(const Chain& chain, const continuation::Branch& branch, bool 
   dBase.assign(base ? count : 0, 0.0);
   dSelf.assign(count, 0.0);
   const double band = kTouchingBand * chain.length();
-  LinkBodies reference;
+  LinkBodies reference, bodies;
   double dRef = std::numeric_limits<double>::quiet_NaN();
   bool exactRef = false;
   SelfClearanceHint hint;
   hint.stopBelow = -2.0 * band;
+  ClearanceScratch scratch;
   for (size_t i = 0; i < count; ++i) {
-    LinkBodies bodies = linkBodies(chain, branch.points[i].u.head(n));
+    linkBodies(chain, branch.points[i].u.head(n), bodies);
     if (base) dBase[i] = baseDistanceOf(bodies);
     if (std::isfinite(dRef)) {
       const double moved = 2.0 * largestMove(bodies, reference);
@@ -182,11 +198,11 @@ void scanDistances(const Chain& chain, const continuation::Branch& branch, bool 
         continue;
       }
     }
-    const SelfClearance c = selfClearanceOf(bodies, hint, &exactRef);
+    const SelfClearance c = selfClearanceOf(bodies, hint, &exactRef, scratch);
     dSelf[i] = c.distance;
     hint.linkA = c.linkA;
     hint.linkB = c.linkB;
-    reference = std::move(bodies);
+    std::swap(reference, bodies);
     dRef = dSelf[i];
   }
 }
@@ -206,12 +222,38 @@ BaseClearance baseClearance(const Chain& chain, ConstVectorRef q) {
 SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) { return selfClearance(chain, q, {}, nullptr); }
 
 SelfClearance selfClearance(const Chain& chain, ConstVectorRef q, const SelfClearanceHint& hint, bool* exact) {
-  return selfClearanceOf(linkBodies(chain, q), hint, exact);
+  ClearanceScratch scratch;
+  return selfClearanceOf(linkBodies(chain, q), hint, exact, scratch);
 }
 
 namespace {
 
-SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint& hint, bool* exact) {
+/// byX sorted by the links' mid-point x: insertion sort from the previous shape's order (a few
+/// moves where consecutive shapes are near), std::sort once that costs more than a full sort would.
+void sortByX(std::vector<int>& byX, const Eigen::Matrix2Xd& mid) {
+  const size_t links = size_t(mid.cols());
+  if (byX.size() != links) {
+    byX.resize(links);
+    for (size_t a = 0; a < links; ++a) byX[a] = int(a);
+  }
+  const auto lessX = [&mid](int i, int j) { return mid(0, i) < mid(0, j); };
+  size_t moves = 0;
+  const size_t budget = 8 * links;
+  for (size_t i = 1; i < links; ++i) {
+    const int v = byX[i];
+    size_t j = i;
+    for (; j > 0 && lessX(v, byX[j - 1]); --j) byX[j] = byX[j - 1];
+    byX[j] = v;
+    moves += i - j;
+    if (moves > budget) {
+      std::sort(byX.begin(), byX.end(), lessX);
+      return;
+    }
+  }
+}
+
+SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint& hint, bool* exact,
+                              ClearanceScratch& scratch) {
   const Eigen::Matrix2Xd& P = bodies.P;
   const int links = int(P.cols()) - 1;  // ℓ_0 … ℓ_n: link m from column m to m + 1
   SelfClearance c;
@@ -220,7 +262,8 @@ SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint&
   if (links < 3) return c;
   // Each triangle's circle about its apex (the joint) through its farthest vertex: a pair of
   // triangles is measured only where its circles' lower bound (as the links' below) beats the best.
-  std::vector<double> reach(bodies.triangles.size());
+  std::vector<double>& reach = scratch.reach;
+  reach.resize(bodies.triangles.size());
   for (size_t t = 0; t < reach.size(); ++t)
     reach[t] = std::max((bodies.triangles[t][1] - bodies.triangles[t][0]).norm(),
                         (bodies.triangles[t][2] - bodies.triangles[t][0]).norm());
@@ -250,21 +293,24 @@ SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint&
   // Bounding circles of the bodies (the link's mid-point, the farthest vertex), and the links
   // sorted by the x of their mid-points: the pairs scanned are those whose circles could beat the
   // best so far.
-  Eigen::Matrix2Xd mid(2, links);
-  Eigen::VectorXd radius(links);
+  Eigen::Matrix2Xd& mid = scratch.mid;
+  mid.resize(2, links);
+  std::vector<double>& radius = scratch.radius;
+  radius.resize(size_t(links));
   double rmax = 0.0, extent = 0.0;
   for (int a = 0; a < links; ++a) {
     mid.col(a) = 0.5 * (P.col(a) + P.col(a + 1));
-    radius[a] = 0.0;
+    double& r = radius[size_t(a)];
+    r = 0.0;
     for (int t = bodies.first[size_t(a)]; t < bodies.first[size_t(a) + 1]; ++t)
-      for (const Point& v : bodies.triangles[size_t(t)]) radius[a] = std::max(radius[a], (v - mid.col(a)).norm());
-    rmax = std::max(rmax, radius[a]);
-    extent = std::max(extent, mid.col(a).cwiseAbs().maxCoeff() + radius[a]);
+      for (const Point& v : bodies.triangles[size_t(t)]) r = std::max(r, (v - mid.col(a)).norm());
+    rmax = std::max(rmax, r);
+    extent = std::max(extent, mid.col(a).cwiseAbs().maxCoeff() + r);
   }
-  std::vector<int> byX(static_cast<size_t>(links));
-  for (int a = 0; a < links; ++a) byX[size_t(a)] = a;
-  std::sort(byX.begin(), byX.end(), [&mid](int i, int j) { return mid(0, i) < mid(0, j); });
-  std::vector<double> xs(byX.size());
+  std::vector<int>& byX = scratch.byX;
+  sortByX(byX, mid);
+  std::vector<double>& xs = scratch.xs;
+  xs.resize(byX.size());
   for (size_t i = 0; i < byX.size(); ++i) xs[i] = mid(0, byX[i]);
   // A pair's signed distance is at least its circles' gap |Δm| − r_a − r_b where that is
   // positive, and at least −r_a − r_b (every projected gap is) where they overlap: the lower
@@ -273,10 +319,9 @@ SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint&
   // the all-pairs scan would skip it too, so scanning only the others, in the same order with the
   // same test, gives the same pair, bit for bit.
   const double margin = 1e-9 * extent;
-  std::vector<int> candidates;
-  candidates.reserve(static_cast<size_t>(links));
+  std::vector<int>& candidates = scratch.candidates;
   for (int a = 0; a < links - 2; ++a) {
-    const double ra = radius[a];
+    const double ra = radius[size_t(a)];
     candidates.clear();
     if (std::isfinite(c.distance)) {
       const double reach = std::max(c.distance, 0.0) + ra + rmax + margin;
@@ -291,8 +336,9 @@ SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint&
       for (int b = a + 2; b < links; ++b) candidates.push_back(b);
     }
     for (const int b : candidates) {
-      const double circles = (mid.col(b) - mid.col(a)).norm() - ra - radius[b];
-      const double bound = circles > 0.0 ? circles : -ra - radius[b];
+      const double rb = radius[size_t(b)];
+      const double circles = (mid.col(b) - mid.col(a)).norm() - ra - rb;
+      const double bound = circles > 0.0 ? circles : -ra - rb;
       if (bound >= c.distance || (hinted && a == hint.linkA && b == hint.linkB)) continue;
       if (measure(a, b)) {
         if (exact) *exact = false;

@@ -15,6 +15,7 @@
 namespace buckle::mechanics {
 
 using structure::kBunchAlpha;
+using structure::largestBlockEigenvalue;
 using structure::kTinyPivot;
 
 MassGenerators massGenerators(const Chain& chain, const InertiaData& inertia) {
@@ -164,7 +165,7 @@ void factorizePencil(PencilStructure& ws, double sigma, bool determinant) {
     ws.dOff[j] = i01;
     ++ws.negative;
     sign = -sign;
-    const double big = 0.5 * std::abs(dj + b) + std::hypot(0.5 * (dj - b), c);
+    const double big = largestBlockEigenvalue(dj, b, c);
     minRatio = std::min(minRatio, std::abs(detD) / (big * scale));
     if (determinant) det.multiply(detD);
     // generators [g_j g_{j+1}] = [ρ_j ρ_{j+1}] D⁻¹; P += [ρ_j ρ_{j+1}] D⁻¹ [ρ_j ρ_{j+1}]ᵀ

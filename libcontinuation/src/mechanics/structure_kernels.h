@@ -16,6 +16,17 @@ constexpr double kBunchAlpha = 0.6180339887498949;
 /// (LAPACK dstebz's pivmin).
 constexpr double kTinyPivot = 1e-290;
 
+/// The largest |eigenvalue| of the symmetric 2×2 pivot block [[d, c], [c, b]]:
+/// |d + b|/2 + √(((d − b)/2)² + c²). The plain square root of the sum where that neither over-
+/// nor underflows: std::hypot's scaling costs more than the rest of a 2×2 step, and indefinite
+/// chains take many.
+inline double largestBlockEigenvalue(double d, double b, double c) {
+  const double h = 0.5 * (d - b);
+  const double s = h * h + c * c;
+  const double radius = s > 1e-290 && s < 1e290 ? std::sqrt(s) : std::hypot(h, c);
+  return 0.5 * std::abs(d + b) + radius;
+}
+
 /// A product of many pivots kept as mantissa · 2^exponent (a log per pivot would dominate the
 /// factorization's cost; the plain product over- or underflows for long chains).
 struct ScaledProduct {
