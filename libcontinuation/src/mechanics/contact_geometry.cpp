@@ -32,14 +32,32 @@ double pointSegment(const Point& p, const Point& a, const Point& b, Point* neare
 
 using Triangle = std::array<Point, 3>;
 
-/// Gap of the projections of A and B on the unit axis u: > 0 separated by that much, ≤ 0 overlapping.
-double projectedGap(const Triangle& A, const Triangle& B, const Point& u) {
-  double minA = u.dot(A[0]), maxA = minA, minB = u.dot(B[0]), maxB = minB;
-  for (int k = 1; k < 3; ++k) {
-    minA = std::min(minA, u.dot(A[k])), maxA = std::max(maxA, u.dot(A[k]));
-    minB = std::min(minB, u.dot(B[k])), maxB = std::max(maxB, u.dot(B[k]));
+/// A triangle's separating axes, the unit normals of its edges (`valid`: the edge is not a
+/// point), and its own extent [lo, hi] along each: computed once a shape for every pair the
+/// triangle is measured against.
+struct TriangleAxes {
+  std::array<Point, 3> normal;
+  std::array<double, 3> lo{}, hi{};
+  std::array<bool, 3> valid{};
+};
+
+/// The extent [lo, hi] of T's projection on the axis u.
+void extentAlong(const Triangle& T, const Point& u, double& lo, double& hi) {
+  lo = hi = u.dot(T[0]);
+  for (int k = 1; k < 3; ++k) lo = std::min(lo, u.dot(T[k])), hi = std::max(hi, u.dot(T[k]));
+}
+
+TriangleAxes axesOf(const Triangle& T) {
+  TriangleAxes a;
+  for (int e = 0; e < 3; ++e) {
+    const Point d = T[(e + 1) % 3] - T[e];
+    const double len = d.norm();
+    a.valid[size_t(e)] = len > 0.0;
+    if (!a.valid[size_t(e)]) continue;
+    a.normal[size_t(e)] = Point(-d.y(), d.x()) / len;
+    extentAlong(T, a.normal[size_t(e)], a.lo[size_t(e)], a.hi[size_t(e)]);
   }
-  return std::max(minB - maxA, minA - maxB);
+  return a;
 }
 
 /// Signed distance of two triangles (either may be flat): the distance while they are disjoint,
@@ -48,15 +66,21 @@ double projectedGap(const Triangle& A, const Triangle& B, const Point& u) {
 /// overlapping, the nearest pair of a vertex and an edge). A separating gap of at least `cutoff`
 /// is returned as it is, onA unset: the distance is at least every projected gap, so it is not
 /// below the cutoff either (the caller's best so far), and the 18 vertex–edge distances are saved.
-double triangleTriangle(const Triangle& A, const Triangle& B, Point& onA,
-                        double cutoff = std::numeric_limits<double>::infinity()) {
+double triangleTriangle(const Triangle& A, const TriangleAxes& axesA, const Triangle& B, const TriangleAxes& axesB,
+                        Point& onA, double cutoff = std::numeric_limits<double>::infinity()) {
+  // the gap of the projections on an axis: > 0 separated by that much, ≤ 0 overlapping
   double gap = -std::numeric_limits<double>::infinity();
-  for (const Triangle* T : {&A, &B})
-    for (int e = 0; e < 3; ++e) {
-      const Point d = (*T)[(e + 1) % 3] - (*T)[e];
-      const double len = d.norm();
-      if (len > 0.0) gap = std::max(gap, projectedGap(A, B, Point(-d.y(), d.x()) / len));
+  double lo = 0.0, hi = 0.0;
+  for (size_t e = 0; e < 3; ++e) {
+    if (axesA.valid[e]) {
+      extentAlong(B, axesA.normal[e], lo, hi);
+      gap = std::max(gap, std::max(lo - axesA.hi[e], axesA.lo[e] - hi));
     }
+    if (axesB.valid[e]) {
+      extentAlong(A, axesB.normal[e], lo, hi);
+      gap = std::max(gap, std::max(axesB.lo[e] - hi, lo - axesB.hi[e]));
+    }
+  }
   if (gap > 0.0 && gap >= cutoff) return gap;
   double best = std::numeric_limits<double>::infinity();
   Point nearest;
@@ -113,6 +137,7 @@ LinkBodies linkBodies(const Chain& chain, ConstVectorRef q) {
 /// selfClearanceOf's working storage, kept across the points of a scan: no allocation per point,
 /// and the links' order by x from the last shape, which the next one mostly keeps.
 struct ClearanceScratch {
+  std::vector<TriangleAxes> axes;
   std::vector<double> reach, xs, radius;
   Eigen::Matrix2Xd mid;
   std::vector<int> byX, candidates;
@@ -262,6 +287,9 @@ SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint&
   if (links < 3) return c;
   // Each triangle's circle about its apex (the joint) through its farthest vertex: a pair of
   // triangles is measured only where its circles' lower bound (as the links' below) beats the best.
+  std::vector<TriangleAxes>& axes = scratch.axes;
+  axes.resize(bodies.triangles.size());
+  for (size_t t = 0; t < axes.size(); ++t) axes[t] = axesOf(bodies.triangles[t]);
   std::vector<double>& reach = scratch.reach;
   reach.resize(bodies.triangles.size());
   for (size_t t = 0; t < reach.size(); ++t)
@@ -275,7 +303,8 @@ SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint&
         const double gap = (bodies.triangles[size_t(t)][0] - bodies.triangles[size_t(s)][0]).norm() - r;
         if ((gap > 0.0 ? gap : -r) >= c.distance) continue;
         Point on = Point::Zero();
-        const double d = triangleTriangle(bodies.triangles[size_t(s)], bodies.triangles[size_t(t)], on, c.distance);
+        const double d = triangleTriangle(bodies.triangles[size_t(s)], axes[size_t(s)], bodies.triangles[size_t(t)],
+                                          axes[size_t(t)], on, c.distance);
         if (d < c.distance) {
           c.distance = d;
           c.linkA = a;
