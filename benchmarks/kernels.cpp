@@ -221,7 +221,9 @@ BENCHMARK(BM_CorrectorSolve)->Apply(denseSizes)->Unit(benchmark::kMicrosecond);
 /// the inertia only (TracerOptions::lowestEigenvalues = 0), as a long continuation would run.
 /// Arg 2: 0 = steps of 0.02 in arclength (about one Newton iteration per point), 1 = steps of
 /// 1.0 (several iterations per point: the cost of a hard step).
-void BM_TracerStep(benchmark::State& state) {
+// The tracer's points: `detect` false leaves the predictor–corrector alone (no stability, no
+// special points, no boundaries), the tracer-only cost a whole run is compared with.
+void tracerSteps(benchmark::State& state, bool detect) {
   const int n = int(state.range(0));
   const bool structured = state.range(1) != 0;
   const double step = state.range(2) != 0 ? 1.0 : 0.02;
@@ -234,6 +236,10 @@ void BM_TracerStep(benchmark::State& state) {
   o.step.minStep = step / 1024;
   o.lambdaMax = 1000.0;
   o.detection.lowestEigenvalues = 0;
+  if (!detect) {
+    o.detection.folds = o.detection.branchPoints = o.detection.boundaries = o.detection.stability = false;
+    o.detection.certifiedCounting = false;
+  }
   o.linearAlgebra = structured ? continuation::TracerOptions::LinearAlgebra::Structured
                                : continuation::TracerOptions::LinearAlgebra::Dense;
   continuation::Tracer tracer(p, o);
@@ -249,6 +255,8 @@ void BM_TracerStep(benchmark::State& state) {
   state.counters["per_point"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["newton_it"] = double(iterations) / double(std::max<size_t>(1, points));
 }
+void BM_TracerStep(benchmark::State& state) { tracerSteps(state, true); }
+void BM_TracerOnly(benchmark::State& state) { tracerSteps(state, false); }
 void tracerArgs(benchmark::internal::Benchmark* b) {
   for (long n : {3L, 10L, 30L, 100L, 300L, 1000L, 3000L, 10000L}) {
     if (n > maxN()) continue;
@@ -258,6 +266,7 @@ void tracerArgs(benchmark::internal::Benchmark* b) {
   }
 }
 BENCHMARK(BM_TracerStep)->Apply(tracerArgs)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TracerOnly)->Apply(tracerArgs)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -286,11 +286,13 @@ void CaseRunner::suddenLoad() {
 
 void CaseRunner::keepTimeForWriting(size_t points) {
   // Writing a point costs in proportion to its values (its n joint angles, its columns of
-  // branches.csv and its share of the special points and the report); kSecondsPerValue is a loaded machine's cost with
-  // a margin (benchmarks/RESULTS.md, the issue 27 rows). The computation stops that much earlier
-  // than the fixed reserve (runner.cpp) allows, so that a fast tree's many points are written
-  // within the limit too. At most half the limit.
-  constexpr double kSecondsPerValue = 1.5e-7;
+  // branches.csv and its share of the special points, the plots and the report); the rows are
+  // formatted as the branches finish (branch_stream.h), so what is left at the end is copying
+  // them, the special points, plots and report. kSecondsPerValue is 2.5 times the largest cost of
+  // those measured (benchmarks/RESULTS.md, the issue 27 rows): a loaded machine's. The
+  // computation stops that much earlier than the fixed reserve (runner.cpp) allows, so that a
+  // fast tree's many points are written within the limit too. At most half the limit.
+  constexpr double kSecondsPerValue = 6e-8;
   constexpr int kValuesPerPoint = 200;  // a point's columns, special points and report share
   storedValues_ += double(points) * double(out_.chain.size() + kValuesPerPoint);
   const double limit = std::min(scene_.solver.timeLimit, 1e9);

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <set>
+#include <string>
 #include <thread>
 
 using namespace buckle::continuation;
@@ -89,6 +90,23 @@ TEST_CASE("Interrupt: time kept before the deadline moves it for every copy, nev
   const Interrupt never;
   never.keepBeforeDeadline(1.0);
   CHECK_FALSE(never.requested());
+}
+
+TEST_CASE("Interrupt: a stop well before the limit says when computing stopped", "[interrupt]") {
+  // 3600 s given, 3599.95 s of it kept for writing: computing stops 0.05 s from now
+  const Interrupt early = Interrupt::after(3600.0);
+  early.keepBeforeDeadline(3599.95);
+  CHECK_FALSE(early.requested());
+  std::this_thread::sleep_for(std::chrono::milliseconds(80));
+  REQUIRE(early.requested());
+  const std::string why = early.describe();
+  CHECK_THAT(why, Contains("time limit of 3600 s reached (computing stopped at 0.05 s"));
+  CHECK_THAT(why, Contains("kept for writing the results"));
+  // at the limit itself (nothing kept): the limit alone
+  const Interrupt atLimit = Interrupt::after(0.05);
+  std::this_thread::sleep_for(std::chrono::milliseconds(80));
+  REQUIRE(atLimit.requested());
+  CHECK(atLimit.describe() == "time limit of 0.05 s reached");
 }
 
 TEST_CASE("Tracer: a requested interrupt stops the branch at once and keeps the start", "[interrupt]") {

@@ -21,6 +21,7 @@ Interrupt Interrupt::after(double seconds) {
 Interrupt &Interrupt::setDeadline(Clock::time_point deadline, double seconds) {
   hasDeadline_ = true;
   deadline_ = deadline;
+  start_ = Clock::now();
   seconds_ = seconds;
   kept_ = std::make_shared<std::atomic<Clock::rep>>(0);  // a new deadline: its own copies
   return *this;
@@ -48,6 +49,15 @@ std::string Interrupt::describe() const {
     case Reason::TimeLimit: {
       std::ostringstream os;
       os << "time limit of " << seconds_ << " s reached";
+      // The deadline moved before the limit by the room kept for writing (keepBeforeDeadline):
+      // say when computing stopped, not only the limit the user set.
+      const double stopped =
+          std::chrono::duration<double>(deadline_ - Clock::duration(kept_->load(std::memory_order_relaxed)) - start_)
+              .count();
+      if (stopped > 0.0 && stopped < 0.9 * seconds_) {
+        os.precision(3);
+        os << " (computing stopped at " << stopped << " s, the rest of the limit kept for writing the results)";
+      }
       return os.str();
     }
   }

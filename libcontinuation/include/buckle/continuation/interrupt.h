@@ -23,7 +23,8 @@ class Interrupt {
   /// Requested once `seconds` have passed from now (infinite or NaN: never).
   static Interrupt after(double seconds);
 
-  /// Requested from `deadline` on; `seconds` is the limit as the user gave it (for messages).
+  /// Requested from `deadline` on; `seconds` is the limit as the user gave it, counted from now
+  /// (for messages: how long the computation ran of it).
   Interrupt &setDeadline(Clock::time_point deadline, double seconds);
   /// Moves the deadline of this Interrupt and of every copy made since setDeadline() to
   /// `seconds` before the one set (never later than an earlier call moved it): room kept for
@@ -42,7 +43,8 @@ class Interrupt {
     return Reason::None;
   }
   bool requested() const { return reason() != Reason::None; }
-  /// "time limit of 5 s reached", the flag's `what`, or "" when not requested.
+  /// "time limit of 5 s reached" (with when the computation stopped where that was well before
+  /// the limit, the rest kept for writing), the flag's `what`, or "" when not requested.
   std::string describe() const;
 
   bool hasDeadline() const { return hasDeadline_; }
@@ -52,6 +54,7 @@ class Interrupt {
  private:
   bool hasDeadline_ = false;
   Clock::time_point deadline_{};
+  Clock::time_point start_{};  ///< when setDeadline() was called: the limit counts from there
   /// keepBeforeDeadline(), in clock ticks, shared by the copies
   std::shared_ptr<std::atomic<Clock::rep>> kept_ = std::make_shared<std::atomic<Clock::rep>>(0);
   double seconds_ = 0.0;
