@@ -22,7 +22,8 @@
 //    beat the best so far), and only the links whose mid-points lie within that reach in x and y
 //    of a link's (a sweep over the links sorted by x) are looked at: nothing is missed, the pair
 //    found is the all-pairs scan's, and a chain that does not fold onto itself costs O(n log n)
-//    per point — O(n) along a branch, whose scan keeps the links' x order from the last shape. Detection: the chain does not yet stop at a self contact (the base wall can be a
+//    per point — O(n) along a branch, whose scan keeps the links' x order from the last shape.
+//    Detection: the chain does not yet stop at a self contact (the base wall can be a
 //    constraint, wall_contact.h).
 //
 // Along a traced branch (branch_report.h) a sign change of d_base or d_self between two
