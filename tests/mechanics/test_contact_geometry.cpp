@@ -404,3 +404,35 @@ TEST_CASE("self contacts along a branch: the bounded scan finds every sign chang
     if (!g.base) found.emplace_back(g.index, g.entering);
   CHECK(found == exact);
 }
+
+TEST_CASE("self contacts along a branch: unrelated shapes one after another, against the exact scan",
+          "[contact_geometry]") {
+  // The scan keeps the links' x order from one shape to the next (insertion sort, a full sort
+  // once that costs more): here every point is a new random shape, so the order kept is useless
+  // and the full sort must take over. The sign changes found are those of selfClearance at each
+  // point, and so are the distances at the points around each change.
+  const int n = 50;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(Wrench::Zero()), Eigen::Vector3d(1, 0, 0));
+  cont::Branch branch;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> angle(-1.6, 1.6);
+  for (int k = 0; k < 200; ++k) {
+    cont::ContinuationPoint p;
+    p.lambda = 0.0;
+    p.u = Vector::Zero(problem.dimension());
+    for (int i = 0; i < n; ++i) p.u[i] = (k % 3 == 0 ? 0.2 : 1.0) * angle(rng);
+    branch.points.push_back(p);
+  }
+  std::vector<std::pair<int, bool>> exact;  // (index, entering)
+  for (size_t i = 0; i + 1 < branch.points.size(); ++i) {
+    const double a = selfClearance(chain, branch.points[i].u.head(n)).distance;
+    const double b = selfClearance(chain, branch.points[i + 1].u.head(n)).distance;
+    if ((a > 0.0) != (b > 0.0)) exact.emplace_back(int(i), a > 0.0);
+  }
+  REQUIRE(exact.size() >= 10);
+  std::vector<std::pair<int, bool>> found;
+  for (const GeometricContact& g : locateGeometricContacts(problem, branch, {}))
+    if (!g.base) found.emplace_back(g.index, g.entering);
+  CHECK(found == exact);
+}
