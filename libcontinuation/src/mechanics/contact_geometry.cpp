@@ -155,7 +155,8 @@ class ClearanceProbe {
   ClearanceProbe(const Chain& chain, bool base) : chain_(chain), base_(base) {}
   double operator()(ConstVectorRef q) {
     if (base_) return baseClearance(chain_, q).distance;
-    const SelfClearance c = selfClearanceOf(linkBodies(chain_, q), hint_, nullptr, scratch_);
+    linkBodies(chain_, q, bodies_);
+    const SelfClearance c = selfClearanceOf(bodies_, hint_, nullptr, scratch_);
     hint_.linkA = c.linkA;
     hint_.linkB = c.linkB;
     return c.distance;
@@ -165,6 +166,7 @@ class ClearanceProbe {
   const Chain& chain_;
   bool base_;
   SelfClearanceHint hint_;
+  LinkBodies bodies_;  // the probed shape's, its storage reused like scratch_'s
   ClearanceScratch scratch_;
 };
 
