@@ -369,6 +369,31 @@ TEST_CASE("self clearance from a hint: the same nearest pair, and a pair below s
   CHECK(stopped >= 10);
 }
 
+namespace {
+
+/// The sign changes (index, entering) of selfClearance between consecutive points, each point's
+/// clearance computed afresh: the exact scan the branch scan is checked against.
+std::vector<std::pair<int, bool>> exactSelfContacts(const Chain& chain, const cont::Branch& branch) {
+  const int n = chain.size();
+  std::vector<std::pair<int, bool>> changes;
+  for (size_t i = 0; i + 1 < branch.points.size(); ++i) {
+    const double a = selfClearance(chain, branch.points[i].u.head(n)).distance;
+    const double b = selfClearance(chain, branch.points[i + 1].u.head(n)).distance;
+    if ((a > 0.0) != (b > 0.0)) changes.emplace_back(int(i), a > 0.0);
+  }
+  return changes;
+}
+
+/// The self contacts locateGeometricContacts finds along the branch, as (index, entering).
+std::vector<std::pair<int, bool>> scannedSelfContacts(EquilibriumProblem& problem, const cont::Branch& branch) {
+  std::vector<std::pair<int, bool>> found;
+  for (const GeometricContact& g : locateGeometricContacts(problem, branch, {}))
+    if (!g.base) found.emplace_back(g.index, g.entering);
+  return found;
+}
+
+}  // namespace
+
 TEST_CASE("self contacts along a branch: the bounded scan finds every sign change an exact scan finds",
           "[contact_geometry]") {
   // A chain curling into a spiral and back (every joint bent by t, t up and down with steps of
@@ -392,17 +417,9 @@ TEST_CASE("self contacts along a branch: the bounded scan finds every sign chang
       for (int i = 0; i < n; ++i) p.u[i] = t * (1.0 + 0.3 * std::sin(0.7 * i));
       branch.points.push_back(p);
     }
-  std::vector<std::pair<int, bool>> exact;  // (index, entering)
-  for (size_t i = 0; i + 1 < branch.points.size(); ++i) {
-    const double a = selfClearance(chain, branch.points[i].u.head(n)).distance;
-    const double b = selfClearance(chain, branch.points[i + 1].u.head(n)).distance;
-    if ((a > 0.0) != (b > 0.0)) exact.emplace_back(int(i), a > 0.0);
-  }
+  const std::vector<std::pair<int, bool>> exact = exactSelfContacts(chain, branch);
   REQUIRE(exact.size() >= 4);  // the spiral meets itself and separates again, more than once
-  std::vector<std::pair<int, bool>> found;
-  for (const GeometricContact& g : locateGeometricContacts(problem, branch, {}))
-    if (!g.base) found.emplace_back(g.index, g.entering);
-  CHECK(found == exact);
+  CHECK(scannedSelfContacts(problem, branch) == exact);
 }
 
 TEST_CASE("self contacts along a branch: unrelated shapes one after another, against the exact scan",
@@ -424,15 +441,7 @@ TEST_CASE("self contacts along a branch: unrelated shapes one after another, aga
     for (int i = 0; i < n; ++i) p.u[i] = (k % 3 == 0 ? 0.2 : 1.0) * angle(rng);
     branch.points.push_back(p);
   }
-  std::vector<std::pair<int, bool>> exact;  // (index, entering)
-  for (size_t i = 0; i + 1 < branch.points.size(); ++i) {
-    const double a = selfClearance(chain, branch.points[i].u.head(n)).distance;
-    const double b = selfClearance(chain, branch.points[i + 1].u.head(n)).distance;
-    if ((a > 0.0) != (b > 0.0)) exact.emplace_back(int(i), a > 0.0);
-  }
+  const std::vector<std::pair<int, bool>> exact = exactSelfContacts(chain, branch);
   REQUIRE(exact.size() >= 10);
-  std::vector<std::pair<int, bool>> found;
-  for (const GeometricContact& g : locateGeometricContacts(problem, branch, {}))
-    if (!g.base) found.emplace_back(g.index, g.entering);
-  CHECK(found == exact);
+  CHECK(scannedSelfContacts(problem, branch) == exact);
 }
