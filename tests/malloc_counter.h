@@ -1,7 +1,8 @@
 // Counts heap allocations, for the tests that hot loops allocate nothing. Interposes malloc,
-// through which operator new, Eigen and SUNDIALS all allocate. Include in exactly one
-// translation unit per test program. Disabled under AddressSanitizer and ThreadSanitizer, which
-// own malloc: BUCKLE_COUNT_MALLOC is then 0 and the tests say so.
+// through which operator new, Eigen and SUNDIALS all allocate. Any test file may include it; exactly
+// one file per test program includes malloc_counter_definition.h, the interposed malloc.
+// Disabled under AddressSanitizer and ThreadSanitizer, which own malloc: BUCKLE_COUNT_MALLOC is
+// then 0 and the tests say so.
 #pragma once
 
 #include <atomic>
@@ -15,9 +16,4 @@ inline std::atomic<long> mallocCalls{0};
 #define BUCKLE_COUNT_MALLOC 0
 #else
 #define BUCKLE_COUNT_MALLOC 1
-extern "C" void *__libc_malloc(std::size_t size);
-extern "C" void *malloc(std::size_t size) noexcept {
-  buckle::testing::mallocCalls.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(size);
-}
 #endif

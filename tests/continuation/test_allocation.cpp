@@ -11,7 +11,7 @@
 
 #include <algorithm>
 
-#include "../malloc_counter.h"
+#include "../malloc_counter_definition.h"
 
 using namespace buckle::continuation;
 using buckle::testing::mallocCalls;

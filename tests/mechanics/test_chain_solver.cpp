@@ -9,7 +9,7 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/linear_buckling.h"
 
-#include "../malloc_counter.h"
+#include "../malloc_counter_definition.h"
 #include "random_segments.h"
 #include "test_chains.h"
 

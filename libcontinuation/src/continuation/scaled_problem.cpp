@@ -268,6 +268,22 @@ bool ScaledProblem::stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, d
   return true;
 }
 
+bool ScaledProblem::stabilitySlopes(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                    double dlambda, int first, ConstVectorRef values, VectorRef slopes) const {
+  Workspace &sw = workspaceAs<Workspace>(ws);
+  const double mu0 = units_.scales().stability;
+  // The values in the problem's units: a few numbers (a 2-vector), on the stack.
+  using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
+  if (values.size() > SmallVector::MaxRowsAtCompileTime) return false;
+  const SmallVector userValues = values * mu0;
+  sw.du = du.cwiseProduct(units_.scales().unknowns);
+  if (!sw.inner.stabilitySlopes(user(sw, u), lambda * units_.parameter(), sw.du, dlambda * units_.parameter(), first,
+                                userValues, slopes))
+    return false;
+  slopes /= mu0;
+  return true;
+}
+
 std::unique_ptr<BorderedSolver> ScaledProblem::makeStructuredSolver(ProblemWorkspace &ws) const {
   Workspace &sw = workspaceAs<Workspace>(ws);
   std::unique_ptr<BorderedSolver> solver = sw.inner.makeStructuredSolver();

@@ -46,6 +46,16 @@ bool measureNearZeroSlopes(const BoundProblem &problem, ContinuationPoint &point
   const int n = problem.dimension();
   if (!sp.valid() || point.tangent.size() != n + 1 || point.u.size() != n) return false;
   if (sp.slopesMeasured) return true;
+  // From the eigenvectors (Hellmann–Feynman) where the problem offers it: no second eigenvalue
+  // search at a point off the branch.
+  const Eigen::Map<const Vector> values(sp.values, sp.count);
+  Eigen::Map<Vector> slopes(sp.slopes, sp.count);
+  if (problem.stabilitySlopes(point.u, point.lambda, point.tangent.head(n), point.tangent[n], sp.first, values,
+                              slopes) &&
+      std::isfinite(sp.slopes[0]) && (sp.count < 2 || std::isfinite(sp.slopes[1]))) {
+    sp.slopesMeasured = true;
+    return true;
+  }
   if (workspace.size() < n) workspace.resize(n);
   // Rate along the tangent: dμ/ds = (μ(x + δt) − μ(x))/δ. The point x + δt is off the branch by
   // O(δ²) only, so the slope is the branch's to O(δ) (Hellmann–Feynman needs no eigenvector).

@@ -5,6 +5,7 @@
 #include "structure_kernels.h"
 
 #include <array>
+#include <cstdint>
 #include <limits>
 
 #include <Eigen/Eigenvalues>
@@ -182,6 +183,73 @@ int lowestEigenvalues(ChainStructure& ws, bool useConstraints, int count, Vector
 double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance) {
   Eigen::Matrix<double, 1, 1> out;
   return lowestEigenvalues(ws, useConstraints, 1, out, tolerance, nullptr) == 1 ? out[0] : 0.0;
+}
+
+namespace {
+
+bool inverseIteration(ChainStructure& ws, bool useConstraints, double sigma, VectorRef v, int iterations) {
+  const int n = ws.n, r = useConstraints ? ws.rank : 0;
+  if (v.size() != n || !std::isfinite(sigma)) return false;
+  factorize(ws, sigma, false);
+  if (ws.singular) {
+    // An exactly zero pivot stands in the factor as the counts' floor (kTinyPivot of the scale),
+    // whose inverse would overflow the solves; for inverse iteration it is the direction wanted,
+    // amplified by 1/ε as by a pivot of rounding size.
+    const double floor = 1e-200 * std::max(ws.typicalScale, ws.frobeniusH);
+    const double rounding = std::numeric_limits<double>::epsilon() * std::max(ws.typicalScale, ws.frobeniusH);
+    for (int k = 0; k < n; ++k)
+      if (ws.blockStart[size_t(k)] == 1 && std::abs(ws.pivA[k]) < floor) ws.pivA[k] = -rounding;
+  }
+  // (H − σI) x + Q y = v, Qᵀx = 0 with H − σI = U (T − σM) Uᵀ and z = Uᵀx, B = U⁻¹Q:
+  //   (T − σM) z + B y = U⁻¹ v,  Bᵀz = 0,  x = U⁻ᵀ z,
+  // by the Schur complement S = Bᵀ(T − σM)⁻¹B of the r ≤ 3 border columns.
+  if (r > 0) {
+    ws.X.leftCols(r) = ws.B.leftCols(r);
+    solveFactored(ws, ws.X, r);
+    ws.S.resize(r, r);
+    ws.S.noalias() = ws.B.leftCols(r).transpose().lazyProduct(ws.X.leftCols(r));
+  }
+  // S is nearly singular at σ (that is what an eigenvalue on ker C means): partial pivoting
+  // divides by its small pivot, which is the amplification wanted; a rank-revealing LU would zero
+  // the very component that carries the eigenvector.
+  const Eigen::PartialPivLU<ChainStructure::SmallMatrix> schur =
+      r > 0 ? Eigen::PartialPivLU<ChainStructure::SmallMatrix>(ws.S) : Eigen::PartialPivLU<ChainStructure::SmallMatrix>();
+  // A fixed start with no structure of its own (no eigenvector of a chain is orthogonal to it
+  // but by accident), the same every call: the same vector for the same point.
+  std::uint32_t state = 2463534242u;
+  for (int i = 0; i < n; ++i) {
+    state ^= state << 13;
+    state ^= state >> 17;
+    state ^= state << 5;
+    v[i] = double(state) / 4294967296.0 - 0.5;
+  }
+  auto g = ws.t1.head(n);
+  for (int it = 0; it < iterations; ++it) {
+    applyUInverse(v, g);
+    solveFactored(ws, g);
+    if (r > 0) {
+      ChainStructure::SmallVector rhs(r);
+      rhs.noalias() = ws.B.leftCols(r).transpose() * g;
+      const ChainStructure::SmallVector y = schur.solve(rhs);
+      g.noalias() -= ws.X.leftCols(r) * y;
+    }
+    applyUInverseTranspose(g, v);
+    const double norm = v.norm();
+    if (!(norm > 0.0) || !std::isfinite(norm)) return false;
+    v /= norm;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool eigenvectorAt(ChainStructure& ws, bool useConstraints, double sigma, VectorRef v, int iterations) {
+  // σ on the eigenvalue to the last bit can make a pivot of T − σM exactly zero (replaced by the
+  // floor, whose inverse overflows): a shift by a few units of rounding leaves the vector as it is.
+  const double nudge = 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(sigma), ws.frobeniusH);
+  for (int attempt = 0; attempt < 3; ++attempt)
+    if (inverseIteration(ws, useConstraints, sigma + attempt * nudge, v, iterations)) return true;
+  return false;
 }
 
 namespace {

@@ -116,7 +116,13 @@ EquilibriumProblem::Workspace::Workspace(const EquilibriumProblem& problem)
       heldRows(problem.heldCount(), problem.segments()),
       spectrumKey(problem.dimension() + 1),
       bodyTerms(problem.bodyTerms_),
-      bodyWork(problem.segments()) {
+      bodyWork(problem.segments()),
+      rateKappa(problem.segments()),
+      rateGenerator(problem.segments()),
+      rateS(problem.segments()),
+      rateC(problem.segments()),
+      eigenvector(problem.segments()),
+      hessianTimes(problem.segments()) {
   if (problem.controlled()) {
     controlGrad.resize(problem.segments());
     controlStiff.resize(problem.segments());

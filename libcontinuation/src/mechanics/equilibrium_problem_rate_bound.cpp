@@ -1,5 +1,7 @@
-// EquilibriumProblem::stabilityRateBound: a bound on how fast the eigenvalues of the stability
-// operator move along a tangent, from the q-cache in O(n) (equilibrium_problem.h).
+// How fast the stability operator's eigenvalues move along a tangent, from the q-cache in O(n)
+// (equilibrium_problem.h): EquilibriumProblem::stabilityRateBound (a bound on every one) and
+// stabilitySlopes (the rates of a few, from their eigenvectors).
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
@@ -11,6 +13,41 @@ using continuation::ProblemWorkspace;
 using continuation::workspaceAs;
 
 using continuation::ConstVectorRef;
+using continuation::VectorRef;
+
+namespace {
+// Up to this chain length the eigenvalues come from one dense solve (equilibrium_problem.cpp,
+// kDenseSpectrumUpTo): differencing two of them costs less than the structure's set-up.
+constexpr int kStructuredSlopesFrom = 17;
+}  // namespace
+
+void EquilibriumProblem::stabilityRates(Workspace& d, const ConstVectorRef& u, double lambda, const ConstVectorRef& du,
+                                        double dlambda) const {
+  const int n = chain_.size();
+  const int m = heldCount();
+  const Wrench W = wrench(u, lambda);
+  Wrench dW = dlambda * direction_;  // loads move with λ, reactions with their unknowns
+  for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = du[n + k];
+  if (d.bodyTerms.active()) bodyGeneratorDerivative(d, du.head(n), lambda, dlambda);  // dγ (eq B5)
+  // H = K_q − K_g with K_g(i, j) = h_max(i,j), h = −F_x C − F_y S (eq 27), so along (du, dλ)
+  // dH = diag(E‴_i du_i) − [dh_max(i,j)] with dh = −dF_x C − F_x dC − dF_y S − F_y dS, and the
+  // tail sums move with θ̇_p = Σ_{i≤p} du_i: dS_j = Σ_{p≥j} ℓ_p cos θ_p θ̇_p, dC_j = −Σ_{p≥j} ℓ_p
+  // sin θ_p θ̇_p, where ℓ_p cos θ_p = C_p − C_{p+1}, ℓ_p sin θ_p = S_p − S_{p+1} (chain.h).
+  double thetaDot = du.head(n).sum(), dS = 0.0, dC = 0.0;
+  for (int p = n - 1; p >= 0; --p) {
+    const double cNext = p + 1 < n ? d.data.C[p + 1] : 0.0, sNext = p + 1 < n ? d.data.S[p + 1] : 0.0;
+    dS += (d.data.C[p] - cNext) * thetaDot;
+    dC -= (d.data.S[p] - sNext) * thetaDot;
+    thetaDot -= du[p];
+    double dh = -dW[0] * d.data.C[p] - W[0] * dC - dW[1] * d.data.S[p] - W[1] * dS;
+    if (d.bodyTerms.active()) dh -= d.bodyWork[p];  // the body loads' generator h − γ (eq B3)
+    const double dControl = control_.active() ? d.controlStiff[p] * dlambda : 0.0;  // ∂K_q/∂λ dλ
+    d.rateKappa[p] = d.stiffRate[p] * du[p] + dControl;
+    d.rateGenerator[p] = dh;
+    d.rateS[p] = dS;
+    d.rateC[p] = dC;
+  }
+}
 
 bool EquilibriumProblem::stabilityRateBound(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ConstVectorRef du,
                                             double dlambda, double& bound) const {
@@ -18,40 +55,25 @@ bool EquilibriumProblem::stabilityRateBound(ProblemWorkspace& ws, ConstVectorRef
   if (!std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() || !prepare(d, u, lambda)) return false;
   const int n = chain_.size();
   const int m = heldCount();
+  stabilityRates(d, u, lambda, du, dlambda);
   const Wrench W = wrench(u, lambda);
-  Wrench dW = dlambda * direction_;  // loads move with λ, reactions with their unknowns
-  for (int k = 0; k < m; ++k) dW[held_[size_t(k)]] = du[n + k];
-  if (d.bodyTerms.active()) bodyGeneratorDerivative(d, du.head(n), lambda, dlambda);  // dγ (eq B5)
   bool heldX = false, heldY = false;
   for (int c : held_) {
     heldX |= c == 0;
     heldY |= c == 1;
   }
-  // H = K_q − K_g with K_g(i, j) = h_max(i,j), h = −F_x C − F_y S (eq 27), so along (du, dλ)
-  // dH = diag(E‴_i du_i) − [dh_max(i,j)] with dh = −dF_x C − F_x dC − dF_y S − F_y dS, and the
-  // tail sums move with θ̇_p = Σ_{i≤p} du_i: dS_j = Σ_{p≥j} ℓ_p cos θ_p θ̇_p, dC_j = −Σ_{p≥j} ℓ_p
-  // sin θ_p θ̇_p, where ℓ_p cos θ_p = C_p − C_{p+1}, ℓ_p sin θ_p = S_p − S_{p+1} (chain.h). In the
-  // Frobenius norms the entries with max(i, j) = p appear 2p + 1 times (0-based), once on the
-  // diagonal. C = J_h has rows (−S, C, 1) of eq 11, so dC has rows (−dS, dC, 0).
-  double thetaDot = du.head(n).sum(), dS = 0.0, dC = 0.0;
+  // In the Frobenius norms the entries with max(i, j) = p appear 2p + 1 times (0-based), once on
+  // the diagonal. C = J_h has rows (−S, C, 1) of eq 11, so dC has rows (−dS, dC, 0).
   double dH2 = 0.0, H2 = 0.0, dC2 = 0.0;
   for (int p = n - 1; p >= 0; --p) {
-    const double cNext = p + 1 < n ? d.data.C[p + 1] : 0.0, sNext = p + 1 < n ? d.data.S[p + 1] : 0.0;
-    dS += (d.data.C[p] - cNext) * thetaDot;
-    dC -= (d.data.S[p] - sNext) * thetaDot;
-    thetaDot -= du[p];
     double h = -W[0] * d.data.C[p] - W[1] * d.data.S[p];
-    double dh = -dW[0] * d.data.C[p] - W[0] * dC - dW[1] * d.data.S[p] - W[1] * dS;
-    if (d.bodyTerms.active()) {  // the body loads' generator h − γ (eq B3) and its rate
-      h -= d.bodyTerms.gammaAt(p, lambda);
-      dh -= d.bodyWork[p];
-    }
-    const double dControl = control_.active() ? d.controlStiff[p] * dlambda : 0.0;  // ∂K_q/∂λ dλ
-    const double dDiagonal = d.stiffRate[p] * du[p] + dControl - dh, diagonal = d.stiff[p] - h;
+    if (d.bodyTerms.active()) h -= d.bodyTerms.gammaAt(p, lambda);
+    const double dh = d.rateGenerator[p];
+    const double dDiagonal = d.rateKappa[p] - dh, diagonal = d.stiff[p] - h;
     dH2 += dDiagonal * dDiagonal + 2.0 * p * dh * dh;
     H2 += diagonal * diagonal + 2.0 * p * h * h;
-    if (heldX) dC2 += dS * dS;
-    if (heldY) dC2 += dC * dC;
+    if (heldX) dC2 += d.rateS[p] * d.rateS[p];
+    if (heldY) dC2 += d.rateC[p] * d.rateC[p];
   }
   bound = std::sqrt(dH2);
   if (m == 0) return std::isfinite(bound);
@@ -70,6 +92,64 @@ bool EquilibriumProblem::stabilityRateBound(ProblemWorkspace& ws, ConstVectorRef
   if (!(sigma2 > 1e-12 * trace)) return false;
   bound += 2.0 * std::sqrt(H2) * std::sqrt(dC2 / sigma2);
   return std::isfinite(bound);
+}
+
+bool EquilibriumProblem::stabilitySlopes(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                         double dlambda, int first, ConstVectorRef values, VectorRef slopes) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  const int n = chain_.size(), m = heldCount();
+  if (!options_.structuredStability || n < kStructuredSlopesFrom || first < 0 || values.size() != slopes.size() ||
+      !values.allFinite() || !std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() ||
+      !prepare(d, u, lambda))
+    return false;
+  assembleFromCache(d, u, lambda, d.structure);
+  for (int k = 0; k < m; ++k) d.heldRows.row(k) = d.J.row(held_[size_t(k)]);
+  // rank-deficient C: ker C jumps along the tangent (no derivative), as for the bound
+  if (m > 0 && setConstraints(d.structure, d.heldRows) < m) return false;
+  if (m == 0) d.structure.rank = 0;
+  stabilityRates(d, u, lambda, du, dlambda);
+  Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
+  for (int k = 0; k < m; ++k)
+    for (int l = 0; l <= k; ++l) G(k, l) = G(l, k) = d.heldRows.row(k).dot(d.heldRows.row(l));
+  const Eigen::LDLT<Eigen::Matrix3d> gram(G);
+  const double scale = std::max(d.structure.typicalScale, d.structure.frobeniusH);
+  Vector& v = d.eigenvector;
+  Vector& Hv = d.hessianTimes;
+  for (Eigen::Index j = 0; j < values.size(); ++j) {
+    const double mu = values[j];
+    if (!eigenvectorAt(d.structure, m > 0, mu, v)) return false;
+    // ζ = −(CCᵀ)⁻¹ C H v (H v + Cᵀζ = μ v with C v = 0), and the residual of the pair: an
+    // eigenvalue given wrong, or one of a cluster tighter than its accuracy, leaves v no
+    // eigenvector to the accuracy the slope needs; then the caller differences instead.
+    applyHessian(d.structure, v, Hv);
+    Eigen::Vector3d zeta = Eigen::Vector3d::Zero();
+    for (int k = 0; k < m; ++k) zeta[k] = -d.heldRows.row(k).dot(Hv);
+    if (m > 0) zeta = gram.solve(zeta);
+    double residual2 = 0.0;
+    for (int i = 0; i < n; ++i) {
+      double ri = Hv[i] - mu * v[i];
+      for (int k = 0; k < m; ++k) ri += d.heldRows(k, i) * zeta[k];
+      residual2 += ri * ri;
+    }
+    if (!(std::sqrt(residual2) <= 1e-8 * scale)) return false;
+    // vᵀ dH v = Σ dκ_p v_p² − Σ_{i,j} dh_max(i,j) v_i v_j, and Σ_{i,j} g_max(i,j) v_i v_j =
+    // Σ_p (g_p − g_{p+1}) P_p² with the prefix sums P_p = Σ_{i≤p} v_i (g_n = 0).
+    double rate = 0.0, prefix = 0.0;
+    for (int p = 0; p < n; ++p) {
+      prefix += v[p];
+      const double dgNext = p + 1 < n ? d.rateGenerator[p + 1] : 0.0;
+      rate += d.rateKappa[p] * v[p] * v[p] - (d.rateGenerator[p] - dgNext) * prefix * prefix;
+    }
+    // + 2 ζᵀ dC v, dC with rows (−dS, dC, 0) for x, y, φ held (eq 11)
+    for (int k = 0; k < m; ++k) {
+      const int c = held_[size_t(k)];
+      if (c == 2) continue;
+      const double dCv = c == 0 ? -d.rateS.dot(v) : d.rateC.dot(v);
+      rate += 2.0 * zeta[k] * dCv;
+    }
+    slopes[j] = rate;
+  }
+  return slopes.allFinite();
 }
 
 }  // namespace buckle::mechanics

@@ -66,6 +66,10 @@ class BoundProblem {
   bool stabilityRateBound(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda, double &bound) const {
     return problem_->stabilityRateBound(*ws_, u, lambda, du, dlambda, bound);
   }
+  bool stabilitySlopes(ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda, int first,
+                       ConstVectorRef values, VectorRef slopes) const {
+    return problem_->stabilitySlopes(*ws_, u, lambda, du, dlambda, first, values, slopes);
+  }
   std::unique_ptr<BorderedSolver> makeStructuredSolver() const;
   int boundaryCount() const { return problem_->boundaryCount(); }
   double boundary(int k, ConstVectorRef u, double lambda) const { return problem_->boundary(*ws_, k, u, lambda); }

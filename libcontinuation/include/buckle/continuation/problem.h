@@ -179,6 +179,16 @@ class Problem {
                                   double /*dlambda*/, double & /*bound*/) const {
     return false;
   }
+  /// The rates dμ_i/dε along (u + ε·du, λ + ε·dlambda) at ε = 0 of the eigenvalues of H on ker C
+  /// with indices first … first + values.size() − 1, `values` being those eigenvalues at (u, λ) as
+  /// stabilityEigenvalues() returned them, into `slopes` (Hellmann–Feynman: dμ = vᵀ dH v + 2 ζᵀ dC v
+  /// for the eigenvector v, ‖v‖ = 1, and its multiplier ζ, H v + Cᵀζ = μ v). False (the default):
+  /// not offered, and the certified counting differences the eigenvalues along the tangent
+  /// instead (spectral_monitor.h), one more eigenvalue search per point.
+  virtual bool stabilitySlopes(ProblemWorkspace &, ConstVectorRef /*u*/, double /*lambda*/, ConstVectorRef /*du*/,
+                               double /*dlambda*/, int /*first*/, ConstVectorRef /*values*/, VectorRef /*slopes*/) const {
+    return false;
+  }
 
   // ---- optional: structured linear algebra ---------------------------------------------
   /// A solver for the bordered Jacobian [[F_u, F_λ], [cᵀ]] that exploits the problem's

@@ -119,6 +119,9 @@ class ScaledProblem final : public Problem {
   /// The problem's bound along the user direction (D_u du, λ₀ dλ), / μ₀.
   bool stabilityRateBound(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
                           double &bound) const override;
+  /// The problem's slopes along the user direction (D_u du, λ₀ dλ) of the values × μ₀, / μ₀.
+  bool stabilitySlopes(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef du, double dlambda,
+                       int first, ConstVectorRef values, VectorRef slopes) const override;
   /// The problem's structured solver seen through the change of variables (still O(its cost)).
   std::unique_ptr<BorderedSolver> makeStructuredSolver(ProblemWorkspace &ws) const override;
   int boundaryCount() const override { return problem_.boundaryCount(); }

@@ -174,6 +174,15 @@ int eigenvaluesFrom(ChainStructure& ws, bool useConstraints, int first, int coun
                     double tolerance = 1e-13, const Vector* guess = nullptr);
 /// Smallest eigenvalue (lowestEigenvalues with count 1; 0 if the dimension is 0).
 double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolerance = 1e-13);
+/// The unit eigenvector v of H, or of Zᵀ H Z in q-space (v in ker C, after setConstraints()) when
+/// useConstraints, for the eigenvalue σ as eigenvaluesFrom() found it: `iterations` steps of
+/// inverse iteration from a fixed start, one factorization of T − σM and, per step, O(n r) solves
+/// with the r border columns. Each step shrinks the other eigenvectors' parts by
+/// |σ − μ|/|σ − μ_i|: from σ within τ = 1e−13·‖H‖ of μ, one step leaves them at τ/gap, and a
+/// Rayleigh quotient or a derivative vᵀ dH v off by that relative to ‖dH‖ (another eigenvalue
+/// within the accuracy: v is some vector of their eigenspace). False when a solve breaks down (v
+/// not finite). Uses the factor and X, S, t1.
+bool eigenvectorAt(ChainStructure& ws, bool useConstraints, double sigma, VectorRef v, int iterations = 1);
 
 /// Small chains (n ≤ kSmallDense): inertia of H on ker C and its `count` lowest eigenvalues
 /// (written to lowest[0 … found−1]) from a dense, heap-free eigen-solve: Householder

@@ -109,6 +109,10 @@ class EquilibriumProblem final : public continuation::Problem {
     Vector bodyWork;                                 // size n: dγ and other body-load scratch
     EigenvalueMemory found;                          // warm starts of the structured eigenvalue searches (by index)
     Vector guess;  // their guesses (size kMaxBorder once used: no allocation per call)
+    // stabilityRates() along a direction (size n each): dκ; the rate of the generator h of
+    // K_q − H (eq 27, body loads included); the tail sums' rates dS, dC (the held rows' rates, eq 11).
+    Vector rateKappa, rateGenerator, rateS, rateC;
+    Vector eigenvector, hessianTimes;  // stabilitySlopes(): v and H v (size n)
   };
   std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override;
 
@@ -203,6 +207,15 @@ class EquilibriumProblem final : public continuation::Problem {
   /// rank-deficient (no finite bound) or the point is refused.
   bool stabilityRateBound(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                           continuation::ConstVectorRef du, double dlambda, double& bound) const override;
+  /// dμ of the eigenvalues `values` (indices first …) of K_q − K_g on ker J_h along (du, dλ) by
+  /// Hellmann–Feynman (Problem::stabilitySlopes): each eigenvector by inverse iteration on the O(n)
+  /// structure (chain_structure.h, eigenvectorAt), dH and dC from the q-cache as for the bound.
+  /// O(n) per eigenvalue. False for the short chains of the dense route (n ≤ 16: their eigenvalues
+  /// come from one dense solve, which the difference of two costs less than the structure's
+  /// set-up), for rank-deficient J_h, and when an eigenvector's residual shows it was not found.
+  bool stabilitySlopes(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                       continuation::ConstVectorRef du, double dlambda, int first, continuation::ConstVectorRef values,
+                       continuation::VectorRef slopes) const override;
 
   /// T of H = K_q − K_g(F(u, λ)) into ws (chain_structure.h) and the end Jacobian (3×n) into J,
   /// from the q-cache: what the structured stability and the structured solver linearise on.
@@ -269,6 +282,10 @@ class EquilibriumProblem final : public continuation::Problem {
   /// The body loads' dγ along (du_q, dλ) into the workspace's bodyWork (zero without them).
   void bodyGeneratorDerivative(Workspace& d, const continuation::ConstVectorRef& dq, double lambda,
                                double dlambda) const;
+  /// The rates of H = K_q − K_g and of the held rows along (du, dλ) into d.rateKappa,
+  /// d.rateGenerator, d.rateS, d.rateC, from the q-cache (after prepare(d, u, λ)). O(n).
+  void stabilityRates(Workspace& d, const continuation::ConstVectorRef& u, double lambda,
+                      const continuation::ConstVectorRef& du, double dlambda) const;
 
   Chain chain_;
   EndCondition end_;

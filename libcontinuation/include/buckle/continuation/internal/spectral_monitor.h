@@ -8,15 +8,16 @@
 // both ends they are the same two indices): one of them moves towards zero at the start of the
 // step and away from it at the end, so it has an interior extremum. The monitor records these two
 // eigenvalues and their rates dμ/ds along the tangent at every point (Problem::stabilityEigenvalues,
-// O(n) for a chain by isolation on shifted Sturm counts, and one forward difference along the
-// tangent), and flags an interval when, for one of them, the tangent lines from both ends meet on
+// O(n) for a chain by isolation on shifted Sturm counts; the rates from the eigenvectors where the
+// problem offers them, Problem::stabilitySlopes, else one forward difference along the tangent),
+// and flags an interval when, for one of them, the tangent lines from both ends meet on
 // the far side of zero (or within `margin` of it): the interior minimum of |μ| may reach zero.
 // The locator then minimises |μ| along the step (locator.h, locateHiddenCrossings): a sign change
 // splits the step into intervals whose counts differ (two branch points, located separately), a
 // minimum at zero within the touch tolerance is an eigenvalue touch.
 //
-// The slopes cost a second evaluation of the problem per point (off the branch, at x + δt). They
-// are needed only where an eigenvalue could come near zero: with a bound D ≥ |dμ_i/ds| for every
+// The slopes cost an eigenvector per value (or, differenced, a second eigenvalue search off the
+// branch, at x + δt). They are needed only where an eigenvalue could come near zero: with a bound D ≥ |dμ_i/ds| for every
 // eigenvalue (Problem::stabilityRateBound; Weyl: |dμ_i/ds| ≤ ‖dH/ds‖₂ for symmetric H), the
 // tangent lines of suspectHiddenCrossings with any slopes in [−D, D] meet no lower than the
 // lines of slopes ∓D_a, ±D_b; when that value stays above the margin, no slope the
@@ -36,7 +37,8 @@ constexpr double kSuspectMargin = 0.25;
 
 /// Fills point.spectrum: the eigenvalues with indices ν − 1 and ν (ν = point.stability.negative;
 /// only ν when ν = 0, only ν − 1 when ν is the dimension) and their slopes along point.tangent,
-/// by a forward difference with step `delta` (backward if the problem refuses the forward point).
+/// from Problem::stabilitySlopes where offered, else by a forward difference with step `delta`
+/// (backward if the problem refuses the forward point).
 /// False (spectrum left invalid) without stability or when the problem refuses the eigenvalues.
 bool measureNearZeroSpectrum(const BoundProblem &problem, ContinuationPoint &point, double delta = 1e-6);
 
