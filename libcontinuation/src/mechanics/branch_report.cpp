@@ -256,8 +256,9 @@ void describeReactionPathStop(const EquilibriumProblem& problem, const cont::Bra
 
 // ---- reportBranch, part by part ---------------------------------------------------------------
 
-// Every point of the branch (returned, also those out of range: the stability of neighbours);
-// those in range, with their stiffness, into r.points.
+// Every point of the branch (also those out of range: the stability of neighbours); those in
+// range, with their stiffness, into r.points. Returned only where the two differ (traced through
+// a reaction, options.heldCoordinate): else every point is in range and r.points is the list.
 std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::Branch& b, const ReportOptions& options,
                                       const std::vector<ContactStretch>& stretches, HeldStability* held,
                                       BranchReport& r) {
@@ -301,11 +302,16 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
       pr.negative = held->negative(pr.q, pr.F, &pr.minEigenvalue, pr.locked);
       pr.stable = pr.negative == 0;
     }
-    all.push_back(pr);
+    all.push_back(std::move(pr));
   }
-  for (const PointReport& p : all) {
-    if (throughReaction && !inRange(p.parameter, options)) continue;
-    PointReport pr = p;
+  // every point in range: r.points takes them over (no copy of each shape)
+  if (!throughReaction) r.points.swap(all);
+  std::vector<PointReport>& reported = r.points;
+  const size_t kept = reported.size();
+  for (size_t i = 0; i < (throughReaction ? all.size() : kept); ++i) {
+    if (throughReaction && !inRange(all[i].parameter, options)) continue;
+    if (throughReaction) reported.push_back(all[i]);
+    PointReport& pr = throughReaction ? reported.back() : reported[i];
     if (options.stiffness) {
       // along a control path K_q is that of the free lengths at the point's λ
       // and with body loads the Hessian's generator h − γ (eq B3)
@@ -320,7 +326,6 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
       pr.haveStiffness = true;
     }
     r.worstResidual = std::max(r.worstResidual, pr.residual);
-    r.points.push_back(std::move(pr));
   }
   return all;
 }
@@ -560,7 +565,8 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     }
   }
 
-  const std::vector<PointReport> all = reportPoints(problem, b, options, stretches, held.get(), r);
+  const std::vector<PointReport> inAndOutOfRange = reportPoints(problem, b, options, stretches, held.get(), r);
+  const std::vector<PointReport>& all = throughReaction ? inAndOutOfRange : r.points;
   reportLocatedPoints(problem, b, options, stretches, all, r);
   reportCollapsedLimit(chain, b, limitJoint, all, r);
   reportHeldCoordinateFolds(b, options, all, r);

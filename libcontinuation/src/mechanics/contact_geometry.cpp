@@ -497,6 +497,7 @@ void reportGeometricContacts(EquilibriumProblem& problem, const continuation::Br
   GeometricContacts& found = contacts ? *contacts : local;
   if (!found.given) {
     std::vector<ContactSet> locked;
+    locked.reserve(all.size());
     for (const PointReport& p : all) locked.push_back(p.locked);
     found.list = locateGeometricContacts(problem, branch, locked, 1e-12, options.interrupt);
   }
