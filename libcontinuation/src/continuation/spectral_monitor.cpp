@@ -22,14 +22,20 @@ bool measureNearZeroValues(const BoundProblem &problem, ContinuationPoint &point
   const int nu = point.stability.negative;
   int first = std::max(0, nu - 1);
   int count = nu > 0 ? 2 : 1;
-  Eigen::Vector2d here;
-  const Vector &lowest = point.stability.lowest;  // already isolated by the point's stability()
-  if (lowest.size() >= first + count) {
-    here.head(count) = lowest.segment(first, count);
-  } else if (!eigenvaluesAt(problem, point.u, point.lambda, first, count, here)) {
-    // ν is the dimension (no eigenvalue ν), or the problem offers only part of the spectrum
-    if (count == 1 || !eigenvaluesAt(problem, point.u, point.lambda, first, 1, here)) return false;
-    count = 1;
+  Eigen::Vector2d here, rest;
+  // The leading ones the point's stability() already isolated (its lowest eigenvalues: ν − 1 = 0
+  // when ν = 1) are not searched again.
+  const Vector &lowest = point.stability.lowest;
+  const int have = std::clamp(int(lowest.size()) - first, 0, count);
+  here.head(have) = lowest.segment(first, have);
+  if (have < count) {
+    if (eigenvaluesAt(problem, point.u, point.lambda, first + have, count - have, rest)) {
+      here.segment(have, count - have) = rest.head(count - have);
+    } else {
+      // ν is the dimension (no eigenvalue ν), or the problem offers only part of the spectrum
+      if (count == 1 || (have == 0 && !eigenvaluesAt(problem, point.u, point.lambda, first, 1, here))) return false;
+      count = 1;
+    }
   }
   point.spectrum.first = first;
   point.spectrum.count = count;
