@@ -43,10 +43,8 @@ void writeAll(int fd, const char* data, size_t bytes, const std::string& file) {
 
 }  // namespace
 
-BranchStream::BranchStream(const Scene& scene, const std::string& directory) : layout_(scene) {
-  csv_.fd = anonymousFile(directory);
-  if (layout_.sideFile()) npy_.fd = anonymousFile(directory);
-}
+BranchStream::BranchStream(const Scene& scene, const std::string& directory, size_t inMemoryBytes)
+    : layout_(scene), directory_(directory), inMemoryBytes_(inMemoryBytes) {}
 
 BranchStream::~BranchStream() {
   if (csv_.fd >= 0) ::close(csv_.fd);
@@ -54,7 +52,16 @@ BranchStream::~BranchStream() {
 }
 
 void BranchStream::append(Spool& spool, const std::string& bytes) {
-  writeAll(spool.fd, bytes.data(), bytes.size(), "the spool file of branches.csv");
+  if (spool.fd < 0 && spool.memory.size() + bytes.size() <= inMemoryBytes_) {
+    spool.memory += bytes;
+  } else {
+    if (spool.fd < 0) {
+      spool.fd = anonymousFile(directory_);
+      writeAll(spool.fd, spool.memory.data(), spool.memory.size(), "the spool file of branches.csv");
+      std::string().swap(spool.memory);
+    }
+    writeAll(spool.fd, bytes.data(), bytes.size(), "the spool file of branches.csv");
+  }
   spool.size += bytes.size();
 }
 
@@ -94,6 +101,10 @@ std::vector<int> BranchStream::branchIds(size_t c) const {
 }
 
 void BranchStream::copy(const Spool& spool, size_t offset, size_t bytes, int to, const std::string& file) const {
+  if (spool.fd < 0) {
+    writeAll(to, spool.memory.data() + offset, bytes, file);
+    return;
+  }
   // In the kernel where the file system can (the spool lies beside the output): no round trip of
   // hundreds of megabytes through this process; read and write what it leaves.
   while (bytes > 0) {

@@ -16,9 +16,12 @@ namespace buckle::scene {
 
 class BranchStream {
  public:
-  /// Spool files in `directory` (which exists), unlinked as soon as they are open: nothing is
-  /// left behind, whatever ends the program.
-  BranchStream(const Scene& scene, const std::string& directory);
+  /// Rows held in memory up to `inMemoryBytes` per file, then in spool files in `directory` (which
+  /// exists), unlinked as soon as they are open: nothing is left behind, whatever ends the program.
+  BranchStream(const Scene& scene, const std::string& directory, size_t inMemoryBytes = kInMemoryBytes);
+  /// A small run's rows stay in memory (no spool file to create, fill and copy: most of a short
+  /// run's file-system work); a large one's memory stays bounded by this.
+  static constexpr size_t kInMemoryBytes = size_t(4) << 20;
   ~BranchStream();
   BranchStream(const BranchStream&) = delete;
   BranchStream& operator=(const BranchStream&) = delete;
@@ -44,13 +47,16 @@ class BranchStream {
     size_t csvOffset = 0, csvBytes = 0, npyOffset = 0, npyBytes = 0;
   };
   struct Spool {
-    int fd = -1;
-    size_t size = 0;
+    int fd = -1;         ///< the spool file, once the rows outgrew `memory`
+    size_t size = 0;     ///< bytes written, in memory or in the file
+    std::string memory;  ///< the rows while they fit in kInMemoryBytes
   };
   void append(Spool& spool, const std::string& bytes);
   void copy(const Spool& spool, size_t offset, size_t bytes, int to, const std::string& file) const;
 
   BranchRows layout_;
+  std::string directory_;
+  size_t inMemoryBytes_;
   Spool csv_, npy_;
   std::vector<std::vector<Piece>> cases_;
   size_t rows_ = 0;

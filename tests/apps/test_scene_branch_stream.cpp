@@ -92,6 +92,42 @@ TEST_CASE("streamed branches.csv, joint_angles.npy and plot data equal the in-me
   }
 }
 
+TEST_CASE("rows beyond the stream's memory bound go through a spool file: the same bytes, nothing left", "[scene][stream]") {
+  const fs::path dir = buckle::test::scratchDirectory("branch_stream") / "spilled";
+  fs::remove_all(dir);
+  // 14 segments: branches.csv and joint_angles.npy, both spilled after their first 1000 bytes
+  const Scene scene = loadScene(defaultScene(dir, 14, false).string());
+  const RunResult held = runAndWrite(scene, dir / "held", {});
+  fs::create_directories(dir / "spool");
+  BranchStream memory(scene, (dir / "spool").string()), spilled(scene, (dir / "spool").string(), 1000);
+  const CaseResult& cr = held.cases.front();
+  size_t pieces = 0;
+  for (size_t first = 0; first < cr.points.size();) {
+    size_t last = first;
+    while (last < cr.points.size() && cr.points[last].branch == cr.points[first].branch) ++last;
+    const std::vector<buckle::mechanics::PointReport> piece(cr.points.begin() + long(first), cr.points.begin() + long(last));
+    memory.add(0, cr, piece);
+    spilled.add(0, cr, piece);
+    ++pieces;
+    first = last;
+  }
+  REQUIRE(pieces > 3);
+  CHECK(fs::is_empty(dir / "spool"));  // the spool files are unlinked as soon as they are open
+  for (const auto& [stream, name] : {std::pair<const BranchStream*, const char*>{&memory, "memory"}, {&spilled, "spilled"}}) {
+    fs::create_directories(dir / name);
+    stream->write((dir / name).string());
+    const auto a = buckle::test::snapshot(dir / "held"), b = buckle::test::snapshot(dir / name);
+    for (const char* file : {"branches.csv", "joint_angles.npy"}) {
+      CAPTURE(name, file);
+      REQUIRE(a.count(file) == 1);
+      REQUIRE(b.count(file) == 1);
+      CHECK(b.at(file) == a.at(file));
+    }
+  }
+  // the test spills: the rows are far more than the bound
+  CHECK(buckle::test::snapshot(dir / "held").at("branches.csv").size() > 10 * 1000);
+}
+
 TEST_CASE("an interrupted streamed run's rows belong to the branches summary.json lists", "[scene][stream]") {
   const fs::path dir = buckle::test::scratchDirectory("branch_stream") / "interrupted";
   fs::remove_all(dir);
