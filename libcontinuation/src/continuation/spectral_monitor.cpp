@@ -27,7 +27,7 @@ bool measureNearZeroValues(const BoundProblem &problem, ContinuationPoint &point
   // when ν = 1) are not searched again.
   const Vector &lowest = point.stability.lowest;
   const int have = std::clamp(int(lowest.size()) - first, 0, count);
-  here.head(have) = lowest.segment(first, have);
+  if (have > 0) here.head(have) = lowest.segment(first, have);
   if (have < count) {
     if (eigenvaluesAt(problem, point.u, point.lambda, first + have, count - have, rest)) {
       here.segment(have, count - have) = rest.head(count - have);
