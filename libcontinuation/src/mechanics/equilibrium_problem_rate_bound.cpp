@@ -16,9 +16,10 @@ using continuation::ConstVectorRef;
 using continuation::VectorRef;
 
 namespace {
-// Up to this chain length the eigenvalues come from one dense solve (equilibrium_problem.cpp,
-// kDenseSpectrumUpTo): differencing two of them costs less than the structure's set-up.
-constexpr int kStructuredSlopesFrom = 17;
+// Below this chain length differencing two dense spectra (equilibrium_problem.cpp's small dense
+// route) costs less than the structure's set-up and an inverse iteration per value: whole race
+// runs (benchmarks/race_auto.sh) cross over between n = 4 and 6.
+constexpr int kStructuredSlopesFrom = 5;
 }  // namespace
 
 void EquilibriumProblem::stabilityRates(Workspace& d, const ConstVectorRef& u, double lambda, const ConstVectorRef& du,

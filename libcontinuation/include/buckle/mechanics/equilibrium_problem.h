@@ -210,9 +210,9 @@ class EquilibriumProblem final : public continuation::Problem {
   /// dμ of the eigenvalues `values` (indices first …) of K_q − K_g on ker J_h along (du, dλ) by
   /// Hellmann–Feynman (Problem::stabilitySlopes): each eigenvector by inverse iteration on the O(n)
   /// structure (chain_structure.h, eigenvectorAt), dH and dC from the q-cache as for the bound.
-  /// O(n) per eigenvalue. False for the short chains of the dense route (n ≤ 16: their eigenvalues
-  /// come from one dense solve, which the difference of two costs less than the structure's
-  /// set-up), for rank-deficient J_h, and when an eigenvector's residual shows it was not found.
+  /// O(n) per eigenvalue. False for chains of n ≤ 4 (differencing their small dense spectra costs
+  /// less than the structure's set-up), for rank-deficient J_h, and when an eigenvector's residual
+  /// shows it was not found.
   bool stabilitySlopes(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                        continuation::ConstVectorRef du, double dlambda, int first, continuation::ConstVectorRef values,
                        continuation::VectorRef slopes) const override;
