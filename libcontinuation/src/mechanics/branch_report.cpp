@@ -305,13 +305,12 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
     all.push_back(std::move(pr));
   }
   // every point in range: r.points takes them over (no copy of each shape)
-  if (!throughReaction) r.points.swap(all);
-  std::vector<PointReport>& reported = r.points;
-  const size_t kept = reported.size();
-  for (size_t i = 0; i < (throughReaction ? all.size() : kept); ++i) {
-    if (throughReaction && !inRange(all[i].parameter, options)) continue;
-    if (throughReaction) reported.push_back(all[i]);
-    PointReport& pr = throughReaction ? reported.back() : reported[i];
+  if (!throughReaction)
+    r.points.swap(all);
+  else
+    for (const PointReport& p : all)
+      if (inRange(p.parameter, options)) r.points.push_back(p);
+  for (PointReport& pr : r.points) {
     if (options.stiffness) {
       // along a control path K_q is that of the free lengths at the point's λ
       // and with body loads the Hessian's generator h − γ (eq B3)

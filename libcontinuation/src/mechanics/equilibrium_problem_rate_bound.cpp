@@ -20,6 +20,16 @@ namespace {
 // route) costs less than the structure's set-up and an inverse iteration per value: whole race
 // runs (benchmarks/race_auto.sh) cross over between n = 4 and 6.
 constexpr int kStructuredSlopesFrom = 5;
+
+// The Gram matrix C Cᵀ of the m ≤ 3 held rows (the first m rows of `rows`), padded with
+// `padding` on the unused diagonal.
+Eigen::Matrix3d heldGram(const continuation::Matrix& rows, int m, double padding) {
+  Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
+  for (int k = 0; k < m; ++k)
+    for (int l = 0; l <= k; ++l) G(k, l) = G(l, k) = rows.row(k).dot(rows.row(l));
+  for (int k = m; k < 3; ++k) G(k, k) = padding;
+  return G;
+}
 }  // namespace
 
 void EquilibriumProblem::stabilityRates(Workspace& d, const ConstVectorRef& u, double lambda, const ConstVectorRef& du,
@@ -82,9 +92,8 @@ bool EquilibriumProblem::stabilityRateBound(ProblemWorkspace& ws, ConstVectorRef
   // ‖ζ‖ ≤ ‖H‖₂/σ_min(C); and dμ = vᵀ dH v + 2 ζᵀ dC v (differentiate and multiply by vᵀ).
   // σ_min(C)² = the smallest eigenvalue of the Gram matrix CCᵀ (m ≤ 3; the unused diagonal is
   // padded above every eigenvalue of the m×m block, which stays decoupled).
-  Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
-  for (int k = 0; k < m; ++k)
-    for (int l = 0; l <= k; ++l) G(k, l) = G(l, k) = d.J.row(held_[size_t(k)]).dot(d.J.row(held_[size_t(l)]));
+  for (int k = 0; k < m; ++k) d.heldRows.row(k) = d.J.row(held_[size_t(k)]);
+  Eigen::Matrix3d G = heldGram(d.heldRows, m, 0.0);
   const double trace = G.trace();
   for (int k = m; k < 3; ++k) G(k, k) = 2.0 * trace + 1.0;
   const double sigma2 =
@@ -106,13 +115,9 @@ bool EquilibriumProblem::stabilitySlopes(ProblemWorkspace& ws, ConstVectorRef u,
   assembleFromCache(d, u, lambda, d.structure);
   for (int k = 0; k < m; ++k) d.heldRows.row(k) = d.J.row(held_[size_t(k)]);
   // rank-deficient C: ker C jumps along the tangent (no derivative), as for the bound
-  if (m > 0 && setConstraints(d.structure, d.heldRows) < m) return false;
-  if (m == 0) d.structure.rank = 0;
+  if ((m > 0 ? setConstraints(d.structure, d.heldRows) : (d.structure.rank = 0)) < m) return false;
   stabilityRates(d, u, lambda, du, dlambda);
-  Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
-  for (int k = 0; k < m; ++k)
-    for (int l = 0; l <= k; ++l) G(k, l) = G(l, k) = d.heldRows.row(k).dot(d.heldRows.row(l));
-  const Eigen::LDLT<Eigen::Matrix3d> gram(G);
+  const Eigen::LDLT<Eigen::Matrix3d> gram(heldGram(d.heldRows, m, 1.0));
   const double scale = std::max(d.structure.typicalScale, d.structure.frobeniusH);
   Vector& v = d.eigenvector;
   Vector& Hv = d.hessianTimes;
