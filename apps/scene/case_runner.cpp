@@ -255,6 +255,9 @@ void CaseRunner::suddenLoad() {
     rec.rest = r.rest;
     for (size_t i = 0; i < r.contactSides.size(); ++i)
       if (r.contactSides[i] != 0) rec.contacts.push_back({int(i), r.contactSides[i], r.contactTorques[Eigen::Index(i)]});
+    for (size_t k = 0; k < r.wallContacts.size() && Eigen::Index(k) < r.wallForces.size(); ++k)
+      rec.wall.push_back({r.wallContacts[k], r.wallForces[Eigen::Index(k)]});
+    rec.events = r.dynamics.contactEvents;
     if (r.rest.size() == n) rec.restPose = mech::endPose(out_.chain, r.rest);
     rec.stable = r.stable;
     rec.haveStatic = r.compared;

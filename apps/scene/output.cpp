@@ -76,6 +76,34 @@ json contactsJson(const std::vector<mechanics::JointContact>& contacts) {
   return a;
 }
 
+/// Vertices resting on the base wall: the vertex (wall column spelling) and its wall force μ_v.
+json wallJson(const std::vector<mechanics::WallSupport>& wall) {
+  json a = json::array();
+  for (const mechanics::WallSupport& v : wall) a.push_back({{"vertex", v.vertex.label()}, {"wall_force", jsonNumber(v.force)}});
+  return a;
+}
+
+/// The contacts made and released during dynamics: the time (the model's), the joint (1-based,
+/// with its side) or the wall vertex, "contact" or "release", the contact torque or wall force
+/// then, and an impact's kinetic-energy loss.
+json contactEventsJson(const std::vector<mechanics::ContactEvent>& events) {
+  json a = json::array();
+  for (const mechanics::ContactEvent& e : events) {
+    json j{{"t", jsonNumber(e.t)}, {"event", e.contact ? "contact" : "release"}};
+    if (e.joint >= 0) {
+      j["joint"] = e.joint + 1;
+      j["side"] = e.side > 0 ? "upper" : "lower";
+      j["contact_torque"] = jsonNumber(e.torque);
+    } else {
+      j["vertex"] = e.vertex.label();
+      j["wall_force"] = jsonNumber(e.torque);
+    }
+    if (e.contact) j["kinetic_lost"] = jsonNumber(e.kineticLost);
+    a.push_back(j);
+  }
+  return a;
+}
+
 /// A special point's contacts: where the chain touches the wall or itself, the joint that locks
 /// or releases (CT / RL), the vertex that reaches or leaves the wall (WC / WR) and, located on a
 /// wall stretch, the forces of its vertices there.
@@ -84,10 +112,10 @@ void addContacts(const mechanics::SpecialPointReport& s, json& p) {
   if (s.joint >= 0)
     p["contact"] = {{"joint", s.joint + 1}, {"contact_torque", jsonNumber(s.contactTorque)}, {"locked_after", s.lockedAfter.label()}};
   if (!s.wallVertices.empty()) {
-    json w = json::array();
+    std::vector<mechanics::WallSupport> wall;
     for (size_t k = 0; k < s.wallVertices.size() && Eigen::Index(k) < s.wallForces.size(); ++k)
-      w.push_back({{"vertex", s.wallVertices[k].label()}, {"wall_force", jsonNumber(s.wallForces[Eigen::Index(k)])}});
-    p["wall"] = w;
+      wall.push_back({s.wallVertices[k], s.wallForces[Eigen::Index(k)]});
+    p["wall"] = wallJson(wall);
   }
   if (s.vertex.segment >= 0)
     p["wall_contact"] = {{"vertex", s.vertex.label()}, {"contact_force", jsonNumber(s.contactForce)},
@@ -167,9 +195,7 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
         j["distance"] = jsonNumber(l.distance);
         j["contacts"] = contactsJson(l.contacts);
         if (!l.wall.empty()) {  // vertices held on the base wall
-          json w = json::array();
-          for (const mechanics::WallSupport& v : l.wall) w.push_back({{"vertex", v.vertex.label()}, {"wall_force", jsonNumber(v.force)}});
-          j["wall"] = w;
+          j["wall"] = wallJson(l.wall);
         }
         if (!l.success && l.wallBlocked) j["landing"] = "not landed: " + l.message;
         p["jump_to"] = j;
@@ -223,7 +249,9 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
              {"residual", jsonNumber(r.residual)},
              {"energy_balance_error", jsonNumber(r.energyBalanceError)}};
       if (r.rest.size() > 0)
-        e["rest"] = json{{"q", jsonVector(r.rest)}, {"position", poseJson(r.restPose)}, {"contacts", contactsJson(r.contacts)}};
+        e["rest"] = json{{"q", jsonVector(r.rest)}, {"position", poseJson(r.restPose)}, {"contacts", contactsJson(r.contacts)},
+                         {"wall", wallJson(r.wall)}};
+      e["contact_events"] = contactEventsJson(r.events);
       if (r.haveStatic)
         e["quasi_static"] = json{{"q", jsonVector(r.staticShape)},
                                  {"position", poseJson(r.staticPose)},

@@ -79,6 +79,9 @@ struct SuddenLoadRecord {
   double peakKinetic = 0.0, maxExcursion = 0.0, duration = 0.0, residual = 0.0;
   double energyBalanceError = 0.0;
   std::vector<mechanics::JointContact> contacts;  ///< joints resting against their limits
+  std::vector<mechanics::WallSupport> wall;       ///< vertices resting on the base wall
+  /// The contacts made and released during the dynamics (joint stops, the wall), in time order.
+  std::vector<mechanics::ContactEvent> events;
   std::vector<mechanics::TrajectorySample> trajectory;
 };
 

@@ -16,6 +16,7 @@
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/linear_buckling.h"
+#include "relative_error.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -25,7 +26,7 @@ namespace {
 const std::vector<double> kScales = {1e-3, 1.0, 1e3};
 const std::vector<double> kStiffnessScales = {1e-6, 1e-3, 1.0, 1e3, 1e6};
 
-double relativeError(double x, double reference) { return std::abs(x - reference) / std::abs(reference); }
+using buckle::test::relativeError;
 
 // The AUTO-07p harness's options (DS = 0.01, DSMAX = 0.05, DSMIN = 1e-4), λ range
 // [lambdaMin, lambdaMax]: the same (dimensionless) steps for every unit system.

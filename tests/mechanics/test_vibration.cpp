@@ -19,6 +19,7 @@
 #include "buckle/mechanics/wall_contact.h"
 
 #include "test_chains.h"
+#include "relative_error.h"
 
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
@@ -29,7 +30,7 @@ using testing::stiffChain;
 
 constexpr double kPi = 3.14159265358979323846;
 
-double relativeError(double x, double reference) { return std::abs(x - reference) / std::abs(reference); }
+using buckle::test::relativeError;
 
 // Equilibrium of the free end under F by Newton on ∂Π/∂q with the dense Hessian, from q = 0.
 Vector freeEquilibrium(const Chain& chain, const Wrench& F) {

@@ -163,17 +163,40 @@ void DynamicsModel::evaluateStatics(ConstVectorRef q) {
     h_[k] = data_.pose[c] - end_.value[c];
   }
   // locked joints: rows e_iᵀ, h = q_i − q̄_i (Jh_ holds their zeros since setContacts)
-  for (int k = mh; k < m; ++k) {
+  const int w0 = wallRowBegin();
+  for (int k = mh; k < w0; ++k) {
     const int i = locked_[size_t(k - mh)];
     h_[k] = q[i] - limitAngle(i, sides_[size_t(i)]);
   }
+  if (!wall_.empty()) wallRows();
   A_.noalias() = Jh_ * Jh_.transpose();
   // J_h loses rank where the held coordinate is stationary (x held on the straight chain): a
   // relative 1e-12 shift keeps the factorization defined and is invisible at regular points.
   // (Not on the locked rows: unit rows, and the shift would let a locked joint creep.)
   if (mh > 0)
     A_.diagonal().head(mh).array() += 1e-12 * std::max(lengthUnit_ * lengthUnit_, A_.topLeftCorner(mh, mh).trace());
+  for (int k = w0; k < m; ++k) A_(k, k) += 1e-12 * std::max(lengthUnit_ * lengthUnit_, A_(k, k));
   llt_.compute(A_);
+}
+
+void DynamicsModel::wallRows() {
+  // Joint j at end − (C_j, S_j) (the tail sums of ChainData: ∂y/∂q_j = x_end − x_Pj, −∂x/∂q_j =
+  // y_end − y_Pj), as jointPositions' column j + 1, without a sine or cosine.
+  const int n = segments();
+  positions_.col(0).setZero();
+  for (int j = 0; j < n; ++j) positions_.col(j + 1) << data_.pose[0] - data_.C[j], data_.pose[1] - data_.S[j];
+  positions_.col(n + 1) << data_.pose[0], data_.pose[1];
+  const int w0 = wallRowBegin();
+  for (int k = 0; k < wallCount(); ++k) {
+    const WallVertex& v = wall_[size_t(k)];
+    const double before = v.segment > 0 ? data_.theta[v.segment - 1] : 0.0;
+    const Eigen::Vector2d point =
+        segmentVertex(chain_.segment(v.segment).parameters(), positions_.col(v.segment + 1), before, data_.theta[v.segment],
+                      v.corner);
+    wallVertexDerivatives(positions_, point, v, wallRow_, wallGen_.col(k));
+    Jh_.row(w0 + k) = wallRow_.transpose();
+    h_[w0 + k] = point.x();
+  }
 }
 
 double DynamicsModel::potential(ConstVectorRef q) {
@@ -224,9 +247,10 @@ double DynamicsModel::naturalResidual(ConstVectorRef q) {
   const double raw = equilibriumResidual(q);  // fills grad_ / tmpN_ and h_
   if (constraintCount() == 0) return raw / torqueUnit_;
   const int mh = heldCount();
-  // held rows in lengths, locked rows in radians (their own unit)
+  // held and wall rows in lengths, locked rows in radians (their own unit)
   double h = mh > 0 ? h_.head(mh).cwiseAbs().maxCoeff() / lengthUnit_ : 0.0;
-  if (lockedCount() > 0) h = std::max(h, h_.tail(lockedCount()).cwiseAbs().maxCoeff());
+  if (lockedCount() > 0) h = std::max(h, h_.segment(mh, lockedCount()).cwiseAbs().maxCoeff());
+  if (wallCount() > 0) h = std::max(h, h_.tail(wallCount()).cwiseAbs().maxCoeff() / lengthUnit_);
   return std::max(tmpN_.cwiseAbs().maxCoeff() / torqueUnit_, h);
 }
 
@@ -269,15 +293,33 @@ void DynamicsModel::setContacts(const std::vector<int>& sides) {
   for (int s : sides)
     if (s < -1 || s > 1) throw std::invalid_argument("contact sides must be -1, 0 or +1");
   sides_ = sides;
-  staticsValid_ = false;  // h_ and the rows depend on the contact set
   locked_.clear();
   for (int i = 0; i < n; ++i)
     if (sides_[size_t(i)] != 0) locked_.push_back(i);
+  rebuildConstraints();
+}
+
+void DynamicsModel::setWallContacts(const std::vector<WallVertex>& vertices) {
+  for (size_t k = 0; k < vertices.size(); ++k) {
+    checkWallVertex(vertices[k], segments());
+    if (std::find(vertices.begin(), vertices.begin() + long(k), vertices[k]) != vertices.begin() + long(k))
+      throw std::invalid_argument("wall contacts: vertex " + vertices[k].label() + " given twice");
+  }
+  wall_ = vertices;
+  rebuildConstraints();
+}
+
+void DynamicsModel::rebuildConstraints() {
+  const int n = segments();
+  staticsValid_ = false;  // h_ and the rows depend on the contact set
   const int mh = heldCount(), m = constraintCount();
   Matrix held = Jh_.topRows(mh);
   Jh_ = Matrix::Zero(m, n);
   Jh_.topRows(mh) = held;
-  for (int k = mh; k < m; ++k) Jh_(k, locked_[size_t(k - mh)]) = 1.0;
+  for (int k = mh; k < wallRowBegin(); ++k) Jh_(k, locked_[size_t(k - mh)]) = 1.0;
+  wallGen_ = Matrix::Zero(n, wallCount());
+  positions_.resize(2, n + 2);
+  wallRow_.resize(n);
   h_ = Vector::Zero(m);
   A_ = Matrix::Identity(m, m);
   llt_.compute(A_);
@@ -292,6 +334,15 @@ void DynamicsModel::contactTorques(const double* x, VectorRef torques) {
   fdPlus_.resize(size_t(stateSize()));
   rhs(x, fdPlus_.data());  // the multipliers r_ at x
   for (int k = 0; k < lockedCount(); ++k) torques[locked_[size_t(k)]] = r_[heldCount() + k];
+}
+
+void DynamicsModel::contactForces(const double* x, VectorRef torques, VectorRef wallForces) {
+  torques.setZero();
+  if (locked_.empty() && wall_.empty()) return;
+  fdPlus_.resize(size_t(stateSize()));
+  rhs(x, fdPlus_.data());  // the multipliers r_ at x
+  for (int k = 0; k < lockedCount(); ++k) torques[locked_[size_t(k)]] = r_[heldCount() + k];
+  wallForces = r_.tail(wallCount());
 }
 
 double DynamicsModel::restSpeed(const double* x) {

@@ -10,15 +10,10 @@ namespace buckle::mechanics {
 
 namespace {
 
-/// out = ∇²p_c v for the end coordinate c: ∂²x/∂q_i∂q_j = −C_max(i,j), ∂²y/∂q_i∂q_j = −S_max(i,j)
-/// (eq 26–27), ∂²φ = 0; as (G v)_i = g_i Σ_{j≤i} v_j + Σ_{j>i} g_j v_j, O(n).
-void applyEndHessian(const ChainData& data, int c, ConstVectorRef v, VectorRef out) {
+/// out = −G v for the generator form G(i, j) = g_max(i,j): (G v)_i = g_i Σ_{j≤i} v_j + Σ_{j>i} g_j v_j,
+/// O(n). The Hessians of the end coordinates and of a wall vertex's x are −G of their generators.
+void applyNegativeGenerator(ConstVectorRef g, ConstVectorRef v, VectorRef out) {
   const Eigen::Index n = v.size();
-  if (c == static_cast<int>(EndCoordinate::Phi)) {
-    out.setZero();
-    return;
-  }
-  const Vector& g = c == 0 ? data.C : data.S;
   double head = 0.0, tail = 0.0;
   for (Eigen::Index i = 0; i < n; ++i) {
     head += v[i];
@@ -28,6 +23,13 @@ void applyEndHessian(const ChainData& data, int c, ConstVectorRef v, VectorRef o
     out[i] -= tail;
     tail += g[i] * v[i];
   }
+}
+
+/// out = ∇²p_c v for the end coordinate c: ∂²x/∂q_i∂q_j = −C_max(i,j), ∂²y/∂q_i∂q_j = −S_max(i,j)
+/// (eq 26–27), ∂²φ = 0.
+void applyEndHessian(const ChainData& data, int c, ConstVectorRef v, VectorRef out) {
+  if (c == static_cast<int>(EndCoordinate::Phi)) out.setZero();
+  else applyNegativeGenerator(c == 0 ? data.C : data.S, v, out);
 }
 
 }  // namespace
@@ -140,6 +142,8 @@ bool GradientFlowModel::solveLinearized(const double* x, double a, const double*
     // H_r = U T Uᵀ from the statics velocity() evaluated (K_q and the kinematics at q)
     loadHessianGenerator(data_, total, structure_.h);
     subtractBodyGenerator(structure_.h);
+    // the wall forces' −Σ μ_v ∂²x_v: the generator h gains −μ_v g_v (wall_contact.h)
+    for (int k = 0; k < wallCount(); ++k) structure_.h -= r_[wallRowBegin() + k] * wallGen_.col(k);
     structure_.kappa = stiffness_;
     assemble(structure_.kappa, structure_.h, structure_);
     // (I − aJ̃) k = b with s = a/c: (I + s(P H_r + κ_h J_h⁺J_h − J_h⁺E)) k = b. With
@@ -151,8 +155,9 @@ bool GradientFlowModel::solveLinearized(const double* x, double a, const double*
       for (int j = 0; j < m; ++j) {
         applyHessian(structure_, V_.col(j), W_.col(j));
         W_.col(j) -= kappaH_ * V_.col(j);
-        if (j >= mh) continue;  // a locked joint's row e_iᵀ is constant: no E term
-        applyEndHessian(data_, held_[size_t(j)], qdot_, tmpN_);
+        if (j >= mh && j < wallRowBegin()) continue;  // a locked joint's row e_iᵀ is constant: no E term
+        if (j < mh) applyEndHessian(data_, held_[size_t(j)], qdot_, tmpN_);
+        else applyNegativeGenerator(wallGen_.col(j - wallRowBegin()), qdot_, tmpN_);  // ∇²x_v q̇
         W_.col(j) -= c_ * tmpN_;
       }
     }

@@ -288,6 +288,16 @@ void InertialModel::rhs(const double* x, double* dxdt) {
       if (k < mh && c != static_cast<int>(EndCoordinate::Phi))
         for (int i = 0; i < n; ++i)
           jdot -= l[i + 1] * (c == 0 ? cos_[i] : sin_[i]) * thetaDot_[i] * thetaDot_[i];
+      // a wall vertex: q̇ᵀ∇²x_v q̇ = −Σ_{i,j} g_max(i,j) q̇_i q̇_j = −Σ_m g_m (θ̇_m² − θ̇_(m−1)²)
+      if (k >= wallRowBegin()) {
+        const auto g = wallGen_.col(k - wallRowBegin());
+        double previous = 0.0;
+        for (int i = 0; i <= wall_[size_t(k - wallRowBegin())].lastJoint(); ++i) {
+          const double square = thetaDot_[i] * thetaDot_[i];
+          jdot -= g[i] * (square - previous);
+          previous = square;
+        }
+      }
       tmpM_[k] = -jdot - 2.0 * omega_ * Jh_.row(k).dot(v) - omega_ * omega_ * h_[k];
     }
     tmpM_.noalias() -= Jh_ * acc_;

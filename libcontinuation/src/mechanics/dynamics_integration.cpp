@@ -1,5 +1,5 @@
 // Integration of the dynamics models (dynamics.h, "integration"): options, the accepted-step loop
-// with the rest / guard monitor and the joint contacts as events, and simulate(). The steppers
+// with the rest / guard monitor and the contacts as events (dynamics_contacts.h), and simulate(). The steppers
 // themselves are in dynamics_steppers.h.
 #include "buckle/mechanics/dynamics.h"
 
@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "buckle/continuation/root_finding.h"
+#include "dynamics_contacts.h"
 #include "dynamics_steppers.h"
 
 namespace buckle::mechanics {
@@ -80,7 +81,7 @@ class Monitor {
     if (slow && residual <= options_.residualTolerance)
       return stop(IntegrationStop::Rest, "at rest: |qdot| and the equilibrium residual are below tolerance at t = " + num(t));
     ++sinceSettleCheck_;
-    if (options_.settled && model_.lockedCount() == 0 && residual <= options_.settleResidual &&
+    if (options_.settled && model_.lockedCount() == 0 && model_.wallCount() == 0 && residual <= options_.settleResidual &&
         sinceSettleCheck_ >= options_.settleInterval) {
       sinceSettleCheck_ = 0;
       if (options_.settled(q))
@@ -110,7 +111,9 @@ class Monitor {
     result_.residual = model_.equilibriumResidual(q);
     result_.contactSides = model_.contactSides();
     result_.contactTorques = Vector::Zero(n);
-    model_.contactTorques(x, result_.contactTorques);
+    result_.wallContacts = model_.wallContacts();
+    result_.wallForces = Vector::Zero(model_.wallCount());
+    model_.contactForces(x, result_.contactTorques, result_.wallForces);
     if (options_.recordTrajectory && (result_.trajectory.empty() || result_.trajectory.back().t < t)) forceRecord(t, x);
   }
 
@@ -169,85 +172,6 @@ auto resetController(C& controller, int) -> decltype(controller.reset(), void())
 template <class C>
 void resetController(C&, long) {}
 
-/// The one-sided joint limits during an integration (dynamics.h, file comment): event functions,
-/// their location inside an accepted step, and the contact set's update at an event.
-class ContactTracker {
- public:
-  ContactTracker(DynamicsModel& model, DynamicsResult& result)
-      : model_(model), result_(result), g_(size_t(model.segments())), torques_(model.segments()) {}
-
-  /// Event functions at x, in the chain's own units: for a free joint the distance to its nearer
-  /// limit (radians, > 0 inside), for a locked one its compression −side·τ_c / k̄b̄² (> 0 while
-  /// the contact pushes).
-  const std::vector<double>& events(const double* x) {
-    const int n = model_.segments();
-    const Vector& lo = model_.chain().lowerLimits();
-    const Vector& hi = model_.chain().upperLimits();
-    model_.contactTorques(x, torques_);
-    for (int i = 0; i < n; ++i) {
-      const int side = model_.contactSides()[size_t(i)];
-      g_[size_t(i)] = side == 0 ? std::min(x[i] - lo[i], hi[i] - x[i]) : -side * torques_[i] / model_.torqueUnit();
-    }
-    return g_;
-  }
-
-  /// Locks `joint` at its nearer limit (side 0) or releases it, at time t; x is made admissible.
-  void toggle(double* x, double t, int joint) {
-    std::vector<int> sides = model_.contactSides();
-    const bool lock = sides[size_t(joint)] == 0;
-    ContactEvent e;
-    e.t = t;
-    e.joint = joint;
-    if (lock) {
-      const double lo = model_.chain().lowerLimits()[joint], hi = model_.chain().upperLimits()[joint];
-      sides[size_t(joint)] = hi - x[joint] <= x[joint] - lo ? 1 : -1;
-    } else {
-      model_.contactTorques(x, torques_);
-      e.torque = torques_[joint];
-      sides[size_t(joint)] = 0;
-    }
-    e.side = lock ? sides[size_t(joint)] : model_.contactSides()[size_t(joint)];
-    e.contact = lock;
-    model_.setContacts(sides);
-    if (lock) {
-      e.kineticLost = model_.impact(x);
-      model_.contactTorques(x, torques_);
-      e.torque = torques_[joint];
-    }
-    result_.contactEvents.push_back(e);
-  }
-
-  /// The contact set consistent at x (after an event or at the start): free joints beyond a
-  /// limit are locked, then the locked joint pulling hardest is released, one at a time (an
-  /// active-set iteration; at most 2n + 2 changes). False when it does not settle.
-  bool settle(double* x, double t) {
-    const int n = model_.segments();
-    for (int change = 0; change <= 2 * n + 2; ++change) {
-      const std::vector<double>& g = events(x);
-      int beyond = -1, pulling = -1;
-      double worst = 0.0;
-      for (int i = 0; i < n; ++i) {
-        if (model_.contactSides()[size_t(i)] == 0) {
-          if (g[size_t(i)] < 0.0 && beyond < 0) beyond = i;
-        } else if (g[size_t(i)] < worst) {
-          worst = g[size_t(i)];
-          pulling = i;
-        }
-      }
-      if (beyond >= 0) toggle(x, t, beyond);
-      else if (pulling >= 0) toggle(x, t, pulling);
-      else return true;
-    }
-    return false;
-  }
-
- private:
-  DynamicsModel& model_;
-  DynamicsResult& result_;
-  std::vector<double> g_;
-  Vector torques_;
-};
-
 /// The stop after the step size fell below minStep while steps kept leaving the admissible states
 /// at x (the last accepted state): at the barrier when the last trial was finite and within the
 /// limits (only IntegrationOptions::admissible rejected it), else at the nearest joint limit, or
@@ -283,9 +207,9 @@ void runLoop(Controller& controller, System system, State& x, const double* (*da
   double t = 0.0, dt = options.initialStep;
   const int n = model.segments();
   auto mutableData = [&](State& s) { return const_cast<double*>(data(s)); };
-  ContactTracker contacts(model, result);
+  ContactTracker contacts(model, options, result);
   std::vector<double> gPrevious;
-  if (options.contact) {
+  if (contacts.active()) {
     model.impact(mutableData(x));  // the caller's locked joints sit on their limits
     if (!contacts.settle(mutableData(x), t)) {
       monitor.stop(IntegrationStop::JointLimit, "the contact set at the start did not settle");
@@ -351,15 +275,15 @@ void runLoop(Controller& controller, System system, State& x, const double* (*da
       }
       continue;
     }
-    if (options.contact) {
+    if (contacts.active()) {
       // Events in the step: an event function that went from >= 0 to < 0. Each crossing is
       // located by Illinois iteration on the step length τ in (0, t − tPrevious], each trial a
       // step of the integrator's method from the last accepted state; the earliest one is taken.
       const std::vector<double> gNow = contacts.events(data(x));
       const double h = t - tPrevious;
-      int joint = -1;
+      int joint = -1;  // the event's index (contacts.events())
       double at = h;
-      for (int i = 0; i < n; ++i) {
+      for (int i = 0; i < contacts.size(); ++i) {
         const double g0 = gPrevious[size_t(i)], g1 = gNow[size_t(i)];
         if (!(g0 >= 0.0 && g1 < 0.0)) continue;
         double root = 0.0;
@@ -403,7 +327,7 @@ void runLoop(Controller& controller, System system, State& x, const double* (*da
         }
         resetController(controller, 0);
         eventsWithoutProgress = at > 0.0 ? 0 : eventsWithoutProgress + 1;
-        if (eventsWithoutProgress > 2 * n + 2) {
+        if (eventsWithoutProgress > 2 * contacts.size() + 2) {
           monitor.stop(IntegrationStop::JointLimit, "contacts keep changing without progress at t = " + std::to_string(t));
           break;
         }
@@ -451,6 +375,7 @@ DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef 
   model.packState(q0, qdot0, x0);
   Monitor monitor(model, natural, result);
   const std::vector<int> initialSides = model.contactSides();
+  const std::vector<WallVertex> initialWall = model.wallContacts();
 
   // The structured Rosenbrock method runs on the model's solveLinearized() (both models have it).
   const bool structured = natural.stepper == StepperKind::StructuredRosenbrock4;
@@ -502,6 +427,7 @@ DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef 
   }
   // the contacts found are the result's; the model is left as the caller set it (repeatable runs)
   model.setContacts(initialSides);
+  model.setWallContacts(initialWall);
   result.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
   return result;
 }

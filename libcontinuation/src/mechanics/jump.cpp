@@ -60,9 +60,10 @@ struct RestPoint {
   Vector wallForces;
 };
 
-/// The landing of dynamics stopped at the base wall (IntegrationStop::Barrier): the vertex of
-/// `chain` (the model's) nearest to the wall and the joints locked then start the active set of
-/// landOnWall (wall_landing.h).
+/// The landing of dynamics that ended on the base wall: at rest with vertices on it
+/// (IntegrationOptions::wall), or stopped at it (IntegrationStop::Barrier: the vertex of `chain`,
+/// the model's, nearest to the wall). Those vertices and the joints locked then start the active
+/// set of landOnWall (wall_landing.h).
 RestPoint wallRestPoint(EquilibriumProblem& problem, const Chain& chain, const DynamicsResult& dyn, double lambda,
                         const continuation::CorrectorOptions& options) {
   RestPoint rp;
@@ -70,7 +71,8 @@ RestPoint wallRestPoint(EquilibriumProblem& problem, const Chain& chain, const D
   ContactSet start;
   for (int i = 0; i < n && dyn.contactSides.size() == size_t(n); ++i)
     if (dyn.contactSides[size_t(i)] != 0) start.lock(i, dyn.contactSides[size_t(i)] > 0 ? LimitSide::Upper : LimitSide::Lower);
-  start.touch(nearestWallVertex(chain, dyn.q).vertex);
+  for (const WallVertex& v : dyn.wallContacts) start.touch(v);
+  if (dyn.reason == IntegrationStop::Barrier) start.touch(nearestWallVertex(chain, dyn.q).vertex);
   const WallLanding w = landOnWall(problem, start, dyn.q, lambda, options.tolerance, options.maxIterations);
   rp.polished.u = w.u;
   rp.polished.converged = w.converged;
@@ -85,6 +87,25 @@ RestPoint wallRestPoint(EquilibriumProblem& problem, const Chain& chain, const D
   rp.wall = w.contacts.wall();
   rp.wallForces = w.wallForces;
   return rp;
+}
+
+/// Whether the dynamics reached the base wall, and where first: the first wall contact event
+/// (its vertex's x at that instant), or the vertex nearest to the wall where the caller's
+/// barrier stopped them (IntegrationStop::Barrier).
+void noteWallReached(const DynamicsModel& model, const DynamicsResult& dyn, bool& reached, WallVertex& vertex,
+                     double& gap) {
+  for (const ContactEvent& e : dyn.contactEvents) {
+    if (e.joint >= 0 || !e.contact) continue;
+    reached = true;
+    vertex = e.vertex;
+    gap = 0.0;
+    return;
+  }
+  if (dyn.reason != IntegrationStop::Barrier) return;
+  const WallApproach at = nearestWallVertex(model.chain(), dyn.q);
+  reached = true;
+  vertex = at.vertex;
+  gap = at.distance;
 }
 
 /// Whether the integration ended where a landing can be read off: at rest, handed over, or at
@@ -102,7 +123,8 @@ RestPoint polishRestPoint(EquilibriumProblem& problem, const Chain& chain, const
   const int n = problem.segments();
   rp.sides = dyn.contactSides.size() == size_t(n) ? dyn.contactSides : std::vector<int>(size_t(n), 0);
   rp.torques = Vector::Zero(n);
-  if (dyn.reason == IntegrationStop::Barrier) return wallRestPoint(problem, chain, dyn, lambda, options);
+  if (dyn.reason == IntegrationStop::Barrier || (dyn.reason == IntegrationStop::Rest && !dyn.wallContacts.empty()))
+    return wallRestPoint(problem, chain, dyn, lambda, options);
   if (dyn.reason == IntegrationStop::Settled && settled && !anyContact(rp.sides)) {
     rp.polished = *settled;
     cont::BoundProblem(problem).stability(rp.polished.u, lambda, 3, rp.stability);
@@ -432,15 +454,10 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
       ++result.basinTests;
       return basinTest(problem, *model, q, lambda, options.polish, certified);
     };
-  if (options.wall) integration.admissible = wallBarrier(model->chain());
+  integration.wall = integration.wall || options.wall;
   result.dynamics = simulate(*model, qStart, Vector::Zero(n), integration);
   const DynamicsResult& dyn = result.dynamics;
-  if (dyn.reason == IntegrationStop::Barrier) {
-    const WallApproach at = nearestWallVertex(model->chain(), dyn.q);
-    result.reachedWall = true;
-    result.wallVertex = at.vertex;
-    result.wallGap = at.distance;
-  }
+  noteWallReached(*model, dyn, result.reachedWall, result.wallVertex, result.wallGap);
   result.stopReason = dyn.reason;
   result.duration = dyn.time;
   result.steps = dyn.steps;
@@ -468,7 +485,7 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.wallForces = rest.wallForces;
 
   std::ostringstream os;
-  os << "integration stopped: " << dyn.message << "; " << (result.reachedWall ? "landing on the wall: " : "polish: ")
+  os << "integration stopped: " << dyn.message << "; " << (!rest.wall.empty() ? "landing on the wall: " : "polish: ")
      << (polished.converged ? "converged" : "not converged") << " (" << polished.message << ", residual "
      << polished.residual << "); landing " << describe(result.stabilityTo);
   if (anyContact(rest.sides)) os << " with the joints locked; in contact: " << describeContacts(rest.sides, rest.torques);
@@ -526,13 +543,11 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
   }
 
   IntegrationOptions integration = options.integration;
-  if (options.wall) integration.admissible = wallBarrier(model->chain());
+  integration.wall = integration.wall || options.wall;
   result.dynamics = simulate(*model, result.start, Vector::Zero(n), integration);
   const DynamicsResult& dyn = result.dynamics;
-  if (dyn.reason == IntegrationStop::Barrier) {
-    result.reachedWall = true;
-    result.wallVertex = nearestWallVertex(model->chain(), dyn.q).vertex;
-  }
+  double gap = 0.0;
+  noteWallReached(*model, dyn, result.reachedWall, result.wallVertex, gap);
   for (const TrajectorySample& s : dyn.trajectory) {
     result.peakKinetic = std::max(result.peakKinetic, s.kinetic);
     result.maxExcursion = std::max(result.maxExcursion, (s.q - result.start).cwiseAbs().maxCoeff());

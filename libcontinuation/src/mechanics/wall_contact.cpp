@@ -61,11 +61,14 @@ void wallVertexDerivatives(const Eigen::Matrix2Xd& P, const Eigen::Vector2d& poi
   }
 }
 
-WallApproach nearestWallVertex(const Chain& chain, ConstVectorRef q, const std::vector<WallVertex>& exclude) {
+namespace {
+
+/// Calls visit(vertex, point) for every moving vertex at q, in the order of movingVertices. One
+/// sine and cosine per joint.
+template <class Visit>
+void forEachMovingVertex(const Chain& chain, ConstVectorRef q, Visit visit) {
   const int n = chain.size();
   const Eigen::Matrix2Xd P = jointPositions(chain, q);  // checks the size
-  WallApproach c;
-  c.distance = std::numeric_limits<double>::infinity();
   double theta = 0.0;
   Point before = dir(0.0);
   for (int i = 0; i < n; ++i) {
@@ -76,18 +79,36 @@ WallApproach nearestWallVertex(const Chain& chain, ConstVectorRef q, const std::
     const bool shared = i > 0 && p.a1 == chain.segment(i - 1).parameters().a2;
     for (int corner = i > 0 ? 0 : 3; corner <= 4; ++corner) {
       if (shared && (corner == 1 || corner == 2)) continue;
-      const WallVertex v{i, corner};
-      if (std::find(exclude.begin(), exclude.end(), v) != exclude.end()) continue;
-      const Point x = segmentVertex(p, P.col(i + 1), before, after, corner);
-      if (x.x() < c.distance) {
-        c.distance = x.x();
-        c.vertex = v;
-        c.point = x;
-      }
+      visit(WallVertex{i, corner}, segmentVertex(p, P.col(i + 1), before, after, corner));
     }
     theta += q[i];
     before = after;
   }
+}
+
+}  // namespace
+
+std::vector<WallVertex> movingVertices(const Chain& chain) {
+  std::vector<WallVertex> out;
+  forEachMovingVertex(chain, Vector::Zero(chain.size()), [&](const WallVertex& v, const Point&) { out.push_back(v); });
+  return out;
+}
+
+void movingVertexAbscissae(const Chain& chain, ConstVectorRef q, std::vector<double>& xs) {
+  xs.clear();
+  forEachMovingVertex(chain, q, [&](const WallVertex&, const Point& x) { xs.push_back(x.x()); });
+}
+
+WallApproach nearestWallVertex(const Chain& chain, ConstVectorRef q, const std::vector<WallVertex>& exclude) {
+  WallApproach c;
+  c.distance = std::numeric_limits<double>::infinity();
+  forEachMovingVertex(chain, q, [&](const WallVertex& v, const Point& x) {
+    if (x.x() < c.distance && std::find(exclude.begin(), exclude.end(), v) == exclude.end()) {
+      c.distance = x.x();
+      c.vertex = v;
+      c.point = x;
+    }
+  });
   return c;
 }
 

@@ -41,6 +41,14 @@
 // one step of the integrator's own method from the last accepted state) on q̄_i − q_i (its sign
 // towards the inside) and on the compression — not by clamping steps.
 //
+// The base wall x = 0 (IntegrationOptions::wall) is a one-sided, friction-free contact of the
+// same kind: a moving vertex v (wall_contact.h) that reaches it is held there, its row ∇x_vᵀ
+// (h_v = x_v) joining the constraint rows, so the chain slides along the wall; its multiplier is
+// the wall force μ_v (along +x on the chain; ∇Π = Σ μ_v ∇x_v + … at rest, as ContactProblem's
+// rows), the velocity terms of the inertial model gain q̇ᵀ∇²x_v q̇ and the reactions' Hessian
+// −μ_v ∂²x_v (the generator form of wall_contact.h, O(n)). A vertex leaves the wall where μ_v
+// returns to zero; contact (x_v = 0, the impact as at a joint) and release are located events.
+//
 // Both models append the dissipated energy to the state; the integrator (simulate) stops at
 // rest (velocity and equilibrium residual below tolerance) or at a guard (time, steps, a joint
 // limit without contact, step-size underflow, a non-finite state) and says which. Models own
@@ -62,6 +70,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/end_condition.h"
+#include "buckle/mechanics/wall_contact.h"
 
 namespace buckle::mechanics {
 
@@ -151,6 +160,16 @@ class DynamicsModel {
   /// Contact torques τ_c,i at state x (size n): the multipliers of the locked joints' constraint
   /// rows (file comment), 0 at free joints. Evaluates the right-hand side once.
   void contactTorques(const double* x, VectorRef torques);
+  /// Vertices held on the base wall (file comment), in the order of their rows.
+  const std::vector<WallVertex>& wallContacts() const { return wall_; }
+  int wallCount() const { return static_cast<int>(wall_.size()); }
+  /// Sets the vertices held on the wall (no duplicates); resizes the constraint workspace.
+  /// Throws std::invalid_argument for a vertex that is not a moving one (checkWallVertex) or a
+  /// duplicate.
+  void setWallContacts(const std::vector<WallVertex>& vertices);
+  /// Contact torques (as contactTorques) and the wall forces μ_v (one per wallContacts() entry)
+  /// at state x: the multipliers of their rows. Evaluates the right-hand side once.
+  void contactForces(const double* x, VectorRef torques, VectorRef wallForces);
   /// At a contact instant: sets the locked joints' angles to their limits and (inertial) makes
   /// the velocity admissible by the inelastic impact; returns the kinetic energy lost (added to
   /// the dissipated energy in x).
@@ -201,10 +220,17 @@ class DynamicsModel {
 
  protected:
   DynamicsModel(const Chain& chain, const EndCondition& end);
-  /// Constraint rows: the held coordinates, then the locked joints.
-  int constraintCount() const { return heldCount() + lockedCount(); }
+  /// Constraint rows: the held coordinates, then the locked joints, then the wall vertices.
+  int constraintCount() const { return heldCount() + lockedCount() + wallCount(); }
+  /// The first wall vertex's row.
+  int wallRowBegin() const { return heldCount() + lockedCount(); }
   /// The derived model's constraint-sized workspace after setContacts().
   virtual void resizeConstraints() {}
+  /// The constraint workspace for the current held, locked and wall rows (setContacts,
+  /// setWallContacts); calls resizeConstraints().
+  void rebuildConstraints();
+  /// The wall vertices' rows ∇x_vᵀ, h = x_v and generators (wallGen_) at the cached kinematics.
+  void wallRows();
   /// Kinematics, J, E, ∇Π, the joint stiffnesses K_q and (with held coordinates) J_h, h, the
   /// Cholesky of J_h J_hᵀ at q, from one pass of the spring model. Cached for the last q (bitwise;
   /// setContacts() invalidates): a step evaluates the right-hand side at the accepted state, and
@@ -221,6 +247,8 @@ class DynamicsModel {
   double lengthUnit_, torqueUnit_;
   std::vector<int> held_, loaded_;
   std::vector<int> sides_, locked_;  ///< contact side per joint; the locked joints
+  std::vector<WallVertex> wall_;     ///< vertices held on the base wall
+  Matrix wallGen_;  ///< n×w: generators g_m = x_v − x_Pm of −∂²x_v (wall_contact.h), at the statics
   Wrench loads_;  ///< F_l on loaded coordinates, 0 on held ones
   ChainData data_;
   Matrix J_;      ///< 3×n end Jacobian
@@ -230,13 +258,15 @@ class DynamicsModel {
   Vector staticsQ_;      ///< q of the cached statics
   Vector sinHalf_, cosHalf_;  ///< sin(q_i/2), cos(q_i/2) of the cached statics (evaluateStatics)
   bool staticsValid_ = false;
-  Matrix Jh_;     ///< m×n constraint rows: held coordinates, then e_iᵀ of the locked joints
-  Vector h_;      ///< p_h − target, then q_i − q̄_i
+  Matrix Jh_;     ///< m×n constraint rows: held coordinates, e_iᵀ of the locked joints, ∇x_vᵀ
+  Vector h_;      ///< p_h − target, then q_i − q̄_i, then x_v
   Matrix A_;      ///< J_h J_hᵀ
   Eigen::LLT<Matrix> llt_;
   Vector r_, tmpM_;  // size m (r_: the multipliers of the last right-hand side)
   Vector tmpN_;      // size n
   std::vector<double> fdPlus_, fdMinus_, fdState_;  // for the finite-difference jacobian()
+  Eigen::Matrix2Xd positions_;  ///< joint positions (jointPositions' columns) at the statics, with wall rows
+  Vector wallRow_;               ///< scratch, size n
   std::shared_ptr<BodyLoadTerms> body_;  ///< null: no body loads
   Vector bodyWork_;                      ///< τ or γ of the body loads (size n)
   double bodyPotential_ = 0.0;           ///< V at the cached statics
@@ -416,8 +446,14 @@ struct IntegrationOptions {
   /// Joint limits as one-sided constraints (file comment); false: stop at the first limit
   /// reached (IntegrationStop::JointLimit), the time bisected down to minStep.
   bool contact = true;
+  /// The base wall x = 0 as a one-sided, friction-free contact (file comment; jump.h
+  /// JumpOptions::wall): a moving vertex that reaches it is held on it and slides along it, and
+  /// leaves it where its wall force returns to zero. The integration starts with the model's
+  /// wall vertices (setWallContacts) and ends with those on the wall then
+  /// (DynamicsResult::wallContacts). false: the chain passes through the wall.
+  bool wall = false;
   /// Hand-over test (optional; jump.h, JumpOptions::handover): consulted after an accepted step
-  /// without locked joints whose naturalResidual() is <= settleResidual, at most every
+  /// without contacts (no locked joint, no vertex on the wall) whose naturalResidual() is <= settleResidual, at most every
   /// settleInterval accepted steps, with the joint angles of that step. True ends the
   /// integration (IntegrationStop::Settled): the caller has certified where the flow goes from
   /// there and takes over (e.g. with Newton), so the creep to rest is not integrated.
@@ -453,13 +489,17 @@ struct TrajectorySample {
   double constraintViolation = 0.0;
 };
 
-/// A contact or release instant of the one-sided joint limits.
+/// A contact or release instant of the one-sided joint limits or of the base wall.
 struct ContactEvent {
   double t = 0.0;          ///< model time
-  int joint = -1;          ///< 0-based
+  int joint = -1;          ///< 0-based; −1 for a wall event
   int side = 0;            ///< +1 upper limit, −1 lower
-  bool contact = true;     ///< true: the joint locked; false: released
-  double torque = 0.0;     ///< contact torque τ_c,i just after locking / at the release
+  /// A wall event (segment ≥ 0): the vertex that reached or left the wall (joint −1).
+  WallVertex vertex{-1, 0};
+  bool contact = true;     ///< true: the joint locked / the vertex held; false: released
+  /// Contact torque τ_c,i (a joint) or wall force μ_v (a vertex) just after the contact / at the
+  /// release.
+  double torque = 0.0;
   double kineticLost = 0.0;  ///< inertial: the impact's kinetic-energy loss
 };
 
@@ -480,14 +520,17 @@ struct DynamicsResult {
   std::vector<ContactEvent> contactEvents;  ///< in time order
   std::vector<int> contactSides;            ///< the model's locked joints at the end (per joint)
   Vector contactTorques;                    ///< τ_c,i at the end (0 at free joints)
+  std::vector<WallVertex> wallContacts;     ///< IntegrationOptions::wall: the vertices on the wall at the end
+  Vector wallForces;                        ///< their wall forces μ_v at the end
   std::vector<TrajectorySample> trajectory;
   bool trajectoryTruncated = false;
 };
 
 /// Integrates the model from (q0, q̇0) until rest or a guard, starting with the model's locked
-/// joints (setContacts; their angles are set to the limits). With options.contact the contacts
-/// change at the located events (DynamicsResult::contactEvents, contactSides at the end); the
-/// model's own contact set is restored on return. Throws
+/// joints (setContacts; their angles are set to the limits) and wall vertices (setWallContacts).
+/// With options.contact (options.wall) the joint (wall) contacts change at the located events
+/// (DynamicsResult::contactEvents, contactSides and wallContacts at the end); the model's own
+/// contact set is restored on return. Throws
 /// std::invalid_argument for invalid options or sizes; every other ending is reported in
 /// DynamicsResult::reason.
 DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef qdot0, const IntegrationOptions& options);

@@ -136,9 +136,11 @@ struct JumpOptions {
   /// A landing closer than this (‖Δq‖∞) to the start means the chain did not jump.
   double sameStateTolerance = 1e-6;
   Handover handover = Handover::Automatic;
-  /// The base wall x = 0 as a barrier (wall_contact.h; the scene traces the wall): the dynamics
-  /// stop where a moving vertex reaches it (IntegrationStop::Barrier) and the chain lands on the
-  /// equilibrium with that vertex held on the wall (wall_landing.h). false: the wall is ignored
+  /// The base wall x = 0 as a one-sided contact (wall_contact.h; the scene traces the wall): a
+  /// moving vertex that reaches it during the dynamics is held on it and slides along it
+  /// (IntegrationOptions::wall), leaves it where its force returns to zero, and the chain comes
+  /// to rest on the constrained equilibrium, polished with the vertices then on the wall
+  /// (wall_landing.h's active set). false: the wall is ignored
   /// (the chain passes through it, as the continuation without the wall); a landing behind it is
   /// flagged (JumpResult::behindWall) and said so in the message.
   bool wall = false;
@@ -177,8 +179,9 @@ struct JumpResult {
   /// and their contact torques τ_c,i (contact.h: ∂E/∂q_i − (JᵀF)_i, 0 at free joints).
   std::vector<int> contactSides;
   Vector contactTorques;
-  /// JumpOptions::wall: the dynamics stopped where `wallVertex` reached the base wall
-  /// (IntegrationStop::Barrier), its x there `wallGap` (0 to the step size).
+  /// JumpOptions::wall: the chain reached the base wall during the dynamics, `wallVertex` first
+  /// (its x then `wallGap`: 0 to the event location's accuracy; or the caller's barrier
+  /// IntegrationOptions::admissible stopped the dynamics there, IntegrationStop::Barrier).
   bool reachedWall = false;
   WallVertex wallVertex;
   double wallGap = 0.0;
@@ -202,7 +205,7 @@ struct SuddenLoadOptions {
   continuation::CorrectorOptions polish = defaultPolishOptions();
   /// ‖q_dynamic − q_static‖∞ above this: the two answers differ.
   double sameStateTolerance = 1e-6;
-  /// The base wall as a barrier (as JumpOptions::wall).
+  /// The base wall as a one-sided contact (as JumpOptions::wall).
   bool wall = false;
 
   /// Empty when valid for `chain`, else what is wrong, the field named by its path.

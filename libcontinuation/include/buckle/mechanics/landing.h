@@ -2,7 +2,7 @@
 // history's jump (load_history.h), in physical quantities. Joint limits are one-sided contacts
 // during the jump (dynamics.h): a chain that comes to rest against limits lands on a stable
 // constrained equilibrium ("stable equilibrium in contact"), reported with the joints in contact
-// and their contact torques. With the base wall as a barrier (JumpOptions::wall) a chain that
+// and their contact torques. With the base wall as a contact (JumpOptions::wall) a chain that
 // reaches the wall lands on the stable equilibrium with vertices held on it ("stable equilibrium
 // on the wall", wall_landing.h), reported with those vertices and their wall forces, or is not
 // landed (wallBlocked); without it a landing behind the wall is flagged in the message. Only dynamics run without contact (IntegrationOptions::contact =

@@ -67,6 +67,14 @@ Eigen::Vector2d wallVertexPoint(const Chain& chain, ConstVectorRef q, const Eige
 void wallVertexDerivatives(const Eigen::Matrix2Xd& P, const Eigen::Vector2d& point, const WallVertex& v,
                            VectorRef gradient, VectorRef generator);
 
+/// Every moving vertex of the chain, each once (a proximal corner that is the previous
+/// segment's distal one is named by the latter, as nearestWallVertex): base to end, corners in
+/// increasing order.
+std::vector<WallVertex> movingVertices(const Chain& chain);
+/// x of every vertex of movingVertices(chain) at q, in that order, into xs (resized). O(n), one
+/// sine and cosine per joint.
+void movingVertexAbscissae(const Chain& chain, ConstVectorRef q, std::vector<double>& xs);
+
 /// The moving vertex nearest to the wall, i.e. of smallest x, leaving out `exclude` (the vertices
 /// already held on it). distance +inf when none is left. A link's two triangles share their base
 /// (ℓ_m = b_m2 + b_(m+1)1): where the half-heights are equal (a_(i+1)1 = a_i2) the proximal

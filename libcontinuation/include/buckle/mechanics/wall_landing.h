@@ -1,9 +1,10 @@
-// Landing on the base wall: a jump or sudden load whose dynamics stopped where a moving vertex
-// reached the wall x = 0 (IntegrationStop::Barrier, jump.h JumpOptions::wall) lands on the
-// equilibrium with that vertex held on the wall (contact.h, wall_contact.h: its row −x_v = 0,
-// its force μ_v an unknown, friction-free), not on a state through it.
+// Landing on the base wall: a jump or sudden load whose dynamics came to rest with vertices on
+// the wall x = 0 (IntegrationOptions::wall, jump.h JumpOptions::wall), or stopped where a moving
+// vertex reached it (a caller's barrier, IntegrationStop::Barrier), lands on the equilibrium with
+// those vertices held on the wall (contact.h, wall_contact.h: each row −x_v = 0, its force μ_v an
+// unknown, friction-free), not on a state through it.
 //
-// The contact set is found by an active-set iteration from the barrier state: solve the
+// The contact set is found by an active-set iteration from the dynamics' last state: solve the
 // constrained equilibrium (solveConstrainedEquilibrium); a vertex whose force came out pulling
 // (μ_v < 0) or a locked joint whose compression did is released, one at a time (the most
 // negative first); a vertex not on the wall that the solution puts behind it (x_v < 0), or a
