@@ -237,7 +237,7 @@ void CaseRunner::suddenLoad() {
   }
   const mech::EndCondition loaded = loadPath().at(spec.value);
   mech::SuddenLoadOptions opt;
-  opt.integration = integrationOptions();
+  opt.integration = integrationOptions(mech::jumpIntegrationDefaults(n));  // the stiff steppers of long chains
   opt.wall = tracesWall();
   if (spec.massPerLength > 0) {
     opt.scene.inertia = mech::InertiaData::uniformRods(out_.chain, spec.massPerLength);

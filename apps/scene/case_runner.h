@@ -118,7 +118,7 @@ class CaseRunner {
     return opt;
   }
   /// With contact and the wall, the base wall x = 0 is a unilateral constraint: the continuation
-  /// holds the vertices that reach it, and the dynamics stop at it and land on it (JumpOptions::wall).
+  /// holds the vertices that reach it, and the dynamics slide on it and land on it (JumpOptions::wall).
   bool tracesWall() const { return scene_.analyses.continuation.contact && scene_.analyses.continuation.wall; }
   /// Integration settings of the dynamics with the run's interrupt.
   mechanics::IntegrationOptions integrationOptions(mechanics::IntegrationOptions opt = mechanics::IntegrationOptions()) const {

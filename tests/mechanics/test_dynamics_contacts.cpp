@@ -13,6 +13,8 @@
 #include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/jump.h"
+#include "buckle/mechanics/unloaded_shape.h"
 
 #include "curled_chain.h"
 #include "wall_statics.h"
@@ -174,6 +176,51 @@ TEST_CASE("wall contact: the inertial chain hits the wall inelastically, slides 
   CHECK((ce.u.head(5) - r.q).cwiseAbs().maxCoeff() <= 1e-7);
   for (int k = 0; k < r.wallForces.size(); ++k) {
     CHECK(r.wallForces[k] > 0.0);
+    CHECK(r.wallForces[k] == Approx(ce.wallForces[k]).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("wall contact: long curled chains pushed into the wall come to rest on it (n = 50, 1000)",
+          "[wall][dynamics][long]") {
+  // Every joint bent by 170°/n: the chain curls back towards the clamp, its end in front of the
+  // wall; an end force Fx < 0 (a load on the soft long chain of the size of its buckling loads)
+  // pushes the last triangle onto the wall.
+  const int n = GENERATE(50, 1000);
+  INFO("n = " << n);
+  const Eigen::VectorXd q0 = Eigen::VectorXd::Constant(n, 170.0 * M_PI / 180.0 / n);
+  const std::vector<SegmentParameters> segs(size_t(n), SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  const Chain chain(preloadsForShape(segs, q0));
+  const double L = chain.linkLengths().sum();
+  REQUIRE(smallestVertexX(chain, q0) > 0.0);
+  const double fx = -20.0 / (double(n) * n);
+  std::unique_ptr<DynamicsModel> model =
+      makeDynamicsModel(chain, EndCondition::freeEnd(Wrench(fx, 0.0, 0.0)), DynamicsScene(), q0);
+  IntegrationOptions o = jumpIntegrationDefaults(n);  // the stiff steppers of long chains
+  o.wall = true;
+  o.recordTrajectory = true;
+  o.recordInterval = 0.5;
+  const DynamicsResult r = simulate(*model, q0, Vector(), o);
+  INFO(r.message);
+  REQUIRE(r.reason == IntegrationStop::Rest);
+  const ContactEvent* touch = firstWallContact(r);
+  REQUIRE(touch != nullptr);
+  REQUIRE_FALSE(r.wallContacts.empty());
+  // The held vertex drifts off the wall by the integration error, which its lever arms sum
+  // (‖∇x_v‖₁ times a step's error tolerance per joint; the κ_h terms pull it back): within ten
+  // times that, and nothing deeper.
+  const Eigen::VectorXd gx = vertexGradient(chain, r.q, touch->vertex);
+  const double drift = 10.0 * gx.lpNorm<1>() * (o.absoluteTolerance + o.relativeTolerance * r.q.cwiseAbs().maxCoeff());
+  INFO("drift bound " << drift << " (b = 1)");
+  CHECK(drift < 1e-4 * L);
+  for (const TrajectorySample& b : r.trajectory) CHECK(smallestVertexX(chain, b.q) >= -drift);
+  ContactSet set;
+  for (const WallVertex& v : r.wallContacts) set.touch(v);
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(1, 0, 0), testing::withWall());
+  const ConstrainedEquilibrium ce = solveConstrainedEquilibrium(problem, set, problem.initialGuess(r.q, fx), fx);
+  REQUIRE(ce.converged);
+  CHECK((ce.u.head(n) - r.q).cwiseAbs().maxCoeff() <= 1e-7);
+  for (int k = 0; k < r.wallForces.size(); ++k) {
+    CHECK(ce.wallForces[k] > 0.0);
     CHECK(r.wallForces[k] == Approx(ce.wallForces[k]).epsilon(1e-6));
   }
 }

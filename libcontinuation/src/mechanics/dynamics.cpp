@@ -172,10 +172,10 @@ void DynamicsModel::evaluateStatics(ConstVectorRef q) {
   A_.noalias() = Jh_ * Jh_.transpose();
   // J_h loses rank where the held coordinate is stationary (x held on the straight chain): a
   // relative 1e-12 shift keeps the factorization defined and is invisible at regular points.
-  // (Not on the locked rows: unit rows, and the shift would let a locked joint creep.)
+  // (Not on the locked rows, unit rows, nor on the wall rows, whose vertices a wall force keeps
+  // off their joints' line: the shift would let the joint or the vertex creep by ε r / κ_h.)
   if (mh > 0)
     A_.diagonal().head(mh).array() += 1e-12 * std::max(lengthUnit_ * lengthUnit_, A_.topLeftCorner(mh, mh).trace());
-  for (int k = w0; k < m; ++k) A_(k, k) += 1e-12 * std::max(lengthUnit_ * lengthUnit_, A_(k, k));
   llt_.compute(A_);
 }
 
