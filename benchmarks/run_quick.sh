@@ -37,4 +37,5 @@ run actuation_path "$BIN/actuation_path" --quick   # issue 29
 run task_path "$BIN/task_path" --quick   # issue 29, task-space paths
 run gravity_path "$BIN/gravity_path" --quick   # issue 31, weight
 run wall_path "$BIN/wall_path" --quick   # issue 31, the base wall
+run wall_sliding bash "$HERE/wall_sliding.sh" "$BUILD" 3 50   # issue 31, the wall in the dynamics
 exit $status
