@@ -13,7 +13,8 @@ BUILD=${1:-build}
 shift $(( $# > 1 ? 1 : $# ))
 SIZES=("$@")
 ((${#SIZES[@]})) || SIZES=(3 50 1000)
-BUCKLE=$ROOT/$BUILD/bin/buckle
+[[ $BUILD == /* ]] || BUILD=$ROOT/$BUILD
+BUCKLE=$BUILD/bin/buckle
 [[ -x $BUCKLE ]] || { echo "no $BUCKLE: build it first" >&2; exit 2; }
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/buckle-wall.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT
