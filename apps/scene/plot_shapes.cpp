@@ -131,11 +131,12 @@ void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFil
 }
 
 /// The plot command of one chain drawn by drawChain (files BASE_{lim,tri,spr,jnt,near}.dat),
-/// the clamped base a hatched wall; `under`: a plot clause drawn first, beneath the chain. Not
+/// the clamped base a hatched wall over the panel's whole height (the half-plane x ≤ 0: a chain
+/// may rest on it anywhere); `under`: a plot clause drawn first, beneath the chain. Not
 /// `detailed`: the centre line, and only the joints near a limit marked (small red rings).
 void chainPanel(std::ostream& os, const std::string& base, double L, const std::string& under = std::string(),
                 bool touch = false, bool detailed = true) {
-  os << "set object 1 rect from " << num(-0.1 * L) << "," << num(-0.3 * L) << " to 0," << num(0.3 * L)
+  os << "set object 1 rect from first " << num(-0.1 * L) << ", graph 0 to first 0, graph 1"
      << " fc rgb '#bbbbbb' fs pattern 4 border lc rgb '#555555'\n";
   const std::string touchClause =
       touch ? ", \\\n  " + quote(base + "_touch.dat") + " using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'magenta'" +
@@ -269,10 +270,10 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   s.body << "set encoding utf8\nset size ratio -1\nunset key\nset grid lc rgb '#eeeeee'\nset tics font ',9'\n";
   s.body << "set multiplot layout " << nc * rowsPerCase << "," << cols << " title "
          << quote(!spec.title.empty() ? spec.title
-                  : detailed ? std::string("Chain shapes" + scene.units.suffix(Dimension::Length) + ", each panel to its own scale; grey arcs: "
+                  : detailed ? std::string("Chain shapes" + scene.units.suffix(Dimension::Length) + ", each panel to its own scale\ngrey arcs: "
                                            "joint limits, red: joint within 5% of a limit, green: vertex held on the wall, magenta star: through the clamp or itself")
                              : std::string("Chain shapes" + scene.units.suffix(Dimension::Length) + ", each panel to its own scale, centre lines "
-                                           "(base, joints, end); red: joint within 5% of a limit, green: vertex held on the wall, magenta star: through the clamp or itself"))
+                                           "(base, joints, end)\nred: joint within 5% of a limit, green: vertex held on the wall, magenta star: through the clamp or itself"))
          << " font ',11'\n";
   for (size_t o = 0; o < nc; ++o) {
     const size_t c = size_t(spec.cases[o]);
