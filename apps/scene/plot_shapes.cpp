@@ -405,14 +405,16 @@ void drawSuddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
       near.write(dir / (b + "_near.dat"));
       start.write(dir / (b + "_start.dat"));
       std::ostringstream t;
-      if (k == 0)
+      if (k == 0) {
         t << "dynamic rest: " << (ok[0] ? (r.stable ? "stable" : "not stable") : "none")
           << (r.haveStatic ? ", Π = " + short4(r.potentialDynamic) : std::string());
-      else if (ok[1])
+        for (size_t v = 0; v < r.wall.size(); ++v) t << (v ? " " : ", on the wall: ") << r.wall[v].vertex.label();
+      } else if (ok[1]) {
         t << "quasi-static: Π = " << short4(r.potentialStatic) << (r.differs ? " (differs" : " (same")
           << ", max |Δq| = " << short4(r.maxDifference) << ")";
-      else
+      } else {
         t << "quasi-static: not reached";
+      }
       s.body << "set title " << quote(t.str()) << " noenhanced font ',10'\n";
       s.body << "unset key\nunset logscale x\nset format x '% h'\nunset xlabel\nunset ylabel\nset size ratio -1\n";
       s.body << "set xrange [" << num(std::min(box.min().x() - pad, -0.1 * L)) << ":" << num(box.max().x() + pad)
