@@ -383,7 +383,8 @@ void drawSuddenPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
       const Eigen::Matrix2Xd P = mechanics::jointPositions(cr.chain, *q);
       for (Eigen::Index j = 1; j < P.cols(); ++j) box.extend(Eigen::Vector2d(P.col(j)));
     }
-    const double pad = 1.2, L = cr.chain.length();
+    // (a margin of about one triangle half-length b̄ = L / 2n, in the scene's length unit)
+    const double L = cr.chain.length(), pad = std::max(1.2 * L / (2.0 * cr.chain.size()), 0.03 * box.sizes().maxCoeff());
     const bool ok[2] = {r.rest.size() == cr.chain.size(), r.haveStatic && r.staticShape.size() == cr.chain.size()};
     const bool detailed = detailedChain(cr.chain, box, Eigen::Vector2d(s.width / 3.0, 420.0));
     for (int k = 0; k < 2; ++k) {
