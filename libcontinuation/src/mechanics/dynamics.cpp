@@ -329,11 +329,8 @@ void DynamicsModel::rebuildConstraints() {
 }
 
 void DynamicsModel::contactTorques(const double* x, VectorRef torques) {
-  torques.setZero();
-  if (locked_.empty()) return;
-  fdPlus_.resize(size_t(stateSize()));
-  rhs(x, fdPlus_.data());  // the multipliers r_ at x
-  for (int k = 0; k < lockedCount(); ++k) torques[locked_[size_t(k)]] = r_[heldCount() + k];
+  wallForces_.resize(wallCount());
+  contactForces(x, torques, wallForces_);
 }
 
 void DynamicsModel::contactForces(const double* x, VectorRef torques, VectorRef wallForces) {

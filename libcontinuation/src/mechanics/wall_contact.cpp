@@ -64,24 +64,30 @@ void wallVertexDerivatives(const Eigen::Matrix2Xd& P, const Eigen::Vector2d& poi
 namespace {
 
 /// Calls visit(vertex, point) for every moving vertex at q, in the order of movingVertices. One
-/// sine and cosine per joint.
+/// sine and cosine per joint, nothing allocated.
 template <class Visit>
 void forEachMovingVertex(const Chain& chain, ConstVectorRef q, Visit visit) {
   const int n = chain.size();
-  const Eigen::Matrix2Xd P = jointPositions(chain, q);  // checks the size
+  if (q.size() != n)
+    throw std::invalid_argument("joint angles: " + std::to_string(q.size()) + " values for a chain of " +
+                                std::to_string(n) + " segments");
+  const Vector& length = chain.linkLengths();
+  // the joint positions summed as jointPositions sums them, without its matrix
+  Point joint(length[0], 0.0);
   double theta = 0.0;
   Point before = dir(0.0);
   for (int i = 0; i < n; ++i) {
     const SegmentParameters& p = chain.segment(i).parameters();
-    const Point after = dir(theta + q[i]);
+    theta += q[i];
+    const Point after = dir(theta);
     // segment 1's proximal triangle is clamped; a proximal corner on the previous segment's distal
     // one (equal half-heights: the link's two triangles share their base) is that vertex
     const bool shared = i > 0 && p.a1 == chain.segment(i - 1).parameters().a2;
     for (int corner = i > 0 ? 0 : 3; corner <= 4; ++corner) {
       if (shared && (corner == 1 || corner == 2)) continue;
-      visit(WallVertex{i, corner}, segmentVertex(p, P.col(i + 1), before, after, corner));
+      visit(WallVertex{i, corner}, segmentVertex(p, joint, before, after, corner));
     }
-    theta += q[i];
+    joint += length[i + 1] * after;
     before = after;
   }
 }

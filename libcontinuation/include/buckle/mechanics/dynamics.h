@@ -267,6 +267,7 @@ class DynamicsModel {
   std::vector<double> fdPlus_, fdMinus_, fdState_;  // for the finite-difference jacobian()
   Eigen::Matrix2Xd positions_;  ///< joint positions (jointPositions' columns) at the statics, with wall rows
   Vector wallRow_;               ///< scratch, size n
+  Vector wallForces_;            ///< scratch of contactTorques, size w
   std::shared_ptr<BodyLoadTerms> body_;  ///< null: no body loads
   Vector bodyWork_;                      ///< τ or γ of the body loads (size n)
   double bodyPotential_ = 0.0;           ///< V at the cached statics
