@@ -27,6 +27,8 @@ BranchRows::BranchRows(const Scene& scene)
       // and stability
       sideFile_(n_ > kBranchesCsvJointColumns),
       stiffness_(scene.analyses.stiffness),
+      self_(scene.analyses.continuation.enabled && scene.analyses.continuation.contact &&
+            scene.analyses.continuation.self),
       frequencies_(scene.analyses.frequencies.enabled ? scene.analyses.frequencies.count : 0),
       inputs_(scene.inputColumns()) {}
 
@@ -41,6 +43,7 @@ std::string BranchRows::header() const {
     }
   }
   os += ",stable,negative,min_eig,locked,contact_torque,wall,wall_force";
+  if (self_) os += ",self,self_force";
   if (stiffness_)
     for (const std::string& column : stiffnessColumns()) os += "," + column;
   if (frequencies_ > 0)
@@ -88,6 +91,11 @@ void BranchRows::appendRow(std::string& os, size_t c, const CaseResult& cr, cons
   os += ',';
   os += escape::csvField(p.locked.wallLabel());
   field(p.wallForces.sum());
+  if (self_) {
+    os += ',';
+    os += escape::csvField(p.locked.selfLabel());
+    field(p.selfForces.sum());
+  }
   if (stiffness_)
     for (const std::string& column : stiffnessColumns()) field(stiffnessColumnValue(column, p.K, p.C, p.rotationalStiffness));
   for (int i = 0; i < frequencies_; ++i) field(i < p.omega.size() ? p.omega[i] : std::numeric_limits<double>::quiet_NaN());

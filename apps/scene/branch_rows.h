@@ -38,6 +38,7 @@ class BranchRows {
   int n_;
   bool sideFile_;
   bool stiffness_;
+  bool self_;        // self contact traced: the self and self_force columns
   int frequencies_;  // count of omega columns (0: none)
   std::vector<std::string> inputs_;
 };

@@ -355,6 +355,7 @@ void CaseRunner::continuation() {
   mech::EquilibriumOptions equilibriumOptions;
   // with contact and the wall, the base wall is a unilateral constraint like the joint stops (contact.h)
   equilibriumOptions.wallAsBoundary = tracesWall();
+  equilibriumOptions.selfContactAsBoundary = tracesSelf();
   if (throughLoad()) {
     // trace with the held coordinate's reaction as parameter (PathSpec::throughReaction), each
     // branch ending where the coordinate leaves the path's range

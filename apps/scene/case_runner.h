@@ -120,6 +120,9 @@ class CaseRunner {
   /// With contact and the wall, the base wall x = 0 is a unilateral constraint: the continuation
   /// holds the vertices that reach it, and the dynamics slide on it and land on it (JumpOptions::wall).
   bool tracesWall() const { return scene_.analyses.continuation.contact && scene_.analyses.continuation.wall; }
+  /// With contact and `self`, the chain's contact with itself is a unilateral constraint of the
+  /// continuation: a vertex that reaches another link's triangle is held on its edge (SH / SR).
+  bool tracesSelf() const { return scene_.analyses.continuation.contact && scene_.analyses.continuation.self; }
   /// Integration settings of the dynamics with the run's interrupt.
   mechanics::IntegrationOptions integrationOptions(mechanics::IntegrationOptions opt = mechanics::IntegrationOptions()) const {
     opt.interrupt = control_.interrupt;

@@ -120,6 +120,9 @@ void addContacts(const mechanics::SpecialPointReport& s, json& p) {
   if (s.vertex.segment >= 0)
     p["wall_contact"] = {{"vertex", s.vertex.label()}, {"contact_force", jsonNumber(s.contactForce)},
                          {"wall_after", s.lockedAfter.wallLabel()}};
+  if (s.selfContact.vertex.segment >= 0)
+    p["self_contact"] = {{"vertex", s.selfContact.vertex.label()}, {"edge", s.selfContact.edge.label()},
+                         {"contact_force", jsonNumber(s.contactForce)}, {"self_after", s.lockedAfter.selfLabel()}};
 }
 
 }  // namespace

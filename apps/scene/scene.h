@@ -120,6 +120,9 @@ struct ContinuationSpec {
   /// With contact: the base wall x = 0 holds the vertices that reach it (mechanics/contact.h,
   /// wall_contact.h: WC / WR); false: the chain passes through it, detected only (BC).
   bool wall = false;
+  /// With contact: a vertex that reaches another link's triangle is held on its edge
+  /// (mechanics/self_contact.h: SH / SR); false: the links pass through each other, detected only (SC).
+  bool self = false;
   /// An exactly mirror-symmetric scene (mechanics/mirror_symmetry.h) mirrors the − side child of
   /// every symmetric pitchfork instead of tracing it; false: both traced (for checking).
   bool mirror = true;

@@ -49,12 +49,13 @@ void parseContinuation(const Reader& r, const json& c, const Pointer& pc, Analys
   if (c.is_boolean()) {
     s.continuation.enabled = c.get<bool>();
   } else {
-    r.onlyKeys(c, pc, {"branch_switching", "contact", "wall", "branch_points", "child_points", "mirror", "threads"});
+    r.onlyKeys(c, pc, {"branch_switching", "contact", "wall", "self", "branch_points", "child_points", "mirror", "threads"});
     s.continuation.enabled = true;
     if (c.contains("branch_switching"))
       s.continuation.branchSwitching = r.integer(c["branch_switching"], pc / "branch_switching", 0, 4);
     if (c.contains("contact")) s.continuation.contact = r.boolean(c["contact"], pc / "contact");
     if (c.contains("wall")) s.continuation.wall = r.boolean(c["wall"], pc / "wall");
+    if (c.contains("self")) s.continuation.self = r.boolean(c["self"], pc / "self");
     if (c.contains("mirror")) s.continuation.mirror = r.boolean(c["mirror"], pc / "mirror");
     if (c.contains("branch_points"))
       s.continuation.branchPoints = r.integer(c["branch_points"], pc / "branch_points", 1, 10000000);

@@ -22,6 +22,8 @@ const std::vector<SpecialStyle>& specialStyles() {
       {EventType::Release, 3, "RL contact released", "#17becf"},
       {EventType::WallContact, 15, "WC vertex on the wall", "#006d2c"},
       {EventType::WallRelease, 3, "WR vertex leaves the wall", "#08519c"},
+      {EventType::SelfHold, 15, "SH vertex held on another link", "#54278f"},
+      {EventType::SelfRelease, 3, "SR self contact released", "#807dba"},
       {EventType::BaseContact, 5, "BC base contact (detected)", "#e377c2"},
       {EventType::SelfContact, 5, "SC self contact (detected)", "#7f7f7f"},
       {EventType::EigenvalueTouch, 7, "ET eigenvalue touches zero", "#555555"}};

@@ -5,7 +5,11 @@
 
 #include <random>
 
+#include "buckle/continuation/tracer.h"
+#include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/self_contact.h"
+#include "buckle/mechanics/unloaded_shape.h"
 #include "random_segments.h"
 #include "wall_statics.h"
 
@@ -140,4 +144,115 @@ TEST_CASE("self contact: the touching pair is the nearest vertex over an edge (b
     CHECK(std::abs(testGap(chain, q, found)) == Approx(best).margin(1e-12));
   }
   CHECK_THROWS_AS(mech::touchingPair(chain, VectorXd::Zero(n), 2, 3), std::invalid_argument);
+}
+
+namespace {
+
+// A hook: three straight segments, five curled by 0.9 rad, free end under an end moment Me: the
+// curl closes until the end's distal corner 8d− meets the straight part (link 3's triangle).
+// Lengths scaled by sL, stiffnesses by sK.
+struct Hook {
+  VectorXd q0 = (VectorXd(8) << 0, 0, 0, 0.9, 0.9, 0.9, 0.9, 0.9).finished();
+  mech::Chain chain;
+  mech::EquilibriumProblem problem;
+  Hook(double sL, double sK)
+      : chain(mech::preloadsForShape(
+            std::vector<mech::SegmentParameters>(8, mech::SegmentParameters::symmetric(0.3 * sL, sL, sK, 2.25 * sL)), q0)),
+        problem(chain, mech::EndCondition::freeEnd(), Eigen::Vector3d(0, 0, 1), options()) {}
+  static mech::EquilibriumOptions options() {
+    mech::EquilibriumOptions o;
+    o.selfContactAsBoundary = true;
+    return o;
+  }
+};
+
+// The statics of a point holding self contact c under the end moment Me, by the test's own
+// geometry: joint j carries Me and, when it moves the vertex's body but not the edge's, the moment
+// of μ n_e at the vertex (joints that move both bodies see the pair of forces cancel). μ from the
+// joint where its lever is largest; the largest imbalance over every joint, and μ.
+std::pair<double, double> hookStatics(const mech::Chain& chain, const VectorXd& q, double Me, const mech::SelfContact& c) {
+  const int n = chain.size();
+  const Vector2d p = buckle::test::vertexAt(chain, q, c.vertex);
+  const Vector2d e0 = buckle::test::vertexAt(chain, q, {c.edge.segment, c.edge.corner(0)});
+  const Vector2d e1 = buckle::test::vertexAt(chain, q, {c.edge.segment, c.edge.corner(1)});
+  const Vector2d third = buckle::test::vertexAt(chain, q, {c.edge.segment, c.edge.corner(2)});
+  Vector2d normal(e1.y() - e0.y(), e0.x() - e1.x());
+  normal.normalize();
+  if (normal.dot(third - e0) > 0.0) normal = -normal;
+  const buckle::test::Geometry g = buckle::test::geometry(chain, q);
+  const int lo = std::min(c.vertex.lastJoint(), c.edge.lastJoint()), hi = std::max(c.vertex.lastJoint(), c.edge.lastJoint());
+  const double sigma = c.vertex.lastJoint() > c.edge.lastJoint() ? 1.0 : -1.0;  // the force on the distal body: ±μ n
+  VectorXd lever = VectorXd::Zero(n), dE(n);
+  for (int j = 0; j < n; ++j) {
+    dE[j] = -chain.segment(j).torque(q[j]);
+    if (j > lo && j <= hi) lever[j] = sigma * buckle::test::moment(p, g.P.col(j), normal);
+  }
+  int k = 0;
+  lever.cwiseAbs().maxCoeff(&k);
+  const double mu = (dE[k] - Me) / lever[k];
+  double imbalance = 0.0;
+  for (int j = 0; j < n; ++j) imbalance = std::max(imbalance, std::abs(dE[j] - Me - mu * lever[j]));
+  return {imbalance, mu};
+}
+
+}  // namespace
+
+TEST_CASE("self contact: a hook curled by an end moment is held on its own link, in any units", "[self_contact]") {
+  namespace cont = buckle::continuation;
+  double reference = 0.0;
+  for (const auto& [sL, sK] : {std::pair{1.0, 1.0}, std::pair{1e4, 1e-8}, std::pair{1e-4, 1e8}}) {
+    INFO("lengths x" << sL << ", stiffnesses x" << sK);
+    Hook hook(sL, sK);
+    const double torqueUnit = sK * sL * sL;
+    mech::EquilibriumBranchOptions o;
+    o.tracer.lambdaMax = 0.25 * torqueUnit;
+    o.tracer.step.initialStep = 0.01;
+    o.tracer.step.maxStep = 0.02;
+    o.tree.branchSwitching = 0;
+    const mech::EquilibriumBranches t =
+        mech::traceEquilibria(hook.problem, hook.q0, 0.0, cont::InitialDirection::increasingLambda(), o);
+    REQUIRE(t.tree.branches.size() == 1);
+    const cont::Branch& b = t.tree.branches[0];
+    REQUIRE(t.contact[0].size() == 2);  // free, then the self contact held to the range end
+    const mech::ContactSet& held = t.contact[0][1].locked;
+    REQUIRE(held.selfCount() == 1);
+    const mech::SelfContact c = held.self()[0];
+    CHECK(c.label() == "8d- on 3p[j,+]");
+    CHECK(b.stopReason == cont::StopReason::LambdaRange);
+    // the touch: located where the test's own gap of the pair is zero, at the same load in any units
+    const int e = t.contact[0][1].firstPoint - 1;
+    const double Mc = b.points[size_t(e)].lambda / torqueUnit;
+    CHECK(std::abs(testGap(hook.chain, b.points[size_t(e)].u.head(8), c)) < 1e-10 * sL);
+    if (reference == 0.0) reference = Mc;
+    CHECK(Mc == Approx(reference).epsilon(1e-9));
+    // every held point: on the edge, pushing, in equilibrium by the test's own statics, and the
+    // library's force the same
+    mech::ContactProblem problem(hook.problem, held);
+    auto ws = problem.createWorkspace();
+    int heldPoints = 0;
+    for (size_t i = size_t(e) + 1; i < b.points.size(); ++i, ++heldPoints) {
+      const VectorXd q = b.points[i].u.head(8);
+      const double Me = b.points[i].lambda;
+      CHECK(std::abs(testGap(hook.chain, q, c)) < 1e-9 * sL);
+      const auto [imbalance, mu] = hookStatics(hook.chain, q, Me, c);
+      CHECK(imbalance < 1e-9 * torqueUnit);
+      CHECK(mu > 0.0);
+      CHECK(problem.selfForces(*ws, b.points[i].u, Me)[0] == Approx(mu).epsilon(1e-7));
+    }
+    CHECK(heldPoints >= 3);
+    // back down from the range end: the contact releases at the load where it began (SR at Mc)
+    const cont::ContinuationPoint& last = b.points.back();
+    const std::unique_ptr<mech::ContactProblem> stretch = mech::lockedProblem(hook.problem, held, 10.0);
+    cont::TracerOptions down = o.tracer;
+    down.lambdaMin = 0.0;
+    cont::Tracer tracer(*stretch, down);
+    cont::Branch back = tracer.trace(stretch->withWallForces(*stretch->createWorkspace(), last.u, last.lambda), last.lambda,
+                                     cont::InitialDirection::decreasingLambda());
+    const std::vector<mech::ContactStretch> stretches = mech::continueUnderContact(hook.problem, back, down, 50, 10.0, held);
+    REQUIRE(stretches.size() == 2);
+    CHECK(stretches[1].locked.empty());
+    const double released = back.points[size_t(stretches[1].firstPoint - 1)].lambda / torqueUnit;
+    CHECK(released == Approx(Mc).epsilon(1e-9));
+    CHECK(back.stopReason == cont::StopReason::LambdaRange);
+  }
 }

@@ -35,6 +35,8 @@ const char* label(EventType type) {
     case EventType::SelfContact: return "SC";
     case EventType::WallContact: return "WC";
     case EventType::WallRelease: return "WR";
+    case EventType::SelfHold: return "SH";
+    case EventType::SelfRelease: return "SR";
     case EventType::EigenvalueTouch: return cont::label(cont::SpecialPointType::EigenvalueTouch);
     case EventType::StabilityLoss: return "LS";
     case EventType::InputBound: return "IB";
@@ -198,6 +200,46 @@ void reportWallEvent(EquilibriumProblem& problem, const cont::Branch& b, const c
   s.note = os.str();
 }
 
+/// A boundary after which the branch's self contacts change (continueUnderContact): SH when a
+/// vertex is held on another link's edge, SR when a self contact releases.
+void reportSelfEvent(EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
+                     const ContactSet& before, const ContactSet& after, const std::vector<PointReport>& all,
+                     SpecialPointReport& s) {
+  SelfContact changed, left;
+  for (const SelfContact& c : after.self())
+    if (!before.holding(c)) changed = c;
+  for (const SelfContact& c : before.self())
+    if (!after.holding(c)) left = c;
+  const bool contact = changed.vertex.segment >= 0;
+  const bool slides = contact && left.vertex == changed.vertex;  // onto its edge's neighbour
+  if (!contact) changed = left;
+  if (changed.vertex.segment < 0) return;
+  const ContactSet& set = contact ? after : before;
+  ContactProblem held(problem, set);
+  const Vector mu = held.selfForces(*held.createWorkspace(), sp.u, sp.lambda);
+  const auto k = std::lower_bound(set.self().begin(), set.self().end(), changed) - set.self().begin();
+  const int n = problem.segments();
+  const Eigen::Matrix2Xd P = jointPositions(problem.chain(), sp.u.head(n));
+  s.type = contact ? EventType::SelfHold : EventType::SelfRelease;
+  s.phenomenon = Phenomenon::None;  // a change of the constraints, none of the paper's three phenomena
+  s.selfContact = changed;
+  s.contactForce = mu[k];
+  s.contactPoint = wallVertexPoint(problem.chain(), sp.u.head(n), P, changed.vertex);
+  s.lockedAfter = after;
+  if (size_t(sp.index + 1) < all.size()) s.negativeAfter = all[size_t(sp.index + 1)].negative;
+  if (sp.index < int(b.points.size())) s.negativeBefore = all[size_t(sp.index)].negative;
+  std::ostringstream os;
+  os.precision(6);
+  os << "vertex " << changed.vertex.label() << " at (" << s.contactPoint.x() << ", " << s.contactPoint.y() << ") on edge "
+     << changed.edge.label() << ": "
+     << (slides    ? "slides on from edge " + left.edge.label()
+         : contact ? std::string("the links touch and are held apart")
+                   : std::string("contact force returns to zero: the links separate"))
+     << "; contact force = " << s.contactForce
+     << "; self contacts after: " << (after.self().empty() ? std::string("none") : after.selfLabel());
+  s.note = os.str();
+}
+
 /// A boundary after which the branch's locked joints change (continueUnderContact): CT when a
 /// joint locks, RL when one releases; s is left a plain boundary otherwise.
 void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
@@ -217,7 +259,10 @@ void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, cons
     for (const LockedJoint& l : before.joints())
       if (!after.locked(l.joint)) joint = l.joint;
   if (joint < 0) {
-    reportWallEvent(problem, b, sp, before, after, all, s);
+    if (before.self() != after.self())
+      reportSelfEvent(problem, b, sp, before, after, all, s);
+    else
+      reportWallEvent(problem, b, sp, before, after, all, s);
     return;
   }
   const LimitSide side = contact ? after.side(joint) : before.side(joint);
@@ -283,11 +328,13 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
     pr.minEigenvalue = p.stability.smallest;
     pr.residual = p.residualNorm;
     pr.locked = lockedAt(stretches, int(i));
-    if (pr.locked.wallCount() > 0) {
-      // the wall forces close the free rows (ContactProblem::wallForces); the joints' contact
-      // torques include their terms
+    if (pr.locked.gapCount() > 0) {
+      // the wall's and the self contacts' forces close the free rows (ContactProblem::contactForces);
+      // the joints' contact torques include their terms
       ContactProblem held(problem, pr.locked);
-      pr.wallForces = held.wallForces(*held.createWorkspace(), p.u, p.lambda);
+      const Vector mu = held.contactForces(*held.createWorkspace(), p.u, p.lambda);
+      pr.wallForces = mu.head(pr.locked.wallCount());
+      pr.selfForces = mu.tail(pr.locked.selfCount());
       for (const LockedJoint& l : pr.locked.joints())
         pr.contactTorque =
             std::max(pr.contactTorque, held.compression(*held.createWorkspace(), p.u, p.lambda, l.joint));
@@ -311,7 +358,8 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
     for (const PointReport& p : all)
       if (inRange(p.parameter, options)) r.points.push_back(p);
   for (PointReport& pr : r.points) {
-    if (options.stiffness) {
+    // a self contact's rank-2 Hessian term is outside the structured stiffness: K stays NaN there
+    if (options.stiffness && pr.locked.selfCount() == 0) {
       // along a control path K_q is that of the free lengths at the point's λ
       // and with body loads the Hessian's generator h − γ (eq B3)
       const double lambda = b.points[size_t(pr.index)].lambda;

@@ -73,8 +73,24 @@ std::string ContactSet::wallLabel() const {
   return s;
 }
 
+void ContactSet::hold(const SelfContact& c) {
+  auto it = std::lower_bound(self_.begin(), self_.end(), c);
+  if (it == self_.end() || *it != c) self_.insert(it, c);
+}
+
+void ContactSet::separate(const SelfContact& c) { self_.erase(std::remove(self_.begin(), self_.end(), c), self_.end()); }
+
+bool ContactSet::holding(const SelfContact& c) const { return std::binary_search(self_.begin(), self_.end(), c); }
+
+std::string ContactSet::selfLabel() const {
+  std::string s;
+  for (const SelfContact& c : self_) s += (s.empty() ? "" : "; ") + c.label();
+  return s;
+}
+
 void ContactSet::check(int segments) const {
   for (const WallVertex& v : wall_) checkWallVertex(v, segments);
+  for (const SelfContact& c : self_) checkSelfContact(c, segments);
   for (const LockedJoint& l : joints_)
     if (l.joint >= segments)
       throw std::invalid_argument("contact: locked joint " + std::to_string(l.joint + 1) + " does not exist (the chain has " +
@@ -175,14 +191,18 @@ ContactProblem::Workspace::Workspace(const ContactProblem& problem)
       reduced(std::max(1, int(problem.free_.size()))),
       J(3, problem.base_.segments()),
       Jf(3, Eigen::Index(problem.free_.size())),
-      heldRows(Eigen::Index(problem.held_.size() + size_t(problem.locked_.wallCount())),
+      heldRows(Eigen::Index(problem.held_.size() + size_t(problem.locked_.gapCount())),
                Eigen::Index(problem.free_.size())),
       kf(problem.free_.size()),
       hf(problem.free_.size()),
       residual(problem.base_.dimension()),
-      wallGrad(problem.base_.segments(), problem.locked_.wallCount()),
-      wallGen(problem.base_.segments(), problem.locked_.wallCount()),
-      wallX(problem.locked_.wallCount()) {
+      wallGrad(problem.base_.segments(), problem.locked_.gapCount()),
+      wallGen(problem.base_.segments(), problem.locked_.gapCount()),
+      wallX(problem.locked_.gapCount()),
+      selfCoupling(problem.base_.segments(), problem.locked_.selfCount()),
+      selfWeights(problem.base_.segments(), problem.locked_.selfCount()),
+      selfAlong(problem.locked_.selfCount()),
+      selfEdgeLength(problem.locked_.selfCount()) {
   reduced.typicalScale = problem.base_.stiffnessUnit() * problem.base_.lengthUnit() * problem.base_.lengthUnit();
   full.typicalScale = reduced.typicalScale;
 }
@@ -192,7 +212,7 @@ std::unique_ptr<ProblemWorkspace> ContactProblem::createWorkspace() const { retu
 bool ContactProblem::wallKinematics(ProblemWorkspace& ws, ConstVectorRef q) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int w = locked_.wallCount();
-  if (w == 0) return true;
+  if (locked_.gapCount() == 0) return true;
   if (!q.allFinite()) return false;
   const Eigen::Matrix2Xd P = jointPositions(base_.chain(), q);
   for (int k = 0; k < w; ++k) {
@@ -201,22 +221,61 @@ bool ContactProblem::wallKinematics(ProblemWorkspace& ws, ConstVectorRef q) cons
     d.wallX[k] = x.x();
     wallVertexDerivatives(P, x, v, d.wallGrad.col(k), d.wallGen.col(k));
   }
+  for (int k = 0; k < locked_.selfCount(); ++k) {
+    const SelfContact& c = locked_.self()[size_t(k)];
+    const SelfContactGap g = selfContactGap(base_.chain(), q, P, c);
+    d.wallX[w + k] = g.gap;
+    d.selfAlong[k] = g.along;
+    d.selfEdgeLength[k] = g.edgeLength;
+    selfContactDerivatives(P, c, g, d.wallGrad.col(w + k), d.wallGen.col(w + k), d.selfCoupling.col(k),
+                           d.selfWeights.col(k));
+  }
   return true;
 }
 
+namespace {
+
+// −μ ∂²g of every bordered contact added to the n×n block H (self_contact.h: the generator form,
+// and the self contacts' rank-2 term).
+void addContactHessians(const ContactSet& contacts, const ContactProblem::Workspace& d, ConstVectorRef mu,
+                        MatrixRef H) {
+  const int w = contacts.wallCount(), n = int(H.rows());
+  for (int k = 0; k < w; ++k) {  // −μ ∂²x_v = μ g_max(j,l) (wall_contact.h)
+    const int last = contacts.wall()[size_t(k)].lastJoint();
+    for (int j = 0; j <= last; ++j)
+      for (int l = 0; l <= last; ++l) H(j, l) += mu[k] * d.wallGen(std::max(j, l), k);
+  }
+  for (int k = 0; k < contacts.selfCount(); ++k) {
+    const auto c = d.selfCoupling.col(k), wt = d.selfWeights.col(k);
+    for (int j = 0; j < n; ++j)
+      for (int l = 0; l < n; ++l)
+        H(j, l) += mu[w + k] * (d.wallGen(std::max(j, l), w + k) - c[j] * wt[l] - wt[j] * c[l]);
+  }
+}
+
+}  // namespace
+
 bool ContactProblem::baseRowsWithWall(ProblemWorkspace& ws, ConstVectorRef u, double lambda, VectorRef F) const {
   Workspace& d = workspaceAs<Workspace>(ws);
-  const int N = base_.dimension(), n = base_.segments(), w = locked_.wallCount();
+  const int N = base_.dimension(), n = base_.segments(), w = locked_.gapCount();
   if (!base_.residual(*d.base, u.head(N), lambda, F)) return false;
   if (w == 0) return true;
   if (!wallKinematics(ws, u.head(n))) return false;
-  F.head(n).noalias() -= d.wallGrad * u.segment(N, w);  // −Σ μ_v ∇x_v (wall_contact.h)
+  F.head(n).noalias() -= d.wallGrad * u.segment(N, w);  // −Σ μ ∇g (wall_contact.h, self_contact.h)
   return true;
 }
 
 Vector ContactProblem::wallForces(ProblemWorkspace& ws, ConstVectorRef u, double lambda) const {
+  return contactForces(ws, u, lambda).head(locked_.wallCount());
+}
+
+Vector ContactProblem::selfForces(ProblemWorkspace& ws, ConstVectorRef u, double lambda) const {
+  return contactForces(ws, u, lambda).tail(locked_.selfCount());
+}
+
+Vector ContactProblem::contactForces(ProblemWorkspace& ws, ConstVectorRef u, double lambda) const {
   Workspace& d = workspaceAs<Workspace>(ws);
-  const int N = base_.dimension(), w = locked_.wallCount();
+  const int N = base_.dimension(), w = locked_.gapCount();
   Vector mu = Vector::Constant(w, std::numeric_limits<double>::quiet_NaN());
   if (w == 0 || !base_.residual(*d.base, u.head(N), lambda, d.residual) ||
       !wallKinematics(ws, u.head(base_.segments())))
@@ -237,7 +296,7 @@ Vector ContactProblem::withWallForces(ProblemWorkspace& ws, ConstVectorRef u, do
   const int N = base_.dimension();
   Vector full(dimension());
   full.head(N) = u.head(N);
-  full.tail(locked_.wallCount()) = wallForces(ws, u, lambda);
+  full.tail(locked_.gapCount()) = contactForces(ws, u, lambda);
   return full;
 }
 
@@ -257,7 +316,7 @@ bool ContactProblem::residual(ProblemWorkspace& ws, ConstVectorRef u, double lam
   Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension();
   if (!baseRowsWithWall(ws, u, lambda, F.head(N))) return false;
-  F.tail(locked_.wallCount()) = -d.wallX.head(locked_.wallCount());  // −x_v = 0
+  F.tail(locked_.gapCount()) = -d.wallX.head(locked_.gapCount());  // −x_v = 0, −g = 0
   for (const LockedJoint& l : locked_.joints()) F[l.joint] = limitAngle(base_.chain(), l.joint, l.side) - u[l.joint];
   return true;
 }
@@ -265,19 +324,14 @@ bool ContactProblem::residual(ProblemWorkspace& ws, ConstVectorRef u, double lam
 bool ContactProblem::jacobian(ProblemWorkspace& ws, ConstVectorRef u, double lambda, MatrixRef Fu,
                               VectorRef Flambda) const {
   Workspace& d = workspaceAs<Workspace>(ws);
-  const int N = base_.dimension(), n = base_.segments(), w = locked_.wallCount();
+  const int N = base_.dimension(), n = base_.segments(), w = locked_.gapCount();
   if (!base_.jacobian(*d.base, u.head(N), lambda, Fu.topLeftCorner(N, N), Flambda.head(N))) return false;
   if (w > 0) {
     if (!wallKinematics(ws, u.head(n))) return false;
     Fu.rightCols(w).setZero();
     Fu.bottomRows(w).setZero();
     Flambda.tail(w).setZero();
-    for (int k = 0; k < w; ++k) {  // −μ ∂²x_v = μ g_max(j,l) (wall_contact.h)
-      const double mu = u[N + k];
-      const int last = locked_.wall()[size_t(k)].lastJoint();
-      for (int j = 0; j <= last; ++j)
-        for (int l = 0; l <= last; ++l) Fu(j, l) += mu * d.wallGen(std::max(j, l), k);
-    }
+    addContactHessians(locked_, d, u.segment(N, w), Fu.topLeftCorner(n, n));
     Fu.block(0, N, n, w) = -d.wallGrad;
     Fu.block(N, 0, w, n) = -d.wallGrad.transpose();
   }
@@ -293,8 +347,9 @@ bool ContactProblem::jacobianDirectionalDerivative(ProblemWorkspace& ws, ConstVe
                                                    ConstVectorRef du, double dlambda, MatrixRef dFu,
                                                    VectorRef dFlambda) const {
   Workspace& d = workspaceAs<Workspace>(ws);
-  // With wall vertices, the central differences of jacobian() (the locked rows stay linear).
-  if (locked_.wallCount() > 0) return Problem::jacobianDirectionalDerivative(ws, u, lambda, du, dlambda, dFu, dFlambda);
+  // With wall vertices or self contacts, the central differences of jacobian() (the locked rows
+  // stay linear).
+  if (locked_.gapCount() > 0) return Problem::jacobianDirectionalDerivative(ws, u, lambda, du, dlambda, dFu, dFlambda);
   if (!base_.jacobianDirectionalDerivative(*d.base, u, lambda, du, dlambda, dFu, dFlambda)) return false;
   for (const LockedJoint& l : locked_.joints()) {  // the locked rows are linear
     dFu.row(l.joint).setZero();
@@ -307,13 +362,9 @@ bool ContactProblem::stabilityOperator(ProblemWorkspace& ws, ConstVectorRef u, d
                                        Matrix& C) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   Matrix Ch;
-  const int N = base_.dimension(), n = base_.segments(), w = locked_.wallCount();
+  const int N = base_.dimension(), n = base_.segments(), w = locked_.gapCount();
   if (!base_.stabilityOperator(*d.base, u.head(N), lambda, H, Ch) || !wallKinematics(ws, u.head(n))) return false;
-  for (int k = 0; k < w; ++k) {
-    const int last = locked_.wall()[size_t(k)].lastJoint();
-    for (int j = 0; j <= last; ++j)
-      for (int l = 0; l <= last; ++l) H(j, l) += u[N + k] * d.wallGen(std::max(j, l), k);
-  }
+  addContactHessians(locked_, d, u.segment(N, w), H);
   C = Matrix::Zero(Ch.rows() + locked_.count() + w, n);
   C.topRows(Ch.rows()) = Ch;
   for (int k = 0; k < locked_.count(); ++k) C(Ch.rows() + k, locked_.joints()[size_t(k)].joint) = 1.0;
@@ -325,6 +376,7 @@ bool ContactProblem::assembleFull(ProblemWorkspace& ws, ConstVectorRef u, double
                                   MatrixRef J) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   const int N = base_.dimension(), w = locked_.wallCount();
+  if (locked_.selfCount() > 0) return false;  // outside the structure (file comment)
   if (!base_.assembleStructure(*d.base, u.head(N), lambda, full, J)) return false;
   if (w == 0) return true;
   if (!wallKinematics(ws, u.head(base_.segments()))) return false;
@@ -353,8 +405,9 @@ bool ContactProblem::stability(ProblemWorkspace& ws, ConstVectorRef u, double la
     return true;
   }
   // the chain structure's counts take at most 3 constraint rows (setConstraints): with more held
-  // coordinates and wall vertices together, the dense route of the core (O(n³))
-  if (d.heldRows.rows() > 3) return Problem::stability(ws, u, lambda, lowestCount, info);
+  // coordinates and wall vertices together, the dense route of the core (O(n³)); a self contact's
+  // rank-2 Hessian term is outside the structure
+  if (d.heldRows.rows() > 3 || locked_.selfCount() > 0) return Problem::stability(ws, u, lambda, lowestCount, info);
   if (!assembleReduced(ws, u, lambda, d.reduced, d.Jf)) return false;
   for (size_t k = 0; k < held_.size(); ++k) d.heldRows.row(Eigen::Index(k)) = d.Jf.row(held_[k]);
   for (int k = 0; k < locked_.wallCount(); ++k)  // the wall rows ∇x_vᵀ on the free joints
@@ -367,11 +420,11 @@ bool ContactProblem::stability(ProblemWorkspace& ws, ConstVectorRef u, double la
 continuation::ProblemScales ContactProblem::scales() const {
   continuation::ProblemScales s = base_.scales();
   for (const LockedJoint& l : locked_.joints()) s.residuals[l.joint] = 1.0;  // q̄ − q: an angle
-  const int N = base_.dimension(), w = locked_.wallCount();
+  const int N = base_.dimension(), w = locked_.gapCount();
   s.unknowns.conservativeResize(N + w);
   s.residuals.conservativeResize(N + w);
   s.unknowns.tail(w).setConstant(base_.stiffnessUnit() * base_.lengthUnit());  // μ: a force k̄b̄
-  s.residuals.tail(w).setConstant(base_.lengthUnit());                          // −x_v: a length b̄
+  s.residuals.tail(w).setConstant(base_.lengthUnit());                          // −x_v, −g: a length b̄
   return s;
 }
 
@@ -386,7 +439,14 @@ int ContactProblem::wallReleaseBoundary(int k) const {
   return torqueBoundBegin() + (std::isfinite(maxCompression_) ? locked_.count() : 0) + (base_.wallIsBoundary() ? 1 : 0) +
          k;
 }
-int ContactProblem::boundaryCount() const { return wallReleaseBoundary(locked_.wallCount()); }
+int ContactProblem::selfClearanceBoundary() const {
+  return base_.selfContactIsBoundary() ? wallReleaseBoundary(locked_.wallCount()) : -1;
+}
+int ContactProblem::selfReleaseBoundary(int k) const {
+  return wallReleaseBoundary(locked_.wallCount()) + (base_.selfContactIsBoundary() ? 1 : 0) + k;
+}
+int ContactProblem::selfEdgeBoundary(int k) const { return selfReleaseBoundary(locked_.selfCount()) + k; }
+int ContactProblem::boundaryCount() const { return selfEdgeBoundary(locked_.selfCount()); }
 
 namespace {
 
@@ -398,6 +458,14 @@ double boundaryValue(const ContactProblem& p, ContactProblem::Workspace& d, int 
   const EquilibriumProblem& base = p.base();
   const int n = base.segments(), N = base.dimension();
   if (k == p.wallClearanceBoundary()) return nearestWallVertex(base.chain(), u.head(n), p.contacts().wall()).distance;
+  const int w = p.contacts().wallCount();
+  if (k >= p.selfEdgeBoundary(0)) {  // min(t, 1 − t)·|e|: the vertex over its edge
+    if (!p.wallKinematics(d, u.head(n))) return std::numeric_limits<double>::quiet_NaN();
+    const int r = k - p.selfEdgeBoundary(0);
+    return std::min(d.selfAlong[r], 1.0 - d.selfAlong[r]) * d.selfEdgeLength[r];
+  }
+  if (k >= p.selfReleaseBoundary(0)) return wallForce(w + k - p.selfReleaseBoundary(0));  // μ ≥ 0
+  if (k == p.selfClearanceBoundary()) return selfClearanceApart(base.chain(), u.head(n), p.contacts().self());
   if (k >= p.wallReleaseBoundary(0)) return wallForce(k - p.wallReleaseBoundary(0));  // μ_v ≥ 0
   if (k >= p.torqueBoundBegin())
     return maxCompression - compression(p.contacts().joints()[size_t(k - p.torqueBoundBegin())].joint);
@@ -414,7 +482,7 @@ double ContactProblem::boundary(ProblemWorkspace& ws, int k, ConstVectorRef u, d
   return boundaryValue(
       *this, workspaceAs<Workspace>(ws), k, u, lambda, maxCompression_,
       [&](int joint) { return compression(ws, u, lambda, joint); },
-      [&](int r) { return u.size() == dimension() ? u[N + r] : wallForces(ws, u, lambda)[r]; });
+      [&](int r) { return u.size() == dimension() ? u[N + r] : contactForces(ws, u, lambda)[r]; });
 }
 
 void ContactProblem::boundaries(ProblemWorkspace& ws, ConstVectorRef u, double lambda, VectorRef g) const {
@@ -437,7 +505,7 @@ void ContactProblem::boundaries(ProblemWorkspace& ws, ConstVectorRef u, double l
   };
   const auto wallForceOf = [&](int r) {
     if (withForces) return u[N + r];
-    if (!forcesFormed) forces = wallForces(ws, u, lambda), forcesFormed = true;
+    if (!forcesFormed) forces = contactForces(ws, u, lambda), forcesFormed = true;
     return forces[r];
   };
   for (int k = 0; k < int(g.size()); ++k)
@@ -447,6 +515,9 @@ void ContactProblem::boundaries(ProblemWorkspace& ws, ConstVectorRef u, double l
 std::string ContactProblem::boundaryName(int k) const {
   const int n = base_.segments();
   if (k == wallClearanceBoundary()) return EquilibriumProblem::wallBoundaryName();
+  if (k >= selfEdgeBoundary(0)) return selfEdgeName(locked_.self()[size_t(k - selfEdgeBoundary(0))]);
+  if (k >= selfReleaseBoundary(0)) return selfReleaseName(locked_.self()[size_t(k - selfReleaseBoundary(0))]);
+  if (k == selfClearanceBoundary()) return EquilibriumProblem::selfContactBoundaryName();
   if (k >= wallReleaseBoundary(0)) return wallReleaseName(locked_.wall()[size_t(k - wallReleaseBoundary(0))]);
   if (k >= torqueBoundBegin()) {
     std::ostringstream os;
@@ -459,6 +530,14 @@ std::string ContactProblem::boundaryName(int k) const {
   if (locked_.locked(b.joint) && locked_.side(b.joint) == b.side)
     return "joint " + std::to_string(b.joint + 1) + " " + toString(b.side) + " contact released (contact torque -> 0)";
   return base_.boundaryName(k);
+}
+
+std::string selfReleaseName(const SelfContact& c) {
+  return "vertex " + c.vertex.label() + " leaves edge " + c.edge.label() + " (self contact force -> 0)";
+}
+
+std::string selfEdgeName(const SelfContact& c) {
+  return "vertex " + c.vertex.label() + " reaches an end of edge " + c.edge.label();
 }
 
 std::string wallReleaseName(const WallVertex& v) {

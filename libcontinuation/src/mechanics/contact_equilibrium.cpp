@@ -72,8 +72,9 @@ ConstrainedEquilibrium solveConstrainedEquilibrium(const EquilibriumProblem& bas
   out.converged = norm <= tolerance;
   if (!out.converged && out.message.empty()) out.message = "no convergence in " + std::to_string(maxIterations) + " iterations";
   out.torques = Vector::Zero(base.segments());
-  out.wallForces = u.tail(D - N);
-  out.minCompression = out.wallForces.size() > 0 ? out.wallForces.minCoeff() : std::numeric_limits<double>::infinity();
+  out.wallForces = u.segment(N, locked.wallCount());
+  out.selfForces = u.tail(locked.selfCount());
+  out.minCompression = D > N ? u.tail(D - N).minCoeff() : std::numeric_limits<double>::infinity();
   for (const LockedJoint& l : locked.joints()) {
     out.torques[l.joint] = problem.contactTorque(bound.workspace(), u, lambda, l.joint);
     out.minCompression = std::min(out.minCompression, -double(int(l.side)) * out.torques[l.joint]);

@@ -248,6 +248,22 @@ BaseClearance baseClearance(const Chain& chain, ConstVectorRef q) {
 
 SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) { return selfClearance(chain, q, {}, nullptr); }
 
+double selfClearanceApart(const Chain& chain, ConstVectorRef q, const std::vector<SelfContact>& held, int* linkA,
+                          int* linkB) {
+  SelfClearanceHint hint;
+  for (const SelfContact& c : held) {
+    // the vertex's links: a joint is on both of its segment's
+    const int le = c.edge.link();
+    const int first = c.vertex.corner == 0 || !c.vertex.distal() ? c.vertex.segment : c.vertex.segment + 1;
+    const int last = c.vertex.corner == 0 || c.vertex.distal() ? c.vertex.segment + 1 : c.vertex.segment;
+    for (int lv = first; lv <= last; ++lv) hint.exclude.push_back({std::min(lv, le), std::max(lv, le)});
+  }
+  const SelfClearance c = selfClearance(chain, q, hint, nullptr);
+  if (linkA) *linkA = c.linkA;
+  if (linkB) *linkB = c.linkB;
+  return c.distance;
+}
+
 SelfClearance selfClearance(const Chain& chain, ConstVectorRef q, const SelfClearanceHint& hint, bool* exact) {
   ClearanceScratch scratch;
   return selfClearanceOf(linkBodies(chain, q), hint, exact, scratch);
@@ -299,6 +315,9 @@ SelfClearance selfClearanceOf(const LinkBodies& bodies, const SelfClearanceHint&
                         (bodies.triangles[t][2] - bodies.triangles[t][0]).norm());
   // the smallest signed distance of two links' triangles; true when it ends the search
   const auto measure = [&](int a, int b) {
+    if (!hint.exclude.empty() &&
+        std::find(hint.exclude.begin(), hint.exclude.end(), std::pair{a, b}) != hint.exclude.end())
+      return false;
     for (int s = bodies.first[size_t(a)]; s < bodies.first[size_t(a) + 1]; ++s)
       for (int t = bodies.first[size_t(b)]; t < bodies.first[size_t(b) + 1]; ++t) {
         const double r = reach[size_t(s)] + reach[size_t(t)];
@@ -391,11 +410,13 @@ std::vector<GeometricContact> locateGeometricContacts(EquilibriumProblem& proble
   const size_t count = branch.points.size();
   if (count < 2) return found;
   const double lambdaScale = problem.scales().parameter;
-  const bool scanBase = !problem.wallIsBoundary();  // the wall as a constraint: WC / WR (contact.h)
+  // the wall and self contact as constraints: WC / WR and SH / SR (contact.h), not scanned
+  const bool scanBase = !problem.wallIsBoundary(), scanSelf = !problem.selfContactIsBoundary();
+  if (!scanBase && !scanSelf) return found;
   std::vector<double> dBase, dSelf;
   scanDistances(chain, branch, scanBase, dBase, dSelf);
   for (bool base : {true, false}) {
-    if (base && !scanBase) continue;
+    if ((base && !scanBase) || (!base && !scanSelf)) continue;
     std::vector<double>& d = base ? dBase : dSelf;
     ClearanceProbe distance(chain, base);
     // Bodies that rest on each other (a vertex on the wall, triangles meeting where joints lock at

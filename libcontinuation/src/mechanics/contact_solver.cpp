@@ -290,7 +290,9 @@ class ReducedChainSolver final : public continuation::BorderedSolver {
 }  // namespace
 
 std::unique_ptr<continuation::BorderedSolver> ContactProblem::makeStructuredSolver(ProblemWorkspace& ws) const {
-  if (free_.empty()) return std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(*this, ws));
+  // every joint locked, or a self contact's rank-2 coupling (self_contact.h): the dense route
+  if (free_.empty() || locked_.selfCount() > 0)
+    return std::make_unique<continuation::DenseBorderedSolver>(continuation::BoundProblem(*this, ws));
   return std::make_unique<ReducedChainSolver>(*this, ws);
 }
 

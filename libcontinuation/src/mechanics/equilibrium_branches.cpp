@@ -17,18 +17,22 @@ namespace buckle::mechanics {
 namespace {
 
 // What a branch's last special point stopped on: a joint limit or a joint's release (joint ≥ 0),
-// the wall reached by a vertex or a vertex's release from it (vertex.segment ≥ 0), or nothing.
+// the wall reached by a vertex or a vertex's release from it (vertex.segment ≥ 0), two links
+// touching, a self contact's release or its vertex at an end of its edge (onSelf), or nothing.
 struct BoundaryEvent {
   LockedJoint joint;
   WallVertex vertex;
   bool wallRelease = false;
-  bool any() const { return joint.joint >= 0 || vertex.segment >= 0; }
+  SelfContact self;
+  bool onSelf = false, selfRelease = false, selfEdgeEnd = false;
+  bool any() const { return joint.joint >= 0 || vertex.segment >= 0 || onSelf; }
 };
 
 // The event found by the boundary's name among the problem's boundaries (the joints' limits and
-// contacts, the wall's clearance and releases); `wall` the vertices on the wall before it.
+// contacts, the wall's clearance and releases, the self contacts'); `contacts` those before it.
 BoundaryEvent endEvent(const EquilibriumProblem& base, const continuation::Problem& problem,
-                      const continuation::Branch& branch, const std::vector<WallVertex>& wall) {
+                      const continuation::Branch& branch, const ContactSet& contacts) {
+  const std::vector<WallVertex>& wall = contacts.wall();
   BoundaryEvent e;
   const int segments = base.segments();
   if (branch.stopReason != continuation::StopReason::Boundary || branch.specialPoints.empty()) return e;
@@ -48,6 +52,18 @@ BoundaryEvent endEvent(const EquilibriumProblem& base, const continuation::Probl
       e.vertex = v;
       e.wallRelease = true;
     }
+  if (base.selfContactIsBoundary() && sp.boundaryName == EquilibriumProblem::selfContactBoundaryName()) {
+    int a = -1, b = -1;
+    selfClearanceApart(base.chain(), sp.u.head(segments), contacts.self(), &a, &b);
+    if (a >= 0 && b >= 0) {
+      e.self = touchingPair(base.chain(), sp.u.head(segments), a, b);
+      e.onSelf = true;
+    }
+  }
+  for (const SelfContact& c : contacts.self()) {
+    if (sp.boundaryName == selfReleaseName(c)) e.self = c, e.onSelf = e.selfRelease = true;
+    if (sp.boundaryName == selfEdgeName(c)) e.self = c, e.onSelf = e.selfEdgeEnd = true;
+  }
   return e;
 }
 
@@ -103,6 +119,14 @@ void appendMirroredTail(const continuation::Reflection& mirror, const continuati
 double contactRate(EquilibriumProblem& problem, const ContactSet& before, const BoundaryEvent& hit, bool release,
                    int wallIndex, const continuation::ContinuationPoint& p0) {
   const int n = problem.segments(), D = int(p0.u.size());
+  if (hit.onSelf) {  // a self contact's force (wallIndex: its index), or a released one's gap ∇g·t_q
+    if (!release) return p0.tangent[problem.dimension() + before.wallCount() + wallIndex];
+    const Eigen::Matrix2Xd P = jointPositions(problem.chain(), p0.u.head(n));
+    const SelfContactGap g = selfContactGap(problem.chain(), p0.u.head(n), P, hit.self);
+    continuation::Vector grad(n), gen(n), coupling(n), weights(n);
+    selfContactDerivatives(P, hit.self, g, grad, gen, coupling, weights);
+    return grad.dot(p0.tangent.head(n));
+  }
   if (hit.joint.joint >= 0) {
     const int i = hit.joint.joint;
     const double sideSign = hit.joint.side == LimitSide::Upper ? 1.0 : -1.0;
@@ -190,19 +214,41 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
   std::vector<ContactStretch> stretches{ContactStretch{0, initial}};
   std::unique_ptr<ContactProblem> current;  // the problem of the last stretch (null: `problem`)
   if (!initial.empty()) current = lockedProblem(problem, initial, maxContactTorque);
-  if (initial.wallCount() > 0) {  // traced with the wall forces among the unknowns: keep (q, r)
+  if (initial.gapCount() > 0) {  // traced with the contact forces among the unknowns: keep (q, r)
     for (continuation::ContinuationPoint& p : branch.points) toBaseUnknowns(p.u, p.tangent, problem.dimension());
     for (continuation::SpecialPoint& sp : branch.specialPoints) toBaseUnknowns(sp, problem.dimension());
   }
   for (int events = 0; events < maxContactEvents && !branch.points.empty(); ++events) {
     const continuation::Problem& traced = current ? static_cast<const continuation::Problem&>(*current) : problem;
-    const BoundaryEvent hit = endEvent(problem, traced, branch, stretches.back().locked.wall());
+    const BoundaryEvent hit = endEvent(problem, traced, branch, stretches.back().locked);
     if (!hit.any()) break;
+    // A vertex at the end of its edge slides onto the link outline's next edge (self_contact.h);
+    // elsewhere (an apex, unequal half-heights) where it goes on is not followed.
+    SelfContact slidTo;
+    if (hit.selfEdgeEnd) {
+      const continuation::SpecialPoint& sp = branch.specialPoints.back();
+      const Eigen::VectorXd q = sp.u.head(n);
+      const double along = selfContactGap(problem.chain(), q, jointPositions(problem.chain(), q), hit.self).along;
+      if (!slideOntoNeighbour(problem.chain(), hit.self, along, slidTo)) {
+        std::string& note = branch.specialPoints.back().note;
+        note += std::string(note.empty() ? "" : "; ") + "self contact " + hit.self.label() +
+                ": the vertex reaches an end of its edge; sliding past it is not followed, the branch ends here";
+        break;
+      }
+    }
     ContactSet locked = stretches.back().locked;
     const bool onJoint = hit.joint.joint >= 0;
-    const bool release = onJoint ? locked.locked(hit.joint.joint) && locked.side(hit.joint.joint) == hit.joint.side
-                                 : hit.wallRelease;
-    if (onJoint && release)
+    const bool release = onJoint   ? locked.locked(hit.joint.joint) && locked.side(hit.joint.joint) == hit.joint.side
+                         : hit.onSelf ? hit.selfRelease
+                                    : hit.wallRelease;
+    const SelfContact& heldSelf = hit.selfEdgeEnd ? slidTo : hit.self;
+    if (hit.onSelf && release) {
+      locked.separate(hit.self);
+    } else if (hit.onSelf) {
+      if (hit.selfEdgeEnd) locked.separate(hit.self);
+      locked.hold(heldSelf);
+    }
+    else if (onJoint && release)
       locked.release(hit.joint.joint);
     else if (onJoint)
       locked.lock(hit.joint.joint, hit.joint.side);
@@ -222,9 +268,11 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     if (o.maxPoints < 2 || !(o.maxArclength > 0.0)) break;
     auto next = lockedProblem(problem, locked, maxContactTorque);
     const std::string what =
-        onJoint ? std::string(release ? "release of joint " : "contact of joint ") + std::to_string(hit.joint.joint + 1) +
-                      " " + toString(hit.joint.side)
-                : std::string(release ? "release of vertex " : "wall contact of vertex ") + hit.vertex.label();
+        onJoint      ? std::string(release ? "release of joint " : "contact of joint ") +
+                      std::to_string(hit.joint.joint + 1) + " " + toString(hit.joint.side)
+        : hit.selfEdgeEnd ? "self contact " + hit.self.label() + " sliding onto " + heldSelf.edge.label()
+        : hit.onSelf      ? std::string(release ? "release of self contact " : "self contact ") + hit.self.label()
+                     : std::string(release ? "release of vertex " : "wall contact of vertex ") + hit.vertex.label();
     auto giveUp = [&branch, &what](const std::string& why) {
       std::string& note = branch.specialPoints.back().note;
       note += (note.empty() ? "" : "; ") + what + ": " + why;
@@ -246,17 +294,21 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // is ambiguous: on an unstable branch a joint can reach its limit with the locked branch
     // turning back in λ (a corner).
     const int N = problem.dimension(), D = next->dimension();
-    const int wallIndex = onJoint ? -1
-                                  : int(std::lower_bound(locked.wall().begin(), locked.wall().end(), hit.vertex) -
-                                        locked.wall().begin());
-    const int changed = onJoint ? (hit.joint.side == LimitSide::Upper ? hit.joint.joint : hit.joint.joint + n)
-                        : release ? next->wallClearanceBoundary()
-                                  : next->wallReleaseBoundary(wallIndex);
+    const int wallIndex =
+        onJoint      ? -1
+        : hit.onSelf ? int(std::lower_bound(locked.self().begin(), locked.self().end(), heldSelf) - locked.self().begin())
+                     : int(std::lower_bound(locked.wall().begin(), locked.wall().end(), hit.vertex) -
+                           locked.wall().begin());
+    const int changed = onJoint      ? (hit.joint.side == LimitSide::Upper ? hit.joint.joint : hit.joint.joint + n)
+                        : hit.onSelf ? (release ? next->selfClearanceBoundary() : next->selfReleaseBoundary(wallIndex))
+                        : release    ? next->wallClearanceBoundary()
+                                     : next->wallReleaseBoundary(wallIndex);
     auto startPoint = [&](const continuation::Vector& direction, continuation::ContinuationPoint& p) {
       p = continuation::ContinuationPoint();
       p.u.resize(D);
       p.u.head(N) = start.u;
-      p.u.tail(D - N) = start.wallForces;
+      p.u.segment(N, locked.wallCount()) = start.wallForces;
+      p.u.tail(locked.selfCount()) = start.selfForces;
       p.lambda = at.lambda;
       tracer.units().toScaled(p);
       if (!tracer.completePoint(p, tracer.units().directionToScaled(direction))) return false;
@@ -304,7 +356,9 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       break;
     }
     if (continuation::BoundProblem(*next).boundary(changed, stretch.points[1].u, stretch.points[1].lambda) < 0.0) {
-      giveUp(release ? (onJoint ? "the free joint would go past its limit" : "the vertex would go through the wall")
+      giveUp(release ? (onJoint      ? "the free joint would go past its limit"
+                        : hit.onSelf ? "the bodies would pass into each other"
+                                     : "the vertex would go through the wall")
                      : "the contact would pull (tension)");
       break;
     }

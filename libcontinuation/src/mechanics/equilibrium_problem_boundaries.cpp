@@ -1,12 +1,14 @@
 // The boundaries of the equilibrium problem (Problem::boundary): the joint limits, where the
 // tracer stops or contact begins (contact.h), and the held coordinate's path range of a
 // displacement path traced through its reaction (EquilibriumOptions::heldRange), and the base
-// wall (EquilibriumOptions::wallAsBoundary), where a wall contact begins.
+// wall (EquilibriumOptions::wallAsBoundary), where a wall contact begins, and the chain's clearance
+// from itself (EquilibriumOptions::selfContactAsBoundary), where a self contact begins.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/self_contact.h"
 #include "buckle/mechanics/wall_contact.h"
 
 namespace buckle::mechanics {
@@ -16,7 +18,9 @@ using continuation::ProblemWorkspace;
 using continuation::VectorRef;
 using continuation::workspaceAs;
 
-int EquilibriumProblem::boundaryCount() const { return wallBoundaryIndex() + (options_.wallAsBoundary ? 1 : 0); }
+int EquilibriumProblem::boundaryCount() const {
+  return selfContactBoundaryIndex() + (options_.selfContactAsBoundary ? 1 : 0);
+}
 
 // A joint limit is the joint angle at the limit itself, geometric (the closing spring's length
 // is zero, or |c1 − c2|) or the user's: the spring model is regular there (inDomain,
@@ -25,6 +29,7 @@ double EquilibriumProblem::boundary(ProblemWorkspace& ws, int k, ConstVectorRef 
   Workspace& d = workspaceAs<Workspace>(ws);
   const int n = chain_.size();
   if (options_.wallAsBoundary && k == wallBoundaryIndex()) return nearestWallVertex(chain_, u.head(n)).distance;
+  if (options_.selfContactAsBoundary && k == selfContactBoundaryIndex()) return selfClearanceApart(chain_, u.head(n), {});
   const int r = k - rangeBoundaryBegin();
   if (r >= 0) {
     // the pose from the evaluation cache (no allocation per point); outside the domain, directly.
@@ -54,6 +59,7 @@ void EquilibriumProblem::boundaries(ProblemWorkspace& ws, ConstVectorRef u, doub
 std::string EquilibriumProblem::boundaryName(int k) const {
   const int n = chain_.size();
   if (options_.wallAsBoundary && k == wallBoundaryIndex()) return wallBoundaryName();
+  if (options_.selfContactAsBoundary && k == selfContactBoundaryIndex()) return selfContactBoundaryName();
   if (const int r = k - rangeBoundaryBegin(); r >= 0) {
     static const char* names[3] = {"x", "y", "phi"};
     const EquilibriumOptions::CoordinateRange& range = options_.heldRange;

@@ -100,6 +100,18 @@ void selfContactDerivatives(const Eigen::Matrix2Xd& P, const SelfContact& c, con
     for (int m = 0; m <= hi; ++m) weights[m] = 1.0;
 }
 
+bool slideOntoNeighbour(const Chain& chain, const SelfContact& c, double along, SelfContact& next) {
+  const int s = c.edge.segment, n = chain.size();
+  if (c.edge.edge == 0 || along < 0.5) return false;
+  const int other = c.edge.distal ? s + 1 : s - 1;
+  if (other < 0 || other >= n) return false;
+  const double here = c.edge.distal ? chain.segment(s).parameters().a2 : chain.segment(s).parameters().a1;
+  const double there = c.edge.distal ? chain.segment(other).parameters().a1 : chain.segment(other).parameters().a2;
+  if (here != there) return false;
+  next = SelfContact{c.vertex, TriangleEdge{other, !c.edge.distal, c.edge.edge}};
+  return true;
+}
+
 SelfContact touchingPair(const Chain& chain, ConstVectorRef q, int linkA, int linkB) {
   const int n = chain.size();
   if (linkA < 0 || linkB < 0 || linkA > n || linkB > n || std::abs(linkA - linkB) < 2)

@@ -49,6 +49,8 @@ enum class EventType {
   InputBound,        ///< "IB": along a task path, a control input reaches its bound (task_path.h)
   WallContact,       ///< "WC": a vertex reaches the base wall and is held on it (contact.h, wall_contact.h)
   WallRelease,       ///< "WR": a vertex's wall force returns to zero: it leaves the wall
+  SelfHold,          ///< "SH": a vertex reaches another link's triangle and is held on it (self_contact.h)
+  SelfRelease,       ///< "SR": a self contact's force returns to zero: the bodies separate
 };
 
 /// "BP", "LP", "LPF", "BD", "KMIN", "JUMP", "CT", "RL", "BC", "SC", "ET", "LS", "IB": the one spelling
@@ -116,6 +118,8 @@ struct PointReport {
   Eigen::VectorXd inputs;
   /// The wall forces μ_v (a force along +x on the chain), one per vertex of locked.wall().
   Eigen::VectorXd wallForces;
+  /// The self contacts' forces (pushing the bodies apart), one per locked.self().
+  Eigen::VectorXd selfForces;
 };
 
 /// One special point of a branch, named in the field's words.
@@ -156,6 +160,8 @@ struct SpecialPointReport {
   /// at the point (≈ 0 there; NaN otherwise).
   WallVertex vertex{-1, 0};
   double contactForce = std::numeric_limits<double>::quiet_NaN();
+  /// SH / SR: the self contact held or released (vertex.segment −1 otherwise); its force is contactForce.
+  SelfContact selfContact;
   /// Located on a stretch with vertices on the wall: those vertices (the stretch's, i.e. the traced
   /// point's before it) and their forces μ_v at the point, in the same order; empty otherwise.
   std::vector<WallVertex> wallVertices;

@@ -23,6 +23,11 @@
 // only: μ is recovered at any equilibrium by least squares on the free rows, which it closes
 // exactly (wallForces), as a locked joint's torque is read off its row.
 //
+// Self contacts (self_contact.h: a vertex held on another link's triangle edge) are bordered like
+// the wall's vertices, after them: u = (q, r, μ_wall, μ_self), rows −g(q) = 0, the q rows gain
+// −μ ∇g and the Hessian −μ ∂²g, whose rank-2 part leaves the chain structure: while one is held,
+// the solves and the stability take the dense route (O(n³) a point).
+//
 // Structure (O(n)): with the locked rows eliminated, F_u restricted to the free joints is
 // K_q − K_g on the free indices F, whose entries are κ_a δ_ab − h_max(a,b) (eq 27): the same
 // generator form, so the free block is U T Uᵀ of a chain structure of size |F| (chain_structure.h)
@@ -42,6 +47,7 @@
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "buckle/mechanics/self_contact.h"
 #include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/wall_contact.h"
 
@@ -60,8 +66,8 @@ struct LockedJoint {
   bool operator==(const LockedJoint& o) const { return joint == o.joint && side == o.side; }
 };
 
-/// The joints locked at their limits, sorted by joint, at most one side per joint, and the
-/// vertices held on the base wall (wall_contact.h), sorted.
+/// The joints locked at their limits, sorted by joint, at most one side per joint, the vertices
+/// held on the base wall (wall_contact.h), sorted, and the self contacts (self_contact.h), sorted.
 class ContactSet {
  public:
   ContactSet() = default;
@@ -75,8 +81,8 @@ class ContactSet {
   LimitSide side(int joint) const;
   /// Number of locked joints.
   int count() const { return int(joints_.size()); }
-  /// No joint locked and no vertex on the wall: the free chain.
-  bool empty() const { return joints_.empty() && wall_.empty(); }
+  /// No joint locked, no vertex on the wall, no self contact: the free chain.
+  bool empty() const { return joints_.empty() && wall_.empty() && self_.empty(); }
   const std::vector<LockedJoint>& joints() const { return joints_; }
   /// 1-based joint numbers with their side, "3U 5L" ("" when none): the `locked` column.
   std::string label() const;
@@ -89,15 +95,27 @@ class ContactSet {
   const std::vector<WallVertex>& wall() const { return wall_; }
   /// The vertices on the wall, "3d+ 4j" ("" when none): the `wall` column.
   std::string wallLabel() const;
-  /// Throws std::invalid_argument naming the problem when a joint is outside [0, segments) or a
-  /// vertex is not a moving one (checkWallVertex).
+  /// Holds the self contact `c` (no-op when it is held).
+  void hold(const SelfContact& c);
+  /// Lets the self contact `c` go (no-op when it is not held).
+  void separate(const SelfContact& c);
+  bool holding(const SelfContact& c) const;
+  int selfCount() const { return int(self_.size()); }
+  const std::vector<SelfContact>& self() const { return self_; }
+  /// The self contacts, "7d+ on 3d[j,+]; …" ("" when none): the `self` column.
+  std::string selfLabel() const;
+  /// Vertices on the wall and self contacts: the bordered contacts, whose forces follow (q, r).
+  int gapCount() const { return wallCount() + selfCount(); }
+  /// Throws std::invalid_argument naming the problem when a joint is outside [0, segments), a
+  /// vertex is not a moving one (checkWallVertex) or a self contact is not one (checkSelfContact).
   void check(int segments) const;
-  bool operator==(const ContactSet& o) const { return joints_ == o.joints_ && wall_ == o.wall_; }
+  bool operator==(const ContactSet& o) const { return joints_ == o.joints_ && wall_ == o.wall_ && self_ == o.self_; }
   bool operator!=(const ContactSet& o) const { return !(*this == o); }
 
  private:
   std::vector<LockedJoint> joints_;
   std::vector<WallVertex> wall_;
+  std::vector<SelfContact> self_;
 };
 
 /// The limit angle q̄ of joint i on `side` (the chain's limits: geometric or the scene's).
@@ -136,10 +154,15 @@ class ContactProblem final : public continuation::Problem {
   /// close the free joints' rows of the base problem at (q, r) = u.head(base dimension) in the
   /// least-squares sense: exact at a constrained equilibrium. NaN outside the domain.
   Vector wallForces(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda) const;
-  /// (q, r) extended to this problem's unknowns (q, r, μ) with μ = wallForces.
+  /// The self contacts' forces (one per contacts().self(), pushing the bodies apart along the
+  /// edge's normal), read off the free rows as wallForces reads the wall's.
+  Vector selfForces(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda) const;
+  /// Both, wall then self (this problem's unknowns after (q, r)). NaN outside the domain.
+  Vector contactForces(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda) const;
+  /// (q, r) extended to this problem's unknowns (q, r, μ) with μ = contactForces.
   Vector withWallForces(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda) const;
 
-  int dimension() const override { return base_.dimension() + locked_.wallCount(); }
+  int dimension() const override { return base_.dimension() + locked_.gapCount(); }
   bool residual(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                 continuation::VectorRef F) const override;
   bool jacobian(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
@@ -169,6 +192,13 @@ class ContactProblem final : public continuation::Problem {
   int torqueBoundBegin() const;
   int wallClearanceBoundary() const;
   int wallReleaseBoundary(int k) const;
+  /// The self contacts' boundaries: the clearance of the link pairs not in contact (−1 when the
+  /// base does not trace self contact, EquilibriumOptions::selfContactAsBoundary), the release of
+  /// self contact k (its force ≥ 0) and its vertex's distance to the ends of its edge
+  /// (min(t, 1 − t)·|e| ≥ 0: it slides off the edge there).
+  int selfClearanceBoundary() const;
+  int selfReleaseBoundary(int k) const;
+  int selfEdgeBoundary(int k) const;
   double boundary(continuation::ProblemWorkspace& ws, int k, continuation::ConstVectorRef u,
                   double lambda) const override;
   /// Every boundary(k) at once: the rows whose locked entries are the contact torques, and the
@@ -187,7 +217,8 @@ class ContactProblem final : public continuation::Problem {
   bool assembleFull(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                     ChainStructure& full, continuation::MatrixRef J) const;
   /// The wall vertices' ∇x_v (columns of wallGradients(), n×w) and generators of −∂²x_v (columns
-  /// of wallGenerators(), wall_contact.h) at q; false when q is not finite.
+  /// of wallGenerators(), wall_contact.h) at q, then the self contacts' ∇g and generators (their
+  /// rank-2 terms in the workspace's selfCoupling, selfWeights); false when q is not finite.
   bool wallKinematics(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef q) const;
   static const Matrix& wallGradients(const continuation::ProblemWorkspace& ws) {
     return continuation::workspaceAs<Workspace>(ws).wallGrad;
@@ -205,8 +236,10 @@ class ContactProblem final : public continuation::Problem {
     Vector kf, hf;    // κ_F, h_F of the reduced structure
     Vector residual;  // the free equilibrium's rows (contact torques), size N
     Vector lastLowest;
-    Matrix wallGrad, wallGen;  // n×w: ∇x_v and the generators of −∂²x_v (wallKinematics)
-    Vector wallX;              // x_v of the wall vertices
+    Matrix wallGrad, wallGen;  // n×(w + s): ∇g and the generators of −∂²g (wallKinematics)
+    Vector wallX;              // the gaps: x_v of the wall vertices, then the self contacts' g
+    Matrix selfCoupling, selfWeights;  // n×s: −∂²g's rank-2 term (self_contact.h)
+    Vector selfAlong, selfEdgeLength;  // where each self contact's vertex is along its edge
     Vector unknowns;           // (q, r, μ) of boundaries()
   };
   std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override;
@@ -230,6 +263,9 @@ void reduceToFreeJoints(const ChainStructure& full, const std::vector<int>& free
 
 /// The name of ContactProblem's release boundary of a vertex on the wall.
 std::string wallReleaseName(const WallVertex& v);
+/// The names of a self contact's release boundary and of its edge-end boundary.
+std::string selfReleaseName(const SelfContact& c);
+std::string selfEdgeName(const SelfContact& c);
 
 /// A stretch of a traced branch with one set of locked joints: points [firstPoint, the next
 /// stretch's firstPoint) of the branch (equilibrium_branches.h). The point where a contact
@@ -257,6 +293,8 @@ struct ConstrainedEquilibrium {
   continuation::Vector torques;    ///< contact torque τ_c,i of every joint (0 at free ones)
   /// The wall forces μ_v, one per vertex of locked.wall() (a force along +x on the chain).
   continuation::Vector wallForces;
+  /// The self contacts' forces, one per locked.self().
+  continuation::Vector selfForces;
   /// Smallest compression among the locked joints and the wall forces (+inf when none): < 0
   /// means the contact would pull, so that joint or vertex should be released.
   double minCompression = 0.0;

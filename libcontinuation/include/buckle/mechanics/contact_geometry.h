@@ -69,6 +69,8 @@ SelfClearance selfClearance(const Chain& chain, ConstVectorRef q);
 struct SelfClearanceHint {
   int linkA = -1, linkB = -1;
   double stopBelow = -std::numeric_limits<double>::infinity();
+  /// Pairs of links (lower first) left out of the search: those holding a self contact.
+  std::vector<std::pair<int, int>> exclude;
 };
 /// As selfClearance(chain, q), exact unless a pair below hint.stopBelow ended the search
 /// (`exact` false: then distance < stopBelow and d_self ≤ distance).

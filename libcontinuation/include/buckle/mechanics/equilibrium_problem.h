@@ -53,6 +53,10 @@ struct EquilibriumOptions {
   /// smallest x over the moving vertices, so the tracer stops where a vertex reaches x = 0 (where
   /// the wall contact begins, contact.h).
   bool wallAsBoundary = false;
+  /// Self contact as a boundary (self_contact.h): one more after the wall's, g = d_self
+  /// (contact_geometry.h), so the tracer stops where two links' triangles touch (where a self
+  /// contact begins, contact.h).
+  bool selfContactAsBoundary = false;
   /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
   std::string validate(const std::string& prefix = "") const;
   bool IsValid(std::string* why) const { return continuation::reportValidity(validate(), why); }
@@ -256,6 +260,10 @@ class EquilibriumProblem final : public continuation::Problem {
   bool wallIsBoundary() const { return options_.wallAsBoundary; }
   /// Its name (SpecialPoint::boundaryName where the tracer stopped on it).
   static const char* wallBoundaryName() { return "a vertex reaches the base wall x = 0"; }
+  /// The self contact boundary (EquilibriumOptions::selfContactAsBoundary): its index and name.
+  int selfContactBoundaryIndex() const { return wallBoundaryIndex() + (options_.wallAsBoundary ? 1 : 0); }
+  bool selfContactIsBoundary() const { return options_.selfContactAsBoundary; }
+  static const char* selfContactBoundaryName() { return "two links' triangles touch (self contact)"; }
 
  private:
   /// Inside the model's domain: finite, every joint within its geometric limits (or just past one,

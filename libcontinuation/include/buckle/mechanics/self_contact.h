@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/wall_contact.h"
@@ -86,5 +87,17 @@ void selfContactDerivatives(const Eigen::Matrix2Xd& P, const SelfContact& c, con
 /// other's, the one whose vertex lies nearest to the edge's line with its projection on the edge
 /// (0 ≤ t ≤ 1), by |g|. Throws std::invalid_argument for links that cannot touch.
 SelfContact touchingPair(const Chain& chain, ConstVectorRef q, int linkA, int linkB);
+
+/// Where a held vertex that reaches the base-corner end of a side edge (along = 1) slides on: the
+/// same side's edge of the link's other triangle, which shares that corner when the two
+/// triangles' half-heights are equal (the link's outline). False for the apex end (along = 0), a
+/// base edge, a link with one triangle there or unequal half-heights: not followed.
+bool slideOntoNeighbour(const Chain& chain, const SelfContact& c, double along, SelfContact& next);
+
+/// d_self (contact_geometry.h) over the pairs of links that hold none of `held` between them: the
+/// clearance boundary of a chain holding those self contacts. The pair it was found on in linkA,
+/// linkB when given. O(n log n) unless the chain folds onto itself.
+double selfClearanceApart(const Chain& chain, ConstVectorRef q, const std::vector<SelfContact>& held,
+                          int* linkA = nullptr, int* linkB = nullptr);
 
 }  // namespace buckle::mechanics
