@@ -73,10 +73,10 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
   const auto P = static_cast<Eigen::Index>(cr.points.size());
   py::dict d;
   Eigen::VectorXi branch(P), point(P), negative(P);
-  VectorXd contactTorque(P), wallForce(P);
+  VectorXd contactTorque(P), wallForce(P), selfForce(P);
   py::array_t<bool> stable(P);
   auto stableView = stable.mutable_unchecked<1>();
-  std::vector<std::string> locked, wall;
+  std::vector<std::string> locked, wall, self;
   std::vector<const mechanics::PointReport*> rows;
   for (Eigen::Index i = 0; i < P; ++i) {
     const mechanics::PointReport& p = cr.points[static_cast<size_t>(i)];
@@ -89,6 +89,8 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
     contactTorque[i] = p.contactTorque;
     wall.push_back(p.locked.wallLabel());
     wallForce[i] = p.wallForces.sum();
+    self.push_back(p.locked.selfLabel());
+    selfForce[i] = p.selfForces.sum();
   }
   // in the order of branches.csv's columns
   d["branch"] = branch;
@@ -102,6 +104,11 @@ py::dict branchArrays(const scene::Scene& s, const scene::CaseResult& cr) {
   d["contact_torque"] = contactTorque;
   d["wall"] = wall;
   d["wall_force"] = wallForce;
+  const scene::ContinuationSpec& c = s.analyses.continuation;
+  if (c.enabled && c.contact && c.self) {  // as branches.csv: with self contact traced
+    d["self"] = self;
+    d["self_force"] = selfForce;
+  }
   addValues(d, tailColumns(s), rows, cr);
   return d;
 }

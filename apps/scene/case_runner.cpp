@@ -157,7 +157,7 @@ void CaseRunner::jumps() {
 // drawn as an arrow in the bifurcation plots.
 void CaseRunner::loadHistory() {
   // its pieces are held at the base wall as the continuation's branches are
-  mech::EquilibriumProblem problem = pathProblem(tracesWall());
+  mech::EquilibriumProblem problem = pathProblem(true);
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();
   opt.jump.perturbation = scene_.analyses.loadHistory.perturbation;
@@ -224,7 +224,7 @@ void CaseRunner::suddenLoad() {
     opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
     opt.jump.wall = tracesWall();
     try {
-      mech::EquilibriumProblem held = pathProblem(tracesWall());  // held at the wall as the history is
+      mech::EquilibriumProblem held = pathProblem(true);  // held at the wall as the history is
       const mech::LoadHistoryResult h = mech::followLoadHistory(held, out_.qStart, {s0, spec.value}, opt);
       if (h.success && !h.segments.empty()) qStatic = h.segments.back().points.back().u.head(n);
       if (problem.bodyLoads().active() && !h.segments.empty() && !h.segments.front().points.empty())

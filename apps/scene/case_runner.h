@@ -130,10 +130,12 @@ class CaseRunner {
   }
   /// The scene's path of the end condition: prescribed(λ) = start values + (λ − s0)·direction.
   mechanics::LoadPath loadPath() const { return {spec_.end.condition, spec_.path.direction, out_.startValue}; }
-  /// The path as an EquilibriumProblem; with `wall` the base wall is a constraint (tracesWall()).
-  mechanics::EquilibriumProblem pathProblem(bool wall = false) const {
+  /// The path as an EquilibriumProblem; with `contact` the base wall and the chain's contact with
+  /// itself are constraints as the scene traces them (tracesWall(), tracesSelf()).
+  mechanics::EquilibriumProblem pathProblem(bool contact = false) const {
     mechanics::EquilibriumOptions options;
-    options.wallAsBoundary = wall;
+    options.wallAsBoundary = contact && tracesWall();
+    options.selfContactAsBoundary = contact && tracesSelf();
     return mechanics::EquilibriumProblem(out_.chain, loadPath().problemEnd(), spec_.path.direction, options,
                                          controlDirection(), bodyLoads());
   }

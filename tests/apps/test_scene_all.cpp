@@ -254,6 +254,17 @@ TEST_CASE("every scene in data/scenes runs and matches the closed forms", "[scen
           CHECK(std::abs(p["wall_contact"]["contact_force"].get<double>()) <= 1e-9);
           REQUIRE(p.contains("contact_point"));
           CHECK(std::abs(p["contact_point"][0].get<double>()) <= 1e-9 * std::max(1.0, std::abs(p["position"]["x"].get<double>())));
+        } else if (type == "SH" || type == "SR") {
+          // a vertex is held on or leaves another link's edge (mechanics/self_contact.h): the free
+          // and the held equilibria meet there, so the contact force is zero to the location's
+          // accuracy, between links two or more apart
+          CHECK(field == "none");
+          CHECK(!p.contains("jump_to"));
+          REQUIRE(p.contains("self_contact"));
+          CHECK(!p["self_contact"]["vertex"].get<std::string>().empty());
+          CHECK(!p["self_contact"]["edge"].get<std::string>().empty());
+          CHECK(std::abs(p["self_contact"]["contact_force"].get<double>()) <= 1e-9);
+          REQUIRE(p.contains("contact_point"));
         } else if (type == "BC" || type == "SC") {
           // base / self contact (mechanics/contact_geometry.h): detected, no phenomenon, the
           // touching point on the wall x = 0 for BC

@@ -11,61 +11,11 @@
 
 #include "buckle/continuation/multiplicity_switching.h"
 #include "buckle/mechanics/mirror_symmetry.h"
+#include "contact_events.h"
 
 namespace buckle::mechanics {
 
 namespace {
-
-// What a branch's last special point stopped on: a joint limit or a joint's release (joint ≥ 0),
-// the wall reached by a vertex or a vertex's release from it (vertex.segment ≥ 0), two links
-// touching, a self contact's release or its vertex at an end of its edge (onSelf), or nothing.
-struct BoundaryEvent {
-  LockedJoint joint;
-  WallVertex vertex;
-  bool wallRelease = false;
-  SelfContact self;
-  bool onSelf = false, selfRelease = false, selfEdgeEnd = false;
-  bool any() const { return joint.joint >= 0 || vertex.segment >= 0 || onSelf; }
-};
-
-// The event found by the boundary's name among the problem's boundaries (the joints' limits and
-// contacts, the wall's clearance and releases, the self contacts'); `contacts` those before it.
-BoundaryEvent endEvent(const EquilibriumProblem& base, const continuation::Problem& problem,
-                      const continuation::Branch& branch, const ContactSet& contacts) {
-  const std::vector<WallVertex>& wall = contacts.wall();
-  BoundaryEvent e;
-  const int segments = base.segments();
-  if (branch.stopReason != continuation::StopReason::Boundary || branch.specialPoints.empty()) return e;
-  const continuation::SpecialPoint& sp = branch.specialPoints.back();
-  if (sp.type != continuation::SpecialPointType::Boundary) return e;
-  for (int k = 0; k < std::min(problem.boundaryCount(), 2 * segments); ++k)
-    if (problem.boundaryName(k) == sp.boundaryName) {
-      e.joint = limitOfBoundary(k, segments);
-      return e;
-    }
-  if (base.wallIsBoundary() && sp.boundaryName == EquilibriumProblem::wallBoundaryName()) {
-    e.vertex = nearestWallVertex(base.chain(), sp.u.head(segments), wall).vertex;
-    return e;
-  }
-  for (const WallVertex& v : wall)
-    if (sp.boundaryName == wallReleaseName(v)) {
-      e.vertex = v;
-      e.wallRelease = true;
-    }
-  if (base.selfContactIsBoundary() && sp.boundaryName == EquilibriumProblem::selfContactBoundaryName()) {
-    int a = -1, b = -1;
-    selfClearanceApart(base.chain(), sp.u.head(segments), contacts.self(), &a, &b);
-    if (a >= 0 && b >= 0) {
-      e.self = touchingPair(base.chain(), sp.u.head(segments), a, b);
-      e.onSelf = true;
-    }
-  }
-  for (const SelfContact& c : contacts.self()) {
-    if (sp.boundaryName == selfReleaseName(c)) e.self = c, e.onSelf = e.selfRelease = true;
-    if (sp.boundaryName == selfEdgeName(c)) e.self = c, e.onSelf = e.selfEdgeEnd = true;
-  }
-  return e;
-}
 
 // A stretch's point or special point in the branch's unknowns (q, r): the wall forces μ, which
 // the stretch's problem carries after them (contact.h), are dropped (wallForces recovers them).
@@ -109,39 +59,6 @@ void appendMirroredTail(const continuation::Reflection& mirror, const continuati
   }
   image.stopReason = source.stopReason;
   image.stopMessage = mirror.mapText(source.stopMessage);
-}
-
-// dg/ds at the start p0 of a stretch (on its problem's unknowns (q, r, μ), λ) for the changed
-// contact's boundary g: a released joint's g = side·(q̄ − q) moves with −side·t_q; a joint contact's
-// compression −side·τ_c with −side·(F_u,i t_u + F_λ,i t_λ) (row i of the stretch before, exact); a
-// vertex's wall force μ_v with its own component of the tangent; a released vertex's x_v with
-// ∇x_v·t_q.
-double contactRate(EquilibriumProblem& problem, const ContactSet& before, const BoundaryEvent& hit, bool release,
-                   int wallIndex, const continuation::ContinuationPoint& p0) {
-  const int n = problem.segments(), D = int(p0.u.size());
-  if (hit.onSelf) {  // a self contact's force (wallIndex: its index), or a released one's gap ∇g·t_q
-    if (!release) return p0.tangent[problem.dimension() + before.wallCount() + wallIndex];
-    const Eigen::Matrix2Xd P = jointPositions(problem.chain(), p0.u.head(n));
-    const SelfContactGap g = selfContactGap(problem.chain(), p0.u.head(n), P, hit.self);
-    continuation::Vector grad(n), gen(n), coupling(n), weights(n);
-    selfContactDerivatives(P, hit.self, g, grad, gen, coupling, weights);
-    return grad.dot(p0.tangent.head(n));
-  }
-  if (hit.joint.joint >= 0) {
-    const int i = hit.joint.joint;
-    const double sideSign = hit.joint.side == LimitSide::Upper ? 1.0 : -1.0;
-    if (release) return -sideSign * p0.tangent[i];
-    ContactProblem prior(problem, before);  // the same wall vertices: the same unknowns
-    continuation::Matrix Fu(D, D);
-    continuation::Vector Fl(D);
-    if (!continuation::BoundProblem(prior).jacobian(p0.u, p0.lambda, Fu, Fl)) return 0.0;
-    return -sideSign * (Fu.row(i).dot(p0.tangent.head(D)) + Fl[i] * p0.tangent[D]);
-  }
-  if (!release) return p0.tangent[D - before.wallCount() - 1 + wallIndex];
-  const Eigen::Matrix2Xd P = jointPositions(problem.chain(), p0.u.head(n));
-  continuation::Vector grad(n), gen(n);
-  wallVertexDerivatives(P, wallVertexPoint(problem.chain(), p0.u.head(n), P, hit.vertex), hit.vertex, grad, gen);
-  return grad.dot(p0.tangent.head(n));
 }
 
 // What a child's own work (TreeOptions::childWork) computed on the thread that traced it: its
@@ -222,41 +139,16 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     const continuation::Problem& traced = current ? static_cast<const continuation::Problem&>(*current) : problem;
     const BoundaryEvent hit = endEvent(problem, traced, branch, stretches.back().locked);
     if (!hit.any()) break;
-    // A vertex at the end of its edge slides onto the link outline's next edge (self_contact.h);
-    // elsewhere (an apex, unequal half-heights) where it goes on is not followed.
-    SelfContact slidTo;
-    if (hit.selfEdgeEnd) {
-      const continuation::SpecialPoint& sp = branch.specialPoints.back();
-      const Eigen::VectorXd q = sp.u.head(n);
-      const double along = selfContactGap(problem.chain(), q, jointPositions(problem.chain(), q), hit.self).along;
-      if (!slideOntoNeighbour(problem.chain(), hit.self, along, slidTo)) {
-        std::string& note = branch.specialPoints.back().note;
-        note += std::string(note.empty() ? "" : "; ") + "self contact " + hit.self.label() +
-                ": the vertex reaches an end of its edge; sliding past it is not followed, the branch ends here";
-        break;
-      }
-    }
-    ContactSet locked = stretches.back().locked;
-    const bool onJoint = hit.joint.joint >= 0;
-    const bool release = onJoint   ? locked.locked(hit.joint.joint) && locked.side(hit.joint.joint) == hit.joint.side
-                         : hit.onSelf ? hit.selfRelease
-                                    : hit.wallRelease;
-    const SelfContact& heldSelf = hit.selfEdgeEnd ? slidTo : hit.self;
-    if (hit.onSelf && release) {
-      locked.separate(hit.self);
-    } else if (hit.onSelf) {
-      if (hit.selfEdgeEnd) locked.separate(hit.self);
-      locked.hold(heldSelf);
-    }
-    else if (onJoint && release)
-      locked.release(hit.joint.joint);
-    else if (onJoint)
-      locked.lock(hit.joint.joint, hit.joint.side);
-    else if (release)
-      locked.leave(hit.vertex);
-    else
-      locked.touch(hit.vertex);
     const continuation::SpecialPoint& at = branch.specialPoints.back();
+    const ContactChange change = changeOf(problem, at, hit, stretches.back().locked);
+    if (!change.followed) {
+      std::string& note = branch.specialPoints.back().note;
+      note += std::string(note.empty() ? "" : "; ") + change.what +
+              ": the vertex reaches an end of its edge; sliding past it is not followed, the branch ends here";
+      break;
+    }
+    const ContactSet& locked = change.after;
+    const bool onJoint = hit.joint.joint >= 0, release = change.release;
     // The budget of points and arclength is the whole branch's.
     continuation::TracerOptions o = options;
     o.maxPoints = options.maxPoints - int(branch.points.size()) + 1;
@@ -267,12 +159,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     o.detection.certifiedCounting = false;
     if (o.maxPoints < 2 || !(o.maxArclength > 0.0)) break;
     auto next = lockedProblem(problem, locked, maxContactTorque);
-    const std::string what =
-        onJoint      ? std::string(release ? "release of joint " : "contact of joint ") +
-                      std::to_string(hit.joint.joint + 1) + " " + toString(hit.joint.side)
-        : hit.selfEdgeEnd ? "self contact " + hit.self.label() + " sliding onto " + heldSelf.edge.label()
-        : hit.onSelf      ? std::string(release ? "release of self contact " : "self contact ") + hit.self.label()
-                     : std::string(release ? "release of vertex " : "wall contact of vertex ") + hit.vertex.label();
+    const std::string& what = change.what;
     auto giveUp = [&branch, &what](const std::string& why) {
       std::string& note = branch.specialPoints.back().note;
       note += (note.empty() ? "" : "; ") + what + ": " + why;
@@ -294,11 +181,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // is ambiguous: on an unstable branch a joint can reach its limit with the locked branch
     // turning back in λ (a corner).
     const int N = problem.dimension(), D = next->dimension();
-    const int wallIndex =
-        onJoint      ? -1
-        : hit.onSelf ? int(std::lower_bound(locked.self().begin(), locked.self().end(), heldSelf) - locked.self().begin())
-                     : int(std::lower_bound(locked.wall().begin(), locked.wall().end(), hit.vertex) -
-                           locked.wall().begin());
+    const int wallIndex = change.index;
     const int changed = onJoint      ? (hit.joint.side == LimitSide::Upper ? hit.joint.joint : hit.joint.joint + n)
                         : hit.onSelf ? (release ? next->selfClearanceBoundary() : next->selfReleaseBoundary(wallIndex))
                         : release    ? next->wallClearanceBoundary()

@@ -83,7 +83,7 @@ bool stabilityOn(EquilibriumProblem& problem, const ContactSet& set, const Vecto
                  cont::StabilityInfo& info) {
   if (set.empty()) return cont::BoundProblem(problem).stability(u, lambda, wanted, info);
   const std::unique_ptr<ContactProblem> stretch = lockedProblem(problem, set, EquilibriumBranchOptions().maxContactTorque);
-  const Vector x = set.wallCount() > 0 ? stretch->withWallForces(*stretch->createWorkspace(), u, lambda) : u;
+  const Vector x = set.gapCount() > 0 ? stretch->withWallForces(*stretch->createWorkspace(), u, lambda) : u;
   return cont::BoundProblem(*stretch).stability(x, lambda, wanted, info);
 }
 
@@ -261,9 +261,9 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       std::unique_ptr<ContactProblem> stretchProblem;
       if (!locked.empty()) stretchProblem = lockedProblem(problem, locked, contact.maxContactTorque);
       // a piece with vertices on the wall has their forces among its unknowns (contact.h)
-      if (stretchProblem && u.size() == problem.dimension() && locked.wallCount() > 0)
+      if (stretchProblem && u.size() == problem.dimension() && locked.gapCount() > 0)
         u = stretchProblem->withWallForces(*stretchProblem->createWorkspace(), u, lambda);
-      else if (u.size() > problem.dimension() && (!stretchProblem || locked.wallCount() == 0))
+      else if (u.size() > problem.dimension() && (!stretchProblem || locked.gapCount() == 0))
         u = Vector(u.head(problem.dimension()));
       cont::Branch branch = stretchProblem ? cont::trace(*stretchProblem, u, lambda, direction, legOptions)
                                            : cont::trace(problem, u, lambda, direction, legOptions);

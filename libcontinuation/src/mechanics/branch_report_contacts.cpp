@@ -1,0 +1,136 @@
+#include "branch_report_contacts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+namespace buckle::mechanics {
+
+namespace cont = buckle::continuation;
+
+namespace {
+
+/// A boundary after which the branch's vertices on the wall change (continueUnderContact): WC when
+/// a vertex reaches the wall, WR when one leaves it.
+void reportWallEvent(EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
+                     const ContactSet& before, const ContactSet& after, const std::vector<PointReport>& all,
+                     SpecialPointReport& s) {
+  WallVertex vertex{-1, 0};
+  for (const WallVertex& v : after.wall())
+    if (!before.touching(v)) vertex = v;
+  const bool contact = vertex.segment >= 0;
+  if (!contact)
+    for (const WallVertex& v : before.wall())
+      if (!after.touching(v)) vertex = v;
+  if (vertex.segment < 0) return;
+  const ContactSet& set = contact ? after : before;
+  ContactProblem held(problem, set);
+  const Vector mu = held.wallForces(*held.createWorkspace(), sp.u, sp.lambda);
+  const auto k = std::lower_bound(set.wall().begin(), set.wall().end(), vertex) - set.wall().begin();
+  const int n = problem.segments();
+  const Eigen::Matrix2Xd P = jointPositions(problem.chain(), sp.u.head(n));
+  s.type = contact ? EventType::WallContact : EventType::WallRelease;
+  s.phenomenon = Phenomenon::None;  // a change of the constraints, none of the paper's three phenomena
+  s.vertex = vertex;
+  s.contactForce = mu[k];
+  s.contactPoint = wallVertexPoint(problem.chain(), sp.u.head(n), P, vertex);
+  s.lockedAfter = after;
+  if (size_t(sp.index + 1) < all.size()) s.negativeAfter = all[size_t(sp.index + 1)].negative;
+  if (sp.index < int(b.points.size())) s.negativeBefore = all[size_t(sp.index)].negative;
+  std::ostringstream os;
+  os.precision(6);
+  os << "vertex " << vertex.label() << " at (" << s.contactPoint.x() << ", " << s.contactPoint.y() << "): "
+     << (contact ? "reaches the base wall and is held on it" : "wall force returns to zero: leaves the wall")
+     << "; wall force = " << s.contactForce
+     << "; on the wall after: " << (after.wall().empty() ? std::string("none") : after.wallLabel());
+  s.note = os.str();
+}
+
+/// A boundary after which the branch's self contacts change (continueUnderContact): SH when a
+/// vertex is held on another link's edge, SR when a self contact releases.
+void reportSelfEvent(EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
+                     const ContactSet& before, const ContactSet& after, const std::vector<PointReport>& all,
+                     SpecialPointReport& s) {
+  SelfContact changed, left;
+  for (const SelfContact& c : after.self())
+    if (!before.holding(c)) changed = c;
+  for (const SelfContact& c : before.self())
+    if (!after.holding(c)) left = c;
+  const bool contact = changed.vertex.segment >= 0;
+  const bool slides = contact && left.vertex == changed.vertex;  // onto its edge's neighbour
+  if (!contact) changed = left;
+  if (changed.vertex.segment < 0) return;
+  const ContactSet& set = contact ? after : before;
+  ContactProblem held(problem, set);
+  const Vector mu = held.selfForces(*held.createWorkspace(), sp.u, sp.lambda);
+  const auto k = std::lower_bound(set.self().begin(), set.self().end(), changed) - set.self().begin();
+  const int n = problem.segments();
+  const Eigen::Matrix2Xd P = jointPositions(problem.chain(), sp.u.head(n));
+  s.type = contact ? EventType::SelfHold : EventType::SelfRelease;
+  s.phenomenon = Phenomenon::None;  // a change of the constraints, none of the paper's three phenomena
+  s.selfContact = changed;
+  s.contactForce = mu[k];
+  s.contactPoint = wallVertexPoint(problem.chain(), sp.u.head(n), P, changed.vertex);
+  s.lockedAfter = after;
+  if (size_t(sp.index + 1) < all.size()) s.negativeAfter = all[size_t(sp.index + 1)].negative;
+  if (sp.index < int(b.points.size())) s.negativeBefore = all[size_t(sp.index)].negative;
+  std::ostringstream os;
+  os.precision(6);
+  os << "vertex " << changed.vertex.label() << " at (" << s.contactPoint.x() << ", " << s.contactPoint.y() << ") on edge "
+     << changed.edge.label() << ": "
+     << (slides    ? "slides on from edge " + left.edge.label()
+         : contact ? std::string("the links touch and are held apart")
+                   : std::string("contact force returns to zero: the links separate"))
+     << "; contact force = " << s.contactForce
+     << "; self contacts after: " << (after.self().empty() ? std::string("none") : after.selfLabel());
+  s.note = os.str();
+}
+
+}  // namespace
+
+/// A boundary after which the branch's locked joints change (continueUnderContact): CT when a
+/// joint locks, RL when one releases; s is left a plain boundary otherwise.
+void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
+                        const std::vector<ContactStretch>& stretches, const std::vector<PointReport>& all,
+                        SpecialPointReport& s) {
+  const ContactStretch* next = nullptr;
+  for (const ContactStretch& st : stretches)
+    if (st.firstPoint == sp.index + 1) next = &st;
+  if (!next) return;
+  const ContactSet& before = lockedAt(stretches, sp.index);
+  const ContactSet& after = next->locked;
+  int joint = -1;
+  for (const LockedJoint& l : after.joints())
+    if (!before.locked(l.joint)) joint = l.joint;
+  const bool contact = joint >= 0;
+  if (!contact)
+    for (const LockedJoint& l : before.joints())
+      if (!after.locked(l.joint)) joint = l.joint;
+  if (joint < 0) {
+    if (before.self() != after.self())
+      reportSelfEvent(problem, b, sp, before, after, all, s);
+    else
+      reportWallEvent(problem, b, sp, before, after, all, s);
+    return;
+  }
+  const LimitSide side = contact ? after.side(joint) : before.side(joint);
+  ContactProblem locked(problem, contact ? after : before);
+  s.type = contact ? EventType::Contact : EventType::Release;
+  s.phenomenon = Phenomenon::None;  // a change of the constraints, none of the paper's three phenomena
+  s.joint = joint;
+  s.contactTorque = locked.contactTorque(*locked.createWorkspace(), sp.u, sp.lambda, joint);
+  s.lockedAfter = after;
+  if (size_t(sp.index + 1) < all.size()) s.negativeAfter = all[size_t(sp.index + 1)].negative;
+  if (sp.index < int(b.points.size())) s.negativeBefore = all[size_t(sp.index)].negative;
+  const double limit = limitAngle(problem.chain(), joint, side);
+  std::ostringstream os;
+  os.precision(6);
+  os << "joint " << joint + 1 << " " << toString(side) << " limit " << limit << " rad: "
+     << (contact ? "locks (contact starts)" : "contact torque returns to zero: released")
+     << "; contact torque tau_c = " << s.contactTorque << ", |q - limit| = " << std::abs(sp.u[joint] - limit)
+     << "; locked after: " << (after.empty() ? std::string("none") : after.label());
+  s.note = os.str();
+}
+
+}  // namespace buckle::mechanics
