@@ -11,6 +11,23 @@ namespace cont = buckle::continuation;
 
 namespace {
 
+/// The fields every contact event shares: its type (no phenomenon: a change of the constraints,
+/// none of the paper's three), the force and the vertex of the contact at the point, the contacts
+/// after it and the stability either side.
+void markContactEvent(const EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
+                      const std::vector<PointReport>& all, const ContactSet& after, EventType type,
+                      const WallVertex& vertex, double force, SpecialPointReport& s) {
+  const int n = problem.segments();
+  const Eigen::Matrix2Xd P = jointPositions(problem.chain(), sp.u.head(n));
+  s.type = type;
+  s.phenomenon = Phenomenon::None;
+  s.contactForce = force;
+  s.contactPoint = wallVertexPoint(problem.chain(), sp.u.head(n), P, vertex);
+  s.lockedAfter = after;
+  if (size_t(sp.index + 1) < all.size()) s.negativeAfter = all[size_t(sp.index + 1)].negative;
+  if (sp.index < int(b.points.size())) s.negativeBefore = all[size_t(sp.index)].negative;
+}
+
 /// A boundary after which the branch's vertices on the wall change (continueUnderContact): WC when
 /// a vertex reaches the wall, WR when one leaves it.
 void reportWallEvent(EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
@@ -28,16 +45,9 @@ void reportWallEvent(EquilibriumProblem& problem, const cont::Branch& b, const c
   ContactProblem held(problem, set);
   const Vector mu = held.wallForces(*held.createWorkspace(), sp.u, sp.lambda);
   const auto k = std::lower_bound(set.wall().begin(), set.wall().end(), vertex) - set.wall().begin();
-  const int n = problem.segments();
-  const Eigen::Matrix2Xd P = jointPositions(problem.chain(), sp.u.head(n));
-  s.type = contact ? EventType::WallContact : EventType::WallRelease;
-  s.phenomenon = Phenomenon::None;  // a change of the constraints, none of the paper's three phenomena
+  markContactEvent(problem, b, sp, all, after, contact ? EventType::WallContact : EventType::WallRelease, vertex, mu[k],
+                   s);
   s.vertex = vertex;
-  s.contactForce = mu[k];
-  s.contactPoint = wallVertexPoint(problem.chain(), sp.u.head(n), P, vertex);
-  s.lockedAfter = after;
-  if (size_t(sp.index + 1) < all.size()) s.negativeAfter = all[size_t(sp.index + 1)].negative;
-  if (sp.index < int(b.points.size())) s.negativeBefore = all[size_t(sp.index)].negative;
   std::ostringstream os;
   os.precision(6);
   os << "vertex " << vertex.label() << " at (" << s.contactPoint.x() << ", " << s.contactPoint.y() << "): "
@@ -65,16 +75,9 @@ void reportSelfEvent(EquilibriumProblem& problem, const cont::Branch& b, const c
   ContactProblem held(problem, set);
   const Vector mu = held.selfForces(*held.createWorkspace(), sp.u, sp.lambda);
   const auto k = std::lower_bound(set.self().begin(), set.self().end(), changed) - set.self().begin();
-  const int n = problem.segments();
-  const Eigen::Matrix2Xd P = jointPositions(problem.chain(), sp.u.head(n));
-  s.type = contact ? EventType::SelfHold : EventType::SelfRelease;
-  s.phenomenon = Phenomenon::None;  // a change of the constraints, none of the paper's three phenomena
+  markContactEvent(problem, b, sp, all, after, contact ? EventType::SelfHold : EventType::SelfRelease, changed.vertex,
+                   mu[k], s);
   s.selfContact = changed;
-  s.contactForce = mu[k];
-  s.contactPoint = wallVertexPoint(problem.chain(), sp.u.head(n), P, changed.vertex);
-  s.lockedAfter = after;
-  if (size_t(sp.index + 1) < all.size()) s.negativeAfter = all[size_t(sp.index + 1)].negative;
-  if (sp.index < int(b.points.size())) s.negativeBefore = all[size_t(sp.index)].negative;
   std::ostringstream os;
   os.precision(6);
   os << "vertex " << changed.vertex.label() << " at (" << s.contactPoint.x() << ", " << s.contactPoint.y() << ") on edge "
