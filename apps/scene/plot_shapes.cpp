@@ -45,13 +45,15 @@ void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFil
                BlockFile& limits, BlockFile& joints, BlockFile& nearLimit, BlockFile* touch = nullptr,
                bool detailed = true, BlockFile* wall = nullptr) {
   // a vertex within 1e-9 of the chain's length of x = 0 rests on the wall (held there by the
-  // contact, wall_contact.h); deeper is through it
+  // contact, wall_contact.h), two links within it rest on each other (self_contact.h); deeper is
+  // through
   const double onWall = 1e-9 * chain.length();
+  const mechanics::SelfClearance self =
+      touch || wall ? mechanics::selfClearance(chain, q) : mechanics::SelfClearance{};
   if (touch) {
     const mechanics::BaseClearance base = mechanics::baseClearance(chain, q);
     if (base.distance < -onWall) touch->point({base.point.x(), base.point.y()});
-    const mechanics::SelfClearance self = mechanics::selfClearance(chain, q);
-    if (self.distance <= 0.0) touch->point({self.point.x(), self.point.y()});
+    if (self.distance < -onWall) touch->point({self.point.x(), self.point.y()});
   }
   if (wall) {
     std::vector<mechanics::WallVertex> on;
@@ -60,6 +62,7 @@ void drawChain(const mechanics::Chain& chain, const Eigen::VectorXd& q, BlockFil
       wall->point({a.point.x(), a.point.y()});
       on.push_back(a.vertex);
     }
+    if (std::abs(self.distance) <= onWall) wall->point({self.point.x(), self.point.y()});
   }
   const int n = chain.size();
   const Eigen::Matrix2Xd P = mechanics::jointPositions(chain, q);
@@ -271,9 +274,9 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
   s.body << "set multiplot layout " << nc * rowsPerCase << "," << cols << " title "
          << quote(!spec.title.empty() ? spec.title
                   : detailed ? std::string("Chain shapes" + scene.units.suffix(Dimension::Length) + ", each panel to its own scale\ngrey arcs: "
-                                           "joint limits, red: joint within 5% of a limit, green: vertex held on the wall, magenta star: through the clamp or itself")
+                                           "joint limits, red: joint within 5% of a limit, green: vertex held on the wall or another link, magenta star: through the clamp or itself")
                              : std::string("Chain shapes" + scene.units.suffix(Dimension::Length) + ", each panel to its own scale, centre lines "
-                                           "(base, joints, end)\nred: joint within 5% of a limit, green: vertex held on the wall, magenta star: through the clamp or itself"))
+                                           "(base, joints, end)\nred: joint within 5% of a limit, green: vertex held on the wall or another link, magenta star: through the clamp or itself"))
          << " font ',11'\n";
   for (size_t o = 0; o < nc; ++o) {
     const size_t c = size_t(spec.cases[o]);
@@ -299,6 +302,7 @@ void drawShapesPlot(const Scene& scene, const RunResult& run, const PlotSpec& sp
                 << " " << scene.units.unit(Dimension::Stiffness);
         if (!p->locked.label().empty()) title << lockedTitle(p->locked.label());  // joints locked at a limit
         if (!p->locked.wallLabel().empty()) title << ",  on the wall: " << p->locked.wallLabel();  // vertices held on the wall
+        if (!p->locked.selfLabel().empty()) title << ",  held: " << p->locked.selfLabel();  // self contacts
       } else {
         title << (nc > 1 ? cr.label + ": " : std::string()) << parameter << " = " << num(spec.at[k]) << ": not drawn";
         s.body << "set label 1 " << quote(missingOf[o][k]) << " at graph 0.5, graph 0.5 center font ',9' noenhanced\n";

@@ -256,3 +256,45 @@ TEST_CASE("self contact: a hook curled by an end moment is held on its own link,
     CHECK(back.stopReason == cont::StopReason::LambdaRange);
   }
 }
+
+TEST_CASE("self contact: the loaded stiffness of the held hook against differences of its equilibria", "[self_contact]") {
+  namespace cont = buckle::continuation;
+  for (const auto& [sL, sK] : {std::pair{1.0, 1.0}, std::pair{1e4, 1e-8}}) {
+    INFO("lengths x" << sL << ", stiffnesses x" << sK);
+    Hook hook(sL, sK);
+    const double torqueUnit = sK * sL * sL, forceUnit = sK * sL;
+    mech::EquilibriumBranchOptions o;
+    o.tracer.lambdaMax = 0.25 * torqueUnit;
+    o.tracer.step.initialStep = 0.01;
+    o.tracer.step.maxStep = 0.02;
+    o.tree.branchSwitching = 0;
+    const mech::EquilibriumBranches t =
+        mech::traceEquilibria(hook.problem, hook.q0, 0.0, cont::InitialDirection::increasingLambda(), o);
+    REQUIRE(t.contact[0].size() == 2);
+    const mech::ContactSet& held = t.contact[0][1].locked;
+    const cont::ContinuationPoint& p = t.tree.branches[0].points.back();
+    const mech::ContactProblem problem(hook.problem, held);
+    const mech::CartesianStiffness K = mech::denseContactStiffness(problem, p.u, p.lambda);
+    REQUIRE(K.compliance.allFinite());
+    CHECK(K.negativeDirections == 0);
+    CHECK_FALSE(K.rotationHeld);
+    // C_F column c: the end's displacement per force δF e_c, the contact kept, by central
+    // differences of the constrained equilibria under the end wrench (±δ e_c, 0, Me)
+    const double delta = 1e-5 * forceUnit;
+    for (int c = 0; c < 2; ++c) {
+      Eigen::Vector2d moved[2];
+      for (int side = 0; side < 2; ++side) {
+        Eigen::Vector3d wrench = Eigen::Vector3d::Zero();
+        wrench[c] = side == 0 ? delta : -delta;
+        mech::EquilibriumProblem pushed(hook.chain, mech::EndCondition::freeEnd(wrench), Eigen::Vector3d(0, 0, 1),
+                                        Hook::options());
+        const mech::ConstrainedEquilibrium e = mech::solveConstrainedEquilibrium(pushed, held, p.u, p.lambda);
+        REQUIRE(e.converged);
+        moved[side] = buckle::test::geometry(hook.chain, e.u.head(8)).end;
+      }
+      const Eigen::Vector2d column = (moved[0] - moved[1]) / (2 * delta);
+      for (int r = 0; r < 2; ++r) CHECK(K.compliance(r, c) == Approx(column[r]).epsilon(1e-6).margin(1e-9 * sL / forceUnit));
+    }
+    CHECK((K.stiffness * K.compliance - Eigen::Matrix2d::Identity()).cwiseAbs().maxCoeff() < 1e-9);
+  }
+}

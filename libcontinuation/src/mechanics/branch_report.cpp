@@ -238,8 +238,15 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
     for (const PointReport& p : all)
       if (inRange(p.parameter, options)) r.points.push_back(p);
   for (PointReport& pr : r.points) {
-    // a self contact's rank-2 Hessian term is outside the structured stiffness: K stays NaN there
-    if (options.stiffness && pr.locked.selfCount() == 0) {
+    if (options.stiffness && pr.locked.selfCount() > 0) {
+      // a self contact's rank-2 Hessian term is outside the structured stiffness: the dense one
+      const cont::ContinuationPoint& p = b.points[size_t(pr.index)];
+      const CartesianStiffness s = denseContactStiffness(ContactProblem(problem, pr.locked), p.u, p.lambda);
+      pr.K = s.stiffness;
+      pr.C = s.compliance;
+      pr.rotationalStiffness = s.rotationalStiffness;
+      pr.haveStiffness = true;
+    } else if (options.stiffness) {
       // along a control path K_q is that of the free lengths at the point's λ
       // and with body loads the Hessian's generator h − γ (eq B3)
       const double lambda = b.points[size_t(pr.index)].lambda;

@@ -320,4 +320,11 @@ CartesianStiffness lockedLoadedStiffness(const Chain& chain, continuation::Const
                                          const StiffnessOptions& options = {},
                                          continuation::ConstVectorRef wallForces = continuation::Vector());
 
+/// The loaded stiffness of `problem`'s constrained chain at (u, λ) (u = (q, r) or with the contact
+/// forces), dense: C_F = J_p Z (Zᵀ H Z)⁻¹ Zᵀ J_pᵀ with H its stability operator (the contacts'
+/// Hessian terms, a self contact's rank-2 one included) and Z a basis of the motions that keep the
+/// locked joints, the contacts and φ where it is held. O(n³): what points holding a self contact
+/// take, where lockedLoadedStiffness has no room for the rank-2 term.
+CartesianStiffness denseContactStiffness(const ContactProblem& problem, continuation::ConstVectorRef u, double lambda);
+
 }  // namespace buckle::mechanics
