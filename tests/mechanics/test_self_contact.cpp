@@ -159,6 +159,19 @@ struct Hook {
       : chain(mech::preloadsForShape(
             std::vector<mech::SegmentParameters>(8, mech::SegmentParameters::symmetric(0.3 * sL, sL, sK, 2.25 * sL)), q0)),
         problem(chain, mech::EndCondition::freeEnd(), Eigen::Vector3d(0, 0, 1), options()) {}
+  /// One branch from Me = 0 to `to` torque units (k b² of the scaled chain), the scene's steps.
+  mech::EquilibriumBranchOptions upTo(double to) const {
+    mech::EquilibriumBranchOptions o;
+    o.tracer.lambdaMax = to * chain.segment(0).parameters().k1 * chain.segment(0).parameters().b1 *
+                         chain.segment(0).parameters().b1;
+    o.tracer.step.initialStep = 0.01;
+    o.tracer.step.maxStep = 0.02;
+    o.tree.branchSwitching = 0;
+    return o;
+  }
+  mech::EquilibriumBranches trace(const mech::EquilibriumBranchOptions& o) {
+    return mech::traceEquilibria(problem, q0, 0.0, buckle::continuation::InitialDirection::increasingLambda(), o);
+  }
   static mech::EquilibriumOptions options() {
     mech::EquilibriumOptions o;
     o.selfContactAsBoundary = true;
@@ -204,13 +217,8 @@ TEST_CASE("self contact: a hook curled by an end moment is held on its own link,
     INFO("lengths x" << sL << ", stiffnesses x" << sK);
     Hook hook(sL, sK);
     const double torqueUnit = sK * sL * sL;
-    mech::EquilibriumBranchOptions o;
-    o.tracer.lambdaMax = 0.25 * torqueUnit;
-    o.tracer.step.initialStep = 0.01;
-    o.tracer.step.maxStep = 0.02;
-    o.tree.branchSwitching = 0;
-    const mech::EquilibriumBranches t =
-        mech::traceEquilibria(hook.problem, hook.q0, 0.0, cont::InitialDirection::increasingLambda(), o);
+    const mech::EquilibriumBranchOptions o = hook.upTo(0.25);
+    const mech::EquilibriumBranches t = hook.trace(o);
     REQUIRE(t.tree.branches.size() == 1);
     const cont::Branch& b = t.tree.branches[0];
     REQUIRE(t.contact[0].size() == 2);  // free, then the self contact held to the range end
@@ -262,14 +270,9 @@ TEST_CASE("self contact: the loaded stiffness of the held hook against differenc
   for (const auto& [sL, sK] : {std::pair{1.0, 1.0}, std::pair{1e4, 1e-8}}) {
     INFO("lengths x" << sL << ", stiffnesses x" << sK);
     Hook hook(sL, sK);
-    const double torqueUnit = sK * sL * sL, forceUnit = sK * sL;
-    mech::EquilibriumBranchOptions o;
-    o.tracer.lambdaMax = 0.25 * torqueUnit;
-    o.tracer.step.initialStep = 0.01;
-    o.tracer.step.maxStep = 0.02;
-    o.tree.branchSwitching = 0;
-    const mech::EquilibriumBranches t =
-        mech::traceEquilibria(hook.problem, hook.q0, 0.0, cont::InitialDirection::increasingLambda(), o);
+    const double forceUnit = sK * sL;
+    const mech::EquilibriumBranchOptions o = hook.upTo(0.25);
+    const mech::EquilibriumBranches t = hook.trace(o);
     REQUIRE(t.contact[0].size() == 2);
     const mech::ContactSet& held = t.contact[0][1].locked;
     const cont::ContinuationPoint& p = t.tree.branches[0].points.back();
