@@ -1,7 +1,7 @@
 // `frequencies` (docs/scenes.md): the natural frequencies of small oscillations about every
 // reported point of the traced branches, from the library's vibration analysis
 // (mechanics/vibration.h) of the constrained chain at that point: its held end coordinates, the
-// joints locked at their limits and the vertices held on the base wall there.
+// joints locked at their limits and the vertices held on the base wall or on other links there.
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -15,7 +15,7 @@ namespace mech = buckle::mechanics;
 
 Eigen::VectorXd CaseRunner::naturalFrequencies(const Eigen::VectorXd& q, const mech::Wrench& F,
                                                const mech::ContactSet& contacts, const Eigen::VectorXd& wallForces,
-                                               double parameter) {
+                                               const Eigen::VectorXd& selfForces, double parameter) {
   const FrequenciesSpec& spec = scene_.analyses.frequencies;
   Eigen::VectorXd omega = Eigen::VectorXd::Constant(spec.count, std::numeric_limits<double>::quiet_NaN());
   try {
@@ -25,12 +25,14 @@ Eigen::VectorXd CaseRunner::naturalFrequencies(const Eigen::VectorXd& q, const m
       vibration_ = std::make_unique<mech::VibrationAnalysis>(
           control.active() ? mech::chainWithControls(out_.chain, control, parameter) : out_.chain,
           caseInertia(spec.massPerLength));
-    if (wallForces.size() != contacts.wallCount()) return omega;
+    if (wallForces.size() != contacts.wallCount() || selfForces.size() != contacts.selfCount()) return omega;
+    Eigen::VectorXd forces(wallForces.size() + selfForces.size());
+    forces << wallForces, selfForces;
     // with weight or point loads the Hessian's generator h − γ (body_loads.h, eq B3)
     if (!bodyProblem_ && spec_.body.any()) bodyProblem_ = std::make_unique<mech::EquilibriumProblem>(pathProblem());
     const Eigen::VectorXd gamma = bodyProblem_ ? bodyProblem_->bodyLoadGenerator(q, parameter) : Eigen::VectorXd();
     const mech::VibrationModes m =
-        vibration_->modes(q, F, spec_.end.condition.heldIndices(), contacts, wallForces, spec.count, false, gamma);
+        vibration_->modes(q, F, spec_.end.condition.heldIndices(), contacts, forces, spec.count, false, gamma);
     for (int i = 0; i < m.omegaSquared.size(); ++i) omega[i] = mech::signedFrequency(m.omegaSquared[i]);
   } catch (const std::exception& e) {
     if (!vibrationFailed_) {

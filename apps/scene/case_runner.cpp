@@ -70,7 +70,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   std::vector<mech::PointReport> points(report.points);
   for (mech::PointReport& p : points) {
     p.branch = b.id;
-    if (frequencies) p.omega = naturalFrequencies(p.q, p.F, p.locked, p.wallForces, p.parameter);
+    if (frequencies) p.omega = naturalFrequencies(p.q, p.F, p.locked, p.wallForces, p.selfForces, p.parameter);
   }
   keepPoints(std::move(points));
   run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
@@ -83,7 +83,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
       const mech::PointReport* before = &report.points.front();
       for (const mech::PointReport& p : report.points)
         if (p.index <= sp.index) before = &p;
-      s.omega = naturalFrequencies(sp.q, sp.F, before->locked, sp.wallForces, sp.parameter);
+      s.omega = naturalFrequencies(sp.q, sp.F, before->locked, sp.wallForces, sp.selfForces, sp.parameter);
     }
     if (sp.source >= 0) run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
     out_.specials.push_back(std::move(s));
@@ -136,6 +136,7 @@ void CaseRunner::jumps() {
       opt.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
       opt.integration.recordTrajectory = false;
       opt.wall = tracesWall();
+      opt.self = tracesSelf();
       s.landing = mech::jumpFromFold(problem, fold, opt);
     }
     landings[{s.branch, s.source}] = s.landing;
@@ -163,6 +164,7 @@ void CaseRunner::loadHistory() {
   opt.jump.perturbation = scene_.analyses.loadHistory.perturbation;
   opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
   opt.jump.wall = tracesWall();
+  opt.jump.self = tracesSelf();
   mech::LoadHistoryResult h;
   try {
     h = mech::followLoadHistory(problem, out_.qStart, scene_.analyses.loadHistory.waypoints, opt);
@@ -223,6 +225,7 @@ void CaseRunner::suddenLoad() {
     opt.tracer = solverOptions();
     opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(out_.chain.size()));
     opt.jump.wall = tracesWall();
+    opt.jump.self = tracesSelf();
     try {
       mech::EquilibriumProblem held = pathProblem(true);  // held at the wall as the history is
       const mech::LoadHistoryResult h = mech::followLoadHistory(held, out_.qStart, {s0, spec.value}, opt);
@@ -239,6 +242,7 @@ void CaseRunner::suddenLoad() {
   mech::SuddenLoadOptions opt;
   opt.integration = integrationOptions(mech::jumpIntegrationDefaults(n));  // the stiff steppers of long chains
   opt.wall = tracesWall();
+  opt.self = tracesSelf();
   if (spec.massPerLength > 0) {
     opt.scene.inertia = mech::InertiaData::uniformRods(out_.chain, spec.massPerLength);
     if (spec.damping > 0) opt.scene.jointDamping.assign(size_t(n), spec.damping);
@@ -257,6 +261,8 @@ void CaseRunner::suddenLoad() {
       if (r.contactSides[i] != 0) rec.contacts.push_back({int(i), r.contactSides[i], r.contactTorques[Eigen::Index(i)]});
     for (size_t k = 0; k < r.wallContacts.size() && Eigen::Index(k) < r.wallForces.size(); ++k)
       rec.wall.push_back({r.wallContacts[k], r.wallForces[Eigen::Index(k)]});
+    for (size_t k = 0; k < r.selfContacts.size() && Eigen::Index(k) < r.selfForces.size(); ++k)
+      rec.self.push_back({r.selfContacts[k], r.selfForces[Eigen::Index(k)]});
     rec.events = r.dynamics.contactEvents;
     if (r.rest.size() == n) rec.restPose = mech::endPose(out_.chain, r.rest);
     rec.stable = r.stable;

@@ -77,11 +77,12 @@ class CaseRunner {
   void keepPoints(std::vector<mechanics::PointReport>&& points);
 
   /// `frequencies` (case_frequencies.cpp): the signed natural frequencies at joint angles q under
-  /// the total end wrench F with the joints of `locked` locked and its wall vertices held by the
-  /// forces `wallForces` (NaN when they are not known; `parameter`: for a message).
+  /// the total end wrench F with the joints of `locked` locked, its wall vertices and self
+  /// contacts held by the forces `wallForces`, `selfForces` (NaN when they are not known;
+  /// `parameter`: for a message).
   Eigen::VectorXd naturalFrequencies(const Eigen::VectorXd& q, const mechanics::Wrench& F,
                                      const mechanics::ContactSet& locked, const Eigen::VectorXd& wallForces,
-                                     double parameter);
+                                     const Eigen::VectorXd& selfForces, double parameter);
   bool throughLoad() const { return spec_.path.throughReaction; }
   /// Through the reaction (case_runner_reaction.cpp): the load limit, the scene's or derived from
   /// the critical reactions (into out_); 0, said in the run's problems, when none can be had.

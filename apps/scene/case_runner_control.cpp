@@ -37,11 +37,13 @@ bool CaseRunner::actuationStart() {
   if ((direction.array() == 0.0).all() && !full.active()) return true;  // no payload: the unloaded shape
   mech::EquilibriumOptions held;
   held.wallAsBoundary = tracesWall();  // the payload's history is held at the wall as the path is
+  held.selfContactAsBoundary = tracesSelf();
   mech::EquilibriumProblem problem(out_.chain, ramp, direction, held, {}, body);
   mech::LoadHistoryOptions opt;
   opt.tracer = solverOptions();
   opt.jump.integration = integrationOptions(mech::jumpIntegrationDefaults(n));
   opt.jump.wall = tracesWall();
+  opt.jump.self = tracesSelf();
   mech::LoadHistoryResult h;
   try {
     h = mech::followLoadHistory(problem, out_.q0, {0.0, 1.0}, opt);

@@ -83,9 +83,16 @@ json wallJson(const std::vector<mechanics::WallSupport>& wall) {
   return a;
 }
 
+json selfJson(const std::vector<mechanics::SelfSupport>& self) {
+  json a = json::array();
+  for (const mechanics::SelfSupport& c : self)
+    a.push_back({{"vertex", c.contact.vertex.label()}, {"edge", c.contact.edge.label()}, {"contact_force", jsonNumber(c.force)}});
+  return a;
+}
+
 /// The contacts made and released during dynamics: the time (the model's), the joint (1-based,
-/// with its side) or the wall vertex, "contact" or "release", the contact torque or wall force
-/// then, and an impact's kinetic-energy loss.
+/// with its side), the wall vertex or the self contact (vertex and edge), "contact" or "release",
+/// the contact torque, wall force or contact force then, and an impact's kinetic-energy loss.
 json contactEventsJson(const std::vector<mechanics::ContactEvent>& events) {
   json a = json::array();
   for (const mechanics::ContactEvent& e : events) {
@@ -94,6 +101,10 @@ json contactEventsJson(const std::vector<mechanics::ContactEvent>& events) {
       j["joint"] = e.joint + 1;
       j["side"] = e.side > 0 ? "upper" : "lower";
       j["contact_torque"] = jsonNumber(e.torque);
+    } else if (e.self.vertex.segment >= 0) {
+      j["vertex"] = e.self.vertex.label();
+      j["edge"] = e.self.edge.label();
+      j["contact_force"] = jsonNumber(e.torque);
     } else {
       j["vertex"] = e.vertex.label();
       j["wall_force"] = jsonNumber(e.torque);
@@ -197,9 +208,8 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
         j["energy_released"] = jsonNumber(l.energyReleased);
         j["distance"] = jsonNumber(l.distance);
         j["contacts"] = contactsJson(l.contacts);
-        if (!l.wall.empty()) {  // vertices held on the base wall
-          j["wall"] = wallJson(l.wall);
-        }
+        if (!l.wall.empty()) j["wall"] = wallJson(l.wall);  // vertices held on the base wall
+        if (!l.self.empty()) j["self"] = selfJson(l.self);  // self contacts held
         if (!l.success && l.wallBlocked) j["landing"] = "not landed: " + l.message;
         p["jump_to"] = j;
       }
@@ -253,7 +263,7 @@ json specialPointsJson(const Scene& scene, const RunResult& run) {
              {"energy_balance_error", jsonNumber(r.energyBalanceError)}};
       if (r.rest.size() > 0)
         e["rest"] = json{{"q", jsonVector(r.rest)}, {"position", poseJson(r.restPose)}, {"contacts", contactsJson(r.contacts)},
-                         {"wall", wallJson(r.wall)}};
+                         {"wall", wallJson(r.wall)}, {"self", selfJson(r.self)}};
       e["contact_events"] = contactEventsJson(r.events);
       if (r.haveStatic)
         e["quasi_static"] = json{{"q", jsonVector(r.staticShape)},

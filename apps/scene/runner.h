@@ -80,7 +80,9 @@ struct SuddenLoadRecord {
   double energyBalanceError = 0.0;
   std::vector<mechanics::JointContact> contacts;  ///< joints resting against their limits
   std::vector<mechanics::WallSupport> wall;       ///< vertices resting on the base wall
-  /// The contacts made and released during the dynamics (joint stops, the wall), in time order.
+  std::vector<mechanics::SelfSupport> self;       ///< self contacts held at rest
+  /// The contacts made and released during the dynamics (joint stops, the wall, the chain's own
+  /// links), in time order.
   std::vector<mechanics::ContactEvent> events;
   std::vector<mechanics::TrajectorySample> trajectory;
 };

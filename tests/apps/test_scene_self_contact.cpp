@@ -74,3 +74,35 @@ TEST_CASE("self-contact scene: held from SH, released at the same moment on the 
   CHECK(heldRows >= 3);
   fs::remove_all(out);
 }
+
+TEST_CASE("self-contact scene: a sudden moment strikes the hook's end on its own link and it rests held there",
+          "[scene]") {
+  const fs::path out = buckle::test::absentPath("self_contact_sudden", "out");
+  std::ostringstream log, err;
+  buckle::scene::RunCommandOptions opt;
+  opt.scene = (fs::path(BUCKLE_SOURCE_DIR) / "data" / "scenes" / "self_contact_sudden.json").string();
+  opt.out = out.string();
+  const int status = buckle::scene::runSceneCommand(opt, log, err);
+  INFO(err.str());
+  REQUIRE(status == 0);
+  std::ifstream in(out / "special_points.json");
+  const json doc = json::parse(in);
+  REQUIRE(doc["sudden_load"].size() == 1);
+  const json& s = doc["sudden_load"][0];
+  INFO(s["message"]);
+  CHECK(s["success"] == true);
+  CHECK(s["model"] == "inertial");
+  // the strike: a contact event of the end's corner on segment 3, with a kinetic-energy loss
+  bool struck = false;
+  for (const json& e : s["contact_events"])
+    if (e["event"] == "contact" && e.value("vertex", "") == "8d-" && e.value("edge", "") == "3p[j,+]")
+      struck = e["kinetic_lost"].get<double>() > 0.0;
+  CHECK(struck);
+  // at rest held on itself, pushing, and the quasi-static answer (the held continuation) the same
+  REQUIRE(s["rest"]["self"].size() == 1);
+  CHECK(s["rest"]["self"][0]["vertex"] == "8d-");
+  CHECK(s["rest"]["self"][0]["edge"] == "3p[j,+]");
+  CHECK(s["rest"]["self"][0]["contact_force"].get<double>() > 0.0);
+  CHECK(s["quasi_static"]["differs"] == false);
+  CHECK(s["quasi_static"]["max_difference"].get<double>() < 1e-8);
+}

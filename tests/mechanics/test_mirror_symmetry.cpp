@@ -271,3 +271,37 @@ TEST_CASE("mirror: an image's base and self contacts, mirrored from its source, 
   CHECK(geometric > 0);  // the children's coils reach the wall or themselves
   CHECK((lockedPoints > 0) == !interrupt);  // joints lock on the contact stretches only
 }
+
+TEST_CASE("mirror: a held self contact's image holds the mirrored chain with the same gap and force",
+          "[mirror_symmetry][self_contact]") {
+  // a symmetric chain at q and −q: the image of vertex v on edge e is v's other-side corner on the
+  // same triangle's other side edge, its gap and its derivatives' sizes the same
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> angle(-0.6, 0.6);
+  const int n = 7;
+  const Chain chain(std::vector<SegmentParameters>(size_t(n), SegmentParameters::symmetric(0.3, 1.0, 1.0, 2.25)));
+  int checked = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    Eigen::VectorXd q(n);
+    for (int i = 0; i < n; ++i) q[i] = angle(rng);
+    const Eigen::Matrix2Xd P = jointPositions(chain, q), Pm = jointPositions(chain, -q);
+    for (const int corner : {0, 3, 4})
+      for (int edge = 0; edge < 3; ++edge)
+        for (const bool distal : {false, true}) {
+          const SelfContact c{WallVertex{6, corner}, TriangleEdge{2, distal, edge}};
+          ContactSet set;
+          set.hold(c);
+          const std::vector<ContactStretch> image = mirrored(std::vector<ContactStretch>{ContactStretch{0, set}});
+          REQUIRE(image[0].locked.selfCount() == 1);
+          const SelfContact m = image[0].locked.self()[0];
+          CHECK(mirrorText(c.label()) == m.label());
+          const SelfContactGap g = selfContactGap(chain, q, P, c), gm = selfContactGap(chain, -q, Pm, m);
+          CHECK(gm.gap == Approx(g.gap).margin(1e-13));
+          // (a base edge runs from its +a to its −a corner: the image runs the other way)
+          CHECK(gm.along == Approx(edge == 0 ? 1.0 - g.along : g.along).margin(1e-13));
+          ++checked;
+        }
+  }
+  CHECK(checked == 180);
+  CHECK(mirrorText("8d- on 3p[j,+]; 2p+ on 5d[+,-]") == "8d+ on 3p[j,-]; 2p- on 5d[+,-]");
+}

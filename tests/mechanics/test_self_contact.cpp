@@ -3,17 +3,25 @@
 // gap; the touching pair against a brute-force scan of every vertex–edge distance.
 #include <catch2/catch.hpp>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <limits>
 #include <random>
 
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/contact.h"
+#include "buckle/mechanics/contact_geometry.h"
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/self_contact.h"
 #include "buckle/mechanics/unloaded_shape.h"
+#include "buckle/mechanics/vibration.h"
+#include "hook_chain.h"
 #include "random_segments.h"
 #include "wall_statics.h"
 
 namespace mech = buckle::mechanics;
+using buckle::test::Hook;
+using buckle::test::hookStatics;
 using Eigen::Vector2d;
 using Eigen::VectorXd;
 
@@ -146,69 +154,6 @@ TEST_CASE("self contact: the touching pair is the nearest vertex over an edge (b
   CHECK_THROWS_AS(mech::touchingPair(chain, VectorXd::Zero(n), 2, 3), std::invalid_argument);
 }
 
-namespace {
-
-// A hook: three straight segments, five curled by 0.9 rad, free end under an end moment Me: the
-// curl closes until the end's distal corner 8d− meets the straight part (link 3's triangle).
-// Lengths scaled by sL, stiffnesses by sK.
-struct Hook {
-  VectorXd q0 = (VectorXd(8) << 0, 0, 0, 0.9, 0.9, 0.9, 0.9, 0.9).finished();
-  mech::Chain chain;
-  mech::EquilibriumProblem problem;
-  Hook(double sL, double sK)
-      : chain(mech::preloadsForShape(
-            std::vector<mech::SegmentParameters>(8, mech::SegmentParameters::symmetric(0.3 * sL, sL, sK, 2.25 * sL)), q0)),
-        problem(chain, mech::EndCondition::freeEnd(), Eigen::Vector3d(0, 0, 1), options()) {}
-  /// One branch from Me = 0 to `to` torque units (k b² of the scaled chain), the scene's steps.
-  mech::EquilibriumBranchOptions upTo(double to) const {
-    mech::EquilibriumBranchOptions o;
-    o.tracer.lambdaMax = to * chain.segment(0).parameters().k1 * chain.segment(0).parameters().b1 *
-                         chain.segment(0).parameters().b1;
-    o.tracer.step.initialStep = 0.01;
-    o.tracer.step.maxStep = 0.02;
-    o.tree.branchSwitching = 0;
-    return o;
-  }
-  mech::EquilibriumBranches trace(const mech::EquilibriumBranchOptions& o) {
-    return mech::traceEquilibria(problem, q0, 0.0, buckle::continuation::InitialDirection::increasingLambda(), o);
-  }
-  static mech::EquilibriumOptions options() {
-    mech::EquilibriumOptions o;
-    o.selfContactAsBoundary = true;
-    return o;
-  }
-};
-
-// The statics of a point holding self contact c under the end moment Me, by the test's own
-// geometry: joint j carries Me and, when it moves the vertex's body but not the edge's, the moment
-// of μ n_e at the vertex (joints that move both bodies see the pair of forces cancel). μ from the
-// joint where its lever is largest; the largest imbalance over every joint, and μ.
-std::pair<double, double> hookStatics(const mech::Chain& chain, const VectorXd& q, double Me, const mech::SelfContact& c) {
-  const int n = chain.size();
-  const Vector2d p = buckle::test::vertexAt(chain, q, c.vertex);
-  const Vector2d e0 = buckle::test::vertexAt(chain, q, {c.edge.segment, c.edge.corner(0)});
-  const Vector2d e1 = buckle::test::vertexAt(chain, q, {c.edge.segment, c.edge.corner(1)});
-  const Vector2d third = buckle::test::vertexAt(chain, q, {c.edge.segment, c.edge.corner(2)});
-  Vector2d normal(e1.y() - e0.y(), e0.x() - e1.x());
-  normal.normalize();
-  if (normal.dot(third - e0) > 0.0) normal = -normal;
-  const buckle::test::Geometry g = buckle::test::geometry(chain, q);
-  const int lo = std::min(c.vertex.lastJoint(), c.edge.lastJoint()), hi = std::max(c.vertex.lastJoint(), c.edge.lastJoint());
-  const double sigma = c.vertex.lastJoint() > c.edge.lastJoint() ? 1.0 : -1.0;  // the force on the distal body: ±μ n
-  VectorXd lever = VectorXd::Zero(n), dE(n);
-  for (int j = 0; j < n; ++j) {
-    dE[j] = -chain.segment(j).torque(q[j]);
-    if (j > lo && j <= hi) lever[j] = sigma * buckle::test::moment(p, g.P.col(j), normal);
-  }
-  int k = 0;
-  lever.cwiseAbs().maxCoeff(&k);
-  const double mu = (dE[k] - Me) / lever[k];
-  double imbalance = 0.0;
-  for (int j = 0; j < n; ++j) imbalance = std::max(imbalance, std::abs(dE[j] - Me - mu * lever[j]));
-  return {imbalance, mu};
-}
-
-}  // namespace
 
 TEST_CASE("self contact: a hook curled by an end moment is held on its own link, in any units", "[self_contact]") {
   namespace cont = buckle::continuation;
@@ -299,5 +244,124 @@ TEST_CASE("self contact: the loaded stiffness of the held hook against differenc
       for (int r = 0; r < 2; ++r) CHECK(K.compliance(r, c) == Approx(column[r]).epsilon(1e-6).margin(1e-9 * sL / forceUnit));
     }
     CHECK((K.stiffness * K.compliance - Eigen::Matrix2d::Identity()).cwiseAbs().maxCoeff() < 1e-9);
+  }
+}
+
+TEST_CASE("self contact: natural frequencies of the held hook against a generalized eigen-solve, in any units",
+          "[self_contact][vibration]") {
+  namespace cont = buckle::continuation;
+  double reference = 0.0;
+  for (const auto& [sL, sK] : {std::pair{1.0, 1.0}, std::pair{1e4, 1e-8}, std::pair{1e-4, 1e8}}) {
+    INFO("lengths x" << sL << ", stiffnesses x" << sK);
+    Hook hook(sL, sK);
+    const mech::EquilibriumBranches t = hook.trace(hook.upTo(0.25));
+    REQUIRE(t.contact[0].size() == 2);
+    const mech::ContactSet& held = t.contact[0][1].locked;
+    const cont::ContinuationPoint& p = t.tree.branches[0].points.back();
+    const mech::ContactProblem problem(hook.problem, held);
+    auto ws = problem.createWorkspace();
+    const VectorXd u = problem.withWallForces(*ws, p.u, p.lambda);
+    const VectorXd q = u.head(8), mu = problem.contactForces(*ws, p.u, p.lambda);
+    // uniform rods of unit mass per length: ω² scales as k / (ρ b)
+    mech::VibrationAnalysis va(hook.chain, mech::InertiaData::uniformRods(hook.chain, 1.0));
+    const mech::VibrationModes m = va.modes(q, mech::Wrench(0.0, 0.0, p.lambda), {}, held, mu, 4, true);
+    REQUIRE(m.dimension == 7);  // eight joints, one contact row
+    // the same pencil from the continuation's own constrained operator: H with −μ ∂²g, C with ∇gᵀ
+    Eigen::MatrixXd H, C, M(8, 8);
+    REQUIRE(problem.stabilityOperator(*ws, u, p.lambda, H, C));
+    va.massMatrix(q, M);
+    const Eigen::MatrixXd Z = Eigen::FullPivLU<Eigen::MatrixXd>(C).kernel();
+    REQUIRE(Z.cols() == 7);
+    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> pencil(Z.transpose() * H * Z,
+                                                                          Z.transpose() * M * Z);
+    const double scale = pencil.eigenvalues().cwiseAbs().maxCoeff();
+    for (int i = 0; i < 4; ++i) CHECK(std::abs(m.omegaSquared[i] - pencil.eigenvalues()[i]) < 1e-10 * scale);
+    CHECK(m.omegaSquared[0] > 0.0);  // the held hook is stable
+    // each shape keeps the contact (∇g·v = 0) and solves H v = ω² M v on it
+    for (int i = 0; i < 4; ++i) {
+      const VectorXd v = m.shapes.col(i);
+      CHECK(std::abs(C.row(0).dot(v)) < 1e-10 * C.row(0).norm() * v.norm());
+      const VectorXd r = Z.transpose() * (H * v - m.omegaSquared[i] * M * v);
+      CHECK(r.norm() < 1e-9 * scale * (M * v).norm());
+    }
+    // without the contact's row and its −μ ∂²g the lowest frequency is another one
+    const mech::VibrationModes free = va.modes(q, mech::Wrench(0.0, 0.0, p.lambda), {}, std::vector<int>{}, 1, false);
+    CHECK(std::abs(free.omegaSquared[0] - m.omegaSquared[0]) > 1e-3 * m.omegaSquared[0]);
+    const double invariant = m.omegaSquared[0] * sL / sK;
+    if (reference == 0.0) reference = invariant;
+    CHECK(invariant == Approx(reference).epsilon(1e-8));
+  }
+}
+
+TEST_CASE("self contact: a vertex at its edge's corner is pinned there on both edges and leaves along one",
+          "[self_contact]") {
+  namespace cont = buckle::continuation;
+  // fifty segments, the last forty curled by 4.5/40 rad: the end's corner reaches the straight
+  // part, slides along link 9 to its corner, is pinned there, slides on along the link's other
+  // edge and reaches the joint, where the branch ends (a vertex at a joint is not followed)
+  for (const auto& [sL, sK] : {std::pair{1.0, 1.0}, std::pair{1e4, 1e-8}}) {
+    INFO("lengths x" << sL << ", stiffnesses x" << sK);
+    const int n = 50;
+    VectorXd q0 = VectorXd::Zero(n);
+    q0.tail(40).setConstant(4.5 / 40);
+    const mech::Chain chain(mech::preloadsForShape(
+        std::vector<mech::SegmentParameters>(size_t(n), mech::SegmentParameters::symmetric(0.3 * sL, sL, sK, 2.25 * sL)), q0));
+    mech::EquilibriumProblem problem(chain, mech::EndCondition::freeEnd(), Eigen::Vector3d(0, 0, 1), Hook::options());
+    mech::EquilibriumBranchOptions o;
+    o.tracer.lambdaMax = 0.03 * sK * sL * sL;
+    o.tracer.step.initialStep = 0.01;
+    o.tracer.step.maxStep = 0.02;
+    o.tree.branchSwitching = 0;
+    const mech::EquilibriumBranches t =
+        mech::traceEquilibria(problem, q0, 0.0, cont::InitialDirection::increasingLambda(), o);
+    const cont::Branch& b = t.tree.branches[0];
+    const std::vector<mech::ContactStretch>& stretches = t.contact[0];
+    int pins = 0, slides = 0;
+    for (size_t k = 0; k < stretches.size(); ++k) {
+      const mech::ContactSet& held = stretches[k].locked;
+      const size_t first = size_t(stretches[k].firstPoint), last = k + 1 < stretches.size()
+                                                                       ? size_t(stretches[k + 1].firstPoint)
+                                                                       : b.points.size();
+      mech::ContactProblem stretch(problem, held);
+      auto ws = stretch.createWorkspace();
+      for (size_t i = first; i < last; ++i) {
+        const VectorXd q = b.points[i].u.head(n);
+        // no two links pass into each other anywhere on the branch, but for a second vertex of a
+        // pair of links already holding a contact (not traced: self_contact.h)
+        CHECK(mech::selfClearanceApart(chain, q, held.self()) >= -1e-9 * sL);
+        const VectorXd mu = stretch.selfForces(*ws, b.points[i].u, b.points[i].lambda);
+        for (int c = 0; c < held.selfCount(); ++c) {
+          const mech::SelfContact& contact = held.self()[size_t(c)];
+          CHECK(std::abs(testGap(chain, q, contact)) < 1e-9 * sL);
+          CHECK(mu[c] > -1e-12 * sK * sL);
+          if (!mech::heldAtCorner(chain, contact, held.self())) continue;
+          // pinned: the vertex at the corner the two edges share
+          ++pins;
+          mech::SelfContact other;
+          REQUIRE(mech::cornerNeighbour(chain, contact, other));
+          const Vector2d p = buckle::test::vertexAt(chain, q, contact.vertex);
+          double nearest = std::numeric_limits<double>::infinity();
+          for (int e = 0; e < 2; ++e)
+            for (int f = 0; f < 2; ++f)
+              if (buckle::test::vertexAt(chain, q, {contact.edge.segment, contact.edge.corner(e)})
+                      .isApprox(buckle::test::vertexAt(chain, q, {other.edge.segment, other.edge.corner(f)}), 1e-12))
+                nearest = std::min(nearest, (p - buckle::test::vertexAt(chain, q, {contact.edge.segment, contact.edge.corner(e)})).norm());
+          CHECK(nearest < 1e-9 * sL);
+        }
+      }
+      // a stretch that leaves a pin along one edge: its vertex moves away from the shared corner
+      if (k == 0 || held.selfCount() == 0) continue;
+      const mech::ContactSet& before = stretches[k - 1].locked;
+      for (const mech::SelfContact& c : before.self())
+        if (mech::heldAtCorner(chain, c, before.self()) && !held.holding(c) && last > first + 1) ++slides;
+    }
+    CHECK(pins >= 2);
+    CHECK(slides >= 1);
+    // past the corner (at Me = 0.0166 k b², where the vertex once chattered between the two edges
+    // and the branch ended as a false closed loop) to the joint
+    double reached = 0.0;
+    for (const cont::ContinuationPoint& p : b.points) reached = std::max(reached, p.lambda);
+    CHECK(reached > 0.0171 * sK * sL * sL);
+    CHECK(b.stopReason != cont::StopReason::ClosedLoop);
   }
 }

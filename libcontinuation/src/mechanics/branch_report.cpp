@@ -294,10 +294,12 @@ void reportLocatedPoints(EquilibriumProblem& problem, const cont::Branch& b, con
     s.multiplicity = sp.multiplicity;
     s.branchesPredicted = sp.branchesPredicted;
     s.branchesFound = sp.branchesFound;
-    if (const ContactSet& set = lockedAt(stretches, sp.index); set.wallCount() > 0) {
-      ContactProblem held(problem, set);  // the forces of the stretch's wall vertices at the point
+    if (const ContactSet& set = lockedAt(stretches, sp.index); set.gapCount() > 0) {
+      ContactProblem held(problem, set);  // the forces of the stretch's wall vertices and self contacts at the point
+      const Vector mu = held.contactForces(*held.createWorkspace(), sp.u, sp.lambda);
       s.wallVertices = set.wall();
-      s.wallForces = held.wallForces(*held.createWorkspace(), sp.u, sp.lambda);
+      s.wallForces = mu.head(set.wallCount());
+      s.selfForces = mu.tail(set.selfCount());
     }
     const Classification cl = classify(problem, sp);
     s.phenomenon = cl.phenomenon;

@@ -68,8 +68,11 @@ void reportSelfEvent(EquilibriumProblem& problem, const cont::Branch& b, const c
   for (const SelfContact& c : before.self())
     if (!after.holding(c)) left = c;
   const bool contact = changed.vertex.segment >= 0;
-  const bool slides = contact && left.vertex == changed.vertex;  // onto its edge's neighbour
   if (!contact) changed = left;
+  // the vertex at the corner its edge shares with the neighbour's (self_contact.h heldAtCorner)
+  SelfContact partner;
+  const bool corner = changed.vertex.segment >= 0 && cornerNeighbour(problem.chain(), changed, partner) &&
+                      before.holding(partner) && after.holding(partner);
   if (changed.vertex.segment < 0) return;
   const ContactSet& set = contact ? after : before;
   ContactProblem held(problem, set);
@@ -82,7 +85,9 @@ void reportSelfEvent(EquilibriumProblem& problem, const cont::Branch& b, const c
   os.precision(6);
   os << "vertex " << changed.vertex.label() << " at (" << s.contactPoint.x() << ", " << s.contactPoint.y() << ") on edge "
      << changed.edge.label() << ": "
-     << (slides    ? "slides on from edge " + left.edge.label()
+     << (corner && contact ? "reaches the corner it shares with edge " + partner.edge.label() +
+                                 ": held at the corner on both edges"
+         : corner  ? "contact force returns to zero: leaves the corner along edge " + partner.edge.label()
          : contact ? std::string("the links touch and are held apart")
                    : std::string("contact force returns to zero: the links separate"))
      << "; contact force = " << s.contactForce

@@ -180,6 +180,7 @@ ContactProblem::ContactProblem(const EquilibriumProblem& base, ContactSet locked
       maxCompression_(maxCompression),
       free_(freeJointsOf(locked_, base.segments())),
       held_(base.endCondition().heldIndices()) {
+  for (const SelfContact& c : locked_.self()) selfAtCorner_.push_back(heldAtCorner(base.chain(), c, locked_.self()));
   if (!(maxCompression > 0.0))
     throw std::invalid_argument("contact: the bound of the contact torque must be positive, got " +
                                 std::to_string(maxCompression));
@@ -445,7 +446,7 @@ int ContactProblem::selfClearanceBoundary() const {
 int ContactProblem::selfReleaseBoundary(int k) const {
   return wallReleaseBoundary(locked_.wallCount()) + (base_.selfContactIsBoundary() ? 1 : 0) + k;
 }
-int ContactProblem::selfEdgeBoundary(int k) const { return selfReleaseBoundary(locked_.selfCount()) + k; }
+int ContactProblem::selfEdgeBoundary(int k) const { return selfReleaseBoundary(locked_.selfCount()) + 2 * k; }
 int ContactProblem::boundaryCount() const { return selfEdgeBoundary(locked_.selfCount()); }
 
 namespace {
@@ -459,10 +460,12 @@ double boundaryValue(const ContactProblem& p, ContactProblem::Workspace& d, int 
   const int n = base.segments(), N = base.dimension();
   if (k == p.wallClearanceBoundary()) return nearestWallVertex(base.chain(), u.head(n), p.contacts().wall()).distance;
   const int w = p.contacts().wallCount();
-  if (k >= p.selfEdgeBoundary(0)) {  // min(t, 1 − t)·|e|: the vertex over its edge
+  if (k >= p.selfEdgeBoundary(0)) {  // t·|e| and (1 − t)·|e|: the vertex over its edge
     if (!p.wallKinematics(d, u.head(n))) return std::numeric_limits<double>::quiet_NaN();
-    const int r = k - p.selfEdgeBoundary(0);
-    return std::min(d.selfAlong[r], 1.0 - d.selfAlong[r]) * d.selfEdgeLength[r];
+    const int r = (k - p.selfEdgeBoundary(0)) / 2;
+    if (p.selfHeldAtCorner(r)) return d.selfEdgeLength[r];
+    const double t = (k - p.selfEdgeBoundary(0)) % 2 == 0 ? d.selfAlong[r] : 1.0 - d.selfAlong[r];
+    return t * d.selfEdgeLength[r];
   }
   if (k >= p.selfReleaseBoundary(0)) return wallForce(w + k - p.selfReleaseBoundary(0));  // μ ≥ 0
   if (k == p.selfClearanceBoundary()) return selfClearanceApart(base.chain(), u.head(n), p.contacts().self());
@@ -515,7 +518,7 @@ void ContactProblem::boundaries(ProblemWorkspace& ws, ConstVectorRef u, double l
 std::string ContactProblem::boundaryName(int k) const {
   const int n = base_.segments();
   if (k == wallClearanceBoundary()) return EquilibriumProblem::wallBoundaryName();
-  if (k >= selfEdgeBoundary(0)) return selfEdgeName(locked_.self()[size_t(k - selfEdgeBoundary(0))]);
+  if (k >= selfEdgeBoundary(0)) return selfEdgeName(locked_.self()[size_t((k - selfEdgeBoundary(0)) / 2)]);
   if (k >= selfReleaseBoundary(0)) return selfReleaseName(locked_.self()[size_t(k - selfReleaseBoundary(0))]);
   if (k == selfClearanceBoundary()) return EquilibriumProblem::selfContactBoundaryName();
   if (k >= wallReleaseBoundary(0)) return wallReleaseName(locked_.wall()[size_t(k - wallReleaseBoundary(0))]);

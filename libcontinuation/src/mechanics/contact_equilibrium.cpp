@@ -1,5 +1,5 @@
 // Constrained equilibria, stability and stiffness of the chain with joints locked at their
-// limits and vertices held on the base wall (contact.h).
+// limits and vertices held on the base wall or on other links (contact.h).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -108,6 +108,26 @@ void wallConstraintTerms(const Chain& chain, ConstVectorRef q, const ContactSet&
     wallVertexDerivatives(P, wallVertexPoint(chain, q, P, v), v, gradient, vertexGenerator);
     rows.row(k) = gradient.transpose();
     generator += wallForces[k] * vertexGenerator;
+  }
+}
+
+void selfConstraintTerms(const Chain& chain, ConstVectorRef q, const ContactSet& contacts, ConstVectorRef selfForces,
+                         const char* caller, MatrixRef rows, Vector& generator, Matrix& coupling) {
+  const int n = chain.size(), s = contacts.selfCount();
+  if (selfForces.size() != s)
+    throw std::invalid_argument(std::string(caller) + ": one force per self contact (" + std::to_string(s) + "), got " +
+                                std::to_string(selfForces.size()));
+  if (s == 0) return;
+  if (generator.size() != n) generator = Vector::Zero(n);
+  if (coupling.rows() != n || coupling.cols() != n) coupling = Matrix::Zero(n, n);
+  const Eigen::Matrix2Xd P = jointPositions(chain, q);
+  Vector gradient(n), gapGenerator(n), c(n), w(n);
+  for (int k = 0; k < s; ++k) {
+    const SelfContact& contact = contacts.self()[size_t(k)];
+    selfContactDerivatives(P, contact, selfContactGap(chain, q, P, contact), gradient, gapGenerator, c, w);
+    rows.row(k) = gradient.transpose();
+    generator += selfForces[k] * gapGenerator;
+    coupling.noalias() -= selfForces[k] * (c * w.transpose() + w * c.transpose());
   }
 }
 

@@ -34,7 +34,7 @@ BoundaryEvent endEvent(const EquilibriumProblem& base, const continuation::Probl
     int a = -1, b = -1;
     selfClearanceApart(base.chain(), sp.u.head(segments), contacts.self(), &a, &b);
     if (a >= 0 && b >= 0) {
-      e.self = touchingPair(base.chain(), sp.u.head(segments), a, b);
+      e.self = touchingPair(base.chain(), sp.u.head(segments), a, b, contacts.self());
       e.onSelf = true;
     }
   }
@@ -73,19 +73,24 @@ ContactChange changeOf(const EquilibriumProblem& problem, const continuation::Sp
   c.release = hit.selfRelease;
   SelfContact held = hit.self;
   c.what = std::string(c.release ? "release of self contact " : "self contact ") + hit.self.label();
+  const Eigen::VectorXd q = at.u.head(problem.segments());
+  const Eigen::Matrix2Xd P = jointPositions(problem.chain(), q);
   if (hit.selfEdgeEnd) {
-    const Eigen::VectorXd q = at.u.head(problem.segments());
-    const double along = selfContactGap(problem.chain(), q, jointPositions(problem.chain(), q), hit.self).along;
-    c.followed = slideOntoNeighbour(problem.chain(), hit.self, along, held);
+    // At the base corner the force can only turn into the corner's normal cone with the vertex
+    // pinned there: the corner's other edge is held too (the vertex leaves the corner later by
+    // the release of either). Past the corner along its edge the vertex would lose its support.
+    c.followed = selfContactGap(problem.chain(), q, P, hit.self).along >= 0.5 &&
+                 cornerNeighbour(problem.chain(), hit.self, held);
     if (!c.followed) return c;
-    c.what += " sliding onto " + held.edge.label();
-    locked.separate(hit.self);
+    c.what += " reaches its edge's corner: held there on " + held.edge.label() + " too";
   }
   if (c.release)
     locked.separate(hit.self);
   else
     locked.hold(held);
   c.index = int(std::lower_bound(locked.self().begin(), locked.self().end(), held) - locked.self().begin());
+  if (SelfContact partner; c.release && cornerNeighbour(problem.chain(), hit.self, partner) && locked.holding(partner))
+    c.slidesOn = int(std::lower_bound(locked.self().begin(), locked.self().end(), partner) - locked.self().begin());
   return c;
 }
 

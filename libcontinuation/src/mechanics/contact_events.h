@@ -31,13 +31,18 @@ BoundaryEvent endEvent(const EquilibriumProblem& base, const continuation::Probl
 
 // What an event changes (continueUnderContact): the contacts after it, whether it releases one, its
 // words for notes, and the index of the changed wall vertex or self contact among `after`'s (−1:
-// a joint). A vertex at the base-corner end of its edge slides onto the link outline's next edge
-// (self_contact.h); elsewhere (an apex, unequal half-heights) `followed` is false.
+// a joint). A vertex at the base-corner end of its edge is held there on the corner's other edge
+// too (self_contact.h cornerNeighbour; the index is that contact's); elsewhere (an apex, unequal
+// half-heights) `followed` is false.
 struct ContactChange {
   ContactSet after;
   bool release = false, followed = true;
   std::string what;
   int index = -1;
+  /// The release of one of a vertex's two contacts at a corner: the index among `after`'s self
+  /// contacts of the one that stays, along whose edge the vertex slides away from the corner
+  /// (−1 otherwise). The outline is convex there: the released edge's gap decreases on the way.
+  int slidesOn = -1;
 };
 ContactChange changeOf(const EquilibriumProblem& problem, const continuation::SpecialPoint& at, const BoundaryEvent& hit,
                        const ContactSet& before);

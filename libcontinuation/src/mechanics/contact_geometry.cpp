@@ -261,7 +261,13 @@ double selfClearanceApart(const Chain& chain, ConstVectorRef q, const std::vecto
   const SelfClearance c = selfClearance(chain, q, hint, nullptr);
   if (linkA) *linkA = c.linkA;
   if (linkB) *linkB = c.linkB;
-  return c.distance;
+  if (held.empty()) return c.distance;
+  int a = -1, b = -1;
+  const double pairs = heldPairsClearance(chain, q, jointPositions(chain, q), held, &a, &b);
+  if (!(pairs < c.distance)) return c.distance;
+  if (linkA) *linkA = a;
+  if (linkB) *linkB = b;
+  return pairs;
 }
 
 SelfClearance selfClearance(const Chain& chain, ConstVectorRef q, const SelfClearanceHint& hint, bool* exact) {

@@ -168,7 +168,7 @@ void DynamicsModel::evaluateStatics(ConstVectorRef q) {
     const int i = locked_[size_t(k - mh)];
     h_[k] = q[i] - limitAngle(i, sides_[size_t(i)]);
   }
-  if (!wall_.empty()) wallRows();
+  if (!wall_.empty() || !self_.empty()) gapRows();
   A_.noalias() = Jh_ * Jh_.transpose();
   // J_h loses rank where the held coordinate is stationary (x held on the straight chain): a
   // relative 1e-12 shift keeps the factorization defined and is invisible at regular points.
@@ -179,7 +179,7 @@ void DynamicsModel::evaluateStatics(ConstVectorRef q) {
   llt_.compute(A_);
 }
 
-void DynamicsModel::wallRows() {
+void DynamicsModel::gapRows() {
   // Joint j at end − (C_j, S_j) (the tail sums of ChainData: ∂y/∂q_j = x_end − x_Pj, −∂x/∂q_j =
   // y_end − y_Pj), as jointPositions' column j + 1, without a sine or cosine.
   const int n = segments();
@@ -196,6 +196,15 @@ void DynamicsModel::wallRows() {
     wallVertexDerivatives(positions_, point, v, wallRow_, wallGen_.col(k));
     Jh_.row(w0 + k) = wallRow_.transpose();
     h_[w0 + k] = point.x();
+  }
+  const int s0 = selfRowBegin();
+  for (int k = 0; k < selfCount(); ++k) {
+    const SelfContact& c = self_[size_t(k)];
+    const SelfContactGap g = selfContactGap(chain_, staticsQ_, positions_, c);
+    selfContactDerivatives(positions_, c, g, wallRow_, wallGen_.col(wallCount() + k), selfCoupling_.col(k),
+                           selfWeights_.col(k));
+    Jh_.row(s0 + k) = wallRow_.transpose();
+    h_[s0 + k] = g.gap;
   }
 }
 
@@ -250,7 +259,8 @@ double DynamicsModel::naturalResidual(ConstVectorRef q) {
   // held and wall rows in lengths, locked rows in radians (their own unit)
   double h = mh > 0 ? h_.head(mh).cwiseAbs().maxCoeff() / lengthUnit_ : 0.0;
   if (lockedCount() > 0) h = std::max(h, h_.segment(mh, lockedCount()).cwiseAbs().maxCoeff());
-  if (wallCount() > 0) h = std::max(h, h_.tail(wallCount()).cwiseAbs().maxCoeff() / lengthUnit_);
+  const int gaps = wallCount() + selfCount();  // the wall's and the self contacts' gaps, lengths
+  if (gaps > 0) h = std::max(h, h_.tail(gaps).cwiseAbs().maxCoeff() / lengthUnit_);
   return std::max(tmpN_.cwiseAbs().maxCoeff() / torqueUnit_, h);
 }
 
@@ -309,6 +319,16 @@ void DynamicsModel::setWallContacts(const std::vector<WallVertex>& vertices) {
   rebuildConstraints();
 }
 
+void DynamicsModel::setSelfContacts(const std::vector<SelfContact>& contacts) {
+  for (size_t k = 0; k < contacts.size(); ++k) {
+    checkSelfContact(contacts[k], segments());
+    if (std::find(contacts.begin(), contacts.begin() + long(k), contacts[k]) != contacts.begin() + long(k))
+      throw std::invalid_argument("self contacts: " + contacts[k].label() + " given twice");
+  }
+  self_ = contacts;
+  rebuildConstraints();
+}
+
 void DynamicsModel::rebuildConstraints() {
   const int n = segments();
   staticsValid_ = false;  // h_ and the rows depend on the contact set
@@ -317,7 +337,9 @@ void DynamicsModel::rebuildConstraints() {
   Jh_ = Matrix::Zero(m, n);
   Jh_.topRows(mh) = held;
   for (int k = mh; k < wallRowBegin(); ++k) Jh_(k, locked_[size_t(k - mh)]) = 1.0;
-  wallGen_ = Matrix::Zero(n, wallCount());
+  wallGen_ = Matrix::Zero(n, wallCount() + selfCount());
+  selfCoupling_ = Matrix::Zero(n, selfCount());
+  selfWeights_ = Matrix::Zero(n, selfCount());
   positions_.resize(2, n + 2);
   wallRow_.resize(n);
   h_ = Vector::Zero(m);
@@ -330,16 +352,23 @@ void DynamicsModel::rebuildConstraints() {
 
 void DynamicsModel::contactTorques(const double* x, VectorRef torques) {
   wallForces_.resize(wallCount());
-  contactForces(x, torques, wallForces_);
+  selfForces_.resize(selfCount());
+  contactForces(x, torques, wallForces_, selfForces_);
 }
 
 void DynamicsModel::contactForces(const double* x, VectorRef torques, VectorRef wallForces) {
+  selfForces_.resize(selfCount());
+  contactForces(x, torques, wallForces, selfForces_);
+}
+
+void DynamicsModel::contactForces(const double* x, VectorRef torques, VectorRef wallForces, VectorRef selfForces) {
   torques.setZero();
-  if (locked_.empty() && wall_.empty()) return;
+  if (locked_.empty() && wall_.empty() && self_.empty()) return;
   fdPlus_.resize(size_t(stateSize()));
   rhs(x, fdPlus_.data());  // the multipliers r_ at x
   for (int k = 0; k < lockedCount(); ++k) torques[locked_[size_t(k)]] = r_[heldCount() + k];
-  wallForces = r_.tail(wallCount());
+  wallForces = r_.segment(wallRowBegin(), wallCount());
+  selfForces = r_.tail(selfCount());
 }
 
 double DynamicsModel::restSpeed(const double* x) {

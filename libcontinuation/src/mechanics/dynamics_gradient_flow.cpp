@@ -2,8 +2,10 @@
 // O(n) stage solves of the stiff integrator on the chain structure.
 #include "buckle/mechanics/dynamics.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace buckle::mechanics {
@@ -53,11 +55,11 @@ GradientFlowModel::GradientFlowModel(const Chain& chain, const EndCondition& end
 }
 
 void GradientFlowModel::resizeConstraints() {
-  const int m = constraintCount();
-  y_ = Vector::Zero(m);
-  zeroM_ = Vector::Zero(m);
-  V_.resize(segments(), m);
-  W_.resize(segments(), m);
+  const int p = constraintCount() + 2 * selfCount();  // the border: rows, and each self contact's rank-2 pair
+  y_ = Vector::Zero(p);
+  zeroM_ = Vector::Zero(p);
+  V_.resize(segments(), p);
+  W_.resize(segments(), p);
   factoredFor_ = std::numeric_limits<double>::quiet_NaN();  // the factored system had other rows
 }
 
@@ -121,10 +123,29 @@ void GradientFlowModel::jacobian(const double* x, double* jacobianRowMajor) {
   Jac.bottomLeftCorner(1, n) = -2.0 * tmpN_.transpose();
 }
 
+bool GradientFlowModel::solveLinearizedDense(const double* x, double a, const double* b, double* k) {
+  // more rows than the chain structure's border takes: the dense LU of I − aJ̃, J̃ by central
+  // differences of the right-hand side (as the inertial model with constraints)
+  const int N = stateSize();
+  const bool cached = factoredFor_ == a && lastState_.size() == N && std::equal(x, x + N, lastState_.data());
+  if (!cached) {
+    factoredFor_ = std::numeric_limits<double>::quiet_NaN();
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(N, N);
+    DynamicsModel::jacobian(x, J.data());
+    denseLU_.compute(Matrix::Identity(N, N) - a * Matrix(J));
+    factoredFor_ = a;
+    lastState_ = Eigen::Map<const Vector>(x, N);
+  }
+  Eigen::Map<Vector> kv(k, N);
+  kv = denseLU_.solve(Eigen::Map<const Vector>(b, N));
+  return kv.allFinite();
+}
+
 bool GradientFlowModel::solveLinearized(const double* x, double a, const double* b, double* k) {
   const int n = segments();
-  const int mh = heldCount(), m = constraintCount();
+  const int mh = heldCount(), m = constraintCount(), s = selfCount(), p = m + 2 * s;
   if (!(a > 0.0)) return false;
+  if (p > ChainStructure::kMaxBorder) return solveLinearizedDense(x, a, b, k);
   Eigen::Map<const Vector> q(x, n), bq(b, n);
   Eigen::Map<Vector> kq(k, n);
   // q̇ and the reactions r at x (kinematics, J_h and A = J_h J_hᵀ as the flow uses them). The
@@ -142,30 +163,48 @@ bool GradientFlowModel::solveLinearized(const double* x, double a, const double*
     // H_r = U T Uᵀ from the statics velocity() evaluated (K_q and the kinematics at q)
     loadHessianGenerator(data_, total, structure_.h);
     subtractBodyGenerator(structure_.h);
-    // the wall forces' −Σ μ_v ∂²x_v: the generator h gains −μ_v g_v (wall_contact.h)
-    for (int k = 0; k < wallCount(); ++k) structure_.h -= r_[wallRowBegin() + k] * wallGen_.col(k);
+    // the wall forces' −Σ μ_v ∂²x_v and the self contacts' −Σ μ ∂²g: the generator h gains −μ g
+    // (wall_contact.h, self_contact.h; the self contacts' rank-2 part is bordered below)
+    for (int k = 0; k < wallCount() + s; ++k) structure_.h -= r_[wallRowBegin() + k] * wallGen_.col(k);
     structure_.kappa = stiffness_;
     assemble(structure_.kappa, structure_.h, structure_);
     // (I − aJ̃) k = b with s = a/c: (I + s(P H_r + κ_h J_h⁺J_h − J_h⁺E)) k = b. With
     // y = s A⁻¹(J_h(κ_h − H_r) − E) k this is (I + sH_r) k + J_hᵀ y = b, A y + s (J_h(H_r − κ_h I) + E) k
     // = 0; dividing the first row by s (y' = y/s):
     //   [[H_r + I/s, J_hᵀ], [J_h (H_r − κ_h I) + E, A]] [k; y'] = [b/s; 0].
+    // A self contact's rank-2 part R = U D Uᵀ of H_r (U = [c, w], D = −μ[[0, 1], [1, 0]]) is
+    // bordered with z = Uᵀk: columns U D beside J_hᵀ, rows Uᵀk − z = 0, and J_h R k = (J_h U D) z.
     if (m > 0) {
-      V_ = Jh_.transpose();
+      V_.leftCols(m) = Jh_.transpose();
       for (int j = 0; j < m; ++j) {
         applyHessian(structure_, V_.col(j), W_.col(j));
         W_.col(j) -= kappaH_ * V_.col(j);
         if (j >= mh && j < wallRowBegin()) continue;  // a locked joint's row e_iᵀ is constant: no E term
         if (j < mh) applyEndHessian(data_, held_[size_t(j)], qdot_, tmpN_);
-        else applyNegativeGenerator(wallGen_.col(j - wallRowBegin()), qdot_, tmpN_);  // ∇²x_v q̇
+        else applyNegativeGenerator(wallGen_.col(j - wallRowBegin()), qdot_, tmpN_);  // ∇²x_v q̇, −G(γ)q̇
+        if (j >= selfRowBegin()) {  // ∇²g q̇ = −G(γ)q̇ + c (wᵀq̇) + w (cᵀq̇)
+          const auto c = selfCoupling_.col(j - selfRowBegin()), w = selfWeights_.col(j - selfRowBegin());
+          tmpN_ += c * w.dot(qdot_) + w * c.dot(qdot_);
+        }
         W_.col(j) -= c_ * tmpN_;
       }
+    }
+    factoredA_.setZero(p, p);
+    factoredA_.topLeftCorner(m, m) = A_;
+    for (int k = 0; k < s; ++k) {
+      const double mu = r_[selfRowBegin() + k];
+      const auto c = selfCoupling_.col(k), w = selfWeights_.col(k);
+      V_.col(m + 2 * k) = -mu * w;
+      V_.col(m + 2 * k + 1) = -mu * c;
+      W_.col(m + 2 * k) = c;
+      W_.col(m + 2 * k + 1) = w;
+      factoredA_.block(0, m + 2 * k, m, 2).noalias() = Jh_ * V_.middleCols(m + 2 * k, 2);
+      factoredA_.block(m + 2 * k, m + 2 * k, 2, 2) = -Eigen::Matrix2d::Identity();
     }
     // H_r + σI is the chain structure of K_q + σI (U (T + σM) Uᵀ, chain_structure.h)
     shifted_ = structure_.kappa.array() + c_ / a;
     assemble(shifted_, structure_.h, structure_);
     // (own copies: rhs() between the stages overwrites A_ and qdot_ at other states)
-    factoredA_ = A_;
     factoredQdot_ = qdot_;
     if (!factorBordered(structure_, V_, W_, factoredA_)) return false;
     factoredFor_ = a;

@@ -289,14 +289,19 @@ void InertialModel::rhs(const double* x, double* dxdt) {
         for (int i = 0; i < n; ++i)
           jdot -= l[i + 1] * (c == 0 ? cos_[i] : sin_[i]) * thetaDot_[i] * thetaDot_[i];
       // a wall vertex: q̇ᵀ∇²x_v q̇ = −Σ_{i,j} g_max(i,j) q̇_i q̇_j = −Σ_m g_m (θ̇_m² − θ̇_(m−1)²)
+      // a self contact: q̇ᵀ∂²g q̇ = −q̇ᵀG(γ)q̇ + 2(cᵀq̇)(wᵀq̇) (self_contact.h), the first term as the wall's
       if (k >= wallRowBegin()) {
-        const auto g = wallGen_.col(k - wallRowBegin());
+        const int r = k - wallRowBegin();
+        const auto g = wallGen_.col(r);
+        const int last = r < wallCount() ? wall_[size_t(r)].lastJoint() : n - 1;
         double previous = 0.0;
-        for (int i = 0; i <= wall_[size_t(k - wallRowBegin())].lastJoint(); ++i) {
+        for (int i = 0; i <= last; ++i) {
           const double square = thetaDot_[i] * thetaDot_[i];
           jdot -= g[i] * (square - previous);
           previous = square;
         }
+        if (k >= selfRowBegin())
+          jdot += 2.0 * selfCoupling_.col(k - selfRowBegin()).dot(v) * selfWeights_.col(k - selfRowBegin()).dot(v);
       }
       tmpM_[k] = -jdot - 2.0 * omega_ * Jh_.row(k).dot(v) - omega_ * omega_ * h_[k];
     }

@@ -81,7 +81,8 @@ class Monitor {
     if (slow && residual <= options_.residualTolerance)
       return stop(IntegrationStop::Rest, "at rest: |qdot| and the equilibrium residual are below tolerance at t = " + num(t));
     ++sinceSettleCheck_;
-    if (options_.settled && model_.lockedCount() == 0 && model_.wallCount() == 0 && residual <= options_.settleResidual &&
+    if (options_.settled && model_.lockedCount() == 0 && model_.wallCount() == 0 && model_.selfCount() == 0 &&
+        residual <= options_.settleResidual &&
         sinceSettleCheck_ >= options_.settleInterval) {
       sinceSettleCheck_ = 0;
       if (options_.settled(q))
@@ -113,7 +114,9 @@ class Monitor {
     result_.contactTorques = Vector::Zero(n);
     result_.wallContacts = model_.wallContacts();
     result_.wallForces = Vector::Zero(model_.wallCount());
-    model_.contactForces(x, result_.contactTorques, result_.wallForces);
+    result_.selfContacts = model_.selfContacts();
+    result_.selfForces = Vector::Zero(model_.selfCount());
+    model_.contactForces(x, result_.contactTorques, result_.wallForces, result_.selfForces);
     if (options_.recordTrajectory && (result_.trajectory.empty() || result_.trajectory.back().t < t)) forceRecord(t, x);
   }
 
@@ -376,6 +379,7 @@ DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef 
   Monitor monitor(model, natural, result);
   const std::vector<int> initialSides = model.contactSides();
   const std::vector<WallVertex> initialWall = model.wallContacts();
+  const std::vector<SelfContact> initialSelf = model.selfContacts();
 
   // The structured Rosenbrock method runs on the model's solveLinearized() (both models have it).
   const bool structured = natural.stepper == StepperKind::StructuredRosenbrock4;
@@ -428,6 +432,7 @@ DynamicsResult simulate(DynamicsModel& model, ConstVectorRef q0, ConstVectorRef 
   // the contacts found are the result's; the model is left as the caller set it (repeatable runs)
   model.setContacts(initialSides);
   model.setWallContacts(initialWall);
+  model.setSelfContacts(initialSelf);
   result.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
   return result;
 }

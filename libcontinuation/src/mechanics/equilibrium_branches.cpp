@@ -182,7 +182,9 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // turning back in λ (a corner).
     const int N = problem.dimension(), D = next->dimension();
     const int wallIndex = change.index;
+    // (a vertex leaving a corner along the edge that stays: that edge's end distance)
     const int changed = onJoint      ? (hit.joint.side == LimitSide::Upper ? hit.joint.joint : hit.joint.joint + n)
+                        : change.slidesOn >= 0 ? next->selfEdgeBoundary(change.slidesOn) + 1
                         : hit.onSelf ? (release ? next->selfClearanceBoundary() : next->selfReleaseBoundary(wallIndex))
                         : release    ? next->wallClearanceBoundary()
                                      : next->wallReleaseBoundary(wallIndex);
@@ -212,7 +214,10 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       giveUp("no unique tangent at the point");
       break;
     }
-    const double rate = contactRate(problem, stretches.back().locked, hit, release, wallIndex, p0);
+    // leaving a corner along the edge that stays takes the vertex inside the released edge's line
+    // (the outline is convex there): its gap decreases
+    const double rate = (change.slidesOn >= 0 ? -1.0 : 1.0) *
+                        contactRate(problem, stretches.back().locked, hit, release, wallIndex, p0);
     if (rate < 0.0 && !startPoint(-p0.tangent, p0)) {
       giveUp("no unique tangent at the point");
       break;
@@ -239,8 +244,9 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       break;
     }
     if (continuation::BoundProblem(*next).boundary(changed, stretch.points[1].u, stretch.points[1].lambda) < 0.0) {
-      giveUp(release ? (onJoint      ? "the free joint would go past its limit"
-                        : hit.onSelf ? "the bodies would pass into each other"
+      giveUp(release ? (onJoint                ? "the free joint would go past its limit"
+                        : change.slidesOn >= 0 ? "the vertex would slide off the corner, away from both edges"
+                        : hit.onSelf           ? "the bodies would pass into each other"
                                      : "the vertex would go through the wall")
                      : "the contact would pull (tension)");
       break;

@@ -58,22 +58,26 @@ struct RestPoint {
   bool stable = false;
   std::vector<WallVertex> wall;  ///< vertices on the wall (a barrier stop's landing)
   Vector wallForces;
+  std::vector<SelfContact> self;  ///< self contacts held at the landing
+  Vector selfForces;
 };
 
-/// The landing of dynamics that ended on the base wall: at rest with vertices on it
-/// (IntegrationOptions::wall), or stopped at it (IntegrationStop::Barrier: the vertex of `chain`,
-/// the model's, nearest to the wall). Those vertices and the joints locked then start the active
-/// set of landOnWall (wall_landing.h).
+/// The landing of dynamics that ended on the base wall or on the chain itself: at rest with
+/// vertices on the wall (IntegrationOptions::wall) or self contacts held (IntegrationOptions::self),
+/// or stopped at the wall (IntegrationStop::Barrier: the vertex of `chain`, the model's, nearest to
+/// the wall). Those contacts and the joints locked then start the active set of landOnWall
+/// (wall_landing.h).
 RestPoint wallRestPoint(EquilibriumProblem& problem, const Chain& chain, const DynamicsResult& dyn, double lambda,
-                        const continuation::CorrectorOptions& options) {
+                        const continuation::CorrectorOptions& options, bool self) {
   RestPoint rp;
   const int n = problem.segments();
   ContactSet start;
   for (int i = 0; i < n && dyn.contactSides.size() == size_t(n); ++i)
     if (dyn.contactSides[size_t(i)] != 0) start.lock(i, dyn.contactSides[size_t(i)] > 0 ? LimitSide::Upper : LimitSide::Lower);
   for (const WallVertex& v : dyn.wallContacts) start.touch(v);
+  for (const SelfContact& c : dyn.selfContacts) start.hold(c);
   if (dyn.reason == IntegrationStop::Barrier) start.touch(nearestWallVertex(chain, dyn.q).vertex);
-  const WallLanding w = landOnWall(problem, start, dyn.q, lambda, options.tolerance, options.maxIterations);
+  const WallLanding w = landOnWall(problem, start, dyn.q, lambda, options.tolerance, options.maxIterations, self);
   rp.polished.u = w.u;
   rp.polished.converged = w.converged;
   rp.polished.iterations = w.solves;
@@ -86,6 +90,8 @@ RestPoint wallRestPoint(EquilibriumProblem& problem, const Chain& chain, const D
   rp.stable = w.stable;
   rp.wall = w.contacts.wall();
   rp.wallForces = w.wallForces;
+  rp.self = w.contacts.self();
+  rp.selfForces = w.selfForces;
   return rp;
 }
 
@@ -95,7 +101,7 @@ RestPoint wallRestPoint(EquilibriumProblem& problem, const Chain& chain, const D
 void noteWallReached(const DynamicsModel& model, const DynamicsResult& dyn, bool& reached, WallVertex& vertex,
                      double& gap) {
   for (const ContactEvent& e : dyn.contactEvents) {
-    if (e.joint >= 0 || !e.contact) continue;
+    if (e.joint >= 0 || !e.contact || e.self.vertex.segment >= 0) continue;
     reached = true;
     vertex = e.vertex;
     gap = 0.0;
@@ -116,15 +122,18 @@ bool arrivedAt(const DynamicsResult& dyn, const RestPoint& rest) {
 }
 
 /// `settled`: the equilibrium the basin test certified when the integration ended Settled
-/// (no joint in contact then: the test runs only without locked joints).
+/// (no joint in contact then: the test runs only without locked joints). `self`: the chain's
+/// contact with itself is traced, so every rest point lands by landOnWall's active set.
 RestPoint polishRestPoint(EquilibriumProblem& problem, const Chain& chain, const DynamicsResult& dyn, double lambda,
-                          const continuation::CorrectorOptions& options, const PolishResult* settled = nullptr) {
+                          const continuation::CorrectorOptions& options, bool self,
+                          const PolishResult* settled = nullptr) {
   RestPoint rp;
   const int n = problem.segments();
   rp.sides = dyn.contactSides.size() == size_t(n) ? dyn.contactSides : std::vector<int>(size_t(n), 0);
   rp.torques = Vector::Zero(n);
-  if (dyn.reason == IntegrationStop::Barrier || (dyn.reason == IntegrationStop::Rest && !dyn.wallContacts.empty()))
-    return wallRestPoint(problem, chain, dyn, lambda, options);
+  if (dyn.reason == IntegrationStop::Barrier ||
+      (dyn.reason == IntegrationStop::Rest && (!dyn.wallContacts.empty() || self)))
+    return wallRestPoint(problem, chain, dyn, lambda, options, self);
   if (dyn.reason == IntegrationStop::Settled && settled && !anyContact(rp.sides)) {
     rp.polished = *settled;
     cont::BoundProblem(problem).stability(rp.polished.u, lambda, 3, rp.stability);
@@ -447,7 +456,7 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   IntegrationOptions integration = options.integration;
   const bool handover = model->kind() == DynamicsKind::GradientFlow &&
                         (options.handover == Handover::Always ||
-                         (options.handover == Handover::Automatic && n > kStructuredJumpFrom));
+                         (options.handover == Handover::Automatic && n > kStructuredJumpFrom && !options.self));
   PolishResult certified;
   if (handover)
     integration.settled = [&](ConstVectorRef q) {
@@ -455,6 +464,7 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
       return basinTest(problem, *model, q, lambda, options.polish, certified);
     };
   integration.wall = integration.wall || options.wall;
+  integration.self = integration.self || options.self;
   result.dynamics = simulate(*model, qStart, Vector::Zero(n), integration);
   const DynamicsResult& dyn = result.dynamics;
   noteWallReached(*model, dyn, result.reachedWall, result.wallVertex, result.wallGap);
@@ -466,7 +476,7 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.restPoint = dyn.q;
 
   // 3. Polish at fixed λ (with the joints in contact fixed) and check stability.
-  const RestPoint rest = polishRestPoint(problem, model->chain(), dyn, lambda, options.polish, &certified);
+  const RestPoint rest = polishRestPoint(problem, model->chain(), dyn, lambda, options.polish, options.self, &certified);
   const PolishResult& polished = rest.polished;
   result.to = polished.u;
   result.polishConverged = polished.converged;
@@ -483,6 +493,8 @@ JumpResult simulateJump(EquilibriumProblem& problem, ConstVectorRef u, double la
   result.contactTorques = rest.torques;
   result.wallContacts = rest.wall;
   result.wallForces = rest.wallForces;
+  result.selfContacts = rest.self;
+  result.selfForces = rest.selfForces;
 
   std::ostringstream os;
   os << "integration stopped: " << dyn.message << "; " << (!rest.wall.empty() ? "landing on the wall: " : "polish: ")
@@ -544,6 +556,7 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
 
   IntegrationOptions integration = options.integration;
   integration.wall = integration.wall || options.wall;
+  integration.self = integration.self || options.self;
   result.dynamics = simulate(*model, result.start, Vector::Zero(n), integration);
   const DynamicsResult& dyn = result.dynamics;
   double gap = 0.0;
@@ -553,7 +566,7 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
     result.maxExcursion = std::max(result.maxExcursion, (s.q - result.start).cwiseAbs().maxCoeff());
   }
 
-  const RestPoint restPoint = polishRestPoint(problem, model->chain(), dyn, 0.0, options.polish);
+  const RestPoint restPoint = polishRestPoint(problem, model->chain(), dyn, 0.0, options.polish, options.self);
   const PolishResult& polished = restPoint.polished;
   result.restUnknowns = polished.u;
   result.rest = polished.u.head(n);
@@ -565,6 +578,8 @@ SuddenLoadResult simulateSuddenLoad(const Chain& chain, const EndCondition& load
   result.contactTorques = restPoint.torques;
   result.wallContacts = restPoint.wall;
   result.wallForces = restPoint.wallForces;
+  result.selfContacts = restPoint.self;
+  result.selfForces = restPoint.selfForces;
   result.potentialDynamic = model->potential(result.rest);
 
   std::ostringstream os;

@@ -16,17 +16,23 @@ void setState(const EquilibriumProblem& problem, const Eigen::VectorXd& q, const
   l.shape = shapeName(q, kStraightTolerance);
 }
 
-/// The joints in contact (sides ≠ 0) with their torques and the vertices on the wall with their
-/// forces; the kind of a successful landing.
-void setContacts(const std::vector<int>& sides, const Eigen::VectorXd& torques, const std::vector<WallVertex>& wall,
-                 const Eigen::VectorXd& wallForces, Landing& l) {
+/// The joints in contact (sides ≠ 0) with their torques, the vertices on the wall and the self
+/// contacts with their forces; the kind of a successful landing.
+template <class Result>
+void setContacts(const Result& j, Landing& l) {
+  const std::vector<int>& sides = j.contactSides;
+  const Eigen::VectorXd& torques = j.contactTorques;
   l.contacts.clear();
   for (size_t i = 0; i < sides.size(); ++i)
     if (sides[i] != 0) l.contacts.push_back({int(i), sides[i], torques.size() > Eigen::Index(i) ? torques[Eigen::Index(i)] : 0.0});
   l.wall.clear();
-  for (size_t k = 0; k < wall.size() && Eigen::Index(k) < wallForces.size(); ++k)
-    l.wall.push_back({wall[k], wallForces[Eigen::Index(k)]});
+  for (size_t k = 0; k < j.wallContacts.size() && Eigen::Index(k) < j.wallForces.size(); ++k)
+    l.wall.push_back({j.wallContacts[k], j.wallForces[Eigen::Index(k)]});
+  l.self.clear();
+  for (size_t k = 0; k < j.selfContacts.size() && Eigen::Index(k) < j.selfForces.size(); ++k)
+    l.self.push_back({j.selfContacts[k], j.selfForces[Eigen::Index(k)]});
   if (l.success && !l.contacts.empty()) l.kind = "stable equilibrium in contact";
+  if (l.success && !l.self.empty()) l.kind = "stable equilibrium held on itself";
   if (l.success && !l.wall.empty()) l.kind = "stable equilibrium on the wall";
 }
 }  // namespace
@@ -51,7 +57,7 @@ Landing jumpFromFold(EquilibriumProblem& problem, const continuation::SpecialPoi
     l.interrupted = !j.success && j.stopReason == IntegrationStop::Interrupted;
     l.wallBlocked = !j.success && j.reachedWall;
     if (j.to.size() >= n) setState(problem, j.to.head(n), problem.wrench(j.to, fold.lambda), l);
-    setContacts(j.contactSides, j.contactTorques, j.wallContacts, j.wallForces, l);
+    setContacts(j, l);
     l.distance = j.distance;
   } catch (const std::invalid_argument& e) {
     l.success = false;
@@ -69,7 +75,7 @@ Landing landingOf(const EquilibriumProblem& problem, const JumpRecord& j) {
   l.kind = j.success ? "stable equilibrium" : "none";
   l.message = j.message;
   if (j.to.size() >= n) setState(problem, j.to.head(n), j.load, l);
-  setContacts(j.contactSides, j.contactTorques, j.wallContacts, j.wallForces, l);
+  setContacts(j, l);
   l.energyReleased = j.energyReleased;
   l.distance = j.distance;
   return l;

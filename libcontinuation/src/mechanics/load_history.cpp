@@ -143,11 +143,13 @@ bool followBifurcated(EquilibriumProblem& problem, const cont::SpecialPoint& sp,
   return true;
 }
 
-ContactSet contactSetOf(const std::vector<int>& sides, const std::vector<WallVertex>& wall = {}) {
+ContactSet contactSetOf(const std::vector<int>& sides, const std::vector<WallVertex>& wall = {},
+                        const std::vector<SelfContact>& self = {}) {
   ContactSet set;
   for (size_t i = 0; i < sides.size(); ++i)
     if (sides[i] != 0) set.lock(int(i), sides[i] > 0 ? LimitSide::Upper : LimitSide::Lower);
   for (const WallVertex& v : wall) set.touch(v);
+  for (const SelfContact& c : self) set.hold(c);
   return set;
 }
 
@@ -183,6 +185,8 @@ bool releaseChain(EquilibriumProblem& problem, const LoadHistoryOptions& options
     rec.contactTorques = jr.contactTorques;
     rec.wallContacts = jr.wallContacts;
     rec.wallForces = jr.wallForces;
+    rec.selfContacts = jr.selfContacts;
+    rec.selfForces = jr.selfForces;
   }
   result.jumps.push_back(rec);
   return jr.success;
@@ -233,7 +237,8 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       return result;
     }
     u = result.jumps.back().to;
-    locked = contactSetOf(result.jumps.back().contactSides, result.jumps.back().wallContacts);
+    locked = contactSetOf(result.jumps.back().contactSides, result.jumps.back().wallContacts,
+                              result.jumps.back().selfContacts);
   }
 
   for (size_t leg = 1; leg < waypoints.size(); ++leg) {
@@ -314,7 +319,8 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       }
       u = result.jumps.back().to;
       lambda = at;
-      locked = contactSetOf(result.jumps.back().contactSides, result.jumps.back().wallContacts);
+      locked = contactSetOf(result.jumps.back().contactSides, result.jumps.back().wallContacts,
+                              result.jumps.back().selfContacts);
       if ((target - lambda) * sign <= 0.0) break;  // the overshoot passed the waypoint
     }
   }

@@ -4,6 +4,21 @@
 
 namespace buckle::mechanics {
 
+namespace {
+
+// A vertex's image: the +a and −a corners trade places (wall_contact.h), the joint stays.
+WallVertex mirroredVertex(const WallVertex& v) {
+  return WallVertex{v.segment, v.corner == 0 ? 0 : v.corner % 2 == 1 ? v.corner + 1 : v.corner - 1};
+}
+
+// A self contact's image: its vertex's, on the same triangle's other side edge (a base edge is
+// its own image).
+SelfContact mirroredSelf(const SelfContact& c) {
+  return SelfContact{mirroredVertex(c.vertex), TriangleEdge{c.edge.segment, c.edge.distal, c.edge.edge == 0 ? 0 : 3 - c.edge.edge}};
+}
+
+}  // namespace
+
 continuation::Reflection mirrorSymmetry(const EquilibriumProblem& problem) {
   continuation::Reflection mirror;
   const Chain& chain = problem.chain();
@@ -36,6 +51,9 @@ std::string mirrorText(const std::string& text) {
     } else if (text.compare(i, lower.size(), lower) == 0) {
       out += upper;
       i += lower.size();
+    } else if (text.compare(i, 5, "[j,+]") == 0 || text.compare(i, 5, "[j,-]") == 0) {
+      out += text[i + 3] == '+' ? "[j,-]" : "[j,+]";  // a self contact's side edge (self_contact.h)
+      i += 5;
     } else if (i > 0 && std::isdigit(static_cast<unsigned char>(text[i - 1])) && i + 1 < text.size() &&
                (text[i] == 'p' || text[i] == 'd') && (text[i + 1] == '+' || text[i + 1] == '-')) {
       out += text[i];  // a wall vertex's label, "3d+" (wall_contact.h): its corner across the link
@@ -54,8 +72,8 @@ std::vector<ContactStretch> mirrored(const std::vector<ContactStretch>& stretche
     ContactStretch m{s.firstPoint, ContactSet()};
     for (const LockedJoint& l : s.locked.joints())
       m.locked.lock(l.joint, l.side == LimitSide::Upper ? LimitSide::Lower : LimitSide::Upper);
-    for (const WallVertex& v : s.locked.wall())  // +a and −a corners trade places (wall_contact.h)
-      m.locked.touch(WallVertex{v.segment, v.corner == 0 ? 0 : v.corner % 2 == 1 ? v.corner + 1 : v.corner - 1});
+    for (const WallVertex& v : s.locked.wall()) m.locked.touch(mirroredVertex(v));
+    for (const SelfContact& c : s.locked.self()) m.locked.hold(mirroredSelf(c));
     image.push_back(m);
   }
   return image;
@@ -72,8 +90,8 @@ Landing mirrored(const Landing& landing) {
     c.side = -c.side;
     c.torque = -c.torque;
   }
-  for (WallSupport& w : image.wall)  // +a and −a corners trade places; the force along x is kept
-    w.vertex.corner = w.vertex.corner == 0 ? 0 : w.vertex.corner % 2 == 1 ? w.vertex.corner + 1 : w.vertex.corner - 1;
+  for (WallSupport& w : image.wall) w.vertex = mirroredVertex(w.vertex);  // the force along x is kept
+  for (SelfSupport& c : image.self) c.contact = mirroredSelf(c.contact);
   image.message = mirrorText(landing.message);
   return image;
 }

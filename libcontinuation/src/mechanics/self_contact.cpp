@@ -29,6 +29,49 @@ std::vector<std::pair<int, bool>> trianglesOf(int link, int segments) {
 
 Point R90(const Point& p) { return Point(-p.y(), p.x()); }
 
+// The corners of a link pair left out of its clearance while it holds the contacts `held`: the
+// held vertices and their edges' ends (the vertex reaches those by its edge's boundaries, and
+// sits on one while held at a corner).
+std::vector<WallVertex> heldCorners(const std::vector<SelfContact>& held) {
+  std::vector<WallVertex> out;
+  for (const SelfContact& c : held) {
+    out.push_back(c.vertex);
+    out.push_back(WallVertex{c.edge.segment, c.edge.corner(0)});
+    out.push_back(WallVertex{c.edge.segment, c.edge.corner(1)});
+  }
+  return out;
+}
+
+// Whether the contact is between links la and lb (its vertex on one, its edge on the other).
+bool onPair(const SelfContact& c, int la, int lb) {
+  const auto [l0, l1] = linksOf(c.vertex);
+  const int le = c.edge.link();
+  return (le == la && (l0 == lb || l1 == lb)) || (le == lb && (l0 == la || l1 == la));
+}
+
+// Signed distance of p to triangle (a, b, c): the distance outside, minus the distance to the
+// nearest edge inside.
+double signedDistance(const Point& p, const Point& a, const Point& b, const Point& c) {
+  const Point corner[3] = {a, b, c};
+  double inside = -std::numeric_limits<double>::infinity(), outside = std::numeric_limits<double>::infinity();
+  bool in = true;
+  for (int e = 0; e < 3; ++e) {
+    const Point& u = corner[e];
+    const Point& v = corner[(e + 1) % 3];
+    const Point& w = corner[(e + 2) % 3];
+    const Point d = v - u;
+    Point normal(d.y(), -d.x());
+    normal.normalize();
+    if (normal.dot(w - u) > 0.0) normal = -normal;
+    const double gap = normal.dot(p - u);
+    in = in && gap <= 0.0;
+    inside = std::max(inside, gap);
+    const double t = std::clamp((p - u).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    outside = std::min(outside, (p - u - t * d).norm());
+  }
+  return in ? inside : outside;
+}
+
 }  // namespace
 
 int TriangleEdge::corner(int k) const {
@@ -100,9 +143,9 @@ void selfContactDerivatives(const Eigen::Matrix2Xd& P, const SelfContact& c, con
     for (int m = 0; m <= hi; ++m) weights[m] = 1.0;
 }
 
-bool slideOntoNeighbour(const Chain& chain, const SelfContact& c, double along, SelfContact& next) {
+bool cornerNeighbour(const Chain& chain, const SelfContact& c, SelfContact& next) {
   const int s = c.edge.segment, n = chain.size();
-  if (c.edge.edge == 0 || along < 0.5) return false;
+  if (c.edge.edge == 0) return false;
   const int other = c.edge.distal ? s + 1 : s - 1;
   if (other < 0 || other >= n) return false;
   const double here = c.edge.distal ? chain.segment(s).parameters().a2 : chain.segment(s).parameters().a1;
@@ -112,28 +155,88 @@ bool slideOntoNeighbour(const Chain& chain, const SelfContact& c, double along, 
   return true;
 }
 
-SelfContact touchingPair(const Chain& chain, ConstVectorRef q, int linkA, int linkB) {
+bool heldAtCorner(const Chain& chain, const SelfContact& c, const std::vector<SelfContact>& held) {
+  SelfContact partner;
+  return cornerNeighbour(chain, c, partner) && std::find(held.begin(), held.end(), partner) != held.end();
+}
+
+double heldPairsClearance(const Chain& chain, ConstVectorRef q, const Eigen::Matrix2Xd& P,
+                          const std::vector<SelfContact>& held, int* linkA, int* linkB) {
+  const int n = chain.size();
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<std::pair<int, int>> pairs;
+  for (const SelfContact& c : held) {
+    const auto [l0, l1] = linksOf(c.vertex);
+    for (const int lv : {l0, l1})
+      if (std::abs(lv - c.edge.link()) >= 2) pairs.push_back({std::min(lv, c.edge.link()), std::max(lv, c.edge.link())});
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  for (const auto& [la, lb] : pairs) {
+    std::vector<SelfContact> here;
+    for (const SelfContact& c : held)
+      if (onPair(c, la, lb)) here.push_back(c);
+    const std::vector<WallVertex> skip = heldCorners(here);
+    for (const auto& [vl, el] : {std::pair{la, lb}, std::pair{lb, la}})
+      for (const auto& [vs, vd] : trianglesOf(vl, n))
+        for (const int corner : vd ? std::vector<int>{0, 3, 4} : std::vector<int>{0, 1, 2}) {
+          const WallVertex v{vs, corner};
+          if (std::find(skip.begin(), skip.end(), v) != skip.end()) continue;
+          const Point p = wallVertexPoint(chain, q, P, v);
+          for (const auto& [es, ed] : trianglesOf(el, n)) {
+            const int c1 = ed ? 3 : 1, c2 = ed ? 4 : 2;
+            const double d = signedDistance(p, wallVertexPoint(chain, q, P, {es, 0}),
+                                            wallVertexPoint(chain, q, P, {es, c1}), wallVertexPoint(chain, q, P, {es, c2}));
+            if (d < best) {
+              best = d;
+              if (linkA) *linkA = la;
+              if (linkB) *linkB = lb;
+            }
+          }
+        }
+  }
+  return best;
+}
+
+SelfContact touchingPair(const Chain& chain, ConstVectorRef q, int linkA, int linkB, const std::vector<SelfContact>& held) {
   const int n = chain.size();
   if (linkA < 0 || linkB < 0 || linkA > n || linkB > n || std::abs(linkA - linkB) < 2)
     throw std::invalid_argument("self contact: links " + std::to_string(linkA) + " and " + std::to_string(linkB) +
                                 " cannot touch (links 0.." + std::to_string(n) + ", two or more apart)");
   const Eigen::Matrix2Xd P = jointPositions(chain, q);
+  std::vector<SelfContact> here;  // contacts the pair already holds: their corners are left out
+  for (const SelfContact& c : held)
+    if (onPair(c, linkA, linkB)) here.push_back(c);
+  const std::vector<WallVertex> skip = heldCorners(here);
   SelfContact best;
   double bestGap = std::numeric_limits<double>::infinity();
   // t on the edge to rounding of the located touch
   constexpr double kSlack = 1e-9;
+  // a vertex inside a triangle of the other link (beyond the slack): the deepest one, on the edge
+  // it is nearest to (the dynamics' and the landing's steps can end there)
+  SelfContact deepest;
+  double depth = 0.0;
   for (const auto& [vl, el] : {std::pair{linkA, linkB}, std::pair{linkB, linkA}})
     for (const auto& [vs, vd] : trianglesOf(vl, n))
       for (const int corner : vd ? std::vector<int>{0, 3, 4} : std::vector<int>{0, 1, 2})
-        for (const auto& [es, ed] : trianglesOf(el, n))
+        for (const auto& [es, ed] : trianglesOf(el, n)) {
+          SelfContact nearest;
+          double inside = -std::numeric_limits<double>::infinity();
           for (int edge = 0; edge < 3; ++edge) {
             const SelfContact c{WallVertex{vs, corner}, TriangleEdge{es, ed, edge}};
+            if (std::find(skip.begin(), skip.end(), c.vertex) != skip.end()) continue;
             const auto [l0, l1] = linksOf(c.vertex);
             if (std::min(std::abs(l0 - el), std::abs(l1 - el)) < 2) continue;  // a joint shared with a neighbour
             const SelfContactGap g = selfContactGap(chain, q, P, c);
-            if (!(g.edgeLength > 0.0) || g.along < -kSlack || g.along > 1.0 + kSlack) continue;
+            if (!(g.edgeLength > 0.0)) continue;
+            if (g.gap > inside) inside = g.gap, nearest = c;
+            if (g.along < -kSlack || g.along > 1.0 + kSlack) continue;
             if (std::abs(g.gap) < bestGap) bestGap = std::abs(g.gap), best = c;
           }
+          const double length = std::max(chain.segment(es).parameters().b1, chain.segment(es).parameters().a1);
+          if (std::isfinite(inside) && inside < -kSlack * length && inside < depth) depth = inside, deepest = nearest;
+        }
+  if (depth < 0.0) return deepest;
   if (!std::isfinite(bestGap))
     throw std::invalid_argument("self contact: no vertex of link " + std::to_string(linkA) + " or " +
                                 std::to_string(linkB) + " lies over an edge of the other");

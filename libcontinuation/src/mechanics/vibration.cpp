@@ -127,26 +127,36 @@ VibrationModes VibrationAnalysis::modes(ConstVectorRef q, const Wrench& F, const
 }
 
 VibrationModes VibrationAnalysis::modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
-                                        const ContactSet& contacts, ConstVectorRef wallForces, int count, bool shapes,
+                                        const ContactSet& contacts, ConstVectorRef forces, int count, bool shapes,
                                         const Vector& bodyGenerator) {
-  const int n = chain_.size(), w = contacts.wallCount();
+  const int n = chain_.size(), w = contacts.wallCount(), s = contacts.selfCount();
   contacts.check(n);
   std::vector<int> locked;
   for (const LockedJoint& j : contacts.joints()) locked.push_back(j.joint);
   checkArguments(q, count, bodyGenerator);
-  Matrix wallRows(w, n);
-  Vector gamma = bodyGenerator;  // as lockedLoadedStiffness: the wall's rows and its forces' generator
-  wallConstraintTerms(chain_, q, contacts, wallForces, "VibrationAnalysis::modes", wallRows, gamma);
-  return route(q, F, held, locked, wallRows, count, shapes, gamma);
+  if (forces.size() != w + s)
+    throw std::invalid_argument("VibrationAnalysis::modes: one force per wall vertex (" + std::to_string(w) +
+                                ") and per self contact (" + std::to_string(s) + "), got " +
+                                std::to_string(forces.size()));
+  Matrix rows(w + s, n), coupling;
+  Vector gamma = bodyGenerator;  // as lockedLoadedStiffness: the contacts' rows and their forces' generator
+  wallConstraintTerms(chain_, q, contacts, forces.head(w), "VibrationAnalysis::modes", rows.topRows(w), gamma);
+  selfConstraintTerms(chain_, q, contacts, forces.tail(s), "VibrationAnalysis::modes", rows.bottomRows(s), gamma,
+                      coupling);
+  return route(q, F, held, locked, rows, count, shapes, gamma, coupling);
 }
 
 VibrationModes VibrationAnalysis::route(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                                         const std::vector<int>& lockedJoints, const Matrix& wallRows, int count,
-                                        bool shapes, const Vector& bodyGenerator) {
+                                        bool shapes, const Vector& bodyGenerator, const Matrix& coupling) {
   const bool structured = route_ == VibrationRoute::Structured ||
                           (route_ == VibrationRoute::Automatic && chain_.size() >= kStructuredFrom);
-  if (structured) return structuredModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator);
-  return denseModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator);
+  if (structured && coupling.size() == 0)
+    return structuredModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator);
+  VibrationModes out = denseModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator, coupling);
+  if (structured)
+    out.fallback = "a held self contact couples the two bodies' joints outside the chain structure: dense route";
+  return out;
 }
 
 void VibrationAnalysis::massMatrix(ConstVectorRef q, MatrixRef M) {
@@ -178,11 +188,12 @@ Matrix VibrationAnalysis::constraintRows(ConstVectorRef q, const std::vector<int
 
 VibrationModes VibrationAnalysis::denseModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                                              const std::vector<int>& lockedJoints, const Matrix& wallRows, int count,
-                                             bool shapes, const Vector& bodyGenerator) {
+                                             bool shapes, const Vector& bodyGenerator, const Matrix& coupling) {
   const int n = chain_.size();
   Matrix H(n, n), M(n, n);
   totalPotentialHessian(chain_, q, F, H);  // K_q − K_g(F), eq 27
   addBodyLoadHessian(bodyGenerator, H);     // the body loads' Γ (eq B3)
+  if (coupling.size() > 0) H += coupling;   // the self contacts' rank-2 term (self_contact.h)
   model_.massMatrix(q, M);
   Matrix C = constraintRows(q, held, lockedJoints);
   if (wallRows.rows() > 0) {

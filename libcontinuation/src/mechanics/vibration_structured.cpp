@@ -192,7 +192,7 @@ VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench
   const Eigen::Index rows = Eigen::Index(held.size()) + wallRows.rows();
   if (rows > 3) {
     // the pencil is bordered by at most three rows (pencil_structure.h)
-    VibrationModes dense = denseModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator);
+    VibrationModes dense = denseModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator, Matrix());
     dense.fallback = std::to_string(rows) + " held and wall rows (the structured route borders at most 3): the dense route";
     return dense;
   }
@@ -254,7 +254,7 @@ VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench
   const double floor = 100.0 * kSearchTolerance * kSearchUnit * ws.scale;
   for (int j = 0; j < k; ++j) {
     if (!inverseIteration(ws, values, j, floor, s.modesTheta, s.massModes, s.BtB, s.xi, s.z, s.Mz)) {
-      VibrationModes dense = denseModes(q, F, held, lockedJoints, wallRows, count, true, bodyGenerator);
+      VibrationModes dense = denseModes(q, F, held, lockedJoints, wallRows, count, true, bodyGenerator, Matrix());
       dense.fallback = "the structured inverse iteration did not converge for mode " + std::to_string(j + 1) +
                        ": shapes (and values) from the dense route";
       return dense;

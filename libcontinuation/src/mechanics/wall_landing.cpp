@@ -1,10 +1,11 @@
 // Landing on the base wall (wall_landing.h): the active-set iteration over the vertices on the
-// wall and the locked joints.
+// wall, the self contacts and the locked joints.
 #include "buckle/mechanics/wall_landing.h"
 
 #include <cmath>
 #include <sstream>
 
+#include "buckle/mechanics/self_contact.h"
 #include "buckle/mechanics/wall_contact.h"
 
 namespace buckle::mechanics {
@@ -15,25 +16,37 @@ namespace {
 // a vertex that reaches the wall with zero force sits on both sides of the test to rounding.
 constexpr double kContactSlack = 1e-9;
 
-/// The most pulling contact of `ce` (a wall force or a locked joint's compression, in the chain's
-/// force / torque units) when it pulls by more than the slack: release it and return true.
+/// The most pulling contact of `ce` (a wall or self contact force or a locked joint's
+/// compression, in the chain's force / torque units) when it pulls by more than the slack: release
+/// it and return true.
 bool releasePulling(const ConstrainedEquilibrium& ce, double force, double torque, ContactSet& set,
                     std::string& what) {
   double worst = -kContactSlack;
-  int wall = -1, joint = -1;
+  int wall = -1, joint = -1, self = -1;
   for (int k = 0; k < set.wallCount(); ++k)
     if (ce.wallForces[k] / force < worst) {
       worst = ce.wallForces[k] / force;
       wall = k;
-      joint = -1;
+    }
+  for (int k = 0; k < set.selfCount(); ++k)
+    if (ce.selfForces[k] / force < worst) {
+      worst = ce.selfForces[k] / force;
+      self = k;
+      wall = -1;
     }
   for (const LockedJoint& l : set.joints()) {
     const double c = -double(int(l.side)) * ce.torques[l.joint] / torque;
     if (c < worst) {
       worst = c;
       joint = l.joint;
-      wall = -1;
+      wall = self = -1;
     }
+  }
+  if (self >= 0) {
+    const SelfContact c = set.self()[size_t(self)];
+    what = "self contact " + c.label() + " released (its force pulled)";
+    set.separate(c);
+    return true;
   }
   if (wall >= 0) {
     const WallVertex v = set.wall()[size_t(wall)];
@@ -49,14 +62,44 @@ bool releasePulling(const ConstrainedEquilibrium& ce, double force, double torqu
   return false;
 }
 
-/// A vertex not on the wall behind it, or a free joint past a limit, at q: add it, return true.
-bool addPenetrating(const Chain& chain, ConstVectorRef q, double length, ContactSet& set, std::string& what) {
+/// With self contact traced: two links that the solution puts into each other are held apart by
+/// the pair by which they touch; a held vertex beyond an end of its edge is held at the base
+/// corner on the corner's other edge too, or released past an end it cannot pass. True when the
+/// set changed.
+bool changeSelfContacts(const Chain& chain, ConstVectorRef q, double length, ContactSet& set, std::string& what) {
+  const Eigen::Matrix2Xd P = jointPositions(chain, q);
+  for (const SelfContact& c : set.self()) {
+    const SelfContactGap g = selfContactGap(chain, q, P, c);
+    if (heldAtCorner(chain, c, set.self()) || (g.along >= -kContactSlack && g.along <= 1.0 + kContactSlack)) continue;
+    SelfContact next;
+    if (g.along > 1.0 && cornerNeighbour(chain, c, next)) {
+      what = "self contact " + c.label() + " held at its edge's corner on " + next.edge.label() + " too";
+      set.hold(next);
+    } else {
+      what = "self contact " + c.label() + " released (the vertex slid off its edge)";
+      set.separate(c);
+    }
+    return true;
+  }
+  int a = -1, b = -1;
+  if (!(selfClearanceApart(chain, q, set.self(), &a, &b) < -kContactSlack * length) || a < 0 || b < 0) return false;
+  const SelfContact c = touchingPair(chain, q, a, b, set.self());
+  what = "self contact " + c.label() + " held (the links were in each other)";
+  set.hold(c);
+  return true;
+}
+
+/// A vertex not on the wall behind it, two links in each other (with `self`), or a free joint past
+/// a limit, at q: add it, return true.
+bool addPenetrating(const Chain& chain, ConstVectorRef q, double length, bool self, ContactSet& set,
+                    std::string& what) {
   const WallApproach a = nearestWallVertex(chain, q, set.wall());
   if (a.distance < -kContactSlack * length) {
     what = "vertex " + a.vertex.label() + " held on the wall (it was behind it)";
     set.touch(a.vertex);
     return true;
   }
+  if (self && changeSelfContacts(chain, q, length, set, what)) return true;
   for (int i = 0; i < chain.size(); ++i) {
     if (set.locked(i)) continue;
     const bool above = q[i] > chain.upperLimits()[i] + kContactSlack, below = q[i] < chain.lowerLimits()[i] - kContactSlack;
@@ -75,10 +118,17 @@ std::string describeWall(const ContactSet& set, const Vector& forces) {
   return os.str();
 }
 
+std::string describeSelf(const ContactSet& set, const Vector& forces) {
+  std::ostringstream os;
+  for (int k = 0; k < set.selfCount(); ++k)
+    os << (k ? ", " : "") << set.self()[size_t(k)].label() << " (contact force " << forces[k] << ")";
+  return os.str();
+}
+
 }  // namespace
 
 WallLanding landOnWall(const EquilibriumProblem& problem, const ContactSet& start, ConstVectorRef q, double lambda,
-                       double tolerance, int maxIterations) {
+                       double tolerance, int maxIterations, bool self) {
   WallLanding out;
   out.contacts = start;
   const int n = problem.segments();
@@ -93,16 +143,18 @@ WallLanding landOnWall(const EquilibriumProblem& problem, const ContactSet& star
     out.u = ce.u;
     out.residual = ce.residual;
     out.wallForces = ce.wallForces;
+    out.selfForces = ce.selfForces;
     out.torques = ce.torques;
     if (!ce.converged) {
       out.message = "the equilibrium with " + (out.contacts.wallCount() ? "vertices " + out.contacts.wallLabel() : "no vertex") +
-                    " on the wall did not converge (" + ce.message + ")" + trail;
+                    " on the wall" + (out.contacts.selfCount() ? " and the self contacts " + out.contacts.selfLabel() : "") +
+                    " did not converge (" + ce.message + ")" + trail;
       return out;
     }
     u = ce.u;
     std::string what;
     if (releasePulling(ce, force, torque, out.contacts, what) ||
-        addPenetrating(problem.chain(), ce.u.head(n), length, out.contacts, what)) {
+        addPenetrating(problem.chain(), ce.u.head(n), length, self, out.contacts, what)) {
       trail += "; " + what;
       continue;
     }
@@ -111,13 +163,16 @@ WallLanding landOnWall(const EquilibriumProblem& problem, const ContactSet& star
     // a contact whose force is zero would release at the slightest disturbance (as a joint stop)
     bool pushing = true;
     for (int k = 0; k < out.contacts.wallCount(); ++k) pushing = pushing && ce.wallForces[k] > 0.0;
+    for (int k = 0; k < out.contacts.selfCount(); ++k) pushing = pushing && ce.selfForces[k] > 0.0;
     for (const LockedJoint& l : out.contacts.joints())
       pushing = pushing && -double(int(l.side)) * ce.torques[l.joint] > 0.0;
     out.stable = out.stability.valid() && out.stability.stable() && pushing;
     std::ostringstream os;
     os << (out.stable ? "stable" : "not stable") << " equilibrium";
     if (out.contacts.wallCount() > 0) os << " on the wall: " << describeWall(out.contacts, ce.wallForces);
-    else os << " off the wall";
+    else if (out.contacts.selfCount() == 0) os << " off the wall";
+    if (out.contacts.selfCount() > 0)
+      os << (out.contacts.wallCount() > 0 ? ", " : " ") << "held on itself: " << describeSelf(out.contacts, ce.selfForces);
     if (!out.stability.valid()) os << " (stability not computed)";
     else if (!out.stability.stable()) os << " (" << out.stability.negative << " negative, " << out.stability.zero << " zero eigenvalues on the constrained tangent)";
     else if (!pushing) os << " (a contact force is zero)";

@@ -166,6 +166,8 @@ struct SpecialPointReport {
   /// point's before it) and their forces μ_v at the point, in the same order; empty otherwise.
   std::vector<WallVertex> wallVertices;
   Eigen::VectorXd wallForces;
+  /// The same for the stretch's self contacts (its ContactSet::self() order).
+  Eigen::VectorXd selfForces;
   /// BC / SC / WC / WR: where the chain touches the wall or itself (NaN otherwise).
   Eigen::Vector2d contactPoint = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
   /// BP of free joints: Koiter's coefficients of the bifurcated branch, λ(ξ) = λ + aξ + bξ² in the

@@ -194,11 +194,15 @@ class ContactProblem final : public continuation::Problem {
   int wallReleaseBoundary(int k) const;
   /// The self contacts' boundaries: the clearance of the link pairs not in contact (−1 when the
   /// base does not trace self contact, EquilibriumOptions::selfContactAsBoundary), the release of
-  /// self contact k (its force ≥ 0) and its vertex's distance to the ends of its edge
-  /// (min(t, 1 − t)·|e| ≥ 0: it slides off the edge there).
+  /// self contact k (its force ≥ 0) and, the first of two, its vertex's distance to the ends of
+  /// its edge (t·|e| ≥ 0 to the apex end, then (1 − t)·|e| ≥ 0 to the base corner: it slides off
+  /// the edge there; two smooth boundaries, as min(t, 1 − t) would let a step that crosses the
+  /// whole edge locate the end it started at; |e|, never crossed, for a vertex held at a corner by
+  /// both its edges: self_contact.h heldAtCorner).
   int selfClearanceBoundary() const;
   int selfReleaseBoundary(int k) const;
   int selfEdgeBoundary(int k) const;
+  bool selfHeldAtCorner(int k) const { return selfAtCorner_[size_t(k)] != 0; }
   double boundary(continuation::ProblemWorkspace& ws, int k, continuation::ConstVectorRef u,
                   double lambda) const override;
   /// Every boundary(k) at once: the rows whose locked entries are the contact torques, and the
@@ -254,6 +258,7 @@ class ContactProblem final : public continuation::Problem {
   double maxCompression_;
   std::vector<int> free_;
   std::vector<int> held_;
+  std::vector<char> selfAtCorner_;  // per self contact: heldAtCorner
 };
 
 /// K_q − K_g on the joints `free` (increasing) of `full`: the generator form κ_a δ_ab − h_max(a,b)

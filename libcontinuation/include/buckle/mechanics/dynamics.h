@@ -49,6 +49,15 @@
 // −μ_v ∂²x_v (the generator form of wall_contact.h, O(n)). A vertex leaves the wall where μ_v
 // returns to zero; contact (x_v = 0, the impact as at a joint) and release are located events.
 //
+// The chain's contact with itself (IntegrationOptions::self) is one more contact of that kind: a
+// vertex held on another link's triangle edge (self_contact.h), its row ∇gᵀ (h = g, the gap), its
+// multiplier the contact force μ, the velocity terms gaining q̇ᵀ∂²g q̇ = −q̇ᵀG(γ)q̇ + 2(cᵀq̇)(wᵀq̇)
+// (self_contact.h's generator γ and rank-2 pair c, w) and the reactions' Hessian −μ∂²g. The links
+// touch where the clearance of the link pairs holding no contact reaches zero (the touching
+// vertex–edge pair is held, with the impact), a contact releases where μ returns to zero, and a
+// vertex at the base corner of its edge is held on the corner's other edge too (pinned there
+// until either force returns to zero) or, at an end it cannot pass, released.
+//
 // Both models append the dissipated energy to the state; the integrator (simulate) stops at
 // rest (velocity and equilibrium residual below tolerance) or at a guard (time, steps, a joint
 // limit without contact, step-size underflow, a non-finite state) and says which. Models own
@@ -57,6 +66,7 @@
 #pragma once
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <Eigen/Core>
 #include <functional>
 #include <limits>
@@ -70,6 +80,7 @@
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/end_condition.h"
+#include "buckle/mechanics/self_contact.h"
 #include "buckle/mechanics/wall_contact.h"
 
 namespace buckle::mechanics {
@@ -167,9 +178,18 @@ class DynamicsModel {
   /// Throws std::invalid_argument for a vertex that is not a moving one (checkWallVertex) or a
   /// duplicate.
   void setWallContacts(const std::vector<WallVertex>& vertices);
+  /// Self contacts held (file comment), in the order of their rows (after the wall's).
+  const std::vector<SelfContact>& selfContacts() const { return self_; }
+  int selfCount() const { return static_cast<int>(self_.size()); }
+  /// Sets the self contacts held (no duplicates); resizes the constraint workspace. Throws
+  /// std::invalid_argument for a contact that is not one of the chain's (checkSelfContact) or a
+  /// duplicate.
+  void setSelfContacts(const std::vector<SelfContact>& contacts);
   /// Contact torques (as contactTorques) and the wall forces μ_v (one per wallContacts() entry)
   /// at state x: the multipliers of their rows. Evaluates the right-hand side once.
   void contactForces(const double* x, VectorRef torques, VectorRef wallForces);
+  /// The same and the self contacts' forces μ (one per selfContacts() entry).
+  void contactForces(const double* x, VectorRef torques, VectorRef wallForces, VectorRef selfForces);
   /// At a contact instant: sets the locked joints' angles to their limits and (inertial) makes
   /// the velocity admissible by the inelastic impact; returns the kinetic energy lost (added to
   /// the dissipated energy in x).
@@ -220,17 +240,19 @@ class DynamicsModel {
 
  protected:
   DynamicsModel(const Chain& chain, const EndCondition& end);
-  /// Constraint rows: the held coordinates, then the locked joints, then the wall vertices.
-  int constraintCount() const { return heldCount() + lockedCount() + wallCount(); }
-  /// The first wall vertex's row.
+  /// Constraint rows: the held coordinates, the locked joints, the wall vertices, the self contacts.
+  int constraintCount() const { return heldCount() + lockedCount() + wallCount() + selfCount(); }
+  /// The first wall vertex's row, and the first self contact's.
   int wallRowBegin() const { return heldCount() + lockedCount(); }
+  int selfRowBegin() const { return wallRowBegin() + wallCount(); }
   /// The derived model's constraint-sized workspace after setContacts().
   virtual void resizeConstraints() {}
   /// The constraint workspace for the current held, locked and wall rows (setContacts,
   /// setWallContacts); calls resizeConstraints().
   void rebuildConstraints();
-  /// The wall vertices' rows ∇x_vᵀ, h = x_v and generators (wallGen_) at the cached kinematics.
-  void wallRows();
+  /// The wall vertices' rows ∇x_vᵀ, h = x_v and generators (wallGen_), then the self contacts'
+  /// ∇gᵀ, h = g, generators and rank-2 pairs (selfCoupling_, selfWeights_), at the cached kinematics.
+  void gapRows();
   /// Kinematics, J, E, ∇Π, the joint stiffnesses K_q and (with held coordinates) J_h, h, the
   /// Cholesky of J_h J_hᵀ at q, from one pass of the spring model. Cached for the last q (bitwise;
   /// setContacts() invalidates): a step evaluates the right-hand side at the accepted state, and
@@ -248,7 +270,11 @@ class DynamicsModel {
   std::vector<int> held_, loaded_;
   std::vector<int> sides_, locked_;  ///< contact side per joint; the locked joints
   std::vector<WallVertex> wall_;     ///< vertices held on the base wall
-  Matrix wallGen_;  ///< n×w: generators g_m = x_v − x_Pm of −∂²x_v (wall_contact.h), at the statics
+  std::vector<SelfContact> self_;    ///< self contacts held
+  /// n×(w+s): generators g_m = x_v − x_Pm of −∂²x_v (wall_contact.h), then the self contacts' γ
+  /// (self_contact.h), at the statics
+  Matrix wallGen_;
+  Matrix selfCoupling_, selfWeights_;  ///< n×s: the self contacts' rank-2 pairs c, w
   Wrench loads_;  ///< F_l on loaded coordinates, 0 on held ones
   ChainData data_;
   Matrix J_;      ///< 3×n end Jacobian
@@ -258,8 +284,8 @@ class DynamicsModel {
   Vector staticsQ_;      ///< q of the cached statics
   Vector sinHalf_, cosHalf_;  ///< sin(q_i/2), cos(q_i/2) of the cached statics (evaluateStatics)
   bool staticsValid_ = false;
-  Matrix Jh_;     ///< m×n constraint rows: held coordinates, e_iᵀ of the locked joints, ∇x_vᵀ
-  Vector h_;      ///< p_h − target, then q_i − q̄_i, then x_v
+  Matrix Jh_;     ///< m×n constraint rows: held coordinates, e_iᵀ of the locked joints, ∇x_vᵀ, ∇gᵀ
+  Vector h_;      ///< p_h − target, then q_i − q̄_i, then x_v, then g
   Matrix A_;      ///< J_h J_hᵀ
   Eigen::LLT<Matrix> llt_;
   Vector r_, tmpM_;  // size m (r_: the multipliers of the last right-hand side)
@@ -267,7 +293,7 @@ class DynamicsModel {
   std::vector<double> fdPlus_, fdMinus_, fdState_;  // for the finite-difference jacobian()
   Eigen::Matrix2Xd positions_;  ///< joint positions (jointPositions' columns) at the statics, with wall rows
   Vector wallRow_;               ///< scratch, size n
-  Vector wallForces_;            ///< scratch of contactTorques, size w
+  Vector wallForces_, selfForces_;  ///< scratch of contactTorques, sizes w and s
   std::shared_ptr<BodyLoadTerms> body_;  ///< null: no body loads
   Vector bodyWork_;                      ///< τ or γ of the body loads (size n)
   double bodyPotential_ = 0.0;           ///< V at the cached statics
@@ -295,7 +321,10 @@ class GradientFlowModel final : public DynamicsModel {
   /// The exact Jacobian J̃ = −(P H_r + κ_h J_h⁺ J_h − J_h⁺E)/c with H_r = K_q − K_g(F_l + r)
   /// (eq 27, the reactions r acting as end loads) and E_k = −c (∇²p_k q̇)ᵀ; the energy row
   /// 2c q̇ᵀJ̃. With H_r = U T Uᵀ (chain_structure.h), I − aJ̃ is the bordered system
-  /// [[H_r + (c/a) I, J_hᵀ], [J_h (H_r − κ_h I) + E, J_h J_hᵀ]], block elimination: O(n m).
+  /// [[H_r + (c/a) I, J_hᵀ], [J_h (H_r − κ_h I) + E, J_h J_hᵀ]], block elimination: O(n m). The
+  /// reactions' −Σ μ ∂²x_v and −Σ μ ∂²g join H_r's generator; a self contact's rank-2 part two
+  /// more border columns (dynamics_gradient_flow.cpp). A border wider than
+  /// ChainStructure::kMaxBorder takes the dense LU of I − aJ̃ (central differences of rhs()).
   bool solveLinearized(const double* x, double a, const double* b, double* k) override;
 
   double damping() const { return c_; }
@@ -316,6 +345,9 @@ class GradientFlowModel final : public DynamicsModel {
   Vector factoredQdot_;
   Vector lastState_;  ///< x of the factored system (with factoredFor_ = a; NaN: none)
   double factoredFor_ = std::numeric_limits<double>::quiet_NaN();
+  // a border wider than ChainStructure::kMaxBorder: the dense LU of I − aJ̃ (central differences)
+  bool solveLinearizedDense(const double* x, double a, const double* b, double* k);
+  Eigen::PartialPivLU<Matrix> denseLU_;
 };
 
 /// (D2). x = (q, q̇, W_d), dx/dt = (q̇, q̈, q̇ᵀ D q̇). Only constructible from explicit mass data.
@@ -453,6 +485,12 @@ struct IntegrationOptions {
   /// wall vertices (setWallContacts) and ends with those on the wall then
   /// (DynamicsResult::wallContacts). false: the chain passes through the wall.
   bool wall = false;
+  /// The chain's contact with itself as a one-sided, friction-free contact (file comment): a
+  /// vertex that reaches another link's triangle is held on its edge and slides along it, and
+  /// leaves it where its force returns to zero. The integration starts with the model's self
+  /// contacts (setSelfContacts) and ends with those held then (DynamicsResult::selfContacts).
+  /// false: the links pass through each other.
+  bool self = false;
   /// Hand-over test (optional; jump.h, JumpOptions::handover): consulted after an accepted step
   /// without contacts (no locked joint, no vertex on the wall) whose naturalResidual() is <= settleResidual, at most every
   /// settleInterval accepted steps, with the joint angles of that step. True ends the
@@ -497,9 +535,11 @@ struct ContactEvent {
   int side = 0;            ///< +1 upper limit, −1 lower
   /// A wall event (segment ≥ 0): the vertex that reached or left the wall (joint −1).
   WallVertex vertex{-1, 0};
+  /// A self contact event (self.vertex.segment ≥ 0): the contact held or released (joint −1).
+  SelfContact self;
   bool contact = true;     ///< true: the joint locked / the vertex held; false: released
-  /// Contact torque τ_c,i (a joint) or wall force μ_v (a vertex) just after the contact / at the
-  /// release.
+  /// Contact torque τ_c,i (a joint), wall force μ_v (a vertex) or self contact force just after
+  /// the contact / at the release.
   double torque = 0.0;
   double kineticLost = 0.0;  ///< inertial: the impact's kinetic-energy loss
 };
@@ -523,6 +563,8 @@ struct DynamicsResult {
   Vector contactTorques;                    ///< τ_c,i at the end (0 at free joints)
   std::vector<WallVertex> wallContacts;     ///< IntegrationOptions::wall: the vertices on the wall at the end
   Vector wallForces;                        ///< their wall forces μ_v at the end
+  std::vector<SelfContact> selfContacts;    ///< IntegrationOptions::self: the self contacts held at the end
+  Vector selfForces;                        ///< their forces at the end
   std::vector<TrajectorySample> trajectory;
   bool trajectoryTruncated = false;
 };

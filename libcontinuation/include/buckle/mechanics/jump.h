@@ -144,6 +144,12 @@ struct JumpOptions {
   /// (the chain passes through it, as the continuation without the wall); a landing behind it is
   /// flagged (JumpResult::behindWall) and said so in the message.
   bool wall = false;
+  /// The chain's contact with itself as a one-sided contact (self_contact.h; the scene traces
+  /// self contact): links that meet during the dynamics are held apart by the touching vertex–edge
+  /// pair (IntegrationOptions::self), which slides, and releases where its force returns to zero;
+  /// the chain comes to rest on the constrained equilibrium with the self contacts then
+  /// (wall_landing.h's active set). false: the links pass through each other.
+  bool self = false;
 
   /// Empty when valid for `problem`, else what is wrong, the field named by its path.
   std::string validate(const EquilibriumProblem& problem, const std::string& prefix = "") const;
@@ -188,6 +194,9 @@ struct JumpResult {
   /// Vertices held on the wall at the landing and their forces μ_v (wall_contact.h; empty: none).
   std::vector<WallVertex> wallContacts;
   Vector wallForces;
+  /// Self contacts held at the landing and their forces (self_contact.h; empty: none).
+  std::vector<SelfContact> selfContacts;
+  Vector selfForces;
   /// Without JumpOptions::wall: the polished landing has a vertex behind the base wall (the
   /// dynamics passed through it; detected, not prevented).
   bool behindWall = false;
@@ -205,8 +214,9 @@ struct SuddenLoadOptions {
   continuation::CorrectorOptions polish = defaultPolishOptions();
   /// ‖q_dynamic − q_static‖∞ above this: the two answers differ.
   double sameStateTolerance = 1e-6;
-  /// The base wall as a one-sided contact (as JumpOptions::wall).
+  /// The base wall and the chain's contact with itself as one-sided contacts (as JumpOptions).
   bool wall = false;
+  bool self = false;
 
   /// Empty when valid for `chain`, else what is wrong, the field named by its path.
   std::string validate(const Chain& chain, const std::string& prefix = "") const;
@@ -233,6 +243,8 @@ struct SuddenLoadResult {
   WallVertex wallVertex;
   std::vector<WallVertex> wallContacts;
   Vector wallForces;
+  std::vector<SelfContact> selfContacts;  ///< as JumpResult
+  Vector selfForces;
   double peakKinetic = 0.0;          ///< over the recorded trajectory
   double maxExcursion = 0.0;         ///< max ‖q(t) − start‖∞ over the recorded trajectory
   // comparison with the quasi-static answer (NaN / false when no q_static was given)

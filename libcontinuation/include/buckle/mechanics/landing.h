@@ -35,6 +35,12 @@ struct WallSupport {
   double force = 0.0;    ///< the wall force μ_v (along +x on the chain): > 0
 };
 
+/// A self contact held at a landing (self_contact.h).
+struct SelfSupport {
+  SelfContact contact;
+  double force = 0.0;    ///< pushing the two bodies apart: > 0
+};
+
 struct Landing {
   bool tried = false;
   bool success = false;         ///< came to rest on a stable (constrained) equilibrium or on a joint limit
@@ -43,10 +49,11 @@ struct Landing {
   /// stable equilibrium on it was found.
   bool wallBlocked = false;
   /// "stable equilibrium", "stable equilibrium in contact", "stable equilibrium on the wall",
-  /// "joint limit" or "none"
+  /// "stable equilibrium held on itself", "joint limit" or "none"
   std::string kind;
   std::vector<JointContact> contacts;  ///< joints in contact at the landing (empty: none)
   std::vector<WallSupport> wall;       ///< vertices held on the base wall (empty: none)
+  std::vector<SelfSupport> self;       ///< self contacts held (empty: none)
   std::string message;
   Eigen::VectorXd q;            ///< joint angles at the landing (empty: none)
   Wrench F = Wrench::Zero();    ///< end wrench there (loads and reactions)

@@ -58,6 +58,9 @@ struct JumpRecord {
   /// Vertices held on the base wall at the landing and their forces (jump.h; empty: none).
   std::vector<WallVertex> wallContacts;
   Vector wallForces;
+  /// Self contacts held at the landing and their forces (jump.h; empty: none).
+  std::vector<SelfContact> selfContacts;
+  Vector selfForces;
   bool success = false;
   bool wallBlocked = false;     ///< not landed because of the base wall (landing.h, Landing::wallBlocked)
   std::string message;

@@ -85,18 +85,37 @@ void selfContactDerivatives(const Eigen::Matrix2Xd& P, const SelfContact& c, con
 /// The vertex–edge pair by which links linkA and linkB (contact_geometry.h numbering, at least two
 /// apart) touch at q: among every vertex of one link's triangles against every edge of the
 /// other's, the one whose vertex lies nearest to the edge's line with its projection on the edge
-/// (0 ≤ t ≤ 1), by |g|. Throws std::invalid_argument for links that cannot touch.
-SelfContact touchingPair(const Chain& chain, ConstVectorRef q, int linkA, int linkB);
+/// (0 ≤ t ≤ 1), by |g|; but where a vertex lies inside a triangle of the other link (beyond
+/// rounding: a step of the dynamics or a landing's solve ended there), the deepest one on the
+/// edge it is nearest to. The vertices `held` on the same pair of links and their edges' ends are
+/// left out: the pair's second contact. Throws std::invalid_argument for links that cannot touch.
+SelfContact touchingPair(const Chain& chain, ConstVectorRef q, int linkA, int linkB,
+                         const std::vector<SelfContact>& held = {});
 
-/// Where a held vertex that reaches the base-corner end of a side edge (along = 1) slides on: the
-/// same side's edge of the link's other triangle, which shares that corner when the two
-/// triangles' half-heights are equal (the link's outline). False for the apex end (along = 0), a
-/// base edge, a link with one triangle there or unequal half-heights: not followed.
-bool slideOntoNeighbour(const Chain& chain, const SelfContact& c, double along, SelfContact& next);
+/// The clearance of the pairs of links that hold contacts in `held`: each vertex of either link's
+/// triangles, but those held on the pair and their edges' ends, against the other link's
+/// triangles (its distance outside, minus its distance to the nearest edge inside); the smallest,
+/// the pair it was found on in linkA, linkB when given (+inf without contacts). O(contacts).
+double heldPairsClearance(const Chain& chain, ConstVectorRef q, const Eigen::Matrix2Xd& P,
+                          const std::vector<SelfContact>& held, int* linkA = nullptr, int* linkB = nullptr);
 
-/// d_self (contact_geometry.h) over the pairs of links that hold none of `held` between them: the
-/// clearance boundary of a chain holding those self contacts. The pair it was found on in linkA,
-/// linkB when given. O(n log n) unless the chain folds onto itself.
+/// The contact of the same vertex on the edge that shares `c`'s base corner (t = 1): the same
+/// side's edge of the link's other triangle (the link's outline is a diamond, convex at its ±a
+/// corners, when the two triangles' half-heights are equal). False for a base edge, a link with
+/// one triangle there or unequal half-heights (the outline has a step there). (At the apex, t = 0,
+/// the edge meets the next link's at a joint, where the outline has a notch or a ridge: a vertex
+/// there touches two links at a point of both, which the model does not hold.)
+bool cornerNeighbour(const Chain& chain, const SelfContact& c, SelfContact& next);
+
+/// Whether `c` is half of a vertex held at its edge's base corner: its corner neighbour is held
+/// too. The two gaps then pin the vertex to the corner (g = 0 along both edges' normals), and the
+/// force may point anywhere in the corner's normal cone (both forces ≥ 0).
+bool heldAtCorner(const Chain& chain, const SelfContact& c, const std::vector<SelfContact>& held);
+
+/// d_self (contact_geometry.h) over the pairs of links that hold none of `held` between them, and
+/// heldPairsClearance over those that do: the clearance boundary of a chain holding those self
+/// contacts. The pair it was found on in linkA, linkB when given. O(n log n) unless the chain
+/// folds onto itself.
 double selfClearanceApart(const Chain& chain, ConstVectorRef q, const std::vector<SelfContact>& held,
                           int* linkA = nullptr, int* linkB = nullptr);
 

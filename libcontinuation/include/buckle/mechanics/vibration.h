@@ -85,14 +85,18 @@ class VibrationAnalysis {
   VibrationModes modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                        const std::vector<int>& lockedJoints, int count, bool shapes = true,
                        const Vector& bodyGenerator = Vector());
-  /// The same on a contact stretch: the joints of `contacts` locked, and each of its vertices on
-  /// the base wall held there (x_v = 0, friction-free) by its force wallForces[k] (order of
-  /// contacts.wall()). The wall rows ∇x_v join C_h and the forces' −Σ μ_v ∂²x_v join H
-  /// (wall_contact.h), so (V1) is the linearisation about the constrained equilibrium while
-  /// every contact stays closed. Throws std::invalid_argument when wallForces has not one force
-  /// per wall vertex or a contact is not one of the chain's.
+  /// The same on a contact stretch: the joints of `contacts` locked, each of its vertices on
+  /// the base wall held there (x_v = 0, friction-free) and each of its self contacts closed
+  /// (g = 0) by its force: `forces` the wall forces (order of contacts.wall()) then the self
+  /// contacts' (order of contacts.self()), ContactProblem::contactForces's layout. The rows ∇x_v,
+  /// ∇g join C_h and the forces' −Σ μ ∂²x_v, −Σ μ ∂²g join H (wall_contact.h, self_contact.h), so
+  /// (V1) is the linearisation about the constrained equilibrium while every contact stays
+  /// closed. A held self contact's Hessian has a rank-2 part outside the chain structure: such a
+  /// point takes the dense route (VibrationModes::fallback says so when the structured was due).
+  /// Throws std::invalid_argument when `forces` has not one force per contact or a contact is not
+  /// one of the chain's.
   VibrationModes modes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held, const ContactSet& contacts,
-                       ConstVectorRef wallForces, int count, bool shapes = true, const Vector& bodyGenerator = Vector());
+                       ConstVectorRef forces, int count, bool shapes = true, const Vector& bodyGenerator = Vector());
 
   /// Joint-space mass matrix M(q) (dense, n×n).
   void massMatrix(ConstVectorRef q, MatrixRef M);
@@ -106,14 +110,15 @@ class VibrationAnalysis {
   };
   // Throws std::invalid_argument for a q, count or generator that does not fit the chain.
   void checkArguments(ConstVectorRef q, int count, const Vector& bodyGenerator) const;
-  // Both routes take the wall rows (w×n, below C_h's rows; empty: none) beside the held and
-  // locked ones; the wall forces' term is already in bodyGenerator.
+  // Both routes take the contact rows (wall then self, below C_h's rows; empty: none) beside the
+  // held and locked ones; the contact forces' generator terms are already in bodyGenerator. The
+  // self contacts' rank-2 term (`coupling`, n×n; empty: none) sends the point to the dense route.
   VibrationModes route(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                        const std::vector<int>& lockedJoints, const Matrix& wallRows, int count, bool shapes,
-                       const Vector& bodyGenerator);
+                       const Vector& bodyGenerator, const Matrix& coupling = Matrix());
   VibrationModes denseModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                             const std::vector<int>& lockedJoints, const Matrix& wallRows, int count, bool shapes,
-                            const Vector& bodyGenerator);
+                            const Vector& bodyGenerator, const Matrix& coupling);
   VibrationModes structuredModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                                  const std::vector<int>& lockedJoints, const Matrix& wallRows, int count, bool shapes,
                                  const Vector& bodyGenerator);

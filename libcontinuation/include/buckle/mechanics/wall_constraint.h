@@ -1,6 +1,7 @@
-// The base wall's terms in the linearisation about an equilibrium with vertices held on it
-// (contact.h, wall_contact.h): shared by the loaded stiffness and the vibration modes of such a
-// point, which see the same constrained chain.
+// The base wall's and the self contacts' terms in the linearisation about an equilibrium with
+// vertices held on the wall or on other links (contact.h, wall_contact.h, self_contact.h): shared
+// by the loaded stiffness and the vibration modes of such a point, which see the same constrained
+// chain.
 #pragma once
 
 #include "buckle/mechanics/contact.h"
@@ -14,5 +15,14 @@ namespace buckle::mechanics {
 /// std::invalid_argument, naming `caller`, unless there is one force per vertex on the wall.
 void wallConstraintTerms(const Chain& chain, ConstVectorRef q, const ContactSet& contacts, ConstVectorRef wallForces,
                          const char* caller, MatrixRef rows, Vector& generator);
+
+/// The same for the self contacts of `contacts` (self_contact.h), forces in contacts.self()'s
+/// order: their rows ∇gᵀ into `rows` (s × n), and −Σ μ ∂²g as its generator part (γ += μ γ_g,
+/// `generator` as above) and its rank-2 part −Σ μ (c wᵀ + w cᵀ), added to `coupling` (n × n, set
+/// to zeros first when empty and a contact is held). The rank-2 part has no place in the chain
+/// structure: a caller holding it takes a dense route. Throws std::invalid_argument, naming
+/// `caller`, unless there is one force per self contact.
+void selfConstraintTerms(const Chain& chain, ConstVectorRef q, const ContactSet& contacts, ConstVectorRef selfForces,
+                         const char* caller, MatrixRef rows, Vector& generator, Matrix& coupling);
 
 }  // namespace buckle::mechanics
