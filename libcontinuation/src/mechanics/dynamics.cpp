@@ -309,22 +309,28 @@ void DynamicsModel::setContacts(const std::vector<int>& sides) {
   rebuildConstraints();
 }
 
-void DynamicsModel::setWallContacts(const std::vector<WallVertex>& vertices) {
-  for (size_t k = 0; k < vertices.size(); ++k) {
-    checkWallVertex(vertices[k], segments());
-    if (std::find(vertices.begin(), vertices.begin() + long(k), vertices[k]) != vertices.begin() + long(k))
-      throw std::invalid_argument("wall contacts: vertex " + vertices[k].label() + " given twice");
+namespace {
+
+// Each contact checked (`check` throws for one that is not the chain's) and given once.
+template <class Contact, class Check>
+void checkContacts(const std::vector<Contact>& contacts, Check check, const char* what) {
+  for (size_t k = 0; k < contacts.size(); ++k) {
+    check(contacts[k]);
+    if (std::find(contacts.begin(), contacts.begin() + long(k), contacts[k]) != contacts.begin() + long(k))
+      throw std::invalid_argument(std::string(what) + contacts[k].label() + " given twice");
   }
+}
+
+}  // namespace
+
+void DynamicsModel::setWallContacts(const std::vector<WallVertex>& vertices) {
+  checkContacts(vertices, [this](const WallVertex& v) { checkWallVertex(v, segments()); }, "wall contacts: vertex ");
   wall_ = vertices;
   rebuildConstraints();
 }
 
 void DynamicsModel::setSelfContacts(const std::vector<SelfContact>& contacts) {
-  for (size_t k = 0; k < contacts.size(); ++k) {
-    checkSelfContact(contacts[k], segments());
-    if (std::find(contacts.begin(), contacts.begin() + long(k), contacts[k]) != contacts.begin() + long(k))
-      throw std::invalid_argument("self contacts: " + contacts[k].label() + " given twice");
-  }
+  checkContacts(contacts, [this](const SelfContact& c) { checkSelfContact(c, segments()); }, "self contacts: ");
   self_ = contacts;
   rebuildConstraints();
 }
