@@ -6,7 +6,8 @@
 namespace buckle::scene {
 
 size_t sampleBytes(const mechanics::PointReport& p) {
-  const auto values = size_t(p.q.size() + p.omega.size() + p.inputs.size() + p.wallForces.size());
+  const auto values =
+      size_t(p.q.size() + p.omega.size() + p.inputs.size() + p.wallForces.size() + p.selfForces.size());
   return sizeof(mechanics::PointReport) + sizeof(double) * values;
 }
 
