@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <atomic>
 #include <limits>
 #include <random>
 
@@ -364,4 +365,24 @@ TEST_CASE("self contact: a vertex at its edge's corner is pinned there on both e
     CHECK(reached > 0.0171 * sK * sL * sL);
     CHECK(b.stopReason != cont::StopReason::ClosedLoop);
   }
+}
+
+TEST_CASE("self contact: a time limit or signal at the contact event ends the branch interrupted, not finished",
+          "[self_contact]") {
+  // the interrupt raised on the step that lands on SH: the branch must not end there as if the
+  // contact boundary were a regular end
+  namespace cont = buckle::continuation;
+  Hook hook(1.0, 1.0);
+  mech::EquilibriumBranchOptions o = hook.upTo(0.25);
+  std::atomic<bool> stop{false};
+  o.tracer.interrupt.watch(&stop, "signal");
+  o.tracer.onStep = [&stop, &hook](const cont::StepInfo& step) {  // the step landed on the touch
+    if (mech::selfClearance(hook.chain, step.point.u.head(8)).distance < 1e-9) stop = true;
+    return cont::StepAction::Continue;
+  };
+  const mech::EquilibriumBranches t = hook.trace(o);
+  REQUIRE(stop);
+  const cont::Branch& b = t.tree.branches[0];
+  CHECK(b.stopReason == cont::StopReason::Interrupted);
+  CHECK(b.points.back().lambda < 0.25);
 }

@@ -139,6 +139,16 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     const continuation::Problem& traced = current ? static_cast<const continuation::Problem&>(*current) : problem;
     const BoundaryEvent hit = endEvent(problem, traced, branch, stretches.back().locked);
     if (!hit.any()) break;
+    // A time limit or a signal during the contact event: the branch ends interrupted, not as if
+    // its contact boundary were a regular end.
+    const auto interrupted = [&branch](const std::string& why) {
+      branch.stopReason = continuation::StopReason::Interrupted;
+      branch.stopMessage = why + " (at a contact event)";
+    };
+    if (options.interrupt.requested()) {
+      interrupted(options.interrupt.describe());
+      break;
+    }
     const continuation::SpecialPoint& at = branch.specialPoints.back();
     const ContactChange change = changeOf(problem, at, hit, stretches.back().locked);
     if (!change.followed) {
@@ -236,6 +246,10 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     continuation::Branch stretch;
     stretch.points.push_back(p0);
     tracer.continueBranch(stretch);
+    if (stretch.stopReason == continuation::StopReason::Interrupted && stretch.points.size() < 2) {
+      interrupted(stretch.stopMessage);
+      break;
+    }
     // A stretch that does not leave its start, or leaves it to the wrong side (a contact that
     // pulls at once, or a released joint or vertex that goes on past its limit or the wall),
     // would chatter: stop.
