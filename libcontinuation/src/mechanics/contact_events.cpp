@@ -94,8 +94,10 @@ ContactChange changeOf(const EquilibriumProblem& problem, const continuation::Sp
   return c;
 }
 
-double contactRate(EquilibriumProblem& problem, const ContactSet& before, const BoundaryEvent& hit, bool release,
-                   int wallIndex, const continuation::ContinuationPoint& p0) {
+double contactRate(EquilibriumProblem& problem, const ContactSet& before, const BoundaryEvent& hit,
+                   const ContactChange& change, const continuation::ContinuationPoint& p0) {
+  const bool release = change.release;
+  const int wallIndex = change.index;
   const int n = problem.segments(), D = int(p0.u.size());
   if (hit.onSelf) {  // a self contact's force (wallIndex: its index), or a released one's gap ∇g·t_q
     if (!release) return p0.tangent[problem.dimension() + before.wallCount() + wallIndex];
@@ -103,7 +105,7 @@ double contactRate(EquilibriumProblem& problem, const ContactSet& before, const 
     const SelfContactGap g = selfContactGap(problem.chain(), p0.u.head(n), P, hit.self);
     continuation::Vector grad(n), gen(n), coupling(n), weights(n);
     selfContactDerivatives(P, hit.self, g, grad, gen, coupling, weights);
-    return grad.dot(p0.tangent.head(n));
+    return (change.slidesOn >= 0 ? -1.0 : 1.0) * grad.dot(p0.tangent.head(n));
   }
   if (hit.joint.joint >= 0) {
     const int i = hit.joint.joint;

@@ -51,8 +51,10 @@ ContactChange changeOf(const EquilibriumProblem& problem, const continuation::Sp
 // contact's boundary g: a released joint's g = side·(q̄ − q) moves with −side·t_q; a joint contact's
 // compression −side·τ_c with −side·(F_u,i t_u + F_λ,i t_λ) (row i of the stretch before, exact); a
 // vertex's wall force μ_v with its own component of the tangent; a released vertex's x_v with
-// ∇x_v·t_q.
-double contactRate(EquilibriumProblem& problem, const ContactSet& before, const BoundaryEvent& hit, bool release,
-                   int wallIndex, const continuation::ContinuationPoint& p0);
+// ∇x_v·t_q; a self contact's force and gap the same way, but a vertex leaving a corner
+// (ContactChange::slidesOn) with −∇g·t_q of the released edge: the outline is convex there, so the
+// vertex moving along the other edge, away from the corner, goes inside the released edge's line.
+double contactRate(EquilibriumProblem& problem, const ContactSet& before, const BoundaryEvent& hit,
+                   const ContactChange& change, const continuation::ContinuationPoint& p0);
 
 }  // namespace buckle::mechanics

@@ -251,13 +251,7 @@ SelfClearance selfClearance(const Chain& chain, ConstVectorRef q) { return selfC
 double selfClearanceApart(const Chain& chain, ConstVectorRef q, const std::vector<SelfContact>& held, int* linkA,
                           int* linkB) {
   SelfClearanceHint hint;
-  for (const SelfContact& c : held) {
-    // the vertex's links: a joint is on both of its segment's
-    const int le = c.edge.link();
-    const int first = c.vertex.corner == 0 || !c.vertex.distal() ? c.vertex.segment : c.vertex.segment + 1;
-    const int last = c.vertex.corner == 0 || c.vertex.distal() ? c.vertex.segment + 1 : c.vertex.segment;
-    for (int lv = first; lv <= last; ++lv) hint.exclude.push_back({std::min(lv, le), std::max(lv, le)});
-  }
+  hint.exclude = heldLinkPairs(held);
   const SelfClearance c = selfClearance(chain, q, hint, nullptr);
   if (linkA) *linkA = c.linkA;
   if (linkB) *linkB = c.linkB;

@@ -41,6 +41,26 @@ void toBaseUnknowns(continuation::SpecialPoint& sp, int N) {
   }
 }
 
+// A stretch traced from the branch's last point appended to the branch (its points after the
+// first, its special points), in the branch's unknowns and arclength; the index of the branch's
+// point the stretch started from.
+int appendStretch(continuation::Branch& stretch, int N, continuation::Branch& branch) {
+  const int base = int(branch.points.size()) - 1;  // the stretch's point 0 is the branch's last point
+  const double s0 = branch.points.back().arclength;
+  for (size_t i = 1; i < stretch.points.size(); ++i) {
+    stretch.points[i].arclength += s0;
+    toBaseUnknowns(stretch.points[i].u, stretch.points[i].tangent, N);
+    branch.points.push_back(std::move(stretch.points[i]));
+  }
+  for (continuation::SpecialPoint& sp : stretch.specialPoints) {
+    sp.index += base;
+    sp.arclength += s0;
+    toBaseUnknowns(sp, N);
+    branch.specialPoints.push_back(std::move(sp));
+  }
+  return base;
+}
+
 // The mirror image's share of what continueUnderContact added to its source after the source's
 // first `traced` (points, special points): the points after them and the special points from
 // the last traced one on (where the contact began; its note may have grown), and the stop.
@@ -224,10 +244,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       giveUp("no unique tangent at the point");
       break;
     }
-    // leaving a corner along the edge that stays takes the vertex inside the released edge's line
-    // (the outline is convex there): its gap decreases
-    const double rate = (change.slidesOn >= 0 ? -1.0 : 1.0) *
-                        contactRate(problem, stretches.back().locked, hit, release, wallIndex, p0);
+    const double rate = contactRate(problem, stretches.back().locked, hit, change, p0);
     if (rate < 0.0 && !startPoint(-p0.tangent, p0)) {
       giveUp("no unique tangent at the point");
       break;
@@ -265,19 +282,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
                      : "the contact would pull (tension)");
       break;
     }
-    const int base = int(branch.points.size()) - 1;  // the stretch's point 0 is the branch's last point
-    const double s0 = branch.points.back().arclength;
-    for (size_t i = 1; i < stretch.points.size(); ++i) {
-      stretch.points[i].arclength += s0;
-      toBaseUnknowns(stretch.points[i].u, stretch.points[i].tangent, N);
-      branch.points.push_back(std::move(stretch.points[i]));
-    }
-    for (continuation::SpecialPoint& sp : stretch.specialPoints) {
-      sp.index += base;
-      sp.arclength += s0;
-      toBaseUnknowns(sp, N);
-      branch.specialPoints.push_back(std::move(sp));
-    }
+    const int base = appendStretch(stretch, N, branch);
     branch.stopReason = stretch.stopReason;
     branch.stopMessage = stretch.stopMessage;
     if (branch.stopReason == continuation::StopReason::MaxPoints)  // the stretch's share named the branch's

@@ -1,6 +1,7 @@
 #include "buckle/mechanics/self_contact.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -26,6 +27,9 @@ std::vector<std::pair<int, bool>> trianglesOf(int link, int segments) {
   if (link <= segments - 1) t.push_back({link, false});
   return t;
 }
+
+// The corners of a segment's proximal (0, 1, 2) or distal (0, 3, 4) triangle.
+std::array<int, 3> cornersOf(bool distal) { return distal ? std::array{0, 3, 4} : std::array{0, 1, 2}; }
 
 Point R90(const Point& p) { return Point(-p.y(), p.x()); }
 
@@ -160,10 +164,7 @@ bool heldAtCorner(const Chain& chain, const SelfContact& c, const std::vector<Se
   return cornerNeighbour(chain, c, partner) && std::find(held.begin(), held.end(), partner) != held.end();
 }
 
-double heldPairsClearance(const Chain& chain, ConstVectorRef q, const Eigen::Matrix2Xd& P,
-                          const std::vector<SelfContact>& held, int* linkA, int* linkB) {
-  const int n = chain.size();
-  double best = std::numeric_limits<double>::infinity();
+std::vector<std::pair<int, int>> heldLinkPairs(const std::vector<SelfContact>& held) {
   std::vector<std::pair<int, int>> pairs;
   for (const SelfContact& c : held) {
     const auto [l0, l1] = linksOf(c.vertex);
@@ -172,21 +173,28 @@ double heldPairsClearance(const Chain& chain, ConstVectorRef q, const Eigen::Mat
   }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  for (const auto& [la, lb] : pairs) {
+  return pairs;
+}
+
+double heldPairsClearance(const Chain& chain, ConstVectorRef q, const Eigen::Matrix2Xd& P,
+                          const std::vector<SelfContact>& held, int* linkA, int* linkB) {
+  const int n = chain.size();
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& [la, lb] : heldLinkPairs(held)) {
     std::vector<SelfContact> here;
     for (const SelfContact& c : held)
       if (onPair(c, la, lb)) here.push_back(c);
     const std::vector<WallVertex> skip = heldCorners(here);
     for (const auto& [vl, el] : {std::pair{la, lb}, std::pair{lb, la}})
       for (const auto& [vs, vd] : trianglesOf(vl, n))
-        for (const int corner : vd ? std::vector<int>{0, 3, 4} : std::vector<int>{0, 1, 2}) {
+        for (const int corner : cornersOf(vd)) {
           const WallVertex v{vs, corner};
           if (std::find(skip.begin(), skip.end(), v) != skip.end()) continue;
           const Point p = wallVertexPoint(chain, q, P, v);
           for (const auto& [es, ed] : trianglesOf(el, n)) {
-            const int c1 = ed ? 3 : 1, c2 = ed ? 4 : 2;
-            const double d = signedDistance(p, wallVertexPoint(chain, q, P, {es, 0}),
-                                            wallVertexPoint(chain, q, P, {es, c1}), wallVertexPoint(chain, q, P, {es, c2}));
+            const std::array<int, 3> t = cornersOf(ed);
+            const double d = signedDistance(p, wallVertexPoint(chain, q, P, {es, t[0]}),
+                                            wallVertexPoint(chain, q, P, {es, t[1]}), wallVertexPoint(chain, q, P, {es, t[2]}));
             if (d < best) {
               best = d;
               if (linkA) *linkA = la;
@@ -218,7 +226,7 @@ SelfContact touchingPair(const Chain& chain, ConstVectorRef q, int linkA, int li
   double depth = 0.0;
   for (const auto& [vl, el] : {std::pair{linkA, linkB}, std::pair{linkB, linkA}})
     for (const auto& [vs, vd] : trianglesOf(vl, n))
-      for (const int corner : vd ? std::vector<int>{0, 3, 4} : std::vector<int>{0, 1, 2})
+      for (const int corner : cornersOf(vd))
         for (const auto& [es, ed] : trianglesOf(el, n)) {
           SelfContact nearest;
           double inside = -std::numeric_limits<double>::infinity();

@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "buckle/mechanics/chain.h"
@@ -91,6 +92,10 @@ void selfContactDerivatives(const Eigen::Matrix2Xd& P, const SelfContact& c, con
 /// left out: the pair's second contact. Throws std::invalid_argument for links that cannot touch.
 SelfContact touchingPair(const Chain& chain, ConstVectorRef q, int linkA, int linkB,
                          const std::vector<SelfContact>& held = {});
+
+/// The pairs of links (contact_geometry.h numbering, lower first, sorted) that the contacts `held`
+/// hold together: the edge's link with each link of the vertex (a joint is on two).
+std::vector<std::pair<int, int>> heldLinkPairs(const std::vector<SelfContact>& held);
 
 /// The clearance of the pairs of links that hold contacts in `held`: each vertex of either link's
 /// triangles, but those held on the pair and their edges' ends, against the other link's
