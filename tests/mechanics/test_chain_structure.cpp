@@ -675,3 +675,63 @@ TEST_CASE("small-chain dense path: inertia and lowest eigenvalues match the dens
     }
   }
 }
+
+TEST_CASE("a coupling R E Rᵀ bordered on the counts: inertia, eigenvalues and eigenvectors of H + R E Rᵀ on ker C "
+          "equal the dense ones",
+          "[chain_structure]") {
+  std::mt19937 rng(31);
+  std::normal_distribution<double> N(0.0, 1.0);
+  for (int n : {40, 200}) {
+    Instance in = randomInstance(n, rng, 1.5);
+    ChainStructure ws(n);
+    assembleInstance(in, ws);
+    for (const auto& held : kHeldSets) {
+      for (int c : {1, 2, 4}) {
+        if (int(held.size()) + c > ChainStructure::kMaxBorder) continue;
+        Matrix R(n, c);
+        Vector E(c);
+        for (int j = 0; j < c; ++j) {
+          // a term of H's size, each sign, and one column zero (a self contact at μ = 0)
+          for (int i = 0; i < n; ++i) R(i, j) = j == 3 ? 0.0 : 0.3 * N(rng) * std::sqrt(in.H.norm() / n);
+          E[j] = j % 2 == 0 ? -1.0 : 1.0;
+        }
+        const Matrix C = rows(in.J, held);
+        const Matrix Hc = in.H + R * E.asDiagonal() * R.transpose();
+        const Vector dense = reducedEigenvalues(Hc, C);
+        const double scale = std::max(1.0, Hc.norm()), tau = 1e-13 * std::max(ws.typicalScale, ws.frobeniusH);
+        INFO("n = " << n << ", held " << held.size() << ", coupling columns " << c);
+        if (held.empty())
+          ws.rank = ws.couplingCount = 0;
+        else
+          setConstraints(ws, C);
+        setCoupling(ws, R, E);
+        const Inertia inertia = borderedInertia(ws);
+        CHECK(inertia.negative == int((dense.array() < -tau).count()));
+        CHECK(inertia.size() == int(dense.size()));
+        Vector out(3);
+        REQUIRE(lowestEigenvalues(ws, true, 3, out) == 3);
+        for (int j = 0; j < 3; ++j) CHECK(std::abs(out[j] - dense[j]) <= 1e-10 * scale);
+        // the eigenvector of the lowest: in ker C and solving (H + R E Rᵀ) v = λ v there
+        Vector v(n);
+        REQUIRE(eigenvectorAt(ws, true, out[0], v, 2));
+        if (!held.empty()) CHECK((C * v).norm() <= 1e-10 * C.norm());
+        Vector r = Hc * v - out[0] * v;
+        if (!held.empty()) {  // the residual's part in ker C
+          Eigen::ColPivHouseholderQR<Matrix> qr(C.transpose());
+          const Matrix Qf = qr.householderQ() * Matrix::Identity(n, n);
+          const Matrix Z = Qf.rightCols(n - qr.rank());
+          r = Z * (Z.transpose() * r);
+        }
+        CHECK(r.norm() <= 1e-8 * scale);
+        // the constraints alone again: setConstraints drops the coupling
+        if (!held.empty()) {
+          setConstraints(ws, C);
+          CHECK(ws.couplingCount == 0);
+          Vector plain(1);
+          lowestEigenvalues(ws, true, 1, plain);
+          CHECK(std::abs(plain[0] - reducedEigenvalues(in.H, C)[0]) <= 1e-10 * scale);
+        }
+      }
+    }
+  }
+}

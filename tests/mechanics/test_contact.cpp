@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/QR>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -586,4 +587,105 @@ TEST_CASE("contact: a branch that comes back to one of its contact events, same 
       }
   }
   CHECK(loops >= 1);
+}
+
+TEST_CASE("contact: self contacts' rank-2 terms on the O(n) solver and counts equal the dense LU and eigen-solve",
+          "[contact]") {
+  // n = 450: past the solver's dense fallback (400 unknowns), so every factorization checked here
+  // is the structured one; q, μ and the held forces random (the algebra holds at any point)
+  std::mt19937 rng(451);
+  std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.4, 0.4);
+  const int n = 450;
+  std::vector<SegmentParameters> segs;
+  for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
+  const Chain chain(segs);
+  const SelfContact distalOnProximal{{300, 3}, {120, true, 1}};   // the vertex's body the distal one
+  const SelfContact proximalOnDistal{{60, 1}, {280, false, 2}};   // the edge's
+  struct Case {
+    std::string name;
+    EndCondition end;
+    bool wall;
+    std::vector<SelfContact> self;
+  };
+  const std::vector<Case> cases = {
+      {"free end, one self contact", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false, {distalOnProximal}},
+      {"free end, two", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false,
+       {distalOnProximal, proximalOnDistal}},
+      {"clamped-pinned, wall, one", EndCondition::clampedPinned(W(rng), 0.1 * W(rng)), true, {proximalOnDistal}}};
+  for (const Case& k : cases) {
+    INFO(k.name);
+    EquilibriumProblem problem(chain, k.end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
+    ContactSet locked;
+    locked.lock(5, LimitSide::Upper);
+    locked.lock(200, LimitSide::Lower);
+    locked.lock(290, LimitSide::Upper);
+    if (k.wall) locked.touch(WallVertex{2, 3});
+    for (const SelfContact& c : k.self) locked.hold(c);
+    const ContactProblem contact(problem, locked);
+    const int N = contact.dimension();
+    Eigen::VectorXd u(N);
+    for (int i = 0; i < N; ++i) u[i] = i < n ? Q(rng) : W(rng);
+    u[N - 1] = -0.5;  // one force pulling: E's signs both ways across the cases
+    const double lambda = W(rng);
+    const cont::BoundProblem bound(contact);
+    auto structured = bound.makeStructuredSolver();
+    cont::DenseBorderedSolver dense(contact);
+    Eigen::VectorXd c(N + 1), b(N + 1), x1(N + 1), x2(N + 1);
+    for (int i = 0; i <= N; ++i) c[i] = W(rng), b[i] = W(rng);
+    REQUIRE(structured->factor(u, lambda, c) == cont::Factorization::Regular);
+    REQUIRE(dense.factor(u, lambda, c) == cont::Factorization::Regular);
+    CHECK(structured->determinantSign() == dense.determinantSign());
+    CHECK(structured->logAbsDeterminant() == Approx(dense.logAbsDeterminant()).epsilon(1e-9));
+    REQUIRE(structured->solve(b, x1));
+    REQUIRE(dense.solve(b, x2));
+    // backward errors (the random points' A is as ill-conditioned as 1e10: x itself agrees to the
+    // condition number only), against the problem's own Jacobian
+    Eigen::MatrixXd Fu(N, N);
+    Eigen::VectorXd Fl(N);
+    REQUIRE(bound.jacobian(u, lambda, Fu, Fl));
+    const auto backward = [](const Eigen::MatrixXd& A, const Eigen::VectorXd& x, const Eigen::VectorXd& r) {
+      return (A * x - r).norm() / (A.norm() * x.norm() + r.norm());
+    };
+    Eigen::MatrixXd A(N + 1, N + 1);
+    A << Fu, Fl, c.transpose();
+    CHECK(backward(A, x1, b) <= 1e-14);
+    CHECK(backward(A, x2, b) <= 1e-14);
+    CHECK((x1 - x2).norm() <= 1e-7 * x2.norm());
+    // the locator's general borders, both ways
+    for (int kb = 1; kb <= std::min(2, structured->maxGeneralBorder()); ++kb)
+      for (bool transposed : {false, true}) {
+        INFO("general borders k = " << kb << ", transposed " << transposed);
+        Eigen::MatrixXd B(N, kb), C(N, kb), D(kb, kb);
+        for (int j = 0; j < kb; ++j) {
+          for (int i = 0; i < N; ++i) B(i, j) = W(rng), C(i, j) = W(rng);
+          for (int i = 0; i < kb; ++i) D(i, j) = W(rng);
+        }
+        Eigen::VectorXd g(N + kb), y1(N + kb), y2(N + kb);
+        for (int i = 0; i < N + kb; ++i) g[i] = W(rng);
+        REQUIRE(dense.factorGeneral(u, lambda, B, C, D, transposed) == cont::Factorization::Regular);
+        REQUIRE(structured->factorGeneral(u, lambda, B, C, D, transposed) == cont::Factorization::Regular);
+        CHECK(structured->determinantSign() == dense.determinantSign());
+        REQUIRE(dense.solve(g, y2));
+        REQUIRE(structured->solve(g, y1));
+        Eigen::MatrixXd G(N + kb, N + kb);
+        if (transposed)
+          G << Fu.transpose(), B, C.transpose(), D;
+        else
+          G << Fu, B, C.transpose(), D;
+        CHECK(backward(G, y1, g) <= 1e-14);
+        CHECK(backward(G, y2, g) <= 1e-14);
+      }
+    // the stability: the counts with the coupling bordered against the dense projection of the
+    // problem's own operator (self contact rank-2 terms included: ContactProblem::stabilityOperator)
+    cont::StabilityInfo info;
+    REQUIRE(bound.stability(u, lambda, 3, info));
+    Matrix Hc, Cc;
+    REQUIRE(bound.stabilityOperator(u, lambda, Hc, Cc));
+    const cont::StabilityInfo reference = cont::projectedInertia(Hc, Cc, 1e-13, 3);
+    CHECK(info.negative == reference.negative);
+    CHECK(info.zero == reference.zero);
+    REQUIRE(info.lowest.size() == reference.lowest.size());
+    const double scale = std::max(1.0, Hc.norm());
+    for (int j = 0; j < int(info.lowest.size()); ++j) CHECK(std::abs(info.lowest[j] - reference.lowest[j]) <= 1e-9 * scale);
+  }
 }

@@ -236,7 +236,14 @@ void structure::factoredSchur(ChainStructure& ws, int r) {
     case 1: return forwardSchur<1>(ws, ws.S);
     case 2: return forwardSchur<2>(ws, ws.S);
     case 3: return forwardSchur<3>(ws, ws.S);
-    default: throw std::invalid_argument("factoredSchur: 1 to 3 constraint rows (setConstraints), got " + std::to_string(r));
+    case 4: return forwardSchur<4>(ws, ws.S);
+    case 5: return forwardSchur<5>(ws, ws.S);
+    case 6: return forwardSchur<6>(ws, ws.S);
+    case 7: return forwardSchur<7>(ws, ws.S);
+    case 8: return forwardSchur<8>(ws, ws.S);
+    default:
+      throw std::invalid_argument("factoredSchur: 1 to kMaxBorder border columns (setConstraints, setCoupling), got " +
+                                  std::to_string(r));
   }
 }
 

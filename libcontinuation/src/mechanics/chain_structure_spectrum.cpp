@@ -36,6 +36,23 @@ int smallNegativeCount(const ChainStructure::SmallMatrix& S) {
   return neg;
 }
 
+/// The border columns the constrained counts take: the rank of C and the coupling's.
+int borderCount(const ChainStructure& ws, bool useConstraints) {
+  return useConstraints ? ws.rank + ws.couplingCount : 0;
+}
+
+/// #{E_jj > 0}: the negative eigenvalues of the coupling's block −E (setCoupling).
+int couplingNegative(const ChainStructure& ws) {
+  int count = 0;
+  for (int j = 0; j < ws.couplingCount; ++j) count += ws.couplingSign[j] > 0.0 ? 1 : 0;
+  return count;
+}
+
+/// S += sign · diag(0_r, E) on the coupling's rows.
+void addCouplingBlock(const ChainStructure& ws, double sign, ChainStructure::SmallMatrix& S) {
+  for (int j = 0; j < ws.couplingCount; ++j) S(ws.rank + j, ws.rank + j) += sign * ws.couplingSign[j];
+}
+
 }  // namespace
 
 double zeroThreshold(const ChainStructure& ws, double zeroTolerance) {
@@ -59,26 +76,40 @@ int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double
     throw std::invalid_argument("setConstraints: C must be m×n with m <= 3");
   const int r = structure::orthonormaliseRows(C, ws.Q, ws.B, rankTolerance);
   ws.rank = r;
+  ws.couplingCount = 0;
   return r;
 }
 
+void setCoupling(ChainStructure& ws, const Eigen::Ref<const Matrix>& R, const Eigen::Ref<const Vector>& signs) {
+  const int c = int(R.cols());
+  if (R.rows() != ws.n || signs.size() != c || ws.rank + c > ChainStructure::kMaxBorder)
+    throw std::invalid_argument("setCoupling: R must be n×c with rank(C) + c <= kMaxBorder and c signs");
+  for (int j = 0; j < c; ++j) {
+    if (signs[j] != 1.0 && signs[j] != -1.0) throw std::invalid_argument("setCoupling: each sign must be +1 or -1");
+    applyUInverse(R.col(j), ws.B.col(ws.rank + j));
+    ws.couplingSign[j] = signs[j];
+  }
+  ws.couplingCount = c;
+}
+
 int constrainedCountBelow(ChainStructure& ws, double sigma, bool determinant) {
-  const int r = ws.rank;
+  const int r = ws.rank, b = borderCount(ws, true);
   factorize(ws, sigma, determinant);
-  if (r == 0) return ws.factorInertia.negative;
+  if (b == 0) return ws.factorInertia.negative;
   if (!determinant) {
     // a count reads S alone: the factor's forward sweep gives it without the solve for X
-    structure::factoredSchur(ws, r);
+    structure::factoredSchur(ws, b);
     ws.S = -ws.S;
-    return ws.factorInertia.negative + smallNegativeCount(ws.S) - r;
+  } else {
+    ws.X.leftCols(b) = ws.B.leftCols(b);
+    solveFactored(ws, ws.X, b);
+    ws.S.resize(b, b);
+    // b ≤ kMaxBorder dot products of length n: coefficient-wise (a general matrix product would
+    // pack both n×b operands for a few entries, and −(BᵀX) as one expression allocated a temporary)
+    ws.S.noalias() = -ws.B.leftCols(b).transpose().lazyProduct(ws.X.leftCols(b));
   }
-  ws.X.leftCols(r) = ws.B.leftCols(r);
-  solveFactored(ws, ws.X, r);
-  ws.S.resize(r, r);
-  // r ≤ kMaxBorder dot products of length n: coefficient-wise (a general matrix product would
-  // pack both n×r operands for a few entries, and −(BᵀX) as one expression allocated a temporary)
-  ws.S.noalias() = -ws.B.leftCols(r).transpose().lazyProduct(ws.X.leftCols(r));
-  return ws.factorInertia.negative + smallNegativeCount(ws.S) - r;
+  addCouplingBlock(ws, -1.0, ws.S);  // S = diag(0, −E) − BᵀX (setCoupling)
+  return ws.factorInertia.negative + smallNegativeCount(ws.S) - r - couplingNegative(ws);
 }
 
 namespace {
@@ -105,8 +136,16 @@ int robustConstrainedCount(ChainStructure& ws, double sigma0) {
 
 Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double zeroTolerance,
                            double rankTolerance) {
-  const int r = C.rows() > 0 ? setConstraints(ws, C, rankTolerance) : (ws.rank = 0);
-  if (r == 0) return hessianInertia(ws, zeroTolerance);
+  if (C.rows() > 0)
+    setConstraints(ws, C, rankTolerance);
+  else
+    ws.rank = ws.couplingCount = 0;
+  return borderedInertia(ws, zeroTolerance);
+}
+
+Inertia borderedInertia(ChainStructure& ws, double zeroTolerance) {
+  const int r = ws.rank;
+  if (borderCount(ws, true) == 0) return hessianInertia(ws, zeroTolerance);
   const double tau = zeroThreshold(ws, zeroTolerance);
   const int below = robustConstrainedCount(ws, -tau);
   const int belowPlus = robustConstrainedCount(ws, tau);
@@ -123,7 +162,7 @@ using search::ShiftEvaluation;
 
 ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double sigma, bool countOnly) {
   ShiftEvaluation ev;
-  const int r = useConstraints ? ws.rank : 0;
+  const int r = borderCount(ws, useConstraints);  // S's size: the constraints' and the coupling's columns
   if (countOnly) {
     // the same factorization's inertia without the determinant's products and derivative
     ev.below = r == 0 ? (factorize(ws, sigma, false), ws.factorInertia.negative) : constrainedCountBelow(ws, sigma, false);
@@ -142,7 +181,7 @@ ShiftEvaluation evaluateShift(ChainStructure& ws, bool useConstraints, double si
   const double detS = ws.S.determinant();
   ev.logAbsDet = ws.logAbsDet + std::log(std::abs(detS));
   ev.sign = ws.detSign * (detS < 0.0 ? -1 : 1);
-  // det K_σ = det(T − σM)·det S, S = −BᵀX with X = (T − σM)⁻¹B: S' = −XᵀMX (M tridiagonal:
+  // det K_σ = det(T − σM)·det S, S = diag(0, −E) − BᵀX with X = (T − σM)⁻¹B: S' = −XᵀMX (M tridiagonal:
   // diagonal 2, …, 2, 1, off-diagonal −1), and (log|det S|)' = tr(S⁻¹S').
   const int n = ws.n;
   ChainStructure::SmallMatrix dS(r, r);
@@ -188,7 +227,7 @@ double smallestEigenvalue(ChainStructure& ws, bool useConstraints, double tolera
 namespace {
 
 bool inverseIteration(ChainStructure& ws, bool useConstraints, double sigma, VectorRef v, int iterations) {
-  const int n = ws.n, r = useConstraints ? ws.rank : 0;
+  const int n = ws.n, r = borderCount(ws, useConstraints);
   if (v.size() != n || !std::isfinite(sigma)) return false;
   factorize(ws, sigma, false);
   if (ws.singular) {
@@ -202,12 +241,14 @@ bool inverseIteration(ChainStructure& ws, bool useConstraints, double sigma, Vec
   }
   // (H − σI) x + Q y = v, Qᵀx = 0 with H − σI = U (T − σM) Uᵀ and z = Uᵀx, B = U⁻¹Q:
   //   (T − σM) z + B y = U⁻¹ v,  Bᵀz = 0,  x = U⁻ᵀ z,
-  // by the Schur complement S = Bᵀ(T − σM)⁻¹B of the r ≤ 3 border columns.
+  // by the Schur complement S = Bᵀ(T − σM)⁻¹B of the r ≤ 3 border columns; with a coupling
+  // (setCoupling) its rows read Bᵀz − E y = 0 and S gains diag(0, E).
   if (r > 0) {
     ws.X.leftCols(r) = ws.B.leftCols(r);
     solveFactored(ws, ws.X, r);
     ws.S.resize(r, r);
     ws.S.noalias() = ws.B.leftCols(r).transpose().lazyProduct(ws.X.leftCols(r));
+    if (useConstraints) addCouplingBlock(ws, 1.0, ws.S);
   }
   // S is nearly singular at σ (that is what an eigenvalue on ker C means): partial pivoting
   // divides by its small pivot, which is the amplification wanted; a rank-revealing LU would zero

@@ -136,11 +136,12 @@ std::vector<int> freeJointsOf(const ContactSet& locked, int n) {
 }
 
 // Inertia and lowest eigenvalues of the reduced H on ker of the held rows (as
-// EquilibriumProblem::stability, on the reduced structure).
-void reducedStability(ChainStructure& ws, const Matrix& heldRows, int lowestCount, Vector& lastLowest,
-                      continuation::StabilityInfo& info) {
+// EquilibriumProblem::stability, on the reduced structure), with the self contacts' rank-2 terms
+// R E Rᵀ when R has columns (setCoupling; the small dense route takes none).
+void reducedStability(ChainStructure& ws, const Matrix& heldRows, const Matrix& R, const Vector& E, int lowestCount,
+                      Vector& lastLowest, continuation::StabilityInfo& info) {
   const int wanted = std::max(0, std::min(lowestCount, EquilibriumProblem::kMaxLowest));
-  if (ws.n <= kSmallDense && wanted > 0) {
+  if (ws.n <= kSmallDense && wanted > 0 && R.cols() == 0) {
     Eigen::Matrix<double, EquilibriumProblem::kMaxLowest, 1> low;
     int found = 0;
     const Inertia in = smallDenseInertia(ws, heldRows, wanted, low.head(wanted), found);
@@ -148,12 +149,20 @@ void reducedStability(ChainStructure& ws, const Matrix& heldRows, int lowestCoun
     info.zero = in.zero;
     info.lowest = low.head(found);
   } else {
-    const Inertia in = constrainedInertia(ws, heldRows);
+    if (heldRows.rows() > 0)
+      setConstraints(ws, heldRows);
+    else
+      ws.rank = 0;
+    if (R.cols() > 0)
+      setCoupling(ws, R, E);
+    else
+      ws.couplingCount = 0;
+    const Inertia in = borderedInertia(ws);
     info.negative = in.negative;
     info.zero = in.zero;
     info.lowest.resize(std::min(wanted, in.size()));
     if (info.lowest.size() > 0) {
-      lowestEigenvalues(ws, ws.rank > 0, int(info.lowest.size()), info.lowest, 1e-13,
+      lowestEigenvalues(ws, ws.rank + ws.couplingCount > 0, int(info.lowest.size()), info.lowest, 1e-13,
                         lastLowest.size() == info.lowest.size() ? &lastLowest : nullptr);
       lastLowest = info.lowest;
     }
@@ -202,6 +211,9 @@ ContactProblem::Workspace::Workspace(const ContactProblem& problem)
       wallX(problem.locked_.gapCount()),
       selfCoupling(problem.base_.segments(), problem.locked_.selfCount()),
       selfWeights(problem.base_.segments(), problem.locked_.selfCount()),
+      selfColumns(problem.base_.segments(), 2 * problem.locked_.selfCount()),
+      selfColumnsFree(Eigen::Index(problem.free_.size()), 2 * problem.locked_.selfCount()),
+      selfSigns(2 * problem.locked_.selfCount()),
       selfAlong(problem.locked_.selfCount()),
       selfEdgeLength(problem.locked_.selfCount()) {
   reduced.typicalScale = problem.base_.stiffnessUnit() * problem.base_.lengthUnit() * problem.base_.lengthUnit();
@@ -376,13 +388,19 @@ bool ContactProblem::stabilityOperator(ProblemWorkspace& ws, ConstVectorRef u, d
 bool ContactProblem::assembleFull(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ChainStructure& full,
                                   MatrixRef J) const {
   Workspace& d = workspaceAs<Workspace>(ws);
-  const int N = base_.dimension(), w = locked_.wallCount();
-  if (locked_.selfCount() > 0) return false;  // outside the structure (file comment)
+  const int N = base_.dimension(), n = base_.segments(), w = locked_.wallCount();
   if (!base_.assembleStructure(*d.base, u.head(N), lambda, full, J)) return false;
-  if (w == 0) return true;
-  if (!wallKinematics(ws, u.head(base_.segments()))) return false;
+  if (locked_.gapCount() == 0) return true;
+  if (!wallKinematics(ws, u.head(n))) return false;
   for (int k = 0; k < w; ++k)  // the generator h gains −μ_v g_v (wall_contact.h)
     for (int m = 0; m <= locked_.wall()[size_t(k)].lastJoint(); ++m) full.h[m] -= u[N + k] * d.wallGen(m, k);
+  for (int k = 0; k < locked_.selfCount(); ++k) {  // and −μ γ, the rank-2 rest as R E Rᵀ (self_contact.h)
+    const double mu = u[N + w + k];
+    for (int m = 0; m < n; ++m) full.h[m] -= mu * d.wallGen(m, w + k);
+    const double s = selfCouplingColumns(d.selfCoupling.col(k), d.selfWeights.col(k), mu, d.selfColumns.middleCols(2 * k, 2));
+    d.selfSigns[2 * k] = -s;
+    d.selfSigns[2 * k + 1] = s;
+  }
   assemble(full.kappa, full.h, full);
   return true;
 }
@@ -405,16 +423,20 @@ bool ContactProblem::stability(ProblemWorkspace& ws, ConstVectorRef u, double la
     info.negative = 0;
     return true;
   }
-  // the chain structure's counts take at most 3 constraint rows (setConstraints): with more held
-  // coordinates and wall vertices together, the dense route of the core (O(n³)); a self contact's
-  // rank-2 Hessian term is outside the structure
-  if (d.heldRows.rows() > 3 || locked_.selfCount() > 0) return Problem::stability(ws, u, lambda, lowestCount, info);
+  // the chain structure's counts take at most 3 constraint rows (setConstraints) and kMaxBorder
+  // borders with the self contacts' two coupling columns each: beyond, and for a short chain
+  // holding a self contact (the small dense route takes no coupling), the dense route of the core
+  const int s = locked_.selfCount();
+  if (d.heldRows.rows() > 3 || d.heldRows.rows() + 2 * s > ChainStructure::kMaxBorder ||
+      (s > 0 && int(free_.size()) <= kSmallDense))
+    return Problem::stability(ws, u, lambda, lowestCount, info);
   if (!assembleReduced(ws, u, lambda, d.reduced, d.Jf)) return false;
   for (size_t k = 0; k < held_.size(); ++k) d.heldRows.row(Eigen::Index(k)) = d.Jf.row(held_[k]);
-  for (int k = 0; k < locked_.wallCount(); ++k)  // the wall rows ∇x_vᵀ on the free joints
+  for (int k = 0; k < locked_.gapCount(); ++k)  // the gap rows ∇gᵀ on the free joints
     for (size_t a = 0; a < free_.size(); ++a)
       d.heldRows(Eigen::Index(held_.size()) + k, Eigen::Index(a)) = d.wallGrad(free_[a], k);
-  reducedStability(d.reduced, d.heldRows, lowestCount, d.lastLowest, info);
+  for (size_t a = 0; a < free_.size(); ++a) d.selfColumnsFree.row(Eigen::Index(a)) = d.selfColumns.row(free_[a]);
+  reducedStability(d.reduced, d.heldRows, d.selfColumnsFree, d.selfSigns, lowestCount, d.lastLowest, info);
   return true;
 }
 

@@ -126,6 +126,15 @@ SelfContactGap selfContactGap(const Chain& chain, ConstVectorRef q, const Eigen:
   return g;
 }
 
+double selfCouplingColumns(ConstVectorRef coupling, ConstVectorRef weights, double mu, MatrixRef R) {
+  const double nc = coupling.norm(), nw = weights.norm();
+  const double beta = nc > 0.0 && nw > 0.0 ? std::sqrt(nw / nc) : 1.0;
+  const double rho = std::sqrt(0.5 * std::abs(mu));
+  R.col(0) = rho * (beta * coupling + weights / beta);
+  R.col(1) = rho * (beta * coupling - weights / beta);
+  return mu < 0.0 ? -1.0 : 1.0;
+}
+
 void selfContactDerivatives(const Eigen::Matrix2Xd& P, const SelfContact& c, const SelfContactGap& g, VectorRef gradient,
                             VectorRef generator, VectorRef coupling, VectorRef weights) {
   gradient.setZero();

@@ -65,9 +65,10 @@ struct Inertia {
 
 /// Workspace for one chain length; T, its factorization and the border storage.
 struct ChainStructure {
-  /// Border columns of the bordered solves: m ≤ 3 held rows, the tracer's one (F_λ | c) and
-  /// one more for the locator's branch-point system (chain_solver.h).
-  static constexpr int kMaxBorder = 6;
+  /// Border columns of the bordered solves: m ≤ 3 held rows, the tracer's one (F_λ | c), one
+  /// more for the locator's branch-point system (chain_solver.h), and a contact problem's gap
+  /// rows with two coupling columns per self contact (contact_solver.cpp).
+  static constexpr int kMaxBorder = 8;
   using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxBorder, kMaxBorder>;
   using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxBorder, 1>;
 
@@ -101,6 +102,10 @@ struct ChainStructure {
   Matrix zeroBorder;  ///< kMaxBorder² zeros (the D block of solveKKT)
   SmallMatrix S;
   int rank = 0;  ///< rank of the last C (rows kept after orthonormalisation)
+  /// Coupling borders (setCoupling): columns rank … rank + couplingCount − 1 of B hold U⁻¹R of a
+  /// term R E Rᵀ (E = diag(couplingSign), each ±1) added to H on ker C. Reset by setConstraints().
+  int couplingCount = 0;
+  Eigen::Matrix<double, kMaxBorder, 1> couplingSign = Eigen::Matrix<double, kMaxBorder, 1>::Zero();
 
   // Bordered factorization (factorBordered): Schur complement S = D − Wᵀ H⁻¹ V and its LU.
   SmallMatrix schur;
@@ -160,6 +165,16 @@ int constrainedCountBelow(ChainStructure& ws, double sigma, bool determinant = t
 /// Inertia of H on ker C (n − rank(C) eigenvalues). C may have zero rows.
 Inertia constrainedInertia(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double zeroTolerance = 1e-13,
                            double rankTolerance = kConstraintRankTolerance);
+
+/// After setConstraints(): the constrained counts, eigenvalues and eigenvectors (useConstraints)
+/// become those of H + R E Rᵀ on ker C, E = diag(signs) with each sign ±1 (R n×c, rank + c ≤
+/// kMaxBorder), still O(n c) a count: the term is bordered as [[H − σI, Q, R], [Qᵀ, 0, 0],
+/// [Rᵀ, 0, −E]], whose Schur complement on the last block is H + R E Rᵀ − σI (Haynsworth), so
+///     #{eigenvalues below σ} = neg(T − σM) + neg(S) − r − #{E_jj > 0},
+/// S = diag(0, −E) − Bᵀ(T − σM)⁻¹B with B = U⁻¹[Q R] (a self contact's rank-2 term: self_contact.h).
+void setCoupling(ChainStructure& ws, const Eigen::Ref<const Matrix>& R, const Eigen::Ref<const Vector>& signs);
+/// Inertia of H (with its coupling) on ker C as set by setConstraints() and setCoupling().
+Inertia borderedInertia(ChainStructure& ws, double zeroTolerance = 1e-13);
 
 /// The `count` lowest eigenvalues (ascending) of H, or of Zᵀ H Z (after setConstraints()) when
 /// useConstraints, to absolute accuracy ~tolerance · max(1, ‖H‖_F), written to out[0 … k−1];

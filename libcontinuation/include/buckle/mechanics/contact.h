@@ -216,8 +216,9 @@ class ContactProblem final : public continuation::Problem {
   /// False outside the domain or when every joint is locked.
   bool assembleReduced(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                        ChainStructure& structure, continuation::MatrixRef Jf) const;
-  /// The full structure (every joint) of K_q − K_g with the wall forces' terms in its generator,
-  /// and the end Jacobian (3×n), at u = (q, r, μ): what the reduced structure is cut from.
+  /// The full structure (every joint) of K_q − K_g with the contact forces' terms in its generator,
+  /// and the end Jacobian (3×n), at u = (q, r, μ): what the reduced structure is cut from. The self
+  /// contacts' rank-2 terms, outside the structure, in selfColumns() and selfSigns().
   bool assembleFull(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                     ChainStructure& full, continuation::MatrixRef J) const;
   /// The wall vertices' ∇x_v (columns of wallGradients(), n×w) and generators of −∂²x_v (columns
@@ -229,6 +230,14 @@ class ContactProblem final : public continuation::Problem {
   }
   static const Matrix& wallGenerators(const continuation::ProblemWorkspace& ws) {
     return continuation::workspaceAs<Workspace>(ws).wallGen;
+  }
+  /// The self contacts' rank-2 terms as R E Rᵀ (selfCouplingColumns) at the last assembleFull():
+  /// R (n×2s, two columns per contact) and E's diagonal (±1).
+  static const Matrix& selfColumns(const continuation::ProblemWorkspace& ws) {
+    return continuation::workspaceAs<Workspace>(ws).selfColumns;
+  }
+  static const Vector& selfSigns(const continuation::ProblemWorkspace& ws) {
+    return continuation::workspaceAs<Workspace>(ws).selfSigns;
   }
 
   /// The base problem's workspace and this problem's scratch (ProblemWorkspace).
@@ -243,6 +252,8 @@ class ContactProblem final : public continuation::Problem {
     Matrix wallGrad, wallGen;  // n×(w + s): ∇g and the generators of −∂²g (wallKinematics)
     Vector wallX;              // the gaps: x_v of the wall vertices, then the self contacts' g
     Matrix selfCoupling, selfWeights;  // n×s: −∂²g's rank-2 term (self_contact.h)
+    Matrix selfColumns, selfColumnsFree;  // −μ∂²g's rank-2 terms as R E Rᵀ: R (n×2s) and its free rows
+    Vector selfSigns;                     // E's diagonal (2s)
     Vector selfAlong, selfEdgeLength;  // where each self contact's vertex is along its edge
     Vector unknowns;           // (q, r, μ) of boundaries()
   };

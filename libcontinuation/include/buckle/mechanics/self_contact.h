@@ -16,8 +16,8 @@
 // (the wall is σ = +1 with lo = −1 and n_e = (1, 0): wall_contact.h). Both are the generator form
 // of K_g (eq 27) plus a symmetric rank-2 term: with G(γ)_jk = γ_max(j,k),
 //     −∂²g = G(γ) − (c wᵀ + w cᵀ),   σ = +1: γ = −c, w = −1 on j ≤ lo;   σ = −1: γ = c, w = +1 on j ≤ hi,
-// since c_min = c_j + c_k − c_max. The rank-2 term couples the two bodies' joints, so a chain
-// holding a self contact leaves the O(n) chain structure: its points take the dense route.
+// since c_min = c_j + c_k − c_max. The rank-2 term couples the two bodies' joints outside the
+// generator form: the O(n) solves and counts border it (selfCouplingColumns).
 #pragma once
 
 #include <Eigen/Core>
@@ -82,6 +82,15 @@ SelfContactGap selfContactGap(const Chain& chain, ConstVectorRef q, const Eigen:
 /// comment; every vector of size n, zero where the formula has no entry). O(n).
 void selfContactDerivatives(const Eigen::Matrix2Xd& P, const SelfContact& c, const SelfContactGap& g, VectorRef gradient,
                             VectorRef generator, VectorRef coupling, VectorRef weights);
+
+/// The rank-2 part −μ(c wᵀ + w cᵀ) of a held self contact's −μ∂²g (c = coupling, w = weights) as
+/// R E Rᵀ with E = diag(−s, s), s = sign μ (+1 at μ = 0): with β = √(‖w‖/‖c‖) balancing the two
+/// (c is a length, w a number: no cancellation whichever is the larger) and ρ = √(|μ|/2),
+///     R = ρ [β c + w/β, β c − w/β],
+/// since c wᵀ + w cᵀ = ½(a aᵀ − b bᵀ) for a = βc + w/β, b = βc − w/β. Bordered by R with the block
+/// −E, whose entries are ±1 at any μ (no 1/μ at release), the term keeps the chain structure's
+/// O(n) form (chain_structure.h, setCoupling). R is n×2; returns s.
+double selfCouplingColumns(ConstVectorRef coupling, ConstVectorRef weights, double mu, MatrixRef R);
 
 /// The vertex–edge pair by which links linkA and linkB (contact_geometry.h numbering, at least two
 /// apart) touch at q: among every vertex of one link's triangles against every edge of the
