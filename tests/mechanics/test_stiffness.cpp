@@ -5,12 +5,16 @@
 #include <Eigen/QR>
 #include <cmath>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/jump.h"
 #include "buckle/mechanics/linear_buckling.h"
 #include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/unloaded_shape.h"
+
+#include "random_segments.h"
 
 using namespace buckle::mechanics;
 
@@ -323,4 +327,44 @@ TEST_CASE("with the links' weight the loaded compliance is the difference quotie
   const Eigen::Matrix2d Kp = loadedStiffness(chain, q + h * dq, W + h * dW, false, plus).stiffness;
   const Eigen::Matrix2d Km = loadedStiffness(chain, q - h * dq, W - h * dW, false, minus).stiffness;
   CHECK((dK - (Kp - Km) / (2 * h)).lpNorm<Eigen::Infinity>() < 1e-6 * K.lpNorm<Eigen::Infinity>());
+}
+
+TEST_CASE("the O(n) stiffness and its rate equal loadedStiffnessDerivative's dense solves (rotation free and held, "
+          "body loads, any units)",
+          "[stiffness]") {
+  std::mt19937 rng(64);
+  std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.4, 0.4);
+  for (int n : {70, 300}) {
+    for (const auto& [sL, sK] : {std::pair{1.0, 1.0}, std::pair{1e4, 1e-8}}) {
+      std::vector<SegmentParameters> segs;
+      for (int i = 0; i < n; ++i) {
+        SegmentParameters p = testing::randomSegment(rng);
+        p.a1 *= sL, p.b1 *= sL, p.a2 *= sL, p.b2 *= sL, p.L1_0 *= sL, p.L2_0 *= sL, p.k1 *= sK, p.k2 *= sK;
+        segs.push_back(p);
+      }
+      const Chain chain(segs);
+      const double force = sK * sL, moment = sK * sL * sL;
+      Eigen::VectorXd q(n), dq(n);
+      for (int i = 0; i < n; ++i) q[i] = Q(rng), dq[i] = W(rng);
+      const Wrench F(0.3 * force * W(rng) / n, 0.3 * force * W(rng) / n, moment * W(rng));
+      const Wrench dF(force * W(rng), force * W(rng), moment * W(rng));
+      for (bool rotationHeld : {false, true})
+        for (bool body : {false, true}) {
+          INFO("n = " << n << ", lengths x" << sL << ", rotation held " << rotationHeld << ", body loads " << body);
+          StiffnessOptions o;
+          if (body) {  // a generator of the body loads' kind (any γ: the formulas do not care)
+            o.bodyGenerator = o.bodyGeneratorRate = Eigen::VectorXd(n);
+            for (int i = 0; i < n; ++i)
+              o.bodyGenerator[i] = 0.1 * moment * W(rng) / n, o.bodyGeneratorRate[i] = moment * W(rng) / n;
+          }
+          Eigen::Matrix2d K1, dK1, K2, dK2, K3;
+          REQUIRE(loadedStiffnessDerivative(chain, q, F, rotationHeld, dq, dF, K1, dK1, o));
+          REQUIRE(structuredStiffnessDerivative(chain, q, F, rotationHeld, dq, dF, K2, &dK2, o));
+          REQUIRE(structuredStiffnessDerivative(chain, q, F, rotationHeld, dq, dF, K3, nullptr, o));
+          CHECK((K2 - K1).norm() <= 1e-9 * K1.norm());
+          CHECK((dK2 - dK1).norm() <= 1e-8 * dK1.norm());
+          CHECK(K3 == K2);
+        }
+    }
+  }
 }

@@ -238,8 +238,16 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
     for (const PointReport& p : all)
       if (inRange(p.parameter, options)) r.points.push_back(p);
   for (PointReport& pr : r.points) {
-    if (options.stiffness && pr.locked.selfCount() > 0) {
-      // a self contact's rank-2 Hessian term is outside the structured stiffness: the dense one
+    CartesianStiffness structured;
+    if (options.stiffness && chain.size() >= kStructuredStiffnessFrom &&
+        structuredContactStiffness(ContactProblem(problem, pr.locked), b.points[size_t(pr.index)].u,
+                                   b.points[size_t(pr.index)].lambda, structured)) {
+      pr.K = structured.stiffness;  // O(n); where it does not apply (contact.h), the dense routes below
+      pr.C = structured.compliance;
+      pr.rotationalStiffness = structured.rotationalStiffness;
+      pr.haveStiffness = true;
+    } else if (options.stiffness && pr.locked.selfCount() > 0) {
+      // a self contact's rank-2 Hessian term is outside lockedLoadedStiffness's solve: the dense one
       const cont::ContinuationPoint& p = b.points[size_t(pr.index)];
       const CartesianStiffness s = denseContactStiffness(ContactProblem(problem, pr.locked), p.u, p.lambda);
       pr.K = s.stiffness;

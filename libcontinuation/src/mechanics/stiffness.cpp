@@ -5,9 +5,11 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "buckle/continuation/problem.h"
 #include "buckle/mechanics/body_loads.h"
+#include "buckle/mechanics/chain_structure.h"
 
 namespace buckle::mechanics {
 
@@ -217,6 +219,74 @@ bool loadedStiffnessDerivative(const Chain& chain, ConstVectorRef q, const Wrenc
   dK = -K * dC * K;
   dK = 0.5 * (dK + dK.transpose());
   return K.allFinite() && dK.allFinite();
+}
+
+namespace {
+
+/// xᵀ G(g) y with G(g)_ij = g_max(i,j) (eq 27's generator form) in O(n): the entries with
+/// max(i, j) = m are row m up to m and column m above it, x_m Y_m + X_{m−1} y_m = X_m Y_m − X_{m−1} Y_{m−1}
+/// with X, Y the prefix sums.
+double generatorForm(ConstVectorRef g, ConstVectorRef x, ConstVectorRef y) {
+  double sum = 0.0, X = 0.0, Y = 0.0;
+  for (Eigen::Index m = 0; m < g.size(); ++m) {
+    const double before = X * Y;
+    X += x[m];
+    Y += y[m];
+    sum += g[m] * (X * Y - before);
+  }
+  return sum;
+}
+
+}  // namespace
+
+bool structuredStiffnessDerivative(const Chain& chain, ConstVectorRef q, const Wrench& F, bool rotationHeld,
+                                   ConstVectorRef dq, const Wrench& dF, Eigen::Matrix2d& K, Eigen::Matrix2d* dK,
+                                   const StiffnessOptions& options) {
+  const int n = chain.size();
+  if (q.size() != n || (dK && dq.size() != n))
+    throw std::invalid_argument("q and dq must have one angle per segment (size " + std::to_string(n) + ")");
+  ChainData data(chain);
+  forwardKinematics(chain, q, data);
+  Matrix J(3, n);
+  endJacobian(data, J);
+  ChainStructure ws(n);
+  jointStiffness(chain, q, ws.kappa);
+  loadHessianGenerator(data, F, ws.h);
+  if (options.bodyGenerator.size() == n) ws.h -= options.bodyGenerator;  // H + G(γ): the generator h − γ
+  assemble(ws.kappa, ws.h, ws);
+  // X = P J_pᵀ: [[H, J_φᵀ], [J_φ, 0]] where the rotation is held, H alone where it is free
+  const int p = rotationHeld ? 1 : 0;
+  const Matrix V = rotationHeld ? Matrix(J.row(2).transpose()) : Matrix(n, 0);
+  const Matrix D = Matrix::Zero(p, p);
+  if (!factorBordered(ws, V, V, D)) return false;
+  Matrix X(n, 2);
+  Vector y(p), zero = Vector::Zero(p);
+  for (int j = 0; j < 2; ++j)
+    if (!solveFactoredBordered(ws, V, V, D, J.row(j).transpose(), zero, X.col(j), y)) return false;
+  Eigen::Matrix2d C = J.topRows(2) * X;
+  C = 0.5 * (C + C.transpose());
+  if (!(conditioning(C) > options.singularTolerance)) return false;
+  K = C.inverse();
+  K = 0.5 * (K + K.transpose());
+  if (!dK) return K.allFinite();
+  // dC = dJ_p X + Xᵀ dJ_pᵀ − Xᵀ dH X with dH = diag(dK_q ⊙ dq) − G(dh − dγ) (loadedStiffnessDerivative)
+  Matrix dJ(3, n);
+  endJacobianDerivative(chain, data, dq, dJ);
+  Vector dkq(n);
+  jointStiffnessDerivative(chain, q, dkq);
+  Vector dh = -dF[0] * data.C - F[0] * dJ.row(1).transpose() - dF[1] * data.S + F[1] * dJ.row(0).transpose();
+  if (options.bodyGeneratorRate.size() == n) dh -= options.bodyGeneratorRate;
+  const Vector diagonal = dkq.cwiseProduct(dq);
+  Eigen::Matrix2d XdHX;
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b <= a; ++b)
+      XdHX(a, b) = XdHX(b, a) =
+          (diagonal.array() * X.col(a).array() * X.col(b).array()).sum() - generatorForm(dh, X.col(a), X.col(b));
+  const Eigen::Matrix2d dJX = dJ.topRows(2) * X;
+  const Eigen::Matrix2d dC = dJX + dJX.transpose() - XdHX;
+  *dK = -K * dC * K;
+  *dK = 0.5 * (*dK + dK->transpose());
+  return K.allFinite() && dK->allFinite();
 }
 
 CartesianStiffness unloadedStiffness(const Chain& chain, ConstVectorRef q, bool rotationHeld,

@@ -4,10 +4,12 @@
 #include <Eigen/LU>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
 #include "buckle/continuation/corrector.h"
 #include "buckle/continuation/scaled_problem.h"
+#include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/stiffness.h"
 
 namespace buckle::mechanics {
@@ -70,22 +72,32 @@ StiffnessRate stiffnessRate(const EquilibriumProblem& problem, cont::ConstVector
   StiffnessOptions body;  // the body loads' γ and dγ (eq B3, B5)
   body.bodyGenerator = problem.bodyLoadGenerator(u.head(n), lambda);
   body.bodyGeneratorRate = problem.bodyLoadGeneratorRate(u.head(n), lambda, du.head(n), dlambda);
+  // O(n) for long chains; the dense solves where the structure's factorization fails
+  const auto derivative = [&](const Chain& chain) {
+    return (n >= kStructuredStiffnessFrom &&
+            structuredStiffnessDerivative(chain, u.head(n), F, rotationHeld, du.head(n), dF, r.K, &dK, body)) ||
+           loadedStiffnessDerivative(chain, u.head(n), F, rotationHeld, du.head(n), dF, r.K, dK, body);
+  };
+  const auto stiffnessAt = [&](const Chain& chain, const StiffnessOptions& o) {
+    Eigen::Matrix2d K;
+    if (n >= kStructuredStiffnessFrom &&
+        structuredStiffnessDerivative(chain, u.head(n), F, rotationHeld, du.head(n), dF, K, nullptr, o))
+      return K;
+    return Eigen::Matrix2d(loadedStiffness(chain, u.head(n), F, rotationHeld, o).stiffness);
+  };
   if (!problem.controlled()) {
-    if (!loadedStiffnessDerivative(problem.chain(), u.head(n), F, rotationHeld, du.head(n), dF, r.K, dK, body))
-      return r;
+    if (!derivative(problem.chain())) return r;
   } else {
     // Along a control path K_q also moves with λ at fixed (q, F): that part of dK by central
     // differences of K_F in λ (step 1e-5 of λ's unit: error ~1e-10 relative), the rest exact.
     try {
-      if (!loadedStiffnessDerivative(problem.chainAt(lambda), u.head(n), F, rotationHeld, du.head(n), dF, r.K, dK,
-                                     body))
-        return r;
+      if (!derivative(problem.chainAt(lambda))) return r;
       const double h = 1e-5 * problem.scales().parameter;
       StiffnessOptions fixed;  // K_q's own λ rate: γ held at its value (its rate is in dγ above)
       fixed.bodyGenerator = body.bodyGenerator;
-      const CartesianStiffness up = loadedStiffness(problem.chainAt(lambda + h), u.head(n), F, rotationHeld, fixed);
-      const CartesianStiffness down = loadedStiffness(problem.chainAt(lambda - h), u.head(n), F, rotationHeld, fixed);
-      dK += (up.stiffness - down.stiffness) * (dlambda / (2.0 * h));
+      const Eigen::Matrix2d up = stiffnessAt(problem.chainAt(lambda + h), fixed);
+      const Eigen::Matrix2d down = stiffnessAt(problem.chainAt(lambda - h), fixed);
+      dK += (up - down) * (dlambda / (2.0 * h));
     } catch (const std::invalid_argument&) {
       return r;  // a free length not positive within the step: no rate
     }
@@ -117,14 +129,17 @@ class BranchSection {
         units_(problem.scales()),
         scaledProblem_(cont::BoundProblem(problem), units_),
         scaled_(scaledProblem_.bound()),
-        corrector_(scaled_, correctorOptions()),
+        structured_(problem.segments() > kSmallDense ? scaled_.makeStructuredSolver() : nullptr),
+        corrector_(scaled_, correctorOptions(), structured_.get()),
         measure_(measure),
         N_(problem.dimension()) {
     xa_ = toScaled(a);
     xb_ = toScaled(b);
     normal_ = (xb_ - xa_).normalized();
-    border_.resize(N_ + 1, N_ + 1);
-    Fu_.resize(N_, N_);
+    if (!structured_) {
+      border_.resize(N_ + 1, N_ + 1);
+      Fu_.resize(N_, N_);
+    }
     Flambda_.resize(N_);
   }
 
@@ -140,14 +155,19 @@ class BranchSection {
     if (!c.converged) return s;
     // Tangent: [[F̃_u, F̃_λ], [nᵀ]] t̃ = e (nᵀt̃ = 1 orients it from a to b), back to the user's
     // units for the derivative of K_F.
-    if (!scaled_.jacobian(s.x.head(N_), s.x[N_], Fu_, Flambda_)) return s;
-    border_.topLeftCorner(N_, N_) = Fu_;
-    border_.topRightCorner(N_, 1) = Flambda_;
-    border_.bottomRows(1) = normal_.transpose();
-    Vector e = Vector::Zero(N_ + 1);
+    Vector e = Vector::Zero(N_ + 1), t(N_ + 1);
     e[N_] = 1.0;
-    const Eigen::PartialPivLU<Matrix> lu(border_);
-    Vector t = lu.solve(e);
+    if (structured_) {  // a long chain: the O(n) bordered solver (chain_solver.h)
+      if (structured_->factor(s.x.head(N_), s.x[N_], normal_) == cont::Factorization::Refused ||
+          !structured_->solve(e, t))
+        return s;
+    } else {
+      if (!scaled_.jacobian(s.x.head(N_), s.x[N_], Fu_, Flambda_)) return s;
+      border_.topLeftCorner(N_, N_) = Fu_;
+      border_.topRightCorner(N_, 1) = Flambda_;
+      border_.bottomRows(1) = normal_.transpose();
+      t = Eigen::PartialPivLU<Matrix>(border_).solve(e);
+    }
     if (!t.allFinite()) return s;
     for (int i = 0; i <= N_; ++i) t[i] *= units_.state(i);
     const Vector x = user(s.x);
@@ -185,6 +205,7 @@ class BranchSection {
   cont::UnitScaling units_;
   cont::BoundScaledProblem scaledProblem_;
   cont::BoundProblem scaled_;  // the section's one workspace
+  std::unique_ptr<cont::BorderedSolver> structured_;
   cont::Corrector corrector_;
   StiffnessMeasure measure_;
   int N_;

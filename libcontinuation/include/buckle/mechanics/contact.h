@@ -343,4 +343,12 @@ CartesianStiffness lockedLoadedStiffness(const Chain& chain, continuation::Const
 /// take, where lockedLoadedStiffness has no room for the rank-2 term.
 CartesianStiffness denseContactStiffness(const ContactProblem& problem, continuation::ConstVectorRef u, double lambda);
 
+/// The same quantities in O(n) through the reduced chain structure (contact_stiffness_structured.cpp):
+/// the counts and certified eigenvalue searches for the inertia and the condition number, bordered
+/// solves for C_F; where ZᵀHZ is singular (`singular`), K_F from the position-held system instead of
+/// NaN. False (s unusable: take the dense one) with more than three constraint rows (gaps and a
+/// held φ), more borders than the structure holds, or a factorization that fails.
+bool structuredContactStiffness(const ContactProblem& problem, continuation::ConstVectorRef u, double lambda,
+                                CartesianStiffness& s);
+
 }  // namespace buckle::mechanics

@@ -104,6 +104,18 @@ bool loadedStiffnessDerivative(const Chain& chain, ConstVectorRef q, const Wrenc
                                ConstVectorRef dq, const Wrench& dF, Eigen::Matrix2d& K, Eigen::Matrix2d& dK,
                                const StiffnessOptions& options = {});
 
+/// K_F and dK_F of loadedStiffnessDerivative in O(n): K_q − K_g through the chain structure
+/// (chain_structure.h; the body loads' γ in its generator), X by bordered solves (J_φ the border
+/// where the rotation is held) and Xᵀ dH X by prefix sums over dH's generator form. The same values
+/// to rounding; false where C_F or K_F is singular to singularTolerance, or K_q − K_g itself to
+/// working precision. dK null: K_F alone (dq unused).
+bool structuredStiffnessDerivative(const Chain& chain, ConstVectorRef q, const Wrench& F, bool rotationHeld,
+                                   ConstVectorRef dq, const Wrench& dF, Eigen::Matrix2d& K, Eigen::Matrix2d* dK,
+                                   const StiffnessOptions& options = {});
+/// Chains of this many segments or more take the O(n) stiffness routes (this one, the branch
+/// reports' structuredContactStiffness): below, the dense solves cost less.
+constexpr int kStructuredStiffnessFrom = 64;
+
 /// Unloaded stiffness K_F⁰ = (J K_q⁻¹ Jᵀ)⁻¹ (eq 21–23): loadedStiffness with F = 0.
 CartesianStiffness unloadedStiffness(const Chain& chain, ConstVectorRef q, bool rotationHeld = false,
                                      const StiffnessOptions& options = {});
