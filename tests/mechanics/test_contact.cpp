@@ -589,7 +589,8 @@ TEST_CASE("contact: a branch that comes back to one of its contact events, same 
   CHECK(loops >= 1);
 }
 
-TEST_CASE("contact: self contacts' rank-2 terms on the O(n) solver and counts equal the dense LU and eigen-solve",
+TEST_CASE("contact: self contacts' rank-2 terms on the O(n) solver, products and counts equal the dense LU, "
+          "Jacobian and eigen-solve",
           "[contact]") {
   // n = 450: past the solver's dense fallback (400 unknowns), so every factorization checked here
   // is the structured one; q, μ and the held forces random (the algebra holds at any point)
@@ -675,6 +676,19 @@ TEST_CASE("contact: self contacts' rank-2 terms on the O(n) solver and counts eq
         CHECK(backward(G, y1, g) <= 1e-14);
         CHECK(backward(G, y2, g) <= 1e-14);
       }
+    // the O(n) products against the dense Jacobian's (Problem's defaults)
+    {
+      auto ws = contact.createWorkspace();
+      Eigen::VectorXd x(N + 1), w(N), y1(N), y2(N), z1(N + 1), z2(N + 1);
+      for (int i = 0; i <= N; ++i) x[i] = W(rng);
+      for (int i = 0; i < N; ++i) w[i] = W(rng);
+      REQUIRE(contact.jacobianApply(*ws, u, lambda, x, y1));
+      REQUIRE(contact.cont::Problem::jacobianApply(*ws, u, lambda, x, y2));
+      CHECK((y1 - y2).norm() <= 1e-12 * (A.norm() * x.norm()));
+      REQUIRE(contact.jacobianTransposeApply(*ws, u, lambda, w, z1));
+      REQUIRE(contact.cont::Problem::jacobianTransposeApply(*ws, u, lambda, w, z2));
+      CHECK((z1 - z2).norm() <= 1e-12 * (A.norm() * w.norm()));
+    }
     // the stability: the counts with the coupling bordered against the dense projection of the
     // problem's own operator (self contact rank-2 terms included: ContactProblem::stabilityOperator)
     cont::StabilityInfo info;

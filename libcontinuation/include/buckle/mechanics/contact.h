@@ -170,6 +170,13 @@ class ContactProblem final : public continuation::Problem {
   bool jacobianDirectionalDerivative(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                                      continuation::ConstVectorRef du, double dlambda, continuation::MatrixRef dFu,
                                      continuation::VectorRef dFlambda) const override;
+  /// F_x x and F_xᵀ w in O(n) (contact_products.cpp): the base problem's products, the contacts'
+  /// −Σ μ ∂²g in its generator form plus the self contacts' rank-2 terms, the gap rows and
+  /// columns −∇g, the locked rows −e_i. The locator's structured refinements evaluate with them.
+  bool jacobianApply(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                     continuation::ConstVectorRef x, continuation::VectorRef y) const override;
+  bool jacobianTransposeApply(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                              continuation::ConstVectorRef w, continuation::VectorRef y) const override;
 
   bool hasStabilityOperator() const override { return true; }
   /// H = K_q − K_g − Σ μ_v ∂²x_v (n×n), C = the held rows J_h, one row e_iᵀ per locked joint and
@@ -256,6 +263,7 @@ class ContactProblem final : public continuation::Problem {
     Vector selfSigns;                     // E's diagonal (2s)
     Vector selfAlong, selfEdgeLength;  // where each self contact's vertex is along its edge
     Vector unknowns;           // (q, r, μ) of boundaries()
+    Vector productIn, productOut;  // the base problem's (N + 1) operands of the O(n) products
   };
   std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override;
 
