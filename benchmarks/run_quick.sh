@@ -38,4 +38,5 @@ run task_path "$BIN/task_path" --quick   # issue 29, task-space paths
 run gravity_path "$BIN/gravity_path" --quick   # issue 31, weight
 run wall_path "$BIN/wall_path" --quick   # issue 31, the base wall
 run wall_sliding bash "$HERE/wall_sliding.sh" "$BUILD" 3 50   # issue 31, the wall in the dynamics
+run self_contact_hook bash "$HERE/self_contact_hook.sh" "$BUILD" 8 50   # issue 31, self contact along a branch
 exit $status

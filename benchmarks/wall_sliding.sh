@@ -8,17 +8,8 @@
 #   bash benchmarks/wall_sliding.sh [BUILD_DIR] [n ...]
 # defaults: build, n = 3 50 1000. Record the machine's load (printed) beside the figures.
 set -Eeuo pipefail
-ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-BUILD=${1:-build}
-shift $(( $# > 1 ? 1 : $# ))
-SIZES=("$@")
-((${#SIZES[@]})) || SIZES=(3 50 1000)
-[[ $BUILD == /* ]] || BUILD=$ROOT/$BUILD
-BUCKLE=$BUILD/bin/buckle
-[[ -x $BUCKLE ]] || { echo "no $BUCKLE: build it first" >&2; exit 2; }
-TMP=$(mktemp -d "${TMPDIR:-/tmp}/buckle-wall.XXXXXX")
-trap 'rm -rf "$TMP"' EXIT
-echo "load: $(uptime)"
+source "$(dirname "${BASH_SOURCE[0]}")/sizes_lib.sh"
+sizes_setup wall 3 50 1000 -- "$@"
 for n in "${SIZES[@]}"; do
   python3 - "$n" "$TMP/wall_$n.json" <<'PY'
 import json, math, sys

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <random>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -33,6 +34,13 @@ inline SegmentParameters randomSegment(std::mt19937& rng, const SegmentRanges& r
 }
 
 /// u = (q, r) of size N for `chain`: joint angles within 70 % of the limits, multipliers in [−1.5, 1.5].
+/// n random segments (randomSegment).
+inline std::vector<SegmentParameters> randomSegments(std::mt19937& rng, int n, const SegmentRanges& r = {}) {
+  std::vector<SegmentParameters> segments;
+  for (int i = 0; i < n; ++i) segments.push_back(randomSegment(rng, r));
+  return segments;
+}
+
 inline Eigen::VectorXd randomState(std::mt19937& rng, const Chain& chain, int N) {
   std::uniform_real_distribution<double> W(-1.5, 1.5);
   const int n = chain.size();

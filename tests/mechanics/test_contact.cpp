@@ -16,6 +16,7 @@
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/unloaded_shape.h"
 
+#include "contact_cases.h"
 #include "random_segments.h"
 
 using namespace buckle::mechanics;
@@ -597,31 +598,19 @@ TEST_CASE("contact: self contacts' rank-2 terms on the O(n) solver, products and
   std::mt19937 rng(451);
   std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.4, 0.4);
   const int n = 450;
-  std::vector<SegmentParameters> segs;
-  for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
-  const Chain chain(segs);
+  const Chain chain(testing::randomSegments(rng, n));
   const SelfContact distalOnProximal{{300, 3}, {120, true, 1}};   // the vertex's body the distal one
   const SelfContact proximalOnDistal{{60, 1}, {280, false, 2}};   // the edge's
-  struct Case {
-    std::string name;
-    EndCondition end;
-    bool wall;
-    std::vector<SelfContact> self;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<testing::ContactCase> cases = {
       {"free end, one self contact", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false, {distalOnProximal}},
       {"free end, two", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false,
        {distalOnProximal, proximalOnDistal}},
       {"clamped-pinned, wall, one", EndCondition::clampedPinned(W(rng), 0.1 * W(rng)), true, {proximalOnDistal}}};
-  for (const Case& k : cases) {
+  for (const testing::ContactCase& k : cases) {
     INFO(k.name);
     EquilibriumProblem problem(chain, k.end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
-    ContactSet locked;
-    locked.lock(5, LimitSide::Upper);
-    locked.lock(200, LimitSide::Lower);
-    locked.lock(290, LimitSide::Upper);
-    if (k.wall) locked.touch(WallVertex{2, 3});
-    for (const SelfContact& c : k.self) locked.hold(c);
+    const ContactSet locked = testing::caseContacts(
+        k, {{5, LimitSide::Upper}, {200, LimitSide::Lower}, {290, LimitSide::Upper}}, WallVertex{2, 3});
     const ContactProblem contact(problem, locked);
     const int N = contact.dimension();
     Eigen::VectorXd u(N);

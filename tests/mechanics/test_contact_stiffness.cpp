@@ -16,6 +16,7 @@
 #include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/unloaded_shape.h"
 
+#include "contact_cases.h"
 #include "random_segments.h"
 
 using namespace buckle::mechanics;
@@ -44,41 +45,30 @@ TEST_CASE("contact stiffness: the O(n) route equals the dense eigen-solve (locke
   std::mt19937 rng(2026);
   std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.3, 0.3);
   const int n = 120;
-  std::vector<SegmentParameters> segs;
-  for (int i = 0; i < n; ++i) segs.push_back(testing::randomSegment(rng));
+  const std::vector<SegmentParameters> segs = testing::randomSegments(rng, n);
   const Chain chain(segs);
   const SelfContact a{{90, 3}, {40, true, 1}}, b{{20, 1}, {100, false, 2}};
-  struct Case {
-    std::string name;
-    EndCondition end;
-    bool wall;
-    std::vector<SelfContact> self;
-    double pulling;  // the last self force's sign
-  };
-  const std::vector<Case> cases = {
+  const std::vector<testing::ContactCase> cases = {
       {"free end, no contact", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false, {}, 1.0},
       {"free end, a self contact pushing", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false, {a}, 1.0},
       {"free end, two, one pulling", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false, {a, b}, -1.0},
       {"guided, wall and a self contact", guided(0.3 * W(rng)), true, {b}, 1.0},
       {"held position, wall", EndCondition::heldPosition(0.6 * chain.length(), 0.2), true, {}, 1.0}};
-  for (const Case& k : cases) {
+  for (const testing::ContactCase& k : cases) {
     for (const auto& [sL, sK] : {std::pair{1.0, 1.0}, std::pair{1e-4, 1e8}}) {
       INFO(k.name << ", lengths x" << sL << ", stiffnesses x" << sK);
       std::vector<SegmentParameters> units;
       for (const SegmentParameters& p : segs) units.push_back(scaled(p, sL, sK));
       const Chain c(units);
       EquilibriumProblem problem(c, k.end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
-      ContactSet locked;
-      locked.lock(3, LimitSide::Upper);
-      locked.lock(70, LimitSide::Lower);
-      if (k.wall) locked.touch(WallVertex{1, 3});
-      for (const SelfContact& s : k.self) locked.hold(s);
+      const ContactSet locked =
+          testing::caseContacts(k, {{3, LimitSide::Upper}, {70, LimitSide::Lower}}, WallVertex{1, 3});
       const ContactProblem contact(problem, locked);
       const int N = contact.dimension();
       const double force = c.segment(0).parameters().k1 * c.segment(0).parameters().b1;
       Eigen::VectorXd u(N);
       for (int i = 0; i < N; ++i) u[i] = i < n ? Q(rng) : 0.5 * force * std::abs(W(rng));
-      if (!k.self.empty()) u[N - 1] *= k.pulling;
+      if (!k.self.empty()) u[N - 1] *= k.lastForceSign;
       const double lambda = 0.2 * force * W(rng);
       const CartesianStiffness dense = denseContactStiffness(contact, u, lambda);
       CartesianStiffness fast;

@@ -12,6 +12,7 @@
 #include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/body_loads.h"
 #include "buckle/mechanics/chain.h"
+#include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/dynamics.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/vibration.h"
@@ -265,4 +266,44 @@ TEST_CASE("vibration structured: the automatic route is dense below kStructuredF
   CHECK_THROWS_AS(va.modes(Vector::Zero(n + 1), Wrench::Zero(), {}, {}, 1), std::invalid_argument);
   CHECK_THROWS_AS(va.modes(Vector::Zero(n), Wrench::Zero(), {}, {n}, 1), std::invalid_argument);
   CHECK_THROWS_AS(va.modes(Vector::Zero(n), Wrench::Zero(), {4}, {}, 1), std::invalid_argument);
+}
+
+TEST_CASE("vibration structured: at points holding self contacts the coupling bordered on the pencil gives the dense "
+          "route's modes",
+          "[vibration][vibration_structured]") {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> U(-0.6, 0.6);
+  const int n = 80;
+  const Chain chain = stiffChain(n);
+  VibrationAnalysis va(chain, periodicInertia(chain, 1.0));
+  Vector q(n);
+  for (int i = 0; i < n; ++i) q[i] = U(rng) * 3.0 / n;
+  const SelfContact a{{70, 3}, {20, true, 1}}, b{{10, 1}, {60, false, 2}};
+  for (const Wrench& F : {Wrench(-0.3, 0.2, 0.1), Wrench(-40.0 / n, 0.5 / n, 0.0)})
+    for (int contacts : {1, 2})
+      for (bool locked : {false, true})
+        for (const std::vector<int>& held : {std::vector<int>{}, {1}}) {
+          INFO("Fx = " << F.x() << ", self contacts " << contacts << ", locked " << locked << ", held " << held.size());
+          ContactSet set;
+          set.hold(a);
+          if (contacts == 2) set.hold(b);
+          if (locked) set.lock(40, LimitSide::Upper);
+          Vector forces(contacts);
+          forces[0] = 0.7;
+          if (contacts == 2) forces[1] = -0.4;  // one pulling: E's signs both ways
+          va.setRoute(VibrationRoute::Dense);
+          const VibrationModes d = va.modes(q, F, held, set, forces, 5, true);
+          va.setRoute(VibrationRoute::Structured);
+          const VibrationModes s = va.modes(q, F, held, set, forces, 5, true);
+          va.setRoute(VibrationRoute::Automatic);
+          REQUIRE(s.route == VibrationRoute::Structured);
+          CHECK(s.fallback.empty());
+          REQUIRE(s.dimension == d.dimension);
+          REQUIRE(s.omegaSquared.size() == d.omegaSquared.size());
+          const double scale = va.modes(q, F, held, set, forces, d.dimension, false).omegaSquared.cwiseAbs().maxCoeff();
+          for (int j = 0; j < d.omegaSquared.size(); ++j) {
+            CHECK(std::abs(s.omegaSquared[j] - d.omegaSquared[j]) <= 1e-11 * scale);
+            CHECK((s.shapes.col(j) - d.shapes.col(j)).norm() <= 1e-6 * d.shapes.col(j).norm());
+          }
+        }
 }

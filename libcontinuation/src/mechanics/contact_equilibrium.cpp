@@ -112,14 +112,15 @@ void wallConstraintTerms(const Chain& chain, ConstVectorRef q, const ContactSet&
 }
 
 void selfConstraintTerms(const Chain& chain, ConstVectorRef q, const ContactSet& contacts, ConstVectorRef selfForces,
-                         const char* caller, MatrixRef rows, Vector& generator, Matrix& coupling) {
+                         const char* caller, MatrixRef rows, Vector& generator, Matrix& columns, Vector& signs) {
   const int n = chain.size(), s = contacts.selfCount();
   if (selfForces.size() != s)
     throw std::invalid_argument(std::string(caller) + ": one force per self contact (" + std::to_string(s) + "), got " +
                                 std::to_string(selfForces.size()));
   if (s == 0) return;
   if (generator.size() != n) generator = Vector::Zero(n);
-  if (coupling.rows() != n || coupling.cols() != n) coupling = Matrix::Zero(n, n);
+  columns.resize(n, 2 * s);
+  signs.resize(2 * s);
   const Eigen::Matrix2Xd P = jointPositions(chain, q);
   Vector gradient(n), gapGenerator(n), c(n), w(n);
   for (int k = 0; k < s; ++k) {
@@ -127,7 +128,9 @@ void selfConstraintTerms(const Chain& chain, ConstVectorRef q, const ContactSet&
     selfContactDerivatives(P, contact, selfContactGap(chain, q, P, contact), gradient, gapGenerator, c, w);
     rows.row(k) = gradient.transpose();
     generator += selfForces[k] * gapGenerator;
-    coupling.noalias() -= selfForces[k] * (c * w.transpose() + w * c.transpose());
+    const double sign = selfCouplingColumns(c, w, selfForces[k], columns.middleCols(2 * k, 2));
+    signs[2 * k] = -sign;
+    signs[2 * k + 1] = sign;
   }
 }
 

@@ -1,14 +1,14 @@
-// The loaded stiffness of a chain holding self contacts (contact.h), dense: a self contact's
-// rank-2 Hessian term (self_contact.h) has no place in the structured solve of
-// lockedLoadedStiffness, so K_F = (J_p P J_pᵀ)⁻¹ (eq 29) is formed here from the constrained
-// operator itself, P = Z (Zᵀ H Z)⁻¹ Zᵀ with Z a basis of the joints' motions that keep every
-// contact (and φ where it is held). O(n³): only points that hold a self contact take it.
+// The loaded stiffness of a chain holding contacts (contact.h), dense: K_F = (J_p P J_pᵀ)⁻¹
+// (eq 29) formed from the constrained operator itself, P = Z (Zᵀ H Z)⁻¹ Zᵀ with Z a basis of the
+// joints' motions that keep every contact (and φ where it is held), a self contact's rank-2
+// Hessian term included. O(n³): short chains and what structuredContactStiffness refuses.
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <cmath>
 #include <limits>
 
 #include "buckle/mechanics/contact.h"
+#include "contact_stiffness.h"
 
 namespace buckle::mechanics {
 
@@ -53,28 +53,34 @@ CartesianStiffness denseContactStiffness(const ContactProblem& problem, continua
   for (int j = 0; j < n; ++j) J.col(j) << -(end.y() - P(1, j + 1)), end.x() - P(0, j + 1), 1.0;
   const Matrix JV = J * Z * eig.eigenvectors();               // 3 × (n − r)
   const Matrix X = mu.cwiseInverse().asDiagonal() * JV.transpose();  // (Zᵀ H Z)⁻¹ (J Z)ᵀ in the eigenbasis
-  const Eigen::Matrix3d C3 = JV * X;
   const double condition = mu.cwiseAbs().maxCoeff() / mu.cwiseAbs().minCoeff();
+  Eigen::Vector3d jNorms, xNorms;
+  for (int i = 0; i < 3; ++i) jNorms[i] = JV.row(i).norm(), xNorms[i] = X.col(i).norm();
+  finishContactStiffness(JV * X, jNorms, xNorms, condition, s);
+  return s;
+}
+
+void finishContactStiffness(const Eigen::Ref<const Matrix>& C, const Eigen::Ref<const Vector>& jNorms,
+                            const Eigen::Ref<const Vector>& xNorms, double condition, CartesianStiffness& s) {
   const double eps = std::numeric_limits<double>::epsilon();
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2; ++j) {
-      s.complianceAccuracy(i, j) = eps * condition * JV.row(i).norm() * X.col(j).norm();
-      s.compliance(i, j) = std::abs(C3(i, j)) <= s.complianceAccuracy(i, j) ? 0.0 : C3(i, j);
+      s.complianceAccuracy(i, j) = eps * condition * jNorms[i] * xNorms[j];
+      s.compliance(i, j) = std::abs(C(i, j)) <= s.complianceAccuracy(i, j) ? 0.0 : C(i, j);
     }
   if (!s.rotationHeld) {
-    s.rotationalComplianceAccuracy = eps * condition * JV.row(2).norm() * X.col(2).norm();
-    s.rotationalCompliance = std::abs(C3(2, 2)) <= s.rotationalComplianceAccuracy ? 0.0 : C3(2, 2);
+    s.rotationalComplianceAccuracy = eps * condition * jNorms[2] * xNorms[2];
+    s.rotationalCompliance = std::abs(C(2, 2)) <= s.rotationalComplianceAccuracy ? 0.0 : C(2, 2);
     s.rotationalStiffness = s.rotationalCompliance == 0.0 ? std::numeric_limits<double>::infinity()
                                                           : 1.0 / s.rotationalCompliance;
   }
   const double det = s.compliance.determinant();
   if (std::abs(det) <= eps * condition * s.compliance.squaredNorm()) {
     s.rigid = true;
-    return s;
+    return;
   }
   s.stiffness = s.compliance.inverse();
   s.positiveDefinite = s.stiffness(0, 0) > 0.0 && s.stiffness.determinant() > 0.0;
-  return s;
 }
 
 }  // namespace buckle::mechanics

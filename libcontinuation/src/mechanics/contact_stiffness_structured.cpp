@@ -15,6 +15,7 @@
 #include <limits>
 
 #include "buckle/mechanics/contact.h"
+#include "contact_stiffness.h"
 
 namespace buckle::mechanics {
 
@@ -33,7 +34,7 @@ bool structuredContactStiffness(const ContactProblem& problem, continuation::Con
   const EquilibriumProblem& base = problem.base();
   const std::vector<int>& free = problem.freeJoints();
   const int nf = int(free.size()), gaps = problem.contacts().gapCount(), z = 2 * problem.contacts().selfCount();
-  const double nan = std::numeric_limits<double>::quiet_NaN(), eps = std::numeric_limits<double>::epsilon();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   s = CartesianStiffness();
   s.stiffness = s.compliance = s.complianceAccuracy = Eigen::Matrix2d::Constant(nan);
   s.rotationHeld = base.endCondition().isHeld(EndCoordinate::Phi);
@@ -98,30 +99,13 @@ bool structuredContactStiffness(const ContactProblem& problem, continuation::Con
   Matrix X(nf, columnsWanted);
   for (int j = 0; j < columnsWanted; ++j)
     if (!solveFactoredBordered(ws, Vp, Vp, Dp, J.row(j).transpose(), zero.head(p), X.col(j), y.head(p))) return false;
-  const Matrix JX = J.topRows(columnsWanted) * X;
   // as the dense route: |Zᵀ J_iᵀ| (J_i's part in ker C, Q orthonormal) and |X_j| with κ = max|ν| / min|ν|
-  Vector projected(columnsWanted);
-  for (int i = 0; i < columnsWanted; ++i)
+  Vector projected(columnsWanted), xNorms(columnsWanted);
+  for (int i = 0; i < columnsWanted; ++i) {
     projected[i] = (J.row(i).transpose() - Q * (Q.transpose() * J.row(i).transpose())).norm();
-  const double condition = largest / nearest;
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j) {
-      s.complianceAccuracy(i, j) = eps * condition * projected[i] * X.col(j).norm();
-      s.compliance(i, j) = std::abs(JX(i, j)) <= s.complianceAccuracy(i, j) ? 0.0 : JX(i, j);
-    }
-  if (!s.rotationHeld) {
-    s.rotationalComplianceAccuracy = eps * condition * projected[2] * X.col(2).norm();
-    s.rotationalCompliance = std::abs(JX(2, 2)) <= s.rotationalComplianceAccuracy ? 0.0 : JX(2, 2);
-    s.rotationalStiffness = s.rotationalCompliance == 0.0 ? std::numeric_limits<double>::infinity()
-                                                          : 1.0 / s.rotationalCompliance;
+    xNorms[i] = X.col(i).norm();
   }
-  const double det = s.compliance.determinant();
-  if (std::abs(det) <= eps * condition * s.compliance.squaredNorm()) {
-    s.rigid = true;
-    return true;
-  }
-  s.stiffness = s.compliance.inverse();
-  s.positiveDefinite = s.stiffness(0, 0) > 0.0 && s.stiffness.determinant() > 0.0;
+  finishContactStiffness(J.topRows(columnsWanted) * X, projected, xNorms, largest / nearest, s);
   return true;
 }
 

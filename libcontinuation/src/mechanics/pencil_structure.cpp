@@ -55,8 +55,8 @@ PencilStructure::PencilStructure(int cap)
       tri(Vector::Zero(cap)),
       g(Matrix::Zero(cap, 2)),
       Q(Matrix::Zero(cap, 3)),
-      B(Matrix::Zero(cap, 3)),
-      X(Matrix::Zero(cap, 3)),
+      B(Matrix::Zero(cap, kMaxBorder)),
+      X(Matrix::Zero(cap, kMaxBorder)),
       work(Vector::Zero(cap)),
       guessChunk(Vector::Zero(0)) {
   if (cap < 1) throw std::invalid_argument("PencilStructure: capacity must be >= 1");
@@ -274,14 +274,27 @@ int setPencilConstraints(PencilStructure& ws, const Eigen::Ref<const Matrix>& C,
   const int n = ws.n;
   if (C.rows() > 3 || (C.rows() > 0 && C.cols() != n))
     throw std::invalid_argument("setPencilConstraints: C must be m×n with m <= 3");
-  const int rank = structure::orthonormaliseRows(C, ws.Q.topRows(n), ws.B.topRows(n), rankTolerance);
+  const int rank = structure::orthonormaliseRows(C, ws.Q.topRows(n), ws.B.topRows(n).leftCols(3), rankTolerance);
   ws.rank = rank;
+  ws.couplingCount = 0;
   return rank;
+}
+
+void setPencilCoupling(PencilStructure& ws, const Eigen::Ref<const Matrix>& R, const Eigen::Ref<const Vector>& signs) {
+  const int c = int(R.cols());
+  if (R.rows() != ws.n || signs.size() != c || ws.rank + c > PencilStructure::kMaxBorder)
+    throw std::invalid_argument("setPencilCoupling: R must be n×c with rank(C) + c <= kMaxBorder and c signs");
+  for (int j = 0; j < c; ++j) {
+    if (signs[j] != 1.0 && signs[j] != -1.0) throw std::invalid_argument("setPencilCoupling: each sign must be +1 or -1");
+    applyUInverse(R.col(j), ws.B.col(ws.rank + j).head(ws.n));
+    ws.couplingSign[j] = signs[j];
+  }
+  ws.couplingCount = c;
 }
 
 int pencilCountBelow(PencilStructure& ws, double sigma, bool determinant) {
   factorizePencil(ws, sigma, determinant);
-  const int r = ws.rank;
+  const int r = ws.rank + ws.couplingCount;  // the constraints' and the coupling's columns
   if (r == 0) return ws.negative;
   for (int c = 0; c < r; ++c) {
     ws.X.col(c).head(ws.n) = ws.B.col(c).head(ws.n);
@@ -290,10 +303,15 @@ int pencilCountBelow(PencilStructure& ws, double sigma, bool determinant) {
   ws.S.resize(r, r);
   ws.S.noalias() = ws.B.topLeftCorner(ws.n, r).transpose() * ws.X.topLeftCorner(ws.n, r);
   ws.S = -0.5 * (ws.S + ws.S.transpose()).eval();
+  int positiveSigns = 0;  // the negative eigenvalues of the coupling's block −E
+  for (int j = 0; j < ws.couplingCount; ++j) {
+    ws.S(ws.rank + j, ws.rank + j) -= ws.couplingSign[j];
+    positiveSigns += ws.couplingSign[j] > 0.0 ? 1 : 0;
+  }
   const Eigen::SelfAdjointEigenSolver<PencilStructure::SmallMatrix> es(ws.S, Eigen::EigenvaluesOnly);
   int negS = 0;
   for (int i = 0; i < r; ++i) negS += es.eigenvalues()[i] < 0.0 ? 1 : 0;
-  return ws.negative + negS - r;
+  return ws.negative + negS - ws.rank - positiveSigns;
 }
 
 namespace {
@@ -308,7 +326,7 @@ search::ShiftEvaluation evaluatePencil(PencilStructure& ws, double sigma, bool c
   ev.logAbsDet = ws.logAbsDet;
   ev.sign = ws.detSign;
   ev.dLog = ws.dLogAbsDet;
-  const int r = ws.rank;
+  const int r = ws.rank + ws.couplingCount;
   if (r == 0) return ev;
   const Eigen::PartialPivLU<PencilStructure::SmallMatrix> lu(ws.S);
   const double detS = lu.determinant();

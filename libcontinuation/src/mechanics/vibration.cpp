@@ -138,25 +138,25 @@ VibrationModes VibrationAnalysis::modes(ConstVectorRef q, const Wrench& F, const
     throw std::invalid_argument("VibrationAnalysis::modes: one force per wall vertex (" + std::to_string(w) +
                                 ") and per self contact (" + std::to_string(s) + "), got " +
                                 std::to_string(forces.size()));
-  Matrix rows(w + s, n), coupling;
+  Matrix rows(w + s, n), columns;
+  Vector signs;
   Vector gamma = bodyGenerator;  // as lockedLoadedStiffness: the contacts' rows and their forces' generator
   wallConstraintTerms(chain_, q, contacts, forces.head(w), "VibrationAnalysis::modes", rows.topRows(w), gamma);
   selfConstraintTerms(chain_, q, contacts, forces.tail(s), "VibrationAnalysis::modes", rows.bottomRows(s), gamma,
-                      coupling);
-  return route(q, F, held, locked, rows, count, shapes, gamma, coupling);
+                      columns, signs);
+  return route(q, F, held, locked, rows, count, shapes, gamma, columns, signs);
 }
 
 VibrationModes VibrationAnalysis::route(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                                         const std::vector<int>& lockedJoints, const Matrix& wallRows, int count,
-                                        bool shapes, const Vector& bodyGenerator, const Matrix& coupling) {
+                                        bool shapes, const Vector& bodyGenerator, const Matrix& couplingColumns,
+                                        const Vector& couplingSigns) {
   const bool structured = route_ == VibrationRoute::Structured ||
                           (route_ == VibrationRoute::Automatic && chain_.size() >= kStructuredFrom);
-  if (structured && coupling.size() == 0)
-    return structuredModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator);
-  VibrationModes out = denseModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator, coupling);
   if (structured)
-    out.fallback = "a held self contact couples the two bodies' joints outside the chain structure: dense route";
-  return out;
+    return structuredModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator, couplingColumns,
+                           couplingSigns);
+  return denseModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator, couplingColumns, couplingSigns);
 }
 
 void VibrationAnalysis::massMatrix(ConstVectorRef q, MatrixRef M) {
@@ -188,12 +188,14 @@ Matrix VibrationAnalysis::constraintRows(ConstVectorRef q, const std::vector<int
 
 VibrationModes VibrationAnalysis::denseModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                                              const std::vector<int>& lockedJoints, const Matrix& wallRows, int count,
-                                             bool shapes, const Vector& bodyGenerator, const Matrix& coupling) {
+                                             bool shapes, const Vector& bodyGenerator, const Matrix& couplingColumns,
+                                             const Vector& couplingSigns) {
   const int n = chain_.size();
   Matrix H(n, n), M(n, n);
   totalPotentialHessian(chain_, q, F, H);  // K_q − K_g(F), eq 27
   addBodyLoadHessian(bodyGenerator, H);     // the body loads' Γ (eq B3)
-  if (coupling.size() > 0) H += coupling;   // the self contacts' rank-2 term (self_contact.h)
+  if (couplingColumns.cols() > 0)  // the self contacts' rank-2 term R E Rᵀ (self_contact.h)
+    H.noalias() += couplingColumns * couplingSigns.asDiagonal() * couplingColumns.transpose();
   model_.massMatrix(q, M);
   Matrix C = constraintRows(q, held, lockedJoints);
   if (wallRows.rows() > 0) {

@@ -61,6 +61,7 @@ struct VibrationAnalysis::Structured {
   Vector xi, z, Mz;
   Matrix modesTheta, massModes;
   PencilStructure::SmallMatrix BtB;
+  Matrix couplingFree;  // the self contacts' coupling columns on the free joints
 };
 
 void VibrationAnalysis::StructuredDeleter::operator()(Structured* p) const { delete p; }
@@ -117,7 +118,8 @@ void assembleFreePencil(const std::vector<int>& free, const Vector& kappa, const
 /// massModes), so close or repeated ω² span their invariant subspace. False if it did not converge.
 bool inverseIteration(PencilStructure& ws, const Vector& values, int j, double floor, Matrix& modes,
                       Matrix& massModes, PencilStructure::SmallMatrix& BtB, Vector& xi, Vector& z, Vector& Mz) {
-  const int n = ws.n, r = ws.rank;
+  // r constraint columns, b with the coupling's (its rows Bᵀz − E y = 0: S gains diag(0, E))
+  const int n = ws.n, r = ws.rank, b = ws.rank + ws.couplingCount;
   double gap = std::numeric_limits<double>::infinity();
   if (j > 0) gap = std::min(gap, values[j] - values[j - 1]);
   if (j + 1 < values.size()) gap = std::min(gap, values[j + 1] - values[j]);
@@ -132,13 +134,16 @@ bool inverseIteration(PencilStructure& ws, const Vector& values, int j, double f
   }
   auto xiH = xi.head(n), zH = z.head(n), MzH = Mz.head(n);
   Eigen::PartialPivLU<PencilStructure::SmallMatrix> schur, gram;
-  if (r > 0) {
-    for (int c = 0; c < r; ++c) {
+  if (b > 0) {
+    for (int c = 0; c < b; ++c) {
       ws.X.col(c).head(n) = ws.B.col(c).head(n);
       solvePencil(ws, ws.X.col(c).head(n));
     }
-    ws.S.noalias() = ws.B.topLeftCorner(n, r).transpose() * ws.X.topLeftCorner(n, r);
+    ws.S.noalias() = ws.B.topLeftCorner(n, b).transpose() * ws.X.topLeftCorner(n, b);
+    for (int c = 0; c < ws.couplingCount; ++c) ws.S(r + c, r + c) += ws.couplingSign[c];
     schur.compute(ws.S);
+  }
+  if (r > 0) {
     BtB.resize(r, r);
     BtB.noalias() = ws.B.topLeftCorner(n, r).transpose() * ws.B.topLeftCorner(n, r);
     gram.compute(BtB);
@@ -167,9 +172,9 @@ bool inverseIteration(PencilStructure& ws, const Vector& values, int j, double f
     xiH = zH;
     zH = MzH;  // (G_σ with the border) z = M ξ
     solvePencil(ws, zH);
-    if (r > 0) {
-      const PencilStructure::SmallMatrix c = ws.B.topLeftCorner(n, r).transpose() * zH;
-      zH.noalias() -= ws.X.topLeftCorner(n, r) * schur.solve(c);
+    if (b > 0) {
+      const PencilStructure::SmallMatrix c = ws.B.topLeftCorner(n, b).transpose() * zH;
+      zH.noalias() -= ws.X.topLeftCorner(n, b) * schur.solve(c);
       project(zH);
     }
     if (!orthonormalise()) return false;
@@ -185,15 +190,19 @@ bool inverseIteration(PencilStructure& ws, const Vector& values, int j, double f
 
 VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                                                   const std::vector<int>& lockedJoints, const Matrix& wallRows,
-                                                  int count, bool shapes, const Vector& bodyGenerator) {
-  const int n = chain_.size();
+                                                  int count, bool shapes, const Vector& bodyGenerator,
+                                                  const Matrix& couplingColumns, const Vector& couplingSigns) {
+  const int n = chain_.size(), coupled = int(couplingColumns.cols());
   for (int c : held)
     if (c < 0 || c > 2) throw std::invalid_argument("held end coordinate " + std::to_string(c) + " outside 0…2");
   const Eigen::Index rows = Eigen::Index(held.size()) + wallRows.rows();
-  if (rows > 3) {
-    // the pencil is bordered by at most three rows (pencil_structure.h)
-    VibrationModes dense = denseModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator, Matrix());
-    dense.fallback = std::to_string(rows) + " held and wall rows (the structured route borders at most 3): the dense route";
+  if (rows > 3 || rows + coupled > PencilStructure::kMaxBorder) {
+    // the pencil is bordered by at most three rows, and kMaxBorder columns with the coupling's (pencil_structure.h)
+    VibrationModes dense =
+        denseModes(q, F, held, lockedJoints, wallRows, count, shapes, bodyGenerator, couplingColumns, couplingSigns);
+    dense.fallback = std::to_string(rows) + " held and contact rows and " + std::to_string(coupled) +
+                     " self-contact coupling columns (the structured route borders at most 3 rows and " +
+                     std::to_string(PencilStructure::kMaxBorder) + " columns): the dense route";
     return dense;
   }
   if (!structured_) structured_.reset(new Structured(chain_, inertia_));
@@ -228,6 +237,11 @@ VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench
     for (Eigen::Index k = 0; k < wallRows.rows(); ++k)
       for (int c = 0; c < m; ++c) C(Eigen::Index(held.size()) + k, c) = wallRows(k, s.freeJoints[size_t(c)]);
     setPencilConstraints(ws, C, kConstraintRankTolerance);
+    if (coupled > 0) {  // the self contacts' rank-2 terms on the free joints (selfConstraintTerms)
+      s.couplingFree.resize(m, coupled);
+      for (int c = 0; c < m; ++c) s.couplingFree.row(c) = couplingColumns.row(s.freeJoints[size_t(c)]);
+      setPencilCoupling(ws, s.couplingFree, couplingSigns);
+    }
   }
   const int p = m - ws.rank;
   out.dimension = p;
@@ -254,7 +268,8 @@ VibrationModes VibrationAnalysis::structuredModes(ConstVectorRef q, const Wrench
   const double floor = 100.0 * kSearchTolerance * kSearchUnit * ws.scale;
   for (int j = 0; j < k; ++j) {
     if (!inverseIteration(ws, values, j, floor, s.modesTheta, s.massModes, s.BtB, s.xi, s.z, s.Mz)) {
-      VibrationModes dense = denseModes(q, F, held, lockedJoints, wallRows, count, true, bodyGenerator, Matrix());
+      VibrationModes dense =
+          denseModes(q, F, held, lockedJoints, wallRows, count, true, bodyGenerator, couplingColumns, couplingSigns);
       dense.fallback = "the structured inverse iteration did not converge for mode " + std::to_string(j + 1) +
                        ": shapes (and values) from the dense route";
       return dense;

@@ -61,7 +61,9 @@ MassGenerators massGenerators(const Chain& chain, const InertiaData& inertia);
 
 /// Workspace of the pencil G_σ = T − σ M_θ.
 struct PencilStructure {
-  using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
+  /// Border columns: at most 3 held rows and two coupling columns per self contact.
+  static constexpr int kMaxBorder = ChainStructure::kMaxBorder;
+  using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxBorder, kMaxBorder>;
 
   explicit PencilStructure(int capacity);
 
@@ -88,9 +90,12 @@ struct PencilStructure {
   double dLogAbsDet = 0.0;     ///< d log|det G_σ| / dσ (NaN without the determinant)
   long factorizations = 0;
 
-  // held rows: Q orthonormal (first `rank` columns), B = U⁻¹Q, X = G_σ⁻¹B, S = −BᵀX
+  // held rows: Q orthonormal (first `rank` columns), B = U⁻¹Q, X = G_σ⁻¹B, S = −BᵀX; then the
+  // coupling's columns U⁻¹R (setPencilCoupling), S = diag(0, −E) − BᵀX
   Matrix Q, B, X;
   int rank = 0;
+  int couplingCount = 0;
+  Eigen::Matrix<double, kMaxBorder, 1> couplingSign = Eigen::Matrix<double, kMaxBorder, 1>::Zero();
   SmallMatrix S;
   Vector work;  ///< scratch (mass products)
   Vector guessChunk;  ///< the warm start of one chunk of the eigenvalue search (resized only when the chunk size changes)
@@ -107,6 +112,10 @@ bool pencilMassPositive(const PencilStructure& ws);
 /// Orthonormalise the rows of C (m×n active, m ≤ 3) into Q; B = U⁻¹Q. Rows whose remainder is
 /// below rankTolerance of the largest row norm are dropped. Returns the rank.
 int setPencilConstraints(PencilStructure& ws, const Eigen::Ref<const Matrix>& C, double rankTolerance = 1e-10);
+/// After setPencilConstraints(): the pencil's stiffness becomes H + R E Rᵀ on ker C (R m×c active,
+/// E = diag(signs), each ±1, rank + c ≤ kMaxBorder), bordered as chain_structure.h's setCoupling
+/// (a self contact's rank-2 term, self_contact.h): the counts subtract #{E_jj > 0}.
+void setPencilCoupling(PencilStructure& ws, const Eigen::Ref<const Matrix>& R, const Eigen::Ref<const Vector>& signs);
 /// Number of eigenvalues of the pencil on ker C below σ (refactorizes at σ; X and S at σ after).
 int pencilCountBelow(PencilStructure& ws, double sigma, bool determinant = true);
 /// Eigenvalues first … first + k − 1 (ascending; k = min(count, n − rank − first)) of the pencil on

@@ -113,15 +113,17 @@ class VibrationAnalysis {
   // Both routes take the contact rows (wall then self, below C_h's rows; empty: none) beside the
   // held and locked ones; the contact forces' generator terms are already in bodyGenerator. The
   // self contacts' rank-2 term (`coupling`, n×n; empty: none) sends the point to the dense route.
+  // couplingColumns, couplingSigns: the self contacts' rank-2 terms as R E Rᵀ (selfConstraintTerms)
   VibrationModes route(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                        const std::vector<int>& lockedJoints, const Matrix& wallRows, int count, bool shapes,
-                       const Vector& bodyGenerator, const Matrix& coupling = Matrix());
+                       const Vector& bodyGenerator, const Matrix& couplingColumns = Matrix(),
+                       const Vector& couplingSigns = Vector());
   VibrationModes denseModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                             const std::vector<int>& lockedJoints, const Matrix& wallRows, int count, bool shapes,
-                            const Vector& bodyGenerator, const Matrix& coupling);
+                            const Vector& bodyGenerator, const Matrix& couplingColumns, const Vector& couplingSigns);
   VibrationModes structuredModes(ConstVectorRef q, const Wrench& F, const std::vector<int>& held,
                                  const std::vector<int>& lockedJoints, const Matrix& wallRows, int count, bool shapes,
-                                 const Vector& bodyGenerator);
+                                 const Vector& bodyGenerator, const Matrix& couplingColumns, const Vector& couplingSigns);
 
   Chain chain_;
   InertiaData inertia_;

@@ -18,11 +18,10 @@ void wallConstraintTerms(const Chain& chain, ConstVectorRef q, const ContactSet&
 
 /// The same for the self contacts of `contacts` (self_contact.h), forces in contacts.self()'s
 /// order: their rows ∇gᵀ into `rows` (s × n), and −Σ μ ∂²g as its generator part (γ += μ γ_g,
-/// `generator` as above) and its rank-2 part −Σ μ (c wᵀ + w cᵀ), added to `coupling` (n × n, set
-/// to zeros first when empty and a contact is held). The rank-2 part has no place in the chain
-/// structure: a caller holding it takes a dense route. Throws std::invalid_argument, naming
+/// `generator` as above) and its rank-2 part −Σ μ (c wᵀ + w cᵀ) as R E Rᵀ (selfCouplingColumns):
+/// R into `columns` (n × 2s), E's diagonal into `signs`. Throws std::invalid_argument, naming
 /// `caller`, unless there is one force per self contact.
 void selfConstraintTerms(const Chain& chain, ConstVectorRef q, const ContactSet& contacts, ConstVectorRef selfForces,
-                         const char* caller, MatrixRef rows, Vector& generator, Matrix& coupling);
+                         const char* caller, MatrixRef rows, Vector& generator, Matrix& columns, Vector& signs);
 
 }  // namespace buckle::mechanics
