@@ -18,6 +18,13 @@ struct ContactCase {
   double lastForceSign = 1.0;  ///< −1: the last contact force pulls
 };
 
+/// Two self contacts across a chain of n segments (n ≥ 40): a distal corner three quarters along
+/// on a distal triangle's edge a quarter along (the vertex's body the distal one), and a proximal
+/// corner an eighth along on a proximal triangle's edge at five eighths (the edge's the distal one).
+inline std::pair<SelfContact, SelfContact> crossingSelfContacts(int n) {
+  return {SelfContact{{3 * n / 4, 3}, {n / 4, true, 1}}, SelfContact{{n / 8, 1}, {5 * n / 8, false, 2}}};
+}
+
 /// The locked joints, the wall vertex when the case has the wall, and the case's self contacts.
 inline ContactSet caseContacts(const ContactCase& k, const std::vector<std::pair<int, LimitSide>>& locked,
                                const WallVertex& wall) {

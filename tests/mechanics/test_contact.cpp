@@ -595,12 +595,11 @@ TEST_CASE("contact: self contacts' rank-2 terms on the O(n) solver, products and
           "[contact]") {
   // n = 450: past the solver's dense fallback (400 unknowns), so every factorization checked here
   // is the structured one; q, μ and the held forces random (the algebra holds at any point)
-  std::mt19937 rng(451);
-  std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.4, 0.4);
   const int n = 450;
+  std::mt19937 rng(451);
   const Chain chain(testing::randomSegments(rng, n));
-  const SelfContact distalOnProximal{{300, 3}, {120, true, 1}};   // the vertex's body the distal one
-  const SelfContact proximalOnDistal{{60, 1}, {280, false, 2}};   // the edge's
+  const auto [distalOnProximal, proximalOnDistal] = testing::crossingSelfContacts(n);
+  std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.4, 0.4);
   const std::vector<testing::ContactCase> cases = {
       {"free end, one self contact", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false, {distalOnProximal}},
       {"free end, two", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false,

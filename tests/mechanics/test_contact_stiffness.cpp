@@ -42,12 +42,12 @@ EndCondition guided(double Fx) {  // x loaded, y free, φ held at 0
 TEST_CASE("contact stiffness: the O(n) route equals the dense eigen-solve (locked joints, wall, self contacts, "
           "rotation free and held)",
           "[contact_stiffness]") {
-  std::mt19937 rng(2026);
-  std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.3, 0.3);
   const int n = 120;
+  std::mt19937 rng(2026);
   const std::vector<SegmentParameters> segs = testing::randomSegments(rng, n);
   const Chain chain(segs);
-  const SelfContact a{{90, 3}, {40, true, 1}}, b{{20, 1}, {100, false, 2}};
+  const auto [a, b] = testing::crossingSelfContacts(n);
+  std::uniform_real_distribution<double> W(-1.0, 1.0), Q(-0.3, 0.3);
   const std::vector<testing::ContactCase> cases = {
       {"free end, no contact", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false, {}, 1.0},
       {"free end, a self contact pushing", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false, {a}, 1.0},

@@ -81,15 +81,7 @@ int setConstraints(ChainStructure& ws, const Eigen::Ref<const Matrix>& C, double
 }
 
 void setCoupling(ChainStructure& ws, const Eigen::Ref<const Matrix>& R, const Eigen::Ref<const Vector>& signs) {
-  const int c = int(R.cols());
-  if (R.rows() != ws.n || signs.size() != c || ws.rank + c > ChainStructure::kMaxBorder)
-    throw std::invalid_argument("setCoupling: R must be n×c with rank(C) + c <= kMaxBorder and c signs");
-  for (int j = 0; j < c; ++j) {
-    if (signs[j] != 1.0 && signs[j] != -1.0) throw std::invalid_argument("setCoupling: each sign must be +1 or -1");
-    applyUInverse(R.col(j), ws.B.col(ws.rank + j));
-    ws.couplingSign[j] = signs[j];
-  }
-  ws.couplingCount = c;
+  ws.couplingCount = structure::setCouplingColumns("setCoupling", R, signs, ws.rank, ws.B, ws.couplingSign);
 }
 
 int constrainedCountBelow(ChainStructure& ws, double sigma, bool determinant) {

@@ -281,15 +281,8 @@ int setPencilConstraints(PencilStructure& ws, const Eigen::Ref<const Matrix>& C,
 }
 
 void setPencilCoupling(PencilStructure& ws, const Eigen::Ref<const Matrix>& R, const Eigen::Ref<const Vector>& signs) {
-  const int c = int(R.cols());
-  if (R.rows() != ws.n || signs.size() != c || ws.rank + c > PencilStructure::kMaxBorder)
-    throw std::invalid_argument("setPencilCoupling: R must be n×c with rank(C) + c <= kMaxBorder and c signs");
-  for (int j = 0; j < c; ++j) {
-    if (signs[j] != 1.0 && signs[j] != -1.0) throw std::invalid_argument("setPencilCoupling: each sign must be +1 or -1");
-    applyUInverse(R.col(j), ws.B.col(ws.rank + j).head(ws.n));
-    ws.couplingSign[j] = signs[j];
-  }
-  ws.couplingCount = c;
+  ws.couplingCount =
+      structure::setCouplingColumns("setPencilCoupling", R, signs, ws.rank, ws.B.topRows(ws.n), ws.couplingSign);
 }
 
 int pencilCountBelow(PencilStructure& ws, double sigma, bool determinant) {

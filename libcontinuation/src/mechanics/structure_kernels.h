@@ -5,6 +5,8 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "buckle/mechanics/chain_structure.h"
 
@@ -47,6 +49,23 @@ struct ScaledProduct {
 /// ws.S = Bᵀ(T − σM)⁻¹B for the first r columns of ws.B, after factorize(ws, σ): WᵀD⁻¹W with
 /// W = L⁻¹B by the factor's forward sweep alone, without the solve for (T − σM)⁻¹B.
 void factoredSchur(ChainStructure& ws, int r);
+
+/// A coupling R E Rᵀ's columns U⁻¹R into B's columns rank … rank + c − 1 and E's diagonal into
+/// `sign` (chain_structure.h setCoupling, pencil_structure.h setPencilCoupling; R n×c, n = B's
+/// active rows). Returns c; throws std::invalid_argument, naming `caller`, for a wrong size or sign.
+template <class Signs>
+int setCouplingColumns(const char* caller, const Eigen::Ref<const Matrix>& R, const Eigen::Ref<const Vector>& signs,
+                       int rank, Eigen::Ref<Matrix> B, Signs& sign) {
+  const int c = int(R.cols());
+  if (R.rows() != B.rows() || signs.size() != c || rank + c > B.cols())
+    throw std::invalid_argument(std::string(caller) + ": R must be n×c with rank(C) + c <= kMaxBorder and c signs");
+  for (int j = 0; j < c; ++j) {
+    if (signs[j] != 1.0 && signs[j] != -1.0) throw std::invalid_argument(std::string(caller) + ": each sign must be +1 or -1");
+    applyUInverse(R.col(j), B.col(rank + j));
+    sign[j] = signs[j];
+  }
+  return c;
+}
 
 /// Orthonormalise the rows of C (m×n) by modified Gram–Schmidt, twice, into the first columns of Q
 /// (n rows), with B = U⁻¹Q alongside; rows whose remainder is below rankTolerance of the largest
