@@ -689,5 +689,14 @@ TEST_CASE("contact: self contacts' rank-2 terms on the O(n) solver, products and
     REQUIRE(info.lowest.size() == reference.lowest.size());
     const double scale = std::max(1.0, Hc.norm());
     for (int j = 0; j < int(info.lowest.size()); ++j) CHECK(std::abs(info.lowest[j] - reference.lowest[j]) <= 1e-9 * scale);
+    // the eigenvalues from an index on (the certified counting's), O(n) against the dense default
+    {
+      auto ws = contact.createWorkspace();
+      Eigen::VectorXd mu(2), dense(2);
+      const int first = std::max(0, reference.negative - 1);
+      REQUIRE(contact.stabilityEigenvalues(*ws, u, lambda, first, mu));
+      REQUIRE(contact.cont::Problem::stabilityEigenvalues(*ws, u, lambda, first, dense));
+      CHECK((mu - dense).cwiseAbs().maxCoeff() <= 1e-9 * scale);
+    }
   }
 }

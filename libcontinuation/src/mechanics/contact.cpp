@@ -135,41 +135,6 @@ std::vector<int> freeJointsOf(const ContactSet& locked, int n) {
   return f;
 }
 
-// Inertia and lowest eigenvalues of the reduced H on ker of the held rows (as
-// EquilibriumProblem::stability, on the reduced structure), with the self contacts' rank-2 terms
-// R E Rᵀ when R has columns (setCoupling; the small dense route takes none).
-void reducedStability(ChainStructure& ws, const Matrix& heldRows, const Matrix& R, const Vector& E, int lowestCount,
-                      Vector& lastLowest, continuation::StabilityInfo& info) {
-  const int wanted = std::max(0, std::min(lowestCount, EquilibriumProblem::kMaxLowest));
-  if (ws.n <= kSmallDense && wanted > 0 && R.cols() == 0) {
-    Eigen::Matrix<double, EquilibriumProblem::kMaxLowest, 1> low;
-    int found = 0;
-    const Inertia in = smallDenseInertia(ws, heldRows, wanted, low.head(wanted), found);
-    info.negative = in.negative;
-    info.zero = in.zero;
-    info.lowest = low.head(found);
-  } else {
-    if (heldRows.rows() > 0)
-      setConstraints(ws, heldRows);
-    else
-      ws.rank = 0;
-    if (R.cols() > 0)
-      setCoupling(ws, R, E);
-    else
-      ws.couplingCount = 0;
-    const Inertia in = borderedInertia(ws);
-    info.negative = in.negative;
-    info.zero = in.zero;
-    info.lowest.resize(std::min(wanted, in.size()));
-    if (info.lowest.size() > 0) {
-      lowestEigenvalues(ws, ws.rank + ws.couplingCount > 0, int(info.lowest.size()), info.lowest, 1e-13,
-                        lastLowest.size() == info.lowest.size() ? &lastLowest : nullptr);
-      lastLowest = info.lowest;
-    }
-  }
-  info.smallest = info.lowest.size() > 0 ? info.lowest[0] : 0.0;
-}
-
 }  // namespace
 
 void reduceToFreeJoints(const ChainStructure& full, const std::vector<int>& free, VectorRef kf, VectorRef hf,
@@ -411,32 +376,6 @@ bool ContactProblem::assembleReduced(ProblemWorkspace& ws, ConstVectorRef u, dou
   if (free_.empty() || !assembleFull(ws, u, lambda, d.full, d.J)) return false;
   reduceToFreeJoints(d.full, free_, d.kf, d.hf, structure);
   for (size_t a = 0; a < free_.size(); ++a) Jf.col(Eigen::Index(a)) = d.J.col(free_[a]);
-  return true;
-}
-
-bool ContactProblem::stability(ProblemWorkspace& ws, ConstVectorRef u, double lambda, int lowestCount,
-                               continuation::StabilityInfo& info) const {
-  Workspace& d = workspaceAs<Workspace>(ws);
-  if (free_.empty()) {  // every joint locked: nothing can move
-    if (!residual(ws, u, lambda, d.residual)) return false;
-    info = continuation::StabilityInfo();
-    info.negative = 0;
-    return true;
-  }
-  // the chain structure's counts take at most 3 constraint rows (setConstraints) and kMaxBorder
-  // borders with the self contacts' two coupling columns each: beyond, and for a short chain
-  // holding a self contact (the small dense route takes no coupling), the dense route of the core
-  const int s = locked_.selfCount();
-  if (d.heldRows.rows() > 3 || d.heldRows.rows() + 2 * s > ChainStructure::kMaxBorder ||
-      (s > 0 && int(free_.size()) <= kSmallDense))
-    return Problem::stability(ws, u, lambda, lowestCount, info);
-  if (!assembleReduced(ws, u, lambda, d.reduced, d.Jf)) return false;
-  for (size_t k = 0; k < held_.size(); ++k) d.heldRows.row(Eigen::Index(k)) = d.Jf.row(held_[k]);
-  for (int k = 0; k < locked_.gapCount(); ++k)  // the gap rows ∇gᵀ on the free joints
-    for (size_t a = 0; a < free_.size(); ++a)
-      d.heldRows(Eigen::Index(held_.size()) + k, Eigen::Index(a)) = d.wallGrad(free_[a], k);
-  for (size_t a = 0; a < free_.size(); ++a) d.selfColumnsFree.row(Eigen::Index(a)) = d.selfColumns.row(free_[a]);
-  reducedStability(d.reduced, d.heldRows, d.selfColumnsFree, d.selfSigns, lowestCount, d.lastLowest, info);
   return true;
 }
 

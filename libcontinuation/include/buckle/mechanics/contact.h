@@ -187,6 +187,10 @@ class ContactProblem final : public continuation::Problem {
   /// the reduced chain structure (file comment).
   bool stability(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda, int lowestCount,
                  continuation::StabilityInfo& info) const override;
+  /// The eigenvalues first … of the same operator by the certified searches, O(n) each
+  /// (contact_stability.cpp); the core's dense default for short chains and beyond the borders.
+  bool stabilityEigenvalues(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                            int first, continuation::VectorRef values) const override;
   /// The reduced structure's O(n) bordered solver (locked rows eliminated).
   std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace& ws) const override;
 
@@ -271,6 +275,11 @@ class ContactProblem final : public continuation::Problem {
   // The base problem's rows at (q, r) with the wall forces' terms −Σ μ_v ∇x_v added to the q rows.
   bool baseRowsWithWall(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                         VectorRef F) const;
+
+  // Whether the reduced structure's counts take this point's constraints and coupling (and more
+  // than denseUpTo free joints); the reduced operator into the workspace (contact_stability.cpp).
+  bool structuredSpectrum(int denseUpTo) const;
+  bool reducedOperator(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda) const;
 
   const EquilibriumProblem& base_;
   ContactSet locked_;
