@@ -56,7 +56,8 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   const bool childBudget = b.parentId >= 0 && scene_.analyses.continuation.childPoints > 0 &&
                            b.stopReason == cont::StopReason::MaxPoints;
   if (childBudget) br.finished = true;
-  if (b.stopReason == cont::StopReason::Interrupted) {
+  br.skipped = report.skipped;
+  if (b.stopReason == cont::StopReason::Interrupted || !report.skipped.empty()) {
     interrupted();  // reported once for the run, not per branch
   } else if (!br.finished) {
     run_.complete = false;
@@ -70,7 +71,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   std::vector<mech::PointReport> points(report.points);
   for (mech::PointReport& p : points) {
     p.branch = b.id;
-    if (frequencies) p.omega = naturalFrequencies(p.q, p.F, p.locked, p.wallForces, p.selfForces, p.parameter);
+    if (frequencies && !interrupted()) p.omega = naturalFrequencies(p.q, p.F, p.locked, p.wallForces, p.selfForces, p.parameter);
   }
   keepPoints(std::move(points));
   run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
@@ -79,7 +80,7 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
     SpecialPointResult s{sp, {}};
     s.branch = b.id;
     // at the located point itself (plots mark it there), the contacts as at the traced point before it
-    if (frequencies && sp.q.size() == out_.chain.size() && !report.points.empty()) {
+    if (frequencies && sp.q.size() == out_.chain.size() && !report.points.empty() && !interrupted()) {
       const mech::PointReport* before = &report.points.front();
       for (const mech::PointReport& p : report.points)
         if (p.index <= sp.index) before = &p;

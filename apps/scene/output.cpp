@@ -388,6 +388,7 @@ json summaryJson(const Scene& scene, const RunResult& run, const PlotReport& plo
     for (const BranchRecord& b : cr.branches) {
       branches.push_back(json{{"id", b.id}, {"parent", b.parent}, {"origin", b.origin}, {"points", b.points},
                               {"stop", b.stopReason}, {"stop_message", b.stopMessage}, {"finished", b.finished}});
+      if (!b.skipped.empty()) branches.back()["skipped"] = b.skipped;
       if (b.fromEquilibrium > 0) {  // disconnected: its seed (rank in equilibria.csv) and the branch it joins
         branches.back()["from_equilibrium"] = b.fromEquilibrium;
         branches.back()["from_equilibrium_at"] = b.fromEquilibriumAt;

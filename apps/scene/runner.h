@@ -42,6 +42,7 @@ struct BranchRecord {
   std::string stopMessage;
   int points = 0;
   bool finished = true;    ///< ended on a regular stop (range, boundary); false: could not go on
+  std::string skipped;     ///< what its report left out, stopped by the time limit or a signal (BranchReport::skipped)
   /// Traced from an equilibrium the continuation's tree does not reach (equilibria "branches"):
   /// the rank (1-based, in equilibria.csv) of the equilibrium its tree grew from; 0: not so.
   int fromEquilibrium = 0;

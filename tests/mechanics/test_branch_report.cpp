@@ -4,6 +4,7 @@
 // classification table of docs/mechanics.md.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <vector>
@@ -181,4 +182,55 @@ TEST_CASE("after an interrupt the report skips the post-buckling refinements and
           std::string::npos);
   }
   CHECK(bps == 2);
+  // what was left out is on the report itself (the run counts it as interrupted)
+  CHECK(full.skipped.empty());
+  CHECK(cut.skipped == "not computed: post-buckling coefficients (SIGTERM received)");
+}
+
+TEST_CASE("after an interrupt the report leaves the remaining stiffness and the minima out and says so",
+          "[branch_report]") {
+  // The quasi-buckling chain of Fig 9/10 (one KMIN): reported again with an interrupt already
+  // requested, no point has K (NaN, haveStiffness false), no KMIN is claimed from the missing
+  // values, and `skipped` counts the points left out.
+  const double theta = std::acos(7.0 / 8.0);
+  Eigen::VectorXd q0(3);
+  q0 << theta, -2.0 * theta, theta;
+  const SegmentParameters p = SegmentParameters::symmetric(0.75, 1.0, 1.0, 2.25);
+  const Chain chain(preloadsForShape(std::vector<SegmentParameters>(3, p), q0));
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions opt;
+  opt.tracer.lambdaMin = -2.0;
+  opt.tracer.lambdaMax = 0.0;
+  opt.tree.branchSwitching = 0;
+  const EquilibriumBranches r = traceEquilibria(problem, q0, 0.0, cont::InitialDirection::decreasingLambda(), opt);
+  const cont::Branch& branch = r.tree.branches.at(0);
+  ReportOptions asked;
+  asked.stiffness = true;
+  const BranchReport full = reportBranch(problem, branch, asked);
+  std::atomic<bool> stop{true};
+  ReportOptions late = asked;
+  late.interrupt.watch(&stop, "SIGINT received");
+  const BranchReport cut = reportBranch(problem, branch, late);
+  REQUIRE(full.points.size() == cut.points.size());
+  REQUIRE(full.points.size() >= 3);
+  auto kmins = [](const BranchReport& rep) {
+    return std::count_if(rep.specialPoints.begin(), rep.specialPoints.end(),
+                         [](const SpecialPointReport& s) { return s.type == EventType::StiffnessMinimum; });
+  };
+  CHECK(kmins(full) == 1);
+  CHECK(kmins(cut) == 0);
+  for (size_t i = 0; i < full.points.size(); ++i) {
+    CHECK(full.points[i].haveStiffness);
+    CHECK(!cut.points[i].haveStiffness);
+    CHECK(std::isnan(cut.points[i].K(0, 0)));
+    CHECK(cut.points[i].parameter == full.points[i].parameter);  // the points themselves are kept
+  }
+  CHECK(full.skipped.empty());
+  // the chain curls through its base on this branch: that contact, detected only, is not located either
+  const bool touches = std::any_of(full.specialPoints.begin(), full.specialPoints.end(), [](const SpecialPointReport& s) {
+    return s.type == EventType::BaseContact || s.type == EventType::SelfContact;
+  });
+  CHECK(cut.skipped == "not computed: the loaded stiffness at " + std::to_string(full.points.size()) + " of " +
+                           std::to_string(full.points.size()) + " points, the stiffness minima" +
+                           (touches ? ", the location of base and self contacts" : "") + " (SIGINT received)");
 }

@@ -62,9 +62,10 @@ std::string formatShort(double x) {
 // A branch point of free joints: Koiter's coefficients and the imperfection sensitivities (a
 // simple point's only: a multiple one has its reduced equation).
 void addPostBuckling(EquilibriumProblem& problem, const cont::SpecialPoint& sp, const cont::Interrupt& interrupt,
-                     SpecialPointReport& s) {
+                     SpecialPointReport& s, BranchReport& r) {
   if (sp.multiplicity != 1) return;
   if (interrupt.requested()) {
+    r.skip("post-buckling coefficients");
     s.note += (s.note.empty() ? "" : "; ") + std::string("post-buckling coefficients not computed: ") +
               interrupt.describe();
     return;
@@ -237,7 +238,13 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
   else
     for (const PointReport& p : all)
       if (inRange(p.parameter, options)) r.points.push_back(p);
+  size_t withoutStiffness = 0;  // from the point where the interrupt was requested on
   for (PointReport& pr : r.points) {
+    r.worstResidual = std::max(r.worstResidual, pr.residual);
+    if (options.stiffness && (withoutStiffness > 0 || options.interrupt.requested())) {
+      ++withoutStiffness;
+      continue;
+    }
     CartesianStiffness structured;
     if (options.stiffness && chain.size() >= kStructuredStiffnessFrom &&
         structuredContactStiffness(ContactProblem(problem, pr.locked), b.points[size_t(pr.index)].u,
@@ -267,8 +274,10 @@ std::vector<PointReport> reportPoints(EquilibriumProblem& problem, const cont::B
       pr.rotationalStiffness = s.rotationalStiffness;
       pr.haveStiffness = true;
     }
-    r.worstResidual = std::max(r.worstResidual, pr.residual);
   }
+  if (withoutStiffness > 0)
+    r.skip("the loaded stiffness at " + std::to_string(withoutStiffness) + " of " + std::to_string(r.points.size()) +
+           " points");
   return all;
 }
 
@@ -315,7 +324,7 @@ void reportLocatedPoints(EquilibriumProblem& problem, const cont::Branch& b, con
     switch (sp.type) {
       case cont::SpecialPointType::BranchPoint:
         s.type = EventType::BranchPoint;
-        if (lockedAt(stretches, sp.index).empty()) addPostBuckling(problem, sp, options.interrupt, s);
+        if (lockedAt(stretches, sp.index).empty()) addPostBuckling(problem, sp, options.interrupt, s, r);
         break;
       case cont::SpecialPointType::Fold:
         s.type = EventType::Fold;
@@ -419,7 +428,9 @@ void reportStiffnessMinima(EquilibriumProblem& problem, const cont::Branch& b, c
   // Bracketed where the exact rate dm/ds along the traced tangents changes from negative to
   // positive between two consecutive stable points, then located on the branch itself
   // (stiffness_extremum.h): neither the step size nor the units move it.
-  if (options.stiffness && r.points.size() >= 2 && !b.points.empty()) {
+  // every point's K is needed (the measure at the start, the depth of each minimum)
+  if (options.stiffness && !r.skipped.empty()) r.skip("the stiffness minima");
+  if (options.stiffness && r.skipped.empty() && r.points.size() >= 2 && !b.points.empty()) {
     const StiffnessMeasure measure = options.stiffnessMeasure;
     const char* name = toString(measure);
     const int N = problem.dimension();
@@ -428,12 +439,14 @@ void reportStiffnessMinima(EquilibriumProblem& problem, const cont::Branch& b, c
     for (size_t i = 0; i < r.points.size(); ++i) {
       const cont::ContinuationPoint& p = b.points[size_t(r.points[i].index)];
       if (p.tangent.size() != N + 1 || !r.points[i].stable || !r.points[i].locked.empty()) continue;  // free stretches only
+      if (options.interrupt.requested()) return r.skip("the stiffness minima");
       const StiffnessRate sr = stiffnessRate(problem, p.u, p.lambda, p.tangent.head(N), p.tangent[N], measure);
       if (sr.valid) rate[i] = sr.rate;
     }
     for (size_t i = 0; i + 1 < r.points.size(); ++i) {
       const PointReport &p0 = r.points[i], &p1 = r.points[i + 1];
       if (p1.index != p0.index + 1 || !(rate[i] < 0.0 && rate[i + 1] > 0.0) || !std::isfinite(m0)) continue;
+      if (options.interrupt.requested()) return r.skip("the stiffness minima");
       const StiffnessExtremum x =
           locateStiffnessMinimum(problem, b.points[size_t(p0.index)], b.points[size_t(p1.index)], measure);
       const double ma = stiffnessMeasure(p0.K, measure), mc = stiffnessMeasure(p1.K, measure);
@@ -469,6 +482,11 @@ void reportStiffnessMinima(EquilibriumProblem& problem, const cont::Branch& b, c
 }
 
 }  // namespace
+
+void BranchReport::skip(const std::string& what) {
+  if (skipped.find(what) != std::string::npos) return;
+  skipped += (skipped.empty() ? "" : ", ") + what;
+}
 
 std::string ReportOptions::validate(const std::string& prefix) const {
   return cont::firstProblem(
@@ -516,6 +534,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
   reportHeldCoordinateFolds(b, options, all, r);
   reportStiffnessMinima(problem, b, options, r);
   reportGeometricContacts(problem, b, all, options, r, geometric);  // base / self contact (contact_geometry.h)
+  if (!r.skipped.empty()) r.skipped = "not computed: " + r.skipped + " (" + options.interrupt.describe() + ")";
   for (PointReport& p : r.points) p.branch = b.id;
   for (SpecialPointReport& s : r.specialPoints) {
     s.branch = b.id;

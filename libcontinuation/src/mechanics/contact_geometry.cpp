@@ -523,6 +523,7 @@ void reportGeometricContacts(EquilibriumProblem& problem, const continuation::Br
     found.list = locateGeometricContacts(problem, branch, locked, 1e-12, options.interrupt);
   }
   for (const GeometricContact& g : found.list) {
+    if (!g.located && options.interrupt.requested()) r.skip("the location of base and self contacts");
     SpecialPointReport s;
     s.type = g.base ? EventType::BaseContact : EventType::SelfContact;
     s.index = g.index;

@@ -79,7 +79,9 @@ struct ReportOptions {
   double deepStiffnessRatio = 0.5;
   /// Once requested (the run's time limit, a signal), the refinements of a report are skipped,
   /// each with a note saying why: Koiter's coefficients and the imperfection sensitivities of the
-  /// branch points, and the location of base and self contacts (then to the point spacing).
+  /// branch points, and the location of base and self contacts (then to the point spacing); the
+  /// loaded stiffness of the points not yet reached (haveStiffness false, K NaN) and the stiffness
+  /// minima — BranchReport::skipped says what was left out.
   continuation::Interrupt interrupt;
   /// Empty when valid, else what is wrong, the field named by its path after `prefix`.
   std::string validate(const std::string& prefix = "") const;
@@ -192,6 +194,11 @@ struct BranchReport {
   std::string stopReason;                     ///< continuation::toString(StopReason), or "joint limit"
   std::string stopMessage;
   double worstResidual = 0.0;                 ///< max corrector residual over the points
+  /// Empty when the report computed everything its options ask for; else what it left out because
+  /// ReportOptions::interrupt was requested, and why (the report is then incomplete).
+  std::string skipped;
+  /// Adds `what` to the parts left out (once each); reportBranch appends the reason at its end.
+  void skip(const std::string& what);
 };
 
 /// Reports `branch`, traced on `problem`. Never throws for a numerical condition.
