@@ -105,6 +105,10 @@ void BranchRows::appendRow(std::string& os, size_t c, const CaseResult& cr, cons
 
 void BranchRows::appendJointAngles(std::string& out, const mechanics::PointReport& p) const {
   static_assert(sizeof(double) == 8);
+  if (p.q.size() == n_) {  // x86-64/ARM: little-endian
+    out.append(reinterpret_cast<const char*>(p.q.data()), jointAnglesRowBytes());
+    return;
+  }
   for (int i = 0; i < n_; ++i) {
     const double v = i < p.q.size() ? p.q[i] : std::numeric_limits<double>::quiet_NaN();
     out.append(reinterpret_cast<const char*>(&v), sizeof v);  // x86-64/ARM: little-endian

@@ -32,6 +32,7 @@ class BranchRows {
   /// The .npy header (format 1.0: magic, a Python-dict header padded to 64 bytes) of `rows` rows.
   std::string jointAnglesHeader(size_t rows) const;
   /// About the bytes of a row (to reserve).
+  size_t jointAnglesRowBytes() const { return sizeof(double) * size_t(n_); }
   size_t rowBytes() const { return size_t(20 + 19 * (sideFile_ ? 13 : 11 + n_)); }
 
  private:

@@ -53,6 +53,8 @@ BranchStream::~BranchStream() {
 
 void BranchStream::append(Spool& spool, const std::string& bytes) {
   if (spool.fd < 0 && spool.memory.size() + bytes.size() <= inMemoryBytes_) {
+    // its whole capacity at once: address space only until written, and never moved as it fills
+    if (spool.memory.capacity() < inMemoryBytes_) spool.memory.reserve(inMemoryBytes_);
     spool.memory += bytes;
   } else {
     if (spool.fd < 0) {
@@ -70,7 +72,8 @@ void BranchStream::add(size_t c, const CaseResult& cr, const std::vector<mechani
   Piece piece;
   piece.branch = points.empty() ? -1 : points.front().branch;
   piece.rows = points.size();
-  std::string text;
+  std::string& text = rows_text_;
+  text.clear();
   text.reserve(points.size() * layout_.rowBytes());
   for (const mechanics::PointReport& p : points) layout_.appendRow(text, c, cr, p);
   piece.csvOffset = csv_.size;
@@ -78,6 +81,7 @@ void BranchStream::add(size_t c, const CaseResult& cr, const std::vector<mechani
   append(csv_, text);
   if (layout_.sideFile()) {
     text.clear();
+    text.reserve(points.size() * layout_.jointAnglesRowBytes());
     for (const mechanics::PointReport& p : points) layout_.appendJointAngles(text, p);
     piece.npyOffset = npy_.size;
     piece.npyBytes = text.size();

@@ -42,7 +42,7 @@ std::string solverFailureInWords(const std::string& solverMessage) {
   return what + "; " + change + " (solver detail: " + solverMessage + ")";
 }
 
-void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report, const std::string& origin) {
+void CaseRunner::record(const cont::Branch& b, mech::BranchReport report, const std::string& origin) {
   BranchRecord br;
   br.id = b.id;
   br.parent = b.parentId;
@@ -68,14 +68,6 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
   out_.branches.push_back(br);
 
   const bool frequencies = scene_.analyses.frequencies.enabled;
-  std::vector<mech::PointReport> points(report.points);
-  for (mech::PointReport& p : points) {
-    p.branch = b.id;
-    if (frequencies && !interrupted()) p.omega = naturalFrequencies(p.q, p.F, p.locked, p.wallForces, p.selfForces, p.parameter);
-  }
-  keepPoints(std::move(points));
-  run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
-
   for (const mech::SpecialPointReport& sp : report.specialPoints) {
     SpecialPointResult s{sp, {}};
     s.branch = b.id;
@@ -89,6 +81,12 @@ void CaseRunner::record(const cont::Branch& b, const mech::BranchReport& report,
     if (sp.source >= 0) run_.worstLocation = std::max(run_.worstLocation, sp.accuracy);
     out_.specials.push_back(std::move(s));
   }
+  for (mech::PointReport& p : report.points) {
+    p.branch = b.id;
+    if (frequencies && !interrupted()) p.omega = naturalFrequencies(p.q, p.F, p.locked, p.wallForces, p.selfForces, p.parameter);
+  }
+  run_.worstResidual = std::max(run_.worstResidual, report.worstResidual);
+  keepPoints(std::move(report.points));
 }
 
 void CaseRunner::keepPoints(std::vector<mech::PointReport>&& points) {
@@ -418,7 +416,7 @@ void CaseRunner::continuation() {
                                               : "BP " + std::to_string(b.parentSpecialPoint) + " of branch " +
                                                     std::to_string(b.parentId) +
                                                     (b.direction > 0 ? ", + side" : ", - side");
-    record(b, report, origin);
+    record(b, std::move(report), origin);
   };
   warnOfOverlappingStart();
   const mech::EquilibriumBranches result = mech::traceEquilibria(problem, out_.qStart, s0, starts, opt);

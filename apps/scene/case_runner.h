@@ -71,7 +71,7 @@ class CaseRunner {
   /// One set of the equilibria analysis at path-parameter value `at`, and the branches through it.
   void equilibriaAt(double at);
   void disconnectedBranchesAt(EquilibriumSet& set);
-  void record(const continuation::Branch& b, const mechanics::BranchReport& report, const std::string& origin);
+  void record(const continuation::Branch& b, mechanics::BranchReport report, const std::string& origin);
   /// One branch's points (in order) into the case: all of them, or streamed (RunControl::streamTo)
   /// their rows written and a sample kept (point_sample.h).
   void keepPoints(std::vector<mechanics::PointReport>&& points);

@@ -92,7 +92,7 @@ void CaseRunner::disconnectedBranchesAt(EquilibriumSet& set) {
              << (b.direction > 0 ? ", + side" : ", - side");
     mechanics::BranchReport report = d.traced.reports[i];
     if (d.joined[i] >= 0) report.stopMessage = "joins branch " + std::to_string(d.joined[i]) + ", traced already";
-    record(b, report, origin.str());
+    record(b, std::move(report), origin.str());
     out_.branches.back().fromEquilibrium = rank;
     out_.branches.back().fromEquilibriumAt = set.at;
     out_.branches.back().joins = d.joined[i];
