@@ -180,7 +180,11 @@ ContactProblem::Workspace::Workspace(const ContactProblem& problem)
       selfColumnsFree(Eigen::Index(problem.free_.size()), 2 * problem.locked_.selfCount()),
       selfSigns(2 * problem.locked_.selfCount()),
       selfAlong(problem.locked_.selfCount()),
-      selfEdgeLength(problem.locked_.selfCount()) {
+      selfEdgeLength(problem.locked_.selfCount()),
+      slopeFree(problem.free_.size()),
+      slopeHv(problem.free_.size()),
+      slopeFull(Vector::Zero(problem.base_.segments())),
+      guess(ChainStructure::kMaxBorder) {
   reduced.typicalScale = problem.base_.stiffnessUnit() * problem.base_.lengthUnit() * problem.base_.lengthUnit();
   full.typicalScale = reduced.typicalScale;
 }

@@ -183,10 +183,6 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     continuation::TracerOptions o = options;
     o.maxPoints = options.maxPoints - int(branch.points.size()) + 1;
     o.maxArclength = options.maxArclength - branch.points.back().arclength;
-    // The locked problem has no O(n) stabilityEigenvalues (the dense default is O(n³) per point
-    // and made the near-zero spectrum most of a 50-segment tree's time): locked stretches keep
-    // the inertia count and the determinant, without the hidden-crossing monitor.
-    o.detection.certifiedCounting = false;
     if (o.maxPoints < 2 || !(o.maxArclength > 0.0)) break;
     auto next = lockedProblem(problem, locked, maxContactTorque);
     const std::string& what = change.what;

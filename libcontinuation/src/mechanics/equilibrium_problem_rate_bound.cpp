@@ -64,6 +64,22 @@ bool EquilibriumProblem::stabilityRateBound(ProblemWorkspace& ws, ConstVectorRef
                                             double dlambda, double& bound) const {
   Workspace& d = workspaceAs<Workspace>(ws);
   if (!std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() || !prepare(d, u, lambda)) return false;
+  const int m = heldCount();
+  for (int k = 0; k < m; ++k) d.heldRows.row(k) = d.J.row(held_[size_t(k)]);
+  return rateBoundOn(d, u, lambda, du, dlambda, nullptr, d.heldRows, bound);
+}
+
+bool EquilibriumProblem::stabilityRateBoundOn(ProblemWorkspace& ws, ConstVectorRef u, double lambda,
+                                              ConstVectorRef du, double dlambda, const std::vector<int>& free,
+                                              const continuation::Matrix& heldRows, double& bound) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (!std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() || !prepare(d, u, lambda)) return false;
+  return rateBoundOn(d, u, lambda, du, dlambda, &free, heldRows, bound);
+}
+
+bool EquilibriumProblem::rateBoundOn(Workspace& d, const ConstVectorRef& u, double lambda, const ConstVectorRef& du,
+                                     double dlambda, const std::vector<int>* free, const continuation::Matrix& heldRows,
+                                     double& bound) const {
   const int n = chain_.size();
   const int m = heldCount();
   stabilityRates(d, u, lambda, du, dlambda);
@@ -73,18 +89,22 @@ bool EquilibriumProblem::stabilityRateBound(ProblemWorkspace& ws, ConstVectorRef
     heldX |= c == 0;
     heldY |= c == 1;
   }
-  // In the Frobenius norms the entries with max(i, j) = p appear 2p + 1 times (0-based), once on
-  // the diagonal. C = J_h has rows (−S, C, 1) of eq 11, so dC has rows (−dS, dC, 0).
+  // In the Frobenius norms the entries with max(i, j) = p appear 2a + 1 times, a the rank of p
+  // among the joints kept (0-based; every joint, or `free`), once on the diagonal. C = J_h has
+  // rows (−S, C, 1) of eq 11, so dC has rows (−dS, dC, 0).
   double dH2 = 0.0, H2 = 0.0, dC2 = 0.0;
+  int rank = free ? int(free->size()) - 1 : n - 1;
   for (int p = n - 1; p >= 0; --p) {
+    if (free && (rank < 0 || (*free)[size_t(rank)] != p)) continue;  // a locked joint: its rows and columns are gone
     double h = -W[0] * d.data.C[p] - W[1] * d.data.S[p];
     if (d.bodyTerms.active()) h -= d.bodyTerms.gammaAt(p, lambda);
     const double dh = d.rateGenerator[p];
     const double dDiagonal = d.rateKappa[p] - dh, diagonal = d.stiff[p] - h;
-    dH2 += dDiagonal * dDiagonal + 2.0 * p * dh * dh;
-    H2 += diagonal * diagonal + 2.0 * p * h * h;
+    dH2 += dDiagonal * dDiagonal + 2.0 * rank * dh * dh;
+    H2 += diagonal * diagonal + 2.0 * rank * h * h;
     if (heldX) dC2 += d.rateS[p] * d.rateS[p];
     if (heldY) dC2 += d.rateC[p] * d.rateC[p];
+    --rank;
   }
   bound = std::sqrt(dH2);
   if (m == 0) return std::isfinite(bound);
@@ -92,8 +112,7 @@ bool EquilibriumProblem::stabilityRateBound(ProblemWorkspace& ws, ConstVectorRef
   // ‖ζ‖ ≤ ‖H‖₂/σ_min(C); and dμ = vᵀ dH v + 2 ζᵀ dC v (differentiate and multiply by vᵀ).
   // σ_min(C)² = the smallest eigenvalue of the Gram matrix CCᵀ (m ≤ 3; the unused diagonal is
   // padded above every eigenvalue of the m×m block, which stays decoupled).
-  for (int k = 0; k < m; ++k) d.heldRows.row(k) = d.J.row(held_[size_t(k)]);
-  Eigen::Matrix3d G = heldGram(d.heldRows, m, 0.0);
+  Eigen::Matrix3d G = heldGram(heldRows, m, 0.0);
   const double trace = G.trace();
   for (int k = m; k < 3; ++k) G(k, k) = 2.0 * trace + 1.0;
   const double sigma2 =
@@ -138,24 +157,41 @@ bool EquilibriumProblem::stabilitySlopes(ProblemWorkspace& ws, ConstVectorRef u,
       residual2 += ri * ri;
     }
     if (!(std::sqrt(residual2) <= 1e-8 * scale)) return false;
-    // vᵀ dH v = Σ dκ_p v_p² − Σ_{i,j} dh_max(i,j) v_i v_j, and Σ_{i,j} g_max(i,j) v_i v_j =
-    // Σ_p (g_p − g_{p+1}) P_p² with the prefix sums P_p = Σ_{i≤p} v_i (g_n = 0).
-    double rate = 0.0, prefix = 0.0;
-    for (int p = 0; p < n; ++p) {
-      prefix += v[p];
-      const double dgNext = p + 1 < n ? d.rateGenerator[p + 1] : 0.0;
-      rate += d.rateKappa[p] * v[p] * v[p] - (d.rateGenerator[p] - dgNext) * prefix * prefix;
-    }
-    // + 2 ζᵀ dC v, dC with rows (−dS, dC, 0) for x, y, φ held (eq 11)
-    for (int k = 0; k < m; ++k) {
-      const int c = held_[size_t(k)];
-      if (c == 2) continue;
-      const double dCv = c == 0 ? -d.rateS.dot(v) : d.rateC.dot(v);
-      rate += 2.0 * zeta[k] * dCv;
-    }
-    slopes[j] = rate;
+    slopes[j] = rateAlong(d, v, zeta);
   }
   return slopes.allFinite();
+}
+
+double EquilibriumProblem::rateAlong(const Workspace& d, const ConstVectorRef& v, const Eigen::Vector3d& zeta) const {
+  const int n = chain_.size(), m = heldCount();
+  // vᵀ dH v = Σ dκ_p v_p² − Σ_{i,j} dh_max(i,j) v_i v_j, and Σ_{i,j} g_max(i,j) v_i v_j =
+  // Σ_p (g_p − g_{p+1}) P_p² with the prefix sums P_p = Σ_{i≤p} v_i (g_n = 0).
+  double rate = 0.0, prefix = 0.0;
+  for (int p = 0; p < n; ++p) {
+    prefix += v[p];
+    const double dgNext = p + 1 < n ? d.rateGenerator[p + 1] : 0.0;
+    rate += d.rateKappa[p] * v[p] * v[p] - (d.rateGenerator[p] - dgNext) * prefix * prefix;
+  }
+  // + 2 ζᵀ dC v, dC with rows (−dS, dC, 0) for x, y, φ held (eq 11)
+  for (int k = 0; k < m; ++k) {
+    const int c = held_[size_t(k)];
+    if (c == 2) continue;
+    const double dCv = c == 0 ? -d.rateS.dot(v) : d.rateC.dot(v);
+    rate += 2.0 * zeta[k] * dCv;
+  }
+  return rate;
+}
+
+bool EquilibriumProblem::eigenvalueRate(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ConstVectorRef du,
+                                        double dlambda, ConstVectorRef v, const Eigen::Vector3d& zeta,
+                                        double& rate) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (v.size() != chain_.size() || !std::isfinite(lambda) || !std::isfinite(dlambda) || !du.allFinite() ||
+      !prepare(d, u, lambda))
+    return false;
+  stabilityRates(d, u, lambda, du, dlambda);
+  rate = rateAlong(d, v, zeta);
+  return std::isfinite(rate);
 }
 
 }  // namespace buckle::mechanics

@@ -45,6 +45,7 @@
 #include "buckle/continuation/bound_problem.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
+#include "buckle/mechanics/eigenvalue_memory.h"
 #include "buckle/mechanics/end_condition.h"
 #include "buckle/mechanics/equilibrium_problem.h"
 #include "buckle/mechanics/self_contact.h"
@@ -191,6 +192,20 @@ class ContactProblem final : public continuation::Problem {
   /// (contact_stability.cpp); the core's dense default for short chains and beyond the borders.
   bool stabilityEigenvalues(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                             int first, continuation::VectorRef values) const override;
+  /// With locked joints only (no wall or self contact): EquilibriumProblem's bound on every
+  /// eigenvalue's rate for H on the free joints and the held rows' free columns
+  /// (stabilityRateBoundOn), O(n); false otherwise (the slopes are then measured at every point).
+  bool stabilityRateBound(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                          continuation::ConstVectorRef du, double dlambda, double& bound) const override;
+  /// With locked joints only (no wall or self contact): the rates of those eigenvalues along
+  /// (du, dλ) by Hellmann–Feynman, each eigenvector by inverse iteration on the reduced structure
+  /// and EquilibriumProblem::eigenvalueRate — a locked joint's row e_iᵀ does not move along the
+  /// tangent, so only the held rows' multipliers enter. O(n) each. False (the core then differences
+  /// the eigenvalues along the tangent) with gaps, whose rows ∇gᵀ move with ∂²g, on the dense
+  /// routes, and when an eigenvector's residual shows it was not found.
+  bool stabilitySlopes(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                       continuation::ConstVectorRef du, double dlambda, int first, continuation::ConstVectorRef values,
+                       continuation::VectorRef slopes) const override;
   /// The reduced structure's O(n) bordered solver (locked rows eliminated).
   std::unique_ptr<continuation::BorderedSolver> makeStructuredSolver(continuation::ProblemWorkspace& ws) const override;
 
@@ -268,6 +283,9 @@ class ContactProblem final : public continuation::Problem {
     Vector selfAlong, selfEdgeLength;  // where each self contact's vertex is along its edge
     Vector unknowns;           // (q, r, μ) of boundaries()
     Vector productIn, productOut;  // the base problem's (N + 1) operands of the O(n) products
+    Vector slopeFree, slopeHv, slopeFull;  // stabilitySlopes(): v and H v on the free joints, v on all
+    EigenvalueMemory found;  // stabilityEigenvalues(): warm starts from the values found lately
+    Vector guess;            // (size ChainStructure::kMaxBorder)
   };
   std::unique_ptr<continuation::ProblemWorkspace> createWorkspace() const override;
 

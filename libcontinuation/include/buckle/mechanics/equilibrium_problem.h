@@ -211,6 +211,12 @@ class EquilibriumProblem final : public continuation::Problem {
   /// rank-deficient (no finite bound) or the point is refused.
   bool stabilityRateBound(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                           continuation::ConstVectorRef du, double dlambda, double& bound) const override;
+  /// The same bound for H on the joints `free` (increasing) and ker of `heldRows` (J_h's columns
+  /// of those joints, held order): a chain whose other joints are locked (contact.h), whose
+  /// locked rows e_iᵀ do not move along the tangent.
+  bool stabilityRateBoundOn(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                            continuation::ConstVectorRef du, double dlambda, const std::vector<int>& free,
+                            const continuation::Matrix& heldRows, double& bound) const;
   /// dμ of the eigenvalues `values` (indices first …) of K_q − K_g on ker J_h along (du, dλ) by
   /// Hellmann–Feynman (Problem::stabilitySlopes): each eigenvector by inverse iteration on the O(n)
   /// structure (chain_structure.h, eigenvectorAt), dH and dC from the q-cache as for the bound.
@@ -220,6 +226,14 @@ class EquilibriumProblem final : public continuation::Problem {
   bool stabilitySlopes(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                        continuation::ConstVectorRef du, double dlambda, int first, continuation::ConstVectorRef values,
                        continuation::VectorRef slopes) const override;
+
+  /// The Hellmann–Feynman rate vᵀ dH v + 2 ζᵀ dJ_h v along (du, dλ) of an eigenvalue of
+  /// H = K_q − K_g on ker J_h and on rows that stay still along the tangent (locked joints:
+  /// contact.h), from its unit eigenvector v (length n, zero on such joints) and the held rows'
+  /// multipliers ζ (held order, H v + J_hᵀζ + … = μ v). O(n). False outside the domain.
+  bool eigenvalueRate(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                      continuation::ConstVectorRef du, double dlambda, continuation::ConstVectorRef v,
+                      const Eigen::Vector3d& zeta, double& rate) const;
 
   /// T of H = K_q − K_g(F(u, λ)) into ws (chain_structure.h) and the end Jacobian (3×n) into J,
   /// from the q-cache: what the structured stability and the structured solver linearise on.
@@ -294,6 +308,12 @@ class EquilibriumProblem final : public continuation::Problem {
   /// d.rateGenerator, d.rateS, d.rateC, from the q-cache (after prepare(d, u, λ)). O(n).
   void stabilityRates(Workspace& d, const continuation::ConstVectorRef& u, double lambda,
                       const continuation::ConstVectorRef& du, double dlambda) const;
+  /// stabilityRateBound on the joints `free` (null: every joint) with the held rows `heldRows`.
+  bool rateBoundOn(Workspace& d, const continuation::ConstVectorRef& u, double lambda,
+                   const continuation::ConstVectorRef& du, double dlambda, const std::vector<int>* free,
+                   const continuation::Matrix& heldRows, double& bound) const;
+  /// vᵀ dH v + 2 ζᵀ dJ_h v from the rates stabilityRates() left in d.
+  double rateAlong(const Workspace& d, const continuation::ConstVectorRef& v, const Eigen::Vector3d& zeta) const;
 
   Chain chain_;
   EndCondition end_;
