@@ -89,6 +89,8 @@ void BranchStream::add(size_t c, const CaseResult& cr, const std::vector<mechani
   }
   cases_[c].push_back(piece);
   rows_ += points.size();
+  // a long chain's branch of thousands of rows is hundreds of megabytes: not kept for the next
+  if (text.capacity() > inMemoryBytes_) std::string().swap(text);
 }
 
 void BranchStream::sortByBranch(size_t c, size_t first) {
