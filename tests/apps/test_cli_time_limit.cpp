@@ -1,5 +1,5 @@
-// `buckle run` under a time limit and under SIGINT / SIGTERM: it stops within a step, writes
-// what it computed (summary.json "complete": false, "interrupted": true, and why), exits 1
+// `buckle run` under a time limit and under SIGINT / SIGTERM: it stops within a step (of the
+// continuation or of a branch report's per-point work), writes what it computed (summary.json "complete": false, "interrupted": true, and why), exits 1
 // (time limit) or 128 + the signal, and leaves no temporary directory behind.
 #include <catch2/catch.hpp>
 
@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <unistd.h>
+#include <vector>
 #include "build_paths.h"
 
 namespace fs = std::filesystem;
@@ -113,6 +114,48 @@ TEST_CASE("a 100-segment default scene with time_limit 5 returns within 6 s with
   CHECK_THAT(run.log, Contains("buckle: ["));
   CHECK(run.log.find('\r') == std::string::npos);
   requireNoTemporaries(run.dir);
+}
+
+TEST_CASE("the time limit stops the branch reports' loaded stiffness too, and the summary says what was left out",
+          "[cli][time]") {
+  // The shipped hook with 5000 segments and the stiffness at every point (tens of ms a point: its
+  // report alone takes longer than the limit, whether the limit comes while the branch is traced
+  // or while it is reported): the report stops computing K there, the points keep their rows with
+  // K nan, the branch says what was left out, and the run ends within the limit, incomplete.
+  const fs::path dir = timeLimitDir() / "report";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ifstream in(std::string(BUCKLE_SOURCE_DIR) + "/data/scenes/self_contact_hook.json");
+  nlohmann::json scene = nlohmann::json::parse(in);
+  const int n = 5000, straight = n / 5;
+  std::vector<double> q0(size_t(n), 0.0);
+  for (int i = straight; i < n; ++i) q0[size_t(i)] = 4.5 / (n - straight);
+  scene["chain"]["segments"] = n;
+  scene["chain"]["q0"] = q0;
+  scene["path"]["to"] = 1.5 / n;
+  scene["analyses"] = {{"continuation", {{"branch_switching", 0}, {"self", true}}}, {"stiffness", true}};
+  scene["plots"] = nlohmann::json::array();
+  const fs::path file = dir / "hook.json", out = dir / "out";
+  std::ofstream(file) << scene.dump();
+  const auto t0 = std::chrono::steady_clock::now();
+  const int rc = exitCode("run '" + file.string() + "' --out '" + out.string() + "' --time-limit 1 --quiet", dir / "log.txt");
+  const double wall = secondsSince(t0);
+  INFO(slurp(dir / "log.txt"));
+  CHECK(rc == 1);
+#if defined(__SANITIZE_ADDRESS__)
+  CHECK(wall < 15.0);
+#else
+  CHECK(wall < 2.0);  // 2.0 s without the reports' interrupt
+#endif
+  requirePartialResults(out);
+  bool named = false;
+  const nlohmann::json summary = summaryOf(out);
+  INFO(summary["cases"][0]["branches"].dump());
+  for (const auto& b : summary["cases"][0]["branches"])
+    named |= b.contains("skipped") && b["skipped"].get<std::string>().find("the loaded stiffness at") != std::string::npos;
+  CHECK(named);
+  CHECK_THAT(slurp(out / "branches.csv"), Contains(",nan,"));
+  requireNoTemporaries(dir);
 }
 
 TEST_CASE("the command line's time limit overrides the scene's, quiet silences the progress", "[cli][time]") {
