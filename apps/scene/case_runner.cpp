@@ -61,9 +61,15 @@ void CaseRunner::record(const cont::Branch& b, mech::BranchReport report, const 
     interrupted();  // reported once for the run, not per branch
   } else if (!br.finished) {
     run_.complete = false;
+    // the point budget is the user's: say which key moves it
+    const std::string advice =
+        b.stopReason != cont::StopReason::MaxPoints ? ""
+        : b.parentId >= 0 ? "; raise /solver/max_points to follow it further, or set "
+                            "/analyses/continuation/child_points to end switched branches there as asked"
+                          : "; raise /solver/max_points to follow it further";
     run_.problems.push_back("case \"" + spec_.label + "\", branch " + std::to_string(b.id) + " (" + origin +
                             ") stopped early: " + br.stopReason +
-                            (b.stopMessage.empty() ? "" : " — " + solverFailureInWords(b.stopMessage)));
+                            (b.stopMessage.empty() ? "" : " — " + solverFailureInWords(b.stopMessage)) + advice);
   }
   out_.branches.push_back(br);
 

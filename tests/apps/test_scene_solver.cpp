@@ -74,3 +74,30 @@ TEST_CASE("solver.location_tolerance: bad values name the key, the path and the 
     if (bad[0] != '"' && bad != "true") CHECK(o.err.find("[1e-15, 1e-2]") != std::string::npos);
   }
 }
+
+TEST_CASE("solver.max_points: a branch that uses them up is said with the keys that move the budget",
+          "[scene][solver]") {
+  // The small scene with one generation of switching and 20 points a branch: the straight branch
+  // (Fx to −1 in steps of at most 0.05, past the U point at −0.706) and the U child both run out; each problem says which key
+  // to change, the child's also how to end switched branches there as asked.
+  std::string text = buckle::test::smallScene(1);
+  const std::string plots = "\"plots\": []";
+  text.replace(text.find(plots), plots.size(), "\"plots\": [], \"solver\": {\"max_points\": 20, \"step\": {\"max_step\": 0.05}}");
+  const buckle::test::SceneOutcome o = buckle::test::runSceneText("scene_solver", "max_points", text);
+  INFO(o.err);
+  CHECK(o.rc == 1);
+  const json summary = readJson(o.out / "summary.json");
+  CHECK_FALSE(summary["complete"].get<bool>());
+  bool straight = false, child = false;
+  for (const json& p : summary["problems"]) {
+    const std::string s = p.get<std::string>();
+    INFO(s);
+    if (s.find("maximum number of points") == std::string::npos) continue;
+    CHECK(s.find("raise /solver/max_points to follow it further") != std::string::npos);
+    const bool switched = s.find("(BP ") != std::string::npos;
+    CHECK((s.find("/analyses/continuation/child_points") != std::string::npos) == switched);
+    (switched ? child : straight) = true;
+  }
+  CHECK(straight);
+  CHECK(child);
+}
