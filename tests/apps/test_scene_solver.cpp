@@ -78,8 +78,9 @@ TEST_CASE("solver.location_tolerance: bad values name the key, the path and the 
 TEST_CASE("solver.max_points: a branch that uses them up is said with the keys that move the budget",
           "[scene][solver]") {
   // The small scene with one generation of switching and 20 points a branch: the straight branch
-  // (Fx to −1 in steps of at most 0.05, past the U point at −0.706) and the U child both run out; each problem says which key
-  // to change, the child's also how to end switched branches there as asked.
+  // (Fx to −1 in steps of at most 0.05, past the U point at −0.706) and the U child both run
+  // out; each problem says which key to change, the child's also how to end switched branches
+  // there as asked.
   std::string text = buckle::test::smallScene(1);
   const std::string plots = "\"plots\": []";
   text.replace(text.find(plots), plots.size(), "\"plots\": [], \"solver\": {\"max_points\": 20, \"step\": {\"max_step\": 0.05}}");
