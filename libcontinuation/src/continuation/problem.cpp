@@ -129,6 +129,21 @@ bool Problem::secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, doub
   return y.allFinite();
 }
 
+bool Problem::secondDerivativeApplyByDifferences(ProblemWorkspace &ws, ConstVectorRef u, double lambda,
+                                                 ConstVectorRef x, ConstVectorRef z, VectorRef y) const {
+  const int n = dimension();
+  const double h = differenceStep(*this, u, lambda, x.head(n), x[n]);
+  if (h == 0.0) {
+    y.setZero();
+    return true;
+  }
+  Vector yp(n), ym(n);
+  if (!jacobianApply(ws, u + h * x.head(n), lambda + h * x[n], z, yp)) return false;
+  if (!jacobianApply(ws, u - h * x.head(n), lambda - h * x[n], z, ym)) return false;
+  y = (yp - ym) / (2.0 * h);
+  return y.allFinite();
+}
+
 std::unique_ptr<BorderedSolver> Problem::makeStructuredSolver(ProblemWorkspace &) const { return nullptr; }
 
 void Problem::boundaries(ProblemWorkspace &ws, ConstVectorRef u, double lambda, VectorRef g) const {

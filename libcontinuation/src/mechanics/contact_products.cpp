@@ -1,5 +1,6 @@
-// ContactProblem's Jacobian products F_x x and F_xᵀ w in O(n) (contact.h): what the locator's
-// structured refinements evaluate their residuals with, instead of the dense Jacobian.
+// ContactProblem's Jacobian products F_x x and F_xᵀ w and the second derivative F_xx[x, z] in O(n)
+// (contact.h): what the locator's structured refinements and the branch points' coefficients
+// evaluate with, instead of the dense Jacobian.
 #include "buckle/mechanics/contact.h"
 
 namespace buckle::mechanics {
@@ -76,6 +77,15 @@ bool ContactProblem::jacobianTransposeApply(ProblemWorkspace& ws, ConstVectorRef
     y.head(n).noalias() -= d.wallGrad * w.segment(N, g);
   }
   for (const LockedJoint& l : locked_.joints()) y[l.joint] -= w[l.joint];
+  return true;
+}
+
+bool ContactProblem::secondDerivativeApply(ProblemWorkspace& ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                           ConstVectorRef z, VectorRef y) const {
+  Workspace& d = workspaceAs<Workspace>(ws);
+  if (locked_.gapCount() > 0) return secondDerivativeApplyByDifferences(ws, u, lambda, x, z, y);
+  if (!base_.secondDerivativeApply(*d.base, u, lambda, x, z, y)) return false;
+  for (const LockedJoint& l : locked_.joints()) y[l.joint] = 0.0;  // the locked rows q_i − limit are linear
   return true;
 }
 

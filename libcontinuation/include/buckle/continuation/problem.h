@@ -151,6 +151,11 @@ class Problem {
   /// (O(N²)); a structured problem overrides it with an exact O(N) product.
   virtual bool secondDerivativeApply(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
                                      ConstVectorRef z, VectorRef y) const;
+  /// F_xx[x, z] by central differences of jacobianApply() along x (the step of the default
+  /// jacobianDirectionalDerivative()): O(N) where the products are, for overrides of
+  /// secondDerivativeApply() whose exact form is not available for some of their rows.
+  bool secondDerivativeApplyByDifferences(ProblemWorkspace &ws, ConstVectorRef u, double lambda, ConstVectorRef x,
+                                          ConstVectorRef z, VectorRef y) const;
 
   // ---- optional: mechanical stability ---------------------------------------------------
   virtual bool hasStabilityOperator() const { return false; }

@@ -178,6 +178,12 @@ class ContactProblem final : public continuation::Problem {
                      continuation::ConstVectorRef x, continuation::VectorRef y) const override;
   bool jacobianTransposeApply(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
                               continuation::ConstVectorRef w, continuation::VectorRef y) const override;
+  /// F_xx[x, z] in O(n): with locked joints only the base problem's exact product, the locked rows
+  /// (linear) zero; with gaps, whose rows and −Σ μ ∂²g move with ∂³g, central differences of
+  /// jacobianApply() (Problem::secondDerivativeApplyByDifferences) — not the dense default's N×N.
+  bool secondDerivativeApply(continuation::ProblemWorkspace& ws, continuation::ConstVectorRef u, double lambda,
+                             continuation::ConstVectorRef x, continuation::ConstVectorRef z,
+                             continuation::VectorRef y) const override;
 
   bool hasStabilityOperator() const override { return true; }
   /// H = K_q − K_g − Σ μ_v ∂²x_v (n×n), C = the held rows J_h, one row e_iᵀ per locked joint and
