@@ -2,6 +2,7 @@
 // stiffness) against the dense ones: an end condition, a wall vertex or none, self contacts.
 #pragma once
 
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,6 +34,20 @@ inline ContactSet caseContacts(const ContactCase& k, const std::vector<std::pair
   if (k.wall) set.touch(wall);
   for (const SelfContact& c : k.self) set.hold(c);
   return set;
+}
+
+/// For each case: its problem on `chain` under a random load direction drawn from `rng`, and the
+/// contact problem with the `locked` joints, the wall vertex (2, 3) when the case has the wall and
+/// the case's self contacts — body(case, contact problem).
+template <class Body>
+void forEachContactCase(std::mt19937& rng, const Chain& chain, const std::vector<ContactCase>& cases,
+                        const std::vector<std::pair<int, LimitSide>>& locked, Body body) {
+  std::uniform_real_distribution<double> W(-1.0, 1.0);
+  for (const ContactCase& k : cases) {
+    EquilibriumProblem problem(chain, k.end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
+    const ContactProblem contact(problem, caseContacts(k, locked, WallVertex{2, 3}));
+    body(k, contact);
+  }
 }
 
 }  // namespace buckle::mechanics::testing

@@ -605,12 +605,9 @@ TEST_CASE("contact: self contacts' rank-2 terms on the O(n) solver, products and
       {"free end, two", EndCondition::freeEnd(Eigen::Vector3d(W(rng), W(rng), W(rng))), false,
        {distalOnProximal, proximalOnDistal}},
       {"clamped-pinned, wall, one", EndCondition::clampedPinned(W(rng), 0.1 * W(rng)), true, {proximalOnDistal}}};
-  for (const testing::ContactCase& k : cases) {
+  testing::forEachContactCase(rng, chain, cases, {{5, LimitSide::Upper}, {200, LimitSide::Lower}, {290, LimitSide::Upper}},
+                              [&](const testing::ContactCase& k, const ContactProblem& contact) {
     INFO(k.name);
-    EquilibriumProblem problem(chain, k.end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
-    const ContactSet locked = testing::caseContacts(
-        k, {{5, LimitSide::Upper}, {200, LimitSide::Lower}, {290, LimitSide::Upper}}, WallVertex{2, 3});
-    const ContactProblem contact(problem, locked);
     const int N = contact.dimension();
     Eigen::VectorXd u(N);
     for (int i = 0; i < N; ++i) u[i] = i < n ? Q(rng) : W(rng);
@@ -698,5 +695,5 @@ TEST_CASE("contact: self contacts' rank-2 terms on the O(n) solver, products and
       REQUIRE(contact.cont::Problem::stabilityEigenvalues(*ws, u, lambda, first, dense));
       CHECK((mu - dense).cwiseAbs().maxCoeff() <= 1e-9 * scale);
     }
-  }
+  });
 }

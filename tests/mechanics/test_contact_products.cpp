@@ -28,12 +28,10 @@ TEST_CASE("contact products: the O(n) second derivative equals the dense one's p
       {"free end, locked joints only", EndCondition::freeEnd(), false, {}},
       {"clamped-pinned, locked joints only", EndCondition::clampedPinned(0.0), false, {}},
       {"clamped-pinned, a wall vertex and a self contact", EndCondition::clampedPinned(0.0), true, {distalOnProximal}}};
-  for (const testing::ContactCase& k : cases) {
+  testing::forEachContactCase(rng, chain, cases, {{4, LimitSide::Upper}, {70, LimitSide::Lower}, {120, LimitSide::Upper}},
+                              [&](const testing::ContactCase& k, const ContactProblem& contact) {
     INFO(k.name);
-    EquilibriumProblem problem(chain, k.end, Eigen::Vector3d(W(rng), W(rng), W(rng)));
-    const ContactSet locked = testing::caseContacts(
-        k, {{4, LimitSide::Upper}, {70, LimitSide::Lower}, {120, LimitSide::Upper}}, WallVertex{2, 3});
-    const ContactProblem contact(problem, locked);
+    const ContactSet& locked = contact.contacts();
     const int N = contact.dimension();
     Eigen::VectorXd u(N), x(N + 1), z(N + 1);
     for (int i = 0; i < N; ++i) u[i] = i < n ? Q(rng) : W(rng);
@@ -49,5 +47,5 @@ TEST_CASE("contact products: the O(n) second derivative equals the dense one's p
     // truncation order) to their accuracy
     const double tolerance = locked.gapCount() == 0 ? 1e-12 : 1e-8;
     CHECK((fast - dense).norm() <= tolerance * size);
-  }
+  });
 }
