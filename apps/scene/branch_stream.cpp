@@ -72,7 +72,7 @@ void BranchStream::add(size_t c, const CaseResult& cr, const std::vector<mechani
   Piece piece;
   piece.branch = points.empty() ? -1 : points.front().branch;
   piece.rows = points.size();
-  std::string& text = rows_text_;
+  std::string& text = rowsText_;
   text.clear();
   text.reserve(points.size() * layout_.rowBytes());
   for (const mechanics::PointReport& p : points) layout_.appendRow(text, c, cr, p);

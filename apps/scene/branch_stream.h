@@ -60,7 +60,7 @@ class BranchStream {
   Spool csv_, npy_;
   /// One branch's rows before they go to a spool: its capacity kept from branch to branch up to
   /// the in-memory size (no fresh pages to fault in and copy into as it grows, once per branch)
-  std::string rows_text_;
+  std::string rowsText_;
   std::vector<std::vector<Piece>> cases_;
   size_t rows_ = 0;
 };

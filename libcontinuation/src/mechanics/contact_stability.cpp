@@ -1,11 +1,10 @@
 // The stability of ContactProblem (contact.h) on the reduced chain structure: the inertia and
 // lowest eigenvalues of K_q − K_g − Σ μ ∂²g on the free joints and ker of the held and gap rows,
 // the self contacts' rank-2 terms bordered (setCoupling), O(n) a point.
-#include <Eigen/Cholesky>
 #include <algorithm>
-#include <cmath>
 
 #include "buckle/mechanics/contact.h"
+#include "held_multipliers.h"
 
 namespace buckle::mechanics {
 
@@ -110,27 +109,12 @@ bool ContactProblem::stabilitySlopes(cont::ProblemWorkspace& ws, cont::ConstVect
   // rank-deficient held rows on the free joints: ker C jumps along the tangent (no derivative)
   if ((m > 0 ? setConstraints(structure, d.heldRows) : (structure.rank = 0)) < m) return false;
   structure.couplingCount = 0;
-  Eigen::Matrix3d gram = Eigen::Matrix3d::Identity();
-  for (int k = 0; k < m; ++k)
-    for (int l = 0; l <= k; ++l) gram(k, l) = gram(l, k) = d.heldRows.row(k).dot(d.heldRows.row(l));
-  const Eigen::LDLT<Eigen::Matrix3d> gramFactor(gram);
-  const double scale = std::max(structure.typicalScale, structure.frobeniusH);
   Vector &v = d.slopeFree, &Hv = d.slopeHv;
   for (Eigen::Index j = 0; j < values.size(); ++j) {
-    const double mu = values[j];
-    if (!eigenvectorAt(structure, m > 0, mu, v)) return false;
-    // ζ = −(C Cᵀ)⁻¹ C H v on the free joints, and the pair's residual (as EquilibriumProblem's)
-    applyHessian(structure, v, Hv);
-    Eigen::Vector3d zeta = Eigen::Vector3d::Zero();
-    for (int k = 0; k < m; ++k) zeta[k] = -d.heldRows.row(k).dot(Hv);
-    if (m > 0) zeta = gramFactor.solve(zeta);
-    double residual2 = 0.0;
-    for (Eigen::Index a = 0; a < v.size(); ++a) {
-      double ra = Hv[a] - mu * v[a];
-      for (int k = 0; k < m; ++k) ra += d.heldRows(k, a) * zeta[k];
-      residual2 += ra * ra;
-    }
-    if (!(std::sqrt(residual2) <= 1e-8 * scale)) return false;
+    Eigen::Vector3d zeta;  // of the held rows on the free joints
+    if (!eigenvectorAt(structure, m > 0, values[j], v) ||
+        !heldMultipliers(structure, d.heldRows, m, values[j], v, Hv, zeta))
+      return false;
     for (size_t a = 0; a < free_.size(); ++a) d.slopeFull[free_[a]] = v[Eigen::Index(a)];
     if (!base_.eigenvalueRate(*d.base, u.head(N), lambda, du.head(N), dlambda, d.slopeFull, zeta, slopes[j]))
       return false;

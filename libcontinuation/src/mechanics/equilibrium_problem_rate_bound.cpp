@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "buckle/mechanics/equilibrium_problem.h"
+#include "held_multipliers.h"
 
 namespace buckle::mechanics {
 
@@ -136,27 +137,13 @@ bool EquilibriumProblem::stabilitySlopes(ProblemWorkspace& ws, ConstVectorRef u,
   // rank-deficient C: ker C jumps along the tangent (no derivative), as for the bound
   if ((m > 0 ? setConstraints(d.structure, d.heldRows) : (d.structure.rank = 0)) < m) return false;
   stabilityRates(d, u, lambda, du, dlambda);
-  const Eigen::LDLT<Eigen::Matrix3d> gram(heldGram(d.heldRows, m, 1.0));
-  const double scale = std::max(d.structure.typicalScale, d.structure.frobeniusH);
   Vector& v = d.eigenvector;
   Vector& Hv = d.hessianTimes;
   for (Eigen::Index j = 0; j < values.size(); ++j) {
-    const double mu = values[j];
-    if (!eigenvectorAt(d.structure, m > 0, mu, v)) return false;
-    // ζ = −(CCᵀ)⁻¹ C H v (H v + Cᵀζ = μ v with C v = 0), and the residual of the pair: an
-    // eigenvalue given wrong, or one of a cluster tighter than its accuracy, leaves v no
-    // eigenvector to the accuracy the slope needs; then the caller differences instead.
-    applyHessian(d.structure, v, Hv);
-    Eigen::Vector3d zeta = Eigen::Vector3d::Zero();
-    for (int k = 0; k < m; ++k) zeta[k] = -d.heldRows.row(k).dot(Hv);
-    if (m > 0) zeta = gram.solve(zeta);
-    double residual2 = 0.0;
-    for (int i = 0; i < n; ++i) {
-      double ri = Hv[i] - mu * v[i];
-      for (int k = 0; k < m; ++k) ri += d.heldRows(k, i) * zeta[k];
-      residual2 += ri * ri;
-    }
-    if (!(std::sqrt(residual2) <= 1e-8 * scale)) return false;
+    Eigen::Vector3d zeta;
+    if (!eigenvectorAt(d.structure, m > 0, values[j], v) ||
+        !heldMultipliers(d.structure, d.heldRows, m, values[j], v, Hv, zeta))
+      return false;
     slopes[j] = rateAlong(d, v, zeta);
   }
   return slopes.allFinite();
