@@ -523,7 +523,7 @@ TEST_CASE("contact: a branch that comes back to one of its contact events, same 
   // The default scene's chain with 20 segments (a = 0.5, b = 1, k = 1, L0 = 2.25, clamped–pinned,
   // compressed by Fx to −2.5): a child of the trivial branch locks and releases joints 9, 11 and 13
   // in a cycle of contact events, its second half the mirror image of the first. Traced on, it
-  // would go round until maxContactEvents; it ends where it is back at an event it has passed.
+  // would go round until its budget of points; it ends where it is back at an event it has passed.
   const int n = 20;
   const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
@@ -535,8 +535,6 @@ TEST_CASE("contact: a branch that comes back to one of its contact events, same 
   o.tracer.maxPoints = 4000;
   o.tracer.detection.lowestEigenvalues = 1;
   o.tree.threads = 1;
-  const int maxEvents = 200;
-  o.maxContactEvents = maxEvents;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
   int loops = 0;
@@ -546,7 +544,7 @@ TEST_CASE("contact: a branch that comes back to one of its contact events, same 
     ++loops;
     const std::vector<ContactStretch>& stretches = r.contact[b];
     INFO("branch " << b << ": " << branch.stopMessage);
-    CHECK(int(stretches.size()) - 1 < maxEvents / 4);  // ended by the loop, far from the guard
+    CHECK(int(branch.points.size()) < o.tracer.maxPoints);  // ended by the loop, before the budget
     // The stretch that started at the point the branch came back to: the same point to far below
     // the test's 1e-6 (a loop, not a near miss).
     const cont::ContinuationPoint& last = branch.points.back();
@@ -588,6 +586,83 @@ TEST_CASE("contact: a branch that comes back to one of its contact events, same 
       }
   }
   CHECK(loops >= 1);
+}
+
+namespace {
+
+/// The default scene's chain with 50 segments (a = 0.5, b = 1, k = 1, L0 = 2.25, clamped–pinned,
+/// compressed by Fx to −2.5), switched only at the 24th simple branch point of the trivial
+/// branch: its + side child locks and releases joints well over a hundred times before it closes
+/// into a loop (the default scene at 50 segments, `buckle run`). `childPoints` > 0: the children's
+/// budget of points.
+EquilibriumBranches manyEventsTree(int childPoints) {
+  const int n = 50;
+  const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMin = -2.5;
+  o.tracer.lambdaMax = 0.0;
+  o.tracer.step.initialStep = 0.02;
+  o.tracer.step.maxStep = 0.05;
+  o.tracer.maxPoints = 20000;
+  o.tree.threads = 1;
+  o.tree.branchSwitching = 1;
+  o.tree.switchAt = [](const cont::Branch& branch, const cont::SpecialPoint& bp) {
+    int before = 0;
+    for (const cont::SpecialPoint& sp : branch.specialPoints)
+      if (sp.type == cont::SpecialPointType::BranchPoint && sp.multiplicity == 1 && sp.arclength < bp.arclength)
+        ++before;
+    return branch.parentId < 0 && before == 23;
+  };
+  if (childPoints > 0) {
+    o.tree.childTracer = o.tracer;
+    o.tree.childTracer->maxPoints = childPoints;
+  }
+  return traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
+}
+
+const EquilibriumBranches& manyEventsTreeOnce() {
+  static const EquilibriumBranches r = manyEventsTree(0);
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("contact: a branch goes through as many contact events as its budget of points allows", "[contact]") {
+  // No count of events ends a branch (a fixed count of 50 used to end such children as if at a
+  // regular boundary): this one passes more than a hundred and ends as a closed loop.
+  const EquilibriumBranches& r = manyEventsTreeOnce();
+  REQUIRE(r.tree.branches.size() == 3);
+  const cont::Branch& child = r.tree.branches[1];
+  const std::vector<ContactStretch>& stretches = r.contact[1];
+  INFO(child.stopMessage);
+  CHECK(int(stretches.size()) - 1 > 100);
+  CHECK(child.stopReason == cont::StopReason::ClosedLoop);
+  CHECK(int(child.points.size()) < 20000);
+}
+
+TEST_CASE("contact: a budget of points spent at a contact event ends the branch for the budget, not at a boundary",
+          "[contact]") {
+  const EquilibriumBranches& full = manyEventsTreeOnce();
+  REQUIRE(full.tree.branches.size() == 3);
+  const cont::Branch& child = full.tree.branches[1];
+  const std::vector<ContactStretch>& stretches = full.contact[1];
+  REQUIRE(stretches.size() > 10);
+  // the event that starts the tenth stretch is the last point the budget allows
+  const int event = stretches[10].firstPoint - 1;
+  const EquilibriumBranches cut = manyEventsTree(event + 1);
+  REQUIRE(cut.tree.branches.size() == 3);
+  const cont::Branch& b = cut.tree.branches[1];
+  INFO(b.stopMessage);
+  CHECK(b.stopReason == cont::StopReason::MaxPoints);
+  CHECK(b.stopMessage.find("at a contact event") != std::string::npos);
+  REQUIRE(int(b.points.size()) == event + 1);
+  CHECK(cut.contact[1].size() == 10);
+  // the same curve as the branch with the larger budget, up to that event
+  for (int i = 0; i <= event; ++i) {
+    CHECK((b.points[size_t(i)].u - child.points[size_t(i)].u).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK(b.points[size_t(i)].lambda == Approx(child.points[size_t(i)].lambda).margin(1e-12));
+  }
 }
 
 TEST_CASE("contact: self contacts' rank-2 terms on the O(n) solver, products and counts equal the dense LU, "

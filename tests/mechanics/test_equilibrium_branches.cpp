@@ -916,7 +916,7 @@ TEST_CASE("wall: a vertex pressed on the wall releases where the reversed load b
   cont::Branch leg2 = cont::trace(pressed, start, 0.0, cont::InitialDirection::increasingLambda(), to);
   REQUIRE(leg2.stopReason == cont::StopReason::Boundary);
   CHECK(leg2.specialPoints.back().boundaryName == wallReleaseName(set.wall()[0]));
-  const std::vector<ContactStretch> stretches = continueUnderContact(down, leg2, to, 50, 10.0, set);
+  const std::vector<ContactStretch> stretches = continueUnderContact(down, leg2, to, 10.0, set);
   REQUIRE(stretches.size() == 2);
   CHECK(stretches[1].locked.empty());
   CHECK(leg2.stopReason == cont::StopReason::LambdaRange);

@@ -202,7 +202,7 @@ TEST_CASE("self contact: a hook curled by an end moment is held on its own link,
     cont::Tracer tracer(*stretch, down);
     cont::Branch back = tracer.trace(stretch->withWallForces(*stretch->createWorkspace(), last.u, last.lambda), last.lambda,
                                      cont::InitialDirection::decreasingLambda());
-    const std::vector<mech::ContactStretch> stretches = mech::continueUnderContact(hook.problem, back, down, 50, 10.0, held);
+    const std::vector<mech::ContactStretch> stretches = mech::continueUnderContact(hook.problem, back, down, 10.0, held);
     REQUIRE(stretches.size() == 2);
     CHECK(stretches[1].locked.empty());
     const double released = back.points[size_t(stretches[1].firstPoint - 1)].lambda / torqueUnit;

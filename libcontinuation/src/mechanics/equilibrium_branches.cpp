@@ -136,6 +136,28 @@ int repeatedStretch(const EquilibriumProblem& problem, const continuation::Branc
   return -1;
 }
 
+// The tracer options of the next stretch: the budget of points and arclength is the whole
+// branch's. False when the branch has spent it at the event it stands on: it ends for its
+// budget there, not at a regular boundary.
+bool budgetLeft(const continuation::TracerOptions& options, size_t stretches, continuation::Branch& branch,
+                continuation::TracerOptions& next) {
+  next.maxPoints = options.maxPoints - int(branch.points.size()) + 1;
+  next.maxArclength = options.maxArclength - branch.points.back().arclength;
+  if (next.maxPoints < 2) {
+    branch.stopReason = continuation::StopReason::MaxPoints;
+    branch.stopMessage = "reached maxPoints = " + std::to_string(options.maxPoints) +
+                         " at a contact event (the whole branch, over " + std::to_string(stretches) +
+                         " contact stretches)";
+    return false;
+  }
+  if (!(next.maxArclength > 0.0)) {
+    branch.stopReason = continuation::StopReason::MaxArclength;
+    branch.stopMessage = "reached maxArclength at a contact event";
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::unique_ptr<ContactProblem> lockedProblem(EquilibriumProblem& problem, const ContactSet& locked,
@@ -145,8 +167,8 @@ std::unique_ptr<ContactProblem> lockedProblem(EquilibriumProblem& problem, const
 }
 
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
-                                                 const continuation::TracerOptions& options, int maxContactEvents,
-                                                 double maxContactTorque, const ContactSet& initial) {
+                                                 const continuation::TracerOptions& options, double maxContactTorque,
+                                                 const ContactSet& initial) {
   const int n = problem.segments();
   std::vector<ContactStretch> stretches{ContactStretch{0, initial}};
   std::unique_ptr<ContactProblem> current;  // the problem of the last stretch (null: `problem`)
@@ -155,7 +177,9 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     for (continuation::ContinuationPoint& p : branch.points) toBaseUnknowns(p.u, p.tangent, problem.dimension());
     for (continuation::SpecialPoint& sp : branch.specialPoints) toBaseUnknowns(sp, problem.dimension());
   }
-  for (int events = 0; events < maxContactEvents && !branch.points.empty(); ++events) {
+  // No count of events bounds the loop: every stretch appended has at least two points, so the
+  // branch's budget of points (and of arclength) ends it, as it ends a branch without contact.
+  while (!branch.points.empty()) {
     const continuation::Problem& traced = current ? static_cast<const continuation::Problem&>(*current) : problem;
     const BoundaryEvent hit = endEvent(problem, traced, branch, stretches.back().locked);
     if (!hit.any()) break;
@@ -179,11 +203,8 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     }
     const ContactSet& locked = change.after;
     const bool onJoint = hit.joint.joint >= 0, release = change.release;
-    // The budget of points and arclength is the whole branch's.
     continuation::TracerOptions o = options;
-    o.maxPoints = options.maxPoints - int(branch.points.size()) + 1;
-    o.maxArclength = options.maxArclength - branch.points.back().arclength;
-    if (o.maxPoints < 2 || !(o.maxArclength > 0.0)) break;
+    if (!budgetLeft(options, stretches.size(), branch, o)) break;
     auto next = lockedProblem(problem, locked, maxContactTorque);
     const std::string& what = change.what;
     auto giveUp = [&branch, &what](const std::string& why) {
@@ -299,7 +320,6 @@ std::string EquilibriumBranchOptions::validate(const std::string& prefix) const 
   namespace cont = continuation;
   return cont::firstProblem({tracer.validate(prefix + "tracer."), tree.validate(prefix + "tree."),
                              report.validate(prefix + "report."),
-                             cont::require(maxContactEvents >= 0, prefix, "maxContactEvents", "must be >= 0"),
                              cont::requirePositive(prefix, "maxContactTorque", maxContactTorque)});
 }
 
@@ -324,8 +344,7 @@ continuation::TreeOptions::ChildWork childWork(EquilibriumProblem& problem, cons
         p->contact = mirrored(source->contact);
         appendMirroredTail(symmetry, sides[size_t(child.mirrorOf)], source->traced, child);
       } else {
-        p->contact = continueUnderContact(problem, child, workerOptions, options.maxContactEvents,
-                                          options.maxContactTorque, locked);
+        p->contact = continueUnderContact(problem, child, workerOptions, options.maxContactTorque, locked);
       }
       if (leaves) {
         for (const continuation::SpecialPoint& sp : child.specialPoints)
@@ -405,8 +424,7 @@ EquilibriumBranches traceEquilibria(EquilibriumProblem& problem, const Eigen::Ve
       appendMirroredTail(tree.symmetry, t.branches[source], traced[source], branch);
     } else {
       const continuation::TracerOptions& o = branch.parentId >= 0 ? childOptions : options.tracer;
-      result.contact[id] =
-          continueUnderContact(problem, branch, o, options.maxContactEvents, options.maxContactTorque, locked);
+      result.contact[id] = continueUnderContact(problem, branch, o, options.maxContactTorque, locked);
     }
   };
   // The children's stretches, and the reports of those never switched at, on the thread that

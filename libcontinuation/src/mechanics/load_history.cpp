@@ -262,7 +262,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       // base wall, a piece before it run into them) and, as the continuation's branches, goes
       // on through the joint limits and the wall (EquilibriumOptions::wallAsBoundary) it meets:
       // a contact holds until its force returns to zero (continueUnderContact).
-      const EquilibriumBranchOptions contact;  // the continuation's bounds on contact events and torques
+      const EquilibriumBranchOptions contact;  // the continuation's bound on contact torques
       std::unique_ptr<ContactProblem> stretchProblem;
       if (!locked.empty()) stretchProblem = lockedProblem(problem, locked, contact.maxContactTorque);
       // a piece with vertices on the wall has their forces among its unknowns (contact.h)
@@ -273,7 +273,7 @@ LoadHistoryResult followLoadHistory(EquilibriumProblem& problem, const Eigen::Ve
       cont::Branch branch = stretchProblem ? cont::trace(*stretchProblem, u, lambda, direction, legOptions)
                                            : cont::trace(problem, u, lambda, direction, legOptions);
       std::vector<ContactStretch> stretches =
-          continueUnderContact(problem, branch, legOptions, contact.maxContactEvents, contact.maxContactTorque, locked);
+          continueUnderContact(problem, branch, legOptions, contact.maxContactTorque, locked);
       if (branch.points.empty()) {
         result.message = "continuation could not start at lambda = " + std::to_string(lambda) + ": " + branch.stopMessage;
         return result;

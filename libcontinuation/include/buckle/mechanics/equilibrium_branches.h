@@ -46,8 +46,6 @@ struct EquilibriumBranchOptions {
   /// where its contact torque returns to zero. False: the branch ends at the limit ("BD").
   /// Needs the problem's joint limits traced as boundaries (EquilibriumOptions).
   bool contact = true;
-  /// At most this many contact / release events per branch (a guard against chattering).
-  int maxContactEvents = 50;
   /// A locked stretch ends (a located boundary, "BD") where a contact torque reaches this many
   /// torque units k̄b̄² of the chain (EquilibriumProblem::scales()): beyond, the chain is pressed
   /// against its stops far harder than its springs carry (e.g. a locked mechanism at a kinematic
@@ -91,7 +89,7 @@ std::unique_ptr<ContactProblem> lockedProblem(EquilibriumProblem& problem, const
 
 std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, continuation::Branch& branch,
                                                  const continuation::TracerOptions& options,
-                                                 int maxContactEvents = 50, double maxContactTorque = 10.0,
+                                                 double maxContactTorque = 10.0,
                                                  const ContactSet& initial = ContactSet());
 
 /// Traces from joint angles q0 at λ0 (the held reactions are initialised by least squares, then
