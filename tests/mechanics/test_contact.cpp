@@ -167,6 +167,40 @@ TEST_CASE("contact: a single segment pushed past its limit carries applied torqu
   }
 }
 
+TEST_CASE("contact: joints that reach their limits at one point lock together and the branch goes on",
+          "[contact]") {
+  // Three equal segments under a pure end moment: every joint carries Me, so all three bend alike
+  // and reach the limit 0.6 at the same load E'(0.6). The first contact's stretch meets the second
+  // at once (and the second's the third); each is taken at that point, and the branch goes on with
+  // all three locked to the end of the path, each carrying Me − E'(0.6).
+  SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
+  p.qMaxUser = 0.6;
+  const Chain chain = Chain::uniform(3, p);
+  const double springAtLimit = chain.segment(0).energyJet(0.6).d1;
+  EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 0, 1));  // Me = λ
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMax = 3.0 * springAtLimit;
+  o.tracer.step.maxStep = 0.1;
+  o.tree.branchSwitching = 0;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const cont::Branch& b = r.tree.branches[0];
+  INFO(b.stopMessage);
+  CHECK(b.stopReason == cont::StopReason::LambdaRange);
+  const BranchReport& rep = r.reports[0];
+  CHECK(countType(rep, EventType::Contact) == 3);
+  for (const SpecialPointReport& s : rep.specialPoints)
+    if (s.type == EventType::Contact) CHECK(std::abs(s.parameter - springAtLimit) <= 1e-10 * springAtLimit);
+  REQUIRE(r.contact[0].size() == 4);
+  CHECK(r.contact[0].back().locked.joints().size() == 3);
+  const PointReport& last = rep.points.back();
+  CHECK(last.parameter == Approx(3.0 * springAtLimit).epsilon(1e-12));
+  REQUIRE(last.locked.joints().size() == 3);
+  for (int i = 0; i < 3; ++i) CHECK(last.q[i] == Approx(0.6).margin(1e-14));
+  // each stop carries the applied moment less the spring's torque at the limit (closed form)
+  CHECK(std::abs(last.contactTorque - (last.parameter - springAtLimit)) <= 1e-10 * springAtLimit);
+}
+
 TEST_CASE("contact: a chain's locked branch agrees with an independent Newton solve with the joint fixed",
           "[contact]") {
   SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);

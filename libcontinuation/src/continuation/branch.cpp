@@ -34,6 +34,7 @@ const char *toString(StopReason reason) {
     case StopReason::Interrupted: return "interrupted";
     case StopReason::Joined: return "joined a traced branch";
     case StopReason::ClosedLoop: return "closed loop";
+    case StopReason::EventNotContinued: return "event not continued";
     case StopReason::Paused: return "paused at a branch point";
   }
   return "unknown";

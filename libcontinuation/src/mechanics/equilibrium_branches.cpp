@@ -136,6 +136,37 @@ int repeatedStretch(const EquilibriumProblem& problem, const continuation::Branc
   return -1;
 }
 
+// Whether the branch, standing at an event with p0 the next stretch's start, is back at one of
+// its earlier events (repeatedStretch): then it ends there as a closed loop.
+bool endsInLoop(const EquilibriumProblem& problem, continuation::Branch& branch,
+                const std::vector<ContactStretch>& stretches, const ContactSet& locked,
+                const continuation::ContinuationPoint& p0) {
+  const int k = repeatedStretch(problem, branch, stretches, locked, p0);
+  if (k <= 0) return false;
+  const int at = stretches[size_t(k)].firstPoint - 1;
+  char lambda[64];
+  std::snprintf(lambda, sizeof lambda, "%.10g", branch.points[size_t(at)].lambda);
+  branch.stopReason = continuation::StopReason::ClosedLoop;
+  branch.stopMessage = "closed loop: back at point " + std::to_string(at) + " (parameter " + lambda +
+                       ") with the same contacts and direction; from there it repeats itself";
+  return true;
+}
+
+// Whether a stretch that did not get away from the event it started from (`first`) ended at once,
+// at its start or within its minimum step, on a contact event of another contact: two contacts
+// changing at one point (joints alike reaching their stops together, e.g. under a pure moment or
+// in symmetric lobes of a long chain), taken one after the other at that point (the stretch
+// between them may hold no point of its own).
+bool secondEventAtOnce(const EquilibriumProblem& problem, const ContactProblem& next, const continuation::Branch& stretch,
+                       const ContactSet& locked, const BoundaryEvent& first) {
+  if (stretch.points.empty() || stretch.stopReason != continuation::StopReason::Boundary) return false;
+  const BoundaryEvent second = endEvent(problem, next, stretch, locked);
+  if (!second.any()) return false;
+  const bool sameJoint = first.joint.joint >= 0 && second.joint.joint == first.joint.joint;
+  const bool sameVertex = first.vertex.segment >= 0 && second.vertex == first.vertex;
+  return !sameJoint && !sameVertex;
+}
+
 // The tracer options of the next stretch: the budget of points and arclength is the whole
 // branch's. False when the branch has spent it at the event it stands on: it ends for its
 // budget there, not at a regular boundary.
@@ -177,8 +208,8 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     for (continuation::ContinuationPoint& p : branch.points) toBaseUnknowns(p.u, p.tangent, problem.dimension());
     for (continuation::SpecialPoint& sp : branch.specialPoints) toBaseUnknowns(sp, problem.dimension());
   }
-  // No count of events bounds the loop: every stretch appended has at least two points, so the
-  // branch's budget of points (and of arclength) ends it, as it ends a branch without contact.
+  // No count of events: every stretch has two points or more, so the branch's budget ends the loop.
+  int atOnce = 0;  // changes taken together at one point so far
   while (!branch.points.empty()) {
     const continuation::Problem& traced = current ? static_cast<const continuation::Problem&>(*current) : problem;
     const BoundaryEvent hit = endEvent(problem, traced, branch, stretches.back().locked);
@@ -206,10 +237,15 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     continuation::TracerOptions o = options;
     if (!budgetLeft(options, stretches.size(), branch, o)) break;
     auto next = lockedProblem(problem, locked, maxContactTorque);
-    const std::string& what = change.what;
-    auto giveUp = [&branch, &what](const std::string& why) {
+    auto giveUp = [&branch, &change](const std::string& why) {
       std::string& note = branch.specialPoints.back().note;
-      note += (note.empty() ? "" : "; ") + what + ": " + why;
+      note += (note.empty() ? "" : "; ") + change.what + ": " + why;
+    };
+    // The branch goes on past the event but is not followed: unfinished, not a regular end.
+    auto notContinued = [&branch, &change, &giveUp](const std::string& why) {
+      giveUp(why);
+      branch.stopReason = continuation::StopReason::EventNotContinued;
+      branch.stopMessage = change.what + ": " + why;
     };
     // The start: the located point polished with the new set of contacts. It lies on the
     // changed contact's boundary (g = 0 to the location's accuracy, either sign), so it is started
@@ -218,7 +254,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     const ConstrainedEquilibrium start =
         solveConstrainedEquilibrium(problem, locked, at.u, at.lambda, std::max(o.location.newtonTolerance, 1e-12));
     if (!start.converged) {
-      giveUp("the equilibrium could not be polished (" + start.message + ")");
+      notContinued("the equilibrium could not be polished (" + start.message + ")");
       break;
     }
     continuation::Tracer tracer(*next, o);
@@ -227,8 +263,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // released vertex): dg/ds > 0 along its tangent. The parent's direction decides only when that
     // is ambiguous: on an unstable branch a joint can reach its limit with the locked branch
     // turning back in λ (a corner).
-    const int N = problem.dimension(), D = next->dimension();
-    const int wallIndex = change.index;
+    const int N = problem.dimension(), D = next->dimension(), wallIndex = change.index;
     // (a vertex leaving a corner along the edge that stays: that edge's end distance)
     const int changed = onJoint      ? (hit.joint.side == LimitSide::Upper ? hit.joint.joint : hit.joint.joint + n)
                         : change.slidesOn >= 0 ? next->selfEdgeBoundary(change.slidesOn) + 1
@@ -258,21 +293,15 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     }
     continuation::ContinuationPoint p0;
     if (!startPoint(direction, p0)) {
-      giveUp("no unique tangent at the point");
+      notContinued("no unique tangent at the point");
       break;
     }
     const double rate = contactRate(problem, stretches.back().locked, hit, change, p0);
     if (rate < 0.0 && !startPoint(-p0.tangent, p0)) {
-      giveUp("no unique tangent at the point");
+      notContinued("no unique tangent at the point");
       break;
     }
-    if (const int k = repeatedStretch(problem, branch, stretches, locked, p0); k > 0) {
-      const continuation::ContinuationPoint& then = branch.points[size_t(stretches[size_t(k)].firstPoint - 1)];
-      branch.stopReason = continuation::StopReason::ClosedLoop;
-      char at[64];
-      std::snprintf(at, sizeof at, "%.10g", then.lambda);
-      branch.stopMessage = "closed loop: back at point " + std::to_string(stretches[size_t(k)].firstPoint - 1) +
-                           " (parameter " + at + ") with the same contacts and direction; from there it repeats itself";
+    if (endsInLoop(problem, branch, stretches, locked, p0)) {
       giveUp(branch.stopMessage);
       break;
     }
@@ -286,12 +315,20 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     }
     // A stretch that does not leave its start, or leaves it to the wrong side (a contact that
     // pulls at once, or a released joint or vertex that goes on past its limit or the wall),
-    // would chatter: stop.
-    if (stretch.points.size() < 2 || !(stretch.points.back().arclength > options.step.minStep)) {
-      giveUp("the branch does not leave the point (" + stretch.stopMessage + ")");
+    // would chatter: stop — unless it ends at once on a second contact change (two contacts
+    // changing at one point), which the next pass takes with this one.
+    const bool left = stretch.points.size() >= 2 && stretch.points.back().arclength > options.step.minStep;
+    const bool together = !left && secondEventAtOnce(problem, *next, stretch, locked, hit) && ++atOnce <= 2 * n;
+    if (!left && !together) {
+      const std::string why = "the branch does not leave the point (" + stretch.stopMessage + ")";
+      if (stretch.stopReason == continuation::StopReason::Boundary && !endEvent(problem, *next, stretch, locked).any())
+        giveUp(why);  // a boundary that is no contact event: the branch ends there
+      else
+        notContinued(why);
       break;
     }
-    if (continuation::BoundProblem(*next).boundary(changed, stretch.points[1].u, stretch.points[1].lambda) < 0.0) {
+    if (left) atOnce = 0;
+    if (left && continuation::BoundProblem(*next).boundary(changed, stretch.points[1].u, stretch.points[1].lambda) < 0.0) {
       giveUp(release ? (onJoint                ? "the free joint would go past its limit"
                         : change.slidesOn >= 0 ? "the vertex would slide off the corner, away from both edges"
                         : hit.onSelf           ? "the bodies would pass into each other"

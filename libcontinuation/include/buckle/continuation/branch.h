@@ -106,6 +106,11 @@ enum class StopReason {
   /// A regular end: the branch came back to a point it had passed, in the same direction (a
   /// closed loop; from there it would trace the same curve again).
   ClosedLoop,
+  /// Not a regular end: the branch reached a located event past which the problem changes (a
+  /// caller's extension, e.g. a contact that starts or ends) and could not be continued through
+  /// it — the new problem's equilibrium could not be polished, it has no unique tangent there, or
+  /// a second event at the same point leaves nothing to step on. stopMessage says which.
+  EventNotContinued,
   /// Not ended: the tracer returned after a step that located a branch point, as asked
   /// (Tracer::pauseAtBranchPoints); Tracer::continueBranch goes on from its last point with
   /// the step it would have taken (Branch::resumeStep): the same points as without the pause,
