@@ -334,3 +334,37 @@ TEST_CASE("contact: every boundary at once equals each boundary alone, a compres
     }
   }
 }
+
+TEST_CASE("constrained equilibrium: a polish that cannot reach its tolerance returns its best iterate and says "
+          "what it reached",
+          "[contact]") {
+  // A fold of the three-segment chain's tree (the default scene): at fixed λ the Jacobian is
+  // singular there. With a tolerance no iterate can meet, every polish runs all its iterations.
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMin = -2.5;
+  o.tracer.lambdaMax = 0.0;
+  o.tree.branchSwitching = 1;
+  o.contact = false;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  const cont::SpecialPoint* fold = nullptr;
+  for (const cont::Branch& b : r.tree.branches)
+    for (const cont::SpecialPoint& sp : b.specialPoints)
+      if (!fold && sp.type == cont::SpecialPointType::Fold) fold = &sp;
+  REQUIRE(fold != nullptr);
+  // A tenth past the fold, where the branch has no equilibrium: Newton from the fold's state
+  // wanders (its residual goes down and up again); the answer after more iterations is never worse.
+  const double lambda = fold->lambda * 1.1;
+  double previous = solveConstrainedEquilibrium(problem, ContactSet(), fold->u, lambda, 0.0, 0).residual;
+  REQUIRE(previous > 0.0);
+  for (int iterations = 1; iterations <= 30; ++iterations) {
+    const ConstrainedEquilibrium polished = solveConstrainedEquilibrium(problem, ContactSet(), fold->u, lambda, 0.0, iterations);
+    INFO(iterations << ": " << polished.message);
+    CHECK_FALSE(polished.converged);
+    CHECK(polished.residual <= previous);
+    previous = polished.residual;
+    if (polished.message.rfind("no convergence", 0) == 0) CHECK_THAT(polished.message, Catch::Contains("scaled residual"));
+  }
+}

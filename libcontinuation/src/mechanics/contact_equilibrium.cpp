@@ -2,6 +2,7 @@
 // limits and vertices held on the base wall or on other links (contact.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -42,6 +43,11 @@ ConstrainedEquilibrium solveConstrainedEquilibrium(const EquilibriumProblem& bas
     return out;
   }
   double norm = scaledNorm(F);
+  // The best iterate is kept: near a fold of the constrained branch (a contact that changes where
+  // the load turns back) the Jacobian at fixed λ is nearly singular and the halved steps, which may
+  // let the residual grow twofold, can wander off an already accurate start.
+  Vector best = u;
+  double bestNorm = norm;
   for (out.iterations = 0; out.iterations < maxIterations && !(norm <= tolerance); ++out.iterations) {
     if (solver->factor(u, lambda, c) != Factorization::Regular) {
       out.message = "singular constrained Jacobian";
@@ -65,12 +71,21 @@ ConstrainedEquilibrium solveConstrainedEquilibrium(const EquilibriumProblem& bas
     }
     u = trial;
     norm = trialNorm;
+    if (norm < bestNorm) {
+      best = u;
+      bestNorm = norm;
+    }
   }
-  if (!bound.residual(u, lambda, F)) norm = std::numeric_limits<double>::infinity();
+  if (bestNorm < norm) u = best;
+  norm = bound.residual(u, lambda, F) ? scaledNorm(F) : std::numeric_limits<double>::infinity();
   out.u = u.head(N);
   out.residual = norm;
   out.converged = norm <= tolerance;
-  if (!out.converged && out.message.empty()) out.message = "no convergence in " + std::to_string(maxIterations) + " iterations";
+  if (!out.converged && out.message.empty()) {
+    char reached[96];
+    std::snprintf(reached, sizeof reached, " (scaled residual %.3g, tolerance %.3g)", norm, tolerance);
+    out.message = "no convergence in " + std::to_string(maxIterations) + " iterations" + reached;
+  }
   out.torques = Vector::Zero(base.segments());
   out.wallForces = u.segment(N, locked.wallCount());
   out.selfForces = u.tail(locked.selfCount());

@@ -247,13 +247,13 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       branch.stopReason = continuation::StopReason::EventNotContinued;
       branch.stopMessage = change.what + ": " + why;
     };
-    // The start: the located point polished with the new set of contacts. It lies on the
-    // changed contact's boundary (g = 0 to the location's accuracy, either sign), so it is started
-    // by continueBranch, which only looks for crossings from g ≥ 0, not by trace(), which refuses a
-    // start with g < 0.
+    // The start: the located point polished with the new contacts (short of the polish's tolerance
+    // but within the corrector's: as accurate as any traced point). On the changed contact's boundary
+    // (g = 0 to the location's accuracy, either sign), it is started by continueBranch, which only
+    // looks for crossings from g ≥ 0, not by trace(), which refuses a start with g < 0.
     const ConstrainedEquilibrium start =
         solveConstrainedEquilibrium(problem, locked, at.u, at.lambda, std::max(o.location.newtonTolerance, 1e-12));
-    if (!start.converged) {
+    if (!start.converged && !(start.residual <= o.corrector.tolerance)) {
       notContinued("the equilibrium could not be polished (" + start.message + ")");
       break;
     }
