@@ -17,6 +17,7 @@
 #include "buckle/mechanics/unloaded_shape.h"
 
 #include "contact_cases.h"
+#include "default_scene_path.h"
 #include "random_segments.h"
 
 using namespace buckle::mechanics;
@@ -83,6 +84,31 @@ int countType(const BranchReport& r, EventType type) {
                            [type](const SpecialPointReport& s) { return s.type == type; }));
 }
 
+/// The default scene's path and steps, on one thread.
+EquilibriumBranchOptions defaultSceneOptions(int maxPoints) {
+  EquilibriumBranchOptions o = testing::defaultScenePath();
+  o.tracer.maxPoints = maxPoints;
+  o.tree.threads = 1;
+  return o;
+}
+
+/// A segment of the paper's chain whose joint stops at 0.6 rad.
+SegmentParameters stoppedAt06() {
+  SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
+  p.qMaxUser = 0.6;
+  return p;
+}
+
+/// A pure end moment Me = λ from 0 to three times the load at which a joint reaches its stop,
+/// steps up to 0.1, no switching.
+EquilibriumBranchOptions momentToThrice(double limitLoad) {
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMax = 3.0 * limitLoad;
+  o.tracer.step.maxStep = 0.1;
+  o.tree.branchSwitching = 0;
+  return o;
+}
+
 }  // namespace
 
 TEST_CASE("ContactSet keeps its joints sorted, one side each, and labels them", "[contact]") {
@@ -104,16 +130,11 @@ TEST_CASE("ContactSet keeps its joints sorted, one side each, and labels them", 
 }
 
 TEST_CASE("contact: a single segment pushed past its limit carries applied torque minus spring torque", "[contact]") {
-  SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
-  p.qMaxUser = 0.6;
-  const Chain chain = Chain::uniform(1, p);
+  const Chain chain = Chain::uniform(1, stoppedAt06());
   const double springAtLimit = chain.segment(0).energyJet(0.6).d1;  // E'(q̄): the limit load
   REQUIRE(springAtLimit > 0.0);
   EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 0, 1));  // Me = λ
-  EquilibriumBranchOptions o;
-  o.tracer.lambdaMax = 3.0 * springAtLimit;
-  o.tracer.step.maxStep = 0.1;
-  o.tree.branchSwitching = 0;
+  EquilibriumBranchOptions o = momentToThrice(springAtLimit);
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(1), 0.0, cont::InitialDirection::increasingLambda(), o);
   const BranchReport& rep = r.reports[0];
@@ -173,17 +194,11 @@ TEST_CASE("contact: joints that reach their limits at one point lock together an
   // and reach the limit 0.6 at the same load E'(0.6). The first contact's stretch meets the second
   // at once (and the second's the third); each is taken at that point, and the branch goes on with
   // all three locked to the end of the path, each carrying Me − E'(0.6).
-  SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
-  p.qMaxUser = 0.6;
-  const Chain chain = Chain::uniform(3, p);
+  const Chain chain = Chain::uniform(3, stoppedAt06());
   const double springAtLimit = chain.segment(0).energyJet(0.6).d1;
   EquilibriumProblem problem(chain, EndCondition::freeEnd(), Eigen::Vector3d(0, 0, 1));  // Me = λ
-  EquilibriumBranchOptions o;
-  o.tracer.lambdaMax = 3.0 * springAtLimit;
-  o.tracer.step.maxStep = 0.1;
-  o.tree.branchSwitching = 0;
-  const EquilibriumBranches r =
-      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::increasingLambda(), o);
+  const EquilibriumBranches r = traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0,
+                                                cont::InitialDirection::increasingLambda(), momentToThrice(springAtLimit));
   const cont::Branch& b = r.tree.branches[0];
   INFO(b.stopMessage);
   CHECK(b.stopReason == cont::StopReason::LambdaRange);
@@ -561,14 +576,8 @@ TEST_CASE("contact: a branch that comes back to one of its contact events, same 
   const int n = 20;
   const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
-  EquilibriumBranchOptions o;
-  o.tracer.lambdaMin = -2.5;
-  o.tracer.lambdaMax = 0.0;
-  o.tracer.step.initialStep = 0.02;
-  o.tracer.step.maxStep = 0.05;
-  o.tracer.maxPoints = 4000;
+  EquilibriumBranchOptions o = defaultSceneOptions(4000);
   o.tracer.detection.lowestEigenvalues = 1;
-  o.tree.threads = 1;
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(n), 0.0, cont::InitialDirection::decreasingLambda(), o);
   int loops = 0;
@@ -633,13 +642,7 @@ EquilibriumBranches manyEventsTree(int childPoints) {
   const int n = 50;
   const Chain chain = Chain::uniform(n, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
-  EquilibriumBranchOptions o;
-  o.tracer.lambdaMin = -2.5;
-  o.tracer.lambdaMax = 0.0;
-  o.tracer.step.initialStep = 0.02;
-  o.tracer.step.maxStep = 0.05;
-  o.tracer.maxPoints = 20000;
-  o.tree.threads = 1;
+  EquilibriumBranchOptions o = defaultSceneOptions(20000);
   o.tree.branchSwitching = 1;
   o.tree.switchAt = [](const cont::Branch& branch, const cont::SpecialPoint& bp) {
     int before = 0;

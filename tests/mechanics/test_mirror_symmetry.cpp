@@ -12,6 +12,8 @@
 #include "buckle/mechanics/equilibrium_branches.h"
 #include "buckle/mechanics/mirror_symmetry.h"
 
+#include "default_scene_path.h"
+
 using namespace buckle::mechanics;
 namespace cont = buckle::continuation;
 
@@ -19,11 +21,7 @@ namespace {
 
 EquilibriumBranchOptions defaultScene(bool mirror) {
   // data/scenes/default.json: Fx from 0 to −2.5, steps 0.02 / 0.05, one switching generation, contact
-  EquilibriumBranchOptions o;
-  o.tracer.lambdaMin = -2.5;
-  o.tracer.lambdaMax = 0.0;
-  o.tracer.step.initialStep = 0.02;
-  o.tracer.step.maxStep = 0.05;
+  EquilibriumBranchOptions o = testing::defaultScenePath();
   o.tracer.detection.lowestEigenvalues = 1;
   o.tree.branchSwitching = 1;
   o.mirror = mirror;
