@@ -204,8 +204,17 @@ TEST_CASE("contact: joints that reach their limits at one point lock together an
   CHECK(b.stopReason == cont::StopReason::LambdaRange);
   const BranchReport& rep = r.reports[0];
   CHECK(countType(rep, EventType::Contact) == 3);
-  for (const SpecialPointReport& s : rep.specialPoints)
-    if (s.type == EventType::Contact) CHECK(std::abs(s.parameter - springAtLimit) <= 1e-10 * springAtLimit);
+  // each event names its own joint, and the contacts after it grow by that joint
+  std::vector<int> joints;
+  for (const SpecialPointReport& s : rep.specialPoints) {
+    if (s.type != EventType::Contact) continue;
+    CHECK(std::abs(s.parameter - springAtLimit) <= 1e-10 * springAtLimit);
+    joints.push_back(s.joint);
+    CHECK(int(s.lockedAfter.joints().size()) == int(joints.size()));
+    CHECK(s.lockedAfter.locked(s.joint));
+  }
+  std::sort(joints.begin(), joints.end());
+  CHECK(joints == std::vector<int>{0, 1, 2});
   REQUIRE(r.contact[0].size() == 4);
   CHECK(r.contact[0].back().locked.joints().size() == 3);
   const PointReport& last = rep.points.back();

@@ -102,12 +102,18 @@ void reportSelfEvent(EquilibriumProblem& problem, const cont::Branch& b, const c
 void reportContactEvent(EquilibriumProblem& problem, const cont::Branch& b, const cont::SpecialPoint& sp,
                         const std::vector<ContactStretch>& stretches, const std::vector<PointReport>& all,
                         SpecialPointReport& s) {
-  const ContactStretch* next = nullptr;
-  for (const ContactStretch& st : stretches)
-    if (st.firstPoint == sp.index + 1) next = &st;
-  if (!next) return;
-  const ContactSet& before = lockedAt(stretches, sp.index);
-  const ContactSet& after = next->locked;
+  // The stretch this event starts: contacts changing together at one point (continueUnderContact)
+  // start stretches from the same point, one per event, in the events' order.
+  int occurrence = 0;
+  for (const cont::SpecialPoint& other : b.specialPoints) {
+    if (&other == &sp) break;
+    if (other.index == sp.index && other.type == cont::SpecialPointType::Boundary) ++occurrence;
+  }
+  size_t k = 0;
+  while (k < stretches.size() && !(stretches[k].firstPoint == sp.index + 1 && occurrence-- == 0)) ++k;
+  if (k == 0 || k == stretches.size()) return;
+  const ContactSet& before = stretches[k - 1].locked;
+  const ContactSet& after = stretches[k].locked;
   int joint = -1;
   for (const LockedJoint& l : after.joints())
     if (!before.locked(l.joint)) joint = l.joint;
