@@ -152,19 +152,20 @@ bool endsInLoop(const EquilibriumProblem& problem, continuation::Branch& branch,
   return true;
 }
 
-// Whether a stretch that did not get away from the event it started from (`first`) ended at once,
-// at its start or within its minimum step, on a contact event of another contact: two contacts
-// changing at one point (joints alike reaching their stops together, e.g. under a pure moment or
-// in symmetric lobes of a long chain), taken one after the other at that point (the stretch
-// between them may hold no point of its own).
-bool secondEventAtOnce(const EquilibriumProblem& problem, const ContactProblem& next, const continuation::Branch& stretch,
-                       const ContactSet& locked, const BoundaryEvent& first) {
-  if (stretch.points.empty() || stretch.stopReason != continuation::StopReason::Boundary) return false;
-  const BoundaryEvent second = endEvent(problem, next, stretch, locked);
-  if (!second.any()) return false;
-  const bool sameJoint = first.joint.joint >= 0 && second.joint.joint == first.joint.joint;
-  const bool sameVertex = first.vertex.segment >= 0 && second.vertex == first.vertex;
-  return !sameJoint && !sameVertex;
+// Whether two contact events change the same contact (a joint's stop, a wall vertex, a self
+// contact): a stretch that meets the change of another contact at once, at the event it started
+// from, has met two contacts changing at one point (joints alike reaching their stops together,
+// e.g. under a pure moment or in symmetric lobes of a long chain), taken one after the other there;
+// the same contact changing again at once is chattering.
+bool sameContact(const BoundaryEvent& a, const BoundaryEvent& b) {
+  return (a.joint.joint >= 0 && a.joint.joint == b.joint.joint) || (a.vertex.segment >= 0 && a.vertex == b.vertex) ||
+         (a.onSelf && b.onSelf && a.self == b.self);
+}
+
+// The budget's end as a branch's stop message.
+std::string maxPointsMessage(int maxPoints, size_t stretches, bool atEvent) {
+  return "reached maxPoints = " + std::to_string(maxPoints) + (atEvent ? " at a contact event" : "") +
+         " (the whole branch, over " + std::to_string(stretches) + " contact stretches)";
 }
 
 // The tracer options of the next stretch: the budget of points and arclength is the whole
@@ -176,9 +177,7 @@ bool budgetLeft(const continuation::TracerOptions& options, size_t stretches, co
   next.maxArclength = options.maxArclength - branch.points.back().arclength;
   if (next.maxPoints < 2) {
     branch.stopReason = continuation::StopReason::MaxPoints;
-    branch.stopMessage = "reached maxPoints = " + std::to_string(options.maxPoints) +
-                         " at a contact event (the whole branch, over " + std::to_string(stretches) +
-                         " contact stretches)";
+    branch.stopMessage = maxPointsMessage(options.maxPoints, stretches, true);
     return false;
   }
   if (!(next.maxArclength > 0.0)) {
@@ -318,10 +317,11 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     // would chatter: stop — unless it ends at once on a second contact change (two contacts
     // changing at one point), which the next pass takes with this one.
     const bool left = stretch.points.size() >= 2 && stretch.points.back().arclength > options.step.minStep;
-    const bool together = !left && secondEventAtOnce(problem, *next, stretch, locked, hit) && ++atOnce <= 2 * n;
+    const BoundaryEvent second = left ? BoundaryEvent() : endEvent(problem, *next, stretch, locked);
+    const bool together = second.any() && !sameContact(hit, second) && ++atOnce <= 2 * n;
     if (!left && !together) {
       const std::string why = "the branch does not leave the point (" + stretch.stopMessage + ")";
-      if (stretch.stopReason == continuation::StopReason::Boundary && !endEvent(problem, *next, stretch, locked).any())
+      if (stretch.stopReason == continuation::StopReason::Boundary && !second.any())
         giveUp(why);  // a boundary that is no contact event: the branch ends there
       else
         notContinued(why);
@@ -340,8 +340,7 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
     branch.stopReason = stretch.stopReason;
     branch.stopMessage = stretch.stopMessage;
     if (branch.stopReason == continuation::StopReason::MaxPoints)  // the stretch's share named the branch's
-      branch.stopMessage = "reached maxPoints = " + std::to_string(options.maxPoints) + " (the whole branch, over " +
-                           std::to_string(stretches.size() + 1) + " contact stretches)";
+      branch.stopMessage = maxPointsMessage(options.maxPoints, stretches.size() + 1, false);
     stretches.push_back(ContactStretch{base + 1, locked});
     current = std::move(next);
   }
