@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstring>
 
 namespace buckle::scene::escape {
 
@@ -140,17 +141,30 @@ std::string jsonText(const nlohmann::json& doc, int indent) {
 std::string jsonForHtmlScript(const nlohmann::json& doc) { return htmlScriptSafe(jsonText(doc, -1)); }
 
 std::string htmlScriptSafe(std::string_view text) {
-  // Whole runs between the '<' appended at once: a page's data is megabytes of text with few or
-  // no '<', and appending it character by character cost more than writing it.
-  std::string out;
-  out.reserve(text.size());
-  for (size_t from = 0; from < text.size();) {
-    const size_t lt = std::min(text.find('<', from), text.size());
-    out.append(text, from, lt - from);
-    if (lt < text.size()) out += "\\u003c";
-    from = lt + 1;
-  }
+  std::string out(text);
+  makeHtmlScriptSafe(out, 0);
   return out;
+}
+
+void makeHtmlScriptSafe(std::string& text, size_t from) {
+  // A page's data is megabytes of text with few or no '<': rewritten only where there are some,
+  // whole runs between them moved at once.
+  const size_t first = text.find('<', from);
+  if (first == std::string::npos) return;
+  const size_t count = size_t(std::count(text.begin() + std::ptrdiff_t(first), text.end(), '<'));
+  constexpr std::string_view kEscape = "\\u003c";
+  size_t write = text.size() + count * (kEscape.size() - 1);
+  size_t read = text.size();
+  text.resize(write);
+  while (read > first) {
+    const size_t lt = text.rfind('<', read - 1);
+    const size_t run = read - (lt + 1);
+    write -= run;
+    std::memmove(&text[write], &text[lt + 1], run);
+    write -= kEscape.size();
+    std::memcpy(&text[write], kEscape.data(), kEscape.size());
+    read = lt;
+  }
 }
 
 }  // namespace buckle::scene::escape

@@ -49,5 +49,7 @@ std::string jsonText(const nlohmann::json& doc, int indent = 2);
 std::string jsonForHtmlScript(const nlohmann::json& doc);
 /// The same for JSON already written as text (the report's large arrays are written directly).
 std::string htmlScriptSafe(std::string_view jsonText);
+/// htmlScriptSafe in place for the text from `from` on (the report's data written into its page).
+void makeHtmlScriptSafe(std::string& text, size_t from);
 
 }  // namespace buckle::scene::escape

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <set>
 #include <stdexcept>
 #include <sstream>
@@ -64,26 +65,32 @@ void appendArray(std::string& out, size_t count, Item&& item) {
   out += ']';
 }
 
-/// Object members as text: the key and its value as dump() writes it.
-using Members = std::vector<std::pair<std::string, std::string>>;
+/// A large object member written directly into the page: its key and what appends its value as
+/// dump() writes it.
+struct Member {
+  std::string key;
+  std::function<void(std::string&)> append;
+};
+using Members = std::vector<Member>;
 
-std::string dumped(const json& v) { return v.dump(-1, ' ', false, json::error_handler_t::replace); }
+void appendDumped(std::string& out, const json& v) { out += v.dump(-1, ' ', false, json::error_handler_t::replace); }
 
-/// The object with the members of `small` and the members already written as text, in the key
-/// order of nlohmann::json's std::map: the text dump() writes for the whole object, without
-/// building the large members as JSON values (a long chain's page holds millions of numbers).
-std::string objectText(const json& small, Members members) {
-  for (const auto& item : small.items()) members.emplace_back(item.key(), dumped(item.value()));
-  std::sort(members.begin(), members.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::string out = "{";
+/// The object with the members of `small` and the large `members`, in the key order of
+/// nlohmann::json's std::map: the text dump() writes for the whole object, appended to `out`
+/// without building the large members as JSON values (a long chain's page holds millions of
+/// numbers) or copying their text.
+void appendObject(std::string& out, const json& small, Members members) {
+  for (const auto& item : small.items())
+    members.push_back({item.key(), [&value = item.value()](std::string& o) { appendDumped(o, value); }});
+  std::sort(members.begin(), members.end(), [](const Member& a, const Member& b) { return a.key < b.key; });
+  out += '{';
   for (size_t i = 0; i < members.size(); ++i) {
     if (i > 0) out += ',';
-    out += dumped(json(members[i].first));
+    appendDumped(out, json(members[i].key));
     out += ':';
-    out += members[i].second;
+    members[i].append(out);
   }
   out += '}';
-  return out;
 }
 
 /// At most this many shape coordinates per case: beyond it every k-th point carries its shape
@@ -132,6 +139,15 @@ PageSelection pageSelection(const CaseResult& cr, size_t columns) {
   return s;
 }
 
+/// About the bytes a case's data take on the page (its shown points' values and shapes, the
+/// special points), so that the page is allocated once.
+size_t estimatedSize(const CaseResult& cr, const PageSelection& shown, size_t columns) {
+  const size_t perShape = 2 * static_cast<size_t>(cr.chain.size() + 2);
+  const size_t shapes = std::min(shown.points.size() * perShape, kShapeBudget + perShape);
+  return shown.points.size() * (10 * columns + 16) + 10 * shapes + shown.specials.size() * 600 +
+         shown.specialShapes * perShape * 10;
+}
+
 /// Columns of branches.csv the page draws: the path parameter and every axis of the scene's
 /// bifurcation and stiffness plots (and of the main diagram).
 std::set<std::string> drawnColumns(const Scene& scene, const std::string& mainX, const std::string& mainY) {
@@ -144,43 +160,46 @@ std::set<std::string> drawnColumns(const Scene& scene, const std::string& mainX,
   return columns;
 }
 
-/// The per-point members of a case (branch, columns, point, shapes, stable) as text, for the
-/// points `shown` selects.
+/// The per-point members of a case (branch, columns, point, shapes, stable), for the points
+/// `shown` selects; they refer to their arguments until appended.
 Members pointMembers(const CaseResult& cr, const std::set<std::string>& columns, const PageSelection& shown) {
   const std::vector<size_t>& keep = shown.points;
-  auto at = [&](size_t k) -> const mechanics::PointReport& { return cr.points[keep[k]]; };
+  auto at = [&cr, &keep](size_t k) -> const mechanics::PointReport& { return cr.points[keep[k]]; };
+  auto integers = [&keep, at](auto field) {
+    return [&keep, at, field](std::string& out) {
+      appendArray(out, keep.size(), [&](size_t k) { out += std::to_string(field(at(k))); });
+    };
+  };
   Members m;
-  std::string text;
-  appendArray(text, keep.size(), [&](size_t k) { text += std::to_string(at(k).branch); });
-  m.emplace_back("branch", std::move(text));
-  Members cols;
-  for (const std::string& name : columns) {
-    std::string values;
-    appendArray(values, keep.size(), [&](size_t k) { appendRoundedJson(values, columnValue(name, at(k), cr), 6); });
-    cols.emplace_back(name, std::move(values));
-  }
-  m.emplace_back("columns", objectText(json::object(), std::move(cols)));
-  text.clear();
-  appendArray(text, keep.size(), [&](size_t k) { text += std::to_string(at(k).index); });
-  m.emplace_back("point", std::move(text));
-  const size_t perShape = 2 * static_cast<size_t>(cr.chain.size() + 2);
-  const size_t stride = std::max<size_t>(1, (keep.size() * perShape + kShapeBudget - 1) / kShapeBudget);
-  text.clear();
-  appendArray(text, keep.size(), [&](size_t k) {
-    if (k % stride == 0 && at(k).q.size() == cr.chain.size())
-      appendJoints(text, cr.chain, at(k).q);
-    else
-      text += "null";
-  });
-  m.emplace_back("shapes", std::move(text));
-  text.clear();
-  appendArray(text, keep.size(), [&](size_t k) { text += at(k).stable ? '1' : '0'; });
-  m.emplace_back("stable", std::move(text));
+  m.push_back({"branch", integers([](const mechanics::PointReport& p) { return p.branch; })});
+  m.push_back({"columns", [&cr, &columns, &keep, at](std::string& out) {
+                 Members cols;
+                 for (const std::string& name : columns)
+                   cols.push_back({name, [&cr, &name, &keep, at](std::string& o) {
+                                     appendArray(o, keep.size(),
+                                                 [&](size_t k) { appendRoundedJson(o, columnValue(name, at(k), cr), 6); });
+                                   }});
+                 appendObject(out, json::object(), std::move(cols));
+               }});
+  m.push_back({"point", integers([](const mechanics::PointReport& p) { return p.index; })});
+  m.push_back({"shapes", [&cr, &keep, at](std::string& out) {
+                 const size_t perShape = 2 * static_cast<size_t>(cr.chain.size() + 2);
+                 const size_t stride = std::max<size_t>(1, (keep.size() * perShape + kShapeBudget - 1) / kShapeBudget);
+                 appendArray(out, keep.size(), [&](size_t k) {
+                   if (k % stride == 0 && at(k).q.size() == cr.chain.size())
+                     appendJoints(out, cr.chain, at(k).q);
+                   else
+                     out += "null";
+                 });
+               }});
+  m.push_back({"stable", [&keep, at](std::string& out) {
+                 appendArray(out, keep.size(), [&](size_t k) { out += at(k).stable ? '1' : '0'; });
+               }});
   return m;
 }
 
-/// A case of the page's data as the text dump() writes for it.
-std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, const std::set<std::string>& columns,
+/// A case of the page's data as dump() writes it, appended to `out`.
+void appendCase(std::string& out, const Scene& scene, const CaseResult& cr, size_t index, const std::set<std::string>& columns,
                      const PageSelection& shown) {
   json c;
   c["index"] = index;
@@ -284,7 +303,7 @@ std::string caseText(const Scene& scene, const CaseResult& cr, size_t index, con
       sudden["static"] = jointsJson(cr.chain, cr.sudden.staticShape);
     c["sudden"] = sudden;
   }
-  return objectText(c, pointMembers(cr, columns, shown));
+  appendObject(out, c, pointMembers(cr, columns, shown));
 }
 
 const char* labelsName(PlotLabels labels) {
@@ -338,12 +357,12 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
   const std::string mainX = first ? first->x : "parameter", mainY = first ? first->y.front() : "q1";
   const std::set<std::string> columns = drawnColumns(scene, mainX, mainY);
   bool anyPoints = false;
-  std::string cases;
+  std::vector<PageSelection> selections;
   size_t points = 0, shownPoints = 0, specials = 0, shownSpecials = 0, shownShapes = 0, stride = 1;
-  appendArray(cases, run.cases.size(), [&](size_t c) {
-    const CaseResult& cr = run.cases[c];
-    const PageSelection shown = pageSelection(cr, columns.size());
-    cases += caseText(scene, cr, c, columns, shown);
+  size_t pageSize = std::strlen(kReportHead) + std::strlen(kReportMiddle) + std::strlen(kReportScript) + (1 << 16);
+  for (const CaseResult& cr : run.cases) {
+    const PageSelection& shown = selections.emplace_back(pageSelection(cr, columns.size()));
+    pageSize += estimatedSize(cr, shown, columns.size());
     anyPoints = anyPoints || !cr.points.empty();
     points += cr.pointCount();
     shownPoints += shown.points.size();
@@ -351,7 +370,7 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
     shownSpecials += shown.specials.size();
     shownShapes += shown.specialShapes;
     stride = std::max(stride, shown.stride * cr.pointStride);  // of the points kept (runner.h)
-  });
+  }
   if (shownPoints < points || shownShapes < specials) {
     std::ostringstream os;
     os << "This page is a summary of a large run: it draws ";
@@ -414,9 +433,21 @@ std::string reportHtml(const Scene& scene, const RunResult& run, const json& spe
       criticalColumn = kEndLoadNames[size_t(c.path.coordinate)];
   }
   data["critical_column"] = criticalColumn;
+  std::string page;
+  page.reserve(pageSize);  // the page's megabytes written once, not regrown and copied
+  page += kReportHead;
+  const size_t dataFrom = page.size();
+  appendObject(page, data, {{"cases", [&](std::string& out) {
+                               appendArray(out, run.cases.size(), [&](size_t c) {
+                                 appendCase(out, scene, run.cases[c], c, columns, selections[c]);
+                               });
+                             }}});
   // every "<" as \u003c: nothing inside the JSON can end or change the <script> element (escape.h)
-  return kReportHead + escape::htmlScriptSafe(objectText(data, {{"cases", std::move(cases)}})) + kReportMiddle +
-         kReportScript + kReportEnd;
+  escape::makeHtmlScriptSafe(page, dataFrom);
+  page += kReportMiddle;
+  page += kReportScript;
+  page += kReportEnd;
+  return page;
 }
 
 void writeReport(const Scene& scene, const RunResult& run, const json& specialPoints, const json& summary,

@@ -223,5 +223,11 @@ TEST_CASE("htmlScriptSafe writes every '<' as the JSON escape u003c and keeps ev
   for (const std::string& s : cases) {
     INFO(s.substr(0, 40));
     CHECK(escape::htmlScriptSafe(s) == reference(s));
+    // in place from an offset (the report's data written after its page's head): the head kept
+    for (size_t from : {size_t(0), std::min<size_t>(1, s.size()), s.size() / 2, s.size()}) {
+      std::string text = s;
+      escape::makeHtmlScriptSafe(text, from);
+      CHECK(text == s.substr(0, from) + reference(s.substr(from)));
+    }
   }
 }
