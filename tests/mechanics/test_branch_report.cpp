@@ -234,3 +234,44 @@ TEST_CASE("after an interrupt the report leaves the remaining stiffness and the 
                            std::to_string(full.points.size()) + " points, the stiffness minima" +
                            (touches ? ", the location of base and self contacts" : "") + " (SIGINT received)");
 }
+
+TEST_CASE("steps that collapse next to a user's stop are no joint limit: the branch is unfinished", "[branch_report]") {
+  // Only a geometric limit (the closing spring at zero length, where the smooth model ends) ends a
+  // collapsing branch regularly. A user's stop inside the geometric range is held by the contact
+  // model (or located as a boundary without it): the U and Z branches of the paper's chain with
+  // |q| ≤ 1.5 lock joints on it and go on to the path's end. The same points ending with the
+  // steps collapsed instead, a joint on its stop, must read as a failure, not as a joint limit.
+  SegmentParameters p = SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25);
+  p.qMinUser = -1.5;
+  p.qMaxUser = 1.5;
+  const Chain chain = Chain::uniform(3, p);
+  REQUIRE(chain.segment(0).geometricUpperLimit() > 1.5 + 0.1);
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions opt;
+  opt.tracer.lambdaMin = -3.0;
+  opt.tracer.lambdaMax = 0.5;
+  opt.tracer.step.maxStep = 0.05;
+  opt.tree.branchSwitching = 1;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), opt);
+  REQUIRE(r.contact.size() == r.tree.branches.size());
+  int checked = 0;
+  for (size_t k = 0; k < r.tree.branches.size(); ++k) {
+    cont::Branch b = r.tree.branches[k];
+    if (b.points.empty() || std::abs(b.points.back().u.head(3).cwiseAbs().maxCoeff() - 1.5) > 1e-9) continue;
+    CHECK(r.reports[k].finished);  // a joint on its stop at the path's end
+    b.stopReason = cont::StopReason::StepSizeTooSmall;
+    b.stopMessage = "step size below minimum";
+    const BranchReport collapsed = reportBranch(problem, b, opt.report, r.contact[k]);
+    CHECK_FALSE(collapsed.finished);
+    CHECK(collapsed.stopReason == cont::toString(cont::StopReason::StepSizeTooSmall));
+    // no collapsed limit added to the points the branch located itself
+    const auto limits = [](const BranchReport& rep) {
+      return std::count_if(rep.specialPoints.begin(), rep.specialPoints.end(),
+                           [](const SpecialPointReport& s) { return s.type == EventType::JointLimit; });
+    };
+    CHECK(limits(collapsed) == limits(r.reports[k]));
+    ++checked;
+  }
+  CHECK(checked >= 2);  // U and Z
+}

@@ -154,13 +154,17 @@ SpecialPointReport atPoint(const PointReport& p, EventType type, Phenomenon phen
   return s;
 }
 
-/// A joint within 0.2 % of its range of a limit at the last point of a branch whose steps
-/// collapsed: near a geometric limit the closing spring's length goes to zero and the model's
-/// derivatives blow up (L' ~ 1/L), so the steps collapse just before it. −1: none.
+/// A joint within 0.2 % of its range of a geometric limit at the last point of a branch whose
+/// steps collapsed: there the closing spring's length goes to zero and the model's derivatives
+/// blow up (L' ~ 1/L), so the steps collapse just before it, where the smooth model ends. Not a
+/// user's stop (q_min, q_max) inside the geometric range: the tracer locates that as a boundary,
+/// or the contact model holds the joint on it, and steps collapsing next to it are a failure.
+/// −1: none.
 int jointAtLimit(const Chain& chain, const Eigen::VectorXd& q) {
   int joint = -1;
   for (int i = 0; i < chain.size(); ++i) {
-    const double lo = chain.lowerLimits()[i], hi = chain.upperLimits()[i];
+    const Segment& s = chain.segment(i);
+    const double lo = s.geometricLowerLimit(), hi = s.geometricUpperLimit();
     if (std::min(hi - q[i], q[i] - lo) < 2e-3 * (hi - lo)) joint = i;
   }
   return joint;
@@ -373,10 +377,11 @@ void reportCollapsedLimit(const Chain& chain, const cont::Branch& b, int limitJo
     s.lambda = b.points.back().lambda;
     s.negativeBefore = s.negativeAfter = p.negative;
     s.accuracy = all.size() >= 2 ? std::abs(p.parameter - all[all.size() - 2].parameter) : 0.0;
-    const double lo = chain.lowerLimits()[limitJoint], hi = chain.upperLimits()[limitJoint];
+    const Segment& segment = chain.segment(limitJoint);
+    const double lo = segment.geometricLowerLimit(), hi = segment.geometricUpperLimit();
     const bool upper = s.q[limitJoint] > 0.5 * (lo + hi);
     std::ostringstream os;
-    os << "joint " << limitJoint + 1 << " " << (upper ? "upper" : "lower") << " limit: last converged point "
+    os << "joint " << limitJoint + 1 << " " << (upper ? "upper" : "lower") << " geometric limit: last converged point "
        << std::abs((upper ? hi : lo) - s.q[limitJoint]) << " rad from it (the closing spring nearly reaches zero length)";
     s.note = os.str();
     r.specialPoints.push_back(std::move(s));
@@ -523,7 +528,7 @@ BranchReport reportBranch(EquilibriumProblem& problem, const cont::Branch& b, co
     if (limitJoint >= 0) {
       r.finished = true;
       r.stopReason = "joint limit";
-      r.stopMessage = "joint " + std::to_string(limitJoint + 1) + " reached its limit (" + b.stopMessage + ")";
+      r.stopMessage = "joint " + std::to_string(limitJoint + 1) + " reached its geometric limit (" + b.stopMessage + ")";
     }
   }
 
