@@ -368,3 +368,54 @@ TEST_CASE("constrained equilibrium: a polish that cannot reach its tolerance ret
     if (polished.message.rfind("no convergence", 0) == 0) CHECK_THAT(polished.message, Catch::Contains("scaled residual"));
   }
 }
+
+TEST_CASE("the start after a contact event: where the polish at fixed λ cannot converge, across the branch",
+          "[contact]") {
+  // polishEventStart (contact.h) at a fold of the three-segment tree, moved a millionth past it in
+  // λ: at that λ there is no equilibrium near the point (what a release right after its contact
+  // meets where the free motion turns back), so the polish at fixed λ fails, while the Keller
+  // system through the point normal to the branch (the fold's tangent) is regular and lands on
+  // the branch.
+  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
+  EquilibriumBranchOptions o;
+  o.tracer.lambdaMin = -2.5;
+  o.tracer.lambdaMax = 0.0;
+  o.tree.branchSwitching = 1;
+  o.contact = false;
+  const EquilibriumBranches r =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
+  const cont::SpecialPoint* fold = nullptr;
+  for (const cont::Branch& b : r.tree.branches)
+    for (const cont::SpecialPoint& sp : b.specialPoints)
+      if (!fold && sp.type == cont::SpecialPointType::Fold) fold = &sp;
+  REQUIRE(fold != nullptr);
+  const int N = problem.dimension();  // the joint angles and the held coordinate's reaction
+  REQUIRE(fold->tangent.size() == N + 1);
+  cont::SpecialPoint at = *fold;
+  at.lambda = fold->lambda * (1.0 + 1e-6);  // |Fx| past its largest on the branch
+  cont::Tracer tracer(problem, o.tracer);
+  const ConstrainedEquilibrium fixed =
+      solveConstrainedEquilibrium(problem, ContactSet(), at.u, at.lambda, std::max(o.tracer.location.newtonTolerance, 1e-12));
+  REQUIRE_FALSE(fixed.converged);
+  REQUIRE(fixed.residual > o.tracer.corrector.tolerance);  // the fallback is what is tested
+
+  // without a direction: the fixed-λ polish alone, unpolished and saying why
+  const EventStart alone = polishEventStart(problem, ContactSet(), at, tracer, Eigen::VectorXd());
+  CHECK_FALSE(alone.polished);
+  CHECK_THAT(alone.message, Catch::Contains("could not be polished"));
+
+  const EventStart start = polishEventStart(problem, ContactSet(), at, tracer, fold->tangent);
+  INFO(start.message);
+  REQUIRE(start.polished);
+  CHECK(start.acrossBranch);
+  REQUIRE(start.u.size() == N);
+  // an equilibrium (the residual of the test's own evaluation) at the fold's load: within the
+  // millionth moved (the branch turns back there, λ − λ_fold quadratic in the distance along it)
+  Eigen::VectorXd F(N);
+  cont::BoundProblem bound(problem);
+  REQUIRE(bound.residual(start.u, start.lambda, F));
+  CHECK(F.cwiseAbs().maxCoeff() <= 1e-9);
+  CHECK(std::abs(start.lambda - fold->lambda) <= 2e-6 * std::abs(fold->lambda));
+  CHECK((start.u - fold->u).norm() <= 1e-2);
+}

@@ -6,8 +6,10 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 #include "buckle/continuation/bordered_solver.h"
+#include "buckle/continuation/tracer.h"
 #include "buckle/mechanics/contact.h"
 #include "buckle/mechanics/wall_constraint.h"
 
@@ -162,6 +164,48 @@ CartesianStiffness lockedLoadedStiffness(const Chain& chain, ConstVectorRef q, c
   StiffnessOptions o = options;
   wallConstraintTerms(chain, q, locked, wallForces, "lockedLoadedStiffness", E.bottomRows(w), o.bodyGenerator);
   return loadedStiffness(chain, q, F, end.isHeld(EndCoordinate::Phi), E, o);
+}
+
+EventStart polishEventStart(const EquilibriumProblem& base, const ContactSet& locked,
+                            const continuation::SpecialPoint& at, continuation::Tracer& tracer,
+                            continuation::ConstVectorRef direction) {
+  const continuation::TracerOptions& o = tracer.options();
+  const ConstrainedEquilibrium fixed =
+      solveConstrainedEquilibrium(base, locked, at.u, at.lambda, std::max(o.location.newtonTolerance, 1e-12));
+  const int N = base.dimension(), D = tracer.problem().dimension();
+  EventStart start;
+  start.u.resize(D);
+  start.u.head(N) = fixed.u;
+  start.u.segment(N, locked.wallCount()) = fixed.wallForces;
+  start.u.tail(locked.selfCount()) = fixed.selfForces;
+  start.lambda = at.lambda;
+  start.polished = fixed.converged || fixed.residual <= o.corrector.tolerance;
+  if (start.polished) return start;
+  if (direction.size() != D + 1 || !(direction.norm() > 0.0)) {
+    start.message = "the equilibrium could not be polished (" + fixed.message + ")";
+    return start;
+  }
+  // from the polish's best iterate, in the corrector's (scaled) units
+  continuation::ContinuationPoint p;
+  p.u = start.u;
+  p.lambda = start.lambda;
+  tracer.units().toScaled(p);
+  continuation::Vector x0(D + 1), x(D + 1);
+  x0 << p.u, p.lambda;
+  const continuation::Vector t = tracer.units().directionToScaled(direction).normalized();
+  const continuation::CorrectorSummary across = tracer.corrector().correct(x0, t, x);
+  if (!across.converged || !x.allFinite()) {
+    start.message = "the equilibrium could not be polished (" + fixed.message + "; across the branch: " +
+                    (across.message.empty() ? std::string(across.flagName) : across.message) + ")";
+    return start;
+  }
+  p.u = x.head(D);
+  p.lambda = x[D];
+  tracer.units().toUser(p);
+  start.u = p.u;
+  start.lambda = p.lambda;
+  start.polished = start.acrossBranch = true;
+  return start;
 }
 
 }  // namespace buckle::mechanics

@@ -246,16 +246,6 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       branch.stopReason = continuation::StopReason::EventNotContinued;
       branch.stopMessage = change.what + ": " + why;
     };
-    // The start: the located point polished with the new contacts (short of the polish's tolerance
-    // but within the corrector's: as accurate as any traced point). On the changed contact's boundary
-    // (g = 0 to the location's accuracy, either sign), it is started by continueBranch, which only
-    // looks for crossings from g ≥ 0, not by trace(), which refuses a start with g < 0.
-    const ConstrainedEquilibrium start =
-        solveConstrainedEquilibrium(problem, locked, at.u, at.lambda, std::max(o.location.newtonTolerance, 1e-12));
-    if (!start.converged && !(start.residual <= o.corrector.tolerance)) {
-      notContinued("the equilibrium could not be polished (" + start.message + ")");
-      break;
-    }
     continuation::Tracer tracer(*next, o);
     // The stretch leaves the point to the admissible side of the changed contact's boundary g
     // (compression of a new contact, distance to the limit of a released joint or to the wall of a
@@ -269,13 +259,12 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
                         : hit.onSelf ? (release ? next->selfClearanceBoundary() : next->selfReleaseBoundary(wallIndex))
                         : release    ? next->wallClearanceBoundary()
                                      : next->wallReleaseBoundary(wallIndex);
+    continuation::Vector u0;
+    double lambda0 = 0.0;
     auto startPoint = [&](const continuation::Vector& direction, continuation::ContinuationPoint& p) {
       p = continuation::ContinuationPoint();
-      p.u.resize(D);
-      p.u.head(N) = start.u;
-      p.u.segment(N, locked.wallCount()) = start.wallForces;
-      p.u.tail(locked.selfCount()) = start.selfForces;
-      p.lambda = at.lambda;
+      p.u = u0;
+      p.lambda = lambda0;
       tracer.units().toScaled(p);
       if (!tracer.completePoint(p, tracer.units().directionToScaled(direction))) return false;
       tracer.units().toUser(p);
@@ -290,6 +279,16 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       direction[D] = at.tangent[N];
       if (onJoint && !release) direction[hit.joint.joint] = 0.0;
     }
+    // The start polished (polishEventStart). On the changed contact's boundary (g = 0 to the location's
+    // accuracy, either sign), it is started by continueBranch, which only looks for crossings from
+    // g ≥ 0, not by trace(), which refuses a start with g < 0.
+    const EventStart start = polishEventStart(problem, locked, at, tracer, direction);
+    if (!start.polished) {
+      notContinued(start.message);
+      break;
+    }
+    u0 = start.u;
+    lambda0 = start.lambda;
     continuation::ContinuationPoint p0;
     if (!startPoint(direction, p0)) {
       notContinued("no unique tangent at the point");

@@ -43,6 +43,7 @@
 
 #include "buckle/continuation/bordered_solver.h"
 #include "buckle/continuation/bound_problem.h"
+#include "buckle/continuation/branch.h"
 #include "buckle/mechanics/chain.h"
 #include "buckle/mechanics/chain_structure.h"
 #include "buckle/mechanics/eigenvalue_memory.h"
@@ -51,6 +52,10 @@
 #include "buckle/mechanics/self_contact.h"
 #include "buckle/mechanics/stiffness.h"
 #include "buckle/mechanics/wall_contact.h"
+
+namespace buckle::continuation {
+class Tracer;
+}
 
 namespace buckle::mechanics {
 
@@ -360,6 +365,26 @@ struct ConstrainedEquilibrium {
 ConstrainedEquilibrium solveConstrainedEquilibrium(const EquilibriumProblem& base, const ContactSet& locked,
                                                    continuation::ConstVectorRef u0, double lambda,
                                                    double tolerance = 1e-12, int maxIterations = 30);
+
+/// The start of the stretch after a contact event (continueUnderContact), on `tracer`'s problem:
+/// the ContactProblem of the new contacts `locked`. The located event point `at` is polished at
+/// its λ (solveConstrainedEquilibrium); a start short of the polish's tolerance but within the
+/// corrector's is as accurate as any traced point. Where that fails — the new stretch (nearly)
+/// turns back in λ at the event, so the equilibrium at fixed λ is (nearly) singular: a release
+/// right after its contact, where the free motion returns from the stop (a grazing contact) —
+/// on the hyperplane through the point normal to `direction` (the branch's, size D + 1 of the
+/// tracer's problem), by the corrector's Keller system, regular at a fold in λ, to the
+/// corrector's tolerance.
+struct EventStart {
+  bool polished = false;
+  bool acrossBranch = false;   ///< by the Keller system (λ moved off the event's), not at fixed λ
+  continuation::Vector u;      ///< (q, r) of the tracer's problem
+  double lambda = 0.0;
+  std::string message;         ///< why not polished
+};
+EventStart polishEventStart(const EquilibriumProblem& base, const ContactSet& locked,
+                            const continuation::SpecialPoint& at, continuation::Tracer& tracer,
+                            continuation::ConstVectorRef direction);
 
 /// Stability of the constrained system at (u, λ): K_q − K_g on the free joints and ker J_h,F.
 continuation::StabilityInfo constrainedStability(const EquilibriumProblem& base, const ContactSet& locked,
