@@ -36,6 +36,16 @@ int denseHeldNegative(const Chain& chain, const Eigen::VectorXd& q, const Wrench
   return cont::projectedInertia(H, C, 1e-10 * std::max(1.0, H.norm())).negative;
 }
 
+// Fx from 0 to −3 (past the U branch's fold and joint limits), the first branch points switched.
+EquilibriumBranchOptions fxToMinus3() {
+  EquilibriumBranchOptions opt;
+  opt.tracer.lambdaMin = -3.0;
+  opt.tracer.lambdaMax = 0.5;
+  opt.tracer.step.maxStep = 0.05;
+  opt.tree.branchSwitching = 1;
+  return opt;
+}
+
 }  // namespace
 
 TEST_CASE("traced through the reaction, a branch is reported against the held coordinate", "[branch_report]") {
@@ -88,11 +98,7 @@ TEST_CASE("a fold with a stable side is a jump, between unstable parts no event"
   // Fig 8 setting: a nearly non-monotonic segment chain folds under Fx.
   const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
-  EquilibriumBranchOptions opt;
-  opt.tracer.lambdaMin = -3.0;
-  opt.tracer.lambdaMax = 0.5;
-  opt.tracer.step.maxStep = 0.05;
-  opt.tree.branchSwitching = 1;
+  const EquilibriumBranchOptions opt = fxToMinus3();
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), opt);
   int folds = 0;
@@ -247,11 +253,7 @@ TEST_CASE("steps that collapse next to a user's stop are no joint limit: the bra
   const Chain chain = Chain::uniform(3, p);
   REQUIRE(chain.segment(0).geometricUpperLimit() > 1.5 + 0.1);
   EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
-  EquilibriumBranchOptions opt;
-  opt.tracer.lambdaMin = -3.0;
-  opt.tracer.lambdaMax = 0.5;
-  opt.tracer.step.maxStep = 0.05;
-  opt.tree.branchSwitching = 1;
+  const EquilibriumBranchOptions opt = fxToMinus3();
   const EquilibriumBranches r =
       traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), opt);
   REQUIRE(r.contact.size() == r.tree.branches.size());

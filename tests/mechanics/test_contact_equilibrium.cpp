@@ -57,6 +57,32 @@ struct PinnedChain {
   EquilibriumProblem problem;
 };
 
+// The three-segment chain's tree (the default scene's, contact off) to Fx = −2.5, past its folds,
+// and its first fold (null if none). Built in place: the problem refers to the chain.
+struct ThreeSegmentFold {
+  Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
+  mutable EquilibriumProblem problem{chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0)};
+  EquilibriumBranchOptions options = toFold();
+  EquilibriumBranches tree =
+      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), options);
+  const cont::SpecialPoint* fold = firstFold(tree);
+
+  static EquilibriumBranchOptions toFold() {
+    EquilibriumBranchOptions o;
+    o.tracer.lambdaMin = -2.5;
+    o.tracer.lambdaMax = 0.0;
+    o.tree.branchSwitching = 1;
+    o.contact = false;
+    return o;
+  }
+  static const cont::SpecialPoint* firstFold(const EquilibriumBranches& r) {
+    for (const cont::Branch& b : r.tree.branches)
+      for (const cont::SpecialPoint& sp : b.specialPoints)
+        if (sp.type == cont::SpecialPointType::Fold) return &sp;
+    return nullptr;
+  }
+};
+
 }  // namespace
 
 TEST_CASE("wall: a segment pressed against the wall holds its vertex there with the force of a moment balance",
@@ -340,27 +366,16 @@ TEST_CASE("constrained equilibrium: a polish that cannot reach its tolerance ret
           "[contact]") {
   // A fold of the three-segment chain's tree (the default scene): at fixed λ the Jacobian is
   // singular there. With a tolerance no iterate can meet, every polish runs all its iterations.
-  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
-  EquilibriumBranchOptions o;
-  o.tracer.lambdaMin = -2.5;
-  o.tracer.lambdaMax = 0.0;
-  o.tree.branchSwitching = 1;
-  o.contact = false;
-  const EquilibriumBranches r =
-      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
-  const cont::SpecialPoint* fold = nullptr;
-  for (const cont::Branch& b : r.tree.branches)
-    for (const cont::SpecialPoint& sp : b.specialPoints)
-      if (!fold && sp.type == cont::SpecialPointType::Fold) fold = &sp;
+  const ThreeSegmentFold tree;
+  const cont::SpecialPoint* fold = tree.fold;
   REQUIRE(fold != nullptr);
   // A tenth past the fold, where the branch has no equilibrium: Newton from the fold's state
   // wanders (its residual goes down and up again); the answer after more iterations is never worse.
   const double lambda = fold->lambda * 1.1;
-  double previous = solveConstrainedEquilibrium(problem, ContactSet(), fold->u, lambda, 0.0, 0).residual;
+  double previous = solveConstrainedEquilibrium(tree.problem, ContactSet(), fold->u, lambda, 0.0, 0).residual;
   REQUIRE(previous > 0.0);
   for (int iterations = 1; iterations <= 30; ++iterations) {
-    const ConstrainedEquilibrium polished = solveConstrainedEquilibrium(problem, ContactSet(), fold->u, lambda, 0.0, iterations);
+    const ConstrainedEquilibrium polished = solveConstrainedEquilibrium(tree.problem, ContactSet(), fold->u, lambda, 0.0, iterations);
     INFO(iterations << ": " << polished.message);
     CHECK_FALSE(polished.converged);
     CHECK(polished.residual <= previous);
@@ -376,20 +391,11 @@ TEST_CASE("the start after a contact event: where the polish at fixed λ cannot 
   // meets where the free motion turns back), so the polish at fixed λ fails, while the Keller
   // system through the point normal to the branch (the fold's tangent) is regular and lands on
   // the branch.
-  const Chain chain = Chain::uniform(3, SegmentParameters::symmetric(0.5, 1.0, 1.0, 2.25));
-  EquilibriumProblem problem(chain, EndCondition::clampedPinned(0.0), Eigen::Vector3d(1, 0, 0));
-  EquilibriumBranchOptions o;
-  o.tracer.lambdaMin = -2.5;
-  o.tracer.lambdaMax = 0.0;
-  o.tree.branchSwitching = 1;
-  o.contact = false;
-  const EquilibriumBranches r =
-      traceEquilibria(problem, Eigen::VectorXd::Zero(3), 0.0, cont::InitialDirection::decreasingLambda(), o);
-  const cont::SpecialPoint* fold = nullptr;
-  for (const cont::Branch& b : r.tree.branches)
-    for (const cont::SpecialPoint& sp : b.specialPoints)
-      if (!fold && sp.type == cont::SpecialPointType::Fold) fold = &sp;
-  REQUIRE(fold != nullptr);
+  const ThreeSegmentFold f;
+  REQUIRE(f.fold != nullptr);
+  EquilibriumProblem& problem = f.problem;
+  const EquilibriumBranchOptions& o = f.options;
+  const cont::SpecialPoint* fold = f.fold;
   const int N = problem.dimension();  // the joint angles and the held coordinate's reaction
   REQUIRE(fold->tangent.size() == N + 1);
   cont::SpecialPoint at = *fold;
