@@ -259,17 +259,6 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
                         : hit.onSelf ? (release ? next->selfClearanceBoundary() : next->selfReleaseBoundary(wallIndex))
                         : release    ? next->wallClearanceBoundary()
                                      : next->wallReleaseBoundary(wallIndex);
-    continuation::Vector u0;
-    double lambda0 = 0.0;
-    auto startPoint = [&](const continuation::Vector& direction, continuation::ContinuationPoint& p) {
-      p = continuation::ContinuationPoint();
-      p.u = u0;
-      p.lambda = lambda0;
-      tracer.units().toScaled(p);
-      if (!tracer.completePoint(p, tracer.units().directionToScaled(direction))) return false;
-      tracer.units().toUser(p);
-      return true;
-    };
     // Leave along the branch's tangent (q, r, λ; the wall forces' rates 0) with the newly locked
     // joint's component removed (the locked branch cannot move it); orientation only.
     continuation::Vector direction = continuation::Vector::Unit(D + 1, D);
@@ -287,8 +276,15 @@ std::vector<ContactStretch> continueUnderContact(EquilibriumProblem& problem, co
       notContinued(start.message);
       break;
     }
-    u0 = start.u;
-    lambda0 = start.lambda;
+    auto startPoint = [&](const continuation::Vector& along, continuation::ContinuationPoint& p) {
+      p = continuation::ContinuationPoint();
+      p.u = start.u;
+      p.lambda = start.lambda;
+      tracer.units().toScaled(p);
+      if (!tracer.completePoint(p, tracer.units().directionToScaled(along))) return false;
+      tracer.units().toUser(p);
+      return true;
+    };
     continuation::ContinuationPoint p0;
     if (!startPoint(direction, p0)) {
       notContinued("no unique tangent at the point");
